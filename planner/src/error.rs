@@ -1,0 +1,44 @@
+//! The planner's one error type.
+
+/// Everything that can go wrong when building or planning a profile.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    /// A limit is zero, negative, NaN or infinite.
+    #[error("limit `{name}` must be a finite number > 0, got {value}")]
+    InvalidLimit {
+        /// Which limit (`vmax`, `amax`, `jmax`).
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A jerk-limited planner was asked to plan without a jerk limit.
+    #[error("profile kind `{kind}` needs a jerk limit (jmax)")]
+    MissingJerkLimit {
+        /// The profile kind that needs it.
+        kind: &'static str,
+    },
+    /// A move parameter (distance, start position) is NaN or infinite.
+    #[error("`{name}` must be finite, got {value}")]
+    NonFinite {
+        /// Which parameter.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// A segment has a negative or non-finite duration, or a non-finite jerk/acceleration.
+    #[error("segment {index}: {reason}")]
+    InvalidSegment {
+        /// Index of the segment in the profile.
+        index: usize,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// An unknown profile kind name.
+    #[error("unknown profile kind `{name}`; allowed: {allowed}")]
+    UnknownKind {
+        /// The name given.
+        name: String,
+        /// The allowed names, comma separated.
+        allowed: &'static str,
+    },
+}

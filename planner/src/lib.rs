@@ -1,0 +1,20 @@
+//! settle-planner: pure kinematics.
+//!
+//! Every planner returns a [`Profile`]: a start state plus a list of segments of constant
+//! jerk (or, for jerk-unlimited profiles such as trapezoids, constant acceleration). One
+//! evaluator, [`Profile::state_at`], serves sampling, plotting, simulation and output.
+//!
+//! No I/O, no clocks, no simulation types. Units are whatever the caller uses consistently
+//! (settle's harness uses metres and seconds).
+
+mod error;
+mod kind;
+mod limits;
+mod profile;
+pub mod scurve;
+pub mod trapezoid;
+
+pub use error::PlanError;
+pub use kind::ProfileKind;
+pub use limits::Limits;
+pub use profile::{Profile, Sample, Segment, State};
