@@ -1,0 +1,26 @@
+//! Sweep throughput: one quickstart run (plan + exact modal simulation + streaming metrics)
+//! per iteration. Simulated seconds per wall second = (move + window) / time per run.
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+
+fn bench(c: &mut Criterion) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+    let (_, runs) = settle::load_runs(&path).expect("quickstart");
+    // The 10 mm S-curve: 0.5 s window + ~0.08 s move, 10 kHz samples.
+    let spec = runs
+        .iter()
+        .find(|r| r.distance_mm == 10.0 && r.profile.name() == "scurve")
+        .expect("10 mm S-curve run");
+    c.bench_function("quickstart_run_10mm_scurve", |b| {
+        b.iter(|| black_box(settle::run::execute(black_box(spec), None).expect("runs")))
+    });
+    c.bench_function("quickstart_sweep_16_runs_1_thread", |b| {
+        b.iter(|| black_box(settle::run_all(&runs, Some(1), false).expect("runs")))
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

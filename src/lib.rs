@@ -1,0 +1,76 @@
+//! settle: which motion profile makes my machine settle fastest, and by how much?
+//!
+//! The harness: scenario files are expanded into runs ([`sweep`]), each run plans a profile
+//! and drives a plant through it ([`run`]), metrics are computed streaming ([`metrics`]) and
+//! written as tables ([`report`]).
+
+pub mod error;
+pub mod locate;
+pub mod metrics;
+pub mod report;
+pub mod run;
+pub mod scenario;
+pub mod series;
+pub mod sweep;
+
+use std::path::Path;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+
+pub use error::Error;
+pub use metrics::Metrics;
+pub use sweep::RunSpec;
+
+/// Run every spec, in parallel on `jobs` threads (all cores when `None`), with a progress
+/// bar on stderr when `progress` is set (and stderr is a terminal). Results come back in
+/// spec order; each run is computed the same way whatever the thread count.
+pub fn run_all(
+    runs: &[RunSpec],
+    jobs: Option<usize>,
+    progress: bool,
+) -> Result<Vec<Result<Metrics, Error>>, Error> {
+    let bar = if progress {
+        let bar =
+            ProgressBar::with_draw_target(Some(runs.len() as u64), ProgressDrawTarget::stderr());
+        if let Ok(style) = ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} runs ({eta} left)",
+        ) {
+            bar.set_style(style);
+        }
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = jobs {
+        builder = builder.num_threads(n);
+    }
+    let pool = builder.build().map_err(|e| Error::Input {
+        at: error::Location {
+            file: "--jobs".into(),
+            line: None,
+            column: None,
+            key: None,
+        },
+        message: format!("cannot start {jobs:?} worker threads: {e}"),
+    })?;
+    let results = pool.install(|| {
+        runs.par_iter()
+            .map(|spec| {
+                let r = run::execute(spec, None);
+                bar.inc(1);
+                r
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    Ok(results)
+}
+
+/// Load a scenario file and expand it into validated runs.
+pub fn load_runs(path: &Path) -> Result<(scenario::Scenario, Vec<RunSpec>), Error> {
+    let (sc, src) = scenario::load(path)?;
+    let runs = sweep::expand(&sc, &src)?;
+    Ok((sc, runs))
+}

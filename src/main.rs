@@ -1,0 +1,172 @@
+//! The `settle` command.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+
+use settle::{Error, report};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "settle",
+    version,
+    about = "Which motion profile makes my machine settle fastest, and by how much?",
+    after_help = "Example:\n  settle sweep scenarios/quickstart.toml\n  (writes results/quickstart/runs.csv and summary.md)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run every point of a scenario's sweep and write runs.csv and summary.md.
+    #[command(
+        after_help = "Example:\n  settle sweep scenarios/quickstart.toml --out /tmp/qs --jobs 2"
+    )]
+    Sweep {
+        /// The scenario file (TOML).
+        scenario: PathBuf,
+        /// Output folder [default: results/<scenario name>/].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Worker threads [default: all cores].
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+        jobs: Option<u16>,
+    },
+    /// Run one point of a sweep in detail: print its metrics, write its full trace as CSV.
+    #[command(
+        after_help = "Example:\n  settle run scenarios/quickstart.toml --case 3\n  (prints the metrics of run 3 and writes results/quickstart/run-3.csv)"
+    )]
+    Run {
+        /// The scenario file (TOML).
+        scenario: PathBuf,
+        /// The run index, as in the `run` column of runs.csv.
+        #[arg(long)]
+        case: usize,
+        /// Trace file [default: results/<scenario name>/run-<case>.csv].
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match dispatch(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            let input = e.downcast_ref::<Error>().is_some_and(Error::is_input_error);
+            ExitCode::from(if input { 2 } else { 1 })
+        }
+    }
+}
+
+fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
+    match cli.command {
+        Command::Sweep {
+            scenario,
+            out,
+            jobs,
+        } => sweep(scenario, out, jobs.map(usize::from)),
+        Command::Run {
+            scenario,
+            case,
+            out,
+        } => run_one(scenario, case, out),
+    }
+}
+
+fn sweep(path: PathBuf, out: Option<PathBuf>, jobs: Option<usize>) -> anyhow::Result<ExitCode> {
+    let started = Instant::now();
+    let (sc, runs) = settle::load_runs(&path)?;
+    let out = out.unwrap_or_else(|| PathBuf::from("results").join(&sc.name));
+    std::fs::create_dir_all(&out).map_err(|source| Error::Write {
+        path: out.clone(),
+        source,
+    })?;
+    eprintln!(
+        "{}: {} runs -> {}",
+        path.display(),
+        runs.len(),
+        out.display()
+    );
+    let results = settle::run_all(&runs, jobs, true)?;
+    let mut metrics = Vec::with_capacity(results.len());
+    for r in results {
+        metrics.push(r.context("a run failed; nothing was written")?);
+    }
+    report::write_atomic(
+        &out.join("runs.csv"),
+        report::runs_csv(&runs, &metrics).as_bytes(),
+    )?;
+    report::write_atomic(
+        &out.join("summary.md"),
+        report::summary_md(&sc, &runs, &metrics).as_bytes(),
+    )?;
+    eprintln!(
+        "wrote {} and {} ({} runs in {:.2} s)",
+        out.join("runs.csv").display(),
+        out.join("summary.md").display(),
+        runs.len(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_one(path: PathBuf, case: usize, out: Option<PathBuf>) -> anyhow::Result<ExitCode> {
+    let (sc, runs) = settle::load_runs(&path)?;
+    let Some(spec) = runs.get(case) else {
+        return Err(Error::Input {
+            at: settle::error::Location {
+                file: path.clone(),
+                line: None,
+                column: None,
+                key: None,
+            },
+            message: format!(
+                "--case {case} does not exist: the scenario has runs 0..={}",
+                runs.len().saturating_sub(1)
+            ),
+        }
+        .into());
+    };
+    let out = out.unwrap_or_else(|| {
+        PathBuf::from("results")
+            .join(&sc.name)
+            .join(format!("run-{case}.csv"))
+    });
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|source| Error::Write {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+    }
+    let mut series = settle::series::Series::new(&settle::run::CHANNELS);
+    let m = settle::run::execute(spec, Some(&mut series))?;
+    let mut csv = Vec::new();
+    series.write_csv(&mut csv).context("formatting the trace")?;
+    report::write_atomic(&out, &csv)?;
+    println!("run {case}: {} {} mm", spec.profile, spec.distance_mm);
+    for (p, v) in &spec.swept {
+        println!("  {p} = {v}");
+    }
+    println!("  move_time_s            {:.6}", m.move_time_s);
+    println!("  residual_peak_um       {:.4}", m.residual_peak_um);
+    println!("  residual_rms_um        {:.4}", m.residual_rms_um);
+    for (i, b) in m.bands_um.iter().enumerate() {
+        let show = |t: Option<f64>| t.map_or("not settled".to_string(), |t| format!("{t:.6}"));
+        println!("  settle_time_s ({b} um)  {}", show(m.settle_time_s[i]));
+        println!(
+            "  move_and_settle_s ({b} um)  {}",
+            show(m.move_and_settle_s(i))
+        );
+    }
+    println!("  overshoot_um           {:.4}", m.overshoot_um);
+    println!("  max_following_error_um {:.4}", m.max_following_error_um);
+    println!("trace: {} ({} samples)", out.display(), series.len());
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,247 @@
+//! Sinks for a sweep: `runs.csv` (one row per run) and `summary.md` (profile kinds side by
+//! side). Files are written atomically: a temporary file in the same folder, then a rename.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use settle_planner::ProfileKind;
+
+use crate::error::Error;
+use crate::metrics::Metrics;
+use crate::scenario::Scenario;
+use crate::sweep::RunSpec;
+
+/// Write `contents` to `path` atomically (temporary file + rename).
+pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), Error> {
+    let err = |source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp: PathBuf = dir.join(format!(".{name}.tmp{}", std::process::id()));
+    std::fs::write(&tmp, contents).map_err(err)?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        err(e)
+    })
+}
+
+fn band_label(b: f64) -> String {
+    format!("{b}um")
+}
+
+/// Format a time that may be "not settled" for the CSV: `inf` when not settled.
+fn csv_time(t: Option<f64>) -> String {
+    t.map_or_else(|| "inf".to_string(), |x| x.to_string())
+}
+
+/// The CSV: run parameters, then metrics. `settle_time_s_<band>` and
+/// `move_and_settle_s_<band>` are `inf` when the run did not settle within the window.
+pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
+    let mut out = String::new();
+    let bands = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
+    let n_modes = runs.first().map_or(0, |r| r.modes.len());
+    out.push_str("run,profile,start_mm,distance_mm,vmax_mm_s,amax_mm_s2,jmax_mm_s3");
+    for i in 0..n_modes {
+        let _ = write!(
+            out,
+            ",mode{i}_frequency_hz,mode{i}_damping_ratio,mode{i}_weight"
+        );
+    }
+    out.push_str(",move_time_s,residual_peak_um,residual_rms_um");
+    for b in &bands {
+        let _ = write!(out, ",settle_time_s_{}", band_label(*b));
+    }
+    for b in &bands {
+        let _ = write!(out, ",move_and_settle_s_{}", band_label(*b));
+    }
+    out.push_str(",overshoot_um,max_following_error_um\n");
+    for (r, m) in runs.iter().zip(metrics) {
+        let _ = write!(
+            out,
+            "{},{},{},{},{},{},{}",
+            r.id,
+            r.profile,
+            r.start_mm,
+            r.distance_mm,
+            r.vmax_mm_s,
+            r.amax_mm_s2,
+            r.jmax_mm_s3.map_or(String::new(), |j| j.to_string())
+        );
+        for md in &r.modes {
+            let _ = write!(
+                out,
+                ",{},{},{}",
+                md.frequency_hz, md.damping_ratio, md.weight
+            );
+        }
+        let _ = write!(
+            out,
+            ",{},{},{}",
+            m.move_time_s, m.residual_peak_um, m.residual_rms_um
+        );
+        for t in &m.settle_time_s {
+            let _ = write!(out, ",{}", csv_time(*t));
+        }
+        for i in 0..m.settle_time_s.len() {
+            let _ = write!(out, ",{}", csv_time(m.move_and_settle_s(i)));
+        }
+        let _ = writeln!(out, ",{},{}", m.overshoot_um, m.max_following_error_um);
+    }
+    out
+}
+
+fn ms(t: Option<f64>) -> String {
+    t.map_or_else(|| "not settled".to_string(), |x| format!("{:.1}", x * 1e3))
+}
+
+/// The summary: one table per band of move-and-settle times, profile kinds side by side
+/// for each swept point (all swept parameters except `profile`), the best marked.
+pub fn summary_md(sc: &Scenario, runs: &[RunSpec], metrics: &[Metrics]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "# {}\n", sc.name);
+    if !sc.description.is_empty() {
+        let _ = writeln!(out, "{}\n", sc.description.trim());
+    }
+    let modes: Vec<String> = sc
+        .machine
+        .modes
+        .iter()
+        .map(|m| format!("{} Hz, zeta {}", m.frequency_hz, m.damping_ratio))
+        .collect();
+    let _ = writeln!(
+        out,
+        "Machine modes: {}. {} runs. Times in ms; **bold** = fastest move-and-settle at that point; \
+gain = how much longer the slowest kind takes than the fastest.\n",
+        modes.join("; "),
+        runs.len()
+    );
+    // Group runs by their swept values other than `profile`, keeping first-seen order.
+    let mut kinds: Vec<ProfileKind> = Vec::new();
+    let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
+    for (i, r) in runs.iter().enumerate() {
+        if !kinds.contains(&r.profile) {
+            kinds.push(r.profile);
+        }
+        let key: Vec<String> = r
+            .swept
+            .iter()
+            .filter(|(p, _)| p != "profile")
+            .map(|(_, v)| v.to_string())
+            .collect();
+        let key = key.join(" | ");
+        match groups.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, v)) => v.push(i),
+            None => groups.push((key, vec![i])),
+        }
+    }
+    let params: Vec<&str> = runs
+        .first()
+        .map(|r| {
+            r.swept
+                .iter()
+                .filter(|(p, _)| p != "profile")
+                .map(|(p, _)| p.as_str())
+                .collect()
+        })
+        .unwrap_or_default();
+    let bands = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
+    for (bi, band) in bands.iter().enumerate() {
+        let _ = writeln!(out, "## Move and settle to within {band} um (ms)\n");
+        let mut header: Vec<String> = params.iter().map(|p| p.to_string()).collect();
+        for k in &kinds {
+            header.push(format!("{k} move"));
+            header.push(format!("{k} settle"));
+            header.push(format!("{k} total"));
+        }
+        header.push("best".into());
+        header.push("gain".into());
+        let _ = writeln!(out, "| {} |", header.join(" | "));
+        let _ = writeln!(out, "|{}", "---:|".repeat(header.len()));
+        for (key, idx) in &groups {
+            let mut row: Vec<String> = if params.is_empty() {
+                Vec::new()
+            } else {
+                key.split(" | ").map(str::to_string).collect()
+            };
+            let totals: Vec<(ProfileKind, Option<f64>)> = kinds
+                .iter()
+                .map(|k| {
+                    let t = idx
+                        .iter()
+                        .find(|&&i| runs[i].profile == *k)
+                        .and_then(|&i| metrics[i].move_and_settle_s(bi));
+                    (*k, t)
+                })
+                .collect();
+            let best = totals
+                .iter()
+                .filter_map(|(k, t)| t.map(|t| (*k, t)))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            for k in &kinds {
+                let m = idx
+                    .iter()
+                    .find(|&&i| runs[i].profile == *k)
+                    .map(|&i| &metrics[i]);
+                match m {
+                    Some(m) => {
+                        let total = ms(m.move_and_settle_s(bi));
+                        let is_best = best.is_some_and(|(bk, _)| bk == *k);
+                        row.push(format!("{:.1}", m.move_time_s * 1e3));
+                        row.push(ms(m.settle_time_s[bi]));
+                        row.push(if is_best {
+                            format!("**{total}**")
+                        } else {
+                            total
+                        });
+                    }
+                    None => row.extend(["-".to_string(), "-".to_string(), "-".to_string()]),
+                }
+            }
+            let worst = totals
+                .iter()
+                .map(|(_, t)| t.unwrap_or(f64::INFINITY))
+                .fold(0.0, f64::max);
+            match best {
+                Some((k, t)) => {
+                    row.push(k.to_string());
+                    row.push(if worst.is_finite() {
+                        format!("{:.0}%", (worst / t - 1.0) * 100.0)
+                    } else {
+                        "other not settled".to_string()
+                    });
+                }
+                None => row.extend(["none settled".to_string(), "-".to_string()]),
+            }
+            let _ = writeln!(out, "| {} |", row.join(" | "));
+        }
+        out.push('\n');
+    }
+    let _ = writeln!(out, "## Residual vibration after the move (peak um)\n");
+    let mut header: Vec<String> = params.iter().map(|p| p.to_string()).collect();
+    header.extend(kinds.iter().map(|k| k.to_string()));
+    let _ = writeln!(out, "| {} |", header.join(" | "));
+    let _ = writeln!(out, "|{}", "---:|".repeat(header.len()));
+    for (key, idx) in &groups {
+        let mut row: Vec<String> = if params.is_empty() {
+            Vec::new()
+        } else {
+            key.split(" | ").map(str::to_string).collect()
+        };
+        for k in &kinds {
+            row.push(
+                idx.iter()
+                    .find(|&&i| runs[i].profile == *k)
+                    .map_or("-".to_string(), |&i| {
+                        format!("{:.2}", metrics[i].residual_peak_um)
+                    }),
+            );
+        }
+        let _ = writeln!(out, "| {} |", row.join(" | "));
+    }
+    out
+}

@@ -1,0 +1,82 @@
+//! `Series`: time-stamped named channels with units, for recording one run in full.
+//! Metrics read it (through the same streaming accumulator the sweep uses); sinks write it.
+
+use std::io::Write;
+
+/// One named channel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Channel {
+    /// Name, e.g. `toolhead`.
+    pub name: String,
+    /// Unit, e.g. `m`.
+    pub unit: String,
+    /// Values, one per time stamp.
+    pub data: Vec<f64>,
+}
+
+/// Time-stamped channels of equal length.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Series {
+    /// Time stamps (s).
+    pub t_s: Vec<f64>,
+    /// Channels, each as long as `t_s`.
+    pub channels: Vec<Channel>,
+}
+
+impl Series {
+    /// An empty series with the given `(name, unit)` channels.
+    pub fn new(channels: &[(&str, &str)]) -> Self {
+        Self {
+            t_s: Vec::new(),
+            channels: channels
+                .iter()
+                .map(|(n, u)| Channel {
+                    name: n.to_string(),
+                    unit: u.to_string(),
+                    data: Vec::new(),
+                })
+                .collect(),
+        }
+    }
+
+    /// Append one row: a time stamp and one value per channel, in channel order.
+    pub fn push(&mut self, t_s: f64, values: &[f64]) {
+        debug_assert_eq!(values.len(), self.channels.len());
+        self.t_s.push(t_s);
+        for (c, v) in self.channels.iter_mut().zip(values) {
+            c.data.push(*v);
+        }
+    }
+
+    /// The channel called `name`.
+    pub fn channel(&self, name: &str) -> Option<&Channel> {
+        self.channels.iter().find(|c| c.name == name)
+    }
+
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.t_s.len()
+    }
+
+    /// True when there are no rows.
+    pub fn is_empty(&self) -> bool {
+        self.t_s.is_empty()
+    }
+
+    /// Write as CSV with a `name_unit` header.
+    pub fn write_csv(&self, mut w: impl Write) -> std::io::Result<()> {
+        write!(w, "t_s")?;
+        for c in &self.channels {
+            write!(w, ",{}_{}", c.name, c.unit)?;
+        }
+        writeln!(w)?;
+        for (i, t) in self.t_s.iter().enumerate() {
+            write!(w, "{t}")?;
+            for c in &self.channels {
+                write!(w, ",{}", c.data[i])?;
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    }
+}

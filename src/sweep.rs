@@ -1,0 +1,385 @@
+//! Sweep expansion: a scenario becomes a list of fully resolved, validated runs. Pure: no
+//! I/O, the same file always gives the same runs in the same order.
+
+use settle_planner::{Limits, ProfileKind};
+use settle_sim::Mode;
+
+use crate::error::Error;
+use crate::scenario::{ModeSpec, Scenario, Source};
+
+/// A value of a swept parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    /// A number (in the parameter's unit).
+    Number(f64),
+    /// A profile kind.
+    Kind(ProfileKind),
+}
+
+impl std::fmt::Display for Value {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Value::Number(x) => write!(f, "{x}"),
+            Value::Kind(k) => write!(f, "{k}"),
+        }
+    }
+}
+
+/// One sweep axis: a parameter and its values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// Parameter name as written (`profile`, `move.distance_mm`, ...).
+    pub param: String,
+    /// Values in order.
+    pub values: Vec<Value>,
+}
+
+/// One point of a sweep, fully resolved (scenario units: mm, s, Hz).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSpec {
+    /// Index in the sweep (0-based, in expansion order).
+    pub id: usize,
+    /// Profile kind.
+    pub profile: ProfileKind,
+    /// Start position (mm).
+    pub start_mm: f64,
+    /// Signed move length (mm).
+    pub distance_mm: f64,
+    /// Maximum speed (mm/s).
+    pub vmax_mm_s: f64,
+    /// Maximum acceleration (mm/s^2).
+    pub amax_mm_s2: f64,
+    /// Maximum jerk (mm/s^3), if given.
+    pub jmax_mm_s3: Option<f64>,
+    /// The machine's modes.
+    pub modes: Vec<ModeSpec>,
+    /// Observation window after the move (s).
+    pub window_s: f64,
+    /// Sample rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Settling bands (um).
+    pub bands_um: Vec<f64>,
+    /// The swept parameters' values of this run, in axis order.
+    pub swept: Vec<(String, Value)>,
+}
+
+/// Parameters that can be swept, for error messages.
+pub const SWEEPABLE: &str = "profile, move.distance_mm, move.start_mm, limits.vmax_mm_s, \
+limits.amax_mm_s2, limits.jmax_mm_s3, machine.modes.N.frequency_hz, machine.modes.N.damping_ratio, \
+machine.modes.N.weight (N = 0-based mode index)";
+
+/// Upper bound on the number of runs one scenario may expand to.
+pub const MAX_RUNS: usize = 10_000_000;
+
+impl RunSpec {
+    /// Kinematic limits in SI units (m, s).
+    pub fn limits_si(&self) -> Result<Limits, settle_planner::PlanError> {
+        Limits::new(
+            self.vmax_mm_s * 1e-3,
+            self.amax_mm_s2 * 1e-3,
+            self.jmax_mm_s3.map(|j| j * 1e-3),
+        )
+    }
+
+    /// The modes as sim types.
+    pub fn modes_sim(&self) -> Result<Vec<Mode>, settle_sim::SimError> {
+        self.modes
+            .iter()
+            .map(|m| Mode::new(m.frequency_hz, m.damping_ratio, m.weight))
+            .collect()
+    }
+
+    fn set(&mut self, param: &str, value: &Value) -> Result<(), String> {
+        let num = |v: &Value| match v {
+            Value::Number(x) => Ok(*x),
+            Value::Kind(_) => Err(format!("`{param}` takes numbers")),
+        };
+        match param {
+            "profile" => match value {
+                Value::Kind(k) => self.profile = *k,
+                Value::Number(_) => return Err("`profile` takes profile kind names".into()),
+            },
+            "move.distance_mm" => self.distance_mm = num(value)?,
+            "move.start_mm" => self.start_mm = num(value)?,
+            "limits.vmax_mm_s" => self.vmax_mm_s = num(value)?,
+            "limits.amax_mm_s2" => self.amax_mm_s2 = num(value)?,
+            "limits.jmax_mm_s3" => self.jmax_mm_s3 = Some(num(value)?),
+            other => {
+                let mode_param = other
+                    .strip_prefix("machine.modes.")
+                    .and_then(|rest| rest.split_once('.'))
+                    .and_then(|(i, field)| Some((i.parse::<usize>().ok()?, field)));
+                let Some((i, field)) = mode_param else {
+                    return Err(format!("`{other}` cannot be swept; allowed: {SWEEPABLE}"));
+                };
+                let n = self.modes.len();
+                let mode = self.modes.get_mut(i).ok_or_else(|| {
+                    format!("mode index {i} out of range: the machine has {n} mode(s)")
+                })?;
+                let x = num(value)?;
+                match field {
+                    "frequency_hz" => mode.frequency_hz = x,
+                    "damping_ratio" => mode.damping_ratio = x,
+                    "weight" => mode.weight = x,
+                    _ => return Err(format!("`{other}` cannot be swept; allowed: {SWEEPABLE}")),
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Read the sweep axes of a scenario.
+pub fn axes(sc: &Scenario, src: &Source) -> Result<Vec<Axis>, Error> {
+    let mut out = Vec::new();
+    for (param, raw) in &sc.sweep {
+        let key = format!("sweep.{param}");
+        let err = |m: String| src.error_at(&key, m);
+        let values = if param == "profile" {
+            let list = raw.as_array().ok_or_else(|| {
+                err("`profile` takes a list of kind names, e.g. [\"trapezoid\", \"scurve\"]".into())
+            })?;
+            list.iter()
+                .map(|v| {
+                    let name = v.as_str().ok_or_else(|| {
+                        err(format!(
+                            "profile kinds are strings; allowed: {}",
+                            ProfileKind::ALLOWED
+                        ))
+                    })?;
+                    ProfileKind::parse(name)
+                        .map(Value::Kind)
+                        .map_err(|e| err(e.to_string()))
+                })
+                .collect::<Result<Vec<_>, _>>()?
+        } else {
+            numbers(raw)
+                .map_err(err)?
+                .into_iter()
+                .map(Value::Number)
+                .collect()
+        };
+        if values.is_empty() {
+            return Err(err("empty sweep axis: give at least one value".into()));
+        }
+        out.push(Axis {
+            param: param.clone(),
+            values,
+        });
+    }
+    Ok(out)
+}
+
+/// A list of numbers, or a range table `{ from, to, steps | step, scale = "linear" | "log" }`.
+fn numbers(raw: &toml::Value) -> Result<Vec<f64>, String> {
+    let as_f64 = |v: &toml::Value| {
+        v.as_float()
+            .or_else(|| v.as_integer().map(|i| i as f64))
+            .ok_or_else(|| format!("expected a number, got `{v}`"))
+    };
+    match raw {
+        toml::Value::Array(list) => list.iter().map(as_f64).collect(),
+        toml::Value::Table(t) => {
+            for k in t.keys() {
+                if !["from", "to", "steps", "step", "scale"].contains(&k.as_str()) {
+                    return Err(format!(
+                        "unknown range key `{k}`; allowed: from, to, steps, step, scale"
+                    ));
+                }
+            }
+            let get = |k: &str| t.get(k).map(as_f64).transpose();
+            let (from, to) = match (get("from")?, get("to")?) {
+                (Some(f), Some(t)) if f.is_finite() && t.is_finite() => (f, t),
+                _ => return Err("a range needs finite `from` and `to`".into()),
+            };
+            let log = match t.get("scale").map(|s| s.as_str()) {
+                None | Some(Some("linear")) => false,
+                Some(Some("log")) => true,
+                _ => return Err("`scale` must be \"linear\" or \"log\"".into()),
+            };
+            if log && (from <= 0.0 || to <= 0.0) {
+                return Err("a log range needs `from` and `to` > 0".into());
+            }
+            let count = match (get("steps")?, get("step")?) {
+                (Some(n), None) if n >= 1.0 && n.fract() == 0.0 && n <= MAX_RUNS as f64 => {
+                    n as usize
+                }
+                (None, Some(s)) if !log && s > 0.0 && s.is_finite() => {
+                    let n = ((to - from).abs() / s + 1e-9).floor() + 1.0;
+                    if n > MAX_RUNS as f64 {
+                        return Err(format!("range has {n} values; at most {MAX_RUNS}"));
+                    }
+                    let dir = if to >= from { 1.0 } else { -1.0 };
+                    return Ok((0..n as usize).map(|i| from + dir * s * i as f64).collect());
+                }
+                _ => {
+                    return Err("a range needs either `steps` (an integer >= 1) or `step` (> 0, linear ranges only)".into());
+                }
+            };
+            if count == 1 {
+                return Ok(vec![from]);
+            }
+            Ok((0..count)
+                .map(|i| {
+                    let f = i as f64 / (count - 1) as f64;
+                    if i == count - 1 {
+                        to
+                    } else if log {
+                        (from.ln() + f * (to.ln() - from.ln())).exp()
+                    } else {
+                        from + f * (to - from)
+                    }
+                })
+                .collect())
+        }
+        other => Err(format!(
+            "expected a list of values or a range table {{ from, to, steps }}, got `{other}`"
+        )),
+    }
+}
+
+/// Expand a scenario into validated runs: the base run, then the cartesian product of the
+/// sweep axes in the order written (the last axis varies fastest).
+pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
+    let base_profile = ProfileKind::parse(&sc.move_.profile)
+        .map_err(|e| src.error_at("move.profile", e.to_string()))?;
+    let base = RunSpec {
+        id: 0,
+        profile: base_profile,
+        start_mm: sc.move_.start_mm,
+        distance_mm: sc.move_.distance_mm,
+        vmax_mm_s: sc.limits.vmax_mm_s,
+        amax_mm_s2: sc.limits.amax_mm_s2,
+        jmax_mm_s3: sc.limits.jmax_mm_s3,
+        modes: sc.machine.modes.clone(),
+        window_s: sc.observe.window_s,
+        sample_rate_hz: sc.observe.sample_rate_hz,
+        bands_um: sc.observe.bands_um.clone(),
+        swept: Vec::new(),
+    };
+    validate_observe(&base, src)?;
+    let axes = axes(sc, src)?;
+    let total = axes
+        .iter()
+        .try_fold(1usize, |acc, a| acc.checked_mul(a.values.len()))
+        .filter(|&n| n <= MAX_RUNS)
+        .ok_or_else(|| {
+            src.error_at(
+                "sweep",
+                format!("the sweep expands to more than {MAX_RUNS} runs"),
+            )
+        })?;
+    let mut runs = Vec::with_capacity(total);
+    for id in 0..total {
+        let mut run = base.clone();
+        run.id = id;
+        let mut rest = id;
+        let mut picks = vec![0; axes.len()];
+        for (i, axis) in axes.iter().enumerate().rev() {
+            picks[i] = rest % axis.values.len();
+            rest /= axis.values.len();
+        }
+        for (axis, &k) in axes.iter().zip(&picks) {
+            let v = &axis.values[k];
+            run.set(&axis.param, v)
+                .map_err(|m| src.error_at(&format!("sweep.{}", axis.param), m))?;
+            run.swept.push((axis.param.clone(), v.clone()));
+        }
+        validate_run(&run, src)?;
+        runs.push(run);
+    }
+    Ok(runs)
+}
+
+/// The key to blame for parameter `param` of `run`: the sweep axis if it is swept.
+fn blame(run: &RunSpec, param: &str) -> String {
+    if run.swept.iter().any(|(p, _)| p == param) {
+        format!("sweep.{param}")
+    } else {
+        param.to_string()
+    }
+}
+
+fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
+    if !(run.window_s.is_finite() && run.window_s > 0.0) {
+        return Err(src.error_at(
+            "observe.window_s",
+            format!("must be a finite number > 0 (s), got {}", run.window_s),
+        ));
+    }
+    if !(run.sample_rate_hz.is_finite() && run.sample_rate_hz > 0.0) {
+        return Err(src.error_at(
+            "observe.sample_rate_hz",
+            format!(
+                "must be a finite number > 0 (Hz), got {}",
+                run.sample_rate_hz
+            ),
+        ));
+    }
+    if run.window_s * run.sample_rate_hz > 1e8 {
+        return Err(src.error_at(
+            "observe.sample_rate_hz",
+            "window_s * sample_rate_hz exceeds 1e8 samples; lower one of them",
+        ));
+    }
+    if run.bands_um.is_empty() || run.bands_um.iter().any(|b| !(b.is_finite() && *b > 0.0)) {
+        return Err(src.error_at(
+            "observe.bands_um",
+            "give one or more bands, each a finite number > 0 (um)",
+        ));
+    }
+    if run.modes.is_empty() {
+        return Err(src.error_at(
+            "machine.modes",
+            "give at least one mode { frequency_hz, damping_ratio }",
+        ));
+    }
+    Ok(())
+}
+
+fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
+    for (name, value) in [
+        ("move.distance_mm", run.distance_mm),
+        ("move.start_mm", run.start_mm),
+    ] {
+        if !value.is_finite() {
+            return Err(src.error_at(&blame(run, name), format!("must be finite, got {value}")));
+        }
+    }
+    if let Err(e) = run.limits_si() {
+        let key = match &e {
+            settle_planner::PlanError::InvalidLimit { name: "vmax", .. } => "limits.vmax_mm_s",
+            settle_planner::PlanError::InvalidLimit { name: "amax", .. } => "limits.amax_mm_s2",
+            _ => "limits.jmax_mm_s3",
+        };
+        return Err(src.error_at(
+            &blame(run, key),
+            format!("{e} (in mm units; every limit must be > 0)"),
+        ));
+    }
+    if run.profile == ProfileKind::SCurve && run.jmax_mm_s3.is_none() {
+        return Err(src.error_at(
+            "limits",
+            "profile kind `scurve` needs `jmax_mm_s3` in [limits]",
+        ));
+    }
+    for (i, m) in run.modes.iter().enumerate() {
+        if let Err(e) = Mode::new(m.frequency_hz, m.damping_ratio, m.weight) {
+            let field = if !(m.frequency_hz.is_finite() && m.frequency_hz > 0.0) {
+                "frequency_hz"
+            } else if !(0.0..1.0).contains(&m.damping_ratio) {
+                "damping_ratio"
+            } else {
+                "weight"
+            };
+            let swept = format!("machine.modes.{i}.{field}");
+            let key = if run.swept.iter().any(|(p, _)| *p == swept) {
+                format!("sweep.{swept}")
+            } else {
+                "machine.modes".to_string()
+            };
+            return Err(src.error_at(&key, format!("mode {i}: {e}")));
+        }
+    }
+    Ok(())
+}
