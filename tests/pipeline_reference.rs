@@ -1,0 +1,46 @@
+//! The whole pipeline (scenario -> planner -> stepped modal plant -> streaming metrics)
+//! against the closed form: the post-move metrics of every quickstart run are recomputed
+//! from the closed-form residual e(t) at the same sample times, with no plant involved.
+
+use std::path::Path;
+
+use settle::metrics::Accumulator;
+use settle_sim::Mode;
+use settle_sim::closed_form::residual_at;
+
+#[test]
+fn quickstart_post_move_metrics_equal_the_closed_form() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+    let (_, runs) = settle::load_runs(&path).expect("quickstart");
+    for spec in &runs {
+        let got = settle::run::execute(spec, None).expect("runs");
+        let lim = spec.limits_si().expect("limits");
+        let prof = spec
+            .profile
+            .rest_to_rest(spec.start_mm * 1e-3, spec.distance_mm * 1e-3, &lim)
+            .expect("plan");
+        let modes: Vec<Mode> = spec.modes_sim().expect("modes");
+        let t_end = prof.duration_s();
+        let target = prof.end().p;
+        let mut acc = Accumulator::new(target, 1.0, t_end, &spec.bands_um);
+        let dt = 1.0 / spec.sample_rate_hz;
+        let n = (spec.window_s * spec.sample_rate_hz).ceil() as usize;
+        for i in 0..=n {
+            let t = t_end + i as f64 * dt;
+            let e: f64 = modes.iter().map(|m| m.weight() * residual_at(&prof, m, t)).sum();
+            acc.push(t, target, target + e);
+        }
+        let want = acc.finish();
+        let ctx = format!("run {} ({} {} mm)", spec.id, spec.profile, spec.distance_mm);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * b.abs().max(1e-3);
+        assert_eq!(got.move_time_s, want.move_time_s, "{ctx}");
+        assert!(close(got.residual_peak_um, want.residual_peak_um), "{ctx}: peak {} vs {}", got.residual_peak_um, want.residual_peak_um);
+        assert!(close(got.residual_rms_um, want.residual_rms_um), "{ctx}: rms {} vs {}", got.residual_rms_um, want.residual_rms_um);
+        for (b, (g, w)) in got.settle_time_s.iter().zip(&want.settle_time_s).enumerate() {
+            match (g, w) {
+                (Some(g), Some(w)) => assert!((g - w).abs() <= 1e-9, "{ctx} band {b}: {g} vs {w}"),
+                _ => assert_eq!(g, w, "{ctx} band {b}"),
+            }
+        }
+    }
+}
