@@ -346,16 +346,18 @@ fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
             return Err(src.error_at(&blame(run, name), format!("must be finite, got {value}")));
         }
     }
-    if let Err(e) = run.limits_si() {
-        let key = match &e {
-            settle_planner::PlanError::InvalidLimit { name: "vmax", .. } => "limits.vmax_mm_s",
-            settle_planner::PlanError::InvalidLimit { name: "amax", .. } => "limits.amax_mm_s2",
-            _ => "limits.jmax_mm_s3",
-        };
-        return Err(src.error_at(
-            &blame(run, key),
-            format!("{e} (in mm units; every limit must be > 0)"),
-        ));
+    let limits = [
+        ("limits.vmax_mm_s", Some(run.vmax_mm_s), "mm/s"),
+        ("limits.amax_mm_s2", Some(run.amax_mm_s2), "mm/s^2"),
+        ("limits.jmax_mm_s3", run.jmax_mm_s3, "mm/s^3"),
+    ];
+    for (key, value, unit) in limits {
+        if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(src.error_at(
+                &blame(run, key),
+                format!("must be a finite number > 0 ({unit}), got {v}"),
+            ));
+        }
     }
     if run.profile == ProfileKind::SCurve && run.jmax_mm_s3.is_none() {
         return Err(src.error_at(
