@@ -27,16 +27,34 @@ fn quickstart_post_move_metrics_equal_the_closed_form() {
         let n = (spec.window_s * spec.sample_rate_hz).ceil() as usize;
         for i in 0..=n {
             let t = t_end + i as f64 * dt;
-            let e: f64 = modes.iter().map(|m| m.weight() * residual_at(&prof, m, t)).sum();
+            let e: f64 = modes
+                .iter()
+                .map(|m| m.weight() * residual_at(&prof, m, t))
+                .sum();
             acc.push(t, target, target + e);
         }
         let want = acc.finish();
         let ctx = format!("run {} ({} {} mm)", spec.id, spec.profile, spec.distance_mm);
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * b.abs().max(1e-3);
         assert_eq!(got.move_time_s, want.move_time_s, "{ctx}");
-        assert!(close(got.residual_peak_um, want.residual_peak_um), "{ctx}: peak {} vs {}", got.residual_peak_um, want.residual_peak_um);
-        assert!(close(got.residual_rms_um, want.residual_rms_um), "{ctx}: rms {} vs {}", got.residual_rms_um, want.residual_rms_um);
-        for (b, (g, w)) in got.settle_time_s.iter().zip(&want.settle_time_s).enumerate() {
+        assert!(
+            close(got.residual_peak_um, want.residual_peak_um),
+            "{ctx}: peak {} vs {}",
+            got.residual_peak_um,
+            want.residual_peak_um
+        );
+        assert!(
+            close(got.residual_rms_um, want.residual_rms_um),
+            "{ctx}: rms {} vs {}",
+            got.residual_rms_um,
+            want.residual_rms_um
+        );
+        for (b, (g, w)) in got
+            .settle_time_s
+            .iter()
+            .zip(&want.settle_time_s)
+            .enumerate()
+        {
             match (g, w) {
                 (Some(g), Some(w)) => assert!((g - w).abs() <= 1e-9, "{ctx} band {b}: {g} vs {w}"),
                 _ => assert_eq!(g, w, "{ctx} band {b}"),
