@@ -3,8 +3,10 @@
 /// Everything that can go wrong when building or planning a profile.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PlanError {
-    /// A limit is zero, negative, NaN or infinite.
-    #[error("limit `{name}` must be a finite number > 0, got {value}")]
+    /// A limit is zero, negative, NaN or infinite (for `vmin`/`amin`: zero, positive, ...).
+    #[error(
+        "limit `{name}` must be finite and nonzero, on the right side of zero (vmax, amax, jmax > 0; vmin, amin < 0), got {value}"
+    )]
     InvalidLimit {
         /// Which limit (`vmax`, `amax`, `jmax`).
         name: &'static str,
@@ -31,6 +33,19 @@ pub enum PlanError {
         /// Index of the segment in the profile.
         index: usize,
         /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// No profile reaches the target (should not happen for valid inputs; reported rather
+    /// than returning a wrong profile).
+    #[error("no valid profile found: {reason}")]
+    NoSolution {
+        /// What failed.
+        reason: &'static str,
+    },
+    /// The target state cannot be held within the limits.
+    #[error("infeasible target: {reason}")]
+    InfeasibleTarget {
+        /// Why.
         reason: &'static str,
     },
     /// An unknown profile kind name.

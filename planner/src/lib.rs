@@ -7,12 +7,16 @@
 //! No I/O, no clocks, no simulation types. Units are whatever the caller uses consistently
 //! (settle's harness uses metres and seconds).
 
+mod brake;
 mod error;
 mod kind;
 mod limits;
+pub mod position;
 mod profile;
 pub mod scurve;
+mod three_arc;
 pub mod trapezoid;
+pub mod velocity;
 
 pub use error::PlanError;
 pub use kind::ProfileKind;

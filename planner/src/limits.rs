@@ -2,13 +2,17 @@
 
 use crate::PlanError;
 
-/// Symmetric kinematic limits of one axis. Construct with [`Limits::new`], which rejects
-/// zero, negative, NaN and infinite values, so every planner can trust them.
+/// Kinematic limits of one axis. Construct with [`Limits::new`] (symmetric) or
+/// [`Limits::asymmetric`], which reject zero, negative, NaN and infinite values, so every
+/// planner can trust them. `vmin`/`amin` are the (negative) lower limits; by default
+/// `-vmax`/`-amax`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Limits {
     vmax: f64,
     amax: f64,
     jmax: Option<f64>,
+    vmin: f64,
+    amin: f64,
 }
 
 fn check(name: &'static str, value: f64) -> Result<f64, PlanError> {
@@ -23,11 +27,51 @@ impl Limits {
     /// Velocity limit `vmax` (units/s), acceleration limit `amax` (units/s^2) and an optional
     /// jerk limit `jmax` (units/s^3; `None` for jerk-unlimited planners such as trapezoids).
     pub fn new(vmax: f64, amax: f64, jmax: Option<f64>) -> Result<Self, PlanError> {
+        let (vmax, amax) = (check("vmax", vmax)?, check("amax", amax)?);
         Ok(Self {
-            vmax: check("vmax", vmax)?,
-            amax: check("amax", amax)?,
+            vmax,
+            amax,
             jmax: jmax.map(|j| check("jmax", j)).transpose()?,
+            vmin: -vmax,
+            amin: -amax,
         })
+    }
+
+    /// Asymmetric limits: `vmin` and `amin` are given as (negative) lower limits, i.e. the
+    /// axis may move between `vmin < 0` and `vmax > 0` and accelerate between `amin < 0` and
+    /// `amax > 0`. `None` means the mirror of the upper limit.
+    pub fn asymmetric(
+        vmax: f64,
+        vmin: Option<f64>,
+        amax: f64,
+        amin: Option<f64>,
+        jmax: Option<f64>,
+    ) -> Result<Self, PlanError> {
+        let mut l = Self::new(vmax, amax, jmax)?;
+        let negative = |name, value: f64| {
+            if value.is_finite() && value < 0.0 {
+                Ok(value)
+            } else {
+                Err(PlanError::InvalidLimit { name, value })
+            }
+        };
+        if let Some(v) = vmin {
+            l.vmin = negative("vmin", v)?;
+        }
+        if let Some(a) = amin {
+            l.amin = negative("amin", a)?;
+        }
+        Ok(l)
+    }
+
+    /// Lower velocity limit (< 0).
+    pub fn vmin(&self) -> f64 {
+        self.vmin
+    }
+
+    /// Lower acceleration limit (< 0).
+    pub fn amin(&self) -> f64 {
+        self.amin
     }
 
     /// Maximum speed (units/s).

@@ -1,0 +1,182 @@
+//! Brake pre-trajectories: bring a start state that violates, or must violate, the limits
+//! back inside them before the time-optimal profile begins (seed 004 steps 1-2).
+//!
+//! The brake law:
+//! 1. `a` beyond its limit: jerk towards the limit until it is reached.
+//! 2. Velocity overshoot: the velocity reached by ramping the acceleration to zero at full
+//!    jerk, `vz = v + a|a|/(2j)`, is above `vmax` (below `vmin`). Jerk `-j` (`+j`) keeps
+//!    `vz` constant while `a` returns to zero and lowers it afterwards (`d vz/dt = 2a`);
+//!    hold `amin` (`amax`) once reached.
+//!
+//! Along this law, braking may stop anywhere from the moment `vz` is back on the limit (the
+//! shortest brake; the profile that follows then meets the limit exactly) to the moment
+//! the velocity itself is back inside (where Ruckig's brake stops). The planner tries
+//! several stopping times and keeps the fastest total.
+
+use crate::{Limits, Segment, State};
+
+/// The brake control law from one start state, as segments up to the latest stopping
+/// time, with the range of stopping times.
+#[derive(Debug, Clone)]
+pub struct BrakeLaw {
+    start: State,
+    segs: Vec<Segment>,
+    earliest_s: f64,
+    latest_s: f64,
+}
+
+impl BrakeLaw {
+    /// The law for `start` under `lim` with jerk limit `j`.
+    pub fn new(start: State, lim: &Limits, j: f64) -> Self {
+        let mut segs = Vec::new();
+        let mut s = start;
+        let mut t = 0.0;
+        let mut push = |seg: Segment, s: &mut State, t: &mut f64| {
+            if seg.duration_s() > 0.0 {
+                *s = seg.end_state(s);
+                *t += seg.duration_s();
+                segs.push(seg);
+            }
+        };
+        if s.a > lim.amax() {
+            push(
+                Segment::Jerk {
+                    duration_s: (s.a - lim.amax()) / j,
+                    jerk: -j,
+                },
+                &mut s,
+                &mut t,
+            );
+            s.a = lim.amax();
+        } else if s.a < lim.amin() {
+            push(
+                Segment::Jerk {
+                    duration_s: (lim.amin() - s.a) / j,
+                    jerk: j,
+                },
+                &mut s,
+                &mut t,
+            );
+            s.a = lim.amin();
+        }
+        let after_accel = t;
+        let vz = s.v + s.a * s.a.abs() / (2.0 * j);
+        // Brake when vz is beyond a limit, or when v is (then, with vz inside, the earliest
+        // stop is immediate and the latest is where v is back inside).
+        let (dir, vlim, alim) = if vz > lim.vmax() || s.v > lim.vmax() {
+            (1.0, lim.vmax(), lim.amin())
+        } else if vz < lim.vmin() || s.v < lim.vmin() {
+            (-1.0, lim.vmin(), lim.amax())
+        } else {
+            return Self {
+                start,
+                segs,
+                earliest_s: t,
+                latest_s: t,
+            };
+        };
+        // Mirrored frame: the overshoot is upwards, the floor acceleration negative.
+        let a = dir * s.a;
+        let excess = (dir * (vz - vlim)).max(0.0);
+        let a_floor = dir * alim;
+        let tau_floor = -a_floor / j;
+        let tau0 = if a < 0.0 { -a / j } else { 0.0 };
+        let ramp = a.max(0.0) / j;
+        // vz = vz0 - j tau^2 on the descent past a = 0.
+        let tau_vz = (tau0 * tau0 + excess / j).sqrt();
+        // v = vz0 - j tau^2 / 2 on the descent: v back on the limit.
+        let vz0 = dir * vz + j * tau0 * tau0;
+        let tau_v = (2.0 * (vz0 - dir * vlim) / j).max(0.0).sqrt();
+        let jerk_len = |tau: f64| ramp + tau.min(tau_floor) - tau0;
+        let earliest = if tau_vz <= tau_floor {
+            after_accel + jerk_len(tau_vz)
+        } else {
+            // Hold at the floor: vz falls at |a_floor| per second.
+            let vz_at_floor = vz0 - j * tau_floor * tau_floor;
+            after_accel + jerk_len(tau_floor) + (vz_at_floor - dir * vlim) / (-a_floor)
+        };
+        let latest;
+        if tau_v <= tau_floor {
+            latest = after_accel + jerk_len(tau_v);
+            push(
+                Segment::Jerk {
+                    duration_s: jerk_len(tau_v),
+                    jerk: -dir * j,
+                },
+                &mut s,
+                &mut t,
+            );
+        } else {
+            push(
+                Segment::Jerk {
+                    duration_s: jerk_len(tau_floor),
+                    jerk: -dir * j,
+                },
+                &mut s,
+                &mut t,
+            );
+            s.a = alim;
+            let v_at_floor = dir * s.v;
+            let hold = ((v_at_floor - dir * vlim) / (-a_floor)).max(0.0);
+            latest = t + hold;
+            push(
+                Segment::Accel {
+                    duration_s: hold,
+                    accel: alim,
+                },
+                &mut s,
+                &mut t,
+            );
+        }
+        Self {
+            start,
+            segs,
+            earliest_s: earliest.min(latest),
+            latest_s: latest,
+        }
+    }
+
+    /// Stopping times to try: the earliest, the latest and evenly spaced ones between.
+    pub fn candidate_times(&self) -> Vec<f64> {
+        const N: usize = 8;
+        if self.latest_s <= self.earliest_s {
+            return vec![self.earliest_s];
+        }
+        (0..=N)
+            .map(|k| self.earliest_s + (self.latest_s - self.earliest_s) * k as f64 / N as f64)
+            .collect()
+    }
+
+    /// The brake segments up to time `tau` and the state there.
+    pub fn until(&self, tau: f64) -> (Vec<Segment>, State) {
+        let mut out = Vec::new();
+        let mut s = self.start;
+        let mut t = 0.0;
+        for seg in &self.segs {
+            let d = seg.duration_s().min(tau - t);
+            if d <= 0.0 {
+                break;
+            }
+            let part = match *seg {
+                Segment::Jerk { jerk, .. } => Segment::Jerk {
+                    duration_s: d,
+                    jerk,
+                },
+                Segment::Accel { accel, .. } => Segment::Accel {
+                    duration_s: d,
+                    accel,
+                },
+            };
+            s = part.end_state(&s);
+            t += d;
+            out.push(part);
+        }
+        (out, s)
+    }
+}
+
+/// The shortest brake (stop as soon as `vz` is back on the limit).
+pub fn brake(start: State, lim: &Limits, j: f64) -> (Vec<Segment>, State) {
+    let law = BrakeLaw::new(start, lim, j);
+    law.until(law.earliest_s)
+}
