@@ -7,6 +7,7 @@
 pub mod error;
 pub mod locate;
 pub mod metrics;
+pub mod plan_lines;
 pub mod report;
 pub mod run;
 pub mod scenario;

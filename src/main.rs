@@ -37,6 +37,15 @@ enum Command {
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
         jobs: Option<u16>,
     },
+    /// Plan motion problems: JSON lines on stdin, one profile (or error) per line on stdout.
+    #[command(
+        after_help = "Example:\n  echo '{\"p0\":[0],\"pf\":[1],\"vmax\":[1],\"amax\":[2],\"jmax\":[10],\"sync\":\"time\"}' | settle plan\n\nInput keys (arrays, one value per axis): p0 v0 a0 pf vf af vmax amax jmax [vmin amin];\n\"sync\": time|phase|none, \"kind\": scurve|trapezoid, \"interface\": position|velocity.\nOutput: {\"duration\":..,\"axes\":[{\"p0\",\"v0\",\"a0\",\"segments\":[[duration,jerk],..]}]}\n(a constant-acceleration segment is [duration,0,accel]) or {\"error\":\"..\"}."
+    )]
+    Plan {
+        /// Worker threads [default: all cores].
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+        jobs: Option<u16>,
+    },
     /// Run one point of a sweep in detail: print its metrics, write its full trace as CSV.
     #[command(
         after_help = "Example:\n  settle run scenarios/quickstart.toml --case 3\n  (prints the metrics of run 3 and writes results/quickstart/run-3.csv)"
@@ -72,6 +81,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             out,
             jobs,
         } => sweep(scenario, out, jobs.map(usize::from)),
+        Command::Plan { jobs } => plan_lines(jobs.map(usize::from)),
         Command::Run {
             scenario,
             case,
@@ -168,5 +178,40 @@ fn run_one(path: PathBuf, case: usize, out: Option<PathBuf>) -> anyhow::Result<E
     println!("  overshoot_um           {:.4}", m.overshoot_um);
     println!("  max_following_error_um {:.4}", m.max_following_error_um);
     println!("trace: {} ({} samples)", out.display(), series.len());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Answer JSON lines from stdin in order, in parallel chunks.
+fn plan_lines(jobs: Option<usize>) -> anyhow::Result<ExitCode> {
+    use rayon::prelude::*;
+    use std::io::{BufRead, Write};
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = jobs {
+        builder = builder.num_threads(n);
+    }
+    let pool = builder.build().context("starting worker threads")?;
+    let stdin = std::io::stdin().lock();
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let mut lines = stdin.lines();
+    loop {
+        let chunk: Vec<String> = lines
+            .by_ref()
+            .take(8192)
+            .collect::<Result<_, _>>()
+            .context("reading stdin")?;
+        if chunk.is_empty() {
+            break;
+        }
+        let answers: Vec<String> = pool.install(|| {
+            chunk
+                .par_iter()
+                .map(|l| settle::plan_lines::answer(l))
+                .collect()
+        });
+        for a in answers {
+            writeln!(out, "{a}").context("writing stdout")?;
+        }
+    }
+    out.flush().context("writing stdout")?;
     Ok(ExitCode::SUCCESS)
 }

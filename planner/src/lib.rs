@@ -8,12 +8,15 @@
 //! (settle's harness uses metres and seconds).
 
 mod brake;
+pub mod duration;
 mod error;
 mod kind;
 mod limits;
 pub mod position;
 mod profile;
+mod roots;
 pub mod scurve;
+pub mod sync;
 mod three_arc;
 pub mod trapezoid;
 pub mod velocity;

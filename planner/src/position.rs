@@ -19,6 +19,7 @@
 //! zero). The random suite against rsruckig measures how often that matters.
 
 use crate::brake::brake;
+use crate::roots::roots;
 use crate::velocity::{Bounds, Change, change};
 use crate::{Limits, PlanError, Profile, Segment, State};
 
@@ -31,7 +32,7 @@ pub enum Shape {
     Trapezoid,
 }
 
-fn bounds(lim: &Limits, shape: Shape) -> Result<Bounds, PlanError> {
+pub(crate) fn bounds(lim: &Limits, shape: Shape) -> Result<Bounds, PlanError> {
     let jmax = match shape {
         Shape::JerkLimited => lim.jmax().ok_or(PlanError::MissingJerkLimit {
             kind: "jerk-limited",
@@ -45,7 +46,7 @@ fn bounds(lim: &Limits, shape: Shape) -> Result<Bounds, PlanError> {
     })
 }
 
-fn finite_state(name: &'static str, s: &State) -> Result<(), PlanError> {
+pub(crate) fn finite_state(name: &'static str, s: &State) -> Result<(), PlanError> {
     for value in [s.p, s.v, s.a] {
         if !value.is_finite() {
             return Err(PlanError::NonFinite { name, value });
@@ -57,7 +58,7 @@ fn finite_state(name: &'static str, s: &State) -> Result<(), PlanError> {
 /// Check that a target can be held within the limits: `af` within the acceleration
 /// limits and the velocity reached when `af` is ramped from zero within the velocity
 /// limits.
-fn check_target(t: &State, lim: &Limits, b: &Bounds) -> Result<(), PlanError> {
+pub(crate) fn check_target(t: &State, lim: &Limits, b: &Bounds) -> Result<(), PlanError> {
     let ramp = if b.jmax.is_finite() {
         t.a * t.a.abs() / (2.0 * b.jmax)
     } else {
@@ -83,7 +84,7 @@ fn check_target(t: &State, lim: &Limits, b: &Bounds) -> Result<(), PlanError> {
 }
 
 /// Brake (jerk-limited) or clamp the velocity (trapezoid) into the limits.
-fn pre(start: State, lim: &Limits, b: &Bounds) -> (Vec<Segment>, State) {
+pub(crate) fn pre(start: State, lim: &Limits, b: &Bounds) -> (Vec<Segment>, State) {
     if b.jmax.is_finite() {
         return brake(start, lim, b.jmax);
     }
@@ -109,7 +110,7 @@ fn pre(start: State, lim: &Limits, b: &Bounds) -> (Vec<Segment>, State) {
     (segs, s)
 }
 
-fn assemble(
+pub(crate) fn assemble(
     start: State,
     mut segs: Vec<Segment>,
     parts: &[&[Segment]],
@@ -206,58 +207,91 @@ pub fn to_state(
     assemble(start, pre_segs, &[&segs])
 }
 
-/// The fastest profile from a state inside the limits: the peak-velocity family (with
-/// cruise) and the three-arc family. Returns its duration and segments.
-fn from_safe(s: &State, target: &State, lim: &Limits, b: &Bounds) -> Option<(f64, Vec<Segment>)> {
-    let dp = target.p - s.p;
-    let phases = |vp: f64| -> Option<(Change, Change, f64, f64)> {
-        let c1 = change(s.v, s.a, vp, 0.0, b)?;
-        let c2 = change(vp, 0.0, target.v, target.a, b)?;
-        let d = c1.end(s.v, s.a).p + c2.end(vp, 0.0).p;
+/// The peak-velocity family from a safe state `s` to `target`: for a peak velocity `vp`,
+/// the two phases, their distance and their duration.
+pub(crate) struct PeakFamily<'a> {
+    s: State,
+    target: State,
+    lim: &'a Limits,
+    b: Bounds,
+}
+
+impl<'a> PeakFamily<'a> {
+    pub(crate) fn new(s: State, target: State, lim: &'a Limits, b: Bounds) -> Self {
+        Self { s, target, lim, b }
+    }
+
+    /// The two phases for peak velocity `vp`, their distance and duration.
+    pub(crate) fn phases(&self, vp: f64) -> Option<(Change, Change, f64, f64)> {
+        let c1 = change(self.s.v, self.s.a, vp, 0.0, &self.b)?;
+        let c2 = change(vp, 0.0, self.target.v, self.target.a, &self.b)?;
+        let d = c1.end(self.s.v, self.s.a).p + c2.end(vp, 0.0).p;
         Some((c1, c2, d, c1.duration_s() + c2.duration_s()))
-    };
-    // Candidates: (total time, vp, cruise time).
-    let mut best: Option<(f64, f64, f64)> = None;
-    let mut consider = |t: f64, vp: f64, cruise: f64| {
-        if t.is_finite() && cruise >= 0.0 && best.is_none_or(|(bt, _, _)| t < bt) {
-            best = Some((t, vp, cruise));
-        }
-    };
+    }
+
+    /// Distance still to cover after the two phases.
+    pub(crate) fn dp(&self) -> f64 {
+        self.target.p - self.s.p
+    }
+
+    /// The profile for peak `vp` with `cruise` seconds at `vp`.
+    pub(crate) fn segments(&self, vp: f64, cruise: f64) -> Option<Vec<Segment>> {
+        let (c1, c2, _, _) = self.phases(vp)?;
+        let mut segs = c1.segments.to_vec();
+        segs.push(Segment::Jerk {
+            duration_s: cruise,
+            jerk: 0.0,
+        });
+        segs.extend(c2.segments);
+        Some(segs)
+    }
+
+    /// Structural breakpoints in `vp` (see [`breakpoints`]).
+    pub(crate) fn knots(&self) -> Vec<f64> {
+        breakpoints(&self.s, &self.target, self.lim, &self.b)
+    }
+}
+
+/// Every locally fastest profile from a state inside the limits, as `(duration, segments)`:
+/// the cruise at `vmax` and at `vmin`, each no-cruise peak velocity, and the three-arc
+/// family's solutions. The fastest of them is the time-optimal profile; the others start
+/// the ranges of longer durations that step 2 (time synchronisation) can stretch to.
+pub(crate) fn candidates(
+    s: &State,
+    target: &State,
+    lim: &Limits,
+    b: &Bounds,
+) -> Vec<(f64, Vec<Segment>)> {
+    let fam = PeakFamily::new(*s, *target, lim, *b);
+    let dp = fam.dp();
+    let mut out = Vec::new();
     for vlim in [lim.vmax(), lim.vmin()] {
-        if let Some((_, _, d, t)) = phases(vlim) {
+        if let Some((_, _, d, t)) = fam.phases(vlim) {
             let cruise = (dp - d) / vlim;
-            consider(t + cruise, vlim, cruise);
+            if cruise >= 0.0 && (t + cruise).is_finite() {
+                out.extend(fam.segments(vlim, cruise).map(|segs| (t + cruise, segs)));
+            }
         }
     }
     for vp in roots(
-        &|vp| phases(vp).map(|(_, _, d, _)| d - dp),
-        &breakpoints(s, target, lim, b),
+        &|vp| fam.phases(vp).map(|(_, _, d, _)| d - dp),
+        &fam.knots(),
     ) {
-        if let Some((_, _, _, t)) = phases(vp) {
-            consider(t, vp, 0.0);
+        if let Some((_, _, _, t)) = fam.phases(vp) {
+            out.extend(fam.segments(vp, 0.0).map(|segs| (t, segs)));
         }
     }
-    let arcs = if b.jmax.is_finite() {
-        crate::three_arc::candidates(s, target, lim, b)
-    } else {
-        Vec::new()
-    };
-    let best_arc = arcs
+    if b.jmax.is_finite() {
+        out.extend(crate::three_arc::candidates(s, target, lim, b));
+    }
+    out
+}
+
+/// The fastest profile from a state inside the limits. Returns its duration and segments.
+fn from_safe(s: &State, target: &State, lim: &Limits, b: &Bounds) -> Option<(f64, Vec<Segment>)> {
+    candidates(s, target, lim, b)
         .into_iter()
         .min_by(|x, y| x.0.total_cmp(&y.0))
-        .filter(|(t, _)| best.is_none_or(|(bt, _, _)| *t < bt));
-    if best_arc.is_some() {
-        return best_arc;
-    }
-    let (t, vp, cruise) = best?;
-    let (c1, c2, _, _) = phases(vp)?;
-    let mut segs = c1.segments.to_vec();
-    segs.push(Segment::Jerk {
-        duration_s: cruise,
-        jerk: 0.0,
-    });
-    segs.extend(c2.segments);
-    Some((t, segs))
 }
 
 /// Peak velocities where either phase changes structure, plus the velocity limits.
@@ -279,139 +313,4 @@ fn breakpoints(s: &State, t: &State, lim: &Limits, b: &Bounds) -> Vec<f64> {
     v.sort_by(f64::total_cmp);
     v.dedup();
     v
-}
-
-/// Every root of `g` on `[first, last]` of the sorted `knots`, bracketed on a grid that
-/// refines each knot interval, then bisected to full precision.
-pub(crate) fn roots(g: &dyn Fn(f64) -> Option<f64>, knots: &[f64]) -> Vec<f64> {
-    const SUB: usize = 16;
-    let mut grid = Vec::with_capacity(knots.len() * SUB);
-    for w in knots.windows(2) {
-        for k in 0..SUB {
-            grid.push(w[0] + (w[1] - w[0]) * k as f64 / SUB as f64);
-        }
-    }
-    if let Some(&last) = knots.last() {
-        grid.push(last);
-    }
-    let mut pts: Vec<(f64, Option<f64>)> = Vec::with_capacity(grid.len() + 8);
-    for &x in &grid {
-        let gx = g(x);
-        // Where the domain of g ends between two grid points, add its edge (bisected), so
-        // roots next to it are bracketed too.
-        if let Some(&(xp, gp)) = pts.last()
-            && gp.is_some() != gx.is_some()
-        {
-            {
-                let (mut valid, mut invalid) = if gp.is_some() { (xp, x) } else { (x, xp) };
-                for _ in 0..200 {
-                    let mid = 0.5 * (valid + invalid);
-                    if mid == valid || mid == invalid {
-                        break;
-                    }
-                    if g(mid).is_some() {
-                        valid = mid;
-                    } else {
-                        invalid = mid;
-                    }
-                }
-                if valid != xp && valid != x {
-                    pts.push((valid, g(valid)));
-                }
-            }
-        }
-        pts.push((x, gx));
-    }
-    // Where |g| has a local minimum between samples without a sign change, g may dip
-    // through zero and back (two close roots): find the extremum by golden-section search
-    // and, if it crosses zero, split the interval there.
-    let mut i = 1;
-    while i + 1 < pts.len() {
-        if let ((xa, Some(ga)), (_, Some(gb)), (xc, Some(gc))) = (pts[i - 1], pts[i], pts[i + 1])
-            && ga.signum() == gb.signum()
-            && gc.signum() == gb.signum()
-            && gb.abs() <= ga.abs()
-            && gb.abs() <= gc.abs()
-            && let Some((xm, gm)) = golden_min(&|x| g(x).map(|v| v * gb.signum()), xa, xc)
-            && gm < 0.0
-        {
-            let at = if xm < pts[i].0 { i } else { i + 1 };
-            pts.insert(at, (xm, Some(gm * gb.signum())));
-            i += 1;
-        }
-        i += 1;
-    }
-    let mut out = Vec::new();
-    for i in 0..pts.len() {
-        let (xi, Some(gi)) = pts[i] else { continue };
-        if gi == 0.0 {
-            out.push(xi);
-            continue;
-        }
-        let Some(&(xn, Some(gn))) = pts.get(i + 1) else {
-            continue;
-        };
-        if gi.signum() != gn.signum() && gn != 0.0 {
-            out.push(bisect(g, xi, gi, xn));
-        }
-    }
-    out
-}
-
-/// Bisect `g` on `[lo, hi]` (g(lo) = glo, opposite sign at hi) to full precision.
-fn bisect(g: &dyn Fn(f64) -> Option<f64>, lo: f64, glo: f64, hi: f64) -> f64 {
-    let (mut lo, mut hi, mut glo) = (lo, hi, glo);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo.min(hi) || mid >= hi.max(lo) {
-            break;
-        }
-        match g(mid) {
-            Some(gm) if gm.signum() == glo.signum() => {
-                lo = mid;
-                glo = gm;
-            }
-            Some(_) => hi = mid,
-            None => break,
-        }
-    }
-    if glo.abs() <= g(hi).map_or(f64::INFINITY, f64::abs) {
-        lo
-    } else {
-        hi
-    }
-}
-
-/// Minimum of `f` on `[a, b]` by golden-section search (f assumed unimodal there).
-fn golden_min(f: &dyn Fn(f64) -> Option<f64>, a: f64, b: f64) -> Option<(f64, f64)> {
-    const R: f64 = 0.618_033_988_749_894_9;
-    let (mut a, mut b) = (a, b);
-    let mut c = b - R * (b - a);
-    let mut d = a + R * (b - a);
-    let (mut fc, mut fd) = (f(c)?, f(d)?);
-    for _ in 0..100 {
-        if fc < 0.0 {
-            return Some((c, fc));
-        }
-        if fd < 0.0 {
-            return Some((d, fd));
-        }
-        if fc < fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - R * (b - a);
-            fc = f(c)?;
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + R * (b - a);
-            fd = f(d)?;
-        }
-        if (b - a).abs() <= 1e-15 * (a.abs() + b.abs()) {
-            break;
-        }
-    }
-    Some(if fc < fd { (c, fc) } else { (d, fd) })
 }

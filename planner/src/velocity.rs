@@ -85,7 +85,7 @@ pub fn change(v0: f64, a0: f64, vf: f64, af: f64, b: &Bounds) -> Option<Change> 
             }
             let peak = peak.max(a0).max(af);
             if peak <= b.amax {
-                consider(three(j, (peak - a0) / j, 0.0, b.amax, (peak - af) / j));
+                consider(three(j, (peak - a0) / j, 0.0, (peak - af) / j));
             } else {
                 let t1 = (b.amax - a0) / j;
                 let t3 = (b.amax - af) / j;
@@ -93,7 +93,7 @@ pub fn change(v0: f64, a0: f64, vf: f64, af: f64, b: &Bounds) -> Option<Change> 
                     - (b.amax * b.amax - a0 * a0) / (2.0 * j)
                     - (b.amax * b.amax - af * af) / (2.0 * j))
                     / b.amax;
-                consider(three(j, t1, hold.max(0.0), b.amax, t3));
+                consider(three(j, t1, hold.max(0.0), t3));
             }
         }
     }
@@ -106,7 +106,7 @@ pub fn change(v0: f64, a0: f64, vf: f64, af: f64, b: &Bounds) -> Option<Change> 
             }
             let valley = valley.min(a0).min(af);
             if valley >= b.amin {
-                consider(three(-j, (a0 - valley) / j, 0.0, b.amin, (af - valley) / j));
+                consider(three(-j, (a0 - valley) / j, 0.0, (af - valley) / j));
             } else {
                 let t1 = (a0 - b.amin) / j;
                 let t3 = (af - b.amin) / j;
@@ -114,15 +114,15 @@ pub fn change(v0: f64, a0: f64, vf: f64, af: f64, b: &Bounds) -> Option<Change> 
                     - (a0 * a0 - b.amin * b.amin) / (2.0 * j)
                     - (af * af - b.amin * b.amin) / (2.0 * j))
                     / b.amin;
-                consider(three(-j, t1, hold.max(0.0), b.amin, t3));
+                consider(three(-j, t1, hold.max(0.0), t3));
             }
         }
     }
     best
 }
 
-/// Jerk `j1` for `t1`, hold at `a_hold` for `hold`, jerk `-j1` for `t3`.
-fn three(j1: f64, t1: f64, hold: f64, a_hold: f64, t3: f64) -> Change {
+/// Jerk `j1` for `t1`, hold (zero jerk) for `hold`, jerk `-j1` for `t3`.
+fn three(j1: f64, t1: f64, hold: f64, t3: f64) -> Change {
     Change {
         segments: [
             Segment::Jerk {
@@ -130,9 +130,10 @@ fn three(j1: f64, t1: f64, hold: f64, a_hold: f64, t3: f64) -> Change {
                 jerk: j1,
             },
             if hold > 0.0 {
-                Segment::Accel {
+                // The acceleration is already on the limit: hold it with zero jerk.
+                Segment::Jerk {
                     duration_s: hold,
-                    accel: a_hold,
+                    jerk: 0.0,
                 }
             } else {
                 NONE
@@ -199,8 +200,8 @@ mod tests {
         let c = change(0.0, 0.0, 1.0, 0.0, &B).expect("change");
         assert!((c.duration_s() - 0.7).abs() < 1e-12);
         match c.segments[1] {
-            Segment::Accel { duration_s, accel } => {
-                assert!((duration_s - 0.3).abs() < 1e-12 && accel == 2.0)
+            Segment::Jerk { duration_s, jerk } => {
+                assert!((duration_s - 0.3).abs() < 1e-12 && jerk == 0.0)
             }
             other => panic!("expected a hold, got {other:?}"),
         }

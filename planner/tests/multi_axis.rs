@@ -1,0 +1,127 @@
+//! Three axes with time synchronisation against rsruckig (drawn like the Ruckig paper).
+//! Case count: `SETTLE_PLANNER_MULTI_CASES` (default 100,000).
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Gamma, Normal};
+use rsruckig::prelude::*;
+use settle_planner::position::Shape;
+use settle_planner::sync::{Axis, Sync, plan};
+use settle_planner::{Limits, State};
+
+fn cases() -> usize {
+    std::env::var("SETTLE_PLANNER_MULTI_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(100_000)
+}
+
+fn draw(rng: &mut ChaCha8Rng) -> [Axis; 3] {
+    let p = Normal::new(0.0, 4.0).expect("normal");
+    let va = Normal::new(0.0, 0.8).expect("normal");
+    let g = Gamma::new(2.0, 2.0).expect("gamma");
+    std::array::from_fn(|_| Axis {
+        limits: Limits::new(
+            g.sample(rng) + 0.05,
+            g.sample(rng) + 0.05,
+            Some(g.sample(rng) + 0.05),
+        )
+        .expect("limits"),
+        start: State {
+            p: p.sample(rng),
+            v: va.sample(rng),
+            a: va.sample(rng),
+        },
+        target: State {
+            p: p.sample(rng),
+            v: va.sample(rng),
+            a: va.sample(rng),
+        },
+    })
+}
+
+fn ruckig(axes: &[Axis; 3]) -> Option<f64> {
+    let mut otg = Ruckig::<3, ThrowErrorHandler>::new(None, 0.001);
+    let mut input = InputParameter::new(None);
+    for (i, a) in axes.iter().enumerate() {
+        input.current_position[i] = a.start.p;
+        input.current_velocity[i] = a.start.v;
+        input.current_acceleration[i] = a.start.a;
+        input.target_position[i] = a.target.p;
+        input.target_velocity[i] = a.target.v;
+        input.target_acceleration[i] = a.target.a;
+        input.max_velocity[i] = a.limits.vmax();
+        input.max_acceleration[i] = a.limits.amax();
+        input.max_jerk[i] = a.limits.jmax().expect("jerk");
+    }
+    let mut traj = Trajectory::new(None);
+    otg.calculate(&input, &mut traj).ok()?;
+    Some(traj.get_duration())
+}
+
+fn braked(a: &Axis) -> bool {
+    let l = &a.limits;
+    let j = l.jmax().expect("jerk");
+    let vz = a.start.v + a.start.a * a.start.a.abs() / (2.0 * j);
+    a.start.a.abs() > l.amax() || a.start.v.abs() > l.vmax() || vz.abs() > l.vmax()
+}
+
+#[test]
+fn time_synchronised_durations_equal_rsruckig() {
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let (mut equal, mut shorter, mut longer, mut skipped) = (0, 0, 0, 0);
+    for _ in 0..cases() {
+        let axes = draw(&mut rng);
+        let ours = plan(&axes, Shape::JerkLimited, Sync::Time);
+        let theirs = ruckig(&axes);
+        let (profs, t) = match (ours, theirs) {
+            (Ok(p), Some(t)) => (p, t),
+            (Err(_), None) => {
+                skipped += 1;
+                continue;
+            }
+            (o, t) => panic!(
+                "only one solved: ours {:?} rsruckig {t:?}: {axes:?}",
+                o.map(|p| p.len())
+            ),
+        };
+        let dur = profs[0].duration_s();
+        for (p, a) in profs.iter().zip(&axes) {
+            assert!(
+                (p.duration_s() - dur).abs() <= 1e-9 * dur,
+                "axes finish apart: {axes:?}"
+            );
+            let e = p.end();
+            assert!(
+                (e.p - a.target.p).abs() < 1e-8
+                    && (e.v - a.target.v).abs() < 1e-8
+                    && (e.a - a.target.a).abs() < 1e-10,
+                "target missed {e:?}: {axes:?}"
+            );
+        }
+        let rel = (dur - t) / t;
+        if rel.abs() <= 1e-9 {
+            equal += 1;
+        } else if rel < 0.0 && axes.iter().any(braked) {
+            shorter += 1;
+        } else {
+            longer += 1;
+            if longer < 4 {
+                eprintln!("mismatch ours {dur} rsruckig {t}: {axes:?}");
+            }
+        }
+    }
+    let compared = equal + shorter + longer;
+    eprintln!(
+        "3-DoF: equal {equal}, braked and shorter {shorter}, longer {longer}, rejected by both {skipped}"
+    );
+    // Known gap (issue 3, still open): step 2 stretches axes only along the peak-velocity
+    // family, so a few synchronised durations come out longer than Ruckig's, whose step 2
+    // also lowers the acceleration plateau. Every profile above is still exact,
+    // synchronised and within its limits. This bound guards against regressions; the goal
+    // is zero.
+    assert!(
+        (longer as f64) < 0.005 * compared as f64,
+        "{longer} of {compared} synchronised durations longer than rsruckig's"
+    );
+}
