@@ -7,7 +7,8 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rsruckig::prelude::*;
-use settle_planner::{Limits, ProfileKind};
+use settle_planner::position::{Shape, to_state};
+use settle_planner::{Limits, ProfileKind, State};
 
 fn problems() -> Vec<(f64, f64, f64, f64)> {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
@@ -47,6 +48,56 @@ fn bench(c: &mut Criterion) {
                 input.max_acceleration[0] = a;
                 input.max_jerk[0] = j;
                 black_box(otg.calculate(&input, &mut traj).expect("solves"));
+            }
+        })
+    });
+    g.finish();
+
+    // Any state to any target (Ruckig's random distribution, bounded draws).
+    let mut rng = ChaCha8Rng::seed_from_u64(8);
+    let states: Vec<(State, State, Limits)> = (0..1000)
+        .map(|_| {
+            let mut st = || State {
+                p: rng.random_range(-8.0..8.0),
+                v: rng.random_range(-1.0..1.0),
+                a: rng.random_range(-1.0..1.0),
+            };
+            let (s, mut t) = (st(), st());
+            t.a = 0.0;
+            t.v *= 0.3;
+            let lim = Limits::new(
+                rng.random_range(1.5..4.0),
+                rng.random_range(1.5..4.0),
+                Some(rng.random_range(1.5..4.0)),
+            )
+            .expect("limits");
+            (s, t, lim)
+        })
+        .collect();
+    let mut g = c.benchmark_group("any_state_1000");
+    g.bench_function("settle", |b| {
+        b.iter(|| {
+            for (s, t, lim) in &states {
+                black_box(to_state(*s, *t, lim, Shape::JerkLimited).ok());
+            }
+        })
+    });
+    g.bench_function("rsruckig", |b| {
+        let mut otg = Ruckig::<1, ThrowErrorHandler>::new(None, 0.001);
+        let mut input = InputParameter::new(None);
+        let mut traj = Trajectory::new(None);
+        b.iter(|| {
+            for (s, t, lim) in &states {
+                input.current_position[0] = s.p;
+                input.current_velocity[0] = s.v;
+                input.current_acceleration[0] = s.a;
+                input.target_position[0] = t.p;
+                input.target_velocity[0] = t.v;
+                input.target_acceleration[0] = t.a;
+                input.max_velocity[0] = lim.vmax();
+                input.max_acceleration[0] = lim.amax();
+                input.max_jerk[0] = lim.jmax().unwrap_or(f64::INFINITY);
+                black_box(otg.calculate(&input, &mut traj).ok());
             }
         })
     });

@@ -139,7 +139,9 @@ pub(crate) fn assemble(
 }
 
 /// Velocity interface: the fastest profile from `start` to velocity `vf` and acceleration
-/// `af` (position free).
+/// `af` (position free). As in Ruckig, the velocity limits do not apply here (the target
+/// velocity is the command); the target acceleration must lie within the acceleration
+/// limits, and a start acceleration beyond them is first brought back at full jerk.
 pub fn to_velocity(
     start: State,
     vf: f64,
@@ -155,10 +157,23 @@ pub fn to_velocity(
     };
     finite_state("target", &target)?;
     let b = bounds(lim, shape)?;
-    check_target(&target, lim, &b)?;
-    // Only the acceleration needs braking: the velocity is free to pass the limits' side
-    // on the way to vf... but not beyond them; brake handles both.
-    let (pre_segs, s) = pre(start, lim, &b);
+    if af > lim.amax() * (1.0 + 1e-12) || af < lim.amin() * (1.0 + 1e-12) {
+        return Err(PlanError::InfeasibleTarget {
+            reason: "target acceleration outside [amin, amax]",
+        });
+    }
+    let mut pre_segs = Vec::new();
+    let mut s = start;
+    if b.jmax.is_finite() && (s.a > lim.amax() || s.a < lim.amin()) {
+        let to = s.a.clamp(lim.amin(), lim.amax());
+        let seg = Segment::Jerk {
+            duration_s: (s.a - to).abs() / b.jmax,
+            jerk: if s.a > to { -b.jmax } else { b.jmax },
+        };
+        s = seg.end_state(&s);
+        s.a = to;
+        pre_segs.push(seg);
+    }
     let c = change(s.v, s.a, vf, af, &b).ok_or(PlanError::NoSolution {
         reason: "velocity change",
     })?;
@@ -238,9 +253,11 @@ impl<'a> PeakFamily<'a> {
     pub(crate) fn segments(&self, vp: f64, cruise: f64) -> Option<Vec<Segment>> {
         let (c1, c2, _, _) = self.phases(vp)?;
         let mut segs = c1.segments.to_vec();
-        segs.push(Segment::Jerk {
+        // The cruise holds the acceleration at exactly zero: the phase before ends there
+        // only up to rounding, and a cruise can be long enough for that to matter.
+        segs.push(Segment::Accel {
             duration_s: cruise,
-            jerk: 0.0,
+            accel: 0.0,
         });
         segs.extend(c2.segments);
         Some(segs)

@@ -8,6 +8,9 @@ use rsruckig::prelude::*;
 use settle_planner::position::{Shape, to_state};
 use settle_planner::{Limits, State};
 
+mod common;
+use common::check_limits;
+
 fn cases(var: &str, default: usize) -> usize {
     std::env::var(var)
         .ok()
@@ -59,57 +62,6 @@ fn ruckig(pr: &Problem) -> Option<f64> {
     let mut traj = Trajectory::new(None);
     otg.calculate(&input, &mut traj).ok()?;
     Some(traj.get_duration())
-}
-
-/// Limits hold from the moment they first hold (a start outside them is braked back in):
-/// jerk always; acceleration and velocity at every segment end and at interior velocity
-/// extrema. Returns a description of the first violation.
-fn check_limits(prof: &settle_planner::Profile, lim: &Limits) -> Result<(), String> {
-    let tol = 1e-9;
-    let j = lim.jmax().expect("jerk");
-    let (vmax, vmin) = (lim.vmax() * (1.0 + tol), lim.vmin() * (1.0 + tol));
-    let (amax, amin) = (lim.amax() * (1.0 + tol), lim.amin() * (1.0 + tol));
-    let s0 = prof.start();
-    let mut a_in = s0.a <= amax && s0.a >= amin;
-    // The velocity limit binds once the state is safe: v inside, and the velocity reached by
-    // ramping the acceleration to zero (vz) inside too. Before that, exceeding it may be
-    // unavoidable.
-    let safe = |st: &State| {
-        let vz = st.v + st.a * st.a.abs() / (2.0 * j);
-        st.v <= vmax && st.v >= vmin && vz <= vmax && vz >= vmin
-    };
-    let mut v_in = safe(&s0);
-    for (t, s, seg) in prof.iter() {
-        let (a0, jerk) = seg.accel_and_jerk(&s);
-        if jerk.abs() > j * (1.0 + tol) {
-            return Err(format!("jerk {jerk} at t={t}"));
-        }
-        let e = seg.end_state(&s);
-        let mut vs = vec![s.v, e.v];
-        if jerk != 0.0 {
-            let tau = -a0 / jerk;
-            if tau > 0.0 && tau < seg.duration_s() {
-                vs.push(seg.sample(&s, tau).v);
-            }
-        }
-        for val in [a0, e.a] {
-            if a_in && (val > amax || val < amin) {
-                return Err(format!("a = {val} leaves the limits at t={t}"));
-            }
-            if val <= amax && val >= amin {
-                a_in = true;
-            }
-        }
-        for v in vs {
-            if v_in && (v > vmax || v < vmin) {
-                return Err(format!("v = {v} leaves the limits near t={t}"));
-            }
-        }
-        if safe(&e) {
-            v_in = true;
-        }
-    }
-    Ok(())
 }
 
 /// Outcome counts of a comparison run.
