@@ -140,9 +140,12 @@ fn solve(line: &str) -> Result<Value, String> {
             return Err("the velocity interface supports `\"sync\":\"none\"` only for several axes (time synchronisation of velocity moves is not implemented yet)".into());
         }
         axes.iter()
-            .map(|a| to_velocity(a.start, a.target.v, a.target.a, &a.limits, shape))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| e.to_string())?
+            .enumerate()
+            .map(|(i, a)| {
+                to_velocity(a.start, a.target.v, a.target.a, &a.limits, shape)
+                    .map_err(|e| format!("axis {i}: {e}"))
+            })
+            .collect::<Result<Vec<_>, _>>()?
     };
     let duration = profiles.iter().map(Profile::duration_s).fold(0.0, f64::max);
     Ok(json!({

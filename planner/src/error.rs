@@ -48,6 +48,14 @@ pub enum PlanError {
         /// Why.
         reason: &'static str,
     },
+    /// An error on one axis of a multi-axis problem.
+    #[error("axis {axis}: {source}")]
+    OnAxis {
+        /// 0-based axis index.
+        axis: usize,
+        /// What went wrong there.
+        source: Box<PlanError>,
+    },
     /// An unknown profile kind name.
     #[error("unknown profile kind `{name}`; allowed: {allowed}")]
     UnknownKind {

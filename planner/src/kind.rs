@@ -1,6 +1,7 @@
 //! Profile kinds by name, and one entry point that plans any of them.
 
-use crate::{Limits, PlanError, Profile, scurve, trapezoid};
+use crate::position::{Shape, to_state};
+use crate::{Limits, PlanError, Profile, State};
 
 /// The profile kinds settle can plan.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -36,17 +37,43 @@ impl ProfileKind {
             })
     }
 
-    /// Plan a rest-to-rest move of signed `distance` starting at `p0`.
+    /// Plan a rest-to-rest move of signed `distance` starting at `p0`, with the any-state
+    /// planner of [`crate::position`]. (The closed-form planners in [`crate::scurve`] and
+    /// [`crate::trapezoid`] are kept as independent references for the tests.)
     pub fn rest_to_rest(
         self,
         p0: f64,
         distance: f64,
         limits: &Limits,
     ) -> Result<Profile, PlanError> {
-        match self {
-            ProfileKind::Trapezoid => trapezoid::rest_to_rest(p0, distance, limits),
-            ProfileKind::SCurve => scurve::rest_to_rest(p0, distance, limits),
+        let shape = match self {
+            ProfileKind::Trapezoid => Shape::Trapezoid,
+            ProfileKind::SCurve => {
+                limits
+                    .jmax()
+                    .ok_or(PlanError::MissingJerkLimit { kind: "scurve" })?;
+                Shape::JerkLimited
+            }
+        };
+        for (name, value) in [("p0", p0), ("distance", distance)] {
+            if !value.is_finite() {
+                return Err(PlanError::NonFinite { name, value });
+            }
         }
+        let start = State {
+            p: p0,
+            v: 0.0,
+            a: 0.0,
+        };
+        if distance == 0.0 {
+            return Ok(Profile::empty(start));
+        }
+        let target = State {
+            p: p0 + distance,
+            v: 0.0,
+            a: 0.0,
+        };
+        to_state(start, target, limits, shape)
     }
 }
 

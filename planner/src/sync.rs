@@ -38,7 +38,13 @@ pub struct Axis {
 pub fn plan(axes: &[Axis], shape: Shape, sync: Sync) -> Result<Vec<Profile>, PlanError> {
     let fastest: Vec<Profile> = axes
         .iter()
-        .map(|a| to_state(a.start, a.target, &a.limits, shape))
+        .enumerate()
+        .map(|(i, a)| {
+            to_state(a.start, a.target, &a.limits, shape).map_err(|e| PlanError::OnAxis {
+                axis: i,
+                source: Box::new(e),
+            })
+        })
         .collect::<Result<_, _>>()?;
     if sync == Sync::None || axes.len() <= 1 {
         return Ok(fastest);
