@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rsruckig::prelude::*;
 use settle_planner::position::{Shape, to_state};
-use settle_planner::{Limits, ProfileKind, State};
+use settle_planner::{Limits, ProfileKind, State, scurve, trapezoid};
 
 fn problems() -> Vec<(f64, f64, f64, f64)> {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
@@ -27,16 +27,34 @@ fn problems() -> Vec<(f64, f64, f64, f64)> {
 fn bench(c: &mut Criterion) {
     let probs = problems();
     let mut g = c.benchmark_group("rest_to_rest_1000");
-    for kind in ProfileKind::ALL {
-        g.bench_function(kind.name(), |b| {
-            b.iter(|| {
-                for &(d, v, a, j) in &probs {
-                    let lim = Limits::new(v, a, Some(j)).expect("limits");
-                    black_box(kind.rest_to_rest(0.0, black_box(d), &lim).expect("plan"));
-                }
-            })
-        });
-    }
+    g.bench_function("scurve_closed_form", |b| {
+        b.iter(|| {
+            for &(d, v, a, j) in &probs {
+                let lim = Limits::new(v, a, Some(j)).expect("limits");
+                black_box(scurve::rest_to_rest(0.0, black_box(d), &lim).expect("plan"));
+            }
+        })
+    });
+    g.bench_function("trapezoid_closed_form", |b| {
+        b.iter(|| {
+            for &(d, v, a, _) in &probs {
+                let lim = Limits::new(v, a, None).expect("limits");
+                black_box(trapezoid::rest_to_rest(0.0, black_box(d), &lim).expect("plan"));
+            }
+        })
+    });
+    g.bench_function("scurve_any_state", |b| {
+        b.iter(|| {
+            for &(d, v, a, j) in &probs {
+                let lim = Limits::new(v, a, Some(j)).expect("limits");
+                black_box(
+                    ProfileKind::SCurve
+                        .rest_to_rest(0.0, black_box(d), &lim)
+                        .expect("plan"),
+                );
+            }
+        })
+    });
     g.bench_function("rsruckig", |b| {
         let mut otg = Ruckig::<1, ThrowErrorHandler>::new(None, 0.001);
         let mut input = InputParameter::new(None);
