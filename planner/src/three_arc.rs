@@ -151,7 +151,13 @@ fn udu(
 
 /// The velocity stays within `[vmin, vmax]` (in the unmirrored frame) at segment ends and
 /// at interior extrema.
-fn velocity_within(start: &State, segs: &[Segment], vmax: f64, vmin: f64, sign: f64) -> bool {
+pub(crate) fn velocity_within(
+    start: &State,
+    segs: &[Segment],
+    vmax: f64,
+    vmin: f64,
+    sign: f64,
+) -> bool {
     let tol = 1e-12 * vmax.abs().max(vmin.abs());
     let mut st = *start;
     let ok = |v: f64| {

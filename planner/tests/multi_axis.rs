@@ -115,13 +115,13 @@ fn time_synchronised_durations_equal_rsruckig() {
     eprintln!(
         "3-DoF: equal {equal}, braked and shorter {shorter}, longer {longer}, rejected by both {skipped}"
     );
-    // Known gap (issue 3, still open): step 2 stretches axes only along the peak-velocity
-    // family, so a few synchronised durations come out longer than Ruckig's, whose step 2
-    // also lowers the acceleration plateau. Every profile above is still exact,
-    // synchronised and within its limits. This bound guards against regressions; the goal
-    // is zero.
+    // Known gap (issue 3, still open): step 2 covers the stretched peak-velocity family,
+    // three arcs with one plateau at a free level, and four arcs (UDUD); a rare duration
+    // needs two free plateaus (seen once in 72,000: after an acceleration brake), so it
+    // comes out longer than Ruckig's. Every profile above is still exact, synchronised and
+    // within its limits. This bound guards against regressions; the goal is zero.
     assert!(
-        (longer as f64) < 0.005 * compared as f64,
+        (longer as f64) < 1e-4 * compared as f64,
         "{longer} of {compared} synchronised durations longer than rsruckig's"
     );
 }
