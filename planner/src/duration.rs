@@ -13,6 +13,7 @@ use crate::position::{
     PeakFamily, Shape, assemble, bounds, candidates, check_target, finite_state, pre,
 };
 use crate::roots::roots;
+use crate::three_arc::both_senses;
 use crate::velocity::Bounds;
 use crate::{Limits, PlanError, Profile, Segment, State};
 
@@ -176,35 +177,12 @@ pub(crate) fn held_three_arc(
     s: &State,
     t: &State,
     lim: &Limits,
-    b: &crate::velocity::Bounds,
+    b: &Bounds,
     duration_s: f64,
 ) -> Vec<Vec<Segment>> {
-    let mut out = held_udu(s, t, lim.vmax(), lim.vmin(), b, duration_s, 1.0);
-    let ms = State {
-        p: -s.p,
-        v: -s.v,
-        a: -s.a,
-    };
-    let mt = State {
-        p: -t.p,
-        v: -t.v,
-        a: -t.a,
-    };
-    let mb = crate::velocity::Bounds {
-        amax: -b.amin,
-        amin: -b.amax,
-        jmax: b.jmax,
-    };
-    out.extend(held_udu(
-        &ms,
-        &mt,
-        -lim.vmin(),
-        -lim.vmax(),
-        &mb,
-        duration_s,
-        -1.0,
-    ));
-    out
+    both_senses(s, t, lim, b, |s, t, vmax, vmin, b, sign| {
+        held_udu(s, t, vmax, vmin, b, duration_s, sign)
+    })
 }
 
 fn held_udu(
@@ -212,7 +190,7 @@ fn held_udu(
     t: &State,
     vmax: f64,
     vmin: f64,
-    b: &crate::velocity::Bounds,
+    b: &Bounds,
     duration_s: f64,
     sign: f64,
 ) -> Vec<Vec<Segment>> {
@@ -299,35 +277,12 @@ pub(crate) fn four_arc(
     s: &State,
     t: &State,
     lim: &Limits,
-    b: &crate::velocity::Bounds,
+    b: &Bounds,
     duration_s: f64,
 ) -> Vec<Vec<Segment>> {
-    let mut out = udud(s, t, lim.vmax(), lim.vmin(), b, duration_s, 1.0);
-    let ms = State {
-        p: -s.p,
-        v: -s.v,
-        a: -s.a,
-    };
-    let mt = State {
-        p: -t.p,
-        v: -t.v,
-        a: -t.a,
-    };
-    let mb = crate::velocity::Bounds {
-        amax: -b.amin,
-        amin: -b.amax,
-        jmax: b.jmax,
-    };
-    out.extend(udud(
-        &ms,
-        &mt,
-        -lim.vmin(),
-        -lim.vmax(),
-        &mb,
-        duration_s,
-        -1.0,
-    ));
-    out
+    both_senses(s, t, lim, b, |s, t, vmax, vmin, b, sign| {
+        udud(s, t, vmax, vmin, b, duration_s, sign)
+    })
 }
 
 fn udud(
@@ -335,7 +290,7 @@ fn udud(
     t: &State,
     vmax: f64,
     vmin: f64,
-    b: &crate::velocity::Bounds,
+    b: &Bounds,
     duration_s: f64,
     sign: f64,
 ) -> Vec<Vec<Segment>> {

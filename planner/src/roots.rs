@@ -118,7 +118,10 @@ fn bisect(g: &dyn Fn(f64) -> Option<f64>, lo: f64, glo: f64, hi: f64, ghi: f64) 
             break;
         }
     }
-    let (gl, gh) = (g(lo).map_or(f64::INFINITY, f64::abs), g(hi).map_or(f64::INFINITY, f64::abs));
+    let (gl, gh) = (
+        g(lo).map_or(f64::INFINITY, f64::abs),
+        g(hi).map_or(f64::INFINITY, f64::abs),
+    );
     if gl <= gh { lo } else { hi }
 }
 

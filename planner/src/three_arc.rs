@@ -13,27 +13,34 @@
 use crate::velocity::Bounds;
 use crate::{Limits, Segment, State};
 
-/// Candidate profiles `(duration, segments)` of the UDU and DUD families from `s` to `t`.
-pub fn candidates(s: &State, t: &State, lim: &Limits, b: &Bounds) -> Vec<(f64, Vec<Segment>)> {
-    let mut out = udu(s, t, lim.vmax(), lim.vmin(), b, 1.0);
-    // DUD: mirror the problem (p, v, a -> -p, -v, -a; limits swap), solve UDU, mirror back.
-    let ms = State {
-        p: -s.p,
-        v: -s.v,
-        a: -s.a,
-    };
-    let mt = State {
-        p: -t.p,
-        v: -t.v,
-        a: -t.a,
+/// Run a one-sense solver `f(s, t, vmax, vmin, bounds, sign)` on the problem and on its
+/// mirror image (p, v, a -> -p, -v, -a, the limits swapped), where `sign = -1` tells `f` to
+/// mirror its segments back. UDU on the mirror is DUD; UDUD is DUDU.
+pub(crate) fn both_senses<T>(
+    s: &State,
+    t: &State,
+    lim: &Limits,
+    b: &Bounds,
+    f: impl Fn(&State, &State, f64, f64, &Bounds, f64) -> Vec<T>,
+) -> Vec<T> {
+    let mut out = f(s, t, lim.vmax(), lim.vmin(), b, 1.0);
+    let m = |x: &State| State {
+        p: -x.p,
+        v: -x.v,
+        a: -x.a,
     };
     let mb = Bounds {
         amax: -b.amin,
         amin: -b.amax,
         jmax: b.jmax,
     };
-    out.extend(udu(&ms, &mt, -lim.vmin(), -lim.vmax(), &mb, -1.0));
+    out.extend(f(&m(s), &m(t), -lim.vmin(), -lim.vmax(), &mb, -1.0));
     out
+}
+
+/// Candidate profiles `(duration, segments)` of the UDU and DUD families from `s` to `t`.
+pub fn candidates(s: &State, t: &State, lim: &Limits, b: &Bounds) -> Vec<(f64, Vec<Segment>)> {
+    both_senses(s, t, lim, b, udu)
 }
 
 /// UDU candidates; `sign` = -1 mirrors the resulting segments back.
