@@ -3,11 +3,12 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, Gamma, Normal};
 use rsruckig::prelude::*;
 use settle_planner::position::Shape;
 use settle_planner::sync::{Axis, Sync, plan};
-use settle_planner::{Limits, State};
+
+mod common;
+use common::{braked, draw_axis};
 
 fn cases() -> usize {
     std::env::var("SETTLE_PLANNER_MULTI_CASES")
@@ -17,27 +18,7 @@ fn cases() -> usize {
 }
 
 fn draw(rng: &mut ChaCha8Rng) -> [Axis; 3] {
-    let p = Normal::new(0.0, 4.0).expect("normal");
-    let va = Normal::new(0.0, 0.8).expect("normal");
-    let g = Gamma::new(2.0, 2.0).expect("gamma");
-    std::array::from_fn(|_| Axis {
-        limits: Limits::new(
-            g.sample(rng) + 0.05,
-            g.sample(rng) + 0.05,
-            Some(g.sample(rng) + 0.05),
-        )
-        .expect("limits"),
-        start: State {
-            p: p.sample(rng),
-            v: va.sample(rng),
-            a: va.sample(rng),
-        },
-        target: State {
-            p: p.sample(rng),
-            v: va.sample(rng),
-            a: va.sample(rng),
-        },
-    })
+    std::array::from_fn(|_| draw_axis(rng))
 }
 
 fn ruckig(axes: &[Axis; 3]) -> Option<f64> {
@@ -57,13 +38,6 @@ fn ruckig(axes: &[Axis; 3]) -> Option<f64> {
     let mut traj = Trajectory::new(None);
     otg.calculate(&input, &mut traj).ok()?;
     Some(traj.get_duration())
-}
-
-fn braked(a: &Axis) -> bool {
-    let l = &a.limits;
-    let j = l.jmax().expect("jerk");
-    let vz = a.start.v + a.start.a * a.start.a.abs() / (2.0 * j);
-    a.start.a.abs() > l.amax() || a.start.v.abs() > l.vmax() || vz.abs() > l.vmax()
 }
 
 #[test]

@@ -5,40 +5,17 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, Gamma, Normal};
 use settle_planner::position::{Shape, to_state};
 use settle_planner::sync::{Axis, Sync, plan};
-use settle_planner::{Limits, State};
+
+mod common;
+use common::{braked, draw_axis};
 
 fn cases() -> usize {
     std::env::var("SETTLE_PLANNER_RUCKIG_CASES")
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(100_000)
-}
-
-fn draw(rng: &mut ChaCha8Rng) -> Axis {
-    let p = Normal::new(0.0, 4.0).expect("normal");
-    let va = Normal::new(0.0, 0.8).expect("normal");
-    let g = Gamma::new(2.0, 2.0).expect("gamma");
-    Axis {
-        limits: Limits::new(
-            g.sample(rng) + 0.05,
-            g.sample(rng) + 0.05,
-            Some(g.sample(rng) + 0.05),
-        )
-        .expect("limits"),
-        start: State {
-            p: p.sample(rng),
-            v: va.sample(rng),
-            a: va.sample(rng),
-        },
-        target: State {
-            p: p.sample(rng),
-            v: va.sample(rng),
-            a: va.sample(rng),
-        },
-    }
 }
 
 fn official(axes: &[Axis]) -> Option<f64> {
@@ -63,19 +40,12 @@ fn official(axes: &[Axis]) -> Option<f64> {
     }
 }
 
-fn braked(a: &Axis) -> bool {
-    let l = &a.limits;
-    let j = l.jmax().expect("jerk");
-    let vz = a.start.v + a.start.a * a.start.a.abs() / (2.0 * j);
-    a.start.a.abs() > l.amax() || a.start.v.abs() > l.vmax() || vz.abs() > l.vmax()
-}
-
 #[test]
 fn one_dof_durations_equal_the_official_ruckig() {
     let mut rng = ChaCha8Rng::seed_from_u64(31);
     let (mut equal, mut shorter) = (0, 0);
     for _ in 0..cases() {
-        let a = draw(&mut rng);
+        let a = draw_axis(&mut rng);
         let ours = to_state(a.start, a.target, &a.limits, Shape::JerkLimited);
         let (prof, t) = match (ours, official(&[a])) {
             (Ok(p), Some(t)) => (p, t),
@@ -102,7 +72,11 @@ fn three_dof_time_sync_vs_the_official_ruckig() {
     let mut rng = ChaCha8Rng::seed_from_u64(32);
     let (mut equal, mut shorter, mut longer) = (0usize, 0usize, 0usize);
     for _ in 0..cases() / 10 {
-        let axes = [draw(&mut rng), draw(&mut rng), draw(&mut rng)];
+        let axes = [
+            draw_axis(&mut rng),
+            draw_axis(&mut rng),
+            draw_axis(&mut rng),
+        ];
         let (profs, t) = match (plan(&axes, Shape::JerkLimited, Sync::Time), official(&axes)) {
             (Ok(p), Some(t)) => (p, t),
             (Err(_), None) => continue,

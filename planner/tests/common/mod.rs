@@ -1,11 +1,51 @@
 //! Shared helpers of the planner's integration tests.
 
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Gamma, Normal};
 use rsruckig::prelude::*;
+use settle_planner::sync::Axis;
 use settle_planner::{Limits, Profile, State};
+
+/// One axis drawn like the Ruckig paper: p ~ N(0, 4), v and a ~ N(0, 0.8), limits ~
+/// Gamma(2, 2) + 0.05.
+#[allow(dead_code)]
+pub fn draw_axis(rng: &mut ChaCha8Rng) -> Axis {
+    let p = Normal::new(0.0, 4.0).expect("normal");
+    let va = Normal::new(0.0, 0.8).expect("normal");
+    let g = Gamma::new(2.0, 2.0).expect("gamma");
+    let mut limit = || g.sample(rng) + 0.05;
+    let limits = Limits::new(limit(), limit(), Some(limit())).expect("limits");
+    let mut state = || State {
+        p: p.sample(rng),
+        v: va.sample(rng),
+        a: va.sample(rng),
+    };
+    let (start, target) = (state(), state());
+    Axis {
+        limits,
+        start,
+        target,
+    }
+}
+
+/// Does this axis start outside its limits, or bound to overshoot them (so it is braked)?
+#[allow(dead_code)]
+pub fn braked(a: &Axis) -> bool {
+    let l = &a.limits;
+    let j = l.jmax().unwrap_or(f64::INFINITY);
+    let vz = a.start.v + a.start.a * a.start.a.abs() / (2.0 * j);
+    a.start.a > l.amax()
+        || a.start.a < l.amin()
+        || a.start.v > l.vmax()
+        || a.start.v < l.vmin()
+        || vz > l.vmax()
+        || vz < l.vmin()
+}
 
 /// Limits hold from the moment they first hold (a start outside them is braked back in):
 /// jerk always; acceleration and velocity at every segment end and at interior velocity
 /// extrema. Returns a description of the first violation.
+#[allow(dead_code)]
 pub fn check_limits(prof: &Profile, lim: &Limits) -> Result<(), String> {
     let tol = 1e-9;
     let j = lim.jmax().unwrap_or(f64::INFINITY);
