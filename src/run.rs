@@ -93,7 +93,11 @@ pub fn simulate<P: Plant>(
             let t_sample = k as f64 * dt;
             let next = t_sample.min(t1);
             let cmd = seg.sample(&s0, t - t0);
-            plant.step(&mut state, &cmd, next - t)?;
+            // A whole sample interval is stepped as exactly `dt` (k dt - (k-1) dt can differ
+            // from dt in the last bit, which would cost the plant a fresh transition
+            // matrix); partial steps at breakpoints use their true length.
+            let whole = next == t_sample && t == (k - 1) as f64 * dt;
+            plant.step(&mut state, &cmd, if whole { dt } else { next - t })?;
             t = next;
             if t_sample <= t1 {
                 if t_sample < t_end {
