@@ -3,15 +3,15 @@
 //! One problem per input line, e.g.
 //! `{"p0":[0],"pf":[1],"vmax":[1],"amax":[2],"jmax":[10],"sync":"time"}` (v0, a0, vf, af
 //! default to zero; optional `vmin`, `amin`, `"kind":"trapezoid"`,
-//! `"interface":"velocity"`). One output line per input line, in order:
+//! `"interface":"velocity"`, for which the targets are `vf` and `af`). One output line per input line, in order:
 //! `{"duration":1.7,"axes":[{"p0":0,"v0":0,"a0":0,"segments":[[0.2,10.0],...]}]}` where each
 //! segment is `[duration, jerk]`, or `[duration, 0, accel]` for a constant-acceleration
 //! segment whose acceleration jumps to `accel` (trapezoids); or `{"error":"..."}`.
 
 use serde::Deserialize;
 use serde_json::{Value, json};
-use settle_planner::position::{Shape, to_velocity};
-use settle_planner::sync::{Axis, Sync, plan};
+use settle_planner::position::Shape;
+use settle_planner::sync::{Axis, Sync, plan, plan_velocity};
 use settle_planner::{Limits, Profile, Segment, State};
 
 #[derive(Debug, Deserialize)]
@@ -136,16 +136,7 @@ fn solve(line: &str) -> Result<Value, String> {
     let profiles = if position {
         plan(&axes, shape, sync).map_err(|e| e.to_string())?
     } else {
-        if n > 1 && sync != Sync::None {
-            return Err("the velocity interface supports `\"sync\":\"none\"` only for several axes (time synchronisation of velocity moves is not implemented yet)".into());
-        }
-        axes.iter()
-            .enumerate()
-            .map(|(i, a)| {
-                to_velocity(a.start, a.target.v, a.target.a, &a.limits, shape)
-                    .map_err(|e| format!("axis {i}: {e}"))
-            })
-            .collect::<Result<Vec<_>, _>>()?
+        plan_velocity(&axes, shape, sync).map_err(|e| e.to_string())?
     };
     let duration = profiles.iter().map(Profile::duration_s).fold(0.0, f64::max);
     Ok(json!({

@@ -60,9 +60,10 @@ this is not json
 {"p0":[0,0],"pf":[1,2],"vmax":[1,1],"amax":[2,2],"jmax":[10,10],"sync":"phase"}
 {"vf":[0.5],"af":[0.2],"vmax":[1],"amax":[2],"jmax":[10],"interface":"velocity"}
 {"p0":[0],"pf":[1],"vmax":[1,2],"amax":[2],"jmax":[10]}
+{"vf":[0.5,-1],"vmax":[1,1],"amax":[2,2],"jmax":[10,10],"interface":"velocity","sync":"time"}
 "#;
     let out = plan(input);
-    assert_eq!(out.len(), 8);
+    assert_eq!(out.len(), 9);
     // The issue's example: vmax 1, amax 2, jmax 10, 1 m: ramps 0.2 s, holds 0.3 s, cruise
     // 0.3 s: 1.7 s.
     assert!(

@@ -349,3 +349,131 @@ fn udud(
         .map(|segs| segs.to_vec())
         .collect()
 }
+
+/// Velocity interface, step 2: a velocity change from `start` to `(vf, af)` lasting exactly
+/// `duration_s`, or `None`. Shape: two jerk arcs (each rising or falling) through a free
+/// level, with the spare time held as a plateau at the start level, the free level or the
+/// end level.
+pub fn velocity_with_duration(
+    start: State,
+    vf: f64,
+    af: f64,
+    lim: &Limits,
+    duration_s: f64,
+) -> Result<Option<Profile>, PlanError> {
+    let fastest = crate::position::to_velocity(start, vf, af, lim, Shape::JerkLimited)?;
+    if (fastest.duration_s() - duration_s).abs() <= 1e-12 * duration_s.max(1e-9) {
+        return Ok(Some(fastest));
+    }
+    let j = lim.jmax().ok_or(PlanError::MissingJerkLimit {
+        kind: "jerk-limited",
+    })?;
+    // Any acceleration brake first (as in `to_velocity`).
+    let (pre_segs, s) = match fastest.segments().first() {
+        Some(seg) if start.a > lim.amax() || start.a < lim.amin() => {
+            (vec![*seg], seg.end_state(&start))
+        }
+        _ => (Vec::new(), start),
+    };
+    let rest = duration_s - pre_segs.iter().map(Segment::duration_s).sum::<f64>();
+    if rest.is_nan() || rest < 0.0 {
+        return Ok(None);
+    }
+    let a0 = s.a.clamp(lim.amin(), lim.amax());
+    // Template: jerk s1 j to a level A, jerk s2 j on to af, and the remaining time held as
+    // a plateau at the start level a0, at A, or at the end level af. For each choice the
+    // velocity change is a function of A alone; its roots are bracketed and bisected.
+    let tol = 1e-12 * rest.max(1e-9);
+    let build = |level: f64, s1: f64, s2: f64, at: usize| -> Option<[Segment; 5]> {
+        let (t1, t3) = ((level - a0) / (s1 * j), (af - level) / (s2 * j));
+        let hold = rest - t1 - t3;
+        if t1 < -tol || t3 < -tol || hold < -tol {
+            return None;
+        }
+        let h = |k: usize| if k == at { hold.max(0.0) } else { 0.0 };
+        Some([
+            Segment::Jerk {
+                duration_s: h(0),
+                jerk: 0.0,
+            },
+            Segment::Jerk {
+                duration_s: t1.max(0.0),
+                jerk: s1 * j,
+            },
+            Segment::Jerk {
+                duration_s: h(1),
+                jerk: 0.0,
+            },
+            Segment::Jerk {
+                duration_s: t3.max(0.0),
+                jerk: s2 * j,
+            },
+            Segment::Jerk {
+                duration_s: h(2),
+                jerk: 0.0,
+            },
+        ])
+    };
+    let s0 = State {
+        p: 0.0,
+        v: s.v,
+        a: a0,
+    };
+    for at in [1, 0, 2] {
+        for (s1, s2) in [(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)] {
+            let g = |level: f64| {
+                let segs = build(level, s1, s2, at)?;
+                let mut st = s0;
+                for sg in &segs {
+                    st = sg.end_state(&st);
+                }
+                Some(st.v - vf)
+            };
+            let mut knots = vec![lim.amin(), lim.amax(), a0, af];
+            knots.sort_by(f64::total_cmp);
+            knots.dedup();
+            for level in roots(&g, &knots) {
+                let Some(segs) = build(level, s1, s2, at) else {
+                    continue;
+                };
+                let prof = assemble(start, pre_segs.clone(), &[&segs])?;
+                let e = prof.end();
+                let ok = (e.v - vf).abs() <= 1e-9 * vf.abs().max(1.0)
+                    && (e.a - af).abs() <= 1e-9 * lim.amax()
+                    && (prof.duration_s() - duration_s).abs() <= 1e-9 * duration_s.max(1e-9);
+                if ok {
+                    return Ok(Some(prof));
+                }
+            }
+        }
+    }
+    Ok(None)
+}
+
+/// Velocity interface: every duration at which a range of achievable durations starts
+/// (the local optima of `velocity::local_changes`, after any acceleration brake).
+pub fn velocity_branch_starts(start: State, vf: f64, af: f64, lim: &Limits) -> Vec<f64> {
+    let Some(j) = lim.jmax() else {
+        return Vec::new();
+    };
+    let (mut s, mut pre_t) = (start, 0.0);
+    if start.a > lim.amax() || start.a < lim.amin() {
+        let to = start.a.clamp(lim.amin(), lim.amax());
+        pre_t = (start.a - to).abs() / j;
+        let seg = Segment::Jerk {
+            duration_s: pre_t,
+            jerk: if start.a > to { -j } else { j },
+        };
+        s = seg.end_state(&start);
+        s.a = to;
+    }
+    let b = Bounds {
+        amax: lim.amax(),
+        amin: lim.amin(),
+        jmax: j,
+    };
+    crate::velocity::local_changes(s.v, s.a, vf, af, &b)
+        .iter()
+        .map(|c| pre_t + c.duration_s())
+        .collect()
+}

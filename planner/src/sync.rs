@@ -163,3 +163,62 @@ fn within(prof: &Profile, lim: &Limits) -> bool {
             && vs.iter().all(|v| *v <= vmax && *v >= vmin)
     })
 }
+
+/// Velocity interface for several axes: each axis reaches its target velocity and
+/// acceleration; with `Time` (or `Phase`, treated as `Time` here) all at the slowest axis's
+/// duration, each other axis stretched by lowering its acceleration plateau.
+pub fn plan_velocity(axes: &[Axis], shape: Shape, sync: Sync) -> Result<Vec<Profile>, PlanError> {
+    let on_axis = |axis: usize| {
+        move |e: PlanError| PlanError::OnAxis {
+            axis,
+            source: Box::new(e),
+        }
+    };
+    let fastest: Vec<Profile> = axes
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            crate::position::to_velocity(a.start, a.target.v, a.target.a, &a.limits, shape)
+                .map_err(on_axis(i))
+        })
+        .collect::<Result<_, _>>()?;
+    if sync == Sync::None || axes.len() <= 1 {
+        return Ok(fastest);
+    }
+    if shape == Shape::Trapezoid {
+        return Err(PlanError::NoSolution {
+            reason: "time synchronisation of the trapezoid velocity interface is not implemented; use \"sync\":\"none\"",
+        });
+    }
+    // Earliest common duration: the slowest axis's, unless another axis cannot meet it
+    // (a blocked interval); then the next local-optimum duration of any axis.
+    let t_min = fastest.iter().map(Profile::duration_s).fold(0.0, f64::max);
+    let mut candidates = vec![t_min];
+    for a in axes {
+        candidates.extend(
+            crate::duration::velocity_branch_starts(a.start, a.target.v, a.target.a, &a.limits)
+                .into_iter()
+                .filter(|t| *t > t_min),
+        );
+    }
+    candidates.sort_by(f64::total_cmp);
+    candidates.dedup();
+    for t in candidates {
+        let profiles: Option<Vec<Profile>> = axes
+            .iter()
+            .map(|a| {
+                crate::duration::velocity_with_duration(
+                    a.start, a.target.v, a.target.a, &a.limits, t,
+                )
+                .ok()
+                .flatten()
+            })
+            .collect();
+        if let Some(p) = profiles {
+            return Ok(p);
+        }
+    }
+    Err(PlanError::NoSolution {
+        reason: "no common duration found for velocity-interface synchronisation",
+    })
+}

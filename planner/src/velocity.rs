@@ -61,19 +61,26 @@ pub struct Bounds {
 /// The time-optimal change from `(v0, a0)` to `(vf, af)`; `a0` and `af` must lie in
 /// `[amin, amax]` (brake first otherwise). `None` only for non-finite input.
 pub fn change(v0: f64, a0: f64, vf: f64, af: f64, b: &Bounds) -> Option<Change> {
+    local_changes(v0, a0, vf, af, b)
+        .into_iter()
+        .min_by(|x, y| x.duration_s().total_cmp(&y.duration_s()))
+}
+
+/// Every locally fastest velocity change (up-down and down-up, each with its peak or
+/// valley of either sign): the fastest is [`change`]; the others start the ranges of
+/// longer durations that velocity-interface synchronisation can use.
+pub fn local_changes(v0: f64, a0: f64, vf: f64, af: f64, b: &Bounds) -> Vec<Change> {
     if b.jmax.is_infinite() {
-        return Some(trapezoid_change(v0, vf, af, b));
+        return vec![trapezoid_change(v0, vf, af, b)];
     }
     let j = b.jmax;
     let dv = vf - v0;
     let scale = a0.abs().max(af.abs()).max(b.amax).max(-b.amin);
     let eps = 1e-12 * scale;
-    let mut best: Option<Change> = None;
+    let mut all: Vec<Change> = Vec::with_capacity(4);
     let mut consider = |c: Change| {
-        if c.segments.iter().all(|s| s.duration_s() >= 0.0)
-            && best.is_none_or(|b| c.duration_s() < b.duration_s())
-        {
-            best = Some(c);
+        if c.segments.iter().all(|s| s.duration_s() >= 0.0) {
+            all.push(c);
         }
     };
     // Up-down.
@@ -118,7 +125,7 @@ pub fn change(v0: f64, a0: f64, vf: f64, af: f64, b: &Bounds) -> Option<Change> 
             }
         }
     }
-    best
+    all
 }
 
 /// Jerk `j1` for `t1`, hold (zero jerk) for `hold`, jerk `-j1` for `t3`.

@@ -5,7 +5,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rsruckig::prelude::*;
 use settle_planner::position::Shape;
-use settle_planner::sync::{Axis, Sync, plan};
+use settle_planner::sync::{Axis, Sync, plan, plan_velocity};
 
 mod common;
 use common::{braked, draw_axis};
@@ -98,4 +98,76 @@ fn time_synchronised_durations_equal_rsruckig() {
         (longer as f64) < 1e-4 * compared as f64,
         "{longer} of {compared} synchronised durations longer than rsruckig's"
     );
+}
+
+fn ruckig_velocity(axes: &[Axis; 3]) -> Option<f64> {
+    let mut otg = Ruckig::<3, ThrowErrorHandler>::new(None, 0.001);
+    let mut input = InputParameter::new(None);
+    input.control_interface = ControlInterface::Velocity;
+    for (i, a) in axes.iter().enumerate() {
+        input.current_position[i] = a.start.p;
+        input.current_velocity[i] = a.start.v;
+        input.current_acceleration[i] = a.start.a;
+        input.target_velocity[i] = a.target.v;
+        input.target_acceleration[i] = a.target.a;
+        input.max_velocity[i] = a.limits.vmax();
+        input.max_acceleration[i] = a.limits.amax();
+        input.max_jerk[i] = a.limits.jmax().expect("jerk");
+    }
+    let mut traj = Trajectory::new(None);
+    otg.calculate(&input, &mut traj).ok()?;
+    Some(traj.get_duration())
+}
+
+#[test]
+fn velocity_interface_time_sync_equals_rsruckig() {
+    let mut rng = ChaCha8Rng::seed_from_u64(4);
+    let (mut equal, mut compared, mut beyond) = (0, 0, 0);
+    for _ in 0..cases() / 10 {
+        let axes = draw(&mut rng);
+        let ours = plan_velocity(&axes, Shape::JerkLimited, Sync::Time);
+        let (profs, t) = match (ours, ruckig_velocity(&axes)) {
+            (Ok(p), Some(t)) => (p, t),
+            (Err(_), None) => continue,
+            // rsruckig's 3-DoF velocity interface accepts a target acceleration beyond the
+            // limit (its profile must then end beyond amax); settle rejects it.
+            (Err(settle_planner::PlanError::OnAxis { source, axis }), Some(_))
+                if matches!(*source, settle_planner::PlanError::InfeasibleTarget { .. }) =>
+            {
+                let a = &axes[axis];
+                assert!(
+                    a.target.a > a.limits.amax() || a.target.a < a.limits.amin(),
+                    "{axes:?}"
+                );
+                beyond += 1;
+                continue;
+            }
+            (o, t) => panic!(
+                "only one solved: ours {:?} rsruckig {t:?}: {axes:?}",
+                o.map(|p| p.len())
+            ),
+        };
+        compared += 1;
+        let dur = profs[0].duration_s();
+        for (p, a) in profs.iter().zip(&axes) {
+            assert!(
+                (p.duration_s() - dur).abs() <= 1e-9 * dur,
+                "axes finish apart: {axes:?}"
+            );
+            let e = p.end();
+            assert!(
+                (e.v - a.target.v).abs() < 1e-8 && (e.a - a.target.a).abs() < 1e-10,
+                "target missed {e:?}: {axes:?}"
+            );
+        }
+        if ((dur - t) / t).abs() <= 1e-9 {
+            equal += 1;
+        } else {
+            panic!("velocity sync duration {dur} vs rsruckig {t}: {axes:?}");
+        }
+    }
+    eprintln!(
+        "3-DoF velocity interface: {equal} of {compared} equal; {beyond} targets beyond amax accepted by rsruckig, rejected by settle"
+    );
+    assert!(compared > 0 && equal == compared);
 }
