@@ -10,7 +10,7 @@
 
 use crate::brake::BrakeLaw;
 use crate::position::{
-    PeakFamily, Shape, assemble, bounds, candidates, check_target, finite_state, pre,
+    PeakFamily, Shape, assemble, bounds, candidates, check_target, finite_state, pre, verify,
 };
 use crate::roots::roots;
 use crate::three_arc::both_senses;
@@ -76,7 +76,7 @@ pub fn with_duration(
     let b = prepare(target, start, lim, shape)?;
     for (pre_segs, s) in brakes(start, lim, &b) {
         if let Some(p) = from_brake(start, pre_segs, s, target, lim, b, duration_s)? {
-            return Ok(Some(p));
+            return verify(p, &target, lim, true).map(Some);
         }
     }
     Ok(None)

@@ -177,7 +177,12 @@ pub fn to_velocity(
     let c = change(s.v, s.a, vf, af, &b).ok_or(PlanError::NoSolution {
         reason: "velocity change",
     })?;
-    assemble(start, pre_segs, &[&c.segments])
+    verify(
+        assemble(start, pre_segs, &[&c.segments])?,
+        &target,
+        lim,
+        false,
+    )
 }
 
 /// Position interface: the fastest profile from `start` to `target`.
@@ -201,7 +206,7 @@ pub fn to_state(
         let (_, segs) = from_safe(&s, &target, lim, &b).ok_or(PlanError::NoSolution {
             reason: "no peak velocity reaches the target",
         })?;
-        return assemble(start, pre_segs, &[&segs]);
+        return verify(assemble(start, pre_segs, &[&segs])?, &target, lim, true);
     }
     let law = crate::brake::BrakeLaw::new(start, lim, b.jmax);
     let mut best: Option<(f64, Vec<Segment>, Vec<Segment>)> = None;
@@ -219,7 +224,7 @@ pub fn to_state(
     let (_, pre_segs, segs) = best.ok_or(PlanError::NoSolution {
         reason: "no peak velocity reaches the target",
     })?;
-    assemble(start, pre_segs, &[&segs])
+    verify(assemble(start, pre_segs, &[&segs])?, &target, lim, true)
 }
 
 /// The peak-velocity family from a safe state `s` to `target`: for a peak velocity `vp`,
@@ -330,4 +335,34 @@ fn breakpoints(s: &State, t: &State, lim: &Limits, b: &Bounds) -> Vec<f64> {
     v.sort_by(f64::total_cmp);
     v.dedup();
     v
+}
+
+/// Last line of defence: a profile is only returned if it really ends on the target (and
+/// is finite). Extreme inputs (positions near the f64 range, limits near underflow) can
+/// defeat the arithmetic; they get an error, never a wrong profile. Position is checked
+/// relative to the largest position magnitude of the move.
+pub(crate) fn verify(
+    prof: Profile,
+    target: &State,
+    lim: &Limits,
+    position: bool,
+) -> Result<Profile, PlanError> {
+    let e = prof.end();
+    let tol = 1e-8;
+    let finite =
+        prof.duration_s().is_finite() && e.p.is_finite() && e.v.is_finite() && e.a.is_finite();
+    let p_scale = prof
+        .iter()
+        .map(|(_, s, _)| s.p.abs())
+        .fold(prof.start().p.abs().max(target.p.abs()), f64::max);
+    let ok_p = !position || (e.p - target.p).abs() <= tol * p_scale;
+    let ok_v = (e.v - target.v).abs() <= tol * target.v.abs().max(lim.vmax());
+    let ok_a = (e.a - target.a).abs() <= tol * target.a.abs().max(lim.amax());
+    if finite && ok_p && ok_v && ok_a {
+        Ok(prof)
+    } else {
+        Err(PlanError::NoSolution {
+            reason: "the computed profile misses the target (inputs beyond what f64 arithmetic resolves)",
+        })
+    }
 }

@@ -332,3 +332,44 @@ fn seed_004_cases_known_values() {
         p.duration_s()
     );
 }
+
+/// Regression: positions near the f64 range (their difference overflows) and limits near
+/// underflow used to come back as an empty or hold-only profile that never reached the
+/// target; they are errors now, and every returned profile ends on its target.
+#[test]
+fn inputs_beyond_f64_resolution_are_errors_not_wrong_profiles() {
+    let big = Limits::new(1e308, 1e308, Some(1e308)).expect("limits");
+    let r = to_state(
+        State {
+            p: 1e308,
+            v: 0.0,
+            a: 0.0,
+        },
+        State {
+            p: -1e308,
+            v: 0.0,
+            a: 0.0,
+        },
+        &big,
+        Shape::JerkLimited,
+    );
+    assert!(
+        matches!(r, Err(settle_planner::PlanError::NoSolution { .. })),
+        "{r:?}"
+    );
+    let tiny = Limits::new(1e-300, 1e-300, Some(1e-300)).expect("limits");
+    let r = to_state(
+        State::default(),
+        State {
+            p: 1e-300,
+            v: 0.0,
+            a: 0.0,
+        },
+        &tiny,
+        Shape::JerkLimited,
+    );
+    match r {
+        Ok(p) => assert!((p.end().p - 1e-300).abs() <= 1e-8 * 1e-300, "{p:?}"),
+        Err(e) => assert!(matches!(e, settle_planner::PlanError::NoSolution { .. })),
+    }
+}
