@@ -8,6 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rsruckig::prelude::*;
 use settle_planner::position::{Shape, to_state};
+use settle_planner::sync::{Axis, Sync, plan};
 use settle_planner::{Limits, ProfileKind, State, scurve, trapezoid};
 
 fn problems() -> Vec<(f64, f64, f64, f64)> {
@@ -116,6 +117,88 @@ fn bench(c: &mut Criterion) {
                 input.max_acceleration[0] = lim.amax();
                 input.max_jerk[0] = lim.jmax().unwrap_or(f64::INFINITY);
                 black_box(otg.calculate(&input, &mut traj).ok());
+            }
+        })
+    });
+    g.bench_function("ruckig_official", |b| {
+        let mut otg = ruckig::Ruckig::new_direct_and_offline(1);
+        let mut input = ruckig::InputParameter::new(1);
+        let mut traj = ruckig::Trajectory::new_direct(1);
+        b.iter(|| {
+            for (s, t, lim) in &states {
+                input.current_position[0] = s.p;
+                input.current_velocity[0] = s.v;
+                input.current_acceleration[0] = s.a;
+                input.target_position[0] = t.p;
+                input.target_velocity[0] = t.v;
+                input.target_acceleration[0] = t.a;
+                input.max_velocity[0] = lim.vmax();
+                input.max_acceleration[0] = lim.amax();
+                input.max_jerk[0] = lim.jmax().unwrap_or(f64::INFINITY);
+                black_box(otg.calculate(&mut input, &mut traj));
+            }
+        })
+    });
+    g.finish();
+
+    // Three axes, time-synchronised: 300 problems.
+    let axes: Vec<[Axis; 3]> = states
+        .chunks_exact(3)
+        .map(|c| {
+            std::array::from_fn(|i| Axis {
+                start: c[i].0,
+                target: c[i].1,
+                limits: c[i].2,
+            })
+        })
+        .collect();
+    let mut g = c.benchmark_group("three_dof_333");
+    g.bench_function("settle", |b| {
+        b.iter(|| {
+            for a in &axes {
+                black_box(plan(a, Shape::JerkLimited, Sync::Time).ok());
+            }
+        })
+    });
+    g.bench_function("rsruckig", |b| {
+        let mut otg = Ruckig::<3, ThrowErrorHandler>::new(None, 0.001);
+        let mut input = InputParameter::new(None);
+        let mut traj = Trajectory::new(None);
+        b.iter(|| {
+            for a in &axes {
+                for (i, x) in a.iter().enumerate() {
+                    input.current_position[i] = x.start.p;
+                    input.current_velocity[i] = x.start.v;
+                    input.current_acceleration[i] = x.start.a;
+                    input.target_position[i] = x.target.p;
+                    input.target_velocity[i] = x.target.v;
+                    input.target_acceleration[i] = x.target.a;
+                    input.max_velocity[i] = x.limits.vmax();
+                    input.max_acceleration[i] = x.limits.amax();
+                    input.max_jerk[i] = x.limits.jmax().unwrap_or(f64::INFINITY);
+                }
+                black_box(otg.calculate(&input, &mut traj).ok());
+            }
+        })
+    });
+    g.bench_function("ruckig_official", |b| {
+        let mut otg = ruckig::Ruckig::new_direct_and_offline(3);
+        let mut input = ruckig::InputParameter::new(3);
+        let mut traj = ruckig::Trajectory::new_direct(3);
+        b.iter(|| {
+            for a in &axes {
+                for (i, x) in a.iter().enumerate() {
+                    input.current_position[i] = x.start.p;
+                    input.current_velocity[i] = x.start.v;
+                    input.current_acceleration[i] = x.start.a;
+                    input.target_position[i] = x.target.p;
+                    input.target_velocity[i] = x.target.v;
+                    input.target_acceleration[i] = x.target.a;
+                    input.max_velocity[i] = x.limits.vmax();
+                    input.max_acceleration[i] = x.limits.amax();
+                    input.max_jerk[i] = x.limits.jmax().unwrap_or(f64::INFINITY);
+                }
+                black_box(otg.calculate(&mut input, &mut traj));
             }
         })
     });
