@@ -56,6 +56,12 @@ pub enum PlanError {
         /// What went wrong there.
         source: Box<PlanError>,
     },
+    /// Input that does not describe a problem (e.g. a trajectory without axes).
+    #[error("invalid input: {reason}")]
+    InvalidInput {
+        /// What is wrong.
+        reason: &'static str,
+    },
     /// An unknown profile kind name.
     #[error("unknown profile kind `{name}`; allowed: {allowed}")]
     UnknownKind {

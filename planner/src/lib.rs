@@ -19,6 +19,7 @@ pub mod scurve;
 mod stretch;
 pub mod sync;
 mod three_arc;
+mod trajectory;
 pub mod trapezoid;
 pub mod velocity;
 
@@ -26,3 +27,4 @@ pub use error::PlanError;
 pub use kind::ProfileKind;
 pub use limits::Limits;
 pub use profile::{Profile, Sample, Segment, State};
+pub use trajectory::Trajectory;

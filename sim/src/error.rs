@@ -13,6 +13,12 @@ pub enum SimError {
         /// What is allowed.
         allowed: &'static str,
     },
+    /// A lumped model with a missing body, a bad index or an out-of-range parameter.
+    #[error("invalid lumped model: {what}")]
+    InvalidModel {
+        /// What is wrong.
+        what: String,
+    },
     /// A plant needs at least one mode.
     #[error("a modal plant needs at least one mode")]
     NoModes,

@@ -7,6 +7,7 @@
 
 pub mod closed_form;
 mod error;
+pub mod lumped;
 mod modal;
 mod mode;
 mod plant;
