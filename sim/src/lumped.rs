@@ -239,7 +239,7 @@ impl Lumped {
                         && carriage < n
                 }
             };
-            if !k_ok || !(c.damping.is_finite() && c.damping >= 0.0) {
+            if !(k_ok && c.damping.is_finite() && c.damping >= 0.0) {
                 return bad(format!(
                     "coupling `{}`: stiffness and damping must be finite and >= 0",
                     c.name
