@@ -16,6 +16,7 @@ pub mod position;
 mod profile;
 mod roots;
 pub mod scurve;
+pub mod shaper;
 mod stretch;
 pub mod sync;
 mod three_arc;
