@@ -62,6 +62,12 @@ pub enum PlanError {
         /// What is wrong.
         reason: &'static str,
     },
+    /// A path that cannot be planned (see [`crate::path::PathFault`] for what is wrong).
+    #[error("invalid path: {fault}")]
+    InvalidPath {
+        /// What is wrong, and at which point.
+        fault: crate::path::PathFault,
+    },
     /// An unknown profile kind name.
     #[error("unknown profile kind `{name}`; allowed: {allowed}")]
     UnknownKind {

@@ -12,6 +12,7 @@ pub mod duration;
 mod error;
 mod kind;
 mod limits;
+pub mod path;
 pub mod position;
 mod profile;
 mod roots;

@@ -3,7 +3,13 @@
 //! A multi-axis move (a synchronised point-to-point move, a path through corners, a raster
 //! scan line with its step-over) is a trajectory. Each axis is evaluated by its own profile;
 //! an axis that finishes early holds its end state until the longest one ends.
+//!
+//! A trajectory planned along a path also carries the path's geometry
+//! ([`Trajectory::path`]), so contour error and corner rounding can be measured.
 
+use std::sync::Arc;
+
+use crate::path::PathGeometry;
 use crate::{PlanError, Profile, Sample};
 
 /// Several axes in time (axis 0 = X, 1 = Y, 2 = Z by convention).
@@ -11,6 +17,7 @@ use crate::{PlanError, Profile, Sample};
 pub struct Trajectory {
     axes: Vec<Profile>,
     duration_s: f64,
+    path: Option<Arc<PathGeometry>>,
 }
 
 impl Trajectory {
@@ -22,7 +29,11 @@ impl Trajectory {
             });
         }
         let duration_s = axes.iter().map(Profile::duration_s).fold(0.0, f64::max);
-        Ok(Self { axes, duration_s })
+        Ok(Self {
+            axes,
+            duration_s,
+            path: None,
+        })
     }
 
     /// A single-axis trajectory.
@@ -31,7 +42,19 @@ impl Trajectory {
         Self {
             axes: vec![profile],
             duration_s,
+            path: None,
         }
+    }
+
+    /// Attach the geometry of the path this trajectory follows.
+    pub fn with_path(mut self, path: PathGeometry) -> Self {
+        self.path = Some(Arc::new(path));
+        self
+    }
+
+    /// The geometry of the path this trajectory follows, if it was planned along one.
+    pub fn path(&self) -> Option<&PathGeometry> {
+        self.path.as_deref()
     }
 
     /// The per-axis profiles.
