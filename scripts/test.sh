@@ -19,3 +19,5 @@ echo "== cargo clippy"
 cargo clippy --workspace --all-targets --locked -- -D warnings
 echo "== cargo test (release: the property suites are numeric-heavy)"
 cargo test --workspace --release --locked
+echo "== fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
+scripts/fuzz.sh "${SETTLE_FUZZ_SECONDS:-15}"
