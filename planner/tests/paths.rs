@@ -582,3 +582,72 @@ fn contour_error_is_exact_and_hint_independent() {
         );
     }
 }
+
+#[test]
+fn corner_rounding_of_the_commanded_motion_is_the_planned_deviation() {
+    use settle_planner::path::CornerRounding;
+    let lim = Limits::new(0.2, 5.0, Some(500.0)).expect("limits");
+    let path = Path::new(2, square_path(6, 0.02)).expect("path");
+    for (corners, zero) in [
+        (
+            CornerStrategy::Blend {
+                max_deviation_m: 5e-5,
+            },
+            false,
+        ),
+        (CornerStrategy::ExactStop, true),
+    ] {
+        let opts = PathOptions::new(lim, ProfileKind::SCurve, corners).expect("options");
+        let tr = plan_path(&path, &opts).expect("plan");
+        let g = tr.path().expect("geometry");
+        let mut acc = CornerRounding::new(g);
+        // 10 kHz samples of the commanded motion, plus each point's planned passing time.
+        let mut times: Vec<f64> = (0..=(tr.duration_s() * 1e4) as usize)
+            .map(|i| i as f64 * 1e-4)
+            .collect();
+        times.extend(g.corners().iter().map(|c| c.time_s));
+        times.sort_by(f64::total_cmp);
+        for t in times {
+            let p = at(&tr, t)[0];
+            acc.update(t, &p[..2]);
+        }
+        let mins = acc.min_distances_m();
+        for c in &g.corners()[1..g.corners().len() - 1] {
+            let m = mins[c.index];
+            assert!(
+                (m - c.deviation_m).abs() < 1e-12,
+                "{corners:?}: {m} vs {}",
+                c.deviation_m
+            );
+            if zero {
+                assert!(m < 1e-12);
+            } else {
+                // Square corners at 5e-5 tolerance: the tolerance or half the leg binds.
+                assert!(m > 1e-6 && m <= 5e-5 * (1.0 + 1e-9), "{m}");
+            }
+        }
+        assert!((acc.max_corner_rounding_m() - g.max_planned_deviation_m()).abs() < 1e-12);
+        // A toolhead that cuts every corner by 1 mm more along the bisector: the rounding
+        // grows accordingly (measured, not planned).
+        let mut cut = CornerRounding::new(g);
+        for c in g.corners() {
+            cut.update(
+                c.time_s,
+                &[
+                    pts_shift(&path, c.index, 1e-3)[0],
+                    pts_shift(&path, c.index, 1e-3)[1],
+                ],
+            );
+        }
+        for (k, m) in cut.min_distances_m().iter().enumerate() {
+            assert!((m - 1e-3).abs() < 1e-15, "point {k}: {m}");
+        }
+    }
+}
+
+/// Point `k` of `path` moved by `by` metres along +x+y/sqrt2.
+fn pts_shift(path: &Path, k: usize, by: f64) -> V3 {
+    let p = path.points()[k].position;
+    let s = by / 2f64.sqrt();
+    [p[0] + s, p[1] + s, p[2]]
+}
