@@ -26,6 +26,8 @@ struct Node {
 pub(crate) struct Bvh {
     nodes: Vec<Node>,
     order: Vec<u32>,
+    /// Each primitive's box, to skip exact distances that cannot win.
+    boxes: Vec<(V3, V3)>,
 }
 
 fn union(boxes: &[(V3, V3)], idx: &[u32]) -> (V3, V3) {
@@ -61,7 +63,11 @@ impl Bvh {
             let n = order.len();
             split(boxes, &mut order, 0, n, &mut nodes);
         }
-        Self { nodes, order }
+        Self {
+            nodes,
+            order,
+            boxes: boxes.to_vec(),
+        }
     }
 
     /// The nearest primitive to `q` by the exact distance `dist(index)`, starting from the
@@ -92,6 +98,10 @@ impl Bvh {
             if node.count > 0 {
                 let first = node.first as usize;
                 for &i in &self.order[first..first + node.count as usize] {
+                    let (lo, hi) = self.boxes[i as usize];
+                    if box_dist2(q, lo, hi) >= best.0 * best.0 {
+                        continue;
+                    }
                     let d = dist(i as usize);
                     if d < best.0 {
                         best = (d, i as usize);

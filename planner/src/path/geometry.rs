@@ -10,6 +10,7 @@
 
 use super::blend::BlendCase;
 use super::bvh::Bvh;
+use super::poly;
 use super::vector::{V3, add, axpy, dist, dot, from_slice, scale, sub};
 use super::{PathPoint, PointKind};
 
@@ -39,9 +40,6 @@ pub enum Primitive {
     },
 }
 
-/// Samples per arc for bracketing the minima of the squared distance.
-const ARC_SAMPLES: usize = 8;
-
 impl Primitive {
     /// Position on an arc at `t` (the line's `a + t (b - a)` for `t` in `[0, 1]`).
     pub fn point_at(&self, t: f64) -> V3 {
@@ -51,13 +49,6 @@ impl Primitive {
                 axpy(axpy(p0, t, v0), 0.5 * t * t, a0),
                 scale(j, t * t * t / 6.0),
             ),
-        }
-    }
-
-    fn velocity_at(&self, t: f64) -> V3 {
-        match *self {
-            Primitive::Line { a, b } => sub(b, a),
-            Primitive::Arc { v0, a0, j, .. } => axpy(axpy(v0, t, a0), 0.5 * t * t, j),
         }
     }
 
@@ -78,61 +69,28 @@ impl Primitive {
         }
     }
 
-    /// Minimise `|p(t) - q|^2` over `[0, T]`: every interior minimum is a sign change of
-    /// `h(t) = (p(t) - q) . p'(t)` from negative to positive; sign changes are bracketed on
-    /// a uniform grid and solved by Newton steps safeguarded by bisection.
+    /// Minimise `|p(t) - q|^2` over `[0, T]`: the minimum is at an end or at a root of
+    /// `h(t) = (p(t) - q) . p'(t)`, a quintic, all of whose roots in `[0, T]` are found
+    /// (see `poly`), so no local minimum is missed however tightly the arc turns.
     fn arc_distance(&self, q: V3, total: f64) -> f64 {
-        let h = |t: f64| dot(sub(self.point_at(t), q), self.velocity_at(t));
-        let mut best = dist(self.point_at(0.0), q).min(dist(self.point_at(total), q));
-        let step = total / ARC_SAMPLES as f64;
-        let mut t_prev = 0.0;
-        let mut h_prev = h(0.0);
-        for i in 1..=ARC_SAMPLES {
-            let t = if i == ARC_SAMPLES {
-                total
-            } else {
-                step * i as f64
-            };
-            let ht = h(t);
-            if h_prev < 0.0 && ht >= 0.0 {
-                let root = self.bracketed_root(&h, t_prev, t, q);
-                best = best.min(dist(self.point_at(root), q));
+        let Primitive::Arc { p0, v0, a0, j, .. } = *self else {
+            return self.distance(q);
+        };
+        // p(t) - q = c0 + c1 t + c2 t^2 + c3 t^3.
+        let c = [sub(p0, q), v0, scale(a0, 0.5), scale(j, 1.0 / 6.0)];
+        let mut h = [0.0; 6];
+        for (i, ci) in c.iter().enumerate() {
+            for (k, ck) in c.iter().enumerate().skip(1) {
+                h[i + k - 1] += k as f64 * dot(*ci, *ck);
             }
-            t_prev = t;
-            h_prev = ht;
+        }
+        let mut best = dist(self.point_at(0.0), q).min(dist(self.point_at(total), q));
+        let mut roots = [0.0; 5];
+        let n = poly::roots_in(&h, 0.0, total, &mut roots);
+        for &t in &roots[..n] {
+            best = best.min(dist(self.point_at(t), q));
         }
         best
-    }
-
-    fn bracketed_root(&self, h: &impl Fn(f64) -> f64, lo: f64, hi: f64, q: V3) -> f64 {
-        let (mut lo, mut hi) = (lo, hi);
-        let mut t = 0.5 * (lo + hi);
-        for _ in 0..100 {
-            let ht = h(t);
-            if ht < 0.0 {
-                lo = t;
-            } else {
-                hi = t;
-            }
-            // h'(t) = |p'|^2 + (p - q) . p''.
-            let Primitive::Arc { a0, j, .. } = *self else {
-                break;
-            };
-            let acc = axpy(a0, t, j);
-            let v = self.velocity_at(t);
-            let dh = dot(v, v) + dot(sub(self.point_at(t), q), acc);
-            let newton = t - ht / dh;
-            let next = if dh > 0.0 && newton > lo && newton < hi {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
-            if next == t || hi - lo <= 1e-15 * (hi.abs() + 1e-300) {
-                return next;
-            }
-            t = next;
-        }
-        t
     }
 
     /// Axis-aligned bounding box (for an arc: of its Bezier control points, which contain

@@ -87,7 +87,7 @@ impl PathOptions {
             CornerStrategy::ExactStop => {}
             CornerStrategy::Junction(j) => j.validate()?,
             CornerStrategy::Blend { max_deviation_m } => {
-                if !(max_deviation_m >= 0.0) {
+                if max_deviation_m.is_nan() || max_deviation_m < 0.0 {
                     return Err(PlanError::InvalidLimit {
                         name: "max_deviation_m",
                         value: max_deviation_m,

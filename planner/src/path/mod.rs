@@ -27,6 +27,7 @@ pub mod junction;
 pub mod law;
 pub mod lookahead;
 mod pieces;
+mod poly;
 mod rounding;
 pub mod vector;
 
@@ -275,7 +276,7 @@ mod tests {
                 fault: PathFault::Coincident { index: 2 }
             })
         );
-        let e = Path::new(3, vec![p(0.0, 0.0), p(f64::NAN, 1.0)]).unwrap_err();
+        let e = Path::new(3, vec![p(0.0, 0.0), p(f64::NAN, 1.0)]).expect_err("NaN");
         assert!(matches!(
             e,
             PlanError::InvalidPath {
