@@ -150,8 +150,12 @@ pub struct SRamp {
     pub d_peak: f64,
     /// +1 for a positive distance, -1 for a negative one.
     pub direction: f64,
+    /// The parameters it was planned with.
+    pub params: SRampParams,
     /// The motion: starts at `(p0, direction * VSTART, 0)`, ends at
-    /// `(p0 + distance, direction * VSTOP, 0)`.
+    /// `(p0 + distance, direction * VSTOP, 0)`. Always seven segments, segment `i` being
+    /// phase `i` (zero durations kept); B12, B23 and B34 are constant-acceleration
+    /// segments.
     pub profile: Profile,
 }
 
@@ -164,9 +168,10 @@ impl SRamp {
     /// Which limits the ramp reaches, as a case name: `acc`/`no_acc` (AMAX),
     /// `vel`/`no_vel` (VMAX), `dec`/`no_dec` (DMAX), e.g. `acc_vel_dec`.
     pub fn case_name(&self) -> &'static str {
-        let acc = self.phases_s[1] > 0.0;
-        let vel = self.phases_s[3] > 0.0;
-        let dec = self.phases_s[5] > 0.0;
+        let p = &self.params;
+        let acc = self.a_peak >= p.amax;
+        let vel = self.v_peak >= p.vmax;
+        let dec = self.d_peak >= p.dmax;
         match (acc, vel, dec) {
             (true, true, true) => "acc_vel_dec",
             (true, true, false) => "acc_vel_no_dec",
@@ -203,40 +208,39 @@ fn phases(vp: f64, p: &SRampParams) -> ([f64; 7], f64, f64) {
     ([t1, t12, t2, 0.0, t3, t34, t4], a, d)
 }
 
-/// The segments of the seven phases (direction +1), zero-duration ones dropped.
-fn segments(ph: &[f64; 7], p: &SRampParams, s: f64) -> Vec<Segment> {
-    let jerks = [p.bow[0], 0.0, -p.bow[1], 0.0, -p.bow[2], 0.0, p.bow[3]];
-    ph.iter()
-        .zip(jerks)
-        .enumerate()
-        .filter(|(_, (t, _))| **t > 0.0)
-        .map(|(i, (&duration_s, j))| {
-            if i == 3 {
-                // The cruise holds the acceleration at exactly zero (B2 ends there only up
-                // to rounding).
-                Segment::Accel {
-                    duration_s,
-                    accel: 0.0,
-                }
-            } else {
-                Segment::Jerk {
-                    duration_s,
-                    jerk: s * j,
-                }
-            }
-        })
-        .collect()
+/// The seven phases as seven segments (zero durations kept, so segment `i` is phase `i`).
+/// The holds and the cruise are written as constant-acceleration segments at exactly the
+/// peak, zero and the negative peak: the jerk phases reach them only up to rounding, and a
+/// long hold would integrate that rounding into a visible position error.
+fn segments(ph: &[f64; 7], p: &SRampParams, a: f64, d: f64, s: f64) -> Vec<Segment> {
+    let jerk = |duration_s: f64, j: f64| Segment::Jerk {
+        duration_s,
+        jerk: s * j,
+    };
+    let hold = |duration_s: f64, accel: f64| Segment::Accel {
+        duration_s,
+        accel: s * accel,
+    };
+    vec![
+        jerk(ph[0], p.bow[0]),
+        hold(ph[1], a),
+        jerk(ph[2], -p.bow[1]),
+        hold(ph[3], 0.0),
+        jerk(ph[4], -p.bow[2]),
+        hold(ph[5], -d),
+        jerk(ph[6], p.bow[3]),
+    ]
 }
 
 /// Distance of the ramp with peak `vp` and no cruise (direction +1).
 fn distance_no_cruise(vp: f64, p: &SRampParams) -> f64 {
-    let (ph, _, _) = phases(vp, p);
+    let (ph, a, d) = phases(vp, p);
     let mut st = State {
         p: 0.0,
         v: p.vstart,
         a: 0.0,
     };
-    for seg in segments(&ph, p, 1.0) {
+    for seg in segments(&ph, p, a, d, 1.0) {
         st = seg.end_state(&st);
     }
     st.p
@@ -293,13 +297,14 @@ pub fn plan(p0: f64, distance: f64, prm: &SRampParams) -> Result<SRamp, PlanErro
         v: s * prm.vstart,
         a: 0.0,
     };
-    let profile = Profile::new(start, segments(&ph, prm, s))?;
+    let profile = Profile::new(start, segments(&ph, prm, a_peak, d_peak, s))?;
     Ok(SRamp {
         phases_s: ph,
         v_peak: vp,
         a_peak,
         d_peak,
         direction: s,
+        params: *prm,
         profile,
     })
 }
