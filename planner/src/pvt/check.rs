@@ -5,6 +5,13 @@
 //! velocity is quadratic, so its extremes are at the knots or where the acceleration
 //! crosses zero inside the segment; the jerk is constant per segment. An acceleration jump
 //! at a knot is an infinite jerk: reported separately (tolerance `accel_jump_tol`).
+//!
+//! Tolerances: limits are compared with a relative slack of 1e-9, plus the rounding of
+//! the knot data itself. A segment's accelerations follow from its knots as
+//! `6 (x1 - x0)/t^2 - ...`, so rounding of positions of magnitude `|x|` leaves them
+//! uncertain by about `eps (6 |x|/t^2 + 6 |v|/t)` (taken 8 times, `eps` = f64 epsilon,
+//! `|x|` and `|v|` the largest of the move): a small step far from the origin over a short
+//! segment cannot be more precise than that.
 
 use crate::pvt::Pvt;
 use crate::{PlanError, Segment, State};
@@ -41,9 +48,9 @@ impl PvtLimit {
     pub fn describe(self) -> &'static str {
         match self {
             PvtLimit::Velocity => "PVT segment exceeds vmax",
-            PvtLimit::Acceleration => "PVT knot exceeds amax",
+            PvtLimit::Acceleration => "PVT knot with this index exceeds amax",
             PvtLimit::Jerk => "PVT segment exceeds jmax",
-            PvtLimit::AccelerationJump => "PVT acceleration jumps at this knot",
+            PvtLimit::AccelerationJump => "PVT acceleration jumps at the knot with this index",
         }
     }
 }
@@ -89,12 +96,32 @@ impl std::fmt::Display for Violation {
     }
 }
 
-/// Every violation, in the order knots/segments appear (relative tolerance 1e-9).
+/// Uncertainty of segment `k`'s accelerations from the rounding of the knot data (u/s^2).
+/// Knot positions are usually computed as offsets from somewhere in the move, so their
+/// rounding is that of the largest position magnitude of the move, not of their own.
+fn rounding(m: &Pvt, k: usize, xs: f64, vs: f64) -> f64 {
+    let dt = m.knots[k + 1].t_s - m.knots[k].t_s;
+    8.0 * f64::EPSILON * (6.0 * xs / (dt * dt) + 6.0 * vs / dt)
+}
+
+/// Every violation, in the order knots/segments appear.
 pub fn violations(m: &Pvt, lim: &PvtLimits) -> Vec<Violation> {
     let tol = 1e-9;
     let mut out = Vec::new();
-    let jump_tol = lim.accel_jump_tol.max(tol * lim.amax);
+    let n_seg = m.accels.len();
+    let xs = m.knots.iter().fold(0.0f64, |s, k| s.max(k.x.abs()));
+    let vs = m.knots.iter().fold(0.0f64, |s, k| s.max(k.v.abs()));
     for k in 0..m.knots.len() {
+        let round = (if k > 0 {
+            rounding(m, k - 1, xs, vs)
+        } else {
+            0.0
+        }) + (if k < n_seg {
+            rounding(m, k, xs, vs)
+        } else {
+            0.0
+        });
+        let jump_tol = lim.accel_jump_tol.max(tol * lim.amax) + round;
         let jump = m.accel_jump(k).abs();
         if jump > jump_tol {
             out.push(Violation {
@@ -111,7 +138,7 @@ pub fn violations(m: &Pvt, lim: &PvtLimits) -> Vec<Violation> {
         if k < m.accels.len() {
             a_max = a_max.max(m.accels[k].0.abs());
         }
-        if a_max > lim.amax * (1.0 + tol) {
+        if a_max > lim.amax * (1.0 + tol) + round {
             out.push(Violation {
                 limit: PvtLimit::Acceleration,
                 at: k,
@@ -127,7 +154,7 @@ pub fn violations(m: &Pvt, lim: &PvtLimits) -> Vec<Violation> {
         let (a0, a1) = m.accels[k];
         let jerk = (a1 - a0) / dt;
         if let Some(jmax) = lim.jmax
-            && jerk.abs() > jmax * (1.0 + tol)
+            && jerk.abs() > jmax * (1.0 + tol) + 2.0 * rounding(m, k, xs, vs) / dt
         {
             out.push(Violation {
                 limit: PvtLimit::Jerk,

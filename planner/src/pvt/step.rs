@@ -61,8 +61,9 @@ pub fn symmetric(x0: f64, d: f64, lim: &Limits) -> Result<Pvt, PlanError> {
         (tm.t_const_acc, 0.0),
         (tm.t_jerk, s * j),
     ];
+    // Integrate in local coordinates (one rounding of x0 + p per knot, not one per phase).
     let mut st = State {
-        p: x0,
+        p: 0.0,
         v: 0.0,
         a: 0.0,
     };
@@ -82,7 +83,7 @@ pub fn symmetric(x0: f64, d: f64, lim: &Limits) -> Result<Pvt, PlanError> {
         // jerk phases around it are one linear-acceleration segment (5 segments in all).
         let merge = i == 2 && tm.t_cruise == 0.0;
         if dur > 0.0 && !merge {
-            knots.push(Knot::new(t, st.p, st.v));
+            knots.push(Knot::new(t, x0 + st.p, st.v));
         }
     }
     // The end at rest exactly on the target.
