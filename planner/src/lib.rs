@@ -10,11 +10,13 @@
 mod brake;
 pub mod duration;
 mod error;
+pub mod fourjerk;
 mod kind;
 mod limits;
 pub mod position;
 mod profile;
 pub mod pvt;
+pub mod raster;
 mod roots;
 pub mod scurve;
 mod stretch;
@@ -26,7 +28,7 @@ pub mod trapezoid;
 pub mod velocity;
 
 pub use error::PlanError;
-pub use kind::ProfileKind;
+pub use kind::{KindParams, ProfileKind};
 pub use limits::Limits;
 pub use profile::{Profile, Sample, Segment, State};
 pub use trajectory::Trajectory;

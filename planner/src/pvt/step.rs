@@ -61,37 +61,45 @@ pub fn symmetric(x0: f64, d: f64, lim: &Limits) -> Result<Pvt, PlanError> {
         (tm.t_const_acc, 0.0),
         (tm.t_jerk, s * j),
     ];
-    // Integrate in local coordinates (one rounding of x0 + p per knot, not one per phase).
+    // Knots relative to x0 (their precision is that of the step, not of x0), shifted at
+    // the end.
     let mut st = State {
         p: 0.0,
         v: 0.0,
         a: 0.0,
     };
     let mut t = 0.0;
-    let mut knots = vec![Knot::new(0.0, x0, 0.0)];
+    let mut knots = vec![Knot::new(0.0, 0.0, 0.0)];
+    let mut acc: Vec<(f64, f64)> = Vec::with_capacity(7);
+    let mut a_seg_start = 0.0;
     for (i, &(dur, jerk)) in phases.iter().enumerate() {
         st = Segment::Jerk {
             duration_s: dur,
             jerk,
         }
         .end_state(&st);
-        if i == 3 {
-            st.a = 0.0;
-        }
+        // Exact accelerations at the phase ends: +-A, or 0 around the cruise.
+        st.a = match i {
+            0 | 1 => s * tm.a_peak,
+            4 | 5 => -s * tm.a_peak,
+            _ => 0.0,
+        };
         t += dur;
         // No knot where the acceleration passes through zero without a cruise: the two
         // jerk phases around it are one linear-acceleration segment (5 segments in all).
         let merge = i == 2 && tm.t_cruise == 0.0;
         if dur > 0.0 && !merge {
-            knots.push(Knot::new(t, x0 + st.p, st.v));
+            knots.push(Knot::new(t, st.p, st.v));
+            acc.push((a_seg_start, st.a));
+            a_seg_start = st.a;
         }
     }
     // The end at rest exactly on the target.
     if let Some(last) = knots.last_mut() {
-        last.x = x0 + d;
+        last.x = d;
         last.v = 0.0;
     }
-    Pvt::new(knots, 0.0, 0.0)
+    Pvt::with_accels(knots, acc, 0.0, 0.0)?.shifted(x0)
 }
 
 /// The seed's asymmetric shape for one `Ki`, in units of the step `d` and the segment time
@@ -190,5 +198,8 @@ pub fn asymmetric(x0: f64, d: f64, ki: f64, lim: &Limits) -> Result<Pvt, PlanErr
     check_d(d)?;
     let shape = AsymShape::new(ki)?;
     let t1 = shape.t1_for(d, lim)?;
-    Pvt::new(shape.knots(x0, d, t1).to_vec(), 0.0, 0.0)
+    let sc = d / (t1 * t1);
+    let (a0, a3) = (shape.a[0] * sc, shape.a[1] * sc);
+    let acc = vec![(0.0, a0), (a0, -a0), (-a0, a3), (a3, 0.0)];
+    Pvt::with_accels(shape.knots(0.0, d, t1).to_vec(), acc, 0.0, 0.0)?.shifted(x0)
 }
