@@ -10,23 +10,27 @@
 mod brake;
 pub mod duration;
 mod error;
+pub mod fourjerk;
 mod kind;
 mod limits;
 pub mod path;
 pub mod position;
 mod profile;
+pub mod pvt;
+pub mod raster;
 mod roots;
 pub mod scurve;
 pub mod shaper;
 mod stretch;
 pub mod sync;
 mod three_arc;
+pub mod tmc;
 mod trajectory;
 pub mod trapezoid;
 pub mod velocity;
 
 pub use error::PlanError;
-pub use kind::ProfileKind;
+pub use kind::{KindParams, ProfileKind};
 pub use limits::Limits;
 pub use profile::{Profile, Sample, Segment, State};
 pub use trajectory::Trajectory;

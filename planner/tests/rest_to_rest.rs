@@ -100,7 +100,7 @@ fn random_moves_reach_target_within_limits_across_scales() {
         let sign = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
         let d = sign * log_uniform(&mut rng, 1e-9, 1e6);
         let p0 = rng.random_range(-100.0..100.0);
-        for kind in ProfileKind::ALL {
+        for kind in [ProfileKind::Trapezoid, ProfileKind::SCurve] {
             let prof = kind.rest_to_rest(p0, d, &lim).expect("plan");
             check(kind, &prof, p0, d, &lim);
             // The any-state planner equals the closed-form rest-to-rest planner (given the
@@ -109,6 +109,7 @@ fn random_moves_reach_target_within_limits_across_scales() {
             let closed = match kind {
                 ProfileKind::SCurve => scurve::rest_to_rest(p0, d_seen, &lim),
                 ProfileKind::Trapezoid => trapezoid::rest_to_rest(p0, d_seen, &lim),
+                other => unreachable!("{other} has no closed form here"),
             }
             .expect("closed form");
             let rel = (prof.duration_s() - closed.duration_s()).abs() / closed.duration_s();
