@@ -207,9 +207,27 @@ impl SpeedLaw for FourJerkLaw {
     }
 }
 
-/// The law for a profile kind at the path limits (`SCurve` needs `jmax`).
+/// The law for a profile kind at the path limits (`SCurve` and `FourJerk` need `jmax`;
+/// `FourJerk` here uses its default parameters, all four jerks `jmax` and `dmax = amax`:
+/// build a [`FourJerkLaw`] directly for others). The PVT step kinds are point-to-point
+/// moves of fixed shape, not speed-change laws: they are refused.
 pub fn for_kind(kind: ProfileKind, limits: &Limits) -> Result<Arc<dyn SpeedLaw>, PlanError> {
+    let jmax = || {
+        limits.jmax().ok_or(PlanError::MissingJerkLimit {
+            kind: kind.name(),
+        })
+    };
     Ok(match kind {
+        ProfileKind::FourJerk => Arc::new(FourJerkLaw {
+            amax: limits.amax(),
+            dmax: limits.amax(),
+            jerks: [jmax()?; 4],
+        }),
+        ProfileKind::PvtSym | ProfileKind::PvtAsym => {
+            return Err(PlanError::InvalidInput {
+                reason: "the PVT step kinds (pvt_sym, pvt_asym) are point-to-point moves, not path speed laws; use trapezoid, scurve or fourjerk on paths",
+            });
+        }
         ProfileKind::Trapezoid => Arc::new(TrapezoidLaw {
             amax: limits.amax(),
         }),
