@@ -10,6 +10,8 @@ mod error;
 pub mod lumped;
 mod modal;
 mod mode;
+#[cfg(feature = "mujoco")]
+pub mod mujoco;
 mod plant;
 
 pub use error::SimError;
