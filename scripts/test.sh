@@ -5,6 +5,8 @@
 # Environment:
 #   SETTLE_PLANNER_CASES  random planner cases (default 100000)
 #   SETTLE_SIM_CASES      random modal-plant cases (default 2000)
+#   SETTLE_MUJOCO=0       skip the MuJoCo backend (otherwise scripts/setup-mujoco.sh fetches
+#                         libmujoco into .deps/mujoco/ when missing, and its tests run)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -19,3 +21,9 @@ echo "== cargo clippy"
 cargo clippy --workspace --all-targets --locked -- -D warnings
 echo "== cargo test (release: the property suites are numeric-heavy)"
 cargo test --workspace --release --locked
+if [[ "${SETTLE_MUJOCO:-1}" != 0 ]]; then
+  echo "== MuJoCo backend (cargo feature mujoco)"
+  scripts/setup-mujoco.sh
+  cargo clippy --workspace --all-targets --locked --features mujoco -- -D warnings
+  cargo test -p settle-sim --release --locked --features mujoco --test 'mujoco*'
+fi

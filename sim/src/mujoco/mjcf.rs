@@ -24,6 +24,14 @@
 //! The driver torque on the [`Lumped::actuated`] body enters through a `motor` actuator
 //! (`drive`, gear 1, unlimited): its control is the generalised force (N m or N).
 //!
+//! A position-dependent stiffness ([`Stiffness::BeltSpans`]) is the tendon's stiffness at
+//! coordinate 0 plus an actuator on the same tendon with an affine gain
+//! (`gainprm = "0 1 0"`: force = tendon length * control): with the control set to
+//! `-(k(q) - k(0))` before each step, the total tendon force is `-(k(q) e + c e')` with the
+//! extension `e` varying inside the step and `k` held at its value at the predicted
+//! mid-step coordinates. (Changing the tendon stiffness itself would need a model swap per
+//! step, whose layout check costs more than the step.)
+//!
 //! Gravity, contacts, constraints and MuJoCo's automatic reset are disabled: the lumped
 //! model has none of them, and a diverging run must surface as an error, not a silent reset.
 
@@ -76,8 +84,10 @@ pub(crate) struct Layout {
     pub command: Option<(usize, usize)>,
     /// The `drive` actuator's index.
     pub drive: Option<usize>,
-    /// Tendon index and stiffness law of every position-dependent coupling.
-    pub variable_tendons: Vec<(usize, Stiffness)>,
+    /// For every position-dependent coupling: the index of the actuator that adds
+    /// `-(k(q) - k_ref) * extension`, its stiffness law and `k_ref` (its stiffness at
+    /// coordinate 0, the tendon's own stiffness).
+    pub variable: Vec<(usize, Stiffness, f64)>,
 }
 
 /// A name usable as an MJCF identifier: `prefix{index}_{name}` with anything but
@@ -164,7 +174,7 @@ pub(crate) fn generate(
     }
     w(format_args!("  </worldbody>\n"));
 
-    let mut variable_tendons = Vec::new();
+    let mut variable = Vec::new();
     let mut tendons = 0usize;
     let mut tendon_xml = String::new();
     for (ci, c) in lumped.couplings.iter().enumerate() {
@@ -185,11 +195,11 @@ pub(crate) fn generate(
         if coefs.is_empty() {
             continue; // Acts on nothing that moves.
         }
-        // A position-dependent stiffness is set to its current value before every step;
-        // the model starts with its value at coordinate 0.
+        // A position-dependent stiffness: its value at coordinate 0 here, the rest through
+        // an actuator (below).
         let k = c.stiffness.at(0.0);
         if c.stiffness.depends_on().is_some() {
-            variable_tendons.push((tendons, c.stiffness));
+            variable.push((ident("c", ci, &c.name), c.stiffness, k));
         }
         let _ = writeln!(
             tendon_xml,
@@ -222,6 +232,19 @@ pub(crate) fn generate(
         actuators += 1;
         actuators - 1
     });
+    let variable = variable
+        .into_iter()
+        .map(|(tendon, stiffness, k_ref)| {
+            let _ = writeln!(
+                actuator_xml,
+                "    <general name=\"{tendon}_stiffness\" tendon=\"{tendon}\" gaintype=\"affine\" \
+                 gainprm=\"0 1 0\" biastype=\"none\" ctrllimited=\"false\" \
+                 forcelimited=\"false\"/>"
+            );
+            actuators += 1;
+            (actuators - 1, stiffness, k_ref)
+        })
+        .collect();
     let command = uses_command.then(|| {
         let _ = writeln!(
             actuator_xml,
@@ -242,7 +265,7 @@ pub(crate) fn generate(
             bodies: lumped.bodies.len(),
             command,
             drive,
-            variable_tendons,
+            variable,
         },
     )
 }

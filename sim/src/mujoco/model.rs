@@ -42,10 +42,8 @@ pub struct MujocoModel {
     layout: Layout,
     template: MjModel,
     config: MujocoConfig,
-    /// Step size (s) at the reference stiffnesses `k_ref`.
+    /// Step size (s) at the reference stiffnesses (position-dependent ones at q = 0).
     step_s: f64,
-    /// Each position-dependent coupling's stiffness at the reference coordinates (q = 0).
-    k_ref: Vec<f64>,
     /// Whether the stiffness matrix is singular (a free rigid-body mode, e.g. a rotor held
     /// only by the driver force).
     singular: bool,
@@ -65,13 +63,10 @@ impl std::fmt::Debug for MujocoModel {
 }
 
 /// The mutable state of a MuJoCo run: MuJoCo's `mjData` (which owns a copy of the compiled
-/// model), a second copy to swap in when a position-dependent stiffness changes, the
-/// commanded state and the driver force.
+/// model), the commanded state and the driver force.
 #[derive(Debug)]
 pub struct MujocoSim {
     data: MjData<Box<MjModel>>,
-    /// Always `Some` between calls (taken only while swapping).
-    spare: Option<Box<MjModel>>,
     dof: usize,
     drive: Option<usize>,
     command: State,
@@ -133,11 +128,6 @@ impl MujocoModel {
         let (mjcf, layout) = mjcf::generate(lumped, step_s, config.integrator);
         let template = MjModel::from_xml_string(&mjcf)
             .map_err(|e| mujoco_err(format!("MuJoCo rejected the generated MJCF: {e}")))?;
-        let k_ref = layout
-            .variable_tendons
-            .iter()
-            .map(|(_, s)| s.at(0.0))
-            .collect();
         Ok(Self {
             lumped: lumped.clone(),
             mjcf,
@@ -145,7 +135,6 @@ impl MujocoModel {
             template,
             config,
             step_s,
-            k_ref,
             singular,
             lambda_max,
         })
@@ -186,10 +175,9 @@ impl MujocoModel {
         let q = sim.q();
         let alpha = self
             .layout
-            .variable_tendons
+            .variable
             .iter()
-            .zip(&self.k_ref)
-            .map(|((_, s), k0)| s.at(s.depends_on().map_or(0.0, |i| q[i])) / k0)
+            .map(|(_, s, k0)| s.at(s.depends_on().map_or(0.0, |i| q[i])) / k0)
             .fold(1.0f64, f64::max);
         self.step_s / alpha.sqrt()
     }
@@ -266,7 +254,6 @@ impl MujocoModel {
         }
         let mut sim = MujocoSim {
             data: MjData::new(Box::new(self.template.clone())),
-            spare: Some(Box::new(self.template.clone())),
             dof: n,
             drive: self.layout.drive,
             command: *command,
@@ -305,9 +292,6 @@ impl MujocoModel {
         let n = self.lumped.dof();
         if sim.data.model_opt().timestep != h_s {
             sim.data.model_opt_mut().timestep = h_s;
-            if let Some(spare) = sim.spare.as_mut() {
-                spare.opt_mut().timestep = h_s;
-            }
         }
         if let Some((joint, actuator)) = self.layout.command {
             sim.data.qpos_mut()[joint] = cmd.p;
@@ -315,29 +299,13 @@ impl MujocoModel {
             sim.data.act_mut()[0] = cmd.a;
             sim.data.ctrl_mut()[actuator] = cmd.j;
         }
-        if !self.layout.variable_tendons.is_empty() {
-            // Stiffness at the predicted mid-step coordinates (second order in h).
-            let mut spare = sim
-                .spare
-                .take()
-                .ok_or_else(|| mujoco_err("lost the spare model after a failed swap"))?;
+        // Position-dependent stiffness at the predicted mid-step coordinates (second order
+        // in h), as the control of its correction actuator.
+        for (actuator, law, k_ref) in &self.layout.variable {
             let (q, qd) = (sim.data.qpos(), sim.data.qvel());
-            let mut changed = false;
-            for (t, s) in &self.layout.variable_tendons {
-                let mid = s.depends_on().map_or(0.0, |i| q[i] + 0.5 * h_s * qd[i]);
-                let k = s.at(mid);
-                changed |= sim.data.model().tendon_stiffness()[*t] != k;
-                spare.tendon_stiffness_mut()[*t] = k;
-            }
-            if changed {
-                // MuJoCo reads model parameters at every step: swapping in the copy with the
-                // new stiffness (same layout, checked) changes it for this step.
-                spare = sim
-                    .data
-                    .try_swap_model(spare)
-                    .map_err(|e| mujoco_err(format!("model swap failed: {e}")))?;
-            }
-            sim.spare = Some(spare);
+            let mid = law.depends_on().map_or(0.0, |i| q[i] + 0.5 * h_s * qd[i]);
+            let dk = law.at(mid) - k_ref;
+            sim.data.ctrl_mut()[*actuator] = -dk;
         }
         sim.data.step();
         sim.time_s += h_s;

@@ -221,7 +221,7 @@ pub fn rk4_interval(
 /// - belt (rotor -> carriage): `belt` stiffness, 7.2 N s/m (zeta ~0.02);
 /// - carriage 0.2 kg, toolhead 0.5 kg on a 100 kN/m mount with 22.4 N s/m (zeta ~0.05).
 ///
-/// With a 160 kN/m belt the lowest mode is near 39 Hz, the fastest near 350 Hz.
+/// With a 160 kN/m belt the undamped modes are 48, 158 and 282 Hz.
 pub fn printer_axis(belt: Stiffness, driver_spring: bool) -> Lumped {
     let r = 20.0 * 0.002 / std::f64::consts::TAU;
     let body = |name: &str, kind, inertia| Body {
