@@ -12,6 +12,7 @@ mod modal;
 mod mode;
 #[cfg(feature = "mujoco")]
 pub mod mujoco;
+pub mod mujoco_status;
 mod plant;
 
 pub use error::SimError;

@@ -33,6 +33,10 @@ fn moves(d: f64) -> Vec<(&'static str, Profile)> {
 /// MuJoCo through the Plant trait: coordinates after every interval.
 fn mujoco_trace(l: &Lumped, profile: &Profile, intervals: &[Interval]) -> Vec<Vec<f64>> {
     let plant = MujocoPlant::new(l, MujocoConfig::default()).expect("plant");
+    trace_on(&plant, profile, intervals)
+}
+
+fn trace_on(plant: &MujocoPlant, profile: &Profile, intervals: &[Interval]) -> Vec<Vec<f64>> {
     let mut st = plant.initial_state(&profile.start());
     intervals
         .iter()
@@ -311,4 +315,25 @@ fn the_mjcf_maps_every_part_of_the_lumped_model() {
         "{}",
         sim.qd()[0]
     );
+}
+
+#[test]
+fn plants_can_run_on_worker_threads() {
+    fn send_sync<T: Send + Sync>() {}
+    fn send<T: Send>() {}
+    send_sync::<MujocoPlant>();
+    send::<settle_sim::mujoco::MujocoSim>();
+    // Two threads running one shared plant at once give the numbers of a lone run.
+    let plant = MujocoPlant::new(&printer_axis(belt_spans(), true), MujocoConfig::default())
+        .expect("plant");
+    let (_, profile) = moves(0.05).remove(1);
+    let ivs = schedule(&profile, DT, profile.duration_s() + 0.05);
+    let alone = trace_on(&plant, &profile, &ivs);
+    let (a, b) = std::thread::scope(|s| {
+        let a = s.spawn(|| trace_on(&plant, &profile, &ivs));
+        let b = s.spawn(|| trace_on(&plant, &profile, &ivs));
+        (a.join().expect("thread"), b.join().expect("thread"))
+    });
+    assert_eq!(alone, a);
+    assert_eq!(alone, b);
 }
