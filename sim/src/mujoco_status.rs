@@ -24,12 +24,10 @@ pub fn require() -> Result<(), SimError> {
 mod tests {
     #[test]
     fn require_matches_the_feature() {
-        match super::require() {
-            Ok(()) => assert!(cfg!(feature = "mujoco")),
-            Err(e) => {
-                assert!(!cfg!(feature = "mujoco"));
-                assert!(e.to_string().contains("scripts/setup-mujoco.sh"), "{e}");
-            }
+        let r = super::require();
+        assert_eq!(r.is_ok(), super::BUILT);
+        if let Err(e) = r {
+            assert!(e.to_string().contains("scripts/setup-mujoco.sh"), "{e}");
         }
     }
 }
