@@ -284,7 +284,7 @@ impl MujocoModel {
 
     /// One MuJoCo step of exactly `h_s` seconds. `cmd` is the commanded sample at the step
     /// start; its jerk is constant over the step. The driver force set with
-    /// [`MujocoSim::set_drive`] is held over the step.
+    /// [`MujocoModel::set_drive`] is held over the step.
     pub fn step(&self, sim: &mut MujocoSim, cmd: &Sample, h_s: f64) -> Result<(), SimError> {
         if !(h_s.is_finite() && h_s > 0.0) {
             return Err(SimError::InvalidStep { dt_s: h_s });
