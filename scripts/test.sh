@@ -1,10 +1,15 @@
 #!/usr/bin/env bash
-# The whole test suite: formatting, lints, every test. Installs nothing system-wide; what
-# it needs comes from crates.io through cargo. Used verbatim by CI (.ci/run).
+# The whole test suite: formatting, lints, every test, a fuzz smoke run. Installs what it
+# needs without root: crates from crates.io through cargo, libmujoco 3.17.0 from its PyPI
+# wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), cargo-fuzz. Used verbatim by CI
+# (.ci/run).
 #
 # Environment:
-#   SETTLE_PLANNER_CASES  random planner cases (default 100000)
+#   SETTLE_PLANNER_CASES  random planner cases (default 100000; see the README for the rest)
 #   SETTLE_SIM_CASES      random modal-plant cases (default 2000)
+#   SETTLE_MUJOCO=0       skip the MuJoCo backend (otherwise it is fetched when missing and
+#                         every test runs with the `mujoco` feature)
+#   SETTLE_FUZZ_SECONDS   fuzz smoke time per target (default 15)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -13,11 +18,21 @@ if ! command -v cargo >/dev/null; then
   exit 1
 fi
 
+features=()
+if [[ "${SETTLE_MUJOCO:-1}" != 0 ]]; then
+  echo "== MuJoCo library (scripts/setup-mujoco.sh)"
+  scripts/setup-mujoco.sh
+  features=(--features mujoco)
+fi
+
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
-echo "== cargo clippy"
+echo "== cargo clippy (default features, then with MuJoCo)"
 cargo clippy --workspace --all-targets --locked -- -D warnings
+if [[ ${#features[@]} -gt 0 ]]; then
+  cargo clippy --workspace --all-targets --locked "${features[@]}" -- -D warnings
+fi
 echo "== cargo test (release: the property suites are numeric-heavy)"
-cargo test --workspace --release --locked
+cargo test --workspace --release --locked "${features[@]}"
 echo "== fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
 scripts/fuzz.sh "${SETTLE_FUZZ_SECONDS:-15}"

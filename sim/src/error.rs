@@ -34,4 +34,10 @@ pub enum SimError {
         /// Simulation time of the step that produced it (s).
         t_s: f64,
     },
+    /// The MuJoCo library rejected the generated model or failed while stepping.
+    #[error("MuJoCo: {what}")]
+    Mujoco {
+        /// What MuJoCo reported.
+        what: String,
+    },
 }

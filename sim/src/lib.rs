@@ -10,6 +10,9 @@ mod error;
 pub mod lumped;
 mod modal;
 mod mode;
+#[cfg(feature = "mujoco")]
+pub mod mujoco;
+pub mod mujoco_status;
 mod plant;
 
 pub use error::SimError;
