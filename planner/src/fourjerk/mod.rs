@@ -97,14 +97,17 @@ fn valid(start: State, segs: &[Segment], l: &FourJerkLimits) -> bool {
         if a0 > amax || a0 < amin || e.a > amax || e.a < amin {
             return false;
         }
+        // The velocity's monotone pieces: split where the acceleration crosses zero.
         let mut ends = [s.v, e.v, e.v];
+        let mut n = 2;
         if j != 0.0 {
             let tau = -a0 / j;
             if tau > 0.0 && tau < seg.duration_s() {
                 ends[1] = seg.sample(&s, tau).v;
+                n = 3;
             }
         }
-        for w in ends.windows(2) {
+        for w in ends[..n].windows(2) {
             let (va, vb) = (w[0], w[1]);
             if inside {
                 if vb.abs() > vl {

@@ -9,7 +9,8 @@
 //!   once inside it stays inside;
 //! - a start that is unsafe (velocity outside, or the velocity after ramping the
 //!   acceleration to zero at once outside) may only brake: lower the acceleration at full
-//!   jerk or hold `-dmax` (mirrored for a negative overshoot); after the first segment that
+//!   jerk or hold `-dmax` (mirrored for a negative overshoot) until the velocity after
+//!   ramping the acceleration to zero is back inside; after the first segment that
 //!   is not braking, a velocity outside the band must move strictly monotonically towards
 //!   it (no cruise out there) and,
 //!   once inside, stay inside. Velocities are checked on the monotone pieces of each
@@ -109,18 +110,29 @@ pub fn check(start: State, segs: &[Segment], l: &FourJerkLimits) -> Result<(), S
                 s = e;
                 continue;
             }
+            // Braking may only stop once the velocity after ramping the acceleration to
+            // zero at once is back inside (seed 004 step 2: brake until that holds).
+            let vz = v_zero(&s, l);
+            if vz.abs() > vl {
+                return Err(format!(
+                    "segment {k}: stops braking with vz = {vz} beyond the limit"
+                ));
+            }
             braking = 0.0;
             inside = s.v.abs() <= vl;
         }
         // Velocity on monotone pieces.
+        // The velocity's monotone pieces: split where the acceleration crosses zero.
         let mut ends = [s.v, e.v, e.v];
+        let mut n = 2;
         if j != 0.0 {
             let tau = -a0 / j;
             if tau > 0.0 && tau < seg.duration_s() {
                 ends[1] = seg.sample(&s, tau).v;
+                n = 3;
             }
         }
-        for w in ends.windows(2) {
+        for w in ends[..n].windows(2) {
             let (va, vb) = (w[0], w[1]);
             if inside {
                 if vb.abs() > vl {
