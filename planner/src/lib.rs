@@ -7,20 +7,28 @@
 //! No I/O, no clocks, no simulation types. Units are whatever the caller uses consistently
 //! (settle's harness uses metres and seconds).
 
+mod arcs;
+mod blend;
 mod brake;
 pub mod duration;
 mod error;
+mod fastest;
+mod fixed;
+mod four_arcs;
 mod kind;
 mod limits;
+#[cfg(test)]
+mod oracle;
+mod poly;
 pub mod position;
 mod profile;
-mod roots;
 pub mod scurve;
-mod stretch;
+mod second_order;
+mod segs;
 pub mod sync;
-mod three_arc;
 mod trajectory;
 pub mod trapezoid;
+mod unit;
 pub mod velocity;
 
 pub use error::PlanError;
