@@ -172,13 +172,22 @@ fn none(u: &Unit, sign: f64, out: &mut impl Sink) {
     let s_v = if w >= k { rw + (w - k).sqrt() } else { 0.0 };
     hi = hi.min(s_v.max(k.max(0.0).sqrt()));
     hi = hi.min(0.5 * (out.t_max() - af + a0));
+    if lo > hi {
+        return;
+    }
     let (lo, hi) = pad(lo, hi);
     let c1 = 4.0 * k * af + 4.0 / 3.0 * a0 * a0 * a0 - 2.0 * a0 * a0 * af - 4.0 * a0 * v0
         + 2.0 / 3.0 * af * af * af
         + 4.0 * af * v0
         - 4.0 * u.dp;
     let c2 = 4.0 * k - 4.0 * a0 * a0 + 8.0 * v0;
-    for &s in roots_in(&[-k * k, c1, c2, 0.0, 1.0], lo, hi).as_slice() {
+    // With K = 0 (e.g. rest to rest) the quartic is s times a cubic: drop the factor.
+    let roots = if k == 0.0 {
+        roots_in(&[c1, c2, 0.0, 1.0], lo, hi)
+    } else {
+        roots_in(&[-k * k, c1, c2, 0.0, 1.0], lo, hi)
+    };
+    for &s in roots.as_slice() {
         if s < 0.0 || (s == 0.0 && k != 0.0) {
             continue;
         }
@@ -212,6 +221,17 @@ fn acc0(u: &Unit, sign: f64, out: &mut impl Sink) {
     // Velocity peak (x < 0): v0 + amax^2 - a0^2/2 + x^2 - m <= vmax.
     let mv = u.vmax - v0 - amax * amax + 0.5 * a0 * a0 + m;
     lo = lo.max(if mv >= 0.0 { -mv.sqrt() } else { 0.0 });
+    // h1 >= 0 keeps x out of (-sqrt(m), sqrt(m)): up to two intervals, in order of duration
+    // (descending x).
+    let r = m.max(0.0).sqrt();
+    let parts = if m <= 0.0 {
+        [(lo, hi), (1.0, 0.0)]
+    } else {
+        [(lo.max(r), hi), (lo, hi.min(-r))]
+    };
+    if parts.iter().all(|(l, h)| l > h) {
+        return;
+    }
     let c0 = -0.25 * a0.powi(4) + 2.0 / 3.0 * a0.powi(3) * amax - 0.5 * a0 * a0 * amax * amax
         + a0 * a0 * v0
         - 2.0 * a0 * amax * v0
@@ -230,7 +250,10 @@ fn acc0(u: &Unit, sign: f64, out: &mut impl Sink) {
         -2.0 * amax,
         1.0,
     ];
-    let try_roots = |lo: f64, hi: f64, out: &mut _| {
+    for (lo, hi) in parts {
+        if lo > hi {
+            continue;
+        }
         let (lo, hi) = pad(lo, hi);
         for &x in roots_in(&c, lo, hi).as_slice().iter().rev() {
             let h1 = (x * x - m) / amax;
@@ -242,17 +265,8 @@ fn acc0(u: &Unit, sign: f64, out: &mut impl Sink) {
                 x,
                 out,
             ) {
-                return true;
+                return;
             }
-        }
-        false
-    };
-    if m <= 0.0 {
-        try_roots(lo, hi, out);
-    } else {
-        let r = m.sqrt();
-        if !try_roots(lo.max(r), hi, out) {
-            try_roots(lo, hi.min(-r), out);
         }
     }
 }
@@ -279,6 +293,17 @@ fn acc1(u: &Unit, sign: f64, out: &mut impl Sink) {
     }
     // Velocity peak (x > 0): v0 + x^2 - a0^2/2 <= vmax.
     hi = hi.min((u.vmax - v0 + 0.5 * a0 * a0).max(0.0).sqrt());
+    // h2 >= 0 keeps x out of (-sqrt(m), sqrt(m)): up to two intervals, in order of duration
+    // (ascending x).
+    let r = m.max(0.0).sqrt();
+    let parts = if m <= 0.0 {
+        [(lo, hi), (1.0, 0.0)]
+    } else {
+        [(lo, hi.min(-r)), (lo.max(r), hi)]
+    };
+    if parts.iter().all(|(l, h)| l > h) {
+        return;
+    }
     let c0 = 0.25 * a0.powi(4)
         - 2.0 / 3.0 * a0.powi(3) * amin
         - 0.5 * a0 * a0 * amin * amin
@@ -299,7 +324,10 @@ fn acc1(u: &Unit, sign: f64, out: &mut impl Sink) {
         -2.0 * amin,
         1.0,
     ];
-    let try_roots = |lo: f64, hi: f64, out: &mut _| {
+    for (lo, hi) in parts {
+        if lo > hi {
+            continue;
+        }
         let (lo, hi) = pad(lo, hi);
         for &x in roots_in(&c, lo, hi).as_slice() {
             let h2 = (x * x - m) / (-amin);
@@ -311,17 +339,8 @@ fn acc1(u: &Unit, sign: f64, out: &mut impl Sink) {
                 amin,
                 out,
             ) {
-                return true;
+                return;
             }
-        }
-        false
-    };
-    if m <= 0.0 {
-        try_roots(lo, hi, out);
-    } else {
-        let r = m.sqrt();
-        if !try_roots(lo, hi.min(-r), out) {
-            try_roots(lo.max(r), hi, out);
         }
     }
 }
@@ -338,6 +357,9 @@ fn acc0_acc1(u: &Unit, sign: f64, out: &mut impl Sink) {
     if t_max.is_finite() {
         let t0 = 2.0 * amax - a0 - 2.0 * amin + af + (dv - e) / amin;
         hi = hi.min((t_max - t0) / (1.0 - amax / amin));
+    }
+    if lo > hi {
+        return;
     }
     let n = 0.25 * a0.powi(4) - 2.0 / 3.0 * a0.powi(3) * amin - a0 * a0 * amax * amax
         + 2.0 * a0 * a0 * amax * amin

@@ -6,7 +6,6 @@
 //! mixture of their end states.
 
 use crate::Segment;
-use crate::segs::Segs;
 
 /// A cursor over one profile's segments: the current segment, the time left in it, and
 /// the acceleration the profile has now.
@@ -66,7 +65,13 @@ impl<'a> Cursor<'a> {
 
 /// `lambda x + (1 - lambda) y` for profiles `x`, `y` starting with acceleration `a0` and
 /// lasting the same time (up to rounding).
-pub(crate) fn blend(x: &[Segment], y: &[Segment], a0: f64, lambda: f64, out: &mut Segs) {
+pub(crate) fn blend(
+    x: &[Segment],
+    y: &[Segment],
+    a0: f64,
+    lambda: f64,
+    out: &mut impl Extend<Segment>,
+) {
     let mu = 1.0 - lambda;
     let (mut cx, mut cy) = (Cursor::new(x, a0), Cursor::new(y, a0));
     let mut a_out = a0;
@@ -84,16 +89,16 @@ pub(crate) fn blend(x: &[Segment], y: &[Segment], a0: f64, lambda: f64, out: &mu
         let a_mix = lambda * cx.a + mu * cy.a;
         if hx && hy {
             // Both hold (or jump to) a set acceleration: hold the mixture exactly.
-            out.push(Segment::Accel {
+            out.extend([Segment::Accel {
                 duration_s: d,
                 accel: a_mix,
-            });
+            }]);
             a_out = a_mix;
         } else {
-            out.push(Segment::Jerk {
+            out.extend([Segment::Jerk {
                 duration_s: d,
                 jerk: lambda * jx + mu * jy,
-            });
+            }]);
             a_out += (lambda * jx + mu * jy) * d;
         }
         cx.advance(d);
@@ -102,16 +107,17 @@ pub(crate) fn blend(x: &[Segment], y: &[Segment], a0: f64, lambda: f64, out: &mu
     let a_end = lambda * cx.a + mu * cy.a;
     if a_end != a_out && matches!(x.last(), Some(Segment::Accel { .. })) {
         // Trapezoids end with a jump to the target acceleration.
-        out.push(Segment::Accel {
+        out.extend([Segment::Accel {
             duration_s: 0.0,
             accel: a_end,
-        });
+        }]);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::segs::Segs;
     use crate::{Profile, State};
 
     #[test]

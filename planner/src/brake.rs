@@ -188,6 +188,18 @@ impl BrakeLaw {
     }
 }
 
+/// Does `start` need a brake: acceleration beyond its limits, velocity beyond them, or
+/// bound to overshoot them (`v + a|a|/(2j)` beyond)?
+pub(crate) fn needed(start: &State, lim: &Limits, j: f64) -> bool {
+    let vz = start.v + start.a * start.a.abs() / (2.0 * j);
+    !(start.a <= lim.amax()
+        && start.a >= lim.amin()
+        && start.v <= lim.vmax()
+        && start.v >= lim.vmin()
+        && vz <= lim.vmax()
+        && vz >= lim.vmin())
+}
+
 /// The shortest brake (stop as soon as `vz` is back on the limit).
 pub(crate) fn brake(start: State, lim: &Limits, j: f64) -> (Segs, State) {
     let law = BrakeLaw::new(start, lim, j);

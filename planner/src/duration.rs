@@ -9,7 +9,7 @@
 //! `branch_starts` or lies above one of them. Jerk unlimited: the same with `second_order`.
 
 use crate::brake::BrakeLaw;
-use crate::position::{Shape, assemble, bounds, check_target, finite_state, pre, verify};
+use crate::position::{Shape, assemble, bounds, check_target, finish, finite_state, pre, verify};
 use crate::segs::Segs;
 use crate::unit::{Scale, Unit};
 use crate::velocity::Bounds;
@@ -60,19 +60,24 @@ pub fn with_duration(
     duration_s: f64,
 ) -> Result<Option<Profile>, PlanError> {
     let b = prepare(target, start, lim, shape)?;
+    let mut segs = Vec::with_capacity(16);
     if b.jmax.is_infinite() {
         let (pre_segs, s) = pre(start, lim, &b);
         let rest = duration_s - pre_segs.duration_s();
-        if !(rest >= 0.0) {
+        segs.extend_from_slice(pre_segs.as_slice());
+        if !(rest >= 0.0) || !crate::second_order::lasting(&s, &target, lim, rest, &mut segs) {
             return Ok(None);
         }
-        let Some(body) = crate::second_order::lasting(&s, &target, lim, rest) else {
-            return Ok(None);
-        };
-        let prof = assemble(start, &[pre_segs.as_slice(), body.as_slice()])?;
-        return verify(prof, &target, lim, true).map(Some);
+        return verify(finish(start, segs)?, &target, lim, true).map(Some);
     }
     let sc = Scale::new(lim, b.jmax);
+    if !crate::brake::needed(&start, lim, b.jmax) {
+        let u = Unit::new(&start, &target, lim, &sc);
+        if !crate::fixed::lasting(&u, duration_s / sc.t, &sc, &mut segs) {
+            return Ok(None);
+        }
+        return verify(finish(start, segs)?, &target, lim, true).map(Some);
+    }
     let law = BrakeLaw::new(start, lim, b.jmax);
     for tau in law.candidate_times() {
         let rest = duration_s - tau;
@@ -80,10 +85,11 @@ pub fn with_duration(
             continue;
         }
         let u = Unit::new(&law.state_at(tau, lim), &target, lim, &sc);
-        if let Some(body) = crate::fixed::lasting(&u, rest / sc.t, &sc) {
-            let (pre_segs, _) = law.until(tau);
-            let prof = assemble(start, &[pre_segs.as_slice(), body.as_slice()])?;
-            return verify(prof, &target, lim, true).map(Some);
+        let (pre_segs, _) = law.until(tau);
+        segs.clear();
+        segs.extend_from_slice(pre_segs.as_slice());
+        if crate::fixed::lasting(&u, rest / sc.t, &sc, &mut segs) {
+            return verify(finish(start, segs)?, &target, lim, true).map(Some);
         }
     }
     Ok(None)

@@ -20,6 +20,7 @@
 //! lowest end position (otherwise `T` lies in a blocked interval), and mixes the two. When
 //! `dp` is (within rounding) one member's own end position, that member is the profile.
 
+use crate::Segment;
 use crate::arcs::{Arcs, Sink, check};
 use crate::fastest::{Cand, cruise_lasting};
 use crate::segs::Segs;
@@ -58,9 +59,9 @@ impl Sink for Extremes {
     }
 }
 
-/// Segments (physical units) of a profile from the safe state of `u` lasting `t`
-/// (normalised) and reaching the target, or `None` if no such profile exists.
-pub(crate) fn lasting(u: &Unit, t: f64, sc: &Scale) -> Option<Segs> {
+/// Append the segments (physical units) of a profile from the start of `u` lasting `t`
+/// (normalised) and reaching the target; false (nothing appended) if none exists.
+pub(crate) fn lasting(u: &Unit, t: f64, sc: &Scale, out: &mut Vec<Segment>) -> bool {
     let mut ex = Extremes {
         hi: None,
         lo: None,
@@ -76,24 +77,25 @@ pub(crate) fn lasting(u: &Unit, t: f64, sc: &Scale) -> Option<Segs> {
     if !u.safe() {
         unsafe_members(u, t, &mut ex);
     }
-    let ((p_hi, hi), (p_lo, lo)) = (ex.hi?, ex.lo?);
+    let (Some((p_hi, hi)), Some((p_lo, lo))) = (ex.hi, ex.lo) else {
+        return false;
+    };
     let tol = 1e-12 * (1.0 + p_hi.abs().max(p_lo.abs()).max(u.dp.abs()));
     if u.dp > p_hi + tol || u.dp < p_lo - tol {
-        return None;
+        return false;
     }
-    let mut out = Segs::default();
     if (p_hi - u.dp).abs() <= tol || p_hi - p_lo <= tol {
-        hi.segments(sc, &mut out);
+        hi.segments(sc, out);
     } else if (u.dp - p_lo).abs() <= tol {
-        lo.segments(sc, &mut out);
+        lo.segments(sc, out);
     } else {
         let (mut x, mut y) = (Segs::default(), Segs::default());
         hi.segments(sc, &mut x);
         lo.segments(sc, &mut y);
         let lambda = ((u.dp - p_lo) / (p_hi - p_lo)).clamp(0.0, 1.0);
-        crate::blend::blend(x.as_slice(), y.as_slice(), u.a0 * sc.a, lambda, &mut out);
+        crate::blend::blend(x.as_slice(), y.as_slice(), u.a0 * sc.a, lambda, out);
     }
-    Some(out)
+    true
 }
 
 /// From a state that must leave the velocity limits whatever it does (the brake could not

@@ -22,6 +22,7 @@ mod oracle;
 mod poly;
 pub mod position;
 mod profile;
+mod ramp;
 pub mod scurve;
 mod second_order;
 mod segs;

@@ -54,26 +54,62 @@ fn magnitude(c: &[f64], x: f64) -> f64 {
     c.iter().rev().fold(0.0, |m, ck| m * ax + ck.abs())
 }
 
-/// True if `c` has no root in `[lo, hi]` by a Taylor bound around the midpoint.
-fn excluded(c: &[f64], lo: f64, hi: f64) -> bool {
-    let m = 0.5 * (lo + hi);
-    let r = 0.5 * (hi - lo);
-    // Taylor coefficients at m by repeated synthetic division.
-    let mut t = [0.0; MAX_DEG + 1];
+/// Binomial coefficients `C(n, k)` for `n <= MAX_DEG`.
+const BINOM: [[f64; MAX_DEG + 1]; MAX_DEG + 1] = {
+    let mut b = [[0.0; MAX_DEG + 1]; MAX_DEG + 1];
+    let mut n = 0;
+    while n <= MAX_DEG {
+        b[n][0] = 1.0;
+        let mut k = 1;
+        while k <= n {
+            b[n][k] = b[n - 1][k - 1] + if k < n { b[n - 1][k] } else { 0.0 };
+            k += 1;
+        }
+        n += 1;
+    }
+    b
+};
+
+/// Sign changes of `c`'s Bernstein coefficients on `[lo, hi]`: `Some(0)` or `Some(1)` when
+/// that count is certain despite rounding, `None` otherwise (more, or too close to call).
+fn bernstein_changes(c: &[f64], lo: f64, hi: f64) -> Option<usize> {
     let n = c.len() - 1;
-    t[..=n].copy_from_slice(c);
+    // Coefficients of c(lo + h t), t in [0, 1]: Taylor shift, then scale.
+    let mut d = [0.0; MAX_DEG + 1];
+    d[..=n].copy_from_slice(c);
     for k in 0..n {
         for i in (k..n).rev() {
-            t[i] += m * t[i + 1];
+            d[i] += lo * d[i + 1];
         }
     }
-    let mut bound = 0.0;
-    let mut rk = 1.0;
-    for tk in &t[1..=n] {
-        rk *= r;
-        bound += tk.abs() * rk;
+    let h = hi - lo;
+    let mut hk = 1.0;
+    let mut size = 0.0;
+    for dk in &mut d[..=n] {
+        *dk *= hk;
+        hk *= h;
+        size += dk.abs();
     }
-    t[0].abs() > bound * (1.0 + 1e-12) + 1e-300
+    let tol = 64.0 * f64::EPSILON * size;
+    let mut changes = 0;
+    let mut last = 0.0;
+    for i in 0..=n {
+        let mut b = 0.0;
+        for k in 0..=i {
+            b += BINOM[i][k] / BINOM[n][k] * d[k];
+        }
+        if b.abs() <= tol {
+            return None;
+        }
+        if last != 0.0 && (b < 0.0) != (last < 0.0) {
+            changes += 1;
+            if changes > 1 {
+                return None;
+            }
+        }
+        last = b;
+    }
+    Some(changes)
 }
 
 /// The roots of `c` (lowest degree first, degree `c.len() - 1 <= 6`) in `[lo, hi]`,
@@ -99,8 +135,14 @@ pub(crate) fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
         }
         2 => quadratic(c, lo, hi, &mut out),
         _ => {
-            if excluded(c, lo, hi) {
-                return out;
+            match bernstein_changes(c, lo, hi) {
+                Some(0) => return out,
+                Some(_) => {
+                    let fa = eval_d(c, lo).0;
+                    out.push(refine(c, lo, hi, fa));
+                    return out;
+                }
+                None => {}
             }
             let mut d = [0.0; MAX_DEG];
             for k in 1..=n {
@@ -180,11 +222,20 @@ fn isolate(c: &[f64], lo: f64, hi: f64, crit: &[f64], out: &mut Roots) {
 }
 
 /// The root of `c` in `[a, b]` where `c(a) = fa` and `c(b)` differ in sign and `c` is
-/// monotone: Newton's method kept inside the bracket.
+/// monotone: Newton's method kept inside the bracket, to full precision.
 fn refine(c: &[f64], a: f64, b: f64, fa: f64) -> f64 {
     let (mut lo, mut hi) = (a, b);
     let neg_lo = fa < 0.0;
-    let mut x = 0.5 * (lo + hi);
+    let fb = eval_d(c, b).0;
+    let mut x = if fb != fa {
+        a - fa * (b - a) / (fb - fa)
+    } else {
+        0.5 * (a + b)
+    };
+    if !(x > a && x < b) {
+        x = 0.5 * (a + b);
+    }
+    let tol = 2.0 * f64::EPSILON * a.abs().max(b.abs());
     for _ in 0..100 {
         let (f, d) = eval_d(c, x);
         if f == 0.0 {
@@ -201,7 +252,7 @@ fn refine(c: &[f64], a: f64, b: f64, fa: f64) -> f64 {
         }
         let step = (next - x).abs();
         x = next;
-        if step <= 2.0 * f64::EPSILON * x.abs() || hi - lo <= 2.0 * f64::EPSILON * x.abs() {
+        if step <= tol.max(2.0 * f64::EPSILON * x.abs()) || hi - lo <= tol {
             break;
         }
     }

@@ -180,26 +180,97 @@ pub fn to_state(
     lim: &Limits,
     shape: Shape,
 ) -> Result<Profile, PlanError> {
+    plan(start, target, lim, shape)?.profile()
+}
+
+/// The fastest profile of one axis, planned but not yet written out as a [`Profile`]
+/// (several axes only need the slowest one's).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Planned {
+    start: State,
+    target: State,
+    lim: Limits,
+    duration_s: f64,
+    how: How,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum How {
+    /// Jerk limited: brake until `tau`, then `cand` (normalised by `sc`).
+    Jerk {
+        sc: Scale,
+        tau: f64,
+        cand: crate::fastest::Cand,
+    },
+    /// Jerk unlimited: clamp the velocity, then `trap`.
+    Trap(crate::second_order::Trap),
+}
+
+impl Planned {
+    /// Duration (s).
+    pub(crate) fn duration_s(&self) -> f64 {
+        self.duration_s
+    }
+
+    /// The profile, checked to reach the target.
+    pub(crate) fn profile(&self) -> Result<Profile, PlanError> {
+        let mut segs = Vec::with_capacity(12);
+        match self.how {
+            How::Jerk { sc, tau, cand } => {
+                if tau > 0.0 {
+                    let (pre_segs, _) = BrakeLaw::new(self.start, &self.lim, sc.j).until(tau);
+                    segs.extend_from_slice(pre_segs.as_slice());
+                }
+                cand.segments(&sc, &mut segs);
+            }
+            How::Trap(trap) => {
+                let b = bounds(&self.lim, Shape::Trapezoid)?;
+                segs.extend_from_slice(pre(self.start, &self.lim, &b).0.as_slice());
+                trap.segments(&mut segs);
+            }
+        }
+        verify(finish(self.start, segs)?, &self.target, &self.lim, true)
+    }
+}
+
+/// Step 1 for one axis: validate, brake, and find the fastest profile.
+pub(crate) fn plan(
+    start: State,
+    target: State,
+    lim: &Limits,
+    shape: Shape,
+) -> Result<Planned, PlanError> {
     finite_state("start", &start)?;
     finite_state("target", &target)?;
     let b = bounds(lim, shape)?;
     check_target(&target, lim, &b)?;
+    let none = PlanError::NoSolution {
+        reason: "no peak velocity reaches the target",
+    };
+    let planned = |duration_s, how| Planned {
+        start,
+        target,
+        lim: *lim,
+        duration_s,
+        how,
+    };
     if b.jmax.is_infinite() {
         let (pre_segs, s) = pre(start, lim, &b);
-        let mut body = Segs::default();
-        crate::second_order::fastest(&s, &target, lim)
-            .ok_or(PlanError::NoSolution {
-                reason: "no peak velocity reaches the target",
-            })?
-            .segments(lim, &mut body);
-        return verify(
-            assemble(start, &[pre_segs.as_slice(), body.as_slice()])?,
-            &target,
-            lim,
-            true,
-        );
+        let trap = crate::second_order::fastest(&s, &target, lim).ok_or(none)?;
+        return Ok(planned(
+            pre_segs.duration_s() + trap.duration(),
+            How::Trap(trap),
+        ));
     }
     let sc = Scale::new(lim, b.jmax);
+    if !crate::brake::needed(&start, lim, b.jmax) {
+        let u = Unit::new(&start, &target, lim, &sc);
+        let cand = crate::fastest::fastest(&u, f64::INFINITY).ok_or(none)?;
+        return Ok(planned(
+            cand.duration() * sc.t,
+            How::Jerk { sc, tau: 0.0, cand },
+        ));
+    }
     let law = BrakeLaw::new(start, lim, b.jmax);
     // (total duration, brake stopping time, profile after the brake)
     let mut best: Option<(f64, f64, crate::fastest::Cand)> = None;
@@ -214,18 +285,24 @@ pub fn to_state(
             }
         }
     }
-    let (_, tau, c) = best.ok_or(PlanError::NoSolution {
-        reason: "no peak velocity reaches the target",
-    })?;
-    let (pre_segs, _) = law.until(tau);
-    let mut body = Segs::default();
-    c.segments(&sc, &mut body);
-    verify(
-        assemble(start, &[pre_segs.as_slice(), body.as_slice()])?,
-        &target,
-        lim,
-        true,
-    )
+    let (total, tau, cand) = best.ok_or(none)?;
+    Ok(planned(total, How::Jerk { sc, tau, cand }))
+}
+
+/// The profile from `start` through `segs`, dropping zero-duration segments except a
+/// constant-acceleration one that changes the acceleration (as [`assemble`], in place).
+pub(crate) fn finish(start: State, mut segs: Vec<Segment>) -> Result<Profile, PlanError> {
+    let mut a = start.a;
+    segs.retain(|seg| {
+        let keep =
+            seg.duration_s() > 0.0 || matches!(*seg, Segment::Accel { accel, .. } if accel != a);
+        a = match *seg {
+            Segment::Jerk { duration_s, jerk } => a + jerk * duration_s,
+            Segment::Accel { accel, .. } => accel,
+        };
+        keep
+    });
+    Profile::new(start, segs)
 }
 
 /// Last line of defence: a profile is only returned if it really ends on the target (and

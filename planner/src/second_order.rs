@@ -50,23 +50,25 @@ impl Trap {
     }
 
     /// Append the segments.
-    pub(crate) fn segments(&self, _lim: &Limits, out: &mut Segs) {
-        out.push(Segment::Accel {
-            duration_s: self.t1,
-            accel: self.a1,
-        });
-        out.push(Segment::Accel {
-            duration_s: self.cruise,
-            accel: 0.0,
-        });
-        out.push(Segment::Accel {
-            duration_s: self.t2,
-            accel: self.a2,
-        });
-        out.push(Segment::Accel {
-            duration_s: 0.0,
-            accel: self.af,
-        });
+    pub(crate) fn segments(&self, out: &mut impl Extend<Segment>) {
+        out.extend([
+            Segment::Accel {
+                duration_s: self.t1,
+                accel: self.a1,
+            },
+            Segment::Accel {
+                duration_s: self.cruise,
+                accel: 0.0,
+            },
+            Segment::Accel {
+                duration_s: self.t2,
+                accel: self.a2,
+            },
+            Segment::Accel {
+                duration_s: 0.0,
+                accel: self.af,
+            },
+        ]);
     }
 }
 
@@ -161,27 +163,37 @@ fn extreme(v0: f64, vf: f64, af: f64, lim: &Limits, t: f64, mirror: bool) -> Opt
     })
 }
 
-/// Segments of a profile from `s` lasting `t` and reaching `target`, or `None`.
-pub(crate) fn lasting(s: &State, target: &State, lim: &Limits, t: f64) -> Option<Segs> {
+/// Append the segments of a profile from `s` lasting `t` and reaching `target`; false
+/// (nothing appended) if there is none.
+pub(crate) fn lasting(
+    s: &State,
+    target: &State,
+    lim: &Limits,
+    t: f64,
+    out: &mut Vec<Segment>,
+) -> bool {
     let (v0, vf, af) = (s.v, target.v, target.a);
     let dp = target.p - s.p;
-    let hi = extreme(v0, vf, af, lim, t, false)?;
-    let lo = extreme(v0, vf, af, lim, t, true)?;
+    let (Some(hi), Some(lo)) = (
+        extreme(v0, vf, af, lim, t, false),
+        extreme(v0, vf, af, lim, t, true),
+    ) else {
+        return false;
+    };
     let tol = 1e-12 * hi.dist.abs().max(lo.dist.abs()).max(dp.abs()).max(1e-300);
     if dp > hi.dist + tol || dp < lo.dist - tol {
-        return None;
+        return false;
     }
-    let mut out = Segs::default();
     if (hi.dist - dp).abs() <= tol || hi.dist - lo.dist <= tol {
-        hi.segments(lim, &mut out);
+        hi.segments(out);
     } else if (dp - lo.dist).abs() <= tol {
-        lo.segments(lim, &mut out);
+        lo.segments(out);
     } else {
         let (mut x, mut y) = (Segs::default(), Segs::default());
-        hi.segments(lim, &mut x);
-        lo.segments(lim, &mut y);
+        hi.segments(&mut x);
+        lo.segments(&mut y);
         let lambda = ((dp - lo.dist) / (hi.dist - lo.dist)).clamp(0.0, 1.0);
-        crate::blend::blend(x.as_slice(), y.as_slice(), s.a, lambda, &mut out);
+        crate::blend::blend(x.as_slice(), y.as_slice(), s.a, lambda, out);
     }
-    Some(out)
+    true
 }

@@ -2,9 +2,9 @@
 
 use crate::Segment;
 
-/// Capacity: a brake (3) and the longest profile body (a blend of two seven-segment
-/// profiles with their breakpoints merged, 14) fit.
-const CAP: usize = 20;
+/// Capacity: the longest profile body (a blend of two seven-segment profiles with their
+/// breakpoints merged: at most 13 pieces) fits.
+const CAP: usize = 16;
 
 /// Up to [`CAP`] segments, without heap allocation.
 #[derive(Debug, Clone, Copy)]
@@ -41,5 +41,13 @@ impl Segs {
     /// Total duration (s).
     pub(crate) fn duration_s(&self) -> f64 {
         self.as_slice().iter().map(Segment::duration_s).sum()
+    }
+}
+
+impl Extend<Segment> for Segs {
+    fn extend<I: IntoIterator<Item = Segment>>(&mut self, iter: I) {
+        for seg in iter {
+            self.push(seg);
+        }
     }
 }

@@ -9,7 +9,7 @@
 //!   otherwise time synchronisation.
 
 use crate::duration::{branch_starts, with_duration};
-use crate::position::{Shape, to_state};
+use crate::position::{self, Planned, Shape};
 use crate::{Limits, PlanError, Profile, Segment, State};
 
 /// How axes are synchronised.
@@ -36,29 +36,37 @@ pub struct Axis {
 
 /// Plan all axes.
 pub fn plan(axes: &[Axis], shape: Shape, sync: Sync) -> Result<Vec<Profile>, PlanError> {
-    let fastest: Vec<Profile> = axes
+    let on_axis = |axis: usize| {
+        move |e: PlanError| PlanError::OnAxis {
+            axis,
+            source: Box::new(e),
+        }
+    };
+    let fastest: Vec<Planned> = axes
         .iter()
         .enumerate()
-        .map(|(i, a)| {
-            to_state(a.start, a.target, &a.limits, shape).map_err(|e| PlanError::OnAxis {
-                axis: i,
-                source: Box::new(e),
-            })
-        })
+        .map(|(i, a)| position::plan(a.start, a.target, &a.limits, shape).map_err(on_axis(i)))
         .collect::<Result<_, _>>()?;
+    let all = || -> Result<Vec<Profile>, PlanError> {
+        fastest
+            .iter()
+            .enumerate()
+            .map(|(i, p)| p.profile().map_err(on_axis(i)))
+            .collect()
+    };
     if sync == Sync::None || axes.len() <= 1 {
-        return Ok(fastest);
+        return all();
     }
     if sync == Sync::Phase
-        && let Some(profiles) = phase(axes, &fastest)
+        && let Some(profiles) = phase(axes, &all()?)
     {
         return Ok(profiles);
     }
     time(axes, shape, &fastest)
 }
 
-fn time(axes: &[Axis], shape: Shape, fastest: &[Profile]) -> Result<Vec<Profile>, PlanError> {
-    let t_min = fastest.iter().map(Profile::duration_s).fold(0.0, f64::max);
+fn time(axes: &[Axis], shape: Shape, fastest: &[Planned]) -> Result<Vec<Profile>, PlanError> {
+    let t_min = fastest.iter().map(Planned::duration_s).fold(0.0, f64::max);
     if let Some(out) = all_at(axes, shape, fastest, t_min)? {
         return Ok(out);
     }
@@ -88,13 +96,16 @@ fn time(axes: &[Axis], shape: Shape, fastest: &[Profile]) -> Result<Vec<Profile>
 fn all_at(
     axes: &[Axis],
     shape: Shape,
-    fastest: &[Profile],
+    fastest: &[Planned],
     t: f64,
 ) -> Result<Option<Vec<Profile>>, PlanError> {
     let mut out = Vec::with_capacity(axes.len());
-    for (a, f) in axes.iter().zip(fastest) {
+    for (i, (a, f)) in axes.iter().zip(fastest).enumerate() {
         if (f.duration_s() - t).abs() <= 1e-12 * t.max(1e-9) {
-            out.push(f.clone());
+            out.push(f.profile().map_err(|e| PlanError::OnAxis {
+                axis: i,
+                source: Box::new(e),
+            })?);
         } else if let Some(p) = with_duration(a.start, a.target, &a.limits, shape, t)? {
             out.push(p);
         } else {
