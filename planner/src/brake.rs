@@ -13,6 +13,7 @@
 //! the velocity itself is back inside (where Ruckig's brake stops). The planner tries
 //! several stopping times and keeps the fastest total.
 
+use crate::segs::Segs;
 use crate::{Limits, Segment, State};
 
 /// The brake control law from one start state, as segments up to the latest stopping
@@ -20,7 +21,7 @@ use crate::{Limits, Segment, State};
 #[derive(Debug, Clone)]
 pub struct BrakeLaw {
     start: State,
-    segs: Vec<Segment>,
+    segs: Segs,
     earliest_s: f64,
     latest_s: f64,
 }
@@ -28,7 +29,7 @@ pub struct BrakeLaw {
 impl BrakeLaw {
     /// The law for `start` under `lim` with jerk limit `j`.
     pub fn new(start: State, lim: &Limits, j: f64) -> Self {
-        let mut segs = Vec::new();
+        let mut segs = Segs::default();
         let mut s = start;
         let mut t = 0.0;
         let mut push = |seg: Segment, s: &mut State, t: &mut f64| {
@@ -136,23 +137,35 @@ impl BrakeLaw {
         }
     }
 
-    /// Stopping times to try: the earliest, the latest and evenly spaced ones between.
-    pub fn candidate_times(&self) -> Vec<f64> {
+    /// Stopping times to try: the earliest, the latest and evenly spaced ones between
+    /// (one time when the brake has no freedom).
+    pub fn candidate_times(&self) -> impl Iterator<Item = f64> + use<> {
         const N: usize = 8;
-        if self.latest_s <= self.earliest_s {
-            return vec![self.earliest_s];
-        }
-        (0..=N)
-            .map(|k| self.earliest_s + (self.latest_s - self.earliest_s) * k as f64 / N as f64)
-            .collect()
+        let (e, l) = (self.earliest_s, self.latest_s);
+        let n = if l <= e { 0 } else { N };
+        (0..=n).map(move |k| {
+            if n == 0 {
+                e
+            } else {
+                e + (l - e) * k as f64 / N as f64
+            }
+        })
+    }
+
+    /// The state after braking until `tau`, its acceleration snapped onto the limits (the
+    /// brake ends on them up to rounding).
+    pub(crate) fn state_at(&self, tau: f64, lim: &Limits) -> State {
+        let (_, mut s) = self.until(tau);
+        s.a = s.a.clamp(lim.amin(), lim.amax());
+        s
     }
 
     /// The brake segments up to time `tau` and the state there.
-    pub fn until(&self, tau: f64) -> (Vec<Segment>, State) {
-        let mut out = Vec::new();
+    pub(crate) fn until(&self, tau: f64) -> (Segs, State) {
+        let mut out = Segs::default();
         let mut s = self.start;
         let mut t = 0.0;
-        for seg in &self.segs {
+        for seg in self.segs.as_slice() {
             let d = seg.duration_s().min(tau - t);
             if d <= 0.0 {
                 break;
@@ -175,8 +188,20 @@ impl BrakeLaw {
     }
 }
 
+/// Does `start` need a brake: acceleration beyond its limits, velocity beyond them, or
+/// bound to overshoot them (`v + a|a|/(2j)` beyond)?
+pub(crate) fn needed(start: &State, lim: &Limits, j: f64) -> bool {
+    let vz = start.v + start.a * start.a.abs() / (2.0 * j);
+    !(start.a <= lim.amax()
+        && start.a >= lim.amin()
+        && start.v <= lim.vmax()
+        && start.v >= lim.vmin()
+        && vz <= lim.vmax()
+        && vz >= lim.vmin())
+}
+
 /// The shortest brake (stop as soon as `vz` is back on the limit).
-pub fn brake(start: State, lim: &Limits, j: f64) -> (Vec<Segment>, State) {
+pub(crate) fn brake(start: State, lim: &Limits, j: f64) -> (Segs, State) {
     let law = BrakeLaw::new(start, lim, j);
     law.until(law.earliest_s)
 }

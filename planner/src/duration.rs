@@ -1,18 +1,17 @@
 //! Step 2: a profile of a *given* duration for one axis (for time synchronisation).
 //!
-//! Longer than the fastest profile, the peak-velocity family stretches: with peak `vp` and
-//! cruise `(dp - D(vp))/vp >= 0` the total time `T(vp) + (dp - D(vp))/vp` falls
-//! monotonically as `|vp|` grows (its derivative is `-cruise/vp`), so on each side of zero
-//! every duration from the branch's fastest one to infinity is met by exactly one `vp`,
-//! found by bracketing and bisection. Durations between the fastest profile and the start
-//! of a branch that reaches them cannot be met: Ruckig's *blocked intervals*. A move that
-//! starts and ends at rest on the spot is a hold.
+//! Jerk limited: after the brake (each stopping time tried in turn, as in
+//! `position::to_state`), `fixed` finds the members of each profile case that last the
+//! given duration, in closed form, and mixes the highest- and lowest-reaching ones to land
+//! on the target (the reachable positions at a fixed duration form an interval, the
+//! feasible profiles a convex set). Durations whose interval misses the target cannot be
+//! met: Ruckig's *blocked intervals*; every achievable duration is one of the
+//! `branch_starts` or lies above one of them. Jerk unlimited: the same with `second_order`.
 
 use crate::brake::BrakeLaw;
-use crate::position::{
-    PeakFamily, Shape, assemble, bounds, candidates, check_target, finite_state, pre, verify,
-};
-use crate::roots::roots;
+use crate::position::{Shape, assemble, bounds, check_target, finish, finite_state, pre, verify};
+use crate::segs::Segs;
+use crate::unit::{Scale, Unit};
 use crate::velocity::Bounds;
 use crate::{Limits, PlanError, Profile, Segment, State};
 
@@ -27,13 +26,17 @@ pub fn branch_starts(
 ) -> Result<Vec<f64>, PlanError> {
     let b = prepare(target, start, lim, shape)?;
     let mut out = Vec::new();
-    for (pre_segs, s) in brakes(start, lim, &b) {
-        let pre_t: f64 = pre_segs.iter().map(Segment::duration_s).sum();
-        out.extend(
-            candidates(&s, &target, lim, &b)
-                .into_iter()
-                .map(|(t, _)| pre_t + t),
-        );
+    if b.jmax.is_infinite() {
+        let (pre_segs, s) = pre(start, lim, &b);
+        let pre_t = pre_segs.duration_s();
+        crate::second_order::each_duration(&s, &target, lim, |t| out.push(pre_t + t));
+    } else {
+        let sc = Scale::new(lim, b.jmax);
+        let law = BrakeLaw::new(start, lim, b.jmax);
+        for tau in law.candidate_times() {
+            let u = Unit::new(&law.state_at(tau, lim), &target, lim, &sc);
+            crate::fastest::each_duration(&u, |t| out.push(tau + t * sc.t));
+        }
     }
     out.sort_by(f64::total_cmp);
     Ok(out)
@@ -47,22 +50,6 @@ fn prepare(target: State, start: State, lim: &Limits, shape: Shape) -> Result<Bo
     Ok(b)
 }
 
-/// The brake pre-trajectories to try (see `position::to_state`), each with its end state.
-fn brakes(start: State, lim: &Limits, b: &Bounds) -> Vec<(Vec<Segment>, State)> {
-    let snap = |(segs, mut s): (Vec<Segment>, State)| {
-        s.a = s.a.clamp(lim.amin(), lim.amax());
-        (segs, s)
-    };
-    if b.jmax.is_infinite() {
-        return vec![snap(pre(start, lim, b))];
-    }
-    let law = BrakeLaw::new(start, lim, b.jmax);
-    law.candidate_times()
-        .into_iter()
-        .map(|tau| snap(law.until(tau)))
-        .collect()
-}
-
 /// A profile from `start` to `target` lasting exactly `duration_s`, or `None` if that
 /// duration is shorter than the fastest profile or inside a blocked interval.
 pub fn with_duration(
@@ -73,92 +60,36 @@ pub fn with_duration(
     duration_s: f64,
 ) -> Result<Option<Profile>, PlanError> {
     let b = prepare(target, start, lim, shape)?;
-    for (pre_segs, s) in brakes(start, lim, &b) {
-        if let Some(p) = from_brake(start, pre_segs, s, target, lim, b, duration_s)? {
-            return verify(p, &target, lim, true).map(Some);
+    let mut segs = Vec::with_capacity(16);
+    if b.jmax.is_infinite() {
+        let (pre_segs, s) = pre(start, lim, &b);
+        let rest = duration_s - pre_segs.duration_s();
+        segs.extend_from_slice(pre_segs.as_slice());
+        if !(rest >= 0.0) || !crate::second_order::lasting(&s, &target, lim, rest, &mut segs) {
+            return Ok(None);
         }
+        return verify(finish(start, segs)?, &target, lim, true).map(Some);
     }
-    Ok(None)
-}
-
-/// `with_duration` after a given brake.
-fn from_brake(
-    start: State,
-    pre_segs: Vec<Segment>,
-    s: State,
-    target: State,
-    lim: &Limits,
-    b: Bounds,
-    duration_s: f64,
-) -> Result<Option<Profile>, PlanError> {
-    let rest = duration_s - pre_segs.iter().map(Segment::duration_s).sum::<f64>();
-    if rest.is_nan() || rest < 0.0 {
-        return Ok(None);
-    }
-    let tol = 1e-12 * rest.max(1e-9);
-    // A local optimum of exactly this duration.
-    if let Some((_, segs)) = candidates(&s, &target, lim, &b)
-        .into_iter()
-        .find(|(t, _)| (t - rest).abs() <= tol)
-    {
-        return assemble(start, pre_segs, &[&segs]).map(Some);
-    }
-    let fam = PeakFamily::new(s, target, lim, b);
-    let dp = fam.dp();
-    // On the spot: both phases at vp = 0 cover dp exactly, so cruise at zero speed.
-    if let Some((_, _, d, t)) = fam.phases(0.0) {
-        let scale = dp.abs().max(d.abs()).max(1e-300);
-        if (d - dp).abs() <= 1e-12 * scale
-            && t <= rest
-            && let Some(segs) = fam.segments(0.0, rest - t)
-        {
-            return assemble(start, pre_segs, &[&segs]).map(Some);
+    let sc = Scale::new(lim, b.jmax);
+    if !crate::brake::needed(&start, lim, b.jmax) {
+        let u = Unit::new(&start, &target, lim, &sc);
+        if !crate::fixed::lasting(&u, duration_s / sc.t, &sc, &mut segs) {
+            return Ok(None);
         }
+        return verify(finish(start, segs)?, &target, lim, true).map(Some);
     }
-    let total = |vp: f64| -> Option<f64> {
-        let (_, _, d, t) = fam.phases(vp)?;
-        let cruise = (dp - d) / vp;
-        (cruise >= 0.0 && cruise.is_finite()).then_some(t + cruise - rest)
-    };
-    let mut knots = fam.knots();
-    let tiny = 1e-12 * lim.vmax().max(-lim.vmin());
-    knots.retain(|v| v.abs() > tiny);
-    knots.extend([tiny, -tiny]);
-    knots.sort_by(f64::total_cmp);
-    let mut found: Vec<f64> = Vec::new();
-    for side in [1.0, -1.0] {
-        let branch: Vec<f64> = knots
-            .iter()
-            .copied()
-            .filter(|v| v.signum() == side)
-            .collect();
-        found.extend(roots(&total, &branch));
-    }
-    // Three arcs with a plateau at a free level.
-    if b.jmax.is_finite() {
-        let mut shapes = crate::stretch::held_three_arc(&s, &target, lim, &b, rest);
-        shapes.extend(crate::stretch::four_arc(&s, &target, lim, &b, rest));
-        for segs in shapes {
-            let prof = assemble(start, pre_segs.clone(), &[&segs])?;
-            let e = prof.end();
-            let ok_p = (e.p - target.p).abs() <= 1e-9 * target.p.abs().max(dp.abs()).max(1.0);
-            if ok_p && (prof.duration_s() - duration_s).abs() <= 1e-9 * duration_s.max(1e-9) {
-                return Ok(Some(prof));
-            }
-        }
-    }
-    // Prefer the fastest peak (least cruise) in the direction of the move.
-    found.sort_by(|x, y| y.abs().total_cmp(&x.abs()));
-    for vp in found {
-        let Some((_, _, d, _)) = fam.phases(vp) else {
+    let law = BrakeLaw::new(start, lim, b.jmax);
+    for tau in law.candidate_times() {
+        let rest = duration_s - tau;
+        if !(rest >= 0.0) {
             continue;
-        };
-        let cruise = (dp - d) / vp;
-        if let Some(segs) = fam.segments(vp, cruise.max(0.0)) {
-            let prof = assemble(start, pre_segs.clone(), &[&segs])?;
-            if (prof.duration_s() - duration_s).abs() <= 1e-9 * duration_s.max(1e-9) {
-                return Ok(Some(prof));
-            }
+        }
+        let u = Unit::new(&law.state_at(tau, lim), &target, lim, &sc);
+        let (pre_segs, _) = law.until(tau);
+        segs.clear();
+        segs.extend_from_slice(pre_segs.as_slice());
+        if crate::fixed::lasting(&u, rest / sc.t, &sc, &mut segs) {
+            return verify(finish(start, segs)?, &target, lim, true).map(Some);
         }
     }
     Ok(None)
@@ -166,8 +97,11 @@ fn from_brake(
 
 /// Velocity interface, step 2: a velocity change from `start` to `(vf, af)` lasting exactly
 /// `duration_s`, or `None`. Shape: two jerk arcs (each rising or falling) through a free
-/// level, with the spare time held as a plateau at the start level, the free level or the
-/// end level.
+/// level `A`, with the spare time held as a plateau at the start level, at `A` or at the
+/// end level. With arc jerks `s1 j`, `s2 j` (`p = 1/(s1 j)`, `q = 1/(s2 j)`) the plateau lasts
+/// `H(A) = T + a0 p - af q + (q - p) A`, and the velocity gained,
+/// `(A^2 - a0^2) p/2 + (af^2 - A^2) q/2 + L H(A)` with `L` the plateau's level, is a
+/// quadratic in `A`: closed form.
 pub fn velocity_with_duration(
     start: State,
     vf: f64,
@@ -183,74 +117,55 @@ pub fn velocity_with_duration(
         kind: "jerk-limited",
     })?;
     // Any acceleration brake first (as in `to_velocity`).
-    let (pre_segs, s) = match fastest.segments().first() {
-        Some(seg) if start.a > lim.amax() || start.a < lim.amin() => {
-            (vec![*seg], seg.end_state(&start))
-        }
-        _ => (Vec::new(), start),
-    };
-    let rest = duration_s - pre_segs.iter().map(Segment::duration_s).sum::<f64>();
-    if rest.is_nan() || rest < 0.0 {
+    let mut pre_segs = Segs::default();
+    let mut s = start;
+    if let Some(seg) = fastest.segments().first()
+        && (start.a > lim.amax() || start.a < lim.amin())
+    {
+        pre_segs.push(*seg);
+        s = seg.end_state(&start);
+    }
+    let rest = duration_s - pre_segs.duration_s();
+    if !(rest >= 0.0) {
         return Ok(None);
     }
     let a0 = s.a.clamp(lim.amin(), lim.amax());
-    // Template: jerk s1 j to a level A, jerk s2 j on to af, and the remaining time held as
-    // a plateau at the start level a0, at A, or at the end level af. For each choice the
-    // velocity change is a function of A alone; its roots are bracketed and bisected.
+    let dv = vf - s.v;
     let tol = 1e-12 * rest.max(1e-9);
-    let build = |level: f64, s1: f64, s2: f64, at: usize| -> Option<[Segment; 5]> {
-        let (t1, t3) = ((level - a0) / (s1 * j), (af - level) / (s2 * j));
-        let hold = rest - t1 - t3;
-        if t1 < -tol || t3 < -tol || hold < -tol {
-            return None;
-        }
-        let h = |k: usize| if k == at { hold.max(0.0) } else { 0.0 };
-        Some([
-            Segment::Jerk {
-                duration_s: h(0),
-                jerk: 0.0,
-            },
-            Segment::Jerk {
-                duration_s: t1.max(0.0),
-                jerk: s1 * j,
-            },
-            Segment::Jerk {
-                duration_s: h(1),
-                jerk: 0.0,
-            },
-            Segment::Jerk {
-                duration_s: t3.max(0.0),
-                jerk: s2 * j,
-            },
-            Segment::Jerk {
-                duration_s: h(2),
-                jerk: 0.0,
-            },
-        ])
-    };
-    let s0 = State {
-        p: 0.0,
-        v: s.v,
-        a: a0,
-    };
+    let pad = 1e-12 * (lim.amax() - lim.amin());
     for at in [1, 0, 2] {
         for (s1, s2) in [(1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (-1.0, -1.0)] {
-            let g = |level: f64| {
-                let segs = build(level, s1, s2, at)?;
-                let mut st = s0;
-                for sg in &segs {
-                    st = sg.end_state(&st);
-                }
-                Some(st.v - vf)
+            let (p, q) = (1.0 / (s1 * j), 1.0 / (s2 * j));
+            let (h0, h1) = (rest + a0 * p - af * q, q - p);
+            let base = 0.5 * (q * af * af - p * a0 * a0) - dv;
+            let c = match at {
+                1 => [base, h0, 0.5 * (q - p)],
+                0 => [base + a0 * h0, a0 * h1, 0.5 * (p - q)],
+                _ => [base + af * h0, af * h1, 0.5 * (p - q)],
             };
-            let mut knots = vec![lim.amin(), lim.amax(), a0, af];
-            knots.sort_by(f64::total_cmp);
-            knots.dedup();
-            for level in roots(&g, &knots) {
-                let Some(segs) = build(level, s1, s2, at) else {
+            let roots = crate::poly::roots_in(&c, lim.amin() - pad, lim.amax() + pad);
+            for &level in roots.as_slice() {
+                let level = level.clamp(lim.amin(), lim.amax());
+                let (t1, t3) = ((level - a0) * p, (af - level) * q);
+                let hold = rest - t1 - t3;
+                if t1 < -tol || t3 < -tol || hold < -tol {
                     continue;
-                };
-                let prof = assemble(start, pre_segs.clone(), &[&segs])?;
+                }
+                let h = |k: usize| if k == at { hold.max(0.0) } else { 0.0 };
+                let mut body = Segs::default();
+                for (d, jerk) in [
+                    (h(0), 0.0),
+                    (t1.max(0.0), s1 * j),
+                    (h(1), 0.0),
+                    (t3.max(0.0), s2 * j),
+                    (h(2), 0.0),
+                ] {
+                    body.push(Segment::Jerk {
+                        duration_s: d,
+                        jerk,
+                    });
+                }
+                let prof = assemble(start, &[pre_segs.as_slice(), body.as_slice()])?;
                 let e = prof.end();
                 let ok = (e.v - vf).abs() <= 1e-9 * vf.abs().max(1.0)
                     && (e.a - af).abs() <= 1e-9 * lim.amax()
@@ -262,6 +177,45 @@ pub fn velocity_with_duration(
         }
     }
     Ok(None)
+}
+
+/// Velocity interface without a jerk limit, step 2: a constant acceleration `dv / T` for
+/// the whole duration `T`, then a jump to `af`; `None` if that acceleration is beyond the
+/// limits (`T` shorter than the fastest change). Every longer duration is achievable.
+pub fn trapezoid_velocity_with_duration(
+    start: State,
+    vf: f64,
+    af: f64,
+    lim: &Limits,
+    duration_s: f64,
+) -> Result<Option<Profile>, PlanError> {
+    let fastest = crate::position::to_velocity(start, vf, af, lim, Shape::Trapezoid)?;
+    if (fastest.duration_s() - duration_s).abs() <= 1e-12 * duration_s.max(1e-9) {
+        return Ok(Some(fastest));
+    }
+    if !(duration_s > fastest.duration_s()) {
+        return Ok(None);
+    }
+    let a = (vf - start.v) / duration_s;
+    if a > lim.amax() || a < lim.amin() {
+        return Ok(None);
+    }
+    let segs = [
+        Segment::Accel {
+            duration_s,
+            accel: a,
+        },
+        Segment::Accel {
+            duration_s: 0.0,
+            accel: af,
+        },
+    ];
+    let target = State {
+        p: 0.0,
+        v: vf,
+        a: af,
+    };
+    verify(assemble(start, &[&segs])?, &target, lim, false).map(Some)
 }
 
 /// Velocity interface: every duration at which a range of achievable durations starts

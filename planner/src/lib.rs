@@ -7,26 +7,35 @@
 //! No I/O, no clocks, no simulation types. Units are whatever the caller uses consistently
 //! (settle's harness uses metres and seconds).
 
+mod arcs;
+mod blend;
 mod brake;
 pub mod duration;
 mod error;
+mod fastest;
+mod fixed;
+mod four_arcs;
 pub mod fourjerk;
 mod kind;
 mod limits;
+#[cfg(test)]
+mod oracle;
 pub mod path;
+mod poly;
 pub mod position;
 mod profile;
 pub mod pvt;
+mod ramp;
 pub mod raster;
-mod roots;
 pub mod scurve;
+mod second_order;
+mod segs;
 pub mod shaper;
-mod stretch;
 pub mod sync;
-mod three_arc;
 pub mod tmc;
 mod trajectory;
 pub mod trapezoid;
+mod unit;
 pub mod velocity;
 
 pub use error::PlanError;

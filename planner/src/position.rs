@@ -2,25 +2,19 @@
 //! (the position interface), and to a velocity and acceleration (the velocity interface).
 //!
 //! Step 0 brakes a start state that violates, or must violate, the limits (see `brake`).
-//! Then the profile is an acceleration phase to a peak velocity `vp` (ending with `a = 0`),
-//! a cruise at `vp`, and a phase from `(vp, 0)` to `(vf, af)`; both phases are the
-//! time-optimal velocity changes of `velocity`. Writing `D(vp)` and `T(vp)` for the distance
-//! and duration of the two phases, a cruise of `(dp - D(vp))/vp >= 0` completes the move,
-//! and `d/dvp` of the total time is `-cruise/vp`: the optimum is either the cruise at
-//! `vmax` (or `vmin`) or a peak velocity with no cruise, `D(vp) = dp`. These are seed 004's
-//! cases: the no-cruise roots are its DD, DT, TD and TT profiles (D/T: the acceleration
-//! phase does/does not reach the acceleration limit), found here by bracketing every sign
-//! change of `D(vp) - dp` between the structural breakpoints and bisecting to full
-//! precision, then keeping the fastest valid root (the others are the spurious solutions
-//! the seed warns about).
+//! From the safe state the candidates are seed 004's cases in Ruckig's modern form (see
+//! `fastest` and `arcs`): the cruise at `vmax` or `vmin` between two time-optimal velocity
+//! changes, or three jerk arcs (UDU or DUD) with holds at the acceleration limits, each
+//! case a closed-form polynomial whose valid root is picked among spurious ones by
+//! checking the profile. The fastest candidate is the time-optimal profile.
 //!
-//! Not yet covered: profiles whose acceleration does not pass through zero between the two
-//! phases (Ruckig's UDUD family, which can be optimal when both `a0` and `af` are far from
-//! zero). The random suite against rsruckig measures how often that matters.
+//! The bracketing implementation this replaced is kept as a test-only oracle
+//! (`oracle::peak`), and a property test checks that both give the same durations.
 
-use crate::brake::brake;
-use crate::roots::roots;
-use crate::velocity::{Bounds, Change, change};
+use crate::brake::{BrakeLaw, brake};
+use crate::segs::Segs;
+use crate::unit::{Scale, Unit};
+use crate::velocity::{Bounds, change};
 use crate::{Limits, PlanError, Profile, Segment, State};
 
 /// Jerk-limited (7-phase) or jerk-unlimited (trapezoid) profiles.
@@ -84,14 +78,14 @@ pub(crate) fn check_target(t: &State, lim: &Limits, b: &Bounds) -> Result<(), Pl
 }
 
 /// Brake (jerk-limited) or clamp the velocity (trapezoid) into the limits.
-pub(crate) fn pre(start: State, lim: &Limits, b: &Bounds) -> (Vec<Segment>, State) {
+pub(crate) fn pre(start: State, lim: &Limits, b: &Bounds) -> (Segs, State) {
     if b.jmax.is_finite() {
         return brake(start, lim, b.jmax);
     }
     // Trapezoid: the acceleration may jump; only a velocity beyond its limit needs a
     // deceleration phase.
     let mut s = start;
-    let mut segs = Vec::new();
+    let mut segs = Segs::default();
     let (excess, a) = if s.v > lim.vmax() {
         (s.v - lim.vmax(), lim.amin())
     } else if s.v < lim.vmin() {
@@ -110,29 +104,18 @@ pub(crate) fn pre(start: State, lim: &Limits, b: &Bounds) -> (Vec<Segment>, Stat
     (segs, s)
 }
 
-pub(crate) fn assemble(
-    start: State,
-    mut segs: Vec<Segment>,
-    parts: &[&[Segment]],
-) -> Result<Profile, PlanError> {
-    for part in parts {
-        segs.extend(
-            part.iter()
-                .copied()
-                .filter(|s| s.duration_s() > 0.0 || matches!(s, Segment::Accel { .. })),
-        );
-    }
-    // Zero-duration Accel segments only matter where they change the acceleration.
-    let mut out: Vec<Segment> = Vec::with_capacity(segs.len());
-    let mut a = start.a;
+/// The profile from `start` through the segments of every part in order. Zero-duration
+/// segments are dropped, except a constant-acceleration one that changes the acceleration.
+pub(crate) fn assemble(start: State, parts: &[&[Segment]]) -> Result<Profile, PlanError> {
+    let n = parts.iter().map(|p| p.len()).sum();
+    let mut out: Vec<Segment> = Vec::with_capacity(n);
     let mut st = start;
-    for seg in segs {
+    for seg in parts.iter().flat_map(|p| p.iter()) {
         let keep =
-            seg.duration_s() > 0.0 || matches!(seg, Segment::Accel { accel, .. } if accel != a);
+            seg.duration_s() > 0.0 || matches!(*seg, Segment::Accel { accel, .. } if accel != st.a);
         st = seg.end_state(&st);
-        a = st.a;
         if keep {
-            out.push(seg);
+            out.push(*seg);
         }
     }
     Profile::new(start, out)
@@ -162,7 +145,7 @@ pub fn to_velocity(
             reason: "target acceleration outside [amin, amax]",
         });
     }
-    let mut pre_segs = Vec::new();
+    let mut pre_segs = Segs::default();
     let mut s = start;
     if b.jmax.is_finite() && (s.a > lim.amax() || s.a < lim.amin()) {
         let to = s.a.clamp(lim.amin(), lim.amax());
@@ -178,7 +161,7 @@ pub fn to_velocity(
         reason: "velocity change",
     })?;
     verify(
-        assemble(start, pre_segs, &[&c.segments])?,
+        assemble(start, &[pre_segs.as_slice(), &c.segments])?,
         &target,
         lim,
         false,
@@ -197,144 +180,129 @@ pub fn to_state(
     lim: &Limits,
     shape: Shape,
 ) -> Result<Profile, PlanError> {
+    plan(start, target, lim, shape)?.profile()
+}
+
+/// The fastest profile of one axis, planned but not yet written out as a [`Profile`]
+/// (several axes only need the slowest one's).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Planned {
+    start: State,
+    target: State,
+    lim: Limits,
+    duration_s: f64,
+    how: How,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum How {
+    /// Jerk limited: brake until `tau`, then `cand` (normalised by `sc`).
+    Jerk {
+        sc: Scale,
+        tau: f64,
+        cand: crate::fastest::Cand,
+    },
+    /// Jerk unlimited: clamp the velocity, then `trap`.
+    Trap(crate::second_order::Trap),
+}
+
+impl Planned {
+    /// Duration (s).
+    pub(crate) fn duration_s(&self) -> f64 {
+        self.duration_s
+    }
+
+    /// The profile, checked to reach the target.
+    pub(crate) fn profile(&self) -> Result<Profile, PlanError> {
+        let mut segs = Vec::with_capacity(12);
+        match self.how {
+            How::Jerk { sc, tau, cand } => {
+                if tau > 0.0 {
+                    let (pre_segs, _) = BrakeLaw::new(self.start, &self.lim, sc.j).until(tau);
+                    segs.extend_from_slice(pre_segs.as_slice());
+                }
+                cand.segments(&sc, &mut segs);
+            }
+            How::Trap(trap) => {
+                let b = bounds(&self.lim, Shape::Trapezoid)?;
+                segs.extend_from_slice(pre(self.start, &self.lim, &b).0.as_slice());
+                trap.segments(&mut segs);
+            }
+        }
+        verify(finish(self.start, segs)?, &self.target, &self.lim, true)
+    }
+}
+
+/// Step 1 for one axis: validate, brake, and find the fastest profile.
+pub(crate) fn plan(
+    start: State,
+    target: State,
+    lim: &Limits,
+    shape: Shape,
+) -> Result<Planned, PlanError> {
     finite_state("start", &start)?;
     finite_state("target", &target)?;
     let b = bounds(lim, shape)?;
     check_target(&target, lim, &b)?;
+    let none = PlanError::NoSolution {
+        reason: "no peak velocity reaches the target",
+    };
+    let planned = |duration_s, how| Planned {
+        start,
+        target,
+        lim: *lim,
+        duration_s,
+        how,
+    };
     if b.jmax.is_infinite() {
         let (pre_segs, s) = pre(start, lim, &b);
-        let (_, segs) = from_safe(&s, &target, lim, &b).ok_or(PlanError::NoSolution {
-            reason: "no peak velocity reaches the target",
-        })?;
-        return verify(assemble(start, pre_segs, &[&segs])?, &target, lim, true);
+        let trap = crate::second_order::fastest(&s, &target, lim).ok_or(none)?;
+        return Ok(planned(
+            pre_segs.duration_s() + trap.duration(),
+            How::Trap(trap),
+        ));
     }
-    let law = crate::brake::BrakeLaw::new(start, lim, b.jmax);
-    let mut best: Option<(f64, Vec<Segment>, Vec<Segment>)> = None;
+    let sc = Scale::new(lim, b.jmax);
+    if !crate::brake::needed(&start, lim, b.jmax) {
+        let u = Unit::new(&start, &target, lim, &sc);
+        let cand = crate::fastest::fastest(&u, f64::INFINITY).ok_or(none)?;
+        return Ok(planned(
+            cand.duration() * sc.t,
+            How::Jerk { sc, tau: 0.0, cand },
+        ));
+    }
+    let law = BrakeLaw::new(start, lim, b.jmax);
+    // (total duration, brake stopping time, profile after the brake)
+    let mut best: Option<(f64, f64, crate::fastest::Cand)> = None;
     for tau in law.candidate_times() {
-        let (pre_segs, mut s) = law.until(tau);
-        // The brake ends on the acceleration limit up to rounding: snap it there.
-        s.a = s.a.clamp(lim.amin(), lim.amax());
-        if let Some((t, segs)) = from_safe(&s, &target, lim, &b) {
-            let total = tau + t;
-            if best.as_ref().is_none_or(|(bt, _, _)| total < *bt) {
-                best = Some((total, pre_segs, segs));
+        let s = law.state_at(tau, lim);
+        let t_max = best.map_or(f64::INFINITY, |(total, _, _)| (total - tau) / sc.t);
+        let u = Unit::new(&s, &target, lim, &sc);
+        if let Some(c) = crate::fastest::fastest(&u, t_max) {
+            let total = tau + c.duration() * sc.t;
+            if best.is_none_or(|(bt, _, _)| total < bt) {
+                best = Some((total, tau, c));
             }
         }
     }
-    let (_, pre_segs, segs) = best.ok_or(PlanError::NoSolution {
-        reason: "no peak velocity reaches the target",
-    })?;
-    verify(assemble(start, pre_segs, &[&segs])?, &target, lim, true)
+    let (total, tau, cand) = best.ok_or(none)?;
+    Ok(planned(total, How::Jerk { sc, tau, cand }))
 }
 
-/// The peak-velocity family from a safe state `s` to `target`: for a peak velocity `vp`,
-/// the two phases, their distance and their duration.
-pub(crate) struct PeakFamily<'a> {
-    s: State,
-    target: State,
-    lim: &'a Limits,
-    b: Bounds,
-}
-
-impl<'a> PeakFamily<'a> {
-    pub(crate) fn new(s: State, target: State, lim: &'a Limits, b: Bounds) -> Self {
-        Self { s, target, lim, b }
-    }
-
-    /// The two phases for peak velocity `vp`, their distance and duration.
-    pub(crate) fn phases(&self, vp: f64) -> Option<(Change, Change, f64, f64)> {
-        let c1 = change(self.s.v, self.s.a, vp, 0.0, &self.b)?;
-        let c2 = change(vp, 0.0, self.target.v, self.target.a, &self.b)?;
-        let d = c1.end(self.s.v, self.s.a).p + c2.end(vp, 0.0).p;
-        Some((c1, c2, d, c1.duration_s() + c2.duration_s()))
-    }
-
-    /// Distance still to cover after the two phases.
-    pub(crate) fn dp(&self) -> f64 {
-        self.target.p - self.s.p
-    }
-
-    /// The profile for peak `vp` with `cruise` seconds at `vp`.
-    pub(crate) fn segments(&self, vp: f64, cruise: f64) -> Option<Vec<Segment>> {
-        let (c1, c2, _, _) = self.phases(vp)?;
-        let mut segs = c1.segments.to_vec();
-        // The cruise holds the acceleration at exactly zero: the phase before ends there
-        // only up to rounding, and a cruise can be long enough for that to matter.
-        segs.push(Segment::Accel {
-            duration_s: cruise,
-            accel: 0.0,
-        });
-        segs.extend(c2.segments);
-        Some(segs)
-    }
-
-    /// Structural breakpoints in `vp` (see [`breakpoints`]).
-    pub(crate) fn knots(&self) -> Vec<f64> {
-        breakpoints(&self.s, &self.target, self.lim, &self.b)
-    }
-}
-
-/// Every locally fastest profile from a state inside the limits, as `(duration, segments)`:
-/// the cruise at `vmax` and at `vmin`, each no-cruise peak velocity, and the three-arc
-/// family's solutions. The fastest of them is the time-optimal profile; the others start
-/// the ranges of longer durations that step 2 (time synchronisation) can stretch to.
-pub(crate) fn candidates(
-    s: &State,
-    target: &State,
-    lim: &Limits,
-    b: &Bounds,
-) -> Vec<(f64, Vec<Segment>)> {
-    let fam = PeakFamily::new(*s, *target, lim, *b);
-    let dp = fam.dp();
-    let mut out = Vec::new();
-    for vlim in [lim.vmax(), lim.vmin()] {
-        if let Some((_, _, d, t)) = fam.phases(vlim) {
-            let cruise = (dp - d) / vlim;
-            if cruise >= 0.0 && (t + cruise).is_finite() {
-                out.extend(fam.segments(vlim, cruise).map(|segs| (t + cruise, segs)));
-            }
-        }
-    }
-    for vp in roots(
-        &|vp| fam.phases(vp).map(|(_, _, d, _)| d - dp),
-        &fam.knots(),
-    ) {
-        if let Some((_, _, _, t)) = fam.phases(vp) {
-            out.extend(fam.segments(vp, 0.0).map(|segs| (t, segs)));
-        }
-    }
-    if b.jmax.is_finite() {
-        out.extend(crate::three_arc::candidates(s, target, lim, b));
-    }
-    out
-}
-
-/// The fastest profile from a state inside the limits. Returns its duration and segments.
-fn from_safe(s: &State, target: &State, lim: &Limits, b: &Bounds) -> Option<(f64, Vec<Segment>)> {
-    candidates(s, target, lim, b)
-        .into_iter()
-        .min_by(|x, y| x.0.total_cmp(&y.0))
-}
-
-/// Peak velocities where either phase changes structure, plus the velocity limits.
-fn breakpoints(s: &State, t: &State, lim: &Limits, b: &Bounds) -> Vec<f64> {
-    let mut v = vec![lim.vmin(), lim.vmax(), 0.0, s.v, t.v];
-    if b.jmax.is_finite() {
-        let j = b.jmax;
-        let (amax2, amin2) = (b.amax * b.amax, b.amin * b.amin);
-        v.extend([
-            s.v + s.a * s.a.abs() / (2.0 * j),
-            s.v + (amax2 - s.a * s.a / 2.0) / j,
-            s.v + (s.a * s.a / 2.0 - amin2) / j,
-            t.v - t.a * t.a.abs() / (2.0 * j),
-            t.v - (amax2 - t.a * t.a / 2.0) / j,
-            t.v - (t.a * t.a / 2.0 - amin2) / j,
-        ]);
-    }
-    v.retain(|x| x.is_finite() && *x >= lim.vmin() && *x <= lim.vmax());
-    v.sort_by(f64::total_cmp);
-    v.dedup();
-    v
+/// The profile from `start` through `segs`, dropping zero-duration segments except a
+/// constant-acceleration one that changes the acceleration (as [`assemble`], in place).
+pub(crate) fn finish(start: State, mut segs: Vec<Segment>) -> Result<Profile, PlanError> {
+    let mut a = start.a;
+    segs.retain(|seg| {
+        let keep =
+            seg.duration_s() > 0.0 || matches!(*seg, Segment::Accel { accel, .. } if accel != a);
+        a = match *seg {
+            Segment::Jerk { duration_s, jerk } => a + jerk * duration_s,
+            Segment::Accel { accel, .. } => accel,
+        };
+        keep
+    });
+    Profile::new(start, segs)
 }
 
 /// Last line of defence: a profile is only returned if it really ends on the target (and

@@ -9,7 +9,7 @@
 //!   otherwise time synchronisation.
 
 use crate::duration::{branch_starts, with_duration};
-use crate::position::{Shape, to_state};
+use crate::position::{self, Planned, Shape};
 use crate::{Limits, PlanError, Profile, Segment, State};
 
 /// How axes are synchronised.
@@ -36,30 +36,43 @@ pub struct Axis {
 
 /// Plan all axes.
 pub fn plan(axes: &[Axis], shape: Shape, sync: Sync) -> Result<Vec<Profile>, PlanError> {
-    let fastest: Vec<Profile> = axes
+    let on_axis = |axis: usize| {
+        move |e: PlanError| PlanError::OnAxis {
+            axis,
+            source: Box::new(e),
+        }
+    };
+    let fastest: Vec<Planned> = axes
         .iter()
         .enumerate()
-        .map(|(i, a)| {
-            to_state(a.start, a.target, &a.limits, shape).map_err(|e| PlanError::OnAxis {
-                axis: i,
-                source: Box::new(e),
-            })
-        })
+        .map(|(i, a)| position::plan(a.start, a.target, &a.limits, shape).map_err(on_axis(i)))
         .collect::<Result<_, _>>()?;
+    let all = || -> Result<Vec<Profile>, PlanError> {
+        fastest
+            .iter()
+            .enumerate()
+            .map(|(i, p)| p.profile().map_err(on_axis(i)))
+            .collect()
+    };
     if sync == Sync::None || axes.len() <= 1 {
-        return Ok(fastest);
+        return all();
     }
     if sync == Sync::Phase
-        && let Some(profiles) = phase(axes, &fastest)
+        && let Some(profiles) = phase(axes, &all()?)
     {
         return Ok(profiles);
     }
     time(axes, shape, &fastest)
 }
 
-fn time(axes: &[Axis], shape: Shape, fastest: &[Profile]) -> Result<Vec<Profile>, PlanError> {
-    let t_min = fastest.iter().map(Profile::duration_s).fold(0.0, f64::max);
-    let mut candidates = vec![t_min];
+fn time(axes: &[Axis], shape: Shape, fastest: &[Planned]) -> Result<Vec<Profile>, PlanError> {
+    let t_min = fastest.iter().map(Planned::duration_s).fold(0.0, f64::max);
+    if let Some(out) = all_at(axes, shape, fastest, t_min)? {
+        return Ok(out);
+    }
+    // Some axis cannot last t_min (a blocked interval): try the later durations at which
+    // some axis's achievable range starts, in order.
+    let mut candidates = Vec::new();
     for a in axes {
         candidates.extend(
             branch_starts(a.start, a.target, &a.limits, shape)?
@@ -70,23 +83,36 @@ fn time(axes: &[Axis], shape: Shape, fastest: &[Profile]) -> Result<Vec<Profile>
     candidates.sort_by(f64::total_cmp);
     candidates.dedup();
     for t in candidates {
-        let mut out = Vec::with_capacity(axes.len());
-        for (a, f) in axes.iter().zip(fastest) {
-            if (f.duration_s() - t).abs() <= 1e-12 * t.max(1e-9) {
-                out.push(f.clone());
-            } else if let Some(p) = with_duration(a.start, a.target, &a.limits, shape, t)? {
-                out.push(p);
-            } else {
-                break;
-            }
-        }
-        if out.len() == axes.len() {
+        if let Some(out) = all_at(axes, shape, fastest, t)? {
             return Ok(out);
         }
     }
     Err(PlanError::NoSolution {
         reason: "no common duration found for time synchronisation",
     })
+}
+
+/// Every axis lasting `t` (its fastest profile where that lasts `t`), or `None`.
+fn all_at(
+    axes: &[Axis],
+    shape: Shape,
+    fastest: &[Planned],
+    t: f64,
+) -> Result<Option<Vec<Profile>>, PlanError> {
+    let mut out = Vec::with_capacity(axes.len());
+    for (i, (a, f)) in axes.iter().zip(fastest).enumerate() {
+        if (f.duration_s() - t).abs() <= 1e-12 * t.max(1e-9) {
+            out.push(f.profile().map_err(|e| PlanError::OnAxis {
+                axis: i,
+                source: Box::new(e),
+            })?);
+        } else if let Some(p) = with_duration(a.start, a.target, &a.limits, shape, t)? {
+            out.push(p);
+        } else {
+            return Ok(None);
+        }
+    }
+    Ok(Some(out))
 }
 
 /// Phase synchronisation: scale the limiting axis's profile onto the others.
@@ -166,7 +192,8 @@ fn within(prof: &Profile, lim: &Limits) -> bool {
 
 /// Velocity interface for several axes: each axis reaches its target velocity and
 /// acceleration; with `Time` (or `Phase`, treated as `Time` here) all at the slowest axis's
-/// duration, each other axis stretched by lowering its acceleration plateau.
+/// duration, each other axis stretched by lowering its acceleration plateau (jerk limited)
+/// or its constant acceleration (trapezoid).
 pub fn plan_velocity(axes: &[Axis], shape: Shape, sync: Sync) -> Result<Vec<Profile>, PlanError> {
     let on_axis = |axis: usize| {
         move |e: PlanError| PlanError::OnAxis {
@@ -185,14 +212,25 @@ pub fn plan_velocity(axes: &[Axis], shape: Shape, sync: Sync) -> Result<Vec<Prof
     if sync == Sync::None || axes.len() <= 1 {
         return Ok(fastest);
     }
+    let t_min = fastest.iter().map(Profile::duration_s).fold(0.0, f64::max);
     if shape == Shape::Trapezoid {
-        return Err(PlanError::NoSolution {
-            reason: "time synchronisation of the trapezoid velocity interface is not implemented; use \"sync\":\"none\"",
-        });
+        // A constant acceleration dv/T meets any duration from the fastest on.
+        return axes
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                crate::duration::trapezoid_velocity_with_duration(
+                    a.start, a.target.v, a.target.a, &a.limits, t_min,
+                )
+                .map_err(on_axis(i))?
+                .ok_or(PlanError::NoSolution {
+                    reason: "velocity-interface synchronisation of a trapezoid",
+                })
+            })
+            .collect();
     }
     // Earliest common duration: the slowest axis's, unless another axis cannot meet it
     // (a blocked interval); then the next local-optimum duration of any axis.
-    let t_min = fastest.iter().map(Profile::duration_s).fold(0.0, f64::max);
     let mut candidates = vec![t_min];
     for a in axes {
         candidates.extend(

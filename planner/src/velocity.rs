@@ -61,26 +61,45 @@ pub struct Bounds {
 /// The time-optimal change from `(v0, a0)` to `(vf, af)`; `a0` and `af` must lie in
 /// `[amin, amax]` (brake first otherwise). `None` only for non-finite input.
 pub fn change(v0: f64, a0: f64, vf: f64, af: f64, b: &Bounds) -> Option<Change> {
-    local_changes(v0, a0, vf, af, b)
-        .into_iter()
-        .min_by(|x, y| x.duration_s().total_cmp(&y.duration_s()))
+    let mut best: Option<Change> = None;
+    each_local_change(v0, a0, vf, af, b, |c| {
+        if best.is_none_or(|x| c.duration_s() < x.duration_s()) {
+            best = Some(c);
+        }
+    });
+    best
 }
 
 /// Every locally fastest velocity change (up-down and down-up, each with its peak or
 /// valley of either sign): the fastest is [`change`]; the others start the ranges of
 /// longer durations that velocity-interface synchronisation can use.
 pub fn local_changes(v0: f64, a0: f64, vf: f64, af: f64, b: &Bounds) -> Vec<Change> {
+    let mut all = Vec::with_capacity(4);
+    each_local_change(v0, a0, vf, af, b, |c| all.push(c));
+    all
+}
+
+/// Calls `f` with every locally fastest velocity change (see [`local_changes`]), in a fixed
+/// order, without allocating.
+pub(crate) fn each_local_change(
+    v0: f64,
+    a0: f64,
+    vf: f64,
+    af: f64,
+    b: &Bounds,
+    mut f: impl FnMut(Change),
+) {
     if b.jmax.is_infinite() {
-        return vec![trapezoid_change(v0, vf, af, b)];
+        f(trapezoid_change(v0, vf, af, b));
+        return;
     }
     let j = b.jmax;
     let dv = vf - v0;
     let scale = a0.abs().max(af.abs()).max(b.amax).max(-b.amin);
     let eps = 1e-12 * scale;
-    let mut all: Vec<Change> = Vec::with_capacity(4);
     let mut consider = |c: Change| {
         if c.segments.iter().all(|s| s.duration_s() >= 0.0) {
-            all.push(c);
+            f(c);
         }
     };
     // Up-down.
@@ -125,7 +144,6 @@ pub fn local_changes(v0: f64, a0: f64, vf: f64, af: f64, b: &Bounds) -> Vec<Chan
             }
         }
     }
-    all
 }
 
 /// Jerk `j1` for `t1`, hold (zero jerk) for `hold`, jerk `-j1` for `t3`.

@@ -2,8 +2,8 @@
 //! three jerk arcs with a plateau at a free level, and four arcs (UDUD). Used by
 //! `duration::with_duration` when stretching the peak-velocity family is not enough.
 
-use crate::roots::roots;
-use crate::three_arc::both_senses;
+use super::roots::roots;
+use super::three_arc::both_senses;
 use crate::velocity::Bounds;
 use crate::{Limits, Segment, State};
 
@@ -100,7 +100,7 @@ fn held_udu(
         knots.dedup();
         for x in roots(&g, &knots) {
             if let Some(segs) = build(x, first)
-                && crate::three_arc::velocity_within(&start, &segs, vmax, vmin, sign)
+                && super::three_arc::velocity_within(&start, &segs, vmax, vmin, sign)
             {
                 out.push(segs.to_vec());
             }
@@ -187,7 +187,7 @@ fn udud(
     roots(&g, &knots)
         .into_iter()
         .filter_map(build)
-        .filter(|segs| crate::three_arc::velocity_within(&start, segs, vmax, vmin, sign))
+        .filter(|segs| super::three_arc::velocity_within(&start, segs, vmax, vmin, sign))
         .map(|segs| segs.to_vec())
         .collect()
 }

@@ -144,7 +144,7 @@ fn udu(
         knots.retain(|x| x.is_finite() && *x >= x_lo && *x <= x_hi);
         knots.sort_by(f64::total_cmp);
         knots.dedup();
-        for x in crate::roots::roots(&g, &knots) {
+        for x in super::roots::roots(&g, &knots) {
             if let Some(segs) = build(x, branch) {
                 let dur = segs.iter().map(Segment::duration_s).sum();
                 if velocity_within(&start, &segs, vmax, vmin, sign) {

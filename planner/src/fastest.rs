@@ -1,0 +1,293 @@
+//! Step 1 from a safe state: every locally fastest profile (the cruises at `vmax` and
+//! `vmin`, the UDU and DUD families of `arcs`), the fastest of them, and their segments.
+//!
+//! A cruise profile is the time-optimal velocity change to `(vlim, 0)`, a cruise at
+//! `vlim`, and the time-optimal change to `(vf, af)`; it exists when the two changes leave
+//! a non-negative distance to cruise. The fastest-profile search evaluates the cruises
+//! first: their duration bounds the search in the three-arc cases, which then often have
+//! nothing left to solve.
+
+use crate::Segment;
+use crate::arcs::{Arcs, Sink, family};
+use crate::ramp::Ramp;
+use crate::unit::{Scale, Unit};
+use crate::velocity::{Bounds, Change, change};
+
+/// A candidate profile from a safe state, in normalised units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Cand {
+    /// Three arcs (see `arcs`).
+    Arcs(Arcs),
+    /// Change to `(vlim, 0)`, cruise, change to the target.
+    Cruise {
+        /// The cruise velocity (`vmax` or `vmin`, normalised).
+        v: f64,
+        /// The first velocity change.
+        c1: Change,
+        /// Cruise duration (normalised time).
+        cruise: f64,
+        /// The second velocity change.
+        c2: Change,
+    },
+}
+
+impl Cand {
+    /// Duration (normalised time).
+    pub(crate) fn duration(&self) -> f64 {
+        match self {
+            Cand::Arcs(a) => a.duration(),
+            Cand::Cruise { c1, cruise, c2, .. } => c1.duration_s() + cruise + c2.duration_s(),
+        }
+    }
+
+    /// Distance covered from the start of `u` (normalised).
+    pub(crate) fn end_p(&self, u: &Unit) -> f64 {
+        match self {
+            Cand::Arcs(a) => {
+                let (mut p, mut v, mut acc) = (0.0, a.sign * u.v0, a.sign * u.a0);
+                for (t, j) in a.t.iter().zip(a.jerks()) {
+                    p += t * (v + t * (acc / 2.0 + t * j / 6.0));
+                    v += t * (acc + t * j / 2.0);
+                    acc += t * j;
+                }
+                a.sign * p
+            }
+            Cand::Cruise { v, c1, cruise, c2 } => {
+                c1.end(u.v0, u.a0).p + cruise * v + c2.end(*v, 0.0).p
+            }
+        }
+    }
+
+    /// Append the profile's segments in physical units (zero-duration ones included). Holds
+    /// are zero-jerk segments; the cruise is a constant-acceleration segment at exactly
+    /// zero.
+    pub(crate) fn segments(&self, sc: &Scale, out: &mut impl Extend<Segment>) {
+        match self {
+            Cand::Arcs(a) => {
+                out.extend(a.t.iter().zip(a.jerks()).map(|(t, j)| Segment::Jerk {
+                    duration_s: t * sc.t,
+                    jerk: j * a.sign * sc.j,
+                }));
+            }
+            Cand::Cruise { c1, cruise, c2, .. } => {
+                push_change(c1, sc, out);
+                // The cruise holds the acceleration at exactly zero: the change before ends
+                // there only up to rounding, and a cruise can be long enough to matter.
+                out.extend([Segment::Accel {
+                    duration_s: cruise * sc.t,
+                    accel: 0.0,
+                }]);
+                push_change(c2, sc, out);
+            }
+        }
+    }
+}
+
+fn push_change(c: &Change, sc: &Scale, out: &mut impl Extend<Segment>) {
+    out.extend(c.segments.iter().filter_map(|seg| match *seg {
+        Segment::Jerk { duration_s, jerk } => Some(Segment::Jerk {
+            duration_s: duration_s * sc.t,
+            jerk: jerk * sc.j,
+        }),
+        Segment::Accel { .. } => None,
+    }));
+}
+
+/// The time-optimal velocity changes to `(vlim, 0)` and from there to the target, with
+/// their durations' sum and distance. From a safe state toward a limit the first is an
+/// up-down change (down-up toward `vmin`) and the second the mirror, in closed form (see
+/// `ramp`); otherwise `velocity::change` picks the fastest shape.
+fn cruise_changes(u: &Unit, vlim: f64) -> Option<(Change, Change, f64, f64)> {
+    if u.safe() {
+        let s = vlim.signum();
+        let (amax, amin) = if s > 0.0 {
+            (u.amax, u.amin)
+        } else {
+            (-u.amin, -u.amax)
+        };
+        if let (Some(r1), Some(r2)) = (
+            Ramp::up_down(s * u.v0, s * u.a0, s * vlim, 0.0, amax),
+            Ramp::up_down(-s * vlim, 0.0, -s * u.vf, -s * u.af, -amin),
+        ) {
+            return Some((
+                r1.change(s),
+                r2.change(-s),
+                r1.duration() + r2.duration(),
+                s * (r1.dist - r2.dist),
+            ));
+        }
+    }
+    let b = Bounds {
+        amax: u.amax,
+        amin: u.amin,
+        jmax: 1.0,
+    };
+    let c1 = change(u.v0, u.a0, vlim, 0.0, &b)?;
+    let c2 = change(vlim, 0.0, u.vf, u.af, &b)?;
+    let d = c1.end(u.v0, u.a0).p + c2.end(vlim, 0.0).p;
+    Some((c1, c2, c1.duration_s() + c2.duration_s(), d))
+}
+
+/// The cruise profile at `vlim` (`vmax` or `vmin`), if the distance leaves room for it.
+fn cruise(u: &Unit, vlim: f64) -> Option<Cand> {
+    let (c1, c2, _, d) = cruise_changes(u, vlim)?;
+    let cruise = (u.dp - d) / vlim;
+    (cruise >= 0.0 && cruise.is_finite()).then_some(Cand::Cruise {
+        v: vlim,
+        c1,
+        cruise,
+        c2,
+    })
+}
+
+/// The cruise profile at `vlim` lasting `t` (normalised), whatever its distance.
+pub(crate) fn cruise_lasting(u: &Unit, vlim: f64, t: f64) -> Option<Cand> {
+    let (c1, c2, t12, _) = cruise_changes(u, vlim)?;
+    let cruise = t - t12;
+    (cruise >= -1e-12 * (1.0 + t) && cruise.is_finite()).then_some(Cand::Cruise {
+        v: vlim,
+        c1,
+        cruise: cruise.max(0.0),
+        c2,
+    })
+}
+
+/// The fastest profile of `u` shorter than `t_max` (normalised time), if any.
+///
+/// Shortcuts, both exact:
+/// - A cruise at `vmax` that [`cruise_is_optimal`] proves fastest ends the search (and the
+///   mirror for `vmin`).
+/// - The family that moves the other way is skipped when a velocity bound shows it cannot
+///   cover the distance faster than the best so far: every DUD profile stays below
+///   `V = max(v0, vf, v0 + a0^2/2 if a0 > 0, vf + af^2/2 if af < 0)` (its velocity maxima
+///   sit where its acceleration falls through zero, in the first or last arc), so it
+///   covers at most `max(V, 0) t_max` in less than `t_max`; UDU mirrored.
+pub(crate) fn fastest(u: &Unit, t_max: f64) -> Option<Cand> {
+    let mut s = Fastest { t_max, best: None };
+    let safe = u.safe();
+    for vlim in [u.vmax, u.vmin] {
+        if let Some(c) = cruise(u, vlim) {
+            if safe && cruise_is_optimal(u, vlim) {
+                return (c.duration() < t_max).then_some(c);
+            }
+            s.offer(c);
+        }
+    }
+    if !safe {
+        family(u, 1.0, &mut s);
+        family(&u.mirror(), -1.0, &mut s);
+        crate::four_arcs::family(u, 1.0, &mut s);
+        crate::four_arcs::family(&u.mirror(), -1.0, &mut s);
+        return s.best;
+    }
+    let (a0, af) = (u.a0, u.af);
+    let v_hi =
+        u.v0.max(u.vf)
+            .max(u.v0 + 0.5 * a0.max(0.0).powi(2))
+            .max(u.vf + 0.5 * af.min(0.0).powi(2));
+    let v_lo =
+        u.v0.min(u.vf)
+            .min(u.v0 - 0.5 * a0.min(0.0).powi(2))
+            .min(u.vf - 0.5 * af.max(0.0).powi(2));
+    let udu = |s: &mut Fastest| {
+        if !(u.dp <= v_lo.min(0.0) * s.t_max) {
+            family(u, 1.0, s);
+        }
+    };
+    let dud = |s: &mut Fastest| {
+        if !(u.dp >= v_hi.max(0.0) * s.t_max) {
+            family(&u.mirror(), -1.0, s);
+        }
+    };
+    if u.dp >= 0.0 {
+        udu(&mut s);
+        dud(&mut s);
+    } else {
+        dud(&mut s);
+        udu(&mut s);
+    }
+    s.best
+}
+
+/// Is the cruise at `vlim` (which exists) the fastest profile from the safe state of `u`?
+/// Yes if it moves towards the target (`dp > 0` for `vmax`), the target's acceleration
+/// does not oppose leaving the cruise (`af <= 0`), and the start is *backward safe*
+/// (`v0 - a0|a0|/2 <= vmax`: no past within the limits leads to it from above `vmax`).
+/// Mirrored for `vmin`.
+///
+/// Proof. Every profile from a safe start to a target holdable within the limits stays
+/// *forward safe* (`v + a|a|/2 <= vmax`; once above, the velocity must overshoot), so its
+/// velocity never exceeds `u(t)`: the time-optimal rise to `(vmax, 0)`, then `vmax` (where
+/// `u` is on the boundary `v + a^2/2 = vmax` it cannot be passed without leaving it). By
+/// time reversal, with the start backward safe, it never exceeds `w(T - t)`, where `w(tau)`
+/// is the velocity `tau` before the end of the time-optimal descent from `(vmax, 0)` to
+/// the target (then `vmax`); with `af <= 0` that descent only slows, so `w` is
+/// nondecreasing. A profile of duration `T` thus covers at most
+/// `F(T) = int_0^T min(u(t), w(T - t)) dt`, and `F(T_c) = dp` for the cruise profile's
+/// duration `T_c` (its velocity *is* that minimum). `F` grows with `T` at the rate of the
+/// minimum's peak, which rises with `T`: where that peak is positive `F` increases, where
+/// it is not `F <= 0 < dp`. Hence `F(T) < dp` for every `T < T_c`: nothing is faster.
+/// The property test against the oracle checks this on random problems.
+fn cruise_is_optimal(u: &Unit, vlim: f64) -> bool {
+    let s = vlim.signum();
+    let (dp, af, v0, a0) = (s * u.dp, s * u.af, s * u.v0, s * u.a0);
+    dp > 0.0 && af <= 0.0 && v0 - 0.5 * a0 * a0.abs() <= s * vlim
+}
+
+/// Calls `f` with the duration (normalised) of every locally fastest profile of `u`.
+pub(crate) fn each_duration(u: &Unit, f: impl FnMut(f64)) {
+    let mut s = Every(f);
+    for vlim in [u.vmax, u.vmin] {
+        if let Some(c) = cruise(u, vlim) {
+            (s.0)(c.duration());
+        }
+    }
+    family(u, 1.0, &mut s);
+    family(&u.mirror(), -1.0, &mut s);
+    if !u.safe() {
+        crate::four_arcs::family(u, 1.0, &mut s);
+        crate::four_arcs::family(&u.mirror(), -1.0, &mut s);
+    }
+}
+
+struct Fastest {
+    t_max: f64,
+    best: Option<Cand>,
+}
+
+impl Fastest {
+    fn offer(&mut self, c: Cand) -> bool {
+        let t = c.duration();
+        if t < self.t_max {
+            self.t_max = t;
+            self.best = Some(c);
+            true
+        } else {
+            false
+        }
+    }
+}
+
+impl Sink for Fastest {
+    fn t_max(&self) -> f64 {
+        self.t_max
+    }
+    fn offer_arcs(&mut self, arcs: Arcs) -> bool {
+        // Within a case the roots come in order of duration: the first valid one is the
+        // case's fastest, whether or not it beats the best so far.
+        self.offer(Cand::Arcs(arcs));
+        true
+    }
+}
+
+struct Every<F>(F);
+
+impl<F: FnMut(f64)> Sink for Every<F> {
+    fn t_max(&self) -> f64 {
+        f64::INFINITY
+    }
+    fn offer_arcs(&mut self, arcs: Arcs) -> bool {
+        (self.0)(arcs.duration());
+        false
+    }
+}

@@ -1,0 +1,13 @@
+//! Test-only oracle: the bracketing implementation of the any-state planner (step 1) and
+//! of step 2 that the closed-form cases replaced. It is slow (it samples every one-
+//! parameter family on a grid and bisects every sign change) but independent of the
+//! closed forms, so the property tests in `tests` check that both agree on random
+//! problems.
+
+pub(crate) mod duration;
+pub(crate) mod peak;
+mod roots;
+mod stretch;
+pub(crate) mod sync;
+mod tests;
+mod three_arc;

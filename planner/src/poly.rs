@@ -1,0 +1,322 @@
+//! Real roots of polynomials of degree <= 6 inside an interval, without allocation.
+//!
+//! The planner's profile cases reduce to one polynomial equation in one unknown whose valid
+//! solutions lie in a known interval. Rather than solving the quartic in closed form and
+//! filtering, roots are *isolated*: the critical points (roots of the derivative, found the
+//! same way one degree lower, down to the closed-form quadratic) split the interval into
+//! monotone pieces; a piece whose ends differ in sign holds exactly one root, refined by
+//! Newton's method kept inside the bracket (bisection whenever a step would leave it). A
+//! critical point where the polynomial touches zero counts as a (double) root. Work outside
+//! the interval is never done, and an interval whose Taylor bound excludes zero costs one
+//! shifted evaluation.
+
+/// Highest degree handled.
+const MAX_DEG: usize = 6;
+
+/// Up to [`MAX_DEG`] roots, ascending.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Roots {
+    x: [f64; MAX_DEG],
+    n: usize,
+}
+
+impl Roots {
+    fn push(&mut self, x: f64) {
+        if self.n < MAX_DEG && (self.n == 0 || x > self.x[self.n - 1]) {
+            self.x[self.n] = x;
+            self.n += 1;
+        }
+    }
+
+    /// The roots, ascending.
+    pub(crate) fn as_slice(&self) -> &[f64] {
+        &self.x[..self.n]
+    }
+}
+
+/// `c[0] + c[1] x + ... + c[n] x^n` and its derivative.
+#[inline]
+fn eval_d(c: &[f64], x: f64) -> (f64, f64) {
+    let n = c.len() - 1;
+    let mut f = c[n];
+    let mut d = 0.0;
+    for k in (0..n).rev() {
+        d = d * x + f;
+        f = f * x + c[k];
+    }
+    (f, d)
+}
+
+/// `sum |c_k| |x|^k`: the size of the terms, for rounding tolerances.
+#[inline]
+fn magnitude(c: &[f64], x: f64) -> f64 {
+    let ax = x.abs();
+    c.iter().rev().fold(0.0, |m, ck| m * ax + ck.abs())
+}
+
+/// Binomial coefficients `C(n, k)` for `n <= MAX_DEG`.
+const BINOM: [[f64; MAX_DEG + 1]; MAX_DEG + 1] = {
+    let mut b = [[0.0; MAX_DEG + 1]; MAX_DEG + 1];
+    let mut n = 0;
+    while n <= MAX_DEG {
+        b[n][0] = 1.0;
+        let mut k = 1;
+        while k <= n {
+            b[n][k] = b[n - 1][k - 1] + if k < n { b[n - 1][k] } else { 0.0 };
+            k += 1;
+        }
+        n += 1;
+    }
+    b
+};
+
+/// Sign changes of `c`'s Bernstein coefficients on `[lo, hi]`: `Some(0)` or `Some(1)` when
+/// that count is certain despite rounding, `None` otherwise (more, or too close to call).
+fn bernstein_changes(c: &[f64], lo: f64, hi: f64) -> Option<usize> {
+    let n = c.len() - 1;
+    // Coefficients of c(lo + h t), t in [0, 1]: Taylor shift, then scale.
+    let mut d = [0.0; MAX_DEG + 1];
+    d[..=n].copy_from_slice(c);
+    for k in 0..n {
+        for i in (k..n).rev() {
+            d[i] += lo * d[i + 1];
+        }
+    }
+    let h = hi - lo;
+    let mut hk = 1.0;
+    let mut size = 0.0;
+    for dk in &mut d[..=n] {
+        *dk *= hk;
+        hk *= h;
+        size += dk.abs();
+    }
+    let tol = 64.0 * f64::EPSILON * size;
+    let mut changes = 0;
+    let mut last = 0.0;
+    for i in 0..=n {
+        let mut b = 0.0;
+        for k in 0..=i {
+            b += BINOM[i][k] / BINOM[n][k] * d[k];
+        }
+        if b.abs() <= tol {
+            return None;
+        }
+        if last != 0.0 && (b < 0.0) != (last < 0.0) {
+            changes += 1;
+            if changes > 1 {
+                return None;
+            }
+        }
+        last = b;
+    }
+    Some(changes)
+}
+
+/// The roots of `c` (lowest degree first, degree `c.len() - 1 <= 6`) in `[lo, hi]`,
+/// ascending. Roots within rounding of the interval ends are included.
+pub(crate) fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
+    let mut out = Roots::default();
+    if !(lo <= hi) {
+        return out;
+    }
+    // Trailing zero coefficients lower the degree.
+    let mut n = c.len() - 1;
+    while n > 0 && c[n] == 0.0 {
+        n -= 1;
+    }
+    let c = &c[..=n];
+    match n {
+        0 => {}
+        1 => {
+            let x = -c[0] / c[1];
+            if x >= lo && x <= hi {
+                out.push(x);
+            }
+        }
+        2 => quadratic(c, lo, hi, &mut out),
+        _ => {
+            match bernstein_changes(c, lo, hi) {
+                Some(0) => return out,
+                Some(_) => {
+                    let fa = eval_d(c, lo).0;
+                    out.push(refine(c, lo, hi, fa));
+                    return out;
+                }
+                None => {}
+            }
+            let mut d = [0.0; MAX_DEG];
+            for k in 1..=n {
+                d[k - 1] = k as f64 * c[k];
+            }
+            let crit = roots_in(&d[..n], lo, hi);
+            isolate(c, lo, hi, crit.as_slice(), &mut out);
+        }
+    }
+    out
+}
+
+/// Roots of a quadratic in `[lo, hi]`, cancellation free, polished by one Newton step.
+fn quadratic(c: &[f64], lo: f64, hi: f64, out: &mut Roots) {
+    let (a, b, k) = (c[2], c[1], c[0]);
+    let disc = b * b - 4.0 * a * k;
+    let tol = 8.0 * f64::EPSILON * (b * b + (4.0 * a * k).abs());
+    let mut push = |x: f64| {
+        if x >= lo && x <= hi {
+            let (f, d) = eval_d(c, x);
+            let y = if d != 0.0 { x - f / d } else { x };
+            out.push(if y >= lo && y <= hi { y } else { x });
+        }
+    };
+    if disc < -tol {
+        return;
+    }
+    if disc <= tol {
+        push(-b / (2.0 * a));
+        return;
+    }
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    let (x1, x2) = if q == 0.0 { (0.0, 0.0) } else { (q / a, k / q) };
+    let (x1, x2) = if x1 <= x2 { (x1, x2) } else { (x2, x1) };
+    push(x1);
+    if x2 != x1 {
+        push(x2);
+    }
+}
+
+/// Roots of `c` on `[lo, hi]` given its critical points there (ascending).
+fn isolate(c: &[f64], lo: f64, hi: f64, crit: &[f64], out: &mut Roots) {
+    let mut xs = [0.0; MAX_DEG + 2];
+    let mut m = 0;
+    xs[m] = lo;
+    m += 1;
+    for &x in crit {
+        if x > xs[m - 1] && x < hi {
+            xs[m] = x;
+            m += 1;
+        }
+    }
+    if hi > xs[m - 1] {
+        xs[m] = hi;
+        m += 1;
+    }
+    let mut fs = [0.0; MAX_DEG + 2];
+    for i in 0..m {
+        fs[i] = eval_d(c, xs[i]).0;
+    }
+    let tol_at = |x: f64| 16.0 * f64::EPSILON * magnitude(c, x);
+    for i in 0..m {
+        // A value at a point (end or critical point) within rounding of zero is a root:
+        // a double root at a critical point, or a root on the interval's edge.
+        let on_zero = fs[i].abs() <= tol_at(xs[i]);
+        if on_zero {
+            out.push(xs[i]);
+        }
+        if i + 1 < m {
+            let (fa, fb) = (fs[i], fs[i + 1]);
+            let next_zero = fb.abs() <= tol_at(xs[i + 1]);
+            if !on_zero && !next_zero && (fa < 0.0) != (fb < 0.0) {
+                out.push(refine(c, xs[i], xs[i + 1], fa));
+            }
+        }
+    }
+}
+
+/// The root of `c` in `[a, b]` where `c(a) = fa` and `c(b)` differ in sign and `c` is
+/// monotone: Newton's method kept inside the bracket, to full precision.
+fn refine(c: &[f64], a: f64, b: f64, fa: f64) -> f64 {
+    let (mut lo, mut hi) = (a, b);
+    let neg_lo = fa < 0.0;
+    let fb = eval_d(c, b).0;
+    let mut x = if fb != fa {
+        a - fa * (b - a) / (fb - fa)
+    } else {
+        0.5 * (a + b)
+    };
+    if !(x > a && x < b) {
+        x = 0.5 * (a + b);
+    }
+    let tol = 2.0 * f64::EPSILON * a.abs().max(b.abs());
+    for _ in 0..100 {
+        let (f, d) = eval_d(c, x);
+        if f == 0.0 {
+            return x;
+        }
+        if (f < 0.0) == neg_lo {
+            lo = x;
+        } else {
+            hi = x;
+        }
+        let mut next = x - f / d;
+        if !(next > lo && next < hi) {
+            next = 0.5 * (lo + hi);
+        }
+        let step = (next - x).abs();
+        x = next;
+        if step <= tol.max(2.0 * f64::EPSILON * x.abs()) || hi - lo <= tol {
+            break;
+        }
+    }
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn from_roots(r: &[f64]) -> Vec<f64> {
+        // Expand prod (x - r_i), lowest degree first.
+        let mut c = vec![1.0];
+        for &ri in r {
+            let mut next = vec![0.0; c.len() + 1];
+            for (k, ck) in c.iter().enumerate() {
+                next[k + 1] += ck;
+                next[k] -= ri * ck;
+            }
+            c = next;
+        }
+        c
+    }
+
+    #[test]
+    fn finds_every_root_of_known_polynomials() {
+        for r in [
+            vec![-1.0, 0.5, 2.0, 3.0],
+            vec![0.1, 0.1000001, 5.0, -7.0],
+            vec![1.0, 2.0, 3.0],
+            vec![-2.0, 4.0],
+            vec![1e-3, 1e3, 1.0, -1.0],
+            vec![-3.0, -1.0, 0.2, 0.7, 2.5, 9.0],
+            vec![0.3, 0.31, 0.32, 4.0, -4.0],
+        ] {
+            let c = from_roots(&r);
+            let got = roots_in(&c, -10.0, 1e4);
+            let mut want = r.clone();
+            want.sort_by(f64::total_cmp);
+            assert_eq!(got.as_slice().len(), want.len(), "{r:?}: {got:?}");
+            for (g, w) in got.as_slice().iter().zip(&want) {
+                assert!((g - w).abs() <= 1e-9 * w.abs().max(1.0), "{r:?}: {got:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn double_roots_and_interval_limits() {
+        // (x - 1)^2 (x + 2)(x - 4): the double root counts once.
+        let c = from_roots(&[1.0, 1.0, -2.0, 4.0]);
+        let got = roots_in(&c, -5.0, 5.0);
+        assert_eq!(got.as_slice().len(), 3, "{got:?}");
+        assert!((got.as_slice()[1] - 1.0).abs() < 1e-7);
+        // Only roots inside [0, 3].
+        let got = roots_in(&c, 0.0, 3.0);
+        assert_eq!(got.as_slice().len(), 1, "{got:?}");
+        // A root on the edge is kept.
+        let got = roots_in(&c, 4.0, 6.0);
+        assert_eq!(got.as_slice(), &[4.0]);
+        // None.
+        assert!(
+            roots_in(&[1.0, 0.0, 1.0, 0.0, 1.0], -3.0, 3.0)
+                .as_slice()
+                .is_empty()
+        );
+    }
+}

@@ -1,0 +1,106 @@
+//! The up-down velocity change in closed form (normalised units, jerk 1): jerk `+1` from
+//! `a0` to a peak `A`, a hold at the limit if the peak reaches it, jerk `-1` to `a1`, with
+//! its duration and distance, no segments and no search. From a safe state this is the
+//! time-optimal change up to a cruise at `vmax`, and (mirrored) the change down from it to
+//! the target; `velocity::change`, which considers every shape, is the general fallback.
+
+use crate::Segment;
+use crate::velocity::Change;
+
+/// An up-down change: durations of the rising arc, the hold, the falling arc, and the
+/// distance covered.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Ramp {
+    t1: f64,
+    hold: f64,
+    t2: f64,
+    /// Distance covered (normalised).
+    pub dist: f64,
+}
+
+impl Ramp {
+    /// From `(v0, a0)` to `(v1, a1)` with the peak at most `alim > 0`; `None` when the
+    /// peak `A`, `A^2 = v1 - v0 + (a0^2 + a1^2)/2`, would lie below `a0` or `a1` (another
+    /// shape is needed).
+    pub(crate) fn up_down(v0: f64, a0: f64, v1: f64, a1: f64, alim: f64) -> Option<Self> {
+        let q = v1 - v0 + 0.5 * (a0 * a0 + a1 * a1);
+        let lo = a0.max(a1);
+        if !(q >= 0.0) || q.sqrt() < lo - 1e-12 {
+            return None;
+        }
+        let mut a = q.sqrt().max(lo);
+        let mut hold = 0.0;
+        if a > alim {
+            a = alim;
+            hold =
+                ((v1 - v0) - (alim * alim - a0 * a0) / 2.0 - (alim * alim - a1 * a1) / 2.0) / alim;
+            hold = hold.max(0.0);
+        }
+        let (t1, t2) = (a - a0, a - a1);
+        let va = v0 + 0.5 * (a * a - a0 * a0);
+        let vb = va + a * hold;
+        let dist = t1 * (v0 + t1 * (a0 / 2.0 + t1 / 6.0))
+            + hold * (va + a * hold / 2.0)
+            + t2 * (vb + t2 * (a / 2.0 - t2 / 6.0));
+        Some(Self { t1, hold, t2, dist })
+    }
+
+    /// Duration (normalised).
+    pub(crate) fn duration(&self) -> f64 {
+        self.t1 + self.hold + self.t2
+    }
+
+    /// The change as segments (normalised), mirrored for `sign = -1`.
+    pub(crate) fn change(&self, sign: f64) -> Change {
+        Change {
+            segments: [
+                Segment::Jerk {
+                    duration_s: self.t1,
+                    jerk: sign,
+                },
+                Segment::Jerk {
+                    duration_s: self.hold,
+                    jerk: 0.0,
+                },
+                Segment::Jerk {
+                    duration_s: self.t2,
+                    jerk: -sign,
+                },
+            ],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::velocity::{Bounds, change};
+
+    #[test]
+    fn equals_the_general_change_where_it_applies() {
+        let b = Bounds {
+            amax: 1.0,
+            amin: -1.0,
+            jmax: 1.0,
+        };
+        for (v0, a0, v1, a1) in [
+            (0.0, 0.0, 1.0, 0.0),
+            (0.0, 0.0, 3.0, 0.0),
+            (-0.5, -0.8, 0.7, 0.0),
+            (0.2, 0.6, 0.5, -0.3),
+            (1.0, 0.9, 1.5, 0.2),
+        ] {
+            let r = Ramp::up_down(v0, a0, v1, a1, 1.0).expect("up-down applies");
+            let c = change(v0, a0, v1, a1, &b).expect("change");
+            let e = r.change(1.0).end(v0, a0);
+            assert!((r.duration() - c.duration_s()).abs() < 1e-12, "{r:?} {c:?}");
+            assert!(
+                (e.p - r.dist).abs() < 1e-12 && (e.v - v1).abs() < 1e-12,
+                "{e:?}"
+            );
+            assert!((e.a - a1).abs() < 1e-12);
+        }
+        // Peak below the start: not this shape.
+        assert!(Ramp::up_down(0.0, 0.9, 0.1, 0.0, 1.0).is_none());
+    }
+}
