@@ -2,7 +2,7 @@
 //! observation window, and compute the metrics while streaming.
 
 use settle_planner::{Profile, Sample};
-use settle_sim::{ModalPlant, Plant};
+use settle_sim::{AxisModel, ModalPlant, Observation, Plant};
 
 use crate::error::Error;
 use crate::metrics::{Accumulator, Metrics};
@@ -35,10 +35,12 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
         run: spec.id,
         source,
     })?;
-    let plant = ModalPlant::new(modes, 1.0 / spec.sample_rate_hz).map_err(|source| Error::Sim {
-        run: spec.id,
-        source,
-    })?;
+    let plant = AxisModel::from_modes("x", &modes)
+        .and_then(|axis| ModalPlant::new(vec![axis], 1.0 / spec.sample_rate_hz))
+        .map_err(|source| Error::Sim {
+            run: spec.id,
+            source,
+        })?;
     simulate(&plant, &profile, spec, record).map_err(|source| Error::Sim {
         run: spec.id,
         source,
@@ -62,10 +64,12 @@ pub fn simulate<P: Plant>(
     let direction =
         (end.p - profile.start().p).signum() * f64::from(u8::from(spec.distance_mm != 0.0));
     let mut acc = Accumulator::new(end.p, direction, t_end, &spec.bands_um);
-    let mut state = plant.initial_state(&profile.start());
+    let mut state = plant.initial_state(&[profile.start()])?;
 
+    let mut obs = [Observation::default()];
     let mut observe = |t: f64, cmd: &Sample, state: &P::State, acc: &mut Accumulator| {
-        let o = plant.observe(state);
+        plant.observe(state, &mut obs);
+        let o = obs[0];
         acc.push(t, o.commanded_m, o.toolhead_m);
         if let Some(rec) = record.as_deref_mut() {
             rec.push(
@@ -97,7 +101,7 @@ pub fn simulate<P: Plant>(
             // from dt in the last bit, which would cost the plant a fresh transition
             // matrix); partial steps at breakpoints use their true length.
             let whole = next == t_sample && t == (k - 1) as f64 * dt;
-            plant.step(&mut state, &cmd, if whole { dt } else { next - t })?;
+            plant.step(&mut state, &[cmd], if whole { dt } else { next - t })?;
             t = next;
             if t_sample <= t1 {
                 if t_sample < t_end {
@@ -118,7 +122,7 @@ pub fn simulate<P: Plant>(
     }
     let n = (spec.window_s * spec.sample_rate_hz).ceil() as usize;
     for i in 1..=n {
-        plant.step(&mut state, &hold, dt)?;
+        plant.step(&mut state, &[hold], dt)?;
         observe(t_end + i as f64 * dt, &hold, &state, &mut acc);
     }
     Ok(acc.finish())
