@@ -18,7 +18,9 @@ pub mod lumped;
 pub mod machine;
 mod modal;
 mod mode;
+pub mod pencil;
 mod plant;
+pub mod rapier;
 pub mod stepper;
 
 pub use axis::{AxisModel, DriverMode};
@@ -26,3 +28,4 @@ pub use error::SimError;
 pub use modal::{ModalAxis, ModalPlant, ModalState};
 pub use mode::Mode;
 pub use plant::{Observation, Plant, advance_sample, check_step};
+pub use rapier::{BeltModel, RapierOptions, RapierPlant, RapierState};
