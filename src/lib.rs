@@ -6,6 +6,7 @@
 
 pub mod error;
 pub mod locate;
+pub mod machine_file;
 pub mod metrics;
 pub mod plan_lines;
 pub mod report;
@@ -13,6 +14,7 @@ pub mod run;
 pub mod scenario;
 pub mod series;
 pub mod sweep;
+pub mod validate;
 
 use std::path::Path;
 

@@ -7,7 +7,12 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 
+use settle::run::Backend;
 use settle::{Error, report};
+
+fn parse_backend(s: &str) -> Result<Backend, String> {
+    Backend::parse(s).ok_or_else(|| format!("unknown backend `{s}`; allowed: {}", Backend::ALLOWED))
+}
 
 #[derive(Parser, Debug)]
 #[command(
@@ -36,6 +41,21 @@ enum Command {
         /// Worker threads [default: all cores].
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
         jobs: Option<u16>,
+        /// Simulation backend: modal (exact, linear driver only), rapier, mujoco.
+        #[arg(long, default_value = "rapier", value_parser = parse_backend)]
+        backend: Backend,
+    },
+    /// Check every backend against the closed form and against each other; print a table.
+    #[command(
+        after_help = "Example:\n  settle validate\n  settle validate --backend rapier --out validate.md\n\nExit code 1 when a check is past its threshold (frequency 0.5 %, residual 2 %,\nengines 3 %, numerical damping 10 % of the physical)."
+    )]
+    Validate {
+        /// Only this backend (with the modal reference) [default: every available one].
+        #[arg(long, value_parser = parse_backend)]
+        backend: Option<Backend>,
+        /// Also write the table as Markdown to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Plan motion problems: JSON lines on stdin, one profile (or error) per line on stdout.
     #[command(
@@ -59,6 +79,9 @@ enum Command {
         /// Trace file [default: results/<scenario name>/run-<case>.csv].
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Simulation backend: modal, rapier, mujoco.
+        #[arg(long, default_value = "rapier", value_parser = parse_backend)]
+        backend: Backend,
     },
 }
 
@@ -80,26 +103,35 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             scenario,
             out,
             jobs,
-        } => sweep(scenario, out, jobs.map(usize::from)),
+            backend,
+        } => sweep(scenario, out, jobs.map(usize::from), backend),
+        Command::Validate { backend, out } => settle::validate::command(backend, out.as_deref()),
         Command::Plan { jobs } => plan_lines(jobs.map(usize::from)),
         Command::Run {
             scenario,
             case,
             out,
-        } => run_one(scenario, case, out),
+            backend,
+        } => run_one(scenario, case, out, backend),
     }
 }
 
-fn sweep(path: PathBuf, out: Option<PathBuf>, jobs: Option<usize>) -> anyhow::Result<ExitCode> {
+fn sweep(
+    path: PathBuf,
+    out: Option<PathBuf>,
+    jobs: Option<usize>,
+    backend: Backend,
+) -> anyhow::Result<ExitCode> {
     let started = Instant::now();
-    let (sc, runs) = settle::load_runs(&path)?;
+    let (sc, mut runs) = settle::load_runs(&path)?;
+    settle::run::set_backend(&path, &mut runs, backend)?;
     let out = out.unwrap_or_else(|| PathBuf::from("results").join(&sc.name));
     std::fs::create_dir_all(&out).map_err(|source| Error::Write {
         path: out.clone(),
         source,
     })?;
     eprintln!(
-        "{}: {} runs -> {}",
+        "{}: {} runs on {backend} -> {}",
         path.display(),
         runs.len(),
         out.display()
@@ -127,8 +159,14 @@ fn sweep(path: PathBuf, out: Option<PathBuf>, jobs: Option<usize>) -> anyhow::Re
     Ok(ExitCode::SUCCESS)
 }
 
-fn run_one(path: PathBuf, case: usize, out: Option<PathBuf>) -> anyhow::Result<ExitCode> {
-    let (sc, runs) = settle::load_runs(&path)?;
+fn run_one(
+    path: PathBuf,
+    case: usize,
+    out: Option<PathBuf>,
+    backend: Backend,
+) -> anyhow::Result<ExitCode> {
+    let (sc, mut runs) = settle::load_runs(&path)?;
+    settle::run::set_backend(&path, &mut runs, backend)?;
     let Some(spec) = runs.get(case) else {
         return Err(Error::Input {
             at: settle::error::Location {
@@ -155,12 +193,15 @@ fn run_one(path: PathBuf, case: usize, out: Option<PathBuf>) -> anyhow::Result<E
             source,
         })?;
     }
-    let mut series = settle::series::Series::new(&settle::run::CHANNELS);
+    let mut series = settle::series::Series::default();
     let m = settle::run::execute(spec, Some(&mut series))?;
     let mut csv = Vec::new();
     series.write_csv(&mut csv).context("formatting the trace")?;
     report::write_atomic(&out, &csv)?;
-    println!("run {case}: {} {} mm", spec.profile, spec.distance_mm);
+    println!(
+        "run {case}: {} {} mm on axis {} of {} ({} driver, {backend})",
+        spec.profile, spec.distance_mm, spec.axis, spec.machine_name, spec.driver
+    );
     for (p, v) in &spec.swept {
         println!("  {p} = {v}");
     }
@@ -177,6 +218,27 @@ fn run_one(path: PathBuf, case: usize, out: Option<PathBuf>) -> anyhow::Result<E
     }
     println!("  overshoot_um           {:.4}", m.overshoot_um);
     println!("  max_following_error_um {:.4}", m.max_following_error_um);
+    if m.axes.len() > 1 {
+        for a in &m.axes {
+            println!(
+                "  axis {}: residual_peak_um {:.4}, max_following_error_um {:.4}",
+                a.name, a.residual_peak_um, a.max_following_error_um
+            );
+        }
+    }
+    for a in &m.axes {
+        if let Some(deg) = a.max_load_angle_deg {
+            println!(
+                "  axis {}: max load angle {deg:.1} electrical degrees",
+                a.name
+            );
+        }
+    }
+    if let settle::metrics::Status::LostSteps { axis, steps } = &m.status {
+        println!(
+            "  FAILED: lost {steps} full steps (axis {axis}): the numbers above are not a settling result"
+        );
+    }
     println!("trace: {} ({} samples)", out.display(), series.len());
     Ok(ExitCode::SUCCESS)
 }

@@ -1,6 +1,8 @@
 //! Settling metrics, computed streaming (one sample at a time, no traces kept).
 //!
-//! Definitions (DESIGN.md): error = toolhead - commanded end point after the move ends.
+//! Definitions (DESIGN.md): the error is the toolhead position minus the commanded end
+//! point, a vector over the machine's axes; the main metrics use its length (the distance
+//! to the end point), and each axis also gets its own from its component.
 //! - `move_time_s`: commanded duration T.
 //! - `residual_peak_um`, `residual_rms_um`: max |error| and RMS error over the samples in
 //!   [T, T + window].
@@ -8,10 +10,64 @@
 //!   the rest of the window; the crossing is interpolated linearly between the last sample
 //!   out of the band and the next one. `None` (not settled) if the last sample is outside.
 //!   Zero if the error is inside the band from T on.
-//! - `overshoot_um`: largest excursion past the target in the direction of motion, over the
-//!   whole run (0 if none; for a zero-length move, the largest |error|).
+//! - `overshoot_um`: largest excursion past the target along the direction of motion (the
+//!   unit vector from start to end point), over the whole run (0 if none; for a
+//!   zero-length move, the largest |error|).
 //! - `max_following_error_um`: max |toolhead - commanded| for t <= T.
 //! - `move_and_settle_s(band) = move_time_s + settle_time_s(band)`.
+//!
+//! A run whose stepper lost steps is a failed run ([`Status::LostSteps`]): its numbers
+//! describe a machine that no longer knows where it is, so reports show the failure
+//! instead of them and never average them.
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Status {
+    /// Every axis stayed in step.
+    Ok,
+    /// A stepper's load angle passed 90 electrical degrees on `axis`.
+    LostSteps {
+        /// The axis that lost steps first (in axis order).
+        axis: String,
+        /// Full steps lost, summed over axes.
+        steps: u32,
+    },
+}
+
+impl Status {
+    /// `ok` or `lost_steps`, for tables.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::LostSteps { .. } => "lost_steps",
+        }
+    }
+
+    /// Full steps lost (0 when in step).
+    pub fn lost_steps(&self) -> u32 {
+        match self {
+            Status::Ok => 0,
+            Status::LostSteps { steps, .. } => *steps,
+        }
+    }
+}
+
+/// Per-axis metrics (on that axis's error component). Lengths in um, times in s.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxisMetrics {
+    /// Axis name.
+    pub name: String,
+    /// Peak |error| after the move (um).
+    pub residual_peak_um: f64,
+    /// RMS error after the move (um).
+    pub residual_rms_um: f64,
+    /// Settle time per band (s); `None` = not settled within the window.
+    pub settle_time_s: Vec<Option<f64>>,
+    /// Max following error during the move (um).
+    pub max_following_error_um: f64,
+    /// Largest |load angle| of the axis's stepper (electrical degrees), if it has one.
+    pub max_load_angle_deg: Option<f64>,
+}
 
 /// Metrics of one run. Lengths in um, times in s.
 #[derive(Debug, Clone, PartialEq)]
@@ -30,6 +86,10 @@ pub struct Metrics {
     pub overshoot_um: f64,
     /// Max following error during the move (um).
     pub max_following_error_um: f64,
+    /// Per axis, in machine order.
+    pub axes: Vec<AxisMetrics>,
+    /// Whether the run stayed in step.
+    pub status: Status,
 }
 
 impl Metrics {
@@ -37,108 +97,183 @@ impl Metrics {
     pub fn move_and_settle_s(&self, i: usize) -> Option<f64> {
         self.settle_time_s[i].map(|s| self.move_time_s + s)
     }
+
+    /// True when the run stayed in step (its numbers are meaningful).
+    pub fn is_ok(&self) -> bool {
+        self.status == Status::Ok
+    }
 }
 
-#[derive(Debug, Clone, Copy)]
-struct BandState {
-    band_m: f64,
-    /// Crossing time (s after T) of the last entry into the band; None while outside.
-    entered_at: Option<f64>,
-}
-
-/// Streaming metric accumulator. Feed samples in time order with [`Accumulator::push`].
+/// Settle-time bookkeeping for one error signal and every band.
 #[derive(Debug, Clone)]
-pub struct Accumulator {
-    target_m: f64,
-    direction: f64,
-    move_end_s: f64,
-    bands: Vec<BandState>,
-    bands_um: Vec<f64>,
-    prev_post: Option<(f64, f64)>,
+struct Bands {
+    band_m: Vec<f64>,
+    /// Crossing time (s after T) of the last entry into each band; None while outside.
+    entered_at: Vec<Option<f64>>,
+    prev: Option<(f64, f64)>,
     peak_m: f64,
     sum_sq: f64,
-    n_post: usize,
+    n: usize,
+}
+
+impl Bands {
+    fn new(bands_um: &[f64]) -> Self {
+        Self {
+            band_m: bands_um.iter().map(|b| b * 1e-6).collect(),
+            entered_at: vec![Some(0.0); bands_um.len()],
+            prev: None,
+            peak_m: 0.0,
+            sum_sq: 0.0,
+            n: 0,
+        }
+    }
+
+    /// |error| `e` (m) at `tau` s after T.
+    fn push(&mut self, tau: f64, e: f64) {
+        self.peak_m = self.peak_m.max(e);
+        self.sum_sq += e * e;
+        self.n += 1;
+        for (b, entered) in self.band_m.iter().zip(&mut self.entered_at) {
+            if e > *b {
+                *entered = None;
+            } else if entered.is_none() {
+                // Entered between the previous sample (outside) and this one.
+                *entered = Some(match self.prev {
+                    Some((tp, ep)) if ep > e => tp + (tau - tp) * (ep - b) / (ep - e),
+                    _ => tau,
+                });
+            }
+        }
+        self.prev = Some((tau, e));
+    }
+
+    fn rms_m(&self) -> f64 {
+        if self.n > 0 {
+            (self.sum_sq / self.n as f64).sqrt()
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Streaming metric accumulator over one or more axes. Feed samples in time order with
+/// [`Accumulator::push`].
+#[derive(Debug, Clone)]
+pub struct Accumulator {
+    target_m: Vec<f64>,
+    direction: Vec<f64>,
+    move_end_s: f64,
+    bands_um: Vec<f64>,
+    total: Bands,
+    per_axis: Vec<Bands>,
     overshoot_m: f64,
     max_follow_m: f64,
+    axis_follow_m: Vec<f64>,
     abs_err_max_m: f64,
 }
 
 impl Accumulator {
-    /// `target_m`: commanded end point; `direction`: sign of the move (0 for none);
-    /// `move_end_s`: T; `bands_um`: settling bands.
-    pub fn new(target_m: f64, direction: f64, move_end_s: f64, bands_um: &[f64]) -> Self {
+    /// `target_m`: commanded end point per axis; `direction`: the direction of motion per
+    /// axis (normalised here; all zero for no motion); `move_end_s`: T; `bands_um`:
+    /// settling bands.
+    pub fn new(target_m: &[f64], direction: &[f64], move_end_s: f64, bands_um: &[f64]) -> Self {
+        let norm = direction.iter().map(|d| d * d).sum::<f64>().sqrt();
+        let direction = direction
+            .iter()
+            .map(|d| if norm > 0.0 { d / norm } else { 0.0 })
+            .collect();
         Self {
-            target_m,
+            target_m: target_m.to_vec(),
             direction,
             move_end_s,
-            bands: bands_um
-                .iter()
-                .map(|b| BandState {
-                    band_m: b * 1e-6,
-                    entered_at: Some(0.0),
-                })
-                .collect(),
             bands_um: bands_um.to_vec(),
-            prev_post: None,
-            peak_m: 0.0,
-            sum_sq: 0.0,
-            n_post: 0,
+            total: Bands::new(bands_um),
+            per_axis: target_m.iter().map(|_| Bands::new(bands_um)).collect(),
             overshoot_m: 0.0,
             max_follow_m: 0.0,
+            axis_follow_m: vec![0.0; target_m.len()],
             abs_err_max_m: 0.0,
         }
     }
 
-    /// One sample at time `t_s`: commanded and toolhead positions (m).
-    pub fn push(&mut self, t_s: f64, commanded_m: f64, toolhead_m: f64) {
-        let err = toolhead_m - self.target_m;
-        self.overshoot_m = self.overshoot_m.max(err * self.direction);
-        self.abs_err_max_m = self.abs_err_max_m.max(err.abs());
+    /// One sample at time `t_s`: commanded and toolhead positions per axis (m).
+    pub fn push(&mut self, t_s: f64, commanded_m: &[f64], toolhead_m: &[f64]) {
+        let (mut e2, mut along, mut f2) = (0.0, 0.0, 0.0);
+        for i in 0..self.target_m.len() {
+            let e = toolhead_m[i] - self.target_m[i];
+            e2 += e * e;
+            along += e * self.direction[i];
+            let f = toolhead_m[i] - commanded_m[i];
+            f2 += f * f;
+            if t_s <= self.move_end_s {
+                self.axis_follow_m[i] = self.axis_follow_m[i].max(f.abs());
+            }
+        }
+        let err = e2.sqrt();
+        self.overshoot_m = self.overshoot_m.max(along);
+        self.abs_err_max_m = self.abs_err_max_m.max(err);
         if t_s <= self.move_end_s {
-            self.max_follow_m = self.max_follow_m.max((toolhead_m - commanded_m).abs());
+            self.max_follow_m = self.max_follow_m.max(f2.sqrt());
         }
         if t_s < self.move_end_s {
             return;
         }
         let tau = t_s - self.move_end_s;
-        let e = err.abs();
-        self.peak_m = self.peak_m.max(e);
-        self.sum_sq += err * err;
-        self.n_post += 1;
-        for b in &mut self.bands {
-            if e > b.band_m {
-                b.entered_at = None;
-            } else if b.entered_at.is_none() {
-                // Entered between the previous sample (outside) and this one.
-                b.entered_at = Some(match self.prev_post {
-                    Some((tp, ep)) if ep > e => tp + (tau - tp) * (ep - b.band_m) / (ep - e),
-                    _ => tau,
-                });
-            }
+        self.total.push(tau, err);
+        for (i, b) in self.per_axis.iter_mut().enumerate() {
+            b.push(tau, (toolhead_m[i] - self.target_m[i]).abs());
         }
-        self.prev_post = Some((tau, e));
     }
 
-    /// The metrics of everything pushed.
-    pub fn finish(&self) -> Metrics {
+    /// The metrics of everything pushed, for axes named `names`, with status `status` and
+    /// each axis's largest load angle (electrical rad), if it has a motor.
+    pub fn finish_with(
+        &self,
+        names: &[String],
+        load_angles: &[Option<f64>],
+        status: Status,
+    ) -> Metrics {
         let to_um = 1e6;
+        let moving = self.direction.iter().any(|d| *d != 0.0);
         Metrics {
             move_time_s: self.move_end_s,
-            residual_peak_um: self.peak_m * to_um,
-            residual_rms_um: if self.n_post > 0 {
-                (self.sum_sq / self.n_post as f64).sqrt() * to_um
-            } else {
-                0.0
-            },
+            residual_peak_um: self.total.peak_m * to_um,
+            residual_rms_um: self.total.rms_m() * to_um,
             bands_um: self.bands_um.clone(),
-            settle_time_s: self.bands.iter().map(|b| b.entered_at).collect(),
-            overshoot_um: if self.direction == 0.0 {
-                self.abs_err_max_m * to_um
-            } else {
+            settle_time_s: self.total.entered_at.clone(),
+            overshoot_um: if moving {
                 self.overshoot_m * to_um
+            } else {
+                self.abs_err_max_m * to_um
             },
             max_following_error_um: self.max_follow_m * to_um,
+            axes: self
+                .per_axis
+                .iter()
+                .enumerate()
+                .map(|(i, b)| AxisMetrics {
+                    name: names.get(i).cloned().unwrap_or_else(|| format!("axis{i}")),
+                    residual_peak_um: b.peak_m * to_um,
+                    residual_rms_um: b.rms_m() * to_um,
+                    settle_time_s: b.entered_at.clone(),
+                    max_following_error_um: self.axis_follow_m[i] * to_um,
+                    max_load_angle_deg: load_angles.get(i).copied().flatten().map(f64::to_degrees),
+                })
+                .collect(),
+            status,
         }
+    }
+
+    /// The metrics of everything pushed (axes named `x`, `y`, `z`, ..., status ok).
+    pub fn finish(&self) -> Metrics {
+        let names: Vec<String> = (0..self.target_m.len())
+            .map(|i| {
+                ["x", "y", "z"]
+                    .get(i)
+                    .map_or(format!("axis{i}"), |n| n.to_string())
+            })
+            .collect();
+        self.finish_with(&names, &[], Status::Ok)
     }
 }
 
@@ -148,11 +283,11 @@ mod tests {
 
     /// Feed `f(t)` (m) as the toolhead error after a move ending at t = 0.
     fn run(f: impl Fn(f64) -> f64, dt: f64, window: f64, band_um: f64) -> Metrics {
-        let mut acc = Accumulator::new(0.0, 1.0, 0.0, &[band_um]);
+        let mut acc = Accumulator::new(&[0.0], &[1.0], 0.0, &[band_um]);
         let n = (window / dt).round() as usize;
         for i in 0..=n {
             let t = i as f64 * dt;
-            acc.push(t, 0.0, f(t));
+            acc.push(t, &[0.0], &[f(t)]);
         }
         acc.finish()
     }
@@ -218,10 +353,10 @@ mod tests {
     #[test]
     fn peak_rms_following_and_overshoot() {
         // Move ends at 1 s towards +target 1 m; during the move the toolhead lags 2 mm.
-        let mut acc = Accumulator::new(1.0, 1.0, 1.0, &[50.0]);
-        acc.push(0.5, 0.5, 0.498);
-        acc.push(1.0, 1.0, 1.0 + 30e-6);
-        acc.push(1.5, 1.0, 1.0 - 40e-6);
+        let mut acc = Accumulator::new(&[1.0], &[1.0], 1.0, &[50.0]);
+        acc.push(0.5, &[0.5], &[0.498]);
+        acc.push(1.0, &[1.0], &[1.0 + 30e-6]);
+        acc.push(1.5, &[1.0], &[1.0 - 40e-6]);
         let m = acc.finish();
         assert!((m.max_following_error_um - 2000.0).abs() < 1e-6);
         assert!((m.residual_peak_um - 40.0).abs() < 1e-9);
@@ -229,5 +364,30 @@ mod tests {
         assert!((m.overshoot_um - 30.0).abs() < 1e-9);
         assert_eq!(m.settle_time_s[0], Some(0.0));
         assert_eq!(m.move_and_settle_s(0), Some(1.0));
+    }
+
+    #[test]
+    fn vector_error_uses_the_distance_and_the_direction_of_motion() {
+        // A diagonal move to (1, 1) m ending at T = 1 s; after it the toolhead sits 3 um
+        // past the target along x and 4 um short along y: distance 5 um, overshoot along
+        // (1, 1)/sqrt 2 = (3 - 4)/sqrt 2 < 0, so none.
+        let mut acc = Accumulator::new(&[1.0, 1.0], &[2.0, 2.0], 1.0, &[4.5, 10.0]);
+        acc.push(1.0, &[1.0, 1.0], &[1.0 + 3e-6, 1.0 - 4e-6]);
+        acc.push(1.1, &[1.0, 1.0], &[1.0, 1.0]);
+        let m = acc.finish();
+        assert!((m.residual_peak_um - 5.0).abs() < 1e-9);
+        assert!((m.axes[0].residual_peak_um - 3.0).abs() < 1e-9);
+        assert!((m.axes[1].residual_peak_um - 4.0).abs() < 1e-9);
+        assert_eq!(m.overshoot_um, 0.0);
+        // 4.5 um band: the vector error (5 um) is outside at T, inside at T + 0.1 s; the
+        // x error (3 um) and y error (4 um) are inside from T on.
+        assert!(m.settle_time_s[0].expect("settles") > 0.0);
+        assert_eq!(m.axes[0].settle_time_s[0], Some(0.0));
+        assert_eq!(m.axes[1].settle_time_s[0], Some(0.0));
+        assert_eq!(m.settle_time_s[1], Some(0.0));
+        assert_eq!(
+            (m.axes[0].name.as_str(), m.axes[1].name.as_str()),
+            ("x", "y")
+        );
     }
 }

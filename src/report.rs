@@ -52,6 +52,7 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
             ",mode{i}_frequency_hz,mode{i}_damping_ratio,mode{i}_weight"
         );
     }
+    out.push_str(",machine,axis,driver,backend,status,lost_steps");
     out.push_str(",move_time_s,residual_peak_um,residual_rms_um");
     for b in &bands {
         let _ = write!(out, ",settle_time_s_{}", band_label(*b));
@@ -59,7 +60,21 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
     for b in &bands {
         let _ = write!(out, ",move_and_settle_s_{}", band_label(*b));
     }
-    out.push_str(",overshoot_um,max_following_error_um\n");
+    out.push_str(",overshoot_um,max_following_error_um");
+    // Per-axis metrics for physical machines (the modes form has one axis: the above).
+    let axis_names: Vec<String> = metrics
+        .first()
+        .filter(|_| runs.first().is_some_and(|r| r.machine.is_some()))
+        .map(|m| m.axes.iter().map(|a| a.name.clone()).collect())
+        .unwrap_or_default();
+    for a in &axis_names {
+        let _ = write!(out, ",{a}_residual_peak_um,{a}_residual_rms_um");
+        for b in &bands {
+            let _ = write!(out, ",{a}_settle_time_s_{}", band_label(*b));
+        }
+        let _ = write!(out, ",{a}_max_following_error_um,{a}_max_load_angle_deg");
+    }
+    out.push('\n');
     for (r, m) in runs.iter().zip(metrics) {
         let _ = write!(
             out,
@@ -81,6 +96,24 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
         }
         let _ = write!(
             out,
+            ",{},{},{},{},{},{}",
+            r.machine_name,
+            r.axis,
+            r.driver,
+            r.backend,
+            m.status.name(),
+            m.status.lost_steps()
+        );
+        if !m.is_ok() {
+            // A run that lost steps has no settling result: its metric cells stay empty
+            // so that nothing downstream averages them.
+            let cells = 5 + 2 * m.settle_time_s.len() + axis_names.len() * (4 + bands.len());
+            out.push_str(&",".repeat(cells));
+            out.push('\n');
+            continue;
+        }
+        let _ = write!(
+            out,
             ",{},{},{}",
             m.move_time_s, m.residual_peak_um, m.residual_rms_um
         );
@@ -90,7 +123,21 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
         for i in 0..m.settle_time_s.len() {
             let _ = write!(out, ",{}", csv_time(m.move_and_settle_s(i)));
         }
-        let _ = writeln!(out, ",{},{}", m.overshoot_um, m.max_following_error_um);
+        let _ = write!(out, ",{},{}", m.overshoot_um, m.max_following_error_um);
+        for a in m.axes.iter().filter(|a| axis_names.contains(&a.name)) {
+            let _ = write!(out, ",{},{}", a.residual_peak_um, a.residual_rms_um);
+            for t in &a.settle_time_s {
+                let _ = write!(out, ",{}", csv_time(*t));
+            }
+            let _ = write!(
+                out,
+                ",{},{}",
+                a.max_following_error_um,
+                a.max_load_angle_deg
+                    .map_or(String::new(), |d| d.to_string())
+            );
+        }
+        out.push('\n');
     }
     out
 }
@@ -113,13 +160,27 @@ pub fn summary_md(sc: &Scenario, runs: &[RunSpec], metrics: &[Metrics]) -> Strin
         .iter()
         .map(|m| format!("{} Hz, zeta {}", m.frequency_hz, m.damping_ratio))
         .collect();
+    let machine = match runs.first() {
+        Some(r) if r.machine.is_some() => format!(
+            "Machine: {} (axis {}, {} driver), backend {}",
+            r.machine_name, r.axis, r.driver, r.backend
+        ),
+        Some(r) => format!("Machine modes: {}; backend {}", modes.join("; "), r.backend),
+        None => format!("Machine modes: {}", modes.join("; ")),
+    };
     let _ = writeln!(
         out,
-        "Machine modes: {}. {} runs. Times in ms; **bold** = fastest move-and-settle at that point; \
+        "{machine}. {} runs. Times in ms; **bold** = fastest move-and-settle at that point; \
 gain = how much longer the slowest kind takes than the fastest.\n",
-        modes.join("; "),
         runs.len()
     );
+    let failed = metrics.iter().filter(|m| !m.is_ok()).count();
+    if failed > 0 {
+        let _ = writeln!(
+            out,
+            "**{failed} run(s) lost steps** (a stepper's load angle passed 90 electrical degrees): they are failed runs, shown as `lost N steps`, never compared or averaged.\n"
+        );
+    }
     // Group runs by their swept values other than `profile`, keeping first-seen order.
     let mut kinds: Vec<ProfileKind> = Vec::new();
     let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
@@ -174,6 +235,7 @@ gain = how much longer the slowest kind takes than the fastest.\n",
                     let t = idx
                         .iter()
                         .find(|&&i| runs[i].profile == *k)
+                        .filter(|&&i| metrics[i].is_ok())
                         .and_then(|&i| metrics[i].move_and_settle_s(bi));
                     (*k, t)
                 })
@@ -188,6 +250,11 @@ gain = how much longer the slowest kind takes than the fastest.\n",
                     .find(|&&i| runs[i].profile == *k)
                     .map(|&i| &metrics[i]);
                 match m {
+                    Some(m) if !m.is_ok() => row.extend([
+                        format!("{:.1}", m.move_time_s * 1e3),
+                        format!("lost {} steps", m.status.lost_steps()),
+                        "-".to_string(),
+                    ]),
                     Some(m) => {
                         let total = ms(m.move_and_settle_s(bi));
                         let is_best = best.is_some_and(|(bk, _)| bk == *k);
@@ -236,8 +303,9 @@ gain = how much longer the slowest kind takes than the fastest.\n",
             row.push(
                 idx.iter()
                     .find(|&&i| runs[i].profile == *k)
-                    .map_or("-".to_string(), |&i| {
-                        format!("{:.2}", metrics[i].residual_peak_um)
+                    .map_or("-".to_string(), |&i| match &metrics[i] {
+                        m if !m.is_ok() => format!("lost {} steps", m.status.lost_steps()),
+                        m => format!("{:.2}", m.residual_peak_um),
                     }),
             );
         }

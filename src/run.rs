@@ -1,125 +1,403 @@
-//! Executing one run: plan the profile, drive the plant through it and through the
-//! observation window, and compute the metrics while streaming.
+//! Executing one run: compile the machine's axes, plan the move, drive the chosen backend
+//! through it and through the observation window, and compute the metrics while
+//! streaming. [`run_trajectory`] does the same for any multi-axis
+//! [`settle_planner::Trajectory`] (corner paths, raster scans).
 
-use settle_planner::{Profile, Sample};
-use settle_sim::{ModalPlant, Plant};
+use settle_planner::{Profile, Sample, State, Trajectory};
+use settle_sim::{
+    AxisModel, BeltModel, DriverMode, ModalPlant, Observation, Plant, RapierOptions, RapierPlant,
+    SimError,
+};
 
 use crate::error::Error;
-use crate::metrics::{Accumulator, Metrics};
+use crate::metrics::{Accumulator, Metrics, Status};
 use crate::series::Series;
 use crate::sweep::RunSpec;
 
-/// Channels recorded by [`execute`] when asked for a series.
-pub const CHANNELS: [(&str, &str); 6] = [
-    ("cmd_p", "m"),
-    ("cmd_v", "m_s"),
-    ("cmd_a", "m_s2"),
-    ("cmd_j", "m_s3"),
-    ("toolhead", "m"),
-    ("error", "m"),
-];
+/// A simulation backend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Backend {
+    /// The exact discretisation of the linear model (linear driver only).
+    Modal,
+    /// rapier3d (f64): rigid bodies with the couplings and the driver as forces. Needs
+    /// nothing installed, so it is the default.
+    #[default]
+    Rapier,
+    /// MuJoCo 3.17 through mujoco-rs (needs the MuJoCo library).
+    Mujoco,
+}
 
-/// Plan and simulate one run on the modal reference plant. When `record` is given, every
-/// sample is also appended to it (see [`CHANNELS`]).
+/// The message for `--backend mujoco` in a build without MuJoCo.
+pub const NO_MUJOCO: &str =
+    "not built with MuJoCo; run scripts/setup-mujoco.sh and build with --features mujoco";
+
+impl Backend {
+    /// Every backend, in a fixed order.
+    pub const ALL: [Backend; 3] = [Backend::Modal, Backend::Rapier, Backend::Mujoco];
+    /// Names accepted by [`Backend::parse`].
+    pub const ALLOWED: &'static str = "modal, rapier, mujoco";
+
+    /// The name as written on the command line and in tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Modal => "modal",
+            Backend::Rapier => "rapier",
+            Backend::Mujoco => "mujoco",
+        }
+    }
+
+    /// Parse a name.
+    pub fn parse(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|b| b.name() == name)
+    }
+
+    /// Whether this build can run the backend.
+    pub fn available(self) -> bool {
+        !matches!(self, Backend::Mujoco)
+    }
+}
+
+impl std::fmt::Display for Backend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Options every backend honours.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SimOptions {
+    /// Position-dependent belt stiffness: varying (the physics) or frozen at the start
+    /// (the linear model; the modal backend always freezes it).
+    pub belt: BeltModel,
+    /// Largest integration step of time-stepping backends (s); `None`: their own choice
+    /// (rapier: `STEP_FRACTION / w_max`).
+    pub max_step_s: Option<f64>,
+}
+
+/// How a run is observed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observe {
+    /// Observation window after the move (s).
+    pub window_s: f64,
+    /// Sample rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Settling bands (um).
+    pub bands_um: Vec<f64>,
+}
+
+/// The axes a run simulates: the machine compiled for the run's driver model, or one axis
+/// `x` from the modes.
+pub fn axes_of(spec: &RunSpec) -> Result<Vec<AxisModel>, SimError> {
+    match &spec.machine {
+        Some(m) => m.compile(spec.driver),
+        None => Ok(vec![AxisModel::from_modes("x", &spec.modes_sim()?)?]),
+    }
+}
+
+/// The run's trajectory: the planned move on its axis, every other axis holding at 0.
+pub fn trajectory_of(
+    spec: &RunSpec,
+    axes: &[AxisModel],
+) -> Result<Trajectory, settle_planner::PlanError> {
+    let limits = spec.limits_si()?;
+    let profile =
+        spec.profile
+            .rest_to_rest(spec.start_mm * 1e-3, spec.distance_mm * 1e-3, &limits)?;
+    let profiles = axes
+        .iter()
+        .map(|a| {
+            if a.name == spec.axis {
+                profile.clone()
+            } else {
+                Profile::empty(State::default())
+            }
+        })
+        .collect();
+    Trajectory::new(profiles)
+}
+
+/// The channels [`execute`] records for these axes: per axis `cmd_p_<axis>` (m),
+/// `cmd_v_<axis>` (m/s), `cmd_a_<axis>` (m/s^2), `cmd_j_<axis>` (m/s^3), `toolhead_<axis>`
+/// (m), `error_<axis>` (toolhead - command, m) and, where the model has them,
+/// `carriage_<axis>` (m), `motor_angle_<axis>` (rad), `load_angle_<axis>` (electrical
+/// rad), `current_a_<axis>`, `current_b_<axis>` (A, full driver); then `error` (length of
+/// the toolhead-minus-command vector, m).
+pub fn channels(axes: &[AxisModel]) -> Vec<(String, String)> {
+    let mut ch = Vec::new();
+    for a in axes {
+        let n = &a.name;
+        for (c, u) in [
+            ("cmd_p", "m"),
+            ("cmd_v", "m_s"),
+            ("cmd_a", "m_s2"),
+            ("cmd_j", "m_s3"),
+            ("toolhead", "m"),
+            ("error", "m"),
+        ] {
+            ch.push((format!("{c}_{n}"), u.to_string()));
+        }
+        if a.carriage.is_some() {
+            ch.push((format!("carriage_{n}"), "m".into()));
+        }
+        if a.stepper.is_some() {
+            ch.push((format!("motor_angle_{n}"), "rad".into()));
+            ch.push((format!("load_angle_{n}"), "rad".into()));
+        }
+        if a.mode == DriverMode::Full {
+            ch.push((format!("current_a_{n}"), "A".into()));
+            ch.push((format!("current_b_{n}"), "A".into()));
+        }
+    }
+    ch.push(("error".into(), "m".into()));
+    ch
+}
+
+/// Plan and simulate one run on its backend. When `record` is given, it is replaced by a
+/// series with [`channels`] and every sample is appended to it.
 pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, Error> {
-    let plan_err = |source| Error::Plan {
+    let sim_err = |source| Error::Sim {
         run: spec.id,
         source,
     };
-    let limits = spec.limits_si().map_err(plan_err)?;
-    let profile = spec
-        .profile
-        .rest_to_rest(spec.start_mm * 1e-3, spec.distance_mm * 1e-3, &limits)
-        .map_err(plan_err)?;
-    let modes = spec.modes_sim().map_err(|source| Error::Sim {
+    let axes = axes_of(spec).map_err(sim_err)?;
+    let traj = trajectory_of(spec, &axes).map_err(|source| Error::Plan {
         run: spec.id,
         source,
     })?;
-    let plant = ModalPlant::new(modes, 1.0 / spec.sample_rate_hz).map_err(|source| Error::Sim {
-        run: spec.id,
-        source,
-    })?;
-    simulate(&plant, &profile, spec, record).map_err(|source| Error::Sim {
-        run: spec.id,
-        source,
-    })
+    let observe = Observe {
+        window_s: spec.window_s,
+        sample_rate_hz: spec.sample_rate_hz,
+        bands_um: spec.bands_um.clone(),
+    };
+    run_trajectory(
+        axes,
+        spec.backend,
+        &SimOptions::default(),
+        &traj,
+        &observe,
+        record,
+    )
+    .map_err(sim_err)
 }
 
-/// Drive `plant` through `profile`, then hold the end point for the observation window.
+/// Simulate `traj` (one profile per axis, in the order of `axes`) on `backend` and measure
+/// it against the trajectory's end point.
+pub fn run_trajectory(
+    axes: Vec<AxisModel>,
+    backend: Backend,
+    options: &SimOptions,
+    traj: &Trajectory,
+    observe: &Observe,
+    record: Option<&mut Series>,
+) -> Result<Metrics, SimError> {
+    if traj.dof() != axes.len() {
+        return Err(SimError::AxisCount {
+            expected: axes.len(),
+            got: traj.dof(),
+        });
+    }
+    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+    let record = record.map(|rec| {
+        *rec = Series::with_channels(channels(&axes));
+        rec
+    });
+    let meta: Vec<AxisMeta> = axes.iter().map(AxisMeta::of).collect();
+    match backend {
+        Backend::Modal => {
+            let plant = ModalPlant::new(axes, 1.0 / observe.sample_rate_hz)?;
+            simulate(&plant, &names, &meta, traj, observe, record)
+        }
+        Backend::Rapier => {
+            let plant = RapierPlant::new(
+                axes,
+                RapierOptions {
+                    max_step_s: options.max_step_s,
+                    belt: options.belt,
+                },
+            )?;
+            simulate(&plant, &names, &meta, traj, observe, record)
+        }
+        Backend::Mujoco => Err(SimError::Unsupported {
+            backend: "mujoco",
+            reason: NO_MUJOCO.into(),
+        }),
+    }
+}
+
+/// Which optional channels an axis records.
+#[derive(Debug, Clone, Copy)]
+pub struct AxisMeta {
+    carriage: bool,
+    motor: bool,
+    currents: bool,
+}
+
+impl AxisMeta {
+    /// What `axis` has.
+    pub fn of(axis: &AxisModel) -> Self {
+        Self {
+            carriage: axis.carriage.is_some(),
+            motor: axis.stepper.is_some(),
+            currents: axis.mode == DriverMode::Full,
+        }
+    }
+}
+
+/// Drive `plant` through `traj`, then hold the end point for the observation window.
 ///
-/// Samples are taken every `1/sample_rate` s during the move, exactly at the move end T, and
-/// every `1/sample_rate` s after T. Plant steps are split at every profile breakpoint, so the
-/// commanded jerk is constant within each step (the modal plant is then exact).
+/// Samples are taken every `1/sample_rate` s during the move, exactly at the move end T,
+/// and every `1/sample_rate` s after T. Plant steps are split at every breakpoint of every
+/// axis, so each axis's commanded jerk is constant within each step (the modal plant is
+/// then exact).
 pub fn simulate<P: Plant>(
     plant: &P,
-    profile: &Profile,
-    spec: &RunSpec,
+    names: &[String],
+    meta: &[AxisMeta],
+    traj: &Trajectory,
+    observe: &Observe,
     mut record: Option<&mut Series>,
-) -> Result<Metrics, settle_sim::SimError> {
-    let dt = 1.0 / spec.sample_rate_hz;
-    let t_end = profile.duration_s();
-    let end = profile.end();
-    let direction =
-        (end.p - profile.start().p).signum() * f64::from(u8::from(spec.distance_mm != 0.0));
-    let mut acc = Accumulator::new(end.p, direction, t_end, &spec.bands_um);
-    let mut state = plant.initial_state(&profile.start());
+) -> Result<Metrics, SimError> {
+    let n_axes = traj.dof();
+    let dt = 1.0 / observe.sample_rate_hz;
+    let t_end = traj.duration_s();
+    let starts: Vec<State> = traj.axes().iter().map(Profile::start).collect();
+    let ends: Vec<State> = traj.axes().iter().map(Profile::end).collect();
+    let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
+    let direction: Vec<f64> = starts.iter().zip(&ends).map(|(s, e)| e.p - s.p).collect();
+    let mut acc = Accumulator::new(&target, &direction, t_end, &observe.bands_um);
+    let mut state = plant.initial_state(&starts)?;
+    let mut obs = vec![Observation::default(); n_axes];
+    let mut cmd = vec![Sample::default(); n_axes];
+    let mut now = vec![Sample::default(); n_axes];
+    let mut row: Vec<f64> = Vec::new();
+    let mut cmd_p = vec![0.0; n_axes];
+    let mut toolhead = vec![0.0; n_axes];
 
-    let mut observe = |t: f64, cmd: &Sample, state: &P::State, acc: &mut Accumulator| {
-        let o = plant.observe(state);
-        acc.push(t, o.commanded_m, o.toolhead_m);
+    let mut sample = |t: f64,
+                      at: &[Sample],
+                      state: &P::State,
+                      obs: &mut [Observation],
+                      acc: &mut Accumulator| {
+        plant.observe(state, obs);
+        for (i, o) in obs.iter().enumerate() {
+            cmd_p[i] = o.commanded_m;
+            toolhead[i] = o.toolhead_m;
+        }
+        acc.push(t, &cmd_p, &toolhead);
         if let Some(rec) = record.as_deref_mut() {
-            rec.push(
-                t,
-                &[
-                    cmd.p,
-                    cmd.v,
-                    cmd.a,
-                    cmd.j,
-                    o.toolhead_m,
-                    o.toolhead_m - o.commanded_m,
-                ],
-            );
+            row.clear();
+            let mut f2 = 0.0;
+            for ((o, c), m) in obs.iter().zip(at).zip(meta) {
+                let f = o.toolhead_m - o.commanded_m;
+                f2 += f * f;
+                row.extend([c.p, c.v, c.a, c.j, o.toolhead_m, f]);
+                if m.carriage {
+                    row.push(o.carriage_m.unwrap_or(f64::NAN));
+                }
+                if m.motor {
+                    row.push(o.motor_angle_rad.unwrap_or(f64::NAN));
+                    row.push(o.load_angle_rad.unwrap_or(f64::NAN));
+                }
+                if m.currents {
+                    let [ia, ib] = o.currents_a.unwrap_or([f64::NAN; 2]);
+                    row.extend([ia, ib]);
+                }
+            }
+            row.push(f2.sqrt());
+            rec.push(t, &row);
         }
     };
 
-    // The move: walk the segments, stepping to each sample time or segment end.
+    let breakpoints = traj.breakpoints();
+    let mut next_bp = 0usize;
+    traj.state_at(0.0, &mut now);
+    sample(0.0, &now, &state, &mut obs, &mut acc);
     let mut k = 1usize; // index of the next sample during the move
-    let first = profile.state_at(0.0);
-    observe(0.0, &first, &state, &mut acc);
-    for (t0, s0, seg) in profile.iter() {
-        let t1 = t0 + seg.duration_s();
-        let mut t = t0;
-        while t < t1 {
-            let t_sample = k as f64 * dt;
-            let next = t_sample.min(t1);
-            let cmd = seg.sample(&s0, t - t0);
-            // A whole sample interval is stepped as exactly `dt` (k dt - (k-1) dt can differ
-            // from dt in the last bit, which would cost the plant a fresh transition
-            // matrix); partial steps at breakpoints use their true length.
-            let whole = next == t_sample && t == (k - 1) as f64 * dt;
-            plant.step(&mut state, &cmd, if whole { dt } else { next - t })?;
-            t = next;
-            if t_sample <= t1 {
-                if t_sample < t_end {
-                    let now = seg.sample(&s0, t - t0);
-                    observe(t, &now, &state, &mut acc);
-                }
-                k += 1;
+    let mut t = 0.0;
+    while t < t_end {
+        while next_bp < breakpoints.len() && breakpoints[next_bp] <= t {
+            next_bp += 1;
+        }
+        let bp = breakpoints
+            .get(next_bp)
+            .copied()
+            .unwrap_or(t_end)
+            .min(t_end);
+        let t_sample = k as f64 * dt;
+        let next = t_sample.min(bp);
+        traj.state_at(t, &mut cmd);
+        // A whole sample interval is stepped as exactly `dt` (k dt - (k-1) dt can differ
+        // from dt in the last bit, which would cost the modal plant a fresh transition
+        // matrix); partial steps at breakpoints use their true length.
+        let whole = next == t_sample && t == (k - 1) as f64 * dt;
+        plant.step(&mut state, &cmd, if whole { dt } else { next - t })?;
+        t = next;
+        if t_sample <= bp {
+            if t_sample < t_end {
+                traj.state_at(t, &mut now);
+                sample(t, &now, &state, &mut obs, &mut acc);
             }
+            k += 1;
         }
     }
     // The end of the move, then the observation window at the end point.
-    let hold = Sample {
-        p: end.p,
-        ..Sample::default()
-    };
+    let hold: Vec<Sample> = ends
+        .iter()
+        .map(|e| Sample {
+            p: e.p,
+            ..Sample::default()
+        })
+        .collect();
     if t_end > 0.0 {
-        observe(t_end, &hold, &state, &mut acc);
+        sample(t_end, &hold, &state, &mut obs, &mut acc);
     }
-    let n = (spec.window_s * spec.sample_rate_hz).ceil() as usize;
+    let n = (observe.window_s * observe.sample_rate_hz).ceil() as usize;
     for i in 1..=n {
         plant.step(&mut state, &hold, dt)?;
-        observe(t_end + i as f64 * dt, &hold, &state, &mut acc);
+        sample(t_end + i as f64 * dt, &hold, &state, &mut obs, &mut acc);
     }
-    Ok(acc.finish())
+    let lost: u32 = obs.iter().map(|o| o.lost_steps).sum();
+    let status = match obs.iter().position(|o| o.lost_steps > 0) {
+        Some(i) => Status::LostSteps {
+            axis: names[i].clone(),
+            steps: lost,
+        },
+        None => Status::Ok,
+    };
+    let angles: Vec<Option<f64>> = obs.iter().map(|o| o.max_load_angle_rad).collect();
+    Ok(acc.finish_with(names, &angles, status))
+}
+
+/// Set every run's backend, checking that this build has it and that it can simulate the
+/// runs' models (the modal backend: linear driver only). Errors are input errors naming
+/// the scenario file.
+pub fn set_backend(
+    path: &std::path::Path,
+    runs: &mut [RunSpec],
+    backend: Backend,
+) -> Result<(), Error> {
+    let err = |message: String| Error::Input {
+        at: crate::error::Location {
+            file: path.to_path_buf(),
+            line: None,
+            column: None,
+            key: Some("--backend".into()),
+        },
+        message,
+    };
+    if !backend.available() {
+        return Err(err(NO_MUJOCO.to_string()));
+    }
+    if backend == Backend::Modal
+        && let Some(r) = runs.iter().find(|r| r.driver != DriverMode::Linear)
+    {
+        return Err(err(format!(
+            "the modal backend is the exact solution of the linear model: it cannot run the `{}` driver model; set `driver_model = \"linear\"` in [machine] or use --backend rapier",
+            r.driver
+        )));
+    }
+    for r in runs {
+        r.backend = backend;
+    }
+    Ok(())
 }

@@ -3,10 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
+use std::collections::BTreeMap;
+
 use serde::Deserialize;
 
 use crate::error::{Error, Location};
 use crate::locate::KeyIndex;
+use crate::machine_file::{AxisSpec, DriverSpec, MotorSpec};
 
 /// A scenario file as written (mm, s; converted to SI when runs are built).
 #[derive(Debug, Clone, Deserialize)]
@@ -33,12 +36,30 @@ pub struct Scenario {
     pub sweep: toml::Table,
 }
 
-/// The machine: for now one flexible axis described by its modes.
+/// The machine, in one of three forms: its modes (`modes = [...]`, one axis `x`), a
+/// preset or machine file (`preset = "printer_xy"` or a path), or inline axes
+/// (`[machine.axis.x]` ... with the machine-file schema, see [`crate::machine_file`]).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MachineSpec {
-    /// One or more lightly damped modes between command and toolhead.
+    /// One or more lightly damped modes between command and toolhead (one axis, `x`).
+    #[serde(default)]
     pub modes: Vec<ModeSpec>,
+    /// A built-in preset name, or a path to a machine file relative to the scenario.
+    pub preset: Option<String>,
+    /// Name of an inline machine (default: the scenario's name).
+    pub name: Option<String>,
+    /// Inline machine: motor of every axis that does not name its own.
+    pub motor: Option<MotorSpec>,
+    /// Inline machine: driver of every axis that does not name its own.
+    pub driver: Option<DriverSpec>,
+    /// Inline machine: the axes, by name.
+    #[serde(default)]
+    pub axis: BTreeMap<String, AxisSpec>,
+    /// How the motors are driven: `full` (stepper driver model, the default), `spring`
+    /// (a linear spring to the microstep-quantised command) or `linear` (a linear spring
+    /// to the continuous command: the modal backend's model). Physical machines only.
+    pub driver_model: Option<String>,
 }
 
 /// One mode of the axis.
@@ -70,6 +91,13 @@ pub struct MoveSpec {
     /// Profile kind (`trapezoid`, `scurve`); sweep `profile` to compare kinds.
     #[serde(default = "default_profile")]
     pub profile: String,
+    /// The axis that moves (default `x`); the others hold at 0.
+    #[serde(default = "default_axis")]
+    pub axis: String,
+}
+
+fn default_axis() -> String {
+    "x".to_string()
 }
 
 fn default_profile() -> String {

@@ -39,6 +39,21 @@ impl Series {
         }
     }
 
+    /// An empty series with the given `(name, unit)` channels (owned names).
+    pub fn with_channels(channels: Vec<(String, String)>) -> Self {
+        Self {
+            t_s: Vec::new(),
+            channels: channels
+                .into_iter()
+                .map(|(name, unit)| Channel {
+                    name,
+                    unit,
+                    data: Vec::new(),
+                })
+                .collect(),
+        }
+    }
+
     /// Append one row: a time stamp and one value per channel, in channel order.
     pub fn push(&mut self, t_s: f64, values: &[f64]) {
         debug_assert_eq!(values.len(), self.channels.len());

@@ -1,10 +1,13 @@
-//! Sweep expansion: a scenario becomes a list of fully resolved, validated runs. Pure: no
-//! I/O, the same file always gives the same runs in the same order.
+//! Sweep expansion: a scenario becomes a list of fully resolved, validated runs. The same
+//! file always gives the same runs in the same order (the only I/O is reading a machine
+//! file the scenario names by path).
 
 use settle_planner::{Limits, ProfileKind};
-use settle_sim::Mode;
+use settle_sim::machine::{AxisMachine, Machine, Transmission};
+use settle_sim::{DriverMode, Mode};
 
 use crate::error::Error;
+use crate::run::Backend;
 use crate::scenario::{ModeSpec, Scenario, Source};
 
 /// A value of a swept parameter.
@@ -51,8 +54,18 @@ pub struct RunSpec {
     pub amax_mm_s2: f64,
     /// Maximum jerk (mm/s^3), if given.
     pub jmax_mm_s3: Option<f64>,
-    /// The machine's modes.
+    /// The machine's modes (modes form; empty for a physical machine).
     pub modes: Vec<ModeSpec>,
+    /// The physical machine (preset, machine file or inline), if not given by modes.
+    pub machine: Option<Machine>,
+    /// The machine's name (the preset's, or `modes`).
+    pub machine_name: String,
+    /// How the motors are driven (physical machines; `linear` for the modes form).
+    pub driver: DriverMode,
+    /// The axis that moves.
+    pub axis: String,
+    /// The backend that simulates the run (set from the command line).
+    pub backend: Backend,
     /// Observation window after the move (s).
     pub window_s: f64,
     /// Sample rate (Hz).
@@ -66,7 +79,84 @@ pub struct RunSpec {
 /// Parameters that can be swept, for error messages.
 pub const SWEEPABLE: &str = "profile, move.distance_mm, move.start_mm, limits.vmax_mm_s, \
 limits.amax_mm_s2, limits.jmax_mm_s3, machine.modes.N.frequency_hz, machine.modes.N.damping_ratio, \
-machine.modes.N.weight (N = 0-based mode index)";
+machine.modes.N.weight (N = 0-based mode index), and for physical machines \
+machine.axis.<axis>.<field> (e.g. machine.axis.x.mount.stiffness_n_per_m), machine.motor.<field> \
+and machine.driver.<field> (every axis)";
+
+/// Set a numeric field of an axis by its key path inside the axis (as in machine files).
+fn set_axis_field(a: &mut AxisMachine, field: &str, x: f64) -> Result<(), String> {
+    let int = |x: f64| {
+        if x.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(&x) {
+            Ok(x as u32)
+        } else {
+            Err(format!("`{field}` takes whole numbers, got {x}"))
+        }
+    };
+    let no_field = || {
+        Err(format!(
+            "axis `{}` has no numeric field `{field}`; allowed: carriage_kg, toolhead_kg, beam_kg, \
+belt.*, screw.*, mount.*, frame.*, motor.*, driver.* (the machine-file keys)",
+            a.name
+        ))
+    };
+    match field {
+        "carriage_kg" => a.carriage_kg = x,
+        "toolhead_kg" => a.toolhead_kg = x,
+        "beam_kg" => a.beam_kg = x,
+        "mount.stiffness_n_per_m" => a.mount.stiffness_n_per_m = x,
+        "mount.damping_ratio" => a.mount.damping_ratio = x,
+        f if f.starts_with("belt.") => {
+            let Transmission::Belt(b) = &mut a.transmission else {
+                return Err(format!("axis `{}` has no belt", a.name));
+            };
+            match f {
+                "belt.ea_n" => b.ea_n = x,
+                "belt.span_mm" => b.span_mm = x,
+                "belt.pulley_teeth" => b.pulley_teeth = int(x)?,
+                "belt.pitch_mm" => b.pitch_mm = x,
+                "belt.carriage_at_zero_mm" => b.carriage_at_zero_mm = x,
+                "belt.damping_ratio" => b.damping_ratio = x,
+                _ => return no_field(),
+            }
+        }
+        f if f.starts_with("screw.") => {
+            let Transmission::Screw(sc) = &mut a.transmission else {
+                return Err(format!("axis `{}` has no screw", a.name));
+            };
+            match f {
+                "screw.lead_mm" => sc.lead_mm = x,
+                "screw.stiffness_n_per_m" => sc.stiffness_n_per_m = x,
+                "screw.damping_ratio" => sc.damping_ratio = x,
+                _ => return no_field(),
+            }
+        }
+        f if f.starts_with("frame.") => {
+            let Some(fr) = a.frame.as_mut() else {
+                return Err(format!("axis `{}` has no frame mode", a.name));
+            };
+            match f {
+                "frame.mass_kg" => fr.mass_kg = x,
+                "frame.stiffness_n_per_m" => fr.stiffness_n_per_m = x,
+                "frame.damping_ratio" => fr.damping_ratio = x,
+                _ => return no_field(),
+            }
+        }
+        "motor.holding_torque_n_m" => a.motor.holding_torque_n_m = x,
+        "motor.rated_current_a" => a.motor.rated_current_a = x,
+        "motor.resistance_ohm" => a.motor.resistance_ohm = x,
+        "motor.inductance_mh" => a.motor.inductance_mh = x,
+        "motor.rotor_inertia_g_cm2" => a.motor.rotor_inertia_g_cm2 = x,
+        "motor.rotor_teeth" => a.motor.rotor_teeth = int(x)?,
+        "motor.detent_torque_n_m" => a.motor.detent_torque_n_m = x,
+        "motor.damping_ratio" => a.motor.damping_ratio = x,
+        "driver.microsteps" => a.driver.microsteps = int(x)?,
+        "driver.run_current_a_rms" => a.driver.run_current_a_rms = x,
+        "driver.supply_v" => a.driver.supply_v = x,
+        "driver.current_loop_bandwidth_hz" => a.driver.current_loop_bandwidth_hz = x,
+        _ => return no_field(),
+    }
+    Ok(())
+}
 
 /// Upper bound on the number of runs one scenario may expand to.
 pub const MAX_RUNS: usize = 10_000_000;
@@ -104,6 +194,33 @@ impl RunSpec {
             "limits.vmax_mm_s" => self.vmax_mm_s = num(value)?,
             "limits.amax_mm_s2" => self.amax_mm_s2 = num(value)?,
             "limits.jmax_mm_s3" => self.jmax_mm_s3 = Some(num(value)?),
+            other
+                if other.starts_with("machine.axis.")
+                    || other.starts_with("machine.motor.")
+                    || other.starts_with("machine.driver.") =>
+            {
+                let x = num(value)?;
+                let Some(m) = self.machine.as_mut() else {
+                    return Err(format!(
+                        "`{other}` needs a physical machine (preset or [machine.axis.*]), not modes"
+                    ));
+                };
+                if let Some(rest) = other.strip_prefix("machine.axis.") {
+                    let (axis, field) = rest.split_once('.').ok_or_else(|| {
+                        format!("`{other}`: expected machine.axis.<axis>.<field>")
+                    })?;
+                    let names: Vec<String> = m.axes.iter().map(|a| a.name.clone()).collect();
+                    let a = m.axes.iter_mut().find(|a| a.name == axis).ok_or_else(|| {
+                        format!("no axis `{axis}`; the machine has {}", names.join(", "))
+                    })?;
+                    set_axis_field(a, field, x)?;
+                } else {
+                    let field = &other["machine.".len()..];
+                    for a in &mut m.axes {
+                        set_axis_field(a, field, x)?;
+                    }
+                }
+            }
             other => {
                 let mode_param = other
                     .strip_prefix("machine.modes.")
@@ -243,6 +360,21 @@ fn numbers(raw: &toml::Value) -> Result<Vec<f64>, String> {
 pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
     let base_profile = ProfileKind::parse(&sc.move_.profile)
         .map_err(|e| src.error_at("move.profile", e.to_string()))?;
+    let (machine, machine_name, driver) = resolve_machine(sc, src)?;
+    let axis_names: Vec<String> = match &machine {
+        Some(m) => m.axes.iter().map(|a| a.name.clone()).collect(),
+        None => vec!["x".to_string()],
+    };
+    if !axis_names.contains(&sc.move_.axis) {
+        return Err(src.error_at(
+            "move.axis",
+            format!(
+                "no axis `{}`; the machine has {}",
+                sc.move_.axis,
+                axis_names.join(", ")
+            ),
+        ));
+    }
     let base = RunSpec {
         id: 0,
         profile: base_profile,
@@ -252,6 +384,11 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
         amax_mm_s2: sc.limits.amax_mm_s2,
         jmax_mm_s3: sc.limits.jmax_mm_s3,
         modes: sc.machine.modes.clone(),
+        machine,
+        machine_name,
+        driver,
+        axis: sc.move_.axis.clone(),
+        backend: Backend::default(),
         window_s: sc.observe.window_s,
         sample_rate_hz: sc.observe.sample_rate_hz,
         bands_um: sc.observe.bands_um.clone(),
@@ -328,13 +465,73 @@ fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
             "give one or more bands, each a finite number > 0 (um)",
         ));
     }
-    if run.modes.is_empty() {
+    Ok(())
+}
+
+/// The scenario's machine: `(physical machine or None for the modes form, name, driver
+/// model)`.
+fn resolve_machine(
+    sc: &Scenario,
+    src: &Source,
+) -> Result<(Option<Machine>, String, DriverMode), Error> {
+    let m = &sc.machine;
+    let inline = !m.axis.is_empty() || m.motor.is_some() || m.driver.is_some();
+    let physical = inline || m.preset.is_some();
+    if !m.modes.is_empty() && physical {
         return Err(src.error_at(
-            "machine.modes",
-            "give at least one mode { frequency_hz, damping_ratio }",
+            "machine",
+            "give either `modes = [...]` or a physical machine (`preset` or [machine.axis.<name>] tables), not both",
         ));
     }
-    Ok(())
+    if m.preset.is_some() && inline {
+        return Err(src.error_at(
+            "machine.preset",
+            "a preset cannot be combined with inline [machine.axis/motor/driver] tables; copy the preset's file, edit it and give its path",
+        ));
+    }
+    let driver = match m.driver_model.as_deref() {
+        None => None,
+        Some(name) => Some(DriverMode::parse(name).ok_or_else(|| {
+            src.error_at(
+                "machine.driver_model",
+                format!(
+                    "unknown driver model `{name}`; allowed: {}",
+                    DriverMode::ALLOWED
+                ),
+            )
+        })?),
+    };
+    if !m.modes.is_empty() {
+        if driver.is_some_and(|d| d != DriverMode::Linear) {
+            return Err(src.error_at(
+                "machine.driver_model",
+                "a machine given by its modes has no motor: driver_model applies to physical machines only",
+            ));
+        }
+        return Ok((None, "modes".into(), DriverMode::Linear));
+    }
+    let driver = driver.unwrap_or(DriverMode::Full);
+    if let Some(preset) = &m.preset {
+        let (machine, _, _) = crate::machine_file::load_preset(preset, &src.path, src)?;
+        let name = machine.name.clone();
+        return Ok((Some(machine), name, driver));
+    }
+    if inline {
+        let name = m.name.clone().unwrap_or_else(|| sc.name.clone());
+        let machine = crate::machine_file::to_machine(
+            &name,
+            m.motor.as_ref(),
+            m.driver.as_ref(),
+            &m.axis,
+            src,
+            "machine.",
+        )?;
+        return Ok((Some(machine), name, driver));
+    }
+    Err(src.error_at(
+        "machine",
+        "give the machine: `modes = [{ frequency_hz, damping_ratio }]`, `preset = \"printer_xy\"` (or a machine file path), or [machine.axis.<name>] tables",
+    ))
 }
 
 fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
@@ -364,6 +561,36 @@ fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
             "limits",
             "profile kind `scurve` needs `jmax_mm_s3` in [limits]",
         ));
+    }
+    if let Some(machine) = &run.machine {
+        let machine_swept = || {
+            run.swept
+                .iter()
+                .find(|(p, _)| p.starts_with("machine."))
+                .map_or("machine".to_string(), |(p, _)| format!("sweep.{p}"))
+        };
+        if let Err(e) = machine.validate() {
+            return Err(src.error_at(&machine_swept(), e.to_string()));
+        }
+        if let Some(a) = machine.axis(&run.axis)
+            && let Some((lo, hi)) = a.travel_m()
+        {
+            let (lo_mm, hi_mm) = (lo * 1e3, hi * 1e3);
+            for (name, x) in [
+                ("move.start_mm", run.start_mm),
+                ("move.distance_mm", run.start_mm + run.distance_mm),
+            ] {
+                if !(lo_mm..=hi_mm).contains(&x) {
+                    return Err(src.error_at(
+                        &blame(run, name),
+                        format!(
+                            "the move reaches {x} mm, outside the belt travel of axis `{}`: {lo_mm:.1} to {hi_mm:.1} mm (the carriage must stay 5 mm from pulley and idler)",
+                            run.axis
+                        ),
+                    ));
+                }
+            }
+        }
     }
     for (i, m) in run.modes.iter().enumerate() {
         if let Err(e) = Mode::new(m.frequency_hz, m.damping_ratio, m.weight) {

@@ -19,6 +19,36 @@ pub enum SimError {
         /// What is wrong.
         what: String,
     },
+    /// A machine parameter is missing or out of range. `field` is the key path inside the
+    /// axis, as written in a machine file (e.g. `mount.stiffness_n_per_m`).
+    #[error("axis `{axis}`: {field} = {value} is invalid: allowed {allowed}")]
+    InvalidMachine {
+        /// The axis (`x`, `y`, ...), or `machine` for machine-wide problems.
+        axis: String,
+        /// The field, as a dotted key path inside the axis.
+        field: String,
+        /// The offending value.
+        value: f64,
+        /// What is allowed.
+        allowed: String,
+    },
+    /// A backend cannot simulate this model (e.g. the linear modal backend and the
+    /// nonlinear stepper driver).
+    #[error("the {backend} backend cannot simulate this model: {reason}")]
+    Unsupported {
+        /// The backend.
+        backend: &'static str,
+        /// Why, and what to do instead.
+        reason: String,
+    },
+    /// The command has a different number of axes than the plant.
+    #[error("the command has {got} axes, the plant {expected}")]
+    AxisCount {
+        /// Axes of the plant.
+        expected: usize,
+        /// Axes commanded.
+        got: usize,
+    },
     /// A plant needs at least one mode.
     #[error("a modal plant needs at least one mode")]
     NoModes,

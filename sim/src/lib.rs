@@ -1,21 +1,34 @@
 //! settle-sim: plant models driven by a commanded trajectory.
 //!
-//! The reference backend is [`ModalPlant`]: one axis whose toolhead follows the command
-//! through lightly damped base-excited modes, integrated exactly for piecewise
-//! constant-jerk input. [`closed_form`] gives the residual vibration analytically, so the
-//! plant can be checked against an independent formula.
+//! A machine ([`machine::Machine`]: masses, belt or screw, mount, frame, motor, driver) is
+//! compiled per axis into an [`AxisModel`]: a [`lumped::Lumped`] model of bodies and
+//! spring-dampers plus how the command enters it (a linear driver spring, a spring to the
+//! microstep-quantised command, or the full [`stepper`] driver). Every backend simulates
+//! that same model behind the [`Plant`] trait:
+//! - [`ModalPlant`]: the exact discretisation of the linear model (the reference);
+//! - [`RapierPlant`]: rigid bodies in rapier3d (f64), couplings and driver as forces.
+//!
+//! [`closed_form`] gives the residual vibration analytically, so the plants can be checked
+//! against an independent formula.
 
+mod axis;
 pub mod closed_form;
 mod error;
 pub mod lumped;
+pub mod machine;
 mod modal;
 mod mode;
 #[cfg(feature = "mujoco")]
 pub mod mujoco;
 pub mod mujoco_status;
+pub mod pencil;
 mod plant;
+pub mod rapier;
+pub mod stepper;
 
+pub use axis::{AxisModel, DriverMode};
 pub use error::SimError;
-pub use modal::{ModalPlant, ModalState};
+pub use modal::{ModalAxis, ModalPlant, ModalState};
 pub use mode::Mode;
-pub use plant::{Observation, Plant};
+pub use plant::{Observation, Plant, advance_sample, check_step};
+pub use rapier::{BeltModel, RapierOptions, RapierPlant, RapierState};

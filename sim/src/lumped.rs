@@ -67,14 +67,17 @@ pub struct Term {
 pub enum Stiffness {
     /// Constant stiffness (N/m, or N m/rad for an angular extension).
     Constant(f64),
-    /// A belt loop driven at one end: the two spans from the carriage to the drive pulley
-    /// and to the idler act in parallel, `k = EA/s + EA/(L - s)` (N/m), with
+    /// A belt driven at one end: the two belt paths from the carriage back to the drive
+    /// pulley act in parallel, `k = EA/s + EA/(L - s)` (N/m), with
     /// `s = s0_m + q_carriage` the span from the drive pulley to the carriage. Backends that
     /// cannot vary a stiffness during a run use [`Stiffness::at`] at the start position.
     BeltSpans {
-        /// Belt axial stiffness E*A (N): ~ 5-10 kN per mm of width for GT2 glass-fibre belts.
+        /// Belt axial stiffness E*A (N): ~ 10-20 kN for a 6 mm GT2 glass-fibre belt.
         ea_n: f64,
-        /// Total span length pulley-to-idler L (m).
+        /// Length L of belt from the drive pulley, along the carriage, back to the drive
+        /// pulley (m): for the usual closed loop around a free idler, twice the
+        /// pulley-to-idler distance (the return path runs around the idler); for a belt
+        /// whose far end is anchored, the pulley-to-anchor distance.
         length_m: f64,
         /// Span s when the carriage coordinate is 0 (m).
         s0_m: f64,
@@ -322,6 +325,129 @@ impl Lumped {
                     }
             })
             .sum()
+    }
+}
+
+impl Lumped {
+    /// The static equilibrium (m, rad) for a constant command `x_cmd` (m): every coupling
+    /// relaxed, `K q = bk x_cmd`. With `fixed = Some((i, q_i))` body `i` is held at `q_i`
+    /// and the others are solved for (used for a rotor whose equilibrium angle a stepper
+    /// driver decides). Errors if some body is held by nothing.
+    pub fn equilibrium(
+        &self,
+        x_cmd: f64,
+        fixed: Option<(usize, f64)>,
+    ) -> Result<Vec<f64>, SimError> {
+        let n = self.dof();
+        let mut q = vec![0.0; n];
+        // Relaxed couplings do not depend on the stiffness values, but position-dependent
+        // stiffnesses are evaluated near the answer anyway (two passes).
+        for _ in 0..2 {
+            let lin = self.linearised(&q);
+            let free: Vec<usize> = (0..n)
+                .filter(|&i| fixed.is_none_or(|(f, _)| f != i))
+                .collect();
+            let m = free.len();
+            let mut k = DMatrix::zeros(m, m);
+            let mut rhs = DVector::zeros(m);
+            for (a, &i) in free.iter().enumerate() {
+                rhs[a] = lin.bk[i] * x_cmd;
+                if let Some((f, qf)) = fixed {
+                    rhs[a] -= lin.k[(i, f)] * qf;
+                }
+                for (b, &j) in free.iter().enumerate() {
+                    k[(a, b)] = lin.k[(i, j)];
+                }
+            }
+            let sol = k
+                .clone()
+                .lu()
+                .solve(&rhs)
+                .filter(|s| s.iter().all(|x| x.is_finite()));
+            let Some(sol) = sol else {
+                return Err(SimError::InvalidModel {
+                    what: "no static equilibrium: some body is held by no spring (a driver spring or an actuator is missing)".into(),
+                });
+            };
+            for (a, &i) in free.iter().enumerate() {
+                q[i] = sol[a];
+            }
+            if let Some((f, qf)) = fixed {
+                q[f] = qf;
+            }
+        }
+        Ok(q)
+    }
+
+    /// The stiffness of coupling `c` for coordinates `q` (N/m or N m/rad).
+    #[inline]
+    pub fn stiffness_of(c: &Coupling, q: &[f64]) -> f64 {
+        c.stiffness
+            .at(c.stiffness.depends_on().map_or(0.0, |i| q[i]))
+    }
+
+    /// The generalised force (N or N m) every coupling exerts on every body, for
+    /// coordinates `q`, rates `qd`, command position `x_cmd` (m) and velocity `v_cmd`
+    /// (m/s), written into `out` (one entry per body; overwritten). Position-dependent
+    /// stiffnesses are evaluated at `stiffness_q` (pass `q` for the nonlinear model, or
+    /// fixed coordinates to freeze them).
+    pub fn generalised_forces(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        x_cmd: f64,
+        v_cmd: f64,
+        stiffness_q: &[f64],
+        out: &mut [f64],
+    ) {
+        out.iter_mut().for_each(|f| *f = 0.0);
+        let at = |node: Node, pos: bool| match node {
+            Node::Ground => 0.0,
+            Node::Command => {
+                if pos {
+                    x_cmd
+                } else {
+                    v_cmd
+                }
+            }
+            Node::Body(i) => {
+                if pos {
+                    q[i]
+                } else {
+                    qd[i]
+                }
+            }
+        };
+        for c in &self.couplings {
+            let (mut e, mut ed) = (0.0, 0.0);
+            for t in &c.terms {
+                e += t.gain * at(t.node, true);
+                ed += t.gain * at(t.node, false);
+            }
+            let f = Self::stiffness_of(c, stiffness_q) * e + c.damping * ed;
+            for t in &c.terms {
+                if let Node::Body(i) = t.node {
+                    out[i] -= f * t.gain;
+                }
+            }
+        }
+    }
+
+    /// Undamped natural frequencies (Hz, ascending) of the model linearised at `q`: the
+    /// square roots of the eigenvalues of `M^-1/2 K M^-1/2`. A body held by nothing
+    /// (e.g. a rotor left to an actuator) gives a 0 Hz rigid-body mode.
+    pub fn natural_frequencies_hz(&self, q: &[f64]) -> Vec<f64> {
+        let lin = self.linearised(q);
+        let n = self.dof();
+        let s = DVector::from_iterator(n, (0..n).map(|i| 1.0 / lin.m[(i, i)].sqrt()));
+        let kt = DMatrix::from_fn(n, n, |i, j| s[i] * lin.k[(i, j)] * s[j]);
+        let mut f: Vec<f64> = kt
+            .symmetric_eigenvalues()
+            .iter()
+            .map(|l| l.max(0.0).sqrt() / std::f64::consts::TAU)
+            .collect();
+        f.sort_by(f64::total_cmp);
+        f
     }
 }
 

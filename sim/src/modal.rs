@@ -1,153 +1,300 @@
-//! The modal reference plant: exact discretisation of base-excited modes.
+//! The modal reference plant: exact discretisation of the linearised lumped model.
 //!
-//! Each mode's deflection e (toolhead relative to command) obeys
-//! `e'' + 2 zeta w e' + w^2 e = -a(t)`, with `a` the commanded acceleration. Over a step in
-//! which the commanded jerk `j` is constant, the augmented state `[e, e', a, j]` evolves
-//! linearly, so the step is exactly the matrix exponential of the augmented system. The
-//! state is scaled to `[w^2 e, w e', a, j / w]` (all in acceleration units), which makes the
-//! system matrix `w * [[0,1,0,0],[-1,-2 zeta,-1,0],[0,0,0,1],[0,0,0,0]]` well balanced for
-//! the exponential.
+//! For each axis, with `g` the static gain (`K g = bk`: where every body sits for a unit
+//! command), the deflection from the instantaneous static equilibrium `r = q - g x_cmd`
+//! obeys `M r'' + C r' + K r = -M g a + (bc - C g) v` (a base-excited structure: only the
+//! command's velocity and acceleration drive it). Over a step in which the commanded jerk
+//! is constant, the augmented state `[r, r', v, a, j]` evolves linearly, so the step is
+//! exactly the matrix exponential of the augmented system. The exponential is taken in
+//! mass-normalised, frequency-scaled coordinates (`w0^2 M^1/2 r`, `w0 M^1/2 r'`, `w0 v`,
+//! `a`, `j / w0`, with `w0` the highest natural frequency), which balances the matrix, and
+//! mapped back to physical coordinates once.
+//!
+//! Position-dependent stiffness (a belt's spans) is **linearised at the start position**
+//! of each run: the model is exactly linear, which is what makes it the reference. What
+//! that costs against the real belt (stiffer towards the pulley) is measured by
+//! `settle validate` (rapier with the varying belt against rapier with it frozen).
+//!
+//! The modal plant simulates the linear driver spring only ([`DriverMode::Linear`]); the
+//! stepper driver and microstep quantisation are nonlinear and run on rapier or MuJoCo.
 
-use nalgebra::Matrix4;
+use nalgebra::DMatrix;
 use settle_planner::{Sample, State};
 
-use crate::{Mode, Observation, Plant, SimError};
+use crate::axis::{AxisModel, DriverMode};
+use crate::plant::check_step;
+use crate::stepper::StepperState;
+use crate::{Observation, Plant, SimError};
 
-/// The rows of one mode's transition that produce the new (scaled) deflection and rate.
-type Rows = [[f64; 4]; 2];
+/// One axis's linear model, discretised.
+#[derive(Debug, Clone)]
+struct Discrete {
+    n: usize,
+    /// Continuous augmented matrix in scaled coordinates (`w0`-scaled, times 1 s).
+    a_scaled: DMatrix<f64>,
+    /// Scale of each augmented state (physical = scaled / scale).
+    scale: Vec<f64>,
+    /// Static gain g (body coordinate per metre of command).
+    g: Vec<f64>,
+    /// Transition rows for the nominal step, physical coordinates: `2n x (2n + 3)`.
+    nominal: Vec<f64>,
+}
+
+impl Discrete {
+    fn new(axis: &AxisModel, start_m: f64, nominal_dt_s: f64) -> Result<Self, SimError> {
+        let l = &axis.lumped;
+        let n = l.dof();
+        let q0 = l.equilibrium(start_m, None)?;
+        let lin = l.linearised(&q0);
+        let g = lin
+            .k
+            .clone()
+            .lu()
+            .solve(&lin.bk)
+            .filter(|g| g.iter().all(|x| x.is_finite()))
+            .ok_or_else(|| SimError::Unsupported {
+                backend: "modal",
+                reason: format!("axis `{}`: some body is held by no spring", axis.name),
+            })?;
+        let sq: Vec<f64> = (0..n).map(|i| lin.m[(i, i)].sqrt()).collect();
+        let kt = DMatrix::from_fn(n, n, |i, j| lin.k[(i, j)] / (sq[i] * sq[j]));
+        let ct = DMatrix::from_fn(n, n, |i, j| lin.c[(i, j)] / (sq[i] * sq[j]));
+        let w0 = kt
+            .clone()
+            .symmetric_eigenvalues()
+            .iter()
+            .fold(0.0f64, |m, &l| m.max(l))
+            .sqrt()
+            .max(1e-9);
+        // h_a = M^1/2 g, h_v = M^-1/2 (bc - C g).
+        let cg = &lin.c * &g;
+        let ha: Vec<f64> = (0..n).map(|i| sq[i] * g[i]).collect();
+        let hv: Vec<f64> = (0..n).map(|i| (lin.bc[i] - cg[i]) / sq[i]).collect();
+        let dim = 2 * n + 3;
+        let mut a = DMatrix::zeros(dim, dim);
+        for i in 0..n {
+            a[(i, n + i)] = 1.0;
+            for j in 0..n {
+                a[(n + i, j)] = -kt[(i, j)] / (w0 * w0);
+                a[(n + i, n + j)] = -ct[(i, j)] / w0;
+            }
+            a[(n + i, 2 * n)] = hv[i] / w0;
+            a[(n + i, 2 * n + 1)] = -ha[i];
+        }
+        a[(2 * n, 2 * n + 1)] = 1.0;
+        a[(2 * n + 1, 2 * n + 2)] = 1.0;
+        let a_scaled = a * w0;
+        // Scaled state = scale * physical: [w0^2 sqrt(m) r, w0 sqrt(m) r', w0 v, a, j/w0].
+        let mut scale = Vec::with_capacity(dim);
+        scale.extend(sq.iter().map(|s| w0 * w0 * s));
+        scale.extend(sq.iter().map(|s| w0 * s));
+        scale.extend([w0, 1.0, 1.0 / w0]);
+        let mut d = Self {
+            n,
+            a_scaled,
+            scale,
+            g: g.iter().copied().collect(),
+            nominal: Vec::new(),
+        };
+        d.nominal = d.transition(nominal_dt_s);
+        Ok(d)
+    }
+
+    /// The first `2n` rows of the transition over `dt_s`, in physical coordinates.
+    fn transition(&self, dt_s: f64) -> Vec<f64> {
+        let phi = (&self.a_scaled * dt_s).exp();
+        let dim = 2 * self.n + 3;
+        let mut rows = Vec::with_capacity(2 * self.n * dim);
+        for i in 0..2 * self.n {
+            for j in 0..dim {
+                rows.push(phi[(i, j)] * self.scale[j] / self.scale[i]);
+            }
+        }
+        rows
+    }
+}
 
 /// The modal reference plant (model: constant).
 #[derive(Debug, Clone)]
 pub struct ModalPlant {
-    modes: Vec<Mode>,
+    axes: Vec<AxisModel>,
     nominal_dt_s: f64,
-    nominal: Vec<Rows>,
+}
+
+/// One axis's mutable state.
+#[derive(Debug, Clone)]
+pub struct ModalAxis {
+    /// Commanded base state at `t_s`.
+    pub base: State,
+    /// Deflection of every body from the static equilibrium of the command (m, rad).
+    pub r: Vec<f64>,
+    /// Its rate (m/s, rad/s).
+    pub rd: Vec<f64>,
+    /// Load-angle bookkeeping of the axis's motor, if it has one.
+    pub stepper: Option<StepperState>,
+    disc: std::sync::Arc<Discrete>,
+    scratch: Vec<f64>,
 }
 
 /// The modal plant's mutable state.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct ModalState {
     /// Simulation time (s).
     pub t_s: f64,
-    /// Commanded base state at `t_s`.
-    pub base: State,
-    /// Per mode: deflection e (m) and its rate e' (m/s).
-    pub modes: Vec<(f64, f64)>,
-}
-
-fn transition(mode: &Mode, dt_s: f64) -> Rows {
-    let w = mode.omega();
-    let z = mode.damping_ratio();
-    #[rustfmt::skip]
-    let a = Matrix4::new(
-        0.0, 1.0, 0.0, 0.0,
-        -1.0, -2.0 * z, -1.0, 0.0,
-        0.0, 0.0, 0.0, 1.0,
-        0.0, 0.0, 0.0, 0.0,
-    ) * (w * dt_s);
-    let phi = a.exp();
-    [
-        [phi[(0, 0)], phi[(0, 1)], phi[(0, 2)], phi[(0, 3)]],
-        [phi[(1, 0)], phi[(1, 1)], phi[(1, 2)], phi[(1, 3)]],
-    ]
+    /// Per axis.
+    pub axes: Vec<ModalAxis>,
 }
 
 impl ModalPlant {
-    /// A plant with these modes. `nominal_dt_s` is the step size used most (the sample
-    /// period): its transition is computed once; other step sizes (partial steps at
-    /// profile breakpoints) are computed when needed.
-    pub fn new(modes: Vec<Mode>, nominal_dt_s: f64) -> Result<Self, SimError> {
-        if modes.is_empty() {
+    /// A plant for these axes. `nominal_dt_s` is the step size used most (the sample
+    /// period): its transition is computed once per run; other step sizes (partial steps
+    /// at profile breakpoints) are computed when needed. Only [`DriverMode::Linear`] axes.
+    pub fn new(axes: Vec<AxisModel>, nominal_dt_s: f64) -> Result<Self, SimError> {
+        if axes.is_empty() {
             return Err(SimError::NoModes);
         }
         if !(nominal_dt_s.is_finite() && nominal_dt_s >= 0.0) {
             return Err(SimError::InvalidStep { dt_s: nominal_dt_s });
         }
-        let nominal = modes.iter().map(|m| transition(m, nominal_dt_s)).collect();
-        Ok(Self {
-            modes,
-            nominal_dt_s,
-            nominal,
-        })
+        for a in &axes {
+            a.validate()?;
+            if a.mode != DriverMode::Linear {
+                return Err(SimError::Unsupported {
+                    backend: "modal",
+                    reason: format!(
+                        "axis `{}` uses the `{}` driver; the modal backend is the exact solution of the linear model and simulates the `linear` driver only (use driver = \"linear\", or the rapier backend)",
+                        a.name, a.mode
+                    ),
+                });
+            }
+        }
+        Ok(Self { axes, nominal_dt_s })
     }
 
-    /// The modes.
-    pub fn modes(&self) -> &[Mode] {
-        &self.modes
+    /// The axes.
+    pub fn axis_models(&self) -> &[AxisModel] {
+        &self.axes
     }
 
-    /// Envelope of the free vibration of mode `i` from its current state:
-    /// `sqrt(e^2 + ((e' + zeta w e)/wd)^2)` (m). After the move this is the residual
-    /// amplitude at the current instant.
-    pub fn free_amplitude(&self, state: &ModalState, i: usize) -> f64 {
-        let m = &self.modes[i];
-        let (e, ed) = state.modes[i];
-        let x = (ed + m.damping_ratio() * m.omega() * e) / m.omega_d();
-        e.hypot(x)
+    /// Envelope of the free vibration (m) of body `body` of axis `axis` as if it were a
+    /// single mode of angular frequency `w` and damping ratio `zeta` (modal form: body `i`
+    /// is mode `i`): `sqrt(e^2 + ((e' + zeta w e)/wd)^2)`.
+    pub fn free_amplitude(state: &ModalState, axis: usize, body: usize, w: f64, zeta: f64) -> f64 {
+        let a = &state.axes[axis];
+        let (e, ed) = (a.r[body], a.rd[body]);
+        let wd = w * (1.0 - zeta * zeta).sqrt();
+        e.hypot((ed + zeta * w * e) / wd)
     }
-}
-
-#[inline]
-fn apply(rows: &Rows, w: f64, e: &mut (f64, f64), a: f64, j: f64) {
-    let y = [w * w * e.0, w * e.1, a, j / w];
-    let y1 = rows[0][0] * y[0] + rows[0][1] * y[1] + rows[0][2] * y[2] + rows[0][3] * y[3];
-    let y2 = rows[1][0] * y[0] + rows[1][1] * y[1] + rows[1][2] * y[2] + rows[1][3] * y[3];
-    *e = (y1 / (w * w), y2 / w);
 }
 
 impl Plant for ModalPlant {
     type State = ModalState;
 
-    fn initial_state(&self, start: &State) -> ModalState {
-        ModalState {
-            t_s: 0.0,
-            base: *start,
-            modes: vec![(0.0, 0.0); self.modes.len()],
-        }
+    fn axes(&self) -> usize {
+        self.axes.len()
     }
 
-    fn step(&self, state: &mut ModalState, cmd: &Sample, dt_s: f64) -> Result<(), SimError> {
-        if !(dt_s.is_finite() && dt_s >= 0.0) {
-            return Err(SimError::InvalidStep { dt_s });
+    fn initial_state(&self, start: &[State]) -> Result<ModalState, SimError> {
+        if start.len() != self.axes.len() {
+            return Err(SimError::AxisCount {
+                expected: self.axes.len(),
+                got: start.len(),
+            });
         }
+        let axes = self
+            .axes
+            .iter()
+            .zip(start)
+            .map(|(a, s)| {
+                let disc = Discrete::new(a, s.p, self.nominal_dt_s)?;
+                let n = disc.n;
+                let stepper = a.stepper.as_ref().map(|st| {
+                    let mut ss = st.at_rest(s.p).0;
+                    ss.track(0.0);
+                    ss
+                });
+                Ok(ModalAxis {
+                    base: *s,
+                    r: vec![0.0; n],
+                    rd: vec![0.0; n],
+                    stepper,
+                    disc: std::sync::Arc::new(disc),
+                    scratch: vec![0.0; 2 * n],
+                })
+            })
+            .collect::<Result<_, SimError>>()?;
+        Ok(ModalState { t_s: 0.0, axes })
+    }
+
+    fn step(&self, state: &mut ModalState, cmd: &[Sample], dt_s: f64) -> Result<(), SimError> {
+        check_step(self.axes.len(), cmd, dt_s)?;
         let nominal = dt_s == self.nominal_dt_s;
-        for (i, (mode, e)) in self.modes.iter().zip(&mut state.modes).enumerate() {
-            let w = mode.omega();
-            if nominal {
-                apply(&self.nominal[i], w, e, cmd.a, cmd.j);
+        for ((ax, st), c) in self.axes.iter().zip(&mut state.axes).zip(cmd) {
+            let disc = &st.disc;
+            let n = disc.n;
+            let other;
+            let rows: &[f64] = if nominal {
+                &disc.nominal
             } else {
-                apply(&transition(mode, dt_s), w, e, cmd.a, cmd.j);
+                other = disc.transition(dt_s);
+                &other
+            };
+            let dim = 2 * n + 3;
+            for (i, out) in st.scratch.iter_mut().enumerate() {
+                let row = &rows[i * dim..(i + 1) * dim];
+                let mut acc = row[2 * n] * c.v + row[2 * n + 1] * c.a + row[2 * n + 2] * c.j;
+                for k in 0..n {
+                    acc += row[k] * st.r[k] + row[n + k] * st.rd[k];
+                }
+                *out = acc;
+            }
+            st.r.copy_from_slice(&st.scratch[..n]);
+            st.rd.copy_from_slice(&st.scratch[n..]);
+            let h = dt_s;
+            st.base = State {
+                p: c.p + h * (c.v + h * (c.a / 2.0 + h * c.j / 6.0)),
+                v: c.v + h * (c.a + h * c.j / 2.0),
+                a: c.a + h * c.j,
+            };
+            if let (Some(sp), Some(ss)) = (&ax.stepper, st.stepper.as_mut()) {
+                // Linear driver: the load angle is Nr (x rad_per_m - theta) = -Nr r_rotor.
+                let theta = st.r[sp.rotor] + disc.g[sp.rotor] * st.base.p;
+                sp.track_spring(ss, theta, st.base.p);
+            }
+            if !(st.base.p.is_finite() && st.r.iter().chain(&st.rd).all(|x| x.is_finite())) {
+                return Err(SimError::NonFinite {
+                    t_s: state.t_s + dt_s,
+                });
             }
         }
-        let h = dt_s;
-        state.base = State {
-            p: cmd.p + h * (cmd.v + h * (cmd.a / 2.0 + h * cmd.j / 6.0)),
-            v: cmd.v + h * (cmd.a + h * cmd.j / 2.0),
-            a: cmd.a + h * cmd.j,
-        };
         state.t_s += dt_s;
-        let finite = state.base.p.is_finite()
-            && state
-                .modes
-                .iter()
-                .all(|(e, ed)| e.is_finite() && ed.is_finite());
-        if finite {
-            Ok(())
-        } else {
-            Err(SimError::NonFinite { t_s: state.t_s })
-        }
+        Ok(())
     }
 
-    fn observe(&self, state: &ModalState) -> Observation {
-        let deflection: f64 = self
-            .modes
-            .iter()
-            .zip(&state.modes)
-            .map(|(m, (e, _))| m.weight() * e)
-            .sum();
-        Observation {
-            commanded_m: state.base.p,
-            toolhead_m: state.base.p + deflection,
+    fn observe(&self, state: &ModalState, out: &mut [Observation]) {
+        for ((ax, st), o) in self.axes.iter().zip(&state.axes).zip(out.iter_mut()) {
+            let x = st.base.p;
+            let g = &st.disc.g;
+            let q = |i: usize| st.r[i] + g[i] * x;
+            let mut toolhead = 0.0;
+            for t in &ax.lumped.output {
+                toolhead += t.gain
+                    * match t.node {
+                        crate::lumped::Node::Ground => 0.0,
+                        crate::lumped::Node::Command => x,
+                        crate::lumped::Node::Body(i) => q(i),
+                    };
+            }
+            *o = Observation {
+                commanded_m: x,
+                toolhead_m: toolhead,
+                carriage_m: ax.carriage.map(q),
+                motor_angle_rad: ax.stepper.as_ref().map(|s| q(s.rotor)),
+                currents_a: None,
+                load_angle_rad: st.stepper.as_ref().map(|s| s.load_angle_rad),
+                lost_steps: st.stepper.as_ref().map_or(0, StepperState::lost_steps),
+                max_load_angle_rad: st.stepper.as_ref().map(|s| s.max_load_angle_rad),
+            };
         }
     }
 }

@@ -1,16 +1,33 @@
 //! The `Plant` trait every backend implements.
+//!
+//! A plant simulates one or more independent axes ([`crate::AxisModel`]s), each following
+//! its own commanded profile. The model (`self`) is constant; the mutable state is a
+//! separate value, so one model serves many runs in parallel.
 
 use settle_planner::{Sample, State};
 
 use crate::SimError;
 
-/// What a plant reports at an instant (m).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// What a plant reports about one axis at an instant. Lengths in m, angles in rad.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Observation {
-    /// The commanded position the plant is following (m).
+    /// The commanded position the axis is following (m), before microstep quantisation.
     pub commanded_m: f64,
     /// The toolhead position (m).
     pub toolhead_m: f64,
+    /// The carriage position (m), when the axis has a carriage body.
+    pub carriage_m: Option<f64>,
+    /// The motor rotor angle (rad), when the axis has a motor.
+    pub motor_angle_rad: Option<f64>,
+    /// Phase currents A and B (A), when the full driver model runs.
+    pub currents_a: Option<[f64; 2]>,
+    /// Load angle (electrical rad) between the driver's field and the rotor, when the axis
+    /// has a motor.
+    pub load_angle_rad: Option<f64>,
+    /// Full steps lost so far (0 = in step; see [`crate::stepper::StepperState::lost_steps`]).
+    pub lost_steps: u32,
+    /// Largest |load angle| so far (electrical rad), when the axis has a motor.
+    pub max_load_angle_rad: Option<f64>,
 }
 
 /// A plant: a constant model (`self`) and a separate mutable state.
@@ -18,13 +35,43 @@ pub trait Plant {
     /// The mutable state.
     type State;
 
-    /// A fresh state, at rest at the commanded start state.
-    fn initial_state(&self, start: &State) -> Self::State;
+    /// Number of axes.
+    fn axes(&self) -> usize;
 
-    /// Advance `dt_s` seconds. `cmd` is the commanded sample at the step start; its jerk is
-    /// constant over the step (callers split steps at profile breakpoints).
-    fn step(&self, state: &mut Self::State, cmd: &Sample, dt_s: f64) -> Result<(), SimError>;
+    /// A fresh state, at rest at the static equilibrium of each axis's commanded start
+    /// state (`start` has one entry per axis).
+    fn initial_state(&self, start: &[State]) -> Result<Self::State, SimError>;
 
-    /// What the plant shows now.
-    fn observe(&self, state: &Self::State) -> Observation;
+    /// Advance `dt_s` seconds. `cmd` has one commanded sample per axis at the step start;
+    /// each axis's jerk is constant over the step (callers split steps at profile
+    /// breakpoints).
+    fn step(&self, state: &mut Self::State, cmd: &[Sample], dt_s: f64) -> Result<(), SimError>;
+
+    /// What the plant shows now, one entry per axis written into `out`.
+    fn observe(&self, state: &Self::State, out: &mut [Observation]);
+}
+
+/// Check a command's axis count and step size (shared by the backends).
+pub fn check_step(axes: usize, cmd: &[Sample], dt_s: f64) -> Result<(), SimError> {
+    if cmd.len() != axes {
+        return Err(SimError::AxisCount {
+            expected: axes,
+            got: cmd.len(),
+        });
+    }
+    if !(dt_s.is_finite() && dt_s >= 0.0) {
+        return Err(SimError::InvalidStep { dt_s });
+    }
+    Ok(())
+}
+
+/// The command polynomial of a sample `tau` s later (constant jerk).
+#[inline]
+pub fn advance_sample(s: &Sample, tau: f64) -> Sample {
+    Sample {
+        p: s.p + tau * (s.v + tau * (s.a / 2.0 + tau * s.j / 6.0)),
+        v: s.v + tau * (s.a + tau * s.j / 2.0),
+        a: s.a + tau * s.j,
+        j: s.j,
+    }
 }

@@ -10,7 +10,22 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use settle_planner::{Limits, Profile, Sample, Segment, State, scurve, trapezoid};
 use settle_sim::closed_form::{residual_at, residual_envelope, undamped_scurve_residual};
-use settle_sim::{ModalPlant, ModalState, Mode, Plant};
+use settle_sim::{AxisModel, ModalPlant, ModalState, Mode, Plant};
+
+/// The modal plant of one axis with these modes.
+fn plant_of(modes: &[Mode], dt: f64) -> ModalPlant {
+    ModalPlant::new(vec![AxisModel::from_modes("x", modes).expect("axis")], dt).expect("plant")
+}
+
+/// Deflection e and rate e' of mode `i`.
+fn mode_state(st: &ModalState, i: usize) -> (f64, f64) {
+    (st.axes[0].r[i], st.axes[0].rd[i])
+}
+
+/// Free-vibration envelope of the first mode.
+fn amplitude(st: &ModalState, mode: &Mode) -> f64 {
+    ModalPlant::free_amplitude(st, 0, 0, mode.omega(), mode.damping_ratio())
+}
 
 fn cases() -> usize {
     std::env::var("SETTLE_SIM_CASES")
@@ -22,7 +37,7 @@ fn cases() -> usize {
 /// Step `plant` through `profile` at `dt`, splitting steps at segment boundaries, then hold
 /// the end point until `t_stop`. Returns the state at T and at `t_stop`.
 fn drive(plant: &ModalPlant, profile: &Profile, dt: f64, t_stop: f64) -> (ModalState, ModalState) {
-    let mut st = plant.initial_state(&profile.start());
+    let mut st = plant.initial_state(&[profile.start()]).expect("state");
     for (t0, s0, seg) in profile.iter() {
         let t1 = t0 + seg.duration_s();
         let mut t = t0;
@@ -30,7 +45,7 @@ fn drive(plant: &ModalPlant, profile: &Profile, dt: f64, t_stop: f64) -> (ModalS
             let next = ((t / dt).floor() + 1.0) * dt;
             let next = if next <= t { t + dt } else { next }.min(t1);
             plant
-                .step(&mut st, &seg.sample(&s0, t - t0), next - t)
+                .step(&mut st, &[seg.sample(&s0, t - t0)], next - t)
                 .expect("finite");
             t = next;
         }
@@ -46,7 +61,7 @@ fn drive(plant: &ModalPlant, profile: &Profile, dt: f64, t_stop: f64) -> (ModalS
     let mut t = profile.duration_s();
     while t < t_stop {
         let h = dt.min(t_stop - t);
-        plant.step(&mut st, &hold, h).expect("finite");
+        plant.step(&mut st, &[hold], h).expect("finite");
         t += h;
     }
     (at_end, st)
@@ -91,12 +106,12 @@ fn modal_plant_matches_closed_form_residual_on_random_profiles() {
         )
         .expect("mode");
         let dt = [1e-4, 2.5e-4, 1e-3][rng.random_range(0..3)];
-        let plant = ModalPlant::new(vec![mode], dt).expect("plant");
+        let plant = plant_of(&[mode], dt);
         let t_end = profile.duration_s();
         let t_stop = t_end + rng.random_range(0.0..0.2);
         let (at_end, later) = drive(&plant, &profile, dt, t_stop);
         let exact = residual_envelope(&profile, &mode);
-        let got = plant.free_amplitude(&at_end, 0);
+        let got = amplitude(&at_end, &mode);
         // Relative to the residual, with a floor far below any settling band (1e-12 m)
         // for profiles whose residual happens to cancel.
         let rel = (got - exact).abs() / exact.max(1e-12);
@@ -106,12 +121,12 @@ fn modal_plant_matches_closed_form_residual_on_random_profiles() {
             "amplitude {got} vs closed form {exact}: {profile:?} {mode:?}"
         );
         let e_exact = residual_at(&profile, &mode, t_stop);
-        let e_rel = (later.modes[0].0 - e_exact).abs() / exact.max(1e-12);
+        let e_rel = (mode_state(&later, 0).0 - e_exact).abs() / exact.max(1e-12);
         worst_e = worst_e.max(e_rel);
         assert!(
             e_rel <= 1e-6,
             "e({t_stop}) {} vs {e_exact}",
-            later.modes[0].0
+            mode_state(&later, 0).0
         );
     }
     eprintln!(
@@ -132,9 +147,9 @@ fn undamped_scurve_residual_vanishes_when_jerk_phase_is_one_period() {
         assert!((tm.t_jerk - 1.0 / f).abs() < 1e-15 && tm.a_peak == amax);
         let static_defl = amax / mode.omega().powi(2);
         let cf = residual_envelope(&prof, &mode);
-        let plant = ModalPlant::new(vec![mode], 1e-4).expect("plant");
+        let plant = plant_of(&[mode], 1e-4);
         let (at_end, _) = drive(&plant, &prof, 1e-4, prof.duration_s());
-        let sim = plant.free_amplitude(&at_end, 0);
+        let sim = amplitude(&at_end, &mode);
         assert!(cf < 1e-9 * static_defl, "closed form {cf} at d={d}");
         assert!(sim < 1e-9 * static_defl, "plant {sim} at d={d}");
     }
@@ -157,9 +172,9 @@ fn undamped_trapezoid_residual_vanishes_when_accel_phase_is_one_period() {
     for d in [0.01, 0.05, 0.2] {
         let prof = trapezoid::rest_to_rest(0.0, d, &lim).expect("plan");
         let cf = residual_envelope(&prof, &mode);
-        let plant = ModalPlant::new(vec![mode], 1e-4).expect("plant");
+        let plant = plant_of(&[mode], 1e-4);
         let (at_end, _) = drive(&plant, &prof, 1e-4, prof.duration_s());
-        let sim = plant.free_amplitude(&at_end, 0);
+        let sim = amplitude(&at_end, &mode);
         assert!(cf < 1e-9 * static_defl, "closed form {cf} at d={d}");
         assert!(sim < 1e-9 * static_defl, "plant {sim} at d={d}");
     }
@@ -211,14 +226,14 @@ fn constant_acceleration_gives_static_deflection() {
         }],
     )
     .expect("profile");
-    let plant = ModalPlant::new(vec![mode], 1e-3).expect("plant");
+    let plant = plant_of(&[mode], 1e-3);
     let (at_end, _) = drive(&plant, &prof, 1e-3, 1.0);
     // After 1 s the transient has decayed by e^{-zeta w} = e^{-25}.
     let expect = -a / mode.omega().powi(2);
     assert!(
-        (at_end.modes[0].0 - expect).abs() < 1e-9 * expect.abs(),
+        (mode_state(&at_end, 0).0 - expect).abs() < 1e-9 * expect.abs(),
         "{:?}",
-        at_end.modes[0]
+        mode_state(&at_end, 0)
     );
 }
 
@@ -226,18 +241,18 @@ fn constant_acceleration_gives_static_deflection() {
 fn free_decay_has_the_analytic_frequency_and_damping() {
     let mode = Mode::new(55.0, 0.04, 1.0).expect("mode");
     let (w, wd, z) = (mode.omega(), mode.omega_d(), mode.damping_ratio());
-    let plant = ModalPlant::new(vec![mode], 1e-4).expect("plant");
-    let mut st = plant.initial_state(&State::default());
+    let plant = plant_of(&[mode], 1e-4);
+    let mut st = plant.initial_state(&[State::default()]).expect("state");
     let e0 = 1e-4;
-    st.modes[0] = (e0, 0.0);
+    st.axes[0].r[0] = e0;
     let hold = Sample::default();
     let mut worst = 0.0f64;
     for k in 1..=5000 {
-        plant.step(&mut st, &hold, 1e-4).expect("finite");
+        plant.step(&mut st, &[hold], 1e-4).expect("finite");
         let t = k as f64 * 1e-4;
         // e(t) = e0 e^{-zeta w t} (cos wd t + zeta w / wd sin wd t)
         let exact = e0 * (-z * w * t).exp() * ((wd * t).cos() + z * w / wd * (wd * t).sin());
-        worst = worst.max((st.modes[0].0 - exact).abs() / e0);
+        worst = worst.max((mode_state(&st, 0).0 - exact).abs() / e0);
     }
     assert!(worst < 1e-9, "worst error {worst} of e0");
     // One period of the damped oscillation is 2 pi / wd: the phase error after 5000 steps
