@@ -19,3 +19,7 @@ echo "== cargo clippy"
 cargo clippy --workspace --all-targets --locked -- -D warnings
 echo "== cargo test (release: the property suites are numeric-heavy)"
 cargo test --workspace --release --locked
+echo "== settle check: the CI regression gate (scenarios/ci_*.toml vs results/baselines/<name>.csv)"
+for scenario in scenarios/ci_*.toml; do
+  cargo run --release --locked --quiet -- check "$scenario" --baseline "results/baselines/$(basename "$scenario" .toml).csv"
+done
