@@ -34,5 +34,9 @@ if [[ ${#features[@]} -gt 0 ]]; then
 fi
 echo "== cargo test (release: the property suites are numeric-heavy)"
 cargo test --workspace --release --locked "${features[@]}"
+echo "== settle check: the CI regression gate (scenarios/ci_*.toml vs results/baselines/<name>.csv)"
+for scenario in scenarios/ci_*.toml; do
+  cargo run --release --locked --quiet "${features[@]}" -- check "$scenario" --baseline "results/baselines/$(basename "$scenario" .toml).csv"
+done
 echo "== fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
 scripts/fuzz.sh "${SETTLE_FUZZ_SECONDS:-15}"

@@ -15,6 +15,13 @@ pub mod scenario;
 pub mod series;
 pub mod sweep;
 pub mod validate;
+// Outputs people keep (issue 7).
+pub mod check;
+pub mod outputs;
+pub mod plot;
+pub mod shard;
+pub mod sink;
+pub mod table;
 
 use std::path::Path;
 
@@ -33,6 +40,19 @@ pub fn run_all(
     jobs: Option<usize>,
     progress: bool,
 ) -> Result<Vec<Result<Metrics, Error>>, Error> {
+    run_all_with(runs, jobs, progress, |spec| run::execute(spec, None))
+}
+
+/// [`run_all`] with a custom way to run one spec (e.g. recording it: [`sink::Recorder`]).
+pub fn run_all_with<F>(
+    runs: &[RunSpec],
+    jobs: Option<usize>,
+    progress: bool,
+    run_one: F,
+) -> Result<Vec<Result<Metrics, Error>>, Error>
+where
+    F: Fn(&RunSpec) -> Result<Metrics, Error> + Sync,
+{
     let bar = if progress {
         let bar =
             ProgressBar::with_draw_target(Some(runs.len() as u64), ProgressDrawTarget::stderr());
@@ -61,7 +81,7 @@ pub fn run_all(
     let results = pool.install(|| {
         runs.par_iter()
             .map(|spec| {
-                let r = run::execute(spec, None);
+                let r = run_one(spec);
                 bar.inc(1);
                 r
             })

@@ -44,6 +44,12 @@ enum Command {
         /// Simulation backend: modal (exact, linear driver only), rapier, mujoco.
         #[arg(long, default_value = "rapier", value_parser = parse_backend)]
         backend: Backend,
+        #[command(flatten)]
+        outputs: OutputFlags,
+        /// Run only shard K of N (1-based: runs i with i % N == K-1) into
+        /// DIR [default: results/<scenario name>/shard-K-of-N/]; combine with `settle merge`.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<settle::shard::Shard>,
     },
     /// Check every backend against the closed form and against each other; print a table.
     #[command(
@@ -54,6 +60,44 @@ enum Command {
         #[arg(long, value_parser = parse_backend)]
         backend: Option<Backend>,
         /// Also write the table as Markdown to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Rerun a scenario and compare every metric of every run with a committed baseline.
+    #[command(
+        after_help = "Exit status: 0 when every value is within the tolerance, 1 (with a table of run,\nmetric, baseline, now, delta%) when any is not, 2 on bad input.\n\nAny change beyond the tolerance fails, worse or better: settle is deterministic, so a\nchange means behaviour changed, and --update makes accepting it a reviewed commit.\n\nExample:\n  settle check scenarios/ci_quickstart.toml --baseline results/baselines/ci_quickstart.csv\n  settle check scenarios/ci_quickstart.toml --baseline results/baselines/ci_quickstart.csv --update"
+    )]
+    Check {
+        /// The scenario file (TOML).
+        scenario: PathBuf,
+        /// The baseline: a runs.csv written by settle (results/baselines/<name>.csv).
+        #[arg(long)]
+        baseline: PathBuf,
+        /// Relative tolerance in percent (numbers closer than this to the baseline pass).
+        #[arg(long, value_name = "PCT", default_value_t = settle::check::DEFAULT_TOLERANCE_PCT)]
+        tolerance: f64,
+        /// Rewrite the baseline with this run's values (on purpose: commit the diff).
+        #[arg(long)]
+        update: bool,
+        /// Pass when every change is an improvement of a settling metric.
+        #[arg(long)]
+        allow_improvements: bool,
+        /// Simulation backend: modal, rapier, mujoco.
+        #[arg(long, default_value = "rapier", value_parser = parse_backend)]
+        backend: Backend,
+        /// Worker threads [default: all cores].
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+        jobs: Option<u16>,
+    },
+    /// Combine the folders of a sharded sweep into the outputs of an unsharded one.
+    #[command(
+        after_help = "Example:\n  settle sweep scenarios/quickstart.toml --shard 1/2\n  settle sweep scenarios/quickstart.toml --shard 2/2\n  settle merge results/quickstart/shard-1-of-2 results/quickstart/shard-2-of-2\n  (writes results/quickstart/runs.csv, summary.md and plots/, as an unsharded sweep)"
+    )]
+    Merge {
+        /// The shard folders (each written by `settle sweep --shard K/N`), in any order.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Output folder [default: results/<scenario name>/].
         #[arg(long)]
         out: Option<PathBuf>,
     },
@@ -79,10 +123,26 @@ enum Command {
         /// Trace file [default: results/<scenario name>/run-<case>.csv].
         #[arg(long)]
         out: Option<PathBuf>,
+        #[command(flatten)]
+        outputs: OutputFlags,
+        /// Also draw the run's time series as run-<case>.svg and .png beside the trace.
+        #[arg(long)]
+        plot: bool,
         /// Simulation backend: modal, rapier, mujoco.
         #[arg(long, default_value = "rapier", value_parser = parse_backend)]
         backend: Backend,
     },
+}
+
+/// Recordings a sweep or a run can write.
+#[derive(clap::Args, Debug, Clone, Copy)]
+struct OutputFlags {
+    /// Write an MCAP recording per run (zstd, JSON schemas; opens in Foxglove).
+    #[arg(long)]
+    mcap: bool,
+    /// Write a rerun recording (.rrd) per run (needs the `rerun` cargo feature).
+    #[arg(long)]
+    rerun: bool,
 }
 
 fn main() -> ExitCode {
@@ -104,16 +164,78 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             out,
             jobs,
             backend,
-        } => sweep(scenario, out, jobs.map(usize::from), backend),
+            outputs,
+            shard,
+        } => sweep(scenario, out, jobs.map(usize::from), backend, outputs, shard),
         Command::Validate { backend, out } => settle::validate::command(backend, out.as_deref()),
+        Command::Check {
+            scenario,
+            baseline,
+            tolerance,
+            update,
+            allow_improvements,
+            backend,
+            jobs,
+        } => check(
+            &scenario,
+            &baseline,
+            tolerance,
+            update,
+            allow_improvements,
+            backend,
+            jobs.map(usize::from),
+        ),
+        Command::Merge { dirs, out } => merge(&dirs, out),
         Command::Plan { jobs } => plan_lines(jobs.map(usize::from)),
         Command::Run {
             scenario,
             case,
             out,
+            outputs,
+            plot,
             backend,
-        } => run_one(scenario, case, out, backend),
+        } => run_one(scenario, case, out, outputs, plot, backend),
     }
+}
+
+fn create_dir(dir: &std::path::Path) -> Result<(), Error> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Write {
+        path: dir.to_path_buf(),
+        source,
+    })
+}
+
+fn usage_error(what: &str, message: impl Into<String>) -> Error {
+    Error::Input {
+        at: settle::error::Location {
+            file: what.into(),
+            line: None,
+            column: None,
+            key: None,
+        },
+        message: message.into(),
+    }
+}
+
+/// Check recording flags before any work, so a missing feature costs no simulation.
+fn recorder(
+    flags: OutputFlags,
+    dir: PathBuf,
+    scenario: &std::path::Path,
+    name: &str,
+) -> anyhow::Result<Option<settle::sink::Recorder>> {
+    if flags.rerun && !settle::sink::rerun::AVAILABLE {
+        return Err(usage_error("--rerun", settle::sink::rerun::UNAVAILABLE).into());
+    }
+    if !(flags.mcap || flags.rerun) {
+        return Ok(None);
+    }
+    Ok(Some(settle::sink::Recorder {
+        dir,
+        mcap: flags.mcap,
+        rerun: flags.rerun,
+        provenance: settle::sink::Provenance::load(scenario, name)?,
+    }))
 }
 
 fn sweep(
@@ -121,40 +243,298 @@ fn sweep(
     out: Option<PathBuf>,
     jobs: Option<usize>,
     backend: Backend,
+    flags: OutputFlags,
+    shard: Option<settle::shard::Shard>,
 ) -> anyhow::Result<ExitCode> {
     let started = Instant::now();
-    let (sc, mut runs) = settle::load_runs(&path)?;
-    settle::run::set_backend(&path, &mut runs, backend)?;
-    let out = out.unwrap_or_else(|| PathBuf::from("results").join(&sc.name));
-    std::fs::create_dir_all(&out).map_err(|source| Error::Write {
-        path: out.clone(),
-        source,
-    })?;
+    let (sc, mut all_runs) = settle::load_runs(&path)?;
+    settle::run::set_backend(&path, &mut all_runs, backend)?;
+    let base = PathBuf::from("results").join(&sc.name);
+    let out = out.unwrap_or_else(|| match shard {
+        Some(s) => base.join(s.folder()),
+        None => base,
+    });
+    if let Some(s) = shard.filter(|s| s.n > all_runs.len()) {
+        return Err(usage_error(
+            "--shard",
+            format!(
+                "{s}: the scenario has {} runs, so at most {} shards",
+                all_runs.len(),
+                all_runs.len()
+            ),
+        )
+        .into());
+    }
+    let rec = recorder(
+        flags,
+        out.join(settle::outputs::RECORDINGS),
+        &path,
+        &sc.name,
+    )?;
+    let runs = match shard {
+        Some(s) => s.select(&all_runs),
+        None => all_runs.clone(),
+    };
+    create_dir(&out)?;
+    if let Some(r) = &rec {
+        create_dir(&r.dir)?;
+    }
     eprintln!(
-        "{}: {} runs on {backend} -> {}",
+        "{}: {} runs on {backend}{} -> {}",
         path.display(),
         runs.len(),
+        shard.map_or(String::new(), |s| format!(
+            " (shard {s} of {} runs)",
+            all_runs.len()
+        )),
         out.display()
     );
+    let results = match &rec {
+        Some(r) => settle::run_all_with(&runs, jobs, true, |spec| r.run(spec))?,
+        None => settle::run_all(&runs, jobs, true)?,
+    };
+    let mut metrics = Vec::with_capacity(results.len());
+    for r in results {
+        metrics.push(r.context("a run failed; runs.csv and summary.md were not written")?);
+    }
+    let csv = report::runs_csv(&runs, &metrics);
+    match shard {
+        Some(s) => {
+            report::write_atomic(&out.join("runs.csv"), csv.as_bytes())?;
+            let scenario = std::fs::read_to_string(&path).map_err(|source| Error::Read {
+                path: path.clone(),
+                source,
+            })?;
+            settle::shard::write_manifest(
+                &out,
+                &settle::shard::Manifest {
+                    format: settle::shard::FORMAT.to_string(),
+                    settle_version: env!("CARGO_PKG_VERSION").to_string(),
+                    scenario_name: sc.name.clone(),
+                    scenario_file: path.display().to_string(),
+                    shard: s.k,
+                    shards: s.n,
+                    total_runs: all_runs.len(),
+                    runs: runs.iter().map(|r| r.id).collect(),
+                    settings: [("backend".to_string(), backend.name().to_string())]
+                        .into_iter()
+                        .collect(),
+                    scenario,
+                },
+            )?;
+            eprintln!(
+                "wrote shard {s}: {} and {} ({} runs in {:.2} s); combine all shards with `settle merge`",
+                out.join("runs.csv").display(),
+                out.join(settle::shard::MANIFEST).display(),
+                runs.len(),
+                started.elapsed().as_secs_f64()
+            );
+        }
+        None => {
+            settle::outputs::write_sweep(&out, &sc, &runs, &csv)?;
+            eprintln!(
+                "wrote {}, {} and {}/ ({} runs in {:.2} s){}",
+                out.join("runs.csv").display(),
+                out.join("summary.md").display(),
+                out.join(settle::outputs::PLOTS).display(),
+                runs.len(),
+                started.elapsed().as_secs_f64(),
+                rec.map_or(String::new(), |r| format!(
+                    "; recordings in {}",
+                    r.dir.display()
+                ))
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn check(
+    path: &std::path::Path,
+    baseline: &std::path::Path,
+    tolerance_pct: f64,
+    update: bool,
+    allow_improvements: bool,
+    backend: Backend,
+    jobs: Option<usize>,
+) -> anyhow::Result<ExitCode> {
+    if !(tolerance_pct.is_finite() && tolerance_pct >= 0.0) {
+        return Err(usage_error(
+            "--tolerance",
+            format!("must be a finite percentage >= 0, got {tolerance_pct}"),
+        )
+        .into());
+    }
+    let (sc, mut runs) = settle::load_runs(path)?;
+    settle::run::set_backend(path, &mut runs, backend)?;
+    let old = match std::fs::read_to_string(baseline) {
+        Ok(text) => Some(text),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound && update => None,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(usage_error(
+                &baseline.display().to_string(),
+                format!(
+                    "no baseline here; create it on purpose with `settle check {} --baseline {} --update`",
+                    path.display(),
+                    baseline.display()
+                ),
+            )
+            .into());
+        }
+        Err(source) => {
+            return Err(Error::Read {
+                path: baseline.to_path_buf(),
+                source,
+            }
+            .into());
+        }
+    };
+    let old_table = old
+        .as_deref()
+        .map(settle::table::RunsTable::parse)
+        .transpose()
+        .map_err(|e| usage_error(&baseline.display().to_string(), e))?;
     let results = settle::run_all(&runs, jobs, true)?;
     let mut metrics = Vec::with_capacity(results.len());
     for r in results {
-        metrics.push(r.context("a run failed; nothing was written")?);
+        metrics.push(r.context("a run failed")?);
     }
-    report::write_atomic(
-        &out.join("runs.csv"),
-        report::runs_csv(&runs, &metrics).as_bytes(),
-    )?;
-    report::write_atomic(
-        &out.join("summary.md"),
-        report::summary_md(&sc, &runs, &metrics).as_bytes(),
-    )?;
+    let csv = report::runs_csv(&runs, &metrics);
+    let now = settle::table::RunsTable::parse(&csv).map_err(|e| usage_error("runs.csv", e))?;
+    let comparison = old_table
+        .as_ref()
+        .map(|b| settle::check::compare(b, &now, tolerance_pct));
+    if update {
+        if let Some(dir) = baseline.parent().filter(|d| !d.as_os_str().is_empty()) {
+            create_dir(dir)?;
+        }
+        report::write_atomic(baseline, csv.as_bytes())?;
+        match comparison {
+            Some(Ok(c)) if !c.changes.is_empty() => println!(
+                "updated {}: {} values changed beyond {tolerance_pct}%:\n{}",
+                baseline.display(),
+                c.changes.len(),
+                settle::check::table(&c.changes, usize::MAX)
+            ),
+            Some(Ok(_)) => println!(
+                "updated {} ({} runs; no value changed beyond {tolerance_pct}%)",
+                baseline.display(),
+                runs.len()
+            ),
+            Some(Err(e)) => println!("updated {} (it had another shape: {e})", baseline.display()),
+            None => println!("created {} ({} runs)", baseline.display(), runs.len()),
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let c = match comparison {
+        Some(Ok(c)) => c,
+        Some(Err(e)) => {
+            eprintln!(
+                "settle check {}: FAILED against {}: {e}",
+                sc.name,
+                baseline.display()
+            );
+            return Ok(ExitCode::from(1));
+        }
+        None => unreachable!("a missing baseline without --update returned above"),
+    };
+    let failures = c.failures(allow_improvements);
+    use settle::check::Verdict;
+    let counts = format!(
+        "{} worse, {} better, {} changed",
+        c.count(Verdict::Worse),
+        c.count(Verdict::Better),
+        c.count(Verdict::Changed)
+    );
+    if !c.changes.is_empty() {
+        println!("{}", settle::check::table(&c.changes, 500));
+    }
+    if failures > 0 {
+        eprintln!(
+            "settle check {}: FAILED: {} of {} values ({} runs) differ from {} by more than {tolerance_pct}% ({counts}).\n\
+If the change is intended, rewrite the baseline and commit it:\n  settle check {} --baseline {} --update",
+            sc.name,
+            c.changes.len(),
+            c.cells,
+            c.runs,
+            baseline.display(),
+            path.display(),
+            baseline.display()
+        );
+        return Ok(ExitCode::from(1));
+    }
+    println!(
+        "settle check {}: ok: {} values ({} runs) match {} within {tolerance_pct}%{}",
+        sc.name,
+        c.cells,
+        c.runs,
+        baseline.display(),
+        if c.changes.is_empty() {
+            String::new()
+        } else {
+            format!(" except improvements ({counts}), allowed by --allow-improvements")
+        }
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<ExitCode> {
+    let mut m = settle::shard::merge(dirs)?;
+    // The backend the shards ran on (a setting every shard agrees on).
+    if let Some(b) = m
+        .manifest
+        .settings
+        .get("backend")
+        .and_then(|b| Backend::parse(b))
+    {
+        let file = PathBuf::from(&m.manifest.scenario_file);
+        settle::run::set_backend(&file, &mut m.runs, b)?;
+    }
+    let out = out.unwrap_or_else(|| PathBuf::from("results").join(&m.scenario.name));
+    create_dir(&out)?;
+    settle::outputs::write_sweep(&out, &m.scenario, &m.runs, &m.csv)?;
+    // Recordings: gathered into one folder, as an unsharded sweep leaves them.
+    let mut copied = 0usize;
+    for d in dirs {
+        let src = d.join(settle::outputs::RECORDINGS);
+        let Ok(entries) = std::fs::read_dir(&src) else {
+            continue;
+        };
+        let dst = out.join(settle::outputs::RECORDINGS);
+        create_dir(&dst)?;
+        for e in entries {
+            let e = e.map_err(|source| Error::Read {
+                path: src.clone(),
+                source,
+            })?;
+            let name = e.file_name();
+            if name.to_string_lossy().starts_with('.') {
+                continue;
+            }
+            let to = dst.join(&name);
+            if std::fs::hard_link(e.path(), &to).is_err() {
+                std::fs::copy(e.path(), &to).map_err(|source| Error::Write {
+                    path: to.clone(),
+                    source,
+                })?;
+            }
+            copied += 1;
+        }
+    }
     eprintln!(
-        "wrote {} and {} ({} runs in {:.2} s)",
-        out.join("runs.csv").display(),
-        out.join("summary.md").display(),
-        runs.len(),
-        started.elapsed().as_secs_f64()
+        "merged {} shards of `{}` ({} runs) into {}{}",
+        dirs.len(),
+        m.scenario.name,
+        m.runs.len(),
+        out.display(),
+        if copied > 0 {
+            format!(
+                "; {copied} recordings gathered in {}",
+                settle::outputs::RECORDINGS
+            )
+        } else {
+            String::new()
+        }
     );
     Ok(ExitCode::SUCCESS)
 }
@@ -163,6 +543,8 @@ fn run_one(
     path: PathBuf,
     case: usize,
     out: Option<PathBuf>,
+    flags: OutputFlags,
+    plot: bool,
     backend: Backend,
 ) -> anyhow::Result<ExitCode> {
     let (sc, mut runs) = settle::load_runs(&path)?;
@@ -193,11 +575,50 @@ fn run_one(
             source,
         })?;
     }
-    let mut series = settle::series::Series::default();
-    let m = settle::run::execute(spec, Some(&mut series))?;
+    let dir = out
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .map_or_else(|| PathBuf::from("."), PathBuf::from);
+    let rec = recorder(flags, dir.clone(), &path, &sc.name)?;
+    let (series, m) = settle::sink::record_run(spec)?;
     let mut csv = Vec::new();
     series.write_csv(&mut csv).context("formatting the trace")?;
     report::write_atomic(&out, &csv)?;
+    let record = settle::sink::RunRecord {
+        spec,
+        series: &series,
+        metrics: &m,
+        row: settle::sink::row_of(spec, &m),
+    };
+    let mut written = vec![out.display().to_string()];
+    if let Some(r) = &rec {
+        if r.mcap {
+            let p = out.with_extension("mcap");
+            settle::sink::mcap::write_file(&p, &r.provenance, &record)?;
+            written.push(p.display().to_string());
+        }
+        if r.rerun {
+            let p = out.with_extension("rrd");
+            settle::sink::rerun::write_file(&p, &r.provenance, &record)?;
+            written.push(p.display().to_string());
+        }
+    }
+    if plot {
+        let stem = out.file_stem().map_or_else(
+            || format!("run-{case}"),
+            |s| s.to_string_lossy().into_owned(),
+        );
+        let swept: Vec<String> = spec
+            .swept
+            .iter()
+            .map(|(k, v)| format!("{k} = {v}"))
+            .collect();
+        let title = format!("{} run {case}: {}", sc.name, swept.join(", "));
+        let fig = settle::plot::trace::figure(&title, &record);
+        settle::plot::write(&fig, &dir, &stem)?;
+        written.push(dir.join(format!("{stem}.svg")).display().to_string());
+        written.push(dir.join(format!("{stem}.png")).display().to_string());
+    }
     println!(
         "run {case}: {} {} mm on axis {} of {} ({} driver, {backend})",
         spec.profile, spec.distance_mm, spec.axis, spec.machine_name, spec.driver
@@ -239,7 +660,7 @@ fn run_one(
             "  FAILED: lost {steps} full steps (axis {axis}): the numbers above are not a settling result"
         );
     }
-    println!("trace: {} ({} samples)", out.display(), series.len());
+    println!("wrote {} ({} samples)", written.join(", "), series.len());
     Ok(ExitCode::SUCCESS)
 }
 

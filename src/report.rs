@@ -10,6 +10,7 @@ use crate::error::Error;
 use crate::metrics::Metrics;
 use crate::scenario::Scenario;
 use crate::sweep::RunSpec;
+use crate::table::RunsTable;
 
 /// Write `contents` to `path` atomically (temporary file + rename).
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), Error> {
@@ -146,9 +147,66 @@ fn ms(t: Option<f64>) -> String {
     t.map_or_else(|| "not settled".to_string(), |x| format!("{:.1}", x * 1e3))
 }
 
+/// A figure linked from the summary.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// Caption.
+    pub title: String,
+    /// Path of the SVG, relative to the summary's folder.
+    pub svg: String,
+    /// Path of the PNG, relative to the summary's folder.
+    pub png: String,
+}
+
+/// The metrics the summary shows, read from one row of the runs table.
+struct RowView<'a> {
+    table: &'a RunsTable,
+    row: usize,
+}
+
+impl RowView<'_> {
+    fn num(&self, col: &str) -> Option<f64> {
+        self.table.num(self.row, col)
+    }
+    /// A time that is `inf` when not settled.
+    fn time(&self, col: &str) -> Option<f64> {
+        self.num(col).filter(|x| x.is_finite())
+    }
+    fn move_time_s(&self) -> f64 {
+        self.num("move_time_s").unwrap_or(f64::NAN)
+    }
+    fn settle_time_s(&self, band: f64) -> Option<f64> {
+        self.time(&format!("settle_time_s_{}", band_label(band)))
+    }
+    fn move_and_settle_s(&self, band: f64) -> Option<f64> {
+        self.time(&format!("move_and_settle_s_{}", band_label(band)))
+    }
+    fn residual_peak_um(&self) -> f64 {
+        self.num("residual_peak_um").unwrap_or(f64::NAN)
+    }
+    /// A run that lost steps is a failed run (status other than `ok`).
+    fn is_ok(&self) -> bool {
+        self.table.cell(self.row, "status").is_none_or(|s| s == "ok")
+    }
+    fn lost_steps(&self) -> u64 {
+        self.num("lost_steps").map_or(0, |x| x as u64)
+    }
+}
+
 /// The summary: one table per band of move-and-settle times, profile kinds side by side
-/// for each swept point (all swept parameters except `profile`), the best marked.
-pub fn summary_md(sc: &Scenario, runs: &[RunSpec], metrics: &[Metrics]) -> String {
+/// for each swept point (all swept parameters except `profile`), the best marked; then the
+/// residual vibration; then the figures.
+///
+/// It reads the metrics from `table` (the runs table, row `i` = `runs[i]`) rather than from
+/// [`Metrics`], so a summary rebuilt from a merged `runs.csv` is byte-identical to the one
+/// the unsharded sweep wrote.
+pub fn summary_md(
+    sc: &Scenario,
+    runs: &[RunSpec],
+    table: &RunsTable,
+    figures: &[Figure],
+) -> String {
+    let view = |i: usize| RowView { table, row: i };
     let mut out = String::new();
     let _ = writeln!(out, "# {}\n", sc.name);
     if !sc.description.is_empty() {
@@ -174,7 +232,7 @@ pub fn summary_md(sc: &Scenario, runs: &[RunSpec], metrics: &[Metrics]) -> Strin
 gain = how much longer the slowest kind takes than the fastest.\n",
         runs.len()
     );
-    let failed = metrics.iter().filter(|m| !m.is_ok()).count();
+    let failed = (0..runs.len()).filter(|&i| !view(i).is_ok()).count();
     if failed > 0 {
         let _ = writeln!(
             out,
@@ -211,7 +269,8 @@ gain = how much longer the slowest kind takes than the fastest.\n",
         })
         .unwrap_or_default();
     let bands = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
-    for (bi, band) in bands.iter().enumerate() {
+    for band in &bands {
+        let band = *band;
         let _ = writeln!(out, "## Move and settle to within {band} um (ms)\n");
         let mut header: Vec<String> = params.iter().map(|p| p.to_string()).collect();
         for k in &kinds {
@@ -229,15 +288,16 @@ gain = how much longer the slowest kind takes than the fastest.\n",
             } else {
                 key.split(" | ").map(str::to_string).collect()
             };
+            let of_kind = |k: ProfileKind| idx.iter().copied().find(|&i| runs[i].profile == k);
             let totals: Vec<(ProfileKind, Option<f64>)> = kinds
                 .iter()
                 .map(|k| {
-                    let t = idx
-                        .iter()
-                        .find(|&&i| runs[i].profile == *k)
-                        .filter(|&&i| metrics[i].is_ok())
-                        .and_then(|&i| metrics[i].move_and_settle_s(bi));
-                    (*k, t)
+                    (
+                        *k,
+                        of_kind(*k)
+                            .filter(|&i| view(i).is_ok())
+                            .and_then(|i| view(i).move_and_settle_s(band)),
+                    )
                 })
                 .collect();
             let best = totals
@@ -245,21 +305,17 @@ gain = how much longer the slowest kind takes than the fastest.\n",
                 .filter_map(|(k, t)| t.map(|t| (*k, t)))
                 .min_by(|a, b| a.1.total_cmp(&b.1));
             for k in &kinds {
-                let m = idx
-                    .iter()
-                    .find(|&&i| runs[i].profile == *k)
-                    .map(|&i| &metrics[i]);
-                match m {
+                match of_kind(*k).map(view) {
                     Some(m) if !m.is_ok() => row.extend([
-                        format!("{:.1}", m.move_time_s * 1e3),
-                        format!("lost {} steps", m.status.lost_steps()),
+                        "-".to_string(),
+                        format!("lost {} steps", m.lost_steps()),
                         "-".to_string(),
                     ]),
                     Some(m) => {
-                        let total = ms(m.move_and_settle_s(bi));
+                        let total = ms(m.move_and_settle_s(band));
                         let is_best = best.is_some_and(|(bk, _)| bk == *k);
-                        row.push(format!("{:.1}", m.move_time_s * 1e3));
-                        row.push(ms(m.settle_time_s[bi]));
+                        row.push(format!("{:.1}", m.move_time_s() * 1e3));
+                        row.push(ms(m.settle_time_s(band)));
                         row.push(if is_best {
                             format!("**{total}**")
                         } else {
@@ -303,13 +359,20 @@ gain = how much longer the slowest kind takes than the fastest.\n",
             row.push(
                 idx.iter()
                     .find(|&&i| runs[i].profile == *k)
-                    .map_or("-".to_string(), |&i| match &metrics[i] {
-                        m if !m.is_ok() => format!("lost {} steps", m.status.lost_steps()),
-                        m => format!("{:.2}", m.residual_peak_um),
+                    .map_or("-".to_string(), |&i| match view(i) {
+                        m if !m.is_ok() => format!("lost {} steps", m.lost_steps()),
+                        m => format!("{:.2}", m.residual_peak_um()),
                     }),
             );
         }
         let _ = writeln!(out, "| {} |", row.join(" | "));
+    }
+    if !figures.is_empty() {
+        let _ = writeln!(out, "\n## Figures\n");
+        for f in figures {
+            let _ = writeln!(out, "![{}]({})\n", f.title, f.svg);
+            let _ = writeln!(out, "{} ([SVG]({}), [PNG]({}))\n", f.title, f.svg, f.png);
+        }
     }
     out
 }
