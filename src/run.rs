@@ -53,7 +53,7 @@ impl Backend {
 
     /// Whether this build can run the backend.
     pub fn available(self) -> bool {
-        !matches!(self, Backend::Mujoco)
+        cfg!(feature = "mujoco") || !matches!(self, Backend::Mujoco)
     }
 }
 
@@ -217,11 +217,42 @@ pub fn run_trajectory(
             )?;
             simulate(&plant, &names, &meta, traj, observe, record)
         }
+        #[cfg(feature = "mujoco")]
+        Backend::Mujoco => {
+            let axes = match options.belt {
+                BeltModel::Frozen => freeze_belts(axes, traj)?,
+                BeltModel::Varying => axes,
+            };
+            let plant = settle_sim::mujoco::MujocoPlant::new(
+                axes,
+                settle_sim::mujoco::MujocoConfig::default(),
+            )?;
+            simulate(&plant, &names, &meta, traj, observe, record)
+        }
+        #[cfg(not(feature = "mujoco"))]
         Backend::Mujoco => Err(SimError::Unsupported {
             backend: "mujoco",
             reason: NO_MUJOCO.into(),
         }),
     }
+}
+
+/// Every position-dependent stiffness fixed at its value at the start equilibrium (the
+/// frozen belt of the linear model) for backends that otherwise vary it.
+#[cfg(feature = "mujoco")]
+fn freeze_belts(
+    mut axes: Vec<settle_sim::AxisModel>,
+    traj: &Trajectory,
+) -> Result<Vec<settle_sim::AxisModel>, SimError> {
+    for (ax, prof) in axes.iter_mut().zip(traj.axes()) {
+        let q0 = settle_sim::rapier::start_equilibrium(ax, prof.start().p)?.0;
+        for c in &mut ax.lumped.couplings {
+            if let Some(i) = c.stiffness.depends_on() {
+                c.stiffness = settle_sim::lumped::Stiffness::Constant(c.stiffness.at(q0[i]));
+            }
+        }
+    }
+    Ok(axes)
 }
 
 /// Which optional channels an axis records.
