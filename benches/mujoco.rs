@@ -12,9 +12,9 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use settle_planner::{Limits, Profile, scurve};
+use settle_sim::Mode;
 use settle_sim::lumped::{Body, Coupling, DofKind, Lumped, Node, Stiffness, Term};
-use settle_sim::mujoco::{MujocoConfig, MujocoPlant};
-use settle_sim::{Mode, Plant};
+use settle_sim::mujoco::{MujocoConfig, MujocoModel};
 
 /// The harness's sample period (s).
 const DT: f64 = 1e-4;
@@ -68,8 +68,8 @@ fn printer_axis() -> Lumped {
 
 /// One run: the move, then a hold until `t_stop`, sampled every DT (steps split at the
 /// profile's breakpoints as the harness does). Returns the final toolhead position.
-fn run(plant: &MujocoPlant, profile: &Profile, t_stop: f64) -> f64 {
-    let mut st = plant.initial_state(&profile.start());
+fn run(plant: &MujocoModel, profile: &Profile, t_stop: f64) -> f64 {
+    let mut st = plant.state_at_rest(&profile.start());
     for (t0, s0, seg) in profile.iter() {
         let t1 = t0 + seg.duration_s();
         let mut t = t0;
@@ -77,7 +77,7 @@ fn run(plant: &MujocoPlant, profile: &Profile, t_stop: f64) -> f64 {
             let next = (((t / DT) + 1e-9).floor() + 1.0) * DT;
             let next = next.min(t1);
             plant
-                .step(&mut st, &seg.sample(&s0, t - t0), next - t)
+                .advance(&mut st, &seg.sample(&s0, t - t0), next - t)
                 .expect("step");
             t = next;
         }
@@ -90,10 +90,10 @@ fn run(plant: &MujocoPlant, profile: &Profile, t_stop: f64) -> f64 {
     let mut t = profile.duration_s();
     while t < t_stop - 1e-12 {
         let h = DT.min(t_stop - t);
-        plant.step(&mut st, &hold, h).expect("step");
+        plant.advance(&mut st, &hold, h).expect("step");
         t += h;
     }
-    plant.observe(&st).toolhead_m
+    plant.toolhead_m(&st)
 }
 
 fn bench(c: &mut Criterion) {
@@ -103,18 +103,18 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("mujoco");
     g.throughput(Throughput::Elements((t_stop * 1e3).round() as u64));
 
-    let axis = MujocoPlant::new(&printer_axis(), MujocoConfig::default()).expect("plant");
+    let axis = MujocoModel::new(&printer_axis(), MujocoConfig::default()).expect("plant");
     eprintln!(
         "printer axis: {:.3} s simulated per run, MuJoCo RK4 step {:.3e} s at mid-travel",
         t_stop,
-        axis.model().nominal_step_s()
+        axis.nominal_step_s()
     );
     g.bench_function("printer_axis_scurve_100mm", |b| {
         b.iter(|| black_box(run(&axis, black_box(&profile), t_stop)))
     });
 
     let mode = Mode::new(40.0, 0.05, 1.0).expect("mode");
-    let single = MujocoPlant::new(
+    let single = MujocoModel::new(
         &Lumped::from_modes(&[mode]).expect("lumped"),
         MujocoConfig::default(),
     )

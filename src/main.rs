@@ -166,7 +166,14 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             backend,
             outputs,
             shard,
-        } => sweep(scenario, out, jobs.map(usize::from), backend, outputs, shard),
+        } => sweep(
+            scenario,
+            out,
+            jobs.map(usize::from),
+            backend,
+            outputs,
+            shard,
+        ),
         Command::Validate { backend, out } => settle::validate::command(backend, out.as_deref()),
         Command::Check {
             scenario,

@@ -8,12 +8,14 @@
 
 mod mujoco_support;
 
-use mujoco_support::{Exact, Interval, belt_spans, printer_axis, rk4_interval, schedule};
+use mujoco_support::{
+    Exact, Interval, MujocoOne, OneAxis, belt_spans, printer_axis, rk4_interval, schedule,
+};
 use settle_planner::{Limits, Profile, Sample, State, scurve, trapezoid};
+use settle_sim::Mode;
 use settle_sim::SimError;
 use settle_sim::lumped::{Lumped, Stiffness};
 use settle_sim::mujoco::{MujocoConfig, MujocoModel, MujocoPlant};
-use settle_sim::{Mode, Plant};
 
 const DT: f64 = 1e-3;
 const R_PULLEY: f64 = 20.0 * 0.002 / std::f64::consts::TAU;
@@ -32,16 +34,16 @@ fn moves(d: f64) -> Vec<(&'static str, Profile)> {
 
 /// MuJoCo through the Plant trait: coordinates after every interval.
 fn mujoco_trace(l: &Lumped, profile: &Profile, intervals: &[Interval]) -> Vec<Vec<f64>> {
-    let plant = MujocoPlant::new(l, MujocoConfig::default()).expect("plant");
+    let plant = MujocoOne::new(l, MujocoConfig::default());
     trace_on(&plant, profile, intervals)
 }
 
-fn trace_on(plant: &MujocoPlant, profile: &Profile, intervals: &[Interval]) -> Vec<Vec<f64>> {
+fn trace_on(plant: &MujocoOne, profile: &Profile, intervals: &[Interval]) -> Vec<Vec<f64>> {
     let mut st = plant.initial_state(&profile.start());
     intervals
         .iter()
         .map(|iv| {
-            plant.step(&mut st, &iv.cmd, iv.h).expect("step");
+            plant.step(&mut st, &iv.cmd, iv.h);
             st.q().to_vec()
         })
         .collect()
@@ -322,10 +324,10 @@ fn plants_can_run_on_worker_threads() {
     fn send_sync<T: Send + Sync>() {}
     fn send<T: Send>() {}
     send_sync::<MujocoPlant>();
+    send_sync::<MujocoModel>();
     send::<settle_sim::mujoco::MujocoSim>();
     // Two threads running one shared plant at once give the numbers of a lone run.
-    let plant = MujocoPlant::new(&printer_axis(belt_spans(), true), MujocoConfig::default())
-        .expect("plant");
+    let plant = MujocoOne::new(&printer_axis(belt_spans(), true), MujocoConfig::default());
     let (_, profile) = moves(0.05).remove(1);
     let ivs = schedule(&profile, DT, profile.duration_s() + 0.05);
     let alone = trace_on(&plant, &profile, &ivs);

@@ -11,12 +11,12 @@
 
 mod mujoco_support;
 
-use mujoco_support::{Interval, schedule};
+use mujoco_support::{Interval, ModalOne, MujocoOne, OneAxis, schedule};
 use settle_planner::{Limits, Profile, Sample, State, scurve, trapezoid};
+use settle_sim::Mode;
 use settle_sim::closed_form::residual_envelope;
 use settle_sim::lumped::Lumped;
-use settle_sim::mujoco::{Integrator, MujocoConfig, MujocoModel, MujocoPlant};
-use settle_sim::{ModalPlant, Mode, Plant};
+use settle_sim::mujoco::{Integrator, MujocoConfig, MujocoModel};
 
 /// Sample period of the runs (s), as the harness uses.
 const DT: f64 = 1e-3;
@@ -134,15 +134,12 @@ fn rk4_beats_the_first_order_integrators_at_the_same_step() {
 }
 
 /// Run `plant` through `intervals`, returning the toolhead trace and the state at `t_at`.
-fn run<P: Plant>(
+fn run<P: OneAxis>(
     plant: &P,
     start: &State,
     intervals: &[Interval],
     t_at: f64,
-) -> (Vec<f64>, Option<P::State>)
-where
-    P::State: Clone,
-{
+) -> (Vec<f64>, Option<P::S>) {
     let mut st = plant.initial_state(start);
     let mut trace = Vec::with_capacity(intervals.len());
     let mut at = None;
@@ -150,8 +147,8 @@ where
         if at.is_none() && iv.t0 >= t_at - 1e-12 {
             at = Some(st.clone());
         }
-        plant.step(&mut st, &iv.cmd, iv.h).expect("step");
-        trace.push(plant.observe(&st).toolhead_m);
+        plant.step(&mut st, &iv.cmd, iv.h);
+        trace.push(plant.toolhead_m(&st));
     }
     (trace, at)
 }
@@ -164,7 +161,7 @@ fn mujoco_run(
     config: MujocoConfig,
 ) -> (Vec<f64>, (f64, f64)) {
     let l = Lumped::from_modes(&[*mode]).expect("lumped");
-    let plant = MujocoPlant::new(&l, config).expect("plant");
+    let plant = MujocoOne::new(&l, config);
     let model = plant.model();
     let mut st = plant.initial_state(&profile.start());
     let mut trace = Vec::new();
@@ -174,7 +171,7 @@ fn mujoco_run(
             let x = st.command().p;
             at_end = Some((st.q()[0] - x, st.qd()[0] - st.command().v));
         }
-        plant.step(&mut st, &iv.cmd, iv.h).expect("step");
+        plant.step(&mut st, &iv.cmd, iv.h);
         trace.push(model.toolhead_m(&st));
     }
     (trace, at_end.expect("the run covers the move end"))
@@ -221,7 +218,7 @@ fn whole_trace_matches_the_modal_plant() {
         for (kind, profile) in moves() {
             let t_stop = profile.duration_s() + 0.3;
             let (mj, _) = mujoco_run(&mode, &profile, t_stop, MujocoConfig::default());
-            let modal = ModalPlant::new(vec![mode], DT).expect("modal");
+            let modal = ModalOne::new(&[mode], DT);
             let (reference, _) = run(
                 &modal,
                 &profile.start(),
@@ -277,7 +274,7 @@ fn error_shrinks_with_the_step_at_fourth_order() {
     let mode = Mode::new(120.0, 0.02, 1.0).expect("mode");
     let (_, profile) = moves().remove(3); // S-curve, 20 mm
     let t_stop = profile.duration_s() + 0.1;
-    let modal = ModalPlant::new(vec![mode], DT).expect("modal");
+    let modal = ModalOne::new(&[mode], DT);
     let (reference, _) = run(
         &modal,
         &profile.start(),

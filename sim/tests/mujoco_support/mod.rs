@@ -279,3 +279,63 @@ pub fn belt_spans() -> Stiffness {
         carriage: 1,
     }
 }
+
+/// One axis through the uniform single-axis interface these tests compare backends with:
+/// start at rest, step an interval, read the toolhead. (The harness drives plants through
+/// the multi-axis `Plant` trait; these tests compare one lumped axis at a time.)
+pub trait OneAxis {
+    type S: Clone;
+    fn initial_state(&self, start: &settle_planner::State) -> Self::S;
+    fn step(&self, st: &mut Self::S, cmd: &Sample, h: f64);
+    fn toolhead_m(&self, st: &Self::S) -> f64;
+}
+
+/// MuJoCo's core model (build, step, read) as a [`OneAxis`].
+pub struct MujocoOne(pub settle_sim::mujoco::MujocoModel);
+
+impl MujocoOne {
+    pub fn new(l: &Lumped, config: settle_sim::mujoco::MujocoConfig) -> Self {
+        Self(settle_sim::mujoco::MujocoModel::new(l, config).expect("MuJoCo model"))
+    }
+    pub fn model(&self) -> &settle_sim::mujoco::MujocoModel {
+        &self.0
+    }
+}
+
+impl OneAxis for MujocoOne {
+    type S = settle_sim::mujoco::MujocoSim;
+    fn initial_state(&self, start: &settle_planner::State) -> Self::S {
+        self.0.state_at_rest(start)
+    }
+    fn step(&self, st: &mut Self::S, cmd: &Sample, h: f64) {
+        self.0.advance(st, cmd, h).expect("step");
+    }
+    fn toolhead_m(&self, st: &Self::S) -> f64 {
+        self.0.toolhead_m(st)
+    }
+}
+
+/// The exact modal plant of one axis described by its modes, as a [`OneAxis`].
+pub struct ModalOne(pub settle_sim::ModalPlant);
+
+impl ModalOne {
+    pub fn new(modes: &[settle_sim::Mode], dt: f64) -> Self {
+        let axis = settle_sim::AxisModel::from_modes("x", modes).expect("axis");
+        Self(settle_sim::ModalPlant::new(vec![axis], dt).expect("modal plant"))
+    }
+}
+
+impl OneAxis for ModalOne {
+    type S = <settle_sim::ModalPlant as settle_sim::Plant>::State;
+    fn initial_state(&self, start: &settle_planner::State) -> Self::S {
+        settle_sim::Plant::initial_state(&self.0, std::slice::from_ref(start)).expect("state")
+    }
+    fn step(&self, st: &mut Self::S, cmd: &Sample, h: f64) {
+        settle_sim::Plant::step(&self.0, st, std::slice::from_ref(cmd), h).expect("step");
+    }
+    fn toolhead_m(&self, st: &Self::S) -> f64 {
+        let mut o = [settle_sim::Observation::default()];
+        settle_sim::Plant::observe(&self.0, st, &mut o);
+        o[0].toolhead_m
+    }
+}
