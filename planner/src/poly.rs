@@ -70,6 +70,25 @@ const BINOM: [[f64; MAX_DEG + 1]; MAX_DEG + 1] = {
     b
 };
 
+/// Power-to-Bernstein weights `C(i, k) / C(n, k)`, indexed `[n][i][k]`.
+const TO_BERNSTEIN: [[[f64; MAX_DEG + 1]; MAX_DEG + 1]; MAX_DEG + 1] = {
+    let mut w = [[[0.0; MAX_DEG + 1]; MAX_DEG + 1]; MAX_DEG + 1];
+    let mut n = 0;
+    while n <= MAX_DEG {
+        let mut i = 0;
+        while i <= n {
+            let mut k = 0;
+            while k <= i {
+                w[n][i][k] = BINOM[i][k] / BINOM[n][k];
+                k += 1;
+            }
+            i += 1;
+        }
+        n += 1;
+    }
+    w
+};
+
 /// `c`'s coefficients in the Bernstein basis of `[lo, hi]`, and the rounding level below
 /// which their signs are not to be trusted.
 fn bernstein(c: &[f64], lo: f64, hi: f64) -> ([f64; MAX_DEG + 1], f64) {
@@ -91,9 +110,10 @@ fn bernstein(c: &[f64], lo: f64, hi: f64) -> ([f64; MAX_DEG + 1], f64) {
         size += dk.abs();
     }
     let mut b = [0.0; MAX_DEG + 1];
+    let w = &TO_BERNSTEIN[n];
     for (i, bi) in b[..=n].iter_mut().enumerate() {
         for k in 0..=i {
-            *bi += BINOM[i][k] / BINOM[n][k] * d[k];
+            *bi += w[i][k] * d[k];
         }
     }
     (b, 64.0 * f64::EPSILON * size)

@@ -78,14 +78,14 @@ pub(crate) fn check_target(t: &State, lim: &Limits, b: &Bounds) -> Result<(), Pl
 }
 
 /// Brake (jerk-limited) or clamp the velocity (trapezoid) into the limits.
-pub(crate) fn pre(start: State, lim: &Limits, b: &Bounds) -> (Segs, State) {
+pub(crate) fn pre(start: State, lim: &Limits, b: &Bounds) -> (Segs<4>, State) {
     if b.jmax.is_finite() {
         return brake(start, lim, b.jmax);
     }
     // Trapezoid: the acceleration may jump; only a velocity beyond its limit needs a
     // deceleration phase.
     let mut s = start;
-    let mut segs = Segs::default();
+    let mut segs = Segs::<4>::default();
     let (excess, a) = if s.v > lim.vmax() {
         (s.v - lim.vmax(), lim.amin())
     } else if s.v < lim.vmin() {
@@ -145,7 +145,7 @@ pub fn to_velocity(
             reason: "target acceleration outside [amin, amax]",
         });
     }
-    let mut pre_segs = Segs::default();
+    let mut pre_segs = Segs::<4>::default();
     let mut s = start;
     if b.jmax.is_finite() && (s.a > lim.amax() || s.a < lim.amin()) {
         let to = s.a.clamp(lim.amin(), lim.amax());
