@@ -7,62 +7,6 @@
 
 use crate::Segment;
 
-/// A cursor over one profile's segments: the current segment, the time left in it, and
-/// the acceleration the profile has now.
-struct Cursor<'a> {
-    segs: &'a [Segment],
-    i: usize,
-    left: f64,
-    a: f64,
-}
-
-impl<'a> Cursor<'a> {
-    fn new(segs: &'a [Segment], a0: f64) -> Self {
-        let mut c = Self {
-            segs,
-            i: 0,
-            left: 0.0,
-            a: a0,
-        };
-        c.enter();
-        c
-    }
-
-    /// Start segment `i`: an acceleration segment sets the acceleration.
-    fn enter(&mut self) {
-        if let Some(seg) = self.segs.get(self.i) {
-            self.left = seg.duration_s();
-            if let Segment::Accel { accel, .. } = *seg {
-                self.a = accel;
-            }
-        }
-    }
-
-    /// Skip segments with no time left. Returns true if the profile is exhausted.
-    fn settle(&mut self) -> bool {
-        while self.i < self.segs.len() && self.left <= 0.0 {
-            self.i += 1;
-            self.enter();
-        }
-        self.i >= self.segs.len()
-    }
-
-    /// Jerk now, and whether the acceleration is held at a set value.
-    fn now(&self) -> (f64, bool) {
-        match self.segs.get(self.i) {
-            Some(Segment::Jerk { jerk, .. }) => (*jerk, false),
-            // Past the end: hold the final acceleration.
-            Some(Segment::Accel { .. }) | None => (0.0, true),
-        }
-    }
-
-    fn advance(&mut self, d: f64) {
-        let (j, _) = self.now();
-        self.a += j * d;
-        self.left -= d;
-    }
-}
-
 /// `lambda x + (1 - lambda) y` for profiles `x`, `y` starting with acceleration `a0` and
 /// lasting the same time (up to rounding).
 pub(crate) fn blend(
@@ -73,36 +17,79 @@ pub(crate) fn blend(
     out: &mut impl Extend<Segment>,
 ) {
     let mu = 1.0 - lambda;
-    let (mut cx, mut cy) = (Cursor::new(x, a0), Cursor::new(y, a0));
+    // Per profile: the current segment, the time left in it, its jerk, whether it holds a
+    // set acceleration, and the acceleration now.
+    struct Cur<'a> {
+        segs: &'a [Segment],
+        i: usize,
+        left: f64,
+        j: f64,
+        held: bool,
+        a: f64,
+    }
+    impl Cur<'_> {
+        /// Move to the next segment with time left (an acceleration segment sets the
+        /// acceleration as it is passed); past the end, hold the final acceleration.
+        fn next(&mut self) {
+            while self.i < self.segs.len() {
+                let seg = self.segs[self.i];
+                self.i += 1;
+                match seg {
+                    Segment::Jerk { duration_s, jerk } => {
+                        (self.left, self.j, self.held) = (duration_s, jerk, false);
+                    }
+                    Segment::Accel { duration_s, accel } => {
+                        (self.left, self.j, self.held, self.a) = (duration_s, 0.0, true, accel);
+                    }
+                }
+                if self.left > 0.0 {
+                    return;
+                }
+            }
+            (self.left, self.j, self.held) = (f64::INFINITY, 0.0, true);
+        }
+    }
+    let start = |segs| {
+        let mut c = Cur {
+            segs,
+            i: 0,
+            left: 0.0,
+            j: 0.0,
+            held: true,
+            a: a0,
+        };
+        c.next();
+        c
+    };
+    let (mut cx, mut cy) = (start(x), start(y));
     let mut a_out = a0;
     loop {
-        let (ex, ey) = (cx.settle(), cy.settle());
-        if ex && ey {
+        let d = cx.left.min(cy.left);
+        if d == f64::INFINITY {
             break;
         }
-        let d = match (ex, ey) {
-            (false, false) => cx.left.min(cy.left),
-            (false, true) => cx.left,
-            _ => cy.left,
-        };
-        let ((jx, hx), (jy, hy)) = (cx.now(), cy.now());
-        let a_mix = lambda * cx.a + mu * cy.a;
-        if hx && hy {
+        if cx.held && cy.held {
             // Both hold (or jump to) a set acceleration: hold the mixture exactly.
+            a_out = lambda * cx.a + mu * cy.a;
             out.extend([Segment::Accel {
                 duration_s: d,
-                accel: a_mix,
+                accel: a_out,
             }]);
-            a_out = a_mix;
         } else {
+            let jerk = lambda * cx.j + mu * cy.j;
             out.extend([Segment::Jerk {
                 duration_s: d,
-                jerk: lambda * jx + mu * jy,
+                jerk,
             }]);
-            a_out += (lambda * jx + mu * jy) * d;
+            a_out += jerk * d;
         }
-        cx.advance(d);
-        cy.advance(d);
+        for c in [&mut cx, &mut cy] {
+            c.a += c.j * d;
+            c.left -= d;
+            if c.left <= 0.0 {
+                c.next();
+            }
+        }
     }
     let a_end = lambda * cx.a + mu * cy.a;
     if a_end != a_out && matches!(x.last(), Some(Segment::Accel { .. })) {
@@ -151,7 +138,7 @@ mod tests {
                 jerk: 1.0,
             },
         ];
-        let mut out = Segs::default();
+        let mut out = Segs::<16>::default();
         blend(&x, &y, start.a, 0.25, &mut out);
         let (px, py, pm) = (
             Profile::new(start, x.to_vec()).expect("x").end(),

@@ -21,7 +21,7 @@ use crate::{Limits, Segment, State};
 #[derive(Debug, Clone)]
 pub struct BrakeLaw {
     start: State,
-    segs: Segs,
+    segs: Segs<4>,
     earliest_s: f64,
     latest_s: f64,
 }
@@ -29,7 +29,7 @@ pub struct BrakeLaw {
 impl BrakeLaw {
     /// The law for `start` under `lim` with jerk limit `j`.
     pub fn new(start: State, lim: &Limits, j: f64) -> Self {
-        let mut segs = Segs::default();
+        let mut segs = Segs::<4>::default();
         let mut s = start;
         let mut t = 0.0;
         let mut push = |seg: Segment, s: &mut State, t: &mut f64| {
@@ -161,8 +161,8 @@ impl BrakeLaw {
     }
 
     /// The brake segments up to time `tau` and the state there.
-    pub(crate) fn until(&self, tau: f64) -> (Segs, State) {
-        let mut out = Segs::default();
+    pub(crate) fn until(&self, tau: f64) -> (Segs<4>, State) {
+        let mut out = Segs::<4>::default();
         let mut s = self.start;
         let mut t = 0.0;
         for seg in self.segs.as_slice() {
@@ -201,7 +201,7 @@ pub(crate) fn needed(start: &State, lim: &Limits, j: f64) -> bool {
 }
 
 /// The shortest brake (stop as soon as `vz` is back on the limit).
-pub(crate) fn brake(start: State, lim: &Limits, j: f64) -> (Segs, State) {
+pub(crate) fn brake(start: State, lim: &Limits, j: f64) -> (Segs<4>, State) {
     let law = BrakeLaw::new(start, lim, j);
     law.until(law.earliest_s)
 }

@@ -117,7 +117,7 @@ pub fn velocity_with_duration(
         kind: "jerk-limited",
     })?;
     // Any acceleration brake first (as in `to_velocity`).
-    let mut pre_segs = Segs::default();
+    let mut pre_segs = Segs::<4>::default();
     let mut s = start;
     if let Some(seg) = fastest.segments().first()
         && (start.a > lim.amax() || start.a < lim.amin())
@@ -152,7 +152,7 @@ pub fn velocity_with_duration(
                     continue;
                 }
                 let h = |k: usize| if k == at { hold.max(0.0) } else { 0.0 };
-                let mut body = Segs::default();
+                let mut body = Segs::<8>::default();
                 for (d, jerk) in [
                     (h(0), 0.0),
                     (t1.max(0.0), s1 * j),

@@ -11,7 +11,7 @@ use crate::Segment;
 use crate::arcs::{Arcs, Sink, family};
 use crate::ramp::Ramp;
 use crate::unit::{Scale, Unit};
-use crate::velocity::{Bounds, Change, change};
+use crate::velocity::{Bounds, change};
 
 /// A candidate profile from a safe state, in normalised units.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -23,11 +23,11 @@ pub(crate) enum Cand {
         /// The cruise velocity (`vmax` or `vmin`, normalised).
         v: f64,
         /// The first velocity change.
-        c1: Change,
+        c1: Ramp,
         /// Cruise duration (normalised time).
         cruise: f64,
         /// The second velocity change.
-        c2: Change,
+        c2: Ramp,
     },
 }
 
@@ -36,7 +36,7 @@ impl Cand {
     pub(crate) fn duration(&self) -> f64 {
         match self {
             Cand::Arcs(a) => a.duration(),
-            Cand::Cruise { c1, cruise, c2, .. } => c1.duration_s() + cruise + c2.duration_s(),
+            Cand::Cruise { c1, cruise, c2, .. } => c1.duration() + cruise + c2.duration(),
         }
     }
 
@@ -52,9 +52,7 @@ impl Cand {
                 }
                 a.sign * p
             }
-            Cand::Cruise { v, c1, cruise, c2 } => {
-                c1.end(u.v0, u.a0).p + cruise * v + c2.end(*v, 0.0).p
-            }
+            Cand::Cruise { v, c1, cruise, c2 } => c1.dist + cruise * v + c2.dist,
         }
     }
 
@@ -70,34 +68,24 @@ impl Cand {
                 }));
             }
             Cand::Cruise { c1, cruise, c2, .. } => {
-                push_change(c1, sc, out);
+                out.extend(c1.segments(sc));
                 // The cruise holds the acceleration at exactly zero: the change before ends
                 // there only up to rounding, and a cruise can be long enough to matter.
                 out.extend([Segment::Accel {
                     duration_s: cruise * sc.t,
                     accel: 0.0,
                 }]);
-                push_change(c2, sc, out);
+                out.extend(c2.segments(sc));
             }
         }
     }
-}
-
-fn push_change(c: &Change, sc: &Scale, out: &mut impl Extend<Segment>) {
-    out.extend(c.segments.iter().filter_map(|seg| match *seg {
-        Segment::Jerk { duration_s, jerk } => Some(Segment::Jerk {
-            duration_s: duration_s * sc.t,
-            jerk: jerk * sc.j,
-        }),
-        Segment::Accel { .. } => None,
-    }));
 }
 
 /// The time-optimal velocity changes to `(vlim, 0)` and from there to the target, with
 /// their durations' sum and distance. From a safe state toward a limit the first is an
 /// up-down change (down-up toward `vmin`) and the second the mirror, in closed form (see
 /// `ramp`); otherwise `velocity::change` picks the fastest shape.
-fn cruise_changes(u: &Unit, vlim: f64) -> Option<(Change, Change, f64, f64)> {
+fn cruise_changes(u: &Unit, vlim: f64) -> Option<(Ramp, Ramp)> {
     if u.safe() {
         let s = vlim.signum();
         let (amax, amin) = if s > 0.0 {
@@ -109,12 +97,11 @@ fn cruise_changes(u: &Unit, vlim: f64) -> Option<(Change, Change, f64, f64)> {
             Ramp::up_down(s * u.v0, s * u.a0, s * vlim, 0.0, amax),
             Ramp::up_down(-s * vlim, 0.0, -s * u.vf, -s * u.af, -amin),
         ) {
-            return Some((
-                r1.change(s),
-                r2.change(-s),
-                r1.duration() + r2.duration(),
-                s * (r1.dist - r2.dist),
-            ));
+            return Some(if s > 0.0 {
+                (r1, r2.mirrored())
+            } else {
+                (r1.mirrored(), r2)
+            });
         }
     }
     let b = Bounds {
@@ -124,14 +111,16 @@ fn cruise_changes(u: &Unit, vlim: f64) -> Option<(Change, Change, f64, f64)> {
     };
     let c1 = change(u.v0, u.a0, vlim, 0.0, &b)?;
     let c2 = change(vlim, 0.0, u.vf, u.af, &b)?;
-    let d = c1.end(u.v0, u.a0).p + c2.end(vlim, 0.0).p;
-    Some((c1, c2, c1.duration_s() + c2.duration_s(), d))
+    Some((
+        Ramp::from_change(&c1, u.v0, u.a0),
+        Ramp::from_change(&c2, vlim, 0.0),
+    ))
 }
 
 /// The cruise profile at `vlim` (`vmax` or `vmin`), if the distance leaves room for it.
 fn cruise(u: &Unit, vlim: f64) -> Option<Cand> {
-    let (c1, c2, _, d) = cruise_changes(u, vlim)?;
-    let cruise = (u.dp - d) / vlim;
+    let (c1, c2) = cruise_changes(u, vlim)?;
+    let cruise = (u.dp - c1.dist - c2.dist) / vlim;
     (cruise >= 0.0 && cruise.is_finite()).then_some(Cand::Cruise {
         v: vlim,
         c1,
@@ -142,8 +131,8 @@ fn cruise(u: &Unit, vlim: f64) -> Option<Cand> {
 
 /// The cruise profile at `vlim` lasting `t` (normalised), whatever its distance.
 pub(crate) fn cruise_lasting(u: &Unit, vlim: f64, t: f64) -> Option<Cand> {
-    let (c1, c2, t12, _) = cruise_changes(u, vlim)?;
-    let cruise = t - t12;
+    let (c1, c2) = cruise_changes(u, vlim)?;
+    let cruise = t - c1.duration() - c2.duration();
     (cruise >= -1e-12 * (1.0 + t) && cruise.is_finite()).then_some(Cand::Cruise {
         v: vlim,
         c1,

@@ -67,14 +67,39 @@ pub(crate) fn lasting(u: &Unit, t: f64, sc: &Scale, out: &mut Vec<Segment>) -> b
         lo: None,
         u: *u,
     };
-    for vlim in [u.vmax, u.vmin] {
+    // A cruise member at vmax, where it exists, is the highest-reaching profile under the
+    // envelope argument of `fastest::cruise_is_optimal` (every profile's velocity stays
+    // below the cruise profile's); vmin mirrored. Then the three-arc family on that side
+    // is only needed if the other side does not reach below (above) the target.
+    let safe = u.safe();
+    let mut top = [false; 2];
+    for (k, vlim) in [u.vmax, u.vmin].into_iter().enumerate() {
         if let Some(c) = cruise_lasting(u, vlim, t) {
             ex.offer(c);
+            top[k] = safe && envelope(u, vlim.signum());
         }
     }
-    family(u, t, 1.0, &mut ex);
-    family(&u.mirror(), t, -1.0, &mut ex);
-    if !u.safe() {
+    let brackets = |ex: &Extremes| matches!((ex.hi, ex.lo), (Some((h, _)), Some((l, _))) if l <= u.dp && u.dp <= h);
+    match top {
+        [true, false] => {
+            family(&u.mirror(), t, -1.0, &mut ex);
+            if !brackets(&ex) {
+                family(u, t, 1.0, &mut ex);
+            }
+        }
+        [false, true] => {
+            family(u, t, 1.0, &mut ex);
+            if !brackets(&ex) {
+                family(&u.mirror(), t, -1.0, &mut ex);
+            }
+        }
+        [true, true] => {}
+        [false, false] => {
+            family(u, t, 1.0, &mut ex);
+            family(&u.mirror(), t, -1.0, &mut ex);
+        }
+    }
+    if !safe {
         unsafe_members(u, t, &mut ex);
     }
     let (Some((p_hi, hi)), Some((p_lo, lo))) = (ex.hi, ex.lo) else {
@@ -89,13 +114,23 @@ pub(crate) fn lasting(u: &Unit, t: f64, sc: &Scale, out: &mut Vec<Segment>) -> b
     } else if (u.dp - p_lo).abs() <= tol {
         lo.segments(sc, out);
     } else {
-        let (mut x, mut y) = (Segs::default(), Segs::default());
+        let (mut x, mut y) = (Segs::<8>::default(), Segs::<8>::default());
         hi.segments(sc, &mut x);
         lo.segments(sc, &mut y);
         let lambda = ((u.dp - p_lo) / (p_hi - p_lo)).clamp(0.0, 1.0);
         crate::blend::blend(x.as_slice(), y.as_slice(), u.a0 * sc.a, lambda, out);
     }
     true
+}
+
+/// Does the velocity envelope bound every profile of `u` in direction `s` (`1`: below the
+/// cruise profile at `vmax`; `-1`: above the one at `vmin`)? It does when the target is
+/// forward safe (`vf + af|af|/2 <= vmax`) and the start backward safe
+/// (`v0 - a0|a0|/2 <= vmax`), mirrored for `vmin`; see `fastest::cruise_is_optimal`.
+fn envelope(u: &Unit, s: f64) -> bool {
+    let vlim = if s > 0.0 { u.vmax } else { u.vmin };
+    let (v0, a0, vf, af) = (s * u.v0, s * u.a0, s * u.vf, s * u.af);
+    vf + 0.5 * af * af.abs() <= s * vlim && v0 - 0.5 * a0 * a0.abs() <= s * vlim
 }
 
 /// From a state that must leave the velocity limits whatever it does (the brake could not

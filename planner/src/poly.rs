@@ -70,9 +70,28 @@ const BINOM: [[f64; MAX_DEG + 1]; MAX_DEG + 1] = {
     b
 };
 
-/// Sign changes of `c`'s Bernstein coefficients on `[lo, hi]`: `Some(0)` or `Some(1)` when
-/// that count is certain despite rounding, `None` otherwise (more, or too close to call).
-fn bernstein_changes(c: &[f64], lo: f64, hi: f64) -> Option<usize> {
+/// Power-to-Bernstein weights `C(i, k) / C(n, k)`, indexed `[n][i][k]`.
+const TO_BERNSTEIN: [[[f64; MAX_DEG + 1]; MAX_DEG + 1]; MAX_DEG + 1] = {
+    let mut w = [[[0.0; MAX_DEG + 1]; MAX_DEG + 1]; MAX_DEG + 1];
+    let mut n = 0;
+    while n <= MAX_DEG {
+        let mut i = 0;
+        while i <= n {
+            let mut k = 0;
+            while k <= i {
+                w[n][i][k] = BINOM[i][k] / BINOM[n][k];
+                k += 1;
+            }
+            i += 1;
+        }
+        n += 1;
+    }
+    w
+};
+
+/// `c`'s coefficients in the Bernstein basis of `[lo, hi]`, and the rounding level below
+/// which their signs are not to be trusted.
+fn bernstein(c: &[f64], lo: f64, hi: f64) -> ([f64; MAX_DEG + 1], f64) {
     let n = c.len() - 1;
     // Coefficients of c(lo + h t), t in [0, 1]: Taylor shift, then scale.
     let mut d = [0.0; MAX_DEG + 1];
@@ -90,26 +109,73 @@ fn bernstein_changes(c: &[f64], lo: f64, hi: f64) -> Option<usize> {
         hk *= h;
         size += dk.abs();
     }
-    let tol = 64.0 * f64::EPSILON * size;
-    let mut changes = 0;
-    let mut last = 0.0;
-    for i in 0..=n {
-        let mut b = 0.0;
+    let mut b = [0.0; MAX_DEG + 1];
+    let w = &TO_BERNSTEIN[n];
+    for (i, bi) in b[..=n].iter_mut().enumerate() {
         for k in 0..=i {
-            b += BINOM[i][k] / BINOM[n][k] * d[k];
+            *bi += w[i][k] * d[k];
         }
-        if b.abs() <= tol {
-            return None;
-        }
-        if last != 0.0 && (b < 0.0) != (last < 0.0) {
-            changes += 1;
-            if changes > 1 {
-                return None;
-            }
-        }
-        last = b;
     }
-    Some(changes)
+    (b, 64.0 * f64::EPSILON * size)
+}
+
+/// The roots of `c` in `[lo, hi]` by Bernstein subdivision, given its Bernstein
+/// coefficients `b` there: no sign change, no root; one sign change on a monotone control
+/// polygon, one root, refined from where the polygon crosses zero; otherwise split in
+/// halves (de Casteljau). Returns false, having given up, where a coefficient is too close
+/// to zero to trust its sign or the splitting goes too deep (a double root).
+fn subdivide(
+    c: &[f64],
+    b: &[f64],
+    tol: f64,
+    lo: f64,
+    hi: f64,
+    depth: u32,
+    out: &mut Roots,
+) -> bool {
+    let n = b.len() - 1;
+    let mut changes = 0;
+    let mut monotone = true;
+    for i in 0..=n {
+        if b[i].abs() <= tol {
+            return false;
+        }
+        if i > 0 {
+            changes += usize::from((b[i] < 0.0) != (b[i - 1] < 0.0));
+            monotone &= i < 2 || (b[i] > b[i - 1]) == (b[1] > b[0]);
+        }
+    }
+    if changes == 0 {
+        return true;
+    }
+    if changes == 1 && monotone {
+        let i = (0..n)
+            .find(|&i| (b[i] < 0.0) != (b[i + 1] < 0.0))
+            .unwrap_or(0);
+        let t = (i as f64 + b[i] / (b[i] - b[i + 1])) / n as f64;
+        out.push(refine(c, lo, hi, b[0], lo + t * (hi - lo)));
+        return true;
+    }
+    if depth == 0 {
+        return false;
+    }
+    // de Casteljau at t = 1/2: left half's coefficients are the first of each row,
+    // right half's the last.
+    let mut w = [0.0; MAX_DEG + 1];
+    w[..=n].copy_from_slice(b);
+    let (mut left, mut right) = ([0.0; MAX_DEG + 1], [0.0; MAX_DEG + 1]);
+    left[0] = w[0];
+    right[n] = w[n];
+    for r in 1..=n {
+        for i in 0..=n - r {
+            w[i] = 0.5 * (w[i] + w[i + 1]);
+        }
+        left[r] = w[0];
+        right[n - r] = w[n - r];
+    }
+    let mid = 0.5 * (lo + hi);
+    subdivide(c, &left[..=n], tol, lo, mid, depth - 1, out)
+        && subdivide(c, &right[..=n], tol, mid, hi, depth - 1, out)
 }
 
 /// The roots of `c` (lowest degree first, degree `c.len() - 1 <= 6`) in `[lo, hi]`,
@@ -135,15 +201,11 @@ pub(crate) fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
         }
         2 => quadratic(c, lo, hi, &mut out),
         _ => {
-            match bernstein_changes(c, lo, hi) {
-                Some(0) => return out,
-                Some(_) => {
-                    let fa = eval_d(c, lo).0;
-                    out.push(refine(c, lo, hi, fa));
-                    return out;
-                }
-                None => {}
+            let (b, tol) = bernstein(c, lo, hi);
+            if subdivide(c, &b[..=n], tol, lo, hi, 6, &mut out) {
+                return out;
             }
+            out = Roots::default();
             let mut d = [0.0; MAX_DEG];
             for k in 1..=n {
                 d[k - 1] = k as f64 * c[k];
@@ -215,28 +277,28 @@ fn isolate(c: &[f64], lo: f64, hi: f64, crit: &[f64], out: &mut Roots) {
             let (fa, fb) = (fs[i], fs[i + 1]);
             let next_zero = fb.abs() <= tol_at(xs[i + 1]);
             if !on_zero && !next_zero && (fa < 0.0) != (fb < 0.0) {
-                out.push(refine(c, xs[i], xs[i + 1], fa));
+                out.push(refine(c, xs[i], xs[i + 1], fa, f64::NAN));
             }
         }
     }
 }
 
-/// The root of `c` in `[a, b]` where `c(a) = fa` and `c(b)` differ in sign and `c` is
-/// monotone: Newton's method kept inside the bracket, to full precision.
-fn refine(c: &[f64], a: f64, b: f64, fa: f64) -> f64 {
+/// The root of `c` in `[a, b]` where `c(a)` has the sign of `fa` and `c(b)` the other
+/// (exactly one root between), from the guess `x0`: Newton's method kept inside the
+/// shrinking bracket; a bisection step replaces any Newton step that would leave it or
+/// does not at least halve the step before. Stops when a Newton step is below 1e-14 of
+/// the bracket's scale (converged: further steps are lost in rounding) or the bracket is.
+fn refine(c: &[f64], a: f64, b: f64, fa: f64, x0: f64) -> f64 {
     let (mut lo, mut hi) = (a, b);
     let neg_lo = fa < 0.0;
-    let fb = eval_d(c, b).0;
-    let mut x = if fb != fa {
-        a - fa * (b - a) / (fb - fa)
+    let mut x = if x0 > lo && x0 < hi {
+        x0
     } else {
-        0.5 * (a + b)
+        0.5 * (lo + hi)
     };
-    if !(x > a && x < b) {
-        x = 0.5 * (a + b);
-    }
-    let tol = 2.0 * f64::EPSILON * a.abs().max(b.abs());
-    for _ in 0..100 {
+    let tol = 1e-14 * a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
+    let mut dx = hi - lo;
+    for _ in 0..200 {
         let (f, d) = eval_d(c, x);
         if f == 0.0 {
             return x;
@@ -246,14 +308,21 @@ fn refine(c: &[f64], a: f64, b: f64, fa: f64) -> f64 {
         } else {
             hi = x;
         }
-        let mut next = x - f / d;
-        if !(next > lo && next < hi) {
-            next = 0.5 * (lo + hi);
+        let step = f / d;
+        if step.abs() <= tol {
+            // Converged: this last step is at the level of rounding.
+            return (x - step).clamp(lo.min(hi), hi.max(lo));
         }
-        let step = (next - x).abs();
-        x = next;
-        if step <= tol.max(2.0 * f64::EPSILON * x.abs()) || hi - lo <= tol {
-            break;
+        let newton = x - step;
+        let dx_old = std::mem::replace(&mut dx, step);
+        if newton > lo.min(hi) && newton < hi.max(lo) && (2.0 * f).abs() <= (dx_old * d).abs() {
+            x = newton;
+        } else {
+            dx = 0.5 * (hi - lo);
+            x = lo + dx;
+            if dx.abs() <= tol {
+                break;
+            }
         }
     }
     x

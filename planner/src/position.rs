@@ -78,14 +78,14 @@ pub(crate) fn check_target(t: &State, lim: &Limits, b: &Bounds) -> Result<(), Pl
 }
 
 /// Brake (jerk-limited) or clamp the velocity (trapezoid) into the limits.
-pub(crate) fn pre(start: State, lim: &Limits, b: &Bounds) -> (Segs, State) {
+pub(crate) fn pre(start: State, lim: &Limits, b: &Bounds) -> (Segs<4>, State) {
     if b.jmax.is_finite() {
         return brake(start, lim, b.jmax);
     }
     // Trapezoid: the acceleration may jump; only a velocity beyond its limit needs a
     // deceleration phase.
     let mut s = start;
-    let mut segs = Segs::default();
+    let mut segs = Segs::<4>::default();
     let (excess, a) = if s.v > lim.vmax() {
         (s.v - lim.vmax(), lim.amin())
     } else if s.v < lim.vmin() {
@@ -145,7 +145,7 @@ pub fn to_velocity(
             reason: "target acceleration outside [amin, amax]",
         });
     }
-    let mut pre_segs = Segs::default();
+    let mut pre_segs = Segs::<4>::default();
     let mut s = start;
     if b.jmax.is_finite() && (s.a > lim.amax() || s.a < lim.amin()) {
         let to = s.a.clamp(lim.amin(), lim.amax());
@@ -319,11 +319,13 @@ pub(crate) fn verify(
     let tol = 1e-8;
     let finite =
         prof.duration_s().is_finite() && e.p.is_finite() && e.v.is_finite() && e.a.is_finite();
-    let p_scale = prof
-        .iter()
-        .map(|(_, s, _)| s.p.abs())
-        .fold(prof.start().p.abs().max(target.p.abs()), f64::max);
-    let ok_p = !position || (e.p - target.p).abs() <= tol * p_scale;
+    let ok_p = !position || {
+        let err = (e.p - target.p).abs();
+        let ends = prof.start().p.abs().max(target.p.abs());
+        // The scale is the largest position along the move; the ends usually suffice.
+        err <= tol * ends
+            || err <= tol * prof.iter().map(|(_, s, _)| s.p.abs()).fold(ends, f64::max)
+    };
     let ok_v = (e.v - target.v).abs() <= tol * target.v.abs().max(lim.vmax());
     let ok_a = (e.a - target.a).abs() <= tol * target.a.abs().max(lim.amax());
     if finite && ok_p && ok_v && ok_a {

@@ -107,6 +107,9 @@ impl Profile {
     /// Build a profile, validating every segment (durations finite and >= 0, jerks and
     /// accelerations finite).
     pub fn new(start: State, segments: Vec<Segment>) -> Result<Self, PlanError> {
+        let mut starts = Vec::with_capacity(segments.len());
+        let mut t = 0.0;
+        let mut s = start;
         for (index, seg) in segments.iter().enumerate() {
             let d = seg.duration_s();
             if !d.is_finite() || d < 0.0 {
@@ -125,14 +128,9 @@ impl Profile {
                     reason: "jerk/acceleration must be finite",
                 });
             }
-        }
-        let mut starts = Vec::with_capacity(segments.len());
-        let mut t = 0.0;
-        let mut s = start;
-        for seg in &segments {
             starts.push((t, s));
             s = seg.end_state(&s);
-            t += seg.duration_s();
+            t += d;
         }
         Ok(Self {
             start,

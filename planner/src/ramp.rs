@@ -5,15 +5,17 @@
 //! the target; `velocity::change`, which considers every shape, is the general fallback.
 
 use crate::Segment;
+use crate::unit::Scale;
 use crate::velocity::Change;
 
-/// An up-down change: durations of the rising arc, the hold, the falling arc, and the
-/// distance covered.
+/// A velocity change of three phases: jerk `sign` for `t1`, a hold, jerk `-sign` for `t2`
+/// (an up-down change for `sign = 1`, down-up for `-1`), with the distance covered.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Ramp {
     t1: f64,
     hold: f64,
     t2: f64,
+    sign: f64,
     /// Distance covered (normalised).
     pub dist: f64,
 }
@@ -42,7 +44,39 @@ impl Ramp {
         let dist = t1 * (v0 + t1 * (a0 / 2.0 + t1 / 6.0))
             + hold * (va + a * hold / 2.0)
             + t2 * (vb + t2 * (a / 2.0 - t2 / 6.0));
-        Some(Self { t1, hold, t2, dist })
+        Some(Self {
+            t1,
+            hold,
+            t2,
+            sign: 1.0,
+            dist,
+        })
+    }
+
+    /// The same change mirrored (velocities and accelerations negated).
+    pub(crate) fn mirrored(self) -> Self {
+        Self {
+            sign: -self.sign,
+            dist: -self.dist,
+            ..self
+        }
+    }
+
+    /// A change from `velocity::change` (jerk `j1`, hold, jerk `-j1`, normalised), started
+    /// from `(v0, a0)`.
+    pub(crate) fn from_change(c: &Change, v0: f64, a0: f64) -> Self {
+        let d = |k: usize| c.segments[k].duration_s();
+        let sign = match c.segments[0] {
+            Segment::Jerk { jerk, .. } if jerk < 0.0 => -1.0,
+            _ => 1.0,
+        };
+        Self {
+            t1: d(0),
+            hold: d(1),
+            t2: d(2),
+            sign,
+            dist: c.end(v0, a0).p,
+        }
     }
 
     /// Duration (normalised).
@@ -50,31 +84,30 @@ impl Ramp {
         self.t1 + self.hold + self.t2
     }
 
-    /// The change as segments (normalised), mirrored for `sign = -1`.
-    pub(crate) fn change(&self, sign: f64) -> Change {
-        Change {
-            segments: [
-                Segment::Jerk {
-                    duration_s: self.t1,
-                    jerk: sign,
-                },
-                Segment::Jerk {
-                    duration_s: self.hold,
-                    jerk: 0.0,
-                },
-                Segment::Jerk {
-                    duration_s: self.t2,
-                    jerk: -sign,
-                },
-            ],
-        }
+    /// The change's segments, in physical units `sc`.
+    pub(crate) fn segments(&self, sc: &Scale) -> [Segment; 3] {
+        let j = self.sign * sc.j;
+        [
+            Segment::Jerk {
+                duration_s: self.t1 * sc.t,
+                jerk: j,
+            },
+            Segment::Jerk {
+                duration_s: self.hold * sc.t,
+                jerk: 0.0,
+            },
+            Segment::Jerk {
+                duration_s: self.t2 * sc.t,
+                jerk: -j,
+            },
+        ]
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::velocity::{Bounds, change};
+    use crate::velocity::{Bounds, Change, change};
 
     #[test]
     fn equals_the_general_change_where_it_applies() {
@@ -92,7 +125,17 @@ mod tests {
         ] {
             let r = Ramp::up_down(v0, a0, v1, a1, 1.0).expect("up-down applies");
             let c = change(v0, a0, v1, a1, &b).expect("change");
-            let e = r.change(1.0).end(v0, a0);
+            let unit = Scale {
+                t: 1.0,
+                a: 1.0,
+                v: 1.0,
+                p: 1.0,
+                j: 1.0,
+            };
+            let e = Change {
+                segments: r.segments(&unit),
+            }
+            .end(v0, a0);
             assert!((r.duration() - c.duration_s()).abs() < 1e-12, "{r:?} {c:?}");
             assert!(
                 (e.p - r.dist).abs() < 1e-12 && (e.v - v1).abs() < 1e-12,

@@ -189,7 +189,7 @@ pub(crate) fn lasting(
     } else if (dp - lo.dist).abs() <= tol {
         lo.segments(out);
     } else {
-        let (mut x, mut y) = (Segs::default(), Segs::default());
+        let (mut x, mut y) = (Segs::<8>::default(), Segs::<8>::default());
         hi.segments(&mut x);
         lo.segments(&mut y);
         let lambda = ((dp - lo.dist) / (hi.dist - lo.dist)).clamp(0.0, 1.0);

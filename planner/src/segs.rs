@@ -2,18 +2,16 @@
 
 use crate::Segment;
 
-/// Capacity: the longest profile body (a blend of two seven-segment profiles with their
-/// breakpoints merged: at most 13 pieces) fits.
-const CAP: usize = 16;
-
-/// Up to [`CAP`] segments, without heap allocation.
+/// Up to `CAP` segments, without heap allocation. The default capacity holds any profile
+/// a planner builds (a brake and a seven-segment body, or one of the two profiles a
+/// step-2 blend mixes).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Segs {
+pub(crate) struct Segs<const CAP: usize = 8> {
     s: [Segment; CAP],
     n: usize,
 }
 
-impl Default for Segs {
+impl<const CAP: usize> Default for Segs<CAP> {
     fn default() -> Self {
         Self {
             s: [Segment::Jerk {
@@ -25,7 +23,7 @@ impl Default for Segs {
     }
 }
 
-impl Segs {
+impl<const CAP: usize> Segs<CAP> {
     /// Append a segment. Panics beyond the capacity (a planner bug, not an input error).
     pub(crate) fn push(&mut self, seg: Segment) {
         assert!(self.n < CAP, "segment list capacity exceeded");
@@ -44,7 +42,7 @@ impl Segs {
     }
 }
 
-impl Extend<Segment> for Segs {
+impl<const CAP: usize> Extend<Segment> for Segs<CAP> {
     fn extend<I: IntoIterator<Item = Segment>>(&mut self, iter: I) {
         for seg in iter {
             self.push(seg);

@@ -56,16 +56,17 @@ impl Scale {
 impl Unit {
     /// The problem from `s` to `target` in the units `sc`.
     pub(crate) fn new(s: &State, target: &State, lim: &Limits, sc: &Scale) -> Self {
+        let (ra, rv, rp) = (1.0 / sc.a, 1.0 / sc.v, 1.0 / sc.p);
         Self {
-            v0: s.v / sc.v,
-            a0: s.a / sc.a,
-            vf: target.v / sc.v,
-            af: target.a / sc.a,
-            dp: (target.p - s.p) / sc.p,
-            amax: lim.amax() / sc.a,
-            amin: lim.amin() / sc.a,
-            vmax: lim.vmax() / sc.v,
-            vmin: lim.vmin() / sc.v,
+            v0: s.v * rv,
+            a0: s.a * ra,
+            vf: target.v * rv,
+            af: target.a * ra,
+            dp: (target.p - s.p) * rp,
+            amax: lim.amax() * ra,
+            amin: lim.amin() * ra,
+            vmax: lim.vmax() * rv,
+            vmin: lim.vmin() * rv,
         }
     }
 

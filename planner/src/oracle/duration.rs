@@ -48,7 +48,7 @@ fn prepare(target: State, start: State, lim: &Limits, shape: Shape) -> Result<Bo
 
 /// The brake pre-trajectories to try (see `position::to_state`), each with its end state.
 fn brakes(start: State, lim: &Limits, b: &Bounds) -> Vec<(Vec<Segment>, State)> {
-    let snap = |(segs, mut s): (crate::segs::Segs, State)| {
+    let snap = |(segs, mut s): (crate::segs::Segs<4>, State)| {
         s.a = s.a.clamp(lim.amin(), lim.amax());
         (segs.as_slice().to_vec(), s)
     };

@@ -40,7 +40,7 @@ pub fn to_state(
         );
     }
     let law = BrakeLaw::new(start, lim, b.jmax);
-    let mut best: Option<(f64, crate::segs::Segs, Vec<Segment>)> = None;
+    let mut best: Option<(f64, crate::segs::Segs<4>, Vec<Segment>)> = None;
     for tau in law.candidate_times() {
         let (pre_segs, mut s) = law.until(tau);
         // The brake ends on the acceleration limit up to rounding: snap it there.
