@@ -56,6 +56,8 @@ pub struct Case {
     machine: Option<Machine>,
     axis: usize,
     profile: Profile,
+    /// Whether the model-effects table shows this case (the middle distance).
+    effects: bool,
 }
 
 /// One row: a case on a backend.
@@ -158,7 +160,7 @@ pub fn cases() -> Vec<Case> {
                    lim: Limits,
                    dists: &[f64]| {
         for kind in [ProfileKind::Trapezoid, ProfileKind::SCurve] {
-            for &d in dists {
+            for (i, &d) in dists.iter().enumerate() {
                 let Ok(profile) = kind.rest_to_rest(0.0, d * 1e-3, &lim) else {
                     continue;
                 };
@@ -168,6 +170,7 @@ pub fn cases() -> Vec<Case> {
                     machine: machine.clone(),
                     axis,
                     profile,
+                    effects: i == 1,
                 });
             }
         }
@@ -373,9 +376,9 @@ pub fn run(backends: &[Backend]) -> Result<Report, String> {
             }
             rows.push(row);
         }
-        // Model effects: the 10 mm moves of physical machines, on the first engine.
+        // Model effects: the middle distance of physical machines, on rapier.
         if let (Some(machine), Some(&engine)) = (&case.machine, engines.first())
-            && case.name.contains(" 10 mm")
+            && case.effects
             && engine == Backend::Rapier
         {
             let lin = simulate(&case, engine, &frozen, case.axes.clone())?.0;
@@ -485,7 +488,7 @@ numerical damping {DAMPING_PCT} % of the physical. Settle times to {} um.\n",
     if !r.effects.is_empty() {
         let _ = writeln!(
             out,
-            "\nWhat the linear model leaves out (rapier, 10 mm moves; information, no thresholds): \
+            "\nWhat the linear model leaves out (rapier, middle distances; information, no thresholds): \
 residual peak um / settle ms to {} um.\n",
             r.bands_um[0]
         );

@@ -348,6 +348,12 @@ impl Lumped {
                 .filter(|&i| fixed.is_none_or(|(f, _)| f != i))
                 .collect();
             let m = free.len();
+            if m == 0 {
+                if let Some((f, qf)) = fixed {
+                    q[f] = qf;
+                }
+                break;
+            }
             let mut k = DMatrix::zeros(m, m);
             let mut rhs = DVector::zeros(m);
             for (a, &i) in free.iter().enumerate() {

@@ -28,7 +28,7 @@ use crate::plant::{advance_sample, check_step};
 use crate::stepper::StepperState;
 use crate::{Observation, Plant, SimError};
 
-/// Step size against the highest mode: `h <= STEP_FRACTION / w_max`. Symplectic Euler
+/// Step size against the fastest mode: `h <= STEP_FRACTION / w_max` ([`fastest_rate`]). Symplectic Euler
 /// shifts a mode of angular frequency `w` by `-(w h)^2 / 24`: at most 0.375 % for the
 /// highest mode (a rotor or mount mode nobody settles on), so every mode stays within the
 /// 0.5 % frequency threshold, and `0.375 % (w / w_max)^2` for the others, e.g. 0.006 % for
@@ -118,9 +118,12 @@ fn locked_all_but(dir: usize) -> LockedAxes {
     (LockedAxes::TRANSLATION_LOCKED | LockedAxes::ROTATION_LOCKED) - free
 }
 
-/// The highest natural frequency (rad/s) of an axis at its start, with the driver's
-/// magnetic spring (and the detent's extra stiffness) counted in the full driver mode.
-pub fn highest_omega(axis: &AxisModel, start_m: f64) -> Result<f64, SimError> {
+/// The fastest rate (1/s) of an axis at its start: the largest `|lambda|` of its damped
+/// linearised dynamics, i.e. the highest natural frequency, or `c / m` of an overdamped
+/// coupling if that is larger (an explicit integrator needs `|lambda| h < 2` to be stable
+/// and much less to be accurate). In the full driver mode the driver's magnetic spring
+/// (with the detent's extra stiffness) and damping are counted.
+pub fn fastest_rate(axis: &AxisModel, start_m: f64) -> Result<f64, SimError> {
     let mut lumped: Lumped = axis.lumped.clone();
     let q0 = start_equilibrium(axis, start_m)?.0;
     if let (DriverMode::Full, Some(s)) = (axis.mode, &axis.stepper) {
@@ -131,11 +134,23 @@ pub fn highest_omega(axis: &AxisModel, start_m: f64) -> Result<f64, SimError> {
                 gain: 1.0,
             }],
             stiffness: crate::lumped::Stiffness::Constant(s.k_theta() + s.detent_stiffness()),
-            damping: 0.0,
+            damping: s.damping_n_m_s_per_rad,
         });
     }
-    let f = lumped.natural_frequencies_hz(&q0);
-    Ok(f.last().copied().unwrap_or(0.0) * std::f64::consts::TAU)
+    let lin = lumped.linearised(&q0);
+    let n = lumped.dof();
+    let mut a = nalgebra::DMatrix::<f64>::zeros(2 * n, 2 * n);
+    for i in 0..n {
+        a[(i, n + i)] = 1.0;
+        for j in 0..n {
+            a[(n + i, j)] = -lin.k[(i, j)] / lin.m[(i, i)];
+            a[(n + i, n + j)] = -lin.c[(i, j)] / lin.m[(i, i)];
+        }
+    }
+    Ok(a.complex_eigenvalues()
+        .iter()
+        .map(|l| l.norm())
+        .fold(0.0, f64::max))
 }
 
 /// The start configuration of an axis for a command at rest at `start_m`: body
@@ -194,7 +209,7 @@ impl RapierPlant {
         }
         let mut w = 0.0f64;
         for (a, s) in self.axes.iter().zip(start) {
-            w = w.max(highest_omega(a, s.p)?);
+            w = w.max(fastest_rate(a, s.p)?);
         }
         Ok(if w > 0.0 { STEP_FRACTION / w } else { 1e-3 })
     }

@@ -105,7 +105,11 @@ pub fn run<P: Plant>(
     let t_end = profiles.iter().map(Profile::duration_s).fold(0.0, f64::max);
     let mut bps: Vec<f64> = profiles
         .iter()
-        .flat_map(|p| p.iter().map(|(t0, _, s)| t0 + s.duration_s()).collect::<Vec<_>>())
+        .flat_map(|p| {
+            p.iter()
+                .map(|(t0, _, s)| t0 + s.duration_s())
+                .collect::<Vec<_>>()
+        })
         .collect();
     bps.push(t_end);
     bps.sort_by(f64::total_cmp);
@@ -119,7 +123,11 @@ pub fn run<P: Plant>(
     let stop = t_end + window;
     while t < stop - 1e-12 {
         let ts = k as f64 * dt;
-        let next_bp = bps.iter().copied().find(|&b| b > t).unwrap_or(f64::INFINITY);
+        let next_bp = bps
+            .iter()
+            .copied()
+            .find(|&b| b > t)
+            .unwrap_or(f64::INFINITY);
         let next = ts.min(next_bp);
         let cmd: Vec<Sample> = profiles.iter().map(|p| p.state_at(t)).collect();
         let whole = next == ts && t == (k - 1) as f64 * dt;
