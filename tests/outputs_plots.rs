@@ -51,7 +51,11 @@ fn sweep_figures_are_written_and_linked() {
         assert!(svg.contains(text), "`{text}` missing from the SVG");
     }
     let (w, h, ink) = title_ink(&out.join("plots/vs_move_distance_mm.png"));
-    assert_eq!((w, h), (1500, 3 * 380 + 50));
+    assert_eq!(
+        (w, h),
+        (1500, 3 * 380 + 50 + 36),
+        "three rows of panels, one legend row"
+    );
     assert!(
         ink > 200,
         "the PNG title has {ink} dark pixels: no text rendered?"
