@@ -70,9 +70,11 @@ fn rrd_holds_every_channel_and_sample() {
             e.1 |= chunk.timelines().keys().any(|t| t.as_str() == "sim_time");
         }
     }
-    let names: Vec<&str> = settle::run::CHANNELS.iter().map(|c| c.0).collect();
-    let units: Vec<&str> = settle::run::CHANNELS.iter().map(|c| c.1).collect();
-    for g in settle::sink::groups::group_names(&names, &units) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (_, runs) =
+        settle::load_runs(&root.join("scenarios/ci_quickstart.toml")).expect("scenario");
+    let (series, _) = settle::sink::record_run(&runs[1]).expect("runs");
+    for g in settle::sink::groups::groups(&series) {
         for f in &g.fields {
             let path = format!("/{}/{}", g.name, f.key);
             let (n, timed) = entities
