@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite: formatting, lints, every test, a fuzz smoke run. Installs what it
 # needs without root: crates from crates.io through cargo, libmujoco 3.17.0 from its PyPI
-# wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), cargo-fuzz. Used verbatim by CI
+# wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), cargo-fuzz, the official MCAP reader
+# from PyPI into .deps/ (scripts/mcap-python, for the MCAP tests). Used verbatim by CI
 # (.ci/run).
 #
 # Environment:
@@ -10,6 +11,7 @@
 #   SETTLE_MUJOCO=0       skip the MuJoCo backend (otherwise it is fetched when missing and
 #                         every test runs with the `mujoco` feature)
 #   SETTLE_FUZZ_SECONDS   fuzz smoke time per target (default 15)
+#   SETTLE_SKIP_RERUN=1   skip building and testing the `rerun` feature
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -40,3 +42,9 @@ for scenario in scenarios/ci_*.toml; do
 done
 echo "== fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
 scripts/fuzz.sh "${SETTLE_FUZZ_SECONDS:-15}"
+# The rerun sink is behind a cargo feature (the SDK's cold build is ~14 CPU-minutes): build
+# and test it once here. SETTLE_SKIP_RERUN=1 skips it (e.g. for quick local runs).
+if [ "${SETTLE_SKIP_RERUN:-0}" != 1 ]; then
+  echo "== rerun feature: build once and test the .rrd sink"
+  cargo test --release --locked --features rerun --test outputs_rerun
+fi

@@ -28,7 +28,7 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run every point of a scenario's sweep and write runs.csv and summary.md.
+    /// Run every point of a scenario's sweep and write runs.csv, summary.md and plots.
     #[command(
         after_help = "Example:\n  settle sweep scenarios/quickstart.toml --out /tmp/qs --jobs 2"
     )]

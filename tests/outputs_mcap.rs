@@ -121,21 +121,19 @@ fn python_reader_sees_every_channel_schema_message_and_value() {
     files.extend(recordings.iter().cloned());
     let read = python_read(&files);
 
-    // The single run, against its CSV trace.
+    // The single run, against its series computed here through the library (the channels
+    // are whatever the run records) and its CSV trace.
     let file = &read[single.to_str().expect("utf-8")];
+    let (_, runs) = settle::load_runs(&root().join(SCENARIO)).expect("scenario");
+    let (series, _) = settle::sink::record_run(&runs[1]).expect("runs");
     let trace_text = std::fs::read_to_string(&trace).expect("trace");
     let trace_rows: Vec<Vec<f64>> = trace_text
         .lines()
         .skip(1)
         .map(|l| l.split(',').map(|c| c.parse().expect("number")).collect())
         .collect();
-    // The channels the run records (they depend on the machine, not the backend).
-    let (_, specs) =
-        settle::load_runs(std::path::Path::new("scenarios/quickstart.toml")).expect("scenario");
-    let (recorded, _) = settle::sink::record_run(&specs[1]).expect("run");
-    let names: Vec<&str> = recorded.channels.iter().map(|c| c.name.as_str()).collect();
-    let units: Vec<&str> = recorded.channels.iter().map(|c| c.unit.as_str()).collect();
-    let groups = settle::sink::groups::group_names(&names, &units);
+    assert_eq!(trace_rows.len(), series.len());
+    let groups = settle::sink::groups::groups(&series);
     assert_eq!(file["profile"], "");
     assert_eq!(file["compression"], serde_json::json!(["zstd"]));
     let channels = file["channels"].as_array().expect("channels");
@@ -180,12 +178,14 @@ fn python_reader_sees_every_channel_schema_message_and_value() {
         for (k, row) in trace_rows.iter().enumerate() {
             assert_eq!(
                 times[k].as_u64(),
-                Some((row[0] * 1e9).round() as u64),
+                Some((series.t_s[k] * 1e9).round() as u64),
                 "{topic} #{k}"
             );
             for f in &g.fields {
                 let got = exact(&msgs[k][&f.key]);
-                assert_eq!(got, Some(row[1 + f.channel]), "{topic} #{k} {}", f.key);
+                let want = series.channels[f.channel].data[k];
+                assert_eq!(got, Some(want), "{topic} #{k} {}", f.key);
+                assert_eq!(row[1 + f.channel], want, "the CSV trace agrees");
             }
         }
     }

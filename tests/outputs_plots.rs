@@ -51,7 +51,11 @@ fn sweep_figures_are_written_and_linked() {
         assert!(svg.contains(text), "`{text}` missing from the SVG");
     }
     let (w, h, ink) = title_ink(&out.join("plots/vs_move_distance_mm.png"));
-    assert_eq!((w, h), (1500, 3 * 380 + 50));
+    assert_eq!(
+        (w, h),
+        (1500, 3 * 380 + 50 + 36),
+        "three rows of panels, one legend row"
+    );
     assert!(
         ink > 200,
         "the PNG title has {ink} dark pixels: no text rendered?"
@@ -78,17 +82,11 @@ fn run_plot_draws_every_channel_and_the_residual() {
         trace.to_str().expect("utf-8"),
     ]);
     let svg = std::fs::read_to_string(dir.path().join("run-4.svg")).expect("svg");
-    // The quickstart machine is one axis `x` described by its modes: these are its channels
-    // (settle::run::channels).
-    for name in [
-        "cmd_p_x",
-        "cmd_v_x",
-        "cmd_a_x",
-        "cmd_j_x",
-        "toolhead_x",
-        "error_x",
-    ] {
-        assert!(svg.contains(name), "channel {name} not drawn");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (_, runs) = settle::load_runs(&root.join("scenarios/quickstart.toml")).expect("scenario");
+    let (series, _) = settle::sink::record_run(&runs[4]).expect("runs");
+    for c in &series.channels {
+        assert!(svg.contains(&c.name), "channel {} not drawn", c.name);
     }
     assert!(svg.contains("after the move (residual vibration)"));
     assert!(svg.contains("move ends"));

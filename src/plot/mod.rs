@@ -121,6 +121,8 @@ pub struct Panel {
     pub vrules: Vec<Rule>,
     /// Horizontal rules.
     pub hrules: Vec<Rule>,
+    /// Draw the labelled lines' legend inside the panel (off when the figure has one).
+    pub legend: bool,
 }
 
 /// A figure: panels in a grid.
@@ -136,7 +138,40 @@ pub struct Figure {
     pub width: u32,
     /// Height of one panel row (px).
     pub row_height: u32,
+    /// A legend for the whole figure, drawn under the title (empty: none).
+    pub legend: Vec<LegendEntry>,
 }
+
+/// One entry of a figure's legend.
+#[derive(Debug, Clone)]
+pub struct LegendEntry {
+    /// Text.
+    pub label: String,
+    /// Colour.
+    pub color: RGBColor,
+    /// Marker (none: a short line).
+    pub marker: Option<Marker>,
+    /// Draw the marker hollow (the "not settled" glyph).
+    pub hollow: bool,
+}
+
+/// Entries per row of a figure legend at most.
+const LEGEND_COLUMNS: usize = 4;
+
+/// Entries per row of the legend of `f`: as many as fit the longest label.
+fn legend_columns(f: &Figure) -> usize {
+    let longest = f
+        .legend
+        .iter()
+        .map(|e| e.label.chars().count())
+        .max()
+        .unwrap_or(0);
+    // About 8.5 px per character at 16 px, plus the glyph and a gap.
+    let need = longest as f64 * 8.5 + 60.0;
+    (((f.width as f64 - 80.0) / need).floor() as usize).clamp(1, LEGEND_COLUMNS)
+}
+/// Height of one row of a figure legend (px).
+const LEGEND_ROW_PX: u32 = 26;
 
 fn init_fonts() {
     static ONCE: Once = Once::new();
@@ -424,7 +459,7 @@ where
                 .map_err(err)?;
         }
     }
-    if any_inf {
+    if any_inf && p.legend {
         chart
             .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
             .map_err(err)?
@@ -434,7 +469,7 @@ where
                     + TriangleMarker::new((0, 0), 7, RGBColor(90, 90, 90).stroke_width(2))
             });
     }
-    if p.lines.iter().any(|l| l.label.is_some()) {
+    if p.legend && p.lines.iter().any(|l| l.label.is_some()) {
         let frac = |v: f64, lo: f64, hi: f64, log: bool| {
             if log {
                 (v.max(lo).ln() - lo.ln()) / (hi.ln() - lo.ln())
@@ -562,6 +597,13 @@ fn draw_figure<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, f: &Figure) -> 
     let body = root
         .titled(&f.title, (FONT, 24).into_font().style(FontStyle::Bold))
         .map_err(err)?;
+    let body = if f.legend.is_empty() {
+        body
+    } else {
+        let (legend, rest) = body.split_vertically(legend_height(f));
+        draw_legend(&legend, &f.legend, legend_columns(f))?;
+        rest
+    };
     let cols = f.columns.max(1);
     let rows = f.panels.len().div_ceil(cols).max(1);
     let areas = body.split_evenly((rows, cols));
@@ -571,10 +613,55 @@ fn draw_figure<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, f: &Figure) -> 
     root.present().map_err(err)
 }
 
+fn legend_height(f: &Figure) -> u32 {
+    if f.legend.is_empty() {
+        0
+    } else {
+        f.legend.len().div_ceil(legend_columns(f)) as u32 * LEGEND_ROW_PX + 10
+    }
+}
+
+/// The figure legend: entries in rows of `columns`, centred.
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[LegendEntry],
+    columns: usize,
+) -> DrawResult {
+    let (w, _) = area.dim_in_pixel();
+    let col_w = (w as i32 - 80) / columns as i32;
+    let per_row = columns.min(entries.len()).max(1);
+    let x0 = (w as i32 - col_w * per_row as i32) / 2;
+    let font = (FONT, 16).into_font().color(&BLACK);
+    for (i, e) in entries.iter().enumerate() {
+        let x = x0 + col_w * (i % columns) as i32;
+        let y = (i / columns) as i32 * LEGEND_ROW_PX as i32 + 14;
+        let c = (x + 11, y);
+        let filled = e.color.filled();
+        let stroke = e.color.stroke_width(2);
+        let r = match (e.marker, e.hollow) {
+            (_, true) => area.draw(&TriangleMarker::new(c, 7, stroke)),
+            (Some(Marker::Circle), _) => area.draw(&Circle::new(c, 5, filled)),
+            (Some(Marker::Triangle), _) => area.draw(&TriangleMarker::new(c, 6, filled)),
+            (Some(Marker::Square), _) => {
+                area.draw(&Rectangle::new([(x + 6, y - 5), (x + 16, y + 5)], filled))
+            }
+            (Some(Marker::Cross), _) => area.draw(&Cross::new(c, 5, stroke)),
+            (None, _) => area.draw(&PathElement::new(
+                vec![(x, y), (x + 22, y)],
+                e.color.stroke_width(3),
+            )),
+        };
+        r.map_err(err)?;
+        area.draw(&Text::new(e.label.clone(), (x + 30, y - 9), font.clone()))
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
 /// Height (px) of a figure.
 fn height(f: &Figure) -> u32 {
     let rows = f.panels.len().div_ceil(f.columns.max(1)).max(1) as u32;
-    rows * f.row_height + 50
+    rows * f.row_height + 50 + legend_height(f)
 }
 
 /// Write `f` as `<stem>.svg` and `<stem>.png` in `dir`.

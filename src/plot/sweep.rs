@@ -16,7 +16,9 @@ use std::path::Path;
 
 use settle_planner::ProfileKind;
 
-use super::{Figure, Line, Marker, PALETTE, Panel, fmt_num};
+use plotters::style::RGBColor;
+
+use super::{Figure, LegendEntry, Line, Marker, PALETTE, Panel, fmt_num};
 use crate::error::Error;
 use crate::sweep::{RunSpec, Value};
 use crate::table::RunsTable;
@@ -164,10 +166,26 @@ fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &Metric) -> Vec<Li
                     band.push((x, *lo, *hi));
                 }
             }
+            let others: Vec<&str> = runs
+                .first()
+                .map(|r| {
+                    r.swept
+                        .iter()
+                        .filter(|(p, v)| p != param && number(v).is_some())
+                        .map(|(p, _)| p.rsplit('.').next().unwrap_or(p))
+                        .collect()
+                })
+                .unwrap_or_default();
+            let what = if others.len() == 1 {
+                "values of"
+            } else {
+                "combinations of"
+            };
             let mut l = Line::new(
                 Some(format!(
-                    "{k}: median over {} other points (band: min-max)",
-                    combos.len()
+                    "{k}: median over {} {what} {} (band: min-max)",
+                    combos.len(),
+                    others.join(", ")
                 )),
                 color,
                 pts,
@@ -239,12 +257,42 @@ pub fn figure(scenario: &str, runs: &[RunSpec], table: &RunsTable, param: &str) 
             ..Panel::default()
         });
     }
+    // One legend for the figure: the lines are the same in every panel.
+    let mut legend: Vec<LegendEntry> = panels
+        .first()
+        .map(|p| {
+            p.lines
+                .iter()
+                .filter_map(|l| {
+                    Some(LegendEntry {
+                        label: l.label.clone()?,
+                        color: l.color,
+                        marker: l.marker,
+                        hollow: false,
+                    })
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    let any_inf = panels
+        .iter()
+        .flat_map(|p| p.lines.iter())
+        .any(|l| l.points.iter().any(|q| !q.1.is_finite()));
+    if any_inf {
+        legend.push(LegendEntry {
+            label: "not settled in the window (drawn at the top)".into(),
+            color: RGBColor(90, 90, 90),
+            marker: None,
+            hollow: true,
+        });
+    }
     Figure {
         title: format!("{scenario}: settling against {param}"),
         panels,
         columns: 2,
         width: 1500,
         row_height: 380,
+        legend,
     }
 }
 

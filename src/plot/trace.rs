@@ -112,6 +112,7 @@ pub fn figure(title: &str, rec: &RunRecord) -> Figure {
                 y_label: shown,
                 lines,
                 vrules: vec![end_rule.clone()],
+                legend: true,
                 ..Panel::default()
             });
         }
@@ -174,5 +175,6 @@ pub fn figure(title: &str, rec: &RunRecord) -> Figure {
         columns: 1,
         width: 1400,
         row_height: 260,
+        legend: Vec::new(),
     }
 }
