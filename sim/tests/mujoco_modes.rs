@@ -139,7 +139,10 @@ fn run<P: OneAxis>(
     start: &State,
     intervals: &[Interval],
     t_at: f64,
-) -> (Vec<f64>, Option<P::S>) {
+) -> (Vec<f64>, Option<P::S>)
+where
+    P::S: Clone,
+{
     let mut st = plant.initial_state(start);
     let mut trace = Vec::with_capacity(intervals.len());
     let mut at = None;

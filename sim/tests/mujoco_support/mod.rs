@@ -284,7 +284,7 @@ pub fn belt_spans() -> Stiffness {
 /// start at rest, step an interval, read the toolhead. (The harness drives plants through
 /// the multi-axis `Plant` trait; these tests compare one lumped axis at a time.)
 pub trait OneAxis {
-    type S: Clone;
+    type S;
     fn initial_state(&self, start: &settle_planner::State) -> Self::S;
     fn step(&self, st: &mut Self::S, cmd: &Sample, h: f64);
     fn toolhead_m(&self, st: &Self::S) -> f64;
