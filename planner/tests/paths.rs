@@ -261,7 +261,11 @@ fn check(case: &Case, tr: &Trajectory) {
                     );
                 }
                 let allowed = match c.transition {
-                    CornerTransition::Jump { dv, duration_s } => dv * duration_s / 8.0,
+                    // |dv| <= 2 vmax: the cut of a jump is at most vmax T / 4.
+                    CornerTransition::Jump { dv, duration_s } => {
+                        assert!(dv <= 2.0 * case.vmax * tol, "{tag}: jump {dv}");
+                        case.vmax * duration_s / 4.0
+                    }
                     _ => max_dev,
                 };
                 assert!(c.deviation_m <= allowed * tol + 1e-15, "{tag}: deviation");

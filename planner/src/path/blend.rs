@@ -175,8 +175,8 @@ impl BlendShape {
 }
 
 /// The largest speed `<= vmax` whose blend deviates at most `max_deviation_m` from the
-/// corner and needs at most `max_distance_m` of each segment (both grow with the speed).
-/// `cos_half = cos(theta/2)`.
+/// corner and needs at most `max_distance_m` of each segment (both grow with the speed),
+/// by bisection.
 pub fn max_speed(
     theta: f64,
     alimit: f64,
