@@ -15,7 +15,9 @@
 //! torque are computed from the bodies' state and applied, and rapier integrates
 //! (symplectic Euler: velocities from forces, then positions from the new velocities).
 //! That integrator adds no numerical damping to an undamped spring and shifts a mode's
-//! frequency by about `-(w h)^2 / 24`; [`STEP_FRACTION`] sets `h` from the highest mode.
+//! frequency by about `-(w h)^2 / 24`; [`STEP_FRACTION`] sets `h` from the fastest mode at
+//! the start, and the step shrinks with the square root of the belt's stiffening when the
+//! carriage nears a pulley.
 //! Couplings (and the driver) are evaluated with the commanded state at the start of each
 //! step; steps never straddle a profile breakpoint (the harness splits them).
 
@@ -341,7 +343,23 @@ impl Plant for RapierPlant {
         if dt_s == 0.0 {
             return Ok(());
         }
-        let n = (dt_s / state.h_max * (1.0 - 1e-12)).ceil().max(1.0);
+        // A belt stiffer than at the start (the carriage nearer a pulley) raises the
+        // fastest rate by at most the square root of the stiffness ratio (one spring
+        // scaled by f >= 1 gives K <= f K0): shrink the step to keep STEP_FRACTION.
+        let mut stiffer = 1.0f64;
+        if self.options.belt == BeltModel::Varying {
+            for (ax, ab) in self.axes.iter().zip(&state.axes) {
+                for c in &ax.lumped.couplings {
+                    if c.stiffness.depends_on().is_some() {
+                        let now = Lumped::stiffness_of(c, &ab.q);
+                        let start = Lumped::stiffness_of(c, &ab.q_frozen);
+                        stiffer = stiffer.max(now / start);
+                    }
+                }
+            }
+        }
+        let h_max = state.h_max / stiffer.sqrt();
+        let n = (dt_s / h_max * (1.0 - 1e-12)).ceil().max(1.0);
         let h = dt_s / n;
         state.world.integration_parameters.dt = h;
         let varying = self.options.belt == BeltModel::Varying;
