@@ -9,7 +9,7 @@
 //! Couplings as forces: rapier's joints relate the poses of two bodies, but a belt couples
 //! a *rotation* (the pulley) to a *translation* (the carriage), and rapier's joint motors
 //! are implicit springs that add numerical damping of about `w h / 2` per substep: to keep
-//! that under 10 % of a `zeta = 0.05` mode at 250 Hz would take 300,000 substeps per
+//! that under 10 % of a `zeta = 0.05` mode at 250 Hz would take 160,000 substeps per
 //! second. So each step the spring-damper forces of the [`Lumped`] couplings (with the
 //! belt's stiffness at the current carriage position, `EA/s + EA/(L-s)`) and the driver
 //! torque are computed from the bodies' state and applied, and rapier integrates
