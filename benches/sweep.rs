@@ -8,7 +8,10 @@ use criterion::{Criterion, criterion_group, criterion_main};
 
 fn bench(c: &mut Criterion) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
-    let (_, runs) = settle::load_runs(&path).expect("quickstart");
+    let (_, mut runs) = settle::load_runs(&path).expect("quickstart");
+    // The exact modal backend (what this bench has always measured); rapier, the sweep
+    // default, is measured per backend in `benches/sim.rs`.
+    settle::run::set_backend(&path, &mut runs, settle::run::Backend::Modal).expect("modal");
     // The 10 mm S-curve: 0.5 s window + ~0.08 s move, 10 kHz samples.
     let spec = runs
         .iter()

@@ -299,7 +299,6 @@ pub fn simulate<P: Plant>(
     let mut state = plant.initial_state(&starts)?;
     let mut obs = vec![Observation::default(); n_axes];
     let mut cmd = vec![Sample::default(); n_axes];
-    let mut now = vec![Sample::default(); n_axes];
     let mut row: Vec<f64> = Vec::new();
     let mut cmd_p = vec![0.0; n_axes];
     let mut toolhead = vec![0.0; n_axes];
@@ -341,10 +340,11 @@ pub fn simulate<P: Plant>(
 
     let breakpoints = traj.breakpoints();
     let mut next_bp = 0usize;
-    traj.state_at(0.0, &mut now);
-    sample(0.0, &now, &state, &mut obs, &mut acc);
+    traj.state_at(0.0, &mut cmd);
+    sample(0.0, &cmd, &state, &mut obs, &mut acc);
     let mut k = 1usize; // index of the next sample during the move
     let mut t = 0.0;
+    let mut fresh = true; // `cmd` already holds the command at `t`
     while t < t_end {
         while next_bp < breakpoints.len() && breakpoints[next_bp] <= t {
             next_bp += 1;
@@ -356,17 +356,22 @@ pub fn simulate<P: Plant>(
             .min(t_end);
         let t_sample = k as f64 * dt;
         let next = t_sample.min(bp);
-        traj.state_at(t, &mut cmd);
+        if !fresh {
+            traj.state_at(t, &mut cmd);
+        }
         // A whole sample interval is stepped as exactly `dt` (k dt - (k-1) dt can differ
         // from dt in the last bit, which would cost the modal plant a fresh transition
         // matrix); partial steps at breakpoints use their true length.
         let whole = next == t_sample && t == (k - 1) as f64 * dt;
         plant.step(&mut state, &cmd, if whole { dt } else { next - t })?;
         t = next;
+        fresh = false;
         if t_sample <= bp {
             if t_sample < t_end {
-                traj.state_at(t, &mut now);
-                sample(t, &now, &state, &mut obs, &mut acc);
+                // The command at t serves the sample and the next step.
+                traj.state_at(t, &mut cmd);
+                sample(t, &cmd, &state, &mut obs, &mut acc);
+                fresh = true;
             }
             k += 1;
         }

@@ -126,14 +126,49 @@ pub struct ModalPlant {
 pub struct ModalAxis {
     /// Commanded base state at `t_s`.
     pub base: State,
-    /// Deflection of every body from the static equilibrium of the command (m, rad).
-    pub r: Vec<f64>,
-    /// Its rate (m/s, rad/s).
-    pub rd: Vec<f64>,
+    /// The augmented state `[r, r', v, a, j]`: deflection of every body from the static
+    /// equilibrium of the command (m, rad), its rate (m/s, rad/s), and the command's
+    /// velocity, acceleration and jerk at the last step start.
+    z: Vec<f64>,
     /// Load-angle bookkeeping of the axis's motor, if it has one.
     pub stepper: Option<StepperState>,
     disc: std::sync::Arc<Discrete>,
     scratch: Vec<f64>,
+}
+
+impl ModalAxis {
+    /// Deflection of every body from the static equilibrium of the command (m, rad).
+    pub fn r(&self) -> &[f64] {
+        &self.z[..self.disc.n]
+    }
+
+    /// Its rate (m/s, rad/s).
+    pub fn rd(&self) -> &[f64] {
+        &self.z[self.disc.n..2 * self.disc.n]
+    }
+
+    /// Set the deflection of body `i` (m, rad), e.g. to start a free decay.
+    pub fn set_r(&mut self, i: usize, value: f64) {
+        self.z[i] = value;
+    }
+}
+
+/// `sum a_i b_i` with four partial sums (vectorises; fixed order, so deterministic).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let (ca, ra) = a.split_at(a.len() / 4 * 4);
+    let (cb, rb) = b.split_at(ca.len());
+    for (x, y) in ca.chunks_exact(4).zip(cb.chunks_exact(4)) {
+        for l in 0..4 {
+            acc[l] += x[l] * y[l];
+        }
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
 }
 
 /// The modal plant's mutable state.
@@ -181,7 +216,7 @@ impl ModalPlant {
     /// is mode `i`): `sqrt(e^2 + ((e' + zeta w e)/wd)^2)`.
     pub fn free_amplitude(state: &ModalState, axis: usize, body: usize, w: f64, zeta: f64) -> f64 {
         let a = &state.axes[axis];
-        let (e, ed) = (a.r[body], a.rd[body]);
+        let (e, ed) = (a.r()[body], a.rd()[body]);
         let wd = w * (1.0 - zeta * zeta).sqrt();
         e.hypot((ed + zeta * w * e) / wd)
     }
@@ -215,8 +250,7 @@ impl Plant for ModalPlant {
                 });
                 Ok(ModalAxis {
                     base: *s,
-                    r: vec![0.0; n],
-                    rd: vec![0.0; n],
+                    z: vec![0.0; 2 * n + 3],
                     stepper,
                     disc: std::sync::Arc::new(disc),
                     scratch: vec![0.0; 2 * n],
@@ -230,6 +264,17 @@ impl Plant for ModalPlant {
         check_step(self.axes.len(), cmd, dt_s)?;
         let nominal = dt_s == self.nominal_dt_s;
         for ((ax, st), c) in self.axes.iter().zip(&mut state.axes).zip(cmd) {
+            let h = dt_s;
+            st.base = State {
+                p: c.p + h * (c.v + h * (c.a / 2.0 + h * c.j / 6.0)),
+                v: c.v + h * (c.a + h * c.j / 2.0),
+                a: c.a + h * c.j,
+            };
+            // An axis at rest with a command at rest stays exactly at rest (the update
+            // below would compute exact zeros): skip it.
+            if c.v == 0.0 && c.a == 0.0 && c.j == 0.0 && st.z.iter().all(|x| *x == 0.0) {
+                continue;
+            }
             let disc = &st.disc;
             let n = disc.n;
             let other;
@@ -240,28 +285,16 @@ impl Plant for ModalPlant {
                 &other
             };
             let dim = 2 * n + 3;
-            for (i, out) in st.scratch.iter_mut().enumerate() {
-                let row = &rows[i * dim..(i + 1) * dim];
-                let mut acc = row[2 * n] * c.v + row[2 * n + 1] * c.a + row[2 * n + 2] * c.j;
-                for k in 0..n {
-                    acc += row[k] * st.r[k] + row[n + k] * st.rd[k];
-                }
-                *out = acc;
+            st.z[2 * n..].copy_from_slice(&[c.v, c.a, c.j]);
+            for (row, out) in rows.chunks_exact(dim).zip(st.scratch.iter_mut()) {
+                *out = dot(row, &st.z);
             }
-            st.r.copy_from_slice(&st.scratch[..n]);
-            st.rd.copy_from_slice(&st.scratch[n..]);
-            let h = dt_s;
-            st.base = State {
-                p: c.p + h * (c.v + h * (c.a / 2.0 + h * c.j / 6.0)),
-                v: c.v + h * (c.a + h * c.j / 2.0),
-                a: c.a + h * c.j,
-            };
+            st.z[..2 * n].copy_from_slice(&st.scratch);
             if let (Some(sp), Some(ss)) = (&ax.stepper, st.stepper.as_mut()) {
-                // Linear driver: the load angle is Nr (x rad_per_m - theta) = -Nr r_rotor.
-                let theta = st.r[sp.rotor] + disc.g[sp.rotor] * st.base.p;
-                sp.track_spring(ss, theta, st.base.p);
+                // Linear driver: the load angle Nr (x rad_per_m - theta) is -Nr r_rotor.
+                ss.track(-f64::from(sp.rotor_teeth) * st.z[sp.rotor]);
             }
-            if !(st.base.p.is_finite() && st.r.iter().chain(&st.rd).all(|x| x.is_finite())) {
+            if !(st.base.p.is_finite() && st.z.iter().all(|x| x.is_finite())) {
                 return Err(SimError::NonFinite {
                     t_s: state.t_s + dt_s,
                 });
@@ -275,7 +308,7 @@ impl Plant for ModalPlant {
         for ((ax, st), o) in self.axes.iter().zip(&state.axes).zip(out.iter_mut()) {
             let x = st.base.p;
             let g = &st.disc.g;
-            let q = |i: usize| st.r[i] + g[i] * x;
+            let q = |i: usize| st.z[i] + g[i] * x;
             let mut toolhead = 0.0;
             for t in &ax.lumped.output {
                 toolhead += t.gain

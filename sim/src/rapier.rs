@@ -9,13 +9,15 @@
 //! Couplings as forces: rapier's joints relate the poses of two bodies, but a belt couples
 //! a *rotation* (the pulley) to a *translation* (the carriage), and rapier's joint motors
 //! are implicit springs that add numerical damping of about `w h / 2` per substep: to keep
-//! that under 10 % of a `zeta = 0.05` mode at 250 Hz would take 300,000 substeps per
+//! that under 10 % of a `zeta = 0.05` mode at 250 Hz would take 160,000 substeps per
 //! second. So each step the spring-damper forces of the [`Lumped`] couplings (with the
 //! belt's stiffness at the current carriage position, `EA/s + EA/(L-s)`) and the driver
 //! torque are computed from the bodies' state and applied, and rapier integrates
 //! (symplectic Euler: velocities from forces, then positions from the new velocities).
 //! That integrator adds no numerical damping to an undamped spring and shifts a mode's
-//! frequency by about `-(w h)^2 / 24`; [`STEP_FRACTION`] sets `h` from the highest mode.
+//! frequency by about `-(w h)^2 / 24`; [`STEP_FRACTION`] sets `h` from the fastest mode at
+//! the start, and the step shrinks with the square root of the belt's stiffening when the
+//! carriage nears a pulley.
 //! Couplings (and the driver) are evaluated with the commanded state at the start of each
 //! step; steps never straddle a profile breakpoint (the harness splits them).
 
@@ -341,7 +343,23 @@ impl Plant for RapierPlant {
         if dt_s == 0.0 {
             return Ok(());
         }
-        let n = (dt_s / state.h_max * (1.0 - 1e-12)).ceil().max(1.0);
+        // A belt stiffer than at the start (the carriage nearer a pulley) raises the
+        // fastest rate by at most the square root of the stiffness ratio (one spring
+        // scaled by f >= 1 gives K <= f K0): shrink the step to keep STEP_FRACTION.
+        let mut stiffer = 1.0f64;
+        if self.options.belt == BeltModel::Varying {
+            for (ax, ab) in self.axes.iter().zip(&state.axes) {
+                for c in &ax.lumped.couplings {
+                    if c.stiffness.depends_on().is_some() {
+                        let now = Lumped::stiffness_of(c, &ab.q);
+                        let start = Lumped::stiffness_of(c, &ab.q_frozen);
+                        stiffer = stiffer.max(now / start);
+                    }
+                }
+            }
+        }
+        let h_max = state.h_max / stiffer.sqrt();
+        let n = (dt_s / h_max * (1.0 - 1e-12)).ceil().max(1.0);
         let h = dt_s / n;
         state.world.integration_parameters.dt = h;
         let varying = self.options.belt == BeltModel::Varying;

@@ -96,9 +96,14 @@ impl StepperState {
     }
 
     /// Record a load angle (electrical rad).
+    #[inline]
     pub fn track(&mut self, phi: f64) {
         self.load_angle_rad = phi;
         self.max_load_angle_rad = self.max_load_angle_rad.max(phi.abs());
+        // The pole pitch changes only when the angle leaves +-pi around the current one.
+        if (phi - self.pole as f64 * TAU).abs() <= PI {
+            return;
+        }
         let pole = (phi / TAU).round() as i64;
         if pole != self.pole {
             self.slips = self.slips.saturating_add(pole.abs_diff(self.pole) as u32);

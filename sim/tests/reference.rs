@@ -19,7 +19,7 @@ fn plant_of(modes: &[Mode], dt: f64) -> ModalPlant {
 
 /// Deflection e and rate e' of mode `i`.
 fn mode_state(st: &ModalState, i: usize) -> (f64, f64) {
-    (st.axes[0].r[i], st.axes[0].rd[i])
+    (st.axes[0].r()[i], st.axes[0].rd()[i])
 }
 
 /// Free-vibration envelope of the first mode.
@@ -244,7 +244,7 @@ fn free_decay_has_the_analytic_frequency_and_damping() {
     let plant = plant_of(&[mode], 1e-4);
     let mut st = plant.initial_state(&[State::default()]).expect("state");
     let e0 = 1e-4;
-    st.axes[0].r[0] = e0;
+    st.axes[0].set_r(0, e0);
     let hold = Sample::default();
     let mut worst = 0.0f64;
     for k in 1..=5000 {

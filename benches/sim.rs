@@ -1,0 +1,108 @@
+//! Simulation speed per backend on the printer preset, at validated accuracy (each
+//! backend's default step size, the one `settle validate` checks).
+//!
+//! Throughput is reported in elements per second with one element = one simulated
+//! microsecond, so criterion's "Melem/s" reads directly as *simulated seconds per wall
+//! second* (1 Melem/s = real time). Targets per core: rapier >= 20, modal >= 2000.
+//!
+//! The run: `printer_xy`, both axes simulated, a 10 mm S-curve on Y (0.149 s) and the
+//! 0.5 s observation window, sampled at 10 kHz, metrics streaming.
+//!
+//! On a shared machine wall time overstates the cost per core, so after criterion's
+//! measurement each case also runs for a few seconds timed by the thread's own CPU clock
+//! (`/proc/thread-self/schedstat`, Linux) and prints simulated seconds per CPU second.
+
+use std::hint::black_box;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use settle::run::{Backend, Observe, SimOptions, run_trajectory};
+use settle_planner::{Limits, Profile, ProfileKind, State, Trajectory};
+use settle_sim::DriverMode;
+
+fn bench(c: &mut Criterion) {
+    let (_, path, text) = settle::machine_file::PRESETS[0];
+    let (machine, _) =
+        settle::machine_file::parse(text, std::path::Path::new(path)).expect("preset");
+    let lim = Limits::new(0.3, 3.0, Some(100.0)).expect("limits");
+    let y = ProfileKind::SCurve
+        .rest_to_rest(0.0, 0.01, &lim)
+        .expect("plan");
+    let traj = Trajectory::new(vec![Profile::empty(State::default()), y]).expect("trajectory");
+    let observe = Observe {
+        window_s: 0.5,
+        sample_rate_hz: 10_000.0,
+        bands_um: vec![10.0, 50.0],
+    };
+    let simulated_us = ((traj.duration_s() + observe.window_s) * 1e6).round() as u64;
+    let mut group = c.benchmark_group("printer_xy_10mm_scurve_y");
+    group.throughput(Throughput::Elements(simulated_us));
+    for (name, backend, driver) in [
+        ("modal_linear_driver", Backend::Modal, DriverMode::Linear),
+        ("rapier_linear_driver", Backend::Rapier, DriverMode::Linear),
+        ("rapier_full_driver", Backend::Rapier, DriverMode::Full),
+    ] {
+        let axes = machine.compile(driver).expect("compile");
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                black_box(
+                    run_trajectory(
+                        axes.clone(),
+                        backend,
+                        &SimOptions::default(),
+                        black_box(&traj),
+                        &observe,
+                        None,
+                    )
+                    .expect("runs"),
+                )
+            })
+        });
+    }
+    group.finish();
+    for (name, backend, driver) in [
+        ("modal_linear_driver", Backend::Modal, DriverMode::Linear),
+        ("rapier_linear_driver", Backend::Rapier, DriverMode::Linear),
+        ("rapier_full_driver", Backend::Rapier, DriverMode::Full),
+    ] {
+        let axes = machine.compile(driver).expect("compile");
+        let Some(start) = thread_cpu_ns() else {
+            return;
+        };
+        let wall = std::time::Instant::now();
+        let mut runs = 0u32;
+        while wall.elapsed().as_secs_f64() < 3.0 {
+            black_box(
+                run_trajectory(
+                    axes.clone(),
+                    backend,
+                    &SimOptions::default(),
+                    &traj,
+                    &observe,
+                    None,
+                )
+                .expect("runs"),
+            );
+            runs += 1;
+        }
+        let cpu_s = (thread_cpu_ns().unwrap_or(start) - start) as f64 * 1e-9;
+        let simulated = f64::from(runs) * simulated_us as f64 * 1e-6;
+        eprintln!(
+            "{name}: {runs} runs, {:.0}x real time per CPU second ({:.0}x per wall second)",
+            simulated / cpu_s,
+            simulated / wall.elapsed().as_secs_f64()
+        );
+    }
+}
+
+/// This thread's time on a CPU (ns), from `/proc/thread-self/schedstat`.
+fn thread_cpu_ns() -> Option<u64> {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
