@@ -186,7 +186,9 @@ impl RowView<'_> {
     }
     /// A run that lost steps is a failed run (status other than `ok`).
     fn is_ok(&self) -> bool {
-        self.table.cell(self.row, "status").is_none_or(|s| s == "ok")
+        self.table
+            .cell(self.row, "status")
+            .is_none_or(|s| s == "ok")
     }
     fn lost_steps(&self) -> u64 {
         self.num("lost_steps").map_or(0, |x| x as u64)
@@ -357,12 +359,13 @@ gain = how much longer the slowest kind takes than the fastest.\n",
         };
         for k in &kinds {
             row.push(
-                idx.iter()
-                    .find(|&&i| runs[i].profile == *k)
-                    .map_or("-".to_string(), |&i| match view(i) {
+                idx.iter().find(|&&i| runs[i].profile == *k).map_or(
+                    "-".to_string(),
+                    |&i| match view(i) {
                         m if !m.is_ok() => format!("lost {} steps", m.lost_steps()),
                         m => format!("{:.2}", m.residual_peak_um()),
-                    }),
+                    },
+                ),
             );
         }
         let _ = writeln!(out, "| {} |", row.join(" | "));

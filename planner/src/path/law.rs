@@ -213,9 +213,9 @@ impl SpeedLaw for FourJerkLaw {
 /// moves of fixed shape, not speed-change laws: they are refused.
 pub fn for_kind(kind: ProfileKind, limits: &Limits) -> Result<Arc<dyn SpeedLaw>, PlanError> {
     let jmax = || {
-        limits.jmax().ok_or(PlanError::MissingJerkLimit {
-            kind: kind.name(),
-        })
+        limits
+            .jmax()
+            .ok_or(PlanError::MissingJerkLimit { kind: kind.name() })
     };
     Ok(match kind {
         ProfileKind::FourJerk => Arc::new(FourJerkLaw {

@@ -95,7 +95,12 @@ impl Plant for MujocoPlant {
         Ok(MujocoPlantState { axes })
     }
 
-    fn step(&self, state: &mut MujocoPlantState, cmd: &[Sample], dt_s: f64) -> Result<(), SimError> {
+    fn step(
+        &self,
+        state: &mut MujocoPlantState,
+        cmd: &[Sample],
+        dt_s: f64,
+    ) -> Result<(), SimError> {
         check_step(self.axes.len(), cmd, dt_s)?;
         if dt_s == 0.0 {
             return Ok(());
@@ -141,11 +146,7 @@ impl Plant for MujocoPlant {
     }
 
     fn observe(&self, state: &MujocoPlantState, out: &mut [Observation]) {
-        for ((ax, _), (st, o)) in self
-            .axes
-            .iter()
-            .zip(state.axes.iter().zip(out.iter_mut()))
-        {
+        for ((ax, _), (st, o)) in self.axes.iter().zip(state.axes.iter().zip(out.iter_mut())) {
             let x_node = ax.command_node_m(st.base.p);
             let q = st.sim.q();
             *o = Observation {
