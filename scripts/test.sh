@@ -36,9 +36,22 @@ if [[ ${#features[@]} -gt 0 ]]; then
 fi
 echo "== cargo test (release: the property suites are numeric-heavy)"
 cargo test --workspace --release --locked "${features[@]}"
-echo "== settle check: the CI regression gate (scenarios/ci_*.toml vs results/baselines/<name>.csv)"
+echo "== settle check: the CI regression gate (scenarios/ci_<name>.toml vs results/baselines/<name>.<backend>.csv)"
 for scenario in scenarios/ci_*.toml; do
-  cargo run --release --locked --quiet "${features[@]}" -- check "$scenario" --baseline "results/baselines/$(basename "$scenario" .toml).csv"
+  name=$(basename "$scenario" .toml)
+  baselines=(results/baselines/"$name".*.csv)
+  if [[ ! -e ${baselines[0]} ]]; then
+    echo "$scenario has no baseline: settle check $scenario --backend rapier --baseline results/baselines/$name.rapier.csv --update" >&2
+    exit 1
+  fi
+  for baseline in "${baselines[@]}"; do
+    backend=${baseline%.csv}; backend=${backend##*.}
+    if [[ $backend == mujoco && ${#features[@]} -eq 0 ]]; then
+      echo "(skipping $baseline: MuJoCo not built)"
+      continue
+    fi
+    cargo run --release --locked --quiet "${features[@]}" -- check "$scenario" --backend "$backend" --baseline "$baseline"
+  done
 done
 echo "== fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
 scripts/fuzz.sh "${SETTLE_FUZZ_SECONDS:-15}"

@@ -254,6 +254,25 @@ if intended, rewrite the baseline with --update",
     })
 }
 
+/// The backend a baseline was made on: the single value of its `backend` column (`None`
+/// when it has no such column). Several backends in one baseline are an error.
+pub fn baseline_backend(t: &RunsTable) -> Result<Option<String>, String> {
+    let Some(c) = t.column("backend") else {
+        return Ok(None);
+    };
+    let mut names: Vec<&str> = t.rows.iter().map(|r| r[c].as_str()).collect();
+    names.sort_unstable();
+    names.dedup();
+    match names.as_slice() {
+        [] => Ok(None),
+        [one] => Ok(Some(one.to_string())),
+        many => Err(format!(
+            "the baseline mixes backends ({}): keep one baseline per backend",
+            many.join(", ")
+        )),
+    }
+}
+
 fn span(ids: &[String]) -> String {
     match (ids.first(), ids.last()) {
         (Some(a), Some(b)) => format!("run {a} to {b}"),

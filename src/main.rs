@@ -82,9 +82,10 @@ enum Command {
         /// Pass when every change is an improvement of a settling metric.
         #[arg(long)]
         allow_improvements: bool,
-        /// Simulation backend: modal, rapier, mujoco.
-        #[arg(long, default_value = "rapier", value_parser = parse_backend)]
-        backend: Backend,
+        /// Simulation backend: modal, rapier, mujoco [default: the one the baseline was made
+        /// with (its `backend` column); rapier for a new baseline].
+        #[arg(long, value_parser = parse_backend)]
+        backend: Option<Backend>,
         /// Worker threads [default: all cores].
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
         jobs: Option<u16>,
@@ -362,7 +363,7 @@ fn check(
     tolerance_pct: f64,
     update: bool,
     allow_improvements: bool,
-    backend: Backend,
+    backend: Option<Backend>,
     jobs: Option<usize>,
 ) -> anyhow::Result<ExitCode> {
     if !(tolerance_pct.is_finite() && tolerance_pct >= 0.0) {
@@ -373,7 +374,6 @@ fn check(
         .into());
     }
     let (sc, mut runs) = settle::load_runs(path)?;
-    settle::run::set_backend(path, &mut runs, backend)?;
     let old = match std::fs::read_to_string(baseline) {
         Ok(text) => Some(text),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound && update => None,
@@ -401,6 +401,37 @@ fn check(
         .map(settle::table::RunsTable::parse)
         .transpose()
         .map_err(|e| usage_error(&baseline.display().to_string(), e))?;
+    // The backend: as asked, else the baseline's own; a baseline made on another backend
+    // than the one asked for is an error (its numbers are not comparable), unless updating.
+    let made_with = old_table
+        .as_ref()
+        .map(settle::check::baseline_backend)
+        .transpose()
+        .map_err(|e| usage_error(&baseline.display().to_string(), e))?
+        .flatten();
+    let backend = match (backend, made_with.as_deref()) {
+        (Some(b), Some(m)) if b.name() != m && !update => {
+            return Err(usage_error(
+                &baseline.display().to_string(),
+                format!(
+                    "this baseline was made on backend `{m}`, not `{b}`: pass --backend {m}, or rewrite it with --update"
+                ),
+            )
+            .into());
+        }
+        (Some(b), _) => b,
+        (None, Some(m)) => Backend::parse(m).ok_or_else(|| {
+            usage_error(
+                &baseline.display().to_string(),
+                format!(
+                    "unknown backend `{m}` in its backend column; allowed: {}",
+                    Backend::ALLOWED
+                ),
+            )
+        })?,
+        (None, None) => Backend::default(),
+    };
+    settle::run::set_backend(path, &mut runs, backend)?;
     let results = settle::run_all(&runs, jobs, true)?;
     let mut metrics = Vec::with_capacity(results.len());
     for r in results {

@@ -7,7 +7,7 @@ use std::process::{Command, Output};
 use settle::table::RunsTable;
 
 const SCENARIO: &str = "scenarios/ci_quickstart.toml";
-const BASELINE: &str = "results/baselines/ci_quickstart.csv";
+const BASELINE: &str = "results/baselines/ci_quickstart.rapier.csv";
 
 fn settle(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_settle"))
@@ -31,10 +31,50 @@ fn baseline() -> RunsTable {
 }
 
 #[test]
-fn unchanged_run_passes() {
-    let o = settle(&["check", SCENARIO, "--baseline", BASELINE, "--jobs", "2"]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    assert!(text(&o).contains("ok: "), "{}", text(&o));
+fn unchanged_runs_pass_on_every_backend_with_a_baseline() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baselines");
+    let mut checked = Vec::new();
+    for e in std::fs::read_dir(&dir).expect("results/baselines") {
+        let name = e.expect("entry").file_name().to_string_lossy().into_owned();
+        let Some(backend) = name
+            .strip_prefix("ci_quickstart.")
+            .and_then(|r| r.strip_suffix(".csv"))
+        else {
+            continue;
+        };
+        if backend == "mujoco" && !cfg!(feature = "mujoco") {
+            continue;
+        }
+        let base = format!("results/baselines/{name}");
+        // The backend comes from the baseline's own `backend` column.
+        let o = settle(&["check", SCENARIO, "--baseline", &base, "--jobs", "2"]);
+        assert_eq!(o.status.code(), Some(0), "{base}: {}", text(&o));
+        assert!(text(&o).contains("ok: "), "{}", text(&o));
+        checked.push(backend.to_string());
+    }
+    checked.sort();
+    assert!(
+        checked.contains(&"modal".to_string()) && checked.contains(&"rapier".to_string()),
+        "{checked:?}"
+    );
+}
+
+#[test]
+fn a_baseline_of_another_backend_is_refused() {
+    let o = settle(&[
+        "check",
+        SCENARIO,
+        "--baseline",
+        BASELINE,
+        "--backend",
+        "modal",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("made on backend `rapier`"),
+        "{}",
+        text(&o)
+    );
 }
 
 #[test]

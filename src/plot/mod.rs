@@ -199,6 +199,16 @@ pub fn fmt_num(v: f64) -> String {
     s.to_string()
 }
 
+/// A tick label on an axis spanning `span`: rounding noise around zero (e.g. -5.55e-17 on
+/// an axis from -0.4 to 0.3) is shown as 0.
+fn fmt_tick(v: f64, span: f64) -> String {
+    if v.abs() < span.abs() * 1e-9 {
+        "0".into()
+    } else {
+        fmt_num(v)
+    }
+}
+
 /// The finite range of `values`, padded; `None` when there is no finite value.
 fn range(values: impl Iterator<Item = f64>, log: bool, from_zero: bool) -> Option<(f64, f64)> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -347,8 +357,8 @@ where
         .configure_mesh()
         .x_desc(p.x_label.as_str())
         .y_desc(p.y_label.as_str())
-        .x_label_formatter(&|v| fmt_num(*v))
-        .y_label_formatter(&|v| fmt_num(*v))
+        .x_label_formatter(&|v| fmt_tick(*v, xhi - xlo))
+        .y_label_formatter(&|v| fmt_tick(*v, yhi - ylo))
         .label_style((FONT, 15))
         .axis_desc_style((FONT, 16))
         .bold_line_style(BLACK.mix(0.12))
@@ -358,7 +368,7 @@ where
         .draw()
         .map_err(err)?;
     let grey = RGBColor(90, 90, 90);
-    for r in &p.vrules {
+    for (i, r) in p.vrules.iter().enumerate() {
         chart
             .draw_series(DashedLineSeries::new(
                 [(r.at, ylo), (r.at, yhi)],
@@ -367,12 +377,16 @@ where
                 grey.stroke_width(1),
             ))
             .map_err(err)?;
+        // Labels step down one line each, so that rules close together stay readable.
         chart
-            .draw_series(std::iter::once(Text::new(
-                format!(" {}", r.label),
-                (r.at, yhi),
-                (FONT, 14).into_font().color(&grey),
-            )))
+            .draw_series(std::iter::once(
+                EmptyElement::at((r.at, yhi))
+                    + Text::new(
+                        format!(" {}", r.label),
+                        (0, 16 * i as i32),
+                        (FONT, 14).into_font().color(&grey),
+                    ),
+            ))
             .map_err(err)?;
     }
     for r in &p.hrules {

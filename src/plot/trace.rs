@@ -132,6 +132,8 @@ pub fn figure(title: &str, rec: &RunRecord) -> Figure {
         let mut hrules = Vec::new();
         let mut vrules = vec![end_rule.clone()];
         let peak = max_abs(&y);
+        // A length (e.g. the error vector's) is never negative: no lower band then.
+        let signed = y.iter().any(|v| *v < 0.0);
         for b in &rec.spec.bands_um {
             // Bands far outside the residual would squash it: show those that matter.
             if *b <= 3.0 * peak.max(1e-9) {
@@ -139,10 +141,12 @@ pub fn figure(title: &str, rec: &RunRecord) -> Figure {
                     at: *b,
                     label: format!("+{} um", fmt_num(*b)),
                 });
-                hrules.push(Rule {
-                    at: -b,
-                    label: format!("-{} um", fmt_num(*b)),
-                });
+                if signed {
+                    hrules.push(Rule {
+                        at: -b,
+                        label: format!("-{} um", fmt_num(*b)),
+                    });
+                }
             }
             let settle = rec.row.num(0, &format!("settle_time_s_{b}um"));
             match settle {

@@ -3,12 +3,14 @@
 //!
 //! The rule works on channel names alone, so new channels need no sink code:
 //! - a name with a dot is `group.field` (e.g. `x.cmd_p` -> group `x`, field `cmd_p`);
-//! - otherwise the text before the first `_` is the group when at least two channels share
-//!   it (`cmd_p`, `cmd_v`, `cmd_a`, `cmd_j` -> group `cmd`, fields `p`, `v`, `a`, `j`);
-//! - otherwise the channel is a group of its own, its field named like it (`toolhead`).
+//! - otherwise the text before the first `_` is the group and the rest the field
+//!   (`cmd_p_x` -> group `cmd`, field `p_x`; `toolhead_x` -> `toolhead`, `x`;
+//!   `motor_angle_y` -> `motor`, `angle_y`), so a signal's axes share one group;
+//! - a name without `_` is a field of the group of that name (`error`, the length of the
+//!   error vector, joins `error_x` and `error_y` in group `error`).
 //!
 //! A field's key in a message carries its unit the way CSV headers do: `field_unit`
-//! (`p_m`, `v_m_s`), or just `field` when the unit is empty.
+//! (`p_x_m`, `v_x_m_s`), or just `field` when the unit is empty.
 //!
 //! Groups keep the order in which their first channel appears; fields keep channel order.
 
@@ -38,16 +40,11 @@ pub struct Field {
     pub channel_name: String,
 }
 
-fn split(name: &str, shared_prefix: impl Fn(&str) -> bool) -> (String, String) {
-    if let Some((g, f)) = name.split_once('.') {
-        return (g.to_string(), f.to_string());
+fn split(name: &str) -> (String, String) {
+    match name.split_once('.').or_else(|| name.split_once('_')) {
+        Some((g, f)) if !g.is_empty() && !f.is_empty() => (g.to_string(), f.to_string()),
+        _ => (name.to_string(), name.to_string()),
     }
-    if let Some((g, f)) = name.split_once('_')
-        && shared_prefix(g)
-    {
-        return (g.to_string(), f.to_string());
-    }
-    (name.to_string(), name.to_string())
 }
 
 /// The groups of a series (see the module doc for the rule).
@@ -65,15 +62,9 @@ pub fn groups(series: &Series) -> Vec<Group> {
 
 /// The groups of channels given by name and unit (in series order).
 pub fn group_names(names: &[&str], units: &[&str]) -> Vec<Group> {
-    let prefix_count = |p: &str| {
-        names
-            .iter()
-            .filter(|n| !n.contains('.') && n.split_once('_').is_some_and(|(g, _)| g == p))
-            .count()
-    };
     let mut out: Vec<Group> = Vec::new();
     for (i, (name, unit)) in names.iter().zip(units).enumerate() {
-        let (g, f) = split(name, |p| prefix_count(p) >= 2);
+        let (g, f) = split(name);
         let key = if unit.is_empty() {
             f.clone()
         } else {
@@ -110,29 +101,53 @@ mod tests {
     }
 
     #[test]
-    fn todays_channels() {
-        let got = shape(&["cmd_p", "cmd_v", "cmd_a", "cmd_j", "toolhead", "error"]);
+    fn one_axis_run() {
+        let got = shape(&[
+            "cmd_p_x",
+            "cmd_v_x",
+            "cmd_a_x",
+            "cmd_j_x",
+            "toolhead_x",
+            "error_x",
+            "error",
+        ]);
         assert_eq!(
             got,
             vec![
                 (
                     "cmd".to_string(),
-                    vec!["p_m".into(), "v_m".into(), "a_m".into(), "j_m".into()]
+                    vec![
+                        "p_x_m".into(),
+                        "v_x_m".into(),
+                        "a_x_m".into(),
+                        "j_x_m".into()
+                    ]
                 ),
-                ("toolhead".to_string(), vec!["toolhead_m".into()]),
-                ("error".to_string(), vec!["error_m".into()]),
+                ("toolhead".to_string(), vec!["x_m".into()]),
+                ("error".to_string(), vec!["x_m".into(), "error_m".into()]),
             ]
         );
     }
 
     #[test]
-    fn dotted_and_lonely_prefixes() {
-        let got = shape(&["x.cmd_p", "y.cmd_p", "motor_angle", "following_error"]);
-        assert_eq!(got[0], ("x".to_string(), vec!["cmd_p_m".to_string()]));
-        assert_eq!(got[1], ("y".to_string(), vec!["cmd_p_m".to_string()]));
-        // A prefix used once is no group: the channel keeps its whole name.
-        assert_eq!(got[2].0, "motor_angle");
-        assert_eq!(got[3].0, "following_error");
+    fn axes_share_groups_and_dots_name_them() {
+        let got = shape(&[
+            "motor_angle_x",
+            "motor_angle_y",
+            "a.cmd_p",
+            "b.cmd_p",
+            "_odd",
+        ]);
+        assert_eq!(
+            got[0],
+            (
+                "motor".to_string(),
+                vec!["angle_x_m".to_string(), "angle_y_m".to_string()]
+            )
+        );
+        assert_eq!(got[1], ("a".to_string(), vec!["cmd_p_m".to_string()]));
+        assert_eq!(got[2], ("b".to_string(), vec!["cmd_p_m".to_string()]));
+        assert_eq!(got[3], ("_odd".to_string(), vec!["_odd_m".to_string()]));
         let unitless = group_names(&["status"], &[""]);
         assert_eq!(unitless[0].fields[0].key, "status");
     }

@@ -59,7 +59,8 @@ pub struct RunRecord<'a> {
     pub row: RunsTable,
 }
 
-/// Run `spec` recording its full series. The one place a run is executed with a recorder.
+/// Run `spec` recording its full series (the run chooses its channels). The one place a
+/// run is executed with a recorder.
 pub fn record_run(spec: &RunSpec) -> Result<(Series, Metrics), Error> {
     let mut series = Series::default();
     let m = crate::run::execute(spec, Some(&mut series))?;
