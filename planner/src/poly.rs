@@ -37,6 +37,12 @@ impl Roots {
 /// `c[0] + c[1] x + ... + c[n] x^n` and its derivative.
 #[inline]
 fn eval_d(c: &[f64], x: f64) -> (f64, f64) {
+    if let [c0, c1, c2, c3, c4] = *c {
+        // The quartic, unrolled (the common case).
+        let f = (((c4 * x + c3) * x + c2) * x + c1) * x + c0;
+        let d = ((4.0 * c4 * x + 3.0 * c3) * x + 2.0 * c2) * x + c1;
+        return (f, d);
+    }
     let n = c.len() - 1;
     let mut f = c[n];
     let mut d = 0.0;
