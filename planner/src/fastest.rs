@@ -10,6 +10,7 @@
 use crate::Segment;
 use crate::arcs::{Arcs, Sink, family};
 use crate::ramp::Ramp;
+use crate::segs::Push;
 use crate::unit::{Scale, Unit};
 use crate::velocity::{Bounds, change};
 
@@ -56,26 +57,25 @@ impl Cand {
         }
     }
 
-    /// Append the profile's segments in physical units (zero-duration ones included). Holds
+    /// Append the profile's segments in physical units (zero-duration jerk segments left out). Holds
     /// are zero-jerk segments; the cruise is a constant-acceleration segment at exactly
     /// zero.
-    pub(crate) fn segments(&self, sc: &Scale, out: &mut impl Extend<Segment>) {
+    pub(crate) fn segments(&self, sc: &Scale, out: &mut impl Push) {
         match self {
             Cand::Arcs(a) => {
-                out.extend(a.t.iter().zip(a.jerks()).map(|(t, j)| Segment::Jerk {
-                    duration_s: t * sc.t,
-                    jerk: j * a.sign * sc.j,
-                }));
+                for (t, j) in a.t.iter().zip(a.jerks()) {
+                    out.push_jerk(t * sc.t, j * a.sign * sc.j);
+                }
             }
             Cand::Cruise { c1, cruise, c2, .. } => {
-                out.extend(c1.segments(sc));
+                c1.segments(sc, out);
                 // The cruise holds the acceleration at exactly zero: the change before ends
                 // there only up to rounding, and a cruise can be long enough to matter.
-                out.extend([Segment::Accel {
+                out.push_seg(Segment::Accel {
                     duration_s: cruise * sc.t,
                     accel: 0.0,
-                }]);
-                out.extend(c2.segments(sc));
+                });
+                c2.segments(sc, out);
             }
         }
     }

@@ -224,9 +224,9 @@ impl Planned {
     /// The profile, checked to reach the target.
     pub(crate) fn profile(&self) -> Result<Profile, PlanError> {
         let mut segs = Vec::with_capacity(12);
-        match self.how {
-            How::Direct { sc, cand, .. } => cand.segments(&sc, &mut segs),
-            How::Jerk { sc, tau, cand } => {
+        match &self.how {
+            How::Direct { sc, cand, .. } => cand.segments(sc, &mut segs),
+            &How::Jerk { sc, tau, cand } => {
                 if tau > 0.0 {
                     let (pre_segs, _) = BrakeLaw::new(self.start, &self.lim, sc.j).until(tau);
                     segs.extend_from_slice(pre_segs.as_slice());
@@ -246,10 +246,10 @@ impl Planned {
     /// duration cannot be met. Without a brake this reuses step 1's normalised problem and
     /// cruise changes.
     pub(crate) fn lasting(&self, duration_s: f64) -> Result<Option<Profile>, PlanError> {
-        match self.how {
+        match &self.how {
             How::Direct { sc, u, cruises, .. } => {
                 let mut segs = Vec::with_capacity(16);
-                if !crate::fixed::lasting(&u, duration_s / sc.t, &sc, &cruises, &mut segs) {
+                if !crate::fixed::lasting(u, duration_s / sc.t, sc, cruises, &mut segs) {
                     return Ok(None);
                 }
                 verify(finish(self.start, segs)?, &self.target, &self.lim, true).map(Some)
@@ -272,17 +272,19 @@ impl Planned {
     }
 }
 
-/// Step 1 for one axis: validate, brake, and find the fastest profile.
-pub(crate) fn plan(
+/// Step 1 for one axis: validate, brake, find the fastest profile, and append its plan
+/// to `out`.
+pub(crate) fn plan_into(
     start: State,
     target: State,
     lim: &Limits,
     shape: Shape,
-) -> Result<Planned, PlanError> {
-    plan_then(start, target, lim, shape, |p| *p)
+    out: &mut Vec<Planned>,
+) -> Result<(), PlanError> {
+    plan_then(start, target, lim, shape, |p| out.push(*p))
 }
 
-/// [`plan`], handing the result to `then` where it is built (no copy of the plan).
+/// Step 1, handing the plan to `then` where it is built (no copy of the plan).
 #[inline(always)]
 fn plan_then<R>(
     start: State,

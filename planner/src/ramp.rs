@@ -5,6 +5,7 @@
 //! the target; `velocity::change`, which considers every shape, is the general fallback.
 
 use crate::Segment;
+use crate::segs::Push;
 use crate::unit::Scale;
 use crate::velocity::Change;
 
@@ -84,30 +85,19 @@ impl Ramp {
         self.t1 + self.hold + self.t2
     }
 
-    /// The change's segments, in physical units `sc`.
-    pub(crate) fn segments(&self, sc: &Scale) -> [Segment; 3] {
+    /// Append the change's segments (those that last), in physical units `sc`.
+    pub(crate) fn segments(&self, sc: &Scale, out: &mut impl Push) {
         let j = self.sign * sc.j;
-        [
-            Segment::Jerk {
-                duration_s: self.t1 * sc.t,
-                jerk: j,
-            },
-            Segment::Jerk {
-                duration_s: self.hold * sc.t,
-                jerk: 0.0,
-            },
-            Segment::Jerk {
-                duration_s: self.t2 * sc.t,
-                jerk: -j,
-            },
-        ]
+        out.push_jerk(self.t1 * sc.t, j);
+        out.push_jerk(self.hold * sc.t, 0.0);
+        out.push_jerk(self.t2 * sc.t, -j);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::velocity::{Bounds, Change, change};
+    use crate::velocity::{Bounds, change};
 
     #[test]
     fn equals_the_general_change_where_it_applies() {
@@ -132,10 +122,18 @@ mod tests {
                 p: 1.0,
                 j: 1.0,
             };
-            let e = Change {
-                segments: r.segments(&unit),
-            }
-            .end(v0, a0);
+            let mut segs = Vec::new();
+            r.segments(&unit, &mut segs);
+            let e = crate::Profile::new(
+                crate::State {
+                    p: 0.0,
+                    v: v0,
+                    a: a0,
+                },
+                segs,
+            )
+            .expect("valid")
+            .end();
             assert!((r.duration() - c.duration_s()).abs() < 1e-12, "{r:?} {c:?}");
             assert!(
                 (e.p - r.dist).abs() < 1e-12 && (e.v - v1).abs() < 1e-12,

@@ -42,11 +42,13 @@ pub fn plan(axes: &[Axis], shape: Shape, sync: Sync) -> Result<Vec<Profile>, Pla
             source: Box::new(e),
         }
     };
-    let fastest: Vec<Planned> = axes
-        .iter()
-        .enumerate()
-        .map(|(i, a)| position::plan(a.start, a.target, &a.limits, shape).map_err(on_axis(i)))
-        .collect::<Result<_, _>>()?;
+    // Plans are large: built in place (an iterator collecting results would copy each
+    // several times).
+    let mut fastest: Vec<Planned> = Vec::with_capacity(axes.len());
+    for (i, a) in axes.iter().enumerate() {
+        position::plan_into(a.start, a.target, &a.limits, shape, &mut fastest)
+            .map_err(on_axis(i))?;
+    }
     let all = || -> Result<Vec<Profile>, PlanError> {
         fastest
             .iter()
