@@ -73,8 +73,8 @@ pub fn with_duration(
     let sc = Scale::new(lim, b.jmax);
     if !crate::brake::needed(&start, lim, b.jmax) {
         let u = Unit::new(&start, &target, lim, &sc);
-        let cruises = crate::fastest::Cruises::of(&u);
-        if !crate::fixed::lasting(&u, duration_s / sc.t, &sc, &cruises, &mut segs) {
+        let mut cruises = crate::fastest::Cruises::default();
+        if !crate::fixed::lasting(&u, duration_s / sc.t, &sc, &mut cruises, &mut segs) {
             return Ok(None);
         }
         return verify(finish(start, segs)?, &target, lim, true).map(Some);
@@ -89,8 +89,8 @@ pub fn with_duration(
         let (pre_segs, _) = law.until(tau);
         segs.clear();
         segs.extend_from_slice(pre_segs.as_slice());
-        let cruises = crate::fastest::Cruises::of(&u);
-        if crate::fixed::lasting(&u, rest / sc.t, &sc, &cruises, &mut segs) {
+        let mut cruises = crate::fastest::Cruises::default();
+        if crate::fixed::lasting(&u, rest / sc.t, &sc, &mut cruises, &mut segs) {
             return verify(finish(start, segs)?, &target, lim, true).map(Some);
         }
     }

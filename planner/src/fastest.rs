@@ -117,25 +117,17 @@ fn cruise_changes(u: &Unit, vlim: f64) -> Option<(Ramp, Ramp)> {
     ))
 }
 
-/// The velocity changes of the cruises at `vmax` and `vmin` of one problem, computed once
-/// for step 1 and reused by step 2.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The velocity changes of the cruises at `vmax` and `vmin` of one problem, computed when
+/// first needed (often only the one at `vmax` is) and kept for step 2.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct Cruises {
-    vmax: Option<(Ramp, Ramp)>,
-    vmin: Option<(Ramp, Ramp)>,
+    /// `[vmax, vmin]`: `None` until computed.
+    changes: [Option<Option<(Ramp, Ramp)>>; 2],
 }
 
 impl Cruises {
-    /// The changes of `u`'s cruises.
-    pub(crate) fn of(u: &Unit) -> Self {
-        Self {
-            vmax: cruise_changes(u, u.vmax),
-            vmin: cruise_changes(u, u.vmin),
-        }
-    }
-
     /// The cruise at `vmax` (`k = 0`) or `vmin` (`k = 1`), if the distance leaves room.
-    fn cruise(&self, u: &Unit, k: usize) -> Option<Cand> {
+    fn cruise(&mut self, u: &Unit, k: usize) -> Option<Cand> {
         let (v, (c1, c2)) = self.get(u, k)?;
         let cruise = (u.dp - c1.dist - c2.dist) / v;
         (cruise >= 0.0 && cruise.is_finite()).then_some(Cand::Cruise { v, c1, cruise, c2 })
@@ -143,17 +135,15 @@ impl Cruises {
 
     /// The cruise at `vmax` (`k = 0`) or `vmin` (`k = 1`) lasting `t` (normalised),
     /// whatever its distance.
-    pub(crate) fn lasting(&self, u: &Unit, k: usize, t: f64) -> Option<Cand> {
+    pub(crate) fn lasting(&mut self, u: &Unit, k: usize, t: f64) -> Option<Cand> {
         let (v, (c1, c2)) = self.get(u, k)?;
         lasting_with(v, c1, c2, t)
     }
 
-    fn get(&self, u: &Unit, k: usize) -> Option<(f64, (Ramp, Ramp))> {
-        if k == 0 {
-            self.vmax.map(|r| (u.vmax, r))
-        } else {
-            self.vmin.map(|r| (u.vmin, r))
-        }
+    fn get(&mut self, u: &Unit, k: usize) -> Option<(f64, (Ramp, Ramp))> {
+        let v = if k == 0 { u.vmax } else { u.vmin };
+        let r = *self.changes[k].get_or_insert_with(|| cruise_changes(u, v));
+        r.map(|r| (v, r))
     }
 }
 
@@ -183,7 +173,7 @@ fn lasting_with(v: f64, c1: Ramp, c2: Ramp, t: f64) -> Option<Cand> {
 ///   `V = max(v0, vf, v0 + a0^2/2 if a0 > 0, vf + af^2/2 if af < 0)` (its velocity maxima
 ///   sit where its acceleration falls through zero, in the first or last arc), so it
 ///   covers at most `max(V, 0) t_max` in less than `t_max`; UDU mirrored.
-pub(crate) fn fastest(u: &Unit, t_max: f64, cruises: &Cruises) -> Option<Cand> {
+pub(crate) fn fastest(u: &Unit, t_max: f64, cruises: &mut Cruises) -> Option<Cand> {
     let mut s = Fastest { t_max, best: None };
     let safe = u.safe();
     for (k, vlim) in [u.vmax, u.vmin].into_iter().enumerate() {
@@ -258,7 +248,7 @@ fn cruise_is_optimal(u: &Unit, vlim: f64) -> bool {
 /// Calls `f` with the duration (normalised) of every locally fastest profile of `u`.
 pub(crate) fn each_duration(u: &Unit, f: impl FnMut(f64)) {
     let mut s = Every(f);
-    let cruises = Cruises::of(u);
+    let mut cruises = Cruises::default();
     for k in 0..2 {
         if let Some(c) = cruises.cruise(u, k) {
             (s.0)(c.duration());

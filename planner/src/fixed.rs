@@ -65,7 +65,7 @@ pub(crate) fn lasting(
     u: &Unit,
     t: f64,
     sc: &Scale,
-    cruises: &Cruises,
+    cruises: &mut Cruises,
     out: &mut Vec<Segment>,
 ) -> bool {
     let mut ex = Extremes {

@@ -172,7 +172,7 @@ pub fn to_velocity(
 /// Position interface: the fastest profile from `start` to `target`.
 ///
 /// A start that must violate the limits is braked first. Braking just long enough
-/// (`brake::minimal`) is not always fastest overall; braking on along the same control law
+/// (`brake::brake`) is not always fastest overall; braking on along the same control law
 /// until the velocity itself is back inside the limits (where Ruckig stops braking) can
 /// be faster. Both ends and points between them are tried and the fastest total is kept.
 pub fn to_state(
@@ -249,7 +249,8 @@ impl Planned {
         match &self.how {
             How::Direct { sc, u, cruises, .. } => {
                 let mut segs = Vec::with_capacity(16);
-                if !crate::fixed::lasting(u, duration_s / sc.t, sc, cruises, &mut segs) {
+                let mut cruises = *cruises;
+                if !crate::fixed::lasting(u, duration_s / sc.t, sc, &mut cruises, &mut segs) {
                     return Ok(None);
                 }
                 verify(finish(self.start, segs)?, &self.target, &self.lim, true).map(Some)
@@ -319,8 +320,8 @@ fn plan_then<R>(
     let sc = Scale::new(lim, b.jmax);
     if !crate::brake::needed(&start, lim, b.jmax) {
         let u = Unit::new(&start, &target, lim, &sc);
-        let cruises = Cruises::of(&u);
-        let cand = crate::fastest::fastest(&u, f64::INFINITY, &cruises).ok_or(none)?;
+        let mut cruises = Cruises::default();
+        let cand = crate::fastest::fastest(&u, f64::INFINITY, &mut cruises).ok_or(none)?;
         return Ok(then(planned(
             cand.duration() * sc.t,
             How::Direct {
@@ -338,7 +339,7 @@ fn plan_then<R>(
         let s = law.state_at(tau, lim);
         let t_max = best.map_or(f64::INFINITY, |(total, _, _)| (total - tau) / sc.t);
         let u = Unit::new(&s, &target, lim, &sc);
-        if let Some(c) = crate::fastest::fastest(&u, t_max, &Cruises::of(&u)) {
+        if let Some(c) = crate::fastest::fastest(&u, t_max, &mut Cruises::default()) {
             let total = tau + c.duration() * sc.t;
             if best.is_none_or(|(bt, _, _)| total < bt) {
                 best = Some((total, tau, c));
