@@ -129,7 +129,7 @@ fn u_frame(u: &Unit, sign: f64) -> Unit {
 /// are valid.
 fn valid(u: &Unit, mut t: [f64; 5], a1: f64, a2: f64) -> Option<[f64; 5]> {
     let scale = 1.0 + t.iter().map(|x| x.abs()).sum::<f64>();
-    if t.iter().any(|x| !(*x >= -1e-12 * scale)) {
+    if t.iter().any(|x| x.is_nan() || *x < -1e-12 * scale) {
         return None;
     }
     let atol = 1e-12 * (u.amax - u.amin);
@@ -190,7 +190,7 @@ fn none(u: &Unit, sign: f64, out: &mut impl Sink) {
         roots_in(&[-k * k, c1, c2, 0.0, 1.0], lo, hi)
     };
     for &s in roots.as_slice() {
-        if !(s > 0.0) {
+        if s.is_nan() || s <= 0.0 {
             continue;
         }
         let a1 = if s > 0.0 { 0.5 * (s + k / s) } else { 0.0 };

@@ -201,12 +201,15 @@ pub(crate) fn fastest(u: &Unit, t_max: f64, cruises: &mut Cruises) -> Option<Can
             .min(u.v0 - 0.5 * a0.min(0.0).powi(2))
             .min(u.vf - 0.5 * af.max(0.0).powi(2));
     let udu = |s: &mut Fastest| {
-        if !(u.dp <= v_lo.min(0.0) * s.t_max) {
+        // (0 times an infinite bound is NaN: no bound, search.)
+        let beyond = u.dp <= v_lo.min(0.0) * s.t_max;
+        if !beyond {
             family(u, 1.0, s);
         }
     };
     let dud = |s: &mut Fastest| {
-        if !(u.dp >= v_hi.max(0.0) * s.t_max) {
+        let beyond = u.dp >= v_hi.max(0.0) * s.t_max;
+        if !beyond {
             family(&u.mirror(), -1.0, s);
         }
     };

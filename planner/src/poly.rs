@@ -188,7 +188,7 @@ fn subdivide(
 /// ascending. Roots within rounding of the interval ends are included.
 pub(crate) fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
     let mut out = Roots::default();
-    if !(lo <= hi) {
+    if lo.is_nan() || hi.is_nan() || lo > hi {
         return out;
     }
     // Trailing zero coefficients lower the degree.

@@ -195,6 +195,9 @@ pub(crate) struct Planned {
     how: How,
 }
 
+// The variants differ in size; boxing the large one would cost the allocation this plan
+// exists to avoid (it lives on the stack or in the caller's vector).
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy)]
 enum How {
     /// Jerk limited, no brake: `cand`, found for the problem `u` (normalised by `sc`) whose

@@ -28,7 +28,7 @@ impl Ramp {
     pub(crate) fn up_down(v0: f64, a0: f64, v1: f64, a1: f64, alim: f64) -> Option<Self> {
         let q = v1 - v0 + 0.5 * (a0 * a0 + a1 * a1);
         let lo = a0.max(a1);
-        if !(q >= 0.0) || q.sqrt() < lo - 1e-12 {
+        if q.is_nan() || q < 0.0 || q.sqrt() < lo - 1e-12 {
             return None;
         }
         let mut a = q.sqrt().max(lo);

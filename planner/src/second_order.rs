@@ -79,7 +79,7 @@ fn each(s: &State, target: &State, lim: &Limits, mut f: impl FnMut(Trap)) {
     for (up, down) in [(amax, amin), (amin, amax)] {
         let q = (dp + v0 * v0 / (2.0 * up) - vf * vf / (2.0 * down))
             / (1.0 / (2.0 * up) - 1.0 / (2.0 * down));
-        if !(q >= 0.0) {
+        if q.is_nan() || q < 0.0 {
             continue;
         }
         for vp in [q.sqrt(), -q.sqrt()] {
