@@ -47,7 +47,7 @@ impl Cand {
             Cand::Arcs(a) => {
                 let (mut p, mut v, mut acc) = (0.0, a.sign * u.v0, a.sign * u.a0);
                 for (t, j) in a.t.iter().zip(a.jerks()) {
-                    p += t * (v + t * (acc / 2.0 + t * j / 6.0));
+                    p += t * (v + t * (0.5 * acc + t * j * (1.0 / 6.0)));
                     v += t * (acc + t * j / 2.0);
                     acc += t * j;
                 }
@@ -175,21 +175,26 @@ fn lasting_with(v: f64, c1: Ramp, c2: Ramp, t: f64) -> Option<Cand> {
 ///   covers at most `max(V, 0) t_max` in less than `t_max`; UDU mirrored.
 pub(crate) fn fastest(u: &Unit, t_max: f64, cruises: &mut Cruises) -> Option<Cand> {
     let mut s = Fastest { t_max, best: None };
-    let safe = u.safe();
-    for (k, vlim) in [u.vmax, u.vmin].into_iter().enumerate() {
-        if let Some(c) = cruises.cruise(u, k) {
-            if safe && cruise_is_optimal(u, vlim) {
-                return (c.duration() < t_max).then_some(c);
+    if !u.safe() {
+        for k in 0..2 {
+            if let Some(c) = cruises.cruise(u, k) {
+                s.offer(c);
             }
-            s.offer(c);
         }
-    }
-    if !safe {
         family(u, 1.0, &mut s);
         family(&u.mirror(), -1.0, &mut s);
         crate::four_arcs::family(u, 1.0, &mut s);
         crate::four_arcs::family(&u.mirror(), -1.0, &mut s);
         return s.best;
+    }
+    // The cruise towards the target first (often proven fastest), the one away from it
+    // last (rarely a candidate).
+    let (toward, away) = if u.dp >= 0.0 { (0, 1) } else { (1, 0) };
+    if let Some(c) = cruises.cruise(u, toward) {
+        if cruise_is_optimal(u, if toward == 0 { u.vmax } else { u.vmin }) {
+            return (c.duration() < t_max).then_some(c);
+        }
+        s.offer(c);
     }
     let (a0, af) = (u.a0, u.af);
     let v_hi =
@@ -219,6 +224,17 @@ pub(crate) fn fastest(u: &Unit, t_max: f64, cruises: &mut Cruises) -> Option<Can
     } else {
         dud(&mut s);
         udu(&mut s);
+    }
+    // The cruise away from the target changes the velocity to the far limit and back,
+    // which takes at least |dv| / a_limit each way: skip it if that alone is too slow.
+    let (amax, amin) = (u.amax, -u.amin);
+    let slow = if away == 1 {
+        (u.v0 - u.vmin) * amax + (u.vf - u.vmin) * amin >= s.t_max * amax * amin
+    } else {
+        (u.vmax - u.v0) * amin + (u.vmax - u.vf) * amax >= s.t_max * amax * amin
+    };
+    if !slow && let Some(c) = cruises.cruise(u, away) {
+        s.offer(c);
     }
     s.best
 }

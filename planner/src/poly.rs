@@ -304,6 +304,8 @@ fn refine(c: &[f64], a: f64, b: f64, fa: f64, x0: f64) -> f64 {
     };
     let tol = 1e-14 * a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
     let mut dx = hi - lo;
+    // The previous Newton step (infinite until there is one, and after a bisection).
+    let mut prev = f64::INFINITY;
     for _ in 0..200 {
         let (f, d) = eval_d(c, x);
         if f == 0.0 {
@@ -315,15 +317,21 @@ fn refine(c: &[f64], a: f64, b: f64, fa: f64, x0: f64) -> f64 {
             hi = x;
         }
         let step = f / d;
-        if step.abs() <= tol {
-            // Converged: this last step is at the level of rounding.
+        // Converged: this step is at the level of rounding, or Newton converges
+        // quadratically (error after a step ~ step^2 / previous step) and the step after
+        // this one would be.
+        if step.abs() <= tol
+            || (prev.is_finite() && step.abs() <= 1e-3 * prev && step * step <= tol * prev)
+        {
             return (x - step).clamp(lo.min(hi), hi.max(lo));
         }
         let newton = x - step;
         let dx_old = std::mem::replace(&mut dx, step);
         if newton > lo.min(hi) && newton < hi.max(lo) && (2.0 * f).abs() <= (dx_old * d).abs() {
             x = newton;
+            prev = step.abs();
         } else {
+            prev = f64::INFINITY;
             dx = 0.5 * (hi - lo);
             x = lo + dx;
             if dx.abs() <= tol {

@@ -42,9 +42,10 @@ impl Ramp {
         let (t1, t2) = (a - a0, a - a1);
         let va = v0 + 0.5 * (a * a - a0 * a0);
         let vb = va + a * hold;
-        let dist = t1 * (v0 + t1 * (a0 / 2.0 + t1 / 6.0))
+        const SIXTH: f64 = 1.0 / 6.0;
+        let dist = t1 * (v0 + t1 * (0.5 * a0 + t1 * SIXTH))
             + hold * (va + a * hold / 2.0)
-            + t2 * (vb + t2 * (a / 2.0 - t2 / 6.0));
+            + t2 * (vb + t2 * (0.5 * a - t2 * SIXTH));
         Some(Self {
             t1,
             hold,
