@@ -129,7 +129,12 @@ impl Cruises {
     /// The cruise at `vmax` (`k = 0`) or `vmin` (`k = 1`), if the distance leaves room.
     fn cruise(&mut self, u: &Unit, k: usize) -> Option<Cand> {
         let (v, (c1, c2)) = self.get(u, k)?;
-        let cruise = (u.dp - c1.dist - c2.dist) / v;
+        let rest = u.dp - c1.dist - c2.dist;
+        // Room to cruise when the rest of the distance lies in the cruise's direction.
+        if rest * v < 0.0 {
+            return None;
+        }
+        let cruise = rest / v;
         (cruise >= 0.0 && cruise.is_finite()).then_some(Cand::Cruise { v, c1, cruise, c2 })
     }
 
