@@ -89,15 +89,17 @@ pub(crate) fn check(
     valid(u, t, a1, a2).is_some_and(|t| out.offer_arcs(three(sign, t)))
 }
 
-/// As [`check`], for a root of a case polynomial: the profile must also reach the target
-/// position (a guard against spurious roots, e.g. `s = 0` of `none`, which the polynomial
-/// carries as a factor).
+/// As [`check`], for a root of a case polynomial. The polynomials are the position
+/// equations times nonzero factors, so their roots reach the target (the one spurious
+/// root, `s = 0` of `none` when `K = 0`, is divided out there); `debug_assertions` builds
+/// check it.
 fn check_root(u: &Unit, sign: f64, t: [f64; 5], a1: f64, a2: f64, out: &mut impl Sink) -> bool {
     let Some(t) = valid(u, t, a1, a2) else {
         return false;
     };
     let arcs = three(sign, t);
-    reaches(u, &arcs) && out.offer_arcs(arcs)
+    debug_assert!(reaches(u, &arcs), "{u:?} {arcs:?}");
+    out.offer_arcs(arcs)
 }
 
 fn three(sign: f64, t: [f64; 5]) -> Arcs {
@@ -127,7 +129,7 @@ fn u_frame(u: &Unit, sign: f64) -> Unit {
 /// are valid.
 fn valid(u: &Unit, mut t: [f64; 5], a1: f64, a2: f64) -> Option<[f64; 5]> {
     let scale = 1.0 + t.iter().map(|x| x.abs()).sum::<f64>();
-    if t.iter().any(|x| !(*x >= -1e-12 * scale)) {
+    if t.iter().any(|x| x.is_nan() || *x < -1e-12 * scale) {
         return None;
     }
     let atol = 1e-12 * (u.amax - u.amin);
@@ -188,7 +190,7 @@ fn none(u: &Unit, sign: f64, out: &mut impl Sink) {
         roots_in(&[-k * k, c1, c2, 0.0, 1.0], lo, hi)
     };
     for &s in roots.as_slice() {
-        if s < 0.0 || (s == 0.0 && k != 0.0) {
+        if s.is_nan() || s <= 0.0 {
             continue;
         }
         let a1 = if s > 0.0 { 0.5 * (s + k / s) } else { 0.0 };

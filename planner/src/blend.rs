@@ -6,16 +6,11 @@
 //! mixture of their end states.
 
 use crate::Segment;
+use crate::segs::Push;
 
 /// `lambda x + (1 - lambda) y` for profiles `x`, `y` starting with acceleration `a0` and
 /// lasting the same time (up to rounding).
-pub(crate) fn blend(
-    x: &[Segment],
-    y: &[Segment],
-    a0: f64,
-    lambda: f64,
-    out: &mut impl Extend<Segment>,
-) {
+pub(crate) fn blend(x: &[Segment], y: &[Segment], a0: f64, lambda: f64, out: &mut impl Push) {
     let mu = 1.0 - lambda;
     // Per profile: the current segment, the time left in it, its jerk, whether it holds a
     // set acceleration, and the acceleration now.
@@ -71,16 +66,16 @@ pub(crate) fn blend(
         if cx.held && cy.held {
             // Both hold (or jump to) a set acceleration: hold the mixture exactly.
             a_out = lambda * cx.a + mu * cy.a;
-            out.extend([Segment::Accel {
+            out.push_seg(Segment::Accel {
                 duration_s: d,
                 accel: a_out,
-            }]);
+            });
         } else {
             let jerk = lambda * cx.j + mu * cy.j;
-            out.extend([Segment::Jerk {
+            out.push_seg(Segment::Jerk {
                 duration_s: d,
                 jerk,
-            }]);
+            });
             a_out += jerk * d;
         }
         for c in [&mut cx, &mut cy] {
@@ -94,10 +89,10 @@ pub(crate) fn blend(
     let a_end = lambda * cx.a + mu * cy.a;
     if a_end != a_out && matches!(x.last(), Some(Segment::Accel { .. })) {
         // Trapezoids end with a jump to the target acceleration.
-        out.extend([Segment::Accel {
+        out.push_seg(Segment::Accel {
             duration_s: 0.0,
             accel: a_end,
-        }]);
+        });
     }
 }
 

@@ -65,7 +65,10 @@ pub fn with_duration(
         let (pre_segs, s) = pre(start, lim, &b);
         let rest = duration_s - pre_segs.duration_s();
         segs.extend_from_slice(pre_segs.as_slice());
-        if !(rest >= 0.0) || !crate::second_order::lasting(&s, &target, lim, rest, &mut segs) {
+        if rest.is_nan()
+            || rest < 0.0
+            || !crate::second_order::lasting(&s, &target, lim, rest, &mut segs)
+        {
             return Ok(None);
         }
         return verify(finish(start, segs)?, &target, lim, true).map(Some);
@@ -73,7 +76,8 @@ pub fn with_duration(
     let sc = Scale::new(lim, b.jmax);
     if !crate::brake::needed(&start, lim, b.jmax) {
         let u = Unit::new(&start, &target, lim, &sc);
-        if !crate::fixed::lasting(&u, duration_s / sc.t, &sc, &mut segs) {
+        let mut cruises = crate::fastest::Cruises::default();
+        if !crate::fixed::lasting(&u, duration_s / sc.t, &sc, &mut cruises, &mut segs) {
             return Ok(None);
         }
         return verify(finish(start, segs)?, &target, lim, true).map(Some);
@@ -81,14 +85,15 @@ pub fn with_duration(
     let law = BrakeLaw::new(start, lim, b.jmax);
     for tau in law.candidate_times() {
         let rest = duration_s - tau;
-        if !(rest >= 0.0) {
+        if rest.is_nan() || rest < 0.0 {
             continue;
         }
         let u = Unit::new(&law.state_at(tau, lim), &target, lim, &sc);
         let (pre_segs, _) = law.until(tau);
         segs.clear();
         segs.extend_from_slice(pre_segs.as_slice());
-        if crate::fixed::lasting(&u, rest / sc.t, &sc, &mut segs) {
+        let mut cruises = crate::fastest::Cruises::default();
+        if crate::fixed::lasting(&u, rest / sc.t, &sc, &mut cruises, &mut segs) {
             return verify(finish(start, segs)?, &target, lim, true).map(Some);
         }
     }
@@ -126,7 +131,7 @@ pub fn velocity_with_duration(
         s = seg.end_state(&start);
     }
     let rest = duration_s - pre_segs.duration_s();
-    if !(rest >= 0.0) {
+    if rest.is_nan() || rest < 0.0 {
         return Ok(None);
     }
     let a0 = s.a.clamp(lim.amin(), lim.amax());
@@ -193,7 +198,8 @@ pub fn trapezoid_velocity_with_duration(
     if (fastest.duration_s() - duration_s).abs() <= 1e-12 * duration_s.max(1e-9) {
         return Ok(Some(fastest));
     }
-    if !(duration_s > fastest.duration_s()) {
+    let longer = duration_s > fastest.duration_s();
+    if !longer {
         return Ok(None);
     }
     let a = (vf - start.v) / duration_s;

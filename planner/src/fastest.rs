@@ -10,6 +10,7 @@
 use crate::Segment;
 use crate::arcs::{Arcs, Sink, family};
 use crate::ramp::Ramp;
+use crate::segs::Push;
 use crate::unit::{Scale, Unit};
 use crate::velocity::{Bounds, change};
 
@@ -46,7 +47,7 @@ impl Cand {
             Cand::Arcs(a) => {
                 let (mut p, mut v, mut acc) = (0.0, a.sign * u.v0, a.sign * u.a0);
                 for (t, j) in a.t.iter().zip(a.jerks()) {
-                    p += t * (v + t * (acc / 2.0 + t * j / 6.0));
+                    p += t * (v + t * (0.5 * acc + t * j * (1.0 / 6.0)));
                     v += t * (acc + t * j / 2.0);
                     acc += t * j;
                 }
@@ -56,26 +57,25 @@ impl Cand {
         }
     }
 
-    /// Append the profile's segments in physical units (zero-duration ones included). Holds
+    /// Append the profile's segments in physical units (zero-duration jerk segments left out). Holds
     /// are zero-jerk segments; the cruise is a constant-acceleration segment at exactly
     /// zero.
-    pub(crate) fn segments(&self, sc: &Scale, out: &mut impl Extend<Segment>) {
+    pub(crate) fn segments(&self, sc: &Scale, out: &mut impl Push) {
         match self {
             Cand::Arcs(a) => {
-                out.extend(a.t.iter().zip(a.jerks()).map(|(t, j)| Segment::Jerk {
-                    duration_s: t * sc.t,
-                    jerk: j * a.sign * sc.j,
-                }));
+                for (t, j) in a.t.iter().zip(a.jerks()) {
+                    out.push_jerk(t * sc.t, j * a.sign * sc.j);
+                }
             }
             Cand::Cruise { c1, cruise, c2, .. } => {
-                out.extend(c1.segments(sc));
+                c1.segments(sc, out);
                 // The cruise holds the acceleration at exactly zero: the change before ends
                 // there only up to rounding, and a cruise can be long enough to matter.
-                out.extend([Segment::Accel {
+                out.push_seg(Segment::Accel {
                     duration_s: cruise * sc.t,
                     accel: 0.0,
-                }]);
-                out.extend(c2.segments(sc));
+                });
+                c2.segments(sc, out);
             }
         }
     }
@@ -117,24 +117,51 @@ fn cruise_changes(u: &Unit, vlim: f64) -> Option<(Ramp, Ramp)> {
     ))
 }
 
-/// The cruise profile at `vlim` (`vmax` or `vmin`), if the distance leaves room for it.
-fn cruise(u: &Unit, vlim: f64) -> Option<Cand> {
-    let (c1, c2) = cruise_changes(u, vlim)?;
-    let cruise = (u.dp - c1.dist - c2.dist) / vlim;
-    (cruise >= 0.0 && cruise.is_finite()).then_some(Cand::Cruise {
-        v: vlim,
-        c1,
-        cruise,
-        c2,
-    })
+/// The velocity changes of the cruises at `vmax` and `vmin` of one problem, computed when
+/// first needed (often only the one at `vmax` is) and kept for step 2.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct Cruises {
+    /// `[vmax, vmin]`: `None` until computed.
+    changes: [Option<Option<(Ramp, Ramp)>>; 2],
+}
+
+impl Cruises {
+    /// The cruise at `vmax` (`k = 0`) or `vmin` (`k = 1`), if the distance leaves room.
+    fn cruise(&mut self, u: &Unit, k: usize) -> Option<Cand> {
+        let (v, (c1, c2)) = self.get(u, k)?;
+        let rest = u.dp - c1.dist - c2.dist;
+        // Room to cruise when the rest of the distance lies in the cruise's direction.
+        if rest * v < 0.0 {
+            return None;
+        }
+        let cruise = rest / v;
+        (cruise >= 0.0 && cruise.is_finite()).then_some(Cand::Cruise { v, c1, cruise, c2 })
+    }
+
+    /// The cruise at `vmax` (`k = 0`) or `vmin` (`k = 1`) lasting `t` (normalised),
+    /// whatever its distance.
+    pub(crate) fn lasting(&mut self, u: &Unit, k: usize, t: f64) -> Option<Cand> {
+        let (v, (c1, c2)) = self.get(u, k)?;
+        lasting_with(v, c1, c2, t)
+    }
+
+    fn get(&mut self, u: &Unit, k: usize) -> Option<(f64, (Ramp, Ramp))> {
+        let v = if k == 0 { u.vmax } else { u.vmin };
+        let r = *self.changes[k].get_or_insert_with(|| cruise_changes(u, v));
+        r.map(|r| (v, r))
+    }
 }
 
 /// The cruise profile at `vlim` lasting `t` (normalised), whatever its distance.
 pub(crate) fn cruise_lasting(u: &Unit, vlim: f64, t: f64) -> Option<Cand> {
     let (c1, c2) = cruise_changes(u, vlim)?;
+    lasting_with(vlim, c1, c2, t)
+}
+
+fn lasting_with(v: f64, c1: Ramp, c2: Ramp, t: f64) -> Option<Cand> {
     let cruise = t - c1.duration() - c2.duration();
     (cruise >= -1e-12 * (1.0 + t) && cruise.is_finite()).then_some(Cand::Cruise {
-        v: vlim,
+        v,
         c1,
         cruise: cruise.max(0.0),
         c2,
@@ -151,23 +178,28 @@ pub(crate) fn cruise_lasting(u: &Unit, vlim: f64, t: f64) -> Option<Cand> {
 ///   `V = max(v0, vf, v0 + a0^2/2 if a0 > 0, vf + af^2/2 if af < 0)` (its velocity maxima
 ///   sit where its acceleration falls through zero, in the first or last arc), so it
 ///   covers at most `max(V, 0) t_max` in less than `t_max`; UDU mirrored.
-pub(crate) fn fastest(u: &Unit, t_max: f64) -> Option<Cand> {
+pub(crate) fn fastest(u: &Unit, t_max: f64, cruises: &mut Cruises) -> Option<Cand> {
     let mut s = Fastest { t_max, best: None };
-    let safe = u.safe();
-    for vlim in [u.vmax, u.vmin] {
-        if let Some(c) = cruise(u, vlim) {
-            if safe && cruise_is_optimal(u, vlim) {
-                return (c.duration() < t_max).then_some(c);
+    if !u.safe() {
+        for k in 0..2 {
+            if let Some(c) = cruises.cruise(u, k) {
+                s.offer(c);
             }
-            s.offer(c);
         }
-    }
-    if !safe {
         family(u, 1.0, &mut s);
         family(&u.mirror(), -1.0, &mut s);
         crate::four_arcs::family(u, 1.0, &mut s);
         crate::four_arcs::family(&u.mirror(), -1.0, &mut s);
         return s.best;
+    }
+    // The cruise towards the target first (often proven fastest), the one away from it
+    // last (rarely a candidate).
+    let (toward, away) = if u.dp >= 0.0 { (0, 1) } else { (1, 0) };
+    if let Some(c) = cruises.cruise(u, toward) {
+        if cruise_is_optimal(u, if toward == 0 { u.vmax } else { u.vmin }) {
+            return (c.duration() < t_max).then_some(c);
+        }
+        s.offer(c);
     }
     let (a0, af) = (u.a0, u.af);
     let v_hi =
@@ -179,12 +211,15 @@ pub(crate) fn fastest(u: &Unit, t_max: f64) -> Option<Cand> {
             .min(u.v0 - 0.5 * a0.min(0.0).powi(2))
             .min(u.vf - 0.5 * af.max(0.0).powi(2));
     let udu = |s: &mut Fastest| {
-        if !(u.dp <= v_lo.min(0.0) * s.t_max) {
+        // (0 times an infinite bound is NaN: no bound, search.)
+        let beyond = u.dp <= v_lo.min(0.0) * s.t_max;
+        if !beyond {
             family(u, 1.0, s);
         }
     };
     let dud = |s: &mut Fastest| {
-        if !(u.dp >= v_hi.max(0.0) * s.t_max) {
+        let beyond = u.dp >= v_hi.max(0.0) * s.t_max;
+        if !beyond {
             family(&u.mirror(), -1.0, s);
         }
     };
@@ -194,6 +229,17 @@ pub(crate) fn fastest(u: &Unit, t_max: f64) -> Option<Cand> {
     } else {
         dud(&mut s);
         udu(&mut s);
+    }
+    // The cruise away from the target changes the velocity to the far limit and back,
+    // which takes at least |dv| / a_limit each way: skip it if that alone is too slow.
+    let (amax, amin) = (u.amax, -u.amin);
+    let slow = if away == 1 {
+        (u.v0 - u.vmin) * amax + (u.vf - u.vmin) * amin >= s.t_max * amax * amin
+    } else {
+        (u.vmax - u.v0) * amin + (u.vmax - u.vf) * amax >= s.t_max * amax * amin
+    };
+    if !slow && let Some(c) = cruises.cruise(u, away) {
+        s.offer(c);
     }
     s.best
 }
@@ -226,8 +272,9 @@ fn cruise_is_optimal(u: &Unit, vlim: f64) -> bool {
 /// Calls `f` with the duration (normalised) of every locally fastest profile of `u`.
 pub(crate) fn each_duration(u: &Unit, f: impl FnMut(f64)) {
     let mut s = Every(f);
-    for vlim in [u.vmax, u.vmin] {
-        if let Some(c) = cruise(u, vlim) {
+    let mut cruises = Cruises::default();
+    for k in 0..2 {
+        if let Some(c) = cruises.cruise(u, k) {
             (s.0)(c.duration());
         }
     }

@@ -22,7 +22,7 @@
 
 use crate::Segment;
 use crate::arcs::{Arcs, Sink, check};
-use crate::fastest::{Cand, cruise_lasting};
+use crate::fastest::{Cand, Cruises, cruise_lasting};
 use crate::segs::Segs;
 use crate::unit::{Scale, Unit};
 
@@ -61,7 +61,13 @@ impl Sink for Extremes {
 
 /// Append the segments (physical units) of a profile from the start of `u` lasting `t`
 /// (normalised) and reaching the target; false (nothing appended) if none exists.
-pub(crate) fn lasting(u: &Unit, t: f64, sc: &Scale, out: &mut Vec<Segment>) -> bool {
+pub(crate) fn lasting(
+    u: &Unit,
+    t: f64,
+    sc: &Scale,
+    cruises: &mut Cruises,
+    out: &mut Vec<Segment>,
+) -> bool {
     let mut ex = Extremes {
         hi: None,
         lo: None,
@@ -74,7 +80,7 @@ pub(crate) fn lasting(u: &Unit, t: f64, sc: &Scale, out: &mut Vec<Segment>) -> b
     let safe = u.safe();
     let mut top = [false; 2];
     for (k, vlim) in [u.vmax, u.vmin].into_iter().enumerate() {
-        if let Some(c) = cruise_lasting(u, vlim, t) {
+        if let Some(c) = cruises.lasting(u, k, t) {
             ex.offer(c);
             top[k] = safe && envelope(u, vlim.signum());
         }

@@ -111,7 +111,7 @@ fn check(u: &Unit, sign: f64, t: [f64; 6], out: &mut impl Sink) {
 /// limits) are valid.
 fn valid(u: &Unit, sign: f64, t: [f64; 6]) -> Option<Arcs> {
     let scale = 1.0 + t.iter().map(|x| x.abs()).sum::<f64>();
-    if t.iter().any(|x| !(*x >= -1e-12 * scale)) {
+    if t.iter().any(|x| x.is_nan() || *x < -1e-12 * scale) {
         return None;
     }
     let t = t.map(|x| x.max(0.0));

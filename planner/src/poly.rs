@@ -37,6 +37,12 @@ impl Roots {
 /// `c[0] + c[1] x + ... + c[n] x^n` and its derivative.
 #[inline]
 fn eval_d(c: &[f64], x: f64) -> (f64, f64) {
+    if let [c0, c1, c2, c3, c4] = *c {
+        // The quartic, unrolled (the common case).
+        let f = (((c4 * x + c3) * x + c2) * x + c1) * x + c0;
+        let d = ((4.0 * c4 * x + 3.0 * c3) * x + 2.0 * c2) * x + c1;
+        return (f, d);
+    }
     let n = c.len() - 1;
     let mut f = c[n];
     let mut d = 0.0;
@@ -182,7 +188,7 @@ fn subdivide(
 /// ascending. Roots within rounding of the interval ends are included.
 pub(crate) fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
     let mut out = Roots::default();
-    if !(lo <= hi) {
+    if lo.is_nan() || hi.is_nan() || lo > hi {
         return out;
     }
     // Trailing zero coefficients lower the degree.
@@ -298,6 +304,8 @@ fn refine(c: &[f64], a: f64, b: f64, fa: f64, x0: f64) -> f64 {
     };
     let tol = 1e-14 * a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
     let mut dx = hi - lo;
+    // The previous Newton step (infinite until there is one, and after a bisection).
+    let mut prev = f64::INFINITY;
     for _ in 0..200 {
         let (f, d) = eval_d(c, x);
         if f == 0.0 {
@@ -309,15 +317,21 @@ fn refine(c: &[f64], a: f64, b: f64, fa: f64, x0: f64) -> f64 {
             hi = x;
         }
         let step = f / d;
-        if step.abs() <= tol {
-            // Converged: this last step is at the level of rounding.
+        // Converged: this step is at the level of rounding, or Newton converges
+        // quadratically (error after a step ~ step^2 / previous step) and the step after
+        // this one would be.
+        if step.abs() <= tol
+            || (prev.is_finite() && step.abs() <= 1e-3 * prev && step * step <= tol * prev)
+        {
             return (x - step).clamp(lo.min(hi), hi.max(lo));
         }
         let newton = x - step;
         let dx_old = std::mem::replace(&mut dx, step);
         if newton > lo.min(hi) && newton < hi.max(lo) && (2.0 * f).abs() <= (dx_old * d).abs() {
             x = newton;
+            prev = step.abs();
         } else {
+            prev = f64::INFINITY;
             dx = 0.5 * (hi - lo);
             x = lo + dx;
             if dx.abs() <= tol {

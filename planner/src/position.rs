@@ -12,6 +12,7 @@
 //! (`oracle::peak`), and a property test checks that both give the same durations.
 
 use crate::brake::{BrakeLaw, brake};
+use crate::fastest::Cruises;
 use crate::segs::Segs;
 use crate::unit::{Scale, Unit};
 use crate::velocity::{Bounds, change};
@@ -171,7 +172,7 @@ pub fn to_velocity(
 /// Position interface: the fastest profile from `start` to `target`.
 ///
 /// A start that must violate the limits is braked first. Braking just long enough
-/// (`brake::minimal`) is not always fastest overall; braking on along the same control law
+/// (`brake::brake`) is not always fastest overall; braking on along the same control law
 /// until the velocity itself is back inside the limits (where Ruckig stops braking) can
 /// be faster. Both ends and points between them are tried and the fastest total is kept.
 pub fn to_state(
@@ -180,7 +181,7 @@ pub fn to_state(
     lim: &Limits,
     shape: Shape,
 ) -> Result<Profile, PlanError> {
-    plan(start, target, lim, shape)?.profile()
+    plan_then(start, target, lim, shape, |p| p.profile())?
 }
 
 /// The fastest profile of one axis, planned but not yet written out as a [`Profile`]
@@ -194,8 +195,19 @@ pub(crate) struct Planned {
     how: How,
 }
 
+// The variants differ in size; boxing the large one would cost the allocation this plan
+// exists to avoid (it lives on the stack or in the caller's vector).
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy)]
 enum How {
+    /// Jerk limited, no brake: `cand`, found for the problem `u` (normalised by `sc`) whose
+    /// cruise changes step 2 can reuse.
+    Direct {
+        sc: Scale,
+        u: Unit,
+        cruises: Cruises,
+        cand: crate::fastest::Cand,
+    },
     /// Jerk limited: brake until `tau`, then `cand` (normalised by `sc`).
     Jerk {
         sc: Scale,
@@ -215,8 +227,9 @@ impl Planned {
     /// The profile, checked to reach the target.
     pub(crate) fn profile(&self) -> Result<Profile, PlanError> {
         let mut segs = Vec::with_capacity(12);
-        match self.how {
-            How::Jerk { sc, tau, cand } => {
+        match &self.how {
+            How::Direct { sc, cand, .. } => cand.segments(sc, &mut segs),
+            &How::Jerk { sc, tau, cand } => {
                 if tau > 0.0 {
                     let (pre_segs, _) = BrakeLaw::new(self.start, &self.lim, sc.j).until(tau);
                     segs.extend_from_slice(pre_segs.as_slice());
@@ -231,15 +244,59 @@ impl Planned {
         }
         verify(finish(self.start, segs)?, &self.target, &self.lim, true)
     }
+
+    /// A profile of the same problem lasting `duration_s` (step 2), or `None` if that
+    /// duration cannot be met. Without a brake this reuses step 1's normalised problem and
+    /// cruise changes.
+    pub(crate) fn lasting(&self, duration_s: f64) -> Result<Option<Profile>, PlanError> {
+        match &self.how {
+            How::Direct { sc, u, cruises, .. } => {
+                let mut segs = Vec::with_capacity(16);
+                let mut cruises = *cruises;
+                if !crate::fixed::lasting(u, duration_s / sc.t, sc, &mut cruises, &mut segs) {
+                    return Ok(None);
+                }
+                verify(finish(self.start, segs)?, &self.target, &self.lim, true).map(Some)
+            }
+            How::Jerk { .. } => crate::duration::with_duration(
+                self.start,
+                self.target,
+                &self.lim,
+                Shape::JerkLimited,
+                duration_s,
+            ),
+            How::Trap(_) => crate::duration::with_duration(
+                self.start,
+                self.target,
+                &self.lim,
+                Shape::Trapezoid,
+                duration_s,
+            ),
+        }
+    }
 }
 
-/// Step 1 for one axis: validate, brake, and find the fastest profile.
-pub(crate) fn plan(
+/// Step 1 for one axis: validate, brake, find the fastest profile, and append its plan
+/// to `out`.
+pub(crate) fn plan_into(
     start: State,
     target: State,
     lim: &Limits,
     shape: Shape,
-) -> Result<Planned, PlanError> {
+    out: &mut Vec<Planned>,
+) -> Result<(), PlanError> {
+    plan_then(start, target, lim, shape, |p| out.push(*p))
+}
+
+/// Step 1, handing the plan to `then` where it is built (no copy of the plan).
+#[inline(always)]
+fn plan_then<R>(
+    start: State,
+    target: State,
+    lim: &Limits,
+    shape: Shape,
+    then: impl FnOnce(&Planned) -> R,
+) -> Result<R, PlanError> {
     finite_state("start", &start)?;
     finite_state("target", &target)?;
     let b = bounds(lim, shape)?;
@@ -254,22 +311,29 @@ pub(crate) fn plan(
         duration_s,
         how,
     };
+    let then = |p: Planned| then(&p);
     if b.jmax.is_infinite() {
         let (pre_segs, s) = pre(start, lim, &b);
         let trap = crate::second_order::fastest(&s, &target, lim).ok_or(none)?;
-        return Ok(planned(
+        return Ok(then(planned(
             pre_segs.duration_s() + trap.duration(),
             How::Trap(trap),
-        ));
+        )));
     }
     let sc = Scale::new(lim, b.jmax);
     if !crate::brake::needed(&start, lim, b.jmax) {
         let u = Unit::new(&start, &target, lim, &sc);
-        let cand = crate::fastest::fastest(&u, f64::INFINITY).ok_or(none)?;
-        return Ok(planned(
+        let mut cruises = Cruises::default();
+        let cand = crate::fastest::fastest(&u, f64::INFINITY, &mut cruises).ok_or(none)?;
+        return Ok(then(planned(
             cand.duration() * sc.t,
-            How::Jerk { sc, tau: 0.0, cand },
-        ));
+            How::Direct {
+                sc,
+                u,
+                cruises,
+                cand,
+            },
+        )));
     }
     let law = BrakeLaw::new(start, lim, b.jmax);
     // (total duration, brake stopping time, profile after the brake)
@@ -278,7 +342,7 @@ pub(crate) fn plan(
         let s = law.state_at(tau, lim);
         let t_max = best.map_or(f64::INFINITY, |(total, _, _)| (total - tau) / sc.t);
         let u = Unit::new(&s, &target, lim, &sc);
-        if let Some(c) = crate::fastest::fastest(&u, t_max) {
+        if let Some(c) = crate::fastest::fastest(&u, t_max, &mut Cruises::default()) {
             let total = tau + c.duration() * sc.t;
             if best.is_none_or(|(bt, _, _)| total < bt) {
                 best = Some((total, tau, c));
@@ -286,7 +350,7 @@ pub(crate) fn plan(
         }
     }
     let (total, tau, cand) = best.ok_or(none)?;
-    Ok(planned(total, How::Jerk { sc, tau, cand }))
+    Ok(then(planned(total, How::Jerk { sc, tau, cand })))
 }
 
 /// The profile from `start` through `segs`, dropping zero-duration segments except a

@@ -5,6 +5,7 @@
 //! the target; `velocity::change`, which considers every shape, is the general fallback.
 
 use crate::Segment;
+use crate::segs::Push;
 use crate::unit::Scale;
 use crate::velocity::Change;
 
@@ -27,7 +28,7 @@ impl Ramp {
     pub(crate) fn up_down(v0: f64, a0: f64, v1: f64, a1: f64, alim: f64) -> Option<Self> {
         let q = v1 - v0 + 0.5 * (a0 * a0 + a1 * a1);
         let lo = a0.max(a1);
-        if !(q >= 0.0) || q.sqrt() < lo - 1e-12 {
+        if q.is_nan() || q < 0.0 || q.sqrt() < lo - 1e-12 {
             return None;
         }
         let mut a = q.sqrt().max(lo);
@@ -41,9 +42,10 @@ impl Ramp {
         let (t1, t2) = (a - a0, a - a1);
         let va = v0 + 0.5 * (a * a - a0 * a0);
         let vb = va + a * hold;
-        let dist = t1 * (v0 + t1 * (a0 / 2.0 + t1 / 6.0))
+        const SIXTH: f64 = 1.0 / 6.0;
+        let dist = t1 * (v0 + t1 * (0.5 * a0 + t1 * SIXTH))
             + hold * (va + a * hold / 2.0)
-            + t2 * (vb + t2 * (a / 2.0 - t2 / 6.0));
+            + t2 * (vb + t2 * (0.5 * a - t2 * SIXTH));
         Some(Self {
             t1,
             hold,
@@ -84,30 +86,19 @@ impl Ramp {
         self.t1 + self.hold + self.t2
     }
 
-    /// The change's segments, in physical units `sc`.
-    pub(crate) fn segments(&self, sc: &Scale) -> [Segment; 3] {
+    /// Append the change's segments (those that last), in physical units `sc`.
+    pub(crate) fn segments(&self, sc: &Scale, out: &mut impl Push) {
         let j = self.sign * sc.j;
-        [
-            Segment::Jerk {
-                duration_s: self.t1 * sc.t,
-                jerk: j,
-            },
-            Segment::Jerk {
-                duration_s: self.hold * sc.t,
-                jerk: 0.0,
-            },
-            Segment::Jerk {
-                duration_s: self.t2 * sc.t,
-                jerk: -j,
-            },
-        ]
+        out.push_jerk(self.t1 * sc.t, j);
+        out.push_jerk(self.hold * sc.t, 0.0);
+        out.push_jerk(self.t2 * sc.t, -j);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::velocity::{Bounds, Change, change};
+    use crate::velocity::{Bounds, change};
 
     #[test]
     fn equals_the_general_change_where_it_applies() {
@@ -132,10 +123,18 @@ mod tests {
                 p: 1.0,
                 j: 1.0,
             };
-            let e = Change {
-                segments: r.segments(&unit),
-            }
-            .end(v0, a0);
+            let mut segs = Vec::new();
+            r.segments(&unit, &mut segs);
+            let e = crate::Profile::new(
+                crate::State {
+                    p: 0.0,
+                    v: v0,
+                    a: a0,
+                },
+                segs,
+            )
+            .expect("valid")
+            .end();
             assert!((r.duration() - c.duration_s()).abs() < 1e-12, "{r:?} {c:?}");
             assert!(
                 (e.p - r.dist).abs() < 1e-12 && (e.v - v1).abs() < 1e-12,

@@ -11,7 +11,7 @@
 //! at `vmax`, down; the lowest the mirror; a mixture of the two (see `blend`) reaches any
 //! distance between.
 
-use crate::segs::Segs;
+use crate::segs::{Push, Segs};
 use crate::{Limits, Segment, State};
 
 /// A trapezoid profile: `a1` until `vp`, cruise, `a2` until `vf`, jump to `af`.
@@ -50,25 +50,15 @@ impl Trap {
     }
 
     /// Append the segments.
-    pub(crate) fn segments(&self, out: &mut impl Extend<Segment>) {
-        out.extend([
-            Segment::Accel {
-                duration_s: self.t1,
-                accel: self.a1,
-            },
-            Segment::Accel {
-                duration_s: self.cruise,
-                accel: 0.0,
-            },
-            Segment::Accel {
-                duration_s: self.t2,
-                accel: self.a2,
-            },
-            Segment::Accel {
-                duration_s: 0.0,
-                accel: self.af,
-            },
-        ]);
+    pub(crate) fn segments(&self, out: &mut impl Push) {
+        for (duration_s, accel) in [
+            (self.t1, self.a1),
+            (self.cruise, 0.0),
+            (self.t2, self.a2),
+            (0.0, self.af),
+        ] {
+            out.push_seg(Segment::Accel { duration_s, accel });
+        }
     }
 }
 
@@ -89,7 +79,7 @@ fn each(s: &State, target: &State, lim: &Limits, mut f: impl FnMut(Trap)) {
     for (up, down) in [(amax, amin), (amin, amax)] {
         let q = (dp + v0 * v0 / (2.0 * up) - vf * vf / (2.0 * down))
             / (1.0 / (2.0 * up) - 1.0 / (2.0 * down));
-        if !(q >= 0.0) {
+        if q.is_nan() || q < 0.0 {
             continue;
         }
         for vp in [q.sqrt(), -q.sqrt()] {

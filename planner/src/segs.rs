@@ -42,10 +42,27 @@ impl<const CAP: usize> Segs<CAP> {
     }
 }
 
-impl<const CAP: usize> Extend<Segment> for Segs<CAP> {
-    fn extend<I: IntoIterator<Item = Segment>>(&mut self, iter: I) {
-        for seg in iter {
-            self.push(seg);
+/// Somewhere to append segments: a profile's `Vec` or a [`Segs`] on the stack.
+pub(crate) trait Push {
+    /// Append `seg`.
+    fn push_seg(&mut self, seg: Segment);
+
+    /// Append a constant-jerk segment, unless it lasts no time (it would change nothing).
+    fn push_jerk(&mut self, duration_s: f64, jerk: f64) {
+        if duration_s != 0.0 {
+            self.push_seg(Segment::Jerk { duration_s, jerk });
         }
+    }
+}
+
+impl Push for Vec<Segment> {
+    fn push_seg(&mut self, seg: Segment) {
+        self.push(seg);
+    }
+}
+
+impl<const CAP: usize> Push for Segs<CAP> {
+    fn push_seg(&mut self, seg: Segment) {
+        self.push(seg);
     }
 }

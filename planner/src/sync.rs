@@ -8,7 +8,7 @@
 //!   limiting axis's profile scaled onto the others, if it keeps them within their limits;
 //!   otherwise time synchronisation.
 
-use crate::duration::{branch_starts, with_duration};
+use crate::duration::branch_starts;
 use crate::position::{self, Planned, Shape};
 use crate::{Limits, PlanError, Profile, Segment, State};
 
@@ -42,11 +42,13 @@ pub fn plan(axes: &[Axis], shape: Shape, sync: Sync) -> Result<Vec<Profile>, Pla
             source: Box::new(e),
         }
     };
-    let fastest: Vec<Planned> = axes
-        .iter()
-        .enumerate()
-        .map(|(i, a)| position::plan(a.start, a.target, &a.limits, shape).map_err(on_axis(i)))
-        .collect::<Result<_, _>>()?;
+    // Plans are large: built in place (an iterator collecting results would copy each
+    // several times).
+    let mut fastest: Vec<Planned> = Vec::with_capacity(axes.len());
+    for (i, a) in axes.iter().enumerate() {
+        position::plan_into(a.start, a.target, &a.limits, shape, &mut fastest)
+            .map_err(on_axis(i))?;
+    }
     let all = || -> Result<Vec<Profile>, PlanError> {
         fastest
             .iter()
@@ -67,7 +69,7 @@ pub fn plan(axes: &[Axis], shape: Shape, sync: Sync) -> Result<Vec<Profile>, Pla
 
 fn time(axes: &[Axis], shape: Shape, fastest: &[Planned]) -> Result<Vec<Profile>, PlanError> {
     let t_min = fastest.iter().map(Planned::duration_s).fold(0.0, f64::max);
-    if let Some(out) = all_at(axes, shape, fastest, t_min)? {
+    if let Some(out) = all_at(fastest, t_min)? {
         return Ok(out);
     }
     // Some axis cannot last t_min (a blocked interval): try the later durations at which
@@ -83,7 +85,7 @@ fn time(axes: &[Axis], shape: Shape, fastest: &[Planned]) -> Result<Vec<Profile>
     candidates.sort_by(f64::total_cmp);
     candidates.dedup();
     for t in candidates {
-        if let Some(out) = all_at(axes, shape, fastest, t)? {
+        if let Some(out) = all_at(fastest, t)? {
             return Ok(out);
         }
     }
@@ -93,20 +95,18 @@ fn time(axes: &[Axis], shape: Shape, fastest: &[Planned]) -> Result<Vec<Profile>
 }
 
 /// Every axis lasting `t` (its fastest profile where that lasts `t`), or `None`.
-fn all_at(
-    axes: &[Axis],
-    shape: Shape,
-    fastest: &[Planned],
-    t: f64,
-) -> Result<Option<Vec<Profile>>, PlanError> {
-    let mut out = Vec::with_capacity(axes.len());
-    for (i, (a, f)) in axes.iter().zip(fastest).enumerate() {
+fn all_at(fastest: &[Planned], t: f64) -> Result<Option<Vec<Profile>>, PlanError> {
+    let mut out = Vec::with_capacity(fastest.len());
+    for (i, f) in fastest.iter().enumerate() {
         if (f.duration_s() - t).abs() <= 1e-12 * t.max(1e-9) {
             out.push(f.profile().map_err(|e| PlanError::OnAxis {
                 axis: i,
                 source: Box::new(e),
             })?);
-        } else if let Some(p) = with_duration(a.start, a.target, &a.limits, shape, t)? {
+        } else if let Some(p) = f.lasting(t).map_err(|e| PlanError::OnAxis {
+            axis: i,
+            source: Box::new(e),
+        })? {
             out.push(p);
         } else {
             return Ok(None);

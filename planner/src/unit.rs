@@ -56,7 +56,11 @@ impl Scale {
 impl Unit {
     /// The problem from `s` to `target` in the units `sc`.
     pub(crate) fn new(s: &State, target: &State, lim: &Limits, sc: &Scale) -> Self {
-        let (ra, rv, rp) = (1.0 / sc.a, 1.0 / sc.v, 1.0 / sc.p);
+        // One division: 1/t = j/a, 1/v = 1/(a t), 1/p = 1/(v t).
+        let ra = 1.0 / sc.a;
+        let rt = sc.j * ra;
+        let rv = ra * rt;
+        let rp = rv * rt;
         Self {
             v0: s.v * rv,
             a0: s.a * ra,

@@ -97,6 +97,9 @@ fn three_dof_time_sync_vs_the_official_ruckig() {
     eprintln!(
         "3-DoF vs official Ruckig: equal {equal}, shorter after a brake {shorter}, longer {longer}"
     );
-    // Known gap (issue 3): see multi_axis.rs. Guard against regressions; the goal is zero.
-    assert!((longer as f64) < 1e-4 * (equal + shorter + longer) as f64);
+    // As in multi_axis.rs: never longer.
+    assert!(
+        longer == 0,
+        "{longer} synchronised durations longer than Ruckig's"
+    );
 }

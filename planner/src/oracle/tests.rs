@@ -21,20 +21,21 @@ fn cases() -> usize {
         .unwrap_or(20_000)
 }
 
-/// One axis: `kind % 4` = 0 symmetric, 1 asymmetric limits, 2 scaled by 10^(-3..6),
-/// 3 zero target acceleration.
+/// One axis: `kind % 5` = 0 symmetric, 1 asymmetric limits, 2 scaled by 10^(-3..6),
+/// 3 zero target acceleration, 4 long moves (mostly cruising at a velocity limit).
 fn draw(rng: &mut ChaCha8Rng, kind: usize) -> Axis {
+    let kind = kind % 5;
     let p = Normal::new(0.0, 4.0).expect("normal");
     let va = Normal::new(0.0, 0.8).expect("normal");
     let g = Gamma::new(2.0, 2.0).expect("gamma");
-    let scale = if kind % 4 == 2 {
+    let scale = if kind == 2 {
         10f64.powf(rng.random_range(-3.0..6.0))
     } else {
         1.0
     };
     let mut lim = || scale * (g.sample(rng) + 0.05);
     let (vmax, amax, jmax) = (lim(), lim(), lim());
-    let limits = if kind % 4 == 1 {
+    let limits = if kind == 1 {
         Limits::asymmetric(vmax, Some(-lim()), amax, Some(-lim()), Some(jmax))
     } else {
         Limits::new(vmax, amax, Some(jmax))
@@ -46,12 +47,28 @@ fn draw(rng: &mut ChaCha8Rng, kind: usize) -> Axis {
         a: scale * va.sample(rng),
     };
     let (start, mut target) = (state(), state());
-    if kind % 4 == 3 {
+    if kind == 3 {
         target.a = 0.0;
+    }
+    if kind == 4 {
+        target.p = start.p + 10.0 * (target.p - start.p);
     }
     Axis {
         start,
         target,
+        limits,
+    }
+}
+
+/// The jerk-unlimited version of an axis (no jerk limit, zero accelerations).
+fn trapezoid(a: &Axis) -> Axis {
+    let l = &a.limits;
+    let limits = Limits::asymmetric(l.vmax(), Some(l.vmin()), l.amax(), Some(l.amin()), None)
+        .expect("limits");
+    let zero_a = |s: State| State { a: 0.0, ..s };
+    Axis {
+        start: zero_a(a.start),
+        target: zero_a(a.target),
         limits,
     }
 }
@@ -132,24 +149,12 @@ fn step_1_equals_the_oracle() {
         } else {
             Shape::JerkLimited
         };
-        let (mut start, mut target, mut limits) = (a.start, a.target, a.limits);
-        if shape == Shape::Trapezoid {
-            start.a = 0.0;
-            target.a = 0.0;
-            limits = Limits::asymmetric(
-                limits.vmax(),
-                Some(limits.vmin()),
-                limits.amax(),
-                Some(limits.amin()),
-                None,
-            )
-            .expect("limits");
-        }
-        let a = Axis {
-            start,
-            target,
-            limits,
+        let a = if shape == Shape::Trapezoid {
+            trapezoid(&a)
+        } else {
+            a
         };
+        let (start, target, limits) = (a.start, a.target, a.limits);
         let fast = to_state(start, target, &limits, shape);
         let slow = super::peak::to_state(start, target, &limits, shape);
         match (fast, slow) {
