@@ -64,10 +64,18 @@ impl BrakeLaw {
         let vz = s.v + s.a * s.a.abs() / (2.0 * j);
         // Brake when vz is beyond a limit, or when v is (then, with vz inside, the earliest
         // stop is immediate and the latest is where v is back inside).
-        let (dir, vlim, alim) = if vz > lim.vmax() || s.v > lim.vmax() {
-            (1.0, lim.vmax(), lim.amin())
-        } else if vz < lim.vmin() || s.v < lim.vmin() {
-            (-1.0, lim.vmin(), lim.amax())
+        // The direction is where the velocity is heading: vz decides; only with vz inside
+        // does an excess of v itself (which the acceleration is already correcting).
+        let up = (1.0, lim.vmax(), lim.amin(), lim.vmin());
+        let down = (-1.0, lim.vmin(), lim.amax(), lim.vmax());
+        let (dir, vlim, alim, vopp) = if vz > lim.vmax() {
+            up
+        } else if vz < lim.vmin() {
+            down
+        } else if s.v > lim.vmax() {
+            up
+        } else if s.v < lim.vmin() {
+            down
         } else {
             return Self {
                 start,
@@ -96,6 +104,17 @@ impl BrakeLaw {
             let vz_at_floor = vz0 - j * tau_floor * tau_floor;
             after_accel + jerk_len(tau_floor) + (vz_at_floor - dir * vlim) / (-a_floor)
         };
+        // The latest stop is where v is back inside, but no later than where vz reaches the
+        // opposite limit (braking on from there, the velocity must overshoot that limit).
+        let vz_opp = -dir * vopp;
+        let tau_opp = ((vz0 + vz_opp) / j).max(0.0).sqrt();
+        let doomed = if tau_opp <= tau_floor {
+            after_accel + jerk_len(tau_opp)
+        } else {
+            let vz_at_floor = vz0 - j * tau_floor * tau_floor;
+            after_accel + jerk_len(tau_floor) + (vz_at_floor + vz_opp) / (-a_floor)
+        };
+        let tau_v = if tau_opp < tau_v { tau_opp } else { tau_v };
         let latest;
         if tau_v <= tau_floor {
             latest = after_accel + jerk_len(tau_v);
@@ -119,7 +138,7 @@ impl BrakeLaw {
             s.a = alim;
             let v_at_floor = dir * s.v;
             let hold = ((v_at_floor - dir * vlim) / (-a_floor)).max(0.0);
-            latest = t + hold;
+            latest = (t + hold).min(doomed);
             push(
                 Segment::Accel {
                     duration_s: hold,

@@ -42,49 +42,126 @@ pub fn braked(a: &Axis) -> bool {
         || vz < l.vmin()
 }
 
-/// Limits hold from the moment they first hold (a start outside them is braked back in):
-/// jerk always; acceleration and velocity at every segment end and at interior velocity
-/// extrema. Returns a description of the first violation.
+/// Limits hold from the moment they first hold (a start outside them is braked back in).
+/// Returns a description of the first violation. Rules (tolerance 1e-9 relative):
+/// - jerk within `jmax` always;
+/// - acceleration: once inside `[amin, amax]` it stays inside (it is linear in each segment,
+///   so both ends of every segment are checked); outside it only at the start and moving
+///   towards the limits;
+/// - velocity, checked on the monotone pieces of every segment (split where the
+///   acceleration crosses zero, so it cannot slip through the band inside a segment):
+///   once the state is safe (v inside, and the velocity reached by ramping the acceleration
+///   to zero at full jerk, vz, inside too) it stays inside. Before that the start may
+///   overshoot (the side where vz, else v, is beyond the band): on that side it may rise no
+///   higher than the start's own v or vz and, once it falls, never rise beyond the limit
+///   again; beyond the other side only at the start and returning monotonically.
 #[allow(dead_code)]
 pub fn check_limits(prof: &Profile, lim: &Limits) -> Result<(), String> {
     let tol = 1e-9;
     let j = lim.jmax().unwrap_or(f64::INFINITY);
     let (vmax, vmin) = (lim.vmax() * (1.0 + tol), lim.vmin() * (1.0 + tol));
     let (amax, amin) = (lim.amax() * (1.0 + tol), lim.amin() * (1.0 + tol));
+    let vtol = tol * lim.vmax().max(-lim.vmin());
+    let vz_of = |st: &State| {
+        if j.is_finite() {
+            st.v + st.a * st.a.abs() / (2.0 * j)
+        } else {
+            st.v
+        }
+    };
     let s0 = prof.start();
     let mut a_in = s0.a <= amax && s0.a >= amin;
-    // The velocity limit binds once the state is safe: v inside, and the velocity reached by
-    // ramping the acceleration to zero (vz) inside too. Before that, exceeding it may be
-    // unavoidable.
     let safe = |st: &State| {
-        let vz = st.v + st.a * st.a.abs() / (2.0 * j);
+        let vz = vz_of(st);
         st.v <= vmax && st.v >= vmin && vz <= vmax && vz >= vmin
     };
     let mut v_in = safe(&s0);
+    // The overshoot direction of an unsafe start (+1 above vmax, -1 below vmin), in the
+    // frame `d * v` where it is upwards; the band is then [lo, hi].
+    let vz0 = vz_of(&s0);
+    let d = if vz0 > vmax {
+        1.0
+    } else if vz0 < vmin {
+        -1.0
+    } else if s0.v > vmax {
+        1.0
+    } else {
+        -1.0
+    };
+    let (lo, hi) = if d > 0.0 {
+        (vmin, vmax)
+    } else {
+        (-vmax, -vmin)
+    };
+    // The highest velocity the overshoot may reach (mirrored frame).
+    let peak = (d * s0.v).max(d * vz0) + vtol;
+    // Still below the band from the start (allowed while it returns monotonically).
+    let mut below = d * s0.v < lo;
+    let mut fallen = false;
     for (t, s, seg) in prof.iter() {
         let (a0, jerk) = seg.accel_and_jerk(&s);
         if jerk.abs() > j * (1.0 + tol) {
             return Err(format!("jerk {jerk} at t={t}"));
         }
         let e = seg.end_state(&s);
-        let mut vs = vec![s.v, e.v];
-        if jerk != 0.0 {
-            let tau = -a0 / jerk;
-            if tau > 0.0 && tau < seg.duration_s() {
-                vs.push(seg.sample(&s, tau).v);
-            }
+        if seg.duration_s() == 0.0 {
+            continue;
         }
-        for val in [a0, e.a] {
-            if a_in && (val > amax || val < amin) {
-                return Err(format!("a = {val} leaves the limits at t={t}"));
+        // Acceleration (linear in the segment: its ends bound it).
+        if a_in {
+            if a0 > amax || a0 < amin || e.a > amax || e.a < amin {
+                return Err(format!("a = {a0} -> {} leaves the limits at t={t}", e.a));
             }
-            if val <= amax && val >= amin {
+        } else {
+            let towards = (a0 > amax && jerk < 0.0) || (a0 < amin && jerk > 0.0);
+            if !towards {
+                return Err(format!("a = {a0} outside the limits, not returning, t={t}"));
+            }
+            if e.a <= amax && e.a >= amin {
                 a_in = true;
             }
         }
-        for v in vs {
-            if v_in && (v > vmax || v < vmin) {
-                return Err(format!("v = {v} leaves the limits near t={t}"));
+        // Velocity on monotone pieces.
+        let mut ends = [s.v, e.v, e.v];
+        let mut n = 2;
+        if jerk != 0.0 {
+            let tau = -a0 / jerk;
+            if tau > 0.0 && tau < seg.duration_s() {
+                ends[1] = seg.sample(&s, tau).v;
+                n = 3;
+            }
+        }
+        for w in ends[..n].windows(2) {
+            let (va, vb) = (w[0], w[1]);
+            if v_in {
+                if vb > vmax || vb < vmin {
+                    return Err(format!("v = {vb} leaves the limits near t={t}"));
+                }
+                continue;
+            }
+            // Mirrored frame: the overshoot is upwards.
+            let (ma, mb) = (d * va, d * vb);
+            if mb < lo {
+                if !(below && mb > ma) {
+                    return Err(format!(
+                        "v = {va} -> {vb} beyond the side opposite the overshoot near t={t}"
+                    ));
+                }
+            } else {
+                below = false;
+            }
+            if mb > peak {
+                return Err(format!(
+                    "v = {vb} beyond the start's overshoot ({}) near t={t}",
+                    d * peak
+                ));
+            }
+            if mb < ma - vtol {
+                fallen = true;
+            } else if fallen && mb > hi && mb > ma + vtol {
+                return Err(format!(
+                    "v = {va} -> {vb} rises beyond the limit again near t={t}"
+                ));
             }
         }
         if safe(&e) {
