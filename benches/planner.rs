@@ -285,9 +285,55 @@ fn interleaved() {
     );
 }
 
+/// The benches compare equal work: settle's durations on the problem sets equal
+/// rsruckig's within 1e-9 relative (shorter only after a brake, where settle may stop
+/// braking earlier), checked before timing. Prints the counts.
+fn check_durations() {
+    let states = states();
+    let mut rs1 = Rs::<1>::new();
+    let (mut equal, mut shorter) = (0, 0);
+    for x in &states {
+        let ours = to_state(x.0, x.1, &x.2, Shape::JerkLimited)
+            .expect("settle plans")
+            .duration_s();
+        rs1.solve(std::slice::from_ref(x));
+        let theirs = rs1.traj.get_duration();
+        let rel = (ours - theirs) / theirs;
+        assert!(rel <= 1e-9, "settle {ours} s vs rsruckig {theirs} s: {x:?}");
+        if rel >= -1e-9 {
+            equal += 1;
+        } else {
+            shorter += 1;
+        }
+    }
+    let mut rs3 = Rs::<3>::new();
+    let (mut equal3, mut shorter3) = (0, 0);
+    for (a, x) in three_axes(&states).iter().zip(states.chunks_exact(3)) {
+        let ours = plan(a, Shape::JerkLimited, Sync::Time)
+            .expect("settle plans")
+            .iter()
+            .map(|p| p.duration_s())
+            .fold(0.0, f64::max);
+        rs3.solve(x);
+        let theirs = rs3.traj.get_duration();
+        let rel = (ours - theirs) / theirs;
+        assert!(rel <= 1e-9, "settle {ours} s vs rsruckig {theirs} s: {x:?}");
+        if rel >= -1e-9 {
+            equal3 += 1;
+        } else {
+            shorter3 += 1;
+        }
+    }
+    println!(
+        "durations vs rsruckig: 1-DoF {equal} equal, {shorter} shorter after a brake; \
+         3-DoF {equal3} equal, {shorter3} shorter after a brake; none longer"
+    );
+}
+
 criterion_group!(benches, bench);
 
 fn main() {
+    check_durations();
     benches();
     // The interleaved comparison runs with no filter or a filter naming it.
     let filters: Vec<String> = std::env::args()
