@@ -75,6 +75,12 @@ pub enum Error {
         /// What the planner reported.
         source: settle_planner::PlanError,
     },
+    /// The run was not started: the sweep was interrupted (Ctrl-C or SIGTERM).
+    #[error("run {run}: not run, the sweep was interrupted")]
+    Interrupted {
+        /// Run index.
+        run: usize,
+    },
 }
 
 impl Error {

@@ -5,6 +5,8 @@
 //! written as tables ([`report`]).
 
 pub mod error;
+pub mod interrupt;
+pub mod journal;
 pub mod locate;
 pub mod machine_file;
 pub mod metrics;
@@ -44,14 +46,17 @@ pub fn run_all(
 }
 
 /// [`run_all`] with a custom way to run one spec (e.g. recording it: [`sink::Recorder`]).
-pub fn run_all_with<F>(
+/// Once an interruption is requested ([`interrupt`]), runs not yet started are not started
+/// and come back as [`Error::Interrupted`]; runs in progress finish.
+pub fn run_all_with<T, F>(
     runs: &[RunSpec],
     jobs: Option<usize>,
     progress: bool,
     run_one: F,
-) -> Result<Vec<Result<Metrics, Error>>, Error>
+) -> Result<Vec<Result<T, Error>>, Error>
 where
-    F: Fn(&RunSpec) -> Result<Metrics, Error> + Sync,
+    T: Send,
+    F: Fn(&RunSpec) -> Result<T, Error> + Sync,
 {
     let bar = if progress {
         let bar =
@@ -81,6 +86,9 @@ where
     let results = pool.install(|| {
         runs.par_iter()
             .map(|spec| {
+                if interrupt::requested() {
+                    return Err(Error::Interrupted { run: spec.id });
+                }
                 let r = run_one(spec);
                 bar.inc(1);
                 r

@@ -50,6 +50,9 @@ enum Command {
         /// DIR [default: results/<scenario name>/shard-K-of-N/]; combine with `settle merge`.
         #[arg(long, value_name = "K/N")]
         shard: Option<settle::shard::Shard>,
+        /// Continue an interrupted sweep: keep the runs in OUT/journal.csv, run the rest.
+        #[arg(long)]
+        resume: bool,
     },
     /// Check every backend against the closed form and against each other; print a table.
     #[command(
@@ -167,6 +170,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             backend,
             outputs,
             shard,
+            resume,
         } => sweep(
             scenario,
             out,
@@ -174,6 +178,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             backend,
             outputs,
             shard,
+            resume,
         ),
         Command::Validate { backend, out } => settle::validate::command(backend, out.as_deref()),
         Command::Check {
@@ -253,6 +258,7 @@ fn sweep(
     backend: Backend,
     flags: OutputFlags,
     shard: Option<settle::shard::Shard>,
+    resume: bool,
 ) -> anyhow::Result<ExitCode> {
     let started = Instant::now();
     let (sc, mut all_runs) = settle::load_runs(&path)?;
@@ -297,15 +303,91 @@ fn sweep(
         )),
         out.display()
     );
-    let results = match &rec {
-        Some(r) => settle::run_all_with(&runs, jobs, true, |spec| r.run(spec))?,
-        None => settle::run_all(&runs, jobs, true)?,
+    // Every finished run's row goes to the journal at once, so an interruption (or a
+    // crash) loses nothing: `--resume` runs only what is missing (see settle::journal).
+    let header = report::runs_csv(&runs, &[]);
+    let scenario_text = std::fs::read_to_string(&path).map_err(|source| Error::Read {
+        path: path.clone(),
+        source,
+    })?;
+    let key = settle::journal::key_line(
+        &scenario_text,
+        &sc.name,
+        backend.name(),
+        &shard.map_or(String::new(), |s| s.to_string()),
+    );
+    let ids: Vec<usize> = runs.iter().map(|r| r.id).collect();
+    let (journal, done) = match settle::journal::existing(&out) {
+        Some(_) if resume => settle::journal::Journal::resume(&out, &key, &header, &ids)?,
+        Some(p) => {
+            return Err(usage_error(
+                "--resume",
+                format!(
+                    "{} holds an interrupted sweep: continue it with --resume, or delete the file to start over",
+                    p.display()
+                ),
+            )
+            .into());
+        }
+        None => (
+            settle::journal::Journal::start(&out, &key, &header)?,
+            Default::default(),
+        ),
     };
-    let mut metrics = Vec::with_capacity(results.len());
-    for r in results {
-        metrics.push(r.context("a run failed; runs.csv and summary.md were not written")?);
+    if resume {
+        eprintln!(
+            "resuming: {} of {} runs already finished",
+            done.len(),
+            runs.len()
+        );
     }
-    let csv = report::runs_csv(&runs, &metrics);
+    let todo: Vec<settle::RunSpec> = runs
+        .iter()
+        .filter(|r| !done.contains_key(&r.id))
+        .cloned()
+        .collect();
+    settle::interrupt::install().map_err(|m| usage_error("signals", m))?;
+    let run_one = |spec: &settle::RunSpec| -> Result<String, Error> {
+        let m = match &rec {
+            Some(r) => r.run(spec),
+            None => settle::run::execute(spec, None),
+        }
+        // A run that fails is a row with its reason; the sweep goes on (issue 8).
+        .unwrap_or_else(|e| settle::Metrics::failed(&spec.bands_um, format!("{e}")));
+        let row = report::runs_csv(std::slice::from_ref(spec), std::slice::from_ref(&m))
+            [header.len()..]
+            .to_string();
+        journal.append(&row)?;
+        Ok(row)
+    };
+    let results = settle::run_all_with(&todo, jobs, true, run_one)?;
+    let mut rows = done;
+    let mut interrupted = 0usize;
+    for (spec, r) in todo.iter().zip(results) {
+        match r {
+            Ok(row) => {
+                rows.insert(spec.id, row);
+            }
+            Err(Error::Interrupted { .. }) => interrupted += 1,
+            Err(e) => return Err(e.into()),
+        }
+    }
+    if interrupted > 0 || settle::interrupt::requested() {
+        eprintln!(
+            "interrupted: {} of {} runs finished and kept in {}; continue with\n  settle sweep {} --out {} --resume{}",
+            rows.len(),
+            runs.len(),
+            out.join(settle::journal::FILE).display(),
+            path.display(),
+            out.display(),
+            shard.map_or(String::new(), |s| format!(" --shard {s}"))
+        );
+        return Ok(ExitCode::from(settle::interrupt::EXIT_CODE));
+    }
+    let mut csv = header;
+    for r in &runs {
+        csv.push_str(&rows[&r.id]);
+    }
     match shard {
         Some(s) => {
             report::write_atomic(&out.join("runs.csv"), csv.as_bytes())?;
@@ -354,7 +436,43 @@ fn sweep(
             );
         }
     }
-    Ok(ExitCode::SUCCESS)
+    journal.finish()?;
+    Ok(report_failures(&runs, &csv))
+}
+
+/// Print the failed runs (at most 20, then a count) from runs.csv's `status` and `reason`
+/// columns, and return exit code 1 if there are any, success otherwise.
+fn report_failures(runs: &[settle::RunSpec], csv: &str) -> ExitCode {
+    let Ok(table) = settle::table::RunsTable::parse(csv) else {
+        return ExitCode::from(1);
+    };
+    let failed: Vec<usize> = (0..runs.len())
+        .filter(|&i| table.cell(i, "status").is_some_and(|s| s != "ok"))
+        .collect();
+    if failed.is_empty() {
+        return ExitCode::SUCCESS;
+    }
+    eprintln!(
+        "{} of {} runs failed (status and reason in runs.csv):",
+        failed.len(),
+        runs.len()
+    );
+    const SHOWN: usize = 20;
+    for &i in failed.iter().take(SHOWN) {
+        let r = &runs[i];
+        eprintln!(
+            "  run {} ({}, {} mm): {}: {}",
+            r.id,
+            r.profile,
+            r.distance_mm,
+            table.cell(i, "status").unwrap_or_default(),
+            table.cell(i, "reason").unwrap_or_default()
+        );
+    }
+    if failed.len() > SHOWN {
+        eprintln!("  ... and {} more", failed.len() - SHOWN);
+    }
+    ExitCode::from(1)
 }
 
 fn check(

@@ -40,6 +40,14 @@ fn csv_time(t: Option<f64>) -> String {
     t.map_or_else(|| "inf".to_string(), |x| x.to_string())
 }
 
+/// Free text as one CSV cell without quoting: separators and line breaks become `;` and
+/// spaces, quotes apostrophes.
+fn csv_text(s: &str) -> String {
+    s.replace(',', ";")
+        .replace(['\n', '\r'], " ")
+        .replace('"', "'")
+}
+
 /// The CSV: run parameters, then metrics. `settle_time_s_<band>` and
 /// `move_and_settle_s_<band>` are `inf` when the run did not settle within the window.
 pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
@@ -53,7 +61,7 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
             ",mode{i}_frequency_hz,mode{i}_damping_ratio,mode{i}_weight"
         );
     }
-    out.push_str(",machine,axis,driver,backend,status,lost_steps");
+    out.push_str(",machine,axis,driver,backend,status,lost_steps,reason");
     out.push_str(",move_time_s,residual_peak_um,residual_rms_um");
     for b in &bands {
         let _ = write!(out, ",settle_time_s_{}", band_label(*b));
@@ -63,9 +71,11 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
     }
     out.push_str(",overshoot_um,max_following_error_um");
     // Per-axis metrics for physical machines (the modes form has one axis: the above).
-    let axis_names: Vec<String> = metrics
+    // The columns come from the machine, so the header is the same whatever the runs'
+    // results (the sweep journal relies on it: see `journal`).
+    let axis_names: Vec<String> = runs
         .first()
-        .filter(|_| runs.first().is_some_and(|r| r.machine.is_some()))
+        .and_then(|r| r.machine.as_ref())
         .map(|m| m.axes.iter().map(|a| a.name.clone()).collect())
         .unwrap_or_default();
     for a in &axis_names {
@@ -97,13 +107,14 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
         }
         let _ = write!(
             out,
-            ",{},{},{},{},{},{}",
+            ",{},{},{},{},{},{},{}",
             r.machine_name,
             r.axis,
             r.driver,
             r.backend,
             m.status.name(),
-            m.status.lost_steps()
+            m.status.lost_steps(),
+            csv_text(&m.status.reason())
         );
         if !m.is_ok() {
             // A run that lost steps has no settling result: its metric cells stay empty
@@ -190,8 +201,18 @@ impl RowView<'_> {
             .cell(self.row, "status")
             .is_none_or(|s| s == "ok")
     }
-    fn lost_steps(&self) -> u64 {
-        self.num("lost_steps").map_or(0, |x| x as u64)
+    /// What the summary shows instead of a failed run's numbers.
+    fn failure(&self) -> String {
+        match self.table.cell(self.row, "status") {
+            Some("lost_steps") => {
+                format!(
+                    "lost {} steps",
+                    self.num("lost_steps").map_or(0, |x| x as u64)
+                )
+            }
+            Some(other) => other.to_string(),
+            None => String::new(),
+        }
     }
 }
 
@@ -234,12 +255,24 @@ pub fn summary_md(
 gain = how much longer the slowest kind takes than the fastest.\n",
         runs.len()
     );
-    let failed = (0..runs.len()).filter(|&i| !view(i).is_ok()).count();
-    if failed > 0 {
+    let failed: Vec<usize> = (0..runs.len()).filter(|&i| !view(i).is_ok()).collect();
+    if !failed.is_empty() {
         let _ = writeln!(
             out,
-            "**{failed} run(s) lost steps** (a stepper's load angle passed 90 electrical degrees): they are failed runs, shown as `lost N steps`, never compared or averaged.\n"
+            "**{} run(s) failed**: shown as `lost N steps` (a stepper's load angle passed 90 electrical degrees) or `fault` (the simulation broke down), never compared or averaged. Why, per run:\n",
+            failed.len()
         );
+        for &i in &failed {
+            let _ = writeln!(
+                out,
+                "- run {}: {}",
+                runs[i].id,
+                table
+                    .cell(i, "reason")
+                    .unwrap_or(view(i).failure().as_str())
+            );
+        }
+        out.push('\n');
     }
     // Group runs by their swept values other than `profile`, keeping first-seen order.
     let mut kinds: Vec<ProfileKind> = Vec::new();
@@ -308,11 +341,9 @@ gain = how much longer the slowest kind takes than the fastest.\n",
                 .min_by(|a, b| a.1.total_cmp(&b.1));
             for k in &kinds {
                 match of_kind(*k).map(view) {
-                    Some(m) if !m.is_ok() => row.extend([
-                        "-".to_string(),
-                        format!("lost {} steps", m.lost_steps()),
-                        "-".to_string(),
-                    ]),
+                    Some(m) if !m.is_ok() => {
+                        row.extend(["-".to_string(), m.failure(), "-".to_string()])
+                    }
                     Some(m) => {
                         let total = ms(m.move_and_settle_s(band));
                         let is_best = best.is_some_and(|(bk, _)| bk == *k);
@@ -362,7 +393,7 @@ gain = how much longer the slowest kind takes than the fastest.\n",
                 idx.iter().find(|&&i| runs[i].profile == *k).map_or(
                     "-".to_string(),
                     |&i| match view(i) {
-                        m if !m.is_ok() => format!("lost {} steps", m.lost_steps()),
+                        m if !m.is_ok() => m.failure(),
                         m => format!("{:.2}", m.residual_peak_um()),
                     },
                 ),

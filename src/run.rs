@@ -172,7 +172,10 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
     run_trajectory(
         axes,
         spec.backend,
-        &SimOptions::default(),
+        &SimOptions {
+            max_step_s: spec.max_step_s,
+            ..SimOptions::default()
+        },
         &traj,
         &observe,
         record,
@@ -223,10 +226,16 @@ pub fn run_trajectory(
                 BeltModel::Frozen => freeze_belts(axes, traj)?,
                 BeltModel::Varying => axes,
             };
-            let plant = settle_sim::mujoco::MujocoPlant::new(
-                axes,
-                settle_sim::mujoco::MujocoConfig::default(),
-            )?;
+            let config = match options.max_step_s {
+                // A forced step: no model-based bound below it.
+                Some(h) => settle_sim::mujoco::MujocoConfig {
+                    max_step_s: h,
+                    max_lambda_h: f64::MAX,
+                    ..settle_sim::mujoco::MujocoConfig::default()
+                },
+                None => settle_sim::mujoco::MujocoConfig::default(),
+            };
+            let plant = settle_sim::mujoco::MujocoPlant::new(axes, config)?;
             simulate(&plant, &names, &meta, traj, observe, record)
         }
         #[cfg(not(feature = "mujoco"))]
@@ -307,11 +316,15 @@ pub fn simulate<P: Plant>(
                       at: &[Sample],
                       state: &P::State,
                       obs: &mut [Observation],
-                      acc: &mut Accumulator| {
+                      acc: &mut Accumulator|
+     -> Result<(), String> {
         plant.observe(state, obs);
         for (i, o) in obs.iter().enumerate() {
             cmd_p[i] = o.commanded_m;
             toolhead[i] = o.toolhead_m;
+        }
+        if let Some(reason) = fault_in(t, names, obs) {
+            return Err(reason);
         }
         acc.push(t, &cmd_p, &toolhead);
         if let Some(rec) = record.as_deref_mut() {
@@ -336,12 +349,37 @@ pub fn simulate<P: Plant>(
             row.push(f2.sqrt());
             rec.push(t, &row);
         }
+        Ok(())
     };
+    // A fault ends the run where it happened; what was measured so far is kept in the
+    // accumulator but reported as a failed run (no metric values).
+    let angles_of = |obs: &[Observation]| -> Vec<Option<f64>> {
+        obs.iter().map(|o| o.max_load_angle_rad).collect()
+    };
+    macro_rules! fault {
+        ($reason:expr) => {
+            return Ok(acc.finish_with(names, &angles_of(&obs), Status::Fault { reason: $reason }))
+        };
+    }
+    macro_rules! step {
+        ($cmd:expr, $dt:expr, $t:expr) => {
+            if let Err(e) = plant.step(&mut state, $cmd, $dt) {
+                fault!(format!("the backend failed at t = {:.6} s: {e}", $t));
+            }
+        };
+    }
+    macro_rules! sample {
+        ($t:expr, $cmd:expr) => {
+            if let Err(reason) = sample($t, $cmd, &state, &mut obs, &mut acc) {
+                fault!(reason);
+            }
+        };
+    }
 
     let breakpoints = traj.breakpoints();
     let mut next_bp = 0usize;
     traj.state_at(0.0, &mut cmd);
-    sample(0.0, &cmd, &state, &mut obs, &mut acc);
+    sample!(0.0, &cmd);
     let mut k = 1usize; // index of the next sample during the move
     let mut t = 0.0;
     let mut fresh = true; // `cmd` already holds the command at `t`
@@ -363,14 +401,14 @@ pub fn simulate<P: Plant>(
         // from dt in the last bit, which would cost the modal plant a fresh transition
         // matrix); partial steps at breakpoints use their true length.
         let whole = next == t_sample && t == (k - 1) as f64 * dt;
-        plant.step(&mut state, &cmd, if whole { dt } else { next - t })?;
+        step!(&cmd, if whole { dt } else { next - t }, t);
         t = next;
         fresh = false;
         if t_sample <= bp {
             if t_sample < t_end {
                 // The command at t serves the sample and the next step.
                 traj.state_at(t, &mut cmd);
-                sample(t, &cmd, &state, &mut obs, &mut acc);
+                sample!(t, &cmd);
                 fresh = true;
             }
             k += 1;
@@ -385,12 +423,13 @@ pub fn simulate<P: Plant>(
         })
         .collect();
     if t_end > 0.0 {
-        sample(t_end, &hold, &state, &mut obs, &mut acc);
+        sample!(t_end, &hold);
     }
     let n = (observe.window_s * observe.sample_rate_hz).ceil() as usize;
     for i in 1..=n {
-        plant.step(&mut state, &hold, dt)?;
-        sample(t_end + i as f64 * dt, &hold, &state, &mut obs, &mut acc);
+        let t = t_end + i as f64 * dt;
+        step!(&hold, dt, t - dt);
+        sample!(t, &hold);
     }
     let lost: u32 = obs.iter().map(|o| o.lost_steps).sum();
     let status = match obs.iter().position(|o| o.lost_steps > 0) {
@@ -400,8 +439,37 @@ pub fn simulate<P: Plant>(
         },
         None => Status::Ok,
     };
-    let angles: Vec<Option<f64>> = obs.iter().map(|o| o.max_load_angle_rad).collect();
-    Ok(acc.finish_with(names, &angles, status))
+    Ok(acc.finish_with(names, &angles_of(&obs), status))
+}
+
+/// A simulation fault in the observations at `t`: a non-finite value, or an error beyond
+/// [`crate::metrics::BLOWUP_M`] (see there). `None` when everything is physical.
+pub fn fault_in(t: f64, names: &[String], obs: &[Observation]) -> Option<String> {
+    for (i, o) in obs.iter().enumerate() {
+        let axis = names.get(i).map_or("?", String::as_str);
+        let values = [
+            ("toolhead position", Some(o.toolhead_m)),
+            ("commanded position", Some(o.commanded_m)),
+            ("carriage position", o.carriage_m),
+            ("motor angle", o.motor_angle_rad),
+        ];
+        for (what, v) in values {
+            if let Some(v) = v
+                && !v.is_finite()
+            {
+                return Some(format!("{what} of axis {axis} became {v} at t = {t:.6} s"));
+            }
+        }
+        let err = o.toolhead_m - o.commanded_m;
+        if err.abs() > crate::metrics::BLOWUP_M {
+            return Some(format!(
+                "blow-up: axis {axis}'s toolhead is {:.3e} m from its command at t = {t:.6} s (limit {} m)",
+                err,
+                crate::metrics::BLOWUP_M
+            ));
+        }
+    }
+    None
 }
 
 /// Set every run's backend, checking that this build has it and that it can simulate the

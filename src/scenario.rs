@@ -34,6 +34,21 @@ pub struct Scenario {
     /// The cartesian product of all axes, in the order written, gives the runs.
     #[serde(default)]
     pub sweep: toml::Table,
+    /// Numerical settings of the simulation (expert; the defaults are the validated ones).
+    #[serde(default)]
+    pub sim: SimSpec,
+}
+
+/// `[sim]`: numerical settings of the time-stepping backends.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimSpec {
+    /// Integration step of rapier and MuJoCo (s), instead of the one each picks from the
+    /// machine's fastest mode (the step `settle validate` checks). A larger step runs
+    /// faster, loses accuracy, and past the integrator's stability limit blows up: such
+    /// a run is reported as a failed run (`status = fault`). Steps never exceed one
+    /// sample interval. No effect on the modal backend (exact at any step).
+    pub max_step_s: Option<f64>,
 }
 
 /// The machine, in one of three forms: its modes (`modes = [...]`, one axis `x`), a

@@ -72,6 +72,8 @@ pub struct RunSpec {
     pub sample_rate_hz: f64,
     /// Settling bands (um).
     pub bands_um: Vec<f64>,
+    /// `[sim] max_step_s`: forced integration step of rapier and MuJoCo (s).
+    pub max_step_s: Option<f64>,
     /// The swept parameters' values of this run, in axis order.
     pub swept: Vec<(String, Value)>,
 }
@@ -392,6 +394,7 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
         window_s: sc.observe.window_s,
         sample_rate_hz: sc.observe.sample_rate_hz,
         bands_um: sc.observe.bands_um.clone(),
+        max_step_s: sc.sim.max_step_s,
         swept: Vec::new(),
     };
     validate_observe(&base, src)?;
@@ -457,6 +460,14 @@ fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
         return Err(src.error_at(
             "observe.sample_rate_hz",
             "window_s * sample_rate_hz exceeds 1e8 samples; lower one of them",
+        ));
+    }
+    if let Some(h) = run.max_step_s
+        && !(h.is_finite() && h > 0.0)
+    {
+        return Err(src.error_at(
+            "sim.max_step_s",
+            format!("must be a finite number > 0 (s), got {h}"),
         ));
     }
     if run.bands_um.is_empty() || run.bands_um.iter().any(|b| !(b.is_finite() && *b > 0.0)) {

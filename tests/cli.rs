@@ -276,14 +276,14 @@ window_s = 0.1
         .arg(dir.path())
         .output()
         .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    // Every output is written, then the failure is listed and the exit code is 1.
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("1 of 2 runs failed"), "{stderr}");
+    assert!(stderr.contains("lost_steps: lost "), "{stderr}");
     let csv = std::fs::read_to_string(dir.path().join("runs.csv")).expect("csv");
     let rows: Vec<&str> = csv.lines().skip(1).collect();
-    assert!(rows[0].contains(",ok,0,"), "{}", rows[0]);
+    assert!(rows[0].contains(",ok,0,,"), "{}", rows[0]);
     // At 2 g towards 300 mm/s the motor needs more torque than the 48 V supply leaves it
     // at that speed (the back-EMF of a 5 mm lead at 300 mm/s is 63 V): failed, with the
     // count, and no metric values that could be averaged.
@@ -292,11 +292,12 @@ window_s = 0.1
     let at = |name: &str| cells[header.iter().position(|h| *h == name).expect(name)];
     assert_eq!(at("status"), "lost_steps");
     assert!(at("lost_steps").parse::<u32>().expect("count") >= 4);
+    assert!(at("reason").contains("first on axis x"), "{}", at("reason"));
     assert_eq!(at("residual_peak_um"), "");
     assert_eq!(at("settle_time_s_10um"), "");
     let summary = std::fs::read_to_string(dir.path().join("summary.md")).expect("summary");
     assert!(
-        summary.contains("lost steps") && summary.contains("lost "),
+        summary.contains("1 run(s) failed") && summary.contains("lost "),
         "{summary}"
     );
 }
