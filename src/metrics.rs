@@ -90,6 +90,8 @@ pub struct Metrics {
     pub axes: Vec<AxisMetrics>,
     /// Whether the run stayed in step.
     pub status: Status,
+    /// Contour error and corner metrics when the trajectory follows a path.
+    pub path: Option<crate::path_metrics::PathMetrics>,
 }
 
 impl Metrics {
@@ -261,6 +263,7 @@ impl Accumulator {
                 })
                 .collect(),
             status,
+            path: None,
         }
     }
 

@@ -99,6 +99,10 @@ pub fn trajectory_of(
     spec: &RunSpec,
     axes: &[AxisModel],
 ) -> Result<Trajectory, settle_planner::PlanError> {
+    if let Some(c) = &spec.corner {
+        let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+        return crate::corner::trajectory(spec, c, &names);
+    }
     let limits = spec.limits_si()?;
     let profile =
         spec.profile
@@ -198,7 +202,12 @@ pub fn run_trajectory(
     }
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
     let record = record.map(|rec| {
-        *rec = Series::with_channels(channels(&axes));
+        let mut ch = channels(&axes);
+        if traj.path().is_some() {
+            // Distance from the toolhead to the commanded path.
+            ch.push(("contour_error".into(), "m".into()));
+        }
+        *rec = Series::with_channels(ch);
         rec
     });
     let meta: Vec<AxisMeta> = axes.iter().map(AxisMeta::of).collect();
@@ -296,6 +305,9 @@ pub fn simulate<P: Plant>(
     let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
     let direction: Vec<f64> = starts.iter().zip(&ends).map(|(s, e)| e.p - s.p).collect();
     let mut acc = Accumulator::new(&target, &direction, t_end, &observe.bands_um);
+    let mut path_acc = traj
+        .path()
+        .map(|g| crate::path_metrics::PathAccumulator::new(g, t_end));
     let mut state = plant.initial_state(&starts)?;
     let mut obs = vec![Observation::default(); n_axes];
     let mut cmd = vec![Sample::default(); n_axes];
@@ -314,6 +326,7 @@ pub fn simulate<P: Plant>(
             toolhead[i] = o.toolhead_m;
         }
         acc.push(t, &cmd_p, &toolhead);
+        let contour = path_acc.as_mut().map(|p| p.push(t, &toolhead));
         if let Some(rec) = record.as_deref_mut() {
             row.clear();
             let mut f2 = 0.0;
@@ -334,6 +347,7 @@ pub fn simulate<P: Plant>(
                 }
             }
             row.push(f2.sqrt());
+            row.extend(contour);
             rec.push(t, &row);
         }
     };
@@ -401,7 +415,9 @@ pub fn simulate<P: Plant>(
         None => Status::Ok,
     };
     let angles: Vec<Option<f64>> = obs.iter().map(|o| o.max_load_angle_rad).collect();
-    Ok(acc.finish_with(names, &angles, status))
+    let mut metrics = acc.finish_with(names, &angles, status);
+    metrics.path = path_acc.map(|p| p.finish());
+    Ok(metrics)
 }
 
 /// Set every run's backend, checking that this build has it and that it can simulate the
