@@ -239,14 +239,11 @@ impl Corner {
     /// The three points in the path's plane (mm): start, corner, end.
     pub fn points_mm(&self) -> [[f64; 2]; 3] {
         let [cx, cy] = self.corner_mm;
-        let turn = (180.0 - self.angle_deg).to_radians();
+        let (cos, sin) = cos_sin_deg(180.0 - self.angle_deg);
         [
             [cx - self.leg_in_mm, cy],
             [cx, cy],
-            [
-                cx + self.leg_out_mm * turn.cos(),
-                cy + self.leg_out_mm * turn.sin(),
-            ],
+            [cx + self.leg_out_mm * cos, cy + self.leg_out_mm * sin],
         ]
     }
 
@@ -368,6 +365,22 @@ impl Corner {
             }
         }
         Ok(())
+    }
+}
+
+/// `(cos, sin)` of an angle in degrees, exact at multiples of 90 degrees (so that a
+/// 0-degree corner is an exact reversal and 90 degrees an exact square, not off by 1e-16).
+fn cos_sin_deg(deg: f64) -> (f64, f64) {
+    if deg.rem_euclid(90.0) == 0.0 {
+        match (deg.rem_euclid(360.0) / 90.0) as u8 {
+            0 => (1.0, 0.0),
+            1 => (0.0, 1.0),
+            2 => (-1.0, 0.0),
+            _ => (0.0, -1.0),
+        }
+    } else {
+        let r = deg.to_radians();
+        (r.cos(), r.sin())
     }
 }
 
