@@ -68,12 +68,7 @@ fn path(m: &Metrics) -> &PathMetrics {
     m.path.as_ref().expect("a corner run has path metrics")
 }
 
-fn find<'a>(
-    all: &'a [(RunSpec, Metrics)],
-    angle: f64,
-    strategy: Strategy,
-    kind: ProfileKind,
-) -> &'a Metrics {
+fn find(all: &[(RunSpec, Metrics)], angle: f64, strategy: Strategy, kind: ProfileKind) -> &Metrics {
     &all.iter()
         .find(|(r, _)| {
             let c = r.corner.as_ref().expect("corner");
