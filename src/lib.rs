@@ -24,6 +24,9 @@ pub mod plot;
 pub mod shard;
 pub mod sink;
 pub mod table;
+// Corners and paths in the harness (issue 5).
+pub mod corner;
+pub mod path_metrics;
 
 use std::path::Path;
 

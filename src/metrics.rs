@@ -116,6 +116,8 @@ pub struct Metrics {
     pub axes: Vec<AxisMetrics>,
     /// Whether the run stayed in step.
     pub status: Status,
+    /// Contour error and corner metrics when the trajectory follows a path.
+    pub path: Option<crate::path_metrics::PathMetrics>,
 }
 
 impl Metrics {
@@ -132,6 +134,7 @@ impl Metrics {
             max_following_error_um: f64::NAN,
             axes: Vec::new(),
             status: Status::Fault { reason },
+            path: None,
         }
     }
 
@@ -303,6 +306,7 @@ impl Accumulator {
                 })
                 .collect(),
             status,
+            path: None,
         }
     }
 

@@ -85,6 +85,12 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
         }
         let _ = write!(out, ",{a}_max_following_error_um,{a}_max_load_angle_deg");
     }
+    // Corner paths (issue 5): their parameters, then the path metrics.
+    // From the runs, not their results, so the header is the same whatever the results
+    // (the sweep journal relies on it).
+    let any_path = runs.iter().any(|r| r.corner.is_some());
+    out.push_str(&crate::corner::csv_param_header(runs));
+    out.push_str(&crate::path_metrics::csv_header(any_path));
     out.push('\n');
     for (r, m) in runs.iter().zip(metrics) {
         let _ = write!(
@@ -121,6 +127,8 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
             // so that nothing downstream averages them.
             let cells = 5 + 2 * m.settle_time_s.len() + axis_names.len() * (4 + bands.len());
             out.push_str(&",".repeat(cells));
+            out.push_str(&crate::corner::csv_param_cells(runs, r));
+            out.push_str(&crate::path_metrics::csv_cells(any_path, None));
             out.push('\n');
             continue;
         }
@@ -149,6 +157,8 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
                     .map_or(String::new(), |d| d.to_string())
             );
         }
+        out.push_str(&crate::corner::csv_param_cells(runs, r));
+        out.push_str(&crate::path_metrics::csv_cells(any_path, m.path.as_ref()));
         out.push('\n');
     }
     out
@@ -400,6 +410,12 @@ gain = how much longer the slowest kind takes than the fastest.\n",
             );
         }
         let _ = writeln!(out, "| {} |", row.join(" | "));
+    }
+    let corners = crate::corner::summary_section(runs, table);
+    if !corners.is_empty() {
+        out.push('\n');
+        out.push_str(corners.trim_end());
+        out.push('\n');
     }
     if !figures.is_empty() {
         let _ = writeln!(out, "\n## Figures\n");

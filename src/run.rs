@@ -99,6 +99,10 @@ pub fn trajectory_of(
     spec: &RunSpec,
     axes: &[AxisModel],
 ) -> Result<Trajectory, settle_planner::PlanError> {
+    if let Some(c) = &spec.corner {
+        let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+        return crate::corner::trajectory(spec, c, &names);
+    }
     let limits = spec.limits_si()?;
     let profile =
         spec.profile
@@ -201,7 +205,12 @@ pub fn run_trajectory(
     }
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
     let record = record.map(|rec| {
-        *rec = Series::with_channels(channels(&axes));
+        let mut ch = channels(&axes);
+        if traj.path().is_some() {
+            // Distance from the toolhead to the commanded path.
+            ch.push(("contour_error".into(), "m".into()));
+        }
+        *rec = Series::with_channels(ch);
         rec
     });
     let meta: Vec<AxisMeta> = axes.iter().map(AxisMeta::of).collect();
@@ -305,6 +314,9 @@ pub fn simulate<P: Plant>(
     let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
     let direction: Vec<f64> = starts.iter().zip(&ends).map(|(s, e)| e.p - s.p).collect();
     let mut acc = Accumulator::new(&target, &direction, t_end, &observe.bands_um);
+    let mut path_acc = traj
+        .path()
+        .map(|g| crate::path_metrics::PathAccumulator::new(g, t_end));
     let mut state = plant.initial_state(&starts)?;
     let mut obs = vec![Observation::default(); n_axes];
     let mut cmd = vec![Sample::default(); n_axes];
@@ -327,6 +339,7 @@ pub fn simulate<P: Plant>(
             return Err(reason);
         }
         acc.push(t, &cmd_p, &toolhead);
+        let contour = path_acc.as_mut().map(|p| p.push(t, &toolhead));
         if let Some(rec) = record.as_deref_mut() {
             row.clear();
             let mut f2 = 0.0;
@@ -347,6 +360,7 @@ pub fn simulate<P: Plant>(
                 }
             }
             row.push(f2.sqrt());
+            row.extend(contour);
             rec.push(t, &row);
         }
         Ok(())
@@ -439,7 +453,9 @@ pub fn simulate<P: Plant>(
         },
         None => Status::Ok,
     };
-    Ok(acc.finish_with(names, &angles_of(&obs), status))
+    let mut metrics = acc.finish_with(names, &angles_of(&obs), status);
+    metrics.path = path_acc.map(|p| p.finish());
+    Ok(metrics)
 }
 
 /// A simulation fault in the observations at `t`: a non-finite value, or an error beyond

@@ -22,9 +22,11 @@ pub struct Scenario {
     pub description: String,
     /// The machine the moves run on.
     pub machine: MachineSpec,
-    /// The base move (sweeps override its fields).
+    /// The base move (sweeps override its fields). Either `[move]` or `[corner]`.
     #[serde(rename = "move")]
-    pub move_: MoveSpec,
+    pub move_: Option<MoveSpec>,
+    /// A two-segment corner path instead of a point-to-point move ([`crate::corner`]).
+    pub corner: Option<crate::corner::CornerSpec>,
     /// Kinematic limits (sweeps override them).
     pub limits: LimitsSpec,
     /// How and how long the result is observed.

@@ -17,6 +17,8 @@ pub enum Value {
     Number(f64),
     /// A profile kind.
     Kind(ProfileKind),
+    /// A name (e.g. a corner strategy).
+    Text(String),
 }
 
 impl std::fmt::Display for Value {
@@ -24,6 +26,7 @@ impl std::fmt::Display for Value {
         match self {
             Value::Number(x) => write!(f, "{x}"),
             Value::Kind(k) => write!(f, "{k}"),
+            Value::Text(t) => f.write_str(t),
         }
     }
 }
@@ -76,6 +79,8 @@ pub struct RunSpec {
     pub max_step_s: Option<f64>,
     /// The swept parameters' values of this run, in axis order.
     pub swept: Vec<(String, Value)>,
+    /// The corner path the run follows instead of its point-to-point move, if any.
+    pub corner: Option<crate::corner::Corner>,
 }
 
 /// Parameters that can be swept, for error messages.
@@ -83,7 +88,9 @@ pub const SWEEPABLE: &str = "profile, move.distance_mm, move.start_mm, limits.vm
 limits.amax_mm_s2, limits.jmax_mm_s3, machine.modes.N.frequency_hz, machine.modes.N.damping_ratio, \
 machine.modes.N.weight (N = 0-based mode index), and for physical machines \
 machine.axis.<axis>.<field> (e.g. machine.axis.x.mount.stiffness_n_per_m), machine.motor.<field> \
-and machine.driver.<field> (every axis)";
+and machine.driver.<field> (every axis); with a [corner] table: corner.angle_deg, \
+corner.leg_in_mm, corner.leg_out_mm, corner.strategy, corner.junction_deviation_mm, \
+corner.square_corner_velocity_mm_s, corner.blend_deviation_mm";
 
 /// Set a numeric field of an axis by its key path inside the axis (as in machine files).
 fn set_axis_field(a: &mut AxisMachine, field: &str, x: f64) -> Result<(), String> {
@@ -184,12 +191,16 @@ impl RunSpec {
     fn set(&mut self, param: &str, value: &Value) -> Result<(), String> {
         let num = |v: &Value| match v {
             Value::Number(x) => Ok(*x),
-            Value::Kind(_) => Err(format!("`{param}` takes numbers")),
+            _ => Err(format!("`{param}` takes numbers")),
         };
         match param {
             "profile" => match value {
                 Value::Kind(k) => self.profile = *k,
-                Value::Number(_) => return Err("`profile` takes profile kind names".into()),
+                _ => return Err("`profile` takes profile kind names".into()),
+            },
+            other if other.starts_with("corner.") => match self.corner.as_mut() {
+                Some(c) => c.set(&other["corner.".len()..], value)?,
+                None => return Err(format!("`{other}` needs a [corner] table")),
             },
             "move.distance_mm" => self.distance_mm = num(value)?,
             "move.start_mm" => self.start_mm = num(value)?,
@@ -271,6 +282,19 @@ pub fn axes(sc: &Scenario, src: &Source) -> Result<Vec<Axis>, Error> {
                         .map_err(|e| err(e.to_string()))
                 })
                 .collect::<Result<Vec<_>, _>>()?
+        } else if crate::corner::is_text_param(param) {
+            let list = raw
+                .as_array()
+                .ok_or_else(|| err(format!("`{param}` takes a list of names")))?;
+            list.iter()
+                .map(|v| {
+                    let name = v.as_str().ok_or_else(|| {
+                        err(format!("`{param}` takes names (strings), got `{v}`"))
+                    })?;
+                    crate::corner::check_text(param, name).map_err(&err)?;
+                    Ok(Value::Text(name.to_string()))
+                })
+                .collect::<Result<Vec<_>, Error>>()?
         } else {
             numbers(raw)
                 .map_err(err)?
@@ -360,19 +384,50 @@ fn numbers(raw: &toml::Value) -> Result<Vec<f64>, String> {
 /// Expand a scenario into validated runs: the base run, then the cartesian product of the
 /// sweep axes in the order written (the last axis varies fastest).
 pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
-    let base_profile = ProfileKind::parse(&sc.move_.profile)
-        .map_err(|e| src.error_at("move.profile", e.to_string()))?;
+    let (mv, corner) = match (&sc.move_, &sc.corner) {
+        (Some(m), None) => (m.clone(), None),
+        (None, Some(c)) => (
+            crate::scenario::MoveSpec {
+                distance_mm: 0.0,
+                start_mm: 0.0,
+                profile: c.profile.clone(),
+                // Both path axes, e.g. `x+y` (no machine axis has this name, so the
+                // point-to-point travel check leaves the corner to its own).
+                axis: format!("{}+{}", c.axes[0], c.axes[1]),
+            },
+            Some(crate::corner::Corner::from_spec(c, src)?),
+        ),
+        (Some(_), Some(_)) => {
+            return Err(src.error_at(
+                "corner",
+                "give either [move] (a point-to-point move) or [corner] (a corner path), not both",
+            ));
+        }
+        (None, None) => {
+            return Err(src.error_at(
+                "name",
+                "missing the motion: give [move] (a point-to-point move) or [corner] (a corner path)",
+            ));
+        }
+    };
+    let profile_key = if corner.is_some() {
+        "corner.profile"
+    } else {
+        "move.profile"
+    };
+    let base_profile =
+        ProfileKind::parse(&mv.profile).map_err(|e| src.error_at(profile_key, e.to_string()))?;
     let (machine, machine_name, driver) = resolve_machine(sc, src)?;
     let axis_names: Vec<String> = match &machine {
         Some(m) => m.axes.iter().map(|a| a.name.clone()).collect(),
         None => vec!["x".to_string()],
     };
-    if !axis_names.contains(&sc.move_.axis) {
+    if corner.is_none() && !axis_names.contains(&mv.axis) {
         return Err(src.error_at(
             "move.axis",
             format!(
                 "no axis `{}`; the machine has {}",
-                sc.move_.axis,
+                mv.axis,
                 axis_names.join(", ")
             ),
         ));
@@ -380,8 +435,8 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
     let base = RunSpec {
         id: 0,
         profile: base_profile,
-        start_mm: sc.move_.start_mm,
-        distance_mm: sc.move_.distance_mm,
+        start_mm: mv.start_mm,
+        distance_mm: mv.distance_mm,
         vmax_mm_s: sc.limits.vmax_mm_s,
         amax_mm_s2: sc.limits.amax_mm_s2,
         jmax_mm_s3: sc.limits.jmax_mm_s3,
@@ -389,13 +444,14 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
         machine,
         machine_name,
         driver,
-        axis: sc.move_.axis.clone(),
+        axis: mv.axis.clone(),
         backend: Backend::default(),
         window_s: sc.observe.window_s,
         sample_rate_hz: sc.observe.sample_rate_hz,
         bands_um: sc.observe.bands_um.clone(),
         max_step_s: sc.sim.max_step_s,
         swept: Vec::new(),
+        corner,
     };
     validate_observe(&base, src)?;
     let axes = axes(sc, src)?;
@@ -424,6 +480,10 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
             run.set(&axis.param, v)
                 .map_err(|m| src.error_at(&format!("sweep.{}", axis.param), m))?;
             run.swept.push((axis.param.clone(), v.clone()));
+        }
+        if let Some(c) = &run.corner {
+            // A corner run's move length is its path length.
+            run.distance_mm = c.leg_in_mm + c.leg_out_mm;
         }
         validate_run(&run, src)?;
         runs.push(run);
@@ -546,6 +606,9 @@ fn resolve_machine(
 }
 
 fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
+    if let Some(c) = &run.corner {
+        c.validate(run).map_err(|(key, m)| src.error_at(&key, m))?;
+    }
     for (name, value) in [
         ("move.distance_mm", run.distance_mm),
         ("move.start_mm", run.start_mm),

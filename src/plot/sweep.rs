@@ -64,6 +64,25 @@ fn metrics(bands: &[f64]) -> Vec<Metric> {
         scale: 1.0,
         log_ok: true,
     });
+    // Paths (issue 5): contour error during and after the move.
+    for (column, title) in [
+        (
+            crate::path_metrics::columns::MAX_CONTOUR,
+            "contour error during the move: max",
+        ),
+        (
+            crate::path_metrics::columns::CONTOUR_AFTER,
+            "contour error after the move: max",
+        ),
+    ] {
+        out.push(Metric {
+            column: column.into(),
+            title: title.into(),
+            unit: "um",
+            scale: 1.0,
+            log_ok: true,
+        });
+    }
     out
 }
 
@@ -78,7 +97,7 @@ pub fn slug(param: &str) -> String {
 fn number(v: &Value) -> Option<f64> {
     match v {
         Value::Number(x) => Some(*x),
-        Value::Kind(_) => None,
+        Value::Kind(_) | Value::Text(_) => None,
     }
 }
 
@@ -202,10 +221,13 @@ fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &Metric) -> Vec<Li
 fn other_label(r: &RunSpec, param: &str) -> String {
     r.swept
         .iter()
-        .filter(|(p, v)| p != param && number(v).is_some())
-        .map(|(p, v)| {
-            let short = p.rsplit('.').next().unwrap_or(p);
-            format!("{short}={}", number(v).map_or(String::new(), fmt_num))
+        .filter(|(p, v)| p != param && !matches!(v, Value::Kind(_)))
+        .map(|(p, v)| match v {
+            Value::Text(t) => t.clone(),
+            _ => {
+                let short = p.rsplit('.').next().unwrap_or(p);
+                format!("{short}={}", number(v).map_or(String::new(), fmt_num))
+            }
         })
         .collect::<Vec<_>>()
         .join(", ")
@@ -304,6 +326,8 @@ impl Metric {
             "move + settle"
         } else if self.column.contains("peak") {
             "peak"
+        } else if self.column.contains("contour") {
+            "contour error"
         } else {
             "RMS"
         }
