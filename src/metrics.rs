@@ -90,6 +90,9 @@ pub struct Metrics {
     pub axes: Vec<AxisMetrics>,
     /// Whether the run stayed in step.
     pub status: Status,
+    /// Extra named columns of a run kind (e.g. the scan columns of [`crate::scan`]), in
+    /// order; `inf` where a time was not reached.
+    pub extra: Vec<(String, f64)>,
 }
 
 impl Metrics {
@@ -261,6 +264,7 @@ impl Accumulator {
                 })
                 .collect(),
             status,
+            extra: Vec::new(),
         }
     }
 
