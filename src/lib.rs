@@ -13,6 +13,7 @@ pub mod metrics;
 pub mod plan_lines;
 pub mod report;
 pub mod run;
+pub mod scan;
 pub mod scenario;
 pub mod series;
 pub mod sweep;

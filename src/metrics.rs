@@ -118,6 +118,9 @@ pub struct Metrics {
     pub status: Status,
     /// Contour error and corner metrics when the trajectory follows a path.
     pub path: Option<crate::path_metrics::PathMetrics>,
+    /// Extra named columns of a run kind (e.g. the scan columns of [`crate::scan`]), in
+    /// order; `inf` where a time was not reached.
+    pub extra: Vec<(String, f64)>,
 }
 
 impl Metrics {
@@ -135,6 +138,7 @@ impl Metrics {
             axes: Vec::new(),
             status: Status::Fault { reason },
             path: None,
+            extra: Vec::new(),
         }
     }
 
@@ -307,6 +311,7 @@ impl Accumulator {
                 .collect(),
             status,
             path: None,
+            extra: Vec::new(),
         }
     }
 

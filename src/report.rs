@@ -71,13 +71,21 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
     }
     out.push_str(",overshoot_um,max_following_error_um");
     // Per-axis metrics for physical machines (the modes form has one axis: the above).
-    // The columns come from the machine, so the header is the same whatever the runs'
+    // The columns come from the runs (their machines; a swept preset can change the axes:
+    // the union, in first-seen order), so the header is the same whatever the runs'
     // results (the sweep journal relies on it: see `journal`).
-    let axis_names: Vec<String> = runs
-        .first()
-        .and_then(|r| r.machine.as_ref())
-        .map(|m| m.axes.iter().map(|a| a.name.clone()).collect())
-        .unwrap_or_default();
+    let mut axis_names: Vec<String> = Vec::new();
+    if runs.first().is_some_and(|r| r.machine.is_some()) {
+        for a in runs
+            .iter()
+            .filter_map(|r| r.machine.as_ref())
+            .flat_map(|m| &m.axes)
+        {
+            if !axis_names.contains(&a.name) {
+                axis_names.push(a.name.clone());
+            }
+        }
+    }
     for a in &axis_names {
         let _ = write!(out, ",{a}_residual_peak_um,{a}_residual_rms_um");
         for b in &bands {
@@ -91,6 +99,14 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
     let any_path = runs.iter().any(|r| r.corner.is_some());
     out.push_str(&crate::corner::csv_param_header(runs));
     out.push_str(&crate::path_metrics::csv_header(any_path));
+    // Extra columns of a run kind (scan steps), named from the first run that has them.
+    let extra: Vec<String> = runs
+        .iter()
+        .find_map(crate::scan::extra_columns)
+        .unwrap_or_default();
+    for e in &extra {
+        let _ = write!(out, ",{e}");
+    }
     out.push('\n');
     for (r, m) in runs.iter().zip(metrics) {
         let _ = write!(
@@ -129,6 +145,7 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
             out.push_str(&",".repeat(cells));
             out.push_str(&crate::corner::csv_param_cells(runs, r));
             out.push_str(&crate::path_metrics::csv_cells(any_path, None));
+            out.push_str(&",".repeat(extra.len()));
             out.push('\n');
             continue;
         }
@@ -144,7 +161,12 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
             let _ = write!(out, ",{}", csv_time(m.move_and_settle_s(i)));
         }
         let _ = write!(out, ",{},{}", m.overshoot_um, m.max_following_error_um);
-        for a in m.axes.iter().filter(|a| axis_names.contains(&a.name)) {
+        for name in &axis_names {
+            let Some(a) = m.axes.iter().find(|a| &a.name == name) else {
+                // The run's machine has no such axis (swept presets).
+                out.push_str(&",".repeat(4 + bands.len()));
+                continue;
+            };
             let _ = write!(out, ",{},{}", a.residual_peak_um, a.residual_rms_um);
             for t in &a.settle_time_s {
                 let _ = write!(out, ",{}", csv_time(*t));
@@ -159,6 +181,10 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
         }
         out.push_str(&crate::corner::csv_param_cells(runs, r));
         out.push_str(&crate::path_metrics::csv_cells(any_path, m.path.as_ref()));
+        for e in &extra {
+            let v = m.extra.iter().find(|(n, _)| n == e);
+            let _ = write!(out, ",{}", v.map_or(String::new(), |(_, x)| x.to_string()));
+        }
         out.push('\n');
     }
     out
@@ -313,7 +339,15 @@ gain = how much longer the slowest kind takes than the fastest.\n",
                 .collect()
         })
         .unwrap_or_default();
-    let bands = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
+    // A scan sweep's own tables replace the move-and-settle ones (which would measure the
+    // raster's run-out, not the step).
+    let scan = crate::scan::summary_section(runs, table);
+    out.push_str(&scan);
+    let bands = if scan.is_empty() {
+        runs.first().map(|r| r.bands_um.clone()).unwrap_or_default()
+    } else {
+        Vec::new()
+    };
     for band in &bands {
         let band = *band;
         let _ = writeln!(out, "## Move and settle to within {band} um (ms)\n");
@@ -387,12 +421,14 @@ gain = how much longer the slowest kind takes than the fastest.\n",
         }
         out.push('\n');
     }
-    let _ = writeln!(out, "## Residual vibration after the move (peak um)\n");
-    let mut header: Vec<String> = params.iter().map(|p| p.to_string()).collect();
-    header.extend(kinds.iter().map(|k| k.to_string()));
-    let _ = writeln!(out, "| {} |", header.join(" | "));
-    let _ = writeln!(out, "|{}", "---:|".repeat(header.len()));
-    for (key, idx) in &groups {
+    if scan.is_empty() {
+        let _ = writeln!(out, "## Residual vibration after the move (peak um)\n");
+        let mut header: Vec<String> = params.iter().map(|p| p.to_string()).collect();
+        header.extend(kinds.iter().map(|k| k.to_string()));
+        let _ = writeln!(out, "| {} |", header.join(" | "));
+        let _ = writeln!(out, "|{}", "---:|".repeat(header.len()));
+    }
+    for (key, idx) in groups.iter().filter(|_| scan.is_empty()) {
         let mut row: Vec<String> = if params.is_empty() {
             Vec::new()
         } else {

@@ -159,6 +159,9 @@ pub fn channels(axes: &[AxisModel]) -> Vec<(String, String)> {
 /// Plan and simulate one run on its backend. When `record` is given, it is replaced by a
 /// series with [`channels`] and every sample is appended to it.
 pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, Error> {
+    if let Some(scan) = &spec.scan {
+        return crate::scan::execute(spec, scan, record);
+    }
     let sim_err = |source| Error::Sim {
         run: spec.id,
         source,

@@ -32,6 +32,9 @@ pub struct Scenario {
     /// How and how long the result is observed.
     #[serde(default)]
     pub observe: ObserveSpec,
+    /// A raster scan: the move is the step-over between lines (see [`crate::scan`]).
+    #[serde(default)]
+    pub scan: Option<crate::scan::ScanSpec>,
     /// Sweep axes: `parameter = [list]` or `parameter = { from, to, steps | step, scale }`.
     /// The cartesian product of all axes, in the order written, gives the runs.
     #[serde(default)]

@@ -17,7 +17,7 @@ pub enum Value {
     Number(f64),
     /// A profile kind.
     Kind(ProfileKind),
-    /// A name (e.g. a corner strategy).
+    /// A name (a corner strategy, `machine.preset`).
     Text(String),
 }
 
@@ -81,6 +81,8 @@ pub struct RunSpec {
     pub swept: Vec<(String, Value)>,
     /// The corner path the run follows instead of its point-to-point move, if any.
     pub corner: Option<crate::corner::Corner>,
+    /// The raster scan the move is the step of, if the scenario has `[scan]`.
+    pub scan: Option<crate::scan::ScanSpec>,
 }
 
 /// Parameters that can be swept, for error messages.
@@ -88,9 +90,11 @@ pub const SWEEPABLE: &str = "profile, move.distance_mm, move.start_mm, limits.vm
 limits.amax_mm_s2, limits.jmax_mm_s3, machine.modes.N.frequency_hz, machine.modes.N.damping_ratio, \
 machine.modes.N.weight (N = 0-based mode index), and for physical machines \
 machine.axis.<axis>.<field> (e.g. machine.axis.x.mount.stiffness_n_per_m), machine.motor.<field> \
-and machine.driver.<field> (every axis); with a [corner] table: corner.angle_deg, \
-corner.leg_in_mm, corner.leg_out_mm, corner.strategy, corner.junction_deviation_mm, \
-corner.square_corner_velocity_mm_s, corner.blend_deviation_mm";
+and machine.driver.<field> (every axis), machine.preset (preset names or machine files); \
+with a [corner] table: corner.angle_deg, corner.leg_in_mm, corner.leg_out_mm, corner.strategy, \
+corner.junction_deviation_mm, corner.square_corner_velocity_mm_s, corner.blend_deviation_mm; \
+with a [scan] table: scan.v_scan_mm_s, scan.fly_amax_mm_s2, scan.fly_jmax_mm_s3, scan.width_mm, \
+scan.settle_margin_s";
 
 /// Set a numeric field of an axis by its key path inside the axis (as in machine files).
 fn set_axis_field(a: &mut AxisMachine, field: &str, x: f64) -> Result<(), String> {
@@ -207,6 +211,16 @@ impl RunSpec {
             "limits.vmax_mm_s" => self.vmax_mm_s = num(value)?,
             "limits.amax_mm_s2" => self.amax_mm_s2 = num(value)?,
             "limits.jmax_mm_s3" => self.jmax_mm_s3 = Some(num(value)?),
+            // Resolved in `expand` (it reads the preset); nothing to set here.
+            "machine.preset" => {}
+            other if other.starts_with("scan.") => {
+                let x = num(value)?;
+                let scan = self
+                    .scan
+                    .as_mut()
+                    .ok_or_else(|| format!("`{other}` needs a [scan] table in the scenario"))?;
+                scan.set(&other["scan.".len()..], x)?;
+            }
             other
                 if other.starts_with("machine.axis.")
                     || other.starts_with("machine.motor.")
@@ -295,6 +309,19 @@ pub fn axes(sc: &Scenario, src: &Source) -> Result<Vec<Axis>, Error> {
                     Ok(Value::Text(name.to_string()))
                 })
                 .collect::<Result<Vec<_>, Error>>()?
+        } else if param == "machine.preset" {
+            let list = raw.as_array().ok_or_else(|| {
+                err("`machine.preset` takes a list of preset names or machine files".into())
+            })?;
+            list.iter()
+                .map(|v| {
+                    v.as_str()
+                        .map(|s| Value::Text(s.to_string()))
+                        .ok_or_else(|| {
+                            err("machine presets are strings, e.g. \"printer_xy\"".into())
+                        })
+                })
+                .collect::<Result<Vec<_>, _>>()?
         } else {
             numbers(raw)
                 .map_err(err)?
@@ -452,6 +479,7 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
         max_step_s: sc.sim.max_step_s,
         swept: Vec::new(),
         corner,
+        scan: sc.scan.clone(),
     };
     validate_observe(&base, src)?;
     let axes = axes(sc, src)?;
@@ -465,6 +493,13 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
                 format!("the sweep expands to more than {MAX_RUNS} runs"),
             )
         })?;
+    if axes.iter().any(|a| a.param == "machine.preset") && base.machine.is_none() {
+        return Err(src.error_at(
+            "sweep.machine.preset",
+            "sweeping presets needs a physical machine: give `preset` in [machine], not `modes`",
+        ));
+    }
+    let mut presets: Vec<(String, Machine, String)> = Vec::new();
     let mut runs = Vec::with_capacity(total);
     for id in 0..total {
         let mut run = base.clone();
@@ -474,6 +509,30 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
         for (i, axis) in axes.iter().enumerate().rev() {
             picks[i] = rest % axis.values.len();
             rest /= axis.values.len();
+        }
+        // A swept preset replaces the machine first; other machine keys then edit it.
+        for (axis, &k) in axes.iter().zip(&picks) {
+            if let (true, Value::Text(name)) = (axis.param == "machine.preset", &axis.values[k]) {
+                if !presets.iter().any(|(n, _, _)| n == name) {
+                    let (m, _, _) = crate::machine_file::load_preset(name, &src.path, src)?;
+                    let mname = m.name.clone();
+                    presets.push((name.clone(), m, mname));
+                }
+                if let Some((_, m, mname)) = presets.iter().find(|(n, _, _)| n == name) {
+                    run.machine = Some(m.clone());
+                    run.machine_name = mname.clone();
+                }
+                if run
+                    .machine
+                    .as_ref()
+                    .is_some_and(|m| m.axis(&run.axis).is_none())
+                {
+                    return Err(src.error_at(
+                        "sweep.machine.preset",
+                        format!("machine `{name}` has no axis `{}` (move.axis)", run.axis),
+                    ));
+                }
+            }
         }
         for (axis, &k) in axes.iter().zip(&picks) {
             let v = &axis.values[k];
@@ -605,6 +664,11 @@ fn resolve_machine(
     ))
 }
 
+/// Whether `kind` needs a jerk limit: every kind but the trapezoid.
+pub fn needs_jerk(kind: ProfileKind) -> bool {
+    kind != ProfileKind::Trapezoid
+}
+
 fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
     if let Some(c) = &run.corner {
         c.validate(run).map_err(|(key, m)| src.error_at(&key, m))?;
@@ -630,11 +694,19 @@ fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
             ));
         }
     }
-    if run.profile == ProfileKind::SCurve && run.jmax_mm_s3.is_none() {
+    if needs_jerk(run.profile) && run.jmax_mm_s3.is_none() {
         return Err(src.error_at(
             "limits",
-            "profile kind `scurve` needs `jmax_mm_s3` in [limits]",
+            format!(
+                "profile kind `{}` needs `jmax_mm_s3` in [limits] (every kind but `trapezoid` is jerk-limited: scurve, fourjerk, pvt_sym, pvt_asym)",
+                run.profile
+            ),
         ));
+    }
+    if let Some(scan) = &run.scan
+        && let Err((key, message)) = scan.validate()
+    {
+        return Err(src.error_at(&blame(run, &format!("scan.{key}")), message));
     }
     if let Some(machine) = &run.machine {
         let machine_swept = || {

@@ -153,6 +153,30 @@ fn missing_jerk_for_scurve_is_an_error() {
 }
 
 #[test]
+fn missing_jerk_for_the_jerk_limited_kinds_names_file_line_and_key() {
+    // GOOD without jmax: `[limits]` is on line 6.
+    let no_jerk = GOOD.replace("jmax_mm_s3 = 1e5\n", "");
+    for kind in ["scurve", "fourjerk", "pvt_sym", "pvt_asym"] {
+        let msg = parse_err(&no_jerk.replace(
+            "profile = [\"trapezoid\", \"scurve\"]",
+            &format!("profile = [\"trapezoid\", \"{kind}\"]"),
+        ));
+        assert!(
+            msg.starts_with("bad.toml:6:1: key `limits`")
+                && msg.contains(&format!("`{kind}` needs `jmax_mm_s3`")),
+            "{msg}"
+        );
+    }
+    // The trapezoid alone needs no jerk limit.
+    let text = no_jerk.replace(
+        "profile = [\"trapezoid\", \"scurve\"]",
+        "profile = [\"trapezoid\"]",
+    );
+    let (sc, src) = settle::scenario::parse(&text, Path::new("t.toml")).expect("parses");
+    assert_eq!(settle::sweep::expand(&sc, &src).expect("expands").len(), 3);
+}
+
+#[test]
 fn unreadable_file_is_an_input_error() {
     let e = settle::load_runs(Path::new("/nonexistent/x.toml")).expect_err("no such file");
     assert!(matches!(e, Error::Read { .. }) && e.is_input_error());

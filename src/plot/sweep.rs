@@ -34,6 +34,37 @@ struct Metric {
 
 fn metrics(bands: &[f64]) -> Vec<Metric> {
     let mut out = Vec::new();
+    // Scan steps (only present in scan sweeps, see crate::scan).
+    out.push(Metric {
+        column: "scan_reentry_error_um".into(),
+        title: "step axis: |error| when the fly axis re-enters".into(),
+        unit: "um",
+        scale: 1.0,
+        log_ok: true,
+    });
+    out.push(Metric {
+        column: "scan_line_residual_peak_um".into(),
+        title: "step axis: peak |error| during the next line".into(),
+        unit: "um",
+        scale: 1.0,
+        log_ok: true,
+    });
+    for b in bands {
+        out.push(Metric {
+            column: format!("scan_step_settle_time_s_{b}um"),
+            title: format!("step axis: settle time to within {b} um after the step"),
+            unit: "ms",
+            scale: 1e3,
+            log_ok: false,
+        });
+    }
+    out.push(Metric {
+        column: "scan_window_s".into(),
+        title: "window from exit to re-entry (overhead per line)".into(),
+        unit: "ms",
+        scale: 1e3,
+        log_ok: false,
+    });
     for b in bands {
         out.push(Metric {
             column: format!("settle_time_s_{b}um"),
@@ -222,12 +253,10 @@ fn other_label(r: &RunSpec, param: &str) -> String {
     r.swept
         .iter()
         .filter(|(p, v)| p != param && !matches!(v, Value::Kind(_)))
-        .map(|(p, v)| match v {
-            Value::Text(t) => t.clone(),
-            _ => {
-                let short = p.rsplit('.').next().unwrap_or(p);
-                format!("{short}={}", number(v).map_or(String::new(), fmt_num))
-            }
+        .map(|(p, v)| {
+            let short = p.rsplit('.').next().unwrap_or(p);
+            // Names (a swept machine preset) label themselves.
+            number(v).map_or(v.to_string(), |x| format!("{short}={}", fmt_num(x)))
         })
         .collect::<Vec<_>>()
         .join(", ")
@@ -252,8 +281,10 @@ pub fn figure(scenario: &str, runs: &[RunSpec], table: &RunsTable, param: &str) 
         });
     let x_log = lo > 0.0 && hi / lo >= 10.0;
     let mut panels = Vec::new();
+    let scan = table.column("scan_window_s").is_some();
     for m in metrics(&bands) {
-        if table.column(&m.column).is_none() {
+        // A scan sweep shows its step-axis panels only (the others measure the run-out).
+        if table.column(&m.column).is_none() || (scan && !m.column.starts_with("scan_")) {
             continue;
         }
         let lines = lines(runs, table, param, &m);
@@ -320,7 +351,15 @@ pub fn figure(scenario: &str, runs: &[RunSpec], table: &RunsTable, param: &str) 
 
 impl Metric {
     fn column_short(&self) -> &str {
-        if self.column.starts_with("settle_time") {
+        if self.column.starts_with("scan_") {
+            if self.column.contains("settle_time") {
+                "settle time"
+            } else if self.column.contains("window") {
+                "window"
+            } else {
+                "|error|"
+            }
+        } else if self.column.starts_with("settle_time") {
             "settle time"
         } else if self.column.starts_with("move_and_settle") {
             "move + settle"
