@@ -43,6 +43,10 @@ struct AxisState {
     stepper: Option<StepperState>,
     /// The commanded sample (continuous, before quantisation) at the current time.
     base: State,
+    /// Still at rest where it started, with the command held there all along: stepping
+    /// would only keep it there (at its static equilibrium), so steps are skipped until
+    /// the command moves (an idle axis of a multi-axis machine costs nothing).
+    idle: bool,
 }
 
 impl MujocoPlant {
@@ -137,6 +141,7 @@ impl Plant for MujocoPlant {
                     sim: model.state(&q, &qd, s)?,
                     stepper,
                     base: *s,
+                    idle: s.v == 0.0 && s.a == 0.0,
                 });
                 continue;
             }
@@ -153,6 +158,7 @@ impl Plant for MujocoPlant {
                 sim,
                 stepper,
                 base: *s,
+                idle: s.v == 0.0 && s.a == 0.0,
             });
         }
         Ok(MujocoPlantState { axes })
@@ -169,6 +175,12 @@ impl Plant for MujocoPlant {
             return Ok(());
         }
         for ((ax, model), (st, c)) in self.axes.iter().zip(state.axes.iter_mut().zip(cmd)) {
+            if st.idle {
+                if c.p == st.base.p && c.v == 0.0 && c.a == 0.0 && c.j == 0.0 {
+                    continue;
+                }
+                st.idle = false;
+            }
             match (ax.mode, &ax.stepper) {
                 (DriverMode::Full, Some(sp)) => {
                     let ss = st.stepper.as_mut().ok_or_else(|| SimError::InvalidModel {
