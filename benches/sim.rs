@@ -3,7 +3,8 @@
 //!
 //! Throughput is reported in elements per second with one element = one simulated
 //! microsecond, so criterion's "Melem/s" reads directly as *simulated seconds per wall
-//! second* (1 Melem/s = real time). Targets per core: rapier >= 20, modal >= 2000.
+//! second* (1 Melem/s = real time). Targets per core: rapier and MuJoCo >= 20, modal >= 2000.
+//! MuJoCo runs with `cargo bench --features mujoco --bench sim`.
 //!
 //! The run: `printer_xy`, both axes simulated, a 10 mm S-curve on Y (0.149 s) and the
 //! 0.5 s observation window, sampled at 10 kHz, metrics streaming.
@@ -18,6 +19,17 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use settle::run::{Backend, Observe, SimOptions, run_trajectory};
 use settle_planner::{Limits, Profile, ProfileKind, State, Trajectory};
 use settle_sim::DriverMode;
+
+/// The backends and driver models measured (MuJoCo with `--features mujoco`).
+const CASES: &[(&str, Backend, DriverMode)] = &[
+    ("modal_linear_driver", Backend::Modal, DriverMode::Linear),
+    ("rapier_linear_driver", Backend::Rapier, DriverMode::Linear),
+    ("rapier_full_driver", Backend::Rapier, DriverMode::Full),
+    #[cfg(feature = "mujoco")]
+    ("mujoco_linear_driver", Backend::Mujoco, DriverMode::Linear),
+    #[cfg(feature = "mujoco")]
+    ("mujoco_full_driver", Backend::Mujoco, DriverMode::Full),
+];
 
 fn bench(c: &mut Criterion) {
     let (_, path, text) = settle::machine_file::PRESETS[0];
@@ -36,11 +48,7 @@ fn bench(c: &mut Criterion) {
     let simulated_us = ((traj.duration_s() + observe.window_s) * 1e6).round() as u64;
     let mut group = c.benchmark_group("printer_xy_10mm_scurve_y");
     group.throughput(Throughput::Elements(simulated_us));
-    for (name, backend, driver) in [
-        ("modal_linear_driver", Backend::Modal, DriverMode::Linear),
-        ("rapier_linear_driver", Backend::Rapier, DriverMode::Linear),
-        ("rapier_full_driver", Backend::Rapier, DriverMode::Full),
-    ] {
+    for &(name, backend, driver) in CASES {
         let axes = machine.compile(driver).expect("compile");
         group.bench_function(name, |b| {
             b.iter(|| {
@@ -59,11 +67,7 @@ fn bench(c: &mut Criterion) {
         });
     }
     group.finish();
-    for (name, backend, driver) in [
-        ("modal_linear_driver", Backend::Modal, DriverMode::Linear),
-        ("rapier_linear_driver", Backend::Rapier, DriverMode::Linear),
-        ("rapier_full_driver", Backend::Rapier, DriverMode::Full),
-    ] {
+    for &(name, backend, driver) in CASES {
         let axes = machine.compile(driver).expect("compile");
         let Some(start) = thread_cpu_ns() else {
             return;

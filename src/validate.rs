@@ -14,7 +14,8 @@
 //! - **engines**: residual and settle time of each engine against the first engine.
 //!
 //! A second table shows what the linear model leaves out (information, no thresholds):
-//! the real belt's position-dependent stiffness, and the full stepper driver.
+//! the real belt's position-dependent stiffness (on the first engine), and the full
+//! stepper driver (on every engine, so rapier's and MuJoCo's can be compared).
 //! Adding a backend is one line in [`ENGINES`].
 
 use std::fmt::Write as _;
@@ -115,8 +116,10 @@ pub struct Effect {
     pub linear: (f64, Option<f64>),
     /// The same with the belt's stiffness varying with position.
     pub varying_belt: (f64, Option<f64>),
-    /// The same with the full stepper driver (and the varying belt).
-    pub full_driver: (f64, Option<f64>, u32),
+    /// The same with the full stepper driver (and the varying belt), per engine: the
+    /// first engine, then every other engine validated (MuJoCo when built): residual peak
+    /// (um), settle time (s) and lost steps.
+    pub full_driver: Vec<(Backend, f64, Option<f64>, u32)>,
 }
 
 /// Everything validate measured.
@@ -376,26 +379,31 @@ pub fn run(backends: &[Backend]) -> Result<Report, String> {
             }
             rows.push(row);
         }
-        // Model effects: the middle distance of physical machines, on rapier.
+        // Model effects: the middle distance of physical machines, on the first engine
+        // (rapier); the full driver on every engine.
         if let (Some(machine), Some(&engine)) = (&case.machine, engines.first())
             && case.effects
-            && engine == Backend::Rapier
         {
             let lin = simulate(&case, engine, &frozen, case.axes.clone())?.0;
             let var = simulate(&case, engine, &SimOptions::default(), case.axes.clone())?.0;
             let full_axes = machine
                 .compile(DriverMode::Full)
                 .map_err(|e| e.to_string())?;
-            let full = simulate(&case, engine, &SimOptions::default(), full_axes)?.0;
+            let mut full_driver = Vec::new();
+            for &b in &engines {
+                let full = simulate(&case, b, &SimOptions::default(), full_axes.clone())?.0;
+                full_driver.push((
+                    b,
+                    full.residual_peak_um,
+                    full.settle_time_s[0],
+                    full.status.lost_steps(),
+                ));
+            }
             effects.push(Effect {
                 case: case.name.clone(),
                 linear: (lin.residual_peak_um, lin.settle_time_s[0]),
                 varying_belt: (var.residual_peak_um, var.settle_time_s[0]),
-                full_driver: (
-                    full.residual_peak_um,
-                    full.settle_time_s[0],
-                    full.status.lost_steps(),
-                ),
+                full_driver,
             });
         }
     }
@@ -485,35 +493,42 @@ numerical damping {DAMPING_PCT} % of the physical. Settle times to {} um.\n",
             }
         );
     }
-    if !r.effects.is_empty() {
+    if let Some(first) = r.effects.first() {
+        let engine = first
+            .full_driver
+            .first()
+            .map_or("rapier".to_string(), |f| f.0.to_string());
         let _ = writeln!(
             out,
-            "\nWhat the linear model leaves out (rapier, middle distances; information, no thresholds): \
-residual peak um / settle ms to {} um.\n",
+            "\nWhat the linear model leaves out ({engine}, middle distances; the full driver on every engine; \
+information, no thresholds): residual peak um / settle ms to {} um.\n",
             r.bands_um[0]
         );
-        let _ = writeln!(
-            out,
-            "| case | linear, frozen belt | belt stiffness varying | + full stepper driver |"
-        );
-        let _ = writeln!(out, "|---|---:|---:|---:|");
+        let mut head = "| case | linear, frozen belt | belt stiffness varying |".to_string();
+        let mut rule = "|---|---:|---:|".to_string();
+        for f in &first.full_driver {
+            head.push_str(&format!(" + full stepper driver ({}) |", f.0));
+            rule.push_str("---:|");
+        }
+        let _ = writeln!(out, "{head}\n{rule}");
         for e in &r.effects {
-            let lost = if e.full_driver.2 > 0 {
-                format!(" (lost {} steps)", e.full_driver.2)
-            } else {
-                String::new()
-            };
-            let _ = writeln!(
-                out,
-                "| {} | {:.3} / {} | {:.3} / {} | {:.3} / {}{lost} |",
+            let mut line = format!(
+                "| {} | {:.3} / {} | {:.3} / {} |",
                 e.case,
                 e.linear.0,
                 ms(e.linear.1),
                 e.varying_belt.0,
                 ms(e.varying_belt.1),
-                e.full_driver.0,
-                ms(e.full_driver.1),
             );
+            for f in &e.full_driver {
+                let lost = if f.3 > 0 {
+                    format!(" (lost {} steps)", f.3)
+                } else {
+                    String::new()
+                };
+                line.push_str(&format!(" {:.3} / {}{lost} |", f.1, ms(f.2)));
+            }
+            let _ = writeln!(out, "{line}");
         }
     }
     out

@@ -68,3 +68,28 @@ fn validate_without_mujoco_says_how_to_get_it() {
     let e = validate::run(&[Backend::Mujoco]).expect_err("not built");
     assert!(e.contains("scripts/setup-mujoco.sh"), "{e}");
 }
+
+/// With MuJoCo built: every check passes on MuJoCo, each of its rows is compared with
+/// rapier (the engines check), and the model-effects table shows the full stepper driver on
+/// both engines without lost steps.
+#[cfg(feature = "mujoco")]
+#[test]
+fn validate_passes_on_mujoco_against_rapier() {
+    let report = validate::run(&[Backend::Rapier, Backend::Mujoco]).expect("both built");
+    let table = markdown(&report);
+    assert!(report.pass(), "{table}");
+    let mujoco: Vec<_> = report
+        .rows
+        .iter()
+        .filter(|r| r.backend == Backend::Mujoco)
+        .collect();
+    assert_eq!(mujoco.len(), validate::cases().len(), "{table}");
+    assert!(mujoco.iter().all(|r| r.engine_pct.is_some()), "{table}");
+    assert!(report.effects.len() >= 6, "{table}");
+    for e in &report.effects {
+        let engines: Vec<Backend> = e.full_driver.iter().map(|f| f.0).collect();
+        assert_eq!(engines, [Backend::Rapier, Backend::Mujoco], "{table}");
+        assert!(e.full_driver.iter().all(|f| f.3 == 0), "{table}");
+    }
+    assert!(table.contains("+ full stepper driver (mujoco)"), "{table}");
+}

@@ -36,9 +36,25 @@ struct Discrete {
     scale: Vec<f64>,
     /// Static gain g (body coordinate per metre of command).
     g: Vec<f64>,
-    /// Transition rows for the nominal step, physical coordinates: `2n x (2n + 3)`.
+    /// The first `2n` rows of the transition for the nominal step, physical coordinates,
+    /// stored by column (`2n + 3` columns of [`Discrete::stride`] entries, zero padded).
     nominal: Vec<f64>,
+    /// Induced infinity norm of `a_scaled` (1/s): bounds the Taylor remainder.
+    norm_per_s: f64,
+    /// The first `2n` rows of `a_scaled^k / k!` in physical coordinates (by column), for
+    /// partial steps ([`Discrete::partial`]); built at the first partial step.
+    powers: std::sync::OnceLock<Vec<Vec<f64>>>,
 }
+
+/// Largest `|A h|` (infinity norm, scaled coordinates) for which partial steps use the
+/// Taylor series of the exponential instead of `expm`: every term is then below the
+/// previous one and [`TAYLOR_TERMS`] terms leave a remainder below
+/// `1^31/31! e^1 = 3e-34`, far below rounding.
+const TAYLOR_MAX_NORM: f64 = 1.0;
+
+/// Terms of the Taylor series (degree 0 to `TAYLOR_TERMS - 1`); at `|A h| <= 0.3` (the
+/// printer preset at 10 kHz) the last ones are far below rounding and cost little.
+const TAYLOR_TERMS: usize = 24;
 
 impl Discrete {
     fn new(axis: &AxisModel, start_m: f64, nominal_dt_s: f64) -> Result<Self, SimError> {
@@ -89,28 +105,84 @@ impl Discrete {
         scale.extend(sq.iter().map(|s| w0 * w0 * s));
         scale.extend(sq.iter().map(|s| w0 * s));
         scale.extend([w0, 1.0, 1.0 / w0]);
+        let norm_per_s = (0..dim)
+            .map(|i| (0..dim).map(|j| a_scaled[(i, j)].abs()).sum::<f64>())
+            .fold(0.0, f64::max);
         let mut d = Self {
             n,
             a_scaled,
             scale,
             g: g.iter().copied().collect(),
             nominal: Vec::new(),
+            norm_per_s,
+            powers: std::sync::OnceLock::new(),
         };
         d.nominal = d.transition(nominal_dt_s);
         Ok(d)
     }
 
-    /// The first `2n` rows of the transition over `dt_s`, in physical coordinates.
+    /// The first `2n` rows of the transition over `dt_s`, in physical coordinates, by
+    /// column.
     fn transition(&self, dt_s: f64) -> Vec<f64> {
         let phi = (&self.a_scaled * dt_s).exp();
         let dim = 2 * self.n + 3;
-        let mut rows = Vec::with_capacity(2 * self.n * dim);
-        for i in 0..2 * self.n {
-            for j in 0..dim {
-                rows.push(phi[(i, j)] * self.scale[j] / self.scale[i]);
+        let stride = self.stride();
+        let mut cols = vec![0.0; stride * dim];
+        for j in 0..dim {
+            for i in 0..2 * self.n {
+                cols[j * stride + i] = phi[(i, j)] * self.scale[j] / self.scale[i];
             }
         }
-        rows
+        cols
+    }
+
+    /// Rows stored per column: `2n` rounded up to a multiple of 4 (zero padding).
+    fn stride(&self) -> usize {
+        (2 * self.n).div_ceil(4) * 4
+    }
+
+    /// The first `2n` rows of the transition over a partial step `dt_s` (a profile
+    /// breakpoint falls inside a sample interval). Short steps (`|A dt| <= 1`) sum the
+    /// Taylor series `sum_k (A dt)^k / k!` from powers of `A` computed once per run:
+    /// `O(K n^2)` per step instead of a Pade `expm` with its matrix products and solve.
+    /// Longer steps use [`Discrete::transition`].
+    fn partial(&self, dt_s: f64, out: &mut Vec<f64>) {
+        if self.norm_per_s * dt_s > TAYLOR_MAX_NORM {
+            *out = self.transition(dt_s);
+            return;
+        }
+        let powers = self.powers.get_or_init(|| self.taylor_powers());
+        let len = powers[0].len();
+        out.clear();
+        out.resize(len, 0.0);
+        // Horner-free sum, smallest terms first (they only matter near rounding).
+        for (k, p) in powers.iter().enumerate().rev() {
+            let c = dt_s.powi(k as i32);
+            for (o, x) in out.iter_mut().zip(p) {
+                *o += c * x;
+            }
+        }
+    }
+
+    /// `a_scaled^k / k!` (first `2n` rows, physical coordinates) for `k < TAYLOR_TERMS`.
+    fn taylor_powers(&self) -> Vec<Vec<f64>> {
+        let dim = 2 * self.n + 3;
+        let mut out = Vec::with_capacity(TAYLOR_TERMS);
+        let mut p = DMatrix::<f64>::identity(dim, dim);
+        for k in 0..TAYLOR_TERMS {
+            if k > 0 {
+                p = (&self.a_scaled * &p) / k as f64;
+            }
+            let stride = self.stride();
+            let mut cols = vec![0.0; stride * dim];
+            for j in 0..dim {
+                for i in 0..2 * self.n {
+                    cols[j * stride + i] = p[(i, j)] * self.scale[j] / self.scale[i];
+                }
+            }
+            out.push(cols);
+        }
+        out
     }
 }
 
@@ -134,6 +206,8 @@ pub struct ModalAxis {
     pub stepper: Option<StepperState>,
     disc: std::sync::Arc<Discrete>,
     scratch: Vec<f64>,
+    /// The transition of the last partial step (reused buffer).
+    partial: Vec<f64>,
 }
 
 impl ModalAxis {
@@ -153,22 +227,22 @@ impl ModalAxis {
     }
 }
 
-/// `sum a_i b_i` with four partial sums (vectorises; fixed order, so deterministic).
+/// `z[..m] = Phi z` for a transition stored by column (`M >= m` rows per column, zero
+/// padded; `z.len()` columns), with the outputs accumulated in a fixed-size array the
+/// compiler keeps in registers (no store-to-load chain through memory per column).
+/// Columns whose `z` entry is zero (the command's `v, a, j` while it holds) are skipped:
+/// they add exact zeros.
 #[inline]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 4];
-    let (ca, ra) = a.split_at(a.len() / 4 * 4);
-    let (cb, rb) = b.split_at(ca.len());
-    for (x, y) in ca.chunks_exact(4).zip(cb.chunks_exact(4)) {
-        for l in 0..4 {
-            acc[l] += x[l] * y[l];
+fn apply<const M: usize>(cols: &[f64], z: &mut [f64], m: usize) {
+    let mut acc = [0.0f64; M];
+    for (col, &zj) in cols.chunks_exact(M).zip(z.iter()) {
+        if zj != 0.0 {
+            for (a, p) in acc.iter_mut().zip(col) {
+                *a += p * zj;
+            }
         }
     }
-    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
-    }
-    s
+    z[..m].copy_from_slice(&acc[..m]);
 }
 
 /// The modal plant's mutable state.
@@ -243,6 +317,7 @@ impl Plant for ModalPlant {
             .map(|(a, s)| {
                 let disc = Discrete::new(a, s.p, self.nominal_dt_s)?;
                 let n = disc.n;
+                let stride = disc.stride();
                 let stepper = a.stepper.as_ref().map(|st| {
                     let mut ss = st.at_rest(s.p).0;
                     ss.track(0.0);
@@ -253,7 +328,8 @@ impl Plant for ModalPlant {
                     z: vec![0.0; 2 * n + 3],
                     stepper,
                     disc: std::sync::Arc::new(disc),
-                    scratch: vec![0.0; 2 * n],
+                    scratch: vec![0.0; stride],
+                    partial: Vec::new(),
                 })
             })
             .collect::<Result<_, SimError>>()?;
@@ -277,19 +353,30 @@ impl Plant for ModalPlant {
             }
             let disc = &st.disc;
             let n = disc.n;
-            let other;
             let rows: &[f64] = if nominal {
                 &disc.nominal
             } else {
-                other = disc.transition(dt_s);
-                &other
+                disc.partial(dt_s, &mut st.partial);
+                &st.partial
             };
-            let dim = 2 * n + 3;
             st.z[2 * n..].copy_from_slice(&[c.v, c.a, c.j]);
-            for (row, out) in rows.chunks_exact(dim).zip(st.scratch.iter_mut()) {
-                *out = dot(row, &st.z);
+            match disc.stride() {
+                4 => apply::<4>(rows, &mut st.z, 2 * n),
+                8 => apply::<8>(rows, &mut st.z, 2 * n),
+                12 => apply::<12>(rows, &mut st.z, 2 * n),
+                16 => apply::<16>(rows, &mut st.z, 2 * n),
+                stride => {
+                    st.scratch.fill(0.0);
+                    for (col, &zj) in rows.chunks_exact(stride).zip(&st.z) {
+                        if zj != 0.0 {
+                            for (o, p) in st.scratch.iter_mut().zip(col) {
+                                *o += p * zj;
+                            }
+                        }
+                    }
+                    st.z[..2 * n].copy_from_slice(&st.scratch);
+                }
             }
-            st.z[..2 * n].copy_from_slice(&st.scratch);
             if let (Some(sp), Some(ss)) = (&ax.stepper, st.stepper.as_mut()) {
                 // Linear driver: the load angle Nr (x rad_per_m - theta) is -Nr r_rotor.
                 ss.track(-f64::from(sp.rotor_teeth) * st.z[sp.rotor]);

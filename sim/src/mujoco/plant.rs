@@ -1,18 +1,31 @@
 //! [`MujocoPlant`]: the [`Plant`] trait over one [`MujocoModel`] per axis.
+//!
+//! The `full` driver on MuJoCo: the MJCF gets the driver's linear part as a tendon from
+//! the rotor to the command (stiffness `k_theta = Km I Nr`, the driver damping `c`), so
+//! MuJoCo's RK4 integrates the stiff magnetic spring and the slip damping exactly within a
+//! step, and the step size is chosen with that spring in the model. The stepper model's
+//! remaining torque (currents, sinusoidal law, detent, microsteps: the full torque of
+//! [`crate::stepper::Stepper::torque`] minus the tendon's) enters through the MJCF `motor`
+//! actuator on the rotor, evaluated each MuJoCo step at the predicted mid-step rotor angle
+//! and command (a position force held at the predicted midpoint adds no numerical damping
+//! to a spring: the step's transition matrix has determinant 1). After each step the
+//! currents advance over it ([`crate::stepper::Stepper::advance`]) and the load angle is
+//! tracked, exactly as on rapier, so lost steps are detected the same way.
 
 use settle_planner::{Sample, State};
 
 use super::{MujocoConfig, MujocoModel, MujocoSim};
-use crate::stepper::StepperState;
+use crate::lumped::{Coupling, Node, Stiffness, Term};
+use crate::rapier::start_equilibrium;
+use crate::stepper::{Stepper, StepperState};
 use crate::{AxisModel, DriverMode, Observation, Plant, SimError, advance_sample, check_step};
 
 /// The MuJoCo backend as a [`Plant`]: one MuJoCo model per axis, each starting at rest at
 /// its commanded start and following the command through the lumped couplings.
 ///
-/// Driver modes: `linear` (a spring to the continuous command) and `spring` (a spring to
-/// the microstep-quantised command, stepped as a piecewise-constant command) run here.
-/// The `full` current-loop driver runs on rapier: [`MujocoPlant::new`] refuses it with an
-/// error that says so.
+/// Driver modes: `linear` (a spring to the continuous command), `spring` (a spring to the
+/// microstep-quantised command, stepped as a piecewise-constant command) and `full` (the
+/// current-loop stepper driver, see the module documentation).
 #[derive(Debug)]
 pub struct MujocoPlant {
     axes: Vec<(AxisModel, MujocoModel)>,
@@ -30,6 +43,10 @@ struct AxisState {
     stepper: Option<StepperState>,
     /// The commanded sample (continuous, before quantisation) at the current time.
     base: State,
+    /// Still at rest where it started, with the command held there all along: stepping
+    /// would only keep it there (at its static equilibrium), so steps are skipped until
+    /// the command moves (an idle axis of a multi-axis machine costs nothing).
+    idle: bool,
 }
 
 impl MujocoPlant {
@@ -41,15 +58,10 @@ impl MujocoPlant {
         let mut out = Vec::with_capacity(axes.len());
         for a in axes {
             a.validate()?;
-            if a.mode == DriverMode::Full {
-                return Err(SimError::InvalidModel {
-                    what: format!(
-                        "axis `{}`: the MuJoCo backend runs the `linear` and `spring` driver models; the `full` current-loop driver runs on rapier (--backend rapier)",
-                        a.name
-                    ),
-                });
-            }
-            let m = MujocoModel::new(&a.lumped, config)?;
+            let m = match (a.mode, &a.stepper) {
+                (DriverMode::Full, Some(sp)) => full_driver_model(&a, sp, config)?,
+                _ => MujocoModel::new(&a.lumped, config)?,
+            };
             out.push((a, m));
         }
         Ok(Self { axes: out })
@@ -59,6 +71,43 @@ impl MujocoPlant {
     pub fn model(&self, i: usize) -> &MujocoModel {
         &self.axes[i].1
     }
+}
+
+/// The MuJoCo model of a `full`-driver axis: its lumped model plus the driver's linear
+/// spring-damper as a coupling from the rotor to the command (the rotor stays the actuated
+/// body), with the step budget shrunk so that `|lambda| h` also covers the detent's extra
+/// stiffness (`4 Nr Td`), as rapier's step does ([`crate::rapier::fastest_rate`]).
+fn full_driver_model(
+    a: &AxisModel,
+    sp: &Stepper,
+    config: MujocoConfig,
+) -> Result<MujocoModel, SimError> {
+    let mut lumped = a.lumped.clone();
+    lumped.couplings.push(Coupling {
+        name: "driver".into(),
+        terms: vec![
+            Term {
+                node: Node::Body(sp.rotor),
+                gain: 1.0,
+            },
+            Term {
+                node: Node::Command,
+                gain: -sp.rad_per_m,
+            },
+        ],
+        stiffness: Stiffness::Constant(sp.k_theta()),
+        damping: sp.damping_n_m_s_per_rad,
+    });
+    let probe = MujocoModel::new(&lumped, config)?;
+    let fastest = crate::rapier::fastest_rate(a, 0.0)?;
+    if fastest <= probe.lambda_max() {
+        return Ok(probe);
+    }
+    let config = MujocoConfig {
+        max_lambda_h: config.max_lambda_h * probe.lambda_max() / fastest,
+        ..config
+    };
+    MujocoModel::new(&lumped, config)
 }
 
 impl Plant for MujocoPlant {
@@ -77,6 +126,25 @@ impl Plant for MujocoPlant {
         }
         let mut axes = Vec::with_capacity(start.len());
         for ((ax, model), s) in self.axes.iter().zip(start) {
+            if ax.mode == DriverMode::Full {
+                // At rest where the magnetic torque balances the detent and the couplings
+                // (rapier starts from the same configuration), moving rigidly with `s.v`.
+                let (q, stepper) = start_equilibrium(ax, s.p)?;
+                let qd = if s.v == 0.0 {
+                    vec![0.0; q.len()]
+                } else {
+                    let dx = 1e-3;
+                    let q1 = start_equilibrium(ax, s.p + dx)?.0;
+                    q.iter().zip(&q1).map(|(a, b)| (b - a) / dx * s.v).collect()
+                };
+                axes.push(AxisState {
+                    sim: model.state(&q, &qd, s)?,
+                    stepper,
+                    base: *s,
+                    idle: s.v == 0.0 && s.a == 0.0,
+                });
+                continue;
+            }
             let x = ax.command_node_m(s.p);
             let node = State { p: x, ..*s };
             let sim = model.state_at_rest(&node);
@@ -90,6 +158,7 @@ impl Plant for MujocoPlant {
                 sim,
                 stepper,
                 base: *s,
+                idle: s.v == 0.0 && s.a == 0.0,
             });
         }
         Ok(MujocoPlantState { axes })
@@ -106,7 +175,41 @@ impl Plant for MujocoPlant {
             return Ok(());
         }
         for ((ax, model), (st, c)) in self.axes.iter().zip(state.axes.iter_mut().zip(cmd)) {
+            if st.idle {
+                if c.p == st.base.p && c.v == 0.0 && c.a == 0.0 && c.j == 0.0 {
+                    continue;
+                }
+                st.idle = false;
+            }
             match (ax.mode, &ax.stepper) {
+                (DriverMode::Full, Some(sp)) => {
+                    let ss = st.stepper.as_mut().ok_or_else(|| SimError::InvalidModel {
+                        what: format!("axis `{}`: the full driver has no state", ax.name),
+                    })?;
+                    let h_max = model.step_at(&st.sim);
+                    let n = ((dt_s / h_max) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+                    let h = dt_s / n as f64;
+                    let r = sp.rotor;
+                    let k_theta = sp.k_theta();
+                    for k in 0..n {
+                        let tau = h * k as f64;
+                        let c0 = advance_sample(c, tau);
+                        let (th0, w0) = (st.sim.q()[r], st.sim.qd()[r]);
+                        // The stepper torque beyond the tendon's linear spring, at the
+                        // predicted mid-step angle and command (the damping terms are
+                        // equal in both and cancel: omega and v_cmd as 0).
+                        let th_m = th0 + 0.5 * h * w0;
+                        let x_m = advance_sample(c, tau + 0.5 * h).p;
+                        let mut mid = ss.clone();
+                        sp.advance(&mut mid, th0, th_m, w0, &c0, 0.5 * h);
+                        let rest =
+                            sp.torque(&mid, th_m, 0.0, 0.0) + k_theta * (th_m - sp.rad_per_m * x_m);
+                        model.set_drive(&mut st.sim, rest)?;
+                        model.step(&mut st.sim, &c0, h)?;
+                        let (th1, w1) = (st.sim.q()[r], st.sim.qd()[r]);
+                        sp.advance(ss, th0, th1, w1, &c0, h);
+                    }
+                }
                 (DriverMode::Spring, Some(sp)) => {
                     // The quantised command is piecewise constant: step in equal pieces no
                     // longer than the model's step, holding the microstep of each piece's
@@ -154,7 +257,11 @@ impl Plant for MujocoPlant {
                 toolhead_m: ax.lumped.toolhead_m(q, x_node),
                 carriage_m: ax.carriage.map(|i| q[i]),
                 motor_angle_rad: ax.stepper.as_ref().map(|s| q[s.rotor]),
-                currents_a: None,
+                currents_a: st
+                    .stepper
+                    .as_ref()
+                    .filter(|_| ax.mode == DriverMode::Full)
+                    .map(|s| [s.i_a, s.i_b]),
                 load_angle_rad: st.stepper.as_ref().map(|s| s.load_angle_rad),
                 lost_steps: st.stepper.as_ref().map_or(0, StepperState::lost_steps),
                 max_load_angle_rad: st.stepper.as_ref().map(|s| s.max_load_angle_rad),
