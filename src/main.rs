@@ -354,9 +354,7 @@ fn sweep(
         }
         // A run that fails is a row with its reason; the sweep goes on (issue 8).
         .unwrap_or_else(|e| settle::Metrics::failed(&spec.bands_um, format!("{e}")));
-        let row = report::runs_csv(std::slice::from_ref(spec), std::slice::from_ref(&m))
-            [header.len()..]
-            .to_string();
+        let row = report::runs_csv_row(&runs, spec, &m);
         journal.append(&row)?;
         Ok(row)
     };

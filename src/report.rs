@@ -51,6 +51,23 @@ fn csv_text(s: &str) -> String {
 /// The CSV: run parameters, then metrics. `settle_time_s_<band>` and
 /// `move_and_settle_s_<band>` are `inf` when the run did not settle within the window.
 pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
+    runs_csv_with(runs, runs.iter().zip(metrics))
+}
+
+/// The row of runs.csv (with its newline) of run `run` with metrics `m` in the sweep
+/// `runs`: exactly the line [`runs_csv`] writes for it (the columns depend on the whole
+/// sweep, e.g. the union of the axes of swept presets). The sweep journal stores these.
+pub fn runs_csv_row(runs: &[RunSpec], run: &RunSpec, m: &Metrics) -> String {
+    let text = runs_csv_with(runs, std::iter::once((run, m)));
+    let header_end = text.find('\n').map_or(text.len(), |i| i + 1);
+    text[header_end..].to_string()
+}
+
+/// The header from the sweep `runs`, then one row per `(run, metrics)` pair.
+fn runs_csv_with<'a>(
+    runs: &[RunSpec],
+    rows: impl Iterator<Item = (&'a RunSpec, &'a Metrics)>,
+) -> String {
     let mut out = String::new();
     let bands = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
     let n_modes = runs.first().map_or(0, |r| r.modes.len());
@@ -108,7 +125,7 @@ pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
         let _ = write!(out, ",{e}");
     }
     out.push('\n');
-    for (r, m) in runs.iter().zip(metrics) {
+    for (r, m) in rows {
         let _ = write!(
             out,
             "{},{},{},{},{},{},{}",

@@ -301,3 +301,63 @@ window_s = 0.1
         "{summary}"
     );
 }
+
+/// Swept presets with different axes (the printer has x and y, the stage only x): one
+/// runs.csv whose columns are the union, every row as long as the header, the stage's y
+/// cells empty. Rows are written one by one into the sweep journal, so each row must be
+/// formed against the whole sweep.
+#[test]
+fn swept_presets_with_different_axes_share_one_table() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scenario = dir.path().join("presets.toml");
+    std::fs::write(
+        &scenario,
+        r#"name = "presets"
+[machine]
+preset = "printer_xy"
+driver_model = "linear"
+[move]
+distance_mm = 2.0
+[limits]
+vmax_mm_s = 100.0
+amax_mm_s2 = 2000.0
+jmax_mm_s3 = 100000.0
+[observe]
+window_s = 0.05
+[sweep]
+"machine.preset" = ["printer_xy", "leadscrew_stage", "printer_xy"]
+"#,
+    )
+    .expect("write");
+    let out = settle()
+        .arg("sweep")
+        .arg(&scenario)
+        .args(["--backend", "modal", "--jobs", "2", "--out"])
+        .arg(dir.path())
+        .output()
+        .expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.path().join("runs.csv")).expect("csv");
+    let header: Vec<&str> = csv.lines().next().expect("header").split(',').collect();
+    let y = header
+        .iter()
+        .position(|h| *h == "y_residual_peak_um")
+        .expect("the printer's y axis has columns");
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        assert_eq!(r.len(), header.len(), "{r:?}");
+    }
+    assert!(rows[0][y].parse::<f64>().is_ok(), "printer: {}", rows[0][y]);
+    assert_eq!(rows[1][y], "", "the stage has no y axis");
+    // The same machine twice: the same numbers (only the run id differs).
+    assert_eq!(rows[0][1..], rows[2][1..]);
+}
