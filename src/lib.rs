@@ -16,6 +16,7 @@ pub mod run;
 pub mod scan;
 pub mod scenario;
 pub mod series;
+pub mod shaping;
 pub mod sweep;
 pub mod validate;
 // Outputs people keep (issue 7).
