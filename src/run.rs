@@ -105,9 +105,12 @@ pub fn trajectory_of(
         return crate::shaping::shape_trajectory(spec, traj);
     }
     let limits = spec.limits_si()?;
-    let profile =
-        spec.profile
-            .rest_to_rest(spec.start_mm * 1e-3, spec.distance_mm * 1e-3, &limits)?;
+    let profile = spec.profile.rest_to_rest_with(
+        spec.start_mm * 1e-3,
+        spec.distance_mm * 1e-3,
+        &limits,
+        &spec.kind_params,
+    )?;
     let profile = crate::shaping::shape_profile(spec, profile)?;
     let profiles = axes
         .iter()

@@ -85,6 +85,9 @@ pub struct RunSpec {
     pub scan: Option<crate::scan::ScanSpec>,
     /// The input shaper applied to the commanded motion, if the scenario has `[shaper]`.
     pub shaper: Option<crate::shaping::ShaperSetting>,
+    /// Parameters of the kinds that take any (PVT asymmetry, four-jerk BOW1..4 scales);
+    /// the planner's defaults unless `settle tune` searches them.
+    pub kind_params: settle_planner::KindParams,
 }
 
 /// Parameters that can be swept, for error messages.
@@ -509,6 +512,7 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
                     .map_err(|(key, m)| src.error_at(key, m))?,
             ),
         },
+        kind_params: settle_planner::KindParams::default(),
     };
     if base.shaper.is_some() && base.scan.is_some() {
         return Err(src.error_at(
