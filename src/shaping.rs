@@ -138,7 +138,8 @@ pub fn shape_profile(spec: &RunSpec, profile: Profile) -> Result<Profile, PlanEr
     }
 }
 
-/// Shape every axis of a trajectory (Klipper shapes each axis independently).
+/// Shape every axis of a trajectory (Klipper shapes each axis independently), keeping
+/// the path geometry it follows.
 pub fn shape_trajectory(spec: &RunSpec, traj: Trajectory) -> Result<Trajectory, PlanError> {
     match spec
         .shaper
@@ -146,12 +147,20 @@ pub fn shape_trajectory(spec: &RunSpec, traj: Trajectory) -> Result<Trajectory, 
         .map(ShaperSetting::shaper)
         .transpose()?
     {
-        Some(Some(s)) => Trajectory::new(
-            traj.axes()
-                .iter()
-                .map(|p| s.apply(p))
-                .collect::<Result<Vec<_>, _>>()?,
-        ),
+        Some(Some(s)) => {
+            let shaped = Trajectory::new(
+                traj.axes()
+                    .iter()
+                    .map(|p| s.apply(p))
+                    .collect::<Result<Vec<_>, _>>()?,
+            )?;
+            // The path stays the reference of the contour error: the shaper's smoothing of
+            // the corner counts against the shaped run.
+            Ok(match traj.path() {
+                Some(g) => shaped.with_path(g.clone()),
+                None => shaped,
+            })
+        }
         _ => Ok(traj),
     }
 }

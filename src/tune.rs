@@ -32,6 +32,12 @@ use crate::sweep::RunSpec;
 pub struct TuneSpec {
     /// The point-to-point move family: move lengths (mm) [default: `move.distance_mm`].
     pub distances_mm: Option<Vec<f64>>,
+    /// The corner family (a scenario with `[corner]`): interior angles (degrees)
+    /// [default: `corner.angle_deg`].
+    pub angles_deg: Option<Vec<f64>>,
+    /// Corner paths: the largest contour error (um) a candidate may reach on any corner of
+    /// the family; candidates above it are infeasible [default: no limit].
+    pub max_contour_error_um: Option<f64>,
     /// The settling band the score uses (um) [default: the first of `observe.bands_um`].
     pub band_um: Option<f64>,
     /// Profile kinds to search [default: all].
@@ -116,8 +122,11 @@ pub struct Score {
     pub move_time_s: f64,
     /// Mean residual peak (um).
     pub residual_peak_um: f64,
-    /// Mean move-and-settle at the band (s); infinite when some move does not settle.
+    /// Mean move-and-settle at the band (s); infinite when some move does not settle (or
+    /// a corner exceeds `max_contour_error_um`).
     pub move_and_settle_s: f64,
+    /// Largest contour error over the family (um), NaN for point-to-point moves.
+    pub max_contour_error_um: f64,
 }
 
 /// The resolved search.
@@ -125,8 +134,10 @@ pub struct Score {
 pub struct Plan {
     /// The base run (the scenario as written: the untuned default).
     pub base: RunSpec,
-    /// Move lengths (mm).
+    /// Move lengths (mm) of the point-to-point family.
     pub distances_mm: Vec<f64>,
+    /// Interior angles (degrees) of the corner family (empty for point-to-point moves).
+    pub angles_deg: Vec<f64>,
     /// Index of the band in the runs' `bands_um`.
     pub band_index: usize,
     /// Candidates in grid order (the default first).
@@ -156,10 +167,10 @@ pub const FREQUENCY_SCALES: [f64; 7] = [0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2];
 /// Resolve the scenario's search. Errors name the `[tune]` key.
 pub fn plan(sc: &crate::scenario::Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error> {
     let spec = sc.tune.clone().unwrap_or_default();
-    if sc.corner.is_some() || sc.scan.is_some() {
+    if sc.scan.is_some() {
         return Err(src.error_at(
-            "name",
-            "settle tune searches point-to-point moves ([move]); corner and scan-step families are not tunable yet",
+            "scan",
+            "settle tune searches point-to-point moves ([move]) and corners ([corner]); scan steps are not tunable yet",
         ));
     }
     if !sc.sweep.is_empty() {
@@ -186,6 +197,40 @@ pub fn plan(sc: &crate::scenario::Scenario, src: &Source, runs: &[RunSpec]) -> R
         return Err(src.error_at(
             "tune.distances_mm",
             "give one or more finite, non-zero move lengths (mm)",
+        ));
+    }
+    let angles_deg = match &base.corner {
+        None if spec.angles_deg.is_some() => {
+            return Err(src.error_at("tune.angles_deg", "corner angles need a [corner] scenario"));
+        }
+        None => Vec::new(),
+        Some(c) => {
+            if spec.distances_mm.is_some() {
+                return Err(src.error_at(
+                    "tune.distances_mm",
+                    "a [corner] scenario tunes over corner angles: give `angles_deg`, not distances_mm",
+                ));
+            }
+            let angles = spec.angles_deg.clone().unwrap_or_else(|| vec![c.angle_deg]);
+            if angles.is_empty()
+                || angles
+                    .iter()
+                    .any(|a| !(a.is_finite() && (0.0..=180.0).contains(a)))
+            {
+                return Err(src.error_at(
+                    "tune.angles_deg",
+                    "give one or more interior angles from 0 (reversal) to 180 (straight on) degrees",
+                ));
+            }
+            angles
+        }
+    };
+    if let Some(e) = spec.max_contour_error_um
+        && !(e.is_finite() && e > 0.0)
+    {
+        return Err(src.error_at(
+            "tune.max_contour_error_um",
+            "must be a finite number > 0 (um)",
         ));
     }
     let band = spec.band_um.unwrap_or(base.bands_um[0]);
@@ -288,6 +333,8 @@ pub fn plan(sc: &crate::scenario::Scenario, src: &Source, runs: &[RunSpec]) -> R
             jerks.iter().copied().map(Some).collect()
         };
         let params: Vec<KindParams> = match kind {
+            // Corner paths plan their legs from the limits alone.
+            _ if base.corner.is_some() => vec![KindParams::default()],
             ProfileKind::PvtAsym => PVT_KI
                 .iter()
                 .map(|&k| KindParams {
@@ -320,6 +367,7 @@ pub fn plan(sc: &crate::scenario::Scenario, src: &Source, runs: &[RunSpec]) -> R
     Ok(Plan {
         base,
         distances_mm,
+        angles_deg,
         band_index,
         candidates,
         modes,
@@ -345,43 +393,68 @@ pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
     let Ok(axes) = machine.compile(settle_sim::DriverMode::Linear) else {
         return Vec::new();
     };
-    let Some(axis) = axes.iter().find(|a| a.name == base.axis) else {
-        return Vec::new();
-    };
     let Ok(limits) = base.limits_si() else {
         return Vec::new();
     };
-    let Ok(profile) =
-        base.profile
-            .rest_to_rest(base.start_mm * 1e-3, base.distance_mm * 1e-3, &limits)
-    else {
-        return Vec::new();
-    };
-    let Ok(lr) = settle_sim::closed_form::LinearResponse::new(axis, &profile) else {
-        return Vec::new();
-    };
-    lr.modes()
-        .into_iter()
-        .filter(|(f, _, _)| *f > 0.5)
-        .take(2)
-        .map(|(f, z, _)| (f, z))
-        .collect()
+    // The moving axis, or both axes of a corner path (its strongest mode each).
+    let names: Vec<&str> = base.axis.split('+').collect();
+    let per_axis = if names.len() > 1 { 1 } else { 2 };
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for name in names {
+        let Some(axis) = axes.iter().find(|a| a.name == name) else {
+            continue;
+        };
+        let (start_m, dist_m) = if base.corner.is_some() {
+            (0.0, 0.02)
+        } else {
+            (base.start_mm * 1e-3, base.distance_mm * 1e-3)
+        };
+        let Ok(profile) = base.profile.rest_to_rest(start_m, dist_m, &limits) else {
+            continue;
+        };
+        let Ok(lr) = settle_sim::closed_form::LinearResponse::new(axis, &profile) else {
+            continue;
+        };
+        for (f, z, _) in lr
+            .modes()
+            .into_iter()
+            .filter(|(f, _, _)| *f > 0.5)
+            .take(per_axis)
+        {
+            if !out.iter().any(|(g, _)| (g - f).abs() < 1e-6 * f) {
+                out.push((f, z));
+            }
+        }
+    }
+    out
 }
 
 impl Plan {
     /// The runs of `candidates` (each over the move family), in order, ids from 0.
     pub fn runs(&self, candidates: &[Candidate]) -> Vec<RunSpec> {
-        let mut out = Vec::with_capacity(candidates.len() * self.distances_mm.len());
+        let mut out = Vec::with_capacity(candidates.len() * self.family_len());
         for c in candidates {
-            for d in &self.distances_mm {
+            for i in 0..self.family_len() {
                 let mut r = self.base.clone();
                 r.id = out.len();
-                r.distance_mm = *d;
+                match r.corner.as_mut() {
+                    Some(corner) => corner.angle_deg = self.angles_deg[i],
+                    None => r.distance_mm = self.distances_mm[i],
+                }
                 c.apply(&mut r);
                 out.push(r);
             }
         }
         out
+    }
+
+    /// Moves per candidate: the corner angles, or the move lengths.
+    pub fn family_len(&self) -> usize {
+        if self.base.corner.is_some() {
+            self.angles_deg.len()
+        } else {
+            self.distances_mm.len()
+        }
     }
 
     /// Scores of `candidates` from the metrics of [`Plan::runs`] (a failed run scores
@@ -391,12 +464,14 @@ impl Plan {
         candidates: &[Candidate],
         results: &[Result<Metrics, Error>],
     ) -> Vec<Score> {
-        let n = self.distances_mm.len();
+        let n = self.family_len();
+        let limit = self.spec.max_contour_error_um.unwrap_or(f64::INFINITY);
         candidates
             .iter()
             .zip(results.chunks(n))
             .map(|(c, rs)| {
                 let (mut t, mut r, mut mas) = (0.0, 0.0, 0.0);
+                let mut contour = f64::NAN;
                 for m in rs {
                     match m {
                         Ok(m) if m.is_ok() => {
@@ -405,6 +480,12 @@ impl Plan {
                             mas += m
                                 .move_and_settle_s(self.band_index)
                                 .unwrap_or(f64::INFINITY);
+                            if let Some(p) = &m.path {
+                                contour = contour.max(p.max_contour_error_um);
+                                if p.max_contour_error_um > limit {
+                                    mas = f64::INFINITY;
+                                }
+                            }
                         }
                         _ => {
                             t = f64::NAN;
@@ -418,19 +499,24 @@ impl Plan {
                     move_time_s: t / k,
                     residual_peak_um: r / k,
                     move_and_settle_s: mas / k,
+                    max_contour_error_um: contour,
                 }
             })
             .collect()
     }
 }
 
-/// Index of the best score (lowest move-and-settle; the first among equals).
+/// Index of the best score: lowest move-and-settle, then lowest residual (candidates that
+/// are inside the band when their move ends tie on move-and-settle); the first among equals.
 pub fn best(scores: &[Score]) -> Option<usize> {
     let mut best: Option<usize> = None;
     for (i, s) in scores.iter().enumerate() {
-        if s.move_and_settle_s.is_finite()
-            && best.is_none_or(|b| s.move_and_settle_s < scores[b].move_and_settle_s)
-        {
+        let better = |b: &Score| {
+            s.move_and_settle_s < b.move_and_settle_s
+                || (s.move_and_settle_s == b.move_and_settle_s
+                    && s.residual_peak_um < b.residual_peak_um)
+        };
+        if s.move_and_settle_s.is_finite() && best.is_none_or(|b| better(&scores[b])) {
             best = Some(i);
         }
     }

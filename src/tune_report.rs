@@ -32,17 +32,30 @@ pub fn klipper(plan: &Plan, s: &Score) -> String {
     let _ = writeln!(out, "max_accel: {}", b.amax_mm_s2);
     let _ = writeln!(out);
     let _ = writeln!(out, "[input_shaper]");
-    let axis = b.axis.as_str();
-    match c.shaper.and_then(|sh| sh.kind.map(|k| (k, sh))) {
-        Some((k, sh)) => {
-            let _ = writeln!(out, "shaper_type_{axis}: {}", k.name());
-            let _ = writeln!(out, "shaper_freq_{axis}: {:.1}", sh.frequency_hz);
-            let _ = writeln!(out, "damping_ratio_{axis}: {}", sh.damping_ratio);
+    // One line set per moving axis (a corner path moves two; settle applies one shaper
+    // to both).
+    for axis in b.axis.split('+') {
+        match c.shaper.and_then(|sh| sh.kind.map(|k| (k, sh))) {
+            Some((k, sh)) => {
+                let _ = writeln!(out, "shaper_type_{axis}: {}", k.name());
+                let _ = writeln!(out, "shaper_freq_{axis}: {:.1}", sh.frequency_hz);
+                let _ = writeln!(out, "damping_ratio_{axis}: {}", sh.damping_ratio);
+            }
+            None => {
+                let _ = writeln!(out, "# no shaper in the winner: shaping off on {axis}");
+                let _ = writeln!(out, "shaper_freq_{axis}: 0");
+            }
         }
-        None => {
-            let _ = writeln!(out, "# no shaper in the winner: shaping off on {axis}");
-            let _ = writeln!(out, "shaper_freq_{axis}: 0");
-        }
+    }
+    if let Some(corner) = &b.corner
+        && corner.strategy.name() == "square_corner_velocity"
+    {
+        let _ = writeln!(out, "\n[printer]");
+        let _ = writeln!(
+            out,
+            "square_corner_velocity: {}",
+            corner.square_corner_velocity_mm_s
+        );
     }
     out
 }
@@ -125,7 +138,7 @@ pub fn tmc(plan: &Plan, s: &Score) -> String {
 /// The candidates table (one row per candidate).
 pub fn candidates_csv(scores: &[Score]) -> String {
     let mut out = String::from(
-        "candidate,profile,jmax_mm_s3,pvt_asym_ki,bow_scales,shaper_type,shaper_frequency_hz,move_time_s,residual_peak_um,move_and_settle_s\n",
+        "candidate,profile,jmax_mm_s3,pvt_asym_ki,bow_scales,shaper_type,shaper_frequency_hz,move_time_s,residual_peak_um,move_and_settle_s,max_contour_error_um\n",
     );
     for (i, s) in scores.iter().enumerate() {
         let c = &s.candidate;
@@ -139,7 +152,7 @@ pub fn candidates_csv(scores: &[Score]) -> String {
         };
         let _ = writeln!(
             out,
-            "{i},{},{},{},{}/{}/{}/{},{st},{sf},{},{},{}",
+            "{i},{},{},{},{}/{}/{}/{},{st},{sf},{},{},{},{}",
             c.kind,
             c.jmax_mm_s3.map_or(String::new(), |j| j.to_string()),
             c.params.pvt_asym_ki,
@@ -149,10 +162,32 @@ pub fn candidates_csv(scores: &[Score]) -> String {
             b[3],
             s.move_time_s,
             s.residual_peak_um,
-            s.move_and_settle_s
+            s.move_and_settle_s,
+            if s.max_contour_error_um.is_nan() {
+                String::new()
+            } else {
+                s.max_contour_error_um.to_string()
+            }
         );
     }
     out
+}
+
+/// The move family in words.
+fn family(plan: &Plan) -> String {
+    match &plan.base.corner {
+        Some(c) => format!(
+            "Corners: {} x {} mm legs at {:?} degrees, strategy {}{}",
+            c.leg_in_mm,
+            c.leg_out_mm,
+            plan.angles_deg,
+            c.strategy.name(),
+            plan.spec
+                .max_contour_error_um
+                .map_or(String::new(), |e| format!(", contour error <= {e} um"))
+        ),
+        None => format!("Moves: {:?} mm", plan.distances_mm),
+    }
 }
 
 fn ms(x: f64) -> String {
@@ -183,12 +218,12 @@ pub fn markdown(
         .collect();
     let _ = writeln!(
         out,
-        "Machine `{}`, axis `{}`, backend `{}`; modes tuned to: {}. Moves: {:?} mm at vmax {} mm/s, amax {} mm/s^2, jerk <= {} mm/s^3. Score: mean move-and-settle into {band} um. {} candidates.\n",
+        "Machine `{}`, axis `{}`, backend `{}`; modes tuned to: {}. {} at vmax {} mm/s, amax {} mm/s^2, jerk <= {} mm/s^3. Score: mean move-and-settle into {band} um. {} candidates.\n",
         plan.base.machine_name,
         plan.base.axis,
         plan.base.backend,
         modes.join(", "),
-        plan.distances_mm,
+        family(plan),
         plan.base.vmax_mm_s,
         plan.base.amax_mm_s2,
         plan.base.jmax_mm_s3.map_or("-".into(), |j| j.to_string()),
@@ -216,6 +251,13 @@ pub fn markdown(
             ms(s.move_time_s),
             s.residual_peak_um,
             ms(s.move_and_settle_s)
+        );
+    }
+    if plan.base.corner.is_some() {
+        let _ = writeln!(
+            out,
+            "\nLargest contour error over the corners: default {:.1} um, winner {:.1} um.",
+            d.max_contour_error_um, w.max_contour_error_um
         );
     }
     let _ = writeln!(out, "\nGain of the winner over the default: {gain}.\n");

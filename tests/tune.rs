@@ -204,3 +204,65 @@ fn bad_tune_input_names_file_line_and_key() {
         .expect_err("modal refuses the full driver");
     assert!(e.to_string().contains("--backend rapier"), "{e}");
 }
+
+#[test]
+fn corner_family_respects_the_contour_limit_and_holds_on_rapier() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let text = r#"name = "tune_corner_test"
+[machine]
+preset = "printer_xy"
+driver_model = "linear"
+[corner]
+angle_deg = 90.0
+leg_in_mm = 30.0
+leg_out_mm = 30.0
+strategy = "square_corner_velocity"
+profile = "scurve"
+[limits]
+vmax_mm_s = 200.0
+amax_mm_s2 = 3000.0
+jmax_mm_s3 = 100000.0
+[observe]
+window_s = 0.5
+sample_rate_hz = 5000
+bands_um = [10.0]
+[tune]
+angles_deg = [60.0, 120.0]
+kinds = ["trapezoid", "scurve"]
+shapers = ["none", "zv", "mzv"]
+frequency_scales = [0.9, 1.0, 1.1]
+jerk_steps = 2
+max_contour_error_um = 25.0
+"#;
+    let path = write(&dir, text);
+    let o = settle::tune_cmd::tune(&path, Backend::Modal, Some(Backend::Rapier), Some(2), false)
+        .expect("tunes");
+    // Both path axes' modes: the preset's X (~48 Hz) and Y (~39 Hz) first modes.
+    assert_eq!(o.plan.modes.len(), 2);
+    let w = &o.scores[o.winner];
+    assert!(w.max_contour_error_um <= 25.0, "{w:?}");
+    // Every candidate over the limit is infeasible; every candidate within it is scored.
+    for s in &o.scores {
+        // Shaped paths keep their geometry: every scored candidate has a contour error.
+        assert!(
+            s.move_and_settle_s.is_infinite() || s.max_contour_error_um.is_finite(),
+            "{s:?}"
+        );
+        if s.max_contour_error_um > 25.0 {
+            assert!(s.move_and_settle_s.is_infinite(), "{s:?}");
+        }
+    }
+    let (_, rd, rw) = o.check.as_ref().expect("checked");
+    let d = &o.scores[0];
+    assert!(w.move_and_settle_s <= d.move_and_settle_s || d.move_and_settle_s.is_infinite());
+    assert!(
+        rw.move_and_settle_s < rd.move_and_settle_s || rd.move_and_settle_s.is_infinite(),
+        "rapier: winner {rw:?} default {rd:?}"
+    );
+    let k = settle::tune_report::klipper(&o.plan, w);
+    assert!(
+        k.contains("shaper_freq_x:") && k.contains("shaper_freq_y:"),
+        "{k}"
+    );
+    assert!(k.contains("square_corner_velocity: 5"), "{k}");
+}
