@@ -16,7 +16,11 @@ pub mod run;
 pub mod scan;
 pub mod scenario;
 pub mod series;
+pub mod shaping;
 pub mod sweep;
+pub mod tune;
+pub mod tune_cmd;
+pub mod tune_report;
 pub mod validate;
 // Outputs people keep (issue 7).
 pub mod check;

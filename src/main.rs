@@ -114,6 +114,27 @@ enum Command {
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
         jobs: Option<u16>,
     },
+    /// Search the profile parameters (kind, jerk, PVT asymmetry, BOW1..4, input shaper)
+    /// that minimise move-and-settle on the scenario's machine; export the winner.
+    #[command(
+        after_help = "Example:\n  settle tune scenarios/tune_printer.toml --check-on rapier\n  (writes results/tune_printer-tune/tune.md, candidates.csv, pareto.svg/png,\n  klipper.cfg and tmc5160.txt)"
+    )]
+    Tune {
+        /// The scenario file (TOML) with [move], [limits] and an optional [tune] table.
+        scenario: PathBuf,
+        /// Output folder [default: results/<scenario name>-tune/].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Backend of the search [default: modal, exact and fast; needs the linear driver].
+        #[arg(long, default_value = "modal", value_parser = parse_backend)]
+        backend: Backend,
+        /// Re-run the default and the winner on this second backend and compare.
+        #[arg(long, value_parser = parse_backend)]
+        check_on: Option<Backend>,
+        /// Worker threads [default: all cores].
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+        jobs: Option<u16>,
+    },
     /// Run one point of a sweep in detail: print its metrics, write its full trace as CSV.
     #[command(
         after_help = "Example:\n  settle run scenarios/quickstart.toml --case 3\n  (prints the metrics of run 3 and writes results/quickstart/run-3.csv)"
@@ -199,6 +220,23 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             jobs.map(usize::from),
         ),
         Command::Merge { dirs, out } => merge(&dirs, out),
+        Command::Tune {
+            scenario,
+            out,
+            backend,
+            check_on,
+            jobs,
+        } => {
+            let md = settle::tune_cmd::command(
+                &scenario,
+                out,
+                backend,
+                check_on,
+                jobs.map(usize::from),
+            )?;
+            print!("{md}");
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Plan { jobs } => plan_lines(jobs.map(usize::from)),
         Command::Run {
             scenario,

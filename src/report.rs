@@ -116,6 +116,7 @@ fn runs_csv_with<'a>(
     let any_path = runs.iter().any(|r| r.corner.is_some());
     out.push_str(&crate::corner::csv_param_header(runs));
     out.push_str(&crate::path_metrics::csv_header(any_path));
+    out.push_str(&crate::shaping::csv_header(runs));
     // Extra columns of a run kind (scan steps), named from the first run that has them.
     let extra: Vec<String> = runs
         .iter()
@@ -162,6 +163,7 @@ fn runs_csv_with<'a>(
             out.push_str(&",".repeat(cells));
             out.push_str(&crate::corner::csv_param_cells(runs, r));
             out.push_str(&crate::path_metrics::csv_cells(any_path, None));
+            out.push_str(&crate::shaping::csv_cells(runs, r));
             out.push_str(&",".repeat(extra.len()));
             out.push('\n');
             continue;
@@ -198,6 +200,7 @@ fn runs_csv_with<'a>(
         }
         out.push_str(&crate::corner::csv_param_cells(runs, r));
         out.push_str(&crate::path_metrics::csv_cells(any_path, m.path.as_ref()));
+        out.push_str(&crate::shaping::csv_cells(runs, r));
         for e in &extra {
             let v = m.extra.iter().find(|(n, _)| n == e);
             let _ = write!(out, ",{}", v.map_or(String::new(), |(_, x)| x.to_string()));

@@ -101,12 +101,17 @@ pub fn trajectory_of(
 ) -> Result<Trajectory, settle_planner::PlanError> {
     if let Some(c) = &spec.corner {
         let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
-        return crate::corner::trajectory(spec, c, &names);
+        let traj = crate::corner::trajectory(spec, c, &names)?;
+        return crate::shaping::shape_trajectory(spec, traj);
     }
     let limits = spec.limits_si()?;
-    let profile =
-        spec.profile
-            .rest_to_rest(spec.start_mm * 1e-3, spec.distance_mm * 1e-3, &limits)?;
+    let profile = spec.profile.rest_to_rest_with(
+        spec.start_mm * 1e-3,
+        spec.distance_mm * 1e-3,
+        &limits,
+        &spec.kind_params,
+    )?;
+    let profile = crate::shaping::shape_profile(spec, profile)?;
     let profiles = axes
         .iter()
         .map(|a| {

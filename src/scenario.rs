@@ -37,6 +37,12 @@ pub struct Scenario {
     pub scan: Option<crate::scan::ScanSpec>,
     /// Sweep axes: `parameter = [list]` or `parameter = { from, to, steps | step, scale }`.
     /// The cartesian product of all axes, in the order written, gives the runs.
+    /// Input shaping of the commanded motion (issue 9; see `crate::shaping`).
+    #[serde(default)]
+    pub shaper: Option<crate::shaping::ShaperSpec>,
+    /// The search of `settle tune` (issue 9; see `crate::tune`).
+    #[serde(default)]
+    pub tune: Option<crate::tune::TuneSpec>,
     #[serde(default)]
     pub sweep: toml::Table,
     /// Numerical settings of the simulation (expert; the defaults are the validated ones).

@@ -83,6 +83,11 @@ pub struct RunSpec {
     pub corner: Option<crate::corner::Corner>,
     /// The raster scan the move is the step of, if the scenario has `[scan]`.
     pub scan: Option<crate::scan::ScanSpec>,
+    /// The input shaper applied to the commanded motion, if the scenario has `[shaper]`.
+    pub shaper: Option<crate::shaping::ShaperSetting>,
+    /// Parameters of the kinds that take any (PVT asymmetry, four-jerk BOW1..4 scales);
+    /// the planner's defaults unless `settle tune` searches them.
+    pub kind_params: settle_planner::KindParams,
 }
 
 /// Parameters that can be swept, for error messages.
@@ -94,7 +99,7 @@ and machine.driver.<field> (every axis), machine.preset (preset names or machine
 with a [corner] table: corner.angle_deg, corner.leg_in_mm, corner.leg_out_mm, corner.strategy, \
 corner.junction_deviation_mm, corner.square_corner_velocity_mm_s, corner.blend_deviation_mm; \
 with a [scan] table: scan.v_scan_mm_s, scan.fly_amax_mm_s2, scan.fly_jmax_mm_s3, scan.width_mm, \
-scan.settle_margin_s";
+scan.settle_margin_s; with a [shaper] table: shaper.type, shaper.frequency_hz, shaper.damping_ratio";
 
 /// Set a numeric field of an axis by its key path inside the axis (as in machine files).
 fn set_axis_field(a: &mut AxisMachine, field: &str, x: f64) -> Result<(), String> {
@@ -202,6 +207,10 @@ impl RunSpec {
                 Value::Kind(k) => self.profile = *k,
                 _ => return Err("`profile` takes profile kind names".into()),
             },
+            other if other.starts_with("shaper.") => match self.shaper.as_mut() {
+                Some(sh) => sh.set(&other["shaper.".len()..], value)?,
+                None => return Err(format!("`{other}` needs a [shaper] table")),
+            },
             other if other.starts_with("corner.") => match self.corner.as_mut() {
                 Some(c) => c.set(&other["corner.".len()..], value)?,
                 None => return Err(format!("`{other}` needs a [corner] table")),
@@ -296,6 +305,22 @@ pub fn axes(sc: &Scenario, src: &Source) -> Result<Vec<Axis>, Error> {
                         .map_err(|e| err(e.to_string()))
                 })
                 .collect::<Result<Vec<_>, _>>()?
+        } else if param == "shaper.type" {
+            let list = raw
+                .as_array()
+                .ok_or_else(|| err(format!("`{param}` takes a list of shaper names")))?;
+            list.iter()
+                .map(|v| {
+                    let name = v.as_str().ok_or_else(|| {
+                        err(format!(
+                            "shaper types are strings; allowed: {}",
+                            crate::shaping::ALLOWED_TYPES
+                        ))
+                    })?;
+                    crate::shaping::parse_type(name).map_err(&err)?;
+                    Ok(Value::Text(name.to_string()))
+                })
+                .collect::<Result<Vec<_>, Error>>()?
         } else if crate::corner::is_text_param(param) {
             let list = raw
                 .as_array()
@@ -480,7 +505,21 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
         swept: Vec::new(),
         corner,
         scan: sc.scan.clone(),
+        shaper: match &sc.shaper {
+            None => None,
+            Some(spec) => Some(
+                crate::shaping::ShaperSetting::from_spec(spec)
+                    .map_err(|(key, m)| src.error_at(key, m))?,
+            ),
+        },
+        kind_params: settle_planner::KindParams::default(),
     };
+    if base.shaper.is_some() && base.scan.is_some() {
+        return Err(src.error_at(
+            "shaper",
+            "[shaper] is not supported with [scan] yet: shape point-to-point moves or corners",
+        ));
+    }
     validate_observe(&base, src)?;
     let axes = axes(sc, src)?;
     let total = axes
@@ -702,6 +741,11 @@ fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
                 run.profile
             ),
         ));
+    }
+    if let Some(sh) = &run.shaper
+        && let Err((key, message)) = sh.validate()
+    {
+        return Err(src.error_at(&blame(run, key), message));
     }
     if let Some(scan) = &run.scan
         && let Err((key, message)) = scan.validate()

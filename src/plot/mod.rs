@@ -71,7 +71,7 @@ pub struct Line {
     pub points: Vec<(f64, f64)>,
     /// Marker at each point, if any.
     pub marker: Option<Marker>,
-    /// Stroke width (px).
+    /// Stroke width (px); 0 draws the markers only (a scatter).
     pub width: u32,
     /// A shaded band `(x, low, high)` drawn under the line (e.g. min-max).
     pub band: Vec<(f64, f64, f64)>,
@@ -425,7 +425,12 @@ where
                 )))
                 .map_err(err)?;
         }
-        let style = l.color.stroke_width(l.width);
+        // Width 0: markers only (a scatter), the line drawn fully transparent.
+        let style = if l.width == 0 {
+            l.color.mix(0.0).stroke_width(1)
+        } else {
+            l.color.stroke_width(l.width)
+        };
         // Split at non-finite values.
         let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
         for &(px, py) in &l.points {

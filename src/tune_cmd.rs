@@ -1,0 +1,140 @@
+//! The `settle tune SCENARIO.toml` command: search ([`crate::tune`]), optionally re-check
+//! the default and the winner on a second backend, and write the outputs
+//! ([`crate::tune_report`]).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::error::Error;
+use crate::run::Backend;
+use crate::tune::{Plan, Score};
+
+/// What a tuning found.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// The resolved search.
+    pub plan: Plan,
+    /// Every candidate's score; index 0 is the untuned default.
+    pub scores: Vec<Score>,
+    /// Index of the winner in `scores`.
+    pub winner: usize,
+    /// Indices of the Pareto front.
+    pub front: Vec<usize>,
+    /// `(backend, default, winner)` re-run on a second backend, if asked.
+    pub check: Option<(Backend, Score, Score)>,
+}
+
+/// Load `path`, search on `backend`, and re-check on `check_on` if given.
+pub fn tune(
+    path: &Path,
+    backend: Backend,
+    check_on: Option<Backend>,
+    jobs: Option<usize>,
+    progress: bool,
+) -> Result<Outcome, Error> {
+    let (sc, src) = crate::scenario::load(path)?;
+    let mut runs = crate::sweep::expand(&sc, &src)?;
+    crate::run::set_backend(path, &mut runs, backend)?;
+    let plan = crate::tune::plan(&sc, &src, &runs)?;
+    let scores = crate::tune::evaluate(&plan, &plan.candidates, jobs, progress)?;
+    let winner = crate::tune::best(&scores).ok_or_else(|| Error::Input {
+        at: crate::error::Location {
+            file: path.to_path_buf(),
+            line: None,
+            column: None,
+            key: Some("observe.window_s".into()),
+        },
+        message: "no candidate settles within the observation window; lengthen window_s or widen the band".into(),
+    })?;
+    let front = crate::tune::pareto(&scores);
+    let check = match check_on {
+        None => None,
+        Some(b) => {
+            let mut other = plan.clone();
+            let mut base = vec![other.base.clone()];
+            crate::run::set_backend(path, &mut base, b)?;
+            other.base.backend = b;
+            let pair = [scores[0].candidate, scores[winner].candidate];
+            let s = crate::tune::evaluate(&other, &pair, jobs, false)?;
+            Some((b, s[0].clone(), s[1].clone()))
+        }
+    };
+    Ok(Outcome {
+        plan,
+        scores,
+        winner,
+        front,
+        check,
+    })
+}
+
+/// The second-backend paragraph of the report.
+pub fn check_text(o: &Outcome) -> String {
+    let Some((b, d, w)) = &o.check else {
+        return String::new();
+    };
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "\n## Checked on a second backend: {b}\n\n| | candidate | move (ms) | residual peak (um) | move+settle (ms) |\n|---|---|---:|---:|---:|"
+    );
+    for (tag, s) in [("default", d), ("winner", w)] {
+        let _ = writeln!(
+            out,
+            "| {tag} | {} | {:.1} | {:.2} | {:.1} |",
+            s.candidate.label(),
+            s.move_time_s * 1e3,
+            s.residual_peak_um,
+            s.move_and_settle_s * 1e3
+        );
+    }
+    let verdict = if w.move_and_settle_s < d.move_and_settle_s {
+        format!(
+            "the winner still beats the default on {b}: {:.1}% faster",
+            100.0 * (1.0 - w.move_and_settle_s / d.move_and_settle_s)
+        )
+    } else {
+        format!("the winner does NOT beat the default on {b}")
+    };
+    let _ = writeln!(out, "\nVerdict: {verdict}.");
+    out
+}
+
+/// Run the command: tune, write `OUT/tune.md`, `candidates.csv`, `pareto.svg/png`,
+/// `klipper.cfg`, `tmc5160.txt`, print the report. Returns the report text.
+pub fn command(
+    path: &Path,
+    out: Option<PathBuf>,
+    backend: Backend,
+    check_on: Option<Backend>,
+    jobs: Option<usize>,
+) -> Result<String, Error> {
+    let (sc, _) = crate::scenario::load(path)?;
+    let o = tune(path, backend, check_on, jobs, true)?;
+    let out = out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-tune", sc.name)));
+    std::fs::create_dir_all(&out).map_err(|source| Error::Write {
+        path: out.clone(),
+        source,
+    })?;
+    let mut md = crate::tune_report::markdown(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
+    md.push_str(&check_text(&o));
+    let w = &o.scores[o.winner];
+    let klipper = crate::tune_report::klipper(&o.plan, w);
+    let tmc = crate::tune_report::tmc(&o.plan, w);
+    let _ = write!(
+        md,
+        "\n## Export\n\nKlipper (`klipper.cfg`):\n\n```ini\n{klipper}```\n\nTrinamic TMC5160 (`tmc5160.txt`):\n\n```\n{tmc}```\n\n![Pareto front](pareto.svg)\n"
+    );
+    let write =
+        |name: &str, text: &str| crate::report::write_atomic(&out.join(name), text.as_bytes());
+    write("tune.md", &md)?;
+    write(
+        "candidates.csv",
+        &crate::tune_report::candidates_csv(&o.scores),
+    )?;
+    write("klipper.cfg", &klipper)?;
+    write("tmc5160.txt", &tmc)?;
+    let fig = crate::tune_report::pareto_figure(&sc.name, &o.scores, o.winner, &o.front);
+    crate::plot::write(&fig, &out, "pareto")?;
+    Ok(md)
+}
