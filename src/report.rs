@@ -225,6 +225,57 @@ pub struct Figure {
     pub png: String,
 }
 
+/// Runs grouped by their swept values other than `profile` (first-seen order): the rows of
+/// the summary's side-by-side tables.
+#[derive(Debug)]
+pub struct SweptGroups<'a> {
+    /// The profile kinds, in first-seen order (the tables' column groups).
+    pub kinds: Vec<ProfileKind>,
+    /// Per swept point: its values joined by ` | `, and the indices of its runs.
+    pub groups: Vec<(String, Vec<usize>)>,
+    /// The swept parameters other than `profile`, in sweep order.
+    pub params: Vec<&'a str>,
+}
+
+impl<'a> SweptGroups<'a> {
+    /// Group `runs`.
+    pub fn of(runs: &'a [RunSpec]) -> Self {
+        let mut kinds: Vec<ProfileKind> = Vec::new();
+        let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
+        for (i, r) in runs.iter().enumerate() {
+            if !kinds.contains(&r.profile) {
+                kinds.push(r.profile);
+            }
+            let key: Vec<String> = r
+                .swept
+                .iter()
+                .filter(|(p, _)| p != "profile")
+                .map(|(_, v)| v.to_string())
+                .collect();
+            let key = key.join(" | ");
+            match groups.iter_mut().find(|(k, _)| *k == key) {
+                Some((_, v)) => v.push(i),
+                None => groups.push((key, vec![i])),
+            }
+        }
+        let params: Vec<&str> = runs
+            .first()
+            .map(|r| {
+                r.swept
+                    .iter()
+                    .filter(|(p, _)| p != "profile")
+                    .map(|(p, _)| p.as_str())
+                    .collect()
+            })
+            .unwrap_or_default();
+        Self {
+            kinds,
+            groups,
+            params,
+        }
+    }
+}
+
 /// The metrics the summary shows, read from one row of the runs table.
 struct RowView<'a> {
     table: &'a RunsTable,
@@ -330,35 +381,11 @@ gain = how much longer the slowest kind takes than the fastest.\n",
         }
         out.push('\n');
     }
-    // Group runs by their swept values other than `profile`, keeping first-seen order.
-    let mut kinds: Vec<ProfileKind> = Vec::new();
-    let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
-    for (i, r) in runs.iter().enumerate() {
-        if !kinds.contains(&r.profile) {
-            kinds.push(r.profile);
-        }
-        let key: Vec<String> = r
-            .swept
-            .iter()
-            .filter(|(p, _)| p != "profile")
-            .map(|(_, v)| v.to_string())
-            .collect();
-        let key = key.join(" | ");
-        match groups.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, v)) => v.push(i),
-            None => groups.push((key, vec![i])),
-        }
-    }
-    let params: Vec<&str> = runs
-        .first()
-        .map(|r| {
-            r.swept
-                .iter()
-                .filter(|(p, _)| p != "profile")
-                .map(|(p, _)| p.as_str())
-                .collect()
-        })
-        .unwrap_or_default();
+    let SweptGroups {
+        kinds,
+        groups,
+        params,
+    } = SweptGroups::of(runs);
     // A scan sweep's own tables replace the move-and-settle ones (which would measure the
     // raster's run-out, not the step).
     let scan = crate::scan::summary_section(runs, table);

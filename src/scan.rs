@@ -343,34 +343,11 @@ pub fn summary_section(runs: &[RunSpec], table: &crate::table::RunsTable) -> Str
     if table.column("scan_reentry_error_um").is_none() {
         return out;
     }
-    let mut kinds = Vec::new();
-    let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
-    for (i, r) in runs.iter().enumerate() {
-        if !kinds.contains(&r.profile) {
-            kinds.push(r.profile);
-        }
-        let key: Vec<String> = r
-            .swept
-            .iter()
-            .filter(|(p, _)| p != "profile")
-            .map(|(_, v)| v.to_string())
-            .collect();
-        let key = key.join(" | ");
-        match groups.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, v)) => v.push(i),
-            None => groups.push((key, vec![i])),
-        }
-    }
-    let params: Vec<&str> = runs
-        .first()
-        .map(|r| {
-            r.swept
-                .iter()
-                .filter(|(p, _)| p != "profile")
-                .map(|(p, _)| p.as_str())
-                .collect()
-        })
-        .unwrap_or_default();
+    let crate::report::SweptGroups {
+        kinds,
+        groups,
+        params,
+    } = crate::report::SweptGroups::of(runs);
     let bands = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
     let _ = writeln!(
         out,
