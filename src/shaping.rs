@@ -167,8 +167,8 @@ pub fn shape_trajectory(spec: &RunSpec, traj: Trajectory) -> Result<Trajectory, 
 
 /// The mode the `remaining_vibration_pct` column is computed for: `(frequency Hz, damping
 /// ratio)`. The modes form: the mode of largest weight (the first among equals). A physical
-/// machine: the strongest mode of the moving axis's linearised response to the run's
-/// unshaped move (from the closed form).
+/// machine: the strongest mode of the moving axis's (a corner path: its first axis's)
+/// linearised response to the run's unshaped move (from the closed form).
 pub fn dominant_mode(spec: &RunSpec) -> Option<(f64, f64)> {
     if spec.machine.is_none() {
         let mut best: Option<&crate::scenario::ModeSpec> = None;
@@ -181,7 +181,9 @@ pub fn dominant_mode(spec: &RunSpec) -> Option<(f64, f64)> {
     }
     let machine = spec.machine.as_ref()?;
     let axes = machine.compile(settle_sim::DriverMode::Linear).ok()?;
-    let axis = axes.iter().find(|a| a.name == spec.axis)?;
+    // A corner path (`x+y`): its first axis, the one the path starts along.
+    let name = spec.axis.split('+').next()?;
+    let axis = axes.iter().find(|a| a.name == name)?;
     let limits = spec.limits_si().ok()?;
     let profile = spec
         .profile

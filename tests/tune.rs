@@ -266,3 +266,44 @@ max_contour_error_um = 25.0
     );
     assert!(k.contains("square_corner_velocity: 5"), "{k}");
 }
+
+#[test]
+fn tune_command_writes_report_table_plot_and_exports() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = write(&dir, &scenario(SMALL));
+    let out = dir.path().join("out");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_settle"))
+        .arg("tune")
+        .arg(&path)
+        .arg("--out")
+        .arg(&out)
+        .args(["--jobs", "1"])
+        .output()
+        .expect("runs");
+    assert!(status.status.success(), "{status:?}");
+    let stdout = String::from_utf8_lossy(&status.stdout);
+    assert!(
+        stdout.contains("**winner**") && stdout.contains("Gain of the winner"),
+        "{stdout}"
+    );
+    let csv = std::fs::read_to_string(out.join("candidates.csv")).expect("csv");
+    assert_eq!(csv.lines().count(), 1 + 40); // header + the 40 candidates of SMALL
+    for f in ["tune.md", "klipper.cfg", "tmc5160.txt", "pareto.svg"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    let png = image::open(out.join("pareto.png")).expect("decodes");
+    assert!(png.width() >= 800);
+    // Bad input: exit code 2 with file, line and key.
+    let bad = write(&dir, &scenario("kinds = [\"scurv\"]\n"));
+    let r = std::process::Command::new(env!("CARGO_BIN_EXE_settle"))
+        .arg("tune")
+        .arg(&bad)
+        .output()
+        .expect("runs");
+    assert_eq!(r.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("tune_test.toml:18") && err.contains("tune.kinds"),
+        "{err}"
+    );
+}
