@@ -95,13 +95,13 @@ const TO_BERNSTEIN: [[[f64; MAX_DEG + 1]; MAX_DEG + 1]; MAX_DEG + 1] = {
     w
 };
 
-/// `c`'s coefficients in the Bernstein basis of `[lo, hi]`, and the rounding level below
-/// which their signs are not to be trusted.
-fn bernstein(c: &[f64], lo: f64, hi: f64) -> ([f64; MAX_DEG + 1], f64) {
-    let n = c.len() - 1;
+/// `c`'s coefficients (`N = degree + 1` of them) in the Bernstein basis of `[lo, hi]`,
+/// and the rounding level below which their signs are not to be trusted. Fixed-size so
+/// that each degree gets its own fully unrolled code.
+fn bernstein<const N: usize>(c: &[f64; N], lo: f64, hi: f64) -> ([f64; N], f64) {
+    let n = N - 1;
     // Coefficients of c(lo + h t), t in [0, 1]: Taylor shift, then scale.
-    let mut d = [0.0; MAX_DEG + 1];
-    d[..=n].copy_from_slice(c);
+    let mut d = *c;
     for k in 0..n {
         for i in (k..n).rev() {
             d[i] += lo * d[i + 1];
@@ -110,14 +110,14 @@ fn bernstein(c: &[f64], lo: f64, hi: f64) -> ([f64; MAX_DEG + 1], f64) {
     let h = hi - lo;
     let mut hk = 1.0;
     let mut size = 0.0;
-    for dk in &mut d[..=n] {
+    for dk in &mut d {
         *dk *= hk;
         hk *= h;
         size += dk.abs();
     }
-    let mut b = [0.0; MAX_DEG + 1];
+    let mut b = [0.0; N];
     let w = &TO_BERNSTEIN[n];
-    for (i, bi) in b[..=n].iter_mut().enumerate() {
+    for (i, bi) in b.iter_mut().enumerate() {
         for k in 0..=i {
             *bi += w[i][k] * d[k];
         }
@@ -130,16 +130,16 @@ fn bernstein(c: &[f64], lo: f64, hi: f64) -> ([f64; MAX_DEG + 1], f64) {
 /// polygon, one root, refined from where the polygon crosses zero; otherwise split in
 /// halves (de Casteljau). Returns false, having given up, where a coefficient is too close
 /// to zero to trust its sign or the splitting goes too deep (a double root).
-fn subdivide(
-    c: &[f64],
-    b: &[f64],
+fn subdivide<const N: usize>(
+    c: &[f64; N],
+    b: &[f64; N],
     tol: f64,
     lo: f64,
     hi: f64,
     depth: u32,
     out: &mut Roots,
 ) -> bool {
-    let n = b.len() - 1;
+    let n = N - 1;
     let mut changes = 0;
     let mut monotone = true;
     for i in 0..=n {
@@ -167,9 +167,8 @@ fn subdivide(
     }
     // de Casteljau at t = 1/2: left half's coefficients are the first of each row,
     // right half's the last.
-    let mut w = [0.0; MAX_DEG + 1];
-    w[..=n].copy_from_slice(b);
-    let (mut left, mut right) = ([0.0; MAX_DEG + 1], [0.0; MAX_DEG + 1]);
+    let mut w = *b;
+    let (mut left, mut right) = ([0.0; N], [0.0; N]);
     left[0] = w[0];
     right[n] = w[n];
     for r in 1..=n {
@@ -180,8 +179,16 @@ fn subdivide(
         right[n - r] = w[n - r];
     }
     let mid = 0.5 * (lo + hi);
-    subdivide(c, &left[..=n], tol, lo, mid, depth - 1, out)
-        && subdivide(c, &right[..=n], tol, mid, hi, depth - 1, out)
+    subdivide(c, &left, tol, lo, mid, depth - 1, out)
+        && subdivide(c, &right, tol, mid, hi, depth - 1, out)
+}
+
+/// Bernstein isolation of the roots of `c` (degree `N - 1`) in `[lo, hi]`; false if it
+/// gave up (see [`subdivide`]).
+fn bernstein_roots<const N: usize>(c: &[f64], lo: f64, hi: f64, out: &mut Roots) -> bool {
+    let c: &[f64; N] = c.try_into().expect("degree matches");
+    let (b, tol) = bernstein(c, lo, hi);
+    subdivide(c, &b, tol, lo, hi, 6, out)
 }
 
 /// The roots of `c` (lowest degree first, degree `c.len() - 1 <= 6`) in `[lo, hi]`,
@@ -207,8 +214,13 @@ pub(crate) fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
         }
         2 => quadratic(c, lo, hi, &mut out),
         _ => {
-            let (b, tol) = bernstein(c, lo, hi);
-            if subdivide(c, &b[..=n], tol, lo, hi, 6, &mut out) {
+            let isolated = match n {
+                3 => bernstein_roots::<4>(c, lo, hi, &mut out),
+                4 => bernstein_roots::<5>(c, lo, hi, &mut out),
+                5 => bernstein_roots::<6>(c, lo, hi, &mut out),
+                _ => bernstein_roots::<7>(c, lo, hi, &mut out),
+            };
+            if isolated {
                 return out;
             }
             out = Roots::default();

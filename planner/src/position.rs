@@ -181,7 +181,37 @@ pub fn to_state(
     lim: &Limits,
     shape: Shape,
 ) -> Result<Profile, PlanError> {
+    let b = validate(&start, &target, lim, shape)?;
+    if b.jmax.is_finite() && !crate::brake::needed(&start, lim, b.jmax) {
+        // The common case, written out straight from the candidate: no `Planned` (its
+        // step-2 data is not needed here), which saves copying it.
+        let sc = Scale::new(lim, b.jmax);
+        let u = Unit::new(&start, &target, lim, &sc);
+        let cand =
+            crate::fastest::fastest(&u, f64::INFINITY, &mut Cruises::default()).ok_or(NO_PEAK)?;
+        let mut segs = Vec::with_capacity(12);
+        cand.segments(&sc, &mut segs);
+        return verify(finish(start, segs)?, &target, lim, true);
+    }
     plan_then(start, target, lim, shape, |p| p.profile())?
+}
+
+const NO_PEAK: PlanError = PlanError::NoSolution {
+    reason: "no peak velocity reaches the target",
+};
+
+/// Check the inputs of a position-interface problem; the velocity changes' bounds.
+fn validate(
+    start: &State,
+    target: &State,
+    lim: &Limits,
+    shape: Shape,
+) -> Result<Bounds, PlanError> {
+    finite_state("start", start)?;
+    finite_state("target", target)?;
+    let b = bounds(lim, shape)?;
+    check_target(target, lim, &b)?;
+    Ok(b)
 }
 
 /// The fastest profile of one axis, planned but not yet written out as a [`Profile`]
@@ -297,13 +327,8 @@ fn plan_then<R>(
     shape: Shape,
     then: impl FnOnce(&Planned) -> R,
 ) -> Result<R, PlanError> {
-    finite_state("start", &start)?;
-    finite_state("target", &target)?;
-    let b = bounds(lim, shape)?;
-    check_target(&target, lim, &b)?;
-    let none = PlanError::NoSolution {
-        reason: "no peak velocity reaches the target",
-    };
+    let b = validate(&start, &target, lim, shape)?;
+    let none = NO_PEAK;
     let planned = |duration_s, how| Planned {
         start,
         target,
