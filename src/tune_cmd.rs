@@ -73,30 +73,54 @@ pub fn check_text(o: &Outcome) -> String {
     let Some((b, d, w)) = &o.check else {
         return String::new();
     };
+    let plan = &o.plan;
+    let band = plan.base.bands_um[plan.band_index];
+    let [h_move, h_res, h_score] = crate::tune_report::headings(plan);
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "\n## Checked on a second backend: {b}\n\n| | candidate | move (ms) | residual peak (um) | move+settle (ms) |\n|---|---|---:|---:|---:|"
+        "\n## Checked on a second backend: {b}\n\n| | candidate | {h_move} | {h_res} | {h_score} | into {band} um (ms) |\n|---|---|---:|---:|---:|---:|"
     );
+    let ms = |x: f64| {
+        if x.is_finite() {
+            format!("{:.1}", x * 1e3)
+        } else {
+            "not settled".into()
+        }
+    };
     for (tag, s) in [("default", d), ("winner", w)] {
         let _ = writeln!(
             out,
-            "| {tag} | {} | {:.1} | {:.2} | {:.1} |",
+            "| {tag} | {} | {} | {:.2} | {} | {} |",
             s.candidate.label(),
-            s.move_time_s * 1e3,
+            ms(s.move_time_s),
             s.residual_peak_um,
-            s.move_and_settle_s * 1e3
+            ms(s.move_and_settle_s),
+            ms(s.at_band_s)
         );
     }
     let verdict = if w.move_and_settle_s < d.move_and_settle_s {
         format!(
-            "the winner still beats the default on {b}: {:.1}% faster",
+            "the winner still beats the default on {b}: {:.1}% better",
             100.0 * (1.0 - w.move_and_settle_s / d.move_and_settle_s)
         )
     } else {
         format!("the winner does NOT beat the default on {b}")
     };
     let _ = writeln!(out, "\nVerdict: {verdict}.");
+    let searched = &o.scores[o.winner];
+    let _ = writeln!(
+        out,
+        "Into the {band} um band the winner takes {} ms on {b} ({} ms on {}, {}).",
+        ms(w.at_band_s),
+        ms(searched.at_band_s),
+        plan.base.backend,
+        if w.at_band_s <= searched.at_band_s + 1.0 / plan.base.sample_rate_hz {
+            "confirmed within one sample"
+        } else {
+            "later than predicted: consider a smaller [tune] margin"
+        }
+    );
     out
 }
 
@@ -134,7 +158,7 @@ pub fn command(
     )?;
     write("klipper.cfg", &klipper)?;
     write("tmc5160.txt", &tmc)?;
-    let fig = crate::tune_report::pareto_figure(&sc.name, &o.scores, o.winner, &o.front);
+    let fig = crate::tune_report::pareto_figure(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
     crate::plot::write(&fig, &out, "pareto")?;
     Ok(md)
 }
