@@ -420,7 +420,11 @@ pub fn pareto_figure(
         lines.push(l);
     }
     Figure {
-        title: format!("settle tune {name}: move time vs residual"),
+        title: format!(
+            "settle tune {name}: {} vs {}",
+            h_move.replace(" (ms)", " time"),
+            h_res.replace(" peak (um)", "")
+        ),
         panels: vec![Panel {
             title: "every candidate (mean over the move family)".into(),
             x_label: h_move.replace("(ms)", "time (ms)"),
