@@ -33,7 +33,7 @@
 
 use serde::Deserialize;
 use settle_planner::raster::{self, Raster, RasterSpec, StepPlacement};
-use settle_planner::{KindParams, Profile, State, Trajectory};
+use settle_planner::{Profile, State, Trajectory};
 
 use crate::error::Error;
 use crate::metrics::Metrics;
@@ -157,13 +157,26 @@ impl ScanSpec {
 }
 
 /// Plan the raster of a scan run: X fly, Y step, from the step axis's start position 0.
+///
+/// With a `[shaper]`, the step axis's motion is input-shaped: the shaped step lasts the
+/// shaper's duration longer, so the raster is planned with that much more settle margin
+/// (the window is then `max(fastest turnaround, shaped step + settle_margin_s)`, and a
+/// centred step is the shaped one centred), and each turnaround's `step_end_s` and
+/// `overhead.step_s` are those of the shaped step.
 pub fn plan(spec: &RunSpec, scan: &ScanSpec) -> Result<Raster, settle_planner::PlanError> {
     let placement = scan
         .placement()
         .map_err(|_| settle_planner::PlanError::InvalidInput {
             reason: "unknown scan placement",
         })?;
-    raster::plan(&RasterSpec {
+    let shaper = spec
+        .shaper
+        .as_ref()
+        .map(crate::shaping::ShaperSetting::shaper)
+        .transpose()?
+        .flatten();
+    let t_shaper_s = shaper.as_ref().map_or(0.0, |s| s.duration_s());
+    let mut r = raster::plan(&RasterSpec {
         lines: scan.lines,
         width: scan.width_mm * 1e-3,
         step: spec.distance_mm * 1e-3,
@@ -172,10 +185,20 @@ pub fn plan(spec: &RunSpec, scan: &ScanSpec) -> Result<Raster, settle_planner::P
         fly_jmax: scan.fly_jmax_mm_s3.map(|j| j * 1e-3),
         step_kind: spec.profile,
         step_limits: spec.limits_si()?,
-        step_params: KindParams::default(),
+        step_params: spec.kind_params,
         placement,
-        settle_margin_s: scan.settle_margin_s,
-    })
+        settle_margin_s: scan.settle_margin_s + t_shaper_s,
+    })?;
+    if let Some(s) = shaper {
+        let axes = r.trajectory.axes();
+        let step_axis = s.apply(&axes[1])?;
+        r.trajectory = Trajectory::new(vec![axes[0].clone(), step_axis])?;
+        for tr in &mut r.turnarounds {
+            tr.step_end_s += t_shaper_s;
+        }
+        r.overhead.step_s += t_shaper_s;
+    }
+    Ok(r)
 }
 
 fn shifted(p: &Profile, dp: f64) -> Result<Profile, settle_planner::PlanError> {

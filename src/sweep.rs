@@ -514,12 +514,6 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
         },
         kind_params: settle_planner::KindParams::default(),
     };
-    if base.shaper.is_some() && base.scan.is_some() {
-        return Err(src.error_at(
-            "shaper",
-            "[shaper] is not supported with [scan] yet: shape point-to-point moves or corners",
-        ));
-    }
     validate_observe(&base, src)?;
     let axes = axes(sc, src)?;
     let total = axes

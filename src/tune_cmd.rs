@@ -16,8 +16,10 @@ pub struct Outcome {
     pub plan: Plan,
     /// Every candidate's score; index 0 is the untuned default.
     pub scores: Vec<Score>,
-    /// Index of the winner in `scores`.
+    /// Index of the winner in `scores` (after refinement).
     pub winner: usize,
+    /// Index of the best grid candidate (the refinement started from it).
+    pub grid_winner: usize,
     /// Indices of the Pareto front.
     pub front: Vec<usize>,
     /// `(backend, default, winner)` re-run on a second backend, if asked.
@@ -36,8 +38,8 @@ pub fn tune(
     let mut runs = crate::sweep::expand(&sc, &src)?;
     crate::run::set_backend(path, &mut runs, backend)?;
     let plan = crate::tune::plan(&sc, &src, &runs)?;
-    let scores = crate::tune::evaluate(&plan, &plan.candidates, jobs, progress)?;
-    let winner = crate::tune::best(&scores).ok_or_else(|| Error::Input {
+    let mut scores = crate::tune::evaluate(&plan, &plan.candidates, jobs, progress)?;
+    let grid_winner = crate::tune::best(&scores).ok_or_else(|| Error::Input {
         at: crate::error::Location {
             file: path.to_path_buf(),
             line: None,
@@ -46,6 +48,7 @@ pub fn tune(
         },
         message: "no candidate settles within the observation window; lengthen window_s or widen the band".into(),
     })?;
+    let winner = crate::tune::refine(&plan, &mut scores, grid_winner, jobs)?;
     let front = crate::tune::pareto(&scores);
     let check = match check_on {
         None => None,
@@ -63,9 +66,53 @@ pub fn tune(
         plan,
         scores,
         winner,
+        grid_winner,
         front,
         check,
     })
+}
+
+/// The refinement paragraph of the report: the grid winner, how many candidates the
+/// refinement evaluated, and what it gained.
+pub fn refine_text(o: &Outcome) -> String {
+    let extra = o.scores.len() - o.plan.candidates.len();
+    if o.plan
+        .spec
+        .refine_rounds
+        .unwrap_or(crate::tune::DEFAULT_REFINE_ROUNDS)
+        == 0
+    {
+        return String::new();
+    }
+    let (g, w) = (&o.scores[o.grid_winner], &o.scores[o.winner]);
+    let [_, _, h_score] = crate::tune_report::headings(&o.plan);
+    let mut out = format!(
+        "\n## Refinement around the grid winner\n\n{} grid candidates, then {} rounds around the grid winner ({extra} more candidates). ",
+        o.plan.candidates.len(),
+        o.plan
+            .spec
+            .refine_rounds
+            .unwrap_or(crate::tune::DEFAULT_REFINE_ROUNDS),
+    );
+    if o.winner == o.grid_winner {
+        let _ = writeln!(
+            out,
+            "The grid winner {} stays the winner.",
+            g.candidate.label()
+        );
+    } else {
+        let _ = writeln!(
+            out,
+            "Grid winner {}: {} {:.2} ms; refined {}: {:.2} ms ({:.2} ms better).",
+            g.candidate.label(),
+            h_score.trim_end_matches(" (ms)"),
+            g.move_and_settle_s * 1e3,
+            w.candidate.label(),
+            w.move_and_settle_s * 1e3,
+            (g.move_and_settle_s - w.move_and_settle_s) * 1e3
+        );
+    }
+    out
 }
 
 /// The second-backend paragraph of the report.
@@ -73,30 +120,54 @@ pub fn check_text(o: &Outcome) -> String {
     let Some((b, d, w)) = &o.check else {
         return String::new();
     };
+    let plan = &o.plan;
+    let band = plan.base.bands_um[plan.band_index];
+    let [h_move, h_res, h_score] = crate::tune_report::headings(plan);
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "\n## Checked on a second backend: {b}\n\n| | candidate | move (ms) | residual peak (um) | move+settle (ms) |\n|---|---|---:|---:|---:|"
+        "\n## Checked on a second backend: {b}\n\n| | candidate | {h_move} | {h_res} | {h_score} | into {band} um (ms) |\n|---|---|---:|---:|---:|---:|"
     );
+    let ms = |x: f64| {
+        if x.is_finite() {
+            format!("{:.1}", x * 1e3)
+        } else {
+            "not settled".into()
+        }
+    };
     for (tag, s) in [("default", d), ("winner", w)] {
         let _ = writeln!(
             out,
-            "| {tag} | {} | {:.1} | {:.2} | {:.1} |",
+            "| {tag} | {} | {} | {:.2} | {} | {} |",
             s.candidate.label(),
-            s.move_time_s * 1e3,
+            ms(s.move_time_s),
             s.residual_peak_um,
-            s.move_and_settle_s * 1e3
+            ms(s.move_and_settle_s),
+            ms(s.at_band_s)
         );
     }
     let verdict = if w.move_and_settle_s < d.move_and_settle_s {
         format!(
-            "the winner still beats the default on {b}: {:.1}% faster",
+            "the winner still beats the default on {b}: {:.1}% better",
             100.0 * (1.0 - w.move_and_settle_s / d.move_and_settle_s)
         )
     } else {
         format!("the winner does NOT beat the default on {b}")
     };
     let _ = writeln!(out, "\nVerdict: {verdict}.");
+    let searched = &o.scores[o.winner];
+    let _ = writeln!(
+        out,
+        "Into the {band} um band the winner takes {} ms on {b} ({} ms on {}, {}).",
+        ms(w.at_band_s),
+        ms(searched.at_band_s),
+        plan.base.backend,
+        if w.at_band_s <= searched.at_band_s + 1.0 / plan.base.sample_rate_hz {
+            "confirmed within one sample"
+        } else {
+            "later than predicted: consider a smaller [tune] margin"
+        }
+    );
     out
 }
 
@@ -117,6 +188,7 @@ pub fn command(
         source,
     })?;
     let mut md = crate::tune_report::markdown(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
+    md.push_str(&refine_text(&o));
     md.push_str(&check_text(&o));
     let w = &o.scores[o.winner];
     let klipper = crate::tune_report::klipper(&o.plan, w);
@@ -134,7 +206,7 @@ pub fn command(
     )?;
     write("klipper.cfg", &klipper)?;
     write("tmc5160.txt", &tmc)?;
-    let fig = crate::tune_report::pareto_figure(&sc.name, &o.scores, o.winner, &o.front);
+    let fig = crate::tune_report::pareto_figure(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
     crate::plot::write(&fig, &out, "pareto")?;
     Ok(md)
 }

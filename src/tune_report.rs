@@ -173,8 +173,56 @@ pub fn candidates_csv(scores: &[Score]) -> String {
     out
 }
 
+/// Column headings of the report's tables: (move time, residual, score), which for scan
+/// steps are the step, the error over the next line, and the overhead per line.
+pub fn headings(plan: &Plan) -> [&'static str; 3] {
+    if plan.base.scan.is_some() {
+        [
+            "step (ms)",
+            "line residual peak (um)",
+            "overhead per line (ms)",
+        ]
+    } else {
+        ["move (ms)", "residual peak (um)", "move+settle (ms)"]
+    }
+}
+
+/// The score in words (band, margin; scan steps: the overhead per line).
+pub fn score_text(plan: &Plan) -> String {
+    let band = plan.base.bands_um[plan.band_index];
+    let tight = plan.bands_um[plan.score_band_index];
+    let into = if plan.margin < 1.0 {
+        format!(
+            "{tight} um (robustness margin {} x the {band} um band)",
+            plan.margin
+        )
+    } else {
+        format!("{band} um")
+    };
+    if plan.base.scan.is_some() {
+        format!(
+            "mean overhead per line (from the fly axis leaving the region to the step axis settled into {into} and staying there over the next line; at least the fastest turnaround)"
+        )
+    } else {
+        format!("mean move-and-settle into {into}")
+    }
+}
+
 /// The move family in words.
 fn family(plan: &Plan) -> String {
+    if let Some(scan) = &plan.base.scan {
+        return format!(
+            "Scan steps: step-overs {:?} mm on axis `{}` (placement {}, settle margin {} s) while the fly axis `{}` scans {} mm at {} mm/s, turnarounds at {} mm/s^2",
+            plan.distances_mm,
+            plan.base.axis,
+            scan.placement,
+            scan.settle_margin_s,
+            scan.fly_axis,
+            scan.width_mm,
+            scan.v_scan_mm_s,
+            scan.fly_amax_mm_s2
+        );
+    }
     match &plan.base.corner {
         Some(c) => format!(
             "Corners: {} x {} mm legs at {:?} degrees, strategy {}{}",
@@ -209,6 +257,7 @@ pub fn markdown(
     let d = &scores[0];
     let w = &scores[winner];
     let band = plan.base.bands_um[plan.band_index];
+    let [h_move, h_res, h_score] = headings(plan);
     let mut out = String::new();
     let _ = writeln!(out, "# settle tune: {name}\n");
     let modes: Vec<String> = plan
@@ -218,7 +267,7 @@ pub fn markdown(
         .collect();
     let _ = writeln!(
         out,
-        "Machine `{}`, axis `{}`, backend `{}`; modes tuned to: {}. {} at vmax {} mm/s, amax {} mm/s^2, jerk <= {} mm/s^3. Score: mean move-and-settle into {band} um. {} candidates.\n",
+        "Machine `{}`, axis `{}`, backend `{}`; modes tuned to: {}. {} at vmax {} mm/s, amax {} mm/s^2, jerk <= {} mm/s^3. Score: {}. {} candidates.\n",
         plan.base.machine_name,
         plan.base.axis,
         plan.base.backend,
@@ -227,30 +276,42 @@ pub fn markdown(
         plan.base.vmax_mm_s,
         plan.base.amax_mm_s2,
         plan.base.jmax_mm_s3.map_or("-".into(), |j| j.to_string()),
+        score_text(plan),
         scores.len()
     );
     let gain = if w.move_and_settle_s.is_finite() && d.move_and_settle_s.is_finite() {
         format!(
-            "{:.1}% faster ({:.1} ms saved)",
+            "{:.1}% {} ({:.1} ms saved{})",
             100.0 * (1.0 - w.move_and_settle_s / d.move_and_settle_s),
-            (d.move_and_settle_s - w.move_and_settle_s) * 1e3
+            if plan.base.scan.is_some() {
+                "less overhead per line"
+            } else {
+                "faster"
+            },
+            (d.move_and_settle_s - w.move_and_settle_s) * 1e3,
+            if plan.base.scan.is_some() {
+                " per line"
+            } else {
+                ""
+            }
         )
     } else {
         "the default does not settle in the window".into()
     };
     let _ = writeln!(
         out,
-        "| | candidate | move (ms) | residual peak (um) | move+settle (ms) |"
+        "| | candidate | {h_move} | {h_res} | {h_score} | into {band} um (ms) |"
     );
-    let _ = writeln!(out, "|---|---|---:|---:|---:|");
+    let _ = writeln!(out, "|---|---|---:|---:|---:|---:|");
     for (tag, s) in [("default", d), ("**winner**", w)] {
         let _ = writeln!(
             out,
-            "| {tag} | {} | {} | {:.2} | {} |",
+            "| {tag} | {} | {} | {:.2} | {} | {} |",
             s.candidate.label(),
             ms(s.move_time_s),
             s.residual_peak_um,
-            ms(s.move_and_settle_s)
+            ms(s.move_and_settle_s),
+            ms(s.at_band_s)
         );
     }
     if plan.base.corner.is_some() {
@@ -264,7 +325,7 @@ pub fn markdown(
     let _ = writeln!(out, "## Best per profile kind\n");
     let _ = writeln!(
         out,
-        "| kind | best candidate | move (ms) | residual peak (um) | move+settle (ms) |"
+        "| kind | best candidate | {h_move} | {h_res} | {h_score} |"
     );
     let _ = writeln!(out, "|---|---|---:|---:|---:|");
     for k in ProfileKind::ALL {
@@ -291,11 +352,8 @@ pub fn markdown(
             );
         }
     }
-    let _ = writeln!(out, "\n## Pareto front (move time vs residual peak)\n");
-    let _ = writeln!(
-        out,
-        "| candidate | move (ms) | residual peak (um) | move+settle (ms) |"
-    );
+    let _ = writeln!(out, "\n## Pareto front ({h_move} vs {h_res})\n");
+    let _ = writeln!(out, "| candidate | {h_move} | {h_res} | {h_score} |");
     let _ = writeln!(out, "|---|---:|---:|---:|");
     for &i in front {
         let s = &scores[i];
@@ -313,7 +371,14 @@ pub fn markdown(
 
 /// The Pareto plot: every candidate (grey, shaped ones by shaper colour), the front, the
 /// default and the winner.
-pub fn pareto_figure(name: &str, scores: &[Score], winner: usize, front: &[usize]) -> Figure {
+pub fn pareto_figure(
+    name: &str,
+    plan: &Plan,
+    scores: &[Score],
+    winner: usize,
+    front: &[usize],
+) -> Figure {
+    let [h_move, h_res, _] = headings(plan);
     let pt = |s: &Score| (s.move_time_s * 1e3, s.residual_peak_um.max(1e-3));
     let mut lines = Vec::new();
     let groups: Vec<(String, Option<ShaperKind>)> = std::iter::once(("unshaped".into(), None))
@@ -355,11 +420,15 @@ pub fn pareto_figure(name: &str, scores: &[Score], winner: usize, front: &[usize
         lines.push(l);
     }
     Figure {
-        title: format!("settle tune {name}: move time vs residual"),
+        title: format!(
+            "settle tune {name}: {} vs {}",
+            h_move.replace(" (ms)", " time"),
+            h_res.replace(" peak (um)", "")
+        ),
         panels: vec![Panel {
             title: "every candidate (mean over the move family)".into(),
-            x_label: "move time (ms)".into(),
-            y_label: "residual peak (um, log)".into(),
+            x_label: h_move.replace("(ms)", "time (ms)"),
+            y_label: h_res.replace("(um)", "(um, log)"),
             lines,
             y_log: true,
             legend: true,

@@ -189,6 +189,10 @@ fn bad_tune_input_names_file_line_and_key() {
     );
     let msg = tune_err("distances_mm = []\n");
     assert!(msg.contains("key `tune.distances_mm`"), "{msg}");
+    let msg = tune_err("refine_rounds = 50\n");
+    assert!(msg.contains("key `tune.refine_rounds`"), "{msg}");
+    let msg = tune_err("margin = 0.0\n");
+    assert!(msg.contains("key `tune.margin`"), "{msg}");
     let msg = tune_err("jerk_stepz = 3\n");
     assert!(
         msg.contains("jerk_stepz") && msg.contains("jerk_steps"),
@@ -306,4 +310,73 @@ fn tune_command_writes_report_table_plot_and_exports() {
         err.contains("tune_test.toml:18") && err.contains("tune.kinds"),
         "{err}"
     );
+}
+
+#[test]
+fn refinement_never_loses_to_the_grid_and_stays_within_the_limits() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = write(&dir, &scenario(&format!("{SMALL}refine_rounds = 4\n")));
+    let o = settle::tune_cmd::tune(&path, Backend::Modal, Some(Backend::Rapier), Some(2), false)
+        .expect("tunes");
+    let grid = o.plan.candidates.len();
+    assert_eq!(grid, 40);
+    // At most 8 neighbours per round, none evaluated twice.
+    assert!(o.scores.len() > grid && o.scores.len() <= grid + 4 * 8);
+    let (g, w) = (&o.scores[o.grid_winner], &o.scores[o.winner]);
+    assert!(o.grid_winner < grid);
+    assert!(w.move_and_settle_s <= g.move_and_settle_s, "{w:?} vs {g:?}");
+    let (gc, wc) = (g.candidate, w.candidate);
+    assert_eq!((gc.kind, gc.params), (wc.kind, wc.params));
+    // Refinement moves the frequency by at most 2 x (2.5 + 1.25 + 0.625 + 0.3125)% in
+    // total, and never raises the jerk above the scenario's limit.
+    if let (Some(a), Some(b)) = (gc.shaper, wc.shaper) {
+        assert_eq!(a.kind, b.kind);
+        let r = b.frequency_hz / a.frequency_hz;
+        assert!((1.0 - 0.1..=1.0 + 0.1).contains(&r), "{r}");
+    }
+    for s in &o.scores[grid..] {
+        assert!(
+            s.candidate.jmax_mm_s3.is_none_or(|j| j <= 100000.0),
+            "{s:?}"
+        );
+    }
+    // The refined winner is what the second backend re-checks, and it still wins there.
+    let (_, rd, rw) = o.check.as_ref().expect("checked");
+    assert_eq!(rw.candidate, wc);
+    assert!(
+        rw.move_and_settle_s < rd.move_and_settle_s,
+        "{rw:?} vs {rd:?}"
+    );
+}
+
+#[test]
+fn neighbours_step_the_frequency_and_cap_the_jerk() {
+    use settle::shaping::ShaperSetting;
+    use settle::tune::{Candidate, neighbours};
+    use settle_planner::shaper::ShaperKind;
+    use settle_planner::{KindParams, ProfileKind};
+    let c = Candidate {
+        kind: ProfileKind::SCurve,
+        jmax_mm_s3: Some(1e5),
+        params: KindParams::default(),
+        shaper: Some(ShaperSetting {
+            kind: Some(ShaperKind::Mzv),
+            frequency_hz: 40.0,
+            damping_ratio: 0.1,
+        }),
+    };
+    let n = neighbours(&c, 0.025, 2.0, 1e5);
+    let f: Vec<f64> = n
+        .iter()
+        .filter(|x| x.jmax_mm_s3 == Some(1e5))
+        .filter_map(|x| x.shaper.map(|s| s.frequency_hz))
+        .collect();
+    assert_eq!(f, vec![38.0, 39.0, 41.0, 42.0]);
+    // At the jerk limit only lower jerks: 1e5 / 4 and 1e5 / 2.
+    let j: Vec<f64> = n
+        .iter()
+        .filter(|x| x.shaper == c.shaper)
+        .filter_map(|x| x.jmax_mm_s3)
+        .collect();
+    assert_eq!(j, vec![25000.0, 50000.0]);
 }
