@@ -216,9 +216,13 @@ pub struct Accumulator {
     total: Bands,
     per_axis: Vec<Bands>,
     overshoot_m: f64,
-    max_follow_m: f64,
+    /// Largest squared length of the following-error vector (m^2; `sqrt` is monotone, so
+    /// the square root of the largest square is the largest length, bit for bit, and
+    /// costs one `sqrt` per run instead of one per sample).
+    max_follow_sq_m2: f64,
     axis_follow_m: Vec<f64>,
-    abs_err_max_m: f64,
+    /// Largest squared distance to the target (m^2), as `max_follow_sq_m2`.
+    abs_err_max_sq_m2: f64,
 }
 
 impl Accumulator {
@@ -239,38 +243,44 @@ impl Accumulator {
             total: Bands::new(bands_um),
             per_axis: target_m.iter().map(|_| Bands::new(bands_um)).collect(),
             overshoot_m: 0.0,
-            max_follow_m: 0.0,
+            max_follow_sq_m2: 0.0,
             axis_follow_m: vec![0.0; target_m.len()],
-            abs_err_max_m: 0.0,
+            abs_err_max_sq_m2: 0.0,
         }
     }
 
     /// One sample at time `t_s`: commanded and toolhead positions per axis (m).
     pub fn push(&mut self, t_s: f64, commanded_m: &[f64], toolhead_m: &[f64]) {
         let (mut e2, mut along, mut f2) = (0.0, 0.0, 0.0);
-        for i in 0..self.target_m.len() {
-            let e = toolhead_m[i] - self.target_m[i];
+        let during = t_s <= self.move_end_s;
+        let axes = self
+            .target_m
+            .iter()
+            .zip(&self.direction)
+            .zip(commanded_m.iter().zip(toolhead_m))
+            .zip(&mut self.axis_follow_m);
+        for (((target, d), (c, h)), follow) in axes {
+            let e = h - target;
             e2 += e * e;
-            along += e * self.direction[i];
-            let f = toolhead_m[i] - commanded_m[i];
+            along += e * d;
+            let f = h - c;
             f2 += f * f;
-            if t_s <= self.move_end_s {
-                self.axis_follow_m[i] = self.axis_follow_m[i].max(f.abs());
+            if during {
+                *follow = follow.max(f.abs());
             }
         }
-        let err = e2.sqrt();
         self.overshoot_m = self.overshoot_m.max(along);
-        self.abs_err_max_m = self.abs_err_max_m.max(err);
-        if t_s <= self.move_end_s {
-            self.max_follow_m = self.max_follow_m.max(f2.sqrt());
+        self.abs_err_max_sq_m2 = self.abs_err_max_sq_m2.max(e2);
+        if during {
+            self.max_follow_sq_m2 = self.max_follow_sq_m2.max(f2);
         }
         if t_s < self.move_end_s {
             return;
         }
         let tau = t_s - self.move_end_s;
-        self.total.push(tau, err);
-        for (i, b) in self.per_axis.iter_mut().enumerate() {
-            b.push(tau, (toolhead_m[i] - self.target_m[i]).abs());
+        self.total.push(tau, e2.sqrt());
+        for ((b, h), target) in self.per_axis.iter_mut().zip(toolhead_m).zip(&self.target_m) {
+            b.push(tau, (h - target).abs());
         }
     }
 
@@ -293,9 +303,9 @@ impl Accumulator {
             overshoot_um: if moving {
                 self.overshoot_m * to_um
             } else {
-                self.abs_err_max_m * to_um
+                self.abs_err_max_sq_m2.sqrt() * to_um
             },
-            max_following_error_um: self.max_follow_m * to_um,
+            max_following_error_um: self.max_follow_sq_m2.sqrt() * to_um,
             axes: self
                 .per_axis
                 .iter()

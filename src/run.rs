@@ -331,6 +331,10 @@ pub fn simulate<P: Plant>(
     let mut row: Vec<f64> = Vec::new();
     let mut cmd_p = vec![0.0; n_axes];
     let mut toolhead = vec![0.0; n_axes];
+    // Without a recording the metrics need only the positions: plants that can report
+    // them directly ([`Plant::positions`]) skip building observations; `obs` is then
+    // brought up to date where it is read (a fault, the end of the run).
+    let lean = record.is_none();
 
     let mut sample = |t: f64,
                       at: &[Sample],
@@ -338,13 +342,23 @@ pub fn simulate<P: Plant>(
                       obs: &mut [Observation],
                       acc: &mut Accumulator|
      -> Result<(), String> {
-        plant.observe(state, obs);
-        for (i, o) in obs.iter().enumerate() {
-            cmd_p[i] = o.commanded_m;
-            toolhead[i] = o.toolhead_m;
-        }
-        if let Some(reason) = fault_in(t, names, obs) {
-            return Err(reason);
+        let checked = lean
+            && plant.positions(state, &mut cmd_p, &mut toolhead)
+            && cmd_p
+                .iter()
+                .zip(&toolhead)
+                .all(|(c, h)| (h - c).abs() <= crate::metrics::BLOWUP_M);
+        if !checked {
+            // Every value finite and no blow-up is what `fault_in` checks; otherwise it
+            // names the fault.
+            plant.observe(state, obs);
+            for (i, o) in obs.iter().enumerate() {
+                cmd_p[i] = o.commanded_m;
+                toolhead[i] = o.toolhead_m;
+            }
+            if let Some(reason) = fault_in(t, names, obs) {
+                return Err(reason);
+            }
         }
         acc.push(t, &cmd_p, &toolhead);
         let contour = path_acc.as_mut().map(|p| p.push(t, &toolhead));
@@ -379,9 +393,12 @@ pub fn simulate<P: Plant>(
         obs.iter().map(|o| o.max_load_angle_rad).collect()
     };
     macro_rules! fault {
-        ($reason:expr) => {
-            return Ok(acc.finish_with(names, &angles_of(&obs), Status::Fault { reason: $reason }))
-        };
+        ($reason:expr) => {{
+            if lean {
+                plant.observe(&state, &mut obs);
+            }
+            return Ok(acc.finish_with(names, &angles_of(&obs), Status::Fault { reason: $reason }));
+        }};
     }
     macro_rules! step {
         ($cmd:expr, $dt:expr, $t:expr) => {
@@ -452,6 +469,9 @@ pub fn simulate<P: Plant>(
         let t = t_end + i as f64 * dt;
         step!(&hold, dt, t - dt);
         sample!(t, &hold);
+    }
+    if lean {
+        plant.observe(&state, &mut obs);
     }
     let lost: u32 = obs.iter().map(|o| o.lost_steps).sum();
     let status = match obs.iter().position(|o| o.lost_steps > 0) {

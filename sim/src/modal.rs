@@ -30,6 +30,8 @@ use crate::{Observation, Plant, SimError};
 #[derive(Debug, Clone)]
 struct Discrete {
     n: usize,
+    /// Rows stored per column: `2n` rounded up to a multiple of 4 (zero padding).
+    stride: usize,
     /// Continuous augmented matrix in scaled coordinates (`w0`-scaled, times 1 s).
     a_scaled: DMatrix<f64>,
     /// Scale of each augmented state (physical = scaled / scale).
@@ -110,6 +112,7 @@ impl Discrete {
             .fold(0.0, f64::max);
         let mut d = Self {
             n,
+            stride: (2 * n).div_ceil(4) * 4,
             a_scaled,
             scale,
             g: g.iter().copied().collect(),
@@ -138,7 +141,7 @@ impl Discrete {
 
     /// Rows stored per column: `2n` rounded up to a multiple of 4 (zero padding).
     fn stride(&self) -> usize {
-        (2 * self.n).div_ceil(4) * 4
+        self.stride
     }
 
     /// The first `2n` rows of the transition over a partial step `dt_s` (a profile
@@ -198,16 +201,23 @@ pub struct ModalPlant {
 pub struct ModalAxis {
     /// Commanded base state at `t_s`.
     pub base: State,
-    /// The augmented state `[r, r', v, a, j]`: deflection of every body from the static
-    /// equilibrium of the command (m, rad), its rate (m/s, rad/s), and the command's
-    /// velocity, acceleration and jerk at the last step start.
+    /// The state `[r, r']`: deflection of every body from the static equilibrium of the
+    /// command (m, rad) and its rate (m/s, rad/s), zero padded to [`Discrete::stride`]
+    /// entries (the transition's padding rows are zero, so the padding stays zero).
     z: Vec<f64>,
+    /// True while the axis has never been stepped: it sits exactly at the static
+    /// equilibrium of its start (`z` all zero), so a step with the command at rest would
+    /// compute exact zeros and is skipped.
+    idle: bool,
     /// Load-angle bookkeeping of the axis's motor, if it has one.
     pub stepper: Option<StepperState>,
     disc: std::sync::Arc<Discrete>,
     scratch: Vec<f64>,
     /// The transition of the last partial step (reused buffer).
     partial: Vec<f64>,
+    /// `(x, toolhead, probe)` of [`axis_positions`] at the start (`z` zero): what an
+    /// axis that is still idle at the same command reports, computed once.
+    at_rest: (f64, f64, f64),
 }
 
 impl ModalAxis {
@@ -223,26 +233,49 @@ impl ModalAxis {
 
     /// Set the deflection of body `i` (m, rad), e.g. to start a free decay.
     pub fn set_r(&mut self, i: usize, value: f64) {
+        assert!(i < self.disc.n, "body {i} of {}", self.disc.n);
         self.z[i] = value;
+        self.idle = false;
     }
 }
 
-/// `z[..m] = Phi z` for a transition stored by column (`M >= m` rows per column, zero
-/// padded; `z.len()` columns), with the outputs accumulated in a fixed-size array the
-/// compiler keeps in registers (no store-to-load chain through memory per column).
-/// Columns whose `z` entry is zero (the command's `v, a, j` while it holds) are skipped:
-/// they add exact zeros.
+/// `z = Phi [z; cmd]` for a transition stored by column (`M` rows per column, zero
+/// padded; `z.len() == M`; the first `n2` columns multiply the state, the last three the
+/// command's `v, a, j`), with the state and the outputs in fixed-size arrays the compiler
+/// keeps in registers (no store-to-load chain through memory, no `memcpy` of a run-time
+/// length). The sum runs over the columns in order, as a plain matrix-vector product
+/// would. State columns are never skipped: a zero entry adds `p * 0 = +-0` to an
+/// accumulator that starts at `+0` and so can never be `-0`, which leaves it unchanged,
+/// exactly as skipping would. Command columns whose entry is zero (the command holds)
+/// are skipped to save the work.
+///
+/// Returns `sum z_i * 0` over the new state (in no particular order): 0 when every entry
+/// is finite, NaN otherwise.
 #[inline]
-fn apply<const M: usize>(cols: &[f64], z: &mut [f64], m: usize) {
+fn apply<const M: usize>(cols: &[f64], z: &mut [f64], n2: usize, cmd: [f64; 3]) -> f64 {
+    let zs: [f64; M] = z.try_into().expect("state padded to the stride");
     let mut acc = [0.0f64; M];
-    for (col, &zj) in cols.chunks_exact(M).zip(z.iter()) {
-        if zj != 0.0 {
+    for (col, &zj) in cols.chunks_exact(M).zip(&zs[..n2]) {
+        for (a, p) in acc.iter_mut().zip(col) {
+            *a += p * zj;
+        }
+    }
+    for (col, &cj) in cols[n2 * M..].chunks_exact(M).zip(&cmd) {
+        if cj != 0.0 {
             for (a, p) in acc.iter_mut().zip(col) {
-                *a += p * zj;
+                *a += p * cj;
             }
         }
     }
-    z[..m].copy_from_slice(&acc[..m]);
+    z.copy_from_slice(&acc);
+    // Four independent lanes (M is a multiple of 4): no serial chain of M additions.
+    let mut lanes = [0.0f64; 4];
+    for c in acc.chunks_exact(4) {
+        for (l, x) in lanes.iter_mut().zip(c) {
+            *l += x * 0.0;
+        }
+    }
+    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3])
 }
 
 /// The modal plant's mutable state.
@@ -316,16 +349,19 @@ impl Plant for ModalPlant {
             .zip(start)
             .map(|(a, s)| {
                 let disc = Discrete::new(a, s.p, self.nominal_dt_s)?;
-                let n = disc.n;
                 let stride = disc.stride();
                 let stepper = a.stepper.as_ref().map(|st| {
                     let mut ss = st.at_rest(s.p).0;
                     ss.track(0.0);
                     ss
                 });
+                let z = vec![0.0; stride];
+                let (toolhead, probe) = axis_positions(a, &z, &disc.g, s.p);
                 Ok(ModalAxis {
                     base: *s,
-                    z: vec![0.0; 2 * n + 3],
+                    at_rest: (s.p, toolhead, probe),
+                    z,
+                    idle: true,
                     stepper,
                     disc: std::sync::Arc::new(disc),
                     scratch: vec![0.0; stride],
@@ -341,47 +377,55 @@ impl Plant for ModalPlant {
         let nominal = dt_s == self.nominal_dt_s;
         for ((ax, st), c) in self.axes.iter().zip(&mut state.axes).zip(cmd) {
             let h = dt_s;
+            // `h j / 6` is `h j` itself (a signed zero) when j is zero: skip the division.
+            let hj = h * c.j;
+            let hj6 = if c.j == 0.0 { hj } else { hj / 6.0 };
             st.base = State {
-                p: c.p + h * (c.v + h * (c.a / 2.0 + h * c.j / 6.0)),
+                p: c.p + h * (c.v + h * (c.a / 2.0 + hj6)),
                 v: c.v + h * (c.a + h * c.j / 2.0),
                 a: c.a + h * c.j,
             };
             // An axis at rest with a command at rest stays exactly at rest (the update
             // below would compute exact zeros): skip it.
-            if c.v == 0.0 && c.a == 0.0 && c.j == 0.0 && st.z.iter().all(|x| *x == 0.0) {
+            if st.idle && c.v == 0.0 && c.a == 0.0 && c.j == 0.0 {
                 continue;
             }
+            st.idle = false;
             let disc = &st.disc;
-            let n = disc.n;
+            let n2 = 2 * disc.n;
             let rows: &[f64] = if nominal {
                 &disc.nominal
             } else {
                 disc.partial(dt_s, &mut st.partial);
                 &st.partial
             };
-            st.z[2 * n..].copy_from_slice(&[c.v, c.a, c.j]);
-            match disc.stride() {
-                4 => apply::<4>(rows, &mut st.z, 2 * n),
-                8 => apply::<8>(rows, &mut st.z, 2 * n),
-                12 => apply::<12>(rows, &mut st.z, 2 * n),
-                16 => apply::<16>(rows, &mut st.z, 2 * n),
+            let cmd = [c.v, c.a, c.j];
+            let z_probe = match disc.stride() {
+                4 => apply::<4>(rows, &mut st.z, n2, cmd),
+                8 => apply::<8>(rows, &mut st.z, n2, cmd),
+                12 => apply::<12>(rows, &mut st.z, n2, cmd),
+                16 => apply::<16>(rows, &mut st.z, n2, cmd),
                 stride => {
                     st.scratch.fill(0.0);
-                    for (col, &zj) in rows.chunks_exact(stride).zip(&st.z) {
-                        if zj != 0.0 {
+                    for (j, col) in rows.chunks_exact(stride).enumerate() {
+                        let zj = if j < n2 { st.z[j] } else { cmd[j - n2] };
+                        if j < n2 || zj != 0.0 {
                             for (o, p) in st.scratch.iter_mut().zip(col) {
                                 *o += p * zj;
                             }
                         }
                     }
-                    st.z[..2 * n].copy_from_slice(&st.scratch);
+                    st.z.copy_from_slice(&st.scratch);
+                    st.z.iter().fold(0.0, |s, x| s + x * 0.0)
                 }
-            }
+            };
             if let (Some(sp), Some(ss)) = (&ax.stepper, st.stepper.as_mut()) {
                 // Linear driver: the load angle Nr (x rad_per_m - theta) is -Nr r_rotor.
                 ss.track(-f64::from(sp.rotor_teeth) * st.z[sp.rotor]);
             }
-            if !(st.base.p.is_finite() && st.z.iter().all(|x| x.is_finite())) {
+            // `x * 0` is 0 for a finite `x` and NaN otherwise: one sum, no branch per entry.
+            let probe = (st.base.p * 0.0 + (c.v * 0.0 + c.a * 0.0 + c.j * 0.0)) + z_probe;
+            if probe != 0.0 {
                 return Err(SimError::NonFinite {
                     t_s: state.t_s + dt_s,
                 });
@@ -391,23 +435,42 @@ impl Plant for ModalPlant {
         Ok(())
     }
 
+    fn positions(
+        &self,
+        state: &ModalState,
+        commanded_m: &mut [f64],
+        toolhead_m: &mut [f64],
+    ) -> bool {
+        // `x * 0` is 0 for a finite `x` and NaN otherwise.
+        let mut probe = 0.0;
+        for (((ax, st), c), t) in self
+            .axes
+            .iter()
+            .zip(&state.axes)
+            .zip(commanded_m.iter_mut())
+            .zip(toolhead_m.iter_mut())
+        {
+            let x = st.base.p;
+            *c = x;
+            let (toolhead, p) = if st.idle && x.to_bits() == st.at_rest.0.to_bits() {
+                (st.at_rest.1, st.at_rest.2)
+            } else {
+                axis_positions(ax, &st.z, &st.disc.g, x)
+            };
+            *t = toolhead;
+            probe += p;
+        }
+        probe == 0.0
+    }
+
     fn observe(&self, state: &ModalState, out: &mut [Observation]) {
         for ((ax, st), o) in self.axes.iter().zip(&state.axes).zip(out.iter_mut()) {
             let x = st.base.p;
             let g = &st.disc.g;
             let q = |i: usize| st.z[i] + g[i] * x;
-            let mut toolhead = 0.0;
-            for t in &ax.lumped.output {
-                toolhead += t.gain
-                    * match t.node {
-                        crate::lumped::Node::Ground => 0.0,
-                        crate::lumped::Node::Command => x,
-                        crate::lumped::Node::Body(i) => q(i),
-                    };
-            }
             *o = Observation {
                 commanded_m: x,
-                toolhead_m: toolhead,
+                toolhead_m: toolhead(ax, x, q),
                 carriage_m: ax.carriage.map(q),
                 motor_angle_rad: ax.stepper.as_ref().map(|s| q(s.rotor)),
                 currents_a: None,
@@ -417,4 +480,37 @@ impl Plant for ModalPlant {
             };
         }
     }
+}
+
+/// The toolhead position (m) of `axis` for the command at `x` (m), with `q(i)` the
+/// position of body `i`: the sum of the output terms, in their order.
+#[inline]
+fn toolhead(axis: &AxisModel, x: f64, q: impl Fn(usize) -> f64) -> f64 {
+    let mut toolhead = 0.0;
+    for t in &axis.lumped.output {
+        toolhead += t.gain
+            * match t.node {
+                crate::lumped::Node::Ground => 0.0,
+                crate::lumped::Node::Command => x,
+                crate::lumped::Node::Body(i) => q(i),
+            };
+    }
+    toolhead
+}
+
+/// The toolhead position (m) of `axis` for the command at `x` (m) and the state `z`, and
+/// the sum of `v * 0` over `x`, the toolhead, the carriage and the motor angle (0 when
+/// they are all finite, NaN otherwise).
+#[inline]
+fn axis_positions(axis: &AxisModel, z: &[f64], g: &[f64], x: f64) -> (f64, f64) {
+    let q = |i: usize| z[i] + g[i] * x;
+    let t = toolhead(axis, x, q);
+    let mut probe = x * 0.0 + t * 0.0;
+    if let Some(i) = axis.carriage {
+        probe += q(i) * 0.0;
+    }
+    if let Some(s) = &axis.stepper {
+        probe += q(s.rotor) * 0.0;
+    }
+    (t, probe)
 }

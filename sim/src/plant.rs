@@ -49,6 +49,21 @@ pub trait Plant {
 
     /// What the plant shows now, one entry per axis written into `out`.
     fn observe(&self, state: &Self::State, out: &mut [Observation]);
+
+    /// The commanded and toolhead positions per axis (m), written into `commanded_m` and
+    /// `toolhead_m` (the values equal [`Observation::commanded_m`] and
+    /// [`Observation::toolhead_m`] bit for bit): what streaming metrics need each sample,
+    /// without building [`Observation`]s. Returns `true` only when every position and
+    /// angle [`Plant::observe`] would report is finite; `false` (the default, which may
+    /// write nothing) tells the caller to use [`Plant::observe`] instead.
+    fn positions(
+        &self,
+        _state: &Self::State,
+        _commanded_m: &mut [f64],
+        _toolhead_m: &mut [f64],
+    ) -> bool {
+        false
+    }
 }
 
 /// Check a command's axis count and step size (shared by the backends).
