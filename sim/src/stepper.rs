@@ -65,13 +65,20 @@ pub struct Stepper {
     pub current_loop_bandwidth_hz: f64,
 }
 
-/// The driver's torque at the predicted middle of a step ([`Stepper::advance_predicted`]).
+/// The driver's torque over a step, for an integrator that holds it constant
+/// ([`Stepper::advance_predicted`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MidStep {
+    /// Phase A current at mid-step (A).
+    pub i_a: f64,
+    /// Phase B current at mid-step (A).
+    pub i_b: f64,
     /// The predicted rotor angle at mid-step (rad).
     pub theta_rad: f64,
-    /// Magnetic plus detent torque there (N m), with the currents at mid-step; without
-    /// the slip damping (the caller's integrator applies that with its own velocities).
+    /// Magnetic plus detent torque (N m), averaged over the step along the predicted
+    /// rotor path and the currents' closed form (trapezoidal rule on the electrical
+    /// sub-step boundaries); without the slip damping (the caller's integrator applies
+    /// that with its own velocities).
     pub torque_n_m: f64,
 }
 
@@ -390,16 +397,20 @@ impl Stepper {
 
     /// Advance the currents over a step of `h` s in one pass, with the rotor predicted to
     /// turn at a constant `omega` (rad/s) from `theta0` (rad), the command following
-    /// `x(tau) = p + v tau + a tau^2/2 + j tau^3/6` (m), and return the driver's torque at
-    /// mid-step ([`MidStep`]): for an integrator that holds the driver torque over the step
-    /// at its predicted midpoint (MuJoCo's motor actuator, rapier's kick).
+    /// `x(tau) = p + v tau + a tau^2/2 + j tau^3/6` (m), and return the driver torque to
+    /// hold over the step ([`MidStep`]: its mean along the predicted path) for an
+    /// integrator that holds it constant (MuJoCo's motor actuator). For a torque linear in
+    /// the angle the mean is the value at the predicted midpoint, which adds no numerical
+    /// damping to a spring integrated that way; unlike the midpoint value it also carries
+    /// the microstep edges and current transients inside the step with their timing
+    /// (see `sim/tests/mujoco_step_budget.rs` for the printer's Y axis against a 4x
+    /// smaller step).
     ///
-    /// Each electrical sub-step (at most [`ELECTRICAL_SUBSTEP_S`]) freezes the reference
-    /// and back-EMF at its middle and solves `L di/dt = V - R i - e` exactly through its
-    /// clamped and proportional pieces, as [`Stepper::advance`] does; the mid-step currents
-    /// come from the same closed form evaluated at `h/2` (for an odd sub-step count the
-    /// middle sub-step is split in two halves with the same frozen inputs), so one pass
-    /// yields both. Unlike [`Stepper::advance`] the rotor path is the prediction, not the
+    /// Each electrical sub-step (at most [`ELECTRICAL_SUBSTEP_S`], an even number of them)
+    /// freezes the reference and back-EMF at its middle and solves
+    /// `L di/dt = V - R i - e` exactly through its clamped and proportional pieces, as
+    /// [`Stepper::advance`] does; the torque's mean and the mid-step currents come from
+    /// the same pass. Unlike [`Stepper::advance`] the rotor path is the prediction, not the
     /// step's result: the back-EMF is off by the rotor's speed change over the step,
     /// `Km dw`, against a current loop that forgets it within `L / (R + Kp)` (8 us for the
     /// presets). The load angle is not recorded here: call [`Stepper::track_currents`]
@@ -416,13 +427,22 @@ impl Stepper {
         let nr = self.nr();
         let km = self.torque_constant_n_m_per_a;
         let ph = self.phase();
+        // An even count puts mid-step on a sub-step boundary.
         let n = (h / ELECTRICAL_SUBSTEP_S).ceil().max(1.0) as usize;
+        let n = n + n % 2;
         let he = h / n as f64;
         let x_at = |tau: f64| cmd.p + tau * (cmd.v + tau * (cmd.a / 2.0 + tau * cmd.j / 6.0));
         let el_per_m = nr * self.rad_per_m;
         let mut mid = None;
-        // The rotor's electrical angle at mid-step, when a sub-step is centred there.
-        let mut centre = None;
+        // The torque at a sub-step boundary (magnetic and detent, at the predicted angle).
+        let torque_at = |i_a: f64, i_b: f64, theta: f64| {
+            let (s, c) = (nr * theta).sin_cos();
+            // sin(4 x) from sin x and cos x (double angle twice): no third sine.
+            let (s2, c2) = (2.0 * s * c, 1.0 - 2.0 * s * s);
+            km * (-i_a * s + i_b * c) - self.detent_torque_n_m * 2.0 * s2 * c2
+        };
+        // The mean over the step by the trapezoidal rule on the sub-step boundaries.
+        let mut sum = 0.5 * torque_at(st.i_a, st.i_b, theta0);
         for k in 0..n {
             if 2 * k == n {
                 mid = Some((st.i_a, st.i_b));
@@ -432,33 +452,17 @@ impl Stepper {
             let (sq, cq) = el_q.sin_cos();
             let (s, c) = (nr * (theta0 + omega * t)).sin_cos();
             let (e_a, e_b) = (-km * omega * s, km * omega * c);
-            let (ra, rb) = (self.current_a * cq, self.current_a * sq);
-            if 2 * k + 1 == n {
-                centre = Some((theta0 + omega * t, s, c));
-                let (ia, ib) = (
-                    ph.advance(st.i_a, ra, e_a, 0.5 * he),
-                    ph.advance(st.i_b, rb, e_b, 0.5 * he),
-                );
-                mid = Some((ia, ib));
-                st.i_a = ph.advance(ia, ra, e_a, 0.5 * he);
-                st.i_b = ph.advance(ib, rb, e_b, 0.5 * he);
-            } else {
-                st.i_a = ph.advance(st.i_a, ra, e_a, he);
-                st.i_b = ph.advance(st.i_b, rb, e_b, he);
-            }
+            st.i_a = ph.advance(st.i_a, self.current_a * cq, e_a, he);
+            st.i_b = ph.advance(st.i_b, self.current_a * sq, e_b, he);
+            let w = if k + 1 == n { 0.5 } else { 1.0 };
+            sum += w * torque_at(st.i_a, st.i_b, theta0 + omega * (k + 1) as f64 * he);
         }
         let (i_a, i_b) = mid.unwrap_or((st.i_a, st.i_b));
-        let (theta, s, c) = centre.unwrap_or_else(|| {
-            let theta = theta0 + 0.5 * h * omega;
-            let (s, c) = (nr * theta).sin_cos();
-            (theta, s, c)
-        });
-        // sin(4 x) from sin x and cos x (double angle twice): no third sine.
-        let (s2, c2) = (2.0 * s * c, 1.0 - 2.0 * s * s);
-        let detent = self.detent_torque_n_m * 2.0 * s2 * c2;
         MidStep {
-            theta_rad: theta,
-            torque_n_m: km * (-i_a * s + i_b * c) - detent,
+            i_a,
+            i_b,
+            theta_rad: theta0 + 0.5 * h * omega,
+            torque_n_m: sum / n as f64,
         }
     }
 

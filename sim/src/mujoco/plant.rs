@@ -6,11 +6,14 @@
 //! step, and the step size is chosen with that spring in the model. The stepper model's
 //! remaining torque (currents, sinusoidal law, detent, microsteps: the full torque of
 //! [`crate::stepper::Stepper::torque`] minus the tendon's) enters through the MJCF `motor`
-//! actuator on the rotor, evaluated each MuJoCo step at the predicted mid-step rotor angle
-//! and command (a position force held at the predicted midpoint adds no numerical damping
-//! to a spring: the step's transition matrix has determinant 1). After each step the
-//! currents advance over it ([`crate::stepper::Stepper::advance`]) and the load angle is
-//! tracked, exactly as on rapier, so lost steps are detected the same way.
+//! actuator on the rotor, held over each MuJoCo step at its mean along the predicted rotor
+//! path (`theta0 + omega t`) minus the tendon's spring at the predicted midpoint (for a
+//! torque linear in the angle that is the midpoint value, and a position force held at
+//! the predicted midpoint adds no numerical damping to a spring: the step's transition
+//! matrix has determinant 1). One pass of the current loop per step gives both that mean
+//! and the currents at the step's end ([`crate::stepper::Stepper::advance_predicted`]);
+//! after the step the load angle is tracked from the currents and the rotor's new angle,
+//! as on rapier, so lost steps are detected the same way.
 
 use settle_planner::{Sample, State};
 
@@ -216,10 +219,10 @@ impl Plant for MujocoPlant {
                         let tau = h * k as f64;
                         let c0 = advance_sample(c, tau);
                         let (th0, w0) = (st.sim.q()[r], st.sim.qd()[r]);
-                        // The stepper torque beyond the tendon's linear spring, at the
-                        // predicted mid-step angle and command, with the currents at
-                        // mid-step from the same one-pass advance that carries them over
-                        // the step (the damping terms are equal in both and cancel).
+                        // The stepper torque beyond the tendon's linear spring: its mean
+                        // over the step from the one-pass advance that carries the currents
+                        // over it, minus the tendon's spring at the predicted midpoint (the
+                        // damping terms are equal in both and cancel).
                         let x_m = advance_sample(c, tau + 0.5 * h).p;
                         let mid = sp.advance_predicted(ss, th0, w0, &c0, h);
                         let rest = mid.torque_n_m + k_theta * (mid.theta_rad - sp.rad_per_m * x_m);
