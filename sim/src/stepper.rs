@@ -65,6 +65,23 @@ pub struct Stepper {
     pub current_loop_bandwidth_hz: f64,
 }
 
+/// The driver's torque over a step, for an integrator that holds it constant
+/// ([`Stepper::advance_predicted`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MidStep {
+    /// Phase A current at mid-step (A).
+    pub i_a: f64,
+    /// Phase B current at mid-step (A).
+    pub i_b: f64,
+    /// The predicted rotor angle at mid-step (rad).
+    pub theta_rad: f64,
+    /// Magnetic plus detent torque (N m), averaged over the step along the predicted
+    /// rotor path and the currents' closed form (trapezoidal rule on the electrical
+    /// sub-step boundaries); without the slip damping (the caller's integrator applies
+    /// that with its own velocities).
+    pub torque_n_m: f64,
+}
+
 /// The driver's mutable state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepperState {
@@ -375,10 +392,90 @@ impl Stepper {
         // Load angle: the current vector's angle, unwrapped next to the commanded
         // electrical angle (the current never lags its reference by half a turn), minus
         // the rotor's.
-        let el_cmd = nr * self.quantise_m(x_at(h)) * self.rad_per_m;
+        self.track_currents(st, theta1, x_at(h));
+    }
+
+    /// Advance the currents over a step of `h` s in one pass, with the rotor predicted to
+    /// turn at a constant `omega` (rad/s) from `theta0` (rad), the command following
+    /// `x(tau) = p + v tau + a tau^2/2 + j tau^3/6` (m), and return the driver torque to
+    /// hold over the step ([`MidStep`]: its mean along the predicted path) for an
+    /// integrator that holds it constant (MuJoCo's motor actuator). For a torque linear in
+    /// the angle the mean is the value at the predicted midpoint, which adds no numerical
+    /// damping to a spring integrated that way; unlike the midpoint value it also carries
+    /// the microstep edges and current transients inside the step with their timing
+    /// (see `sim/tests/mujoco_step_budget.rs` for the printer's Y axis against a 4x
+    /// smaller step).
+    ///
+    /// Each electrical sub-step (at most [`ELECTRICAL_SUBSTEP_S`], an even number of them)
+    /// freezes the reference and back-EMF at its middle and solves
+    /// `L di/dt = V - R i - e` exactly through its clamped and proportional pieces, as
+    /// [`Stepper::advance`] does; the torque's mean and the mid-step currents come from
+    /// the same pass. Unlike [`Stepper::advance`] the rotor path is the prediction, not the
+    /// step's result: the back-EMF is off by the rotor's speed change over the step,
+    /// `Km dw`, against a current loop that forgets it within `L / (R + Kp)` (8 us for the
+    /// presets). The load angle is not recorded here: call [`Stepper::track_currents`]
+    /// with the rotor angle at the step's end.
+    #[inline]
+    pub fn advance_predicted(
+        &self,
+        st: &mut StepperState,
+        theta0: f64,
+        omega: f64,
+        cmd: &settle_planner::Sample,
+        h: f64,
+    ) -> MidStep {
+        let nr = self.nr();
+        let km = self.torque_constant_n_m_per_a;
+        let ph = self.phase();
+        // An even count puts mid-step on a sub-step boundary.
+        let n = (h / ELECTRICAL_SUBSTEP_S).ceil().max(1.0) as usize;
+        let n = n + n % 2;
+        let he = h / n as f64;
+        let x_at = |tau: f64| cmd.p + tau * (cmd.v + tau * (cmd.a / 2.0 + tau * cmd.j / 6.0));
+        let el_per_m = nr * self.rad_per_m;
+        let mut mid = None;
+        // The torque at a sub-step boundary (magnetic and detent, at the predicted angle).
+        let torque_at = |i_a: f64, i_b: f64, theta: f64| {
+            let (s, c) = (nr * theta).sin_cos();
+            // sin(4 x) from sin x and cos x (double angle twice): no third sine.
+            let (s2, c2) = (2.0 * s * c, 1.0 - 2.0 * s * s);
+            km * (-i_a * s + i_b * c) - self.detent_torque_n_m * 2.0 * s2 * c2
+        };
+        // The mean over the step by the trapezoidal rule on the sub-step boundaries.
+        let mut sum = 0.5 * torque_at(st.i_a, st.i_b, theta0);
+        for k in 0..n {
+            if 2 * k == n {
+                mid = Some((st.i_a, st.i_b));
+            }
+            let t = (k as f64 + 0.5) * he;
+            let el_q = el_per_m * self.quantise_m(x_at(t));
+            let (sq, cq) = el_q.sin_cos();
+            let (s, c) = (nr * (theta0 + omega * t)).sin_cos();
+            let (e_a, e_b) = (-km * omega * s, km * omega * c);
+            st.i_a = ph.advance(st.i_a, self.current_a * cq, e_a, he);
+            st.i_b = ph.advance(st.i_b, self.current_a * sq, e_b, he);
+            let w = if k + 1 == n { 0.5 } else { 1.0 };
+            sum += w * torque_at(st.i_a, st.i_b, theta0 + omega * (k + 1) as f64 * he);
+        }
+        let (i_a, i_b) = mid.unwrap_or((st.i_a, st.i_b));
+        MidStep {
+            i_a,
+            i_b,
+            theta_rad: theta0 + 0.5 * h * omega,
+            torque_n_m: sum / n as f64,
+        }
+    }
+
+    /// Record the load angle at the end of a step: the current vector's angle, unwrapped
+    /// next to the commanded electrical angle for a command at `x_cmd` (m), minus the
+    /// rotor's at `theta` (rad).
+    #[inline]
+    pub fn track_currents(&self, st: &mut StepperState, theta: f64, x_cmd: f64) {
+        let nr = self.nr();
+        let el_cmd = nr * self.quantise_m(x_cmd) * self.rad_per_m;
         let psi = st.i_b.atan2(st.i_a);
         let lag = (psi - el_cmd + PI).rem_euclid(TAU) - PI;
-        st.track(el_cmd + lag - nr * theta1);
+        st.track(el_cmd + lag - nr * theta);
     }
 
     /// Record the load angle of a linear driver spring (no currents): commanded electrical

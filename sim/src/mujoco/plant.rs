@@ -6,11 +6,14 @@
 //! step, and the step size is chosen with that spring in the model. The stepper model's
 //! remaining torque (currents, sinusoidal law, detent, microsteps: the full torque of
 //! [`crate::stepper::Stepper::torque`] minus the tendon's) enters through the MJCF `motor`
-//! actuator on the rotor, evaluated each MuJoCo step at the predicted mid-step rotor angle
-//! and command (a position force held at the predicted midpoint adds no numerical damping
-//! to a spring: the step's transition matrix has determinant 1). After each step the
-//! currents advance over it ([`crate::stepper::Stepper::advance`]) and the load angle is
-//! tracked, exactly as on rapier, so lost steps are detected the same way.
+//! actuator on the rotor, held over each MuJoCo step at its mean along the predicted rotor
+//! path (`theta0 + omega t`) minus the tendon's spring at the predicted midpoint (for a
+//! torque linear in the angle that is the midpoint value, and a position force held at
+//! the predicted midpoint adds no numerical damping to a spring: the step's transition
+//! matrix has determinant 1). One pass of the current loop per step gives both that mean
+//! and the currents at the step's end ([`crate::stepper::Stepper::advance_predicted`]);
+//! after the step the load angle is tracked from the currents and the rotor's new angle,
+//! as on rapier, so lost steps are detected the same way.
 
 use settle_planner::{Sample, State};
 
@@ -75,8 +78,21 @@ impl MujocoPlant {
 
 /// The MuJoCo model of a `full`-driver axis: its lumped model plus the driver's linear
 /// spring-damper as a coupling from the rotor to the command (the rotor stays the actuated
-/// body), with the step budget shrunk so that `|lambda| h` also covers the detent's extra
-/// stiffness (`4 Nr Td`), as rapier's step does ([`crate::rapier::fastest_rate`]).
+/// body).
+///
+/// The step: RK4 integrates the MJCF model (the lumped springs and the driver's tendon),
+/// so `max_lambda_h` applies to that model's fastest eigenvalue, as for the linear driver.
+/// The rest of the driver torque (the detent, the sine law's departure from its tangent)
+/// is not in MuJoCo's model: it is held over each step at the predicted mid-step angle,
+/// which integrates it like rapier's explicit force, with a frequency error of about
+/// `(w_e h)^2 / 24` on the share of stiffness it carries (`w_e^2 = k_e / J`, `J` the rotor
+/// inertia). Its stiffness `k_e` is at most `2 k_theta + 4 Nr Td` (the sine's slope
+/// departs from the tangent's by at most `2 k_theta`, the detent's slope is at most
+/// `4 Nr Td`), so the step is also held to `w_e h <= STEP_FRACTION` (rapier's bound:
+/// 0.375 % at most on that share). For the printer preset that second bound is 145 us,
+/// above the RK4 step; the detent no longer shortens the step as an RK4 spring (that
+/// took a second MuJoCo step per 10 kHz sample on the printer's Y axis for a frequency
+/// change below 0.01 %, see `sim/tests/mujoco_stepper.rs`).
 fn full_driver_model(
     a: &AxisModel,
     sp: &Stepper,
@@ -98,16 +114,24 @@ fn full_driver_model(
         stiffness: Stiffness::Constant(sp.k_theta()),
         damping: sp.damping_n_m_s_per_rad,
     });
-    let probe = MujocoModel::new(&lumped, config)?;
-    let fastest = crate::rapier::fastest_rate(a, 0.0)?;
-    if fastest <= probe.lambda_max() {
-        return Ok(probe);
+    let model = MujocoModel::new(&lumped, config)?;
+    let h_explicit = explicit_step_s(a, sp);
+    if model.nominal_step_s() <= h_explicit {
+        return Ok(model);
     }
     let config = MujocoConfig {
-        max_lambda_h: config.max_lambda_h * probe.lambda_max() / fastest,
+        max_step_s: config.max_step_s.min(h_explicit),
         ..config
     };
     MujocoModel::new(&lumped, config)
+}
+
+/// The longest step (s) for the driver torque MuJoCo does not integrate itself (see
+/// [`full_driver_model`]): `STEP_FRACTION / w_e`, `w_e = sqrt((2 k_theta + 4 Nr Td) / J)`.
+fn explicit_step_s(a: &AxisModel, sp: &Stepper) -> f64 {
+    let j = a.lumped.bodies[sp.rotor].inertia;
+    let k_e = 2.0 * sp.k_theta() + sp.detent_stiffness();
+    crate::rapier::STEP_FRACTION / (k_e / j).sqrt()
 }
 
 impl Plant for MujocoPlant {
@@ -195,19 +219,16 @@ impl Plant for MujocoPlant {
                         let tau = h * k as f64;
                         let c0 = advance_sample(c, tau);
                         let (th0, w0) = (st.sim.q()[r], st.sim.qd()[r]);
-                        // The stepper torque beyond the tendon's linear spring, at the
-                        // predicted mid-step angle and command (the damping terms are
-                        // equal in both and cancel: omega and v_cmd as 0).
-                        let th_m = th0 + 0.5 * h * w0;
+                        // The stepper torque beyond the tendon's linear spring: its mean
+                        // over the step from the one-pass advance that carries the currents
+                        // over it, minus the tendon's spring at the predicted midpoint (the
+                        // damping terms are equal in both and cancel).
                         let x_m = advance_sample(c, tau + 0.5 * h).p;
-                        let mut mid = ss.clone();
-                        sp.advance(&mut mid, th0, th_m, w0, &c0, 0.5 * h);
-                        let rest =
-                            sp.torque(&mid, th_m, 0.0, 0.0) + k_theta * (th_m - sp.rad_per_m * x_m);
+                        let mid = sp.advance_predicted(ss, th0, w0, &c0, h);
+                        let rest = mid.torque_n_m + k_theta * (mid.theta_rad - sp.rad_per_m * x_m);
                         model.set_drive(&mut st.sim, rest)?;
                         model.step(&mut st.sim, &c0, h)?;
-                        let (th1, w1) = (st.sim.q()[r], st.sim.qd()[r]);
-                        sp.advance(ss, th0, th1, w1, &c0, h);
+                        sp.track_currents(ss, st.sim.q()[r], advance_sample(c, tau + h).p);
                     }
                 }
                 (DriverMode::Spring, Some(sp)) => {
