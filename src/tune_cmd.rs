@@ -128,24 +128,7 @@ pub fn check_text(o: &Outcome) -> String {
         out,
         "\n## Checked on a second backend: {b}\n\n| | candidate | {h_move} | {h_res} | {h_score} | into {band} um (ms) |\n|---|---|---:|---:|---:|---:|"
     );
-    let ms = |x: f64| {
-        if x.is_finite() {
-            format!("{:.1}", x * 1e3)
-        } else {
-            "not settled".into()
-        }
-    };
-    for (tag, s) in [("default", d), ("winner", w)] {
-        let _ = writeln!(
-            out,
-            "| {tag} | {} | {} | {:.2} | {} | {} |",
-            s.candidate.label(),
-            ms(s.move_time_s),
-            s.residual_peak_um,
-            ms(s.move_and_settle_s),
-            ms(s.at_band_s)
-        );
-    }
+    crate::tune_report::default_and_winner_rows(&mut out, d, w, "winner");
     let verdict = if w.move_and_settle_s < d.move_and_settle_s {
         format!(
             "the winner still beats the default on {b}: {:.1}% better",
@@ -159,8 +142,8 @@ pub fn check_text(o: &Outcome) -> String {
     let _ = writeln!(
         out,
         "Into the {band} um band the winner takes {} ms on {b} ({} ms on {}, {}).",
-        ms(w.at_band_s),
-        ms(searched.at_band_s),
+        crate::tune_report::ms(w.at_band_s),
+        crate::tune_report::ms(searched.at_band_s),
         plan.base.backend,
         if w.at_band_s <= searched.at_band_s + 1.0 / plan.base.sample_rate_hz {
             "confirmed within one sample"

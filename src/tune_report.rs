@@ -238,11 +238,28 @@ fn family(plan: &Plan) -> String {
     }
 }
 
-fn ms(x: f64) -> String {
+/// Seconds as milliseconds with one decimal, or "not settled".
+pub(crate) fn ms(x: f64) -> String {
     if x.is_finite() {
         format!("{:.1}", x * 1e3)
     } else {
         "not settled".into()
+    }
+}
+
+/// The default's and the winner's rows of a `| | candidate | move | residual | score | into
+/// the band |` table; `winner_tag` is how the winner's row is labelled.
+pub(crate) fn default_and_winner_rows(out: &mut String, d: &Score, w: &Score, winner_tag: &str) {
+    for (tag, s) in [("default", d), (winner_tag, w)] {
+        let _ = writeln!(
+            out,
+            "| {tag} | {} | {} | {:.2} | {} | {} |",
+            s.candidate.label(),
+            ms(s.move_time_s),
+            s.residual_peak_um,
+            ms(s.move_and_settle_s),
+            ms(s.at_band_s)
+        );
     }
 }
 
@@ -303,17 +320,7 @@ pub fn markdown(
         "| | candidate | {h_move} | {h_res} | {h_score} | into {band} um (ms) |"
     );
     let _ = writeln!(out, "|---|---|---:|---:|---:|---:|");
-    for (tag, s) in [("default", d), ("**winner**", w)] {
-        let _ = writeln!(
-            out,
-            "| {tag} | {} | {} | {:.2} | {} | {} |",
-            s.candidate.label(),
-            ms(s.move_time_s),
-            s.residual_peak_um,
-            ms(s.move_and_settle_s),
-            ms(s.at_band_s)
-        );
-    }
+    default_and_winner_rows(&mut out, d, w, "**winner**");
     if plan.base.corner.is_some() {
         let _ = writeln!(
             out,
