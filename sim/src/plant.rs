@@ -64,6 +64,38 @@ pub trait Plant {
     ) -> bool {
         false
     }
+
+    /// Several samples in one call: what the harness's lean path (no recording) does
+    /// between two breakpoints of the command, without a call per sample.
+    ///
+    /// `cmds` holds `n = cmds.len() / axes` samples, sample-major (`cmds[i * axes + a]` is
+    /// axis `a`'s command at the start of step `i`); the steps are consecutive, each
+    /// `dt_s` long, and all lie inside one piece of every axis's command (constant jerk
+    /// throughout), so `cmds[i * axes + a]` is `cmds[a]` advanced by `i dt_s` up to
+    /// rounding. After step `i` the plant writes what [`Plant::positions`] would write
+    /// into `commanded_m[i * axes ..]` and `toolhead_m[i * axes ..]` (same layout). A plant
+    /// may take longer internal steps than `dt_s` and interpolate the samples between
+    /// them, as long as it stays within its validated accuracy.
+    ///
+    /// It stops after the first sample it cannot vouch for (a value [`Plant::observe`]
+    /// would report is not finite, or `|toolhead - commanded| > blowup_m` on an axis),
+    /// leaving the state at that sample: the caller then observes it in full. Returns
+    /// `Ok(Some(k))` with the `k >= 1` samples done and written (all vouched for when
+    /// `k == n`; when `k < n` the last one is not), `Err((k, e))` when step `k` failed
+    /// after `k` good samples (the state is then undefined), and `Ok(None)` (the default)
+    /// when the plant does not implement this: the caller steps sample by sample.
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn step_samples(
+        &self,
+        _state: &mut Self::State,
+        _cmds: &[Sample],
+        _dt_s: f64,
+        _blowup_m: f64,
+        _commanded_m: &mut [f64],
+        _toolhead_m: &mut [f64],
+    ) -> Result<Option<usize>, (usize, SimError)> {
+        Ok(None)
+    }
 }
 
 /// Check a command's axis count and step size (shared by the backends).
