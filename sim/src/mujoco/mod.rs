@@ -9,10 +9,11 @@
 //! The library comes from `scripts/setup-mujoco.sh` (into `.deps/mujoco/`); the build finds
 //! it through `.cargo/config.toml` and the binaries through an rpath.
 
+mod lean;
 mod mjcf;
 mod model;
 mod plant;
 
 pub use mjcf::{COMMAND_MASS_FACTOR, Integrator};
-pub use model::{MujocoConfig, MujocoModel, MujocoSim};
+pub use model::{LONG_EXPLICIT_W_H, LONG_LAMBDA_H, MujocoConfig, MujocoModel, MujocoSim};
 pub use plant::MujocoPlant;

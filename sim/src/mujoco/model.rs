@@ -23,7 +23,20 @@ pub struct MujocoConfig {
     pub max_step_s: f64,
     /// MuJoCo's integrator (RK4 unless comparing integrators).
     pub integrator: Integrator,
+    /// Largest `|lambda| h` for the longer steps of the lean path
+    /// ([`crate::Plant::step_samples`]: several samples per MuJoCo step, the samples in
+    /// between interpolated). Never below `max_lambda_h`. See [`LONG_LAMBDA_H`].
+    pub long_lambda_h: f64,
+    /// The full driver's bound on the torque held over a long step (the detent and the
+    /// sine law's departure from its tangent, which MuJoCo does not integrate itself):
+    /// `w_e h <= long_explicit_w_h` on the lean path. See [`LONG_EXPLICIT_W_H`].
+    pub long_explicit_w_h: f64,
 }
+
+/// Default [`MujocoConfig::long_lambda_h`].
+pub const LONG_LAMBDA_H: f64 = 0.5;
+/// Default [`MujocoConfig::long_explicit_w_h`].
+pub const LONG_EXPLICIT_W_H: f64 = 0.6;
 
 impl Default for MujocoConfig {
     fn default() -> Self {
@@ -31,6 +44,8 @@ impl Default for MujocoConfig {
             max_lambda_h: 0.2,
             max_step_s: 1e-3,
             integrator: Integrator::Rk4,
+            long_lambda_h: LONG_LAMBDA_H,
+            long_explicit_w_h: LONG_EXPLICIT_W_H,
         }
     }
 }
@@ -44,6 +59,9 @@ pub struct MujocoModel {
     config: MujocoConfig,
     /// Step size (s) at the reference stiffnesses (position-dependent ones at q = 0).
     step_s: f64,
+    /// The lean path's longer step (s) at the reference stiffnesses
+    /// ([`MujocoConfig::long_lambda_h`]).
+    long_step_s: f64,
     /// Whether the stiffness matrix is singular (a free rigid-body mode, e.g. a rotor held
     /// only by the driver force).
     singular: bool,
@@ -57,6 +75,7 @@ impl std::fmt::Debug for MujocoModel {
             .field("lumped", &self.lumped)
             .field("config", &self.config)
             .field("step_s", &self.step_s)
+            .field("long_step_s", &self.long_step_s)
             .field("lambda_max", &self.lambda_max)
             .finish_non_exhaustive()
     }
@@ -90,6 +109,16 @@ impl MujocoModel {
                     config.max_lambda_h
                 ),
             });
+        }
+        for (what, v) in [
+            ("long_lambda_h", config.long_lambda_h),
+            ("long_explicit_w_h", config.long_explicit_w_h),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(SimError::InvalidModel {
+                    what: format!("{what} must be finite and > 0, got {v}"),
+                });
+            }
         }
         if !(config.max_step_s.is_finite() && config.max_step_s > 0.0) {
             return Err(SimError::InvalidStep {
@@ -125,6 +154,11 @@ impl MujocoModel {
         } else {
             config.max_step_s
         };
+        let long_step_s = if lambda_max > 0.0 {
+            (config.long_lambda_h.max(config.max_lambda_h) / lambda_max).min(config.max_step_s)
+        } else {
+            config.max_step_s
+        };
         let (mjcf, layout) = mjcf::generate(lumped, step_s, config.integrator);
         let template = MjModel::from_xml_string(&mjcf)
             .map_err(|e| mujoco_err(format!("MuJoCo rejected the generated MJCF: {e}")))?;
@@ -135,6 +169,7 @@ impl MujocoModel {
             template,
             config,
             step_s,
+            long_step_s,
             singular,
             lambda_max,
         })
@@ -172,14 +207,29 @@ impl MujocoModel {
     /// reference (a stiffness scaled by `alpha >= 1` raises no eigenvalue `w^2` by more than
     /// `alpha`, so `|lambda| h` stays within the budget).
     pub fn step_at(&self, sim: &MujocoSim) -> f64 {
+        self.step_s / self.stiffening(sim).sqrt()
+    }
+
+    /// The lean path's longer step (s) at the reference stiffnesses
+    /// ([`MujocoConfig::long_lambda_h`]).
+    pub fn nominal_long_step_s(&self) -> f64 {
+        self.long_step_s
+    }
+
+    /// The lean path's longer step (s) for the state `sim`, shrunk like
+    /// [`MujocoModel::step_at`].
+    pub fn long_step_at(&self, sim: &MujocoSim) -> f64 {
+        self.long_step_s / self.stiffening(sim).sqrt()
+    }
+
+    /// The largest ratio `k_now / k_ref` over the position-dependent couplings (>= 1).
+    fn stiffening(&self, sim: &MujocoSim) -> f64 {
         let q = sim.q();
-        let alpha = self
-            .layout
+        self.layout
             .variable
             .iter()
             .map(|(_, s, k0)| s.at(s.depends_on().map_or(0.0, |i| q[i])) / k0)
-            .fold(1.0f64, f64::max);
-        self.step_s / alpha.sqrt()
+            .fold(1.0f64, f64::max)
     }
 
     /// Coordinates (m, rad) at rest with the command held at `x_cmd` (m): the static
@@ -432,6 +482,24 @@ impl MujocoSim {
     /// The driver force currently applied (N m or N; 0 without a driver).
     pub fn drive(&self) -> f64 {
         self.drive.map_or(0.0, |a| self.data.ctrl()[a])
+    }
+
+    /// Put the lumped coordinates and rates back to `q`, `qd` with the bookkeeping of an
+    /// earlier moment (the lean path's return to a sample inside a step; everything else
+    /// MuJoCo keeps is set again before each step).
+    pub(super) fn rewind(
+        &mut self,
+        q: &[f64],
+        qd: &[f64],
+        command: State,
+        time_s: f64,
+        steps: u64,
+    ) {
+        self.data.qpos_mut()[..self.dof].copy_from_slice(q);
+        self.data.qvel_mut()[..self.dof].copy_from_slice(qd);
+        self.command = command;
+        self.time_s = time_s;
+        self.steps = steps;
     }
 
     /// The MuJoCo data (read only), e.g. for MuJoCo's own energy or force arrays.

@@ -31,25 +31,28 @@ use crate::{AxisModel, DriverMode, Observation, Plant, SimError, advance_sample,
 /// current-loop stepper driver, see the module documentation).
 #[derive(Debug)]
 pub struct MujocoPlant {
-    axes: Vec<(AxisModel, MujocoModel)>,
+    pub(super) axes: Vec<(AxisModel, MujocoModel)>,
+    /// Per axis, the lean path's cap on a long step (s) from the torque held over it (the
+    /// full driver's [`MujocoConfig::long_explicit_w_h`]; infinite otherwise).
+    pub(super) long_cap_s: Vec<f64>,
 }
 
 /// The state of every axis.
 #[derive(Debug)]
 pub struct MujocoPlantState {
-    axes: Vec<AxisState>,
+    pub(super) axes: Vec<AxisState>,
 }
 
 #[derive(Debug)]
-struct AxisState {
-    sim: MujocoSim,
-    stepper: Option<StepperState>,
+pub(super) struct AxisState {
+    pub(super) sim: MujocoSim,
+    pub(super) stepper: Option<StepperState>,
     /// The commanded sample (continuous, before quantisation) at the current time.
-    base: State,
+    pub(super) base: State,
     /// Still at rest where it started, with the command held there all along: stepping
     /// would only keep it there (at its static equilibrium), so steps are skipped until
     /// the command moves (an idle axis of a multi-axis machine costs nothing).
-    idle: bool,
+    pub(super) idle: bool,
 }
 
 impl MujocoPlant {
@@ -59,20 +62,35 @@ impl MujocoPlant {
             return Err(SimError::NoModes);
         }
         let mut out = Vec::with_capacity(axes.len());
+        let mut long_cap_s = Vec::with_capacity(axes.len());
         for a in axes {
             a.validate()?;
-            let m = match (a.mode, &a.stepper) {
-                (DriverMode::Full, Some(sp)) => full_driver_model(&a, sp, config)?,
-                _ => MujocoModel::new(&a.lumped, config)?,
+            let (m, cap) = match (a.mode, &a.stepper) {
+                (DriverMode::Full, Some(sp)) => (
+                    full_driver_model(&a, sp, config)?,
+                    config.long_explicit_w_h / explicit_rate(&a, sp),
+                ),
+                _ => (MujocoModel::new(&a.lumped, config)?, f64::INFINITY),
             };
             out.push((a, m));
+            long_cap_s.push(cap);
         }
-        Ok(Self { axes: out })
+        Ok(Self {
+            axes: out,
+            long_cap_s,
+        })
     }
 
     /// The MuJoCo model of axis `i` (MJCF, step size, state access).
     pub fn model(&self, i: usize) -> &MujocoModel {
         &self.axes[i].1
+    }
+
+    /// The lean path's cap on a long step of axis `i` (s) from the driver torque held over
+    /// it (the full driver's [`MujocoConfig::long_explicit_w_h`]; infinite otherwise). The
+    /// long step is the smaller of this and [`MujocoModel::long_step_at`].
+    pub fn long_cap_s(&self, i: usize) -> f64 {
+        self.long_cap_s[i]
     }
 }
 
@@ -127,11 +145,47 @@ fn full_driver_model(
 }
 
 /// The longest step (s) for the driver torque MuJoCo does not integrate itself (see
-/// [`full_driver_model`]): `STEP_FRACTION / w_e`, `w_e = sqrt((2 k_theta + 4 Nr Td) / J)`.
+/// [`full_driver_model`]): `STEP_FRACTION / w_e`.
 fn explicit_step_s(a: &AxisModel, sp: &Stepper) -> f64 {
+    crate::rapier::STEP_FRACTION / explicit_rate(a, sp)
+}
+
+/// `w_e = sqrt((2 k_theta + 4 Nr Td) / J)` (rad/s): the rate of the driver torque held
+/// over a step (see [`full_driver_model`]).
+fn explicit_rate(a: &AxisModel, sp: &Stepper) -> f64 {
     let j = a.lumped.bodies[sp.rotor].inertia;
     let k_e = 2.0 * sp.k_theta() + sp.detent_stiffness();
-    crate::rapier::STEP_FRACTION / (k_e / j).sqrt()
+    (k_e / j).sqrt()
+}
+
+/// One MuJoCo step of the full driver over `[tau, tau + h]` after the command sample `c`
+/// (constant jerk): the current loop advanced along the predicted rotor path, the rest of
+/// the driver torque held at its mean (see the module documentation), then the load angle
+/// tracked at the step's end.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(super) fn full_step(
+    sp: &Stepper,
+    model: &MujocoModel,
+    sim: &mut MujocoSim,
+    ss: &mut StepperState,
+    c: &Sample,
+    tau: f64,
+    h: f64,
+) -> Result<(), SimError> {
+    let r = sp.rotor;
+    let c0 = advance_sample(c, tau);
+    let (th0, w0) = (sim.q()[r], sim.qd()[r]);
+    // The stepper torque beyond the tendon's linear spring: its mean over the step from
+    // the one-pass advance that carries the currents over it, minus the tendon's spring at
+    // the predicted midpoint (the damping terms are equal in both and cancel).
+    let x_m = advance_sample(c, tau + 0.5 * h).p;
+    let mid = sp.advance_predicted(ss, th0, w0, &c0, h);
+    let rest = mid.torque_n_m + sp.k_theta() * (mid.theta_rad - sp.rad_per_m * x_m);
+    model.set_drive(sim, rest)?;
+    model.step(sim, &c0, h)?;
+    sp.track_currents(ss, sim.q()[r], advance_sample(c, tau + h).p);
+    Ok(())
 }
 
 impl Plant for MujocoPlant {
@@ -213,22 +267,8 @@ impl Plant for MujocoPlant {
                     let h_max = model.step_at(&st.sim);
                     let n = ((dt_s / h_max) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
                     let h = dt_s / n as f64;
-                    let r = sp.rotor;
-                    let k_theta = sp.k_theta();
                     for k in 0..n {
-                        let tau = h * k as f64;
-                        let c0 = advance_sample(c, tau);
-                        let (th0, w0) = (st.sim.q()[r], st.sim.qd()[r]);
-                        // The stepper torque beyond the tendon's linear spring: its mean
-                        // over the step from the one-pass advance that carries the currents
-                        // over it, minus the tendon's spring at the predicted midpoint (the
-                        // damping terms are equal in both and cancel).
-                        let x_m = advance_sample(c, tau + 0.5 * h).p;
-                        let mid = sp.advance_predicted(ss, th0, w0, &c0, h);
-                        let rest = mid.torque_n_m + k_theta * (mid.theta_rad - sp.rad_per_m * x_m);
-                        model.set_drive(&mut st.sim, rest)?;
-                        model.step(&mut st.sim, &c0, h)?;
-                        sp.track_currents(ss, st.sim.q()[r], advance_sample(c, tau + h).p);
+                        full_step(sp, model, &mut st.sim, ss, c, h * k as f64, h)?;
                     }
                 }
                 (DriverMode::Spring, Some(sp)) => {
@@ -267,6 +307,36 @@ impl Plant for MujocoPlant {
             };
         }
         Ok(())
+    }
+
+    fn positions(
+        &self,
+        state: &MujocoPlantState,
+        commanded_m: &mut [f64],
+        toolhead_m: &mut [f64],
+    ) -> bool {
+        let mut finite = true;
+        for (i, ((ax, _), st)) in self.axes.iter().zip(&state.axes).enumerate() {
+            let q = st.sim.q();
+            commanded_m[i] = st.base.p;
+            toolhead_m[i] = ax.lumped.toolhead_m(q, ax.command_node_m(st.base.p));
+            finite &= st.base.p.is_finite()
+                && toolhead_m[i].is_finite()
+                && q.iter().all(|v| v.is_finite());
+        }
+        finite
+    }
+
+    fn step_samples(
+        &self,
+        state: &mut MujocoPlantState,
+        cmds: &[Sample],
+        dt_s: f64,
+        blowup_m: f64,
+        commanded_m: &mut [f64],
+        toolhead_m: &mut [f64],
+    ) -> Result<Option<usize>, (usize, SimError)> {
+        super::lean::step_samples(self, state, cmds, dt_s, blowup_m, commanded_m, toolhead_m)
     }
 
     fn observe(&self, state: &MujocoPlantState, out: &mut [Observation]) {
