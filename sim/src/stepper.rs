@@ -424,6 +424,57 @@ impl Stepper {
         cmd: &settle_planner::Sample,
         h: f64,
     ) -> MidStep {
+        self.advance_predicted_inner::<false>(st, theta0, omega, cmd, h, &mut Vec::new())
+    }
+
+    /// [`Stepper::advance_predicted`] that also keeps, for each electrical sub-step
+    /// boundary inside the step, its time (s after the step start), the current vector's
+    /// angle and the commanded electrical angle (rad) in `inner` (cleared first): with the
+    /// rotor's angle there, [`Stepper::track_peak`] gives the load angle between the
+    /// step's ends, for steps long enough that the ends alone would miss its peak (the
+    /// lean path of a plant that steps several samples at once).
+    #[inline]
+    pub fn advance_predicted_inner_angles(
+        &self,
+        st: &mut StepperState,
+        theta0: f64,
+        omega: f64,
+        cmd: &settle_planner::Sample,
+        h: f64,
+        inner: &mut Vec<[f64; 3]>,
+    ) -> MidStep {
+        inner.clear();
+        self.advance_predicted_inner::<true>(st, theta0, omega, cmd, h, inner)
+    }
+
+    /// Raise `st.max_load_angle_rad` to the largest |load angle| at the points kept by
+    /// [`Stepper::advance_predicted_inner_angles`], `theta(t)` giving the rotor angle
+    /// (rad) at `t` s after the step start. Pole slips are left to
+    /// [`Stepper::track_currents`] at the step's end.
+    pub fn track_peak(
+        &self,
+        st: &mut StepperState,
+        inner: &[[f64; 3]],
+        theta: impl Fn(f64) -> f64,
+    ) {
+        let nr = self.nr();
+        for &[t, psi, el_cmd] in inner {
+            let lag = (psi - el_cmd + PI).rem_euclid(TAU) - PI;
+            let phi = el_cmd + lag - nr * theta(t);
+            st.max_load_angle_rad = st.max_load_angle_rad.max(phi.abs());
+        }
+    }
+
+    #[inline(always)]
+    fn advance_predicted_inner<const KEEP: bool>(
+        &self,
+        st: &mut StepperState,
+        theta0: f64,
+        omega: f64,
+        cmd: &settle_planner::Sample,
+        h: f64,
+        inner: &mut Vec<[f64; 3]>,
+    ) -> MidStep {
         let nr = self.nr();
         let km = self.torque_constant_n_m_per_a;
         let ph = self.phase();
@@ -456,6 +507,9 @@ impl Stepper {
             st.i_b = ph.advance(st.i_b, self.current_a * sq, e_b, he);
             let w = if k + 1 == n { 0.5 } else { 1.0 };
             sum += w * torque_at(st.i_a, st.i_b, theta0 + omega * (k + 1) as f64 * he);
+            if KEEP && k + 1 < n {
+                inner.push([(k + 1) as f64 * he, st.i_b.atan2(st.i_a), el_q]);
+            }
         }
         let (i_a, i_b) = mid.unwrap_or((st.i_a, st.i_b));
         MidStep {

@@ -184,3 +184,147 @@ fn full_driver_lean_path_is_within_the_validate_thresholds() {
     assert!(freq <= FREQUENCY_PCT, "frequency {freq} %");
     assert!(trace <= ENGINES_PCT / 100.0, "trace {trace}");
 }
+
+/// `settle validate`'s single-mode cases through the lean path: 40 Hz (zeta 0.05, 0.02) and
+/// 120 Hz (zeta 0.02) after 2, 20 and 100 mm trapezoids and S-curves, at the harness's
+/// 10 kHz (one MuJoCo step per 10 samples for 40 Hz: the 1 ms cap) and at 1 kHz: the whole
+/// toolhead trace against the exact modal plant (engines 3 %), and the post-move residual
+/// peak (residual 2 %, relative to the larger of the residual and 1e-3 of the static
+/// deflection, as in `mujoco_modes.rs`, for moves whose residual cancels).
+#[test]
+fn single_modes_on_the_lean_path_match_the_exact_modal_plant() {
+    let trap = Limits::new(0.3, 5.0, None).expect("limits");
+    let sc = Limits::new(0.3, 5.0, Some(200.0)).expect("limits");
+    let mut worst = (0.0f64, 0.0f64);
+    for mode in [
+        Mode::new(40.0, 0.05, 1.0).expect("mode"),
+        Mode::new(40.0, 0.02, 1.0).expect("mode"),
+        Mode::new(120.0, 0.02, 1.0).expect("mode"),
+    ] {
+        let axis = AxisModel::from_modes("x", &[mode]).expect("axis");
+        let mj = plant(vec![axis.clone()], MujocoConfig::default());
+        for dt in [1e-4, 1e-3] {
+            let modal = ModalPlant::new(vec![axis.clone()], dt).expect("modal");
+            for d in [0.002, 0.02, 0.1] {
+                for p in [
+                    settle_planner::trapezoid::rest_to_rest(0.0, d, &trap).expect("plan"),
+                    settle_planner::scurve::rest_to_rest(0.0, d, &sc).expect("plan"),
+                ] {
+                    let one = std::slice::from_ref(&p);
+                    let a = run_lean(&mj, one, dt, 0.3);
+                    let b = run(&modal, one, dt, 0.3);
+                    let tr = trace_error(&a, &b, 0);
+                    let (t_end, target) = (p.duration_s(), p.end().p);
+                    let (ra, rb) = (
+                        peak(&post_move(&a, t_end, target, 0)),
+                        peak(&post_move(&b, t_end, target, 0)),
+                    );
+                    let w = mode.omega();
+                    let static_defl = 5.0 / (w * w);
+                    let rel = (ra - rb).abs() / rb.max(1e-3 * static_defl);
+                    eprintln!(
+                        "{:5.0} Hz zeta {:.2} dt {:.0e} {:5.1} mm: residual lean {:.4e} m, modal {:.4e} m ({rel:.1e}); trace {tr:.1e}",
+                        mode.frequency_hz(),
+                        mode.damping_ratio(),
+                        dt,
+                        d * 1e3,
+                        ra,
+                        rb
+                    );
+                    worst = (worst.0.max(rel), worst.1.max(tr));
+                }
+            }
+        }
+    }
+    eprintln!("worst: residual {:.1e}, trace {:.1e}", worst.0, worst.1);
+    assert!(worst.0 < RESIDUAL_PCT / 100.0 && worst.1 < ENGINES_PCT / 100.0);
+    // RK4 at |w h| <= 0.5 (or the 1 ms cap) with the Hermite interpolation is far inside
+    // both: a loss of accuracy (a step too long, an interpolation off by a sample) shows.
+    assert!(worst.0 < 1e-3, "residual {}", worst.0);
+    assert!(worst.1 < 1e-3, "trace {}", worst.1);
+}
+
+/// Both printer axes moving at once (the fixture printer, full driver): the lean path
+/// steps each axis with its own long step in lockstep over the samples; residuals within
+/// 3 % of the per-sample path's, nothing lost, and a repeated run is bit-identical.
+#[test]
+fn two_axes_on_the_lean_path_match_the_per_sample_path_and_repeat() {
+    let lim = Limits::new(0.3, 3.0, Some(100.0)).expect("limits");
+    let axes = vec![
+        common::printer_x().compile(DriverMode::Full).expect("x"),
+        common::printer_y().compile(DriverMode::Full).expect("y"),
+    ];
+    let mj = plant(axes, MujocoConfig::default());
+    for kind in [ProfileKind::SCurve, ProfileKind::Trapezoid] {
+        let p = kind.rest_to_rest(0.0, 0.01, &lim).expect("plan");
+        let profiles = [p.clone(), p.clone()];
+        let a = run_lean(&mj, &profiles, DT, 0.3);
+        let b = run(&mj, &profiles, DT, 0.3);
+        assert_eq!(a, run_lean(&mj, &profiles, DT, 0.3), "bit-identical repeat");
+        let (t_end, target) = (p.duration_s(), p.end().p);
+        for (i, name) in ["x", "y"].iter().enumerate() {
+            let (ra, rb) = (
+                peak(&post_move(&a, t_end, target, i)),
+                peak(&post_move(&b, t_end, target, i)),
+            );
+            let d = (ra / rb - 1.0) * 100.0;
+            let last = &a.last().expect("a").1[i];
+            eprintln!(
+                "{kind} {name}: residual lean {:.3} um, per-sample {:.3} um ({d:+.2} %), max load angle {:.1} deg",
+                ra * 1e6,
+                rb * 1e6,
+                last.max_load_angle_rad.expect("motor").to_degrees()
+            );
+            assert!(d.abs() <= ENGINES_PCT, "{kind} {name}: {d} %");
+            assert_eq!(last.lost_steps, 0);
+        }
+    }
+}
+
+/// A sample that fails the checks (here a blow-up limit of 1 um, exceeded early in the
+/// move) ends the call there, and the state is at that sample: what `observe` then shows
+/// is that sample (commanded position bit for bit, toolhead within 1e-9 of the
+/// interpolated one), close to the per-sample path's at the same time.
+#[test]
+fn a_failed_sample_leaves_the_state_at_that_sample() {
+    let lim = Limits::new(0.3, 3.0, Some(100.0)).expect("limits");
+    let p = ProfileKind::SCurve
+        .rest_to_rest(0.0, 0.01, &lim)
+        .expect("plan");
+    for driver in [DriverMode::Linear, DriverMode::Full] {
+        let mj = plant(
+            vec![preset_y().compile(driver).expect("y")],
+            MujocoConfig::default(),
+        );
+        let mut st = mj.initial_state(&[p.start()]).expect("state");
+        // The first piece of the profile (constant jerk), whole samples only.
+        let first = p.iter().next().expect("a segment").2.duration_s();
+        let n = (first / DT).floor() as usize;
+        let cmds: Vec<_> = (0..n).map(|i| p.state_at(i as f64 * DT)).collect();
+        let (mut c, mut h) = (vec![0.0; n], vec![0.0; n]);
+        let blowup = 1e-6;
+        let k = mj
+            .step_samples(&mut st, &cmds, DT, blowup, &mut c, &mut h)
+            .expect("no step fails")
+            .expect("implemented");
+        assert!(k < n, "the limit is exceeded within the piece");
+        let mut o = [Observation::default()];
+        mj.observe(&st, &mut o);
+        let per_sample = run(&mj, std::slice::from_ref(&p), DT, 0.0);
+        let (t, ref_o) = &per_sample[k];
+        eprintln!(
+            "{driver}: stopped after {k} of {n} samples (t = {t:.4} s): toolhead - command {:.3e} m (interpolated {:.3e}, per-sample path {:.3e})",
+            o[0].toolhead_m - o[0].commanded_m,
+            h[k - 1] - c[k - 1],
+            ref_o[0].toolhead_m - ref_o[0].commanded_m
+        );
+        assert_eq!(o[0].commanded_m, c[k - 1]);
+        assert!((o[0].toolhead_m - o[0].commanded_m).abs() > blowup);
+        assert!((o[0].toolhead_m - h[k - 1]).abs() < 1e-9);
+        assert!((o[0].toolhead_m - ref_o[0].toolhead_m).abs() < 1e-8);
+        assert!(
+            (h[k - 2] - c[k - 2]).abs() <= blowup,
+            "the samples before pass"
+        );
+    }
+}

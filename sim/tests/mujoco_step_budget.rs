@@ -8,8 +8,10 @@
 #![cfg(feature = "mujoco")]
 
 mod common;
+mod lean_support;
 
 use common::run;
+use lean_support::run_lean;
 use settle_planner::{Limits, ProfileKind};
 use settle_sim::machine::{AxisMachine, Frame, Transmission};
 use settle_sim::mujoco::{MujocoConfig, MujocoPlant};
@@ -110,6 +112,65 @@ fn full_driver_default_step_matches_a_4x_smaller_one_on_the_printer_y_axis() {
         let dr = (ra / rb - 1.0) * 100.0;
         eprintln!(
             "{kind}: ringing {:.3} / {:.3} Hz ({df:+.3} %), damping {:.4} / {:.4}, residual {:.3} / {:.3} um ({dr:+.2} %)",
+            ma.frequency_hz,
+            mb.frequency_hz,
+            ma.damping_ratio,
+            mb.damping_ratio,
+            ra * 1e6,
+            rb * 1e6
+        );
+        assert!(df.abs() <= FREQUENCY_PCT, "{kind}: frequency {df} %");
+        assert!(dr.abs() <= RESIDUAL_PCT, "{kind}: residual {dr} %");
+    }
+}
+
+/// The lean path's long step on the same axis (`Plant::step_samples`: RK4 at
+/// `|lambda| h <= 0.5`, 263.5 us = 2.6 samples per MuJoCo step, the samples in between
+/// interpolated; the detent's own bound `w_e h <= 0.6` = 289 us does not bind) against the
+/// same 4x smaller per-sample reference: ringing within 0.5 %, residual within 2 %.
+#[test]
+fn full_driver_long_step_matches_a_4x_smaller_one_on_the_printer_y_axis() {
+    let lim = Limits::new(0.3, 3.0, Some(100.0)).expect("limits");
+    let axis = preset_y().compile(DriverMode::Full).expect("y");
+    let lean = MujocoPlant::new(vec![axis.clone()], MujocoConfig::default()).expect("plant");
+    let fine = MujocoPlant::new(
+        vec![axis],
+        MujocoConfig {
+            max_lambda_h: 0.05,
+            ..MujocoConfig::default()
+        },
+    )
+    .expect("plant");
+    let h = lean.model(0).nominal_long_step_s().min(lean.long_cap_s(0));
+    eprintln!(
+        "long step {:.1} us ({:.2} samples), reference {:.2} us",
+        h * 1e6,
+        h / DT,
+        fine.model(0).nominal_step_s() * 1e6
+    );
+    assert!(h > 2.0 * DT, "the long step spans more than two samples");
+    for kind in [ProfileKind::Trapezoid, ProfileKind::SCurve] {
+        let p = kind.rest_to_rest(0.0, 0.01, &lim).expect("plan");
+        let (t_end, target) = (p.duration_s(), p.end().p);
+        let one = std::slice::from_ref(&p);
+        let a = post_move(&run_lean(&lean, one, DT, 0.3), t_end, target);
+        let b = post_move(&run(&fine, one, DT, 0.3), t_end, target);
+        let fit = |e: &[f64]| {
+            let y: Vec<f64> = e.iter().take(1200).step_by(2).copied().collect();
+            settle_sim::pencil::fit(&y, 2.0 * DT, 8).expect("pencil fit")
+        };
+        let osc = |m: &[settle_sim::pencil::MeasuredMode]| {
+            *m.iter()
+                .find(|m| m.frequency_hz > 5.0)
+                .expect("an oscillatory mode")
+        };
+        let (ma, mb) = (osc(&fit(&a)), osc(&fit(&b)));
+        let peak = |e: &[f64]| e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let (ra, rb) = (peak(&a), peak(&b));
+        let df = (ma.frequency_hz / mb.frequency_hz - 1.0) * 100.0;
+        let dr = (ra / rb - 1.0) * 100.0;
+        eprintln!(
+            "{kind} (lean): ringing {:.3} / {:.3} Hz ({df:+.4} %), damping {:.4} / {:.4}, residual {:.3} / {:.3} um ({dr:+.2} %)",
             ma.frequency_hz,
             mb.frequency_hz,
             ma.damping_ratio,

@@ -6,8 +6,10 @@
 #![cfg(feature = "mujoco")]
 
 mod common;
+mod lean_support;
 
 use common::{nema17, printer_x, printer_y, run};
+use lean_support::run_lean;
 use settle_planner::{Limits, Profile, ProfileKind, Segment, State};
 use settle_sim::lumped::{Body, Coupling, DofKind, Lumped, Node, Stiffness, Term};
 use settle_sim::mujoco::{MujocoConfig, MujocoPlant};
@@ -224,4 +226,108 @@ fn full_driver_on_mujoco_is_deterministic() {
     let a = run(&plant, std::slice::from_ref(&p), 1e-4, 0.05);
     let b = run(&plant, std::slice::from_ref(&p), 1e-4, 0.05);
     assert_eq!(a, b);
+}
+
+/// The same loads through the lean path (`Plant::step_samples`; the drag's `c / J` holds
+/// the RK4 step to 22-36 us here, so the steps are shorter than the samples and not
+/// aligned with them; the load angle is tracked at every step's end): the same lost-step
+/// counts as the per-sample path, no loss below pull-out, and the largest load angle within
+/// 2 degrees of asin(share) there.
+#[test]
+fn lost_steps_on_the_lean_path_match_the_per_sample_path() {
+    let omega = 2.0;
+    for (share, expect_loss) in [(0.8, false), (0.95, false), (1.05, true), (1.3, true)] {
+        let s = motor_with_drag(0.0).stepper.expect("stepper");
+        let c = share * s.peak_torque_n_m() / omega;
+        let p = cruise(omega / s.rad_per_m);
+        let plant = mujoco(vec![motor_with_drag(c)]);
+        let lean = run_lean(&plant, std::slice::from_ref(&p), 1e-4, 0.1)
+            .last()
+            .expect("samples")
+            .1[0];
+        let per_sample = run(&plant, std::slice::from_ref(&p), 1e-4, 0.1)
+            .last()
+            .expect("samples")
+            .1[0];
+        let deg = |o: &Observation| o.max_load_angle_rad.expect("motor").to_degrees();
+        let behind = |o: &Observation| {
+            (p.end().p * s.rad_per_m - o.motor_angle_rad.expect("motor")) / s.full_step_rad()
+        };
+        eprintln!(
+            "load {share:.2} x pull-out: lean {} lost, max load angle {:.2} deg, rotor {:.2} full steps behind; per-sample {} lost, {:.2} deg, {:.2} behind (long step {:.1} us)",
+            lean.lost_steps,
+            deg(&lean),
+            behind(&lean),
+            per_sample.lost_steps,
+            deg(&per_sample),
+            behind(&per_sample),
+            plant
+                .model(0)
+                .nominal_long_step_s()
+                .min(plant.long_cap_s(0))
+                * 1e6
+        );
+        if expect_loss {
+            assert!(lean.lost_steps >= 4, "{share}: expected lost steps");
+            assert!((behind(&lean) - f64::from(lean.lost_steps)).abs() <= 4.0);
+        } else {
+            assert_eq!(lean.lost_steps, 0, "{share}: no steps may be lost");
+            assert!((deg(&lean) - share.asin().to_degrees()).abs() < 2.0);
+            assert!(behind(&lean).abs() < 0.1);
+        }
+        assert_eq!(lean.lost_steps, per_sample.lost_steps, "{share}");
+    }
+}
+
+/// The printer's Y axis (fixture) with long lean steps (several samples per MuJoCo step):
+/// a 20 mm trapezoid at 0.3 m/s and 3 m/s^2 keeps every step, at 1 m/s and 10 m/s^2 the
+/// motor runs out of torque (back-EMF against the 24 V supply) and both paths report the
+/// same lost steps; below pull-out the largest load angle is within 3 % of a reference
+/// that samples it every 26 us (the per-sample path at a 4x smaller step). The lean path
+/// takes it at the 25 us electrical sub-steps inside each long step (along the predicted
+/// rotor path), as the load angle ripples with every microstep.
+#[test]
+fn lost_steps_on_the_printer_with_long_lean_steps() {
+    let plant = mujoco(vec![printer_y().compile(DriverMode::Full).expect("y")]);
+    let fine = MujocoPlant::new(
+        vec![printer_y().compile(DriverMode::Full).expect("y")],
+        MujocoConfig {
+            max_lambda_h: 0.05,
+            ..MujocoConfig::default()
+        },
+    )
+    .expect("plant");
+    let h = plant
+        .model(0)
+        .nominal_long_step_s()
+        .min(plant.long_cap_s(0));
+    for (speed, accel, expect_loss) in [(0.3, 3.0, false), (1.0, 10.0, true)] {
+        let lim = Limits::new(speed, accel, None).expect("limits");
+        let p = ProfileKind::Trapezoid
+            .rest_to_rest(0.0, 0.02, &lim)
+            .expect("plan");
+        let one = std::slice::from_ref(&p);
+        let lean = run_lean(&plant, one, 1e-4, 0.1).last().expect("lean").1[0];
+        let per_sample = run(&plant, one, 1e-4, 0.1).last().expect("run").1[0];
+        let reference = run(&fine, one, 1e-4, 0.1).last().expect("run").1[0];
+        let deg = |o: &Observation| o.max_load_angle_rad.expect("motor").to_degrees();
+        eprintln!(
+            "{speed} m/s, {accel} m/s^2 (long step {:.1} us): lean {} lost, max load angle {:.2} deg; per-sample {} lost, {:.2} deg; reference {} lost, {:.2} deg",
+            h * 1e6,
+            lean.lost_steps,
+            deg(&lean),
+            per_sample.lost_steps,
+            deg(&per_sample),
+            reference.lost_steps,
+            deg(&reference)
+        );
+        assert!(h > 2e-4, "long steps");
+        if expect_loss {
+            assert!(lean.lost_steps > 0);
+            assert_eq!(lean.lost_steps, per_sample.lost_steps);
+        } else {
+            assert_eq!((lean.lost_steps, per_sample.lost_steps), (0, 0));
+            assert!((deg(&lean) / deg(&reference) - 1.0).abs() < 0.03);
+        }
+    }
 }

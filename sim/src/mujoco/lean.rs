@@ -35,6 +35,8 @@ struct Span {
     qd1: Vec<f64>,
     /// Scratch: the interpolated coordinates.
     qi: Vec<f64>,
+    /// Scratch: the full driver's current and command angles inside a step.
+    inner: Vec<[f64; 3]>,
     stepper0: Option<StepperState>,
     command0: State,
     time0_s: f64,
@@ -58,6 +60,7 @@ impl Span {
             q0: q.clone(),
             qd0: qd.clone(),
             qi: q.clone(),
+            inner: Vec::new(),
             rest_toolhead_m: ax.lumped.toolhead_m(&q, ax.command_node_m(st.base.p)),
             q1: q,
             qd1: qd,
@@ -92,7 +95,7 @@ impl Span {
         self.command0 = st.sim.command();
         self.time0_s = st.sim.time_s();
         self.steps0 = st.sim.steps();
-        step_axis(ax, model, st, c, t0, t1 - t0)?;
+        step_axis(ax, model, st, c, t0, t1 - t0, &mut self.inner)?;
         self.q1.copy_from_slice(st.sim.q());
         self.qd1.copy_from_slice(st.sim.qd());
         self.t0 = t0;
@@ -142,7 +145,7 @@ impl Span {
             self.steps0,
         );
         st.stepper.clone_from(&self.stepper0);
-        step_axis(ax, model, st, c, self.t0, t - self.t0)
+        step_axis(ax, model, st, c, self.t0, t - self.t0, &mut self.inner)
     }
 }
 
@@ -150,7 +153,8 @@ fn rewind(sim: &mut MujocoSim, q: &[f64], qd: &[f64], command: State, time_s: f6
     sim.rewind(q, qd, command, time_s, steps);
 }
 
-/// One MuJoCo step of `h` s starting `tau` s after the command sample `c`.
+/// One MuJoCo step of `h` s starting `tau` s after the command sample `c` (`inner`: the
+/// full driver's scratch for the load angle inside the step).
 fn step_axis(
     ax: &AxisModel,
     model: &MujocoModel,
@@ -158,13 +162,14 @@ fn step_axis(
     c: &Sample,
     tau: f64,
     h: f64,
+    inner: &mut Vec<[f64; 3]>,
 ) -> Result<(), SimError> {
     match (ax.mode, &ax.stepper) {
         (DriverMode::Full, Some(sp)) => {
             let ss = st.stepper.as_mut().ok_or_else(|| SimError::InvalidModel {
                 what: format!("axis `{}`: the full driver has no state", ax.name),
             })?;
-            full_step(sp, model, &mut st.sim, ss, c, tau, h)
+            full_step(sp, model, &mut st.sim, ss, c, tau, h, Some(inner))
         }
         _ => {
             model.step(&mut st.sim, &advance_sample(c, tau), h)?;

@@ -155,7 +155,19 @@ impl MujocoModel {
             config.max_step_s
         };
         let long_step_s = if lambda_max > 0.0 {
-            (config.long_lambda_h.max(config.max_lambda_h) / lambda_max).min(config.max_step_s)
+            let lambda_bound = config.long_lambda_h.max(config.max_lambda_h) / lambda_max;
+            let weighted = if singular {
+                None
+            } else {
+                weighted_rate(lumped, &kn, &m_inv_sqrt)
+            };
+            // Without the weights (a free rigid-body mode): the per-sample bound.
+            let share_bound = weighted.map_or(config.max_lambda_h / lambda_max, |w| {
+                config.max_lambda_h / w
+            });
+            lambda_bound
+                .min(share_bound.max(config.max_lambda_h / lambda_max))
+                .min(config.max_step_s)
         } else {
             config.max_step_s
         };
@@ -442,6 +454,42 @@ impl MujocoModel {
             }),
         }
     }
+}
+
+/// The toolhead-weighted mode rate `(sum_i s_i w_i^4)^(1/4)` (rad/s) of a model with a
+/// regular stiffness matrix: `w_i` the undamped mode frequencies, `s_i` each mode's share
+/// of the toolhead's deflection under a steady commanded acceleration (`|c_i| / sum |c_j|`,
+/// `c_i = (g M^-1/2 phi_i)(phi_i M^1/2 r) / w_i^2`, `g` the toolhead's gains on the bodies,
+/// `r = K^-1 bk` the rigid shape per unit command, `phi_i` the mass-normalised modes).
+///
+/// RK4 shifts mode `i`'s frequency by `(w_i h)^4 / 120`; weighted by the share, the
+/// toolhead's error is `h^4 sum_i s_i w_i^4 / 120`, so `h = max_lambda_h / rate` keeps it at
+/// the per-sample path's bound on its fastest mode (`max_lambda_h^4 / 120`). One mode: the
+/// per-sample step. `None` when the toolhead does not deflect (no weights).
+fn weighted_rate(lumped: &Lumped, kn: &DMatrix<f64>, m_inv_sqrt: &DVector<f64>) -> Option<f64> {
+    let n = lumped.dof();
+    let lin = lumped.linearised(&vec![0.0; n]);
+    let r = lin.k.clone().cholesky()?.solve(&lin.bk);
+    let mut g: DVector<f64> = DVector::zeros(n);
+    for t in &lumped.output {
+        if let crate::lumped::Node::Body(i) = t.node {
+            g[i] += t.gain;
+        }
+    }
+    let eig = kn.clone().symmetric_eigen();
+    let (mut sum_c, mut sum_cw4) = (0.0, 0.0);
+    for (i, &w2) in eig.eigenvalues.iter().enumerate() {
+        if w2 <= 0.0 {
+            continue;
+        }
+        let phi = eig.eigenvectors.column(i);
+        let out: f64 = (0..n).map(|j| g[j] * m_inv_sqrt[j] * phi[j]).sum();
+        let inp: f64 = (0..n).map(|j| phi[j] * r[j] / m_inv_sqrt[j]).sum();
+        let c = (out * inp / w2).abs();
+        sum_c += c;
+        sum_cw4 += c * w2 * w2;
+    }
+    (sum_c > 0.0 && sum_cw4.is_finite()).then(|| (sum_cw4 / sum_c).powf(0.25))
 }
 
 /// The command state `h` seconds after sample `s` (constant jerk).

@@ -158,10 +158,22 @@ fn explicit_rate(a: &AxisModel, sp: &Stepper) -> f64 {
     (k_e / j).sqrt()
 }
 
+/// The cubic Hermite interpolant at `t` in `[0, h]` of a coordinate at `x0`, rate `v0` at
+/// 0 and `x1`, `v1` at `h`.
+#[inline]
+pub(super) fn hermite(x0: f64, v0: f64, x1: f64, v1: f64, h: f64, t: f64) -> f64 {
+    let s = t / h;
+    let r = 1.0 - s;
+    (1.0 + 2.0 * s) * r * r * x0 + s * r * r * h * v0 + s * s * (3.0 - 2.0 * s) * x1
+        - s * s * r * h * v1
+}
+
 /// One MuJoCo step of the full driver over `[tau, tau + h]` after the command sample `c`
 /// (constant jerk): the current loop advanced along the predicted rotor path, the rest of
 /// the driver torque held at its mean (see the module documentation), then the load angle
-/// tracked at the step's end.
+/// tracked at the step's end. With `inner` (the lean path's long steps), also its
+/// largest value inside the step, at the electrical sub-step boundaries with the rotor
+/// angle interpolated (cubic Hermite) between the step's ends.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub(super) fn full_step(
@@ -172,6 +184,7 @@ pub(super) fn full_step(
     c: &Sample,
     tau: f64,
     h: f64,
+    inner: Option<&mut Vec<[f64; 3]>>,
 ) -> Result<(), SimError> {
     let r = sp.rotor;
     let c0 = advance_sample(c, tau);
@@ -180,7 +193,19 @@ pub(super) fn full_step(
     // the one-pass advance that carries the currents over it, minus the tendon's spring at
     // the predicted midpoint (the damping terms are equal in both and cancel).
     let x_m = advance_sample(c, tau + 0.5 * h).p;
-    let mid = sp.advance_predicted(ss, th0, w0, &c0, h);
+    let mid = match inner {
+        Some(buf) => {
+            let mid = sp.advance_predicted_inner_angles(ss, th0, w0, &c0, h, buf);
+            let rest = mid.torque_n_m + sp.k_theta() * (mid.theta_rad - sp.rad_per_m * x_m);
+            model.set_drive(sim, rest)?;
+            model.step(sim, &c0, h)?;
+            let (th1, w1) = (sim.q()[r], sim.qd()[r]);
+            sp.track_peak(ss, buf, |t| hermite(th0, w0, th1, w1, h, t));
+            sp.track_currents(ss, th1, advance_sample(c, tau + h).p);
+            return Ok(());
+        }
+        None => sp.advance_predicted(ss, th0, w0, &c0, h),
+    };
     let rest = mid.torque_n_m + sp.k_theta() * (mid.theta_rad - sp.rad_per_m * x_m);
     model.set_drive(sim, rest)?;
     model.step(sim, &c0, h)?;
@@ -268,7 +293,7 @@ impl Plant for MujocoPlant {
                     let n = ((dt_s / h_max) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
                     let h = dt_s / n as f64;
                     for k in 0..n {
-                        full_step(sp, model, &mut st.sim, ss, c, h * k as f64, h)?;
+                        full_step(sp, model, &mut st.sim, ss, c, h * k as f64, h, None)?;
                     }
                 }
                 (DriverMode::Spring, Some(sp)) => {
