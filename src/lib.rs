@@ -32,6 +32,8 @@ pub mod table;
 // Corners and paths in the harness (issue 5).
 pub mod corner;
 pub mod path_metrics;
+// The harness's command cursor (issue 4, performance).
+pub mod cursor;
 
 use std::path::Path;
 

@@ -335,12 +335,17 @@ pub fn simulate<P: Plant>(
     // them directly ([`Plant::positions`]) skip building observations; `obs` is then
     // brought up to date where it is read (a fault, the end of the run).
     let lean = record.is_none();
+    // The lean path steps runs of whole samples in one call ([`Plant::step_samples`])
+    // while the plant implements it: its buffers, allocated once per run.
+    let mut batch = lean.then(|| Batch::new(n_axes));
+    let mut cursor = crate::cursor::Cursor::new(traj);
 
     let mut sample = |t: f64,
                       at: &[Sample],
                       state: &P::State,
                       obs: &mut [Observation],
-                      acc: &mut Accumulator|
+                      acc: &mut Accumulator,
+                      path_acc: &mut Option<crate::path_metrics::PathAccumulator>|
      -> Result<(), String> {
         let checked = lean
             && plant.positions(state, &mut cmd_p, &mut toolhead)
@@ -409,15 +414,51 @@ pub fn simulate<P: Plant>(
     }
     macro_rules! sample {
         ($t:expr, $cmd:expr) => {
-            if let Err(reason) = sample($t, $cmd, &state, &mut obs, &mut acc) {
+            if let Err(reason) = sample($t, $cmd, &state, &mut obs, &mut acc, &mut path_acc) {
                 fault!(reason);
             }
         };
     }
+    // `m` whole samples in one call, the commands at their step starts in `b.cmds`; the
+    // sample after step `i` is at `time(i)` and a failed step `i` is reported at
+    // `fail_time(i)` (what the per-sample path prints). Pushes every sample but the last
+    // one done; `Some(done)`: `done` samples stepped, the state at the last one, which the
+    // caller evaluates in full (`sample!`: the per-sample path's check and push). That
+    // also covers a plant that stopped at an unvouched last sample of the call (it returns
+    // `done == m` then, which reads as "all vouched for"), at one `positions` per call.
+    // `None`: the plant steps sample by sample (nothing was done).
+    macro_rules! batch {
+        ($b:expr, $m:expr, $time:expr, $fail_time:expr) => {{
+            let b: &mut Batch = $b;
+            let m: usize = $m;
+            let len = m * n_axes;
+            match plant.step_samples(
+                &mut state,
+                &b.cmds[..len],
+                dt,
+                crate::metrics::BLOWUP_M,
+                &mut b.cmd_p[..len],
+                &mut b.toolhead[..len],
+            ) {
+                Ok(Some(done)) if (1..=m).contains(&done) => {
+                    b.push(done - 1, &$time, &mut acc, &mut path_acc);
+                    Some(done)
+                }
+                Ok(_) => None,
+                Err((failed, e)) => {
+                    b.push(failed.min(m), &$time, &mut acc, &mut path_acc);
+                    fault!(format!(
+                        "the backend failed at t = {:.6} s: {e}",
+                        $fail_time(failed)
+                    ));
+                }
+            }
+        }};
+    }
 
     let breakpoints = traj.breakpoints();
     let mut next_bp = 0usize;
-    traj.state_at(0.0, &mut cmd);
+    cursor.at(0.0, &mut cmd);
     sample!(0.0, &cmd);
     let mut k = 1usize; // index of the next sample during the move
     let mut t = 0.0;
@@ -434,19 +475,56 @@ pub fn simulate<P: Plant>(
         let t_sample = k as f64 * dt;
         let next = t_sample.min(bp);
         if !fresh {
-            traj.state_at(t, &mut cmd);
+            cursor.at(t, &mut cmd);
         }
         // A whole sample interval is stepped as exactly `dt` (k dt - (k-1) dt can differ
         // from dt in the last bit, which would cost the modal plant a fresh transition
         // matrix); partial steps at breakpoints use their true length.
         let whole = next == t_sample && t == (k - 1) as f64 * dt;
+        if whole
+            && t_sample < t_end
+            && let Some(b) = batch.as_mut()
+        {
+            // Samples k, k + 1, ... up to the breakpoint (inclusive) and before the end:
+            // every step lies in one piece of every axis's command.
+            let mut m = 1;
+            while m < CHUNK {
+                let ts = (k + m) as f64 * dt;
+                if ts > bp || ts >= t_end {
+                    break;
+                }
+                m += 1;
+            }
+            b.cmds[..n_axes].copy_from_slice(&cmd);
+            for i in 1..m {
+                cursor.at(
+                    (k + i - 1) as f64 * dt,
+                    &mut b.cmds[i * n_axes..(i + 1) * n_axes],
+                );
+            }
+            let k0 = k;
+            let time = |i: usize| (k0 + i) as f64 * dt;
+            let fail_time = |i: usize| (k0 - 1 + i) as f64 * dt;
+            match batch!(b, m, time, fail_time) {
+                Some(done) => {
+                    t = time(done - 1);
+                    // The command at the last sample serves it and the next step.
+                    cursor.at(t, &mut cmd);
+                    sample!(t, &cmd);
+                    fresh = true;
+                    k += done;
+                    continue;
+                }
+                None => batch = None,
+            }
+        }
         step!(&cmd, if whole { dt } else { next - t }, t);
         t = next;
         fresh = false;
         if t_sample <= bp {
             if t_sample < t_end {
                 // The command at t serves the sample and the next step.
-                traj.state_at(t, &mut cmd);
+                cursor.at(t, &mut cmd);
                 sample!(t, &cmd);
                 fresh = true;
             }
@@ -465,10 +543,33 @@ pub fn simulate<P: Plant>(
         sample!(t_end, &hold);
     }
     let n = (observe.window_s * observe.sample_rate_hz).ceil() as usize;
-    for i in 1..=n {
+    let mut i = 1;
+    let mut hold_filled = false;
+    while i <= n {
+        if let Some(b) = batch.as_mut() {
+            if !hold_filled {
+                for c in b.cmds.chunks_exact_mut(n_axes) {
+                    c.copy_from_slice(&hold);
+                }
+                hold_filled = true;
+            }
+            let m = (n + 1 - i).min(CHUNK);
+            let i0 = i;
+            let time = |j: usize| t_end + (i0 + j) as f64 * dt;
+            let fail_time = |j: usize| time(j) - dt;
+            match batch!(b, m, time, fail_time) {
+                Some(done) => {
+                    sample!(time(done - 1), &hold);
+                    i += done;
+                    continue;
+                }
+                None => batch = None,
+            }
+        }
         let t = t_end + i as f64 * dt;
         step!(&hold, dt, t - dt);
         sample!(t, &hold);
+        i += 1;
     }
     if lean {
         plant.observe(&state, &mut obs);
@@ -484,6 +585,55 @@ pub fn simulate<P: Plant>(
     let mut metrics = acc.finish_with(names, &angles_of(&obs), status);
     metrics.path = path_acc.map(|p| p.finish());
     Ok(metrics)
+}
+
+/// Samples per [`Plant::step_samples`] call: long enough to make the per-call cost
+/// negligible, short enough that the buffers stay in the first-level cache.
+const CHUNK: usize = 256;
+
+/// The buffers of [`Plant::step_samples`] calls (up to [`CHUNK`] samples, sample-major).
+#[derive(Debug)]
+struct Batch {
+    axes: usize,
+    cmds: Vec<Sample>,
+    cmd_p: Vec<f64>,
+    toolhead: Vec<f64>,
+}
+
+impl Batch {
+    fn new(axes: usize) -> Self {
+        Self {
+            axes,
+            cmds: vec![Sample::default(); CHUNK * axes],
+            cmd_p: vec![0.0; CHUNK * axes],
+            toolhead: vec![0.0; CHUNK * axes],
+        }
+    }
+
+    /// Push the first `count` samples into the metrics (as the per-sample path does), the
+    /// `i`-th at `time(i)`.
+    fn push(
+        &self,
+        count: usize,
+        time: &impl Fn(usize) -> f64,
+        acc: &mut Accumulator,
+        path_acc: &mut Option<crate::path_metrics::PathAccumulator>,
+    ) {
+        let n = self.axes;
+        for (i, (c, h)) in self
+            .cmd_p
+            .chunks_exact(n)
+            .zip(self.toolhead.chunks_exact(n))
+            .take(count)
+            .enumerate()
+        {
+            let t = time(i);
+            acc.push(t, c, h);
+            if let Some(p) = path_acc.as_mut() {
+                p.push(t, h);
+            }
+        }
+    }
 }
 
 /// A simulation fault in the observations at `t`: a non-finite value, or an error beyond
