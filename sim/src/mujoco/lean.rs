@@ -193,7 +193,7 @@ pub(super) fn step_samples(
     toolhead_m: &mut [f64],
 ) -> Result<Option<usize>, (usize, SimError)> {
     let na = plant.axes.len();
-    if na == 0 || cmds.is_empty() || cmds.len() % na != 0 || state.axes.len() != na {
+    if na == 0 || cmds.is_empty() || !cmds.len().is_multiple_of(na) || state.axes.len() != na {
         return Ok(None);
     }
     // The microstep-quantised spring holds a piecewise-constant command: per sample.
