@@ -89,6 +89,9 @@ struct AxisBodies {
     /// (N m s) and that half's length (s; 0 before the first step): the first half of the
     /// next step's kick window (`crate::rapier_driver`).
     window: (f64, f64),
+    /// Whether the axis's bodies are in the world: an axis that starts at rest is left out
+    /// (it sits exactly at its static equilibrium) until its command moves.
+    awake: bool,
 }
 
 /// The rapier plant's mutable state: the physics world and each axis's bookkeeping.
@@ -189,6 +192,46 @@ pub fn start_equilibrium(
     }
 }
 
+/// Insert an axis's bodies into the world at coordinates `q` (m, rad), at rest.
+fn insert_bodies(
+    world: &mut PhysicsWorld,
+    ax: &AxisModel,
+    dir: usize,
+    q: &[f64],
+) -> Vec<RigidBodyHandle> {
+    let mut handles = Vec::with_capacity(ax.lumped.dof());
+    for (body, &q) in ax.lumped.bodies.iter().zip(q) {
+        let builder = RigidBodyBuilder::dynamic()
+            .can_sleep(false)
+            .gyroscopic_forces_enabled(false)
+            .allow_fast_rotation(true);
+        let builder = match body.kind {
+            DofKind::Linear => builder
+                .translation(unit(dir) * q)
+                .locked_axes(locked_all_but(dir))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    body.inertia,
+                    Vector::splat(1.0),
+                )),
+            DofKind::Angular => builder
+                .rotation(Vector::Z * q)
+                .locked_axes(
+                    LockedAxes::TRANSLATION_LOCKED
+                        | LockedAxes::ROTATION_LOCKED_X
+                        | LockedAxes::ROTATION_LOCKED_Y,
+                )
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    1.0,
+                    Vector::splat(body.inertia),
+                )),
+        };
+        handles.push(world.insert_body(builder));
+    }
+    handles
+}
+
 impl RapierPlant {
     /// A plant for these axes (any driver mode).
     pub fn new(axes: Vec<AxisModel>, options: RapierOptions) -> Result<Self, SimError> {
@@ -278,36 +321,14 @@ impl Plant for RapierPlant {
         for (k, (ax, s)) in self.axes.iter().zip(start).enumerate() {
             let dir = k % 3;
             let (q0, stepper) = start_equilibrium(ax, s.p)?;
-            let mut handles = Vec::with_capacity(ax.lumped.dof());
-            for (body, &q) in ax.lumped.bodies.iter().zip(&q0) {
-                let builder = RigidBodyBuilder::dynamic()
-                    .can_sleep(false)
-                    .gyroscopic_forces_enabled(false)
-                    .allow_fast_rotation(true);
-                let builder = match body.kind {
-                    DofKind::Linear => builder
-                        .translation(unit(dir) * q)
-                        .locked_axes(locked_all_but(dir))
-                        .additional_mass_properties(MassProperties::new(
-                            Vector::ZERO,
-                            body.inertia,
-                            Vector::splat(1.0),
-                        )),
-                    DofKind::Angular => builder
-                        .rotation(Vector::Z * q)
-                        .locked_axes(
-                            LockedAxes::TRANSLATION_LOCKED
-                                | LockedAxes::ROTATION_LOCKED_X
-                                | LockedAxes::ROTATION_LOCKED_Y,
-                        )
-                        .additional_mass_properties(MassProperties::new(
-                            Vector::ZERO,
-                            1.0,
-                            Vector::splat(body.inertia),
-                        )),
-                };
-                handles.push(world.insert_body(builder));
-            }
+            // An axis at rest with its command at rest stays exactly where it is: its bodies
+            // join the world when its command first moves (see `step`).
+            let awake = s.v != 0.0 || s.a != 0.0;
+            let handles = if awake {
+                insert_bodies(&mut world, ax, dir, &q0)
+            } else {
+                Vec::new()
+            };
             let n = ax.lumped.dof();
             axes.push(AxisBodies {
                 handles,
@@ -325,6 +346,7 @@ impl Plant for RapierPlant {
                 },
                 stepper,
                 window: (0.0, 0.0),
+                awake,
             });
         }
         let mut st = RapierState {
@@ -374,6 +396,22 @@ impl Plant for RapierPlant {
                 }
             }
         }
+        // Idle axes whose command starts to move join the world (at rest, where they are).
+        let mut any_awake = false;
+        for ((ax, ab), c) in self.axes.iter().zip(&mut state.axes).zip(cmd) {
+            if !ab.awake && (c.p != ab.base.p || c.v != 0.0 || c.a != 0.0 || c.j != 0.0) {
+                ab.handles = insert_bodies(&mut state.world, ax, ab.dir, &ab.q);
+                ab.awake = true;
+            }
+            any_awake |= ab.awake;
+        }
+        if !any_awake {
+            for (ab, c) in state.axes.iter_mut().zip(cmd) {
+                ab.base = advance_sample(c, dt_s);
+            }
+            state.t_s += dt_s;
+            return Ok(());
+        }
         let h_max = state.h_max / stiffer.sqrt();
         let n = (dt_s / h_max * (1.0 - 1e-12)).ceil().max(1.0);
         let h = dt_s / n;
@@ -382,6 +420,9 @@ impl Plant for RapierPlant {
         for k in 0..n as usize {
             let tau = k as f64 * h;
             for ((ax, ab), c) in self.axes.iter().zip(&mut state.axes).zip(cmd) {
+                if !ab.awake {
+                    continue;
+                }
                 // Symplectic Euler is leapfrog with the velocities at half steps: the
                 // bodies' velocities are those of t - h/2. The damping forces need them at
                 // t: advance them by h/2 with the last step's accelerations (second order).
@@ -423,7 +464,8 @@ impl Plant for RapierPlant {
             state.world.step();
             self.read_back(state);
             for ((ax, ab), c) in self.axes.iter().zip(&mut state.axes).zip(cmd) {
-                let (Some(sp), Some(ss)) = (&ax.stepper, ab.stepper.as_mut()) else {
+                let (true, Some(sp), Some(ss)) = (ab.awake, &ax.stepper, ab.stepper.as_mut())
+                else {
                     continue;
                 };
                 let r = sp.rotor;
