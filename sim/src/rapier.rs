@@ -30,6 +30,7 @@ use settle_planner::{Sample, State};
 use crate::axis::{AxisModel, DriverMode};
 use crate::lumped::{DofKind, Lumped, Node};
 use crate::plant::{advance_sample, check_step};
+use crate::rapier_driver::ReferenceCache;
 use crate::stepper::StepperState;
 use crate::{Observation, Plant, SimError};
 
@@ -89,6 +90,7 @@ struct AxisBodies {
     /// (N m s) and that half's length (s; 0 before the first step): the first half of the
     /// next step's kick window (`crate::rapier_driver`).
     window: (f64, f64),
+    reference: ReferenceCache,
     /// Whether the axis's bodies are in the world: an axis that starts at rest is left out
     /// (it sits exactly at its static equilibrium) until its command moves.
     awake: bool,
@@ -346,6 +348,7 @@ impl Plant for RapierPlant {
                 },
                 stepper,
                 window: (0.0, 0.0),
+                reference: ReferenceCache::default(),
                 awake,
             });
         }
@@ -447,7 +450,16 @@ impl Plant for RapierPlant {
                         // At rest before the first step.
                         ab.window = (sp.magnetic_torque(ss, theta) * 0.5 * h, 0.5 * h);
                     }
-                    let ahead = sp.advance_span(ss, &cn, 0.0, 0.5 * h, theta, 0.0, omega);
+                    let ahead = sp.advance_span(
+                        ss,
+                        &mut ab.reference,
+                        &cn,
+                        0.0,
+                        0.5 * h,
+                        theta,
+                        0.0,
+                        omega,
+                    );
                     let magnetic = (ab.window.0 + ahead) / (ab.window.1 + 0.5 * h);
                     ab.forces[r] += magnetic + sp.passive_torque(theta, ab.qd_mid[r], cn.v);
                 }
@@ -477,7 +489,16 @@ impl Plant for RapierPlant {
                         // angle at the step's end.
                         let cn = advance_sample(c, tau);
                         let (theta, omega) = (ab.q[r], ab.qd[r]);
-                        let behind = sp.advance_span(ss, &cn, 0.5 * h, h, theta, h, omega);
+                        let behind = sp.advance_span(
+                            ss,
+                            &mut ab.reference,
+                            &cn,
+                            0.5 * h,
+                            h,
+                            theta,
+                            h,
+                            omega,
+                        );
                         ab.window = (behind, 0.5 * h);
                         sp.track_currents(ss, theta, x1);
                     }

@@ -75,6 +75,25 @@ fn crossing(u: impl Fn(f64) -> f64, du: impl Fn(f64) -> f64, lo: f64, hi: f64, b
     t
 }
 
+/// The phase references' sine and cosine of the last microstep index used (only a
+/// saving: the same numbers are computed again when the index changes).
+#[derive(Debug, Clone, Copy)]
+pub struct ReferenceCache {
+    k: f64,
+    sq: f64,
+    cq: f64,
+}
+
+impl Default for ReferenceCache {
+    fn default() -> Self {
+        Self {
+            k: f64::NAN,
+            sq: 0.0,
+            cq: 0.0,
+        }
+    }
+}
+
 impl Stepper {
     /// The magnetic torque `Km (-ia sin(Nr theta) + ib cos(Nr theta))` (N m) of the state's
     /// currents at rotor angle `theta` (rad).
@@ -96,11 +115,13 @@ impl Stepper {
     /// rotor on the line `theta(tau) = theta_at + omega (tau - tau_at)` (rad, rad/s).
     /// Returns the magnetic torque's integral over the span (N m s): exact in the currents
     /// (closed form between microstep edges found in time), midpoint rule in the rotor
-    /// angle over pieces of at most [`MAX_PIECE_ELECTRICAL_RAD`].
+    /// angle over pieces of at most [`MAX_PIECE_ELECTRICAL_RAD`]. `cache` keeps the last
+    /// microstep's reference (one per axis and run; [`ReferenceCache::default`] to start).
     #[allow(clippy::too_many_arguments)]
     pub fn advance_span(
         &self,
         st: &mut StepperState,
+        cache: &mut ReferenceCache,
         cmd: &Sample,
         tau0: f64,
         tau1: f64,
@@ -143,9 +164,16 @@ impl Stepper {
                     let dir = if k_end > k { 1.0 } else { -1.0 };
                     (crossing(u_at, du_at, t, t_end, k + 0.5 * dir), k + dir)
                 };
-                let (sq, cq) = (el_per_m * (k * step)).sin_cos();
-                let (ia, aa) = ph.advance_integral(st.i_a, self.current_a * cq, e_a, t_next - t);
-                let (ib, ab) = ph.advance_integral(st.i_b, self.current_a * sq, e_b, t_next - t);
+                if k.to_bits() != cache.k.to_bits() {
+                    let (sq, cq) = (el_per_m * (k * step)).sin_cos();
+                    *cache = ReferenceCache { k, sq, cq };
+                }
+                let [(ia, aa), (ib, ab)] = ph.advance_pair(
+                    [st.i_a, st.i_b],
+                    [self.current_a * cache.cq, self.current_a * cache.sq],
+                    [e_a, e_b],
+                    t_next - t,
+                );
                 st.i_a = ia;
                 st.i_b = ib;
                 area_a += aa;

@@ -254,6 +254,44 @@ impl Phase {
     }
 }
 
+impl Phase {
+    /// [`Phase::advance_integral`] for both phases at once: the same numbers, with one
+    /// exponential for both when both stay in the proportional region (the usual case:
+    /// same rate `(R + Kp) / L`), otherwise phase by phase.
+    pub(crate) fn advance_pair(
+        &self,
+        i: [f64; 2],
+        i_ref: [f64; 2],
+        e: [f64; 2],
+        h: f64,
+    ) -> [(f64, f64); 2] {
+        let Phase { r, l, kp, vs } = *self;
+        let linear = |k: usize| {
+            let i_hi = i_ref[k] + (r * i_ref[k] - vs) / kp;
+            let i_lo = i_ref[k] + (r * i_ref[k] + vs) / kp;
+            let target = i_ref[k] - e[k] / (r + kp);
+            // NaN falls through to the phase-by-phase path (same numbers).
+            let inside = |x: f64| (i_hi..=i_lo).contains(&x);
+            (inside(i[k]) && inside(target)).then_some(target)
+        };
+        if let (Some(ta), Some(tb)) = (linear(0), linear(1)) {
+            let rate = (r + kp) / l;
+            let decay = (-rate * h).exp();
+            let one = |i: f64, target: f64| {
+                (
+                    target + (i - target) * decay,
+                    0.0 + (target * h + (i - target) * (1.0 - decay) / rate),
+                )
+            };
+            return [one(i[0], ta), one(i[1], tb)];
+        }
+        [
+            self.advance_integral(i[0], i_ref[0], e[0], h),
+            self.advance_integral(i[1], i_ref[1], e[1], h),
+        ]
+    }
+}
+
 impl Stepper {
     /// Check every parameter; `axis` names the axis in the error.
     pub fn validate(&self, axis: &str) -> Result<(), SimError> {
