@@ -24,6 +24,7 @@ pub mod mujoco_status;
 pub mod pencil;
 mod plant;
 pub mod rapier;
+mod rapier_driver;
 pub mod stepper;
 
 pub use axis::{AxisModel, DriverMode};

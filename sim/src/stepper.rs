@@ -142,7 +142,7 @@ impl StepperState {
 
 /// Electrical constants of one phase, precomputed.
 #[derive(Debug, Clone, Copy)]
-struct Phase {
+pub(crate) struct Phase {
     r: f64,
     l: f64,
     kp: f64,
@@ -200,6 +200,95 @@ impl Phase {
             return target + (i - target) * (-rate * left).exp();
         }
         i
+    }
+}
+
+impl Phase {
+    /// [`Phase::advance`] that also returns the exact integral of the current over the
+    /// interval (A s): each closed-form piece `i(t) = target + (i0 - target) e^{-rate t}`
+    /// integrates to `target T + (i0 - target)(1 - e^{-rate T}) / rate`.
+    pub(crate) fn advance_integral(&self, mut i: f64, i_ref: f64, e: f64, h: f64) -> (f64, f64) {
+        let Phase { r, l, kp, vs } = *self;
+        let i_hi = i_ref + (r * i_ref - vs) / kp;
+        let i_lo = i_ref + (r * i_ref + vs) / kp;
+        let mut regime = if i < i_hi {
+            Regime::High
+        } else if i > i_lo {
+            Regime::Low
+        } else {
+            Regime::Linear
+        };
+        let mut left = h;
+        let mut area = 0.0;
+        for _ in 0..4 {
+            let (target, rate) = match regime {
+                Regime::High => ((vs - e) / r, r / l),
+                Regime::Low => ((-vs - e) / r, r / l),
+                Regime::Linear => (i_ref - e / (r + kp), (r + kp) / l),
+            };
+            let exit = match regime {
+                Regime::High if target > i_hi => Some((i_hi, Regime::Linear)),
+                Regime::Low if target < i_lo => Some((i_lo, Regime::Linear)),
+                Regime::Linear if target < i_hi => Some((i_hi, Regime::High)),
+                Regime::Linear if target > i_lo => Some((i_lo, Regime::Low)),
+                _ => None,
+            };
+            if let Some((b, next)) = exit {
+                let ratio = (i - target) / (b - target);
+                let t_b = if ratio > 1.0 { ratio.ln() / rate } else { 0.0 };
+                if t_b < left {
+                    // Over t_b the current went from i to b: (i - target)(1 - e^{-rate t_b})
+                    // is i - b.
+                    area += target * t_b + (i - b) / rate;
+                    i = b;
+                    left -= t_b;
+                    regime = next;
+                    continue;
+                }
+            }
+            let decay = (-rate * left).exp();
+            area += target * left + (i - target) * (1.0 - decay) / rate;
+            return (target + (i - target) * decay, area);
+        }
+        (i, area)
+    }
+}
+
+impl Phase {
+    /// [`Phase::advance_integral`] for both phases at once: the same numbers, with one
+    /// exponential for both when both stay in the proportional region (the usual case:
+    /// same rate `(R + Kp) / L`), otherwise phase by phase.
+    pub(crate) fn advance_pair(
+        &self,
+        i: [f64; 2],
+        i_ref: [f64; 2],
+        e: [f64; 2],
+        h: f64,
+    ) -> [(f64, f64); 2] {
+        let Phase { r, l, kp, vs } = *self;
+        let linear = |k: usize| {
+            let i_hi = i_ref[k] + (r * i_ref[k] - vs) / kp;
+            let i_lo = i_ref[k] + (r * i_ref[k] + vs) / kp;
+            let target = i_ref[k] - e[k] / (r + kp);
+            // NaN falls through to the phase-by-phase path (same numbers).
+            let inside = |x: f64| (i_hi..=i_lo).contains(&x);
+            (inside(i[k]) && inside(target)).then_some(target)
+        };
+        if let (Some(ta), Some(tb)) = (linear(0), linear(1)) {
+            let rate = (r + kp) / l;
+            let decay = (-rate * h).exp();
+            let one = |i: f64, target: f64| {
+                (
+                    target + (i - target) * decay,
+                    0.0 + (target * h + (i - target) * (1.0 - decay) / rate),
+                )
+            };
+            return [one(i[0], ta), one(i[1], tb)];
+        }
+        [
+            self.advance_integral(i[0], i_ref[0], e[0], h),
+            self.advance_integral(i[1], i_ref[1], e[1], h),
+        ]
     }
 }
 
@@ -266,7 +355,7 @@ impl Stepper {
     }
 
     /// Rotor teeth as a float.
-    fn nr(&self) -> f64 {
+    pub(crate) fn nr(&self) -> f64 {
         f64::from(self.rotor_teeth)
     }
 
@@ -304,7 +393,7 @@ impl Stepper {
         4.0 * self.nr() * self.detent_torque_n_m
     }
 
-    fn phase(&self) -> Phase {
+    pub(crate) fn phase(&self) -> Phase {
         Phase {
             r: self.resistance_ohm,
             l: self.inductance_h,
