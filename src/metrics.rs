@@ -250,6 +250,9 @@ pub struct Accumulator {
     axis_follow_m: Vec<f64>,
     /// Largest squared distance to the target (m^2), as `max_follow_sq_m2`.
     abs_err_max_sq_m2: f64,
+    /// `(tau, e2)` per sample of a [`Accumulator::push_run`] (reused buffer): the time
+    /// after T and the squared distance, computed once for every bookkeeping.
+    scratch: Vec<(f64, f64)>,
 }
 
 impl Accumulator {
@@ -273,6 +276,7 @@ impl Accumulator {
             max_follow_sq_m2: 0.0,
             axis_follow_m: vec![0.0; target_m.len()],
             abs_err_max_sq_m2: 0.0,
+            scratch: Vec::new(),
         }
     }
 
@@ -349,8 +353,11 @@ impl Accumulator {
             self.abs_err_max_sq_m2,
             self.max_follow_sq_m2,
         );
-        // Samples up to the move end, then those after it.
+        // Samples up to the move end, then those after it (with their time after T and
+        // squared distance kept for the settling bookkeeping).
         let mut first_after = count;
+        let mut scratch = std::mem::take(&mut self.scratch);
+        scratch.clear();
         for (i, (c, h)) in commanded_m
             .chunks_exact(n)
             .zip(toolhead_m.chunks_exact(n))
@@ -369,24 +376,27 @@ impl Accumulator {
                 }
                 max_follow = max_follow.max(f2);
             }
-            if first_after == count && t >= end {
-                first_after = i;
+            // As `push`: every sample not before T (`t >= end`, or a NaN time).
+            if t >= end || t.is_nan() {
+                if first_after == count {
+                    first_after = i;
+                }
+                scratch.push((t - end, e2));
             }
         }
         self.overshoot_m = overshoot;
         self.abs_err_max_sq_m2 = abs_err;
         self.max_follow_sq_m2 = max_follow;
-        let after = count - first_after;
-        if after == 0 {
-            return;
+        let after = scratch.len();
+        if after > 0 {
+            let th = &toolhead_m[first_after * n..];
+            let (tau, e2) = (|i: usize| scratch[i].0, |i: usize| scratch[i].1);
+            self.total.push_run(after, tau, |i| e2(i).sqrt());
+            for (a, (b, target)) in self.per_axis.iter_mut().zip(&self.target_m).enumerate() {
+                b.push_run(after, tau, |i| (th[i * n + a] - target).abs());
+            }
         }
-        let tau = |i: usize| t_s(first_after + i) - end;
-        let th = &toolhead_m[first_after * n..];
-        self.total
-            .push_run(after, tau, |i| err(&th[i * n..(i + 1) * n]).0.sqrt());
-        for (a, (b, target)) in self.per_axis.iter_mut().zip(&self.target_m).enumerate() {
-            b.push_run(after, tau, |i| (th[i * n + a] - target).abs());
-        }
+        self.scratch = scratch;
     }
 
     /// The metrics of everything pushed, for axes named `names`, with status `status` and
