@@ -28,12 +28,11 @@ fn plant(modes_per_axis: &[usize]) -> ModalPlant {
     ModalPlant::new(axes, DT).expect("plant")
 }
 
+/// What `step_samples` returns.
+type Done = Result<Option<usize>, (usize, SimError)>;
+
 /// `step_samples`' result and outputs, computed one sample at a time.
-fn one_by_one(
-    p: &ModalPlant,
-    st: &mut ModalState,
-    cmds: &[Sample],
-) -> (Result<Option<usize>, (usize, SimError)>, Vec<f64>, Vec<f64>) {
+fn one_by_one(p: &ModalPlant, st: &mut ModalState, cmds: &[Sample]) -> (Done, Vec<f64>, Vec<f64>) {
     let na = p.axes();
     let (mut c, mut h) = (vec![0.0; cmds.len()], vec![0.0; cmds.len()]);
     for (i, cmd) in cmds.chunks_exact(na).enumerate() {
