@@ -490,20 +490,29 @@ fn run_axis<const M: usize, const N2: usize>(
         if idle && !rest {
             at_idle = axis_positions(ax, &z, g, x);
         }
-        for (cm, th) in outs {
-            let (toolhead, p) = if idle {
-                at_idle
-            } else {
+        if idle {
+            // Nothing moves: the same outputs every sample (and the same checks).
+            let (toolhead, p) = at_idle;
+            if n > 0 {
+                probe += p;
+                within &= (toolhead - x).abs() <= io.blowup_m;
+            }
+            for (cm, th) in outs {
+                *cm = x;
+                *th = toolhead;
+            }
+        } else {
+            for (cm, th) in outs {
                 advance(&phi, &phi_cmd, &mut z, None);
                 if let (Some((nr, rotor)), Some(ss)) = (track, stepper.as_mut()) {
                     ss.track(nr * z[rotor]);
                 }
-                axis_positions(ax, &z, g, x)
-            };
-            probe += p;
-            within &= (toolhead - x).abs() <= io.blowup_m;
-            *cm = x;
-            *th = toolhead;
+                let (toolhead, p) = axis_positions(ax, &z, g, x);
+                probe += p;
+                within &= (toolhead - x).abs() <= io.blowup_m;
+                *cm = x;
+                *th = toolhead;
+            }
         }
     } else {
         for (i, (cm, th)) in outs.enumerate() {
