@@ -11,7 +11,8 @@
 //!
 //! On a shared machine wall time overstates the cost per core, so after criterion's
 //! measurement each case also runs for a few seconds timed by the thread's own CPU clock
-//! (`/proc/thread-self/schedstat`, Linux) and prints simulated seconds per CPU second.
+//! (`/proc/thread-self/schedstat`, Linux) and prints simulated seconds per CPU second;
+//! with a filter (`cargo bench --bench sim -- modal`) only the cases it selects.
 
 use std::hint::black_box;
 
@@ -67,7 +68,12 @@ fn bench(c: &mut Criterion) {
         });
     }
     group.finish();
+    let filter = filter_arg();
     for &(name, backend, driver) in CASES {
+        let id = format!("printer_xy_10mm_scurve_y/{name}");
+        if filter.as_deref().is_some_and(|f| !id.contains(f)) {
+            continue;
+        }
         let axes = machine.compile(driver).expect("compile");
         let Some(start) = thread_cpu_ns() else {
             return;
@@ -96,6 +102,45 @@ fn bench(c: &mut Criterion) {
             simulated / wall.elapsed().as_secs_f64()
         );
     }
+}
+
+/// The benchmark filter given on the command line (`cargo bench --bench sim -- modal`),
+/// if any: the first argument that is neither an option nor an option's value. The CPU
+/// clock loop runs the cases whose id contains it (criterion reads it as a regular
+/// expression; a plain name such as `modal` or `rapier_full` means the same to both).
+fn filter_arg() -> Option<String> {
+    // Criterion's options that take a value.
+    const VALUED: &[&str] = &[
+        "--warm-up-time",
+        "--measurement-time",
+        "--sample-size",
+        "--save-baseline",
+        "--baseline",
+        "--baseline-lenient",
+        "--load-baseline",
+        "--noise-threshold",
+        "--confidence-level",
+        "--significance-level",
+        "--nresamples",
+        "--output-format",
+        "--color",
+        "--profile-time",
+        "--plotting-backend",
+        "--format",
+        "--logfile",
+        "-c",
+        "-s",
+        "-b",
+    ];
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        if VALUED.contains(&a.as_str()) {
+            args.next();
+        } else if !a.starts_with('-') {
+            return Some(a);
+        }
+    }
+    None
 }
 
 /// This thread's time on a CPU (ns), from `/proc/thread-self/schedstat`.

@@ -196,6 +196,33 @@ impl Bands {
         self.prev = Some((tau, e));
     }
 
+    /// [`Bands::push`] for `count` samples, the `i`-th at `tau(i)` with error `e(i)`:
+    /// the same operations in the same order, with the running values in registers.
+    #[inline(always)]
+    fn push_run(&mut self, count: usize, tau: impl Fn(usize) -> f64, e: impl Fn(usize) -> f64) {
+        let (mut peak, mut sum_sq, mut prev) = (self.peak_m, self.sum_sq, self.prev);
+        for i in 0..count {
+            let (tau, e) = (tau(i), e(i));
+            peak = peak.max(e);
+            sum_sq += e * e;
+            for (b, entered) in self.band_m.iter().zip(&mut self.entered_at) {
+                if e > *b {
+                    *entered = None;
+                } else if entered.is_none() {
+                    *entered = Some(match prev {
+                        Some((tp, ep)) if ep > e => tp + (tau - tp) * (ep - b) / (ep - e),
+                        _ => tau,
+                    });
+                }
+            }
+            prev = Some((tau, e));
+        }
+        self.peak_m = peak;
+        self.sum_sq = sum_sq;
+        self.prev = prev;
+        self.n += count;
+    }
+
     fn rms_m(&self) -> f64 {
         if self.n > 0 {
             (self.sum_sq / self.n as f64).sqrt()
@@ -223,6 +250,9 @@ pub struct Accumulator {
     axis_follow_m: Vec<f64>,
     /// Largest squared distance to the target (m^2), as `max_follow_sq_m2`.
     abs_err_max_sq_m2: f64,
+    /// `(tau, e2)` per sample of a [`Accumulator::push_run`] (reused buffer): the time
+    /// after T and the squared distance, computed once for every bookkeeping.
+    scratch: Vec<(f64, f64)>,
 }
 
 impl Accumulator {
@@ -246,6 +276,7 @@ impl Accumulator {
             max_follow_sq_m2: 0.0,
             axis_follow_m: vec![0.0; target_m.len()],
             abs_err_max_sq_m2: 0.0,
+            scratch: Vec::new(),
         }
     }
 
@@ -282,6 +313,90 @@ impl Accumulator {
         for ((b, h), target) in self.per_axis.iter_mut().zip(toolhead_m).zip(&self.target_m) {
             b.push(tau, (h - target).abs());
         }
+    }
+
+    /// [`Accumulator::push`] for `count` samples at once, bit for bit: sample `i` is at
+    /// `t_s(i)` with the positions `commanded_m[i * axes ..]` and `toolhead_m[i * axes
+    /// ..]` (sample-major, `axes` = the accumulator's axis count); times must not
+    /// decrease. Each running value sees the same operations in the same order as with
+    /// one `push` per sample; they are only grouped by value (the vector error's, then
+    /// each settling bookkeeping in turn) so that they stay in registers.
+    pub fn push_run(
+        &mut self,
+        count: usize,
+        t_s: impl Fn(usize) -> f64,
+        commanded_m: &[f64],
+        toolhead_m: &[f64],
+    ) {
+        let n = self.target_m.len();
+        if n == 0 || count == 0 {
+            for i in 0..count {
+                self.push(t_s(i), &[], &[]);
+            }
+            return;
+        }
+        let commanded_m = &commanded_m[..count * n];
+        let toolhead_m = &toolhead_m[..count * n];
+        let end = self.move_end_s;
+        // The squared distance to the target and the component along the motion.
+        let err = |h: &[f64]| {
+            let (mut e2, mut along) = (0.0, 0.0);
+            for ((target, d), h) in self.target_m.iter().zip(&self.direction).zip(h) {
+                let e = h - target;
+                e2 += e * e;
+                along += e * d;
+            }
+            (e2, along)
+        };
+        let (mut overshoot, mut abs_err, mut max_follow) = (
+            self.overshoot_m,
+            self.abs_err_max_sq_m2,
+            self.max_follow_sq_m2,
+        );
+        // Samples up to the move end, then those after it (with their time after T and
+        // squared distance kept for the settling bookkeeping).
+        let mut first_after = count;
+        let mut scratch = std::mem::take(&mut self.scratch);
+        scratch.clear();
+        for (i, (c, h)) in commanded_m
+            .chunks_exact(n)
+            .zip(toolhead_m.chunks_exact(n))
+            .enumerate()
+        {
+            let t = t_s(i);
+            let (e2, along) = err(h);
+            overshoot = overshoot.max(along);
+            abs_err = abs_err.max(e2);
+            if t <= end {
+                let mut f2 = 0.0;
+                for ((c, h), follow) in c.iter().zip(h).zip(&mut self.axis_follow_m) {
+                    let f = h - c;
+                    f2 += f * f;
+                    *follow = follow.max(f.abs());
+                }
+                max_follow = max_follow.max(f2);
+            }
+            // As `push`: every sample not before T (`t >= end`, or a NaN time).
+            if t >= end || t.is_nan() {
+                if first_after == count {
+                    first_after = i;
+                }
+                scratch.push((t - end, e2));
+            }
+        }
+        self.overshoot_m = overshoot;
+        self.abs_err_max_sq_m2 = abs_err;
+        self.max_follow_sq_m2 = max_follow;
+        let after = scratch.len();
+        if after > 0 {
+            let th = &toolhead_m[first_after * n..];
+            let (tau, e2) = (|i: usize| scratch[i].0, |i: usize| scratch[i].1);
+            self.total.push_run(after, tau, |i| e2(i).sqrt());
+            for (a, (b, target)) in self.per_axis.iter_mut().zip(&self.target_m).enumerate() {
+                b.push_run(after, tau, |i| (th[i * n + a] - target).abs());
+            }
+        }
+        self.scratch = scratch;
     }
 
     /// The metrics of everything pushed, for axes named `names`, with status `status` and
@@ -450,5 +565,39 @@ mod tests {
             (m.axes[0].name.as_str(), m.axes[1].name.as_str()),
             ("x", "y")
         );
+    }
+
+    #[test]
+    fn push_run_equals_push_per_sample_bit_for_bit() {
+        // Two axes, a move ending at 0.0123 s, runs of samples that straddle it, errors
+        // that leave and re-enter the bands (a decaying beat), a zero-direction axis.
+        let target = [0.01, -0.002];
+        let (end, dt) = (0.0123, 1e-4);
+        let signal = |t: f64| {
+            let e = 80e-6 * (-t / 0.02).exp() * (2.0 * std::f64::consts::PI * 45.0 * t).cos();
+            let f = 30e-6 * (-t / 0.015).exp() * (2.0 * std::f64::consts::PI * 11.0 * t).sin();
+            (
+                [target[0] - 0.001 * (end - t).max(0.0), target[1]],
+                [target[0] + e, target[1] + f],
+            )
+        };
+        let mut one = Accumulator::new(&target, &[1.0, 0.0], end, &[10.0, 25.0, 50.0]);
+        let mut run = one.clone();
+        let mut k = 0usize;
+        for len in [1, 7, 100, 3, 250, 256, 1] {
+            let t = |i: usize| (k + i) as f64 * dt;
+            let (mut c, mut h) = (Vec::new(), Vec::new());
+            for i in 0..len {
+                let (ci, hi) = signal(t(i));
+                one.push(t(i), &ci, &hi);
+                c.extend(ci);
+                h.extend(hi);
+            }
+            run.push_run(len, t, &c, &h);
+            k += len;
+        }
+        let (a, b) = (one.finish(), run.finish());
+        assert!(a.settle_time_s[0].is_some_and(|s| s > 0.0), "{a:?}");
+        assert_eq!(format!("{a:?}"), format!("{b:?}"));
     }
 }

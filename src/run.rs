@@ -619,18 +619,15 @@ impl Batch {
         acc: &mut Accumulator,
         path_acc: &mut Option<crate::path_metrics::PathAccumulator>,
     ) {
-        let n = self.axes;
-        for (i, (c, h)) in self
-            .cmd_p
-            .chunks_exact(n)
-            .zip(self.toolhead.chunks_exact(n))
-            .take(count)
-            .enumerate()
-        {
-            let t = time(i);
-            acc.push(t, c, h);
-            if let Some(p) = path_acc.as_mut() {
-                p.push(t, h);
+        acc.push_run(count, time, &self.cmd_p, &self.toolhead);
+        if let Some(p) = path_acc.as_mut() {
+            for (i, h) in self
+                .toolhead
+                .chunks_exact(self.axes)
+                .take(count)
+                .enumerate()
+            {
+                p.push(time(i), h);
             }
         }
     }

@@ -218,6 +218,34 @@ pub struct ModalAxis {
     /// `(x, toolhead, probe)` of [`axis_positions`] at the start (`z` zero): what an
     /// axis that is still idle at the same command reports, computed once.
     at_rest: (f64, f64, f64),
+    /// What [`Plant::step_samples`] restores when its fast path meets a sample it cannot
+    /// vouch for (reused buffer).
+    undo: Undo,
+}
+
+/// The part of a [`ModalAxis`] that stepping changes.
+#[derive(Debug, Clone)]
+struct Undo {
+    base: State,
+    z: Vec<f64>,
+    idle: bool,
+    stepper: Option<StepperState>,
+}
+
+impl ModalAxis {
+    fn save(&mut self) {
+        self.undo.base = self.base;
+        self.undo.z.copy_from_slice(&self.z);
+        self.undo.idle = self.idle;
+        self.undo.stepper.clone_from(&self.stepper);
+    }
+
+    fn restore(&mut self) {
+        self.base = self.undo.base;
+        self.z.copy_from_slice(&self.undo.z);
+        self.idle = self.undo.idle;
+        self.stepper.clone_from(&self.undo.stepper);
+    }
 }
 
 impl ModalAxis {
@@ -329,6 +357,229 @@ impl ModalPlant {
     }
 }
 
+impl ModalPlant {
+    /// [`Plant::step_samples`] as [`Plant::step`] and [`Plant::positions`] per sample.
+    fn samples_one_by_one(
+        &self,
+        state: &mut ModalState,
+        cmds: &[Sample],
+        dt_s: f64,
+        blowup_m: f64,
+        commanded_m: &mut [f64],
+        toolhead_m: &mut [f64],
+    ) -> Result<Option<usize>, (usize, SimError)> {
+        let axes = self.axes.len();
+        let n = cmds.len() / axes;
+        for (i, cmd) in cmds.chunks_exact(axes).enumerate() {
+            self.step(state, cmd, dt_s).map_err(|e| (i, e))?;
+            let c = &mut commanded_m[i * axes..(i + 1) * axes];
+            let h = &mut toolhead_m[i * axes..(i + 1) * axes];
+            let vouched = self.positions(state, c, h)
+                && c.iter()
+                    .zip(h.iter())
+                    .all(|(c, h)| (h - c).abs() <= blowup_m);
+            if !vouched {
+                return Ok(Some(i + 1));
+            }
+        }
+        Ok(Some(n))
+    }
+}
+
+/// The inputs of one [`Plant::step_samples`] call.
+struct Io<'a> {
+    cmds: &'a [Sample],
+    axes: usize,
+    dt_s: f64,
+    blowup_m: f64,
+}
+
+/// Axis `a` through every sample of `io` with the nominal transition (`M` rows per
+/// column), writing its commanded and toolhead positions: per sample exactly the
+/// arithmetic of [`ModalPlant::step`] and [`ModalPlant::positions`] for this axis.
+/// Returns whether every sample is one those would vouch for: every value finite (the
+/// step's check and the positions' probe) and the toolhead within `blowup_m` of the
+/// command.
+///
+/// The state's finiteness is checked once, after the last sample: a non-finite entry of
+/// `z` makes every entry non-finite one step later (each row adds `p z_j`, which is
+/// `+-inf` or NaN for a non-finite `z_j` whatever `p` is, and a sum with a non-finite
+/// term is non-finite; state columns are never skipped), and so it stays, so the last
+/// `z` is finite only if every `z` was. The base polynomial only reaches the outputs
+/// through its position, which is checked per sample (with the command, as the step
+/// does; a non-finite command makes the position non-finite).
+#[inline(always)]
+fn run_axis<const M: usize, const N2: usize>(
+    ax: &AxisModel,
+    st: &mut ModalAxis,
+    io: &Io<'_>,
+    a: usize,
+    commanded_m: &mut [f64],
+    toolhead_m: &mut [f64],
+) -> bool {
+    let h = io.dt_s;
+    if st.disc.stride() != M || st.disc.n * 2 != N2 {
+        return false;
+    }
+    let disc = std::sync::Arc::clone(&st.disc);
+    // The transition's first `N2` rows by column: the state columns, then `v, a, j`.
+    // (The padding rows are zero; they only ever add `+-0` to the padding entries of `z`,
+    // which start at +0 and stay +0 while the state is finite, so they are left out: a
+    // non-finite state sends the call to the per-sample path anyway.)
+    let col = |j: usize| -> [f64; N2] {
+        disc.nominal[j * M..j * M + N2]
+            .try_into()
+            .expect("N2 rows per column")
+    };
+    let phi: [[f64; N2]; N2] = std::array::from_fn(col);
+    let phi_cmd: [[f64; N2]; 3] = std::array::from_fn(|j| col(N2 + j));
+    let g: &[f64] = &disc.g;
+    let mut z: [f64; N2] = st.z[..N2].try_into().expect("state of N2 entries");
+    let track = ax
+        .stepper
+        .as_ref()
+        .map(|sp| (-f64::from(sp.rotor_teeth), sp.rotor));
+    let mut stepper = st.stepper.clone();
+    let mut idle = st.idle;
+    let at_rest = st.at_rest;
+    let mut probe = 0.0;
+    let mut within = true;
+    let axes = io.axes;
+    let n = io.cmds.len() / axes;
+    let first = io.cmds[a];
+    // The base polynomial's position after a step from `c`.
+    let base_p = |c: &Sample| {
+        let hj = h * c.j;
+        let hj6 = if c.j == 0.0 { hj } else { hj / 6.0 };
+        c.p + h * (c.v + h * (c.a / 2.0 + hj6))
+    };
+    let (p0, v0, a0, j0) = (
+        first.p.to_bits(),
+        first.v.to_bits(),
+        first.a.to_bits(),
+        first.j.to_bits(),
+    );
+    let held = first.v == 0.0
+        && first.a == 0.0
+        && first.j == 0.0
+        && (1..n).all(|i| {
+            let c = &io.cmds[i * axes + a];
+            (c.p.to_bits() ^ p0)
+                | (c.v.to_bits() ^ v0)
+                | (c.a.to_bits() ^ a0)
+                | (c.j.to_bits() ^ j0)
+                == 0
+        });
+    let outs = commanded_m
+        .iter_mut()
+        .skip(a)
+        .step_by(axes)
+        .zip(toolhead_m.iter_mut().skip(a).step_by(axes))
+        .take(n);
+    let mut last = first;
+    if held {
+        // The command holds (the observation window): the same base position every
+        // sample, no command columns (all zero), and an idle axis stays where it is.
+        let x = base_p(&first);
+        if !idle {
+            // The step's check of the command, the same every sample.
+            probe += x * 0.0 + (first.v * 0.0 + first.a * 0.0 + first.j * 0.0);
+        }
+        let rest = idle && x.to_bits() == at_rest.0.to_bits();
+        let mut at_idle = (at_rest.1, at_rest.2);
+        if idle && !rest {
+            at_idle = axis_positions(ax, &z, g, x);
+        }
+        if idle {
+            // Nothing moves: the same outputs every sample (and the same checks).
+            let (toolhead, p) = at_idle;
+            if n > 0 {
+                probe += p;
+                within &= (toolhead - x).abs() <= io.blowup_m;
+            }
+            for (cm, th) in outs {
+                *cm = x;
+                *th = toolhead;
+            }
+        } else {
+            for (cm, th) in outs {
+                advance(&phi, &phi_cmd, &mut z, None);
+                if let (Some((nr, rotor)), Some(ss)) = (track, stepper.as_mut()) {
+                    ss.track(nr * z[rotor]);
+                }
+                let (toolhead, p) = axis_positions(ax, &z, g, x);
+                probe += p;
+                within &= (toolhead - x).abs() <= io.blowup_m;
+                *cm = x;
+                *th = toolhead;
+            }
+        }
+    } else {
+        for (i, (cm, th)) in outs.enumerate() {
+            let c = &io.cmds[i * axes + a];
+            last = *c;
+            let x = base_p(c);
+            if !(idle && c.v == 0.0 && c.a == 0.0 && c.j == 0.0) {
+                idle = false;
+                advance(&phi, &phi_cmd, &mut z, Some([c.v, c.a, c.j]));
+                if let (Some((nr, rotor)), Some(ss)) = (track, stepper.as_mut()) {
+                    ss.track(nr * z[rotor]);
+                }
+                probe += x * 0.0 + (c.v * 0.0 + c.a * 0.0 + c.j * 0.0);
+            }
+            let (toolhead, p) = if idle && x.to_bits() == at_rest.0.to_bits() {
+                (at_rest.1, at_rest.2)
+            } else {
+                axis_positions(ax, &z, g, x)
+            };
+            probe += p;
+            within &= (toolhead - x).abs() <= io.blowup_m;
+            *cm = x;
+            *th = toolhead;
+        }
+    }
+    // The base after the last step (its velocity and acceleration are read by nothing
+    // in between).
+    let c = last;
+    st.base = State {
+        p: base_p(&c),
+        v: c.v + h * (c.a + h * c.j / 2.0),
+        a: c.a + h * c.j,
+    };
+    st.idle = idle;
+    st.stepper = stepper;
+    st.z[..N2].copy_from_slice(&z);
+    probe == 0.0 && within && z.iter().all(|v| v.is_finite())
+}
+
+/// `z = Phi [z; cmd]` for the state columns `phi` and the command columns `phi_cmd`
+/// (`v, a, j`; `None`: all zero): [`apply`]'s sums, column by column in order, command
+/// columns with a zero entry skipped.
+#[inline(always)]
+fn advance<const N2: usize>(
+    phi: &[[f64; N2]; N2],
+    phi_cmd: &[[f64; N2]; 3],
+    z: &mut [f64; N2],
+    cmd: Option<[f64; 3]>,
+) {
+    let mut acc = [0.0f64; N2];
+    for (col, &zj) in phi.iter().zip(z.iter()) {
+        for (a, p) in acc.iter_mut().zip(col) {
+            *a += p * zj;
+        }
+    }
+    if let Some(cmd) = cmd {
+        for (col, &cj) in phi_cmd.iter().zip(&cmd) {
+            if cj != 0.0 {
+                for (a, p) in acc.iter_mut().zip(col) {
+                    *a += p * cj;
+                }
+            }
+        }
+    }
+    *z = acc;
+}
+
 impl Plant for ModalPlant {
     type State = ModalState;
 
@@ -360,6 +611,12 @@ impl Plant for ModalPlant {
                 Ok(ModalAxis {
                     base: *s,
                     at_rest: (s.p, toolhead, probe),
+                    undo: Undo {
+                        base: *s,
+                        z: z.clone(),
+                        idle: true,
+                        stepper: stepper.clone(),
+                    },
                     z,
                     idle: true,
                     stepper,
@@ -463,6 +720,65 @@ impl Plant for ModalPlant {
         probe == 0.0
     }
 
+    /// Bit for bit what [`Plant::step`] then [`Plant::positions`] give per sample. The
+    /// fast path steps each axis through all samples in one loop (the nominal step's
+    /// transition, the state in registers) and checks at the end that everything stayed
+    /// finite and within `blowup_m`; if not, it restores the axes and repeats the call
+    /// sample by sample, which stops at the first bad sample as the contract asks.
+    fn step_samples(
+        &self,
+        state: &mut ModalState,
+        cmds: &[Sample],
+        dt_s: f64,
+        blowup_m: f64,
+        commanded_m: &mut [f64],
+        toolhead_m: &mut [f64],
+    ) -> Result<Option<usize>, (usize, SimError)> {
+        let axes = self.axes.len();
+        let n = cmds.len() / axes;
+        if dt_s != self.nominal_dt_s || n * axes != cmds.len() {
+            return self.samples_one_by_one(state, cmds, dt_s, blowup_m, commanded_m, toolhead_m);
+        }
+        let io = Io {
+            cmds,
+            axes,
+            dt_s,
+            blowup_m,
+        };
+        let mut good = true;
+        let mut done = 0;
+        for (a, (ax, st)) in self.axes.iter().zip(&mut state.axes).enumerate() {
+            st.save();
+            done = a + 1;
+            // The state's size as a constant: the product unrolls and `z` stays in
+            // registers.
+            good = match 2 * st.disc.n {
+                2 => run_axis::<4, 2>(ax, st, &io, a, commanded_m, toolhead_m),
+                4 => run_axis::<4, 4>(ax, st, &io, a, commanded_m, toolhead_m),
+                6 => run_axis::<8, 6>(ax, st, &io, a, commanded_m, toolhead_m),
+                8 => run_axis::<8, 8>(ax, st, &io, a, commanded_m, toolhead_m),
+                10 => run_axis::<12, 10>(ax, st, &io, a, commanded_m, toolhead_m),
+                12 => run_axis::<12, 12>(ax, st, &io, a, commanded_m, toolhead_m),
+                14 => run_axis::<16, 14>(ax, st, &io, a, commanded_m, toolhead_m),
+                16 => run_axis::<16, 16>(ax, st, &io, a, commanded_m, toolhead_m),
+                _ => false,
+            };
+            if !good {
+                break;
+            }
+        }
+        if !good {
+            for st in &mut state.axes[..done] {
+                st.restore();
+            }
+            return self.samples_one_by_one(state, cmds, dt_s, blowup_m, commanded_m, toolhead_m);
+        }
+        for _ in 0..n {
+            state.t_s += dt_s;
+        }
+        Ok(Some(n))
+    }
+
     fn observe(&self, state: &ModalState, out: &mut [Observation]) {
         for ((ax, st), o) in self.axes.iter().zip(&state.axes).zip(out.iter_mut()) {
             let x = st.base.p;
@@ -484,7 +800,7 @@ impl Plant for ModalPlant {
 
 /// The toolhead position (m) of `axis` for the command at `x` (m), with `q(i)` the
 /// position of body `i`: the sum of the output terms, in their order.
-#[inline]
+#[inline(always)]
 fn toolhead(axis: &AxisModel, x: f64, q: impl Fn(usize) -> f64) -> f64 {
     let mut toolhead = 0.0;
     for t in &axis.lumped.output {
@@ -501,7 +817,7 @@ fn toolhead(axis: &AxisModel, x: f64, q: impl Fn(usize) -> f64) -> f64 {
 /// The toolhead position (m) of `axis` for the command at `x` (m) and the state `z`, and
 /// the sum of `v * 0` over `x`, the toolhead, the carriage and the motor angle (0 when
 /// they are all finite, NaN otherwise).
-#[inline]
+#[inline(always)]
 fn axis_positions(axis: &AxisModel, z: &[f64], g: &[f64], x: f64) -> (f64, f64) {
     let q = |i: usize| z[i] + g[i] * x;
     let t = toolhead(axis, x, q);
