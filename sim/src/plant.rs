@@ -80,8 +80,10 @@ pub trait Plant {
     /// It stops after the first sample it cannot vouch for (a value [`Plant::observe`]
     /// would report is not finite, or `|toolhead - commanded| > blowup_m` on an axis),
     /// leaving the state at that sample: the caller then observes it in full. Returns
-    /// `Ok(Some(k))` with the `k >= 1` samples done and written (all vouched for when
-    /// `k == n`; when `k < n` the last one is not), `Err((k, e))` when step `k` failed
+    /// `Ok(Some(k))` with the `k >= 1` samples done and written and the state at sample
+    /// `k` (when `k < n` the last one is not vouched for; a plant that stops at the last
+    /// sample of the call also returns `n`, so callers evaluate the last sample of every
+    /// call in full), `Err((k, e))` when step `k` failed
     /// after `k` good samples (the state is then undefined), and `Ok(None)` (the default)
     /// when the plant does not implement this: the caller steps sample by sample.
     #[allow(clippy::too_many_arguments, clippy::type_complexity)]
