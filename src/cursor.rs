@@ -26,24 +26,9 @@ impl<'a> Cursor<'a> {
     pub fn at(&mut self, t: f64, out: &mut [Sample]) {
         for ((o, p), i) in out.iter_mut().zip(self.axes).zip(&mut self.seg) {
             let segments = p.segments();
-            if segments.is_empty() || t < 0.0 {
-                let s = p.start();
-                *o = Sample {
-                    p: s.p,
-                    v: s.v,
-                    a: s.a,
-                    j: 0.0,
-                };
-                continue;
-            }
-            if t >= p.duration_s() {
-                let e = p.end();
-                *o = Sample {
-                    p: e.p,
-                    v: e.v,
-                    a: e.a,
-                    j: 0.0,
-                };
+            if segments.is_empty() || t < 0.0 || t >= p.duration_s() {
+                // Before the start or at and after the end: no segment to find.
+                *o = p.state_at(t);
                 continue;
             }
             // The last segment whose start time is <= t (right-continuous at boundaries,

@@ -158,57 +158,18 @@ enum Regime {
 
 impl Phase {
     /// Advance one phase current `i` (A) by `h` s with the reference `i_ref` (A) and
-    /// back-EMF `e` (V) frozen, exactly through the clamped (+-Vs) and proportional pieces.
-    fn advance(&self, mut i: f64, i_ref: f64, e: f64, h: f64) -> f64 {
-        let Phase { r, l, kp, vs } = *self;
-        // Proportional region: V = R i* + Kp (i* - i) within +-Vs, i.e. i_hi <= i <= i_lo.
-        let i_hi = i_ref + (r * i_ref - vs) / kp;
-        let i_lo = i_ref + (r * i_ref + vs) / kp;
-        let mut regime = if i < i_hi {
-            Regime::High
-        } else if i > i_lo {
-            Regime::Low
-        } else {
-            Regime::Linear
-        };
-        let mut left = h;
-        for _ in 0..4 {
-            let (target, rate) = match regime {
-                Regime::High => ((vs - e) / r, r / l),
-                Regime::Low => ((-vs - e) / r, r / l),
-                Regime::Linear => (i_ref - e / (r + kp), (r + kp) / l),
-            };
-            // The boundary the current runs into on its way to `target`, if any.
-            let exit = match regime {
-                Regime::High if target > i_hi => Some((i_hi, Regime::Linear)),
-                Regime::Low if target < i_lo => Some((i_lo, Regime::Linear)),
-                Regime::Linear if target < i_hi => Some((i_hi, Regime::High)),
-                Regime::Linear if target > i_lo => Some((i_lo, Regime::Low)),
-                _ => None,
-            };
-            if let Some((b, next)) = exit {
-                // i(t) = target + (i - target) e^{-rate t} reaches b at t_b.
-                let ratio = (i - target) / (b - target);
-                let t_b = if ratio > 1.0 { ratio.ln() / rate } else { 0.0 };
-                if t_b < left {
-                    i = b;
-                    left -= t_b;
-                    regime = next;
-                    continue;
-                }
-            }
-            return target + (i - target) * (-rate * left).exp();
-        }
-        i
+    /// back-EMF `e` (V) frozen, exactly through the clamped (+-Vs) and proportional pieces
+    /// (the current of [`Phase::advance_integral`]).
+    fn advance(&self, i: f64, i_ref: f64, e: f64, h: f64) -> f64 {
+        self.advance_integral(i, i_ref, e, h).0
     }
-}
 
-impl Phase {
     /// [`Phase::advance`] that also returns the exact integral of the current over the
     /// interval (A s): each closed-form piece `i(t) = target + (i0 - target) e^{-rate t}`
     /// integrates to `target T + (i0 - target)(1 - e^{-rate T}) / rate`.
     pub(crate) fn advance_integral(&self, mut i: f64, i_ref: f64, e: f64, h: f64) -> (f64, f64) {
         let Phase { r, l, kp, vs } = *self;
+        // Proportional region: V = R i* + Kp (i* - i) within +-Vs, i.e. i_hi <= i <= i_lo.
         let i_hi = i_ref + (r * i_ref - vs) / kp;
         let i_lo = i_ref + (r * i_ref + vs) / kp;
         let mut regime = if i < i_hi {
@@ -226,6 +187,7 @@ impl Phase {
                 Regime::Low => ((-vs - e) / r, r / l),
                 Regime::Linear => (i_ref - e / (r + kp), (r + kp) / l),
             };
+            // The boundary the current runs into on its way to `target`, if any.
             let exit = match regime {
                 Regime::High if target > i_hi => Some((i_hi, Regime::Linear)),
                 Regime::Low if target < i_lo => Some((i_lo, Regime::Linear)),

@@ -14,7 +14,6 @@ mod lean_support;
 use common::run;
 use lean_support::run_lean;
 use settle_planner::{Limits, Profile, ProfileKind};
-use settle_sim::machine::{AxisMachine, Frame, Transmission};
 use settle_sim::mujoco::{MujocoConfig, MujocoPlant};
 use settle_sim::{AxisModel, DriverMode, ModalPlant, Mode, Observation, Plant};
 
@@ -25,25 +24,6 @@ const RESIDUAL_PCT: f64 = 2.0;
 /// `settle validate`'s engines threshold (%).
 const ENGINES_PCT: f64 = 3.0;
 const DT: f64 = 1e-4;
-
-/// The `printer_xy` preset's Y axis (as in `mujoco_step_budget.rs`).
-fn preset_y() -> AxisMachine {
-    let mut a = common::printer_y();
-    a.carriage_kg = 0.2;
-    a.beam_kg = 0.93;
-    if let Transmission::Belt(b) = &mut a.transmission {
-        b.ea_n = 30_000.0;
-        b.span_mm = 350.0;
-        b.carriage_at_zero_mm = 175.0;
-        b.damping_ratio = 0.08;
-    }
-    a.frame = Some(Frame {
-        mass_kg: 5.0,
-        stiffness_n_per_m: 2.84e6,
-        damping_ratio: 0.05,
-    });
-    a
-}
 
 fn plant(axes: Vec<AxisModel>, config: MujocoConfig) -> MujocoPlant {
     MujocoPlant::new(axes, config).expect("plant")
@@ -105,7 +85,7 @@ fn moves() -> Vec<(ProfileKind, Profile)> {
 
 /// Lean vs per-sample vs converged on the preset's Y axis for one driver model.
 fn compare(driver: DriverMode, lean_config: MujocoConfig) -> (f64, f64, f64, f64) {
-    let axis = preset_y().compile(driver).expect("y");
+    let axis = common::printer_preset(true).compile(driver).expect("y");
     let lean = plant(vec![axis.clone()], lean_config);
     let per_sample = plant(vec![axis.clone()], MujocoConfig::default());
     let fine = plant(vec![axis], with_lambda_h(0.05));
@@ -293,7 +273,7 @@ fn a_failed_sample_leaves_the_state_at_that_sample() {
         .expect("plan");
     for driver in [DriverMode::Linear, DriverMode::Full] {
         let mj = plant(
-            vec![preset_y().compile(driver).expect("y")],
+            vec![common::printer_preset(true).compile(driver).expect("y")],
             MujocoConfig::default(),
         );
         let mut st = mj.initial_state(&[p.start()]).expect("state");

@@ -13,7 +13,6 @@ mod lean_support;
 use common::run;
 use lean_support::run_lean;
 use settle_planner::{Limits, ProfileKind};
-use settle_sim::machine::{AxisMachine, Frame, Transmission};
 use settle_sim::mujoco::{MujocoConfig, MujocoPlant};
 use settle_sim::{DriverMode, Observation};
 
@@ -22,26 +21,6 @@ const FREQUENCY_PCT: f64 = 0.5;
 /// `settle validate`'s residual threshold (%).
 const RESIDUAL_PCT: f64 = 2.0;
 const DT: f64 = 1e-4;
-
-/// The `printer_xy` preset's Y axis (scenarios/machines/printer_xy.toml): two 6 mm belts
-/// (EA 30 kN) over 350 mm, 0.2 kg carriages, 0.93 kg beam, 5 kg frame at 120 Hz.
-fn preset_y() -> AxisMachine {
-    let mut a = common::printer_y();
-    a.carriage_kg = 0.2;
-    a.beam_kg = 0.93;
-    if let Transmission::Belt(b) = &mut a.transmission {
-        b.ea_n = 30_000.0;
-        b.span_mm = 350.0;
-        b.carriage_at_zero_mm = 175.0;
-        b.damping_ratio = 0.08;
-    }
-    a.frame = Some(Frame {
-        mass_kg: 5.0,
-        stiffness_n_per_m: 2.84e6,
-        damping_ratio: 0.05,
-    });
-    a
-}
 
 /// The toolhead error after the move (m), every sample.
 fn post_move(trace: &[(f64, Vec<Observation>)], t_end: f64, target: f64) -> Vec<f64> {
@@ -52,10 +31,44 @@ fn post_move(trace: &[(f64, Vec<Observation>)], t_end: f64, target: f64) -> Vec<
         .collect()
 }
 
+/// The ringing after the move (a free decay about the microstep and detent rest offset:
+/// frequency and damping by matrix pencil over the first 0.12 s) and the residual peak of
+/// `a` against the reference `b`, printed and asserted within `settle validate`'s
+/// frequency and residual thresholds.
+fn compare(label: &str, a: &[f64], b: &[f64]) {
+    let fit = |e: &[f64]| {
+        let y: Vec<f64> = e.iter().take(1200).step_by(2).copied().collect();
+        settle_sim::pencil::fit(&y, 2.0 * DT, 8).expect("pencil fit")
+    };
+    let osc = |m: &[settle_sim::pencil::MeasuredMode]| {
+        *m.iter()
+            .find(|m| m.frequency_hz > 5.0)
+            .expect("an oscillatory mode")
+    };
+    let (ma, mb) = (osc(&fit(a)), osc(&fit(b)));
+    let peak = |e: &[f64]| e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let (ra, rb) = (peak(a), peak(b));
+    let df = (ma.frequency_hz / mb.frequency_hz - 1.0) * 100.0;
+    let dr = (ra / rb - 1.0) * 100.0;
+    eprintln!(
+        "{label}: ringing {:.3} / {:.3} Hz ({df:+.4} %), damping {:.4} / {:.4}, residual {:.3} / {:.3} um ({dr:+.2} %)",
+        ma.frequency_hz,
+        mb.frequency_hz,
+        ma.damping_ratio,
+        mb.damping_ratio,
+        ra * 1e6,
+        rb * 1e6
+    );
+    assert!(df.abs() <= FREQUENCY_PCT, "{label}: frequency {df} %");
+    assert!(dr.abs() <= RESIDUAL_PCT, "{label}: residual {dr} %");
+}
+
 #[test]
 fn full_driver_default_step_matches_a_4x_smaller_one_on_the_printer_y_axis() {
     let lim = Limits::new(0.3, 3.0, Some(100.0)).expect("limits");
-    let axis = preset_y().compile(DriverMode::Full).expect("y");
+    let axis = common::printer_preset(true)
+        .compile(DriverMode::Full)
+        .expect("y");
     let plant = |max_lambda_h: f64| {
         MujocoPlant::new(
             vec![axis.clone()],
@@ -68,7 +81,11 @@ fn full_driver_default_step_matches_a_4x_smaller_one_on_the_printer_y_axis() {
     };
     let (coarse, fine) = (plant(0.2), plant(0.05));
     let linear = MujocoPlant::new(
-        vec![preset_y().compile(DriverMode::Linear).expect("y")],
+        vec![
+            common::printer_preset(true)
+                .compile(DriverMode::Linear)
+                .expect("y"),
+        ],
         MujocoConfig::default(),
     )
     .expect("linear");
@@ -94,33 +111,7 @@ fn full_driver_default_step_matches_a_4x_smaller_one_on_the_printer_y_axis() {
             t_end,
             target,
         );
-        // The ringing: a free decay about the (microstep and detent) rest offset.
-        let fit = |e: &[f64]| {
-            let y: Vec<f64> = e.iter().take(1200).step_by(2).copied().collect();
-            settle_sim::pencil::fit(&y, 2.0 * DT, 8).expect("pencil fit")
-        };
-        let (fa, fb) = (fit(&a), fit(&b));
-        let osc = |m: &[settle_sim::pencil::MeasuredMode]| {
-            *m.iter()
-                .find(|m| m.frequency_hz > 5.0)
-                .expect("an oscillatory mode")
-        };
-        let (ma, mb) = (osc(&fa), osc(&fb));
-        let peak = |e: &[f64]| e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let (ra, rb) = (peak(&a), peak(&b));
-        let df = (ma.frequency_hz / mb.frequency_hz - 1.0) * 100.0;
-        let dr = (ra / rb - 1.0) * 100.0;
-        eprintln!(
-            "{kind}: ringing {:.3} / {:.3} Hz ({df:+.3} %), damping {:.4} / {:.4}, residual {:.3} / {:.3} um ({dr:+.2} %)",
-            ma.frequency_hz,
-            mb.frequency_hz,
-            ma.damping_ratio,
-            mb.damping_ratio,
-            ra * 1e6,
-            rb * 1e6
-        );
-        assert!(df.abs() <= FREQUENCY_PCT, "{kind}: frequency {df} %");
-        assert!(dr.abs() <= RESIDUAL_PCT, "{kind}: residual {dr} %");
+        compare(&format!("{kind}"), &a, &b);
     }
 }
 
@@ -131,7 +122,9 @@ fn full_driver_default_step_matches_a_4x_smaller_one_on_the_printer_y_axis() {
 #[test]
 fn full_driver_long_step_matches_a_4x_smaller_one_on_the_printer_y_axis() {
     let lim = Limits::new(0.3, 3.0, Some(100.0)).expect("limits");
-    let axis = preset_y().compile(DriverMode::Full).expect("y");
+    let axis = common::printer_preset(true)
+        .compile(DriverMode::Full)
+        .expect("y");
     let lean = MujocoPlant::new(vec![axis.clone()], MujocoConfig::default()).expect("plant");
     let fine = MujocoPlant::new(
         vec![axis],
@@ -155,30 +148,6 @@ fn full_driver_long_step_matches_a_4x_smaller_one_on_the_printer_y_axis() {
         let one = std::slice::from_ref(&p);
         let a = post_move(&run_lean(&lean, one, DT, 0.3), t_end, target);
         let b = post_move(&run(&fine, one, DT, 0.3), t_end, target);
-        let fit = |e: &[f64]| {
-            let y: Vec<f64> = e.iter().take(1200).step_by(2).copied().collect();
-            settle_sim::pencil::fit(&y, 2.0 * DT, 8).expect("pencil fit")
-        };
-        let osc = |m: &[settle_sim::pencil::MeasuredMode]| {
-            *m.iter()
-                .find(|m| m.frequency_hz > 5.0)
-                .expect("an oscillatory mode")
-        };
-        let (ma, mb) = (osc(&fit(&a)), osc(&fit(&b)));
-        let peak = |e: &[f64]| e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let (ra, rb) = (peak(&a), peak(&b));
-        let df = (ma.frequency_hz / mb.frequency_hz - 1.0) * 100.0;
-        let dr = (ra / rb - 1.0) * 100.0;
-        eprintln!(
-            "{kind} (lean): ringing {:.3} / {:.3} Hz ({df:+.4} %), damping {:.4} / {:.4}, residual {:.3} / {:.3} um ({dr:+.2} %)",
-            ma.frequency_hz,
-            mb.frequency_hz,
-            ma.damping_ratio,
-            mb.damping_ratio,
-            ra * 1e6,
-            rb * 1e6
-        );
-        assert!(df.abs() <= FREQUENCY_PCT, "{kind}: frequency {df} %");
-        assert!(dr.abs() <= RESIDUAL_PCT, "{kind}: residual {dr} %");
+        compare(&format!("{kind} (lean)"), &a, &b);
     }
 }

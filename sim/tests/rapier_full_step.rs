@@ -11,36 +11,12 @@
 
 mod common;
 
-use common::{printer_x, printer_y, run, stage_x};
+use common::{printer_preset, printer_x, printer_y, run, stage_x};
 use settle_planner::{Limits, ProfileKind, State};
-use settle_sim::machine::{AxisMachine, Frame, Transmission};
 use settle_sim::{AxisModel, DriverMode, Observation, RapierOptions, RapierPlant};
 
 /// The accuracy asked of the default step (%): half `settle validate`'s residual threshold.
 const RESIDUAL_PCT: f64 = 1.0;
-
-/// The `printer_xy` preset's axes (scenarios/machines/printer_xy.toml): belts of EA 15 kN
-/// (X) and 30 kN (Y, two belts) over 350 mm, 0.2 kg Y carriages, a 0.93 kg beam and a
-/// 5 kg frame at 120 Hz on Y.
-fn preset(y: bool) -> AxisMachine {
-    let mut a = if y { printer_y() } else { printer_x() };
-    if y {
-        a.carriage_kg = 0.2;
-        a.beam_kg = 0.93;
-        a.frame = Some(Frame {
-            mass_kg: 5.0,
-            stiffness_n_per_m: 2.84e6,
-            damping_ratio: 0.05,
-        });
-    }
-    if let Transmission::Belt(b) = &mut a.transmission {
-        b.ea_n = if y { 30_000.0 } else { 15_000.0 };
-        b.span_mm = 350.0;
-        b.carriage_at_zero_mm = 175.0;
-        b.damping_ratio = 0.08;
-    }
-    a
-}
 
 /// Peak |toolhead - target| of axis `i` after the move (m).
 fn residual(trace: &[(f64, Vec<Observation>)], t_end: f64, target: f64, i: usize) -> f64 {
@@ -69,7 +45,12 @@ fn full_driver_default_step_matches_a_16x_smaller_one() {
     let mut worst = 0.0f64;
     for (machine, x, y, lim) in [
         ("fixture", printer_x(), printer_y(), printer),
-        ("preset", preset(false), preset(true), printer),
+        (
+            "preset",
+            printer_preset(false),
+            printer_preset(true),
+            printer,
+        ),
         ("stage", stage_x(), stage_x(), stage),
     ] {
         let axes = vec![

@@ -91,17 +91,32 @@ pub fn stage_x() -> AxisMachine {
     }
 }
 
-/// Step `plant` through `profiles` (one per axis) at `dt`, splitting at breakpoints, then
-/// hold for `window`; returns every sample `(t, observations)`.
-pub fn run<P: Plant>(
-    plant: &P,
-    profiles: &[Profile],
-    dt: f64,
-    window: f64,
-) -> Vec<(f64, Vec<Observation>)> {
-    let n_axes = profiles.len();
-    let starts: Vec<State> = profiles.iter().map(Profile::start).collect();
-    let mut st = plant.initial_state(&starts).expect("state");
+/// The `printer_xy` preset's axes (scenarios/machines/printer_xy.toml): belts of EA 15 kN
+/// (X) and 30 kN (Y, two belts) over 350 mm, 0.2 kg Y carriages, a 0.93 kg beam and a
+/// 5 kg frame at 120 Hz on Y.
+pub fn printer_preset(y: bool) -> AxisMachine {
+    let mut a = if y { printer_y() } else { printer_x() };
+    if y {
+        a.carriage_kg = 0.2;
+        a.beam_kg = 0.93;
+        a.frame = Some(Frame {
+            mass_kg: 5.0,
+            stiffness_n_per_m: 2.84e6,
+            damping_ratio: 0.05,
+        });
+    }
+    if let Transmission::Belt(b) = &mut a.transmission {
+        b.ea_n = if y { 30_000.0 } else { 15_000.0 };
+        b.span_mm = 350.0;
+        b.carriage_at_zero_mm = 175.0;
+        b.damping_ratio = 0.08;
+    }
+    a
+}
+
+/// The end of the longest of `profiles` (s) and every segment end of every axis, with
+/// that end, sorted and deduplicated (s): where [`run`] splits its steps.
+pub fn breakpoints(profiles: &[Profile]) -> (f64, Vec<f64>) {
     let t_end = profiles.iter().map(Profile::duration_s).fold(0.0, f64::max);
     let mut bps: Vec<f64> = profiles
         .iter()
@@ -114,6 +129,29 @@ pub fn run<P: Plant>(
     bps.push(t_end);
     bps.sort_by(f64::total_cmp);
     bps.dedup();
+    (t_end, bps)
+}
+
+/// The first of `bps` after `t` (s), or infinity.
+pub fn next_breakpoint(bps: &[f64], t: f64) -> f64 {
+    bps.iter()
+        .copied()
+        .find(|&b| b > t)
+        .unwrap_or(f64::INFINITY)
+}
+
+/// Step `plant` through `profiles` (one per axis) at `dt`, splitting at breakpoints, then
+/// hold for `window`; returns every sample `(t, observations)`.
+pub fn run<P: Plant>(
+    plant: &P,
+    profiles: &[Profile],
+    dt: f64,
+    window: f64,
+) -> Vec<(f64, Vec<Observation>)> {
+    let n_axes = profiles.len();
+    let starts: Vec<State> = profiles.iter().map(Profile::start).collect();
+    let mut st = plant.initial_state(&starts).expect("state");
+    let (t_end, bps) = breakpoints(profiles);
     let mut out = Vec::new();
     let mut obs = vec![Observation::default(); n_axes];
     plant.observe(&st, &mut obs);
@@ -123,11 +161,7 @@ pub fn run<P: Plant>(
     let stop = t_end + window;
     while t < stop - 1e-12 {
         let ts = k as f64 * dt;
-        let next_bp = bps
-            .iter()
-            .copied()
-            .find(|&b| b > t)
-            .unwrap_or(f64::INFINITY);
+        let next_bp = next_breakpoint(&bps, t);
         let next = ts.min(next_bp);
         let cmd: Vec<Sample> = profiles.iter().map(|p| p.state_at(t)).collect();
         let whole = next == ts && t == (k - 1) as f64 * dt;

@@ -21,18 +21,7 @@ pub fn run_lean<P: Plant>(
     let n_axes = profiles.len();
     let starts: Vec<State> = profiles.iter().map(Profile::start).collect();
     let mut st = plant.initial_state(&starts).expect("state");
-    let t_end = profiles.iter().map(Profile::duration_s).fold(0.0, f64::max);
-    let mut bps: Vec<f64> = profiles
-        .iter()
-        .flat_map(|p| {
-            p.iter()
-                .map(|(t0, _, s)| t0 + s.duration_s())
-                .collect::<Vec<_>>()
-        })
-        .collect();
-    bps.push(t_end);
-    bps.sort_by(f64::total_cmp);
-    bps.dedup();
+    let (t_end, bps) = super::common::breakpoints(profiles);
     let mut out = Vec::new();
     let mut obs = vec![Observation::default(); n_axes];
     plant.observe(&st, &mut obs);
@@ -43,11 +32,7 @@ pub fn run_lean<P: Plant>(
     let mut k = 1usize;
     while t < stop - 1e-12 {
         let ts = k as f64 * dt;
-        let next_bp = bps
-            .iter()
-            .copied()
-            .find(|&b| b > t)
-            .unwrap_or(f64::INFINITY);
+        let next_bp = super::common::next_breakpoint(&bps, t);
         // Whole samples up to the next breakpoint (or the end).
         let limit = next_bp.min(stop + 1e-12);
         let mut m = 0usize;
