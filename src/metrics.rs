@@ -196,30 +196,46 @@ impl Bands {
         self.prev = Some((tau, e));
     }
 
-    /// [`Bands::push`] for `count` samples, the `i`-th at `tau(i)` with error `e(i)`:
-    /// the same operations in the same order, with the running values in registers.
-    #[inline(always)]
-    fn push_run(&mut self, count: usize, tau: impl Fn(usize) -> f64, e: impl Fn(usize) -> f64) {
-        let (mut peak, mut sum_sq, mut prev) = (self.peak_m, self.sum_sq, self.prev);
-        for i in 0..count {
-            let (tau, e) = (tau(i), e(i));
+    /// [`Bands::push`] for the samples `e` (m) at the times `tau` (s after T), bit for
+    /// bit. The peak and the sum of squares see every sample in order, as there. Each
+    /// band's entry time only depends on the last sample outside the band: after it
+    /// the per-sample rule sets the entry to the crossing between that sample and the
+    /// next one (or leaves it unset when it is the last one), and nothing changes it
+    /// afterwards; with no sample outside, only an unset entry changes, at the first
+    /// sample (crossing from the previous call's last one). So each band is one scan
+    /// for its last outside sample and one evaluation of the same crossing formula.
+    fn push_slice(&mut self, tau: &[f64], e: &[f64]) {
+        let count = e.len().min(tau.len());
+        if count == 0 {
+            return;
+        }
+        let (tau, e) = (&tau[..count], &e[..count]);
+        let (mut peak, mut sum_sq) = (self.peak_m, self.sum_sq);
+        for &e in e {
             peak = peak.max(e);
             sum_sq += e * e;
-            for (b, entered) in self.band_m.iter().zip(&mut self.entered_at) {
-                if e > *b {
-                    *entered = None;
-                } else if entered.is_none() {
-                    *entered = Some(match prev {
-                        Some((tp, ep)) if ep > e => tp + (tau - tp) * (ep - b) / (ep - e),
-                        _ => tau,
-                    });
+        }
+        let prev = self.prev;
+        // The per-sample rule's crossing into band `b` at sample `i` after `prev`.
+        let crossing = |prev: Option<(f64, f64)>, i: usize, b: f64| match prev {
+            Some((tp, ep)) if ep > e[i] => tp + (tau[i] - tp) * (ep - b) / (ep - e[i]),
+            _ => tau[i],
+        };
+        for (&b, entered) in self.band_m.iter().zip(&mut self.entered_at) {
+            let last_out = last_above(e, b);
+            match last_out {
+                Some(l) if l + 1 == count => *entered = None,
+                Some(l) => *entered = Some(crossing(Some((tau[l], e[l])), l + 1, b)),
+                None => {
+                    if entered.is_none() {
+                        *entered = Some(crossing(prev, 0, b));
+                    }
                 }
             }
-            prev = Some((tau, e));
         }
         self.peak_m = peak;
         self.sum_sq = sum_sq;
-        self.prev = prev;
+        self.prev = Some((tau[count - 1], e[count - 1]));
         self.n += count;
     }
 
@@ -230,6 +246,23 @@ impl Bands {
             0.0
         }
     }
+}
+
+/// The index of the last entry of `e` above `b` (`e > b`, as [`Bands::push`] tests it: a
+/// NaN is not above). Eight entries at a time without a branch, from the end (a settled
+/// run's samples are all inside), then the exact position within the chunk that has one.
+fn last_above(e: &[f64], b: f64) -> Option<usize> {
+    const W: usize = 8;
+    let whole = e.len() / W * W;
+    if let Some(i) = e[whole..].iter().rposition(|&x| x > b) {
+        return Some(whole + i);
+    }
+    let (k, chunk) = e[..whole]
+        .chunks_exact(W)
+        .enumerate()
+        .rev()
+        .find(|(_, c)| c.iter().fold(false, |any, &x| any | (x > b)))?;
+    chunk.iter().rposition(|&x| x > b).map(|i| k * W + i)
 }
 
 /// Streaming metric accumulator over one or more axes. Feed samples in time order with
@@ -250,9 +283,11 @@ pub struct Accumulator {
     axis_follow_m: Vec<f64>,
     /// Largest squared distance to the target (m^2), as `max_follow_sq_m2`.
     abs_err_max_sq_m2: f64,
-    /// `(tau, e2)` per sample of a [`Accumulator::push_run`] (reused buffer): the time
-    /// after T and the squared distance, computed once for every bookkeeping.
-    scratch: Vec<(f64, f64)>,
+    /// Reused buffers of [`Accumulator::push_run`] for the samples after T: their time
+    /// after T, the distance to the target, and one axis's error at a time.
+    tau_s: Vec<f64>,
+    dist_m: Vec<f64>,
+    axis_err_m: Vec<f64>,
 }
 
 impl Accumulator {
@@ -276,7 +311,9 @@ impl Accumulator {
             max_follow_sq_m2: 0.0,
             axis_follow_m: vec![0.0; target_m.len()],
             abs_err_max_sq_m2: 0.0,
-            scratch: Vec::new(),
+            tau_s: Vec::new(),
+            dist_m: Vec::new(),
+            axis_err_m: Vec::new(),
         }
     }
 
@@ -335,16 +372,38 @@ impl Accumulator {
             }
             return;
         }
+        // The axis count as a constant where it is a common one: the per-axis loops
+        // unroll and the running values stay in registers.
+        match n {
+            1 => self.push_run_n::<1>(count, t_s, commanded_m, toolhead_m),
+            2 => self.push_run_n::<2>(count, t_s, commanded_m, toolhead_m),
+            3 => self.push_run_n::<3>(count, t_s, commanded_m, toolhead_m),
+            _ => self.push_run_n::<0>(count, t_s, commanded_m, toolhead_m),
+        }
+    }
+
+    /// [`Accumulator::push_run`] for `N` axes (`N == 0`: any count).
+    #[inline(always)]
+    fn push_run_n<const N: usize>(
+        &mut self,
+        count: usize,
+        t_s: impl Fn(usize) -> f64,
+        commanded_m: &[f64],
+        toolhead_m: &[f64],
+    ) {
+        let n = if N > 0 { N } else { self.target_m.len() };
         let commanded_m = &commanded_m[..count * n];
         let toolhead_m = &toolhead_m[..count * n];
         let end = self.move_end_s;
+        let (target, direction) = (&self.target_m[..n], &self.direction[..n]);
+        let follow = &mut self.axis_follow_m[..n];
         // The squared distance to the target and the component along the motion.
         let err = |h: &[f64]| {
             let (mut e2, mut along) = (0.0, 0.0);
-            for ((target, d), h) in self.target_m.iter().zip(&self.direction).zip(h) {
-                let e = h - target;
+            for a in 0..n {
+                let e = h[a] - target[a];
                 e2 += e * e;
-                along += e * d;
+                along += e * direction[a];
             }
             (e2, along)
         };
@@ -353,50 +412,64 @@ impl Accumulator {
             self.abs_err_max_sq_m2,
             self.max_follow_sq_m2,
         );
-        // Samples up to the move end, then those after it (with their time after T and
-        // squared distance kept for the settling bookkeeping).
-        let mut first_after = count;
-        let mut scratch = std::mem::take(&mut self.scratch);
-        scratch.clear();
-        for (i, (c, h)) in commanded_m
-            .chunks_exact(n)
-            .zip(toolhead_m.chunks_exact(n))
-            .enumerate()
-        {
+        // The first sample not before T (`t >= end`, or a NaN time, as `push` tests);
+        // times do not decrease, so every later one is not either.
+        let first_after = (0..count)
+            .find(|&i| {
+                let t = t_s(i);
+                t >= end || t.is_nan()
+            })
+            .unwrap_or(count);
+        let after = count - first_after;
+        let (mut tau_s, mut dist_m) = (
+            std::mem::take(&mut self.tau_s),
+            std::mem::take(&mut self.dist_m),
+        );
+        tau_s.clear();
+        tau_s.resize(after, 0.0);
+        dist_m.clear();
+        dist_m.resize(after, 0.0);
+        for i in 0..count {
+            let (c, h) = (
+                &commanded_m[i * n..(i + 1) * n],
+                &toolhead_m[i * n..(i + 1) * n],
+            );
             let t = t_s(i);
             let (e2, along) = err(h);
             overshoot = overshoot.max(along);
             abs_err = abs_err.max(e2);
             if t <= end {
                 let mut f2 = 0.0;
-                for ((c, h), follow) in c.iter().zip(h).zip(&mut self.axis_follow_m) {
-                    let f = h - c;
+                for a in 0..n {
+                    let f = h[a] - c[a];
                     f2 += f * f;
-                    *follow = follow.max(f.abs());
+                    follow[a] = follow[a].max(f.abs());
                 }
                 max_follow = max_follow.max(f2);
             }
-            // As `push`: every sample not before T (`t >= end`, or a NaN time).
-            if t >= end || t.is_nan() {
-                if first_after == count {
-                    first_after = i;
-                }
-                scratch.push((t - end, e2));
+            if let Some(j) = i.checked_sub(first_after) {
+                // The time after T and the distance to the target, for the settling
+                // bookkeeping.
+                tau_s[j] = t - end;
+                dist_m[j] = e2.sqrt();
             }
         }
         self.overshoot_m = overshoot;
         self.abs_err_max_sq_m2 = abs_err;
         self.max_follow_sq_m2 = max_follow;
-        let after = scratch.len();
         if after > 0 {
+            self.total.push_slice(&tau_s, &dist_m);
             let th = &toolhead_m[first_after * n..];
-            let (tau, e2) = (|i: usize| scratch[i].0, |i: usize| scratch[i].1);
-            self.total.push_run(after, tau, |i| e2(i).sqrt());
-            for (a, (b, target)) in self.per_axis.iter_mut().zip(&self.target_m).enumerate() {
-                b.push_run(after, tau, |i| (th[i * n + a] - target).abs());
+            let mut axis_err_m = std::mem::take(&mut self.axis_err_m);
+            for (a, (b, target)) in self.per_axis.iter_mut().zip(target).enumerate() {
+                axis_err_m.clear();
+                axis_err_m.extend(th.chunks_exact(n).map(|h| (h[a] - target).abs()));
+                b.push_slice(&tau_s, &axis_err_m);
             }
+            self.axis_err_m = axis_err_m;
         }
-        self.scratch = scratch;
+        self.tau_s = tau_s;
+        self.dist_m = dist_m;
     }
 
     /// The metrics of everything pushed, for axes named `names`, with status `status` and
@@ -599,5 +672,57 @@ mod tests {
         let (a, b) = (one.finish(), run.finish());
         assert!(a.settle_time_s[0].is_some_and(|s| s > 0.0), "{a:?}");
         assert_eq!(format!("{a:?}"), format!("{b:?}"));
+    }
+
+    #[test]
+    fn push_run_equals_push_per_sample_on_edges_and_nans() {
+        // Errors exactly on a band edge, runs that end outside a band, runs entirely
+        // inside after an outside one, a run entirely outside, and NaN samples (not
+        // outside a band by the per-sample rule): every run length from 1 to 9.
+        // The band as the accumulator stores it (um times 1e-6), so the edge is exact.
+        let band = 10.0 * 1e-6;
+        let pattern = [
+            20e-6,
+            band,
+            5e-6,
+            40e-6,
+            41e-6,
+            band,
+            f64::NAN,
+            30e-6,
+            12e-6,
+            0.0,
+            0.0,
+            band,
+            11e-6,
+            f64::NAN,
+            2e-6,
+            9e-6,
+            band,
+            0.0,
+        ];
+        for len in 1..10 {
+            let mut one = Accumulator::new(&[0.0, 0.0], &[1.0, 0.0], 0.0, &[10.0, 35.0]);
+            let mut run = one.clone();
+            let mut k = 0usize;
+            while k < 4 * pattern.len() {
+                let m = len.min(4 * pattern.len() - k);
+                let t = |i: usize| (k + i) as f64 * 1e-4;
+                let (mut c, mut h) = (Vec::new(), Vec::new());
+                for i in 0..m {
+                    let e = pattern[(k + i) % pattern.len()];
+                    let hi = [e, -0.5 * e];
+                    one.push(t(i), &[0.0, 0.0], &hi);
+                    c.extend([0.0, 0.0]);
+                    h.extend(hi);
+                }
+                run.push_run(m, t, &c, &h);
+                k += m;
+            }
+            let (a, b) = (one.finish(), run.finish());
+            // The last sample outside the 10 um band is the 11 um one (a NaN follows).
+            assert!(a.settle_time_s[0].is_some_and(|s| s > 0.0), "{a:?}");
+            assert_eq!(format!("{a:?}"), format!("{b:?}"), "runs of {len}");
+        }
     }
 }
