@@ -38,9 +38,13 @@ struct Discrete {
     scale: Vec<f64>,
     /// Static gain g (body coordinate per metre of command).
     g: Vec<f64>,
+    /// The nominal step (s).
+    nominal_dt_s: f64,
     /// The first `2n` rows of the transition for the nominal step, physical coordinates,
-    /// stored by column (`2n + 3` columns of [`Discrete::stride`] entries, zero padded).
-    nominal: Vec<f64>,
+    /// stored by column (`2n + 3` columns of [`Discrete::stride`] entries, zero padded);
+    /// computed at the axis's first step ([`Discrete::nominal`]: an axis that never
+    /// moves never needs it).
+    nominal: std::sync::OnceLock<Vec<f64>>,
     /// Induced infinity norm of `a_scaled` (1/s): bounds the Taylor remainder.
     norm_per_s: f64,
     /// The first `2n` rows of `a_scaled^k / k!` in physical coordinates (by column), for
@@ -110,18 +114,23 @@ impl Discrete {
         let norm_per_s = (0..dim)
             .map(|i| (0..dim).map(|j| a_scaled[(i, j)].abs()).sum::<f64>())
             .fold(0.0, f64::max);
-        let mut d = Self {
+        Ok(Self {
             n,
             stride: (2 * n).div_ceil(4) * 4,
             a_scaled,
             scale,
             g: g.iter().copied().collect(),
-            nominal: Vec::new(),
+            nominal_dt_s,
+            nominal: std::sync::OnceLock::new(),
             norm_per_s,
             powers: std::sync::OnceLock::new(),
-        };
-        d.nominal = d.transition(nominal_dt_s);
-        Ok(d)
+        })
+    }
+
+    /// The transition for the nominal step (see [`Discrete::nominal`]).
+    fn nominal(&self) -> &[f64] {
+        self.nominal
+            .get_or_init(|| self.transition(self.nominal_dt_s))
     }
 
     /// The first `2n` rows of the transition over `dt_s`, in physical coordinates, by
@@ -422,17 +431,6 @@ fn run_axis<const M: usize, const N2: usize>(
         return false;
     }
     let disc = std::sync::Arc::clone(&st.disc);
-    // The transition's first `N2` rows by column: the state columns, then `v, a, j`.
-    // (The padding rows are zero; they only ever add `+-0` to the padding entries of `z`,
-    // which start at +0 and stay +0 while the state is finite, so they are left out: a
-    // non-finite state sends the call to the per-sample path anyway.)
-    let col = |j: usize| -> [f64; N2] {
-        disc.nominal[j * M..j * M + N2]
-            .try_into()
-            .expect("N2 rows per column")
-    };
-    let phi: [[f64; N2]; N2] = std::array::from_fn(col);
-    let phi_cmd: [[f64; N2]; 3] = std::array::from_fn(|j| col(N2 + j));
     let g: &[f64] = &disc.g;
     let mut z: [f64; N2] = st.z[..N2].try_into().expect("state of N2 entries");
     let track = ax
@@ -470,6 +468,19 @@ fn run_axis<const M: usize, const N2: usize>(
                 | (c.j.to_bits() ^ j0)
                 == 0
         });
+    // The transition's first `N2` rows by column: the state columns, then `v, a, j`.
+    // (The padding rows are zero; they only ever add `+-0` to the padding entries of `z`,
+    // which start at +0 and stay +0 while the state is finite, so they are left out: a
+    // non-finite state sends the call to the per-sample path anyway.)
+    // An idle axis whose command holds never steps: it needs no transition.
+    let nominal: &[f64] = if held && idle { &[] } else { disc.nominal() };
+    let col = |j: usize| -> [f64; N2] {
+        nominal
+            .get(j * M..j * M + N2)
+            .map_or([0.0; N2], |c| c.try_into().expect("N2 rows per column"))
+    };
+    let phi: [[f64; N2]; N2] = std::array::from_fn(col);
+    let phi_cmd: [[f64; N2]; 3] = std::array::from_fn(|j| col(N2 + j));
     let outs = commanded_m
         .iter_mut()
         .skip(a)
@@ -651,7 +662,7 @@ impl Plant for ModalPlant {
             let disc = &st.disc;
             let n2 = 2 * disc.n;
             let rows: &[f64] = if nominal {
-                &disc.nominal
+                disc.nominal()
             } else {
                 disc.partial(dt_s, &mut st.partial);
                 &st.partial
@@ -802,14 +813,18 @@ impl Plant for ModalPlant {
 /// position of body `i`: the sum of the output terms, in their order.
 #[inline(always)]
 fn toolhead(axis: &AxisModel, x: f64, q: impl Fn(usize) -> f64) -> f64 {
+    let value = |t: &crate::lumped::Term| match t.node {
+        crate::lumped::Node::Ground => 0.0,
+        crate::lumped::Node::Command => x,
+        crate::lumped::Node::Body(i) => q(i),
+    };
+    // One term (every compiled machine: the toolhead body) without the loop.
+    if let [t] = axis.lumped.output.as_slice() {
+        return 0.0 + t.gain * value(t);
+    }
     let mut toolhead = 0.0;
     for t in &axis.lumped.output {
-        toolhead += t.gain
-            * match t.node {
-                crate::lumped::Node::Ground => 0.0,
-                crate::lumped::Node::Command => x,
-                crate::lumped::Node::Body(i) => q(i),
-            };
+        toolhead += t.gain * value(t);
     }
     toolhead
 }
