@@ -212,7 +212,7 @@ impl Bands {
         let (tau, e) = (&tau[..count], &e[..count]);
         let (mut peak, mut sum_sq) = (self.peak_m, self.sum_sq);
         for &e in e {
-            peak = peak.max(e);
+            peak = raise(peak, e);
             sum_sq += e * e;
         }
         let prev = self.prev;
@@ -246,6 +246,17 @@ impl Bands {
             0.0
         }
     }
+}
+
+/// `acc.max(x)` for the running maxima here, in one instruction instead of `f64::max`'s
+/// NaN fix-up: a NaN `x` is ignored and the larger value kept, as there. The two differ
+/// only in the sign of a zero when `acc` and `x` are zeros of opposite signs, which never
+/// happens here: every maximum starts at `+0` and takes values that are never `-0` (an
+/// `abs`, a `sqrt` of a sum of squares, or a sum that starts at `+0`: a sum is `-0` only
+/// if both its terms are).
+#[inline(always)]
+fn raise(acc: f64, x: f64) -> f64 {
+    if x > acc { x } else { acc }
 }
 
 /// The index of the last entry of `e` above `b` (`e > b`, as [`Bands::push`] tests it: a
@@ -436,16 +447,16 @@ impl Accumulator {
             );
             let t = t_s(i);
             let (e2, along) = err(h);
-            overshoot = overshoot.max(along);
-            abs_err = abs_err.max(e2);
+            overshoot = raise(overshoot, along);
+            abs_err = raise(abs_err, e2);
             if t <= end {
                 let mut f2 = 0.0;
                 for a in 0..n {
                     let f = h[a] - c[a];
                     f2 += f * f;
-                    follow[a] = follow[a].max(f.abs());
+                    follow[a] = raise(follow[a], f.abs());
                 }
-                max_follow = max_follow.max(f2);
+                max_follow = raise(max_follow, f2);
             }
             if let Some(j) = i.checked_sub(first_after) {
                 // The time after T and the distance to the target, for the settling

@@ -503,7 +503,9 @@ pub fn simulate<P: Plant>(
                 );
             }
             let k0 = k;
-            let time = |i: usize| (k0 + i) as f64 * dt;
+            // (Sample indices are far below 2^63: `i64` converts in one instruction and
+            // gives the same value as `usize`.)
+            let time = |i: usize| (k0 + i) as i64 as f64 * dt;
             let fail_time = |i: usize| (k0 - 1 + i) as f64 * dt;
             match batch!(b, m, time, fail_time) {
                 Some(done) => {
@@ -555,7 +557,7 @@ pub fn simulate<P: Plant>(
             }
             let m = (n + 1 - i).min(CHUNK);
             let i0 = i;
-            let time = |j: usize| t_end + (i0 + j) as f64 * dt;
+            let time = |j: usize| t_end + (i0 + j) as i64 as f64 * dt;
             let fail_time = |j: usize| time(j) - dt;
             match batch!(b, m, time, fail_time) {
                 Some(done) => {

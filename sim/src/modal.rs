@@ -481,12 +481,13 @@ fn run_axis<const M: usize, const N2: usize>(
     };
     let phi: [[f64; N2]; N2] = std::array::from_fn(col);
     let phi_cmd: [[f64; N2]; 3] = std::array::from_fn(|j| col(N2 + j));
+    // This axis's outputs of every sample, and its commands (sample-major, `axes` per
+    // sample), one chunk per sample.
     let outs = commanded_m
-        .iter_mut()
-        .skip(a)
-        .step_by(axes)
-        .zip(toolhead_m.iter_mut().skip(a).step_by(axes))
-        .take(n);
+        .chunks_exact_mut(axes)
+        .zip(toolhead_m.chunks_exact_mut(axes))
+        .take(n)
+        .map(|(cm, th)| (&mut cm[a], &mut th[a]));
     let mut last = first;
     if held {
         // The command holds (the observation window): the same base position every
@@ -526,8 +527,8 @@ fn run_axis<const M: usize, const N2: usize>(
             }
         }
     } else {
-        for (i, (cm, th)) in outs.enumerate() {
-            let c = &io.cmds[i * axes + a];
+        for ((cm, th), c) in outs.zip(io.cmds.chunks_exact(axes)) {
+            let c = &c[a];
             last = *c;
             let x = base_p(c);
             if !(idle && c.v == 0.0 && c.a == 0.0 && c.j == 0.0) {
