@@ -8,6 +8,8 @@ use settle_planner::{Profile, Sample, Trajectory};
 pub struct Cursor<'a> {
     axes: &'a [Profile],
     seg: Vec<usize>,
+    /// The command of an axis without segments: the same at every time.
+    fixed: Vec<Option<Sample>>,
 }
 
 impl<'a> Cursor<'a> {
@@ -16,6 +18,11 @@ impl<'a> Cursor<'a> {
         Self {
             axes: traj.axes(),
             seg: vec![0; traj.dof()],
+            fixed: traj
+                .axes()
+                .iter()
+                .map(|p| p.segments().is_empty().then(|| p.state_at(0.0)))
+                .collect(),
         }
     }
 
@@ -24,7 +31,12 @@ impl<'a> Cursor<'a> {
     /// the last one instead of searching, and the same evaluation). Any `t` is allowed; a
     /// `t` before the last one restarts the walk from the first segment.
     pub fn at(&mut self, t: f64, out: &mut [Sample]) {
-        for ((o, p), i) in out.iter_mut().zip(self.axes).zip(&mut self.seg) {
+        let axes = out.iter_mut().zip(self.axes).zip(&mut self.seg);
+        for (((o, p), i), fixed) in axes.zip(&self.fixed) {
+            if let Some(s) = fixed {
+                *o = *s;
+                continue;
+            }
             let segments = p.segments();
             if segments.is_empty() || t < 0.0 || t >= p.duration_s() {
                 // Before the start or at and after the end: no segment to find.

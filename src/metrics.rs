@@ -440,30 +440,45 @@ impl Accumulator {
         tau_s.resize(after, 0.0);
         dist_m.clear();
         dist_m.resize(after, 0.0);
-        for i in 0..count {
-            let (c, h) = (
-                &commanded_m[i * n..(i + 1) * n],
-                &toolhead_m[i * n..(i + 1) * n],
-            );
+        // The following error (`t <= end`) of one sample.
+        let mut follow_error = |c: &[f64], h: &[f64], max_follow: &mut f64| {
+            let mut f2 = 0.0;
+            for a in 0..n {
+                let f = h[a] - c[a];
+                f2 += f * f;
+                follow[a] = raise(follow[a], f.abs());
+            }
+            *max_follow = raise(*max_follow, f2);
+        };
+        let split = first_after * n;
+        // Before T (every time there is below `end`, so every sample counts for the
+        // following error).
+        let before = commanded_m[..split]
+            .chunks_exact(n)
+            .zip(toolhead_m[..split].chunks_exact(n));
+        for (c, h) in before {
+            let (e2, along) = err(h);
+            overshoot = raise(overshoot, along);
+            abs_err = raise(abs_err, e2);
+            follow_error(c, h, &mut max_follow);
+        }
+        // From T on (the sample exactly at T also counts for the following error), with
+        // the time after T and the distance to the target kept for the settling
+        // bookkeeping.
+        let from = commanded_m[split..]
+            .chunks_exact(n)
+            .zip(toolhead_m[split..].chunks_exact(n))
+            .zip(tau_s.iter_mut().zip(dist_m.iter_mut()));
+        for (i, ((c, h), (tau, dist))) in (first_after..).zip(from) {
             let t = t_s(i);
             let (e2, along) = err(h);
             overshoot = raise(overshoot, along);
             abs_err = raise(abs_err, e2);
             if t <= end {
-                let mut f2 = 0.0;
-                for a in 0..n {
-                    let f = h[a] - c[a];
-                    f2 += f * f;
-                    follow[a] = raise(follow[a], f.abs());
-                }
-                max_follow = raise(max_follow, f2);
+                follow_error(c, h, &mut max_follow);
             }
-            if let Some(j) = i.checked_sub(first_after) {
-                // The time after T and the distance to the target, for the settling
-                // bookkeeping.
-                tau_s[j] = t - end;
-                dist_m[j] = e2.sqrt();
-            }
+            *tau = t - end;
+            *dist = e2.sqrt();
         }
         self.overshoot_m = overshoot;
         self.abs_err_max_sq_m2 = abs_err;
