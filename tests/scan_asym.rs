@@ -9,7 +9,9 @@
 //! 2. **At the same duration** (the seed's §4.4 "asymmetric move in a symmetric time
 //!    frame"): the asymmetric step vs the pure jerk-limited symmetric step of equal time.
 //!
-//! The test asserts what the physics shows (the numbers are in notes/README-scan.md).
+//! The test asserts what the physics shows (the numbers are in the README's paragraph on
+//! seed 003's asymmetric steps, under "Raster scan steps in the harness", and in
+//! docs/reports/REPORT-scan.md).
 
 use std::path::Path;
 

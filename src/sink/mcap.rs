@@ -1,6 +1,6 @@
 //! MCAP recordings of one run, for Foxglove and any MCAP reader.
 //!
-//! Layout of `run-<id>.mcap` (one file per run; see `notes/README-outputs.md`):
+//! Layout of `run-<id>.mcap` (one file per run; see the README's "MCAP recordings"):
 //! - profile `""` (no ROS); chunks compressed with zstd (single-threaded, so the bytes do not
 //!   depend on the machine's core count); message, chunk and metadata indexes and statistics.
 //! - one channel per signal group of the run's [`Series`] (see [`super::groups`]): topic
