@@ -127,7 +127,8 @@ impl Discrete {
         })
     }
 
-    /// The transition for the nominal step (see [`Discrete::nominal`]).
+    /// The transition for the nominal step, computed at the first call (the field of the
+    /// same name keeps it).
     fn nominal(&self) -> &[f64] {
         self.nominal
             .get_or_init(|| self.transition(self.nominal_dt_s))
