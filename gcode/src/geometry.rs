@@ -161,9 +161,9 @@ impl Bounds {
 
     /// Grows the box to hold a point given as X, Y, Z.
     pub fn include_xyz(&mut self, p: [f64; 3]) {
-        for k in 0..3 {
-            self.min_mm[k] = self.min_mm[k].min(p[k]);
-            self.max_mm[k] = self.max_mm[k].max(p[k]);
+        for ((lo, hi), v) in self.min_mm.iter_mut().zip(self.max_mm.iter_mut()).zip(p) {
+            *lo = lo.min(v);
+            *hi = hi.max(v);
         }
     }
 

@@ -233,14 +233,17 @@ mod tests {
 
     #[test]
     fn commands_comments_numbers_checksums() {
-        assert_eq!(kind("   ").unwrap(), LineKind::Blank);
-        assert_eq!(kind(";LAYER:3").unwrap(), LineKind::Comment("LAYER:3"));
+        assert_eq!(kind("   ").expect("test input"), LineKind::Blank);
         assert_eq!(
-            kind("(just a note)").unwrap(),
+            kind(";LAYER:3").expect("test input"),
+            LineKind::Comment("LAYER:3")
+        );
+        assert_eq!(
+            kind("(just a note)").expect("test input"),
             LineKind::Comment("just a note")
         );
-        assert_eq!(kind("%").unwrap(), LineKind::Percent);
-        match kind("N12 g01X1.5 ; move").unwrap() {
+        assert_eq!(kind("%").expect("test input"), LineKind::Percent);
+        match kind("N12 g01X1.5 ; move").expect("test input") {
             LineKind::Code {
                 letter,
                 number,
@@ -252,11 +255,11 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
-        match kind("G92.1").unwrap() {
+        match kind("G92.1").expect("test input") {
             LineKind::Code { number, sub, .. } => assert_eq!((number, sub), (92, Some(1))),
             other => panic!("{other:?}"),
         }
-        match kind("SET_VELOCITY_LIMIT ACCEL=3000").unwrap() {
+        match kind("SET_VELOCITY_LIMIT ACCEL=3000").expect("test input") {
             LineKind::Extended { name, args, .. } => {
                 assert_eq!((name, args), ("SET_VELOCITY_LIMIT", " ACCEL=3000"))
             }
@@ -267,16 +270,16 @@ mod tests {
         let cs = body.bytes().fold(0u8, |a, b| a ^ b);
         let good = format!("{body}*{cs}");
         assert!(matches!(
-            kind(&good).unwrap(),
+            kind(&good).expect("test input"),
             LineKind::Code { number: 1, .. }
         ));
         let bad = format!("{body}*{}", cs ^ 1);
         assert!(matches!(kind(&bad), Err(LexError::Checksum { .. })));
-        match kind("G1 X1 (half) Y2").unwrap() {
+        match kind("G1 X1 (half) Y2").expect("test input") {
             LineKind::Code { args, .. } => assert_eq!(args, " X1        Y2"),
             other => panic!("{other:?}"),
         }
-        match kind("M593 P\"zv;d\" F40 ; c").unwrap() {
+        match kind("M593 P\"zv;d\" F40 ; c").expect("test input") {
             LineKind::Code { args, .. } => assert_eq!(args, " P\"zv;d\" F40 "),
             other => panic!("{other:?}"),
         }

@@ -91,16 +91,28 @@ mod tests {
     fn splits_and_limits() {
         let text = b"G1 X1\r\n\nabcdefghijk\nG1 X2";
         let mut l = Lines::new(&text[..], 5);
-        assert_eq!(l.next_line().unwrap(), Some(LineStatus::Complete));
+        assert_eq!(
+            l.next_line().expect("test input"),
+            Some(LineStatus::Complete)
+        );
         assert_eq!(l.bytes(), b"G1 X1");
-        assert_eq!(l.next_line().unwrap(), Some(LineStatus::Complete));
+        assert_eq!(
+            l.next_line().expect("test input"),
+            Some(LineStatus::Complete)
+        );
         assert_eq!(l.bytes(), b"");
-        assert_eq!(l.next_line().unwrap(), Some(LineStatus::TooLong));
+        assert_eq!(
+            l.next_line().expect("test input"),
+            Some(LineStatus::TooLong)
+        );
         assert_eq!(l.line_no(), 3);
-        assert_eq!(l.next_line().unwrap(), Some(LineStatus::Complete));
+        assert_eq!(
+            l.next_line().expect("test input"),
+            Some(LineStatus::Complete)
+        );
         assert_eq!(l.bytes(), b"G1 X2");
         assert_eq!(l.line_no(), 4);
-        assert_eq!(l.next_line().unwrap(), None);
+        assert_eq!(l.next_line().expect("test input"), None);
         assert_eq!(l.bytes_read(), text.len() as u64);
     }
 }

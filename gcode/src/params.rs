@@ -81,6 +81,16 @@ impl Params {
             }
             let at = i;
             i = skip_ws(b, i + 1);
+            // `XNaN`, `Finf`: Marlin's strtof and Klipper's float() would read these.
+            let word = &b[i..b.len().min(i + 3)];
+            if word.eq_ignore_ascii_case(b"nan") || word.eq_ignore_ascii_case(b"inf") {
+                let end = args[i..].find([' ', '\t']).map_or(b.len(), |k| i + k);
+                return Err(ParamError::NotANumber {
+                    param: char::from(letter),
+                    at: i,
+                    end,
+                });
+            }
             let value = match b.get(i) {
                 Some(b'"') => {
                     let start = i + 1;
@@ -262,22 +272,22 @@ mod tests {
     #[test]
     fn letters_numbers_flags_strings() {
         let mut p = Params::default();
-        p.parse(" X1.5 y-2 E.25 F3000").unwrap();
+        p.parse(" X1.5 y-2 E.25 F3000").expect("test input");
         assert_eq!(p.get(b'X'), Value::Num(1.5));
         assert_eq!(p.get(b'Y'), Value::Num(-2.0));
         assert_eq!(p.get(b'E'), Value::Num(0.25));
         assert_eq!(p.get(b'Z'), Value::Absent);
-        p.parse("X1E5").unwrap();
+        p.parse("X1E5").expect("test input");
         assert_eq!(
             (p.get(b'X'), p.get(b'E')),
             (Value::Num(1.0), Value::Num(5.0))
         );
-        p.parse(" X Y Z10").unwrap();
+        p.parse(" X Y Z10").expect("test input");
         assert_eq!(
             (p.get(b'X'), p.get(b'Y'), p.get(b'Z')),
             (Value::Flag, Value::Flag, Value::Num(10.0))
         );
-        p.parse(" P\"zv\"\"d\" F40").unwrap();
+        p.parse(" P\"zv\"\"d\" F40").expect("test input");
         assert_eq!(p.get(b'P'), Value::Str(3, 8));
         assert_eq!(p.first_not_in(b"PF"), None);
         assert_eq!(p.first_not_in(b"F"), Some(b'P'));
@@ -294,7 +304,7 @@ mod tests {
             })
         ));
         assert!(matches!(p.parse("X-"), Err(ParamError::NotANumber { .. })));
-        p.parse("E3000:-2.5 H1").unwrap();
+        p.parse("E3000:-2.5 H1").expect("test input");
         assert_eq!(p.get(b'E'), Value::List(1, 10));
         assert!(matches!(
             p.parse("E3000:"),
@@ -305,13 +315,25 @@ mod tests {
             Err(ParamError::Syntax { at: 3, .. })
         ));
         assert!(matches!(p.parse("X{1+2}"), Err(ParamError::Syntax { .. })));
+        assert!(matches!(
+            p.parse("Y1 XNaN"),
+            Err(ParamError::NotANumber {
+                param: 'X',
+                at: 4,
+                end: 7
+            })
+        ));
+        assert!(matches!(
+            p.parse("F-inf"),
+            Err(ParamError::NotANumber { .. })
+        ));
     }
 
     #[test]
     fn key_values() {
         let mut kv = KeyValues::default();
         kv.parse(" accel=3000 SHAPER_TYPE='mzv' VELOCITY=2e2")
-            .unwrap();
+            .expect("test input");
         let keys: Vec<_> = kv
             .pairs()
             .iter()

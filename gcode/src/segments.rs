@@ -22,8 +22,9 @@
 //!   sine/cosine every 9th segment, Z and E each step `(end - current) / segments left`.
 //!   Single precision like the firmware.
 //!
-//! The returned points exclude the start and end exactly at the move's end point (every
-//! firmware sends its last segment to the target as written).
+//! The returned points exclude the start and end at the move's end point (every firmware
+//! sends its last segment to the target as written; Klipper's last E is its running sum
+//! of equal steps, which can differ from the target E in the last bit).
 
 use std::f32::consts::TAU as TAU32;
 use std::f64::consts::TAU;
@@ -180,7 +181,8 @@ fn klipper(mv: &Move, p: &KlipperArcs, out: &mut Vec<Point>) {
     for k in 1..=n {
         e += e_per;
         if k == n {
-            out.push(t);
+            // XYZ land on the target; E is Klipper's running sum.
+            out.push(Point::new(t.x_mm, t.y_mm, t.z_mm, e));
             break;
         }
         let kf = k as f64;
