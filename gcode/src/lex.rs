@@ -54,27 +54,18 @@ pub(crate) enum LexError {
 /// cut out of it (the common case borrows from `line`).
 pub(crate) fn lex<'a>(line: &'a str, scratch: &'a mut String) -> Result<LineKind<'a>, LexError> {
     let bytes = line.as_bytes();
-    if let Some(at) = bytes
-        .iter()
-        .position(|&b| (b < 0x20 && b != b'\t') || b == 0x7f)
-    {
-        return Err(LexError::Control {
-            at,
-            byte: bytes[at],
-        });
-    }
-    // Split off the `;` comment (outside quotes), and note whether parentheses appear.
+    // One pass: control characters anywhere, and (outside quotes) the `;` comment, any
+    // `(` comment and any `*` that may start a checksum.
     let mut in_quote = false;
     let mut code_end = bytes.len();
-    let mut has_paren = false;
+    let (mut has_paren, mut has_star) = (false, false);
     for (i, &b) in bytes.iter().enumerate() {
         match b {
+            0..0x20 | 0x7f if b != b'\t' => return Err(LexError::Control { at: i, byte: b }),
             b'"' => in_quote = !in_quote,
-            b';' if !in_quote => {
-                code_end = i;
-                break;
-            }
-            b'(' if !in_quote => has_paren = true,
+            b';' if !in_quote && code_end == bytes.len() => code_end = i,
+            b'(' if !in_quote && code_end == bytes.len() => has_paren = true,
+            b'*' if code_end == bytes.len() => has_star = true,
             _ => {}
         }
     }
@@ -82,7 +73,7 @@ pub(crate) fn lex<'a>(line: &'a str, scratch: &'a mut String) -> Result<LineKind
     let mut code = &line[..code_end];
     // A trailing `*nn` checksum over the bytes before the `*`.
     let trimmed = code.trim_end();
-    if let Some(star) = trimmed.rfind('*') {
+    if let Some(star) = trimmed.rfind('*').filter(|_| has_star) {
         let digits = &trimmed[star + 1..];
         if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
             let computed = bytes[..star].iter().fold(0u8, |acc, &b| acc ^ b);

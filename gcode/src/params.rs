@@ -57,7 +57,11 @@ impl Default for Params {
 impl Params {
     /// Parses `args` (the text after a letter-number command).
     pub(crate) fn parse(&mut self, args: &str) -> Result<(), ParamError> {
-        self.values = [Value::Absent; 26];
+        let mut old = self.present;
+        while old != 0 {
+            self.values[old.trailing_zeros() as usize] = Value::Absent;
+            old &= old - 1;
+        }
         self.present = 0;
         let b = args.as_bytes();
         let mut i = skip_ws(b, 0);
@@ -147,7 +151,9 @@ impl Params {
                             .all(|x| x.parse::<f64>().is_ok())
                             .then_some(Value::List(start, j))
                     } else {
-                        args[start..j].parse::<f64>().ok().map(Value::Num)
+                        decimal(&b[start..j])
+                            .or_else(|| args[start..j].parse::<f64>().ok())
+                            .map(Value::Num)
                     };
                     match parsed {
                         Some(v) => {
@@ -203,6 +209,46 @@ impl Params {
     pub(crate) fn is_empty(&self) -> bool {
         self.present == 0
     }
+}
+
+/// Exact powers of ten (every one up to 1e22 is a double).
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// `[+-]digits[.digits]` with at most 15 significant digits and 22 decimals, by Clinger's
+/// fast path: an exact integer divided by an exact power of ten is one correctly rounded
+/// IEEE division, the same bits as `str::parse`. `None` for anything else (the caller
+/// falls back to `str::parse`).
+fn decimal(t: &[u8]) -> Option<f64> {
+    let (neg, digits) = match t.first()? {
+        b'-' => (true, &t[1..]),
+        b'+' => (false, &t[1..]),
+        _ => (false, t),
+    };
+    let mut m: u64 = 0;
+    let (mut n, mut frac, mut seen_dot) = (0u32, 0usize, false);
+    for &c in digits {
+        if c == b'.' {
+            if seen_dot {
+                return None;
+            }
+            seen_dot = true;
+            continue;
+        }
+        if !c.is_ascii_digit() || n == 15 {
+            return None;
+        }
+        m = m * 10 + u64::from(c - b'0');
+        n += 1;
+        frac += usize::from(seen_dot);
+    }
+    if n == 0 {
+        return None;
+    }
+    let v = m as f64 / *POW10.get(frac)?;
+    Some(if neg { -v } else { v })
 }
 
 /// Klipper-style `KEY=VALUE` parameters, keys upper-cased.
@@ -327,6 +373,53 @@ mod tests {
             p.parse("F-inf"),
             Err(ParamError::NotANumber { .. })
         ));
+    }
+
+    #[test]
+    fn fast_decimals_match_str_parse() {
+        for t in [
+            "0",
+            "-0",
+            "12.5",
+            "-.5",
+            "3.",
+            "+7",
+            "123.456789012345",
+            "0.1",
+            "99999.99999",
+            "1.000000000000000001",
+        ] {
+            let want = t.parse::<f64>().expect("test input");
+            let got = decimal(t.as_bytes()).unwrap_or(want);
+            assert_eq!(got.to_bits(), want.to_bits(), "{t}");
+        }
+        // Random decimals of 1 to 15 digits with the point anywhere (a fixed LCG).
+        let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = || {
+            x = x
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            x >> 33
+        };
+        for _ in 0..20_000 {
+            let n = 1 + (next() % 15) as usize;
+            let mut t: String = (0..n)
+                .map(|_| char::from(b'0' + (next() % 10) as u8))
+                .collect();
+            t.insert((next() as usize) % (n + 1), '.');
+            if next() % 2 == 0 {
+                t.insert(0, '-');
+            }
+            let want = t.parse::<f64>().expect("test input");
+            assert_eq!(
+                decimal(t.as_bytes()).map(f64::to_bits),
+                Some(want.to_bits()),
+                "{t}"
+            );
+        }
+        assert_eq!(decimal(b"1234567890123456"), None); // 16 digits: left to str::parse
+        assert_eq!(decimal(b"."), None);
+        assert_eq!(decimal(b"1.2.3"), None);
     }
 
     #[test]
