@@ -19,8 +19,7 @@ fn read(c: &mut Criterion) {
         g.bench_function(format!("events_{d}"), |b| {
             b.iter(|| {
                 let events = Reader::new(black_box(&text[..]), ReaderOptions::new(d))
-                    .map(|e| e.expect("valid"))
-                    .count();
+                    .fold(0u64, |n, e| n + u64::from(e.is_ok()));
                 black_box(events)
             })
         });
