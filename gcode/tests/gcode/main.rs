@@ -48,6 +48,16 @@ pub fn error(text: &str, dialect: Dialect) -> GcodeError {
         .unwrap_or_else(|| panic!("expected an error reading {text:?}"))
 }
 
+/// The commands `text` ignores, as `NAME xCOUNT`; panics if it yields any event.
+pub fn ignored(text: &str, dialect: Dialect) -> Vec<String> {
+    let mut r = Reader::new(text.as_bytes(), ReaderOptions::new(dialect));
+    assert_eq!(r.by_ref().count(), 0, "{text}");
+    r.ignored_commands()
+        .iter()
+        .map(|(k, v)| format!("{k} x{v}"))
+        .collect()
+}
+
 /// The repository's test prints.
 pub fn print_path(name: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
