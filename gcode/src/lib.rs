@@ -15,6 +15,30 @@
 //! Commands without effect on motion (temperatures, fans, macros) are counted in
 //! [`Reader::ignored_commands`]. [`Summary`] gathers the statistics a user wants before
 //! planning; [`CanonicalWriter`] writes events back as G-code.
+//!
+//! ```
+//! use settle_gcode::{ArcSegmentation, Dialect, EventKind, MoveKind, Reader, ReaderOptions};
+//!
+//! let text = "G1 X10 Y0 F6000\n;LAYER:0\nG3 X0 Y10 I-10 J0 E1.5 ; a quarter circle\nM104 S200\n";
+//! let mut reader = Reader::new(text.as_bytes(), ReaderOptions::new(Dialect::Klipper));
+//! let mut arcs = 0;
+//! for event in reader.by_ref() {
+//!     let event = event?;
+//!     if let EventKind::Move(mv) = &event.kind {
+//!         // Klipper cuts arcs into floor(length / 1 mm) segments.
+//!         let points = mv.segments_for(&ArcSegmentation::default_for(Dialect::Klipper));
+//!         if mv.kind == MoveKind::Print {
+//!             assert_eq!((event.line, event.layer, points.len()), (3, 1, 15));
+//!             assert!((mv.length_mm() - 5.0 * std::f64::consts::PI).abs() < 1e-12);
+//!             assert_eq!(mv.feed_mm_s, 100.0);
+//!             arcs += 1;
+//!         }
+//!     }
+//! }
+//! assert_eq!(arcs, 1);
+//! assert_eq!(reader.ignored_commands()["M104"], 1);
+//! # Ok::<(), settle_gcode::GcodeError>(())
+//! ```
 
 // `!(x >= 0.0)`-style comparisons reject NaN together with out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
