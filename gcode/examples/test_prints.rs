@@ -1,0 +1,184 @@
+//! Writes settle's own test prints to `gcode/prints/` (committed; the test and docs
+//! inputs):
+//!
+//! - `ringing_tower.gcode`: five layers of a notched square tower wall, sharp 90 degree
+//!   corners at 150 mm/s, layer markers `;LAYER_CHANGE` / `;Z:`.
+//! - `cube_layer.gcode`: the first layer of a 20 mm cube (two perimeters), absolute E
+//!   with `G92 E0`, retracts, layer marker `;LAYER:0`.
+//! - `arc_part.gcode`: a rounded plate with a round hole, arcs in the I/J and R forms,
+//!   a full circle and a helical ramp, layer markers `; layer n, Z = z`. R-form arcs are
+//!   refused by Klipper: read this one with the marlin or rrf dialect.
+//!
+//! Run: `cargo run -p settle-gcode --example test_prints` (from the repository root).
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+/// Appends a formatted line to a `String`.
+macro_rules! put {
+    ($out:expr, $($arg:tt)*) => {{
+        $out.push_str(&format!($($arg)*));
+        $out.push('\n');
+    }};
+}
+
+/// Filament mm per mm of path for a 0.45 mm x 0.2 mm bead of 1.75 mm filament.
+const E_PER_MM: f64 = 0.45 * 0.2 / (PI * 0.875 * 0.875);
+
+fn header(out: &mut String, what: &str) {
+    put!(out, "; settle test print: {what}");
+    put!(
+        out,
+        "; made by `cargo run -p settle-gcode --example test_prints` (gcode/examples/test_prints.rs)"
+    );
+}
+
+/// Relative-E printing moves along a closed polygon, from its first vertex.
+fn loop_relative(out: &mut String, pts: &[(f64, f64)], feed: f64) {
+    for k in 1..=pts.len() {
+        let (a, b) = (pts[k - 1], pts[k % pts.len()]);
+        let len = (b.0 - a.0).hypot(b.1 - a.1);
+        put!(
+            out,
+            "G1 X{:.3} Y{:.3} E{:.5} F{feed:.0}",
+            b.0,
+            b.1,
+            len * E_PER_MM
+        );
+    }
+}
+
+fn ringing_tower() -> String {
+    let mut g = String::new();
+    header(
+        &mut g,
+        "ringing tower, five layers of a notched 40 mm square wall at 150 mm/s",
+    );
+    g.push_str("G21\nG90\nM83\nM104 S210\nM140 S60\nG28\nM204 S4000\nM106 S255\n");
+    let (c, h, n, d) = (110.0, 20.0, 4.0, 3.0); // centre, half side, notch half width, notch depth
+    // One side from corner to corner with a rectangular notch in its middle, then rotated.
+    let side = [(-h, -h), (-n, -h), (-n, -h + d), (n, -h + d), (n, -h)];
+    let mut pts = Vec::new();
+    for q in 0..4 {
+        let (s, co) = (
+            (q as f64 * PI / 2.0).sin().round(),
+            (q as f64 * PI / 2.0).cos().round(),
+        );
+        for &(x, y) in &side {
+            pts.push((c + co * x - s * y, c + s * x + co * y));
+        }
+    }
+    put!(g, "G1 Z5 F600\nG0 X{:.3} Y{:.3} F9000", pts[0].0, pts[0].1);
+    for layer in 1..=5 {
+        let z = 0.2 * layer as f64;
+        put!(g, ";LAYER_CHANGE\n;Z:{z:.1}\n;HEIGHT:0.2\nG1 Z{z:.3} F600");
+        put!(g, "G1 E0.8 F2100");
+        loop_relative(&mut g, &pts, 9000.0);
+        put!(g, "G1 E-0.8 F2100");
+    }
+    g.push_str("G1 Z10 F600\nM400\nM104 S0\nM140 S0\nM107\n");
+    g
+}
+
+fn cube_layer() -> String {
+    let mut g = String::new();
+    header(
+        &mut g,
+        "first layer of a 20 mm cube, two perimeters, absolute E",
+    );
+    g.push_str("G21\nG90\nM82\nG28\nG92 E0\nM204 S1500\n;LAYER:0\nG0 Z0.2 F600\n");
+    let mut e = 0.0;
+    for (k, inset) in [0.225f64, 0.675].iter().enumerate() {
+        let (lo, hi) = (100.0 + inset, 120.0 - inset);
+        let pts = [(lo, lo), (hi, lo), (hi, hi), (lo, hi)];
+        put!(g, "G0 X{:.3} Y{:.3} F9000", pts[0].0, pts[0].1);
+        if k > 0 {
+            e += 0.8;
+            put!(g, "G1 E{e:.5} F2100");
+        }
+        for j in 1..=4 {
+            let (a, b) = (pts[j - 1], pts[j % 4]);
+            e += (b.0 - a.0).hypot(b.1 - a.1) * E_PER_MM;
+            put!(g, "G1 X{:.3} Y{:.3} E{e:.5} F2400", b.0, b.1);
+        }
+        e -= 0.8;
+        put!(g, "G1 E{e:.5} F2100");
+    }
+    g.push_str("G92 E0\nG4 P250\nG1 Z5 F600\n");
+    g
+}
+
+fn arc_part() -> String {
+    let mut g = String::new();
+    header(
+        &mut g,
+        "rounded 30 x 20 mm plate with a 4 mm round hole, arcs in I/J and R forms",
+    );
+    g.push_str("; R-form arcs: read with the marlin or rrf dialect (Klipper refuses R)\n");
+    g.push_str("G21\nG90\nM83\nG28\nG17\nG0 Z0.2 F600\n");
+    let (x0, y0, x1, y1, r) = (95.0, 100.0, 125.0, 120.0, 5.0);
+    for layer in 1..=2 {
+        let z = 0.2 * layer as f64;
+        put!(g, "; layer {layer}, Z = {z:.3}");
+        let arc_e = PI / 2.0 * r * E_PER_MM;
+        // Outline, counter-clockwise from the bottom edge; corners alternate I/J and R forms.
+        put!(g, "G0 X{:.3} Y{y0:.3} F9000", x0 + r);
+        let e = |len: f64| len * E_PER_MM;
+        put!(
+            g,
+            "G1 X{:.3} Y{y0:.3} E{:.5} F3000",
+            x1 - r,
+            e(x1 - x0 - 2.0 * r)
+        );
+        put!(g, "G3 X{x1:.3} Y{:.3} I0 J{r:.3} E{arc_e:.5}", y0 + r);
+        put!(g, "G1 X{x1:.3} Y{:.3} E{:.5}", y1 - r, e(y1 - y0 - 2.0 * r));
+        put!(g, "G3 X{:.3} Y{y1:.3} R{r:.3} E{arc_e:.5}", x1 - r);
+        put!(g, "G1 X{:.3} Y{y1:.3} E{:.5}", x0 + r, e(x1 - x0 - 2.0 * r));
+        put!(g, "G3 X{x0:.3} Y{:.3} I0 J{:.3} E{arc_e:.5}", y1 - r, -r);
+        put!(g, "G1 X{x0:.3} Y{:.3} E{:.5}", y0 + r, e(y1 - y0 - 2.0 * r));
+        put!(g, "G3 X{:.3} Y{y0:.3} R{r:.3} E{arc_e:.5}", x0 + r);
+        // The hole: a full clockwise circle of radius 4 about (110, 110), I/J form.
+        put!(g, "G0 X114.000 Y110.000 F9000");
+        put!(
+            g,
+            "G2 X114.000 Y110.000 I-4.000 J0 E{:.5} F1800",
+            2.0 * PI * 4.0 * E_PER_MM
+        );
+        // Two half-turn R-form arcs through (104, 110): the short way (R > 0) out, the long
+        // way round a 3 mm radius (R < 0) back over a 4 mm chord.
+        put!(g, "G0 X100.000 Y110.000 F9000");
+        put!(
+            g,
+            "G2 X104.000 Y110.000 R2.000 E{:.5} F2400",
+            PI * 2.0 * E_PER_MM
+        );
+        let long = 2.0 * PI - 2.0 * (2.0f64 / 3.0).asin();
+        put!(
+            g,
+            "G3 X100.000 Y110.000 R-3.000 E{:.5}",
+            long * 3.0 * E_PER_MM
+        );
+        if layer == 1 {
+            // Up to the next layer along a helix: one turn of radius 2 mm rising 0.2 mm.
+            put!(g, "G0 X108.000 Y110.000 F9000");
+            put!(g, "G3 X108.000 Y110.000 Z{:.3} I2.000 J0 F1200", z + 0.2);
+        }
+    }
+    g.push_str("G4 S1\nG1 Z5 F600\n");
+    g
+}
+
+fn main() -> std::io::Result<()> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("prints");
+    std::fs::create_dir_all(&dir)?;
+    for (name, text) in [
+        ("ringing_tower.gcode", ringing_tower()),
+        ("cube_layer.gcode", cube_layer()),
+        ("arc_part.gcode", arc_part()),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,242 @@
+//! The crate's one error type, and where in a file an error is.
+
+use std::fmt;
+use std::sync::Arc;
+
+/// A place in the input: the source's name (a path, or `<input>`), the 1-based line and,
+/// where it is known, the 1-based byte column.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Location {
+    /// The path given to [`crate::Reader::open`], or the name given to
+    /// [`crate::Reader::with_name`] (`<input>` by default).
+    pub source_name: Arc<str>,
+    /// 1-based line number.
+    pub line: u64,
+    /// 1-based byte column of the offending text, when known.
+    pub column: Option<usize>,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}", self.source_name, self.line)?;
+        if let Some(c) = self.column {
+            write!(f, ":{c}")?;
+        }
+        Ok(())
+    }
+}
+
+/// Everything that can go wrong reading G-code. Every variant about a line names the
+/// file, the line (and column where known), the command or parameter and what is allowed.
+#[derive(Debug, thiserror::Error)]
+pub enum GcodeError {
+    /// The input could not be opened or read.
+    #[error("{source_name}: cannot read: {source}")]
+    Io {
+        /// The path or input name.
+        source_name: Arc<str>,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A line is longer than the reader's limit; it was not read into memory.
+    #[error("{at}: line longer than {limit_bytes} bytes (binary data or a corrupt file?)")]
+    LineTooLong {
+        /// Where.
+        at: Location,
+        /// The limit ([`crate::ReaderOptions::max_line_bytes`]).
+        limit_bytes: usize,
+    },
+    /// The line is not valid UTF-8.
+    #[error("{at}: invalid UTF-8 (binary data?); G-code is text")]
+    InvalidUtf8 {
+        /// Where (column = first invalid byte).
+        at: Location,
+    },
+    /// A control character other than tab (or a trailing carriage return).
+    #[error("{at}: control character 0x{byte:02x} (binary data?); G-code is text")]
+    ControlCharacter {
+        /// Where.
+        at: Location,
+        /// The byte.
+        byte: u8,
+    },
+    /// Text that is not G-code syntax.
+    #[error("{at}: {what}")]
+    Syntax {
+        /// Where.
+        at: Location,
+        /// What was expected.
+        what: &'static str,
+    },
+    /// A parameter value that is not a number.
+    #[error(
+        "{at}: `{command}` parameter {param}: `{text}` is not a number (allowed: decimal like -12.5)"
+    )]
+    NotANumber {
+        /// Where.
+        at: Location,
+        /// The command (`G1`, `SET_VELOCITY_LIMIT`).
+        command: String,
+        /// The parameter (`X`, `ACCEL`).
+        param: String,
+        /// The text found.
+        text: String,
+    },
+    /// A number outside the range the parameter allows (also NaN and infinity).
+    #[error("{at}: `{command}` parameter {param} = {value}: out of range (allowed: {allowed})")]
+    OutOfRange {
+        /// Where.
+        at: Location,
+        /// The command.
+        command: String,
+        /// The parameter.
+        param: String,
+        /// The value (after unit conversion and, for coordinates, after adding the
+        /// position for relative moves).
+        value: f64,
+        /// What is allowed.
+        allowed: &'static str,
+    },
+    /// The same parameter twice on one line.
+    #[error("{at}: `{command}` has parameter {param} twice")]
+    DuplicateParameter {
+        /// Where.
+        at: Location,
+        /// The command.
+        command: String,
+        /// The parameter.
+        param: String,
+    },
+    /// A parameter the command does not take.
+    #[error("{at}: `{command}` does not take parameter {param} (allowed: {allowed})")]
+    UnknownParameter {
+        /// Where.
+        at: Location,
+        /// The command.
+        command: String,
+        /// The parameter.
+        param: String,
+        /// The parameters it takes.
+        allowed: &'static str,
+    },
+    /// A parameter given without the value it needs (`G1 X`).
+    #[error("{at}: `{command}` parameter {param} needs a value")]
+    MissingValue {
+        /// Where.
+        at: Location,
+        /// The command.
+        command: String,
+        /// The parameter.
+        param: String,
+    },
+    /// A `*nn` checksum that does not match the line (the XOR of its bytes before `*`).
+    #[error("{at}: checksum *{found} does not match the line (computed {computed})")]
+    Checksum {
+        /// Where.
+        at: Location,
+        /// The checksum written in the line.
+        found: u32,
+        /// The XOR of the bytes before `*`.
+        computed: u8,
+    },
+    /// A command the chosen firmware dialect (or this reader) does not support.
+    #[error("{at}: `{command}` is not supported: {why}")]
+    Unsupported {
+        /// Where.
+        at: Location,
+        /// The command.
+        command: String,
+        /// Why, and what to do instead.
+        why: &'static str,
+    },
+    /// An arc command without the centre or radius it needs.
+    #[error("{at}: `{command}` needs a centre offset I/J (not both zero) or a radius R")]
+    ArcWithoutCentre {
+        /// Where.
+        at: Location,
+        /// `G2` or `G3`.
+        command: String,
+    },
+    /// An arc command with both I/J and R.
+    #[error("{at}: `{command}` has both a centre offset (I/J) and a radius (R); give one form")]
+    ArcMixedForms {
+        /// Where.
+        at: Location,
+        /// `G2` or `G3`.
+        command: String,
+    },
+    /// An I/J arc whose end point is not on the circle through its start point.
+    #[error(
+        "{at}: `{command}` start radius {start_radius_mm} mm and end radius {end_radius_mm} mm differ too much (allowed: up to 0.005 mm, or up to 0.1 % of the radius and 0.5 mm)"
+    )]
+    ArcRadiusMismatch {
+        /// Where.
+        at: Location,
+        /// `G2` or `G3`.
+        command: String,
+        /// Distance from the centre to the start point.
+        start_radius_mm: f64,
+        /// Distance from the centre to the end point.
+        end_radius_mm: f64,
+    },
+    /// An R-form arc whose radius is shorter than half the chord.
+    #[error(
+        "{at}: `{command}` radius {radius_mm} mm cannot reach the end point {chord_mm} mm away (needs at least half the chord, 1 % slack)"
+    )]
+    ArcRadiusTooSmall {
+        /// Where.
+        at: Location,
+        /// `G2` or `G3`.
+        command: String,
+        /// |R|.
+        radius_mm: f64,
+        /// Distance from start to end.
+        chord_mm: f64,
+    },
+    /// A firmware dialect name that is not `klipper`, `marlin` or `rrf`.
+    #[error("unknown firmware dialect `{name}` (allowed: klipper, marlin, rrf)")]
+    UnknownDialect {
+        /// The name given.
+        name: String,
+    },
+    /// An R-form arc that ends where it starts, or an arc of zero sweep.
+    #[error("{at}: `{command}`: {why}")]
+    ArcDegenerate {
+        /// Where.
+        at: Location,
+        /// `G2` or `G3`.
+        command: String,
+        /// What is degenerate.
+        why: &'static str,
+    },
+}
+
+impl GcodeError {
+    /// The location of a line error (`None` for I/O errors).
+    pub fn location(&self) -> Option<&Location> {
+        match self {
+            GcodeError::Io { .. } | GcodeError::UnknownDialect { .. } => None,
+            GcodeError::LineTooLong { at, .. }
+            | GcodeError::InvalidUtf8 { at }
+            | GcodeError::ControlCharacter { at, .. }
+            | GcodeError::Syntax { at, .. }
+            | GcodeError::NotANumber { at, .. }
+            | GcodeError::OutOfRange { at, .. }
+            | GcodeError::DuplicateParameter { at, .. }
+            | GcodeError::UnknownParameter { at, .. }
+            | GcodeError::MissingValue { at, .. }
+            | GcodeError::Checksum { at, .. }
+            | GcodeError::Unsupported { at, .. }
+            | GcodeError::ArcWithoutCentre { at, .. }
+            | GcodeError::ArcMixedForms { at, .. }
+            | GcodeError::ArcRadiusMismatch { at, .. }
+            | GcodeError::ArcRadiusTooSmall { at, .. }
+            | GcodeError::ArcDegenerate { at, .. } => Some(at),
+        }
+    }
+
+    /// The 1-based line number of a line error.
+    pub fn line(&self) -> Option<u64> {
+        self.location().map(|l| l.line)
+    }
+}

@@ -1,0 +1,77 @@
+//! settle-gcode: a streaming, strict G-code reader.
+//!
+//! [`Reader`] turns any `BufRead` (or a file, [`Reader::open`]) into [`Event`]s in file
+//! order, each with its 1-based line and its layer: moves ([`Move`]: start and end in a
+//! continuous machine frame, requested feed in mm/s, print/travel/extruder-only, exact arc
+//! geometry), dwells, layer changes, motion-limit changes ([`LimitChange`], in mm/s and
+//! mm/s^2 whatever the firmware's units) and notes. The conventions of the firmware
+//! dialect the caller chooses ([`Dialect`]: Klipper, Marlin, RepRapFirmware) decide units
+//! and modes; [`Move::segments_for`] cuts an arc into the exact points each firmware plans.
+//!
+//! The reader holds one line at a time (at most [`ReaderOptions::max_line_bytes`]), so a
+//! file of any size reads in bounded memory. Bad lines (binary data, NaN or huge
+//! coordinates, a zero feed, inconsistent arcs, ...) are errors that name the file, line,
+//! column and parameter; [`ReaderOptions::skip_bad_lines`] counts and skips them instead.
+//! Commands without effect on motion (temperatures, fans, macros) are counted in
+//! [`Reader::ignored_commands`]. [`Summary`] gathers the statistics a user wants before
+//! planning; [`CanonicalWriter`] writes events back as G-code.
+//!
+//! ```
+//! use settle_gcode::{ArcSegmentation, Dialect, EventKind, MoveKind, Reader, ReaderOptions};
+//!
+//! let text = "G1 X10 Y0 F6000\n;LAYER:0\nG3 X0 Y10 I-10 J0 E1.5 ; a quarter circle\nM104 S200\n";
+//! let mut reader = Reader::new(text.as_bytes(), ReaderOptions::new(Dialect::Klipper));
+//! let mut arcs = 0;
+//! for event in reader.by_ref() {
+//!     let event = event?;
+//!     if let EventKind::Move(mv) = &event.kind {
+//!         // Klipper cuts arcs into floor(length / 1 mm) segments.
+//!         let points = mv.segments_for(&ArcSegmentation::default_for(Dialect::Klipper));
+//!         if mv.kind == MoveKind::Print {
+//!             assert_eq!((event.line, event.layer, points.len()), (3, 1, 15));
+//!             assert!((mv.length_mm() - 5.0 * std::f64::consts::PI).abs() < 1e-12);
+//!             assert_eq!(mv.feed_mm_s, 100.0);
+//!             arcs += 1;
+//!         }
+//!     }
+//! }
+//! assert_eq!(arcs, 1);
+//! assert_eq!(reader.ignored_commands()["M104"], 1);
+//! # Ok::<(), settle_gcode::GcodeError>(())
+//! ```
+
+// `!(x >= 0.0)`-style comparisons reject NaN together with out-of-range values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+mod arc;
+mod canonical;
+mod cmd;
+mod dialect;
+mod error;
+mod event;
+mod geometry;
+mod layers;
+mod lex;
+mod limit_parse;
+mod limits;
+mod lines;
+mod motion;
+mod params;
+mod reader;
+mod segments;
+mod summary;
+
+pub use arc::{
+    Arc, FULL_CIRCLE_TOLERANCE_MM, RADIUS_TOLERANCE_MAX_MM, RADIUS_TOLERANCE_MM,
+    RADIUS_TOLERANCE_REL,
+};
+pub use canonical::CanonicalWriter;
+pub use dialect::Dialect;
+pub use error::{GcodeError, Location};
+pub use event::{Event, EventKind, LayerChange, LayerSource, Note};
+pub use geometry::{Bounds, Move, MoveKind, Path, Point};
+pub use layers::LayerMode;
+pub use limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
+pub use reader::{Reader, ReaderOptions, Skipped};
+pub use segments::{ArcSegmentation, KlipperArcs, MarlinArcs, RrfArcs};
+pub use summary::{LimitSeen, Summary};

@@ -1,0 +1,225 @@
+//! Bad G-code: a clear error with its line, or counted and skipped.
+
+use settle_gcode::{Dialect, EventKind, GcodeError, Reader, ReaderOptions};
+
+use crate::error;
+
+fn skipping(dialect: Dialect) -> ReaderOptions {
+    ReaderOptions {
+        skip_bad_lines: true,
+        ..ReaderOptions::new(dialect)
+    }
+}
+
+#[test]
+fn binary_garbage() {
+    let mut bytes = b"G1 X1\nG1 X2\n".to_vec();
+    bytes.extend_from_slice(&[0x00, 0xff, 0x13, 0x37, 0xfe, b'\n']); // line 3: not UTF-8
+    bytes.extend_from_slice(b"\x01\x02\x03garbage\n"); // line 4: control bytes
+    bytes.extend_from_slice(b"#@!\n"); // line 5: not a command
+    bytes.extend_from_slice(b"G1 X3\n");
+    let all: Vec<_> = Reader::new(&bytes[..], ReaderOptions::new(Dialect::Marlin)).collect();
+    assert_eq!(all.len(), 3, "two moves, then the error ends the stream");
+    let e = all[2].as_ref().expect_err("an error");
+    assert!(matches!(e, GcodeError::InvalidUtf8 { .. }), "{e}");
+    assert_eq!(e.line(), Some(3));
+    assert!(e.to_string().starts_with("<input>:3:"), "{e}");
+
+    let mut r = Reader::new(&bytes[..], skipping(Dialect::Marlin));
+    let moves = r
+        .by_ref()
+        .map(|e| e.expect("test value"))
+        .filter(|e| matches!(e.kind, EventKind::Move(_)))
+        .count();
+    assert_eq!(moves, 3);
+    let s = r.skipped();
+    assert_eq!(s.count, 3);
+    let lines: Vec<_> = s
+        .first
+        .iter()
+        .map(|e| e.line().expect("test value"))
+        .collect();
+    assert_eq!(lines, [3, 4, 5]);
+    assert!(matches!(
+        s.first[1],
+        GcodeError::ControlCharacter { byte: 0, .. } | GcodeError::ControlCharacter { byte: 1, .. }
+    ));
+    assert!(matches!(s.first[2], GcodeError::Syntax { .. }));
+}
+
+#[test]
+fn a_ten_megabyte_line_is_an_error_and_is_skipped_unread() {
+    let mut bytes = b"G1 X1\n".to_vec();
+    bytes.resize(bytes.len() + 10 * 1024 * 1024, b'7');
+    bytes.extend_from_slice(b"\nG1 X2\n");
+    match error(
+        std::str::from_utf8(&bytes).expect("test value"),
+        Dialect::Klipper,
+    ) {
+        GcodeError::LineTooLong { at, limit_bytes } => {
+            assert_eq!((at.line, limit_bytes), (2, 65536))
+        }
+        e => panic!("{e}"),
+    }
+    let mut r = Reader::new(&bytes[..], skipping(Dialect::Klipper));
+    let ev: Vec<_> = r.by_ref().map(|e| e.expect("valid G-code")).collect();
+    assert_eq!(ev.iter().map(|e| e.line).collect::<Vec<_>>(), [1, 3]);
+    assert_eq!(r.skipped().count, 1);
+    assert_eq!(r.bytes_read(), bytes.len() as u64);
+}
+
+#[test]
+fn nan_infinite_and_huge_values() {
+    for text in ["G1 XNaN", "G1 X1 Ynan", "G1 Xinf", "G1 E-inf"] {
+        match error(text, Dialect::Marlin) {
+            GcodeError::NotANumber { at, .. } => assert_eq!(at.line, 1),
+            e => panic!("{text}: {e}"),
+        }
+    }
+    // 1e308 written out: finite, but far beyond any machine.
+    let huge = format!("G1 X1{}", "0".repeat(308));
+    match error(&huge, Dialect::Marlin) {
+        GcodeError::OutOfRange { param, value, .. } => {
+            assert_eq!((param.as_str(), value), ("X", 1e308))
+        }
+        e => panic!("{e}"),
+    }
+    // Digits beyond the f64 range read as infinity.
+    let inf = format!("G1 Y1{}", "0".repeat(400));
+    assert!(matches!(
+        error(&inf, Dialect::Marlin),
+        GcodeError::OutOfRange { .. }
+    ));
+    // A coordinate past the reader's 1e5 mm limit, also when reached by relative moves.
+    assert!(matches!(
+        error("G1 Z100001", Dialect::Rrf),
+        GcodeError::OutOfRange { .. }
+    ));
+    match error("G91\nG1 X60000\nG1 X60000", Dialect::Rrf) {
+        GcodeError::OutOfRange { at, value, .. } => assert_eq!((at.line, value), (3, 120000.0)),
+        e => panic!("{e}"),
+    }
+    // Klipper-style values: nan and 1e308 are refused too.
+    assert!(matches!(
+        error("SET_VELOCITY_LIMIT ACCEL=nan", Dialect::Klipper),
+        GcodeError::OutOfRange { .. }
+    ));
+    assert!(matches!(
+        error("SET_VELOCITY_LIMIT ACCEL=1e308", Dialect::Klipper),
+        GcodeError::OutOfRange { .. }
+    ));
+}
+
+#[test]
+fn feed_must_be_positive() {
+    for text in ["G1 X1 F0", "G1 X1 F-100", "G0 F0"] {
+        match error(text, Dialect::Klipper) {
+            GcodeError::OutOfRange {
+                at,
+                param,
+                value,
+                allowed,
+                ..
+            } => {
+                assert_eq!((at.line, param.as_str()), (1, "F"));
+                assert!(value <= 0.0);
+                assert!(allowed.contains("greater than 0"));
+            }
+            e => panic!("{text}: {e}"),
+        }
+    }
+    // The message names file, line, column, command and parameter.
+    let e = error("G1 X1\nG1 X2 F0", Dialect::Klipper).to_string();
+    assert_eq!(
+        e,
+        "<input>:2:7: `G1` parameter F = 0: out of range (allowed: greater than 0, up to 1e9)"
+    );
+}
+
+#[test]
+fn arcs_with_inconsistent_radii() {
+    let text = "G1 X10 Y0\nG3 X0 Y9 I-10 J0\n";
+    match error(text, Dialect::Marlin) {
+        GcodeError::ArcRadiusMismatch {
+            at,
+            start_radius_mm,
+            end_radius_mm,
+            ..
+        } => {
+            assert_eq!((at.line, start_radius_mm, end_radius_mm), (2, 10.0, 9.0));
+        }
+        e => panic!("{e}"),
+    }
+}
+
+#[test]
+fn syntax_errors() {
+    assert!(matches!(
+        error("G1 X1 X2", Dialect::Marlin),
+        GcodeError::DuplicateParameter { .. }
+    ));
+    assert!(matches!(
+        error("G1 X1.2.3", Dialect::Marlin),
+        GcodeError::NotANumber { .. }
+    ));
+    assert!(matches!(
+        error("G1 X", Dialect::Marlin),
+        GcodeError::MissingValue { .. }
+    ));
+    assert!(matches!(
+        error("G1 X1 S0", Dialect::Marlin),
+        GcodeError::UnknownParameter { .. }
+    ));
+    assert!(matches!(
+        error("G1 X1 ?", Dialect::Marlin),
+        GcodeError::Syntax { .. }
+    ));
+    assert!(matches!(
+        error("G1 X{1+1}", Dialect::Rrf),
+        GcodeError::Syntax { .. }
+    ));
+    assert!(matches!(
+        error("G20", Dialect::Marlin),
+        GcodeError::Unsupported { .. }
+    ));
+    assert!(matches!(
+        error("N3 G1 X1*0", Dialect::Marlin),
+        GcodeError::Checksum { .. }
+    ));
+    assert!(matches!(
+        error("G1 X1 (open", Dialect::Marlin),
+        GcodeError::Syntax { .. }
+    ));
+    assert!(matches!(
+        error("SET_VELOCITY_LIMIT ACCELL=3000", Dialect::Klipper),
+        GcodeError::UnknownParameter { .. }
+    ));
+    assert!(matches!(
+        error("SET_VELOCITY_LIMIT ACCEL", Dialect::Klipper),
+        GcodeError::Syntax { .. }
+    ));
+    assert!(matches!(
+        error("M204 S-1", Dialect::Marlin),
+        GcodeError::OutOfRange { .. }
+    ));
+    // Unknown commands are not errors, whatever their parameters.
+    let r = Reader::new(
+        "M117 Hello (world) #1\nM104 S{temp}\n".as_bytes(),
+        ReaderOptions::new(Dialect::Rrf),
+    );
+    assert_eq!(r.count(), 0);
+}
+
+#[test]
+fn io_errors_name_the_file() {
+    let e = Reader::open(
+        "/nonexistent/part.gcode",
+        ReaderOptions::new(Dialect::Marlin),
+    )
+    .expect_err("an error");
+    assert!(
+        e.to_string()
+            .starts_with("/nonexistent/part.gcode: cannot read"),
+        "{e}"
+    );
+}

@@ -1,0 +1,71 @@
+//! settle-gcode's tests: one binary, one module per subject.
+
+mod arcs;
+mod dialects;
+mod errors;
+mod layers;
+mod roundtrip;
+mod segments;
+mod summary;
+
+use settle_gcode::{
+    Dialect, Event, EventKind, GcodeError, LimitChange, Move, Reader, ReaderOptions,
+};
+
+/// Every event of `text`, read with `dialect`; panics on an error.
+pub fn events(text: &str, dialect: Dialect) -> Vec<Event> {
+    Reader::new(text.as_bytes(), ReaderOptions::new(dialect))
+        .collect::<Result<Vec<_>, _>>()
+        .expect("valid G-code")
+}
+
+/// The moves of `text`.
+pub fn moves(text: &str, dialect: Dialect) -> Vec<Move> {
+    events(text, dialect)
+        .into_iter()
+        .filter_map(|e| match e.kind {
+            EventKind::Move(m) => Some(m),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The limit changes of `text`.
+pub fn limits(text: &str, dialect: Dialect) -> Vec<LimitChange> {
+    events(text, dialect)
+        .into_iter()
+        .filter_map(|e| match e.kind {
+            EventKind::Limits(c) => Some(c),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The error that ends reading `text`; panics if there is none.
+pub fn error(text: &str, dialect: Dialect) -> GcodeError {
+    Reader::new(text.as_bytes(), ReaderOptions::new(dialect))
+        .find_map(Result::err)
+        .unwrap_or_else(|| panic!("expected an error reading {text:?}"))
+}
+
+/// The commands `text` ignores, as `NAME xCOUNT`; panics if it yields any event.
+pub fn ignored(text: &str, dialect: Dialect) -> Vec<String> {
+    let mut r = Reader::new(text.as_bytes(), ReaderOptions::new(dialect));
+    assert_eq!(r.by_ref().count(), 0, "{text}");
+    r.ignored_commands()
+        .iter()
+        .map(|(k, v)| format!("{k} x{v}"))
+        .collect()
+}
+
+/// The repository's test prints.
+pub fn print_path(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("prints")
+        .join(name)
+}
+
+/// `|a - b| <= tol * max(|a|, |b|)`.
+pub fn close_rel(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * a.abs().max(b.abs())
+}
