@@ -29,6 +29,9 @@ pub const MOVE_THRESHOLD: f64 = 0.3;
 /// Samples handed to the matrix pencil at most (decimated above this).
 const PENCIL_SAMPLES: usize = 600;
 
+/// Poles beyond `2 m + 1` given to the matrix pencil.
+const PENCIL_EXTRA_POLES: usize = 6;
+
 /// Samples fitted at most.
 const MAX_FIT_SAMPLES: usize = 20_000;
 
@@ -57,10 +60,17 @@ pub fn fit(
         file: source.to_string(),
         reason,
     };
-    let f_dom = dominant_frequency(s, sample_rate_hz)
-        .ok_or_else(|| fail("no oscillation above 5 Hz in the recording".into()))?;
-    let period = ((sample_rate_hz / f_dom).round() as usize).max(2);
-    let start = decay_start(s, period);
+    let no_oscillation = || fail("no oscillation above 5 Hz in the recording".into());
+    // The move's own spectrum falls with frequency: weigh by f to find the ringing, then
+    // look again at the decay alone.
+    let mut f_dom = dominant_frequency(s, sample_rate_hz, 1).ok_or_else(no_oscillation)?;
+    let mut period = ((sample_rate_hz / f_dom).round() as usize).max(2);
+    let mut start = decay_start(s, period);
+    if let Some(f) = dominant_frequency(&s[start.min(s.len())..], sample_rate_hz, 0) {
+        f_dom = f;
+        period = ((sample_rate_hz / f_dom).round() as usize).max(2);
+        start = decay_start(s, period);
+    }
     let end = s.len().min(start + MAX_FIT_SAMPLES);
     if end - start < 4 * period || end - start < 40 {
         return Err(fail(format!(
@@ -79,7 +89,9 @@ pub fn fit(
     let mut best: Option<(LmFit, f64)> = None;
     let mut candidates = Vec::new();
     for m in 1..=max_modes.max(1) {
-        let Some(found) = settle_sim::pencil::fit(&decimated, dt * q as f64, 2 * m + 1) else {
+        // Extra poles take up the noise, so the m strongest oscillations are the modes.
+        let order = 2 * m + 1 + PENCIL_EXTRA_POLES;
+        let Some(found) = settle_sim::pencil::fit(&decimated, dt * q as f64, order) else {
             break;
         };
         let mut nonlinear: Vec<(f64, f64)> = found
@@ -177,14 +189,19 @@ pub fn fit(
     })
 }
 
-/// The frequency (Hz) of the largest periodogram peak above 5 Hz.
-fn dominant_frequency(s: &[f64], fs: f64) -> Option<f64> {
+/// The frequency (Hz) of the largest peak above 5 Hz of the periodogram times
+/// `f^power`.
+fn dominant_frequency(s: &[f64], fs: f64, power: i32) -> Option<f64> {
     let n = s.len() & !1;
+    if n < 16 {
+        return None;
+    }
     let welch = Welch::new(fs, n);
     let p = welch.psd(&s[..n])?;
     let lo = (5.0 / welch.bin_hz()).ceil() as usize;
     let hi = ((0.45 * fs) / welch.bin_hz()) as usize;
-    let k = (lo..hi.min(p.len())).max_by(|&a, &b| p[a].total_cmp(&p[b]))?;
+    let weighted = |k: usize| p[k] * (k as f64).powi(power);
+    let k = (lo..hi.min(p.len())).max_by(|&a, &b| weighted(a).total_cmp(&weighted(b)))?;
     (p[k] > 0.0).then(|| k as f64 * welch.bin_hz())
 }
 

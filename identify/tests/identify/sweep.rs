@@ -1,0 +1,183 @@
+//! Resonance sweeps (Klipper's test) identified from raw, processed and Shake&Tune files.
+
+use settle_identify::read::{klipper_psd, klipper_raw, stdata};
+use settle_identify::welch::Welch;
+use settle_identify::{Method, Options, SweepTest, identify_recording, identify_spectrum};
+
+use crate::common::check_modes;
+use crate::synth::{self, Truth};
+
+/// A sweep recording: 0.5 s rest, the test, 0.5 s rest; sensor rotated and tilted.
+pub fn sweep_axes(truth: &[Truth], test: &SweepTest, fs: f64, seed: u64) -> [Vec<f64>; 3] {
+    let pieces = test.pieces();
+    let n = ((test.duration_s() + 1.0) * fs) as usize;
+    let accel = synth::toolhead_accel(truth, &pieces, 0.5, fs, n);
+    let rot = synth::rotation(30.0, 12.0, -8.0);
+    synth::adxl345(&accel, [1.0, 0.0, 0.0], &rot, fs, seed)
+}
+
+/// The test at 2 Hz/s (65 s instead of 130 s: keeps the tests fast).
+fn fast_test() -> SweepTest {
+    SweepTest {
+        hz_per_sec: 2.0,
+        ..SweepTest::klipper()
+    }
+}
+
+#[test]
+fn klipper_raw_sweep_one_light_mode() {
+    let truth = [(45.0, 0.02, 1.0)];
+    let test = fast_test();
+    let fs = 1600.0;
+    let axes = sweep_axes(&truth, &test, fs, 1);
+    let text = synth::klipper_raw_csv(&axes, 1234.5, fs);
+    let rec = klipper_raw::parse("raw_data_x.csv", &text).expect("parse");
+    let id = identify_recording(
+        &rec,
+        &Options {
+            test,
+            ..Options::default()
+        },
+    )
+    .expect("identify");
+    assert_eq!(id.method, Method::SweepFit);
+    check_modes(&id, &truth, true);
+    // The motion lies along printer X, seen through the rotation.
+    let rot = synth::rotation(30.0, 12.0, -8.0);
+    let d = id.direction.expect("direction").vector;
+    let cos: f64 = (0..3).map(|k| d[k] * rot[k][0]).sum();
+    assert!(cos.abs() > 0.999, "direction {d:?}");
+    // The same input gives the same numbers, bit for bit.
+    let again = identify_recording(
+        &rec,
+        &Options {
+            test,
+            ..Options::default()
+        },
+    )
+    .expect("identify");
+    assert_eq!(format!("{id:?}"), format!("{again:?}"));
+}
+
+#[test]
+fn klipper_raw_sweep_two_modes() {
+    let truth = [(38.0, 0.05, 0.7), (88.0, 0.1, 0.3)];
+    let test = fast_test();
+    let fs = 3200.0;
+    let axes = sweep_axes(&truth, &test, fs, 2);
+    let text = synth::klipper_raw_csv(&axes, 77.0, fs);
+    let rec = klipper_raw::parse("raw_data_y.csv", &text).expect("parse");
+    let id = identify_recording(
+        &rec,
+        &Options {
+            test,
+            ..Options::default()
+        },
+    )
+    .expect("identify");
+    check_modes(&id, &truth, true);
+}
+
+/// Format like C's `%.3e` (`9.422e+03`).
+fn c_exp(v: f64) -> String {
+    let s = format!("{v:.3e}");
+    let (m, e) = s.split_once('e').expect("exponent");
+    let e: i32 = e.parse().expect("int");
+    format!("{m}e{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
+}
+
+/// A processed file as Klipper's `save_calibration_data` writes it, from the PSDs our
+/// Welch gives (checked against Klipper's own code in `welch_klipper`). With shapers:
+/// normalised (`calibration_data_*`, current layout with `shapers:`); without: raw
+/// (`resonances_*`).
+fn processed_csv(axes: &[Vec<f64>; 3], t_span_s: f64, normalised: bool) -> String {
+    let fs = axes[0].len() as f64 / t_span_s;
+    let welch = Welch::klipper(fs);
+    let mut cols: Vec<Vec<f64>> = axes.iter().map(|a| welch.psd(a).expect("psd")).collect();
+    let sum: Vec<f64> = (0..cols[0].len())
+        .map(|k| cols[0][k] + cols[1][k] + cols[2][k])
+        .collect();
+    cols.push(sum);
+    let freqs = welch.freqs_hz();
+    if normalised {
+        for c in &mut cols {
+            for (v, &f) in c.iter_mut().zip(&freqs) {
+                *v /= f + 0.1;
+                if f < 10.0 {
+                    *v *= (1.0 - (10.0 / (f + 0.1)).powi(2)).exp();
+                }
+            }
+        }
+    }
+    let mut s = String::from("freq,psd_x,psd_y,psd_z,psd_xyz");
+    if normalised {
+        s.push_str(",shapers:,zv(44.8),mzv(42.6)");
+    }
+    s.push('\n');
+    for (k, &f) in freqs.iter().enumerate() {
+        if f >= 200.0 {
+            break;
+        }
+        s.push_str(&format!("{f:.1}"));
+        for c in &cols {
+            s.push(',');
+            s.push_str(&c_exp(c[k]));
+        }
+        if normalised {
+            s.push_str(",,0.950,0.931");
+        }
+        s.push('\n');
+    }
+    s
+}
+
+#[test]
+fn klipper_processed_spectra_both_generations() {
+    let truth = [(38.0, 0.05, 0.7), (88.0, 0.1, 0.3)];
+    let test = fast_test();
+    let fs = 3200.0;
+    let axes = sweep_axes(&truth, &test, fs, 3);
+    let span = (axes[0].len() - 1) as f64 / fs;
+    for normalised in [false, true] {
+        let name = if normalised {
+            "calibration_data_x.csv"
+        } else {
+            "resonances_x.csv"
+        };
+        let psd = klipper_psd::parse(name, &processed_csv(&axes, span, normalised)).expect("parse");
+        assert_eq!(
+            psd.normalisation == klipper_psd::Normalisation::Raw,
+            !normalised
+        );
+        let id = identify_spectrum(
+            &psd,
+            &Options {
+                test,
+                ..Options::default()
+            },
+        )
+        .expect("identify");
+        check_modes(&id, &truth, true);
+    }
+}
+
+#[test]
+fn shaketune_stdata_sweep_heavily_damped() {
+    let truth = [(62.0, 0.18, 1.0)];
+    let test = fast_test();
+    let fs = 1600.0;
+    let axes = sweep_axes(&truth, &test, fs, 4);
+    let bytes = synth::stdata("axis_x", &axes, 5.0, fs);
+    let recs = stdata::parse("x.stdata", &bytes).expect("parse");
+    assert_eq!(recs.len(), 1);
+    assert_eq!(recs[0].name.as_deref(), Some("axis_x"));
+    let id = identify_recording(
+        &recs[0],
+        &Options {
+            test,
+            ..Options::default()
+        },
+    )
+    .expect("identify");
+    check_modes(&id, &truth, true);
+}
