@@ -2,6 +2,8 @@
 //! recordings of settle's own plant in every file format.
 
 mod common;
+mod readers;
 mod ringdown;
 mod sweep;
 mod synth;
+mod welch_klipper;

@@ -181,3 +181,27 @@ fn shaketune_stdata_sweep_heavily_damped() {
     .expect("identify");
     check_modes(&id, &truth, true);
 }
+
+#[test]
+fn noise_alone_has_no_peak() {
+    let fs = 1600.0;
+    let quiet = vec![0.0; (70.0 * fs) as usize];
+    let axes = synth::adxl345(
+        &quiet,
+        [1.0, 0.0, 0.0],
+        &synth::rotation(0.0, 0.0, 0.0),
+        fs,
+        9,
+    );
+    let rec =
+        klipper_raw::parse("quiet.csv", &synth::klipper_raw_csv(&axes, 0.0, fs)).expect("parse");
+    let opts = Options {
+        test: fast_test(),
+        ..Options::default()
+    };
+    let e = identify_recording(&rec, &opts).expect_err("no resonance in noise");
+    assert!(
+        matches!(e, settle_identify::IdentifyError::NoPeak { ref file, .. } if file == "quiet.csv"),
+        "{e}"
+    );
+}

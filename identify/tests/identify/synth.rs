@@ -232,3 +232,20 @@ pub fn stdata(name: &str, axes: &[Vec<f64>; 3], t0: f64, fs: f64) -> Vec<u8> {
     line.push_str("]}\n");
     zstd::stream::encode_all(line.as_bytes(), 3).expect("zstd")
 }
+
+/// The bench's recording: Klipper's default test (5-135 Hz at 1 Hz/s, 130 s) at 3,200 Hz
+/// with 0.5 s of rest either side, two modes (42 Hz zeta 0.04 weight 0.75, 95 Hz zeta
+/// 0.08 weight 0.25), sensor rotated: about 419,000 samples.
+pub fn default_sweep_axes() -> [Vec<f64>; 3] {
+    let test = settle_identify::SweepTest::klipper();
+    let fs = 3200.0;
+    let n = ((test.duration_s() + 1.0) * fs) as usize;
+    let accel = toolhead_accel(
+        &[(42.0, 0.04, 0.75), (95.0, 0.08, 0.25)],
+        &test.pieces(),
+        0.5,
+        fs,
+        n,
+    );
+    adxl345(&accel, [1.0, 0.0, 0.0], &rotation(30.0, 12.0, -8.0), fs, 21)
+}
