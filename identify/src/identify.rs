@@ -299,7 +299,7 @@ fn bin_grid(psd: &ProcessedPsd) -> Result<(usize, f64), IdentifyError> {
     let f0 = mean_f - bin * mean_j;
     let first = (f0 / bin).round().max(0.0);
     let header_line = psd.last_line + 1 - f.len();
-    if !(bin >= 0.5) {
+    if bin.is_nan() || bin < 0.5 {
         return Err(IdentifyError::format(
             &psd.source,
             header_line.saturating_sub(1).max(1),

@@ -25,7 +25,7 @@ pub fn correlation_inflation(r: &[f64]) -> f64 {
     let n = r.len();
     let mean = r.iter().sum::<f64>() / n.max(1) as f64;
     let var: f64 = r.iter().map(|x| (x - mean).powi(2)).sum();
-    if !(var > 0.0) {
+    if var.is_nan() || var <= 0.0 {
         return 1.0;
     }
     let mut sum = 0.0;

@@ -110,7 +110,7 @@ pub fn fit(
     };
     let floor = percentile(&y, 0.05);
     let peak_to_floor = y.iter().copied().fold(0.0, f64::max) / floor;
-    if !(peak_to_floor >= MIN_PEAK_TO_FLOOR) {
+    if peak_to_floor.is_nan() || peak_to_floor < MIN_PEAK_TO_FLOOR {
         return Err(no_peak(
             "largest PSD / noise floor",
             peak_to_floor,
@@ -124,7 +124,8 @@ pub fn fit(
         .copied()
         .enumerate()
         .fold((0, 0.0), |b, (j, r)| if r > b.1 { (j, r) } else { b });
-    if !(peak / median_ratio >= MIN_PROMINENCE) {
+    let prominence = peak / median_ratio;
+    if prominence.is_nan() || prominence < MIN_PROMINENCE {
         return Err(no_peak(
             "largest response / median response",
             peak / median_ratio,

@@ -172,15 +172,15 @@ pub fn parse(file: &str, text: &str) -> Result<ProcessedPsd, IdentifyError> {
             }
             col.push(v);
         }
-        if let Some(m) = marker {
-            if !fields[m].trim().is_empty() {
-                return Err(IdentifyError::format(
-                    file,
-                    n,
-                    format!("`{}` under `shapers:`", truncate(fields[m])),
-                    "an empty field under the `shapers:` column",
-                ));
-            }
+        if let Some(m) = marker
+            && !fields[m].trim().is_empty()
+        {
+            return Err(IdentifyError::format(
+                file,
+                n,
+                format!("`{}` under `shapers:`", truncate(fields[m])),
+                "an empty field under the `shapers:` column",
+            ));
         }
         for (k, name) in shapers.iter().enumerate() {
             parse_number(file, n, name, fields[shaper_start + k])?;

@@ -183,18 +183,23 @@ pub fn adxl345(
     out
 }
 
+/// The samples as `(index, [x, y, z])`.
+fn rows(axes: &[Vec<f64>; 3]) -> impl Iterator<Item = (usize, [f64; 3])> + '_ {
+    axes[0]
+        .iter()
+        .zip(&axes[1])
+        .zip(&axes[2])
+        .map(|((x, y), z)| [*x, *y, *z])
+        .enumerate()
+}
+
 /// Klipper raw CSV text (`adxl345.py`'s `write_to_file`): times from `t0` at `fs`.
 pub fn klipper_raw_csv(axes: &[Vec<f64>; 3], t0: f64, fs: f64) -> String {
     let mut s = String::with_capacity(axes[0].len() * 48);
     s.push_str("#time,accel_x,accel_y,accel_z\n");
-    for i in 0..axes[0].len() {
-        s.push_str(&format!(
-            "{:.6},{:.6},{:.6},{:.6}\n",
-            t0 + i as f64 / fs,
-            axes[0][i],
-            axes[1][i],
-            axes[2][i]
-        ));
+    for (i, [x, y, z]) in rows(axes) {
+        let t = t0 + i as f64 / fs;
+        s.push_str(&format!("{t:.6},{x:.6},{y:.6},{z:.6}\n"));
     }
     s
 }
@@ -202,13 +207,9 @@ pub fn klipper_raw_csv(axes: &[Vec<f64>; 3], t0: f64, fs: f64) -> String {
 /// RepRapFirmware M956 CSV text (all three axes, g with 4 decimals, integer rate).
 pub fn rrf_csv(axes: &[Vec<f64>; 3], rate_hz: u32) -> String {
     let mut s = String::from("Sample,X,Y,Z\n");
-    for i in 0..axes[0].len() {
-        s.push_str(&format!(
-            "{i},{:.4},{:.4},{:.4}\n",
-            axes[0][i] / G_MM_S2,
-            axes[1][i] / G_MM_S2,
-            axes[2][i] / G_MM_S2
-        ));
+    for (i, [x, y, z]) in rows(axes) {
+        let g = [x / G_MM_S2, y / G_MM_S2, z / G_MM_S2];
+        s.push_str(&format!("{i},{:.4},{:.4},{:.4}\n", g[0], g[1], g[2]));
     }
     s.push_str(&format!("Rate {rate_hz}, overflows 0\n"));
     s
@@ -217,17 +218,11 @@ pub fn rrf_csv(axes: &[Vec<f64>; 3], rate_hz: u32) -> String {
 /// Shake&Tune `.stdata` bytes: one measurement, zstd-compressed JSON line.
 pub fn stdata(name: &str, axes: &[Vec<f64>; 3], t0: f64, fs: f64) -> Vec<u8> {
     let mut line = format!("{{\"name\": \"{name}\", \"samples\": [");
-    for i in 0..axes[0].len() {
+    for (i, [x, y, z]) in rows(axes) {
         if i > 0 {
             line.push_str(", ");
         }
-        line.push_str(&format!(
-            "[{}, {}, {}, {}]",
-            t0 + i as f64 / fs,
-            axes[0][i],
-            axes[1][i],
-            axes[2][i]
-        ));
+        line.push_str(&format!("[{}, {x}, {y}, {z}]", t0 + i as f64 / fs));
     }
     line.push_str("]}\n");
     zstd::stream::encode_all(line.as_bytes(), 3).expect("zstd")
