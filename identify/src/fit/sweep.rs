@@ -6,13 +6,16 @@
 //! every level, so equal weights on the log scale are the right ones; the fit is
 //! Levenberg-Marquardt over `theta = (ln G, ln N, (ln f_k, ln zeta_k, ln w_k)...)`.
 //!
-//! Why the damping comes out unbiased: the half-power width of a *power* spectrum is
-//! `2 zeta f` at `|T|^2 = max / 2`, i.e. at `|T| = max / sqrt 2`; reading it with the
-//! amplitude formula (`|T| = max / 2`... or the half-power points of `|T|` instead of
-//! `|T|^2`) misplaces the points and the window's smoothing widens or flattens a narrow
-//! peak. Here no width is read: the model's `|T|^2` is the exact power response, smoothed
-//! by the same kernel as the data and driven by the sweep's own spectrum, so its
-//! parameters are those of the structure (tested on simulated recordings, zeta 0.02-0.2).
+//! Why the damping comes out unbiased: the half-power method reads zeta from the width
+//! of the peak, `2 zeta f` between the points where the *power* `|T|^2` falls to half its
+//! peak. Taking a power spectrum's width at `1/sqrt 2` of its peak (the amplitude rule)
+//! measures `|T|^2 = max / sqrt 2`, a width of `2 * 0.644 zeta f` for a lightly damped
+//! mode: 36 % low. The window's smoothing then widens a peak narrower than a few bins, and
+//! a second mode or the sweep's rising input tilts it. No width is read here: the model's
+//! `|T|^2` is the exact power response of the modal model, smoothed by the same kernel as
+//! the data and multiplied by the sweep's own spectrum, so the fitted parameters are those
+//! of the structure. What remains (see [`MODEL_REL_SIGMA`]) is measured on simulated
+//! recordings and carried in the reported sigma.
 //!
 //! Model size: 1 to `max_modes` modes; a mode is added while the Bayesian information
 //! criterion (with the residuals' correlation counted: `n_eff = n / c`) drops by at least
