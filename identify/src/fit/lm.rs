@@ -44,8 +44,8 @@ impl LmFit {
     }
 }
 
-/// The Jacobian of `f` at `theta` by forward differences (step `1e-6 max(1, |theta_i|)`);
-/// `None` if `f` fails anywhere.
+/// The Jacobian of `f` at `theta` by forward differences (step `1e-6 max(1, |theta_i|)`,
+/// backwards where the forward step leaves `f`'s domain); `None` if both fail.
 fn jacobian<F>(f: &F, theta: &[f64], r0: &[f64]) -> Option<DMatrix<f64>>
 where
     F: Fn(&[f64]) -> Option<Vec<f64>>,
@@ -55,9 +55,17 @@ where
     let mut j = DMatrix::zeros(n, p);
     let mut t = theta.to_vec();
     for k in 0..p {
-        let h = 1e-6 * theta[k].abs().max(1.0);
+        let mut h = 1e-6 * theta[k].abs().max(1.0);
         t[k] = theta[k] + h;
-        let r = f(&t)?;
+        // At the edge of the domain, difference backwards.
+        let r = match f(&t) {
+            Some(r) => r,
+            None => {
+                h = -h;
+                t[k] = theta[k] + h;
+                f(&t)?
+            }
+        };
         t[k] = theta[k];
         for i in 0..n {
             j[(i, k)] = (r[i] - r0[i]) / h;

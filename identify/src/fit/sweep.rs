@@ -46,6 +46,9 @@ pub const MIN_PROMINENCE: f64 = 2.0;
 /// alone is a few tenths of that. These figures bound that bias.
 pub const MODEL_REL_SIGMA: [f64; 3] = [0.0005, 0.03, 0.01];
 
+/// Largest participation weight the fit may reach (a real structure's sum to 1).
+const MAX_WEIGHT: f64 = 5.0;
+
 /// Bins left out at each end of the sweep band (the sweep's start and end ripple).
 const EDGE_BINS: f64 = 3.0;
 
@@ -157,7 +160,21 @@ pub fn fit(
     let mut best: Option<(LmFit, f64)> = None;
     let mut candidates = Vec::new();
     for m in 1..=max_modes.max(1) {
-        let Some(fit) = lm::minimise(|t| fitter.residuals(t), &theta, 200) else {
+        // The first mode also starts from a light and a heavy damping guess (broad,
+        // overlapping peaks mislead the width-based guess); the lowest RSS wins.
+        let mut starts = vec![theta.clone()];
+        if m == 1 {
+            for z in [0.05f64, 0.15] {
+                let mut t = theta.clone();
+                t[3] = z.ln();
+                starts.push(t);
+            }
+        }
+        let Some(fit) = starts
+            .iter()
+            .filter_map(|t| lm::minimise(|t| fitter.residuals(t), t, 200))
+            .min_by(|a, b| a.rss.total_cmp(&b.rss))
+        else {
             break;
         };
         let c = correlation_inflation(&fit.residuals[..bins.len()]);
@@ -269,7 +286,7 @@ impl Fitter<'_> {
             !(m.zeta < 0.95
                 && m.f_hz > 0.5 * self.f_range.0
                 && m.f_hz < 1.5 * self.f_range.1
-                && m.weight < 100.0)
+                && m.weight < MAX_WEIGHT)
         }) {
             return None;
         }
