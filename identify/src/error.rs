@@ -1,0 +1,124 @@
+//! The identify crate's one error type.
+//!
+//! Errors about a file name the file (as the caller named it) and, where one line is to
+//! blame, its 1-based line number (for a `.stdata` file: the line of the decompressed JSON
+//! text).
+
+/// What can go wrong reading a recording or identifying modes from it.
+#[derive(Debug, thiserror::Error)]
+pub enum IdentifyError {
+    /// The file could not be read.
+    #[error("{file}: cannot read: {source}")]
+    Io {
+        /// The file.
+        file: String,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// A line does not have the form the format requires.
+    #[error("{file}:{line}: {found}; expected {expected}")]
+    Format {
+        /// The file.
+        file: String,
+        /// 1-based line number.
+        line: usize,
+        /// What the line holds (or what is wrong with it).
+        found: String,
+        /// What the format allows there.
+        expected: String,
+    },
+    /// A value is NaN or infinite.
+    #[error("{file}:{line}: column `{column}` is {value}; expected a finite number")]
+    NotFinite {
+        /// The file.
+        file: String,
+        /// 1-based line number.
+        line: usize,
+        /// The column's name in the header.
+        column: String,
+        /// The value as read.
+        value: f64,
+    },
+    /// Time stamps must increase from one sample to the next.
+    #[error(
+        "{file}:{line}: time {time_s} s does not increase (the line before holds {previous_s} s); expected strictly increasing time stamps"
+    )]
+    NotMonotonic {
+        /// The file.
+        file: String,
+        /// 1-based line number of the offending sample.
+        line: usize,
+        /// Its time (s).
+        time_s: f64,
+        /// The previous sample's time (s).
+        previous_s: f64,
+    },
+    /// Too few samples (or frequency rows) to analyse.
+    #[error("{file}:{line}: the data end after {found} {what}; at least {needed} are needed")]
+    TooFewSamples {
+        /// The file.
+        file: String,
+        /// 1-based number of the last line read.
+        line: usize,
+        /// What was counted (`samples`, `frequency rows`).
+        what: &'static str,
+        /// How many there are.
+        found: usize,
+        /// How many the analysis needs.
+        needed: usize,
+    },
+    /// The recording holds no resonance: nothing in the band stands out of the noise.
+    #[error(
+        "{file}: no resonance peak above the noise between {band_lo_hz:.1} and {band_hi_hz:.1} Hz ({measure} is {ratio:.2}; at least {needed:.1} is needed)"
+    )]
+    NoPeak {
+        /// The file.
+        file: String,
+        /// Lower edge of the band searched (Hz).
+        band_lo_hz: f64,
+        /// Upper edge of the band searched (Hz).
+        band_hi_hz: f64,
+        /// What was compared (`largest PSD / noise floor`, `largest response / median
+        /// response`).
+        measure: &'static str,
+        /// The ratio found.
+        ratio: f64,
+        /// The ratio required.
+        needed: f64,
+    },
+    /// No free decay (ring-down) could be found in the recording.
+    #[error("{file}: {reason}")]
+    NoRingDown {
+        /// The file.
+        file: String,
+        /// Why not.
+        reason: String,
+    },
+    /// An option passed by the caller is out of range.
+    #[error("option `{name}` = {value} is invalid: allowed {allowed}")]
+    InvalidOption {
+        /// The option's name.
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What is allowed.
+        allowed: &'static str,
+    },
+}
+
+impl IdentifyError {
+    /// A [`IdentifyError::Format`] error.
+    pub(crate) fn format(
+        file: &str,
+        line: usize,
+        found: impl Into<String>,
+        expected: impl Into<String>,
+    ) -> Self {
+        IdentifyError::Format {
+            file: file.to_string(),
+            line,
+            found: found.into(),
+            expected: expected.into(),
+        }
+    }
+}

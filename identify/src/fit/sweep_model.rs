@@ -1,0 +1,171 @@
+//! The expected Welch PSD of a resonance sweep seen through the modal model.
+//!
+//! The sensor on the toolhead measures the toolhead's acceleration. With settle's modal
+//! model (toolhead = command + sum w_k e_k, `e_k'' + 2 zeta_k w_k e_k' + w_k^2 e_k =
+//! -a_cmd`) the transfer from the commanded to the measured acceleration is
+//!
+//! `T(i w) = 1 + sum_k w_k w^2 / (w_k^2 - w^2 + 2 i zeta_k w_k w)`
+//!
+//! (transmissibility; `1` below the modes, `w_k / (2 zeta_k)` in magnitude at an isolated
+//! mode, `1 - sum w_k` far above). The whole record's spectrum is exactly
+//! `|Y(nu)|^2 = |T(nu)|^2 |A(nu)|^2`, and averaging windowed periodograms over the record
+//! smooths it with the window's kernel `K` ([`crate::welch::Welch::kernel_table`]). So the
+//! expected PSD at bin `f` is
+//!
+//! `M(f) = G [ int E(nu) |T(nu)|^2 K(f - nu) dnu + sum_l E_l |T(nu_l)|^2 K(f - nu_l) ] + N`
+//!
+//! with `E` the sweep's energy density and `E_l` the sweeping lines
+//! ([`crate::excitation::SweepTest`]), `G` an unknown gain (record length, sensor scale,
+//! the test's true amplitude) and `N` the sensor's white noise floor. The integral runs on
+//! a grid of `1 / GRID_PER_BIN` bins, fine enough for a half-power width of a fraction of
+//! a bin (the trapezoid rule of a smooth peak converges geometrically once the step is
+//! below its half width). Sweep transients need no extra term: they are part of `T` times
+//! `A`, and only time-local spectra see them as distortion.
+
+use nalgebra::Complex;
+
+use crate::excitation::SweepTest;
+use crate::welch::Welch;
+
+/// Fine-grid points per bin.
+pub const GRID_PER_BIN: usize = 16;
+
+/// Kernel half width (bins): Kaiser(6)'s main lobe is +-2.2 bins, its side lobes below
+/// -44 dB beyond; 6 bins keep what the PSD's dynamic range can show.
+pub const KERNEL_HALF_WIDTH_BINS: usize = 6;
+
+/// A mode's parameters for the model: natural frequency (Hz), damping ratio, weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModeParams {
+    /// Natural frequency (Hz).
+    pub f_hz: f64,
+    /// Damping ratio.
+    pub zeta: f64,
+    /// Participation weight.
+    pub weight: f64,
+}
+
+/// `|T(nu)|^2` of the modal model at `nu_hz`.
+pub fn transmissibility_sq(modes: &[ModeParams], nu_hz: f64) -> f64 {
+    let mut t = Complex::new(1.0, 0.0);
+    for m in modes {
+        let r = nu_hz / m.f_hz;
+        t += m.weight * r * r / Complex::new(1.0 - r * r, 2.0 * m.zeta * r);
+    }
+    t.norm_sqr()
+}
+
+/// The precomputed pieces of the model for a set of bins.
+#[derive(Debug, Clone)]
+pub struct SweepModel {
+    /// Fine grid frequencies (Hz).
+    grid_hz: Vec<f64>,
+    /// Per fitted bin: first fine-grid index and the weights `K E dnu / bin` over the
+    /// following `2 H R + 1` points.
+    rows: Vec<(usize, Vec<f64>)>,
+    /// Sweeping lines: frequency (Hz).
+    line_hz: Vec<f64>,
+    /// Per fitted bin: weight of each line `K E_l / bin`.
+    line_rows: Vec<Vec<f64>>,
+}
+
+impl SweepModel {
+    /// The model for bins `k` (bin index; frequency `k bin_hz`) of an estimator with
+    /// `welch`'s window, under the test `test`.
+    pub fn new(welch: &Welch, bins: &[usize], test: &SweepTest) -> Self {
+        let bin = welch.bin_hz();
+        let r = GRID_PER_BIN;
+        let h = KERNEL_HALF_WIDTH_BINS;
+        let kernel = welch.kernel_table(h, r);
+        let first = bins.first().copied().unwrap_or(0);
+        let last = bins.last().copied().unwrap_or(0);
+        // Fine index g <-> frequency g bin / R; grid from (first - h) to (last + h) bins.
+        let g0 = (first * r).saturating_sub(h * r);
+        let g1 = (last + h) * r;
+        let grid_hz: Vec<f64> = (g0..=g1).map(|g| g as f64 * bin / r as f64).collect();
+        let dnu = bin / r as f64;
+        let energy: Vec<f64> = grid_hz
+            .iter()
+            .map(|&nu| test.sweep_energy_density(nu) * dnu / bin)
+            .collect();
+        let rows = bins
+            .iter()
+            .map(|&k| {
+                let centre = k * r;
+                let start = centre.saturating_sub(h * r).max(g0);
+                let weights = (start..=centre + h * r)
+                    .map(|g| kernel[g.abs_diff(centre)] * energy[g - g0])
+                    .collect();
+                (start - g0, weights)
+            })
+            .collect();
+        let lo = grid_hz.first().copied().unwrap_or(0.0);
+        let hi = grid_hz.last().copied().unwrap_or(0.0);
+        let lines = test.sweeping_lines(lo, hi);
+        let line_hz = lines.iter().map(|l| l.0).collect();
+        let line_rows = bins
+            .iter()
+            .map(|&k| {
+                let f = k as f64 * bin;
+                lines
+                    .iter()
+                    .map(|&(nu, e)| kernel_at(&kernel, (nu - f).abs() / bin) * e / bin)
+                    .collect()
+            })
+            .collect();
+        Self {
+            grid_hz,
+            rows,
+            line_hz,
+            line_rows,
+        }
+    }
+
+    /// The excitation alone seen through the estimator (`|T| = 1`, `G = 1`, `N = 0`).
+    pub fn excitation(&self) -> Vec<f64> {
+        self.rows
+            .iter()
+            .zip(&self.line_rows)
+            .map(|((_, w), l)| w.iter().sum::<f64>() + l.iter().sum::<f64>())
+            .collect()
+    }
+
+    /// The expected PSD per bin for gain `gain`, noise floor `noise` and `modes`, written
+    /// into `out` (one entry per bin given to [`SweepModel::new`]); `t2` is scratch.
+    pub fn evaluate(
+        &self,
+        gain: f64,
+        noise: f64,
+        modes: &[ModeParams],
+        t2: &mut Vec<f64>,
+        out: &mut [f64],
+    ) {
+        t2.clear();
+        t2.extend(
+            self.grid_hz
+                .iter()
+                .map(|&nu| transmissibility_sq(modes, nu)),
+        );
+        let line_t2: Vec<f64> = self
+            .line_hz
+            .iter()
+            .map(|&nu| transmissibility_sq(modes, nu))
+            .collect();
+        for ((o, (start, w)), l) in out.iter_mut().zip(&self.rows).zip(&self.line_rows) {
+            let cont: f64 = w.iter().zip(&t2[*start..]).map(|(a, b)| a * b).sum();
+            let lines: f64 = l.iter().zip(&line_t2).map(|(a, b)| a * b).sum();
+            *o = gain * (cont + lines) + noise;
+        }
+    }
+}
+
+/// Linear interpolation in a kernel table of [`GRID_PER_BIN`] points per bin; 0 beyond.
+fn kernel_at(table: &[f64], d_bins: f64) -> f64 {
+    let x = d_bins * GRID_PER_BIN as f64;
+    let i = x.floor() as usize;
+    if i + 1 >= table.len() {
+        return 0.0;
+    }
+    let t = x - i as f64;
+    table[i] * (1.0 - t) + table[i + 1] * t
+}

@@ -1,0 +1,171 @@
+//! Readers for the accelerometer files users already have. Each returns plain data.
+//!
+//! - [`klipper_raw`]: Klipper's raw accelerometer CSV (`#time,accel_x,accel_y,accel_z`);
+//! - [`klipper_psd`]: Klipper's processed spectra (`freq,psd_x,psd_y,psd_z,psd_xyz...`);
+//! - [`rrf`]: RepRapFirmware's M956 CSV (`Sample,X,Y,Z` ... `Rate <Hz>, overflows <n>`);
+//! - [`stdata`]: Shake&Tune's `.stdata` (zstd-compressed JSON lines).
+//!
+//! [`read_file`] picks the reader from the file's content.
+
+pub mod klipper_psd;
+pub mod klipper_raw;
+pub mod rrf;
+pub mod stdata;
+
+use std::path::Path;
+
+use crate::IdentifyError;
+
+/// Standard gravity (mm/s^2), as Klipper's `adxl345.py` (`FREEFALL_ACCEL`) and the g
+/// values of RepRapFirmware's files use it.
+pub const STANDARD_GRAVITY_MM_S2: f64 = 9_806.65;
+
+/// Fewest samples a reader accepts: below this no spectrum or decay can be measured.
+pub const MIN_SAMPLES: usize = 64;
+
+/// Which file format a recording came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RecordingFormat {
+    /// Klipper raw accelerometer CSV.
+    KlipperRaw,
+    /// RepRapFirmware M956 CSV.
+    RrfM956,
+    /// Shake&Tune `.stdata`.
+    ShakeTune,
+}
+
+/// Accelerometer samples in the sensor's frame (after the firmware's axes map).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    /// Where the data came from (the file name as given), for messages.
+    pub source: String,
+    /// The file format.
+    pub format: RecordingFormat,
+    /// The measurement's name inside the file (Shake&Tune), if any.
+    pub name: Option<String>,
+    /// Sample times (s). For RepRapFirmware files (no time stamps): `n / rate`.
+    pub time_s: Vec<f64>,
+    /// Acceleration per sensor axis x, y, z (mm/s^2); `None` for an axis the file does not
+    /// hold (M956 writes only the requested axes).
+    pub accel_mm_s2: [Option<Vec<f64>>; 3],
+    /// Sample rate (Hz). Klipper files: `N / (t_last - t_first)`, exactly as Klipper's
+    /// `shaper_calibrate.py` computes it; M956 files: the `Rate` line.
+    pub sample_rate_hz: f64,
+    /// The last line number of the file that holds a sample (for messages).
+    pub last_line: usize,
+}
+
+impl Recording {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.time_s.len()
+    }
+
+    /// True when the recording holds no samples (readers never return one).
+    pub fn is_empty(&self) -> bool {
+        self.time_s.is_empty()
+    }
+}
+
+/// What a file held: time-domain recordings or a processed spectrum.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FileData {
+    /// One or more recordings (a `.stdata` file may hold several measurements).
+    Recordings(Vec<Recording>),
+    /// A Klipper processed spectrum.
+    Spectrum(klipper_psd::ProcessedPsd),
+}
+
+/// Read any supported file, choosing the reader by content: zstd magic bytes ->
+/// Shake&Tune, `#time,` -> Klipper raw, `freq,` -> Klipper processed, `Sample` -> M956.
+pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| IdentifyError::Io {
+        file: file.clone(),
+        source,
+    })?;
+    if bytes.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
+        return stdata::parse(&file, &bytes).map(FileData::Recordings);
+    }
+    let text = String::from_utf8(bytes).map_err(|e| {
+        IdentifyError::format(
+            &file,
+            1,
+            format!("bytes that are not UTF-8 text ({e})"),
+            "a CSV text file or a zstd-compressed .stdata file",
+        )
+    })?;
+    let first = text
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty())
+        .unwrap_or("");
+    if first.starts_with("#time") {
+        klipper_raw::parse(&file, &text).map(|r| FileData::Recordings(vec![r]))
+    } else if first.starts_with("freq,") {
+        klipper_psd::parse(&file, &text).map(FileData::Spectrum)
+    } else if first.starts_with("Sample") {
+        rrf::parse(&file, &text).map(|r| FileData::Recordings(vec![r]))
+    } else {
+        Err(IdentifyError::format(
+            &file,
+            1,
+            format!("`{}`", truncate(first)),
+            "a header `#time,accel_x,accel_y,accel_z` (Klipper raw), `freq,psd_x,...` (Klipper processed), `Sample,X,Y,Z` (RepRapFirmware M956) or a zstd-compressed .stdata file",
+        ))
+    }
+}
+
+/// Parse one number of a CSV field, naming the file, line and column on failure.
+pub(crate) fn parse_number(
+    file: &str,
+    line: usize,
+    column: &str,
+    text: &str,
+) -> Result<f64, IdentifyError> {
+    let v: f64 = text.trim().parse().map_err(|_| {
+        IdentifyError::format(
+            file,
+            line,
+            format!("`{}` in column `{column}`", truncate(text.trim())),
+            "a number",
+        )
+    })?;
+    if !v.is_finite() {
+        return Err(IdentifyError::NotFinite {
+            file: file.to_string(),
+            line,
+            column: column.to_string(),
+            value: v,
+        });
+    }
+    Ok(v)
+}
+
+/// Check that time stamps increase strictly; `lines[i]` is sample `i`'s line number.
+pub(crate) fn check_monotonic(
+    file: &str,
+    time_s: &[f64],
+    line_of: impl Fn(usize) -> usize,
+) -> Result<(), IdentifyError> {
+    for (i, w) in time_s.windows(2).enumerate() {
+        if w[1] <= w[0] {
+            return Err(IdentifyError::NotMonotonic {
+                file: file.to_string(),
+                line: line_of(i + 1),
+                time_s: w[1],
+                previous_s: w[0],
+            });
+        }
+    }
+    Ok(())
+}
+
+/// At most 60 characters of `s`, for messages.
+pub(crate) fn truncate(s: &str) -> String {
+    if s.chars().count() <= 60 {
+        s.to_string()
+    } else {
+        format!("{}...", s.chars().take(57).collect::<String>())
+    }
+}

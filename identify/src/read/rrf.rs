@@ -1,0 +1,165 @@
+//! RepRapFirmware's M956 accelerometer CSV (`0:/sys/accelerometer/*.csv`).
+//!
+//! Written by `src/Accelerometers/Accelerometers.cpp` of RepRapFirmware: a header
+//! `Sample` followed by `,X`, `,Y`, `,Z` for the requested axes only (all three when none
+//! is named), then one row per sample: the sample number counting from 0 and the
+//! acceleration of each requested axis in g (printed with 2 to 4 decimals depending on the
+//! resolution). There are no time stamps; the last line is `Rate <Hz>, overflows <n>` (the
+//! measured sample rate). A capture that failed holds a line such as `Failed to collect
+//! data from accelerometer` or `Received bad data` instead.
+
+use super::{
+    MIN_SAMPLES, Recording, RecordingFormat, STANDARD_GRAVITY_MM_S2, parse_number, truncate,
+};
+use crate::IdentifyError;
+
+const EXPECTED_HEADER: &str = "`Sample` followed by one or more of `,X`, `,Y`, `,Z` in that order";
+
+/// Parse the text of an M956 file; `file` names it in errors.
+pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty());
+    let Some((hn, header)) = lines.next() else {
+        return Err(IdentifyError::format(
+            file,
+            1,
+            "an empty file",
+            EXPECTED_HEADER,
+        ));
+    };
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    let mut axis_of_column = Vec::new();
+    let mut last_axis = None;
+    for name in names.iter().skip(1) {
+        let axis = match *name {
+            "X" => 0,
+            "Y" => 1,
+            "Z" => 2,
+            _ => usize::MAX,
+        };
+        if axis == usize::MAX || last_axis.is_some_and(|a| a >= axis) {
+            return Err(IdentifyError::format(
+                file,
+                hn,
+                format!("header `{}`", truncate(header)),
+                EXPECTED_HEADER,
+            ));
+        }
+        last_axis = Some(axis);
+        axis_of_column.push(axis);
+    }
+    if names[0] != "Sample" || axis_of_column.is_empty() {
+        return Err(IdentifyError::format(
+            file,
+            hn,
+            format!("header `{}`", truncate(header)),
+            EXPECTED_HEADER,
+        ));
+    }
+    let mut columns: Vec<Vec<f64>> = vec![Vec::new(); axis_of_column.len()];
+    let mut rate_hz = None;
+    let mut last_line = hn;
+    for (n, l) in lines {
+        if rate_hz.is_some() {
+            return Err(IdentifyError::format(
+                file,
+                n,
+                format!("`{}` after the rate line", truncate(l)),
+                "nothing after the last line `Rate <Hz>, overflows <n>`",
+            ));
+        }
+        if let Some(rest) = l.strip_prefix("Rate") {
+            rate_hz = Some(parse_rate_line(file, n, rest)?);
+            continue;
+        }
+        let mut fields = l.split(',');
+        let index = fields.next().unwrap_or("").trim();
+        let expected_index = columns[0].len();
+        if index.parse::<usize>().ok() != Some(expected_index) {
+            let expected = format!(
+                "a row `{expected_index},<g>...` (sample numbers count up from 0), or the last line `Rate <Hz>, overflows <n>`"
+            );
+            return Err(IdentifyError::format(
+                file,
+                n,
+                format!("`{}`", truncate(l)),
+                expected,
+            ));
+        }
+        for (k, col) in columns.iter_mut().enumerate() {
+            let name = names[k + 1];
+            let Some(v) = fields.next() else {
+                return Err(IdentifyError::format(
+                    file,
+                    n,
+                    format!("no value for column `{name}` (`{}`)", truncate(l)),
+                    format!(
+                        "{} values in g after the sample number",
+                        axis_of_column.len()
+                    ),
+                ));
+            };
+            col.push(parse_number(file, n, name, v)? * STANDARD_GRAVITY_MM_S2);
+        }
+        if fields.next().is_some() {
+            return Err(IdentifyError::format(
+                file,
+                n,
+                format!("more fields than the header names (`{}`)", truncate(l)),
+                format!(
+                    "{} values in g after the sample number",
+                    axis_of_column.len()
+                ),
+            ));
+        }
+        last_line = n;
+    }
+    let Some(rate_hz) = rate_hz else {
+        return Err(IdentifyError::format(
+            file,
+            last_line,
+            "no rate line at the end of the file (a capture cut short?)",
+            "the last line `Rate <Hz>, overflows <n>`",
+        ));
+    };
+    let count = columns[0].len();
+    if count < MIN_SAMPLES {
+        return Err(IdentifyError::TooFewSamples {
+            file: file.to_string(),
+            line: last_line,
+            what: "samples",
+            found: count,
+            needed: MIN_SAMPLES,
+        });
+    }
+    let mut accel: [Option<Vec<f64>>; 3] = [None, None, None];
+    for (axis, col) in axis_of_column.into_iter().zip(columns) {
+        accel[axis] = Some(col);
+    }
+    Ok(Recording {
+        source: file.to_string(),
+        format: RecordingFormat::RrfM956,
+        name: None,
+        time_s: (0..count).map(|i| i as f64 / rate_hz).collect(),
+        accel_mm_s2: accel,
+        sample_rate_hz: rate_hz,
+        last_line,
+    })
+}
+
+/// `rest` is what follows `Rate`: ` <Hz>, overflows <n>`.
+fn parse_rate_line(file: &str, line: usize, rest: &str) -> Result<f64, IdentifyError> {
+    let expected = "`Rate <Hz>, overflows <n>` with a rate > 0";
+    let bad = || IdentifyError::format(file, line, format!("`Rate{}`", truncate(rest)), expected);
+    let (rate, overflows) = rest.split_once(',').ok_or_else(bad)?;
+    let rate: f64 = rate.trim().parse().map_err(|_| bad())?;
+    let overflows = overflows.trim().strip_prefix("overflows").ok_or_else(bad)?;
+    overflows.trim().parse::<u64>().map_err(|_| bad())?;
+    if !(rate.is_finite() && rate > 0.0) {
+        return Err(bad());
+    }
+    Ok(rate)
+}

@@ -1,0 +1,84 @@
+//! Shake&Tune's `.stdata` files.
+//!
+//! Written by `MeasurementsManager` in Shake&Tune's `shaketune/helpers/accelerometer.py`: a
+//! zstd stream of JSON lines, one measurement per line, each `{"name": <str>, "samples":
+//! [[t, x, y, z], ...]}` with the samples as Klipper's accelerometer client delivers them
+//! (time in s, acceleration in mm/s^2, axes map applied). Line numbers in errors count
+//! the lines of the decompressed text.
+
+use std::io::Read;
+
+use serde::Deserialize;
+
+use super::{MIN_SAMPLES, Recording, RecordingFormat, check_monotonic};
+use crate::IdentifyError;
+
+#[derive(Deserialize)]
+struct Measurement {
+    name: String,
+    samples: Vec<[f64; 4]>,
+}
+
+/// Parse the bytes of a `.stdata` file into one recording per measurement.
+pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> {
+    let mut text = String::new();
+    zstd::stream::read::Decoder::new(bytes)
+        .and_then(|mut d| d.read_to_string(&mut text))
+        .map_err(|e| {
+            IdentifyError::format(
+                file,
+                1,
+                format!("data that do not decompress to text ({e})"),
+                "a zstd-compressed stream of JSON lines (Shake&Tune .stdata)",
+            )
+        })?;
+    let mut out = Vec::new();
+    let mut last = 0;
+    for (i, line) in text.lines().enumerate() {
+        let n = i + 1;
+        last = n;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let m: Measurement = serde_json::from_str(line).map_err(|e| {
+            IdentifyError::format(
+                file,
+                n,
+                format!("invalid JSON at column {}: {e}", e.column()),
+                "one JSON object per line: {\"name\": <text>, \"samples\": [[t, x, y, z], ...]} with finite numbers",
+            )
+        })?;
+        if m.samples.len() < MIN_SAMPLES {
+            return Err(IdentifyError::TooFewSamples {
+                file: file.to_string(),
+                line: n,
+                what: "samples",
+                found: m.samples.len(),
+                needed: MIN_SAMPLES,
+            });
+        }
+        let time_s: Vec<f64> = m.samples.iter().map(|s| s[0]).collect();
+        check_monotonic(file, &time_s, |_| n)?;
+        let axis = |k: usize| Some(m.samples.iter().map(|s| s[k]).collect::<Vec<f64>>());
+        let span = time_s[time_s.len() - 1] - time_s[0];
+        out.push(Recording {
+            source: file.to_string(),
+            format: RecordingFormat::ShakeTune,
+            name: Some(m.name.clone()),
+            sample_rate_hz: time_s.len() as f64 / span,
+            accel_mm_s2: [axis(1), axis(2), axis(3)],
+            time_s,
+            last_line: n,
+        });
+    }
+    if out.is_empty() {
+        return Err(IdentifyError::TooFewSamples {
+            file: file.to_string(),
+            line: last.max(1),
+            what: "measurements",
+            found: 0,
+            needed: 1,
+        });
+    }
+    Ok(out)
+}
