@@ -4,7 +4,7 @@
 # `#fragment` names an element id of the target page). Links to http(s) and mailto are
 # not followed. Installs mdBook when it is missing (see below).
 #
-#   scripts/check-docs.sh        (from anywhere; output in docs/book/, git-ignored)
+#   scripts/check-docs.sh        (from anywhere; the HTML goes to target/book/, git-ignored)
 #
 # Where mdBook comes from, in order:
 #   1. `mdbook` on PATH, if it is version 0.5.x (the book's config needs 0.5);
@@ -76,7 +76,7 @@ fi
 echo "== mdbook build docs ($("$MDBOOK" --version))"
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
-rm -rf docs/book
+rm -rf target/book
 if ! "$MDBOOK" build docs >"$log" 2>&1; then
   cat "$log" >&2
   fail "mdbook build failed"
@@ -85,8 +85,8 @@ if grep -E '(^|[[:space:]])(WARN|ERROR)([[:space:]]|$)' "$log" >&2; then
   fail "mdbook printed warnings (treated as errors)"
 fi
 
-echo "== internal links and images of docs/book"
-python3 - docs/book <<'EOF'
+echo "== internal links and images of target/book"
+python3 - target/book <<'EOF'
 """Every relative href/src of the built book resolves to a file inside it, and every
 #fragment to an id on the target page. mdBook's own pages (print, toc, 404) and its
 assets are not checked as sources."""
