@@ -147,6 +147,9 @@ ABOUT = {
 }
 # Seconds simulated per criterion "element", for the groups that declare a throughput.
 ELEMENT_S = {"printer_xy_10mm_scurve_y": 1e-6, "mujoco": 1e-3}
+# Seconds simulated per iteration of benches without a declared throughput: the
+# quickstart's 10 mm S-curve is a 149.3 ms move and the 0.5 s window.
+ITER_S = {"quickstart_run_10mm_scurve": 0.6493}
 TIME_UNIT = {"ps": 1e-12, "ns": 1e-9, "µs": 1e-6, "us": 1e-6, "ms": 1e-3, "s": 1.0}
 ELEM_UNIT = {"elem/s": 1.0, "Kelem/s": 1e3, "Melem/s": 1e6, "Gelem/s": 1e9}
 NOTE = re.compile(r"interleaved|durations vs|real time per CPU second|simulated per run|"
@@ -187,7 +190,8 @@ for raw in open(log_path, encoding="utf-8", errors="replace"):
             current["rows"][-1]["thrpt"] = float(vals[1][0]) * ELEM_UNIT[vals[1][1]]
         continue
     if NOTE.search(line):
-        current["notes"].append(line.strip())
+        if line.strip() not in current["notes"]:
+            current["notes"].append(line.strip())
         continue
     if not line.startswith((" ", "Benchmarking", "Found", "Warning", "warning", "Compiling",
                             "Finished", "Running", "Gnuplot", "change", "No change",
@@ -212,6 +216,13 @@ w("")
 w("Every figure is a time measured on the machine above; on a machine shared with other "
   "work the same code reads up to tens of percent apart between runs. Criterion's "
   "estimate is the middle of its confidence interval, given in brackets.")
+busy = max(float(x) for x in env["PERF_LOAD"].replace(",", " ").split()[:7]
+           if re.fullmatch(r"[0-9.]+", x))
+if busy > float(env["PERF_CORES"]):
+    w("")
+    w(f"**The machine was busy while this page was measured** (load average up to "
+      f"{busy:g} on {env['PERF_CORES']} cores): other work shared the cores, so the times "
+      f"are upper bounds and the ratios noisier than on a quiet machine.")
 for sec in sections:
     if sec["bench"] == "scale":
         continue
@@ -223,17 +234,23 @@ for sec in sections:
     w("```text")
     out.extend(sec["cmds"])
     w("```")
+    def real_time(r):
+        group = r["name"].split("/")[0]
+        if r["thrpt"] is not None and group in ELEMENT_S:
+            return f"{r['thrpt'] * ELEMENT_S[group]:.0f}x"
+        if r["name"] in ITER_S:
+            return f"{ITER_S[r['name']] / r['time'][1]:.0f}x"
+        return None
+
     if sec["rows"]:
+        rt = any(real_time(r) for r in sec["rows"])
         w("")
-        w("| bench | time per iteration | interval | x real time |")
-        w("|---|---:|---|---:|")
+        w("| bench | time per iteration | interval |" + (" x real time |" if rt else ""))
+        w("|---|---:|---|" + ("---:|" if rt else ""))
         for r in sec["rows"]:
             lo, mid, hi = r["time"]
-            group = r["name"].split("/")[0]
-            rt = ""
-            if r["thrpt"] is not None and group in ELEMENT_S:
-                rt = f"{r['thrpt'] * ELEMENT_S[group]:.0f}x"
-            w(f"| `{r['name']}` | {fmt_time(mid)} | [{fmt_time(lo)}, {fmt_time(hi)}] | {rt} |")
+            cell = f" {real_time(r) or ''} |" if rt else ""
+            w(f"| `{r['name']}` | {fmt_time(mid)} | [{fmt_time(lo)}, {fmt_time(hi)}] |{cell}")
     if sec["notes"]:
         w("")
         w("Printed by the bench:")
