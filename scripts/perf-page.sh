@@ -65,6 +65,9 @@ if [[ $quick == 1 ]]; then
 else
   mt=(--warm-up-time 1 --measurement-time 5)
   bench "$planner_pkg" planner -- "${mt[@]}"
+  # The bench's own interleaved comparison runs only without a filter or with one naming
+  # it, and it reads option values as filters: call it on its own.
+  bench "$planner_pkg" planner -- interleaved
   bench "$planner_pkg" fourjerk -- "${mt[@]}"
   bench "$planner_pkg" path -- "${mt[@]}"
   bench settle sweep -- "${mt[@]}"
