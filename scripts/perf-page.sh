@@ -4,7 +4,8 @@
 # shipped sweeps timed with /usr/bin/time, and `scripts/scale.sh memory`. The page starts
 # with the date, the commit and the machine (CPU, cores, memory, rustc, load average).
 #
-#   scripts/perf-page.sh            everything (about 15-25 minutes on 2 cores, builds included)
+#   scripts/perf-page.sh            everything (about 30 minutes on a busy 2-core machine with
+#                                   the bench builds; about 10 minutes of measuring)
 #   scripts/perf-page.sh --quick    the cheapest subset: the sweep bench, the modal case of
 #                                   the simulation bench, the any-state planner bench, the
 #                                   quickstart sweep; short measurement times
@@ -68,8 +69,10 @@ else
   # The bench's own interleaved comparison runs only without a filter or with one naming
   # it, and it reads option values as filters: call it on its own.
   bench "$planner_pkg" planner -- interleaved
-  bench "$planner_pkg" fourjerk -- "${mt[@]}"
-  bench "$planner_pkg" path -- "${mt[@]}"
+  # Iterations of 0.7 s (four-jerk, any state) and 1.8 s (brute-force contour error):
+  # criterion's minimum of 10 samples instead of 100 keeps each under half a minute.
+  bench "$planner_pkg" fourjerk -- "${mt[@]}" --sample-size 10
+  bench "$planner_pkg" path -- "${mt[@]}" --sample-size 10
   bench settle sweep -- "${mt[@]}"
   bench settle sim "${features[@]}" -- "${mt[@]}"
   if [[ ${#features[@]} -gt 0 ]]; then
