@@ -5,7 +5,7 @@
 # with the date, the commit and the machine (CPU, cores, memory, rustc, load average).
 #
 #   scripts/perf-page.sh            everything (about 30 minutes on a busy 2-core machine with
-#                                   the bench builds; about 10 minutes of measuring)
+#                                   the bench builds; about 5 minutes of measuring)
 #   scripts/perf-page.sh --quick    the cheapest subset: the sweep bench, the modal case of
 #                                   the simulation bench, the any-state planner bench, the
 #                                   quickstart sweep; short measurement times
