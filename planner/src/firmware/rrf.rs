@@ -245,19 +245,30 @@ impl RrfPlanner {
             return;
         }
         let nf = self.frozen();
-        let mut next = self.ring.front().map_or(f64::INFINITY, |d| d.end_time_s);
-        if let Some(d) = self.ring.get(nf)
-            && nf * 2 < self.cfg.ring_length
-        {
-            let margin = if d.is_good_to_prepare() {
-                USUAL_MIN_PREPARED_S
-            } else {
-                ABSOLUTE_MIN_PREPARED_S
-            };
-            next = next.min(self.prepared_end_s - margin);
+        let completion = self.ring.front().map_or(f64::INFINITY, |d| d.end_time_s);
+        let due = match self.ring.get(nf) {
+            Some(d) if nf * 2 < self.cfg.ring_length => {
+                let margin = if d.is_good_to_prepare() {
+                    USUAL_MIN_PREPARED_S
+                } else {
+                    ABSOLUTE_MIN_PREPARED_S
+                };
+                self.prepared_end_s - margin
+            }
+            _ => f64::INFINITY,
+        };
+        if due <= completion {
+            // The next move falls due for preparation before anything finishes.
+            self.now_s = due.max(self.now_s);
+            self.recycle();
+            let nf = self.frozen();
+            if nf < self.ring.len() {
+                self.freeze_next(nf);
+            }
+        } else {
+            self.now_s = completion.max(self.now_s);
+            self.recycle();
         }
-        self.now_s = next.max(self.now_s);
-        self.recycle();
         self.prepare();
     }
 
@@ -284,7 +295,13 @@ impl FirmwarePlanner for RrfPlanner {
         self.e_pos += mv.extrude_m;
         self.recycle();
         while !self.can_add() {
+            let before = (self.now_s, self.ring.len(), self.frozen());
             self.advance();
+            if (self.now_s, self.ring.len(), self.frozen()) == before {
+                return Err(PlanError::NoSolution {
+                    reason: "the RepRapFirmware ring can neither take a move nor advance",
+                });
+            }
         }
         let meld = self
             .ring
