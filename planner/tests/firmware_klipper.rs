@@ -313,3 +313,42 @@ fn matches_klippers_toolhead_on_a_mixed_job() {
         1e-9,
     );
 }
+
+#[test]
+fn extruder_corner_velocity_limits_a_straight_junction() {
+    // Straight on, extrusion 0.05 then 0.01 mm per mm: the extruder's share changes by
+    // 0.04, so the junction is instantaneous_corner_velocity / 0.04 = 25 mm/s.
+    let (v, a, l) = (100.0 * MM, 3000.0 * MM, 50.0 * MM);
+    let e = |from: f64, to: f64, ratio: f64| {
+        LinearMove::new(
+            [from * MM, 0.0, 0.0],
+            [to * MM, 0.0, 0.0],
+            (to - from) * ratio * MM,
+            100.0 * MM,
+        )
+    };
+    let (out, t) = plan(
+        cfg(100.0, 3000.0, 0.5),
+        &[e(0.0, 50.0, 0.05), e(50.0, 100.0, 0.01)],
+    );
+    let vj = 25.0 * MM;
+    assert_rel("junction", out[0].end_speed_m_s, vj, 1e-12);
+    let leg = v / a + (v - vj) / a + (l - v * v / (2.0 * a) - (v * v - vj * vj) / (2.0 * a)) / v;
+    assert_rel("print time", t, 2.0 * leg, 1e-9);
+}
+
+#[test]
+fn bad_input_is_refused() {
+    let mut p = KlipperPlanner::new(cfg(100.0, 3000.0, 0.5)).expect("config");
+    let nan = LinearMove::new([0.0; 3], [f64::NAN, 0.0, 0.0], 0.0, 0.1);
+    assert!(p.push(&nan).is_err());
+    let stop = LinearMove::new([0.0; 3], [0.01, 0.0, 0.0], 0.0, 0.0);
+    assert!(p.push(&stop).is_err());
+    assert!(p.set_velocity_limit(None, None, None, Some(1.0)).is_err());
+    let mut c = cfg(100.0, 3000.0, 0.5);
+    c.extruder = None;
+    let mut p = KlipperPlanner::new(c).expect("config");
+    let extrude = LinearMove::new([0.0; 3], [0.01, 0.0, 0.0], 0.001, 0.1);
+    assert!(p.push(&extrude).is_err());
+    assert!(p.dwell(-1.0).is_err());
+}

@@ -50,6 +50,14 @@ impl KlipperPlanner {
         &self.cfg
     }
 
+    /// Replace the settings for the moves queued from now on (the `SET_VELOCITY_LIMIT`
+    /// settings and those Klipper reads only from printer.cfg).
+    pub fn set_config(&mut self, cfg: KlipperConfig) -> Result<(), PlanError> {
+        cfg.validate()?;
+        self.cfg = cfg;
+        Ok(())
+    }
+
     /// `SET_VELOCITY_LIMIT` (and `M204`, which sets `accel`): change the given settings for
     /// the moves queued from now on. Moves already queued keep theirs, as in Klipper.
     pub fn set_velocity_limit(

@@ -370,12 +370,13 @@ impl ProfileStream {
         // Bezier: steps meeting the exact speed, then a bridge onto the exact position.
         let n = ((tb - ta) / self.opts.bezier_step_s).ceil().max(1.0) as usize;
         let h = (tb - ta) / n as f64;
+        let mut v0 = p.state(ta);
         for k in 0..n.saturating_sub(2) {
-            let (t0, t1) = (ta + k as f64 * h, ta + (k + 1) as f64 * h);
-            let (v0, v1) = (p.state(t0), p.state(t1));
+            let v1 = p.state(ta + (k + 1) as f64 * h);
             for i in 0..AXES {
                 self.push_accel(i, h, (v1[i].1 - v0[i].1) / h);
             }
+            v0 = v1;
         }
         let bs = ta + n.saturating_sub(2) as f64 * h;
         let target = p.state(tb);

@@ -123,6 +123,8 @@ pub struct RrfPlanner {
     ring: VecDeque<Dda>,
     /// The last finished move, as the next look-ahead sees it.
     retired: Retired,
+    /// How many moves at the front of `ring` are frozen.
+    n_frozen: usize,
     /// The simulated time at which the ring is looked at (s).
     now_s: f64,
     /// End of the last frozen move (s).
@@ -140,6 +142,7 @@ impl RrfPlanner {
             cfg,
             ring: VecDeque::new(),
             retired: Retired::default(),
+            n_frozen: 0,
             now_s: 0.0,
             prepared_end_s: 0.0,
             timeline: Timeline::default(),
@@ -166,10 +169,7 @@ impl RrfPlanner {
     }
 
     fn frozen(&self) -> usize {
-        self.ring
-            .iter()
-            .take_while(|d| d.state == DdaState::Frozen)
-            .count()
+        self.n_frozen
     }
 
     fn running(&self) -> bool {
@@ -205,6 +205,7 @@ impl RrfPlanner {
                 decel_field: d.decel_field(),
             };
             self.ring.pop_front();
+            self.n_frozen -= 1;
         }
     }
 
@@ -213,6 +214,7 @@ impl RrfPlanner {
         let start = self.prepared_end_s.max(self.now_s);
         self.timeline.idle_until(start);
         let planned: PlannedMove = self.ring[nf].freeze(start);
+        self.n_frozen += 1;
         self.prepared_end_s = self.ring[nf].end_time_s;
         self.timeline.emit(planned);
     }
@@ -274,7 +276,7 @@ impl RrfPlanner {
 
     /// Run every queued move to the end and idle until it has finished.
     fn drain(&mut self) {
-        while self.ring.iter().any(|d| d.state == DdaState::Provisional) {
+        while self.n_frozen < self.ring.len() {
             let nf = self.frozen();
             self.freeze_next(nf);
         }
