@@ -68,7 +68,7 @@ impl Iterator for Job {
                 (start[1] + len * ang.sin()).clamp(0.0, 0.1),
                 start[2],
             ];
-            if self.i % 500 == 0 {
+            if self.i.is_multiple_of(500) {
                 end[2] += 0.2 * MM;
             }
             let travel = kind > 0.9;
