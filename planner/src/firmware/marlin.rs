@@ -1,5 +1,8 @@
-//! Marlin's planner (Marlin/src/module/planner.cpp, the 2.0.9 to 2.1 line) with its block
-//! buffer.
+//! Marlin's planner (Marlin/src/module/planner.cpp) with its block buffer.
+//!
+//! Read from planner.cpp of Marlin 2.0.9.x and stepper.cpp of a 2.1.x version; later 2.1
+//! releases reworked the rounding in `calculate_trapezoid_for_block`, which this model
+//! does not follow.
 //!
 //! Marlin plans in stepper steps. A move becomes a *block* (`_populate_block`): positions
 //! are rounded to whole steps, a block of fewer than `MIN_STEPS_PER_SEGMENT` steps on

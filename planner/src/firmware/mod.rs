@@ -25,6 +25,36 @@
 //! the printer moves (printing from a file), so every queue is as full as the firmware
 //! allows whenever it decides something. What each model approximates is said in its
 //! module.
+//!
+//! ```
+//! use settle_planner::firmware::klipper::{KlipperConfig, KlipperPlanner};
+//! use settle_planner::firmware::profiles::{ProfileOptions, ProfileStream};
+//! use settle_planner::firmware::{FirmwarePlanner, LinearMove};
+//!
+//! // max_velocity 300 mm/s, max_accel 3000 mm/s^2, Klipper's other defaults.
+//! let mut planner = KlipperPlanner::new(KlipperConfig::new(0.3, 3.0))?;
+//! let mut stream = ProfileStream::new(ProfileOptions::default())?;
+//! let corner = [
+//!     LinearMove::new([0.0, 0.0, 0.0], [0.05, 0.0, 0.0], 0.0, 0.1),
+//!     LinearMove::new([0.05, 0.0, 0.0], [0.05, 0.05, 0.0], 0.0, 0.1),
+//! ];
+//! for mv in &corner {
+//!     planner.push(mv)?;
+//!     while let Some(planned) = planner.pop() {
+//!         stream.push(&planned)?;
+//!     }
+//! }
+//! planner.finish();
+//! while let Some(planned) = planner.pop() {
+//!     // 5 mm/s at the corner: Klipper's square_corner_velocity.
+//!     assert!(planned.end_speed_m_s < 0.0051);
+//!     stream.push(&planned)?;
+//! }
+//! stream.finish()?;
+//! let chunk = stream.pop().expect("one chunk");
+//! assert_eq!(chunk.trajectory.dof(), 4); // X, Y, Z, E
+//! # Ok::<(), settle_planner::PlanError>(())
+//! ```
 
 pub mod klipper;
 mod klipper_queue;
