@@ -4,40 +4,12 @@
 use settle_planner::firmware::klipper::{KlipperConfig, KlipperPlanner};
 use settle_planner::firmware::{FirmwarePlanner, LinearMove, PlannedMove};
 
-const MM: f64 = 1e-3;
+mod firmware_common;
 
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs().max(1e-300)
-}
+use firmware_common::{MM, assert_rel, leg, plan_with, xy};
 
-fn assert_rel(what: &str, got: f64, want: f64, tol: f64) {
-    assert!(
-        rel(got, want) <= tol,
-        "{what}: got {got:.15e}, want {want:.15e}"
-    );
-}
-
-/// A move between two XY points (mm) at `speed` (mm/s), no extrusion.
-fn xy(from: [f64; 2], to: [f64; 2], speed: f64) -> LinearMove {
-    LinearMove::new(
-        [from[0] * MM, from[1] * MM, 0.0],
-        [to[0] * MM, to[1] * MM, 0.0],
-        0.0,
-        speed * MM,
-    )
-}
-
-/// Plan `moves` to the end; return the planned moves and the print time.
 fn plan(cfg: KlipperConfig, moves: &[LinearMove]) -> (Vec<PlannedMove>, f64) {
-    let mut p = KlipperPlanner::new(cfg).expect("config");
-    let mut out = Vec::new();
-    for m in moves {
-        p.push(m).expect("move");
-        out.extend(std::iter::from_fn(|| p.pop()));
-    }
-    p.finish();
-    out.extend(std::iter::from_fn(|| p.pop()));
-    (out, p.print_time_s())
+    plan_with(&mut KlipperPlanner::new(cfg).expect("config"), moves)
 }
 
 fn cfg(v_mm_s: f64, a_mm_s2: f64, mcr: f64) -> KlipperConfig {
@@ -70,8 +42,7 @@ fn ninety_degree_corner_passes_at_square_corner_velocity() {
     assert_rel("corner speed", out[0].end_speed_m_s, vj, 1e-12);
     assert_rel("corner speed", out[1].start_speed_m_s, vj, 1e-12);
     // Each leg: a ramp between rest and v, a ramp between v and v_j, a cruise between.
-    let leg = v / a + (v - vj) / a + (l - v * v / (2.0 * a) - (v * v - vj * vj) / (2.0 * a)) / v;
-    assert_rel("print time", t, 2.0 * leg, 1e-9);
+    assert_rel("print time", t, 2.0 * leg(l, v, a, 0.0, vj), 1e-9);
     assert_rel("accel time", out[0].accel_t_s, v / a, 1e-12);
     assert_rel("decel time", out[0].decel_t_s, (v - vj) / a, 1e-12);
 }
@@ -333,8 +304,7 @@ fn extruder_corner_velocity_limits_a_straight_junction() {
     );
     let vj = 25.0 * MM;
     assert_rel("junction", out[0].end_speed_m_s, vj, 1e-12);
-    let leg = v / a + (v - vj) / a + (l - v * v / (2.0 * a) - (v * v - vj * vj) / (2.0 * a)) / v;
-    assert_rel("print time", t, 2.0 * leg, 1e-9);
+    assert_rel("print time", t, 2.0 * leg(l, v, a, 0.0, vj), 1e-9);
 }
 
 #[test]

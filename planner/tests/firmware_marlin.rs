@@ -5,34 +5,14 @@
 //! `floor`, and the stepper's ramps in continuous time between those step counts.
 
 use settle_planner::firmware::marlin::{JdSmallSegments, MarlinConfig, MarlinJerk, MarlinPlanner};
-use settle_planner::firmware::{FirmwarePlanner, LinearMove, PlannedMove, RampShape};
+use settle_planner::firmware::{LinearMove, PlannedMove, RampShape};
 
-const MM: f64 = 1e-3;
+mod firmware_common;
 
-fn assert_rel(what: &str, got: f64, want: f64, tol: f64) {
-    let r = (got - want).abs() / want.abs().max(1e-300);
-    assert!(r <= tol, "{what}: got {got:.15e}, want {want:.15e}");
-}
-
-fn xy(from: [f64; 2], to: [f64; 2], speed: f64) -> LinearMove {
-    LinearMove::new(
-        [from[0] * MM, from[1] * MM, 0.0],
-        [to[0] * MM, to[1] * MM, 0.0],
-        0.0,
-        speed * MM,
-    )
-}
+use firmware_common::{MM, assert_rel, plan_with, xy};
 
 fn plan(cfg: MarlinConfig, moves: &[LinearMove]) -> (Vec<PlannedMove>, f64) {
-    let mut p = MarlinPlanner::new(cfg).expect("config");
-    let mut out = Vec::new();
-    for m in moves {
-        p.push(m).expect("move");
-        out.extend(std::iter::from_fn(|| p.pop()));
-    }
-    p.finish();
-    out.extend(std::iter::from_fn(|| p.pop()));
-    (out, p.print_time_s())
+    plan_with(&mut MarlinPlanner::new(cfg).expect("config"), moves)
 }
 
 /// The defaults: 80 steps/mm on X and Y, 3000 mm/s^2, junction deviation 0.013 mm.
@@ -69,6 +49,37 @@ fn trapezoid_time(n: f64, rn: f64, a: f64, r0: f64, rf: f64, na: f64, nd: f64) -
         ramp_time(peak, -a, nd)
     };
     t_acc + t_cruise + t_dec
+}
+
+/// Steps to change rate from `from` to `to` at `a` (estimate_acceleration_distance).
+fn steps(from: f64, to: f64, a: f64) -> f64 {
+    (to * to - from * from) / (2.0 * a)
+}
+
+/// Two 50 mm blocks at 100 mm/s (4000 steps at 8000 steps/s, 240000 steps/s^2 each) from
+/// rest to rest through a junction at rate `rj`: acceleration steps `ceil`ed,
+/// deceleration steps `floor`ed, 120 steps/s at both ends.
+fn two_blocks(rj: f64) -> f64 {
+    let (n, rn, a) = (4000.0, 8000.0, 240_000.0);
+    let t1 = trapezoid_time(
+        n,
+        rn,
+        a,
+        120.0,
+        rj,
+        steps(120.0, rn, a).ceil(),
+        steps(rj, rn, a).floor(),
+    );
+    let t2 = trapezoid_time(
+        n,
+        rn,
+        a,
+        rj,
+        120.0,
+        steps(rj, rn, a).ceil(),
+        steps(120.0, rn, a).floor(),
+    );
+    t1 + t2
 }
 
 #[test]
@@ -117,29 +128,9 @@ fn ninety_degree_corner_junction_deviation() {
     let vj = (3.0 * 0.013e-3 * s / (1.0 - s)).sqrt();
     // Both blocks: N = 4000 steps in 0.5 s, nominal 8000 steps/s. The corner rate:
     // ceil(8000 vj / 0.1).
-    let (n, rn, a) = (4000.0, 8000.0, 240_000.0);
-    let rj = (rn * vj / 0.1).ceil();
+    let rj = (8000.0 * vj / 0.1).ceil();
     assert_eq!(rj, 777.0);
-    let steps = |from: f64, to: f64| (to * to - from * from) / (2.0 * a);
-    let t1 = trapezoid_time(
-        n,
-        rn,
-        a,
-        120.0,
-        rj,
-        steps(120.0, rn).ceil(),
-        steps(rj, rn).floor(),
-    );
-    let t2 = trapezoid_time(
-        n,
-        rn,
-        a,
-        rj,
-        120.0,
-        steps(rj, rn).ceil(),
-        steps(120.0, rn).floor(),
-    );
-    assert_rel("print time", t, t1 + t2, 1e-12);
+    assert_rel("print time", t, two_blocks(rj), 1e-12);
     assert_rel(
         "corner entry",
         out[1].start_speed_m_s,
@@ -163,28 +154,8 @@ fn ninety_degree_corner_classic_jerk() {
     // speed, 10 mm/s; both blocks' safe speeds (10 mm/s) are above 0.99 of it, so the
     // safe speed is taken: 10 mm/s, 800 steps/s.
     let (out, t) = corner(classic(10.0));
-    let (n, rn, a, rj) = (4000.0, 8000.0, 240_000.0, 800.0);
-    let steps = |from: f64, to: f64| (to * to - from * from) / (2.0 * a);
-    assert_eq!(steps(rj, rn), 132.0);
-    let t1 = trapezoid_time(
-        n,
-        rn,
-        a,
-        120.0,
-        rj,
-        steps(120.0, rn).ceil(),
-        steps(rj, rn).floor(),
-    );
-    let t2 = trapezoid_time(
-        n,
-        rn,
-        a,
-        rj,
-        120.0,
-        steps(rj, rn).ceil(),
-        steps(120.0, rn).floor(),
-    );
-    assert_rel("print time", t, t1 + t2, 1e-12);
+    assert_eq!(steps(800.0, 8000.0, 240_000.0), 132.0);
+    assert_rel("print time", t, two_blocks(800.0), 1e-12);
     assert_rel("corner", out[0].end_speed_m_s, 10.0 * MM, 1e-12);
     // Classic jerk passes this corner faster than junction deviation 0.013 mm (9.70).
     let (_, t_jd) = corner(defaults());
@@ -197,44 +168,14 @@ fn reversal_junction_deviation_stops_classic_jerk_does_not() {
         xy([0.0, 0.0], [50.0, 0.0], 100.0),
         xy([50.0, 0.0], [0.0, 0.0], 100.0),
     ];
-    let (n, rn, a) = (4000.0, 8000.0, 240_000.0);
-    let steps = |from: f64, to: f64| (to * to - from * from) / (2.0 * a);
     // Junction deviation: cos(theta) > 0.999999 -> MINIMUM_PLANNER_SPEED, 120 steps/s.
     let (_, t) = plan(defaults(), &moves);
-    let rest = trapezoid_time(
-        n,
-        rn,
-        a,
-        120.0,
-        120.0,
-        steps(120.0, rn).ceil(),
-        steps(120.0, rn).floor(),
-    );
-    assert_rel("jd reversal", t, 2.0 * rest, 1e-12);
+    assert_rel("jd reversal", t, two_blocks(120.0), 1e-12);
     // Classic jerk: the reversal counts the larger of the two speeds as the jump, 100
     // mm/s on X -> factor 0.1 -> 10 mm/s, and the safe speeds take it: the toolhead
     // reverses from +10 to -10 mm/s at once.
     let (out, t) = plan(classic(10.0), &moves);
-    let rj = 800.0;
-    let t1 = trapezoid_time(
-        n,
-        rn,
-        a,
-        120.0,
-        rj,
-        steps(120.0, rn).ceil(),
-        steps(rj, rn).floor(),
-    );
-    let t2 = trapezoid_time(
-        n,
-        rn,
-        a,
-        rj,
-        120.0,
-        steps(rj, rn).ceil(),
-        steps(120.0, rn).floor(),
-    );
-    assert_rel("classic reversal", t, t1 + t2, 1e-12);
+    assert_rel("classic reversal", t, two_blocks(800.0), 1e-12);
     assert_eq!(out[1].axes_r[0], -1.0);
     assert_rel("reversal speed", out[1].start_speed_m_s, 10.0 * MM, 1e-12);
 }
@@ -258,8 +199,7 @@ fn first_block_is_planned_with_three_blocks_known() {
     // N = 800, nominal 200 mm/s = 16000 steps/s; exit rate ceil(16000 v / 0.2).
     let (n, rn, a) = (800.0, 16000.0, 240_000.0);
     let rf = (rn * v_exit / 0.2).ceil();
-    let steps = |from: f64, to: f64| (to * to - from * from) / (2.0 * a);
-    let (na, nd) = (steps(120.0, rn).ceil(), steps(rf, rn).floor());
+    let (na, nd) = (steps(120.0, rn, a).ceil(), steps(rf, rn, a).floor());
     assert!(na + nd > n, "no cruise in this block");
     // A triangle: accelerate ceil(intersection_distance) steps, then decelerate.
     let na = ((2.0 * a * n - 120.0 * 120.0 + rf * rf) / (4.0 * a)).ceil();

@@ -7,7 +7,9 @@ use settle_planner::firmware::marlin::{MarlinConfig, MarlinPlanner};
 use settle_planner::firmware::profiles::{ProfileChunk, ProfileOptions, ProfileStream};
 use settle_planner::firmware::{FirmwarePlanner, LinearMove, PlannedMove};
 
-const MM: f64 = 1e-3;
+mod firmware_common;
+
+use firmware_common::{MM, xy};
 
 fn run(
     planner: &mut dyn FirmwarePlanner,
@@ -59,15 +61,6 @@ fn profile(chunks: &[ProfileChunk], axis: usize, t: f64) -> (f64, f64) {
     let i = chunks.partition_point(|c| c.start_time_s <= t).max(1) - 1;
     let s = chunks[i].trajectory.axes()[axis].state_at(t - chunks[i].start_time_s);
     (s.p, s.v)
-}
-
-fn xy(from: [f64; 2], to: [f64; 2], speed: f64) -> LinearMove {
-    LinearMove::new(
-        [from[0] * MM, from[1] * MM, 0.0],
-        [to[0] * MM, to[1] * MM, 0.0],
-        0.0,
-        speed * MM,
-    )
 }
 
 #[test]

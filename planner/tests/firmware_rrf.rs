@@ -3,39 +3,12 @@
 use settle_planner::firmware::rrf::{RrfConfig, RrfPlanner};
 use settle_planner::firmware::{FirmwarePlanner, Kinematics, LinearMove, PlannedMove};
 
-const MM: f64 = 1e-3;
+mod firmware_common;
 
-fn assert_rel(what: &str, got: f64, want: f64, tol: f64) {
-    let r = (got - want).abs() / want.abs().max(1e-300);
-    assert!(r <= tol, "{what}: got {got:.15e}, want {want:.15e}");
-}
-
-fn mv(from: [f64; 2], to: [f64; 2], e_mm: f64, speed: f64) -> LinearMove {
-    LinearMove::new(
-        [from[0] * MM, from[1] * MM, 0.0],
-        [to[0] * MM, to[1] * MM, 0.0],
-        e_mm * MM,
-        speed * MM,
-    )
-}
+use firmware_common::{MM, assert_rel, leg, plan_with, xye as mv};
 
 fn plan(cfg: RrfConfig, moves: &[LinearMove]) -> (Vec<PlannedMove>, f64) {
-    let mut p = RrfPlanner::new(cfg).expect("config");
-    let mut out = Vec::new();
-    for m in moves {
-        p.push(m).expect("move");
-        out.extend(std::iter::from_fn(|| p.pop()));
-    }
-    p.finish();
-    out.extend(std::iter::from_fn(|| p.pop()));
-    (out, p.print_time_s())
-}
-
-/// One leg of `l` at cruise `v` with acceleration `a`, from `v0` to `v1`.
-fn leg(l: f64, v: f64, a: f64, v0: f64, v1: f64) -> f64 {
-    (v - v0) / a
-        + (v - v1) / a
-        + (l - (v * v - v0 * v0) / (2.0 * a) - (v * v - v1 * v1) / (2.0 * a)) / v
+    plan_with(&mut RrfPlanner::new(cfg).expect("config"), moves)
 }
 
 #[test]
