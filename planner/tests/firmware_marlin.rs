@@ -5,7 +5,7 @@
 //! `floor`, and the stepper's ramps in continuous time between those step counts.
 
 use settle_planner::firmware::marlin::{JdSmallSegments, MarlinConfig, MarlinJerk, MarlinPlanner};
-use settle_planner::firmware::{LinearMove, PlannedMove, RampShape};
+use settle_planner::firmware::{Kinematics, LinearMove, PlannedMove, RampShape};
 
 mod firmware_common;
 
@@ -311,6 +311,29 @@ fn small_segments_take_the_arc_speed() {
         "look-ahead entry",
         without[20].start_speed_m_s,
         start(v_ahead2),
+        1e-12,
+    );
+}
+
+#[test]
+fn corexy_diagonal_runs_one_motor_like_a_straight_line() {
+    // CoreXY, X and Y +50 mm at 100 mm/s: motor A turns 100 mm (8000 steps), B stays.
+    // With M203 A/B at 100 mm/s, motor A at sqrt2 x the path speed is too fast: factor
+    // 1/sqrt2, nominal
+    // rate floor(ceil(8000 sqrt2) / sqrt2) = 8000 steps/s; the acceleration is A's
+    // limit, 240000 steps/s^2. In steps this is the straight-line block exactly, at a
+    // path speed of 100/sqrt2 mm/s.
+    let mut c = defaults();
+    c.kinematics = Kinematics::CoreXy;
+    c.max_feedrate_m_s[0] = 0.1;
+    c.max_feedrate_m_s[1] = 0.1;
+    let (out, t) = plan(c, &[xy([0.0, 0.0], [50.0, 50.0], 100.0)]);
+    let (line, t_line) = plan(defaults(), &[xy([0.0, 0.0], [100.0, 0.0], 100.0)]);
+    assert_rel("print time", t, t_line, 1e-12);
+    assert_rel(
+        "cruise",
+        out[0].cruise_speed_m_s,
+        line[0].cruise_speed_m_s * std::f64::consts::FRAC_1_SQRT_2,
         1e-12,
     );
 }
