@@ -17,6 +17,7 @@ mod brake;
 pub mod duration;
 mod error;
 mod fastest;
+pub mod firmware;
 mod fixed;
 mod four_arcs;
 pub mod fourjerk;
