@@ -95,9 +95,8 @@ pub(super) fn impulses(
     };
     let fs = ftm_fs_hz as f32;
     let n1 = ((base / f_hz as f32 / df) * fs).round();
-    let period_s = 1.0 / f64::from(ftm_fs_hz);
     let times = (0..a.len())
-        .map(|i| i as f64 * f64::from(n1) * period_s)
+        .map(|i| i as f64 * f64::from(n1) / f64::from(ftm_fs_hz))
         .collect();
     (a.into_iter().map(f64::from).collect(), times)
 }

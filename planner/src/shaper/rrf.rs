@@ -122,6 +122,6 @@ pub(super) fn impulses(shaper: RrfShaper, f_hz: f64, zeta: f64, step_clock_hz: u
     // "The sum of the coefficients must total 1, use this to fill in the last coefficient."
     let sum: f64 = a.iter().sum();
     a.push(1.0 - sum);
-    let tick_s = 1.0 / f64::from(step_clock_hz);
-    (a, delays.into_iter().map(|d| d as f64 * tick_s).collect())
+    let clock = f64::from(step_clock_hz);
+    (a, delays.into_iter().map(|d| d as f64 / clock).collect())
 }
