@@ -123,6 +123,8 @@ impl RrfShaper {
     }
 }
 
+/// Klipper's default damping ratio of a shaper (`DEFAULT_DAMPING_RATIO`).
+pub const KLIPPER_DEFAULT_DAMPING_RATIO: f64 = 0.1;
 /// Klipper's default vibration tolerance of `ei` (`1/SHAPER_VIBRATION_REDUCTION`, 5%).
 pub const KLIPPER_V_TOL: f64 = 1.0 / 20.0;
 /// Marlin's default vibration tolerance of its EI family (`FTM_SHAPING_V_TOL`, 5%).
@@ -245,6 +247,20 @@ impl ShaperKind {
             ShaperKind::Marlin { .. } => Firmware::Marlin,
             ShaperKind::Rrf { .. } => Firmware::Rrf,
             _ => Firmware::Klipper,
+        }
+    }
+
+    /// Klipper's lowest test frequency for the family in its shaper choice (`min_freq` in
+    /// shaper_defs.py's `INPUT_SHAPERS`, "chosen to have projected max_accel ~= 1500"), Hz;
+    /// `None` for other firmwares' shapers.
+    pub fn klipper_min_freq_hz(self) -> Option<f64> {
+        match self {
+            ShaperKind::Zv => Some(21.0),
+            ShaperKind::Mzv { .. } => Some(23.0),
+            ShaperKind::Zvd | ShaperKind::Ei { .. } => Some(29.0),
+            ShaperKind::TwoHumpEi => Some(39.0),
+            ShaperKind::ThreeHumpEi => Some(48.0),
+            ShaperKind::Marlin { .. } | ShaperKind::Rrf { .. } => None,
         }
     }
 

@@ -30,8 +30,8 @@ mod rrf;
 mod tests;
 
 pub use kind::{
-    Firmware, KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL, MarlinShaper, RRF_STEP_CLOCK_HZ,
-    RrfShaper, ShaperKind,
+    Firmware, KLIPPER_DEFAULT_DAMPING_RATIO, KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL,
+    MarlinShaper, RRF_STEP_CLOCK_HZ, RrfShaper, ShaperKind,
 };
 pub use response::{remaining_vibration, smoothing_mm};
 
