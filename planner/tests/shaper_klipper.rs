@@ -11,8 +11,10 @@ use settle_planner::PlanError;
 use settle_planner::shaper::{Shaper, ShaperKind};
 
 /// (name as written, f_hz, zeta, A, T) from shaper_defs.py.
+type Expected = (&'static str, f64, f64, &'static [f64], &'static [f64]);
+
 #[rustfmt::skip]
-const KLIPPER: &[(&str, f64, f64, &[f64], &[f64])] = &[
+const KLIPPER: &[Expected] = &[
     ("zv", 50.0, 0.1, &[1.0, 0.7292476142876709], &[0.0, 0.01005037815259212]),
     ("zv", 37.3, 0.0, &[1.0, 1.0], &[0.0, 0.013404825737265416]),
     ("zv", 61.7, 0.17, &[1.0, 0.5816074871328755], &[0.0, 0.008223427411507063]),
