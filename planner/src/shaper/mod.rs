@@ -15,7 +15,7 @@
 //! - `rrf:...` are RepRapFirmware M593's (src/Movement/AxisShaper.cpp), with delays rounded
 //!   to the step clock.
 //!
-//! The shaped profile is again a [`Profile`]: between consecutive shifted breakpoints every
+//! The shaped profile is again a [`crate::Profile`]: between consecutive shifted breakpoints every
 //! copy has constant jerk, so the sum does too; acceleration jumps (trapezoids) stay jumps.
 
 mod apply;

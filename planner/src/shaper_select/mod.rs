@@ -6,18 +6,18 @@
 //! How Klipper chooses (and so how [`find_best_shaper`] does):
 //! 1. For each shaper (by default `zv`, `mzv`, `ei`, `2hump_ei`, `3hump_ei`; `zvd` is not
 //!    tried) and each test frequency from 150 Hz down to the shaper's minimum (21, 23, 29,
-//!    29, 39, 48 Hz) in 0.2 Hz steps ([`grid`]), the shaper is built at the configured
+//!    29, 39, 48 Hz) in 0.2 Hz steps (numpy's `arange`), the shaper is built at the configured
 //!    damping ratio (0.1) and scored on the PSD (`psd_xyz`, bins up to `max_freq`, 200 Hz):
 //!    remaining vibration `sum(max(V(f) PSD - thr, 0)) / sum(max(PSD - thr, 0))`,
 //!    `thr = max(PSD)/20`, worst over the test damping ratios 0.075, 0.1, 0.15 and over the
 //!    data sets; smoothing at 5000 mm/s^2 and the square-corner velocity (5 mm/s);
 //!    `score = smoothing (v^1.5 + 0.2 v + 0.01)`; `max_accel` the largest acceleration
-//!    whose smoothing stays <= 0.12 mm ([`accel`]). With `max_smoothing`, the scan stops
+//!    whose smoothing stays <= 0.12 mm. With `max_smoothing`, the scan stops
 //!    at the first frequency that smooths more (once a result exists).
 //! 2. Per shaper, the least-vibrating frequency is the "best"; going up in frequency from
 //!    the lowest, any frequency within `1.1 best + 0.0005` of its vibration and with a
 //!    lower score (or, with `max_vibrations`, when the best exceeds it) replaces the pick.
-//! 3. Across shapers ([`choose`]), a shaper replaces the recommendation if its score is 20%
+//! 3. Across shapers, a shaper replaces the recommendation if its score is 20%
 //!    lower, or 5% lower with 10% less smoothing, or (with `max_vibrations`) if the
 //!    recommendation vibrates more than allowed and it vibrates less; then any of the
 //!    shaper's frequencies that both vibrates and smooths less than the recommendation
