@@ -81,6 +81,18 @@ pub struct RegisterWrite {
     pub note: String,
 }
 
+impl RegisterWrite {
+    /// A write of `value` to register `name` at `addr`, with what it means.
+    pub fn new(name: &'static str, addr: u8, value: u32, note: String) -> Self {
+        Self {
+            name,
+            addr,
+            value,
+            note,
+        }
+    }
+}
+
 /// The register file as text: `#` comment lines, then `NAME 0xAA = value  ; note`.
 pub fn register_file_text(header: &[String], writes: &[RegisterWrite]) -> String {
     let mut out = String::new();

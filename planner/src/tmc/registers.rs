@@ -124,12 +124,7 @@ impl RegisterSet {
     /// The register file of a move: RAMPMODE (S-shaped positioning), the ramp values and
     /// XTARGET last (writing it starts the move), each with its physical meaning in `u`.
     pub fn register_file(&self, u: &TmcUnits) -> Vec<RegisterWrite> {
-        let w = |name, addr, value: u32, note: String| RegisterWrite {
-            name,
-            addr,
-            value,
-            note,
-        };
+        let w = RegisterWrite::new;
         let (vl, al, bl) = (u.velocity_lsb(), u.accel_lsb(), u.bow_lsb());
         let mut out = vec![
             w("CLK_FREQ", addr::CLK_FREQ, self.clk_freq, "Hz".into()),

@@ -263,12 +263,7 @@ impl Tmc5160Registers {
     /// (writing it starts the move).
     pub fn register_file(&self, u: &Tmc5160Units) -> Vec<RegisterWrite> {
         let (vl, al) = (u.velocity_lsb(), u.accel_lsb());
-        let w = |name, addr, value: u32, note: String| RegisterWrite {
-            name,
-            addr,
-            value,
-            note,
-        };
+        let w = RegisterWrite::new;
         let v = |raw: u32| format!("{} u/s", f64::from(raw) * vl);
         let a = |raw: u32| format!("{} u/s^2", f64::from(raw) * al);
         vec![
