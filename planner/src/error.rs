@@ -76,4 +76,25 @@ pub enum PlanError {
         /// The allowed names, comma separated.
         allowed: &'static str,
     },
+    /// A shaper name that parses but whose parameters, frequency or damping ratio its
+    /// firmware refuses.
+    #[error("shaper `{name}`: {reason}")]
+    InvalidShaper {
+        /// The shaper as written (or as `Display` writes it).
+        name: String,
+        /// What is wrong and what is allowed.
+        reason: String,
+    },
+    /// A value a motion-controller chip cannot hold in its register.
+    #[error("{chip} register {register}: {reason} (value {value})")]
+    Register {
+        /// The chip (`TMC4361A`, `TMC5160`).
+        chip: &'static str,
+        /// The register (`AMAX`, `BOW1`, ...).
+        register: &'static str,
+        /// The physical value asked for, in the caller's units.
+        value: f64,
+        /// Why it does not fit, with the register's range.
+        reason: String,
+    },
 }

@@ -36,6 +36,7 @@ pub mod scurve;
 mod second_order;
 mod segs;
 pub mod shaper;
+pub mod shaper_select;
 pub mod sync;
 pub mod tmc;
 mod trajectory;

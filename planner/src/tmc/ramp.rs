@@ -1,4 +1,4 @@
-//! The TMC4361A S-shaped ramp in physical units (seed 000).
+//! The TMC4361A S-shaped ramp in physical units.
 //!
 //! Seven phases (the chip's names): **B1** raises the acceleration from 0 to AMAX at jerk
 //! BOW1, **B12** holds AMAX, **B2** lowers it to 0 at BOW2 (reaching VMAX), **B23** cruises
@@ -23,10 +23,10 @@
 //! A negative distance mirrors the ramp (VSTART, VMAX, VSTOP are speeds, the register
 //! values are unsigned magnitudes; the direction comes from the sign of the distance).
 //!
-//! Seed 000's phase-distance formulas: the distance of B2 with `v3` the velocity at its
+//! Phase-distance formulas: the distance of B2 with `v3` the velocity at its
 //! start, `a` = AMAX and `j2` = BOW2 (the register values), `t3 = a/j2`, is
 //! `d3 = v3 t3 + a t3^2/2 - j2 t3^3/6` (the vendor's 1/6 form) and of B4 with `v7` at its
-//! start, `a` = DMAX, `j4` = BOW4: `d7 = v7 t7 - a t7^2/2 + j4 t7^3/6`. The seed's "1/3"
+//! start, `a` = DMAX, `j4` = BOW4: `d7 = v7 t7 - a t7^2/2 + j4 t7^3/6`. The "1/3"
 //! correction is the identity `d = v0 t + a t^2/2 - j t^3/3` for `a` the acceleration at the
 //! *end* of a constant-jerk phase and `j` its signed jerk: true as algebra, but its
 //! derivation (`a = a0 + j2 t3` with `a = AMAX`) describes a phase that *raises* the

@@ -1,12 +1,14 @@
 //! TMC4361A register values of an S-shaped ramp: export for a given clock frequency and
-//! microsteps per length unit, and import back.
+//! the machine's microsteps per length unit, import back, and the register file.
 //!
-//! Register addresses, widths and unit formats (TMC4361A datasheet, register table of the
-//! ramp generator; the same facts are in Trinamic's/ADI's TMC-API,
-//! `tmc/ic/TMC4361A/TMC4361A_Register.h` and `TMC4361A_Fields.h`):
+//! Register addresses, widths and unit formats of the ramp generator (TMC4361A datasheet,
+//! Rev. 1.22 2017-JAN-12, register map of the ramp generator, addresses 0x20..0x37; the
+//! same facts transcribed in ADI's TMC-API `tmc/ic/TMC4361A/TMC4361A_Register.h` and
+//! `TMC4361A_Fields.h`, which these were checked against):
 //!
 //! | register | addr | bits | unit and format |
 //! |---|---|---|---|
+//! | RAMPMODE | 0x20 | 3             | bit 2: positioning mode; bits 1:0: 2 = S-shaped ramp |
 //! | VMAX     | 0x24 | signed 32     | pps, 24.8 fixed point (24 integer, 8 fractional bits) |
 //! | VSTART   | 0x25 | unsigned 31   | pps, 23.8 fixed point |
 //! | VSTOP    | 0x26 | unsigned 31   | pps, 23.8 fixed point |
@@ -17,19 +19,33 @@
 //! | XTARGET  | 0x37 | signed 32     | microsteps |
 //!
 //! "pps" is (micro)steps per second. A physical value `x` (in the caller's length unit `u`)
-//! becomes `x * usteps_per_unit` steps; the register value is that, scaled by the format
-//! and rounded to the nearest integer, so import(export(x)) is within half an LSB of `x`
-//! and export(import(r)) == r.
+//! becomes `x * usteps_per_unit` steps, where `usteps_per_unit` is the machine's own
+//! (full steps per revolution x microsteps / travel per revolution, see
+//! [`TmcUnits::usteps_per_unit_of`]); the register value is that, scaled by the format and
+//! rounded to the nearest integer, so import(export(x)) is within half an LSB of `x` and
+//! export(import(r)) == r. What the chip cannot hold is refused, naming the register and
+//! its range: a value above the register's width, a nonzero value that rounds to 0, and a
+//! zero VMAX, AMAX, DMAX or BOW (an S-ramp with them never arrives). The jerks are where
+//! the chip is tightest: in frequency mode one BOW LSB is 1 pps^3 and the largest
+//! 16,777,215 pps^3, i.e. 13,107 mm/s^3 at 1280 microsteps/mm; the direct mode reaches
+//! further with coarser steps.
 //!
 //! In the default (frequency) mode the clock frequency only appears in CLK_FREQ; in the
 //! direct modes it scales the acceleration and bow values. VMAX is exported as a magnitude
 //! (positioning mode takes the direction from XTARGET - XACTUAL).
 
+use super::field::{Field, RegisterWrite, register_file_text};
 use crate::PlanError;
 use crate::tmc::SRampParams;
 
+const CHIP: &str = "TMC4361A";
+
 /// Register addresses (TMC4361A).
 pub mod addr {
+    /// GENERAL_CONF (holds `direct_acc_val_en`, bit 1, and `direct_bow_val_en`, bit 2).
+    pub const GENERAL_CONF: u8 = 0x00;
+    /// RAMPMODE.
+    pub const RAMPMODE: u8 = 0x20;
     /// VMAX.
     pub const VMAX: u8 = 0x24;
     /// VSTART.
@@ -48,13 +64,17 @@ pub mod addr {
     pub const XTARGET: u8 = 0x37;
 }
 
+/// RAMPMODE for an S-shaped ramp in positioning mode (bit 2 set, profile 2).
+pub const RAMPMODE_S_POSITIONING: u32 = 0b110;
+
 /// How physical units map to the chip: clock, microsteps per length unit, and the two
 /// GENERAL_CONF switches that change the acceleration and bow formats.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TmcUnits {
     /// Clock frequency fCLK (Hz, 4e6 ..= 32e6; integer, as written to CLK_FREQ).
     pub f_clk_hz: u32,
-    /// Microsteps per length unit (e.g. 80 * 16 for 80 full steps/mm at 16 microsteps).
+    /// The machine's microsteps per length unit (e.g. 80 * 16 = 1280 for 80 full steps/mm
+    /// at 16 microsteps). No default: it is the machine's.
     pub usteps_per_unit: f64,
     /// GENERAL_CONF.direct_acc_val_en: AMAX/DMAX in delta-v per clock cycle.
     pub direct_acc: bool,
@@ -84,7 +104,7 @@ pub struct RegisterSet {
 }
 
 impl RegisterSet {
-    /// `(address, value as written over SPI)` for every register, in address order.
+    /// `(address, value as written over SPI)` for every ramp value, in address order.
     pub fn writes(&self) -> [(u8, u32); 11] {
         [
             (addr::VMAX, self.vmax as u32),
@@ -100,18 +120,111 @@ impl RegisterSet {
             (addr::XTARGET, self.xtarget as u32),
         ]
     }
+
+    /// The register file of a move: RAMPMODE (S-shaped positioning), the ramp values and
+    /// XTARGET last (writing it starts the move), each with its physical meaning in `u`.
+    pub fn register_file(&self, u: &TmcUnits) -> Vec<RegisterWrite> {
+        let w = RegisterWrite::new;
+        let (vl, al, bl) = (u.velocity_lsb(), u.accel_lsb(), u.bow_lsb());
+        let mut out = vec![
+            w("CLK_FREQ", addr::CLK_FREQ, self.clk_freq, "Hz".into()),
+            w(
+                "RAMPMODE",
+                addr::RAMPMODE,
+                RAMPMODE_S_POSITIONING,
+                "S-shaped ramp, positioning mode".into(),
+            ),
+            w(
+                "VSTART",
+                addr::VSTART,
+                self.vstart,
+                format!("{} u/s", f64::from(self.vstart) * vl),
+            ),
+            w(
+                "VSTOP",
+                addr::VSTOP,
+                self.vstop,
+                format!("{} u/s", f64::from(self.vstop) * vl),
+            ),
+            w(
+                "VMAX",
+                addr::VMAX,
+                self.vmax as u32,
+                format!("{} u/s", f64::from(self.vmax) * vl),
+            ),
+            w(
+                "AMAX",
+                addr::AMAX,
+                self.amax,
+                format!("{} u/s^2", f64::from(self.amax) * al),
+            ),
+            w(
+                "DMAX",
+                addr::DMAX,
+                self.dmax,
+                format!("{} u/s^2", f64::from(self.dmax) * al),
+            ),
+        ];
+        for (i, name) in ["BOW1", "BOW2", "BOW3", "BOW4"].into_iter().enumerate() {
+            out.push(w(
+                name,
+                addr::BOW1 + i as u8,
+                self.bow[i],
+                format!("{} u/s^3", f64::from(self.bow[i]) * bl),
+            ));
+        }
+        out.push(w(
+            "XTARGET",
+            addr::XTARGET,
+            self.xtarget as u32,
+            format!(
+                "{} u (microsteps, signed)",
+                f64::from(self.xtarget) * u.position_lsb()
+            ),
+        ));
+        out
+    }
+
+    /// The register file as text, headed by the units it was computed for.
+    pub fn register_file_text(&self, u: &TmcUnits) -> String {
+        let header = vec![
+            format!(
+                "{CHIP} ramp registers: {} microsteps per unit u, fCLK {} Hz",
+                u.usteps_per_unit, self.clk_freq
+            ),
+            format!(
+                "GENERAL_CONF (0x{:02X}) must have direct_acc_val_en = {}, direct_bow_val_en = {}",
+                addr::GENERAL_CONF,
+                u8::from(u.direct_acc),
+                u8::from(u.direct_bow)
+            ),
+        ];
+        register_file_text(&header, &self.register_file(u))
+    }
 }
 
-const U24_MAX: f64 = ((1u32 << 24) - 1) as f64;
-const U31_MAX: f64 = ((1u32 << 31) - 1) as f64;
-const I32_MAX: f64 = i32::MAX as f64;
-const I32_MIN: f64 = i32::MIN as f64;
+const U24_MAX: i64 = (1 << 24) - 1;
+const U31_MAX: i64 = (1 << 31) - 1;
 
 impl TmcUnits {
+    /// Microsteps per unit of a stepper axis: `full_steps_per_rev * microsteps /
+    /// travel_per_rev` (Klipper's `full_steps_per_rotation * microsteps /
+    /// rotation_distance`), e.g. 200 * 16 / 40 mm = 80 per mm.
+    pub fn usteps_per_unit_of(
+        full_steps_per_rev: u32,
+        microsteps: u32,
+        travel_per_rev: f64,
+    ) -> f64 {
+        f64::from(full_steps_per_rev) * f64::from(microsteps) / travel_per_rev
+    }
+
     fn check(&self) -> Result<(), PlanError> {
         if !(4_000_000..=32_000_000).contains(&self.f_clk_hz) {
-            return Err(PlanError::InvalidInput {
-                reason: "CLK_FREQ must be 4 MHz ..= 32 MHz",
+            return Err(PlanError::Register {
+                chip: CHIP,
+                register: "CLK_FREQ",
+                value: f64::from(self.f_clk_hz),
+                reason: "the clock must be 4 MHz ..= 32 MHz".into(),
             });
         }
         if !(self.usteps_per_unit.is_finite() && self.usteps_per_unit > 0.0) {
@@ -158,15 +271,15 @@ impl TmcUnits {
         };
         pps3 / self.usteps_per_unit
     }
-}
 
-/// Round `x / lsb` into `[lo, hi]`, or the error naming the register.
-fn raw(x: f64, lsb: f64, lo: f64, hi: f64, err: &'static str) -> Result<f64, PlanError> {
-    let r = (x / lsb).round();
-    if r.is_finite() && r >= lo && r <= hi {
-        Ok(r)
-    } else {
-        Err(PlanError::InvalidInput { reason: err })
+    fn field(&self, name: &'static str, min: i64, max: i64, lsb: f64) -> Field {
+        Field {
+            chip: CHIP,
+            name,
+            min,
+            max,
+            lsb,
+        }
     }
 }
 
@@ -174,62 +287,29 @@ fn raw(x: f64, lsb: f64, lo: f64, hi: f64, err: &'static str) -> Result<f64, Pla
 pub fn export(target: f64, p: &SRampParams, u: &TmcUnits) -> Result<RegisterSet, PlanError> {
     u.check()?;
     p.validate()?;
-    let vl = u.velocity_lsb();
-    let al = u.accel_lsb();
-    let bl = u.bow_lsb();
-    let bow_err = [
-        "BOW1 out of range (unsigned 24 bit)",
-        "BOW2 out of range (unsigned 24 bit)",
-        "BOW3 out of range (unsigned 24 bit)",
-        "BOW4 out of range (unsigned 24 bit)",
-    ];
+    let (vl, al, bl) = (u.velocity_lsb(), u.accel_lsb(), u.bow_lsb());
+    let i32_range = (i64::from(i32::MIN), i64::from(i32::MAX));
     let mut bow = [0u32; 4];
-    for i in 0..4 {
-        bow[i] = raw(p.bow[i], bl, 0.0, U24_MAX, bow_err[i])? as u32;
+    for (i, name) in ["BOW1", "BOW2", "BOW3", "BOW4"].into_iter().enumerate() {
+        bow[i] = u.field(name, 1, U24_MAX, bl).raw(p.bow[i])? as u32;
     }
     Ok(RegisterSet {
-        xtarget: raw(
-            target,
-            u.position_lsb(),
-            I32_MIN,
-            I32_MAX,
-            "XTARGET out of range (signed 32 bit microsteps)",
-        )? as i32,
-        vmax: raw(
-            p.vmax,
-            vl,
-            0.0,
-            I32_MAX,
-            "VMAX out of range (signed 32 bit, 24.8 pps)",
-        )? as i32,
-        vstart: raw(
-            p.vstart,
-            vl,
-            0.0,
-            U31_MAX,
-            "VSTART out of range (unsigned 31 bit, 23.8 pps)",
-        )? as u32,
-        vstop: raw(
-            p.vstop,
-            vl,
-            0.0,
-            U31_MAX,
-            "VSTOP out of range (unsigned 31 bit, 23.8 pps)",
-        )? as u32,
-        amax: raw(
-            p.amax,
-            al,
-            0.0,
-            U24_MAX,
-            "AMAX out of range (unsigned 24 bit)",
-        )? as u32,
-        dmax: raw(
-            p.dmax,
-            al,
-            0.0,
-            U24_MAX,
-            "DMAX out of range (unsigned 24 bit)",
-        )? as u32,
+        xtarget: u
+            .field("XTARGET", i32_range.0, i32_range.1, u.position_lsb())
+            .raw(target)
+            .or_else(|e| {
+                // A target that rounds to microstep 0 is a move to 0, not a refusal.
+                if (target / u.position_lsb()).abs() < 0.5 {
+                    Ok(0)
+                } else {
+                    Err(e)
+                }
+            })? as i32,
+        vmax: u.field("VMAX", 1, i32_range.1, vl).raw(p.vmax)? as i32,
+        vstart: u.field("VSTART", 0, U31_MAX, vl).raw(p.vstart)? as u32,
+        vstop: u.field("VSTOP", 0, U31_MAX, vl).raw(p.vstop)? as u32,
+        amax: u.field("AMAX", 1, U24_MAX, al).raw(p.amax)? as u32,
+        dmax: u.field("DMAX", 1, U24_MAX, al).raw(p.dmax)? as u32,
         bow,
         clk_freq: u.f_clk_hz,
     })
@@ -244,26 +324,22 @@ pub fn import(r: &RegisterSet, u: &TmcUnits) -> Result<(f64, SRampParams), PlanE
         ..*u
     };
     u.check()?;
-    if r.vstart >= 1 << 31 || r.vstop >= 1 << 31 {
-        return Err(PlanError::InvalidInput {
-            reason: "VSTART/VSTOP have 31 bits",
-        });
-    }
-    if r.amax >= 1 << 24 || r.dmax >= 1 << 24 || r.bow.iter().any(|&b| b >= 1 << 24) {
-        return Err(PlanError::InvalidInput {
-            reason: "AMAX, DMAX and BOW1..4 have 24 bits",
-        });
-    }
-    let vl = u.velocity_lsb();
-    let al = u.accel_lsb();
-    let bl = u.bow_lsb();
+    let (vl, al, bl) = (u.velocity_lsb(), u.accel_lsb(), u.bow_lsb());
+    let v31 = |name, raw: u32| u.field(name, 0, U31_MAX, vl).check_raw(i64::from(raw));
+    let a24 = |name, raw: u32| u.field(name, 0, U24_MAX, al).check_raw(i64::from(raw));
+    let b24 = |name, raw: u32| u.field(name, 0, U24_MAX, bl).check_raw(i64::from(raw));
     let params = SRampParams {
-        vstart: f64::from(r.vstart) * vl,
+        vstart: v31("VSTART", r.vstart)?,
         vmax: f64::from(r.vmax).abs() * vl,
-        vstop: f64::from(r.vstop) * vl,
-        amax: f64::from(r.amax) * al,
-        dmax: f64::from(r.dmax) * al,
-        bow: r.bow.map(|b| f64::from(b) * bl),
+        vstop: v31("VSTOP", r.vstop)?,
+        amax: a24("AMAX", r.amax)?,
+        dmax: a24("DMAX", r.dmax)?,
+        bow: [
+            b24("BOW1", r.bow[0])?,
+            b24("BOW2", r.bow[1])?,
+            b24("BOW3", r.bow[2])?,
+            b24("BOW4", r.bow[3])?,
+        ],
     };
     Ok((f64::from(r.xtarget) * u.position_lsb(), params))
 }
@@ -321,24 +397,86 @@ mod tests {
     }
 
     #[test]
-    fn out_of_range_names_the_register() {
+    fn what_the_chip_cannot_hold_is_refused_by_name() {
         let u = TmcUnits {
             f_clk_hz: 16_000_000,
             usteps_per_unit: 1.0,
             direct_acc: false,
             direct_bow: false,
         };
+        // AMAX 1e7 pps^2 needs 4e7 LSB of 1/4 pps^2: above 24 bits.
         let p = SRampParams::symmetric(1.0, 1e7, 1.0);
-        assert_eq!(
+        match export(0.0, &p, &u) {
+            Err(
+                e @ PlanError::Register {
+                    register: "AMAX", ..
+                },
+            ) => {
+                let text = e.to_string();
+                assert!(
+                    text.contains("TMC4361A") && text.contains("16777215"),
+                    "{text}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        // A jerk of 0.4 pps^3 rounds to BOW = 0: the ramp would never leave B1.
+        let p = SRampParams {
+            bow: [1.0, 1.0, 0.4, 1.0],
+            ..SRampParams::symmetric(1.0, 1.0, 1.0)
+        };
+        assert!(matches!(
             export(0.0, &p, &u),
-            Err(PlanError::InvalidInput {
-                reason: "AMAX out of range (unsigned 24 bit)"
+            Err(PlanError::Register {
+                register: "BOW3",
+                ..
             })
-        );
+        ));
+        // 2^24 pps^3 is one more than BOW holds.
+        let p = SRampParams::symmetric(1.0, 1.0, 16_777_216.0);
+        assert!(matches!(
+            export(0.0, &p, &u),
+            Err(PlanError::Register {
+                register: "BOW1",
+                ..
+            })
+        ));
         let bad_clock = TmcUnits {
             f_clk_hz: 1_000_000,
             ..u
         };
-        assert!(export(0.0, &SRampParams::symmetric(1.0, 1.0, 1.0), &bad_clock).is_err());
+        assert!(matches!(
+            export(0.0, &SRampParams::symmetric(1.0, 1.0, 1.0), &bad_clock),
+            Err(PlanError::Register {
+                register: "CLK_FREQ",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn register_file_lists_rampmode_and_ends_with_xtarget() {
+        // 200 full steps x 16 microsteps per 40 mm = 80 microsteps per mm.
+        let usteps = TmcUnits::usteps_per_unit_of(200, 16, 40.0);
+        assert_eq!(usteps, 80.0);
+        let u = TmcUnits {
+            f_clk_hz: 16_000_000,
+            usteps_per_unit: usteps,
+            direct_acc: false,
+            direct_bow: false,
+        };
+        let r = export(20.0, &SRampParams::symmetric(100.0, 2000.0, 1e5), &u).expect("export");
+        let file = r.register_file(&u);
+        assert_eq!(file[1].name, "RAMPMODE");
+        assert_eq!((file[1].addr, file[1].value), (0x20, 6));
+        let last = file.last().expect("writes");
+        assert_eq!((last.name, last.addr, last.value), ("XTARGET", 0x37, 1600));
+        // 100 mm/s * 80 = 8000 pps = 2,048,000 in 24.8; 2000 mm/s^2 * 80 * 4 = 640,000;
+        // 1e5 mm/s^3 * 80 = 8,000,000 pps^3.
+        let text = r.register_file_text(&u);
+        assert!(text.contains("VMAX      0x24 = 2048000"), "{text}");
+        assert!(text.contains("AMAX      0x28 = 640000"), "{text}");
+        assert!(text.contains("BOW4      0x30 = 8000000"), "{text}");
+        assert!(text.contains("80 microsteps per unit"), "{text}");
     }
 }

@@ -1,0 +1,104 @@
+//! Shaping a profile: the weighted sum of shifted copies, again as a [`Profile`].
+
+use super::Shaper;
+use crate::{PlanError, Profile, Sample, Segment, State};
+
+impl Shaper {
+    /// Shape a profile: `q(t) = sum_i w_i p(t - T_i)`. Outside its span the profile is
+    /// extended by its start state before `t = 0` and its end state after its end, moving on
+    /// at constant velocity (so a move that starts and ends at rest is shaped into one that
+    /// does too, `duration_s()` longer). The start and end accelerations must be zero (a
+    /// move, not a fragment). Since the weights are positive and sum to 1, the shaped
+    /// velocity, acceleration and jerk stay within the original's bounds.
+    pub fn apply(&self, profile: &Profile) -> Result<Profile, PlanError> {
+        let (start, end) = (profile.start(), profile.end());
+        if start.a != 0.0 || end.a != 0.0 {
+            return Err(PlanError::InvalidInput {
+                reason: "input shaping needs a profile that starts and ends with zero acceleration",
+            });
+        }
+        let weights: Vec<f64> = self.weights().collect();
+        let t_end = profile.duration_s();
+        let eval = |t: f64| -> Sample {
+            if t < 0.0 {
+                return Sample {
+                    p: start.p + start.v * t,
+                    v: start.v,
+                    a: 0.0,
+                    j: 0.0,
+                };
+            }
+            if t >= t_end {
+                return Sample {
+                    p: end.p + end.v * (t - t_end),
+                    v: end.v,
+                    a: 0.0,
+                    j: 0.0,
+                };
+            }
+            profile.state_at(t)
+        };
+        let shaped = |t: f64| -> Sample {
+            let mut s = Sample::default();
+            for (w, ti) in weights.iter().zip(&self.times_s) {
+                let x = eval(t - ti);
+                s.p += w * x.p;
+                s.v += w * x.v;
+                s.a += w * x.a;
+                s.j += w * x.j;
+            }
+            s
+        };
+        // Every breakpoint of every shifted copy.
+        let mut knots: Vec<f64> = Vec::new();
+        for ti in &self.times_s {
+            knots.push(ti + 0.0);
+            for (t0, _, seg) in profile.iter() {
+                knots.push(t0 + ti);
+                knots.push(t0 + seg.duration_s() + ti);
+            }
+        }
+        knots.sort_by(f64::total_cmp);
+        knots.dedup();
+        let mut segments = Vec::with_capacity(knots.len());
+        let mut a_now = 0.0;
+        let s0 = shaped(0.0);
+        for pair in knots.windows(2) {
+            let (ta, tb) = (pair[0], pair[1]);
+            let dur = tb - ta;
+            if dur <= 0.0 {
+                continue;
+            }
+            // Right limits on the interval: evaluate just inside it.
+            let mid = shaped(ta + 0.5 * dur);
+            let a_start = mid.a - mid.j * 0.5 * dur;
+            let jumps = (a_start - a_now).abs() > 1e-12 * (1.0 + a_start.abs() + a_now.abs());
+            if mid.j == 0.0 {
+                segments.push(Segment::Accel {
+                    duration_s: dur,
+                    accel: a_start,
+                });
+            } else {
+                if jumps {
+                    segments.push(Segment::Accel {
+                        duration_s: 0.0,
+                        accel: a_start,
+                    });
+                }
+                segments.push(Segment::Jerk {
+                    duration_s: dur,
+                    jerk: mid.j,
+                });
+            }
+            a_now = a_start + mid.j * dur;
+        }
+        Profile::new(
+            State {
+                p: s0.p,
+                v: s0.v,
+                a: 0.0,
+            },
+            segments,
+        )
+    }
+}
