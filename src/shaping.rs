@@ -225,7 +225,7 @@ pub fn csv_cells(runs: &[RunSpec], run: &RunSpec) -> String {
         return ",".repeat(COLUMNS.len());
     };
     let mut s = String::new();
-    let name = setting.kind.map_or("none", ShaperKind::name);
+    let name = setting.kind.map_or_else(|| "none".into(), ShaperKind::name);
     let _ = write!(
         s,
         ",{name},{},{}",

@@ -99,7 +99,7 @@ impl Candidate {
         if let Some(sh) = self.shaper.filter(|s| s.kind.is_some()) {
             s.push_str(&format!(
                 " +{}@{:.1}Hz",
-                sh.kind.map_or("none", ShaperKind::name),
+                sh.kind.map_or_else(|| "none".into(), ShaperKind::name),
                 sh.frequency_hz
             ));
         }

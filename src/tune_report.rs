@@ -148,7 +148,7 @@ pub fn candidates_csv(scores: &[Score]) -> String {
             .and_then(|sh| sh.kind.map(|k| (k, sh.frequency_hz)))
         {
             Some((k, f)) => (k.name(), f.to_string()),
-            None => ("none", String::new()),
+            None => ("none".to_string(), String::new()),
         };
         let _ = writeln!(
             out,

@@ -360,7 +360,7 @@ fn neighbours_step_the_frequency_and_cap_the_jerk() {
         jmax_mm_s3: Some(1e5),
         params: KindParams::default(),
         shaper: Some(ShaperSetting {
-            kind: Some(ShaperKind::Mzv),
+            kind: Some(ShaperKind::MZV),
             frequency_hz: 40.0,
             damping_ratio: 0.1,
         }),
