@@ -59,6 +59,8 @@ mod motion;
 mod params;
 mod reader;
 mod segments;
+mod setting;
+mod setting_parse;
 mod summary;
 
 pub use arc::{
@@ -74,4 +76,5 @@ pub use layers::LayerMode;
 pub use limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
 pub use reader::{Reader, ReaderOptions, Skipped};
 pub use segments::{ArcSegmentation, KlipperArcs, MarlinArcs, RrfArcs};
+pub use setting::Setting;
 pub use summary::{LimitSeen, Summary};
