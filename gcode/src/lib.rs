@@ -46,6 +46,7 @@
 mod arc;
 mod canonical;
 mod cmd;
+pub mod config;
 mod dialect;
 mod error;
 mod event;
