@@ -255,10 +255,16 @@ impl<W: Write> CanonicalWriter<W> {
             LimitChange::RrfJerk {
                 per_axis_mm_s,
                 policy,
+                sets_maximum: true,
             } => {
                 write!(o, "M566{}", axes(per_axis_mm_s, per_min))?;
                 opt(o, " P", policy.map(f64::from))?;
             }
+            LimitChange::RrfJerk {
+                per_axis_mm_s,
+                sets_maximum: false,
+                ..
+            } => write!(o, "M205{}", axes(per_axis_mm_s, |v| v))?,
             LimitChange::MarlinInputShaping {
                 axes: a,
                 frequency_hz,

@@ -182,6 +182,7 @@ pub(crate) fn m_code(
             limits(LimitChange::RrfJerk {
                 per_axis_mm_s: axes(cmd, p, NON_NEGATIVE, scale)?,
                 policy: small(cmd, p, b'P', 1, "0 or 1")?,
+                sets_maximum: number == 566,
             })
         }
         (Marlin, 593) => {

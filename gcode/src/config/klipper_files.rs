@@ -58,7 +58,7 @@ pub(crate) fn read_text(path: &Path) -> Result<String, GcodeError> {
 }
 
 /// `path` made absolute and normalised lexically (Python's `os.path.abspath`).
-fn absolute(path: &Path) -> PathBuf {
+pub(crate) fn absolute(path: &Path) -> PathBuf {
     let joined = match std::env::current_dir() {
         Ok(cwd) if path.is_relative() => cwd.join(path),
         _ => path.to_path_buf(),

@@ -10,6 +10,8 @@ mod klipper_files;
 mod klipper_shaper;
 mod klipper_values;
 mod machine;
+mod rrf;
+mod rrf_script;
 
 pub use klipper::{
     DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
@@ -17,3 +19,4 @@ pub use klipper::{
     KlipperStepper,
 };
 pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
+pub use rrf::{RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RrfAxis, RrfConfig};

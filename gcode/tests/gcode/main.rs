@@ -2,6 +2,7 @@
 
 mod arcs;
 mod config_klipper;
+mod config_rrf;
 mod dialects;
 mod errors;
 mod layers;
