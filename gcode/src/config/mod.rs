@@ -3,6 +3,8 @@
 //! ([`KlipperConfig`], [`RrfConfig`]) with the values the firmware would use, and input
 //! shaper settings written back in each firmware's own syntax, ready to paste.
 
+mod export_klipper;
+mod export_rrf;
 mod glob;
 mod ini;
 mod klipper;
@@ -13,6 +15,8 @@ mod machine;
 mod rrf;
 mod rrf_script;
 
+pub use export_klipper::KlipperExport;
+pub use export_rrf::RrfExport;
 pub use klipper::{
     DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
     DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,

@@ -55,8 +55,8 @@ const SHAPERS: [&str; 8] = [
 
 /// `M593 F` limits, Hz (`AxisShaper::Configure`): above `StepClockRate / (2 * 65535)` with
 /// Duet 3's 750 kHz step clock (`src/RepRapFirmware.h`), at most 1000.
-const MIN_SHAPER_FREQUENCY_HZ: f64 = 750_000.0 / (2.0 * 65535.0);
-const MAX_SHAPER_FREQUENCY_HZ: f64 = 1000.0;
+pub(crate) const MIN_SHAPER_FREQUENCY_HZ: f64 = 750_000.0 / (2.0 * 65535.0);
+pub(crate) const MAX_SHAPER_FREQUENCY_HZ: f64 = 1000.0;
 
 /// RepRapFirmware's input shaper before any `M593` (`AxisShaper::AxisShaper`): off, with
 /// 40 Hz and damping 0.05 waiting for a type.
