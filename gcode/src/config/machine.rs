@@ -82,12 +82,18 @@ impl ShaperSetting {
     }
 
     /// The name in the syntax of `settle_planner::shaper::ShaperKind`: Klipper's text as is,
-    /// `rrf:<type>` for RepRapFirmware, `marlin:<name>` for Marlin.
-    pub fn kind_name(&self, firmware: Dialect) -> String {
+    /// `rrf:<type>` for RepRapFirmware, `marlin:<name>` for Marlin. `None` when the
+    /// firmware does not shape with it ([`ShaperSetting::is_enabled`]) or it is
+    /// RepRapFirmware's `custom` shaper, known only by its impulses.
+    pub fn kind_name(&self, firmware: Dialect) -> Option<String> {
+        if !self.is_enabled(firmware) {
+            return None;
+        }
         match firmware {
-            Dialect::Klipper => self.name.clone(),
-            Dialect::Rrf => format!("rrf:{}", self.name),
-            Dialect::Marlin => format!("marlin:{}", self.name),
+            Dialect::Klipper => Some(self.name.clone()),
+            Dialect::Rrf if self.name == "custom" => None,
+            Dialect::Rrf => Some(format!("rrf:{}", self.name)),
+            Dialect::Marlin => Some(format!("marlin:{}", self.name)),
         }
     }
 }

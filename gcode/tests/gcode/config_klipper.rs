@@ -10,8 +10,8 @@
 
 use std::path::{Path, PathBuf};
 
-use settle_gcode::GcodeError;
 use settle_gcode::config::{KlipperConfig, ShaperSetting};
+use settle_gcode::{Dialect, GcodeError};
 
 use crate::data_path;
 
@@ -57,6 +57,8 @@ fn voron_config_reads_as_klipper_does() {
     assert_eq!(s.x, shaper("mzv", 54.2, 0.08));
     assert_eq!(s.y, shaper("ei", 41.4, 0.1));
     assert_eq!(s.z, shaper("mzv", 0.0, 0.1));
+    assert_eq!(s.y.kind_name(Dialect::Klipper).as_deref(), Some("ei"));
+    assert_eq!(s.z.kind_name(Dialect::Klipper), None);
     let x = c.steppers.x.as_ref().expect("stepper_x");
     assert_eq!(x.drive.microsteps_per_mm, 160.0);
     assert_eq!(x.drive.microsteps, 32);

@@ -74,7 +74,10 @@ fn mini5plus_config_reads_as_the_firmware_applies_it() {
             damping_ratio: 0.1
         }
     );
-    assert_eq!(c.input_shaper.kind_name(Dialect::Rrf), "rrf:mzv");
+    assert_eq!(
+        c.input_shaper.kind_name(Dialect::Rrf).as_deref(),
+        Some("rrf:mzv")
+    );
     let files: Vec<String> = c
         .files
         .iter()
@@ -161,6 +164,7 @@ fn defaults_are_the_firmwares() {
     );
     assert_eq!(c.input_shaper.name, "none");
     assert!(!c.input_shaper.is_enabled(Dialect::Rrf));
+    assert_eq!(c.input_shaper.kind_name(Dialect::Rrf), None);
     assert_eq!(parse("M669 K1\n").kinematics, "corexy");
     assert_eq!(parse("M665 L360 R180 H400\n").kinematics, "delta");
 }
