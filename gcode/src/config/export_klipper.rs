@@ -12,6 +12,7 @@
 //!
 //! [`KlipperConfig`]: super::KlipperConfig
 
+use super::export_text::{comment_text, refuse};
 use super::klipper_shaper;
 use super::machine::ShaperSetting;
 use crate::error::GcodeError;
@@ -33,21 +34,6 @@ pub struct KlipperExport {
     pub minimum_cruise_ratio: Option<f64>,
     /// `square_corner_velocity`, mm/s (written only when given).
     pub square_corner_velocity_mm_s: Option<f64>,
-}
-
-fn refuse(key: &str, value: impl ToString, allowed: impl Into<String>) -> GcodeError {
-    GcodeError::ExportValue {
-        key: key.to_string(),
-        value: value.to_string(),
-        allowed: allowed.into(),
-    }
-}
-
-/// One comment line's text: control characters (line breaks) become spaces.
-pub(crate) fn comment_text(text: &str) -> String {
-    text.chars()
-        .map(|c| if c.is_control() { ' ' } else { c })
-        .collect()
 }
 
 fn axis(out: &mut String, letter: char, s: &ShaperSetting) -> Result<(), GcodeError> {

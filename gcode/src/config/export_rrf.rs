@@ -7,7 +7,7 @@
 //!
 //! [`RrfConfig`]: super::RrfConfig
 
-use super::export_klipper::comment_text;
+use super::export_text::{comment_text, refuse};
 use super::machine::ShaperSetting;
 use super::rrf::{MAX_SHAPER_FREQUENCY_HZ, MIN_SHAPER_FREQUENCY_HZ};
 use crate::error::GcodeError;
@@ -28,14 +28,6 @@ pub struct RrfExport {
     pub print_accel_mm_s2: Option<f64>,
     /// `M204 T`: acceleration of travel moves, mm/s^2 (written only when given).
     pub travel_accel_mm_s2: Option<f64>,
-}
-
-fn refuse(key: &str, value: impl ToString, allowed: impl Into<String>) -> GcodeError {
-    GcodeError::ExportValue {
-        key: key.to_string(),
-        value: value.to_string(),
-        allowed: allowed.into(),
-    }
 }
 
 impl RrfExport {

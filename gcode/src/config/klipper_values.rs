@@ -99,6 +99,24 @@ impl<'a> Values<'a> {
         self.store.get(section, key).map(|o| (o, o.value()))
     }
 
+    /// A number parsed as `T`, checked against `range`; `what` names the kind for errors.
+    fn number<T: std::str::FromStr + Copy>(
+        &self,
+        section: &str,
+        key: &str,
+        range: Range,
+        what: &str,
+        as_f64: fn(T) -> f64,
+    ) -> Result<Option<T>, GcodeError> {
+        let Some((opt, value)) = self.text(section, key) else {
+            return Ok(None);
+        };
+        match value.trim().parse::<T>() {
+            Ok(v) if as_f64(v).is_finite() && range.holds(as_f64(v)) => Ok(Some(v)),
+            _ => Err(invalid(opt, section, &value, range.describe(what))),
+        }
+    }
+
     /// `getfloat`.
     pub(crate) fn float(
         &self,
@@ -106,18 +124,7 @@ impl<'a> Values<'a> {
         key: &str,
         range: Range,
     ) -> Result<Option<f64>, GcodeError> {
-        let Some((opt, value)) = self.text(section, key) else {
-            return Ok(None);
-        };
-        match value.trim().parse::<f64>() {
-            Ok(v) if v.is_finite() && range.holds(v) => Ok(Some(v)),
-            _ => Err(invalid(
-                opt,
-                section,
-                &value,
-                range.describe("a finite number"),
-            )),
-        }
+        self.number(section, key, range, "a finite number", |v| v)
     }
 
     /// `getint`.
@@ -127,18 +134,7 @@ impl<'a> Values<'a> {
         key: &str,
         range: Range,
     ) -> Result<Option<i64>, GcodeError> {
-        let Some((opt, value)) = self.text(section, key) else {
-            return Ok(None);
-        };
-        match value.trim().parse::<i64>() {
-            Ok(v) if range.holds(v as f64) => Ok(Some(v)),
-            _ => Err(invalid(
-                opt,
-                section,
-                &value,
-                range.describe("a whole number"),
-            )),
-        }
+        self.number(section, key, range, "a whole number", |v| v as f64)
     }
 
     /// `getboolean` (configparser's `BOOLEAN_STATES`, any case).

@@ -49,6 +49,7 @@
 
 mod export_klipper;
 mod export_rrf;
+mod export_text;
 mod glob;
 mod ini;
 mod klipper;
