@@ -10,9 +10,9 @@
 //!   single `AxisShaper`; `M593` names no axis). `M593` with `F` or `S` but no `P` while
 //!   shaping is off selects `zvd`, as the firmware does.
 //! - `M98 P"file"` and `M501` (`config-override.g`) run the named file in place: relative
-//!   names are looked up in the folder of the file being read (the SD card's `/sys`),
-//!   `/name` and `0:/name` from that folder's parent (the card's root). A file that is not
-//!   there is a note, as the firmware only warns.
+//!   names are looked up in the folder of `config.g` (the SD card's `/sys`) whichever
+//!   file calls them, `/name` and `0:/name` from that folder's parent (the card's root).
+//!   A file that is not there is a note, as the firmware only warns.
 //! - Meta-commands and `{expressions}` are not evaluated (see the notes).
 
 use std::path::{Path, PathBuf};
@@ -102,6 +102,13 @@ pub struct RrfConfig {
     pub notes: Vec<ConfigNote>,
 }
 
+/// Where macros are looked up, and the files being read (absolute, outermost first).
+#[derive(Debug)]
+struct Files {
+    sys: PathBuf,
+    stack: Vec<PathBuf>,
+}
+
 /// Per-axis state while reading, in the firmware's units where they differ.
 #[derive(Debug, Clone)]
 struct AxisState {
@@ -161,15 +168,19 @@ impl RrfConfig {
     /// anchors the macros it runs; it need not exist).
     pub fn parse(text: &str, path: impl AsRef<Path>) -> Result<Self, GcodeError> {
         let mut c = Self::defaults();
-        let mut stack = Vec::new();
-        c.run(text, path.as_ref(), &mut stack)?;
+        let path = path.as_ref();
+        let mut files = Files {
+            sys: path.parent().unwrap_or(Path::new("")).to_path_buf(),
+            stack: Vec::new(),
+        };
+        c.run(text, path, &mut files)?;
         Ok(c)
     }
 
-    fn run(&mut self, text: &str, path: &Path, stack: &mut Vec<PathBuf>) -> Result<(), GcodeError> {
+    fn run(&mut self, text: &str, path: &Path, files: &mut Files) -> Result<(), GcodeError> {
         let source: Arc<str> = Arc::from(path.display().to_string());
         self.files.push(path.to_path_buf());
-        stack.push(absolute(path));
+        files.stack.push(absolute(path));
         let script = unconditional(text, &source);
         self.notes.extend(script.notes);
         let reader = Reader::new(script.text.as_bytes(), ReaderOptions::new(Dialect::Rrf))
@@ -185,23 +196,24 @@ impl RrfConfig {
                 EventKind::Setting(s) => self.setting(&s, &at)?,
                 EventKind::Limits(l) => self.limits(&l, &at)?,
                 EventKind::Note(Note::MacroCall { path: name, .. }) => {
-                    self.macro_call(path, &name, at, stack)?;
+                    self.macro_call(&name, at, files)?;
                 }
                 _ => {}
             }
         }
-        stack.pop();
+        files.stack.pop();
         Ok(())
     }
 
+    /// Runs macro `name` as `Platform::OpenSysFile` finds it: relative to `/sys` whichever
+    /// file calls it.
     fn macro_call(
         &mut self,
-        from: &Path,
         name: &str,
         at: Location,
-        stack: &mut Vec<PathBuf>,
+        files: &mut Files,
     ) -> Result<(), GcodeError> {
-        let sys = from.parent().unwrap_or(Path::new(""));
+        let sys = files.sys.as_path();
         let name = match name.split_once(':') {
             Some((drive, rest)) if drive.chars().all(|c| c.is_ascii_digit()) => rest,
             _ => name,
@@ -210,8 +222,12 @@ impl RrfConfig {
             Some(from_root) => sys.parent().unwrap_or(Path::new("")).join(from_root),
             None => sys.join(name),
         };
-        if stack.contains(&absolute(&file)) {
-            let mut chain: Vec<String> = stack.iter().map(|p| p.display().to_string()).collect();
+        if files.stack.contains(&absolute(&file)) {
+            let mut chain: Vec<String> = files
+                .stack
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect();
             chain.push(file.display().to_string());
             return Err(GcodeError::IncludeCycle {
                 at,
@@ -230,7 +246,7 @@ impl RrfConfig {
             return Ok(());
         }
         let text = read_text(&file)?;
-        self.run(&text, &file, stack)
+        self.run(&text, &file, files)
     }
 
     fn axes_mut(&mut self) -> [&mut RrfAxis; 3] {

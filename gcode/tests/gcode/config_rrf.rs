@@ -259,6 +259,19 @@ fn macro_cycles_are_errors() {
 }
 
 #[test]
+fn relative_macro_names_are_found_in_sys_whoever_calls_them() {
+    let dir = tree(&[
+        ("sys/config.g", "M98 P\"0:/macros/m.g\"\n"),
+        ("macros/m.g", "M98 P\"b.g\"\n"),
+        ("sys/b.g", "M201 X1234\n"),
+        ("macros/b.g", "M201 X9\n"),
+    ]);
+    let c = RrfConfig::read(dir.path().join("sys/config.g")).expect("valid");
+    assert_eq!(c.axes.x.max_accel_mm_s2, 1234.0);
+    assert_eq!(c.files.last(), Some(&dir.path().join("sys/b.g")));
+}
+
+#[test]
 fn other_dialects_ignore_configuration_commands() {
     assert_eq!(
         ignored(
