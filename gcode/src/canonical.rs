@@ -14,6 +14,7 @@ use crate::dialect::Dialect;
 use crate::event::{Event, EventKind, LayerSource, Note};
 use crate::geometry::{Move, Path};
 use crate::limits::{AxisFlags, AxisValues, LimitChange};
+use crate::setting::Setting;
 
 /// Writes events as G-code.
 #[derive(Debug)]
@@ -113,8 +114,70 @@ impl<W: Write> CanonicalWriter<W> {
                 self.skip_dwell = command.starts_with("G4");
                 writeln!(self.out, "{command}")
             }
+            EventKind::Note(Note::MacroCall { command, path }) => match *command {
+                "M501" => writeln!(self.out, "M501"),
+                _ => writeln!(self.out, "{command} P\"{}\"", path.replace('"', "\"\"")),
+            },
             EventKind::Limits(c) => self.write_limits(c),
+            EventKind::Setting(c) => self.write_setting(c),
         }
+    }
+
+    fn write_setting(&mut self, c: &Setting) -> io::Result<()> {
+        let o = &mut self.out;
+        match c {
+            Setting::StepsPerMm {
+                per_axis,
+                at_microstepping,
+            } => {
+                write!(o, "M92{}", axes(per_axis, |v| v))?;
+                opt(o, " S", at_microstepping.map(f64::from))?;
+            }
+            Setting::Microstepping {
+                per_axis,
+                interpolation,
+            } => write!(
+                o,
+                "M350{} I{}",
+                axes(per_axis, |v| v),
+                u8::from(*interpolation)
+            )?,
+            Setting::MotorCurrent {
+                per_axis_ma,
+                idle_percent,
+            } => {
+                write!(o, "M906{}", axes(per_axis_ma, |v| v))?;
+                opt(o, " I", *idle_percent)?;
+            }
+            Setting::AxisLimits {
+                minimum_mm,
+                maximum_mm,
+            } => {
+                // One command holds single values of one kind only: minimums (S1) or
+                // maximums; pairs mean both either way.
+                let s1 = [
+                    (minimum_mm.x, maximum_mm.x),
+                    (minimum_mm.y, maximum_mm.y),
+                    (minimum_mm.z, maximum_mm.z),
+                ]
+                .iter()
+                .any(|(lo, hi)| lo.is_some() && hi.is_none());
+                write!(o, "M208{}", if s1 { " S1" } else { "" })?;
+                for (l, lo, hi) in [
+                    ("X", minimum_mm.x, maximum_mm.x),
+                    ("Y", minimum_mm.y, maximum_mm.y),
+                    ("Z", minimum_mm.z, maximum_mm.z),
+                ] {
+                    match (lo, hi) {
+                        (Some(lo), Some(hi)) => write!(o, " {l}{lo}:{hi}")?,
+                        (Some(v), None) | (None, Some(v)) => write!(o, " {l}{v}")?,
+                        (None, None) => {}
+                    }
+                }
+            }
+            Setting::Kinematics { code } => write!(o, "M669 K{code}")?,
+        }
+        writeln!(o)
     }
 
     fn write_move(&mut self, mv: &Move) -> io::Result<()> {
@@ -192,10 +255,16 @@ impl<W: Write> CanonicalWriter<W> {
             LimitChange::RrfJerk {
                 per_axis_mm_s,
                 policy,
+                sets_maximum: true,
             } => {
                 write!(o, "M566{}", axes(per_axis_mm_s, per_min))?;
                 opt(o, " P", policy.map(f64::from))?;
             }
+            LimitChange::RrfJerk {
+                per_axis_mm_s,
+                sets_maximum: false,
+                ..
+            } => write!(o, "M205{}", axes(per_axis_mm_s, |v| v))?,
             LimitChange::MarlinInputShaping {
                 axes: a,
                 frequency_hz,

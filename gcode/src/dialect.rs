@@ -13,7 +13,8 @@
 //! | G2/G3 R form | refused (`klippy/extras/gcode_arcs.py`) | yes | yes |
 //! | G2/G3 in G91 | refused (`gcode_arcs.py`) | yes | yes |
 //! | M203 | not a command | mm/s | mm/min (mm/s with `S1`) |
-//! | jerk | `SQUARE_CORNER_VELOCITY` | M205 X/Y/Z/E mm/s, J junction deviation | M566 mm/min, M205 mm/s |
+//! | jerk | `SQUARE_CORNER_VELOCITY` | M205 X/Y/Z/E mm/s, J junction deviation | M566 mm/min (limit), M205 mm/s (printing moves) |
+//! | M92 M350 M906 M208 M669 M98 M501 | not commands (`printer.cfg` holds these settings) | counted as ignored | [`crate::Setting`]s and macro-call notes (`config.g`) |
 
 use std::fmt;
 use std::str::FromStr;

@@ -26,8 +26,9 @@ impl fmt::Display for Location {
     }
 }
 
-/// Everything that can go wrong reading G-code. Every variant about a line names the
-/// file, the line (and column where known), the command or parameter and what is allowed.
+/// Everything that can go wrong reading G-code or a firmware configuration file. Every
+/// variant about a line names the file, the line (and column where known), the command,
+/// option or parameter and what is allowed.
 #[derive(Debug, thiserror::Error)]
 pub enum GcodeError {
     /// The input could not be opened or read.
@@ -199,6 +200,68 @@ pub enum GcodeError {
         /// The name given.
         name: String,
     },
+    /// A line of a firmware configuration file that is not what the format allows there.
+    #[error("{at}: {what}")]
+    ConfigSyntax {
+        /// Where.
+        at: Location,
+        /// What was found and what is allowed.
+        what: String,
+    },
+    /// A configuration value that is malformed or out of the range the firmware accepts.
+    #[error("{at}: [{section}] {key} = `{value}`: not allowed (allowed: {allowed})")]
+    ConfigValue {
+        /// Where the option (or command) is.
+        at: Location,
+        /// The section (Klipper) or command (RepRapFirmware, `M350`).
+        section: String,
+        /// The option (Klipper) or parameter (RepRapFirmware).
+        key: String,
+        /// The value as written.
+        value: Box<str>,
+        /// What is allowed.
+        allowed: Box<str>,
+    },
+    /// An option the firmware requires is not set.
+    #[error("{source_name}: [{section}] has no `{key}` ({why})")]
+    ConfigMissing {
+        /// The configuration file (the main one when the whole section is missing).
+        source_name: Arc<str>,
+        /// The section.
+        section: String,
+        /// The option.
+        key: String,
+        /// Why it is needed.
+        why: &'static str,
+    },
+    /// An include that names a file (no wildcard) that does not exist.
+    #[error("{at}: included file `{path}` does not exist")]
+    IncludeNotFound {
+        /// The include line.
+        at: Location,
+        /// The path looked for.
+        path: String,
+    },
+    /// A file that includes itself, directly or through others.
+    #[error("{at}: `{path}` is already being read (include cycle: {chain})")]
+    IncludeCycle {
+        /// The include line that closes the cycle.
+        at: Location,
+        /// The file included again.
+        path: String,
+        /// The files being read, outermost first, joined by ` -> `.
+        chain: String,
+    },
+    /// An exporter was given a value the firmware would not accept.
+    #[error("cannot export {key} = {value} (allowed: {allowed})")]
+    ExportValue {
+        /// The setting (`shaper_type_x`, `M593 F`).
+        key: String,
+        /// The value given.
+        value: String,
+        /// What is allowed.
+        allowed: String,
+    },
     /// An R-form arc that ends where it starts, or an arc of zero sweep.
     #[error("{at}: `{command}`: {why}")]
     ArcDegenerate {
@@ -215,7 +278,10 @@ impl GcodeError {
     /// The location of a line error (`None` for I/O errors).
     pub fn location(&self) -> Option<&Location> {
         match self {
-            GcodeError::Io { .. } | GcodeError::UnknownDialect { .. } => None,
+            GcodeError::Io { .. }
+            | GcodeError::UnknownDialect { .. }
+            | GcodeError::ConfigMissing { .. }
+            | GcodeError::ExportValue { .. } => None,
             GcodeError::LineTooLong { at, .. }
             | GcodeError::InvalidUtf8 { at }
             | GcodeError::ControlCharacter { at, .. }
@@ -231,7 +297,11 @@ impl GcodeError {
             | GcodeError::ArcMixedForms { at, .. }
             | GcodeError::ArcRadiusMismatch { at, .. }
             | GcodeError::ArcRadiusTooSmall { at, .. }
-            | GcodeError::ArcDegenerate { at, .. } => Some(at),
+            | GcodeError::ArcDegenerate { at, .. }
+            | GcodeError::ConfigSyntax { at, .. }
+            | GcodeError::ConfigValue { at, .. }
+            | GcodeError::IncludeNotFound { at, .. }
+            | GcodeError::IncludeCycle { at, .. } => Some(at),
         }
     }
 

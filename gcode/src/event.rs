@@ -2,6 +2,7 @@
 
 use crate::geometry::Move;
 use crate::limits::{AxisFlags, LimitChange};
+use crate::setting::Setting;
 
 /// One thing the file asks for.
 #[derive(Debug, Clone, PartialEq)]
@@ -30,6 +31,9 @@ pub enum EventKind {
     Layer(LayerChange),
     /// Motion limits or shaping change from here on.
     Limits(LimitChange),
+    /// A machine setting (steps per mm, microstepping, current, travel, kinematics) changes
+    /// from here on; configuration-file commands, RepRapFirmware only.
+    Setting(Setting),
     /// Something the reader does not simulate but a user should know about.
     Note(Note),
 }
@@ -78,5 +82,15 @@ pub enum Note {
         command: String,
         /// What the firmware says.
         reason: &'static str,
+    },
+    /// RepRapFirmware runs another file here (`M98 P"file"`, or `M501`, which runs
+    /// `config-override.g`); the reader does not open it
+    /// ([`crate::config::RrfConfig`] does).
+    MacroCall {
+        /// `M98` or `M501`.
+        command: &'static str,
+        /// The file as written (relative names are relative to the firmware's `/sys`
+        /// folder).
+        path: String,
     },
 }

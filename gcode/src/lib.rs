@@ -1,4 +1,9 @@
-//! settle-gcode: a streaming, strict G-code reader.
+//! settle-gcode: what firmware reads — G-code jobs and firmware configuration files.
+//!
+//! Two parts: the streaming G-code reader below, and [`config`], which reads Klipper's
+//! `printer.cfg` and RepRapFirmware's `config.g` into plain data with the values the
+//! firmware would use (includes, SAVE_CONFIG, macros, defaults) and writes input shaper
+//! settings back in each firmware's syntax.
 //!
 //! [`Reader`] turns any `BufRead` (or a file, [`Reader::open`]) into [`Event`]s in file
 //! order, each with its 1-based line and its layer: moves ([`Move`]: start and end in a
@@ -7,6 +12,8 @@
 //! mm/s^2 whatever the firmware's units) and notes. The conventions of the firmware
 //! dialect the caller chooses ([`Dialect`]: Klipper, Marlin, RepRapFirmware) decide units
 //! and modes; [`Move::segments_for`] cuts an arc into the exact points each firmware plans.
+//! In the RepRapFirmware dialect the configuration commands (`M92`, `M350`, `M906`,
+//! `M208`, `M669`) arrive as [`Setting`]s and macro calls (`M98`, `M501`) as notes.
 //!
 //! The reader holds one line at a time (at most [`ReaderOptions::max_line_bytes`]), so a
 //! file of any size reads in bounded memory. Bad lines (binary data, NaN or huge
@@ -46,6 +53,7 @@
 mod arc;
 mod canonical;
 mod cmd;
+pub mod config;
 mod dialect;
 mod error;
 mod event;
@@ -59,6 +67,8 @@ mod motion;
 mod params;
 mod reader;
 mod segments;
+mod setting;
+mod setting_parse;
 mod summary;
 
 pub use arc::{
@@ -74,4 +84,5 @@ pub use layers::LayerMode;
 pub use limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
 pub use reader::{Reader, ReaderOptions, Skipped};
 pub use segments::{ArcSegmentation, KlipperArcs, MarlinArcs, RrfArcs};
+pub use setting::Setting;
 pub use summary::{LimitSeen, Summary};

@@ -94,7 +94,7 @@ pub(crate) fn m_code(
             })
         }
         (Rrf, 201) => {
-            cmd.allow(p, b"XYZE", "X Y Z E (mm/s^2)")?;
+            cmd.allow(p, b"XYZEUVWABCD", "X Y Z E ... (mm/s^2)")?;
             limits(LimitChange::MaxAccel {
                 per_axis_mm_s2: axes(cmd, p, POSITIVE, 1.0)?,
                 xy_frequency_limit_hz: None,
@@ -111,8 +111,8 @@ pub(crate) fn m_code(
         (Rrf, 203) => {
             cmd.allow(
                 p,
-                b"XYZEIS",
-                "X Y Z E I (mm/min, or mm/s with S1), S (0 or 1)",
+                b"XYZEISUVWABCD",
+                "X Y Z E ... I (mm/min, or mm/s with S1), S (0 or 1)",
             )?;
             let scale = if cmd.num(p, b'S', BOOL)? == Some(1.0) {
                 1.0
@@ -164,23 +164,25 @@ pub(crate) fn m_code(
             })
         }
         (Rrf, 205 | 566) => {
+            // Axes beyond X Y Z E (U V W A B C D) are accepted and not reported.
             let (allowed, scale): (&[u8], f64) = if number == 205 {
-                (b"XYZE", 1.0)
+                (b"XYZEUVWABCD", 1.0)
             } else {
-                (b"XYZEP", PER_MIN)
+                (b"XYZEPUVWABCD", PER_MIN)
             };
             cmd.allow(
                 p,
                 allowed,
                 if number == 205 {
-                    "X Y Z E (mm/s)"
+                    "X Y Z E ... (mm/s)"
                 } else {
-                    "X Y Z E (mm/min), P (policy)"
+                    "X Y Z E ... (mm/min), P (policy)"
                 },
             )?;
             limits(LimitChange::RrfJerk {
                 per_axis_mm_s: axes(cmd, p, NON_NEGATIVE, scale)?,
                 policy: small(cmd, p, b'P', 1, "0 or 1")?,
+                sets_maximum: number == 566,
             })
         }
         (Marlin, 593) => {

@@ -117,12 +117,15 @@ pub enum LimitChange {
     },
     /// RepRapFirmware `M566` (mm/min) and `M205` (mm/s): the largest instantaneous speed
     /// change per axis, mm/s, and `M566 P` the jerk policy (`src/GCodes/GCodes2.cpp`
-    /// cases 205/566).
+    /// cases 205/566). `M566` sets the machine's limit; `M205` only the value printing
+    /// moves use, capped by that limit (`Move::SetInstantDv`).
     RrfJerk {
         /// Per axis, mm/s.
         per_axis_mm_s: AxisValues,
         /// `P`: 0 = jerk only between printing moves, 1 = between any moves.
         policy: Option<u32>,
+        /// `M566` (true) or `M205` (false).
+        sets_maximum: bool,
     },
     /// Marlin `M593`: its built-in ZV input shaper (MarlinDocumentation `_gcode/M593.md`).
     /// No axis flag means every shaped axis.
@@ -219,6 +222,10 @@ impl LimitChange {
             LimitChange::MaxFeedrate { .. } => "M203",
             LimitChange::Accel { .. } => "M204",
             LimitChange::MarlinAdvanced { .. } => "M205",
+            LimitChange::RrfJerk {
+                sets_maximum: false,
+                ..
+            } => "M205",
             LimitChange::RrfJerk { .. } => "M566",
             LimitChange::MarlinInputShaping { .. } | LimitChange::RrfInputShaping { .. } => "M593",
             LimitChange::FtMotion { .. } => "M493",

@@ -18,6 +18,7 @@ use crate::limit_parse::{self, Outcome};
 use crate::lines::{LineStatus, Lines};
 use crate::motion::Motion;
 use crate::params::{KeyValues, Params};
+use crate::setting_parse;
 
 /// How the reader reads.
 #[derive(Debug, Clone, PartialEq)]
@@ -243,6 +244,11 @@ impl<R: BufRead> Iterator for Reader<R> {
     }
 }
 
+/// RepRapFirmware's configuration commands ([`setting_parse`]).
+fn is_rrf_setting(number: u32) -> bool {
+    matches!(number, 92 | 350 | 906 | 208 | 669 | 665 | 98 | 501)
+}
+
 impl Interp {
     fn push(&mut self, line: u64, kind: EventKind) {
         self.queue.push_back(Event {
@@ -382,10 +388,12 @@ impl Interp {
         let known = sub.is_none()
             && match letter {
                 b'G' => matches!(number, 0..=4 | 17..=21 | 28 | 90..=92),
-                b'M' => matches!(
-                    number,
-                    82 | 83 | 400 | 201 | 203 | 204 | 205 | 566 | 593 | 493 | 494
-                ),
+                b'M' => {
+                    matches!(
+                        number,
+                        82 | 83 | 400 | 201 | 203 | 204 | 205 | 566 | 593 | 493 | 494
+                    ) || (self.opts.dialect == Dialect::Rrf && is_rrf_setting(number))
+                }
                 _ => false,
             };
         if !known {
@@ -446,6 +454,14 @@ impl Interp {
                 self.motion.set_e_relative(number == 83);
             }
             (b'M', 400) => self.push(line, EventKind::Dwell { duration_s: 0.0 }),
+            (b'M', n) if is_rrf_setting(n) => {
+                match setting_parse::m_code(self.opts.dialect, cmd, number, p)? {
+                    setting_parse::Outcome::Setting(s) => self.push(line, EventKind::Setting(s)),
+                    setting_parse::Outcome::Note(n) => self.push(line, EventKind::Note(n)),
+                    setting_parse::Outcome::Nothing => {}
+                    setting_parse::Outcome::Unknown => self.ignore(cmd.name),
+                }
+            }
             (b'M', _) => match limit_parse::m_code(self.opts.dialect, cmd, number, p)? {
                 Outcome::Limits(c) => self.push(line, EventKind::Limits(c)),
                 Outcome::Note(n) => self.push(line, EventKind::Note(n)),

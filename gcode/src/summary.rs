@@ -9,6 +9,7 @@ use crate::event::{Event, EventKind, Note};
 use crate::geometry::{Bounds, MoveKind, Path};
 use crate::limits::LimitChange;
 use crate::reader::Reader;
+use crate::setting::Setting;
 
 /// Distinct limit changes (and notes) kept; further distinct ones are only counted.
 const MAX_KEPT: usize = 256;
@@ -63,6 +64,8 @@ pub struct Summary {
     pub limits: Vec<LimitSeen>,
     /// Limit-change events beyond the distinct ones kept.
     pub limits_not_kept: u64,
+    /// Machine settings with their line (the first few hundred; RepRapFirmware only).
+    pub settings: Vec<(u64, Setting)>,
     /// Notes with their line (the first few hundred).
     pub notes: Vec<(u64, Note)>,
     /// Commands ignored, by name.
@@ -92,6 +95,7 @@ impl Default for Summary {
             dwell_s: 0.0,
             limits: Vec::new(),
             limits_not_kept: 0,
+            settings: Vec::new(),
             notes: Vec::new(),
             ignored: BTreeMap::new(),
             skipped_lines: 0,
@@ -174,6 +178,11 @@ impl Summary {
                     self.limits_not_kept += 1;
                 }
             }
+            EventKind::Setting(c) => {
+                if self.settings.len() < MAX_KEPT {
+                    self.settings.push((ev.line, c.clone()));
+                }
+            }
             EventKind::Note(n) => {
                 if self.notes.len() < MAX_KEPT {
                     self.notes.push((ev.line, n.clone()));
@@ -229,6 +238,9 @@ impl fmt::Display for Summary {
         }
         if self.limits_not_kept > 0 {
             writeln!(f, "  ... and {} more", self.limits_not_kept)?;
+        }
+        for (line, c) in &self.settings {
+            writeln!(f, "setting, line {line}: {c:?}")?;
         }
         for (line, n) in &self.notes {
             writeln!(f, "note, line {line}: {n:?}")?;

@@ -266,6 +266,7 @@ fn rrf_limits_convert_mm_per_min() {
     let LimitChange::RrfJerk {
         per_axis_mm_s,
         policy,
+        sets_maximum: true,
     } = &got[4]
     else {
         panic!("{:?}", got[4])
@@ -279,7 +280,8 @@ fn rrf_limits_convert_mm_per_min() {
         got[5],
         LimitChange::RrfJerk {
             per_axis_mm_s: ax(Some(10.0), None),
-            policy: None
+            policy: None,
+            sets_maximum: false
         }
     );
     assert_eq!(

@@ -1,6 +1,9 @@
 //! settle-gcode's tests: one binary, one module per subject.
 
 mod arcs;
+mod config_export;
+mod config_klipper;
+mod config_rrf;
 mod dialects;
 mod errors;
 mod layers;
@@ -62,6 +65,13 @@ pub fn ignored(text: &str, dialect: Dialect) -> Vec<String> {
 pub fn print_path(name: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("prints")
+        .join(name)
+}
+
+/// A file or folder under `tests/data/`.
+pub fn data_path(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
         .join(name)
 }
 

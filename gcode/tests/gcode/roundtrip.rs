@@ -73,7 +73,10 @@ fn every_kind_of_event_round_trips() {
     let rrf = format!(
         "{common}G4 P300\nG3 X7 Y1 R-3 F1234.5\nM201 X3000 Y3000 E1000:1000\nM203 X18000 Y18000 Z1200 I30\n\
          M203 S1 X300\nM204 P2000 T5000\nM566 X900 Y900 Z60 E3000 P1\nM205 X12.5\n\
-         M593 P\"zvdd\" F50.2 S0.05 L0.2\nM593 P\"custom\" H0.4:0.7 T0.0125:0.0125\n"
+         M593 P\"zvdd\" F50.2 S0.05 L0.2\nM593 P\"custom\" H0.4:0.7 T0.0125:0.0125\n\
+         M92 X80 Y80.5 Z400 E420:415 S16\nM350 X32 Y32 I1\nM350 Z16\nM906 X1200 Y1200 Z800 I30\n\
+         M208 X-5:250 Y0:210\nM208 S1 Z0\nM208 S1 X-2 Y-1:200\nM669 K1\nM665 L360\n\
+         M98 P\"homeall.g\"\nM501\n"
     );
     for (d, text) in [
         (Dialect::Klipper, klipper),
@@ -86,6 +89,11 @@ fn every_kind_of_event_round_trips() {
             .filter(|e| matches!(e.kind, EventKind::Limits(_)))
             .count();
         assert!(limits >= 4, "{d}: {limits} limit events");
+        let settings = events
+            .iter()
+            .filter(|e| matches!(e.kind, EventKind::Setting(_)))
+            .count();
+        assert_eq!(settings, if d == Dialect::Rrf { 9 } else { 0 }, "{d}");
         assert!(
             canonical
                 .lines()

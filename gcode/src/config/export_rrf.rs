@@ -1,0 +1,76 @@
+//! Input shaping written as RepRapFirmware `config.g` lines: one `M593` line, because the
+//! firmware has one shaper for every axis (`Move` holds a single `AxisShaper`, applied to
+//! each drive in `Move::AddLinearSegments`; `M593` takes no axis), and `M204` when
+//! accelerations are given. Numbers are written shortest-exact, so [`RrfConfig`] reads
+//! back the same values bit for bit. When the axes were tuned apart, the caller picks the
+//! one setting to write.
+//!
+//! [`RrfConfig`]: super::RrfConfig
+
+use super::export_text::{comment_text, refuse};
+use super::machine::ShaperSetting;
+use super::rrf::{MAX_SHAPER_FREQUENCY_HZ, MIN_SHAPER_FREQUENCY_HZ};
+use crate::error::GcodeError;
+
+/// The `M593 P` types written (`custom` needs its impulses and is not).
+const TYPES: [&str; 7] = ["none", "zvd", "zvdd", "zvddd", "mzv", "ei2", "ei3"];
+
+/// What to write.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RrfExport {
+    /// What produced the values (a scenario, a command line); written as a comment.
+    pub produced_by: String,
+    /// The shaper of all axes: `name` an `M593 P` type (`zvd`, `mzv`, `ei2`, ...; a
+    /// `rrf:` prefix, as in `ShaperKind` names, is dropped), frequency in Hz, damping
+    /// ratio.
+    pub shaper: ShaperSetting,
+    /// `M204 P`: acceleration of printing moves, mm/s^2 (written only when given).
+    pub print_accel_mm_s2: Option<f64>,
+    /// `M204 T`: acceleration of travel moves, mm/s^2 (written only when given).
+    pub travel_accel_mm_s2: Option<f64>,
+}
+
+impl RrfExport {
+    /// The lines, or an error naming the first value the firmware would refuse.
+    pub fn to_config(&self) -> Result<String, GcodeError> {
+        let s = &self.shaper;
+        let name = s.name.strip_prefix("rrf:").unwrap_or(&s.name);
+        if !TYPES.contains(&name) {
+            return Err(refuse("M593 P", &s.name, TYPES.join(", ")));
+        }
+        if !(MIN_SHAPER_FREQUENCY_HZ..=MAX_SHAPER_FREQUENCY_HZ).contains(&s.frequency_hz) {
+            return Err(refuse(
+                "M593 F",
+                s.frequency_hz,
+                format!("{MIN_SHAPER_FREQUENCY_HZ:.3} to {MAX_SHAPER_FREQUENCY_HZ} Hz"),
+            ));
+        }
+        if !(0.0..=0.99).contains(&s.damping_ratio) {
+            return Err(refuse("M593 S", s.damping_ratio, "0 to 0.99"));
+        }
+        let by = comment_text(&self.produced_by);
+        let mut out = format!(
+            "; Written by settle: {by}\n\
+             ; RepRapFirmware has one input shaper for all axes: put these lines at the end of\n\
+             ; config.g (after any M501) in place of its other M593 line.\n\
+             M593 P\"{name}\" F{} S{}\n",
+            s.frequency_hz, s.damping_ratio
+        );
+        let mut m204 = String::new();
+        for (word, key, v) in [
+            ("P", "M204 P", self.print_accel_mm_s2),
+            ("T", "M204 T", self.travel_accel_mm_s2),
+        ] {
+            if let Some(a) = v {
+                if !(a.is_finite() && a > 0.0) {
+                    return Err(refuse(key, a, "a finite acceleration > 0 mm/s^2"));
+                }
+                m204.push_str(&format!(" {word}{a}"));
+            }
+        }
+        if !m204.is_empty() {
+            out.push_str(&format!("M204{m204}\n"));
+        }
+        Ok(out)
+    }
+}

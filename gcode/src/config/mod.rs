@@ -1,0 +1,71 @@
+//! Firmware configuration files in and out: Klipper's `printer.cfg` (with its includes and
+//! SAVE_CONFIG block) and RepRapFirmware's `config.g` (with the macros it runs) read into
+//! plain data ([`KlipperConfig`], [`RrfConfig`]) with the values the firmware would use,
+//! and input shaper settings written back in each firmware's own syntax, ready to paste
+//! ([`KlipperExport`], [`RrfExport`]).
+//!
+//! Both readers return per-axis [`AxisDrive`]s (microsteps per mm, microstepping, current,
+//! travel) and [`ShaperSetting`]s (shaper name, frequency, damping ratio; Klipper per axis,
+//! RepRapFirmware one for all), and [`ConfigNote`]s for what was read in a way worth
+//! knowing. Options and commands settle does not need are not read; a value settle reads
+//! that the firmware would refuse is an error naming the file, line, option and what is
+//! allowed. Each reader's module documentation says which firmware source each rule comes
+//! from; two that surprise:
+//!
+//! - Klipper drops an option from the SAVE_CONFIG block when the rest of the
+//!   configuration sets it (`klippy/configfile.py` `_strip_duplicates`): the block
+//!   overrides nothing; `SAVE_CONFIG` comments out the main file's lines when it saves.
+//! - RepRapFirmware's `M350` rescales the steps per mm already set, and `M593` has one
+//!   shaper for all axes.
+//!
+//! ```
+//! use settle_gcode::Dialect;
+//! use settle_gcode::config::{KlipperConfig, KlipperExport, RrfExport};
+//!
+//! let text = "[printer]\nkinematics: corexy\nmax_velocity: 300\nmax_accel: 5000\n\
+//!             [input_shaper]\nshaper_type_x: mzv\nshaper_freq_x: 52.4\n\
+//!             shaper_type_y: ei\nshaper_freq_y: 41.5\n";
+//! let c = KlipperConfig::parse(text, "printer.cfg")?;
+//! let shaper = c.input_shaper.expect("an [input_shaper] section");
+//! assert_eq!(shaper.x.kind_name(Dialect::Klipper).as_deref(), Some("mzv"));
+//! assert_eq!((shaper.x.frequency_hz, shaper.x.damping_ratio), (52.4, 0.1)); // default zeta
+//! assert_eq!(c.printer.minimum_cruise_ratio, 0.5); // Klipper's default
+//!
+//! let klipper = KlipperExport {
+//!     produced_by: "an example".into(),
+//!     x: shaper.x.clone(),
+//!     y: shaper.y.clone(),
+//!     max_accel_mm_s2: Some(6000.0),
+//!     minimum_cruise_ratio: None,
+//!     square_corner_velocity_mm_s: None,
+//! };
+//! assert!(klipper.to_config()?.contains("[input_shaper]\nshaper_type_x: mzv\n"));
+//! let mut one = shaper.y.clone();
+//! one.name = "ei2".into(); // RepRapFirmware's name for a two-hump EI
+//! let rrf = RrfExport { produced_by: "an example".into(), shaper: one, print_accel_mm_s2: None, travel_accel_mm_s2: None };
+//! assert!(rrf.to_config()?.ends_with("M593 P\"ei2\" F41.5 S0.1\n"));
+//! # Ok::<(), settle_gcode::GcodeError>(())
+//! ```
+
+mod export_klipper;
+mod export_rrf;
+mod export_text;
+mod glob;
+mod ini;
+mod klipper;
+mod klipper_files;
+mod klipper_shaper;
+mod klipper_values;
+mod machine;
+mod rrf;
+mod rrf_script;
+
+pub use export_klipper::KlipperExport;
+pub use export_rrf::RrfExport;
+pub use klipper::{
+    DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
+    DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,
+    KlipperStepper,
+};
+pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
+pub use rrf::{RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RrfAxis, RrfConfig};
