@@ -7,8 +7,9 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 
-use settle::run::Backend;
-use settle::{Error, report};
+use settle::Error;
+use settle::execute::run::Backend;
+use settle::output::report;
 
 fn parse_backend(s: &str) -> Result<Backend, String> {
     Backend::parse(s).ok_or_else(|| format!("unknown backend `{s}`; allowed: {}", Backend::ALLOWED))
@@ -49,7 +50,7 @@ enum Command {
         /// Run only shard K of N (1-based: runs i with i % N == K-1) into
         /// DIR [default: results/<scenario name>/shard-K-of-N/]; combine with `settle merge`.
         #[arg(long, value_name = "K/N")]
-        shard: Option<settle::shard::Shard>,
+        shard: Option<settle::workflows::shard::Shard>,
         /// Continue an interrupted sweep: keep the runs in OUT/journal.csv, run the rest.
         #[arg(long)]
         resume: bool,
@@ -77,7 +78,7 @@ enum Command {
         #[arg(long)]
         baseline: PathBuf,
         /// Relative tolerance in percent (numbers closer than this to the baseline pass).
-        #[arg(long, value_name = "PCT", default_value_t = settle::check::DEFAULT_TOLERANCE_PCT)]
+        #[arg(long, value_name = "PCT", default_value_t = settle::workflows::check::DEFAULT_TOLERANCE_PCT)]
         tolerance: f64,
         /// Rewrite the baseline with this run's values (on purpose: commit the diff).
         #[arg(long)]
@@ -201,7 +202,9 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             shard,
             resume,
         ),
-        Command::Validate { backend, out } => settle::validate::command(backend, out.as_deref()),
+        Command::Validate { backend, out } => {
+            settle::workflows::validate::command(backend, out.as_deref())
+        }
         Command::Check {
             scenario,
             baseline,
@@ -227,7 +230,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             check_on,
             jobs,
         } => {
-            let md = settle::tune_cmd::command(
+            let md = settle::workflows::tune::command(
                 &scenario,
                 out,
                 backend,
@@ -274,18 +277,18 @@ fn recorder(
     dir: PathBuf,
     scenario: &std::path::Path,
     name: &str,
-) -> anyhow::Result<Option<settle::sink::Recorder>> {
-    if flags.rerun && !settle::sink::rerun::AVAILABLE {
-        return Err(usage_error("--rerun", settle::sink::rerun::UNAVAILABLE).into());
+) -> anyhow::Result<Option<settle::output::sink::Recorder>> {
+    if flags.rerun && !settle::output::sink::rerun::AVAILABLE {
+        return Err(usage_error("--rerun", settle::output::sink::rerun::UNAVAILABLE).into());
     }
     if !(flags.mcap || flags.rerun) {
         return Ok(None);
     }
-    Ok(Some(settle::sink::Recorder {
+    Ok(Some(settle::output::sink::Recorder {
         dir,
         mcap: flags.mcap,
         rerun: flags.rerun,
-        provenance: settle::sink::Provenance::load(scenario, name)?,
+        provenance: settle::output::sink::Provenance::load(scenario, name)?,
     }))
 }
 
@@ -295,12 +298,12 @@ fn sweep(
     jobs: Option<usize>,
     backend: Backend,
     flags: OutputFlags,
-    shard: Option<settle::shard::Shard>,
+    shard: Option<settle::workflows::shard::Shard>,
     resume: bool,
 ) -> anyhow::Result<ExitCode> {
     let started = Instant::now();
     let (sc, mut all_runs) = settle::load_runs(&path)?;
-    settle::run::set_backend(&path, &mut all_runs, backend)?;
+    settle::execute::run::set_backend(&path, &mut all_runs, backend)?;
     let base = PathBuf::from("results").join(&sc.name);
     let out = out.unwrap_or_else(|| match shard {
         Some(s) => base.join(s.folder()),
@@ -319,7 +322,7 @@ fn sweep(
     }
     let rec = recorder(
         flags,
-        out.join(settle::outputs::RECORDINGS),
+        out.join(settle::output::sweep_files::RECORDINGS),
         &path,
         &sc.name,
     )?;
@@ -342,21 +345,23 @@ fn sweep(
         out.display()
     );
     // Every finished run's row goes to the journal at once, so an interruption (or a
-    // crash) loses nothing: `--resume` runs only what is missing (see settle::journal).
+    // crash) loses nothing: `--resume` runs only what is missing (see settle::workflows::journal).
     let header = report::runs_csv(&runs, &[]);
     let scenario_text = std::fs::read_to_string(&path).map_err(|source| Error::Read {
         path: path.clone(),
         source,
     })?;
-    let key = settle::journal::key_line(
+    let key = settle::workflows::journal::key_line(
         &scenario_text,
         &sc.name,
         backend.name(),
         &shard.map_or(String::new(), |s| s.to_string()),
     );
     let ids: Vec<usize> = runs.iter().map(|r| r.id).collect();
-    let (journal, done) = match settle::journal::existing(&out) {
-        Some(_) if resume => settle::journal::Journal::resume(&out, &key, &header, &ids)?,
+    let (journal, done) = match settle::workflows::journal::existing(&out) {
+        Some(_) if resume => {
+            settle::workflows::journal::Journal::resume(&out, &key, &header, &ids)?
+        }
         Some(p) => {
             return Err(usage_error(
                 "--resume",
@@ -368,7 +373,7 @@ fn sweep(
             .into());
         }
         None => (
-            settle::journal::Journal::start(&out, &key, &header)?,
+            settle::workflows::journal::Journal::start(&out, &key, &header)?,
             Default::default(),
         ),
     };
@@ -384,11 +389,11 @@ fn sweep(
         .filter(|r| !done.contains_key(&r.id))
         .cloned()
         .collect();
-    settle::interrupt::install().map_err(|m| usage_error("signals", m))?;
+    settle::execute::interrupt::install().map_err(|m| usage_error("signals", m))?;
     let run_one = |spec: &settle::RunSpec| -> Result<String, Error> {
         let m = match &rec {
             Some(r) => r.run(spec),
-            None => settle::run::execute(spec, None),
+            None => settle::execute::run::execute(spec, None),
         }
         // A run that fails is a row with its reason; the sweep goes on (issue 8).
         .unwrap_or_else(|e| settle::Metrics::failed(&spec.bands_um, format!("{e}")));
@@ -408,17 +413,17 @@ fn sweep(
             Err(e) => return Err(e.into()),
         }
     }
-    if interrupted > 0 || settle::interrupt::requested() {
+    if interrupted > 0 || settle::execute::interrupt::requested() {
         eprintln!(
             "interrupted: {} of {} runs finished and kept in {}; continue with\n  settle sweep {} --out {} --resume{}",
             rows.len(),
             runs.len(),
-            out.join(settle::journal::FILE).display(),
+            out.join(settle::workflows::journal::FILE).display(),
             path.display(),
             out.display(),
             shard.map_or(String::new(), |s| format!(" --shard {s}"))
         );
-        return Ok(ExitCode::from(settle::interrupt::EXIT_CODE));
+        return Ok(ExitCode::from(settle::execute::interrupt::EXIT_CODE));
     }
     let mut csv = header;
     for r in &runs {
@@ -431,10 +436,10 @@ fn sweep(
                 path: path.clone(),
                 source,
             })?;
-            settle::shard::write_manifest(
+            settle::workflows::shard::write_manifest(
                 &out,
-                &settle::shard::Manifest {
-                    format: settle::shard::FORMAT.to_string(),
+                &settle::workflows::shard::Manifest {
+                    format: settle::workflows::shard::FORMAT.to_string(),
                     settle_version: env!("CARGO_PKG_VERSION").to_string(),
                     scenario_name: sc.name.clone(),
                     scenario_file: path.display().to_string(),
@@ -451,18 +456,18 @@ fn sweep(
             eprintln!(
                 "wrote shard {s}: {} and {} ({} runs in {:.2} s); combine all shards with `settle merge`",
                 out.join("runs.csv").display(),
-                out.join(settle::shard::MANIFEST).display(),
+                out.join(settle::workflows::shard::MANIFEST).display(),
                 runs.len(),
                 started.elapsed().as_secs_f64()
             );
         }
         None => {
-            settle::outputs::write_sweep(&out, &sc, &runs, &csv)?;
+            settle::output::sweep_files::write_sweep(&out, &sc, &runs, &csv)?;
             eprintln!(
                 "wrote {}, {} and {}/ ({} runs in {:.2} s){}",
                 out.join("runs.csv").display(),
                 out.join("summary.md").display(),
-                out.join(settle::outputs::PLOTS).display(),
+                out.join(settle::output::sweep_files::PLOTS).display(),
                 runs.len(),
                 started.elapsed().as_secs_f64(),
                 rec.map_or(String::new(), |r| format!(
@@ -479,7 +484,7 @@ fn sweep(
 /// Print the failed runs (at most 20, then a count) from runs.csv's `status` and `reason`
 /// columns, and return exit code 1 if there are any, success otherwise.
 fn report_failures(runs: &[settle::RunSpec], csv: &str) -> ExitCode {
-    let Ok(table) = settle::table::RunsTable::parse(csv) else {
+    let Ok(table) = settle::input::runs_table::RunsTable::parse(csv) else {
         return ExitCode::from(1);
     };
     let failed: Vec<usize> = (0..runs.len())
@@ -552,14 +557,14 @@ fn check(
     };
     let old_table = old
         .as_deref()
-        .map(settle::table::RunsTable::parse)
+        .map(settle::input::runs_table::RunsTable::parse)
         .transpose()
         .map_err(|e| usage_error(&baseline.display().to_string(), e))?;
     // The backend: as asked, else the baseline's own; a baseline made on another backend
     // than the one asked for is an error (its numbers are not comparable), unless updating.
     let made_with = old_table
         .as_ref()
-        .map(settle::check::baseline_backend)
+        .map(settle::workflows::check::baseline_backend)
         .transpose()
         .map_err(|e| usage_error(&baseline.display().to_string(), e))?
         .flatten();
@@ -585,17 +590,18 @@ fn check(
         })?,
         (None, None) => Backend::default(),
     };
-    settle::run::set_backend(path, &mut runs, backend)?;
+    settle::execute::run::set_backend(path, &mut runs, backend)?;
     let results = settle::run_all(&runs, jobs, true)?;
     let mut metrics = Vec::with_capacity(results.len());
     for r in results {
         metrics.push(r.context("a run failed")?);
     }
     let csv = report::runs_csv(&runs, &metrics);
-    let now = settle::table::RunsTable::parse(&csv).map_err(|e| usage_error("runs.csv", e))?;
+    let now = settle::input::runs_table::RunsTable::parse(&csv)
+        .map_err(|e| usage_error("runs.csv", e))?;
     let comparison = old_table
         .as_ref()
-        .map(|b| settle::check::compare(b, &now, tolerance_pct));
+        .map(|b| settle::workflows::check::compare(b, &now, tolerance_pct));
     if update {
         if let Some(dir) = baseline.parent().filter(|d| !d.as_os_str().is_empty()) {
             create_dir(dir)?;
@@ -606,7 +612,7 @@ fn check(
                 "updated {}: {} values changed beyond {tolerance_pct}%:\n{}",
                 baseline.display(),
                 c.changes.len(),
-                settle::check::table(&c.changes, usize::MAX)
+                settle::workflows::check::table(&c.changes, usize::MAX)
             ),
             Some(Ok(_)) => println!(
                 "updated {} ({} runs; no value changed beyond {tolerance_pct}%)",
@@ -631,7 +637,7 @@ fn check(
         None => unreachable!("a missing baseline without --update returned above"),
     };
     let failures = c.failures(allow_improvements);
-    use settle::check::Verdict;
+    use settle::workflows::check::Verdict;
     let counts = format!(
         "{} worse, {} better, {} changed",
         c.count(Verdict::Worse),
@@ -639,7 +645,7 @@ fn check(
         c.count(Verdict::Changed)
     );
     if !c.changes.is_empty() {
-        println!("{}", settle::check::table(&c.changes, 500));
+        println!("{}", settle::workflows::check::table(&c.changes, 500));
     }
     if failures > 0 {
         eprintln!(
@@ -671,7 +677,7 @@ If the change is intended, rewrite the baseline and commit it:\n  settle check {
 }
 
 fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<ExitCode> {
-    let mut m = settle::shard::merge(dirs)?;
+    let mut m = settle::workflows::shard::merge(dirs)?;
     // The backend the shards ran on (a setting every shard agrees on).
     if let Some(b) = m
         .manifest
@@ -680,19 +686,19 @@ fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<ExitCode> {
         .and_then(|b| Backend::parse(b))
     {
         let file = PathBuf::from(&m.manifest.scenario_file);
-        settle::run::set_backend(&file, &mut m.runs, b)?;
+        settle::execute::run::set_backend(&file, &mut m.runs, b)?;
     }
     let out = out.unwrap_or_else(|| PathBuf::from("results").join(&m.scenario.name));
     create_dir(&out)?;
-    settle::outputs::write_sweep(&out, &m.scenario, &m.runs, &m.csv)?;
+    settle::output::sweep_files::write_sweep(&out, &m.scenario, &m.runs, &m.csv)?;
     // Recordings: gathered into one folder, as an unsharded sweep leaves them.
     let mut copied = 0usize;
     for d in dirs {
-        let src = d.join(settle::outputs::RECORDINGS);
+        let src = d.join(settle::output::sweep_files::RECORDINGS);
         let Ok(entries) = std::fs::read_dir(&src) else {
             continue;
         };
-        let dst = out.join(settle::outputs::RECORDINGS);
+        let dst = out.join(settle::output::sweep_files::RECORDINGS);
         create_dir(&dst)?;
         for e in entries {
             let e = e.map_err(|source| Error::Read {
@@ -722,7 +728,7 @@ fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<ExitCode> {
         if copied > 0 {
             format!(
                 "; {copied} recordings gathered in {}",
-                settle::outputs::RECORDINGS
+                settle::output::sweep_files::RECORDINGS
             )
         } else {
             String::new()
@@ -740,7 +746,7 @@ fn run_one(
     backend: Backend,
 ) -> anyhow::Result<ExitCode> {
     let (sc, mut runs) = settle::load_runs(&path)?;
-    settle::run::set_backend(&path, &mut runs, backend)?;
+    settle::execute::run::set_backend(&path, &mut runs, backend)?;
     let Some(spec) = runs.get(case) else {
         return Err(Error::Input {
             at: settle::error::Location {
@@ -772,26 +778,26 @@ fn run_one(
         .filter(|d| !d.as_os_str().is_empty())
         .map_or_else(|| PathBuf::from("."), PathBuf::from);
     let rec = recorder(flags, dir.clone(), &path, &sc.name)?;
-    let (series, m) = settle::sink::record_run(spec)?;
+    let (series, m) = settle::output::sink::record_run(spec)?;
     let mut csv = Vec::new();
     series.write_csv(&mut csv).context("formatting the trace")?;
     report::write_atomic(&out, &csv)?;
-    let record = settle::sink::RunRecord {
+    let record = settle::output::sink::RunRecord {
         spec,
         series: &series,
         metrics: &m,
-        row: settle::sink::row_of(spec, &m),
+        row: settle::output::sink::row_of(spec, &m),
     };
     let mut written = vec![out.display().to_string()];
     if let Some(r) = &rec {
         if r.mcap {
             let p = out.with_extension("mcap");
-            settle::sink::mcap::write_file(&p, &r.provenance, &record)?;
+            settle::output::sink::mcap::write_file(&p, &r.provenance, &record)?;
             written.push(p.display().to_string());
         }
         if r.rerun {
             let p = out.with_extension("rrd");
-            settle::sink::rerun::write_file(&p, &r.provenance, &record)?;
+            settle::output::sink::rerun::write_file(&p, &r.provenance, &record)?;
             written.push(p.display().to_string());
         }
     }
@@ -806,8 +812,8 @@ fn run_one(
             .map(|(k, v)| format!("{k} = {v}"))
             .collect();
         let title = format!("{} run {case}: {}", sc.name, swept.join(", "));
-        let fig = settle::plot::trace::figure(&title, &record);
-        settle::plot::write(&fig, &dir, &stem)?;
+        let fig = settle::output::plot::trace::figure(&title, &record);
+        settle::output::plot::write(&fig, &dir, &stem)?;
         written.push(dir.join(format!("{stem}.svg")).display().to_string());
         written.push(dir.join(format!("{stem}.png")).display().to_string());
     }
@@ -847,7 +853,7 @@ fn run_one(
             );
         }
     }
-    if let settle::metrics::Status::LostSteps { axis, steps } = &m.status {
+    if let settle::measure::metrics::Status::LostSteps { axis, steps } = &m.status {
         println!(
             "  FAILED: lost {steps} full steps (axis {axis}): the numbers above are not a settling result"
         );
@@ -880,7 +886,7 @@ fn plan_lines(jobs: Option<usize>) -> anyhow::Result<ExitCode> {
         let answers: Vec<String> = pool.install(|| {
             chunk
                 .par_iter()
-                .map(|l| settle::plan_lines::answer(l))
+                .map(|l| settle::workflows::plan::answer(l))
                 .collect()
         });
         for a in answers {

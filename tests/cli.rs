@@ -142,7 +142,7 @@ fn backend_flag_errors_are_input_errors() {
         None,
         "driver_model = \"linear\"",
     );
-    if !settle::run::Backend::Mujoco.available() {
+    if !settle::execute::run::Backend::Mujoco.available() {
         assert_input_error(
             &["sweep", "scenarios/quickstart.toml", "--backend", "mujoco"],
             None,

@@ -7,10 +7,10 @@
 use std::path::Path;
 
 use settle::Metrics;
-use settle::corner::Strategy;
-use settle::path_metrics::PathMetrics;
-use settle::run::Backend;
-use settle::sweep::RunSpec;
+use settle::execute::run::Backend;
+use settle::expand::RunSpec;
+use settle::kinds::corner::Strategy;
+use settle::measure::path_metrics::PathMetrics;
 use settle_planner::ProfileKind;
 
 const VMAX: f64 = 200.0; // mm/s
@@ -52,10 +52,10 @@ profile = ["trapezoid", "scurve"]
 
 fn run_sweep() -> Vec<(RunSpec, Metrics)> {
     let (sc, src) =
-        settle::scenario::parse(&scenario(), Path::new("corner_test.toml")).expect("parses");
-    let mut runs = settle::sweep::expand(&sc, &src).expect("expands");
+        settle::input::scenario::parse(&scenario(), Path::new("corner_test.toml")).expect("parses");
+    let mut runs = settle::expand::expand(&sc, &src).expect("expands");
     assert_eq!(runs.len(), 32);
-    settle::run::set_backend(Path::new("corner_test.toml"), &mut runs, Backend::Modal)
+    settle::execute::run::set_backend(Path::new("corner_test.toml"), &mut runs, Backend::Modal)
         .expect("modal runs the linear driver");
     let results = settle::run_all(&runs, None, false).expect("pool");
     runs.into_iter()
@@ -234,12 +234,13 @@ fn recorded_command_passes_the_corner_at_the_planned_distance() {
         "\"corner.angle_deg\" = [0, 60, 90, 180]\n\"corner.strategy\" = [\"exact_stop\", \"junction_deviation\", \"square_corner_velocity\", \"blend\"]\nprofile = [\"trapezoid\", \"scurve\"]",
         "\"corner.strategy\" = [\"blend\"]",
     );
-    let (sc, src) = settle::scenario::parse(&text, Path::new("t.toml")).expect("parses");
-    let mut runs = settle::sweep::expand(&sc, &src).expect("expands");
+    let (sc, src) = settle::input::scenario::parse(&text, Path::new("t.toml")).expect("parses");
+    let mut runs = settle::expand::expand(&sc, &src).expect("expands");
     assert_eq!(runs.len(), 1);
-    settle::run::set_backend(Path::new("t.toml"), &mut runs, Backend::Modal).expect("modal");
-    let mut series = settle::series::Series::default();
-    let m = settle::run::execute(&runs[0], Some(&mut series)).expect("runs");
+    settle::execute::run::set_backend(Path::new("t.toml"), &mut runs, Backend::Modal)
+        .expect("modal");
+    let mut series = settle::measure::series::Series::default();
+    let m = settle::execute::run::execute(&runs[0], Some(&mut series)).expect("runs");
     let p = path(&m);
     let ch = |name: &str| {
         &series
@@ -276,8 +277,8 @@ fn recorded_command_passes_the_corner_at_the_planned_distance() {
 }
 
 fn corner_err(text: &str) -> String {
-    let r = settle::scenario::parse(text, Path::new("bad.toml"))
-        .and_then(|(sc, src)| settle::sweep::expand(&sc, &src));
+    let r = settle::input::scenario::parse(text, Path::new("bad.toml"))
+        .and_then(|(sc, src)| settle::expand::expand(&sc, &src));
     match r {
         Ok(runs) => panic!("expected an error, got {} runs", runs.len()),
         Err(e) => {

@@ -7,7 +7,8 @@ use settle::Error;
 use settle_sim::DriverMode;
 
 fn expand(text: &str, path: &Path) -> Result<Vec<settle::RunSpec>, Error> {
-    settle::scenario::parse(text, path).and_then(|(sc, src)| settle::sweep::expand(&sc, &src))
+    settle::input::scenario::parse(text, path)
+        .and_then(|(sc, src)| settle::expand::expand(&sc, &src))
 }
 
 fn err(text: &str) -> String {
@@ -35,12 +36,12 @@ jmax_mm_s3 = 1e5
 #[test]
 fn presets_parse_compile_and_ring_where_their_comments_say() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for (name, path, text) in settle::machine_file::PRESETS {
+    for (name, path, text) in settle::input::machine_file::PRESETS {
         // The embedded text is the checked-in file.
         let on_disk = std::fs::read_to_string(dir.join(path)).expect("preset file");
         assert_eq!(on_disk, text, "{name}");
         let (m, description) =
-            settle::machine_file::parse(text, Path::new(path)).expect("preset parses");
+            settle::input::machine_file::parse(text, Path::new(path)).expect("preset parses");
         assert_eq!(m.name, name);
         assert!(!description.is_empty());
         for mode in [DriverMode::Full, DriverMode::Spring, DriverMode::Linear] {
@@ -190,7 +191,7 @@ fn machine_form_errors() {
 #[test]
 fn machine_file_by_path_reports_its_own_file_and_line() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let preset = settle::machine_file::PRESETS[1].2;
+    let preset = settle::input::machine_file::PRESETS[1].2;
     std::fs::write(dir.path().join("stage.toml"), preset).expect("write");
     let scenario = PRINTER
         .replace("\"printer_xy\"", "\"stage.toml\"")

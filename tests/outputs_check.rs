@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use settle::table::RunsTable;
+use settle::input::runs_table::RunsTable;
 
 const SCENARIO: &str = "scenarios/ci_quickstart.toml";
 const BASELINE: &str = "results/baselines/ci_quickstart.rapier.csv";

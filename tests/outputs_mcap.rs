@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use serde_json::Value;
-use settle::table::RunsTable;
+use settle::input::runs_table::RunsTable;
 
 const SCENARIO: &str = "scenarios/ci_quickstart.toml";
 
@@ -125,7 +125,7 @@ fn python_reader_sees_every_channel_schema_message_and_value() {
     // are whatever the run records) and its CSV trace.
     let file = &read[single.to_str().expect("utf-8")];
     let (_, runs) = settle::load_runs(&root().join(SCENARIO)).expect("scenario");
-    let (series, _) = settle::sink::record_run(&runs[1]).expect("runs");
+    let (series, _) = settle::output::sink::record_run(&runs[1]).expect("runs");
     let trace_text = std::fs::read_to_string(&trace).expect("trace");
     let trace_rows: Vec<Vec<f64>> = trace_text
         .lines()
@@ -133,7 +133,7 @@ fn python_reader_sees_every_channel_schema_message_and_value() {
         .map(|l| l.split(',').map(|c| c.parse().expect("number")).collect())
         .collect();
     assert_eq!(trace_rows.len(), series.len());
-    let groups = settle::sink::groups::groups(&series);
+    let groups = settle::output::sink::groups::groups(&series);
     assert_eq!(file["profile"], "");
     assert_eq!(file["compression"], serde_json::json!(["zstd"]));
     let channels = file["channels"].as_array().expect("channels");

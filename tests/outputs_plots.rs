@@ -84,7 +84,7 @@ fn run_plot_draws_every_channel_and_the_residual() {
     let svg = std::fs::read_to_string(dir.path().join("run-4.svg")).expect("svg");
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let (_, runs) = settle::load_runs(&root.join("scenarios/quickstart.toml")).expect("scenario");
-    let (series, _) = settle::sink::record_run(&runs[4]).expect("runs");
+    let (series, _) = settle::output::sink::record_run(&runs[4]).expect("runs");
     for c in &series.channels {
         assert!(svg.contains(&c.name), "channel {} not drawn", c.name);
     }

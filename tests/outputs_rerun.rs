@@ -73,8 +73,8 @@ fn rrd_holds_every_channel_and_sample() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let (_, runs) =
         settle::load_runs(&root.join("scenarios/ci_quickstart.toml")).expect("scenario");
-    let (series, _) = settle::sink::record_run(&runs[1]).expect("runs");
-    for g in settle::sink::groups::groups(&series) {
+    let (series, _) = settle::output::sink::record_run(&runs[1]).expect("runs");
+    for g in settle::output::sink::groups::groups(&series) {
         for f in &g.fields {
             let path = format!("/{}/{}", g.name, f.key);
             let (n, timed) = entities

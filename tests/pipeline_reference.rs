@@ -6,18 +6,18 @@
 
 use std::path::Path;
 
-use settle::metrics::Accumulator;
-use settle::run::Backend;
+use settle::execute::run::Backend;
+use settle::measure::metrics::Accumulator;
 use settle_sim::Mode;
 use settle_sim::closed_form::residual_at;
 
 fn check(backend: Backend, rel_tol: f64, settle_tol_s: f64) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
     let (_, mut runs) = settle::load_runs(&path).expect("quickstart");
-    settle::run::set_backend(&path, &mut runs, backend).expect("backend");
+    settle::execute::run::set_backend(&path, &mut runs, backend).expect("backend");
     let mut worst = 0.0f64;
     for spec in &runs {
-        let got = settle::run::execute(spec, None).expect("runs");
+        let got = settle::execute::run::execute(spec, None).expect("runs");
         let lim = spec.limits_si().expect("limits");
         let prof = spec
             .profile

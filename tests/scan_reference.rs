@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use settle::run::Backend;
+use settle::execute::run::Backend;
 use settle_planner::KindParams;
 use settle_sim::Mode;
 use settle_sim::closed_form::residual_at;
@@ -24,12 +24,12 @@ fn extra(m: &settle::Metrics, name: &str) -> f64 {
 fn reentry_error_and_settling_equal_the_closed_form_on_modal() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/ci_scan.toml");
     let (_, mut runs) = settle::load_runs(&path).expect("loads");
-    settle::run::set_backend(&path, &mut runs, Backend::Modal).expect("modal");
+    settle::execute::run::set_backend(&path, &mut runs, Backend::Modal).expect("modal");
     let mode = Mode::new(40.0, 0.05, 1.0).expect("mode");
     for spec in &runs {
         let scan = spec.scan.as_ref().expect("scan run");
-        let m = settle::run::execute(spec, None).expect("runs");
-        let r = settle::scan::plan(spec, scan).expect("plans");
+        let m = settle::execute::run::execute(spec, None).expect("runs");
+        let r = settle::kinds::scan::plan(spec, scan).expect("plans");
         let tr = r.turnarounds[0];
         let step = spec
             .profile

@@ -7,8 +7,8 @@ use settle::Error;
 
 fn parse_err(text: &str) -> String {
     let path = Path::new("bad.toml");
-    let r =
-        settle::scenario::parse(text, path).and_then(|(sc, src)| settle::sweep::expand(&sc, &src));
+    let r = settle::input::scenario::parse(text, path)
+        .and_then(|(sc, src)| settle::expand::expand(&sc, &src));
     match r {
         Ok(runs) => panic!("expected an error, got {} runs", runs.len()),
         Err(e) => {
@@ -49,8 +49,8 @@ fn every_scenario_file_parses_and_expands() {
 
 #[test]
 fn sweep_expands_in_order_with_log_ranges() {
-    let (sc, src) = settle::scenario::parse(GOOD, Path::new("t.toml")).expect("parses");
-    let runs = settle::sweep::expand(&sc, &src).expect("expands");
+    let (sc, src) = settle::input::scenario::parse(GOOD, Path::new("t.toml")).expect("parses");
+    let runs = settle::expand::expand(&sc, &src).expect("expands");
     assert_eq!(runs.len(), 6);
     let d: Vec<f64> = runs.iter().map(|r| r.distance_mm).collect();
     assert_eq!(d[0], 1.0);
@@ -172,8 +172,8 @@ fn missing_jerk_for_the_jerk_limited_kinds_names_file_line_and_key() {
         "profile = [\"trapezoid\", \"scurve\"]",
         "profile = [\"trapezoid\"]",
     );
-    let (sc, src) = settle::scenario::parse(&text, Path::new("t.toml")).expect("parses");
-    assert_eq!(settle::sweep::expand(&sc, &src).expect("expands").len(), 3);
+    let (sc, src) = settle::input::scenario::parse(&text, Path::new("t.toml")).expect("parses");
+    assert_eq!(settle::expand::expand(&sc, &src).expect("expands").len(), 3);
 }
 
 #[test]

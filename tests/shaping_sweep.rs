@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use settle::run::Backend;
+use settle::execute::run::Backend;
 use settle_planner::shaper::{Shaper, ShaperKind};
 use settle_planner::{Limits, ProfileKind};
 use settle_sim::Mode;
@@ -53,10 +53,10 @@ fn closed_form_peak_m(profile: &settle_planner::Profile, mode: &Mode) -> f64 {
 #[test]
 fn shaped_trapezoid_leaves_the_closed_form_fraction_of_the_residual() {
     let path = Path::new("shaped.toml");
-    let (sc, src) = settle::scenario::parse(&scenario(), path).expect("parses");
-    let mut runs = settle::sweep::expand(&sc, &src).expect("expands");
+    let (sc, src) = settle::input::scenario::parse(&scenario(), path).expect("parses");
+    let mut runs = settle::expand::expand(&sc, &src).expect("expands");
     assert_eq!(runs.len(), 7);
-    settle::run::set_backend(path, &mut runs, Backend::Modal).expect("modal");
+    settle::execute::run::set_backend(path, &mut runs, Backend::Modal).expect("modal");
     let results = settle::run_all(&runs, Some(1), false).expect("pool");
     let metrics: Vec<_> = results.into_iter().map(|r| r.expect("runs")).collect();
 
@@ -76,7 +76,7 @@ fn shaped_trapezoid_leaves_the_closed_form_fraction_of_the_residual() {
     );
     assert!(plain_peak_um > 50.0, "the test needs a real residual");
 
-    let csv = settle::report::runs_csv(&runs, &metrics);
+    let csv = settle::output::report::runs_csv(&runs, &metrics);
     let header: Vec<&str> = csv.lines().next().expect("header").split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
     let rv_col = col("remaining_vibration_pct");
@@ -124,8 +124,8 @@ fn shaped_trapezoid_leaves_the_closed_form_fraction_of_the_residual() {
 }
 
 fn parse_err(text: &str) -> String {
-    let r = settle::scenario::parse(text, Path::new("bad.toml"))
-        .and_then(|(sc, src)| settle::sweep::expand(&sc, &src));
+    let r = settle::input::scenario::parse(text, Path::new("bad.toml"))
+        .and_then(|(sc, src)| settle::expand::expand(&sc, &src));
     match r {
         Ok(runs) => panic!("expected an error, got {} runs", runs.len()),
         Err(e) => {

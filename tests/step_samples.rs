@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use settle::Metrics;
-use settle::run::{AxisMeta, Observe, simulate};
+use settle::execute::run::{AxisMeta, Observe, simulate};
 use settle_planner::{Limits, Profile, ProfileKind, Sample, State, Trajectory};
 use settle_sim::{AxisModel, DriverMode, ModalPlant, Observation, Plant, SimError};
 
@@ -169,8 +169,8 @@ fn same(a: &Metrics, b: &Metrics) -> bool {
 
 /// The bench's run: printer_xy, a 10 mm S-curve on Y, X idle, 0.5 s at 10 kHz.
 fn printer_case() -> Case {
-    let (_, path, text) = settle::machine_file::PRESETS[0];
-    let (machine, _) = settle::machine_file::parse(text, Path::new(path)).expect("preset");
+    let (_, path, text) = settle::input::machine_file::PRESETS[0];
+    let (machine, _) = settle::input::machine_file::parse(text, Path::new(path)).expect("preset");
     let lim = Limits::new(0.3, 3.0, Some(100.0)).expect("limits");
     let y = ProfileKind::SCurve
         .rest_to_rest(0.0, 0.01, &lim)
@@ -207,11 +207,11 @@ window_s = 0.1
 sample_rate_hz = 10000
 bands_um = [10.0]
 "#;
-    let (sc, src) = settle::scenario::parse(text, Path::new("corner.toml")).expect("parses");
-    let runs = settle::sweep::expand(&sc, &src).expect("expands");
+    let (sc, src) = settle::input::scenario::parse(text, Path::new("corner.toml")).expect("parses");
+    let runs = settle::expand::expand(&sc, &src).expect("expands");
     let spec = &runs[0];
-    let axes = settle::run::axes_of(spec).expect("axes");
-    let traj = settle::run::trajectory_of(spec, &axes).expect("plan");
+    let axes = settle::execute::run::axes_of(spec).expect("axes");
+    let traj = settle::execute::run::trajectory_of(spec, &axes).expect("plan");
     assert!(traj.path().is_some(), "a path run");
     Case {
         axes,

@@ -5,8 +5,8 @@
 
 use std::path::PathBuf;
 
-use settle::run::Backend;
-use settle::tune::{Score, pareto};
+use settle::execute::run::Backend;
+use settle::workflows::tune::search::{Score, pareto};
 
 fn scenario(tune: &str) -> String {
     format!(
@@ -51,8 +51,9 @@ fn write(dir: &tempfile::TempDir, text: &str) -> PathBuf {
 fn tuned_on_modal_still_beats_the_default_on_rapier() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = write(&dir, &scenario(SMALL));
-    let o = settle::tune_cmd::tune(&path, Backend::Modal, Some(Backend::Rapier), Some(2), false)
-        .expect("tunes");
+    let o =
+        settle::workflows::tune::tune(&path, Backend::Modal, Some(Backend::Rapier), Some(2), false)
+            .expect("tunes");
     // Grid: default + trapezoid (1 jerk) x 7 shapers + scurve x 2 jerks x 7 shapers; two
     // modes x three scales x two types = 12 shaped + 1 unshaped per (kind, jerk).
     assert_eq!(o.scores.len(), 1 + 13 + 2 * 13);
@@ -102,7 +103,7 @@ fn tuned_on_modal_still_beats_the_default_on_rapier() {
     assert_eq!(pareto(&o.scores), *front);
 
     // Klipper export names the winner's shaper on the moving axis.
-    let k = settle::tune_report::klipper(&o.plan, w);
+    let k = settle::workflows::tune::report::klipper(&o.plan, w);
     assert!(k.contains("max_accel: 3000"), "{k}");
     match w.candidate.shaper.and_then(|s| s.kind) {
         Some(kind) => {
@@ -122,9 +123,10 @@ fn tmc_export_of_an_scurve_reads_back_to_its_jerk() {
     let dir = tempfile::tempdir().expect("tempdir");
     let only_scurve = "distances_mm = [20.0]\nkinds = [\"scurve\"]\nshapers = [\"none\"]\njerk_steps = 1\nusteps_per_mm = 80.0\n";
     let path = write(&dir, &scenario(only_scurve));
-    let o = settle::tune_cmd::tune(&path, Backend::Modal, None, Some(1), false).expect("tunes");
+    let o =
+        settle::workflows::tune::tune(&path, Backend::Modal, None, Some(1), false).expect("tunes");
     let w = &o.scores[o.winner];
-    let text = settle::tune_report::tmc(&o.plan, w);
+    let text = settle::workflows::tune::report::tmc(&o.plan, w);
     let reg = |name: &str| -> u32 {
         text.lines()
             .find(|l| l.starts_with(name))
@@ -159,7 +161,7 @@ fn tmc_export_of_an_scurve_reads_back_to_its_jerk() {
 fn tune_err(tune: &str) -> String {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = write(&dir, &scenario(tune));
-    match settle::tune_cmd::tune(&path, Backend::Modal, None, Some(1), false) {
+    match settle::workflows::tune::tune(&path, Backend::Modal, None, Some(1), false) {
         Ok(_) => panic!("expected an error"),
         Err(e) => {
             assert!(e.is_input_error(), "{e}");
@@ -204,7 +206,7 @@ fn bad_tune_input_names_file_line_and_key() {
         &dir,
         &scenario("").replace("driver_model = \"linear\"", "driver_model = \"full\""),
     );
-    let e = settle::tune_cmd::tune(&path, Backend::Modal, None, Some(1), false)
+    let e = settle::workflows::tune::tune(&path, Backend::Modal, None, Some(1), false)
         .expect_err("modal refuses the full driver");
     assert!(e.to_string().contains("--backend rapier"), "{e}");
 }
@@ -239,8 +241,9 @@ jerk_steps = 2
 max_contour_error_um = 25.0
 "#;
     let path = write(&dir, text);
-    let o = settle::tune_cmd::tune(&path, Backend::Modal, Some(Backend::Rapier), Some(2), false)
-        .expect("tunes");
+    let o =
+        settle::workflows::tune::tune(&path, Backend::Modal, Some(Backend::Rapier), Some(2), false)
+            .expect("tunes");
     // Both path axes' modes: the preset's X (~48 Hz) and Y (~39 Hz) first modes.
     assert_eq!(o.plan.modes.len(), 2);
     let w = &o.scores[o.winner];
@@ -263,7 +266,7 @@ max_contour_error_um = 25.0
         rw.move_and_settle_s < rd.move_and_settle_s || rd.move_and_settle_s.is_infinite(),
         "rapier: winner {rw:?} default {rd:?}"
     );
-    let k = settle::tune_report::klipper(&o.plan, w);
+    let k = settle::workflows::tune::report::klipper(&o.plan, w);
     assert!(
         k.contains("shaper_freq_x:") && k.contains("shaper_freq_y:"),
         "{k}"
@@ -316,8 +319,9 @@ fn tune_command_writes_report_table_plot_and_exports() {
 fn refinement_never_loses_to_the_grid_and_stays_within_the_limits() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = write(&dir, &scenario(&format!("{SMALL}refine_rounds = 4\n")));
-    let o = settle::tune_cmd::tune(&path, Backend::Modal, Some(Backend::Rapier), Some(2), false)
-        .expect("tunes");
+    let o =
+        settle::workflows::tune::tune(&path, Backend::Modal, Some(Backend::Rapier), Some(2), false)
+            .expect("tunes");
     let grid = o.plan.candidates.len();
     assert_eq!(grid, 40);
     // At most 8 neighbours per round, none evaluated twice.
@@ -351,8 +355,8 @@ fn refinement_never_loses_to_the_grid_and_stays_within_the_limits() {
 
 #[test]
 fn neighbours_step_the_frequency_and_cap_the_jerk() {
-    use settle::shaping::ShaperSetting;
-    use settle::tune::{Candidate, neighbours};
+    use settle::kinds::shaping::ShaperSetting;
+    use settle::workflows::tune::search::{Candidate, neighbours};
     use settle_planner::shaper::ShaperKind;
     use settle_planner::{KindParams, ProfileKind};
     let c = Candidate {

@@ -12,7 +12,7 @@
 
 use std::path::{Path, PathBuf};
 
-use settle::run::Backend;
+use settle::execute::run::Backend;
 use settle_planner::KindParams;
 use settle_planner::shaper::Shaper;
 use settle_sim::Mode;
@@ -71,14 +71,14 @@ profile = ["trapezoid", "scurve"]
 "#,
     );
     let (_, mut runs) = settle::load_runs(&path).expect("loads");
-    settle::run::set_backend(&path, &mut runs, Backend::Modal).expect("modal");
+    settle::execute::run::set_backend(&path, &mut runs, Backend::Modal).expect("modal");
     assert_eq!(runs.len(), 16);
     let mode = Mode::new(F_HZ, ZETA, 1.0).expect("mode");
     let mut unshaped_um = std::collections::HashMap::new();
     for spec in &runs {
         let scan = spec.scan.as_ref().expect("scan run");
-        let m = settle::run::execute(spec, None).expect("runs");
-        let r = settle::scan::plan(spec, scan).expect("plans");
+        let m = settle::execute::run::execute(spec, None).expect("runs");
+        let r = settle::kinds::scan::plan(spec, scan).expect("plans");
         let tr = r.turnarounds[0];
         let plain = spec
             .profile
@@ -182,8 +182,9 @@ usteps_per_mm = 80.0
 fn scan_family_winner_beats_the_default_on_rapier_and_its_overhead_is_real() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = write(&dir, "tune_scan_test.toml", &scan_scenario(SMALL));
-    let o = settle::tune_cmd::tune(&path, Backend::Modal, Some(Backend::Rapier), Some(2), false)
-        .expect("tunes");
+    let o =
+        settle::workflows::tune::tune(&path, Backend::Modal, Some(Backend::Rapier), Some(2), false)
+            .expect("tunes");
     assert_eq!(o.scores.len(), 1 + 13 + 2 * 13);
     // The score band: 0.8 x 10 um, added to the runs' bands.
     assert_eq!(o.plan.bands_um, vec![10.0, 8.0]);
@@ -212,9 +213,9 @@ fn scan_family_winner_beats_the_default_on_rapier_and_its_overhead_is_real() {
     let both = [o.scores[0].candidate, o.scores[o.winner].candidate];
     let mut stretched = 0;
     for (i, mut run) in o.plan.runs(&both).into_iter().enumerate() {
-        let m = settle::run::execute(&run, None).expect("runs");
+        let m = settle::execute::run::execute(&run, None).expect("runs");
         let scan = run.scan.clone().expect("scan");
-        let f = settle::tune::scan_figures(&scan, &m, &o.plan.bands_um);
+        let f = settle::workflows::tune::search::scan_figures(&scan, &m, &o.plan.bands_um);
         let overhead = f.overhead_s[o.plan.score_band_index];
         assert!(overhead.is_finite(), "step {i}: {f:?}");
         if overhead <= f.window_s + 1e-3 {
@@ -222,7 +223,7 @@ fn scan_family_winner_beats_the_default_on_rapier_and_its_overhead_is_real() {
         }
         let mut check = |margin_s: f64| {
             run.scan.as_mut().expect("scan").settle_margin_s = margin_s;
-            let m = settle::run::execute(&run, None).expect("runs");
+            let m = settle::execute::run::execute(&run, None).expect("runs");
             (extra(&m, "scan_window_s"), extra(&m, "scan_settled_8um"))
         };
         eprintln!(
@@ -256,8 +257,9 @@ fn the_default_margin_keeps_the_corner_winner_inside_the_band_on_rapier() {
     // Margin 1: scored on the 10 um band itself. The winner's residual sits at the edge
     // of the band on modal and rapier settles it later than modal predicted.
     let edge = write(&dir, "tune_corner.toml", &format!("{text}margin = 1.0\n"));
-    let o = settle::tune_cmd::tune(&edge, Backend::Modal, Some(Backend::Rapier), Some(2), false)
-        .expect("tunes");
+    let o =
+        settle::workflows::tune::tune(&edge, Backend::Modal, Some(Backend::Rapier), Some(2), false)
+            .expect("tunes");
     let (_, _, rw) = o.check.as_ref().expect("checked");
     let w = &o.scores[o.winner];
     assert!(
@@ -268,9 +270,13 @@ fn the_default_margin_keeps_the_corner_winner_inside_the_band_on_rapier() {
     );
     // The shipped scenario (default margin 0.8): rapier settles the winner into the band
     // when modal says, and it still beats the default there.
-    let o = settle::tune_cmd::tune(&file, Backend::Modal, Some(Backend::Rapier), Some(2), false)
-        .expect("tunes");
-    assert_eq!(o.plan.margin, settle::tune::DEFAULT_MARGIN);
+    let o =
+        settle::workflows::tune::tune(&file, Backend::Modal, Some(Backend::Rapier), Some(2), false)
+            .expect("tunes");
+    assert_eq!(
+        o.plan.margin,
+        settle::workflows::tune::search::DEFAULT_MARGIN
+    );
     let (_, rd, rw) = o.check.as_ref().expect("checked");
     let w = &o.scores[o.winner];
     assert!(

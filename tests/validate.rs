@@ -3,8 +3,8 @@
 //! of the modal reference, numerical damping within 10 % of the physical, engines within
 //! 3 % of each other.
 
-use settle::run::Backend;
-use settle::validate::{self, markdown};
+use settle::execute::run::Backend;
+use settle::workflows::validate::{self, markdown};
 
 fn check(backend: Backend) -> validate::Report {
     let report = validate::run(&[backend]).expect("backend available");

@@ -1,0 +1,5 @@
+//! Run kinds.
+
+pub mod corner;
+pub mod scan;
+pub mod shaping;
