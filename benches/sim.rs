@@ -17,7 +17,8 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use settle::execute::run::{Backend, Observe, SimOptions, run_trajectory};
+use settle::execute::{Observe, SimOptions, run_trajectory};
+use settle::spec::backend::Backend;
 use settle_planner::{Limits, Profile, ProfileKind, State, Trajectory};
 use settle_sim::DriverMode;
 

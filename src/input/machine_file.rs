@@ -18,9 +18,8 @@ use settle_sim::machine::{
     AxisMachine, Belt, Driver, Frame, Machine, Motor, Mount, Screw, Transmission,
 };
 
-use crate::error::{Error, Location};
-use crate::input::keys::KeyIndex;
-use crate::input::scenario::Source;
+use crate::error::Error;
+use crate::input::source::Source;
 
 /// The built-in presets: name, repository path, text.
 pub const PRESETS: [(&str, &str, &str); 2] = [
@@ -308,24 +307,8 @@ pub fn to_machine(
 
 /// Parse a machine file's text; `path` names it in errors.
 pub fn parse(text: &str, path: &Path) -> Result<(Machine, String), Error> {
-    let keys = KeyIndex::new(text);
-    let file: MachineFile = toml::from_str(text).map_err(|e| {
-        let (line, column) = e.span().map(|s| keys.line_col(s.start)).unzip();
-        let key = line.and_then(|l| keys.key_at_line(l)).map(str::to_string);
-        Error::Input {
-            at: Location {
-                file: path.to_path_buf(),
-                line,
-                column,
-                key,
-            },
-            message: e.message().trim().to_string(),
-        }
-    })?;
-    let src = Source {
-        path: path.to_path_buf(),
-        keys,
-    };
+    let src = Source::new(text, path);
+    let file: MachineFile = src.document(&[])?;
     let m = to_machine(
         &file.name,
         file.motor.as_ref(),

@@ -1,16 +1,16 @@
-//! The runs table: `runs.csv` read back as named columns of text cells.
+//! The runs table: `runs.csv` read back as named columns of text cells, and the text of a
+//! table (the one place a CSV record is written, with the `csv` crate's quoting).
 //!
 //! Everything a sweep leaves besides the recordings is a function of this table (and the
 //! scenario): the summary, the plots, the regression gate (`settle check`) and the merge of
-//! sharded sweeps. Working on the table rather than on [`crate::Metrics`] keeps those outputs
+//! sharded sweeps. Working on the table rather than on metrics structs keeps those outputs
 //! generic: a column added to `runs.csv` is carried, compared and merged without more code.
 //!
 //! Cells are kept as the exact text written; numbers are written by Rust's shortest
 //! round-trip formatting, so parsing a cell gives back the very `f64` that was written.
+//! Free text (a failed run's reason) is quoted where it holds a comma or a quote.
 
-use std::fmt::Write as _;
-
-/// A CSV table of plain cells (no quoting: settle never writes commas inside a cell).
+/// A CSV table of text cells.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct RunsTable {
     /// Column names, in order.
@@ -24,39 +24,52 @@ pub fn number(cell: &str) -> Option<f64> {
     cell.parse::<f64>().ok()
 }
 
+/// One CSV record with its newline: cells separated by commas, a cell quoted when it holds
+/// a comma, a quote or a line break (a record of one empty cell is `""`).
+pub fn record<S: AsRef<[u8]>>(cells: &[S]) -> String {
+    let mut w = csv::WriterBuilder::new().from_writer(Vec::new());
+    // Writing to memory cannot fail.
+    let _ = w.write_record(cells);
+    let bytes = w.into_inner().unwrap_or_default();
+    String::from_utf8(bytes).unwrap_or_default()
+}
+
 impl RunsTable {
     /// Parse CSV text. Errors name the 1-based line.
     pub fn parse(text: &str) -> Result<Self, String> {
-        let mut lines = text.lines();
-        let header: Vec<String> = match lines.next() {
-            Some(h) if !h.trim().is_empty() => h.split(',').map(str::to_string).collect(),
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .from_reader(text.as_bytes());
+        let mut records = reader.records();
+        let header: Vec<String> = match records.next() {
+            Some(Ok(h)) if !(h.len() == 1 && h[0].trim().is_empty()) => {
+                h.iter().map(str::to_string).collect()
+            }
+            Some(Err(e)) => return Err(e.to_string()),
             _ => return Err("empty file: expected a header line".into()),
         };
         let mut rows = Vec::new();
-        for (i, line) in lines.enumerate() {
-            if line.is_empty() {
-                continue;
-            }
-            let row: Vec<String> = line.split(',').map(str::to_string).collect();
-            if row.len() != header.len() {
+        for r in records {
+            let r = r.map_err(|e| e.to_string())?;
+            if r.len() != header.len() {
+                let line = r.position().map_or(0, csv::Position::line);
                 return Err(format!(
-                    "line {}: {} cells, but the header has {} columns",
-                    i + 2,
-                    row.len(),
+                    "line {line}: {} cells, but the header has {} columns",
+                    r.len(),
                     header.len()
                 ));
             }
-            rows.push(row);
+            rows.push(r.iter().map(str::to_string).collect());
         }
         Ok(Self { header, rows })
     }
 
     /// The CSV text (header, then one line per row, each ending in a newline).
     pub fn to_csv(&self) -> String {
-        let mut out = String::new();
-        let _ = writeln!(out, "{}", self.header.join(","));
+        let mut out = record(&self.header);
         for r in &self.rows {
-            let _ = writeln!(out, "{}", r.join(","));
+            out.push_str(&record(r));
         }
         out
     }
@@ -107,5 +120,21 @@ mod tests {
         let e = RunsTable::parse("a,b\n1,2\n3\n").expect_err("ragged");
         assert!(e.contains("line 3"), "{e}");
         assert!(RunsTable::parse("").is_err());
+    }
+
+    #[test]
+    fn free_text_with_commas_and_quotes_is_quoted_and_read_back() {
+        let reason = "the backend failed at t = 0.1 s: \"step\" rejected, h = 2e-3";
+        let t = RunsTable {
+            header: vec!["run".into(), "reason".into(), "empty".into()],
+            rows: vec![vec!["0".into(), reason.into(), String::new()]],
+        };
+        let text = t.to_csv();
+        assert_eq!(
+            text,
+            "run,reason,empty\n0,\"the backend failed at t = 0.1 s: \"\"step\"\" rejected, h = 2e-3\",\n"
+        );
+        assert_eq!(RunsTable::parse(&text).expect("parses"), t);
+        assert_eq!(record(&["a", "b"]), "a,b\n");
     }
 }

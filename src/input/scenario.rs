@@ -1,15 +1,16 @@
 //! Scenario files: what a user writes. Parsed strictly (unknown keys are errors) and
-//! reported with file, line and key.
-
-use std::path::{Path, PathBuf};
+//! reported with file, line and key. The run kinds' tables (`[corner]`, `[scan]`,
+//! `[shaper]`, ...) are read by the kinds themselves (`crate::kinds`); this is the rest.
 
 use std::collections::BTreeMap;
+use std::path::Path;
 
 use serde::Deserialize;
 
-use crate::error::{Error, Location};
-use crate::input::keys::KeyIndex;
+use crate::error::Error;
 use crate::input::machine_file::{AxisSpec, DriverSpec, MotorSpec};
+use crate::input::source::Source;
+use crate::input::tune_spec::TuneSpec;
 
 /// A scenario file as written (mm, s; converted to SI when runs are built).
 #[derive(Debug, Clone, Deserialize)]
@@ -22,27 +23,21 @@ pub struct Scenario {
     pub description: String,
     /// The machine the moves run on.
     pub machine: MachineSpec,
-    /// The base move (sweeps override its fields). Either `[move]` or `[corner]`.
+    /// The base move (sweeps override its fields): a point-to-point move, or the move a run
+    /// kind builds on (the step of a `[scan]`). A kind with a path of its own (`[corner]`)
+    /// replaces it.
     #[serde(rename = "move")]
     pub move_: Option<MoveSpec>,
-    /// A two-segment corner path instead of a point-to-point move ([`crate::kinds::corner`]).
-    pub corner: Option<crate::kinds::corner::CornerSpec>,
     /// Kinematic limits (sweeps override them).
     pub limits: LimitsSpec,
     /// How and how long the result is observed.
     #[serde(default)]
     pub observe: ObserveSpec,
-    /// A raster scan: the move is the step-over between lines (see [`crate::kinds::scan`]).
+    /// The search of `settle tune` (see `crate::workflows::tune`).
     #[serde(default)]
-    pub scan: Option<crate::kinds::scan::ScanSpec>,
+    pub tune: Option<TuneSpec>,
     /// Sweep axes: `parameter = [list]` or `parameter = { from, to, steps | step, scale }`.
     /// The cartesian product of all axes, in the order written, gives the runs.
-    /// Input shaping of the commanded motion (issue 9; see `crate::kinds::shaping`).
-    #[serde(default)]
-    pub shaper: Option<crate::kinds::shaping::ShaperSpec>,
-    /// The search of `settle tune` (issue 9; see `crate::workflows::tune::search`).
-    #[serde(default)]
-    pub tune: Option<crate::workflows::tune::search::TuneSpec>,
     #[serde(default)]
     pub sweep: toml::Table,
     /// Numerical settings of the simulation (expert; the defaults are the validated ones).
@@ -179,61 +174,35 @@ impl Default for ObserveSpec {
     }
 }
 
-/// A parsed scenario with what is needed to report errors against its source.
-#[derive(Debug, Clone)]
-pub struct Source {
-    /// The file.
-    pub path: PathBuf,
-    /// Key-to-line index of its text.
-    pub keys: KeyIndex,
+/// Read and parse a scenario file; `claimed` are the top-level tables others read (the run
+/// kinds' tables: `crate::kinds::tables`), left out of the strict parse.
+pub fn load(path: &Path, claimed: &[&str]) -> Result<(Scenario, Source), Error> {
+    let source = Source::load(path)?;
+    let scenario = parse_source(&source, claimed)?;
+    Ok((scenario, source))
 }
 
-impl Source {
-    /// An input error at `key` (a dotted path) with `message`.
-    pub fn error_at(&self, key: &str, message: impl Into<String>) -> Error {
-        let (line, column) = self.keys.find(key).unzip();
-        Error::Input {
-            at: Location {
-                file: self.path.clone(),
-                line,
-                column,
-                key: Some(key.to_string()),
-            },
-            message: message.into(),
+/// Parse scenario text (see [`load`]); `path` is used in error messages.
+pub fn parse(text: &str, path: &Path, claimed: &[&str]) -> Result<(Scenario, Source), Error> {
+    let source = Source::new(text, path);
+    let scenario = parse_source(&source, claimed)?;
+    Ok((scenario, source))
+}
+
+fn parse_source(source: &Source, claimed: &[&str]) -> Result<Scenario, Error> {
+    let scenario: Scenario = source.document(claimed).map_err(|e| match e {
+        // The strict parse names the core keys; the claimed tables are allowed too.
+        Error::Input { at, message }
+            if message.starts_with("unknown field") && !claimed.is_empty() =>
+        {
+            let tables: Vec<String> = claimed.iter().map(|t| format!("`{t}`")).collect();
+            Error::Input {
+                at,
+                message: format!("{message}, or a run kind's table: {}", tables.join(", ")),
+            }
         }
-    }
-}
-
-/// Read and parse a scenario file.
-pub fn load(path: &Path) -> Result<(Scenario, Source), Error> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
-        path: path.to_path_buf(),
-        source,
+        other => other,
     })?;
-    parse(&text, path)
-}
-
-/// Parse scenario text; `path` is used in error messages.
-pub fn parse(text: &str, path: &Path) -> Result<(Scenario, Source), Error> {
-    let keys = KeyIndex::new(text);
-    let scenario: Scenario = toml::from_str(text).map_err(|e| {
-        let (line, column) = e.span().map(|s| keys.line_col(s.start)).unzip();
-        let key = line.and_then(|l| keys.key_at_line(l)).map(str::to_string);
-        // The message names an unknown key itself; a wrong type is named by the key line.
-        Error::Input {
-            at: Location {
-                file: path.to_path_buf(),
-                line,
-                column,
-                key,
-            },
-            message: e.message().trim().to_string(),
-        }
-    })?;
-    let source = Source {
-        path: path.to_path_buf(),
-        keys,
-    };
     if scenario.name.is_empty()
         || !scenario
             .name
@@ -248,5 +217,5 @@ pub fn parse(text: &str, path: &Path) -> Result<(Scenario, Source), Error> {
             ),
         ));
     }
-    Ok((scenario, source))
+    Ok(scenario)
 }

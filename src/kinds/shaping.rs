@@ -1,6 +1,7 @@
-//! Input shaping in sweeps: the scenario's `[shaper]` table, its sweepable keys
-//! (`shaper.type`, `shaper.frequency_hz`, `shaper.damping_ratio`), applying the shaper to a
-//! run's commanded motion and its runs.csv columns.
+//! Input shaping in sweeps, a modifier kind: the scenario's `[shaper]` table, its sweepable
+//! keys (`shaper.type`, `shaper.frequency_hz`, `shaper.damping_ratio`), the shaper it
+//! hands the run's motion kind (which applies it where it belongs: every axis of a path,
+//! the step of a raster) and its runs.csv columns.
 //!
 //! Design: the shaper is a table of its own, orthogonal to the profile kind, rather than
 //! compound kinds such as `trapezoid+mzv`. A shaper needs a frequency and a damping ratio
@@ -8,13 +9,17 @@
 //! `profile x shaper.type x shaper.frequency_hz` is the plain cartesian product every other
 //! sweep is. `type = "none"` switches shaping off inside a sweep (the unshaped reference).
 
-use std::fmt::Write as _;
-
 use serde::Deserialize;
+use settle_planner::PlanError;
 use settle_planner::shaper::{Shaper, ShaperKind};
-use settle_planner::{PlanError, Profile, Trajectory};
 
-use crate::expand::RunSpec;
+use crate::error::Error;
+use crate::input::scenario::ModeSpec;
+use crate::input::source::Source;
+use crate::kinds::{Kind, KindState, Role, any_has};
+use crate::measure::metrics::Metrics;
+use crate::spec::run_spec::RunSpec;
+use crate::spec::value::Value;
 
 /// Klipper's default damping ratio of its shapers (`damping_ratio_x`), 0.1: a shaper
 /// designed for 10% damping still works on the lightly damped modes of a real frame.
@@ -84,26 +89,6 @@ impl ShaperSetting {
             .transpose()
     }
 
-    /// Set a swept key (`type`, `frequency_hz`, `damping_ratio`).
-    pub fn set(&mut self, key: &str, value: &crate::expand::Value) -> Result<(), String> {
-        use crate::expand::Value;
-        match (key, value) {
-            ("type", Value::Text(t)) => self.kind = parse_type(t)?,
-            ("frequency_hz", Value::Number(x)) => self.frequency_hz = *x,
-            ("damping_ratio", Value::Number(x)) => self.damping_ratio = *x,
-            ("type", _) => return Err(format!("`shaper.type` takes names: {ALLOWED_TYPES}")),
-            ("frequency_hz" | "damping_ratio", _) => {
-                return Err(format!("`shaper.{key}` takes numbers"));
-            }
-            _ => {
-                return Err(format!(
-                    "`shaper.{key}` cannot be swept; allowed: shaper.type, shaper.frequency_hz, shaper.damping_ratio"
-                ));
-            }
-        }
-        Ok(())
-    }
-
     /// Check the setting: `(key, message)` on error.
     pub fn validate(&self) -> Result<(), (&'static str, String)> {
         if !(self.frequency_hz.is_finite() && self.frequency_hz > 0.0) {
@@ -125,43 +110,27 @@ impl ShaperSetting {
     }
 }
 
-/// Shape one profile with the run's shaper (unchanged without one).
-pub fn shape_profile(spec: &RunSpec, profile: Profile) -> Result<Profile, PlanError> {
-    match spec
-        .shaper
-        .as_ref()
-        .map(ShaperSetting::shaper)
-        .transpose()?
-    {
-        Some(Some(s)) => s.apply(&profile),
-        _ => Ok(profile),
+impl KindState for ShaperSetting {
+    fn table(&self) -> &'static str {
+        "shaper"
     }
-}
 
-/// Shape every axis of a trajectory (Klipper shapes each axis independently), keeping
-/// the path geometry it follows.
-pub fn shape_trajectory(spec: &RunSpec, traj: Trajectory) -> Result<Trajectory, PlanError> {
-    match spec
-        .shaper
-        .as_ref()
-        .map(ShaperSetting::shaper)
-        .transpose()?
-    {
-        Some(Some(s)) => {
-            let shaped = Trajectory::new(
-                traj.axes()
-                    .iter()
-                    .map(|p| s.apply(p))
-                    .collect::<Result<Vec<_>, _>>()?,
-            )?;
-            // The path stays the reference of the contour error: the shaper's smoothing of
-            // the corner counts against the shaped run.
-            Ok(match traj.path() {
-                Some(g) => shaped.with_path(g.clone()),
-                None => shaped,
-            })
+    fn set(&mut self, key: &str, value: &Value) -> Result<(), String> {
+        match (key, value) {
+            ("type", Value::Text(t)) => self.kind = parse_type(t)?,
+            ("frequency_hz", Value::Number(x)) => self.frequency_hz = *x,
+            ("damping_ratio", Value::Number(x)) => self.damping_ratio = *x,
+            ("type", _) => return Err(format!("`shaper.type` takes names: {ALLOWED_TYPES}")),
+            ("frequency_hz" | "damping_ratio", _) => {
+                return Err(format!("`shaper.{key}` takes numbers"));
+            }
+            _ => {
+                return Err(format!(
+                    "`shaper.{key}` cannot be swept; allowed: shaper.type, shaper.frequency_hz, shaper.damping_ratio"
+                ));
+            }
         }
-        _ => Ok(traj),
+        Ok(())
     }
 }
 
@@ -171,7 +140,7 @@ pub fn shape_trajectory(spec: &RunSpec, traj: Trajectory) -> Result<Trajectory, 
 /// linearised response to the run's unshaped move (from the closed form).
 pub fn dominant_mode(spec: &RunSpec) -> Option<(f64, f64)> {
     if spec.machine.is_none() {
-        let mut best: Option<&crate::input::scenario::ModeSpec> = None;
+        let mut best: Option<&ModeSpec> = None;
         for m in &spec.modes {
             if best.is_none_or(|b| m.weight.abs() > b.weight.abs()) {
                 best = Some(m);
@@ -206,44 +175,84 @@ pub const COLUMNS: [&str; 6] = [
     "smoothing_mm",
 ];
 
-/// `,name` for every shaping column (empty when no run has a shaper).
-pub fn csv_header(runs: &[RunSpec]) -> String {
-    if runs.iter().all(|r| r.shaper.is_none()) {
-        return String::new();
-    }
-    COLUMNS.iter().map(|c| format!(",{c}")).collect()
-}
+/// Input shaping of the commanded motion.
+#[derive(Debug, Clone, Copy)]
+pub struct Shaping;
 
-/// The shaping cells of `run`. `remaining_vibration_pct` is Klipper's figure for the
-/// [`dominant_mode`] (100 = no reduction; 100 for `none`), `smoothing_mm` Klipper's at the
-/// run's acceleration and [`SMOOTHING_SCV_MM_S`] (0 for `none`).
-pub fn csv_cells(runs: &[RunSpec], run: &RunSpec) -> String {
-    if runs.iter().all(|r| r.shaper.is_none()) {
-        return String::new();
+impl Kind for Shaping {
+    fn name(&self) -> &'static str {
+        "input shaper"
     }
-    let Some(setting) = &run.shaper else {
-        return ",".repeat(COLUMNS.len());
-    };
-    let mut s = String::new();
-    let name = setting.kind.map_or("none", ShaperKind::name);
-    let _ = write!(
-        s,
-        ",{name},{},{}",
-        setting.frequency_hz, setting.damping_ratio
-    );
-    match setting.shaper() {
-        Ok(Some(sh)) => {
-            let rv = dominant_mode(run)
-                .map(|(f, z)| (100.0 * sh.remaining_vibration(f, z)).to_string())
-                .unwrap_or_default();
-            let _ = write!(
-                s,
-                ",{},{rv},{}",
-                sh.duration_s(),
-                sh.smoothing_mm(run.amax_mm_s2, SMOOTHING_SCV_MM_S)
-            );
+
+    fn table(&self) -> Option<&'static str> {
+        Some("shaper")
+    }
+
+    fn role(&self) -> Role {
+        Role::Modifier
+    }
+
+    fn sweepable(&self) -> &'static str {
+        "shaper.type, shaper.frequency_hz, shaper.damping_ratio"
+    }
+
+    fn parse(&self, src: &Source) -> Result<Option<Box<dyn KindState>>, Error> {
+        let Some(spec) = src.table::<ShaperSpec>("shaper")? else {
+            return Ok(None);
+        };
+        let setting = ShaperSetting::from_spec(&spec).map_err(|(key, m)| src.error_at(key, m))?;
+        Ok(Some(Box::new(setting)))
+    }
+
+    fn validate(&self, run: &RunSpec) -> Result<(), (String, String)> {
+        match run.state::<ShaperSetting>().map(ShaperSetting::validate) {
+            Some(Err((key, message))) => Err((run.blame(key), message)),
+            _ => Ok(()),
         }
-        _ => s.push_str(",0,100,0"),
     }
-    s
+
+    fn shaper(&self, run: &RunSpec) -> Result<Option<Shaper>, PlanError> {
+        Ok(run
+            .state::<ShaperSetting>()
+            .map(ShaperSetting::shaper)
+            .transpose()?
+            .flatten())
+    }
+
+    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+        if !any_has::<ShaperSetting>(runs) {
+            return Vec::new();
+        }
+        COLUMNS.iter().map(|c| c.to_string()).collect()
+    }
+
+    /// `remaining_vibration_pct` is Klipper's figure for the [`dominant_mode`] (100 = no
+    /// reduction; 100 for `none`), `smoothing_mm` Klipper's at the run's acceleration and
+    /// [`SMOOTHING_SCV_MM_S`] (0 for `none`).
+    fn cells(&self, run: &RunSpec, _m: &Metrics) -> Vec<String> {
+        let Some(setting) = run.state::<ShaperSetting>() else {
+            return Vec::new();
+        };
+        let name = setting.kind.map_or("none", ShaperKind::name);
+        let mut out = vec![
+            name.to_string(),
+            setting.frequency_hz.to_string(),
+            setting.damping_ratio.to_string(),
+        ];
+        match setting.shaper() {
+            Ok(Some(sh)) => {
+                let rv = dominant_mode(run)
+                    .map(|(f, z)| (100.0 * sh.remaining_vibration(f, z)).to_string())
+                    .unwrap_or_default();
+                out.extend([
+                    sh.duration_s().to_string(),
+                    rv,
+                    sh.smoothing_mm(run.amax_mm_s2, SMOOTHING_SCV_MM_S)
+                        .to_string(),
+                ]);
+            }
+            _ => out.extend(["0", "100", "0"].map(String::from)),
+        }
+        out
+    }
 }

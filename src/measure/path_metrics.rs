@@ -1,4 +1,4 @@
-//! Metrics of motion along a path (issue 5), computed streaming beside
+//! Metrics of motion along a path, computed streaming beside
 //! [`crate::measure::metrics::Accumulator`] whenever the trajectory carries path geometry.
 //!
 //! Definitions (toolhead position `q`, a vector over the machine's axes, which are the
@@ -15,8 +15,6 @@
 //!   corner point while the plan passes it; the largest over the corners.
 //! - `corner_speed_mm_s`: the lowest planned speed at an interior point (the corner speed
 //!   of a two-segment corner).
-
-use std::fmt::Write as _;
 
 use settle_planner::path::{CornerRounding, PathGeometry};
 
@@ -134,31 +132,6 @@ impl<'a> PathAccumulator<'a> {
             contour_error_after_um: self.max_after_m * 1e6,
             max_sharp_error_um: self.max_sharp_m * 1e6,
             toolhead_corner_rounding_um: self.rounding.max_corner_rounding_m() * 1e6,
-        }
-    }
-}
-
-/// `,name` for every path metric column, when any run measured a path.
-pub fn csv_header(any_path: bool) -> String {
-    if !any_path {
-        return String::new();
-    }
-    columns::ALL.iter().map(|c| format!(",{c}")).collect()
-}
-
-/// The path metric cells of one run (empty cells for a failed run or one without a path).
-pub fn csv_cells(any_path: bool, m: Option<&PathMetrics>) -> String {
-    if !any_path {
-        return String::new();
-    }
-    match m {
-        None => ",".repeat(columns::ALL.len()),
-        Some(m) => {
-            let mut s = String::new();
-            for v in m.values() {
-                let _ = write!(s, ",{v}");
-            }
-            s
         }
     }
 }

@@ -3,6 +3,8 @@
 
 use std::io::Write;
 
+use crate::input::runs_table::record;
+
 /// One named channel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Channel {
@@ -78,19 +80,21 @@ impl Series {
         self.t_s.is_empty()
     }
 
-    /// Write as CSV with a `name_unit` header.
+    /// Write as CSV with a `name_unit` header (numbers in Rust's shortest round-trip form).
     pub fn write_csv(&self, mut w: impl Write) -> std::io::Result<()> {
-        write!(w, "t_s")?;
-        for c in &self.channels {
-            write!(w, ",{}_{}", c.name, c.unit)?;
-        }
-        writeln!(w)?;
+        let mut cells: Vec<String> = Vec::with_capacity(self.channels.len() + 1);
+        cells.push("t_s".into());
+        cells.extend(
+            self.channels
+                .iter()
+                .map(|c| format!("{}_{}", c.name, c.unit)),
+        );
+        w.write_all(record(&cells).as_bytes())?;
         for (i, t) in self.t_s.iter().enumerate() {
-            write!(w, "{t}")?;
-            for c in &self.channels {
-                write!(w, ",{}", c.data[i])?;
-            }
-            writeln!(w)?;
+            cells.clear();
+            cells.push(t.to_string());
+            cells.extend(self.channels.iter().map(|c| c.data[i].to_string()));
+            w.write_all(record(&cells).as_bytes())?;
         }
         Ok(())
     }

@@ -14,11 +14,12 @@
 
 use std::path::Path;
 
-use crate::error::{Error, Location};
-use crate::expand::RunSpec;
+use crate::error::Error;
 use crate::input::runs_table::RunsTable;
 use crate::input::scenario::Scenario;
-use crate::output::report::{summary_md, write_atomic};
+use crate::output::atomic::write_atomic;
+use crate::output::summary::summary_md;
+use crate::spec::run_spec::RunSpec;
 
 /// Folder of the sweep figures inside the output folder.
 pub const PLOTS: &str = "plots";
@@ -26,18 +27,11 @@ pub const PLOTS: &str = "plots";
 /// Folder of the per-run recordings inside the output folder.
 pub const RECORDINGS: &str = "recordings";
 
-/// Write `runs.csv` (the text `csv`, as written by [`crate::output::report::runs_csv`]), the
+/// Write `runs.csv` (the text `csv`, as written by [`crate::output::runs_csv`]), the
 /// figures and `summary.md` into `out`.
 pub fn write_sweep(out: &Path, sc: &Scenario, runs: &[RunSpec], csv: &str) -> Result<(), Error> {
-    let table = RunsTable::parse(csv).map_err(|message| Error::Input {
-        at: Location {
-            file: out.join("runs.csv"),
-            line: None,
-            column: None,
-            key: None,
-        },
-        message,
-    })?;
+    let table =
+        RunsTable::parse(csv).map_err(|message| Error::input(out.join("runs.csv"), message))?;
     write_atomic(&out.join("runs.csv"), csv.as_bytes())?;
     let figures = crate::output::plot::sweep::write_all(&out.join(PLOTS), &sc.name, runs, &table)?;
     write_atomic(

@@ -23,7 +23,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use crate::error::{Error, Location};
+use crate::error::Error;
 
 /// File name of the journal inside the output folder.
 pub const FILE: &str = "journal.csv";
@@ -65,15 +65,7 @@ pub fn key_line(scenario_text: &str, name: &str, backend: &str, shard: &str) -> 
 }
 
 fn journal_error(path: &Path, message: String) -> Error {
-    Error::Input {
-        at: Location {
-            file: path.to_path_buf(),
-            line: None,
-            column: None,
-            key: None,
-        },
-        message,
-    }
+    Error::input(path, message)
 }
 
 /// The journal path in `out`, if one exists.

@@ -157,3 +157,32 @@ fn axis_json(p: &Profile) -> Value {
         .collect();
     json!({ "p0": s.p, "v0": s.v, "a0": s.a, "segments": segs })
 }
+
+/// Answer the JSON lines of `input` on `output`, in order, in parallel chunks of 8192 lines
+/// on `jobs` threads (all cores when `None`).
+pub fn plan_stream(
+    input: impl std::io::BufRead,
+    mut output: impl std::io::Write,
+    jobs: Option<usize>,
+) -> Result<(), crate::error::Error> {
+    use rayon::prelude::*;
+    let pool = crate::execute::pool::thread_pool(jobs)?;
+    let read_err = |e| crate::error::Error::read("stdin", e);
+    let write_err = |e| crate::error::Error::write("stdout", e);
+    let mut lines = input.lines();
+    loop {
+        let chunk: Vec<String> = lines
+            .by_ref()
+            .take(8192)
+            .collect::<Result<_, _>>()
+            .map_err(read_err)?;
+        if chunk.is_empty() {
+            break;
+        }
+        let answers: Vec<String> = pool.install(|| chunk.par_iter().map(|l| answer(l)).collect());
+        for a in answers {
+            writeln!(output, "{a}").map_err(write_err)?;
+        }
+    }
+    output.flush().map_err(write_err)
+}

@@ -19,10 +19,10 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Location};
-use crate::expand::RunSpec;
+use crate::error::Error;
 use crate::input::runs_table::RunsTable;
 use crate::input::scenario::Scenario;
+use crate::spec::run_spec::RunSpec;
 
 /// The manifest's file name in a shard folder.
 pub const MANIFEST: &str = "shard.toml";
@@ -115,15 +115,7 @@ pub struct Manifest {
 }
 
 fn input_error(file: &Path, message: String) -> Error {
-    Error::Input {
-        at: Location {
-            file: file.to_path_buf(),
-            line: None,
-            column: None,
-            key: None,
-        },
-        message,
-    }
+    Error::input(file, message)
 }
 
 /// Read a shard folder: its manifest and its runs table.
@@ -171,7 +163,7 @@ pub fn write_manifest(dir: &Path, m: &Manifest) -> Result<(), Error> {
     let text = format!(
         "# A shard of a settle sweep: combine all shards with `settle merge DIR...`.\n{text}"
     );
-    crate::output::report::write_atomic(&path, text.as_bytes())
+    crate::output::atomic::write_atomic(&path, text.as_bytes())
 }
 
 /// The result of merging shards.
@@ -187,7 +179,8 @@ pub struct Merged {
     pub manifest: Manifest,
 }
 
-/// Merge shard folders (any order). See the module doc for what is checked.
+/// Merge shard folders (any order) into one runs table. See the module doc for what is
+/// checked.
 pub fn merge(dirs: &[PathBuf]) -> Result<Merged, Error> {
     let mut shards: Vec<(PathBuf, Manifest, RunsTable)> = Vec::new();
     for d in dirs {
@@ -295,8 +288,7 @@ was it interrupted or edited? Rerun `settle sweep --shard {shard}`",
         }
     }
     let file = PathBuf::from(&first.scenario_file);
-    let (scenario, src) = crate::input::scenario::parse(&first.scenario, &file)?;
-    let runs = crate::expand::expand(&scenario, &src)?;
+    let (scenario, runs) = crate::expand::parse_runs(&first.scenario, &file)?;
     if runs.len() != first.total_runs {
         return Err(input_error(
             &file,

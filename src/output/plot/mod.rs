@@ -698,7 +698,7 @@ pub fn write(f: &Figure, dir: &Path, stem: &str) -> Result<(), Error> {
         f,
     )
     .map_err(|e| fail(&svg, e))?;
-    crate::output::report::write_atomic(&svg, text.as_bytes())?;
+    crate::output::atomic::write_atomic(&svg, text.as_bytes())?;
     let png = dir.join(format!("{stem}.png"));
     // The bitmap encoder picks the format from the extension: keep `.png` last.
     let tmp = dir.join(format!(".{stem}.tmp{}.png", std::process::id()));

@@ -20,101 +20,70 @@ use plotters::style::RGBColor;
 
 use super::{Figure, LegendEntry, Line, Marker, PALETTE, Panel, fmt_num};
 use crate::error::Error;
-use crate::expand::{RunSpec, Value};
 use crate::input::runs_table::RunsTable;
+use crate::kinds::{self, PlotColumn};
+use crate::spec::run_spec::RunSpec;
+use crate::spec::value::Value;
 
-/// A metric panel: column, title, unit label, scale from the column's unit.
-struct Metric {
-    column: String,
-    title: String,
-    unit: &'static str,
-    scale: f64,
-    log_ok: bool,
-}
-
-fn metrics(bands: &[f64]) -> Vec<Metric> {
+/// The panels of a sweep figure: a run kind's that replace the common ones when the table
+/// has them (a scan's step-axis panels: the common ones would measure the run-out), else the
+/// common ones (per band the settle and move-and-settle times, the residual peak and RMS)
+/// and the other kinds' (a corner's contour error); only columns the table has.
+fn columns(bands: &[f64], table: &RunsTable) -> Vec<PlotColumn> {
+    let present = |p: &PlotColumn| table.column(&p.column).is_some();
+    for k in kinds::all().iter().filter(|k| k.replaces_move_tables()) {
+        let own: Vec<PlotColumn> = k.figures(bands).into_iter().filter(present).collect();
+        if !own.is_empty() {
+            return own;
+        }
+    }
+    let panel = |column: String, title: String, quantity, unit, scale, log_ok| PlotColumn {
+        column,
+        title,
+        quantity,
+        unit,
+        scale,
+        log_ok,
+    };
     let mut out = Vec::new();
-    // Scan steps (only present in scan sweeps, see crate::kinds::scan).
-    out.push(Metric {
-        column: "scan_reentry_error_um".into(),
-        title: "step axis: |error| when the fly axis re-enters".into(),
-        unit: "um",
-        scale: 1.0,
-        log_ok: true,
-    });
-    out.push(Metric {
-        column: "scan_line_residual_peak_um".into(),
-        title: "step axis: peak |error| during the next line".into(),
-        unit: "um",
-        scale: 1.0,
-        log_ok: true,
-    });
     for b in bands {
-        out.push(Metric {
-            column: format!("scan_step_settle_time_s_{b}um"),
-            title: format!("step axis: settle time to within {b} um after the step"),
-            unit: "ms",
-            scale: 1e3,
-            log_ok: false,
-        });
+        out.push(panel(
+            format!("settle_time_s_{b}um"),
+            format!("settle time to within {b} um"),
+            "settle time",
+            "ms",
+            1e3,
+            false,
+        ));
+        out.push(panel(
+            format!("move_and_settle_s_{b}um"),
+            format!("move + settle to within {b} um"),
+            "move + settle",
+            "ms",
+            1e3,
+            false,
+        ));
     }
-    out.push(Metric {
-        column: "scan_window_s".into(),
-        title: "window from exit to re-entry (overhead per line)".into(),
-        unit: "ms",
-        scale: 1e3,
-        log_ok: false,
-    });
-    for b in bands {
-        out.push(Metric {
-            column: format!("settle_time_s_{b}um"),
-            title: format!("settle time to within {b} um"),
-            unit: "ms",
-            scale: 1e3,
-            log_ok: false,
-        });
-        out.push(Metric {
-            column: format!("move_and_settle_s_{b}um"),
-            title: format!("move + settle to within {b} um"),
-            unit: "ms",
-            scale: 1e3,
-            log_ok: false,
-        });
+    out.push(panel(
+        "residual_peak_um".into(),
+        "residual vibration after the move: peak".into(),
+        "peak",
+        "um",
+        1.0,
+        true,
+    ));
+    out.push(panel(
+        "residual_rms_um".into(),
+        "residual vibration after the move: RMS".into(),
+        "RMS",
+        "um",
+        1.0,
+        true,
+    ));
+    for k in kinds::all().iter().filter(|k| !k.replaces_move_tables()) {
+        out.extend(k.figures(bands));
     }
-    out.push(Metric {
-        column: "residual_peak_um".into(),
-        title: "residual vibration after the move: peak".into(),
-        unit: "um",
-        scale: 1.0,
-        log_ok: true,
-    });
-    out.push(Metric {
-        column: "residual_rms_um".into(),
-        title: "residual vibration after the move: RMS".into(),
-        unit: "um",
-        scale: 1.0,
-        log_ok: true,
-    });
-    // Paths (issue 5): contour error during and after the move.
-    for (column, title) in [
-        (
-            crate::measure::path_metrics::columns::MAX_CONTOUR,
-            "contour error during the move: max",
-        ),
-        (
-            crate::measure::path_metrics::columns::CONTOUR_AFTER,
-            "contour error after the move: max",
-        ),
-    ] {
-        out.push(Metric {
-            column: column.into(),
-            title: title.into(),
-            unit: "um",
-            scale: 1.0,
-            log_ok: true,
-        });
-    }
-    out
+    out.into_iter().filter(present).collect()
 }
 
 /// File-name-safe form of a parameter (`move.distance_mm` -> `move_distance_mm`).
@@ -126,10 +95,7 @@ pub fn slug(param: &str) -> String {
 }
 
 fn number(v: &Value) -> Option<f64> {
-    match v {
-        Value::Number(x) => Some(*x),
-        Value::Kind(_) | Value::Text(_) => None,
-    }
+    v.number()
 }
 
 /// The swept numeric parameters of a sweep, in axis order.
@@ -146,7 +112,7 @@ pub fn numeric_params(runs: &[RunSpec]) -> Vec<String> {
 }
 
 /// The lines of one metric against `param`.
-fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &Metric) -> Vec<Line> {
+fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &PlotColumn) -> Vec<Line> {
     let mut kinds: Vec<ProfileKind> = Vec::new();
     let mut combos: Vec<String> = Vec::new();
     for r in runs {
@@ -281,12 +247,7 @@ pub fn figure(scenario: &str, runs: &[RunSpec], table: &RunsTable, param: &str) 
         });
     let x_log = lo > 0.0 && hi / lo >= 10.0;
     let mut panels = Vec::new();
-    let scan = table.column("scan_window_s").is_some();
-    for m in metrics(&bands) {
-        // A scan sweep shows its step-axis panels only (the others measure the run-out).
-        if table.column(&m.column).is_none() || (scan && !m.column.starts_with("scan_")) {
-            continue;
-        }
+    for m in columns(&bands, table) {
         let lines = lines(runs, table, param, &m);
         let ys: Vec<f64> = lines
             .iter()
@@ -302,7 +263,7 @@ pub fn figure(scenario: &str, runs: &[RunSpec], table: &RunsTable, param: &str) 
         panels.push(Panel {
             title: m.title.clone(),
             x_label: param.to_string(),
-            y_label: format!("{} ({})", m.column_short(), m.unit),
+            y_label: format!("{} ({})", m.quantity, m.unit),
             lines,
             x_log,
             y_log,
@@ -349,30 +310,6 @@ pub fn figure(scenario: &str, runs: &[RunSpec], table: &RunsTable, param: &str) 
     }
 }
 
-impl Metric {
-    fn column_short(&self) -> &str {
-        if self.column.starts_with("scan_") {
-            if self.column.contains("settle_time") {
-                "settle time"
-            } else if self.column.contains("window") {
-                "window"
-            } else {
-                "|error|"
-            }
-        } else if self.column.starts_with("settle_time") {
-            "settle time"
-        } else if self.column.starts_with("move_and_settle") {
-            "move + settle"
-        } else if self.column.contains("peak") {
-            "peak"
-        } else if self.column.contains("contour") {
-            "contour error"
-        } else {
-            "RMS"
-        }
-    }
-}
-
 /// Write every sweep figure into `dir` (created if needed); returns them for the summary
 /// with paths relative to `dir`'s parent (`plots/...`).
 pub fn write_all(
@@ -380,15 +317,12 @@ pub fn write_all(
     scenario: &str,
     runs: &[RunSpec],
     table: &RunsTable,
-) -> Result<Vec<crate::output::report::Figure>, Error> {
+) -> Result<Vec<crate::output::summary::Figure>, Error> {
     let params = numeric_params(runs);
     if params.is_empty() || table.rows.is_empty() {
         return Ok(Vec::new());
     }
-    std::fs::create_dir_all(dir).map_err(|source| Error::Write {
-        path: dir.to_path_buf(),
-        source,
-    })?;
+    crate::output::atomic::create_dir(dir)?;
     let folder = dir
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -397,7 +331,7 @@ pub fn write_all(
     for p in params {
         let stem = format!("vs_{}", slug(&p));
         super::write(&figure(scenario, runs, table, &p), dir, &stem)?;
-        out.push(crate::output::report::Figure {
+        out.push(crate::output::summary::Figure {
             title: format!("Settle time and residual vibration against {p}"),
             svg: format!("{folder}/{stem}.svg"),
             png: format!("{folder}/{stem}.png"),

@@ -201,7 +201,7 @@ pub fn write_file(path: &Path, p: &Provenance, rec: &RunRecord) -> Result<Vec<Ch
         path: path.to_path_buf(),
         source,
     };
-    let tmp = super::tmp_path(path);
+    let tmp = crate::output::atomic::tmp_path(path);
     let file = std::fs::File::create(&tmp).map_err(err)?;
     let mut w = BufWriter::new(file);
     let result = write(&mut w, p, rec)

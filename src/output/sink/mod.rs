@@ -1,7 +1,7 @@
 //! Sinks for whole runs: recordings (MCAP, rerun) written from a run's full [`Series`].
 //!
 //! Recording needs the full series of a run in memory (one per worker thread at a time);
-//! a sweep that records nothing keeps the streaming path ([`crate::run_all`]) and holds no
+//! a sweep that records nothing keeps the streaming path ([`crate::execute::pool::run_all`]) and holds no
 //! traces at all. The series is written generically: whatever channels the run records, in
 //! the groups of [`groups`].
 
@@ -12,10 +12,10 @@ pub mod rerun;
 use std::path::{Path, PathBuf};
 
 use crate::error::Error;
-use crate::expand::RunSpec;
 use crate::input::runs_table::RunsTable;
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
+use crate::spec::run_spec::RunSpec;
 
 /// Where a recording comes from (MCAP metadata, rerun recording properties).
 #[derive(Debug, Clone)]
@@ -63,13 +63,14 @@ pub struct RunRecord<'a> {
 /// run is executed with a recorder.
 pub fn record_run(spec: &RunSpec) -> Result<(Series, Metrics), Error> {
     let mut series = Series::default();
-    let m = crate::execute::run::execute(spec, Some(&mut series))?;
+    let m = crate::execute::execute(spec, Some(&mut series))?;
     Ok((series, m))
 }
 
 /// The `runs.csv` row of one run, as a table.
 pub fn row_of(spec: &RunSpec, m: &Metrics) -> RunsTable {
-    let csv = crate::output::report::runs_csv(std::slice::from_ref(spec), std::slice::from_ref(m));
+    let csv =
+        crate::output::runs_csv::runs_csv(std::slice::from_ref(spec), std::slice::from_ref(m));
     // runs_csv writes one header and one row of plain cells: this cannot fail.
     RunsTable::parse(&csv).unwrap_or_default()
 }
@@ -121,13 +122,4 @@ impl Recorder {
         }
         Ok(())
     }
-}
-
-/// A temporary name beside `path` (same folder, so a rename is atomic).
-pub(crate) fn tmp_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.tmp{}", std::process::id()))
 }

@@ -39,7 +39,7 @@ pub fn write_file(path: &Path, p: &Provenance, rec: &RunRecord) -> Result<(), Er
         path: path.to_path_buf(),
         source: std::io::Error::other(e),
     };
-    let tmp = super::tmp_path(path);
+    let tmp = crate::output::atomic::tmp_path(path);
     let result = (|| -> Result<(), String> {
         let stream = RecordingStreamBuilder::new("settle")
             .save(&tmp)

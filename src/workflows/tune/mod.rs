@@ -1,6 +1,5 @@
-//! The `settle tune SCENARIO.toml` command: search ([`crate::workflows::tune::search`]), optionally re-check
-//! the default and the winner on a second backend, and write the outputs
-//! ([`crate::workflows::tune::report`]).
+//! `settle tune SCENARIO.toml`: search ([`search`]), optionally re-check the default and
+//! the winner on a second backend, and write the outputs ([`report`]).
 
 pub mod report;
 pub mod search;
@@ -9,8 +8,11 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::error::Error;
-use crate::execute::run::Backend;
-use crate::workflows::tune::search::{Plan, Score};
+use crate::execute::pool::{Progress, quiet};
+use crate::output::atomic::{create_dir, write_atomic};
+use crate::spec::backend::Backend;
+use crate::workflows::{Exit, Report};
+use search::{Plan, Score};
 
 /// What a tuning found.
 #[derive(Debug, Clone)]
@@ -35,34 +37,31 @@ pub fn tune(
     backend: Backend,
     check_on: Option<Backend>,
     jobs: Option<usize>,
-    progress: bool,
+    progress: Progress,
 ) -> Result<Outcome, Error> {
-    let (sc, src) = crate::input::scenario::load(path)?;
+    let (sc, src) = crate::expand::load(path)?;
     let mut runs = crate::expand::expand(&sc, &src)?;
-    crate::execute::run::set_backend(path, &mut runs, backend)?;
-    let plan = crate::workflows::tune::search::plan(&sc, &src, &runs)?;
-    let mut scores =
-        crate::workflows::tune::search::evaluate(&plan, &plan.candidates, jobs, progress)?;
-    let grid_winner = crate::workflows::tune::search::best(&scores).ok_or_else(|| Error::Input {
-        at: crate::error::Location {
-            file: path.to_path_buf(),
-            line: None,
-            column: None,
-            key: Some("observe.window_s".into()),
-        },
-        message: "no candidate settles within the observation window; lengthen window_s or widen the band".into(),
+    crate::execute::set_backend(path, &mut runs, backend)?;
+    let plan = search::plan(&sc, &src, &runs)?;
+    let mut scores = search::evaluate(&plan, &plan.candidates, jobs, progress)?;
+    let grid_winner = search::best(&scores).ok_or_else(|| {
+        Error::input_key(
+            path,
+            "observe.window_s",
+            "no candidate settles within the observation window; lengthen window_s or widen the band",
+        )
     })?;
-    let winner = crate::workflows::tune::search::refine(&plan, &mut scores, grid_winner, jobs)?;
-    let front = crate::workflows::tune::search::pareto(&scores);
+    let winner = search::refine(&plan, &mut scores, grid_winner, jobs)?;
+    let front = search::pareto(&scores);
     let check = match check_on {
         None => None,
         Some(b) => {
             let mut other = plan.clone();
             let mut base = vec![other.base.clone()];
-            crate::execute::run::set_backend(path, &mut base, b)?;
+            crate::execute::set_backend(path, &mut base, b)?;
             other.base.backend = b;
             let pair = [scores[0].candidate, scores[winner].candidate];
-            let s = crate::workflows::tune::search::evaluate(&other, &pair, jobs, false)?;
+            let s = search::evaluate(&other, &pair, jobs, &quiet)?;
             Some((b, s[0].clone(), s[1].clone()))
         }
     };
@@ -83,20 +82,20 @@ pub fn refine_text(o: &Outcome) -> String {
     if o.plan
         .spec
         .refine_rounds
-        .unwrap_or(crate::workflows::tune::search::DEFAULT_REFINE_ROUNDS)
+        .unwrap_or(search::DEFAULT_REFINE_ROUNDS)
         == 0
     {
         return String::new();
     }
     let (g, w) = (&o.scores[o.grid_winner], &o.scores[o.winner]);
-    let [_, _, h_score] = crate::workflows::tune::report::headings(&o.plan);
+    let [_, _, h_score] = report::headings(&o.plan);
     let mut out = format!(
         "\n## Refinement around the grid winner\n\n{} grid candidates, then {} rounds around the grid winner ({extra} more candidates). ",
         o.plan.candidates.len(),
         o.plan
             .spec
             .refine_rounds
-            .unwrap_or(crate::workflows::tune::search::DEFAULT_REFINE_ROUNDS),
+            .unwrap_or(search::DEFAULT_REFINE_ROUNDS),
     );
     if o.winner == o.grid_winner {
         let _ = writeln!(
@@ -126,13 +125,13 @@ pub fn check_text(o: &Outcome) -> String {
     };
     let plan = &o.plan;
     let band = plan.base.bands_um[plan.band_index];
-    let [h_move, h_res, h_score] = crate::workflows::tune::report::headings(plan);
+    let [h_move, h_res, h_score] = report::headings(plan);
     let mut out = String::new();
     let _ = writeln!(
         out,
         "\n## Checked on a second backend: {b}\n\n| | candidate | {h_move} | {h_res} | {h_score} | into {band} um (ms) |\n|---|---|---:|---:|---:|---:|"
     );
-    crate::workflows::tune::report::default_and_winner_rows(&mut out, d, w, "winner");
+    report::default_and_winner_rows(&mut out, d, w, "winner");
     let verdict = if w.move_and_settle_s < d.move_and_settle_s {
         format!(
             "the winner still beats the default on {b}: {:.1}% better",
@@ -146,8 +145,8 @@ pub fn check_text(o: &Outcome) -> String {
     let _ = writeln!(
         out,
         "Into the {band} um band the winner takes {} ms on {b} ({} ms on {}, {}).",
-        crate::workflows::tune::report::ms(w.at_band_s),
-        crate::workflows::tune::report::ms(searched.at_band_s),
+        report::ms(w.at_band_s),
+        report::ms(searched.at_band_s),
         plan.base.backend,
         if w.at_band_s <= searched.at_band_s + 1.0 / plan.base.sample_rate_hz {
             "confirmed within one sample"
@@ -158,46 +157,63 @@ pub fn check_text(o: &Outcome) -> String {
     out
 }
 
-/// Run the command: tune, write `OUT/tune.md`, `candidates.csv`, `pareto.svg/png`,
-/// `klipper.cfg`, `tmc5160.txt`, print the report. Returns the report text.
-pub fn command(
+/// What `settle tune` found and wrote.
+#[derive(Debug, Clone)]
+pub struct Tuned {
+    /// The search and its result.
+    pub outcome: Outcome,
+    /// The report (`tune.md`).
+    pub markdown: String,
+    /// The output folder.
+    pub out: PathBuf,
+}
+
+impl Tuned {
+    /// What `settle tune` prints: the report.
+    pub fn report(&self) -> Report {
+        Report {
+            stdout: self.markdown.clone(),
+            stderr: String::new(),
+            exit: Exit::Ok,
+        }
+    }
+}
+
+/// Tune `path` on `backend` (re-checked on `check_on`), and write `OUT/tune.md`,
+/// `candidates.csv`, `pareto.svg/png`, `klipper.cfg` and `tmc5160.txt` into `out`
+/// [default: `results/<name>-tune/`].
+pub fn tune_to(
     path: &Path,
     out: Option<PathBuf>,
     backend: Backend,
     check_on: Option<Backend>,
     jobs: Option<usize>,
-) -> Result<String, Error> {
-    let (sc, _) = crate::input::scenario::load(path)?;
-    let o = tune(path, backend, check_on, jobs, true)?;
+    progress: Progress,
+) -> Result<Tuned, Error> {
+    let (sc, _) = crate::expand::load(path)?;
+    let o = tune(path, backend, check_on, jobs, progress)?;
     let out = out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-tune", sc.name)));
-    std::fs::create_dir_all(&out).map_err(|source| Error::Write {
-        path: out.clone(),
-        source,
-    })?;
-    let mut md =
-        crate::workflows::tune::report::markdown(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
+    create_dir(&out)?;
+    let mut md = report::markdown(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
     md.push_str(&refine_text(&o));
     md.push_str(&check_text(&o));
     let w = &o.scores[o.winner];
-    let klipper = crate::workflows::tune::report::klipper(&o.plan, w);
-    let tmc = crate::workflows::tune::report::tmc(&o.plan, w);
+    let klipper = report::klipper(&o.plan, w);
+    let tmc = report::tmc(&o.plan, w);
     let _ = write!(
         md,
         "\n## Export\n\nKlipper (`klipper.cfg`):\n\n```ini\n{klipper}```\n\nTrinamic TMC5160 (`tmc5160.txt`):\n\n```\n{tmc}```\n\n![Pareto front](pareto.svg)\n"
     );
-    let write = |name: &str, text: &str| {
-        crate::output::report::write_atomic(&out.join(name), text.as_bytes())
-    };
+    let write = |name: &str, text: &str| write_atomic(&out.join(name), text.as_bytes());
     write("tune.md", &md)?;
-    write(
-        "candidates.csv",
-        &crate::workflows::tune::report::candidates_csv(&o.scores),
-    )?;
+    write("candidates.csv", &report::candidates_csv(&o.scores))?;
     write("klipper.cfg", &klipper)?;
     write("tmc5160.txt", &tmc)?;
-    let fig = crate::workflows::tune::report::pareto_figure(
-        &sc.name, &o.plan, &o.scores, o.winner, &o.front,
-    );
+    let fig = report::pareto_figure(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
     crate::output::plot::write(&fig, &out, "pareto")?;
-    Ok(md)
+    Ok(Tuned {
+        outcome: o,
+        markdown: md,
+        out,
+    })
 }

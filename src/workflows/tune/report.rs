@@ -8,8 +8,11 @@ use settle_planner::shaper::ShaperKind;
 use settle_planner::tmc::ramp::SRampParams;
 use settle_planner::tmc::registers::{TmcUnits, export};
 
+use super::search::{Plan, Score};
+use crate::input::runs_table::record;
+use crate::kinds::corner::Corner;
+use crate::kinds::scan::ScanSpec;
 use crate::output::plot::{Figure, Line, Marker, PALETTE, Panel};
-use crate::workflows::tune::search::{Plan, Score};
 
 /// Klipper's `[printer]` / `[input_shaper]` lines for the winner on axis `axis`. Klipper
 /// plans trapezoids: a jerk-limited winner is exported with its shaper and acceleration and
@@ -47,7 +50,7 @@ pub fn klipper(plan: &Plan, s: &Score) -> String {
             }
         }
     }
-    if let Some(corner) = &b.corner
+    if let Some(corner) = b.state::<Corner>()
         && corner.strategy.name() == "square_corner_velocity"
     {
         let _ = writeln!(out, "\n[printer]");
@@ -137,9 +140,19 @@ pub fn tmc(plan: &Plan, s: &Score) -> String {
 
 /// The candidates table (one row per candidate).
 pub fn candidates_csv(scores: &[Score]) -> String {
-    let mut out = String::from(
-        "candidate,profile,jmax_mm_s3,pvt_asym_ki,bow_scales,shaper_type,shaper_frequency_hz,move_time_s,residual_peak_um,move_and_settle_s,max_contour_error_um\n",
-    );
+    let mut out = record(&[
+        "candidate",
+        "profile",
+        "jmax_mm_s3",
+        "pvt_asym_ki",
+        "bow_scales",
+        "shaper_type",
+        "shaper_frequency_hz",
+        "move_time_s",
+        "residual_peak_um",
+        "move_and_settle_s",
+        "max_contour_error_um",
+    ]);
     for (i, s) in scores.iter().enumerate() {
         let c = &s.candidate;
         let b = c.params.fourjerk_jerk_scale;
@@ -150,25 +163,23 @@ pub fn candidates_csv(scores: &[Score]) -> String {
             Some((k, f)) => (k.name(), f.to_string()),
             None => ("none", String::new()),
         };
-        let _ = writeln!(
-            out,
-            "{i},{},{},{},{}/{}/{}/{},{st},{sf},{},{},{},{}",
-            c.kind,
+        out.push_str(&record(&[
+            i.to_string(),
+            c.kind.to_string(),
             c.jmax_mm_s3.map_or(String::new(), |j| j.to_string()),
-            c.params.pvt_asym_ki,
-            b[0],
-            b[1],
-            b[2],
-            b[3],
-            s.move_time_s,
-            s.residual_peak_um,
-            s.move_and_settle_s,
+            c.params.pvt_asym_ki.to_string(),
+            format!("{}/{}/{}/{}", b[0], b[1], b[2], b[3]),
+            st.to_string(),
+            sf,
+            s.move_time_s.to_string(),
+            s.residual_peak_um.to_string(),
+            s.move_and_settle_s.to_string(),
             if s.max_contour_error_um.is_nan() {
                 String::new()
             } else {
                 s.max_contour_error_um.to_string()
-            }
-        );
+            },
+        ]));
     }
     out
 }
@@ -176,7 +187,7 @@ pub fn candidates_csv(scores: &[Score]) -> String {
 /// Column headings of the report's tables: (move time, residual, score), which for scan
 /// steps are the step, the error over the next line, and the overhead per line.
 pub fn headings(plan: &Plan) -> [&'static str; 3] {
-    if plan.base.scan.is_some() {
+    if plan.base.state::<ScanSpec>().is_some() {
         [
             "step (ms)",
             "line residual peak (um)",
@@ -199,7 +210,7 @@ pub fn score_text(plan: &Plan) -> String {
     } else {
         format!("{band} um")
     };
-    if plan.base.scan.is_some() {
+    if plan.base.state::<ScanSpec>().is_some() {
         format!(
             "mean overhead per line (from the fly axis leaving the region to the step axis settled into {into} and staying there over the next line; at least the fastest turnaround)"
         )
@@ -210,7 +221,7 @@ pub fn score_text(plan: &Plan) -> String {
 
 /// The move family in words.
 fn family(plan: &Plan) -> String {
-    if let Some(scan) = &plan.base.scan {
+    if let Some(scan) = plan.base.state::<ScanSpec>() {
         return format!(
             "Scan steps: step-overs {:?} mm on axis `{}` (placement {}, settle margin {} s) while the fly axis `{}` scans {} mm at {} mm/s, turnarounds at {} mm/s^2",
             plan.distances_mm,
@@ -223,7 +234,7 @@ fn family(plan: &Plan) -> String {
             scan.fly_amax_mm_s2
         );
     }
-    match &plan.base.corner {
+    match plan.base.state::<Corner>() {
         Some(c) => format!(
             "Corners: {} x {} mm legs at {:?} degrees, strategy {}{}",
             c.leg_in_mm,
@@ -300,13 +311,13 @@ pub fn markdown(
         format!(
             "{:.1}% {} ({:.1} ms saved{})",
             100.0 * (1.0 - w.move_and_settle_s / d.move_and_settle_s),
-            if plan.base.scan.is_some() {
+            if plan.base.state::<ScanSpec>().is_some() {
                 "less overhead per line"
             } else {
                 "faster"
             },
             (d.move_and_settle_s - w.move_and_settle_s) * 1e3,
-            if plan.base.scan.is_some() {
+            if plan.base.state::<ScanSpec>().is_some() {
                 " per line"
             } else {
                 ""
@@ -321,7 +332,7 @@ pub fn markdown(
     );
     let _ = writeln!(out, "|---|---|---:|---:|---:|---:|");
     default_and_winner_rows(&mut out, d, w, "**winner**");
-    if plan.base.corner.is_some() {
+    if plan.base.state::<Corner>().is_some() {
         let _ = writeln!(
             out,
             "\nLargest contour error over the corners: default {:.1} um, winner {:.1} um.",
@@ -336,7 +347,7 @@ pub fn markdown(
     );
     let _ = writeln!(out, "|---|---|---:|---:|---:|");
     for k in ProfileKind::ALL {
-        if let Some(i) = crate::workflows::tune::search::best(
+        if let Some(i) = super::search::best(
             &scores
                 .iter()
                 .map(|s| {

@@ -1,5 +1,5 @@
 //! `settle tune`: search the profile parameters that minimise move-and-settle on the
-//! scenario's machine (issue 9).
+//! scenario's machine.
 //!
 //! The search is a deterministic grid, evaluated through the same runs as a sweep (so a
 //! tuned candidate is a plain [`RunSpec`] that any backend can re-run):
@@ -20,53 +20,19 @@
 //! per line at which the step is settled (see [`scan_figures`]). Ties break on the lower
 //! residual, then grid order, so the result is deterministic.
 
-use serde::Deserialize;
 use settle_planner::shaper::ShaperKind;
 use settle_planner::{KindParams, ProfileKind};
 
 use crate::error::Error;
-use crate::expand::RunSpec;
-use crate::input::scenario::Source;
+use crate::execute::pool::{Progress, quiet, run_all};
+use crate::input::scenario::Scenario;
+use crate::input::source::Source;
+use crate::input::tune_spec::TuneSpec;
+use crate::kinds::corner::Corner;
+use crate::kinds::scan::ScanSpec;
 use crate::kinds::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
 use crate::measure::metrics::Metrics;
-
-/// The `[tune]` table of a scenario (every key optional).
-#[derive(Debug, Clone, Deserialize, PartialEq, Default)]
-#[serde(deny_unknown_fields)]
-pub struct TuneSpec {
-    /// The point-to-point move family: move lengths (mm) [default: `move.distance_mm`].
-    pub distances_mm: Option<Vec<f64>>,
-    /// The corner family (a scenario with `[corner]`): interior angles (degrees)
-    /// [default: `corner.angle_deg`].
-    pub angles_deg: Option<Vec<f64>>,
-    /// Corner paths: the largest contour error (um) a candidate may reach on any corner of
-    /// the family; candidates above it are infeasible [default: no limit].
-    pub max_contour_error_um: Option<f64>,
-    /// The settling band the score uses (um) [default: the first of `observe.bands_um`].
-    pub band_um: Option<f64>,
-    /// Robustness margin in (0, 1]: candidates are scored on settling into
-    /// `margin x band_um`, so the winner's residual has room inside the band for what
-    /// another engine or the real machine adds [default [`DEFAULT_MARGIN`]].
-    pub margin: Option<f64>,
-    /// Profile kinds to search [default: all].
-    pub kinds: Option<Vec<String>>,
-    /// Shaper types to search, `none` included [default: none and all six].
-    pub shapers: Option<Vec<String>>,
-    /// Shaper frequencies as multiples of each mode frequency [default 0.8 to 1.2].
-    pub frequency_scales: Option<Vec<f64>>,
-    /// Number of jerk values [default 6].
-    pub jerk_steps: Option<usize>,
-    /// Lowest jerk = jmax / jerk_span [default 30: jerk phases up to 30x longer].
-    pub jerk_span: Option<f64>,
-    /// Rounds of local refinement around the grid winner (a compass search on the shaper
-    /// frequency and the jerk with halving steps; 0 = grid only) [default
-    /// [`DEFAULT_REFINE_ROUNDS`]].
-    pub refine_rounds: Option<usize>,
-    /// Microsteps per mm for the Trinamic export [default 1280 = 80 full steps/mm x 16].
-    pub usteps_per_mm: Option<f64>,
-    /// TMC5160 clock (Hz) for the Trinamic export [default 12 MHz, the internal clock].
-    pub tmc_clock_hz: Option<u32>,
-}
+use crate::spec::run_spec::RunSpec;
 
 /// One point of the search grid.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -111,7 +77,10 @@ impl Candidate {
         run.profile = self.kind;
         run.jmax_mm_s3 = self.jmax_mm_s3.or(run.jmax_mm_s3);
         run.kind_params = self.params;
-        run.shaper = self.shaper;
+        match self.shaper {
+            Some(sh) => run.put_state(Box::new(sh)),
+            None => run.remove_state("shaper"),
+        }
     }
 
     /// The candidate a run is (its profile, jerk, kind parameters and shaper).
@@ -120,7 +89,7 @@ impl Candidate {
             kind: run.profile,
             jmax_mm_s3: run.jmax_mm_s3,
             params: run.kind_params,
-            shaper: run.shaper,
+            shaper: run.state::<ShaperSetting>().copied(),
         }
     }
 }
@@ -180,7 +149,7 @@ pub const BOW_PATTERNS: [[f64; 4]; 5] = [
     [0.5, 1.0, 0.5, 1.0],
 ];
 
-/// PVT asymmetries searched (the seed's Ki in (1/3, 1); 0.5 is its default).
+/// PVT asymmetries searched (`KindParams::pvt_asym_ki`, in (1/3, 1); 0.5 is its default).
 pub const PVT_KI: [f64; 4] = [0.4, 0.5, 0.65, 0.8];
 
 /// Default frequency scales: the mode frequency +-20% (shapers are tuned to a measured
@@ -204,11 +173,7 @@ pub const DEFAULT_REFINE_ROUNDS: usize = 0;
 pub const DEFAULT_MARGIN: f64 = 0.8;
 
 /// Resolve the scenario's search. Errors name the `[tune]` key.
-pub fn plan(
-    sc: &crate::input::scenario::Scenario,
-    src: &Source,
-    runs: &[RunSpec],
-) -> Result<Plan, Error> {
+pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error> {
     let spec = sc.tune.clone().unwrap_or_default();
     if !sc.sweep.is_empty() {
         return Err(src.error_at(
@@ -236,7 +201,7 @@ pub fn plan(
             "give one or more finite, non-zero move lengths (mm)",
         ));
     }
-    let angles_deg = match &base.corner {
+    let angles_deg = match base.state::<Corner>() {
         None if spec.angles_deg.is_some() => {
             return Err(src.error_at("tune.angles_deg", "corner angles need a [corner] scenario"));
         }
@@ -392,7 +357,7 @@ pub fn plan(
         };
         let params: Vec<KindParams> = match kind {
             // Corner paths plan their legs from the limits alone.
-            _ if base.corner.is_some() => vec![KindParams::default()],
+            _ if base.state::<Corner>().is_some() => vec![KindParams::default()],
             ProfileKind::PvtAsym => PVT_KI
                 .iter()
                 .map(|&k| KindParams {
@@ -465,7 +430,7 @@ pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
         let Some(axis) = axes.iter().find(|a| a.name == name) else {
             continue;
         };
-        let (start_m, dist_m) = if base.corner.is_some() {
+        let (start_m, dist_m) = if base.state::<Corner>().is_some() {
             (0.0, 0.02)
         } else {
             (base.start_mm * 1e-3, base.distance_mm * 1e-3)
@@ -499,7 +464,7 @@ impl Plan {
                 let mut r = self.base.clone();
                 r.id = out.len();
                 r.bands_um = self.bands_um.clone();
-                match r.corner.as_mut() {
+                match r.state_mut::<Corner>() {
                     Some(corner) => corner.angle_deg = self.angles_deg[i],
                     None => r.distance_mm = self.distances_mm[i],
                 }
@@ -512,7 +477,7 @@ impl Plan {
 
     /// Moves per candidate: the corner angles, or the move lengths.
     pub fn family_len(&self) -> usize {
-        if self.base.corner.is_some() {
+        if self.base.state::<Corner>().is_some() {
             self.angles_deg.len()
         } else {
             self.distances_mm.len()
@@ -537,25 +502,26 @@ impl Plan {
                 for m in rs {
                     match m {
                         Ok(m) if m.is_ok() => {
-                            let (time, residual, scored, nominal) = match &self.base.scan {
-                                Some(scan) => {
-                                    let f = scan_figures(scan, m, &self.bands_um);
-                                    (
-                                        f.step_s,
-                                        f.line_residual_peak_um,
-                                        f.overhead_s[self.score_band_index],
-                                        f.overhead_s[self.band_index],
-                                    )
-                                }
-                                None => (
-                                    m.move_time_s,
-                                    m.residual_peak_um,
-                                    m.move_and_settle_s(self.score_band_index)
-                                        .unwrap_or(f64::INFINITY),
-                                    m.move_and_settle_s(self.band_index)
-                                        .unwrap_or(f64::INFINITY),
-                                ),
-                            };
+                            let (time, residual, scored, nominal) =
+                                match self.base.state::<ScanSpec>() {
+                                    Some(scan) => {
+                                        let f = scan_figures(scan, m, &self.bands_um);
+                                        (
+                                            f.step_s,
+                                            f.line_residual_peak_um,
+                                            f.overhead_s[self.score_band_index],
+                                            f.overhead_s[self.band_index],
+                                        )
+                                    }
+                                    None => (
+                                        m.move_time_s,
+                                        m.residual_peak_um,
+                                        m.move_and_settle_s(self.score_band_index)
+                                            .unwrap_or(f64::INFINITY),
+                                        m.move_and_settle_s(self.band_index)
+                                            .unwrap_or(f64::INFINITY),
+                                    ),
+                                };
                             t += time;
                             r += residual;
                             mas += scored;
@@ -633,16 +599,16 @@ pub fn pareto(scores: &[Score]) -> Vec<usize> {
     idx
 }
 
-/// Evaluate every candidate of `plan` (all runs in one parallel batch, with a progress bar
-/// when `progress`).
+/// Evaluate every candidate of `plan` (all runs in one parallel batch, reporting to
+/// `progress`).
 pub fn evaluate(
     plan: &Plan,
     candidates: &[Candidate],
     jobs: Option<usize>,
-    progress: bool,
+    progress: Progress,
 ) -> Result<Vec<Score>, Error> {
     let runs = plan.runs(candidates);
-    let results = crate::execute::pool::run_all(&runs, jobs, progress)?;
+    let results = run_all(&runs, jobs, progress)?;
     Ok(plan.scores(candidates, &results))
 }
 
@@ -763,7 +729,7 @@ pub fn refine(
             .filter(|n| !scores.iter().any(|s| s.candidate == *n))
             .collect();
         if !next.is_empty() {
-            let found = evaluate(plan, &next, jobs, false)?;
+            let found = evaluate(plan, &next, jobs, &quiet)?;
             scores.extend(found);
             winner = best(scores).unwrap_or(winner);
         }
