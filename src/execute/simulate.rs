@@ -6,7 +6,8 @@ use settle_planner::{Profile, Sample, State, Trajectory};
 use settle_sim::{AxisModel, DriverMode, Observation, Plant, SimError};
 
 use crate::execute::Observe;
-use crate::measure::metrics::{Accumulator, Metrics, Status};
+use crate::measure::accumulator::Accumulator;
+use crate::measure::metrics::{Metrics, Status};
 use crate::measure::series::Series;
 
 /// The channels [`crate::execute::execute`] records for these axes: per axis `cmd_p_<axis>` (m),

@@ -19,7 +19,8 @@ pub struct TuneSpec {
     pub band_um: Option<f64>,
     /// Robustness margin in (0, 1]: candidates are scored on settling into
     /// `margin x band_um`, so the winner's residual has room inside the band for what
-    /// another engine or the real machine adds [default `crate::workflows::tune::search::DEFAULT_MARGIN`].
+    /// another engine or the real machine adds [default
+    /// `crate::workflows::tune::grid::DEFAULT_MARGIN`].
     pub margin: Option<f64>,
     /// Profile kinds to search [default: all].
     pub kinds: Option<Vec<String>>,
@@ -33,7 +34,7 @@ pub struct TuneSpec {
     pub jerk_span: Option<f64>,
     /// Rounds of local refinement around the grid winner (a compass search on the shaper
     /// frequency and the jerk with halving steps; 0 = grid only) [default
-    /// `crate::workflows::tune::search::DEFAULT_REFINE_ROUNDS`].
+    /// `crate::workflows::tune::rank::DEFAULT_REFINE_ROUNDS`].
     pub refine_rounds: Option<usize>,
     /// Microsteps per mm for the Trinamic export [default 1280 = 80 full steps/mm x 16].
     pub usteps_per_mm: Option<f64>,

@@ -28,21 +28,16 @@
 //!    table with [`Source::table`], so errors name the file, line and key), `plan` for a
 //!    motion kind, and whichever of `validate`, `columns`/`cells`, `summary`, `figures` it
 //!    needs (each has a default that adds nothing).
-//! 2. `pub mod <name>;` and `&<name>::<Kind>` in [`KINDS`], at the place its runs.csv
-//!    columns and summary section belong (registration order is their order).
+//! 2. `<name>::<Kind>,` in the `register!` list below (it declares the module and puts the
+//!    kind in [`KINDS`]), at the place its runs.csv columns and summary section belong
+//!    (registration order is their order).
 //!
-//! `src/kinds/toy.rs` (compiled for the unit tests only) is such a kind, and its tests run
-//! it through the whole pipeline: parse, sweep, run, runs.csv, summary.
-
-pub mod corner;
-pub mod point;
-pub mod scan;
-pub mod shaping;
-#[cfg(test)]
-pub mod toy;
+//! `src/kinds/toy.rs` (compiled for the unit tests only, registered by its line in the
+//! list) is such a kind; `src/workflows/toy_pipeline.rs` runs it through the whole
+//! pipeline: parse, sweep, run, runs.csv, summary, figures.
 
 use settle_planner::shaper::Shaper;
-use settle_planner::{PlanError, Trajectory};
+use settle_planner::{PlanError, Profile, State, Trajectory};
 
 use crate::error::Error;
 use crate::input::runs_table::RunsTable;
@@ -52,16 +47,25 @@ use crate::measure::series::Series;
 pub use crate::spec::run_spec::KindState;
 use crate::spec::run_spec::RunSpec;
 
-/// Every run kind, in registration order: runs.csv's kind columns, the summary's kind
-/// sections and the figures' kind panels follow it.
-pub static KINDS: &[&dyn Kind] = &[
-    &point::PointMove,
-    &corner::CornerPath,
-    &shaping::Shaping,
-    &scan::ScanStep,
+/// Declares each kind's module and lists its kind in [`KINDS`]: one line per kind.
+macro_rules! register {
+    ($($(#[$attr:meta])* $module:ident :: $kind:ident),* $(,)?) => {
+        $($(#[$attr])* pub mod $module;)*
+
+        /// Every run kind, in registration order: runs.csv's kind columns, the summary's
+        /// kind sections and the figures' kind panels follow it.
+        pub static KINDS: &[&dyn Kind] = &[$($(#[$attr])* &$module::$kind),*];
+    };
+}
+
+register! {
+    point::PointMove,
+    corner::CornerPath,
+    shaping::Shaping,
+    scan::ScanStep,
     #[cfg(test)]
-    &toy::Toy,
-];
+    toy::Toy,
+}
 
 /// The registered kinds ([`KINDS`]).
 pub fn all() -> &'static [&'static dyn Kind] {
@@ -133,6 +137,43 @@ pub struct PlotColumn {
     pub scale: f64,
     /// Whether a logarithmic y axis suits it (when it spans more than a factor of 20).
     pub log_ok: bool,
+}
+
+impl PlotColumn {
+    /// The panel of `column`, titled `title`, its y axis `quantity (unit)` after `scale`.
+    pub fn new(
+        column: impl Into<String>,
+        title: impl Into<String>,
+        quantity: &'static str,
+        unit: &'static str,
+        scale: f64,
+        log_ok: bool,
+    ) -> Self {
+        Self {
+            column: column.into(),
+            title: title.into(),
+            quantity,
+            unit,
+            scale,
+            log_ok,
+        }
+    }
+}
+
+/// A trajectory with `profile` on machine axis `axis`, every other axis of `axes` holding
+/// at 0 (a move on one axis).
+pub fn on_axis(axes: &[String], axis: &str, profile: &Profile) -> Result<Trajectory, PlanError> {
+    Trajectory::new(
+        axes.iter()
+            .map(|a| {
+                if a == axis {
+                    profile.clone()
+                } else {
+                    Profile::empty(State::default())
+                }
+            })
+            .collect(),
+    )
 }
 
 /// A run kind (see the module documentation).
@@ -242,7 +283,7 @@ pub fn by_table(table: &str) -> Option<&'static dyn Kind> {
 pub fn has(run: &RunSpec, kind: &dyn Kind) -> bool {
     match kind.table() {
         Some(t) => run.state_of(t).is_some(),
-        None => std::ptr::addr_eq(motion(run), kind),
+        None => kind.role() != Role::Modifier && motion(run).table().is_none(),
     }
 }
 

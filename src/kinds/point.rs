@@ -3,9 +3,9 @@
 //! run that no other motion kind claims, and the common metrics (move and settle, residual
 //! vibration) are its figures.
 
-use settle_planner::{PlanError, Profile, State, Trajectory};
+use settle_planner::PlanError;
 
-use crate::kinds::{Kind, PlanContext, Planned, Role};
+use crate::kinds::{Kind, PlanContext, Planned, Role, on_axis};
 use crate::spec::run_spec::RunSpec;
 
 /// The point-to-point move.
@@ -37,19 +37,8 @@ impl Kind for PointMove {
             Some(s) => s.apply(&profile)?,
             None => profile,
         };
-        let profiles = ctx
-            .axes
-            .iter()
-            .map(|a| {
-                if *a == run.axis {
-                    profile.clone()
-                } else {
-                    Profile::empty(State::default())
-                }
-            })
-            .collect();
         Ok(Planned {
-            trajectory: Trajectory::new(profiles)?,
+            trajectory: on_axis(ctx.axes, &run.axis, &profile)?,
             probe: None,
         })
     }

@@ -233,7 +233,9 @@ impl Kind for Shaping {
         let Some(setting) = run.state::<ShaperSetting>() else {
             return Vec::new();
         };
-        let name = setting.kind.map_or("none", ShaperKind::name);
+        let name = setting
+            .kind
+            .map_or_else(|| "none".to_string(), |k| k.name().to_string());
         let mut out = vec![
             name.to_string(),
             setting.frequency_hz.to_string(),

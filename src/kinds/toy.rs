@@ -10,12 +10,14 @@
 use std::fmt::Write as _;
 
 use serde::Deserialize;
-use settle_planner::{PlanError, Profile, Segment, State, Trajectory};
+use settle_planner::{PlanError, Profile, Segment};
 
 use crate::error::Error;
 use crate::input::runs_table::RunsTable;
 use crate::input::source::Source;
-use crate::kinds::{Kind, KindState, PlanContext, Planned, PlotColumn, Probe, Role, any_has};
+use crate::kinds::{
+    Kind, KindState, PlanContext, Planned, PlotColumn, Probe, Role, any_has, on_axis,
+};
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
 use crate::spec::run_spec::RunSpec;
@@ -125,19 +127,8 @@ impl Kind for Toy {
         }
         let shuttle = Profile::new(there.start(), segments)?;
         let move_end_s = shuttle.duration_s();
-        let profiles = ctx
-            .axes
-            .iter()
-            .map(|a| {
-                if *a == run.axis {
-                    shuttle.clone()
-                } else {
-                    Profile::empty(State::default())
-                }
-            })
-            .collect();
         Ok(Planned {
-            trajectory: Trajectory::new(profiles)?,
+            trajectory: on_axis(ctx.axes, &run.axis, &shuttle)?,
             probe: Some(Box::new(MaxError { move_end_s })),
         })
     }
@@ -179,13 +170,13 @@ impl Kind for Toy {
     }
 
     fn figures(&self, _bands_um: &[f64]) -> Vec<PlotColumn> {
-        vec![PlotColumn {
-            column: "toy_max_error_um".into(),
-            title: "shuttle: largest error during the move".into(),
-            quantity: "|error|",
-            unit: "um",
-            scale: 1.0,
-            log_ok: true,
-        }]
+        vec![PlotColumn::new(
+            "toy_max_error_um",
+            "shuttle: largest error during the move",
+            "|error|",
+            "um",
+            1.0,
+            true,
+        )]
     }
 }

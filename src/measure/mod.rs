@@ -1,5 +1,8 @@
-//! Metrics, computed streaming from a run's samples, and the series a run records.
+//! Measuring runs: the metrics and their definitions ([`metrics`]), computed streaming
+//! ([`accumulator`]; contour error along a path: [`path_metrics`]), and the full
+//! [`series::Series`] a run records when asked. No knowledge of backends or run kinds.
 
+pub mod accumulator;
 pub mod metrics;
 pub mod path_metrics;
 pub mod series;

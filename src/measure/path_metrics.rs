@@ -1,5 +1,5 @@
 //! Metrics of motion along a path, computed streaming beside
-//! [`crate::measure::metrics::Accumulator`] whenever the trajectory carries path geometry.
+//! [`crate::measure::accumulator::Accumulator`] whenever the trajectory carries path geometry.
 //!
 //! Definitions (toolhead position `q`, a vector over the machine's axes, which are the
 //! path's coordinates):

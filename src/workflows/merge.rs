@@ -25,7 +25,7 @@ pub struct MergeOutcome {
     pub recordings: usize,
 }
 
-/// Merge `dirs` (any order) into `out` [default: `results/<name>/`].
+/// Merge `dirs` (any order) into `out` (default: `results/<name>/`).
 pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> Result<MergeOutcome, Error> {
     let mut m = crate::workflows::shard::merge(dirs)?;
     // The backend the shards ran on (a setting every shard agrees on).

@@ -19,7 +19,7 @@ pub struct RunOptions {
     pub scenario: PathBuf,
     /// The run index, as in the `run` column of runs.csv.
     pub case: usize,
-    /// Trace file [default: `results/<name>/run-<case>.csv`].
+    /// Trace file (default: `results/<name>/run-<case>.csv`).
     pub out: Option<PathBuf>,
     /// Also write an MCAP recording beside the trace.
     pub mcap: bool,

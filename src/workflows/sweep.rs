@@ -26,8 +26,8 @@ use crate::workflows::{Exit, Report};
 pub struct SweepOptions {
     /// The scenario file.
     pub scenario: PathBuf,
-    /// Output folder [default: `results/<name>/`, `results/<name>/shard-K-of-N/` for a
-    /// shard].
+    /// Output folder (default: `results/<name>/`, `results/<name>/shard-K-of-N/` for a
+    /// shard).
     pub out: Option<PathBuf>,
     /// Worker threads [default: all cores].
     pub jobs: Option<usize>,

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use settle::measure::metrics::Accumulator;
+use settle::measure::accumulator::Accumulator;
 use settle::spec::backend::Backend;
 use settle_sim::Mode;
 use settle_sim::closed_form::residual_at;

@@ -6,7 +6,8 @@
 use std::path::PathBuf;
 
 use settle::spec::backend::Backend;
-use settle::workflows::tune::search::{Score, pareto};
+use settle::workflows::tune::rank::pareto;
+use settle::workflows::tune::search::Score;
 
 fn scenario(tune: &str) -> String {
     format!(
@@ -389,7 +390,8 @@ fn refinement_never_loses_to_the_grid_and_stays_within_the_limits() {
 #[test]
 fn neighbours_step_the_frequency_and_cap_the_jerk() {
     use settle::kinds::shaping::ShaperSetting;
-    use settle::workflows::tune::search::{Candidate, neighbours};
+    use settle::workflows::tune::rank::neighbours;
+    use settle::workflows::tune::search::Candidate;
     use settle_planner::shaper::ShaperKind;
     use settle_planner::{KindParams, ProfileKind};
     let c = Candidate {

@@ -217,7 +217,7 @@ fn scan_family_winner_beats_the_default_on_rapier_and_its_overhead_is_real() {
     for (i, mut run) in o.plan.runs(&both).into_iter().enumerate() {
         let m = settle::execute::execute(&run, None).expect("runs");
         let scan = run.state::<ScanSpec>().cloned().expect("scan");
-        let f = settle::workflows::tune::search::scan_figures(&scan, &m, &o.plan.bands_um);
+        let f = settle::workflows::tune::scan_figures::scan_figures(&scan, &m, &o.plan.bands_um);
         let overhead = f.overhead_s[o.plan.score_band_index];
         assert!(overhead.is_finite(), "step {i}: {f:?}");
         if overhead <= f.window_s + 1e-3 {
@@ -285,10 +285,7 @@ fn the_default_margin_keeps_the_corner_winner_inside_the_band_on_rapier() {
         &settle::execute::pool::quiet,
     )
     .expect("tunes");
-    assert_eq!(
-        o.plan.margin,
-        settle::workflows::tune::search::DEFAULT_MARGIN
-    );
+    assert_eq!(o.plan.margin, settle::workflows::tune::grid::DEFAULT_MARGIN);
     let (_, rd, rw) = o.check.as_ref().expect("checked");
     let w = &o.scores[o.winner];
     assert!(

@@ -174,14 +174,7 @@ impl Kind for CornerPath {
             (col::CONTOUR_AFTER, "contour error after the move: max"),
         ]
         .into_iter()
-        .map(|(column, title)| PlotColumn {
-            column: column.into(),
-            title: title.into(),
-            quantity: "contour error",
-            unit: "um",
-            scale: 1.0,
-            log_ok: true,
-        })
+        .map(|(column, title)| PlotColumn::new(column, title, "contour error", "um", 1.0, true))
         .collect()
     }
 }

@@ -188,7 +188,7 @@ impl Kind for ScanStep {
     }
 
     /// The columns, named from the first scan run's bands, so the header never depends on
-    /// results; [`step_metrics`] fills them.
+    /// results; [`step_metrics()`] fills them.
     fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
         runs.iter()
             .find(|r| r.state::<ScanSpec>().is_some())
@@ -218,26 +218,18 @@ impl Kind for ScanStep {
     }
 
     fn figures(&self, bands_um: &[f64]) -> Vec<PlotColumn> {
-        let panel = |column: String, title: String, quantity, unit, scale, log_ok| PlotColumn {
-            column,
-            title,
-            quantity,
-            unit,
-            scale,
-            log_ok,
-        };
         let mut out = vec![
-            panel(
-                "scan_reentry_error_um".into(),
-                "step axis: |error| when the fly axis re-enters".into(),
+            PlotColumn::new(
+                "scan_reentry_error_um",
+                "step axis: |error| when the fly axis re-enters",
                 "|error|",
                 "um",
                 1.0,
                 true,
             ),
-            panel(
-                "scan_line_residual_peak_um".into(),
-                "step axis: peak |error| during the next line".into(),
+            PlotColumn::new(
+                "scan_line_residual_peak_um",
+                "step axis: peak |error| during the next line",
                 "|error|",
                 "um",
                 1.0,
@@ -245,7 +237,7 @@ impl Kind for ScanStep {
             ),
         ];
         for b in bands_um {
-            out.push(panel(
+            out.push(PlotColumn::new(
                 format!("scan_step_settle_time_s_{b}um"),
                 format!("step axis: settle time to within {b} um after the step"),
                 "settle time",
@@ -254,9 +246,9 @@ impl Kind for ScanStep {
                 false,
             ));
         }
-        out.push(panel(
-            "scan_window_s".into(),
-            "window from exit to re-entry (overhead per line)".into(),
+        out.push(PlotColumn::new(
+            "scan_window_s",
+            "window from exit to re-entry (overhead per line)",
             "window",
             "ms",
             1e3,

@@ -37,17 +37,9 @@ fn columns(bands: &[f64], table: &RunsTable) -> Vec<PlotColumn> {
             return own;
         }
     }
-    let panel = |column: String, title: String, quantity, unit, scale, log_ok| PlotColumn {
-        column,
-        title,
-        quantity,
-        unit,
-        scale,
-        log_ok,
-    };
     let mut out = Vec::new();
     for b in bands {
-        out.push(panel(
+        out.push(PlotColumn::new(
             format!("settle_time_s_{b}um"),
             format!("settle time to within {b} um"),
             "settle time",
@@ -55,7 +47,7 @@ fn columns(bands: &[f64], table: &RunsTable) -> Vec<PlotColumn> {
             1e3,
             false,
         ));
-        out.push(panel(
+        out.push(PlotColumn::new(
             format!("move_and_settle_s_{b}um"),
             format!("move + settle to within {b} um"),
             "move + settle",
@@ -64,17 +56,17 @@ fn columns(bands: &[f64], table: &RunsTable) -> Vec<PlotColumn> {
             false,
         ));
     }
-    out.push(panel(
-        "residual_peak_um".into(),
-        "residual vibration after the move: peak".into(),
+    out.push(PlotColumn::new(
+        "residual_peak_um",
+        "residual vibration after the move: peak",
         "peak",
         "um",
         1.0,
         true,
     ));
-    out.push(panel(
-        "residual_rms_um".into(),
-        "residual vibration after the move: RMS".into(),
+    out.push(PlotColumn::new(
+        "residual_rms_um",
+        "residual vibration after the move: RMS",
         "RMS",
         "um",
         1.0,

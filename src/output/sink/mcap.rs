@@ -3,8 +3,8 @@
 //! Layout of `run-<id>.mcap` (one file per run; see the README's "MCAP recordings"):
 //! - profile `""` (no ROS); chunks compressed with zstd (single-threaded, so the bytes do not
 //!   depend on the machine's core count); message, chunk and metadata indexes and statistics.
-//! - one channel per signal group of the run's [`Series`] (see [`super::groups`]): topic
-//!   `/<group>`, message encoding `json`, schema `settle.<group>` in encoding `jsonschema`,
+//! - one channel per signal group of the run's [`crate::measure::series::Series`] (see
+//!   [`super::groups`]): topic `/<group>`, message encoding `json`, schema `settle.<group>` in encoding `jsonschema`,
 //!   one message per sample whose keys are the group's fields with their units (`p_m`,
 //!   `v_m_s`, ...). `log_time` = `publish_time` = simulation time in ns from the start of the
 //!   run.

@@ -61,7 +61,7 @@ pub enum CheckOutcome {
         /// The comparison with the old baseline, if there was one.
         comparison: Option<Result<Comparison, String>>,
     },
-    /// The comparison (passed or failed, see [`CheckOutcome::passed`]).
+    /// The comparison (passed or failed, see [`Checked::passed`]).
     Compared(Comparison),
     /// The baseline does not describe this scenario (columns or runs added or missing).
     Shape(String),

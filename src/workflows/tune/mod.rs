@@ -1,7 +1,11 @@
-//! `settle tune SCENARIO.toml`: search ([`search`]), optionally re-check the default and
-//! the winner on a second backend, and write the outputs ([`report`]).
+//! `settle tune SCENARIO.toml`: the search grid ([`grid`], candidates and scores in
+//! [`search`]), evaluated and refined ([`rank`]), optionally re-checked on a second backend,
+//! and the outputs ([`report`]).
 
+pub mod grid;
+pub mod rank;
 pub mod report;
+pub mod scan_figures;
 pub mod search;
 
 use std::fmt::Write as _;
@@ -42,17 +46,17 @@ pub fn tune(
     let (sc, src) = crate::expand::load(path)?;
     let mut runs = crate::expand::expand(&sc, &src)?;
     crate::execute::set_backend(path, &mut runs, backend)?;
-    let plan = search::plan(&sc, &src, &runs)?;
-    let mut scores = search::evaluate(&plan, &plan.candidates, jobs, progress)?;
-    let grid_winner = search::best(&scores).ok_or_else(|| {
+    let plan = grid::plan(&sc, &src, &runs)?;
+    let mut scores = rank::evaluate(&plan, &plan.candidates, jobs, progress)?;
+    let grid_winner = rank::best(&scores).ok_or_else(|| {
         Error::input_key(
             path,
             "observe.window_s",
             "no candidate settles within the observation window; lengthen window_s or widen the band",
         )
     })?;
-    let winner = search::refine(&plan, &mut scores, grid_winner, jobs)?;
-    let front = search::pareto(&scores);
+    let winner = rank::refine(&plan, &mut scores, grid_winner, jobs)?;
+    let front = rank::pareto(&scores);
     let check = match check_on {
         None => None,
         Some(b) => {
@@ -61,7 +65,7 @@ pub fn tune(
             crate::execute::set_backend(path, &mut base, b)?;
             other.base.backend = b;
             let pair = [scores[0].candidate, scores[winner].candidate];
-            let s = search::evaluate(&other, &pair, jobs, &quiet)?;
+            let s = rank::evaluate(&other, &pair, jobs, &quiet)?;
             Some((b, s[0].clone(), s[1].clone()))
         }
     };
@@ -82,7 +86,7 @@ pub fn refine_text(o: &Outcome) -> String {
     if o.plan
         .spec
         .refine_rounds
-        .unwrap_or(search::DEFAULT_REFINE_ROUNDS)
+        .unwrap_or(rank::DEFAULT_REFINE_ROUNDS)
         == 0
     {
         return String::new();
@@ -95,7 +99,7 @@ pub fn refine_text(o: &Outcome) -> String {
         o.plan
             .spec
             .refine_rounds
-            .unwrap_or(search::DEFAULT_REFINE_ROUNDS),
+            .unwrap_or(rank::DEFAULT_REFINE_ROUNDS),
     );
     if o.winner == o.grid_winner {
         let _ = writeln!(
@@ -181,7 +185,7 @@ impl Tuned {
 
 /// Tune `path` on `backend` (re-checked on `check_on`), and write `OUT/tune.md`,
 /// `candidates.csv`, `pareto.svg/png`, `klipper.cfg` and `tmc5160.txt` into `out`
-/// [default: `results/<name>-tune/`].
+/// (default: `results/<name>-tune/`).
 pub fn tune_to(
     path: &Path,
     out: Option<PathBuf>,

@@ -160,8 +160,8 @@ pub fn candidates_csv(scores: &[Score]) -> String {
             .shaper
             .and_then(|sh| sh.kind.map(|k| (k, sh.frequency_hz)))
         {
-            Some((k, f)) => (k.name(), f.to_string()),
-            None => ("none", String::new()),
+            Some((k, f)) => (k.name().to_string(), f.to_string()),
+            None => ("none".to_string(), String::new()),
         };
         out.push_str(&record(&[
             i.to_string(),
@@ -347,7 +347,7 @@ pub fn markdown(
     );
     let _ = writeln!(out, "|---|---|---:|---:|---:|");
     for k in ProfileKind::ALL {
-        if let Some(i) = super::search::best(
+        if let Some(i) = super::rank::best(
             &scores
                 .iter()
                 .map(|s| {
