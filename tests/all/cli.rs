@@ -1,8 +1,13 @@
-//! End to end through the `settle` binary.
+//! End to end through the `settle` binary (its wiring: arguments, outputs, exit codes), and
+//! sweeps whose outputs are compared, in-process (`settle::workflows::sweep`).
 
 use std::path::Path;
 
-use crate::support::settle;
+use settle::execute::pool::quiet;
+use settle::spec::backend::Backend;
+use settle::workflows::sweep::{SweepOptions, sweep};
+
+use crate::support::{root, settle};
 
 #[test]
 fn quickstart_sweep_writes_one_row_per_run() {
@@ -163,19 +168,13 @@ fn modal_and_rapier_agree_on_the_quickstart() {
     let dirs: Vec<_> = (0..2)
         .map(|_| tempfile::tempdir().expect("tempdir"))
         .collect();
-    for (dir, backend) in dirs.iter().zip(["modal", "rapier"]) {
-        let st = settle()
-            .args([
-                "sweep",
-                "scenarios/quickstart.toml",
-                "--backend",
-                backend,
-                "--out",
-            ])
-            .arg(dir.path())
-            .status()
-            .expect("runs");
-        assert!(st.success());
+    for (dir, backend) in dirs.iter().zip([Backend::Modal, Backend::Rapier]) {
+        sweep_into(
+            &root().join("scenarios/quickstart.toml"),
+            dir.path(),
+            backend,
+            None,
+        );
     }
     let read =
         |d: &tempfile::TempDir| std::fs::read_to_string(d.path().join("runs.csv")).expect("csv");
@@ -197,27 +196,24 @@ fn modal_and_rapier_agree_on_the_quickstart() {
     assert!(rapier.contains(",rapier,ok,0,") && modal.contains(",modal,ok,0,"));
 }
 
+/// Sweep `scenario` into `out` in-process on `backend` (`jobs` threads); all runs ok.
+fn sweep_into(scenario: &Path, out: &Path, backend: Backend, jobs: Option<usize>) {
+    let opts = SweepOptions {
+        out: Some(out.to_path_buf()),
+        jobs,
+        ..SweepOptions::new(scenario, backend)
+    };
+    let o = sweep(&opts, &|_| {}, &quiet).expect("sweeps");
+    assert!(o.failed.is_empty() && o.interrupted.is_none(), "{o:?}");
+}
+
 #[test]
 fn printer_preset_sweep_is_deterministic_and_reports_per_axis() {
     let a = tempfile::tempdir().expect("tempdir");
     let b = tempfile::tempdir().expect("tempdir");
-    for (dir, jobs) in [(&a, "1"), (&b, "2")] {
-        let out = settle()
-            .args([
-                "sweep",
-                "scenarios/printer_xy.toml",
-                "--jobs",
-                jobs,
-                "--out",
-            ])
-            .arg(dir.path())
-            .output()
-            .expect("runs");
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+    for (dir, jobs) in [(&a, 1), (&b, 2)] {
+        let scenario = root().join("scenarios/printer_xy.toml");
+        sweep_into(&scenario, dir.path(), Backend::Rapier, Some(jobs));
     }
     for f in ["runs.csv", "summary.md"] {
         let x = std::fs::read(a.path().join(f)).expect("read");
@@ -324,18 +320,7 @@ window_s = 0.05
 "#,
     )
     .expect("write");
-    let out = settle()
-        .arg("sweep")
-        .arg(&scenario)
-        .args(["--backend", "modal", "--jobs", "2", "--out"])
-        .arg(dir.path())
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    sweep_into(&scenario, dir.path(), Backend::Modal, Some(2));
     let csv = std::fs::read_to_string(dir.path().join("runs.csv")).expect("csv");
     let header: Vec<&str> = csv.lines().next().expect("header").split(',').collect();
     let y = header

@@ -1,17 +1,20 @@
-//! The regression gate end to end: an unchanged run passes, a worsened metric fails with the
-//! table, `--update` rewrites the baseline, bad baselines are clear errors.
+//! The regression gate: an unchanged run passes, a worsened metric fails with the table,
+//! `--update` rewrites the baseline, bad baselines are clear errors. The binary's exit codes
+//! are checked end to end; the comparisons in-process (`settle::workflows::check`).
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
+use settle::execute::pool::quiet;
 use settle::input::runs_table::RunsTable;
+use settle::workflows::check::{CheckOptions, check};
+use settle::workflows::{Exit, Report};
 
 const SCENARIO: &str = "scenarios/ci_quickstart.toml";
 const BASELINE: &str = "results/baselines/ci_quickstart.rapier.csv";
 
 fn settle(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_settle"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+    crate::support::settle()
         .args(args)
         .output()
         .expect("settle runs")
@@ -23,6 +26,24 @@ fn text(o: &Output) -> String {
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
     )
+}
+
+/// `settle check SCENARIO --baseline baseline` in-process, with `edit` applied to the
+/// options: its report (stdout then stderr as `text`), or the error.
+fn check_with(
+    scenario: &Path,
+    baseline: &Path,
+    edit: impl FnOnce(&mut CheckOptions),
+) -> Result<(Report, String), settle::Error> {
+    let mut opts = CheckOptions::new(scenario, baseline);
+    edit(&mut opts);
+    let r = check(&opts, &quiet)?.report();
+    let text = format!("{}{}", r.stdout, r.stderr);
+    Ok((r, text))
+}
+
+fn scenario() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(SCENARIO)
 }
 
 fn baseline() -> RunsTable {
@@ -61,20 +82,13 @@ fn unchanged_runs_pass_on_every_backend_with_a_baseline() {
 
 #[test]
 fn a_baseline_of_another_backend_is_refused() {
-    let o = settle(&[
-        "check",
-        SCENARIO,
-        "--baseline",
-        BASELINE,
-        "--backend",
-        "modal",
-    ]);
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(
-        text(&o).contains("made on backend `rapier`"),
-        "{}",
-        text(&o)
-    );
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join(BASELINE);
+    let e = check_with(&scenario(), &base, |o| {
+        o.backend = Some(settle::spec::backend::Backend::Modal)
+    })
+    .expect_err("refused");
+    assert!(e.is_input_error(), "{e}");
+    assert!(e.to_string().contains("made on backend `rapier`"), "{e}");
 }
 
 #[test]
@@ -89,25 +103,19 @@ fn a_worsened_metric_fails_with_the_table() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("base.csv");
     std::fs::write(&path, b.to_csv()).expect("write");
-    let o = settle(&[
-        "check",
-        SCENARIO,
-        "--baseline",
-        path.to_str().expect("utf-8"),
-    ]);
-    let t = text(&o);
-    assert_eq!(o.status.code(), Some(1), "{t}");
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    let header = stdout.lines().next().expect("table header");
+    let (r, t) = check_with(&scenario(), &path, |_| {}).expect("checks");
+    assert_eq!(r.exit, Exit::Failed, "{t}");
+    let header = r.stdout.lines().next().expect("table header");
     for h in ["run", "metric", "baseline", "now", "delta%"] {
         assert!(header.contains(h), "{header}");
     }
-    let rows: Vec<&str> = stdout
+    let rows: Vec<&str> = r
+        .stdout
         .lines()
         .skip(2)
         .filter(|l| !l.trim().is_empty())
         .collect();
-    assert_eq!(rows.len(), 1, "exactly the edited cell: {stdout}");
+    assert_eq!(rows.len(), 1, "exactly the edited cell: {}", r.stdout);
     let cells: Vec<&str> = rows[0].split_whitespace().collect();
     let pct = (old / new - 1.0) * 100.0;
     assert_eq!(
@@ -123,35 +131,22 @@ fn a_worsened_metric_fails_with_the_table() {
     );
     assert!(t.contains("--update"), "tells how to accept it: {t}");
     // --allow-improvements does not let a regression through.
-    let o = settle(&[
-        "check",
-        SCENARIO,
-        "--baseline",
-        path.to_str().expect("utf-8"),
-        "--allow-improvements",
-    ]);
-    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let (r, t) = check_with(&scenario(), &path, |o| o.allow_improvements = true).expect("checks");
+    assert_eq!(r.exit, Exit::Failed, "{t}");
 }
 
 #[test]
 fn a_worse_machine_fails_on_settling_metrics() {
     // Less damping: the same moves ring longer. Checked against the committed baseline.
     let dir = tempfile::tempdir().expect("tempdir");
-    let src = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(SCENARIO))
-        .expect("scenario");
+    let src = std::fs::read_to_string(scenario()).expect("scenario");
     let worse = src.replace("damping_ratio = 0.05", "damping_ratio = 0.03");
     assert_ne!(worse, src);
     let p = dir.path().join("ci_quickstart.toml");
     std::fs::write(&p, worse).expect("write");
     let base = Path::new(env!("CARGO_MANIFEST_DIR")).join(BASELINE);
-    let o = settle(&[
-        "check",
-        p.to_str().expect("utf-8"),
-        "--baseline",
-        base.to_str().expect("utf-8"),
-    ]);
-    let t = text(&o);
-    assert_eq!(o.status.code(), Some(1), "{t}");
+    let (r, t) = check_with(&p, &base, |_| {}).expect("checks");
+    assert_eq!(r.exit, Exit::Failed, "{t}");
     // The damping column changed, and settle times got worse.
     assert!(
         t.contains("mode0_damping_ratio") && t.contains("changed"),
@@ -194,14 +189,10 @@ fn a_baseline_of_another_shape_is_a_failure_with_the_reason() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("short.csv");
     std::fs::write(&path, b.to_csv()).expect("write");
-    let o = settle(&[
-        "check",
-        SCENARIO,
-        "--baseline",
-        path.to_str().expect("utf-8"),
-    ]);
-    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
-    assert!(text(&o).contains("the sweep changed"), "{}", text(&o));
+    let (r, t) = check_with(&scenario(), &path, |_| {}).expect("checks");
+    assert_eq!(r.exit, Exit::Failed, "{t}");
+    assert!(t.contains("the sweep changed"), "{t}");
+    // A negative tolerance is bad input, from the binary too.
     let o = settle(&[
         "check",
         SCENARIO,

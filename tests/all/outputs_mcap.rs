@@ -16,8 +16,7 @@ fn root() -> &'static Path {
 }
 
 fn settle(args: &[&str]) -> std::process::Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_settle"))
-        .current_dir(root())
+    let out = crate::support::settle()
         .args(args)
         .output()
         .expect("settle runs");

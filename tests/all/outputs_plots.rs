@@ -3,11 +3,9 @@
 //! rendered from the embedded font (no system fonts needed).
 
 use std::path::Path;
-use std::process::Command;
 
 fn ok(args: &[&str]) {
-    let o = Command::new(env!("CARGO_BIN_EXE_settle"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+    let o = crate::support::settle()
         .args(args)
         .output()
         .expect("settle runs");

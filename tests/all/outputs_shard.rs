@@ -2,11 +2,10 @@
 //! (runs.csv, summary.md, every plot, every recording); bad merges are clear errors.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn settle(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_settle"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+    crate::support::settle()
         .args(args)
         .output()
         .expect("settle runs")

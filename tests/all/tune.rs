@@ -308,7 +308,7 @@ fn tune_command_writes_report_table_plot_and_exports() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = write(&dir, &scenario(SMALL));
     let out = dir.path().join("out");
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_settle"))
+    let status = crate::support::settle()
         .arg("tune")
         .arg(&path)
         .arg("--out")
@@ -331,7 +331,7 @@ fn tune_command_writes_report_table_plot_and_exports() {
     assert!(png.width() >= 800);
     // Bad input: exit code 2 with file, line and key.
     let bad = write(&dir, &scenario("kinds = [\"scurv\"]\n"));
-    let r = std::process::Command::new(env!("CARGO_BIN_EXE_settle"))
+    let r = crate::support::settle()
         .arg("tune")
         .arg(&bad)
         .output()

@@ -302,7 +302,7 @@ fn tune_command_on_a_scan_writes_the_report_and_exports() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = write(&dir, "tune_scan_test.toml", &scan_scenario(SMALL));
     let out = dir.path().join("out");
-    let r = std::process::Command::new(env!("CARGO_BIN_EXE_settle"))
+    let r = crate::support::settle()
         .arg("tune")
         .arg(&path)
         .arg("--out")
@@ -334,7 +334,7 @@ fn tune_command_on_a_scan_writes_the_report_and_exports() {
         "tune_scan_test.toml",
         &scan_scenario("margin = 1.5\n"),
     );
-    let r = std::process::Command::new(env!("CARGO_BIN_EXE_settle"))
+    let r = crate::support::settle()
         .arg("tune")
         .arg(&bad)
         .output()

@@ -4,10 +4,10 @@
 //! - profile `""` (no ROS); chunks compressed with zstd (single-threaded, so the bytes do not
 //!   depend on the machine's core count); message, chunk and metadata indexes and statistics.
 //! - one channel per signal group of the run's [`crate::measure::series::Series`] (see
-//!   [`super::groups`]): topic `/<group>`, message encoding `json`, schema `settle.<group>` in encoding `jsonschema`,
-//!   one message per sample whose keys are the group's fields with their units (`p_m`,
-//!   `v_m_s`, ...). `log_time` = `publish_time` = simulation time in ns from the start of the
-//!   run.
+//!   [`super::groups`]): topic `/<group>`, message encoding `json`, schema
+//!   `settle.<group>` in encoding `jsonschema`, one message per sample whose keys are the
+//!   group's fields with their units (`p_m`, `v_m_s`, ...). `log_time` = `publish_time` =
+//!   simulation time in ns from the start of the run.
 //! - channel `/metrics` (schema `settle.metrics`): one message at the last sample's time
 //!   holding the run's `runs.csv` row (parameters and metrics) as JSON; numbers as numbers,
 //!   `inf` (not settled) as `null`, text (e.g. the profile kind) as strings.
