@@ -168,6 +168,16 @@ impl RunSpec {
         self.kinds.retain(|s| s.table() != table);
     }
 
+    /// The swept values as `key = value`, joined by `sep`.
+    pub fn swept_text(&self, sep: &str) -> String {
+        let parts: Vec<String> = self
+            .swept
+            .iter()
+            .map(|(k, v)| format!("{k} = {v}"))
+            .collect();
+        parts.join(sep)
+    }
+
     /// The key to blame for parameter `param`: the sweep axis if it is swept.
     pub fn blame(&self, param: &str) -> String {
         if self.swept.iter().any(|(p, _)| p == param) {

@@ -118,12 +118,7 @@ pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
             || format!("run-{case}"),
             |s| s.to_string_lossy().into_owned(),
         );
-        let swept: Vec<String> = spec
-            .swept
-            .iter()
-            .map(|(k, v)| format!("{k} = {v}"))
-            .collect();
-        let title = format!("{} run {case}: {}", sc.name, swept.join(", "));
+        let title = format!("{} run {case}: {}", sc.name, spec.swept_text(", "));
         let fig = crate::output::plot::trace::figure(&title, &record);
         crate::output::plot::write(&fig, &dir, &stem)?;
         written.push(dir.join(format!("{stem}.svg")));

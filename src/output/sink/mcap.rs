@@ -95,19 +95,13 @@ fn metrics_message(rec: &RunRecord) -> (Value, Value) {
 }
 
 fn metadata(p: &Provenance, rec: &RunRecord) -> BTreeMap<String, String> {
-    let swept: Vec<String> = rec
-        .spec
-        .swept
-        .iter()
-        .map(|(k, v)| format!("{k} = {v}"))
-        .collect();
     BTreeMap::from([
         ("settle_version".to_string(), p.settle_version.to_string()),
         ("scenario_name".to_string(), p.scenario_name.clone()),
         ("scenario_file".to_string(), p.scenario_file.clone()),
         ("scenario".to_string(), p.scenario_text.clone()),
         ("run".to_string(), rec.spec.id.to_string()),
-        ("swept".to_string(), swept.join("; ")),
+        ("swept".to_string(), rec.spec.swept_text("; ")),
     ])
 }
 

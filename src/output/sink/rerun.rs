@@ -59,19 +59,13 @@ pub fn write_file(path: &Path, p: &Provenance, rec: &RunRecord) -> Result<(), Er
                     .map_err(|e| e.to_string())?;
             }
         }
-        let swept: Vec<String> = rec
-            .spec
-            .swept
-            .iter()
-            .map(|(k, v)| format!("{k} = {v}"))
-            .collect();
         let provenance = format!(
             "settle {}\n\nscenario `{}` ({})\n\nrun {}: {}\n",
             p.settle_version,
             p.scenario_name,
             p.scenario_file,
             rec.spec.id,
-            swept.join("; ")
+            rec.spec.swept_text("; ")
         );
         for (entity, text) in [
             ("settle/metrics", markdown_row(rec)),
