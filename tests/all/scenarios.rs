@@ -182,3 +182,27 @@ fn unreadable_file_is_an_input_error() {
     assert!(matches!(e, Error::Read { .. }) && e.is_input_error());
     assert!(e.to_string().contains("/nonexistent/x.toml"));
 }
+
+#[test]
+fn unknown_tables_and_keys_inside_a_kind_table_name_their_line() {
+    // An unknown table: the strict scenario parse names its line and lists the run kinds'
+    // tables besides its own keys.
+    let msg = parse_err(&GOOD.replace("[sweep]", "[scna]\nlines = 3\n[sweep]"));
+    assert!(msg.starts_with("bad.toml:10:"), "{msg}");
+    assert!(
+        msg.contains("scna") && msg.contains("`scan`") && msg.contains("`corner`"),
+        "{msg}"
+    );
+    // A key the `[scan]` kind does not know: its own parse names the line and the key.
+    let scan = GOOD.replace(
+        "[sweep]",
+        "[scan]\nv_scan_mm_s = 100.0\nfly_amax_mm_s2 = 10000.0\nline = 3\n[sweep]",
+    );
+    let msg = parse_err(&scan);
+    assert!(msg.starts_with("bad.toml:13:1: key `scan.line`"), "{msg}");
+    assert!(msg.contains("lines"), "lists the allowed keys: {msg}");
+    // A wrong type inside `[scan]`.
+    let msg = parse_err(&scan.replace("v_scan_mm_s = 100.0", "v_scan_mm_s = \"fast\""));
+    assert!(msg.starts_with("bad.toml:11:"), "{msg}");
+    assert!(msg.contains("key `scan.v_scan_mm_s`"), "{msg}");
+}
