@@ -17,7 +17,8 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use settle::run::{Backend, Observe, SimOptions, run_trajectory};
+use settle::execute::{Observe, SimOptions, run_trajectory};
+use settle::spec::backend::Backend;
 use settle_planner::{Limits, Profile, ProfileKind, State, Trajectory};
 use settle_sim::DriverMode;
 
@@ -33,9 +34,9 @@ const CASES: &[(&str, Backend, DriverMode)] = &[
 ];
 
 fn bench(c: &mut Criterion) {
-    let (_, path, text) = settle::machine_file::PRESETS[0];
+    let (_, path, text) = settle::input::machine_file::PRESETS[0];
     let (machine, _) =
-        settle::machine_file::parse(text, std::path::Path::new(path)).expect("preset");
+        settle::input::machine_file::parse(text, std::path::Path::new(path)).expect("preset");
     let lim = Limits::new(0.3, 3.0, Some(100.0)).expect("limits");
     let y = ProfileKind::SCurve
         .rest_to_rest(0.0, 0.01, &lim)

@@ -1,11 +1,16 @@
-//! The harness's error type.
+//! The harness's error type (the foundation layer: every other module may use it).
+//!
+//! Where an input error is: a [`Location`]. Locations are built here ([`Location::file`],
+//! [`Location::key`]) or, for a key of a TOML file, by
+//! [`crate::input::source::Source::error_at`], which adds the line and column; no call
+//! site assembles one by hand.
 
 use std::path::PathBuf;
 
 /// Where in an input file something is wrong.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Location {
-    /// The file.
+    /// The file (or a folder, or a command-line option such as `--jobs`).
     pub file: PathBuf,
     /// 1-based line, when known.
     pub line: Option<usize>,
@@ -13,6 +18,26 @@ pub struct Location {
     pub column: Option<usize>,
     /// The dotted key path (e.g. `limits.vmax_mm_s`), when known.
     pub key: Option<String>,
+}
+
+impl Location {
+    /// A whole file, folder or command-line option, no line known.
+    pub fn file(file: impl Into<PathBuf>) -> Self {
+        Self {
+            file: file.into(),
+            line: None,
+            column: None,
+            key: None,
+        }
+    }
+
+    /// A key of `file` whose line is not known (e.g. `--backend` for a scenario).
+    pub fn key(file: impl Into<PathBuf>, key: impl Into<String>) -> Self {
+        Self {
+            key: Some(key.into()),
+            ..Self::file(file)
+        }
+    }
 }
 
 impl std::fmt::Display for Location {
@@ -31,11 +56,12 @@ impl std::fmt::Display for Location {
     }
 }
 
-/// Everything the harness reports. Input errors (exit code 2) are separated from failures
-/// while running (exit code 1) by [`Error::is_input_error`].
+/// Everything the harness reports. Bad input (exit code 2) is told apart from failures
+/// while running or writing (exit code 1) by [`Error::is_input_error`].
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// A scenario file (or another input file) is unreadable, malformed or invalid.
+    /// A scenario file (or another input file, or a command-line value) is unreadable,
+    /// malformed or invalid.
     #[error("{at}: {message}")]
     Input {
         /// Where.
@@ -84,11 +110,46 @@ pub enum Error {
 }
 
 impl Error {
-    /// True for bad input (exit code 2), false for failures while running (exit code 1).
+    /// Bad input in `file` (a file, folder or command-line option) at no particular line.
+    pub fn input(file: impl Into<PathBuf>, message: impl Into<String>) -> Self {
+        Error::Input {
+            at: Location::file(file),
+            message: message.into(),
+        }
+    }
+
+    /// Bad input at `key` of `file`, line unknown (e.g. `--backend` against a scenario).
+    pub fn input_key(
+        file: impl Into<PathBuf>,
+        key: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Error::Input {
+            at: Location::key(file, key),
+            message: message.into(),
+        }
+    }
+
+    /// `path` could not be read.
+    pub fn read(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Read {
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// `path` could not be written.
+    pub fn write(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Write {
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// True for bad input (exit code 2: a malformed or invalid file, a bad option, a file
+    /// that cannot be read), false for failures while running or writing (exit code 1: a
+    /// run that broke down, a full disk).
     pub fn is_input_error(&self) -> bool {
-        matches!(
-            self,
-            Error::Input { .. } | Error::Read { .. } | Error::Write { .. }
-        )
+        matches!(self, Error::Input { .. } | Error::Read { .. })
     }
 }

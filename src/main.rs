@@ -1,14 +1,17 @@
-//! The `settle` command.
+//! The `settle` command: arguments, a call to a workflow of the library
+//! (`settle::workflows`), printing, and exit codes: 0 ok; 1 failed runs, a regression or an
+//! I/O failure; 2 bad input or usage; 130 an interrupted sweep.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
 
-use anyhow::Context;
 use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use settle::run::Backend;
-use settle::{Error, report};
+use settle::Error;
+use settle::execute::interrupt;
+use settle::spec::backend::Backend;
+use settle::workflows::{self, Exit, Report};
 
 fn parse_backend(s: &str) -> Result<Backend, String> {
     Backend::parse(s).ok_or_else(|| format!("unknown backend `{s}`; allowed: {}", Backend::ALLOWED))
@@ -49,7 +52,7 @@ enum Command {
         /// Run only shard K of N (1-based: runs i with i % N == K-1) into
         /// DIR [default: results/<scenario name>/shard-K-of-N/]; combine with `settle merge`.
         #[arg(long, value_name = "K/N")]
-        shard: Option<settle::shard::Shard>,
+        shard: Option<workflows::shard::Shard>,
         /// Continue an interrupted sweep: keep the runs in OUT/journal.csv, run the rest.
         #[arg(long)]
         resume: bool,
@@ -77,7 +80,7 @@ enum Command {
         #[arg(long)]
         baseline: PathBuf,
         /// Relative tolerance in percent (numbers closer than this to the baseline pass).
-        #[arg(long, value_name = "PCT", default_value_t = settle::check::DEFAULT_TOLERANCE_PCT)]
+        #[arg(long, value_name = "PCT", default_value_t = workflows::check::DEFAULT_TOLERANCE_PCT)]
         tolerance: f64,
         /// Rewrite the baseline with this run's values (on purpose: commit the diff).
         #[arg(long)]
@@ -171,37 +174,88 @@ struct OutputFlags {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    match dispatch(cli) {
-        Ok(code) => code,
+    match dispatch(Cli::parse().command) {
+        Ok(report) => {
+            print!("{}", report.stdout);
+            eprint!("{}", report.stderr);
+            ExitCode::from(match report.exit {
+                Exit::Ok => 0,
+                Exit::Failed => 1,
+                Exit::Interrupted => interrupt::EXIT_CODE,
+            })
+        }
         Err(e) => {
-            eprintln!("error: {e:#}");
-            let input = e.downcast_ref::<Error>().is_some_and(Error::is_input_error);
-            ExitCode::from(if input { 2 } else { 1 })
+            eprintln!("error: {e}");
+            ExitCode::from(if e.is_input_error() { 2 } else { 1 })
         }
     }
 }
 
-fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
-    match cli.command {
+/// A progress bar on stderr (drawn only when stderr is a terminal), fed by the workflows'
+/// progress callback.
+fn progress_bar() -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template(
+        "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} runs ({eta} left)",
+    ) {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// Ctrl-C and SIGTERM stop new runs from starting (the finished ones are in the sweep's
+/// journal); a second signal exits at once, which loses nothing either.
+fn install_interrupt() -> Result<(), Error> {
+    ctrlc::set_handler(|| {
+        if interrupt::request() {
+            eprintln!("\nsettle: second interrupt, exiting now");
+            std::process::exit(i32::from(interrupt::EXIT_CODE));
+        }
+        eprintln!(
+            "\nsettle: interrupted; finishing the runs in progress (interrupt again to exit at once)"
+        );
+    })
+    .map_err(|e| {
+        Error::input(
+            "signals",
+            format!("cannot install the Ctrl-C/SIGTERM handler: {e}"),
+        )
+    })
+}
+
+fn dispatch(command: Command) -> Result<Report, Error> {
+    let bar = progress_bar();
+    let progress = |done: usize, total: usize| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    };
+    let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
+    let jobs = |j: Option<u16>| j.map(usize::from);
+    let report = match command {
         Command::Sweep {
             scenario,
             out,
-            jobs,
+            jobs: j,
             backend,
             outputs,
             shard,
             resume,
-        } => sweep(
-            scenario,
-            out,
-            jobs.map(usize::from),
-            backend,
-            outputs,
-            shard,
-            resume,
-        ),
-        Command::Validate { backend, out } => settle::validate::command(backend, out.as_deref()),
+        } => {
+            install_interrupt()?;
+            let opts = workflows::sweep::SweepOptions {
+                out,
+                jobs: jobs(j),
+                mcap: outputs.mcap,
+                rerun: outputs.rerun,
+                shard,
+                resume,
+                ..workflows::sweep::SweepOptions::new(scenario, backend)
+            };
+            workflows::sweep::sweep(&opts, &note, &progress)?.report()
+        }
+        Command::Validate { backend, out } => {
+            workflows::validate::validate(backend, out.as_deref())?.report()
+        }
         Command::Check {
             scenario,
             baseline,
@@ -209,35 +263,33 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             update,
             allow_improvements,
             backend,
-            jobs,
-        } => check(
-            &scenario,
-            &baseline,
-            tolerance,
-            update,
-            allow_improvements,
-            backend,
-            jobs.map(usize::from),
-        ),
-        Command::Merge { dirs, out } => merge(&dirs, out),
+            jobs: j,
+        } => {
+            let opts = workflows::check::CheckOptions {
+                tolerance_pct: tolerance,
+                update,
+                allow_improvements,
+                backend,
+                jobs: jobs(j),
+                ..workflows::check::CheckOptions::new(scenario, baseline)
+            };
+            workflows::check::check(&opts, &progress)?.report()
+        }
+        Command::Merge { dirs, out } => workflows::merge::merge(&dirs, out)?.report(),
         Command::Tune {
             scenario,
             out,
             backend,
             check_on,
-            jobs,
-        } => {
-            let md = settle::tune_cmd::command(
-                &scenario,
-                out,
-                backend,
-                check_on,
-                jobs.map(usize::from),
-            )?;
-            print!("{md}");
-            Ok(ExitCode::SUCCESS)
+            jobs: j,
+        } => workflows::tune::tune_to(&scenario, out, backend, check_on, jobs(j), &progress)?
+            .report(),
+        Command::Plan { jobs: j } => {
+            let stdin = std::io::stdin().lock();
+            let stdout = std::io::BufWriter::new(std::io::stdout().lock());
+            workflows::plan::plan_stream(stdin, stdout, jobs(j))?;
+            Report::new(Exit::Ok)
         }
-        Command::Plan { jobs } => plan_lines(jobs.map(usize::from)),
         Command::Run {
             scenario,
             case,
@@ -245,648 +297,17 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             outputs,
             plot,
             backend,
-        } => run_one(scenario, case, out, outputs, plot, backend),
-    }
-}
-
-fn create_dir(dir: &std::path::Path) -> Result<(), Error> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Write {
-        path: dir.to_path_buf(),
-        source,
-    })
-}
-
-fn usage_error(what: &str, message: impl Into<String>) -> Error {
-    Error::Input {
-        at: settle::error::Location {
-            file: what.into(),
-            line: None,
-            column: None,
-            key: None,
-        },
-        message: message.into(),
-    }
-}
-
-/// Check recording flags before any work, so a missing feature costs no simulation.
-fn recorder(
-    flags: OutputFlags,
-    dir: PathBuf,
-    scenario: &std::path::Path,
-    name: &str,
-) -> anyhow::Result<Option<settle::sink::Recorder>> {
-    if flags.rerun && !settle::sink::rerun::AVAILABLE {
-        return Err(usage_error("--rerun", settle::sink::rerun::UNAVAILABLE).into());
-    }
-    if !(flags.mcap || flags.rerun) {
-        return Ok(None);
-    }
-    Ok(Some(settle::sink::Recorder {
-        dir,
-        mcap: flags.mcap,
-        rerun: flags.rerun,
-        provenance: settle::sink::Provenance::load(scenario, name)?,
-    }))
-}
-
-fn sweep(
-    path: PathBuf,
-    out: Option<PathBuf>,
-    jobs: Option<usize>,
-    backend: Backend,
-    flags: OutputFlags,
-    shard: Option<settle::shard::Shard>,
-    resume: bool,
-) -> anyhow::Result<ExitCode> {
-    let started = Instant::now();
-    let (sc, mut all_runs) = settle::load_runs(&path)?;
-    settle::run::set_backend(&path, &mut all_runs, backend)?;
-    let base = PathBuf::from("results").join(&sc.name);
-    let out = out.unwrap_or_else(|| match shard {
-        Some(s) => base.join(s.folder()),
-        None => base,
-    });
-    if let Some(s) = shard.filter(|s| s.n > all_runs.len()) {
-        return Err(usage_error(
-            "--shard",
-            format!(
-                "{s}: the scenario has {} runs, so at most {} shards",
-                all_runs.len(),
-                all_runs.len()
-            ),
-        )
-        .into());
-    }
-    let rec = recorder(
-        flags,
-        out.join(settle::outputs::RECORDINGS),
-        &path,
-        &sc.name,
-    )?;
-    let runs = match shard {
-        Some(s) => s.select(&all_runs),
-        None => all_runs.clone(),
-    };
-    create_dir(&out)?;
-    if let Some(r) = &rec {
-        create_dir(&r.dir)?;
-    }
-    eprintln!(
-        "{}: {} runs on {backend}{} -> {}",
-        path.display(),
-        runs.len(),
-        shard.map_or(String::new(), |s| format!(
-            " (shard {s} of {} runs)",
-            all_runs.len()
-        )),
-        out.display()
-    );
-    // Every finished run's row goes to the journal at once, so an interruption (or a
-    // crash) loses nothing: `--resume` runs only what is missing (see settle::journal).
-    let header = report::runs_csv(&runs, &[]);
-    let scenario_text = std::fs::read_to_string(&path).map_err(|source| Error::Read {
-        path: path.clone(),
-        source,
-    })?;
-    let key = settle::journal::key_line(
-        &scenario_text,
-        &sc.name,
-        backend.name(),
-        &shard.map_or(String::new(), |s| s.to_string()),
-    );
-    let ids: Vec<usize> = runs.iter().map(|r| r.id).collect();
-    let (journal, done) = match settle::journal::existing(&out) {
-        Some(_) if resume => settle::journal::Journal::resume(&out, &key, &header, &ids)?,
-        Some(p) => {
-            return Err(usage_error(
-                "--resume",
-                format!(
-                    "{} holds an interrupted sweep: continue it with --resume, or delete the file to start over",
-                    p.display()
-                ),
-            )
-            .into());
-        }
-        None => (
-            settle::journal::Journal::start(&out, &key, &header)?,
-            Default::default(),
-        ),
-    };
-    if resume {
-        eprintln!(
-            "resuming: {} of {} runs already finished",
-            done.len(),
-            runs.len()
-        );
-    }
-    let todo: Vec<settle::RunSpec> = runs
-        .iter()
-        .filter(|r| !done.contains_key(&r.id))
-        .cloned()
-        .collect();
-    settle::interrupt::install().map_err(|m| usage_error("signals", m))?;
-    let run_one = |spec: &settle::RunSpec| -> Result<String, Error> {
-        let m = match &rec {
-            Some(r) => r.run(spec),
-            None => settle::run::execute(spec, None),
-        }
-        // A run that fails is a row with its reason; the sweep goes on (issue 8).
-        .unwrap_or_else(|e| settle::Metrics::failed(&spec.bands_um, format!("{e}")));
-        let row = report::runs_csv_row(&runs, spec, &m);
-        journal.append(&row)?;
-        Ok(row)
-    };
-    let results = settle::run_all_with(&todo, jobs, true, run_one)?;
-    let mut rows = done;
-    let mut interrupted = 0usize;
-    for (spec, r) in todo.iter().zip(results) {
-        match r {
-            Ok(row) => {
-                rows.insert(spec.id, row);
-            }
-            Err(Error::Interrupted { .. }) => interrupted += 1,
-            Err(e) => return Err(e.into()),
-        }
-    }
-    if interrupted > 0 || settle::interrupt::requested() {
-        eprintln!(
-            "interrupted: {} of {} runs finished and kept in {}; continue with\n  settle sweep {} --out {} --resume{}",
-            rows.len(),
-            runs.len(),
-            out.join(settle::journal::FILE).display(),
-            path.display(),
-            out.display(),
-            shard.map_or(String::new(), |s| format!(" --shard {s}"))
-        );
-        return Ok(ExitCode::from(settle::interrupt::EXIT_CODE));
-    }
-    let mut csv = header;
-    for r in &runs {
-        csv.push_str(&rows[&r.id]);
-    }
-    match shard {
-        Some(s) => {
-            report::write_atomic(&out.join("runs.csv"), csv.as_bytes())?;
-            let scenario = std::fs::read_to_string(&path).map_err(|source| Error::Read {
-                path: path.clone(),
-                source,
-            })?;
-            settle::shard::write_manifest(
-                &out,
-                &settle::shard::Manifest {
-                    format: settle::shard::FORMAT.to_string(),
-                    settle_version: env!("CARGO_PKG_VERSION").to_string(),
-                    scenario_name: sc.name.clone(),
-                    scenario_file: path.display().to_string(),
-                    shard: s.k,
-                    shards: s.n,
-                    total_runs: all_runs.len(),
-                    runs: runs.iter().map(|r| r.id).collect(),
-                    settings: [("backend".to_string(), backend.name().to_string())]
-                        .into_iter()
-                        .collect(),
-                    scenario,
-                },
-            )?;
-            eprintln!(
-                "wrote shard {s}: {} and {} ({} runs in {:.2} s); combine all shards with `settle merge`",
-                out.join("runs.csv").display(),
-                out.join(settle::shard::MANIFEST).display(),
-                runs.len(),
-                started.elapsed().as_secs_f64()
-            );
-        }
-        None => {
-            settle::outputs::write_sweep(&out, &sc, &runs, &csv)?;
-            eprintln!(
-                "wrote {}, {} and {}/ ({} runs in {:.2} s){}",
-                out.join("runs.csv").display(),
-                out.join("summary.md").display(),
-                out.join(settle::outputs::PLOTS).display(),
-                runs.len(),
-                started.elapsed().as_secs_f64(),
-                rec.map_or(String::new(), |r| format!(
-                    "; recordings in {}",
-                    r.dir.display()
-                ))
-            );
-        }
-    }
-    journal.finish()?;
-    Ok(report_failures(&runs, &csv))
-}
-
-/// Print the failed runs (at most 20, then a count) from runs.csv's `status` and `reason`
-/// columns, and return exit code 1 if there are any, success otherwise.
-fn report_failures(runs: &[settle::RunSpec], csv: &str) -> ExitCode {
-    let Ok(table) = settle::table::RunsTable::parse(csv) else {
-        return ExitCode::from(1);
-    };
-    let failed: Vec<usize> = (0..runs.len())
-        .filter(|&i| table.cell(i, "status").is_some_and(|s| s != "ok"))
-        .collect();
-    if failed.is_empty() {
-        return ExitCode::SUCCESS;
-    }
-    eprintln!(
-        "{} of {} runs failed (status and reason in runs.csv):",
-        failed.len(),
-        runs.len()
-    );
-    const SHOWN: usize = 20;
-    for &i in failed.iter().take(SHOWN) {
-        let r = &runs[i];
-        eprintln!(
-            "  run {} ({}, {} mm): {}: {}",
-            r.id,
-            r.profile,
-            r.distance_mm,
-            table.cell(i, "status").unwrap_or_default(),
-            table.cell(i, "reason").unwrap_or_default()
-        );
-    }
-    if failed.len() > SHOWN {
-        eprintln!("  ... and {} more", failed.len() - SHOWN);
-    }
-    ExitCode::from(1)
-}
-
-fn check(
-    path: &std::path::Path,
-    baseline: &std::path::Path,
-    tolerance_pct: f64,
-    update: bool,
-    allow_improvements: bool,
-    backend: Option<Backend>,
-    jobs: Option<usize>,
-) -> anyhow::Result<ExitCode> {
-    if !(tolerance_pct.is_finite() && tolerance_pct >= 0.0) {
-        return Err(usage_error(
-            "--tolerance",
-            format!("must be a finite percentage >= 0, got {tolerance_pct}"),
-        )
-        .into());
-    }
-    let (sc, mut runs) = settle::load_runs(path)?;
-    let old = match std::fs::read_to_string(baseline) {
-        Ok(text) => Some(text),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound && update => None,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(usage_error(
-                &baseline.display().to_string(),
-                format!(
-                    "no baseline here; create it on purpose with `settle check {} --baseline {} --update`",
-                    path.display(),
-                    baseline.display()
-                ),
-            )
-            .into());
-        }
-        Err(source) => {
-            return Err(Error::Read {
-                path: baseline.to_path_buf(),
-                source,
-            }
-            .into());
+        } => {
+            let opts = workflows::run::RunOptions {
+                out,
+                mcap: outputs.mcap,
+                rerun: outputs.rerun,
+                plot,
+                ..workflows::run::RunOptions::new(scenario, case, backend)
+            };
+            workflows::run::run(&opts)?.report()
         }
     };
-    let old_table = old
-        .as_deref()
-        .map(settle::table::RunsTable::parse)
-        .transpose()
-        .map_err(|e| usage_error(&baseline.display().to_string(), e))?;
-    // The backend: as asked, else the baseline's own; a baseline made on another backend
-    // than the one asked for is an error (its numbers are not comparable), unless updating.
-    let made_with = old_table
-        .as_ref()
-        .map(settle::check::baseline_backend)
-        .transpose()
-        .map_err(|e| usage_error(&baseline.display().to_string(), e))?
-        .flatten();
-    let backend = match (backend, made_with.as_deref()) {
-        (Some(b), Some(m)) if b.name() != m && !update => {
-            return Err(usage_error(
-                &baseline.display().to_string(),
-                format!(
-                    "this baseline was made on backend `{m}`, not `{b}`: pass --backend {m}, or rewrite it with --update"
-                ),
-            )
-            .into());
-        }
-        (Some(b), _) => b,
-        (None, Some(m)) => Backend::parse(m).ok_or_else(|| {
-            usage_error(
-                &baseline.display().to_string(),
-                format!(
-                    "unknown backend `{m}` in its backend column; allowed: {}",
-                    Backend::ALLOWED
-                ),
-            )
-        })?,
-        (None, None) => Backend::default(),
-    };
-    settle::run::set_backend(path, &mut runs, backend)?;
-    let results = settle::run_all(&runs, jobs, true)?;
-    let mut metrics = Vec::with_capacity(results.len());
-    for r in results {
-        metrics.push(r.context("a run failed")?);
-    }
-    let csv = report::runs_csv(&runs, &metrics);
-    let now = settle::table::RunsTable::parse(&csv).map_err(|e| usage_error("runs.csv", e))?;
-    let comparison = old_table
-        .as_ref()
-        .map(|b| settle::check::compare(b, &now, tolerance_pct));
-    if update {
-        if let Some(dir) = baseline.parent().filter(|d| !d.as_os_str().is_empty()) {
-            create_dir(dir)?;
-        }
-        report::write_atomic(baseline, csv.as_bytes())?;
-        match comparison {
-            Some(Ok(c)) if !c.changes.is_empty() => println!(
-                "updated {}: {} values changed beyond {tolerance_pct}%:\n{}",
-                baseline.display(),
-                c.changes.len(),
-                settle::check::table(&c.changes, usize::MAX)
-            ),
-            Some(Ok(_)) => println!(
-                "updated {} ({} runs; no value changed beyond {tolerance_pct}%)",
-                baseline.display(),
-                runs.len()
-            ),
-            Some(Err(e)) => println!("updated {} (it had another shape: {e})", baseline.display()),
-            None => println!("created {} ({} runs)", baseline.display(), runs.len()),
-        }
-        return Ok(ExitCode::SUCCESS);
-    }
-    let c = match comparison {
-        Some(Ok(c)) => c,
-        Some(Err(e)) => {
-            eprintln!(
-                "settle check {}: FAILED against {}: {e}",
-                sc.name,
-                baseline.display()
-            );
-            return Ok(ExitCode::from(1));
-        }
-        None => unreachable!("a missing baseline without --update returned above"),
-    };
-    let failures = c.failures(allow_improvements);
-    use settle::check::Verdict;
-    let counts = format!(
-        "{} worse, {} better, {} changed",
-        c.count(Verdict::Worse),
-        c.count(Verdict::Better),
-        c.count(Verdict::Changed)
-    );
-    if !c.changes.is_empty() {
-        println!("{}", settle::check::table(&c.changes, 500));
-    }
-    if failures > 0 {
-        eprintln!(
-            "settle check {}: FAILED: {} of {} values ({} runs) differ from {} by more than {tolerance_pct}% ({counts}).\n\
-If the change is intended, rewrite the baseline and commit it:\n  settle check {} --baseline {} --update",
-            sc.name,
-            c.changes.len(),
-            c.cells,
-            c.runs,
-            baseline.display(),
-            path.display(),
-            baseline.display()
-        );
-        return Ok(ExitCode::from(1));
-    }
-    println!(
-        "settle check {}: ok: {} values ({} runs) match {} within {tolerance_pct}%{}",
-        sc.name,
-        c.cells,
-        c.runs,
-        baseline.display(),
-        if c.changes.is_empty() {
-            String::new()
-        } else {
-            format!(" except improvements ({counts}), allowed by --allow-improvements")
-        }
-    );
-    Ok(ExitCode::SUCCESS)
-}
-
-fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<ExitCode> {
-    let mut m = settle::shard::merge(dirs)?;
-    // The backend the shards ran on (a setting every shard agrees on).
-    if let Some(b) = m
-        .manifest
-        .settings
-        .get("backend")
-        .and_then(|b| Backend::parse(b))
-    {
-        let file = PathBuf::from(&m.manifest.scenario_file);
-        settle::run::set_backend(&file, &mut m.runs, b)?;
-    }
-    let out = out.unwrap_or_else(|| PathBuf::from("results").join(&m.scenario.name));
-    create_dir(&out)?;
-    settle::outputs::write_sweep(&out, &m.scenario, &m.runs, &m.csv)?;
-    // Recordings: gathered into one folder, as an unsharded sweep leaves them.
-    let mut copied = 0usize;
-    for d in dirs {
-        let src = d.join(settle::outputs::RECORDINGS);
-        let Ok(entries) = std::fs::read_dir(&src) else {
-            continue;
-        };
-        let dst = out.join(settle::outputs::RECORDINGS);
-        create_dir(&dst)?;
-        for e in entries {
-            let e = e.map_err(|source| Error::Read {
-                path: src.clone(),
-                source,
-            })?;
-            let name = e.file_name();
-            if name.to_string_lossy().starts_with('.') {
-                continue;
-            }
-            let to = dst.join(&name);
-            if std::fs::hard_link(e.path(), &to).is_err() {
-                std::fs::copy(e.path(), &to).map_err(|source| Error::Write {
-                    path: to.clone(),
-                    source,
-                })?;
-            }
-            copied += 1;
-        }
-    }
-    eprintln!(
-        "merged {} shards of `{}` ({} runs) into {}{}",
-        dirs.len(),
-        m.scenario.name,
-        m.runs.len(),
-        out.display(),
-        if copied > 0 {
-            format!(
-                "; {copied} recordings gathered in {}",
-                settle::outputs::RECORDINGS
-            )
-        } else {
-            String::new()
-        }
-    );
-    Ok(ExitCode::SUCCESS)
-}
-
-fn run_one(
-    path: PathBuf,
-    case: usize,
-    out: Option<PathBuf>,
-    flags: OutputFlags,
-    plot: bool,
-    backend: Backend,
-) -> anyhow::Result<ExitCode> {
-    let (sc, mut runs) = settle::load_runs(&path)?;
-    settle::run::set_backend(&path, &mut runs, backend)?;
-    let Some(spec) = runs.get(case) else {
-        return Err(Error::Input {
-            at: settle::error::Location {
-                file: path.clone(),
-                line: None,
-                column: None,
-                key: None,
-            },
-            message: format!(
-                "--case {case} does not exist: the scenario has runs 0..={}",
-                runs.len().saturating_sub(1)
-            ),
-        }
-        .into());
-    };
-    let out = out.unwrap_or_else(|| {
-        PathBuf::from("results")
-            .join(&sc.name)
-            .join(format!("run-{case}.csv"))
-    });
-    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|source| Error::Write {
-            path: dir.to_path_buf(),
-            source,
-        })?;
-    }
-    let dir = out
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .map_or_else(|| PathBuf::from("."), PathBuf::from);
-    let rec = recorder(flags, dir.clone(), &path, &sc.name)?;
-    let (series, m) = settle::sink::record_run(spec)?;
-    let mut csv = Vec::new();
-    series.write_csv(&mut csv).context("formatting the trace")?;
-    report::write_atomic(&out, &csv)?;
-    let record = settle::sink::RunRecord {
-        spec,
-        series: &series,
-        metrics: &m,
-        row: settle::sink::row_of(spec, &m),
-    };
-    let mut written = vec![out.display().to_string()];
-    if let Some(r) = &rec {
-        if r.mcap {
-            let p = out.with_extension("mcap");
-            settle::sink::mcap::write_file(&p, &r.provenance, &record)?;
-            written.push(p.display().to_string());
-        }
-        if r.rerun {
-            let p = out.with_extension("rrd");
-            settle::sink::rerun::write_file(&p, &r.provenance, &record)?;
-            written.push(p.display().to_string());
-        }
-    }
-    if plot {
-        let stem = out.file_stem().map_or_else(
-            || format!("run-{case}"),
-            |s| s.to_string_lossy().into_owned(),
-        );
-        let swept: Vec<String> = spec
-            .swept
-            .iter()
-            .map(|(k, v)| format!("{k} = {v}"))
-            .collect();
-        let title = format!("{} run {case}: {}", sc.name, swept.join(", "));
-        let fig = settle::plot::trace::figure(&title, &record);
-        settle::plot::write(&fig, &dir, &stem)?;
-        written.push(dir.join(format!("{stem}.svg")).display().to_string());
-        written.push(dir.join(format!("{stem}.png")).display().to_string());
-    }
-    println!(
-        "run {case}: {} {} mm on axis {} of {} ({} driver, {backend})",
-        spec.profile, spec.distance_mm, spec.axis, spec.machine_name, spec.driver
-    );
-    for (p, v) in &spec.swept {
-        println!("  {p} = {v}");
-    }
-    println!("  move_time_s            {:.6}", m.move_time_s);
-    println!("  residual_peak_um       {:.4}", m.residual_peak_um);
-    println!("  residual_rms_um        {:.4}", m.residual_rms_um);
-    for (i, b) in m.bands_um.iter().enumerate() {
-        let show = |t: Option<f64>| t.map_or("not settled".to_string(), |t| format!("{t:.6}"));
-        println!("  settle_time_s ({b} um)  {}", show(m.settle_time_s[i]));
-        println!(
-            "  move_and_settle_s ({b} um)  {}",
-            show(m.move_and_settle_s(i))
-        );
-    }
-    println!("  overshoot_um           {:.4}", m.overshoot_um);
-    println!("  max_following_error_um {:.4}", m.max_following_error_um);
-    if m.axes.len() > 1 {
-        for a in &m.axes {
-            println!(
-                "  axis {}: residual_peak_um {:.4}, max_following_error_um {:.4}",
-                a.name, a.residual_peak_um, a.max_following_error_um
-            );
-        }
-    }
-    for a in &m.axes {
-        if let Some(deg) = a.max_load_angle_deg {
-            println!(
-                "  axis {}: max load angle {deg:.1} electrical degrees",
-                a.name
-            );
-        }
-    }
-    if let settle::metrics::Status::LostSteps { axis, steps } = &m.status {
-        println!(
-            "  FAILED: lost {steps} full steps (axis {axis}): the numbers above are not a settling result"
-        );
-    }
-    println!("wrote {} ({} samples)", written.join(", "), series.len());
-    Ok(ExitCode::SUCCESS)
-}
-
-/// Answer JSON lines from stdin in order, in parallel chunks.
-fn plan_lines(jobs: Option<usize>) -> anyhow::Result<ExitCode> {
-    use rayon::prelude::*;
-    use std::io::{BufRead, Write};
-    let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = jobs {
-        builder = builder.num_threads(n);
-    }
-    let pool = builder.build().context("starting worker threads")?;
-    let stdin = std::io::stdin().lock();
-    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-    let mut lines = stdin.lines();
-    loop {
-        let chunk: Vec<String> = lines
-            .by_ref()
-            .take(8192)
-            .collect::<Result<_, _>>()
-            .context("reading stdin")?;
-        if chunk.is_empty() {
-            break;
-        }
-        let answers: Vec<String> = pool.install(|| {
-            chunk
-                .par_iter()
-                .map(|l| settle::plan_lines::answer(l))
-                .collect()
-        });
-        for a in answers {
-            writeln!(out, "{a}").context("writing stdout")?;
-        }
-    }
-    out.flush().context("writing stdout")?;
-    Ok(ExitCode::SUCCESS)
+    bar.finish_and_clear();
+    Ok(report)
 }

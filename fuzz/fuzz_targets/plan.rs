@@ -9,7 +9,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     for line in text.lines() {
-        let out = settle::plan_lines::answer(line);
+        let out = settle::workflows::plan::answer(line);
         let v: serde_json_check::Value = serde_json_check::from_str(&out).expect("answer is JSON");
         assert!(v.get("error").is_some() || v.get("axes").is_some(), "{out}");
     }

@@ -15,15 +15,10 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let path = Path::new("fuzz.toml");
-    match settle::scenario::parse(text, path) {
+    match settle::expand::parse(text, path) {
         Ok((sc, src)) => {
-            if let Ok(axes) = settle::sweep::axes(&sc, &src) {
-                let runs = axes
-                    .iter()
-                    .try_fold(1usize, |n, a| n.checked_mul(a.values.len()));
-                if runs.is_some_and(|n| n <= MAX_EXPANDED) {
-                    let _ = settle::sweep::expand(&sc, &src);
-                }
+            if settle::expand::sweep_of(&sc, &src).is_ok_and(|s| s.total <= MAX_EXPANDED) {
+                let _ = settle::expand::expand(&sc, &src);
             }
         }
         Err(e) => {

@@ -1,0 +1,120 @@
+//! Executing runs: the machine's axes compiled for the run, its motion planned by its run
+//! kind, the one [`sim_options`] every kind's run is simulated with, the simulation loop
+//! ([`simulate`]) on the chosen backend ([`engine`]), the worker pool with progress
+//! reported through a callback ([`pool`]) and interruption ([`interrupt`]).
+
+pub mod cursor;
+pub mod engine;
+pub mod interrupt;
+pub mod pool;
+pub mod simulate;
+
+use settle_sim::{AxisModel, DriverMode, SimError};
+
+use crate::error::Error;
+use crate::measure::metrics::Metrics;
+use crate::measure::series::Series;
+use crate::spec::backend::{Backend, NO_MUJOCO};
+use crate::spec::run_spec::RunSpec;
+
+pub use engine::{SimOptions, run_trajectory};
+
+/// How a run is observed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observe {
+    /// Observation window after the move (s).
+    pub window_s: f64,
+    /// Sample rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Settling bands (um).
+    pub bands_um: Vec<f64>,
+}
+
+/// How `spec` is observed.
+pub fn observe_of(spec: &RunSpec) -> Observe {
+    Observe {
+        window_s: spec.window_s,
+        sample_rate_hz: spec.sample_rate_hz,
+        bands_um: spec.bands_um.clone(),
+    }
+}
+
+/// The simulation options of `spec`: the one place a run's settings (`[sim] max_step_s`)
+/// become what the backends honour, whatever the run's kind.
+pub fn sim_options(spec: &RunSpec) -> SimOptions {
+    SimOptions {
+        max_step_s: spec.max_step_s,
+        ..SimOptions::default()
+    }
+}
+
+/// The axes a run simulates: the machine compiled for the run's driver model, or one axis
+/// `x` from the modes.
+pub fn axes_of(spec: &RunSpec) -> Result<Vec<AxisModel>, SimError> {
+    match &spec.machine {
+        Some(m) => m.compile(spec.driver),
+        None => Ok(vec![AxisModel::from_modes("x", &spec.modes_sim()?)?]),
+    }
+}
+
+/// Plan and simulate one run on its backend. When `record` is given, it is replaced by a
+/// series with the run's channels ([`simulate::channels`]) and every sample is appended to
+/// it. A run kind that measures more than the common metrics ([`crate::kinds::Probe`]) gets
+/// the series recorded (into `record`, or a series of its own) and adds its figures to an
+/// ok run's metrics.
+pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, Error> {
+    let sim_err = |source| Error::Sim {
+        run: spec.id,
+        source,
+    };
+    let axes = axes_of(spec).map_err(sim_err)?;
+    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+    let planned = crate::kinds::plan(spec, &names).map_err(|source| Error::Plan {
+        run: spec.id,
+        source,
+    })?;
+    let options = sim_options(spec);
+    let observe = observe_of(spec);
+    let traj = &planned.trajectory;
+    let Some(probe) = planned.probe else {
+        return run_trajectory(axes, spec.backend, &options, traj, &observe, record)
+            .map_err(sim_err);
+    };
+    let mut local = Series::default();
+    let series = match record {
+        Some(s) => s,
+        None => &mut local,
+    };
+    let mut m = run_trajectory(axes, spec.backend, &options, traj, &observe, Some(series))
+        .map_err(sim_err)?;
+    if m.is_ok() {
+        probe.measure(spec, series, &mut m)?;
+    }
+    Ok(m)
+}
+
+/// Set every run's backend, checking that this build has it and that it can simulate the
+/// runs' models (the modal backend: linear driver only). Errors are input errors naming
+/// the scenario file.
+pub fn set_backend(
+    path: &std::path::Path,
+    runs: &mut [RunSpec],
+    backend: Backend,
+) -> Result<(), Error> {
+    let err = |message: String| Error::input_key(path, "--backend", message);
+    if !backend.available() {
+        return Err(err(NO_MUJOCO.to_string()));
+    }
+    if backend == Backend::Modal
+        && let Some(r) = runs.iter().find(|r| r.driver != DriverMode::Linear)
+    {
+        return Err(err(format!(
+            "the modal backend is the exact solution of the linear model: it cannot run the `{}` driver model; set `driver_model = \"linear\"` in [machine] or use --backend rapier",
+            r.driver
+        )));
+    }
+    for r in runs {
+        r.backend = backend;
+    }
+    Ok(())
+}

@@ -1,0 +1,77 @@
+//! The worker pool: runs in parallel, results in spec order, progress reported through a
+//! callback (the binary draws a progress bar with it; tests and library callers pass
+//! [`quiet`] or their own).
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use rayon::prelude::*;
+
+use crate::error::Error;
+use crate::measure::metrics::Metrics;
+use crate::spec::run_spec::RunSpec;
+
+/// Called after each finished run with `(runs finished, runs in the batch)`, from the
+/// worker threads.
+pub type Progress<'a> = &'a (dyn Fn(usize, usize) + Sync);
+
+/// A [`Progress`] that reports nothing.
+pub fn quiet(_done: usize, _total: usize) {}
+
+/// A thread pool of `jobs` threads (all cores when `None`).
+pub fn thread_pool(jobs: Option<usize>) -> Result<rayon::ThreadPool, Error> {
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = jobs {
+        builder = builder.num_threads(n);
+    }
+    builder.build().map_err(|e| {
+        Error::input(
+            "--jobs",
+            format!("cannot start {jobs:?} worker threads: {e}"),
+        )
+    })
+}
+
+/// Run every spec, in parallel on `jobs` threads (all cores when `None`), reporting to
+/// `progress`. Results come back in spec order; each run is computed the same way whatever
+/// the thread count.
+pub fn run_all(
+    runs: &[RunSpec],
+    jobs: Option<usize>,
+    progress: Progress,
+) -> Result<Vec<Result<Metrics, Error>>, Error> {
+    run_all_with(runs, jobs, progress, |spec| {
+        crate::execute::execute(spec, None)
+    })
+}
+
+/// [`run_all`] with a custom way to run one spec (e.g. recording it, or appending its row
+/// to a journal). Once an interruption is requested ([`crate::execute::interrupt`]), runs
+/// not yet started are not started and come back as [`Error::Interrupted`]; runs in
+/// progress finish.
+pub fn run_all_with<T, F>(
+    runs: &[RunSpec],
+    jobs: Option<usize>,
+    progress: Progress,
+    run_one: F,
+) -> Result<Vec<Result<T, Error>>, Error>
+where
+    T: Send,
+    F: Fn(&RunSpec) -> Result<T, Error> + Sync,
+{
+    let pool = thread_pool(jobs)?;
+    let done = AtomicUsize::new(0);
+    let total = runs.len();
+    let results = pool.install(|| {
+        runs.par_iter()
+            .map(|spec| {
+                if crate::execute::interrupt::requested() {
+                    return Err(Error::Interrupted { run: spec.id });
+                }
+                let r = run_one(spec);
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                r
+            })
+            .collect()
+    });
+    Ok(results)
+}

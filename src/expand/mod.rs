@@ -1,0 +1,269 @@
+//! Sweep expansion: a scenario becomes a list of fully resolved, validated runs. The same
+//! file always gives the same runs in the same order (the only I/O is reading a machine
+//! file the scenario names by path).
+//!
+//! The base run comes from the scenario's core tables and the run kinds' tables (each
+//! registered kind parses its own, `crate::kinds`); the sweep axes ([`axes`]) then vary it,
+//! the last axis fastest, and every run is checked ([`validate`]).
+
+pub mod axes;
+pub mod machine;
+pub mod validate;
+
+use std::path::Path;
+
+use settle_planner::ProfileKind;
+use settle_sim::machine::Machine;
+
+use crate::error::Error;
+use crate::input::scenario::{MoveSpec, Scenario};
+use crate::input::source::Source;
+use crate::kinds::{self, Kind, KindState, Role};
+use crate::spec::backend::Backend;
+use crate::spec::run_spec::{RunSpec, SWEEPABLE};
+use crate::spec::value::Value;
+
+pub use axes::{Axis, MAX_RUNS};
+
+/// Read a scenario file (its core and every kind's table).
+pub fn load(path: &Path) -> Result<(Scenario, Source), Error> {
+    crate::input::scenario::load(path, &kinds::tables())
+}
+
+/// Parse scenario text (see [`load`]); `path` is used in error messages.
+pub fn parse(text: &str, path: &Path) -> Result<(Scenario, Source), Error> {
+    crate::input::scenario::parse(text, path, &kinds::tables())
+}
+
+/// Load a scenario file and expand it into validated runs.
+pub fn load_runs(path: &Path) -> Result<(Scenario, Vec<RunSpec>), Error> {
+    let (sc, src) = load(path)?;
+    let runs = expand(&sc, &src)?;
+    Ok((sc, runs))
+}
+
+/// Parse scenario text and expand it into validated runs.
+pub fn parse_runs(text: &str, path: &Path) -> Result<(Scenario, Vec<RunSpec>), Error> {
+    let (sc, src) = parse(text, path)?;
+    let runs = expand(&sc, &src)?;
+    Ok((sc, runs))
+}
+
+/// Everything that can be swept, for messages: the keys of every run, then each kind's.
+pub fn sweepable() -> String {
+    let mut out = SWEEPABLE.to_string();
+    for k in kinds::all() {
+        if let (Some(t), s) = (k.table(), k.sweepable())
+            && !s.is_empty()
+        {
+            out.push_str(&format!("; with a [{t}] table: {s}"));
+        }
+    }
+    out
+}
+
+/// How a kind is given in a scenario, for messages: `[corner] (a corner path)`.
+fn given_as(k: &dyn Kind) -> String {
+    format!("[{}] (a {})", k.table().unwrap_or("move"), k.name())
+}
+
+/// The run kinds' states from their tables, and the move every run starts from: `[move]`
+/// (`None`), or a path kind's stand-in for it (with the key its profile kind is blamed on).
+type BaseMotion = (Vec<Box<dyn KindState>>, MoveSpec, Option<&'static str>);
+
+fn base_motion(sc: &Scenario, src: &Source) -> Result<BaseMotion, Error> {
+    let mut states = Vec::new();
+    let mut motion: Option<&dyn Kind> = None;
+    for k in kinds::all() {
+        let Some(state) = k.parse(src)? else {
+            continue;
+        };
+        if k.role() != Role::Modifier {
+            if let Some(m) = motion {
+                return Err(src.error_at(
+                    k.table().unwrap_or("name"),
+                    format!(
+                        "{} cannot be combined with {}: give one motion",
+                        given_as(*k),
+                        given_as(m)
+                    ),
+                ));
+            }
+            motion = Some(*k);
+        }
+        states.push(state);
+    }
+    let paths: Vec<String> = kinds::all()
+        .iter()
+        .filter(|k| k.role() == Role::Path)
+        .map(|k| given_as(*k))
+        .collect();
+    let path = motion.filter(|k| k.role() == Role::Path).and_then(|k| {
+        let state = states.iter().find(|s| Some(s.table()) == k.table())?;
+        Some((k, k.path_move(&**state)?))
+    });
+    match (&sc.move_, path) {
+        (Some(m), None) => Ok((states, m.clone(), None)),
+        (None, Some((_, p))) => Ok((
+            states,
+            MoveSpec {
+                distance_mm: 0.0,
+                start_mm: 0.0,
+                profile: p.profile,
+                axis: p.axis,
+            },
+            Some(p.profile_key),
+        )),
+        (Some(_), Some((k, _))) => Err(src.error_at(
+            k.table().unwrap_or("move"),
+            format!(
+                "give either [move] (a point-to-point move) or {}, not both",
+                given_as(k)
+            ),
+        )),
+        (None, None) => Err(src.error_at(
+            "name",
+            format!(
+                "missing the motion: give [move] (a point-to-point move) or {}",
+                paths.join(" or ")
+            ),
+        )),
+    }
+}
+
+/// A scenario's sweep before expansion: the base run and the axes.
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    /// The run every point starts from.
+    pub base: RunSpec,
+    /// The sweep axes, in the order written.
+    pub axes: Vec<Axis>,
+    /// The number of runs (the product of the axes' lengths).
+    pub total: usize,
+}
+
+/// The base run and the sweep axes of a scenario (checked, not yet expanded).
+pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
+    let (states, mv, path_profile_key) = base_motion(sc, src)?;
+    let is_path = path_profile_key.is_some();
+    let profile_key = path_profile_key.unwrap_or("move.profile");
+    let base_profile =
+        ProfileKind::parse(&mv.profile).map_err(|e| src.error_at(profile_key, e.to_string()))?;
+    let (machine, machine_name, driver) = machine::resolve_machine(sc, src)?;
+    let axis_names: Vec<String> = match &machine {
+        Some(m) => m.axes.iter().map(|a| a.name.clone()).collect(),
+        None => vec!["x".to_string()],
+    };
+    if !is_path && !axis_names.contains(&mv.axis) {
+        return Err(src.error_at(
+            "move.axis",
+            format!(
+                "no axis `{}`; the machine has {}",
+                mv.axis,
+                axis_names.join(", ")
+            ),
+        ));
+    }
+    let base = RunSpec {
+        id: 0,
+        profile: base_profile,
+        start_mm: mv.start_mm,
+        distance_mm: mv.distance_mm,
+        vmax_mm_s: sc.limits.vmax_mm_s,
+        amax_mm_s2: sc.limits.amax_mm_s2,
+        jmax_mm_s3: sc.limits.jmax_mm_s3,
+        modes: sc.machine.modes.clone(),
+        machine,
+        machine_name,
+        driver,
+        axis: mv.axis.clone(),
+        backend: Backend::default(),
+        window_s: sc.observe.window_s,
+        sample_rate_hz: sc.observe.sample_rate_hz,
+        bands_um: sc.observe.bands_um.clone(),
+        max_step_s: sc.sim.max_step_s,
+        swept: Vec::new(),
+        kind_params: settle_planner::KindParams::default(),
+        kinds: states,
+    };
+    validate::validate_observe(&base, src)?;
+    let axes = axes::axes(sc, src, &base)?;
+    let total = axes
+        .iter()
+        .try_fold(1usize, |acc, a| acc.checked_mul(a.values.len()))
+        .filter(|&n| n <= MAX_RUNS)
+        .ok_or_else(|| {
+            src.error_at(
+                "sweep",
+                format!("the sweep expands to more than {MAX_RUNS} runs"),
+            )
+        })?;
+    if axes.iter().any(|a| a.param == "machine.preset") && base.machine.is_none() {
+        return Err(src.error_at(
+            "sweep.machine.preset",
+            "sweeping presets needs a physical machine: give `preset` in [machine], not `modes`",
+        ));
+    }
+    Ok(Sweep { base, axes, total })
+}
+
+/// Expand a scenario into validated runs: the base run, then the cartesian product of the
+/// sweep axes in the order written (the last axis varies fastest).
+pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
+    let Sweep { base, axes, total } = sweep_of(sc, src)?;
+    let mut presets: Vec<(String, Machine, String)> = Vec::new();
+    let mut runs = Vec::with_capacity(total);
+    for id in 0..total {
+        let mut run = base.clone();
+        run.id = id;
+        let mut rest = id;
+        let mut picks = vec![0; axes.len()];
+        for (i, axis) in axes.iter().enumerate().rev() {
+            picks[i] = rest % axis.values.len();
+            rest /= axis.values.len();
+        }
+        // A swept preset replaces the machine first; other machine keys then edit it.
+        for (axis, &k) in axes.iter().zip(&picks) {
+            if let (true, Value::Text(name)) = (axis.param == "machine.preset", &axis.values[k]) {
+                if !presets.iter().any(|(n, _, _)| n == name) {
+                    let (m, _, _) = crate::input::machine_file::load_preset(name, &src.path, src)?;
+                    let mname = m.name.clone();
+                    presets.push((name.clone(), m, mname));
+                }
+                if let Some((_, m, mname)) = presets.iter().find(|(n, _, _)| n == name) {
+                    run.machine = Some(m.clone());
+                    run.machine_name = mname.clone();
+                }
+                if run
+                    .machine
+                    .as_ref()
+                    .is_some_and(|m| m.axis(&run.axis).is_none())
+                {
+                    return Err(src.error_at(
+                        "sweep.machine.preset",
+                        format!("machine `{name}` has no axis `{}` (move.axis)", run.axis),
+                    ));
+                }
+            }
+        }
+        for (axis, &k) in axes.iter().zip(&picks) {
+            let v = &axis.values[k];
+            let key = format!("sweep.{}", axis.param);
+            let known = run.set(&axis.param, v).map_err(|m| src.error_at(&key, m))?;
+            if !known {
+                return Err(src.error_at(
+                    &key,
+                    format!("`{}` cannot be swept; allowed: {}", axis.param, sweepable()),
+                ));
+            }
+            run.swept.push((axis.param.clone(), v.clone()));
+        }
+        // A path kind's move length is its path length.
+        if let Some(d) = kinds::motion(&run).path_length_mm(&run) {
+            run.distance_mm = d;
+        }
+        validate::validate_run(&run, src)?;
+        runs.push(run);
+    }
+    Ok(runs)
+}

@@ -1,0 +1,357 @@
+//! Machine files (TOML): what a user writes to describe a gantry, parsed strictly and
+//! reported with file, line and key, then converted to [`settle_sim::machine::Machine`].
+//!
+//! A machine file has a `name`, an optional `description`, machine-wide `[motor]` and
+//! `[driver]` tables (defaults for every axis) and one `[axis.<name>]` table per axis
+//! (`x`, `y`, ...; axes are ordered by name), each with `carriage_kg`, `toolhead_kg`,
+//! optional `beam_kg`, exactly one of `[axis.<name>.belt]` or `[axis.<name>.screw]`, a
+//! `[axis.<name>.mount]`, an optional `[axis.<name>.frame]` and optional `motor` / `driver`
+//! overrides. The same tables can be written inline in a scenario under `[machine]`.
+//! Built-in presets (`scenarios/machines/*.toml`) are compiled into the binary.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use settle_sim::SimError;
+use settle_sim::machine::{
+    AxisMachine, Belt, Driver, Frame, Machine, Motor, Mount, Screw, Transmission,
+};
+
+use crate::error::Error;
+use crate::input::source::Source;
+
+/// The built-in presets: name, repository path, text.
+pub const PRESETS: [(&str, &str, &str); 2] = [
+    (
+        "printer_xy",
+        "scenarios/machines/printer_xy.toml",
+        include_str!("../../scenarios/machines/printer_xy.toml"),
+    ),
+    (
+        "leadscrew_stage",
+        "scenarios/machines/leadscrew_stage.toml",
+        include_str!("../../scenarios/machines/leadscrew_stage.toml"),
+    ),
+];
+
+/// A machine file as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MachineFile {
+    /// Name, for reports.
+    pub name: String,
+    /// Free text.
+    #[serde(default)]
+    pub description: String,
+    /// Motor of every axis that does not name its own.
+    pub motor: Option<MotorSpec>,
+    /// Driver of every axis that does not name its own.
+    pub driver: Option<DriverSpec>,
+    /// The axes, by name.
+    pub axis: BTreeMap<String, AxisSpec>,
+}
+
+/// One axis as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisSpec {
+    /// Carriage mass (kg).
+    pub carriage_kg: f64,
+    /// Toolhead mass (kg).
+    pub toolhead_kg: f64,
+    /// Mass carried rigidly with the carriage (kg), e.g. the X beam on a Y axis.
+    #[serde(default)]
+    pub beam_kg: f64,
+    /// A belt drive.
+    pub belt: Option<BeltSpec>,
+    /// A screw drive.
+    pub screw: Option<ScrewSpec>,
+    /// Toolhead mount.
+    pub mount: MountSpec,
+    /// Optional frame mode.
+    pub frame: Option<FrameSpec>,
+    /// Motor (else the machine-wide one).
+    pub motor: Option<MotorSpec>,
+    /// Driver (else the machine-wide one).
+    pub driver: Option<DriverSpec>,
+}
+
+/// `[axis.<name>.belt]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeltSpec {
+    /// Axial stiffness E*A (N).
+    pub ea_n: f64,
+    /// Drive pulley to idler (mm).
+    pub span_mm: f64,
+    /// Drive pulley teeth.
+    pub pulley_teeth: u32,
+    /// Belt pitch (mm); GT2 = 2.
+    #[serde(default = "two")]
+    pub pitch_mm: f64,
+    /// Pulley-to-carriage belt length at axis position 0 (mm).
+    pub carriage_at_zero_mm: f64,
+    /// Damping ratio against the carried mass.
+    pub damping_ratio: f64,
+}
+
+fn two() -> f64 {
+    2.0
+}
+
+/// `[axis.<name>.screw]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScrewSpec {
+    /// Lead (mm per revolution).
+    pub lead_mm: f64,
+    /// Axial stiffness (N/m).
+    pub stiffness_n_per_m: f64,
+    /// Damping ratio against the carried mass.
+    pub damping_ratio: f64,
+}
+
+/// `[axis.<name>.mount]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MountSpec {
+    /// Stiffness (N/m).
+    pub stiffness_n_per_m: f64,
+    /// Damping ratio against the toolhead mass.
+    pub damping_ratio: f64,
+}
+
+/// `[axis.<name>.frame]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameSpec {
+    /// Modal mass (kg).
+    pub mass_kg: f64,
+    /// Stiffness to ground (N/m).
+    pub stiffness_n_per_m: f64,
+    /// Damping ratio.
+    pub damping_ratio: f64,
+}
+
+/// `[motor]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotorSpec {
+    /// Holding torque, both phases at rated current (N m).
+    pub holding_torque_n_m: f64,
+    /// Rated phase current (A).
+    pub rated_current_a: f64,
+    /// Phase resistance (ohm).
+    pub resistance_ohm: f64,
+    /// Phase inductance (mH).
+    pub inductance_mh: f64,
+    /// Rotor inertia (g cm^2).
+    pub rotor_inertia_g_cm2: f64,
+    /// Rotor teeth (50 for 1.8 degree motors).
+    #[serde(default = "fifty")]
+    pub rotor_teeth: u32,
+    /// Detent torque (N m).
+    #[serde(default)]
+    pub detent_torque_n_m: f64,
+    /// Damping ratio of the rotor on the driver's magnetic spring.
+    pub damping_ratio: f64,
+}
+
+fn fifty() -> u32 {
+    50
+}
+
+/// `[driver]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriverSpec {
+    /// Microsteps per full step.
+    pub microsteps: u32,
+    /// Run current (A rms).
+    pub run_current_a_rms: f64,
+    /// Supply voltage (V).
+    pub supply_v: f64,
+    /// Current loop bandwidth (Hz). Default 20 kHz.
+    #[serde(default = "bandwidth")]
+    pub current_loop_bandwidth_hz: f64,
+}
+
+fn bandwidth() -> f64 {
+    20_000.0
+}
+
+/// Convert parsed axes into a validated machine. `prefix` is the key path of the tables
+/// in `src` (`""` in a machine file, `"machine."` inline in a scenario), for errors.
+pub fn to_machine(
+    name: &str,
+    motor: Option<&MotorSpec>,
+    driver: Option<&DriverSpec>,
+    axes: &BTreeMap<String, AxisSpec>,
+    src: &Source,
+    prefix: &str,
+) -> Result<Machine, Error> {
+    if axes.is_empty() {
+        return Err(src.error_at(
+            &format!("{prefix}axis"),
+            "a machine needs at least one [axis.<name>] table",
+        ));
+    }
+    let mut out = Vec::new();
+    for (axis, a) in axes {
+        let key = |k: &str| format!("{prefix}axis.{axis}.{k}");
+        let transmission = match (&a.belt, &a.screw) {
+            (Some(b), None) => Transmission::Belt(Belt {
+                ea_n: b.ea_n,
+                span_mm: b.span_mm,
+                pulley_teeth: b.pulley_teeth,
+                pitch_mm: b.pitch_mm,
+                carriage_at_zero_mm: b.carriage_at_zero_mm,
+                damping_ratio: b.damping_ratio,
+            }),
+            (None, Some(s)) => Transmission::Screw(Screw {
+                lead_mm: s.lead_mm,
+                stiffness_n_per_m: s.stiffness_n_per_m,
+                damping_ratio: s.damping_ratio,
+            }),
+            _ => {
+                return Err(src.error_at(
+                    &format!("{prefix}axis.{axis}"),
+                    "give exactly one of [belt] or [screw] for this axis",
+                ));
+            }
+        };
+        let (m, motor_key) = match (&a.motor, motor) {
+            (Some(m), _) => (m, key("motor")),
+            (None, Some(m)) => (m, format!("{prefix}motor")),
+            (None, None) => {
+                return Err(src.error_at(
+                    &format!("{prefix}axis.{axis}"),
+                    "no motor: give [motor] (for every axis) or [axis.<name>.motor]",
+                ));
+            }
+        };
+        let (d, driver_key) = match (&a.driver, driver) {
+            (Some(d), _) => (d, key("driver")),
+            (None, Some(d)) => (d, format!("{prefix}driver")),
+            (None, None) => {
+                return Err(src.error_at(
+                    &format!("{prefix}axis.{axis}"),
+                    "no driver: give [driver] (for every axis) or [axis.<name>.driver]",
+                ));
+            }
+        };
+        let machine_axis = AxisMachine {
+            name: axis.clone(),
+            carriage_kg: a.carriage_kg,
+            toolhead_kg: a.toolhead_kg,
+            beam_kg: a.beam_kg,
+            transmission,
+            mount: Mount {
+                stiffness_n_per_m: a.mount.stiffness_n_per_m,
+                damping_ratio: a.mount.damping_ratio,
+            },
+            frame: a.frame.as_ref().map(|f| Frame {
+                mass_kg: f.mass_kg,
+                stiffness_n_per_m: f.stiffness_n_per_m,
+                damping_ratio: f.damping_ratio,
+            }),
+            motor: Motor {
+                holding_torque_n_m: m.holding_torque_n_m,
+                rated_current_a: m.rated_current_a,
+                resistance_ohm: m.resistance_ohm,
+                inductance_mh: m.inductance_mh,
+                rotor_inertia_g_cm2: m.rotor_inertia_g_cm2,
+                rotor_teeth: m.rotor_teeth,
+                detent_torque_n_m: m.detent_torque_n_m,
+                damping_ratio: m.damping_ratio,
+            },
+            driver: Driver {
+                microsteps: d.microsteps,
+                run_current_a_rms: d.run_current_a_rms,
+                supply_v: d.supply_v,
+                current_loop_bandwidth_hz: d.current_loop_bandwidth_hz,
+            },
+        };
+        if let Err(e) = machine_axis.validate() {
+            return Err(match e {
+                SimError::InvalidMachine {
+                    field,
+                    value,
+                    allowed,
+                    ..
+                } => {
+                    let k = if let Some(f) = field.strip_prefix("motor.") {
+                        format!("{motor_key}.{f}")
+                    } else if let Some(f) = field.strip_prefix("driver.") {
+                        format!("{driver_key}.{f}")
+                    } else {
+                        key(&field)
+                    };
+                    src.error_at(&k, format!("must be {allowed}, got {value}"))
+                }
+                other => src.error_at(&format!("{prefix}axis.{axis}"), other.to_string()),
+            });
+        }
+        out.push(machine_axis);
+    }
+    let machine = Machine {
+        name: name.to_string(),
+        axes: out,
+    };
+    machine
+        .validate()
+        .map_err(|e| src.error_at(&format!("{prefix}axis"), e.to_string()))?;
+    Ok(machine)
+}
+
+/// Parse a machine file's text; `path` names it in errors.
+pub fn parse(text: &str, path: &Path) -> Result<(Machine, String), Error> {
+    let src = Source::new(text, path);
+    let file: MachineFile = src.document(&[])?;
+    let m = to_machine(
+        &file.name,
+        file.motor.as_ref(),
+        file.driver.as_ref(),
+        &file.axis,
+        &src,
+        "",
+    )?;
+    Ok((m, file.description))
+}
+
+/// Resolve `preset = "<value>"` of a scenario at `scenario_path`: a built-in preset name,
+/// or a path to a machine file (relative to the scenario's folder). Returns the machine,
+/// its description and the file it came from.
+pub fn load_preset(
+    value: &str,
+    scenario_path: &Path,
+    src: &Source,
+) -> Result<(Machine, String, PathBuf), Error> {
+    if let Some((_, path, text)) = PRESETS.iter().find(|(n, _, _)| *n == value) {
+        let path = PathBuf::from(path);
+        let (m, d) = parse(text, &path)?;
+        return Ok((m, d, path));
+    }
+    let looks_like_path = value.contains('/') || value.ends_with(".toml");
+    if !looks_like_path {
+        let names: Vec<&str> = PRESETS.iter().map(|(n, _, _)| *n).collect();
+        return Err(src.error_at(
+            "machine.preset",
+            format!(
+                "unknown preset `{value}`; built in: {}, or give a path to a machine file (ending in .toml)",
+                names.join(", ")
+            ),
+        ));
+    }
+    let base = scenario_path.parent().unwrap_or(Path::new("."));
+    let path = base.join(value);
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        src.error_at(
+            "machine.preset",
+            format!("cannot read machine file {}: {e}", path.display()),
+        )
+    })?;
+    let (m, d) = parse(&text, &path)?;
+    Ok((m, d, path))
+}

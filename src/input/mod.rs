@@ -1,0 +1,11 @@
+//! Input files as plain data: scenario files (their core; the run kinds read their own
+//! tables), machine files, the `[tune]` table and runs tables (runs.csv: baselines and
+//! shard folders are inputs too). [`source::Source`] is where every input error gets its
+//! file, line and key.
+
+pub mod keys;
+pub mod machine_file;
+pub mod runs_table;
+pub mod scenario;
+pub mod source;
+pub mod tune_spec;

@@ -1,0 +1,334 @@
+//! Run kinds: what one run of a sweep does with the machine. A point-to-point move, a
+//! corner path, a raster scan's step, input shaping of the commanded motion: each is a
+//! [`Kind`], one module of this folder, and the expander (`crate::expand`), the runner
+//! (`crate::execute`), runs.csv and the summary (`crate::output`) go through [`all`], the
+//! registered kinds, without naming one.
+//!
+//! A kind
+//! - claims a table of the scenario file ([`Kind::table`]: `[corner]`, `[scan]`,
+//!   `[shaper]`; the point move claims none: it is the kind of a run no other motion kind
+//!   claims) and parses it into the per-run state every run of the sweep starts from
+//!   ([`Kind::parse`], a [`KindState`] that the sweep then sets through its keys,
+//!   `corner.angle_deg`, ...),
+//! - checks each run ([`Kind::validate`]),
+//! - plans the run's motion ([`Kind::plan`], [`Role::Move`] and [`Role::Path`] kinds), or
+//!   transforms the motion another kind plans ([`Kind::shaper`], [`Role::Modifier`]),
+//! - may measure more than the common metrics from the run's series ([`Planned::probe`]),
+//! - names its extra runs.csv columns and fills their cells ([`Kind::columns`],
+//!   [`Kind::cells`]), and adds its section to the summary and its panels to the figures
+//!   ([`Kind::summary`], [`Kind::figures`]).
+//!
+//! # Adding a kind
+//!
+//! One file and one line:
+//! 1. `src/kinds/<name>.rs`: the table as a `#[derive(Deserialize)]
+//!    #[serde(deny_unknown_fields)]` struct; the per-run state (`Clone + PartialEq + Debug`)
+//!    implementing [`KindState`] (`table` returns the table's name, `set` takes its swept
+//!    keys); a unit struct implementing [`Kind`]: `table` and `role`, `parse` (read the
+//!    table with [`Source::table`], so errors name the file, line and key), `plan` for a
+//!    motion kind, and whichever of `validate`, `columns`/`cells`, `summary`, `figures` it
+//!    needs (each has a default that adds nothing).
+//! 2. `<name>::<Kind>,` in the `register!` list below (it declares the module and puts the
+//!    kind in [`KINDS`]), at the place its runs.csv columns and summary section belong
+//!    (registration order is their order).
+//!
+//! `src/kinds/toy.rs` (compiled for the unit tests only, registered by its line in the
+//! list) is such a kind; `src/workflows/toy_pipeline.rs` runs it through the whole
+//! pipeline: parse, sweep, run, runs.csv, summary, figures.
+
+use settle_planner::shaper::Shaper;
+use settle_planner::{PlanError, Profile, State, Trajectory};
+
+use crate::error::Error;
+use crate::input::runs_table::RunsTable;
+use crate::input::source::Source;
+use crate::measure::metrics::Metrics;
+use crate::measure::series::Series;
+pub use crate::spec::run_spec::KindState;
+use crate::spec::run_spec::RunSpec;
+
+/// Declares each kind's module and lists its kind in [`KINDS`]: one line per kind.
+macro_rules! register {
+    ($($(#[$attr:meta])* $module:ident :: $kind:ident),* $(,)?) => {
+        $($(#[$attr])* pub mod $module;)*
+
+        /// Every run kind, in registration order: runs.csv's kind columns, the summary's
+        /// kind sections and the figures' kind panels follow it.
+        pub static KINDS: &[&dyn Kind] = &[$($(#[$attr])* &$module::$kind),*];
+    };
+}
+
+register! {
+    point::PointMove,
+    corner::CornerPath,
+    shaping::Shaping,
+    scan::ScanStep,
+    #[cfg(test)]
+    toy::Toy,
+}
+
+/// The registered kinds ([`KINDS`]).
+pub fn all() -> &'static [&'static dyn Kind] {
+    KINDS
+}
+
+/// What a kind does with the run's motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// Plans the motion from `[move]` (the point-to-point move, which claims no table; a
+    /// raster scan, whose step is the move).
+    Move,
+    /// Plans a motion of its own instead of `[move]` (a corner path).
+    Path,
+    /// Transforms the motion the run's motion kind plans (an input shaper).
+    Modifier,
+}
+
+/// What a path kind stands in for `[move]` with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathMove {
+    /// The profile kind named in its table (the speed law of the path).
+    pub profile: String,
+    /// The key of that name (`corner.profile`), for errors.
+    pub profile_key: &'static str,
+    /// The machine axes it moves, joined by `+` (runs.csv's `axis`, e.g. `x+y`: no machine
+    /// axis has this name, so the point move's travel check leaves the path to its kind).
+    pub axis: String,
+}
+
+/// What a motion kind plans with.
+#[derive(Debug, Clone)]
+pub struct PlanContext<'a> {
+    /// The machine's axes, in order: the trajectory has one profile per axis.
+    pub axes: &'a [String],
+    /// The input shaper of the run's modifier kinds, if any: the motion kind applies it
+    /// where it belongs (every axis of a path, the step of a raster).
+    pub shaper: Option<Shaper>,
+}
+
+/// Figures of a run beyond the common metrics, measured from its full series.
+pub trait Probe: std::fmt::Debug + Send {
+    /// Add them to `m` (as [`Metrics::extra`]) from `series`, the run's recording.
+    fn measure(&self, run: &RunSpec, series: &Series, m: &mut Metrics) -> Result<(), Error>;
+}
+
+/// A planned run.
+#[derive(Debug)]
+pub struct Planned {
+    /// One profile per machine axis (with the path geometry, when it follows a path).
+    pub trajectory: Trajectory,
+    /// What the kind measures beyond the common metrics: the runner then records the run's
+    /// series for it.
+    pub probe: Option<Box<dyn Probe>>,
+}
+
+/// A runs.csv column a kind plots against each swept parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlotColumn {
+    /// The column.
+    pub column: String,
+    /// The panel's title.
+    pub title: String,
+    /// The y axis's quantity (`settle time`, `|error|`).
+    pub quantity: &'static str,
+    /// The y axis's unit after `scale` (`ms`, `um`).
+    pub unit: &'static str,
+    /// Factor from the column's unit to `unit`.
+    pub scale: f64,
+    /// Whether a logarithmic y axis suits it (when it spans more than a factor of 20).
+    pub log_ok: bool,
+}
+
+impl PlotColumn {
+    /// The panel of `column`, titled `title`, its y axis `quantity (unit)` after `scale`.
+    pub fn new(
+        column: impl Into<String>,
+        title: impl Into<String>,
+        quantity: &'static str,
+        unit: &'static str,
+        scale: f64,
+        log_ok: bool,
+    ) -> Self {
+        Self {
+            column: column.into(),
+            title: title.into(),
+            quantity,
+            unit,
+            scale,
+            log_ok,
+        }
+    }
+}
+
+/// A trajectory with `profile` on machine axis `axis`, every other axis of `axes` holding
+/// at 0 (a move on one axis).
+pub fn on_axis(axes: &[String], axis: &str, profile: &Profile) -> Result<Trajectory, PlanError> {
+    Trajectory::new(
+        axes.iter()
+            .map(|a| {
+                if a == axis {
+                    profile.clone()
+                } else {
+                    Profile::empty(State::default())
+                }
+            })
+            .collect(),
+    )
+}
+
+/// A run kind (see the module documentation).
+pub trait Kind: std::fmt::Debug + Sync {
+    /// What it is, in messages (`corner path`).
+    fn name(&self) -> &'static str;
+
+    /// The scenario table it claims (`corner` for `[corner]`); `None` for the point move.
+    fn table(&self) -> Option<&'static str>;
+
+    /// What it does with the run's motion.
+    fn role(&self) -> Role;
+
+    /// Its swept keys, for messages (`corner.angle_deg, corner.strategy`).
+    fn sweepable(&self) -> &'static str {
+        ""
+    }
+
+    /// Parse its table from the scenario: the state every run starts from, `None` when the
+    /// scenario has no such table.
+    fn parse(&self, src: &Source) -> Result<Option<Box<dyn KindState>>, Error> {
+        let _ = src;
+        Ok(None)
+    }
+
+    /// A path kind's stand-in for `[move]` (from its state in the scenario).
+    fn path_move(&self, state: &dyn KindState) -> Option<PathMove> {
+        let _ = state;
+        None
+    }
+
+    /// A path kind's move length (mm) for `run` (runs.csv's `distance_mm`).
+    fn path_length_mm(&self, run: &RunSpec) -> Option<f64> {
+        let _ = run;
+        None
+    }
+
+    /// Check a run that has this kind's state: `(key to blame, message)` for the first
+    /// problem.
+    fn validate(&self, run: &RunSpec) -> Result<(), (String, String)> {
+        let _ = run;
+        Ok(())
+    }
+
+    /// The input shaper a modifier applies to the commanded motion, if any.
+    fn shaper(&self, run: &RunSpec) -> Result<Option<Shaper>, PlanError> {
+        let _ = run;
+        Ok(None)
+    }
+
+    /// Plan the run's motion (motion kinds: [`Role::Move`], [`Role::Path`]).
+    fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {
+        let _ = (run, ctx);
+        Err(PlanError::InvalidInput {
+            reason: "this run kind plans no motion",
+        })
+    }
+
+    /// Its extra runs.csv columns, named from the runs alone (never from results, so that
+    /// the header is the same whatever the results: the sweep journal relies on it).
+    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+        let _ = runs;
+        Vec::new()
+    }
+
+    /// The cells of [`Kind::columns`] for `run` with metrics `m`, in column order; asked
+    /// only when the sweep has the columns (missing cells are left empty, e.g. all of
+    /// them for a run without this kind's state). A failed run's metrics are not numbers:
+    /// leave their cells empty.
+    fn cells(&self, run: &RunSpec, m: &Metrics) -> Vec<String> {
+        let _ = (run, m);
+        Vec::new()
+    }
+
+    /// Its summary section, read from the runs table (row `i` = `runs[i]`) so that a
+    /// merged sweep's summary is the same; `None` when it has nothing to show.
+    fn summary(&self, runs: &[RunSpec], table: &RunsTable) -> Option<String> {
+        let _ = (runs, table);
+        None
+    }
+
+    /// Its panels in the sweep figures (shown when their column is in the table).
+    fn figures(&self, bands_um: &[f64]) -> Vec<PlotColumn> {
+        let _ = bands_um;
+        Vec::new()
+    }
+
+    /// Whether its summary section and panels replace the common move-and-settle ones
+    /// (which would not measure what the kind is about: a raster's run-out, not its step).
+    fn replaces_move_tables(&self) -> bool {
+        false
+    }
+}
+
+/// The tables the kinds claim (left out of the scenario's strict parse).
+pub fn tables() -> Vec<&'static str> {
+    all().iter().filter_map(|k| k.table()).collect()
+}
+
+/// The kind whose table is `table`.
+pub fn by_table(table: &str) -> Option<&'static dyn Kind> {
+    all().iter().copied().find(|k| k.table() == Some(table))
+}
+
+/// Whether `run` has `kind`: its state (a kind with a table), or no other motion kind (the
+/// point move).
+pub fn has(run: &RunSpec, kind: &dyn Kind) -> bool {
+    match kind.table() {
+        Some(t) => run.state_of(t).is_some(),
+        None => kind.role() != Role::Modifier && motion(run).table().is_none(),
+    }
+}
+
+/// The kinds `run` has, in registration order.
+pub fn of(run: &RunSpec) -> impl Iterator<Item = &'static dyn Kind> + '_ {
+    all().iter().copied().filter(move |k| has(run, *k))
+}
+
+/// The kind that plans `run`'s motion: the first motion kind whose state it has, else the
+/// point move (the motion kind without a table).
+pub fn motion(run: &RunSpec) -> &'static dyn Kind {
+    let is_motion = |k: &&dyn Kind| k.role() != Role::Modifier;
+    all()
+        .iter()
+        .copied()
+        .filter(is_motion)
+        .find(|k| k.table().is_some_and(|t| run.state_of(t).is_some()))
+        .or_else(|| {
+            all()
+                .iter()
+                .copied()
+                .filter(is_motion)
+                .find(|k| k.table().is_none())
+        })
+        .unwrap_or(&point::PointMove)
+}
+
+/// The input shaper `run`'s modifier kinds apply (the last one that has one).
+pub fn shaper(run: &RunSpec) -> Result<Option<Shaper>, PlanError> {
+    let mut shaper = None;
+    for k in of(run).filter(|k| k.role() == Role::Modifier) {
+        if let Some(s) = k.shaper(run)? {
+            shaper = Some(s);
+        }
+    }
+    Ok(shaper)
+}
+
+/// Plan `run` on a machine with axes `axes`: its motion kind, with its modifiers' shaper.
+pub fn plan(run: &RunSpec, axes: &[String]) -> Result<Planned, PlanError> {
+    let shaper = shaper(run)?;
+    motion(run).plan(run, &PlanContext { axes, shaper })
+}
+
+/// Whether `runs` share a kind state of type `T` (any of them has one).
+pub fn any_has<T: KindState>(runs: &[RunSpec]) -> bool {
+    runs.iter().any(|r| r.state::<T>().is_some())
+}

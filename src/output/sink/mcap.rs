@@ -1,0 +1,209 @@
+//! MCAP recordings of one run, for Foxglove and any MCAP reader.
+//!
+//! Layout of `run-<id>.mcap` (one file per run; see the README's "MCAP recordings"):
+//! - profile `""` (no ROS); chunks compressed with zstd (single-threaded, so the bytes do not
+//!   depend on the machine's core count); message, chunk and metadata indexes and statistics.
+//! - one channel per signal group of the run's [`crate::measure::series::Series`] (see
+//!   [`super::groups`]): topic `/<group>`, message encoding `json`, schema
+//!   `settle.<group>` in encoding `jsonschema`, one message per sample whose keys are the
+//!   group's fields with their units (`p_m`, `v_m_s`, ...). `log_time` = `publish_time` =
+//!   simulation time in ns from the start of the run.
+//! - channel `/metrics` (schema `settle.metrics`): one message at the last sample's time
+//!   holding the run's `runs.csv` row (parameters and metrics) as JSON; numbers as numbers,
+//!   `inf` (not settled) as `null`, text (e.g. the profile kind) as strings.
+//! - a metadata record `settle` with `settle_version`, `scenario_name`, `scenario_file`,
+//!   `scenario` (the scenario file's full text), `run` and `swept` (the run's swept values).
+
+use std::collections::BTreeMap;
+use std::io::{BufWriter, Seek, Write};
+use std::path::Path;
+
+use serde_json::{Map, Value, json};
+
+use super::groups::{Group, groups};
+use super::{Provenance, RunRecord};
+use crate::error::Error;
+use crate::input::runs_table::number;
+
+/// Schema name of the metrics channel.
+pub const METRICS_TOPIC: &str = "/metrics";
+
+/// What one channel of a written file holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelInfo {
+    /// Topic, e.g. `/cmd`.
+    pub topic: String,
+    /// Schema name, e.g. `settle.cmd`.
+    pub schema_name: String,
+    /// The JSON schema text.
+    pub schema: String,
+    /// Messages written.
+    pub messages: u64,
+}
+
+/// Simulation time (s) to MCAP time (ns).
+fn ns(t_s: f64) -> u64 {
+    (t_s * 1e9).round().max(0.0) as u64
+}
+
+/// JSON schema of one signal group.
+fn group_schema(g: &Group) -> Value {
+    let mut props = Map::new();
+    for f in &g.fields {
+        let unit = if f.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", f.unit)
+        };
+        props.insert(
+            f.key.clone(),
+            json!({ "type": "number", "description": format!("channel {}{unit}", f.channel_name) }),
+        );
+    }
+    json!({
+        "title": format!("settle.{}", g.name),
+        "description": "one sample of the run; log_time is the simulation time",
+        "type": "object",
+        "properties": props,
+        "required": g.fields.iter().map(|f| f.key.clone()).collect::<Vec<_>>(),
+    })
+}
+
+/// The metrics row as a JSON object and its schema.
+fn metrics_message(rec: &RunRecord) -> (Value, Value) {
+    let mut msg = Map::new();
+    let mut props = Map::new();
+    for (name, cell) in rec.row.header.iter().zip(&rec.row.rows[0]) {
+        let (value, schema) = match number(cell) {
+            Some(x) if x.is_finite() => (json!(x), json!({ "type": ["number", "null"] })),
+            Some(_) => (
+                Value::Null,
+                json!({ "type": ["number", "null"], "description": format!("null: `{cell}` in runs.csv (not settled)") }),
+            ),
+            None => (json!(cell), json!({ "type": "string" })),
+        };
+        msg.insert(name.clone(), value);
+        props.insert(name.clone(), schema);
+    }
+    let schema = json!({
+        "title": "settle.metrics",
+        "description": "the run's row of runs.csv: parameters, then metrics (units in the names)",
+        "type": "object",
+        "properties": props,
+    });
+    (Value::Object(msg), schema)
+}
+
+fn metadata(p: &Provenance, rec: &RunRecord) -> BTreeMap<String, String> {
+    BTreeMap::from([
+        ("settle_version".to_string(), p.settle_version.to_string()),
+        ("scenario_name".to_string(), p.scenario_name.clone()),
+        ("scenario_file".to_string(), p.scenario_file.clone()),
+        ("scenario".to_string(), p.scenario_text.clone()),
+        ("run".to_string(), rec.spec.id.to_string()),
+        ("swept".to_string(), rec.spec.swept_text("; ")),
+    ])
+}
+
+/// Write one run to `w`; returns what each channel holds.
+pub fn write<W: Write + Seek>(
+    w: W,
+    p: &Provenance,
+    rec: &RunRecord,
+) -> Result<Vec<ChannelInfo>, mcap::McapError> {
+    let mut out = mcap::WriteOptions::new()
+        .compression(Some(mcap::Compression::Zstd))
+        .compression_threads(0)
+        .library(format!("settle {}", p.settle_version))
+        .create(w)?;
+    out.write_metadata(&mcap::records::Metadata {
+        name: "settle".to_string(),
+        metadata: metadata(p, rec),
+    })?;
+    let series = rec.series;
+    let mut info = Vec::new();
+    let mut ids = Vec::new();
+    for g in groups(series) {
+        let schema = group_schema(&g).to_string();
+        let name = format!("settle.{}", g.name);
+        let schema_id = out.add_schema(&name, "jsonschema", schema.as_bytes())?;
+        let topic = format!("/{}", g.name);
+        let id = out.add_channel(schema_id, &topic, "json", &BTreeMap::new())?;
+        ids.push((id, g));
+        info.push(ChannelInfo {
+            topic,
+            schema_name: name,
+            schema,
+            messages: series.len() as u64,
+        });
+    }
+    let mut buf = Vec::with_capacity(256);
+    for (i, &t) in series.t_s.iter().enumerate() {
+        let time = ns(t);
+        for (id, g) in &ids {
+            buf.clear();
+            buf.push(b'{');
+            for (k, f) in g.fields.iter().enumerate() {
+                if k > 0 {
+                    buf.push(b',');
+                }
+                // Keys are channel names and units: plain identifiers, but escape anyway.
+                serde_json::to_writer(&mut buf, &f.key).map_err(std::io::Error::from)?;
+                buf.push(b':');
+                serde_json::to_writer(&mut buf, &series.channels[f.channel].data[i])
+                    .map_err(std::io::Error::from)?;
+            }
+            buf.push(b'}');
+            out.write_to_known_channel(
+                &mcap::records::MessageHeader {
+                    channel_id: *id,
+                    sequence: i as u32,
+                    log_time: time,
+                    publish_time: time,
+                },
+                &buf,
+            )?;
+        }
+    }
+    let (msg, schema) = metrics_message(rec);
+    let schema = schema.to_string();
+    let schema_id = out.add_schema("settle.metrics", "jsonschema", schema.as_bytes())?;
+    let id = out.add_channel(schema_id, METRICS_TOPIC, "json", &BTreeMap::new())?;
+    let end = ns(series.t_s.last().copied().unwrap_or(0.0));
+    out.write_to_known_channel(
+        &mcap::records::MessageHeader {
+            channel_id: id,
+            sequence: 0,
+            log_time: end,
+            publish_time: end,
+        },
+        msg.to_string().as_bytes(),
+    )?;
+    info.push(ChannelInfo {
+        topic: METRICS_TOPIC.to_string(),
+        schema_name: "settle.metrics".to_string(),
+        schema,
+        messages: 1,
+    });
+    out.finish()?;
+    Ok(info)
+}
+
+/// Write one run to the file `path` (atomically: a temporary file, then a rename).
+pub fn write_file(path: &Path, p: &Provenance, rec: &RunRecord) -> Result<Vec<ChannelInfo>, Error> {
+    let err = |source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let tmp = crate::output::atomic::tmp_path(path);
+    let file = std::fs::File::create(&tmp).map_err(err)?;
+    let mut w = BufWriter::new(file);
+    let result = write(&mut w, p, rec)
+        .map_err(|e| err(std::io::Error::other(e)))
+        .and_then(|info| w.flush().map_err(err).map(|()| info))
+        .and_then(|info| std::fs::rename(&tmp, path).map_err(err).map(|()| info));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}

@@ -1,0 +1,9 @@
+//! What one run is: [`run_spec::RunSpec`] (one point of a sweep, resolved) with the values
+//! it was swept to ([`value::Value`]), the backend it runs on ([`backend::Backend`]) and
+//! the states of its run kinds ([`run_spec::KindState`], filled in by `crate::kinds`).
+
+pub mod backend;
+pub mod groups;
+pub mod machine;
+pub mod run_spec;
+pub mod value;

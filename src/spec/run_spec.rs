@@ -1,0 +1,249 @@
+//! One point of a sweep, fully resolved: [`RunSpec`], and [`KindState`], the per-run state
+//! of a run kind (`crate::kinds`) that a `RunSpec` carries without knowing the kind.
+
+use std::any::Any;
+
+use settle_planner::{Limits, ProfileKind};
+use settle_sim::machine::Machine;
+use settle_sim::{DriverMode, Mode};
+
+use crate::input::scenario::ModeSpec;
+use crate::spec::backend::Backend;
+use crate::spec::value::Value;
+
+/// The per-run state of a run kind: its scenario table, resolved (e.g. the corner of a
+/// corner run), set by the sweep through its keys (`corner.angle_deg`).
+///
+/// Implement [`KindState::table`] and [`KindState::set`] on a type that is `Clone`,
+/// `PartialEq` and `Debug`; cloning and comparing come with it ([`StateBox`]). The kind
+/// reads its state back with [`RunSpec::state`].
+pub trait KindState: StateBox + std::fmt::Debug + Send + Sync {
+    /// The scenario table the state comes from (`corner` for `[corner]`): swept keys
+    /// `<table>.<key>` are set on it.
+    fn table(&self) -> &'static str;
+
+    /// Set swept key `key` (without the `<table>.` prefix) to `value`; the error says what
+    /// the key takes.
+    fn set(&mut self, key: &str, value: &Value) -> Result<(), String>;
+}
+
+/// Cloning and comparing a boxed [`KindState`] (implemented for every `Clone + PartialEq`
+/// state).
+pub trait StateBox: Any {
+    /// A boxed copy.
+    fn clone_box(&self) -> Box<dyn KindState>;
+    /// Whether `other` is the same type with the same value.
+    fn eq_box(&self, other: &dyn KindState) -> bool;
+}
+
+impl<T: KindState + Clone + PartialEq> StateBox for T {
+    fn clone_box(&self) -> Box<dyn KindState> {
+        Box::new(self.clone())
+    }
+
+    fn eq_box(&self, other: &dyn KindState) -> bool {
+        (other as &dyn Any)
+            .downcast_ref::<T>()
+            .is_some_and(|o| o == self)
+    }
+}
+
+impl Clone for Box<dyn KindState> {
+    fn clone(&self) -> Self {
+        self.clone_box()
+    }
+}
+
+impl PartialEq for Box<dyn KindState> {
+    fn eq(&self, other: &Self) -> bool {
+        self.eq_box(&**other)
+    }
+}
+
+/// One point of a sweep, fully resolved (scenario units: mm, s, Hz).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSpec {
+    /// Index in the sweep (0-based, in expansion order).
+    pub id: usize,
+    /// Profile kind.
+    pub profile: ProfileKind,
+    /// Start position (mm).
+    pub start_mm: f64,
+    /// Signed move length (mm); a path kind's path length.
+    pub distance_mm: f64,
+    /// Maximum speed (mm/s).
+    pub vmax_mm_s: f64,
+    /// Maximum acceleration (mm/s^2).
+    pub amax_mm_s2: f64,
+    /// Maximum jerk (mm/s^3), if given.
+    pub jmax_mm_s3: Option<f64>,
+    /// The machine's modes (modes form; empty for a physical machine).
+    pub modes: Vec<ModeSpec>,
+    /// The physical machine (preset, machine file or inline), if not given by modes.
+    pub machine: Option<Machine>,
+    /// The machine's name (the preset's, or `modes`).
+    pub machine_name: String,
+    /// How the motors are driven (physical machines; `linear` for the modes form).
+    pub driver: DriverMode,
+    /// The axis that moves (a path kind's axes joined by `+`, e.g. `x+y`).
+    pub axis: String,
+    /// The backend that simulates the run (set from the command line).
+    pub backend: Backend,
+    /// Observation window after the move (s).
+    pub window_s: f64,
+    /// Sample rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Settling bands (um).
+    pub bands_um: Vec<f64>,
+    /// `[sim] max_step_s`: forced integration step of rapier and MuJoCo (s).
+    pub max_step_s: Option<f64>,
+    /// The swept parameters' values of this run, in axis order.
+    pub swept: Vec<(String, Value)>,
+    /// Parameters of the profile kinds that take any (PVT asymmetry, four-jerk BOW1..4
+    /// scales); the planner's defaults unless `settle tune` searches them.
+    pub kind_params: settle_planner::KindParams,
+    /// The states of the run kinds whose tables the scenario has (at most one each).
+    pub kinds: Vec<Box<dyn KindState>>,
+}
+
+/// The parameters every scenario can sweep, for messages (the run kinds add theirs).
+pub const SWEEPABLE: &str = "profile, move.distance_mm, move.start_mm, limits.vmax_mm_s, \
+limits.amax_mm_s2, limits.jmax_mm_s3, machine.modes.N.frequency_hz, machine.modes.N.damping_ratio, \
+machine.modes.N.weight (N = 0-based mode index), and for physical machines \
+machine.axis.<axis>.<field> (e.g. machine.axis.x.mount.stiffness_n_per_m), machine.motor.<field> \
+and machine.driver.<field> (every axis), machine.preset (preset names or machine files)";
+
+/// Whether `kind` needs a jerk limit: every kind but the trapezoid.
+pub fn needs_jerk(kind: ProfileKind) -> bool {
+    kind != ProfileKind::Trapezoid
+}
+
+impl RunSpec {
+    /// Kinematic limits in SI units (m, s).
+    pub fn limits_si(&self) -> Result<Limits, settle_planner::PlanError> {
+        Limits::new(
+            self.vmax_mm_s * 1e-3,
+            self.amax_mm_s2 * 1e-3,
+            self.jmax_mm_s3.map(|j| j * 1e-3),
+        )
+    }
+
+    /// The modes as sim types.
+    pub fn modes_sim(&self) -> Result<Vec<Mode>, settle_sim::SimError> {
+        self.modes
+            .iter()
+            .map(|m| Mode::new(m.frequency_hz, m.damping_ratio, m.weight))
+            .collect()
+    }
+
+    /// The run's state of type `T` (a run kind's), if it has one.
+    pub fn state<T: KindState>(&self) -> Option<&T> {
+        self.kinds
+            .iter()
+            .find_map(|s| (&**s as &dyn Any).downcast_ref::<T>())
+    }
+
+    /// The run's state of type `T`, to change it.
+    pub fn state_mut<T: KindState>(&mut self) -> Option<&mut T> {
+        self.kinds
+            .iter_mut()
+            .find_map(|s| (&mut **s as &mut dyn Any).downcast_mut::<T>())
+    }
+
+    /// The state of the kind whose table is `table`.
+    pub fn state_of(&self, table: &str) -> Option<&dyn KindState> {
+        self.kinds.iter().find(|s| s.table() == table).map(|s| &**s)
+    }
+
+    /// Give the run `state`, replacing its state of the same table.
+    pub fn put_state(&mut self, state: Box<dyn KindState>) {
+        match self.kinds.iter_mut().find(|s| s.table() == state.table()) {
+            Some(s) => *s = state,
+            None => self.kinds.push(state),
+        }
+    }
+
+    /// Remove the state of the kind whose table is `table`.
+    pub fn remove_state(&mut self, table: &str) {
+        self.kinds.retain(|s| s.table() != table);
+    }
+
+    /// The swept values as `key = value`, joined by `sep`.
+    pub fn swept_text(&self, sep: &str) -> String {
+        let parts: Vec<String> = self
+            .swept
+            .iter()
+            .map(|(k, v)| format!("{k} = {v}"))
+            .collect();
+        parts.join(sep)
+    }
+
+    /// The key to blame for parameter `param`: the sweep axis if it is swept.
+    pub fn blame(&self, param: &str) -> String {
+        if self.swept.iter().any(|(p, _)| p == param) {
+            format!("sweep.{param}")
+        } else {
+            param.to_string()
+        }
+    }
+
+    /// Set swept parameter `param` to `value`: a key of every run, or `<table>.<key>` of a
+    /// kind state the run has. `Ok(false)`: no such parameter (the caller names the
+    /// allowed ones).
+    pub fn set(&mut self, param: &str, value: &Value) -> Result<bool, String> {
+        let num = |v: &Value| v.number().ok_or_else(|| format!("`{param}` takes numbers"));
+        if let Some((table, key)) = param.split_once('.')
+            && let Some(state) = self.kinds.iter_mut().find(|s| s.table() == table)
+        {
+            state.set(key, value)?;
+            return Ok(true);
+        }
+        match param {
+            "profile" => match value {
+                Value::Kind(k) => self.profile = *k,
+                _ => return Err("`profile` takes profile kind names".into()),
+            },
+            "move.distance_mm" => self.distance_mm = num(value)?,
+            "move.start_mm" => self.start_mm = num(value)?,
+            "limits.vmax_mm_s" => self.vmax_mm_s = num(value)?,
+            "limits.amax_mm_s2" => self.amax_mm_s2 = num(value)?,
+            "limits.jmax_mm_s3" => self.jmax_mm_s3 = Some(num(value)?),
+            // Resolved by the expander (it reads the preset); nothing to set here.
+            "machine.preset" => {}
+            other => {
+                if let Some(rest) = ["axis.", "motor.", "driver."]
+                    .iter()
+                    .find_map(|p| other.strip_prefix("machine.").filter(|r| r.starts_with(p)))
+                {
+                    let x = num(value)?;
+                    let Some(m) = self.machine.as_mut() else {
+                        return Err(format!(
+                            "`{other}` needs a physical machine (preset or [machine.axis.*]), not modes"
+                        ));
+                    };
+                    crate::spec::machine::set_machine_field(m, other, rest, x)?;
+                    return Ok(true);
+                }
+                let mode_param = other
+                    .strip_prefix("machine.modes.")
+                    .and_then(|rest| rest.split_once('.'))
+                    .and_then(|(i, field)| Some((i.parse::<usize>().ok()?, field)));
+                let Some((i, field)) = mode_param else {
+                    return Ok(false);
+                };
+                let n = self.modes.len();
+                let mode = self.modes.get_mut(i).ok_or_else(|| {
+                    format!("mode index {i} out of range: the machine has {n} mode(s)")
+                })?;
+                let x = num(value)?;
+                match field {
+                    "frequency_hz" => mode.frequency_hz = x,
+                    "damping_ratio" => mode.damping_ratio = x,
+                    "weight" => mode.weight = x,
+                    _ => return Ok(false),
+                }
+            }
+        }
+        Ok(true)
+    }
+}

@@ -1,0 +1,188 @@
+//! `settle plan`: planning problems as JSON lines in, profiles as JSON lines out.
+//!
+//! One problem per input line, e.g.
+//! `{"p0":[0],"pf":[1],"vmax":[1],"amax":[2],"jmax":[10],"sync":"time"}` (v0, a0, vf, af
+//! default to zero; optional `vmin`, `amin`, `"kind":"trapezoid"`,
+//! `"interface":"velocity"`, for which the targets are `vf` and `af`). One output line per input line, in order:
+//! `{"duration":1.7,"axes":[{"p0":0,"v0":0,"a0":0,"segments":[[0.2,10.0],...]}]}` where each
+//! segment is `[duration, jerk]`, or `[duration, 0, accel]` for a constant-acceleration
+//! segment whose acceleration jumps to `accel` (trapezoids); or `{"error":"..."}`.
+
+use serde::Deserialize;
+use serde_json::{Value, json};
+use settle_planner::position::Shape;
+use settle_planner::sync::{Axis, Sync, plan, plan_velocity};
+use settle_planner::{Limits, Profile, Segment, State};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Problem {
+    #[serde(default)]
+    p0: Vec<f64>,
+    #[serde(default)]
+    v0: Vec<f64>,
+    #[serde(default)]
+    a0: Vec<f64>,
+    #[serde(default)]
+    pf: Vec<f64>,
+    #[serde(default)]
+    vf: Vec<f64>,
+    #[serde(default)]
+    af: Vec<f64>,
+    vmax: Vec<f64>,
+    amax: Vec<f64>,
+    #[serde(default)]
+    jmax: Vec<f64>,
+    #[serde(default)]
+    vmin: Vec<f64>,
+    #[serde(default)]
+    amin: Vec<f64>,
+    #[serde(default = "default_sync")]
+    sync: String,
+    #[serde(default = "default_kind")]
+    kind: String,
+    #[serde(default = "default_interface")]
+    interface: String,
+}
+
+fn default_sync() -> String {
+    "time".into()
+}
+fn default_kind() -> String {
+    "scurve".into()
+}
+fn default_interface() -> String {
+    "position".into()
+}
+
+/// Answer one input line with one output line (no newline).
+pub fn answer(line: &str) -> String {
+    match solve(line) {
+        Ok(v) => v.to_string(),
+        Err(e) => json!({ "error": e }).to_string(),
+    }
+}
+
+fn solve(line: &str) -> Result<Value, String> {
+    let pr: Problem = serde_json::from_str(line).map_err(|e| format!("invalid problem: {e}"))?;
+    let n = pr.vmax.len();
+    if n == 0 {
+        return Err("`vmax` must list one value per axis".into());
+    }
+    let shape = match pr.kind.as_str() {
+        "scurve" => Shape::JerkLimited,
+        "trapezoid" => Shape::Trapezoid,
+        k => return Err(format!("unknown kind `{k}`; allowed: scurve, trapezoid")),
+    };
+    let sync = match pr.sync.as_str() {
+        "time" => Sync::Time,
+        "phase" => Sync::Phase,
+        "none" => Sync::None,
+        s => return Err(format!("unknown sync `{s}`; allowed: time, phase, none")),
+    };
+    let get = |name: &str, v: &[f64], required: bool, i: usize| -> Result<Option<f64>, String> {
+        match (v.len(), required) {
+            (0, false) => Ok(None),
+            (len, _) if len == n => Ok(Some(v[i])),
+            (len, _) => Err(format!(
+                "`{name}` has {len} values, expected {n} (one per axis, as `vmax`)"
+            )),
+        }
+    };
+    let position = match pr.interface.as_str() {
+        "position" => true,
+        "velocity" => false,
+        i => {
+            return Err(format!(
+                "unknown interface `{i}`; allowed: position, velocity"
+            ));
+        }
+    };
+    let mut axes = Vec::with_capacity(n);
+    for i in 0..n {
+        let or0 = |name: &str, v: &[f64]| get(name, v, false, i).map(|x| x.unwrap_or(0.0));
+        let jmax = get("jmax", &pr.jmax, shape == Shape::JerkLimited, i)?;
+        let limits = Limits::asymmetric(
+            pr.vmax[i],
+            get("vmin", &pr.vmin, false, i)?,
+            get("amax", &pr.amax, true, i)?.unwrap_or(f64::NAN),
+            get("amin", &pr.amin, false, i)?,
+            if shape == Shape::JerkLimited {
+                jmax
+            } else {
+                None
+            },
+        )
+        .map_err(|e| format!("axis {i}: {e}"))?;
+        let pf = if position {
+            get("pf", &pr.pf, true, i)?.unwrap_or(f64::NAN)
+        } else {
+            0.0
+        };
+        axes.push(Axis {
+            start: State {
+                p: or0("p0", &pr.p0)?,
+                v: or0("v0", &pr.v0)?,
+                a: or0("a0", &pr.a0)?,
+            },
+            target: State {
+                p: pf,
+                v: or0("vf", &pr.vf)?,
+                a: or0("af", &pr.af)?,
+            },
+            limits,
+        });
+    }
+    let profiles = if position {
+        plan(&axes, shape, sync).map_err(|e| e.to_string())?
+    } else {
+        plan_velocity(&axes, shape, sync).map_err(|e| e.to_string())?
+    };
+    let duration = profiles.iter().map(Profile::duration_s).fold(0.0, f64::max);
+    Ok(json!({
+        "duration": duration,
+        "axes": profiles.iter().map(axis_json).collect::<Vec<_>>(),
+    }))
+}
+
+fn axis_json(p: &Profile) -> Value {
+    let s = p.start();
+    let segs: Vec<Value> = p
+        .segments()
+        .iter()
+        .map(|seg| match *seg {
+            Segment::Jerk { duration_s, jerk } => json!([duration_s, jerk]),
+            Segment::Accel { duration_s, accel } => json!([duration_s, 0.0, accel]),
+        })
+        .collect();
+    json!({ "p0": s.p, "v0": s.v, "a0": s.a, "segments": segs })
+}
+
+/// Answer the JSON lines of `input` on `output`, in order, in parallel chunks of 8192 lines
+/// on `jobs` threads (all cores when `None`).
+pub fn plan_stream(
+    input: impl std::io::BufRead,
+    mut output: impl std::io::Write,
+    jobs: Option<usize>,
+) -> Result<(), crate::error::Error> {
+    use rayon::prelude::*;
+    let pool = crate::execute::pool::thread_pool(jobs)?;
+    let read_err = |e| crate::error::Error::read("stdin", e);
+    let write_err = |e| crate::error::Error::write("stdout", e);
+    let mut lines = input.lines();
+    loop {
+        let chunk: Vec<String> = lines
+            .by_ref()
+            .take(8192)
+            .collect::<Result<_, _>>()
+            .map_err(read_err)?;
+        if chunk.is_empty() {
+            break;
+        }
+        let answers: Vec<String> = pool.install(|| chunk.par_iter().map(|l| answer(l)).collect());
+        for a in answers {
+            writeln!(output, "{a}").map_err(write_err)?;
+        }
+    }
+    output.flush().map_err(write_err)
+}

@@ -1,0 +1,208 @@
+//! `settle run SCENARIO --case ID`: one point of a sweep in detail: its full trace as CSV,
+//! optionally its recordings and a figure of its time series, and its metrics.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use crate::error::Error;
+use crate::measure::metrics::{Metrics, Status};
+use crate::output::atomic::{create_dir, write_atomic};
+use crate::output::sink::{RunRecord, record_run, row_of};
+use crate::spec::backend::Backend;
+use crate::spec::run_spec::RunSpec;
+use crate::workflows::{Exit, Report};
+
+/// Which run, and what to write.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOptions {
+    /// The scenario file.
+    pub scenario: PathBuf,
+    /// The run index, as in the `run` column of runs.csv.
+    pub case: usize,
+    /// Trace file (default: `results/<name>/run-<case>.csv`).
+    pub out: Option<PathBuf>,
+    /// Also write an MCAP recording beside the trace.
+    pub mcap: bool,
+    /// Also write a rerun recording beside the trace (needs the `rerun` feature).
+    pub rerun: bool,
+    /// Also draw the run's time series as `<trace>.svg` and `.png`.
+    pub plot: bool,
+    /// The backend.
+    pub backend: Backend,
+}
+
+impl RunOptions {
+    /// Run `case` of `scenario` on `backend`, writing the trace only.
+    pub fn new(scenario: impl Into<PathBuf>, case: usize, backend: Backend) -> Self {
+        Self {
+            scenario: scenario.into(),
+            case,
+            out: None,
+            mcap: false,
+            rerun: false,
+            plot: false,
+            backend,
+        }
+    }
+}
+
+/// What the run did and where it is written.
+#[derive(Debug, Clone)]
+pub struct RunOutcome {
+    /// The run.
+    pub spec: RunSpec,
+    /// Its metrics.
+    pub metrics: Metrics,
+    /// The files written (the trace first).
+    pub written: Vec<PathBuf>,
+    /// Samples in the trace.
+    pub samples: usize,
+}
+
+/// Run one case.
+pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
+    let path = &opts.scenario;
+    let case = opts.case;
+    let (sc, mut runs) = crate::expand::load_runs(path)?;
+    crate::execute::set_backend(path, &mut runs, opts.backend)?;
+    let Some(spec) = runs.get(case) else {
+        return Err(Error::input(
+            path,
+            format!(
+                "--case {case} does not exist: the scenario has runs 0..={}",
+                runs.len().saturating_sub(1)
+            ),
+        ));
+    };
+    let out = opts.out.clone().unwrap_or_else(|| {
+        PathBuf::from("results")
+            .join(&sc.name)
+            .join(format!("run-{case}.csv"))
+    });
+    let dir = out
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .map_or_else(|| PathBuf::from("."), PathBuf::from);
+    if out.parent().is_some_and(|d| !d.as_os_str().is_empty()) {
+        create_dir(&dir)?;
+    }
+    let rec =
+        crate::workflows::sweep::recorder(opts.mcap, opts.rerun, dir.clone(), path, &sc.name)?;
+    let (series, m) = record_run(spec)?;
+    let mut csv = Vec::new();
+    series
+        .write_csv(&mut csv)
+        .map_err(|e| Error::write(&out, e))?;
+    write_atomic(&out, &csv)?;
+    let record = RunRecord {
+        spec,
+        series: &series,
+        metrics: &m,
+        row: row_of(spec, &m),
+    };
+    let mut written = vec![out.clone()];
+    if let Some(r) = &rec {
+        if r.mcap {
+            let p = out.with_extension("mcap");
+            crate::output::sink::mcap::write_file(&p, &r.provenance, &record)?;
+            written.push(p);
+        }
+        if r.rerun {
+            let p = out.with_extension("rrd");
+            crate::output::sink::rerun::write_file(&p, &r.provenance, &record)?;
+            written.push(p);
+        }
+    }
+    if opts.plot {
+        let stem = out.file_stem().map_or_else(
+            || format!("run-{case}"),
+            |s| s.to_string_lossy().into_owned(),
+        );
+        let title = format!("{} run {case}: {}", sc.name, spec.swept_text(", "));
+        let fig = crate::output::plot::trace::figure(&title, &record);
+        crate::output::plot::write(&fig, &dir, &stem)?;
+        written.push(dir.join(format!("{stem}.svg")));
+        written.push(dir.join(format!("{stem}.png")));
+    }
+    Ok(RunOutcome {
+        spec: spec.clone(),
+        metrics: m,
+        written,
+        samples: series.len(),
+    })
+}
+
+impl RunOutcome {
+    /// What `settle run` prints: the run, its swept values and metrics, the files.
+    pub fn report(&self) -> Report {
+        let (spec, m) = (&self.spec, &self.metrics);
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "run {}: {} {} mm on axis {} of {} ({} driver, {})",
+            spec.id,
+            spec.profile,
+            spec.distance_mm,
+            spec.axis,
+            spec.machine_name,
+            spec.driver,
+            spec.backend
+        );
+        for (p, v) in &spec.swept {
+            let _ = writeln!(s, "  {p} = {v}");
+        }
+        let _ = writeln!(s, "  move_time_s            {:.6}", m.move_time_s);
+        let _ = writeln!(s, "  residual_peak_um       {:.4}", m.residual_peak_um);
+        let _ = writeln!(s, "  residual_rms_um        {:.4}", m.residual_rms_um);
+        let show = |t: Option<f64>| t.map_or("not settled".to_string(), |t| format!("{t:.6}"));
+        for (i, b) in m.bands_um.iter().enumerate() {
+            let _ = writeln!(s, "  settle_time_s ({b} um)  {}", show(m.settle_time_s[i]));
+            let _ = writeln!(
+                s,
+                "  move_and_settle_s ({b} um)  {}",
+                show(m.move_and_settle_s(i))
+            );
+        }
+        let _ = writeln!(s, "  overshoot_um           {:.4}", m.overshoot_um);
+        let _ = writeln!(
+            s,
+            "  max_following_error_um {:.4}",
+            m.max_following_error_um
+        );
+        if m.axes.len() > 1 {
+            for a in &m.axes {
+                let _ = writeln!(
+                    s,
+                    "  axis {}: residual_peak_um {:.4}, max_following_error_um {:.4}",
+                    a.name, a.residual_peak_um, a.max_following_error_um
+                );
+            }
+        }
+        for a in &m.axes {
+            if let Some(deg) = a.max_load_angle_deg {
+                let _ = writeln!(
+                    s,
+                    "  axis {}: max load angle {deg:.1} electrical degrees",
+                    a.name
+                );
+            }
+        }
+        if let Status::LostSteps { axis, steps } = &m.status {
+            let _ = writeln!(
+                s,
+                "  FAILED: lost {steps} full steps (axis {axis}): the numbers above are not a settling result"
+            );
+        }
+        let written: Vec<String> = self
+            .written
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        let _ = writeln!(s, "wrote {} ({} samples)", written.join(", "), self.samples);
+        Report {
+            stdout: s,
+            stderr: String::new(),
+            exit: Exit::Ok,
+        }
+    }
+}

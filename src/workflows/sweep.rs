@@ -1,0 +1,350 @@
+//! `settle sweep`: run every point of a scenario's sweep (or one shard of it) and write the
+//! output folder. Every finished run's row goes to the journal at once, so an interruption
+//! (or a crash) loses nothing: `resume` runs only what is missing (see
+//! [`crate::workflows::journal`]). A run that fails is a row with its reason; the sweep
+//! goes on and reports the failures at the end.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::error::Error;
+use crate::execute::pool::{Progress, run_all_with};
+use crate::input::runs_table::RunsTable;
+use crate::measure::metrics::Metrics;
+use crate::output::atomic::{create_dir, write_atomic};
+use crate::output::runs_csv::RunsCsv;
+use crate::output::sink::{Provenance, Recorder};
+use crate::output::sweep_files::{PLOTS, RECORDINGS, write_sweep};
+use crate::spec::backend::Backend;
+use crate::spec::run_spec::RunSpec;
+use crate::workflows::journal::{self, Journal};
+use crate::workflows::shard::{self, Manifest, Shard};
+use crate::workflows::{Exit, Report};
+
+/// What to sweep and how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepOptions {
+    /// The scenario file.
+    pub scenario: PathBuf,
+    /// Output folder (default: `results/<name>/`, `results/<name>/shard-K-of-N/` for a
+    /// shard).
+    pub out: Option<PathBuf>,
+    /// Worker threads [default: all cores].
+    pub jobs: Option<usize>,
+    /// The backend.
+    pub backend: Backend,
+    /// Write an MCAP recording per run.
+    pub mcap: bool,
+    /// Write a rerun recording per run (needs the `rerun` feature).
+    pub rerun: bool,
+    /// Run only this shard.
+    pub shard: Option<Shard>,
+    /// Continue an interrupted sweep from its journal.
+    pub resume: bool,
+}
+
+impl SweepOptions {
+    /// Sweep `scenario` on `backend` with every other option at its default.
+    pub fn new(scenario: impl Into<PathBuf>, backend: Backend) -> Self {
+        Self {
+            scenario: scenario.into(),
+            out: None,
+            jobs: None,
+            backend,
+            mcap: false,
+            rerun: false,
+            shard: None,
+            resume: false,
+        }
+    }
+}
+
+/// A failed run (from runs.csv's `status` and `reason`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FailedRun {
+    /// Its id.
+    pub id: usize,
+    /// `profile, distance` as in the listing (`scurve, 5 mm`).
+    pub what: String,
+    /// `lost_steps` or `fault`.
+    pub status: String,
+    /// Why.
+    pub reason: String,
+}
+
+/// What a sweep did.
+#[derive(Debug, Clone)]
+pub struct SweepOutcome {
+    /// The scenario file.
+    pub scenario: PathBuf,
+    /// The output folder.
+    pub out: PathBuf,
+    /// The runs of this sweep (or shard).
+    pub runs: usize,
+    /// The shard, if one.
+    pub shard: Option<Shard>,
+    /// The failed runs (empty when all ran).
+    pub failed: Vec<FailedRun>,
+    /// Runs finished and kept in the journal when the sweep was interrupted, else `None`.
+    pub interrupted: Option<usize>,
+    /// Where the recordings are, when asked for.
+    pub recordings: Option<PathBuf>,
+    /// Wall-clock time (s).
+    pub elapsed_s: f64,
+}
+
+/// The recorder the flags ask for, checked before any work (a missing feature costs no
+/// simulation).
+pub fn recorder(
+    mcap: bool,
+    rerun: bool,
+    dir: PathBuf,
+    scenario: &Path,
+    name: &str,
+) -> Result<Option<Recorder>, Error> {
+    if rerun && !crate::output::sink::rerun::AVAILABLE {
+        return Err(Error::input(
+            "--rerun",
+            crate::output::sink::rerun::UNAVAILABLE,
+        ));
+    }
+    if !(mcap || rerun) {
+        return Ok(None);
+    }
+    Ok(Some(Recorder {
+        dir,
+        mcap,
+        rerun,
+        provenance: Provenance::load(scenario, name)?,
+    }))
+}
+
+/// Run the sweep. `note` gets the lines worth showing as they happen (what runs where,
+/// resuming); `progress` the finished runs.
+pub fn sweep(
+    opts: &SweepOptions,
+    note: &dyn Fn(&str),
+    progress: Progress,
+) -> Result<SweepOutcome, Error> {
+    let started = Instant::now();
+    let path = &opts.scenario;
+    let (sc, mut all_runs) = crate::expand::load_runs(path)?;
+    crate::execute::set_backend(path, &mut all_runs, opts.backend)?;
+    let base = PathBuf::from("results").join(&sc.name);
+    let out = opts.out.clone().unwrap_or_else(|| match opts.shard {
+        Some(s) => base.join(s.folder()),
+        None => base,
+    });
+    if let Some(s) = opts.shard.filter(|s| s.n > all_runs.len()) {
+        return Err(Error::input(
+            "--shard",
+            format!(
+                "{s}: the scenario has {} runs, so at most {} shards",
+                all_runs.len(),
+                all_runs.len()
+            ),
+        ));
+    }
+    let rec = recorder(opts.mcap, opts.rerun, out.join(RECORDINGS), path, &sc.name)?;
+    let runs = match opts.shard {
+        Some(s) => s.select(&all_runs),
+        None => all_runs.clone(),
+    };
+    create_dir(&out)?;
+    if let Some(r) = &rec {
+        create_dir(&r.dir)?;
+    }
+    note(&format!(
+        "{}: {} runs on {}{} -> {}",
+        path.display(),
+        runs.len(),
+        opts.backend,
+        opts.shard.map_or(String::new(), |s| format!(
+            " (shard {s} of {} runs)",
+            all_runs.len()
+        )),
+        out.display()
+    ));
+    let layout = RunsCsv::new(&runs);
+    let header = layout.header();
+    let scenario_text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let key = journal::key_line(
+        &scenario_text,
+        &sc.name,
+        opts.backend.name(),
+        &opts.shard.map_or(String::new(), |s| s.to_string()),
+    );
+    let ids: Vec<usize> = runs.iter().map(|r| r.id).collect();
+    let (journal, done) = match journal::existing(&out) {
+        Some(_) if opts.resume => Journal::resume(&out, &key, &header, &ids)?,
+        Some(p) => {
+            return Err(Error::input(
+                "--resume",
+                format!(
+                    "{} holds an interrupted sweep: continue it with --resume, or delete the file to start over",
+                    p.display()
+                ),
+            ));
+        }
+        None => (Journal::start(&out, &key, &header)?, Default::default()),
+    };
+    if opts.resume {
+        note(&format!(
+            "resuming: {} of {} runs already finished",
+            done.len(),
+            runs.len()
+        ));
+    }
+    let todo: Vec<RunSpec> = runs
+        .iter()
+        .filter(|r| !done.contains_key(&r.id))
+        .cloned()
+        .collect();
+    let run_one = |spec: &RunSpec| -> Result<String, Error> {
+        let m = match &rec {
+            Some(r) => r.run(spec),
+            None => crate::execute::execute(spec, None),
+        }
+        .unwrap_or_else(|e| Metrics::failed(&spec.bands_um, format!("{e}")));
+        let row = layout.row(spec, &m);
+        journal.append(&row)?;
+        Ok(row)
+    };
+    let results = run_all_with(&todo, opts.jobs, progress, run_one)?;
+    let mut rows = done;
+    let mut interrupted = 0usize;
+    for (spec, r) in todo.iter().zip(results) {
+        match r {
+            Ok(row) => {
+                rows.insert(spec.id, row);
+            }
+            Err(Error::Interrupted { .. }) => interrupted += 1,
+            Err(e) => return Err(e),
+        }
+    }
+    let mut outcome = SweepOutcome {
+        scenario: path.clone(),
+        out: out.clone(),
+        runs: runs.len(),
+        shard: opts.shard,
+        failed: Vec::new(),
+        interrupted: None,
+        recordings: rec.as_ref().map(|r| r.dir.clone()),
+        elapsed_s: 0.0,
+    };
+    if interrupted > 0 || crate::execute::interrupt::requested() {
+        outcome.interrupted = Some(rows.len());
+        outcome.elapsed_s = started.elapsed().as_secs_f64();
+        return Ok(outcome);
+    }
+    let mut csv = header;
+    for r in &runs {
+        csv.push_str(&rows[&r.id]);
+    }
+    match opts.shard {
+        Some(s) => {
+            write_atomic(&out.join("runs.csv"), csv.as_bytes())?;
+            shard::write_manifest(
+                &out,
+                &Manifest {
+                    format: shard::FORMAT.to_string(),
+                    settle_version: env!("CARGO_PKG_VERSION").to_string(),
+                    scenario_name: sc.name.clone(),
+                    scenario_file: path.display().to_string(),
+                    shard: s.k,
+                    shards: s.n,
+                    total_runs: all_runs.len(),
+                    runs: ids,
+                    settings: [("backend".to_string(), opts.backend.name().to_string())]
+                        .into_iter()
+                        .collect(),
+                    scenario: scenario_text,
+                },
+            )?;
+        }
+        None => write_sweep(&out, &sc, &runs, &csv)?,
+    }
+    outcome.elapsed_s = started.elapsed().as_secs_f64();
+    journal.finish()?;
+    outcome.failed = failures(&runs, &csv);
+    Ok(outcome)
+}
+
+/// The failed runs, from runs.csv's `status` and `reason` columns.
+fn failures(runs: &[RunSpec], csv: &str) -> Vec<FailedRun> {
+    let Ok(table) = RunsTable::parse(csv) else {
+        return Vec::new();
+    };
+    (0..runs.len())
+        .filter(|&i| table.cell(i, "status").is_some_and(|s| s != "ok"))
+        .map(|i| FailedRun {
+            id: runs[i].id,
+            what: format!("{}, {} mm", runs[i].profile, runs[i].distance_mm),
+            status: table.cell(i, "status").unwrap_or_default().to_string(),
+            reason: table.cell(i, "reason").unwrap_or_default().to_string(),
+        })
+        .collect()
+}
+
+impl SweepOutcome {
+    /// What `settle sweep` prints: where the outputs are, and the failed runs (at most 20,
+    /// then a count).
+    pub fn report(&self) -> Report {
+        let out = &self.out;
+        if let Some(kept) = self.interrupted {
+            let mut r = Report::new(Exit::Interrupted);
+            r.err(format!(
+                "interrupted: {kept} of {} runs finished and kept in {}; continue with\n  settle sweep {} --out {} --resume{}",
+                self.runs,
+                out.join(journal::FILE).display(),
+                self.scenario.display(),
+                out.display(),
+                self.shard.map_or(String::new(), |s| format!(" --shard {s}"))
+            ));
+            return r;
+        }
+        let mut r = Report::new(if self.failed.is_empty() {
+            Exit::Ok
+        } else {
+            Exit::Failed
+        });
+        match self.shard {
+            Some(s) => r.err(format!(
+                "wrote shard {s}: {} and {} ({} runs in {:.2} s); combine all shards with `settle merge`",
+                out.join("runs.csv").display(),
+                out.join(shard::MANIFEST).display(),
+                self.runs,
+                self.elapsed_s
+            )),
+            None => r.err(format!(
+                "wrote {}, {} and {}/ ({} runs in {:.2} s){}",
+                out.join("runs.csv").display(),
+                out.join("summary.md").display(),
+                out.join(PLOTS).display(),
+                self.runs,
+                self.elapsed_s,
+                self.recordings
+                    .as_ref()
+                    .map_or(String::new(), |d| format!("; recordings in {}", d.display()))
+            )),
+        }
+        if !self.failed.is_empty() {
+            r.err(format!(
+                "{} of {} runs failed (status and reason in runs.csv):",
+                self.failed.len(),
+                self.runs
+            ));
+            const SHOWN: usize = 20;
+            for f in self.failed.iter().take(SHOWN) {
+                r.err(format!(
+                    "  run {} ({}): {}: {}",
+                    f.id, f.what, f.status, f.reason
+                ));
+            }
+            if self.failed.len() > SHOWN {
+                r.err(format!("  ... and {} more", self.failed.len() - SHOWN));
+            }
+        }
+        r
+    }
+}

@@ -1,0 +1,319 @@
+//! The search grid of `settle tune`: the `[tune]` table resolved against the scenario's
+//! base run into candidates (kinds, jerks, kind parameters, shapers) and the move family.
+
+use settle_planner::shaper::ShaperKind;
+use settle_planner::{KindParams, ProfileKind};
+
+use crate::error::Error;
+use crate::input::scenario::Scenario;
+use crate::input::source::Source;
+use crate::kinds::corner::Corner;
+use crate::kinds::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
+use crate::spec::run_spec::RunSpec;
+use crate::workflows::tune::search::{Candidate, Plan};
+
+/// Four-jerk BOW1..4 patterns searched (multiples of jmax; each <= 1).
+pub const BOW_PATTERNS: [[f64; 4]; 5] = [
+    [1.0, 1.0, 1.0, 1.0],
+    [1.0, 0.5, 0.5, 1.0],
+    [0.5, 1.0, 1.0, 0.5],
+    [1.0, 0.5, 1.0, 0.5],
+    [0.5, 1.0, 0.5, 1.0],
+];
+
+/// PVT asymmetries searched (`KindParams::pvt_asym_ki`, in (1/3, 1); 0.5 is its default).
+pub const PVT_KI: [f64; 4] = [0.4, 0.5, 0.65, 0.8];
+
+/// Default frequency scales: the mode frequency +-20% (shapers are tuned to a measured
+/// frequency; the neighbourhood covers the shift of the damped and coupled modes).
+pub const FREQUENCY_SCALES: [f64; 7] = [0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2];
+
+/// Default robustness margin, 0.8: score on settling into 80% of the band. The engines
+/// agree on residual peaks to a few percent on fixed-stiffness machines but up to ~20% on
+/// the belt printer (rapier's belt stiffness varies along the move; tune_corner: 9.18 um on
+/// modal, 10.9 um on rapier), so a winner scored at the band's edge can miss the band on
+/// another engine; 0.8 keeps that 20% inside it.
+pub const DEFAULT_MARGIN: f64 = 0.8;
+
+/// Resolve the scenario's search. Errors name the `[tune]` key.
+pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error> {
+    let spec = sc.tune.clone().unwrap_or_default();
+    if !sc.sweep.is_empty() {
+        return Err(src.error_at(
+            "sweep",
+            "settle tune does its own search: remove [sweep] (give the move family in [tune] distances_mm)",
+        ));
+    }
+    let base = runs
+        .first()
+        .cloned()
+        .ok_or_else(|| src.error_at("name", "the scenario has no run"))?;
+    let jmax = base.jmax_mm_s3.ok_or_else(|| {
+        src.error_at(
+            "limits",
+            "settle tune needs `jmax_mm_s3` in [limits]: the machine's jerk limit bounds the jerk search",
+        )
+    })?;
+    let distances_mm = spec
+        .distances_mm
+        .clone()
+        .unwrap_or_else(|| vec![base.distance_mm]);
+    if distances_mm.is_empty() || distances_mm.iter().any(|d| !(d.is_finite() && *d != 0.0)) {
+        return Err(src.error_at(
+            "tune.distances_mm",
+            "give one or more finite, non-zero move lengths (mm)",
+        ));
+    }
+    let angles_deg = match base.state::<Corner>() {
+        None if spec.angles_deg.is_some() => {
+            return Err(src.error_at("tune.angles_deg", "corner angles need a [corner] scenario"));
+        }
+        None => Vec::new(),
+        Some(c) => {
+            if spec.distances_mm.is_some() {
+                return Err(src.error_at(
+                    "tune.distances_mm",
+                    "a [corner] scenario tunes over corner angles: give `angles_deg`, not distances_mm",
+                ));
+            }
+            let angles = spec.angles_deg.clone().unwrap_or_else(|| vec![c.angle_deg]);
+            if angles.is_empty()
+                || angles
+                    .iter()
+                    .any(|a| !(a.is_finite() && (0.0..=180.0).contains(a)))
+            {
+                return Err(src.error_at(
+                    "tune.angles_deg",
+                    "give one or more interior angles from 0 (reversal) to 180 (straight on) degrees",
+                ));
+            }
+            angles
+        }
+    };
+    if let Some(e) = spec.max_contour_error_um
+        && !(e.is_finite() && e > 0.0)
+    {
+        return Err(src.error_at(
+            "tune.max_contour_error_um",
+            "must be a finite number > 0 (um)",
+        ));
+    }
+    let band = spec.band_um.unwrap_or(base.bands_um[0]);
+    let band_index = base
+        .bands_um
+        .iter()
+        .position(|b| *b == band)
+        .ok_or_else(|| {
+            src.error_at(
+                "tune.band_um",
+                format!(
+                    "{band} um is not one of observe.bands_um = {:?}",
+                    base.bands_um
+                ),
+            )
+        })?;
+    let margin = spec.margin.unwrap_or(DEFAULT_MARGIN);
+    if !(margin.is_finite() && margin > 0.0 && margin <= 1.0) {
+        return Err(src.error_at(
+            "tune.margin",
+            format!("must be in (0, 1] (the scored band is margin x band_um), got {margin}"),
+        ));
+    }
+    let mut bands_um = base.bands_um.clone();
+    let tight = band * margin;
+    let score_band_index = match bands_um.iter().position(|b| *b == tight) {
+        Some(i) => i,
+        None => {
+            bands_um.push(tight);
+            bands_um.len() - 1
+        }
+    };
+    let kinds = match &spec.kinds {
+        None => ProfileKind::ALL.to_vec(),
+        Some(list) if list.is_empty() => {
+            return Err(src.error_at("tune.kinds", "give at least one profile kind"));
+        }
+        Some(list) => list
+            .iter()
+            .map(|k| ProfileKind::parse(k).map_err(|e| src.error_at("tune.kinds", e.to_string())))
+            .collect::<Result<_, _>>()?,
+    };
+    let shapers: Vec<Option<ShaperKind>> = match &spec.shapers {
+        None => std::iter::once(None)
+            .chain(ShaperKind::ALL.map(Some))
+            .collect(),
+        Some(list) if list.is_empty() => {
+            return Err(src.error_at(
+                "tune.shapers",
+                "give at least one shaper type (or \"none\")",
+            ));
+        }
+        Some(list) => list
+            .iter()
+            .map(|s| {
+                crate::kinds::shaping::parse_type(s).map_err(|m| src.error_at("tune.shapers", m))
+            })
+            .collect::<Result<_, _>>()?,
+    };
+    let scales = spec
+        .frequency_scales
+        .clone()
+        .unwrap_or_else(|| FREQUENCY_SCALES.to_vec());
+    if scales.is_empty() || scales.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(src.error_at(
+            "tune.frequency_scales",
+            "give one or more finite multiples > 0 of the mode frequency",
+        ));
+    }
+    if spec.refine_rounds.is_some_and(|r| r > 20) {
+        return Err(src.error_at("tune.refine_rounds", "must be 0 to 20"));
+    }
+    let steps = spec.jerk_steps.unwrap_or(6);
+    if !(1..=100).contains(&steps) {
+        return Err(src.error_at("tune.jerk_steps", "must be 1 to 100"));
+    }
+    let span = spec.jerk_span.unwrap_or(30.0);
+    if !(span.is_finite() && span >= 1.0) {
+        return Err(src.error_at("tune.jerk_span", "must be a finite number >= 1"));
+    }
+    let jerks: Vec<f64> = (0..steps)
+        .map(|i| {
+            if steps == 1 {
+                jmax
+            } else {
+                let f = i as f64 / (steps - 1) as f64;
+                jmax / span.powf(1.0 - f)
+            }
+        })
+        .collect();
+    let modes = tuning_modes(&base);
+    if modes.is_empty() && shapers.iter().any(Option::is_some) {
+        return Err(src.error_at(
+            "machine",
+            "found no vibration mode of the moving axis to tune shapers to",
+        ));
+    }
+    let mut shaper_settings: Vec<Option<ShaperSetting>> = Vec::new();
+    for s in &shapers {
+        match s {
+            None => shaper_settings.push(None),
+            Some(k) => {
+                for (f, _) in &modes {
+                    for x in &scales {
+                        shaper_settings.push(Some(ShaperSetting {
+                            kind: Some(*k),
+                            frequency_hz: f * x,
+                            damping_ratio: DEFAULT_DAMPING_RATIO,
+                        }));
+                    }
+                }
+            }
+        }
+    }
+    let default = Candidate::of(&base);
+    let mut candidates = vec![default];
+    for kind in kinds {
+        let jerk_list: Vec<Option<f64>> = if kind == ProfileKind::Trapezoid {
+            vec![None]
+        } else {
+            jerks.iter().copied().map(Some).collect()
+        };
+        let params: Vec<KindParams> = match kind {
+            // Corner paths plan their legs from the limits alone.
+            _ if base.state::<Corner>().is_some() => vec![KindParams::default()],
+            ProfileKind::PvtAsym => PVT_KI
+                .iter()
+                .map(|&k| KindParams {
+                    pvt_asym_ki: k,
+                    ..KindParams::default()
+                })
+                .collect(),
+            ProfileKind::FourJerk => BOW_PATTERNS
+                .iter()
+                .map(|&b| KindParams {
+                    fourjerk_jerk_scale: b,
+                    ..KindParams::default()
+                })
+                .collect(),
+            _ => vec![KindParams::default()],
+        };
+        for j in &jerk_list {
+            for p in &params {
+                for sh in &shaper_settings {
+                    candidates.push(Candidate {
+                        kind,
+                        jmax_mm_s3: *j,
+                        params: *p,
+                        shaper: *sh,
+                    });
+                }
+            }
+        }
+    }
+    Ok(Plan {
+        base,
+        distances_mm,
+        angles_deg,
+        band_index,
+        score_band_index,
+        margin,
+        bands_um,
+        candidates,
+        modes,
+        spec,
+    })
+}
+
+/// The modes shapers are tuned to: the scenario's modes (by weight, at most two), or the
+/// two strongest modes of the moving axis's linearised response.
+pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
+    if base.machine.is_none() {
+        let mut m: Vec<_> = base.modes.clone();
+        m.sort_by(|a, b| b.weight.abs().total_cmp(&a.weight.abs()));
+        return m
+            .iter()
+            .take(2)
+            .map(|m| (m.frequency_hz, m.damping_ratio))
+            .collect();
+    }
+    let Some(machine) = &base.machine else {
+        return Vec::new();
+    };
+    let Ok(axes) = machine.compile(settle_sim::DriverMode::Linear) else {
+        return Vec::new();
+    };
+    let Ok(limits) = base.limits_si() else {
+        return Vec::new();
+    };
+    // The moving axis, or both axes of a corner path (its strongest mode each).
+    let names: Vec<&str> = base.axis.split('+').collect();
+    let per_axis = if names.len() > 1 { 1 } else { 2 };
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for name in names {
+        let Some(axis) = axes.iter().find(|a| a.name == name) else {
+            continue;
+        };
+        let (start_m, dist_m) = if base.state::<Corner>().is_some() {
+            (0.0, 0.02)
+        } else {
+            (base.start_mm * 1e-3, base.distance_mm * 1e-3)
+        };
+        let Ok(profile) = base.profile.rest_to_rest(start_m, dist_m, &limits) else {
+            continue;
+        };
+        let Ok(lr) = settle_sim::closed_form::LinearResponse::new(axis, &profile) else {
+            continue;
+        };
+        for (f, z, _) in lr
+            .modes()
+            .into_iter()
+            .filter(|(f, _, _)| *f > 0.5)
+            .take(per_axis)
+        {
+            if !out.iter().any(|(g, _)| (g - f).abs() < 1e-6 * f) {
+                out.push((f, z));
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,32 @@
+//! Helpers shared by the test modules.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The `settle` binary, run from the repository root.
+pub fn settle() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_settle"));
+    c.current_dir(env!("CARGO_MANIFEST_DIR"));
+    c
+}
+
+/// The repository root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Write `text` as `dir/name`; its path.
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).expect("writes");
+    p
+}
+
+/// The extra figure `name` of a run kind in `m`.
+pub fn extra(m: &settle::Metrics, name: &str) -> f64 {
+    m.extra
+        .iter()
+        .find(|(n, _)| n == name)
+        .unwrap_or_else(|| panic!("no column {name}"))
+        .1
+}
