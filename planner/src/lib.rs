@@ -11,21 +11,20 @@
 // guards against; the "clearer" `x < 0.0` would let NaN through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-mod arcs;
-mod blend;
 mod brake;
+mod case_poly;
 pub mod duration;
 mod error;
 mod fastest;
 mod fixed;
-mod four_arcs;
 pub mod fourjerk;
+mod jerk_arcs;
 mod kind;
 mod limits;
+mod mixture;
 #[cfg(test)]
 mod oracle;
 pub mod path;
-mod poly;
 pub mod position;
 mod profile;
 pub mod pvt;
@@ -39,6 +38,8 @@ pub mod sync;
 pub mod tmc;
 mod trajectory;
 pub mod trapezoid;
+mod udu;
+mod udud;
 mod unit;
 pub mod velocity;
 

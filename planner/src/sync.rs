@@ -103,7 +103,7 @@ fn all_at(fastest: &[Planned], t: f64) -> Result<Option<Vec<Profile>>, PlanError
                 axis: i,
                 source: Box::new(e),
             })?);
-        } else if let Some(p) = f.lasting(t).map_err(|e| PlanError::OnAxis {
+        } else if let Some(p) = crate::duration::lasting(f, t).map_err(|e| PlanError::OnAxis {
             axis: i,
             source: Box::new(e),
         })? {

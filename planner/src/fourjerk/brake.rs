@@ -10,8 +10,8 @@
 //! overshoot the other way). The total time over that range is not monotone: the planner samples it and
 //! refines the best sample. A negative overshoot is the mirror image.
 
-use crate::fourjerk::FourJerkLimits;
-use crate::fourjerk::arcs::{mirror, push_down, push_hold, run, v_zero};
+use super::arc_algebra::{mirror, push_down, push_hold, run, v_zero};
+use super::limits::FourJerkLimits;
 use crate::{Segment, State};
 
 /// The brake law from one start (acceleration within the limits).

@@ -26,8 +26,8 @@ use super::geometry::{CornerPlan, CornerTransition, PathGeometry, Primitive};
 use super::junction::Junction;
 use super::law::{self, SpeedLaw, largest};
 use super::pieces::{Piece, VSeg, VState, profiles};
+use super::polyline::{Path, PathPoint, PointKind, interior_angle};
 use super::vector::{axpy, norm, scale, sub};
-use super::{Path, PathPoint, PointKind, interior_angle};
 use crate::{Limits, PlanError, ProfileKind, Trajectory};
 
 /// How control points are passed.

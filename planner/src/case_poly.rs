@@ -193,7 +193,7 @@ fn bernstein_roots<const N: usize>(c: &[f64], lo: f64, hi: f64, out: &mut Roots)
 
 /// The roots of `c` (lowest degree first, degree `c.len() - 1 <= 6`) in `[lo, hi]`,
 /// ascending. Roots within rounding of the interval ends are included.
-pub(crate) fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
+pub(crate) fn case_roots(c: &[f64], lo: f64, hi: f64) -> Roots {
     let mut out = Roots::default();
     if lo.is_nan() || hi.is_nan() || lo > hi {
         return out;
@@ -228,7 +228,7 @@ pub(crate) fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
             for k in 1..=n {
                 d[k - 1] = k as f64 * c[k];
             }
-            let crit = roots_in(&d[..n], lo, hi);
+            let crit = case_roots(&d[..n], lo, hi);
             isolate(c, lo, hi, crit.as_slice(), &mut out);
         }
     }
@@ -384,7 +384,7 @@ mod tests {
             vec![0.3, 0.31, 0.32, 4.0, -4.0],
         ] {
             let c = from_roots(&r);
-            let got = roots_in(&c, -10.0, 1e4);
+            let got = case_roots(&c, -10.0, 1e4);
             let mut want = r.clone();
             want.sort_by(f64::total_cmp);
             assert_eq!(got.as_slice().len(), want.len(), "{r:?}: {got:?}");
@@ -398,18 +398,18 @@ mod tests {
     fn double_roots_and_interval_limits() {
         // (x - 1)^2 (x + 2)(x - 4): the double root counts once.
         let c = from_roots(&[1.0, 1.0, -2.0, 4.0]);
-        let got = roots_in(&c, -5.0, 5.0);
+        let got = case_roots(&c, -5.0, 5.0);
         assert_eq!(got.as_slice().len(), 3, "{got:?}");
         assert!((got.as_slice()[1] - 1.0).abs() < 1e-7);
         // Only roots inside [0, 3].
-        let got = roots_in(&c, 0.0, 3.0);
+        let got = case_roots(&c, 0.0, 3.0);
         assert_eq!(got.as_slice().len(), 1, "{got:?}");
         // A root on the edge is kept.
-        let got = roots_in(&c, 4.0, 6.0);
+        let got = case_roots(&c, 4.0, 6.0);
         assert_eq!(got.as_slice(), &[4.0]);
         // None.
         assert!(
-            roots_in(&[1.0, 0.0, 1.0, 0.0, 1.0], -3.0, 3.0)
+            case_roots(&[1.0, 0.0, 1.0, 0.0, 1.0], -3.0, 3.0)
                 .as_slice()
                 .is_empty()
         );

@@ -10,7 +10,7 @@ use crate::segs::Push;
 
 /// `lambda x + (1 - lambda) y` for profiles `x`, `y` starting with acceleration `a0` and
 /// lasting the same time (up to rounding).
-pub(crate) fn blend(x: &[Segment], y: &[Segment], a0: f64, lambda: f64, out: &mut impl Push) {
+pub(crate) fn mix(x: &[Segment], y: &[Segment], a0: f64, lambda: f64, out: &mut impl Push) {
     let mu = 1.0 - lambda;
     // Per profile: the current segment, the time left in it, its jerk, whether it holds a
     // set acceleration, and the acceleration now.
@@ -134,7 +134,7 @@ mod tests {
             },
         ];
         let mut out = Segs::<16>::default();
-        blend(&x, &y, start.a, 0.25, &mut out);
+        mix(&x, &y, start.a, 0.25, &mut out);
         let (px, py, pm) = (
             Profile::new(start, x.to_vec()).expect("x").end(),
             Profile::new(start, y.to_vec()).expect("y").end(),

@@ -26,47 +26,9 @@
 //! acceleration limits, and the velocity peak (the only place a UDU profile from a safe
 //! state to a holdable target can leave the velocity limits).
 
-use crate::poly::roots_in;
+use crate::case_poly::case_roots;
+use crate::jerk_arcs::{Arcs, Sink, reaches};
 use crate::unit::Unit;
-
-/// A profile of jerk arcs in normalised units, in the frame where it starts with jerk
-/// `+1`; `sign = -1` marks one found on the mirrored problem. Three arcs (UDU): jerk `+1`
-/// for `t[0]`, hold at `amax` for `t[1]`, jerk `-1` for `t[2]`, hold at `amin` for `t[3]`,
-/// jerk `+1` for `t[4]` (`t[5] = 0`). Four arcs (UDUD, see `four_arcs`): jerk `+1`, hold at
-/// `amax`, jerk `-1` down to zero acceleration, jerk `+1`, hold at `amax`, jerk `-1`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Arcs {
-    /// `1` as found, `-1` mirrored.
-    pub sign: f64,
-    /// Four arcs rather than three.
-    pub four: bool,
-    /// Phase durations (normalised time).
-    pub t: [f64; 6],
-}
-
-impl Arcs {
-    /// Duration (normalised time).
-    pub(crate) fn duration(&self) -> f64 {
-        self.t.iter().sum()
-    }
-
-    /// The jerk of each phase (normalised, in the frame of the search).
-    pub(crate) fn jerks(&self) -> [f64; 6] {
-        if self.four {
-            [1.0, 0.0, -1.0, 1.0, 0.0, -1.0]
-        } else {
-            [1.0, 0.0, -1.0, 0.0, 1.0, 0.0]
-        }
-    }
-}
-
-/// Receives valid profiles.
-pub(crate) trait Sink {
-    /// Only profiles shorter than this are wanted (normalised time).
-    fn t_max(&self) -> f64;
-    /// Take a profile. Returns true if slower roots of the same case are not wanted.
-    fn offer_arcs(&mut self, arcs: Arcs) -> bool;
-}
 
 /// Every case of the UDU family of `u` (`sign = 1`) or, given the mirrored problem and
 /// `sign = -1`, of the DUD family.
@@ -108,21 +70,6 @@ fn three(sign: f64, t: [f64; 5]) -> Arcs {
         four: false,
         t: [t[0], t[1], t[2], t[3], t[4], 0.0],
     }
-}
-
-/// Does `arcs` reach the target position of `u` (the frame it was found in)? A guard
-/// against spurious roots (such as `s = 0` of `none`, a factor of its quartic), relative
-/// to the size of the terms that make up the position, so it also holds for tiny moves.
-pub(crate) fn reaches(u: &Unit, arcs: &Arcs) -> bool {
-    let p = crate::fastest::Cand::Arcs(*arcs).end_p(&u_frame(u, arcs.sign));
-    let t = arcs.duration();
-    let scale = u.dp.abs() + t * (u.v0.abs() + t * (0.5 * u.a0.abs() + t / 6.0));
-    (p - arcs.sign * u.dp).abs() <= 1e-8 * scale
-}
-
-/// The problem in the original frame, given the (possibly mirrored) frame `u` of a family.
-fn u_frame(u: &Unit, sign: f64) -> Unit {
-    if sign > 0.0 { *u } else { u.mirror() }
 }
 
 /// Phase times (rounding below zero clamped) if they, the extremes and the velocity peak
@@ -185,9 +132,9 @@ fn none(u: &Unit, sign: f64, out: &mut impl Sink) {
     let c2 = 4.0 * k - 4.0 * a0 * a0 + 8.0 * v0;
     // With K = 0 (e.g. rest to rest) the quartic is s times a cubic: drop the factor.
     let roots = if k == 0.0 {
-        roots_in(&[c1, c2, 0.0, 1.0], lo, hi)
+        case_roots(&[c1, c2, 0.0, 1.0], lo, hi)
     } else {
-        roots_in(&[-k * k, c1, c2, 0.0, 1.0], lo, hi)
+        case_roots(&[-k * k, c1, c2, 0.0, 1.0], lo, hi)
     };
     for &s in roots.as_slice() {
         if s.is_nan() || s <= 0.0 {
@@ -257,7 +204,7 @@ fn acc0(u: &Unit, sign: f64, out: &mut impl Sink) {
             continue;
         }
         let (lo, hi) = pad(lo, hi);
-        for &x in roots_in(&c, lo, hi).as_slice().iter().rev() {
+        for &x in case_roots(&c, lo, hi).as_slice().iter().rev() {
             let h1 = (x * x - m) / amax;
             if check_root(
                 u,
@@ -331,7 +278,7 @@ fn acc1(u: &Unit, sign: f64, out: &mut impl Sink) {
             continue;
         }
         let (lo, hi) = pad(lo, hi);
-        for &x in roots_in(&c, lo, hi).as_slice() {
+        for &x in case_roots(&c, lo, hi).as_slice() {
             let h2 = (x * x - m) / (-amin);
             if check_root(
                 u,
@@ -387,7 +334,7 @@ fn acc0_acc1(u: &Unit, sign: f64, out: &mut impl Sink) {
         1.0,
     ];
     let (lo, hi) = pad(lo, hi);
-    for &h1 in roots_in(&c, lo, hi).as_slice() {
+    for &h1 in case_roots(&c, lo, hi).as_slice() {
         let h2 = (dv - e - h1 * amax) / amin;
         let t = [amax - a0, h1, amax - amin, h2, af - amin];
         if check_root(u, sign, t, amax, amin, out) {

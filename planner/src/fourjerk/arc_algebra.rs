@@ -8,7 +8,7 @@
 //! accelerations: a U arc from `x` to `y` gains `gu(y) - gu(x)`, a D arc from `x` to `y`
 //! gains `gd(x) - gd(y)`, with `gu(a) = a^2/(2 J_U(a))` and `gd(a) = a^2/(2 J_D(a))`.
 
-use crate::fourjerk::FourJerkLimits;
+use super::limits::FourJerkLimits;
 use crate::{Segment, State};
 
 impl FourJerkLimits {

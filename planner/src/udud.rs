@@ -16,8 +16,8 @@
 //! - `acc0` (hold at `A = amax`): a quartic in `B`; `acc1` (hold at `B = amax`): a
 //!   quartic in `A`; `acc0_acc1`: linear in the first hold.
 
-use crate::arcs::{Arcs, Sink, reaches};
-use crate::poly::roots_in;
+use crate::case_poly::case_roots;
+use crate::jerk_arcs::{Arcs, Sink, reaches};
 use crate::unit::Unit;
 
 /// Every case of the UDUD family of `u` (`sign = 1`), or on the mirrored problem with
@@ -61,7 +61,7 @@ pub(crate) fn family(u: &Unit, sign: f64, out: &mut impl Sink) {
             12.0 * r * (2.0 * r * r + 2.0 * v0 - a2),
             base + 6.0 * a2 * r - 6.0 * r.powi(3) - 12.0 * r * v0,
         ];
-        for &s in roots_in(&co, -1e-12, 1.0 + 1e-12).as_slice() {
+        for &s in case_roots(&co, -1e-12, 1.0 + 1e-12).as_slice() {
             let w = 1.0 + s * s;
             let (a, b) = (r * (1.0 - s * s) / w, r * 2.0 * s / w);
             check(u, sign, [a - a0, 0.0, a, b, 0.0, b - af], out);
@@ -75,7 +75,7 @@ pub(crate) fn family(u: &Unit, sign: f64, out: &mut impl Sink) {
         -2.0 * amax,
         1.0,
     ];
-    for &b in roots_in(&co, lo_b - 1e-12, amax + 1e-12).as_slice() {
+    for &b in case_roots(&co, lo_b - 1e-12, amax + 1e-12).as_slice() {
         check(u, sign, [amax - a0, hold(b), amax, b, 0.0, b - af], out);
     }
     // acc1: B = amax, the first peak A free.
@@ -86,7 +86,7 @@ pub(crate) fn family(u: &Unit, sign: f64, out: &mut impl Sink) {
         2.0 * amax,
         -1.0,
     ];
-    for &a in roots_in(&co, lo_a - 1e-12, amax + 1e-12).as_slice() {
+    for &a in case_roots(&co, lo_a - 1e-12, amax + 1e-12).as_slice() {
         check(u, sign, [a - a0, 0.0, a, amax, hold(a), amax - af], out);
     }
     // acc0_acc1: both peaks at amax; linear in the first hold.

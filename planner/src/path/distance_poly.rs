@@ -14,7 +14,7 @@ pub(crate) fn eval(c: &[f64], x: f64) -> f64 {
 
 /// The roots of `c` (coefficients, constant first, degree <= 5) in `[lo, hi]`, ascending,
 /// written to `out`; returns how many.
-pub(crate) fn roots_in(c: &[f64], lo: f64, hi: f64, out: &mut [f64; MAX_DEGREE]) -> usize {
+pub(crate) fn distance_roots(c: &[f64], lo: f64, hi: f64, out: &mut [f64; MAX_DEGREE]) -> usize {
     let mut deg = c.len().saturating_sub(1).min(MAX_DEGREE);
     while deg > 0 && c[deg] == 0.0 {
         deg -= 1;
@@ -37,7 +37,7 @@ pub(crate) fn roots_in(c: &[f64], lo: f64, hi: f64, out: &mut [f64; MAX_DEGREE])
                 d[k - 1] = k as f64 * c[k];
             }
             let mut crit = [0.0; MAX_DEGREE];
-            let nc = roots_in(&d[..deg], lo, hi, &mut crit);
+            let nc = distance_roots(&d[..deg], lo, hi, &mut crit);
             let mut knots = [0.0; MAX_DEGREE + 2];
             knots[0] = lo;
             knots[1..=nc].copy_from_slice(&crit[..nc]);
@@ -117,13 +117,13 @@ mod tests {
             c = n;
         }
         let mut out = [0.0; MAX_DEGREE];
-        let n = roots_in(&c, 0.0, 1.0, &mut out);
+        let n = distance_roots(&c, 0.0, 1.0, &mut out);
         assert_eq!(n, 4, "{out:?}");
         for (got, want) in out[..n].iter().zip([0.1, 0.1001, 0.5, 0.9]) {
             assert!((got - want).abs() < 1e-12, "{got} vs {want}");
         }
         // A double root (tangency) is found too.
-        let n = roots_in(&[0.25, -1.0, 1.0], 0.0, 1.0, &mut out);
+        let n = distance_roots(&[0.25, -1.0, 1.0], 0.0, 1.0, &mut out);
         assert_eq!((n, (out[0] - 0.5).abs() < 1e-7), (1, true));
     }
 }
