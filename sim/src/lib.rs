@@ -21,6 +21,7 @@ mod mode;
 #[cfg(feature = "mujoco")]
 pub mod mujoco;
 pub mod mujoco_status;
+pub mod numerics;
 pub mod pencil;
 mod plant;
 pub mod rapier;
