@@ -50,9 +50,9 @@ impl Cand {
         }
     }
 
-    /// Append the profile's segments in physical units (zero-duration jerk segments left out). Holds
-    /// are zero-jerk segments; the cruise is a constant-acceleration segment at exactly
-    /// zero.
+    /// Append the profile's segments in physical units (zero-duration jerk segments left
+    /// out). Holds are zero-jerk segments; the cruise is a constant-acceleration segment at
+    /// exactly zero.
     pub(crate) fn segments(&self, sc: &Scale, out: &mut impl Push) {
         match self {
             Cand::Arcs(a) => {

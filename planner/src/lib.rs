@@ -3,6 +3,20 @@
 //! Every planner returns a [`Profile`]: a start state plus a list of segments of constant
 //! jerk (or, for jerk-unlimited profiles such as trapezoids, constant acceleration). One
 //! evaluator, [`Profile::state_at`], serves sampling, plotting, simulation and output.
+//! Several axes in time are a [`Trajectory`].
+//!
+//! What is where:
+//! - one axis, rest to rest: [`scurve`] (7-phase S-curve), [`trapezoid`];
+//! - one axis from any state to any target, time-optimal: [`position`] (step 1: brake, then
+//!   the fastest of the cruise and the three-arc cases), [`duration`] (step 2: a profile
+//!   of a given duration), [`velocity`] (velocity changes); derivations of the case
+//!   polynomials in `planner/derivations/`;
+//! - several axes: [`sync`] (each axis's fastest profile, all fitted to the slowest);
+//! - four independent jerks: [`fourjerk`] (any state) and [`tmc`] (the TMC4361A ramp and
+//!   its registers);
+//! - [`pvt`] (PVT segments, turnarounds, step moves), [`raster`] (raster scans),
+//!   [`path`] (polylines with corners, look-ahead), [`shaper`] (input shapers);
+//! - [`ProfileKind`]: every kind by name, one entry point.
 //!
 //! No I/O, no clocks, no simulation types. Units are whatever the caller uses consistently
 //! (settle's harness uses metres and seconds).

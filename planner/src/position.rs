@@ -2,13 +2,16 @@
 //! (the position interface), and to a velocity and acceleration (the velocity interface).
 //!
 //! Step 0 brakes a start state that violates, or must violate, the limits (see `brake`).
-//! From the safe state the candidates are seed 004's cases in Ruckig's modern form (see
-//! `fastest` and `arcs`): the cruise at `vmax` or `vmin` between two time-optimal velocity
-//! changes, or three jerk arcs (UDU or DUD) with holds at the acceleration limits, each
-//! case a closed-form polynomial whose valid root is picked among spurious ones by
-//! checking the profile. The fastest candidate is the time-optimal profile.
+//! From the safe state the candidates are the cases of Haschke, Weitnauer, Ritter, "On-Line
+//! Planning of Time-Optimal, Jerk-Limited Trajectories" (IROS 2008) in the form Ruckig
+//! gives them (Berscheid, Kröger, "Jerk-limited Real-time Trajectory Generation with
+//! Arbitrary Target States", RSS 2021; see `fastest` and `udu`): the cruise at `vmax` or
+//! `vmin` between two time-optimal velocity changes, or three jerk arcs (UDU or DUD) with
+//! holds at the acceleration limits, each case a closed-form polynomial whose valid root is
+//! picked among spurious ones by checking the profile. The fastest candidate is the
+//! time-optimal profile.
 //!
-//! The bracketing implementation this replaced is kept as a test-only oracle
+//! An independent bracketing implementation is kept as a test-only oracle
 //! (`oracle::peak`), and a property test checks that both give the same durations.
 
 use crate::brake::{BrakeLaw, brake};

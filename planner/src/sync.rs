@@ -1,4 +1,5 @@
-//! Several axes: each axis's fastest profile, then all fitted to the slowest (house rule 3).
+//! Several axes: each axis's fastest profile (step 1), then all fitted to the slowest
+//! (step 2), as Ruckig synchronises axes.
 //!
 //! - `None`: every axis on its own, fastest.
 //! - `Time`: every axis finishes together, at the earliest duration every axis can meet

@@ -5,11 +5,11 @@
 //! time-optimal profile is bang-bang between boundary arcs (holds at an acceleration
 //! limit, cruises at a velocity limit), with at most two switches between them, so without
 //! a cruise the shape is UDU or DUD with holds. (Four-arc shapes whose acceleration only
-//! touches zero, seed 004's peak-velocity roots of kinds UD|UD and DU|DU, are never
+//! touches zero, the peak-velocity profiles of kinds UD|UD and DU|DU of `udud`, are never
 //! fastest; the test-only oracle still lists them and the property test checks this.)
 //!
 //! Each case is named after the limits it reaches and reduces to one polynomial in one
-//! unknown, derived for this crate with sympy (`notes/derivations/arcs.py`), in the
+//! unknown, derived for this crate with sympy (`planner/derivations/udu.py`), in the
 //! normalised units of [`Unit`] (jerk 1), where `dv = vf - v0`:
 //! - `none` (no hold): unknown `s = A1 - A2 = t2`. The acceleration and velocity equations
 //!   give `A1 + A2 = K / s` with `K = dv - (af^2 - a0^2)/2`, the duration is

@@ -1,15 +1,16 @@
 //! Step 1 from a state that must still leave the velocity limits after its brake: four
 //! jerk arcs whose acceleration touches zero between them, `+j, -j` to `(vp, 0)` then
 //! `+j, -j` to the target (UDUD, holds at `amax` allowed in both halves), and the mirror
-//! (DUDU). These are seed 004's peak-velocity profiles whose two phases accelerate the
-//! same way. From a safe state they are never fastest (Pontryagin: at most two switches
-//! between boundary arcs, and a touch of zero acceleration is none), so the search only
-//! runs where the brake leaves the state unsafe in the other direction (limits so tight
-//! that braking one way overshoots the other); there the peak velocity `vp` is required
-//! to lie within the limits, as in the oracle.
+//! (DUDU). These are the peak-velocity profiles (a change to a velocity peak `(vp, 0)`,
+//! then a change to the target) whose two phases accelerate the same way. From a safe state
+//! they are never fastest (Pontryagin: at most two switches between boundary arcs, and a
+//! touch of zero acceleration is none), so the search only runs where the brake leaves the
+//! state unsafe in the other direction (limits so tight that braking one way overshoots the
+//! other); there the peak velocity `vp` is required to lie within the limits, as in the
+//! oracle.
 //!
 //! Cases (normalised units, jerk 1), named after the limits reached, polynomials derived
-//! with sympy (`notes/derivations/four_arcs.py`):
+//! with sympy (`planner/derivations/udud.py`):
 //! - `none`: peaks `A`, `B` with `A^2 + B^2 = C = dv + (a0^2 + af^2)/2`, parametrised
 //!   rationally, `A = r (1 - s^2)/(1 + s^2)`, `B = r 2s/(1 + s^2)`, `r = sqrt(C)`,
 //!   `s in [0, 1]`: position is a sextic in `s`.

@@ -27,7 +27,7 @@
 //! cubic (`x(t) = (k + 1/2) * microstep`); the back-EMF and the torque's rotor angle are
 //! held at the middle of pieces of at most [`MAX_PIECE_ELECTRICAL_RAD`] of rotor travel
 //! (one piece per half step at the printer's speeds). The currents' integrals are exact.
-//! Measured in `sim/tests/rapier_full_step.rs` against a 16x smaller step.
+//! Measured in `sim/tests/all/rapier_full_step.rs` against a 16x smaller step.
 
 use settle_planner::Sample;
 

@@ -13,16 +13,16 @@
 //! orients the limits along the move (AMAX and BOW1/BOW2 always speed the axis up, as on
 //! the chip); [`plan`] uses them in the axis frame as given.
 //!
-//! A start outside the limits is handled as in seed 004: an acceleration beyond AMAX/DMAX
-//! is first brought back at full jerk; a velocity that is (or must become) beyond VMAX is
-//! braked along the brake law (see `brake`), stopping at the best time in its range. From
-//! there the candidates (see `families`) are the three-arc family in both senses (which
-//! contains the peak-velocity profiles without cruise) and the cruise at `+-vmax`; the
-//! velocity limit binds from the moment the state is safe (velocity inside, and the
-//! velocity after ramping the acceleration to zero at once inside too). The fastest valid
-//! profile is returned, after checking that it ends on the target.
+//! A start outside the limits is handled as by the one-jerk planner (`crate::brake`): an
+//! acceleration beyond AMAX/DMAX is first brought back at full jerk; a velocity that is (or
+//! must become) beyond VMAX is braked along the brake law (see `brake`), stopping at the
+//! best time in its range. From there the candidates (see `families`) are the three-arc
+//! family in both senses (which contains the peak-velocity profiles without cruise) and the
+//! cruise at `+-vmax`; the velocity limit binds from the moment the state is safe (velocity
+//! inside, and the velocity after ramping the acceleration to zero at once inside too). The
+//! fastest valid profile is returned, after checking that it ends on the target.
 //!
-//! No other tool plans this (Ruckig has one jerk limit); `planner/tests/fourjerk.rs` checks
+//! No other tool plans this (Ruckig has one jerk limit); `planner/tests/all/fourjerk.rs` checks
 //! optimality against an independent search over arc durations and the symmetric case
 //! against [`crate::position::to_state`].
 
@@ -37,9 +37,9 @@ use crate::{PlanError, Profile, Segment, State};
 
 /// Does the profile after the brake keep the limits? The acceleration must stay inside
 /// (the caller starts inside). A velocity outside the band (left over from braking) must
-/// move strictly monotonically back towards it (no cruise out there); once inside, it must stay inside (checked on the
-/// monotone pieces of each segment, so it cannot slip through the band between segment
-/// ends).
+/// move strictly monotonically back towards it (no cruise out there); once inside, it must
+/// stay inside (checked on the monotone pieces of each segment, so it cannot slip through
+/// the band between segment ends).
 fn valid(start: State, segs: &[Segment], l: &FourJerkLimits) -> bool {
     let tol = 1e-9;
     let (amax, amin) = (l.amax * (1.0 + tol), -l.dmax * (1.0 + tol));

@@ -135,7 +135,8 @@ pub enum CornerTransition {
     Stop,
     /// Straight through (no direction change) at the planned speed.
     Pass,
-    /// Seed 001's blend: leaves `distance_m` before the point, rejoins `distance_m` after.
+    /// The jerk-limited corner blend ([`super::blend`]): leaves `distance_m` before the
+    /// point, rejoins `distance_m` after.
     Blend {
         /// Which acceleration shape.
         case: BlendCase,

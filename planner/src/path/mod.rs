@@ -4,14 +4,14 @@
 //! - [`Path`]: the validated polyline (2-D or 3-D).
 //! - [`junction`]: corner speeds of GRBL's junction deviation and Klipper's square corner
 //!   velocity (sharp corners).
-//! - [`blend`]: seed 001's jerk-limited corner blend (the corner is rounded).
-//! - [`law`]: how a segment changes speed between corners (attack, sustain, release of
-//!   seed 002): trapezoid, S-curve, four-jerk, or any [`law::SpeedLaw`].
+//! - [`blend`]: the jerk-limited corner blend (the corner is rounded).
+//! - [`law`]: how a segment changes speed between corners (attack, sustain, release):
+//!   trapezoid, S-curve, four-jerk, or any [`law::SpeedLaw`].
 //! - [`lookahead`]: backward and forward passes over the corners, producing a multi-axis
 //!   [`crate::Trajectory`] with its [`PathGeometry`] attached.
 //! - [`PathGeometry`], [`CornerRounding`]: contour error and corner rounding for metrics.
 //!
-//! **Angle convention** (used everywhere here, as in seed 001, GRBL and Klipper): the corner
+//! **Angle convention** (used everywhere here, as in GRBL and Klipper): the corner
 //! angle `theta` at a point is the *interior* angle between the two segments as drawn, the
 //! angle between `p0 - p1` and `p2 - p1`: `cos(theta) = -u_in . u_out` for the unit travel
 //! directions. `theta = pi` is a straight line (no corner), `theta = pi/2` a square corner,

@@ -106,11 +106,11 @@ impl MujocoPlant {
 /// `(w_e h)^2 / 24` on the share of stiffness it carries (`w_e^2 = k_e / J`, `J` the rotor
 /// inertia). Its stiffness `k_e` is at most `2 k_theta + 4 Nr Td` (the sine's slope
 /// departs from the tangent's by at most `2 k_theta`, the detent's slope is at most
-/// `4 Nr Td`), so the step is also held to `w_e h <= STEP_FRACTION` (the explicit-force bound
-/// of [`crate::numerics::STEP_FRACTION`]: 0.375 % at most on that share). For the printer preset that second bound is 145 us,
-/// above the RK4 step; the detent no longer shortens the step as an RK4 spring (that
-/// took a second MuJoCo step per 10 kHz sample on the printer's Y axis for a frequency
-/// change below 0.01 %, see `sim/tests/mujoco_stepper.rs`).
+/// `4 Nr Td`), so the step is also held to `w_e h <= STEP_FRACTION` (the explicit-force
+/// bound of [`crate::numerics::STEP_FRACTION`]: 0.375 % at most on that share). For the
+/// printer preset that second bound is 145 us, above the RK4 step. (Integrating the detent
+/// as an RK4 spring instead would take a second MuJoCo step per 10 kHz sample on the
+/// printer's Y axis for a frequency change below 0.01 %, see `sim/tests/all/mujoco_stepper.rs`.)
 fn full_driver_model(
     a: &AxisModel,
     sp: &Stepper,
