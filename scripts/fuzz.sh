@@ -21,6 +21,14 @@ if ! cargo fuzz --version >/dev/null 2>&1; then
 fi
 # Keep fuzz builds apart from the workspace's (different instrumentation flags).
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}-fuzz"
+# Build every target in one cargo invocation (their shared dependencies once, the targets'
+# own code in parallel); `cargo fuzz run` below then finds them built.
+echo "== fuzz build (${targets[*]})"
+if [ "$#" -eq 0 ]; then
+  cargo fuzz build --sanitizer none -O
+else
+  for t in "${targets[@]}"; do cargo fuzz build --sanitizer none -O "$t"; done
+fi
 for t in "${targets[@]}"; do
   echo "== fuzz $t for ${secs}s"
   mkdir -p "corpus/$t"
