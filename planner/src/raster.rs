@@ -108,7 +108,7 @@ pub struct Raster {
     /// Axes X (fly) and Y (step), starting at rest at `t = 0`.
     pub trajectory: Trajectory,
     /// The fly axis as PVT knots (continuity and limits can be checked with
-    /// [`crate::pvt::check`]).
+    /// [`crate::pvt::check()`]).
     pub fly: Pvt,
     /// One entry per turnaround.
     pub turnarounds: Vec<Turnaround>,

@@ -21,7 +21,7 @@
 //! Couplings are evaluated with the commanded state at the start of each step; steps never
 //! straddle a profile breakpoint (the harness splits them). The full stepper driver's
 //! magnetic torque is the mean over the step's kick window `[t - h/2, t + h/2]` instead,
-//! with the microstep edges resolved in time ([`crate::rapier_driver`]): sampling it at `t`
+//! with the microstep edges resolved in time (`rapier_driver.rs`): sampling it at `t`
 //! would move every edge by up to `h/2`, up to 7 % off in residual at the default step.
 
 use rapier3d_f64::prelude::*;

@@ -115,8 +115,8 @@ impl Stepper {
     /// rotor on the line `theta(tau) = theta_at + omega (tau - tau_at)` (rad, rad/s).
     /// Returns the magnetic torque's integral over the span (N m s): exact in the currents
     /// (closed form between microstep edges found in time), midpoint rule in the rotor
-    /// angle over pieces of at most [`MAX_PIECE_ELECTRICAL_RAD`]. `cache` keeps the last
-    /// microstep's reference (one per axis and run; [`ReferenceCache::default`] to start).
+    /// angle over pieces of at most `MAX_PIECE_ELECTRICAL_RAD`. `cache` keeps the last
+    /// microstep's reference (one per axis and run; `ReferenceCache::default()` to start).
     #[allow(clippy::too_many_arguments)]
     pub fn advance_span(
         &self,

@@ -2,7 +2,7 @@
 //!
 //! Position and velocity are continuous by construction; the acceleration is continuous
 //! at a knot only if the two segments meeting there agree (the turnarounds and step moves
-//! of this module are designed so; [`Pvt::accel_jump`] and [`crate::pvt::check`] report it
+//! of this module are designed so; [`Pvt::accel_jump`] and [`crate::pvt::check()`] report it
 //! when not). A jump is written as a zero-duration [`Segment::Accel`] in the profile (a
 //! jerk impulse), a segment of constant acceleration as a [`Segment::Accel`] of its
 //! duration.

@@ -23,7 +23,7 @@ use crate::numerics::STEP_FRACTION;
 use crate::stepper::{Stepper, StepperState};
 use crate::{AxisModel, DriverMode, SimError, advance_sample};
 
-/// The MuJoCo backend as a [`Plant`]: one MuJoCo model per axis, each starting at rest at
+/// The MuJoCo backend as a [`crate::Plant`]: one MuJoCo model per axis, each starting at rest at
 /// its commanded start and following the command through the lumped couplings.
 ///
 /// Driver modes: `linear` (a spring to the continuous command), `spring` (a spring to the
