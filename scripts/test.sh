@@ -11,7 +11,7 @@
 #     depend on it change with the feature; everything else is reused), `cargo doc`: type
 #     checking only, one set of dependency metadata for all three;
 #   - profile `ci` (optimised like release, without LTO or debug info): every test of the
-#     workspace, then the regression gate with the `settle` binary that build made;
+#     workspace, then the regression gate with the `settle` binary the tests built;
 #   - profile `ci-rerun` (unoptimised: the rerun test writes one small recording): the
 #     `rerun` feature's build and its test;
 #   - scripts/fuzz.sh: libFuzzer-instrumented, in "$CARGO_TARGET_DIR-fuzz".
@@ -94,6 +94,9 @@ cargo test --workspace --profile ci --locked "${features[@]}" --no-run
 phase "cargo test: run"
 cargo test --workspace --profile ci --locked "${features[@]}"
 
+# The gate runs the `settle` binary the test build made (a `cargo run` would build it
+# again: without the dev-dependencies, some of its dependencies' features differ).
+settle_bin="${CARGO_TARGET_DIR:-target}/ci/settle"
 phase "settle check: the regression gate (scenarios/ci_<name>.toml vs results/baselines/<name>.<backend>.csv)"
 for scenario in scenarios/ci_*.toml; do
   name=$(basename "$scenario" .toml)
@@ -108,7 +111,7 @@ for scenario in scenarios/ci_*.toml; do
       echo "(skipping $baseline: MuJoCo not built)"
       continue
     fi
-    cargo run --profile ci --locked --quiet "${features[@]}" -- check "$scenario" --backend "$backend" --baseline "$baseline"
+    "$settle_bin" check "$scenario" --backend "$backend" --baseline "$baseline"
   done
 done
 
