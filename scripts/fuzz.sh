@@ -21,12 +21,23 @@ if ! cargo fuzz --version >/dev/null 2>&1; then
 fi
 # Keep fuzz builds apart from the workspace's (different instrumentation flags).
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}-fuzz"
+# Optimised, no sanitizer; 16 codegen units instead of cargo-fuzz's default of 1 build
+# the instrumented harness faster, for somewhat fewer executions a second.
+build=(--sanitizer none -O --codegen-units 16)
+# Build every target in one cargo invocation (their shared dependencies once, the targets'
+# own code in parallel); `cargo fuzz run` below then finds them built.
+echo "== fuzz build (${targets[*]})"
+if [ "$#" -eq 0 ]; then
+  cargo fuzz build "${build[@]}"
+else
+  for t in "${targets[@]}"; do cargo fuzz build "${build[@]}" "$t"; done
+fi
 for t in "${targets[@]}"; do
   echo "== fuzz $t for ${secs}s"
   mkdir -p "corpus/$t"
   log="$(mktemp)"
   status=0
-  cargo fuzz run --sanitizer none -O "$t" "corpus/$t" -- \
+  cargo fuzz run "${build[@]}" "$t" "corpus/$t" -- \
     -max_total_time="$secs" -max_len=4096 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
     >"$log" 2>&1 || status=$?
   # Show libFuzzer's summary, and everything on failure.

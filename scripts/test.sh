@@ -1,17 +1,35 @@
 #!/usr/bin/env bash
-# The whole test suite: formatting, lints, every test, a fuzz smoke run. Installs what it
+# The whole test suite, used verbatim by CI (.ci/run): formatting, lints, API docs, every
+# test, the regression gate, a fuzz smoke run and the `rerun` feature. Installs what it
 # needs without root: crates from crates.io through cargo, libmujoco 3.17.0 from its PyPI
-# wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), cargo-fuzz, the official MCAP reader
-# from PyPI into .deps/ (scripts/mcap-python, for the MCAP tests). Used verbatim by CI
-# (.ci/run).
+# wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), cargo-fuzz into ~/.cargo/bin once
+# (scripts/fuzz.sh), the official MCAP reader from PyPI into .deps/ (scripts/mcap-python,
+# for the MCAP tests).
+#
+# Builds, and what they share (the cargo profiles are in Cargo.toml):
+#   - clippy (default features), clippy with MuJoCo (only settle-sim and the crates that
+#     depend on it change with the feature; everything else is reused), `cargo doc`: type
+#     checking only, one set of dependency metadata for all three;
+#   - profile `ci` (optimised like release, without LTO or debug info): every test of the
+#     workspace, then the regression gate with the `settle` binary the tests built;
+#   - profile `ci-rerun` (unoptimised: the rerun test writes one small recording): the
+#     `rerun` feature's build and its test;
+#   - scripts/fuzz.sh: libFuzzer-instrumented, in "$CARGO_TARGET_DIR-fuzz".
+# Every phase prints the time since the start; a table of phase durations ends the output.
 #
 # Environment:
-#   SETTLE_PLANNER_CASES  random planner cases (default 100000; see the README for the rest)
-#   SETTLE_SIM_CASES      random modal-plant cases (default 2000)
+#   CARGO_TARGET_DIR      cargo's build directory (.ci/run keeps ~/.cache/settle/target
+#                         between runs; default: target/ in the clone)
+#   SETTLE_PLANNER_CASES  random planner cases (default 100000); the other planner and sim
+#                         case counts (SETTLE_PLANNER_STATE_CASES, ..._EDGE_CASES,
+#                         ..._MULTI_CASES, ..._BRAKED_CASES, ..._RUCKIG_CASES,
+#                         ..._ORACLE_CASES, SETTLE_PATH_CASES, SETTLE_SIM_CASES) are in the
+#                         README and each suite's documentation
 #   SETTLE_MUJOCO=0       skip the MuJoCo backend (otherwise it is fetched when missing and
 #                         every test runs with the `mujoco` feature)
 #   SETTLE_FUZZ_SECONDS   fuzz smoke time per target (default 15)
 #   SETTLE_SKIP_RERUN=1   skip building and testing the `rerun` feature
+#   SETTLE_MCAP_PY_VERSION  the MCAP reader's version (scripts/mcap-python)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -20,23 +38,66 @@ if ! command -v cargo >/dev/null; then
   exit 1
 fi
 
+# Phase timing: `phase NAME` ends the current phase and starts the next.
+start_s=$(date +%s)
+phase_name=""
+phase_start_s=$start_s
+timings=()
+mmss() { printf '%d:%02d' $(($1 / 60)) $(($1 % 60)); }
+phase() {
+  local now_s
+  now_s=$(date +%s)
+  if [[ -n $phase_name ]]; then
+    timings+=("$(printf '%7s  %s' "$(mmss $((now_s - phase_start_s)))" "$phase_name")")
+  fi
+  phase_name=${1:-}
+  phase_start_s=$now_s
+  if [[ -n $phase_name ]]; then
+    echo "== [$(mmss $((now_s - start_s)))] $phase_name"
+  fi
+}
+report() {
+  local status=$?
+  phase ""
+  echo "== phase times (m:ss), total $(mmss $(($(date +%s) - start_s)))$([[ $status -ne 0 ]] && echo ", FAILED in the last phase")"
+  printf '%s\n' "${timings[@]}"
+}
+trap report EXIT
+
 features=()
 if [[ "${SETTLE_MUJOCO:-1}" != 0 ]]; then
-  echo "== MuJoCo library (scripts/setup-mujoco.sh)"
+  phase "MuJoCo library (scripts/setup-mujoco.sh)"
   scripts/setup-mujoco.sh
   features=(--features mujoco)
 fi
 
-echo "== cargo fmt --check"
+phase "cargo fmt --check"
 cargo fmt --all -- --check
-echo "== cargo clippy (default features, then with MuJoCo)"
+
+phase "cargo clippy (default features)"
 cargo clippy --workspace --all-targets --locked -- -D warnings
 if [[ ${#features[@]} -gt 0 ]]; then
+  phase "cargo clippy (with MuJoCo: rechecks what the feature changes)"
   cargo clippy --workspace --all-targets --locked "${features[@]}" -- -D warnings
 fi
-echo "== cargo test (release: the property suites are numeric-heavy)"
-cargo test --workspace --release --locked "${features[@]}"
-echo "== settle check: the CI regression gate (scenarios/ci_<name>.toml vs results/baselines/<name>.<backend>.csv)"
+
+phase "cargo doc --no-deps (warnings are errors)"
+RUSTDOCFLAGS="${RUSTDOCFLAGS:-} -D warnings" cargo doc --workspace --no-deps --locked "${features[@]}"
+
+# Reserved here, in this order, for what the book and the HTML report will need:
+#   - `mdbook build docs` and a check of the book's internal links;
+#   - the HTML report in headless Chromium.
+
+phase "cargo test: build (profile ci)"
+cargo test --workspace --profile ci --locked "${features[@]}" --no-run
+
+phase "cargo test: run"
+cargo test --workspace --profile ci --locked "${features[@]}"
+
+# The gate runs the `settle` binary the test build made (a `cargo run` would build it
+# again: without the dev-dependencies, some of its dependencies' features differ).
+settle_bin="${CARGO_TARGET_DIR:-target}/ci/settle"
+phase "settle check: the regression gate (scenarios/ci_<name>.toml vs results/baselines/<name>.<backend>.csv)"
 for scenario in scenarios/ci_*.toml; do
   name=$(basename "$scenario" .toml)
   baselines=(results/baselines/"$name".*.csv)
@@ -50,14 +111,22 @@ for scenario in scenarios/ci_*.toml; do
       echo "(skipping $baseline: MuJoCo not built)"
       continue
     fi
-    cargo run --release --locked --quiet "${features[@]}" -- check "$scenario" --backend "$backend" --baseline "$baseline"
+    "$settle_bin" check "$scenario" --backend "$backend" --baseline "$baseline"
   done
 done
-echo "== fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
+
+phase "fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
 scripts/fuzz.sh "${SETTLE_FUZZ_SECONDS:-15}"
-# The rerun sink is behind a cargo feature (the SDK's cold build is ~14 CPU-minutes): build
-# and test it once here. SETTLE_SKIP_RERUN=1 skips it (e.g. for quick local runs).
-if [ "${SETTLE_SKIP_RERUN:-0}" != 1 ]; then
-  echo "== rerun feature: build once and test the .rrd sink"
-  cargo test --release --locked --features rerun --test outputs_rerun
+
+# The rerun sink is behind a cargo feature (the SDK's build is the largest of all): built
+# once here, unoptimised, and its tests run (the harness's tests in one binary, tests/all,
+# or in tests/outputs_rerun.rs: whichever this tree has).
+if [[ "${SETTLE_SKIP_RERUN:-0}" != 1 ]]; then
+  phase "rerun feature: build (profile ci-rerun) and test the .rrd sink"
+  if [[ -f tests/all/main.rs ]]; then
+    rerun_tests=(--test all -- rerun)
+  else
+    rerun_tests=(--test outputs_rerun)
+  fi
+  cargo test --profile ci-rerun --locked --features rerun "${rerun_tests[@]}"
 fi

@@ -1,5 +1,7 @@
 //! Brake pre-trajectories: bring a start state that violates, or must violate, the limits
-//! back inside them before the time-optimal profile begins (seed 004 steps 1-2).
+//! back inside them before the time-optimal profile begins: first the acceleration, then
+//! the velocity, as in Haschke, Weitnauer, Ritter, "On-Line Planning of Time-Optimal,
+//! Jerk-Limited Trajectories" (IROS 2008).
 //!
 //! The brake law:
 //! 1. `a` beyond its limit: jerk towards the limit until it is reached.

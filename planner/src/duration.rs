@@ -9,7 +9,7 @@
 //! `branch_starts` or lies above one of them. Jerk unlimited: the same with `second_order`.
 
 use crate::brake::BrakeLaw;
-use crate::position::{Shape, assemble, bounds, check_target, finish, finite_state, pre, verify};
+use crate::position::{How, Planned, Shape, assemble, finish, pre, validate, verify};
 use crate::segs::Segs;
 use crate::unit::{Scale, Unit};
 use crate::velocity::Bounds;
@@ -24,7 +24,7 @@ pub fn branch_starts(
     lim: &Limits,
     shape: Shape,
 ) -> Result<Vec<f64>, PlanError> {
-    let b = prepare(target, start, lim, shape)?;
+    let b = validate(&start, &target, lim, shape)?;
     let mut out = Vec::new();
     if b.jmax.is_infinite() {
         let (pre_segs, s) = pre(start, lim, &b);
@@ -42,12 +42,34 @@ pub fn branch_starts(
     Ok(out)
 }
 
-fn prepare(target: State, start: State, lim: &Limits, shape: Shape) -> Result<Bounds, PlanError> {
-    finite_state("start", &start)?;
-    finite_state("target", &target)?;
-    let b = bounds(lim, shape)?;
-    check_target(&target, lim, &b)?;
-    Ok(b)
+/// A profile of the problem `plan` solved in step 1 lasting `duration_s` (step 2), or
+/// `None` if that duration cannot be met. Without a brake this reuses step 1's normalised
+/// problem and cruise changes.
+pub(crate) fn lasting(plan: &Planned, duration_s: f64) -> Result<Option<Profile>, PlanError> {
+    match &plan.how {
+        How::Direct { sc, u, cruises, .. } => {
+            let mut segs = Vec::with_capacity(16);
+            let mut cruises = *cruises;
+            if !crate::fixed::lasting(u, duration_s / sc.t, sc, &mut cruises, &mut segs) {
+                return Ok(None);
+            }
+            verify(finish(plan.start, segs)?, &plan.target, &plan.lim, true).map(Some)
+        }
+        How::Jerk { .. } => with_duration(
+            plan.start,
+            plan.target,
+            &plan.lim,
+            Shape::JerkLimited,
+            duration_s,
+        ),
+        How::Trap(_) => with_duration(
+            plan.start,
+            plan.target,
+            &plan.lim,
+            Shape::Trapezoid,
+            duration_s,
+        ),
+    }
 }
 
 /// A profile from `start` to `target` lasting exactly `duration_s`, or `None` if that
@@ -59,7 +81,7 @@ pub fn with_duration(
     shape: Shape,
     duration_s: f64,
 ) -> Result<Option<Profile>, PlanError> {
-    let b = prepare(target, start, lim, shape)?;
+    let b = validate(&start, &target, lim, shape)?;
     let mut segs = Vec::with_capacity(16);
     if b.jmax.is_infinite() {
         let (pre_segs, s) = pre(start, lim, &b);
@@ -148,7 +170,7 @@ pub fn velocity_with_duration(
                 0 => [base + a0 * h0, a0 * h1, 0.5 * (p - q)],
                 _ => [base + af * h0, af * h1, 0.5 * (p - q)],
             };
-            let roots = crate::poly::roots_in(&c, lim.amin() - pad, lim.amax() + pad);
+            let roots = crate::case_poly::case_roots(&c, lim.amin() - pad, lim.amax() + pad);
             for &level in roots.as_slice() {
                 let level = level.clamp(lim.amin(), lim.amax());
                 let (t1, t3) = ((level - a0) * p, (af - level) * q);

@@ -1,5 +1,5 @@
 //! Step 1 from a safe state: every locally fastest profile (the cruises at `vmax` and
-//! `vmin`, the UDU and DUD families of `arcs`), the fastest of them, and their segments.
+//! `vmin`, the UDU and DUD families of `udu`), the fastest of them, and their segments.
 //!
 //! A cruise profile is the time-optimal velocity change to `(vlim, 0)`, a cruise at
 //! `vlim`, and the time-optimal change to `(vf, af)`; it exists when the two changes leave
@@ -8,16 +8,17 @@
 //! nothing left to solve.
 
 use crate::Segment;
-use crate::arcs::{Arcs, Sink, family};
+use crate::jerk_arcs::{Arcs, Sink};
 use crate::ramp::Ramp;
 use crate::segs::Push;
+use crate::udu::family;
 use crate::unit::{Scale, Unit};
 use crate::velocity::{Bounds, change};
 
 /// A candidate profile from a safe state, in normalised units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Cand {
-    /// Three arcs (see `arcs`).
+    /// Three arcs (see `udu`) or, from an unsafe state, four (see `udud`).
     Arcs(Arcs),
     /// Change to `(vlim, 0)`, cruise, change to the target.
     Cruise {
@@ -44,22 +45,14 @@ impl Cand {
     /// Distance covered from the start of `u` (normalised).
     pub(crate) fn end_p(&self, u: &Unit) -> f64 {
         match self {
-            Cand::Arcs(a) => {
-                let (mut p, mut v, mut acc) = (0.0, a.sign * u.v0, a.sign * u.a0);
-                for (t, j) in a.t.iter().zip(a.jerks()) {
-                    p += t * (v + t * (0.5 * acc + t * j * (1.0 / 6.0)));
-                    v += t * (acc + t * j / 2.0);
-                    acc += t * j;
-                }
-                a.sign * p
-            }
+            Cand::Arcs(a) => a.end_p(u),
             Cand::Cruise { v, c1, cruise, c2 } => c1.dist + cruise * v + c2.dist,
         }
     }
 
-    /// Append the profile's segments in physical units (zero-duration jerk segments left out). Holds
-    /// are zero-jerk segments; the cruise is a constant-acceleration segment at exactly
-    /// zero.
+    /// Append the profile's segments in physical units (zero-duration jerk segments left
+    /// out). Holds are zero-jerk segments; the cruise is a constant-acceleration segment at
+    /// exactly zero.
     pub(crate) fn segments(&self, sc: &Scale, out: &mut impl Push) {
         match self {
             Cand::Arcs(a) => {
@@ -188,8 +181,8 @@ pub(crate) fn fastest(u: &Unit, t_max: f64, cruises: &mut Cruises) -> Option<Can
         }
         family(u, 1.0, &mut s);
         family(&u.mirror(), -1.0, &mut s);
-        crate::four_arcs::family(u, 1.0, &mut s);
-        crate::four_arcs::family(&u.mirror(), -1.0, &mut s);
+        crate::udud::family(u, 1.0, &mut s);
+        crate::udud::family(&u.mirror(), -1.0, &mut s);
         return s.best;
     }
     // The cruise towards the target first (often proven fastest), the one away from it
@@ -281,8 +274,8 @@ pub(crate) fn each_duration(u: &Unit, f: impl FnMut(f64)) {
     family(u, 1.0, &mut s);
     family(&u.mirror(), -1.0, &mut s);
     if !u.safe() {
-        crate::four_arcs::family(u, 1.0, &mut s);
-        crate::four_arcs::family(&u.mirror(), -1.0, &mut s);
+        crate::udud::family(u, 1.0, &mut s);
+        crate::udud::family(&u.mirror(), -1.0, &mut s);
     }
 }
 

@@ -21,9 +21,10 @@
 //! `dp` is (within rounding) one member's own end position, that member is the profile.
 
 use crate::Segment;
-use crate::arcs::{Arcs, Sink, check};
 use crate::fastest::{Cand, Cruises, cruise_lasting};
+use crate::jerk_arcs::{Arcs, Sink};
 use crate::segs::Segs;
+use crate::udu::check;
 use crate::unit::{Scale, Unit};
 
 /// The extreme-position members of duration `t` (normalised): highest and lowest end
@@ -124,7 +125,7 @@ pub(crate) fn lasting(
         hi.segments(sc, &mut x);
         lo.segments(sc, &mut y);
         let lambda = ((u.dp - p_lo) / (p_hi - p_lo)).clamp(0.0, 1.0);
-        crate::blend::blend(x.as_slice(), y.as_slice(), u.a0 * sc.a, lambda, out);
+        crate::mixture::mix(x.as_slice(), y.as_slice(), u.a0 * sc.a, lambda, out);
     }
     true
 }
@@ -148,8 +149,8 @@ fn envelope(u: &Unit, s: f64) -> bool {
 /// `t`, for `vp` sampled across the limits. Mixing the two members that bracket the target
 /// reaches it. (Rare: about 2 in 100,000 random problems.)
 fn unsafe_members(u: &Unit, t: f64, ex: &mut Extremes) {
-    crate::four_arcs::lasting(u, t, 1.0, ex);
-    crate::four_arcs::lasting(&u.mirror(), t, -1.0, ex);
+    crate::udud::lasting(u, t, 1.0, ex);
+    crate::udud::lasting(&u.mirror(), t, -1.0, ex);
     const N: usize = 64;
     for k in 0..=N {
         let vp = u.vmin + (u.vmax - u.vmin) * k as f64 / N as f64;

@@ -17,14 +17,14 @@ pub enum ProfileKind {
     /// `fourjerk_jerk_scale` (multiples of `jmax`) and `fourjerk_dmax_scale` (multiple of
     /// `amax`); with the defaults it is the S-curve.
     FourJerk,
-    /// Seed 003's symmetric PVT step: five linear-acceleration segments (plus a
+    /// Symmetric PVT step: five linear-acceleration segments (plus a
     /// constant-velocity one when vmax is reached), knots at the S-curve's phase ends, the
     /// fastest within vmax, amax, jmax (see [`crate::pvt::step::symmetric`]). No
     /// parameters.
     PvtSym,
-    /// Seed 003's asymmetric PVT step: peak acceleration and jerk in the first half, time
-    /// scaled to the fastest within vmax, amax, jmax (see [`crate::pvt::step::asymmetric`]).
-    /// Parameter: [`KindParams`] `pvt_asym_ki` (the seed's `Ki`, 1/3 < Ki < 1).
+    /// Asymmetric PVT step: peak acceleration and jerk in the first half, time scaled to
+    /// the fastest within vmax, amax, jmax (see [`crate::pvt::step::asymmetric`]).
+    /// Parameter: [`KindParams`] `pvt_asym_ki` (`Ki`, 1/3 < Ki < 1).
     PvtAsym,
 }
 
@@ -32,10 +32,10 @@ pub enum ProfileKind {
 /// kind plannable from [`Limits`] alone.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KindParams {
-    /// `pvt_asym`: the seed's `Ki` (twice the fraction of the step covered when the
-    /// acceleration peaks), in (1/3, 1). Default 0.5, the seed's choice (§4.1 `Ki: 1/2`):
-    /// peak acceleration at one third of the move, 0.375 d/t1^2 against a final
-    /// deceleration of a third of that.
+    /// `pvt_asym`: `Ki` (twice the fraction of the step covered when the acceleration
+    /// peaks, see [`crate::pvt::step::AsymShape`]), in (1/3, 1). Default 0.5: peak
+    /// acceleration at one third of the move, 0.375 d/t1^2 against a final deceleration
+    /// of a third of that.
     pub pvt_asym_ki: f64,
     /// `fourjerk`: the jerks `[j1, j2, j3, j4]` as multiples of `jmax` (raise acceleration,
     /// lower it, raise deceleration, lower it: BOW1..BOW4). Default `[1, 1, 1, 1]`.
@@ -143,7 +143,7 @@ impl ProfileKind {
         to_state(start, target, limits, shape)
     }
 
-    /// The kinds of issue 6 (four-jerk and PVT steps).
+    /// The four-jerk and PVT-step kinds.
     fn plan_extended(
         self,
         p0: f64,

@@ -3,6 +3,20 @@
 //! Every planner returns a [`Profile`]: a start state plus a list of segments of constant
 //! jerk (or, for jerk-unlimited profiles such as trapezoids, constant acceleration). One
 //! evaluator, [`Profile::state_at`], serves sampling, plotting, simulation and output.
+//! Several axes in time are a [`Trajectory`].
+//!
+//! What is where:
+//! - one axis, rest to rest: [`scurve`] (7-phase S-curve), [`trapezoid`];
+//! - one axis from any state to any target, time-optimal: [`position`] (step 1: brake, then
+//!   the fastest of the cruise and the three-arc cases), [`duration`] (step 2: a profile
+//!   of a given duration), [`velocity`] (velocity changes); derivations of the case
+//!   polynomials in `planner/derivations/`;
+//! - several axes: [`sync`] (each axis's fastest profile, all fitted to the slowest);
+//! - four independent jerks: [`fourjerk`] (any state) and [`tmc`] (the TMC4361A ramp and
+//!   its registers);
+//! - [`pvt`] (PVT segments, turnarounds, step moves), [`raster`] (raster scans),
+//!   [`path`] (polylines with corners, look-ahead), [`shaper`] (input shapers);
+//! - [`ProfileKind`]: every kind by name, one entry point.
 //!
 //! No I/O, no clocks, no simulation types. Units are whatever the caller uses consistently
 //! (settle's harness uses metres and seconds).
@@ -11,22 +25,21 @@
 // guards against; the "clearer" `x < 0.0` would let NaN through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-mod arcs;
-mod blend;
 mod brake;
+mod case_poly;
 pub mod duration;
 mod error;
 mod fastest;
 pub mod firmware;
 mod fixed;
-mod four_arcs;
 pub mod fourjerk;
+mod jerk_arcs;
 mod kind;
 mod limits;
+mod mixture;
 #[cfg(test)]
 mod oracle;
 pub mod path;
-mod poly;
 pub mod position;
 mod profile;
 pub mod pvt;
@@ -41,6 +54,8 @@ pub mod sync;
 pub mod tmc;
 mod trajectory;
 pub mod trapezoid;
+mod udu;
+mod udud;
 mod unit;
 pub mod velocity;
 

@@ -2,13 +2,16 @@
 //! (the position interface), and to a velocity and acceleration (the velocity interface).
 //!
 //! Step 0 brakes a start state that violates, or must violate, the limits (see `brake`).
-//! From the safe state the candidates are seed 004's cases in Ruckig's modern form (see
-//! `fastest` and `arcs`): the cruise at `vmax` or `vmin` between two time-optimal velocity
-//! changes, or three jerk arcs (UDU or DUD) with holds at the acceleration limits, each
-//! case a closed-form polynomial whose valid root is picked among spurious ones by
-//! checking the profile. The fastest candidate is the time-optimal profile.
+//! From the safe state the candidates are the cases of Haschke, Weitnauer, Ritter, "On-Line
+//! Planning of Time-Optimal, Jerk-Limited Trajectories" (IROS 2008) in the form Ruckig
+//! gives them (Berscheid, Kröger, "Jerk-limited Real-time Trajectory Generation with
+//! Arbitrary Target States", RSS 2021; see `fastest` and `udu`): the cruise at `vmax` or
+//! `vmin` between two time-optimal velocity changes, or three jerk arcs (UDU or DUD) with
+//! holds at the acceleration limits, each case a closed-form polynomial whose valid root is
+//! picked among spurious ones by checking the profile. The fastest candidate is the
+//! time-optimal profile.
 //!
-//! The bracketing implementation this replaced is kept as a test-only oracle
+//! An independent bracketing implementation is kept as a test-only oracle
 //! (`oracle::peak`), and a property test checks that both give the same durations.
 
 use crate::brake::{BrakeLaw, brake};
@@ -201,7 +204,7 @@ const NO_PEAK: PlanError = PlanError::NoSolution {
 };
 
 /// Check the inputs of a position-interface problem; the velocity changes' bounds.
-fn validate(
+pub(crate) fn validate(
     start: &State,
     target: &State,
     lim: &Limits,
@@ -218,18 +221,18 @@ fn validate(
 /// (several axes only need the slowest one's).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Planned {
-    start: State,
-    target: State,
-    lim: Limits,
+    pub(crate) start: State,
+    pub(crate) target: State,
+    pub(crate) lim: Limits,
     duration_s: f64,
-    how: How,
+    pub(crate) how: How,
 }
 
 // The variants differ in size; boxing the large one would cost the allocation this plan
 // exists to avoid (it lives on the stack or in the caller's vector).
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy)]
-enum How {
+pub(crate) enum How {
     /// Jerk limited, no brake: `cand`, found for the problem `u` (normalised by `sc`) whose
     /// cruise changes step 2 can reuse.
     Direct {
@@ -273,36 +276,6 @@ impl Planned {
             }
         }
         verify(finish(self.start, segs)?, &self.target, &self.lim, true)
-    }
-
-    /// A profile of the same problem lasting `duration_s` (step 2), or `None` if that
-    /// duration cannot be met. Without a brake this reuses step 1's normalised problem and
-    /// cruise changes.
-    pub(crate) fn lasting(&self, duration_s: f64) -> Result<Option<Profile>, PlanError> {
-        match &self.how {
-            How::Direct { sc, u, cruises, .. } => {
-                let mut segs = Vec::with_capacity(16);
-                let mut cruises = *cruises;
-                if !crate::fixed::lasting(u, duration_s / sc.t, sc, &mut cruises, &mut segs) {
-                    return Ok(None);
-                }
-                verify(finish(self.start, segs)?, &self.target, &self.lim, true).map(Some)
-            }
-            How::Jerk { .. } => crate::duration::with_duration(
-                self.start,
-                self.target,
-                &self.lim,
-                Shape::JerkLimited,
-                duration_s,
-            ),
-            How::Trap(_) => crate::duration::with_duration(
-                self.start,
-                self.target,
-                &self.lim,
-                Shape::Trapezoid,
-                duration_s,
-            ),
-        }
     }
 }
 

@@ -1,27 +1,27 @@
-//! Raster scan kinematics (seed 003): the fly axis X scans lines at `v_scan` across the
+//! Raster scan kinematics: the fly axis X scans lines at `v_scan` across the
 //! scan region `[0, width]`, alternating direction; between lines it turns around outside
 //! the region while the step axis Y moves one step-over. The output is a 2-axis
 //! [`Trajectory`] (X, Y) and, per turnaround, when and where the fly axis re-enters the
 //! region: the moment the step must be settled.
 //!
 //! **Fly axis.** Run-in from rest to `v_scan` (a two-segment PVT with a triangular
-//! acceleration), lines at constant velocity, the seed's symmetric 2-segment turnarounds,
-//! a mirrored run-out. A turnaround of `2 tOut` with apex acceleration `4 v/(2 tOut)`
-//! overtravels `v (2 tOut)/3`; the fastest uses the fly axis's acceleration limit (and its
-//! jerk limit, `a^2/(2 v) <= jmax`).
+//! acceleration), lines at constant velocity, symmetric 2-segment PVT turnarounds
+//! ([`crate::pvt::turnaround`]), a mirrored run-out. A turnaround of `2 t_out` with apex
+//! acceleration `4 v/(2 t_out)` overtravels `v (2 t_out)/3`; the fastest uses the fly
+//! axis's acceleration limit (and its jerk limit, `a^2/(2 v) <= jmax`).
 //!
-//! **Overhead per line** (the seed's `tOvrHd = tOut + tEdge/2 + tAdd` per half-turn): the
-//! time between leaving and re-entering the region, `2 tOut + tEdge`. The step move (any
+//! **Overhead per line** (per half-turn `t_out + t_edge/2 + t_add`): the time between
+//! leaving and re-entering the region, `2 t_out + t_edge`. The step move (any
 //! point-to-point [`ProfileKind`]) must fit in that window, with the settling margin
-//! after it. The window is the shorter possible: `max(2 tOut_min, T_step + margin)`. When
-//! the step is the longer, the seed lets the fly axis stop and wait at the apex (`tEdge`,
+//! after it. The window is the shorter possible: `max(2 t_out_min, T_step + margin)`. When
+//! the step is the longer, the fly axis could stop and wait at the apex (for `t_edge`,
 //! with acceleration jumps at both ends of the wait); here the turnaround is stretched to
 //! the window instead (lower apex acceleration, continuous acceleration, the same
-//! overhead), and `t_edge_s` reports the time the step adds. The seed's other lever,
-//! slowing the fly axis by `v1Diff` before the edge, is not used: it trades scan speed
-//! inside the region (`tAdd = tln v1Diff/(3 v1Scan)`) for a shorter turnaround, and where
-//! the step axis limits the overhead the seed's own result (`rscn_tOv`) is that the
-//! overhead grows with `v1Diff`; see [`seed_fly_overhead_s`].
+//! overhead), and `t_edge_s` reports the time the step adds. The other lever, slowing the
+//! fly axis by `v_diff` before the edge, is not used: it trades scan speed inside the
+//! region (`t_add = t_ln v_diff/(3 v_scan)`) for a shorter turnaround, and where the step
+//! axis limits the overhead, the overhead grows with `v_diff`; see
+//! [`slowdown_fly_overhead_s`] and its test in `planner/tests/all/raster.rs`.
 
 use crate::kind::{KindParams, ProfileKind};
 use crate::pvt::turnaround::TwoSegment;
@@ -48,7 +48,7 @@ pub struct RasterSpec {
     pub step: f64,
     /// Fly-axis scan speed (u/s, > 0).
     pub v_scan: f64,
-    /// Fly-axis acceleration limit (u/s^2, > 0): the seed's `a1Max`.
+    /// Fly-axis acceleration limit (u/s^2, > 0).
     pub fly_amax: f64,
     /// Fly-axis jerk limit (u/s^3), if any.
     pub fly_jmax: Option<f64>,
@@ -71,7 +71,7 @@ pub struct Overhead {
     pub t_out_min_s: f64,
     /// Fly half-turn actually used (s): half the window.
     pub t_out_s: f64,
-    /// Time the step adds to the fastest turnaround (s): the seed's `tEdge`.
+    /// Time the step adds to the fastest turnaround (s): `t_edge`.
     pub t_edge_s: f64,
     /// The step move's duration (s).
     pub step_s: f64,
@@ -108,7 +108,7 @@ pub struct Raster {
     /// Axes X (fly) and Y (step), starting at rest at `t = 0`.
     pub trajectory: Trajectory,
     /// The fly axis as PVT knots (continuity and limits can be checked with
-    /// [`crate::pvt::check`]).
+    /// [`crate::pvt::check()`]).
     pub fly: Pvt,
     /// One entry per turnaround.
     pub turnarounds: Vec<Turnaround>,
@@ -249,13 +249,13 @@ pub fn plan(spec: &RasterSpec) -> Result<Raster, PlanError> {
     })
 }
 
-/// The seed's fly-axis overhead with a slow-down before the edge (seed 003 §4.6,
-/// `rscn_ax1_Tol_sol`, `rscn_tAdd`, `tOvrHd_basic` with `tEdge = 0`): over `t_ln` before
-/// the edge the fly axis slows from `v_scan` by `v_diff` (its acceleration linear from 0),
-/// then stops with apex acceleration `a_max`. Returns `(tOut, tAdd, tOut + tAdd)` (s):
-/// `tOut = 2 tln (v_scan - v_diff)/(2 v_diff + a_max tln)`,
-/// `tAdd = tln v_diff/(3 v_scan)`.
-pub fn seed_fly_overhead_s(v_scan: f64, a_max: f64, t_ln: f64, v_diff: f64) -> (f64, f64, f64) {
+/// The fly-axis overhead per half-turn with a slow-down before the edge (and
+/// `t_edge = 0`): over `t_ln` before the edge the fly axis slows from `v_scan` by `v_diff`
+/// (its acceleration linear from 0), then stops with apex acceleration `a_max`. Returns
+/// `(t_out, t_add, t_out + t_add)` (s):
+/// `t_out = 2 t_ln (v_scan - v_diff)/(2 v_diff + a_max t_ln)`,
+/// `t_add = t_ln v_diff/(3 v_scan)` (the scan time lost inside the region).
+pub fn slowdown_fly_overhead_s(v_scan: f64, a_max: f64, t_ln: f64, v_diff: f64) -> (f64, f64, f64) {
     let t_out = 2.0 * t_ln * (v_scan - v_diff) / (2.0 * v_diff + a_max * t_ln);
     let t_add = t_ln * v_diff / (3.0 * v_scan);
     (t_out, t_add, t_out + t_add)

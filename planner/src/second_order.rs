@@ -8,7 +8,7 @@
 //! and down-up the mirror; with a cruise, `vp` is `vmax` or `vmin`. (Up-up and down-down
 //! cover a fixed distance, `(vf^2 - v0^2)/(2a)`, and are a candidate only for exactly that
 //! distance.) For a given duration the highest-reaching profile is up-down, or up, cruise
-//! at `vmax`, down; the lowest the mirror; a mixture of the two (see `blend`) reaches any
+//! at `vmax`, down; the lowest the mirror; a mixture of the two (see `mixture`) reaches any
 //! distance between.
 
 use crate::segs::{Push, Segs};
@@ -183,7 +183,7 @@ pub(crate) fn lasting(
         hi.segments(&mut x);
         lo.segments(&mut y);
         let lambda = ((dp - lo.dist) / (hi.dist - lo.dist)).clamp(0.0, 1.0);
-        crate::blend::blend(x.as_slice(), y.as_slice(), s.a, lambda, out);
+        crate::mixture::mix(x.as_slice(), y.as_slice(), s.a, lambda, out);
     }
     true
 }

@@ -4,7 +4,7 @@ use crate::Segment;
 
 /// Up to `CAP` segments, without heap allocation. The default capacity holds any profile
 /// a planner builds (a brake and a seven-segment body, or one of the two profiles a
-/// step-2 blend mixes).
+/// step-2 mixture combines, see `mixture`).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Segs<const CAP: usize = 8> {
     s: [Segment; CAP],

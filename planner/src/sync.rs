@@ -1,4 +1,5 @@
-//! Several axes: each axis's fastest profile, then all fitted to the slowest (house rule 3).
+//! Several axes: each axis's fastest profile (step 1), then all fitted to the slowest
+//! (step 2), as Ruckig synchronises axes.
 //!
 //! - `None`: every axis on its own, fastest.
 //! - `Time`: every axis finishes together, at the earliest duration every axis can meet
@@ -103,7 +104,7 @@ fn all_at(fastest: &[Planned], t: f64) -> Result<Option<Vec<Profile>>, PlanError
                 axis: i,
                 source: Box::new(e),
             })?);
-        } else if let Some(p) = f.lasting(t).map_err(|e| PlanError::OnAxis {
+        } else if let Some(p) = crate::duration::lasting(f, t).map_err(|e| PlanError::OnAxis {
             axis: i,
             source: Box::new(e),
         })? {

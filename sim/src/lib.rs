@@ -6,10 +6,14 @@
 //! microstep-quantised command, or the full [`stepper`] driver). Every backend simulates
 //! that same model behind the [`Plant`] trait:
 //! - [`ModalPlant`]: the exact discretisation of the linear model (the reference);
-//! - [`RapierPlant`]: rigid bodies in rapier3d (f64), couplings and driver as forces.
+//! - [`RapierPlant`]: rigid bodies in rapier3d (f64), couplings and driver as forces;
+//! - `mujoco::MujocoPlant` (cargo feature `mujoco`): the model as MJCF, stepped by the
+//!   MuJoCo library ([`mujoco_status`] says whether it is built).
 //!
-//! [`closed_form`] gives the residual vibration analytically, so the plants can be checked
-//! against an independent formula.
+//! Backends never import each other: what they share (the explicit step bound, the start
+//! equilibrium) is in [`numerics`]. [`closed_form`] gives the residual vibration
+//! analytically, so the plants can be checked against an independent formula; [`pencil`]
+//! measures modes from a free response (the matrix pencil method).
 
 mod axis;
 pub mod closed_form;
@@ -21,6 +25,7 @@ mod mode;
 #[cfg(feature = "mujoco")]
 pub mod mujoco;
 pub mod mujoco_status;
+pub mod numerics;
 pub mod pencil;
 mod plant;
 pub mod rapier;

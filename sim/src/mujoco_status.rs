@@ -3,7 +3,7 @@
 
 use crate::SimError;
 
-/// True when settle-sim was built with the `mujoco` feature ([`crate::mujoco`] exists).
+/// True when settle-sim was built with the `mujoco` feature (the `mujoco` module exists).
 pub const BUILT: bool = cfg!(feature = "mujoco");
 
 /// What to do when the MuJoCo backend is asked for but not built in.

@@ -21,28 +21,19 @@
 //! Couplings are evaluated with the commanded state at the start of each step; steps never
 //! straddle a profile breakpoint (the harness splits them). The full stepper driver's
 //! magnetic torque is the mean over the step's kick window `[t - h/2, t + h/2]` instead,
-//! with the microstep edges resolved in time ([`crate::rapier_driver`]): sampled at `t` it
-//! moved every edge by up to `h/2` and was up to 7 % off in residual at the default step.
+//! with the microstep edges resolved in time (`rapier_driver.rs`): sampling it at `t`
+//! would move every edge by up to `h/2`, up to 7 % off in residual at the default step.
 
 use rapier3d_f64::prelude::*;
 use settle_planner::{Sample, State};
 
 use crate::axis::{AxisModel, DriverMode};
 use crate::lumped::{DofKind, Lumped, Node};
+pub use crate::numerics::{STEP_FRACTION, start_equilibrium};
 use crate::plant::{advance_sample, check_step};
 use crate::rapier_driver::ReferenceCache;
 use crate::stepper::StepperState;
 use crate::{Observation, Plant, SimError};
-
-/// Step size against the fastest mode: `h <= STEP_FRACTION / w_max` ([`fastest_rate`]). Symplectic Euler
-/// shifts a mode of angular frequency `w` by `-(w h)^2 / 24`: at most 0.375 % for the
-/// highest mode (a rotor or mount mode nobody settles on), so every mode stays within the
-/// 0.5 % frequency threshold, and `0.375 % (w / w_max)^2` for the others, e.g. 0.006 % for
-/// a 43 Hz belt mode under a 345 Hz mount mode. The damping terms use velocities advanced
-/// to the force instant (second order), so the damping error is of the same order.
-/// `settle validate` and the tests measure both. (At 10 kHz sampling the printer preset
-/// needs no substeps: its `h_max` is 0.14 ms.)
-pub const STEP_FRACTION: f64 = 0.3;
 
 /// How a position-dependent stiffness (a belt's spans) is treated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -165,33 +156,6 @@ pub fn fastest_rate(axis: &AxisModel, start_m: f64) -> Result<f64, SimError> {
         .iter()
         .map(|l| l.norm())
         .fold(0.0, f64::max))
-}
-
-/// The start configuration of an axis for a command at rest at `start_m`: body
-/// coordinates and the driver state (full mode: the rotor where magnetic torque balances
-/// the detent; otherwise the linear spring's equilibrium).
-pub fn start_equilibrium(
-    axis: &AxisModel,
-    start_m: f64,
-) -> Result<(Vec<f64>, Option<StepperState>), SimError> {
-    match (axis.mode, &axis.stepper) {
-        (DriverMode::Full, Some(s)) => {
-            let (st, theta) = s.at_rest(start_m);
-            let q = axis.lumped.equilibrium(start_m, Some((s.rotor, theta)))?;
-            Ok((q, Some(st)))
-        }
-        (_, stepper) => {
-            let x = axis.command_node_m(start_m);
-            let q = axis.lumped.equilibrium(x, None)?;
-            let st = stepper.as_ref().map(|s| {
-                let mut st = s.at_rest(start_m).0;
-                s.track_spring(&mut st, q[s.rotor], x);
-                st.max_load_angle_rad = st.load_angle_rad.abs();
-                st
-            });
-            Ok((q, st))
-        }
-    }
 }
 
 /// Insert an axis's bodies into the world at coordinates `q` (m, rad), at rest.

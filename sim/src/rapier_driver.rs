@@ -27,7 +27,7 @@
 //! cubic (`x(t) = (k + 1/2) * microstep`); the back-EMF and the torque's rotor angle are
 //! held at the middle of pieces of at most [`MAX_PIECE_ELECTRICAL_RAD`] of rotor travel
 //! (one piece per half step at the printer's speeds). The currents' integrals are exact.
-//! Measured in `sim/tests/rapier_full_step.rs` against a 16x smaller step.
+//! Measured in `sim/tests/all/rapier_full_step.rs` against a 16x smaller step.
 
 use settle_planner::Sample;
 
@@ -115,8 +115,8 @@ impl Stepper {
     /// rotor on the line `theta(tau) = theta_at + omega (tau - tau_at)` (rad, rad/s).
     /// Returns the magnetic torque's integral over the span (N m s): exact in the currents
     /// (closed form between microstep edges found in time), midpoint rule in the rotor
-    /// angle over pieces of at most [`MAX_PIECE_ELECTRICAL_RAD`]. `cache` keeps the last
-    /// microstep's reference (one per axis and run; [`ReferenceCache::default`] to start).
+    /// angle over pieces of at most `MAX_PIECE_ELECTRICAL_RAD`. `cache` keeps the last
+    /// microstep's reference (one per axis and run; `ReferenceCache::default()` to start).
     #[allow(clippy::too_many_arguments)]
     pub fn advance_span(
         &self,

@@ -454,7 +454,7 @@ impl Stepper {
     /// the angle the mean is the value at the predicted midpoint, which adds no numerical
     /// damping to a spring integrated that way; unlike the midpoint value it also carries
     /// the microstep edges and current transients inside the step with their timing
-    /// (see `sim/tests/mujoco_step_budget.rs` for the printer's Y axis against a 4x
+    /// (see `sim/tests/all/mujoco_step_budget.rs` for the printer's Y axis against a 4x
     /// smaller step).
     ///
     /// Each electrical sub-step (at most [`ELECTRICAL_SUBSTEP_S`], an even number of them)

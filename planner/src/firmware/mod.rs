@@ -57,14 +57,10 @@
 //! ```
 
 pub mod klipper;
-mod klipper_queue;
 pub mod marlin;
-mod marlin_block;
-mod marlin_trapezoid;
 mod planned;
 pub mod profiles;
 pub mod rrf;
-mod rrf_dda;
 mod timeline;
 
 pub use planned::{MAX_PHASES, PathState, Phase, PlannedMove, RampShape};

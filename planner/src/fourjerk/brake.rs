@@ -1,17 +1,18 @@
-//! The brake law under four jerks (seed 004 step 2): a start whose velocity is, or must
-//! become, beyond VMAX lowers its acceleration at full jerk (`j2` while positive, `j3`
-//! once negative) and holds DMAX once there, until it may stop braking.
+//! The brake law under four jerks (the velocity brake of `crate::brake`, each arc at its
+//! own jerk): a start whose velocity is, or must become, beyond VMAX lowers its
+//! acceleration at full jerk (`j2` while positive, `j3` once negative) and holds DMAX once
+//! there, until it may stop braking.
 //!
 //! While `a > 0` this keeps `vz = v + a^2/(2 j2)` (the velocity after ramping the
 //! acceleration to zero at once) constant; once `a < 0`, `vz = v - a^2/(2 j4)` falls. Braking
 //! may stop anywhere from the moment `vz` is back on the limit (the earliest: the profile
 //! that follows then meets VMAX exactly) to the moment the velocity itself is (the
 //! latest), but not after `vz` has fallen below -VMAX (from there the velocity must
-//! overshoot the other way). The total time over that range is not monotone: the planner samples it and
-//! refines the best sample. A negative overshoot is the mirror image.
+//! overshoot the other way). The total time over that range is not monotone: the planner
+//! samples it and refines the best sample. A negative overshoot is the mirror image.
 
-use crate::fourjerk::FourJerkLimits;
-use crate::fourjerk::arcs::{mirror, push_down, push_hold, run, v_zero};
+use super::arc_algebra::{mirror, push_down, push_hold, run, v_zero};
+use super::limits::FourJerkLimits;
 use crate::{Segment, State};
 
 /// The brake law from one start (acceleration within the limits).

@@ -12,8 +12,8 @@
 //!   `(vf, 0)`; a closed form when the cruise is non-negative.
 //! - **DUD** and the cruise at `-vmax`: the same on the mirrored problem.
 
-use crate::fourjerk::FourJerkLimits;
-use crate::fourjerk::arcs::{change_to_zero, mirror, push_down, push_hold, push_up, run};
+use super::arc_algebra::{change_to_zero, mirror, push_down, push_hold, push_up, run};
+use super::limits::FourJerkLimits;
 use crate::{Segment, State};
 
 /// A candidate: duration (s) and segments.

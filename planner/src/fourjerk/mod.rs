@@ -13,78 +13,33 @@
 //! orients the limits along the move (AMAX and BOW1/BOW2 always speed the axis up, as on
 //! the chip); [`plan`] uses them in the axis frame as given.
 //!
-//! A start outside the limits is handled as in seed 004: an acceleration beyond AMAX/DMAX
-//! is first brought back at full jerk; a velocity that is (or must become) beyond VMAX is
-//! braked along the brake law (see `brake`), stopping at the best time in its range. From
-//! there the candidates (see `families`) are the three-arc family in both senses (which
-//! contains the peak-velocity profiles without cruise) and the cruise at `+-vmax`; the
-//! velocity limit binds from the moment the state is safe (velocity inside, and the
-//! velocity after ramping the acceleration to zero at once inside too). The fastest valid
-//! profile is returned, after checking that it ends on the target.
+//! A start outside the limits is handled as by the one-jerk planner (`crate::brake`): an
+//! acceleration beyond AMAX/DMAX is first brought back at full jerk; a velocity that is (or
+//! must become) beyond VMAX is braked along the brake law (see `brake`), stopping at the
+//! best time in its range. From there the candidates (see `families`) are the three-arc
+//! family in both senses (which contains the peak-velocity profiles without cruise) and the
+//! cruise at `+-vmax`; the velocity limit binds from the moment the state is safe (velocity
+//! inside, and the velocity after ramping the acceleration to zero at once inside too). The
+//! fastest valid profile is returned, after checking that it ends on the target.
 //!
-//! No other tool plans this (Ruckig has one jerk limit); `planner/tests/fourjerk.rs` checks
+//! No other tool plans this (Ruckig has one jerk limit); `planner/tests/all/fourjerk.rs` checks
 //! optimality against an independent search over arc durations and the symmetric case
 //! against [`crate::position::to_state`].
 
-mod arcs;
+mod arc_algebra;
 mod brake;
 mod families;
+mod limits;
 
-use crate::{Limits, PlanError, Profile, Segment, State};
+pub use limits::FourJerkLimits;
 
-/// Limits of the four-jerk planner (symmetric velocity limit; magnitudes, all > 0).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FourJerkLimits {
-    /// Speed limit (u/s).
-    pub vmax: f64,
-    /// Upper acceleration limit (u/s^2): `a <= amax`.
-    pub amax: f64,
-    /// Lower acceleration limit magnitude (u/s^2): `a >= -dmax`.
-    pub dmax: f64,
-    /// `[j1, j2, j3, j4]` (u/s^3): raise `a >= 0`, lower `a > 0`, lower `a <= 0`,
-    /// raise `a < 0`.
-    pub jerk: [f64; 4],
-}
-
-impl FourJerkLimits {
-    /// Validated limits (every value finite and > 0, named in the error).
-    pub fn new(vmax: f64, amax: f64, dmax: f64, jerk: [f64; 4]) -> Result<Self, PlanError> {
-        let named = [
-            ("vmax", vmax),
-            ("amax", amax),
-            ("dmax", dmax),
-            ("j1", jerk[0]),
-            ("j2", jerk[1]),
-            ("j3", jerk[2]),
-            ("j4", jerk[3]),
-        ];
-        for (name, value) in named {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(PlanError::InvalidLimit { name, value });
-            }
-        }
-        Ok(Self {
-            vmax,
-            amax,
-            dmax,
-            jerk,
-        })
-    }
-
-    /// The symmetric special case of `lim` (needs a jerk limit; uses `vmax`, `amax`).
-    pub fn symmetric(lim: &Limits) -> Result<Self, PlanError> {
-        let j = lim
-            .jmax()
-            .ok_or(PlanError::MissingJerkLimit { kind: "fourjerk" })?;
-        Self::new(lim.vmax(), lim.amax(), lim.amax(), [j; 4])
-    }
-}
+use crate::{PlanError, Profile, Segment, State};
 
 /// Does the profile after the brake keep the limits? The acceleration must stay inside
 /// (the caller starts inside). A velocity outside the band (left over from braking) must
-/// move strictly monotonically back towards it (no cruise out there); once inside, it must stay inside (checked on the
-/// monotone pieces of each segment, so it cannot slip through the band between segment
-/// ends).
+/// move strictly monotonically back towards it (no cruise out there); once inside, it must
+/// stay inside (checked on the monotone pieces of each segment, so it cannot slip through
+/// the band between segment ends).
 fn valid(start: State, segs: &[Segment], l: &FourJerkLimits) -> bool {
     let tol = 1e-9;
     let (amax, amin) = (l.amax * (1.0 + tol), -l.dmax * (1.0 + tol));
@@ -149,11 +104,11 @@ pub fn plan(start: State, target: State, l: &FourJerkLimits) -> Result<Profile, 
     let mut pre = Vec::new();
     let mut s = start;
     if s.a > l.amax {
-        arcs::push_down(&mut pre, s.a, l.amax, l);
+        arc_algebra::push_down(&mut pre, s.a, l.amax, l);
     } else if s.a < -l.dmax {
-        arcs::push_up(&mut pre, s.a, -l.dmax, l);
+        arc_algebra::push_up(&mut pre, s.a, -l.dmax, l);
     }
-    s = arcs::run(s, &pre);
+    s = arc_algebra::run(s, &pre);
     s.a = s.a.clamp(-l.dmax, l.amax);
     // Brake where the velocity overshoots, stopping at the best time in the law's range;
     // from the stop, the fastest valid candidate.

@@ -1,4 +1,5 @@
-//! Oracle (test only): the bracketing implementation of step 2 that `fixed` replaced.
+//! Oracle (test only): a bracketing implementation of step 2, to check the closed forms of
+//! `fixed`.
 //!
 //! Longer than the fastest profile, the peak-velocity family stretches: with peak `vp` and
 //! cruise `(dp - D(vp))/vp >= 0` the total time `T(vp) + (dp - D(vp))/vp` falls

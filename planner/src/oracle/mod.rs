@@ -1,5 +1,5 @@
-//! Test-only oracle: the bracketing implementation of the any-state planner (step 1) and
-//! of step 2 that the closed-form cases replaced. It is slow (it samples every one-
+//! Test-only oracle: a bracketing implementation of the any-state planner (step 1) and
+//! of step 2, independent of the closed-form cases. It is slow (it samples every one-
 //! parameter family on a grid and bisects every sign change) but independent of the
 //! closed forms, so the property tests in `tests` check that both agree on random
 //! problems.

@@ -1,5 +1,5 @@
-//! Oracle (test only): the bracketing implementation of step 1 that the closed-form cases
-//! replaced, kept to check them. Peak-velocity family: an acceleration phase to a peak
+//! Oracle (test only): a bracketing implementation of step 1, independent of the
+//! closed-form cases, to check them. Peak-velocity family: an acceleration phase to a peak
 //! velocity `vp` (ending with `a = 0`), a cruise at `vp`, and a phase to the target; the
 //! no-cruise roots of `D(vp) = dp` are found by bracketing every sign change between the
 //! structural breakpoints and bisecting to full precision, plus the three-arc family

@@ -1,5 +1,5 @@
-//! Oracle (test only): time synchronisation as it was before the closed-form step 2 (all
-//! branch starts computed up front, each duration tried with the bracketing step 2).
+//! Oracle (test only): time synchronisation without the closed-form step 2 (all branch
+//! starts computed up front, each duration tried with the bracketing step 2).
 
 use super::duration::{branch_starts, with_duration};
 use super::peak::to_state;

@@ -1,4 +1,4 @@
-//! Seed 001: the jerk-limited corner blend.
+//! The jerk-limited corner blend.
 //!
 //! Instead of stopping at the corner `p1` of `p0 -> p1 -> p2`, the toolhead leaves the first
 //! segment a distance `d` before `p1` at speed `s` and joins the second segment `d` after
@@ -69,12 +69,12 @@ pub struct BlendShape {
     pub deviation_m: f64,
 }
 
-/// Seed 001, triangle case: `d = s sqrt(2 s cos(theta/2) / jlimit)`.
+/// Triangle case: `d = s sqrt(2 s cos(theta/2) / jlimit)`.
 pub fn distance_triangle(s: f64, theta: f64, jlimit: f64) -> f64 {
     s * (2.0 * s * (0.5 * theta).cos() / jlimit).sqrt()
 }
 
-/// Seed 001, trapezoid case: `d = s^2 cos(theta/2)/alimit + 0.5 s alimit/jlimit`.
+/// Trapezoid case: `d = s^2 cos(theta/2)/alimit + 0.5 s alimit/jlimit`.
 pub fn distance_trapezoid(s: f64, theta: f64, alimit: f64, jlimit: f64) -> f64 {
     s * s * (0.5 * theta).cos() / alimit + 0.5 * s * alimit / jlimit
 }
@@ -261,7 +261,7 @@ mod tests {
     use std::f64::consts::PI;
 
     #[test]
-    fn cases_agree_with_the_seed_closed_forms() {
+    fn cases_agree_with_the_closed_forms() {
         let (a, j) = (2.0, 50.0);
         for s in [0.01, 0.05, 0.2, 1.0] {
             for deg in [1.0_f64, 30.0, 90.0, 150.0, 179.0] {

@@ -10,9 +10,9 @@
 
 use super::blend::BlendCase;
 use super::bvh::Bvh;
-use super::poly;
+use super::distance_poly::distance_roots;
+use super::polyline::{PathPoint, PointKind};
 use super::vector::{V3, add, axpy, dist, dot, from_slice, scale, sub};
-use super::{PathPoint, PointKind};
 
 /// One primitive of a path.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,7 +71,7 @@ impl Primitive {
 
     /// Minimise `|p(t) - q|^2` over `[0, T]`: the minimum is at an end or at a root of
     /// `h(t) = (p(t) - q) . p'(t)`, a quintic, all of whose roots in `[0, T]` are found
-    /// (see `poly`), so no local minimum is missed however tightly the arc turns.
+    /// (see `distance_poly`), so no local minimum is missed however tightly the arc turns.
     fn arc_distance(&self, q: V3, total: f64) -> f64 {
         let Primitive::Arc { p0, v0, a0, j, .. } = *self else {
             return self.distance(q);
@@ -86,7 +86,7 @@ impl Primitive {
         }
         let mut best = dist(self.point_at(0.0), q).min(dist(self.point_at(total), q));
         let mut roots = [0.0; 5];
-        let n = poly::roots_in(&h, 0.0, total, &mut roots);
+        let n = distance_roots(&h, 0.0, total, &mut roots);
         for &t in &roots[..n] {
             best = best.min(dist(self.point_at(t), q));
         }
@@ -135,7 +135,8 @@ pub enum CornerTransition {
     Stop,
     /// Straight through (no direction change) at the planned speed.
     Pass,
-    /// Seed 001's blend: leaves `distance_m` before the point, rejoins `distance_m` after.
+    /// The jerk-limited corner blend ([`super::blend`]): leaves `distance_m` before the
+    /// point, rejoins `distance_m` after.
     Blend {
         /// Which acceleration shape.
         case: BlendCase,

@@ -1,16 +1,16 @@
-//! How a path segment changes its speed between corners: seed 002's attack (accelerate),
-//! sustain (cruise) and release (decelerate), with the speed-change law pluggable.
+//! How a path segment changes its speed between corners: attack (accelerate), sustain
+//! (cruise) and release (decelerate), with the speed-change law pluggable.
 //!
 //! A [`SpeedLaw`] answers one question: the fastest change of the path speed from `v0` to
 //! `v1`, starting and ending with zero path acceleration, as profile segments of the path
-//! coordinate. Everything else is derived from it: the distance a change needs (seed 002's
+//! coordinate. Everything else is derived from it: the distance a change needs (the
 //! *minimum segment length*: a segment entered at `v0 > 0` needs at least the distance of
 //! the change to its exit speed), the highest speed reachable within a length, and the
 //! segment profile (attack to a peak speed, sustain, release; the peak is `vmax` when the
 //! segment is long enough, else the highest peak whose attack and release fit).
 //!
 //! Laws here: [`TrapezoidLaw`] (acceleration steps), [`SCurveLaw`] (symmetric jerk) and
-//! [`FourJerkLaw`] (seed 000's four independent jerks: `j1` raises and `j2` lowers the
+//! [`FourJerkLaw`] (the TMC4361A's four independent jerks: `j1` raises and `j2` lowers the
 //! acceleration of an attack, `j3` raises and `j4` lowers the deceleration of a release).
 //! Another planner (e.g. a Trinamic register-level ramp) plugs in by implementing the
 //! trait.
@@ -171,7 +171,7 @@ impl SpeedLaw for SCurveLaw {
     }
 }
 
-/// Seed 000's four-jerk ramp as a speed law: an attack raises the acceleration with `j1`
+/// The TMC4361A's four-jerk ramp as a speed law: an attack raises the acceleration with `j1`
 /// to at most `amax` and lowers it with `j2`; a release raises the deceleration with `j3`
 /// to at most `dmax` and lowers it with `j4` (Trinamic's BOW1..BOW4, AMAX, DMAX).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -260,12 +260,12 @@ pub(crate) fn largest(lo: f64, hi: f64, ok: impl Fn(f64) -> bool) -> f64 {
     lo
 }
 
-/// Seed 002's minimum segment length: the distance the change `v0 -> v1` needs (m).
+/// The minimum segment length: the distance the change `v0 -> v1` needs (m).
 pub fn min_length(law: &dyn SpeedLaw, v0: f64, v1: f64) -> f64 {
     law.change(v0, v1).distance_m
 }
 
-/// Seed 002's maximum segment length for a segment of `duration_s` entered at `v0` and
+/// The maximum segment length for a segment of `duration_s` entered at `v0` and
 /// left at `v1` under `vmax`: attack to the highest peak whose attack and release fit the
 /// time, sustain for the rest (m). `None` if even the direct change takes longer.
 pub fn max_length(law: &dyn SpeedLaw, v0: f64, v1: f64, duration_s: f64, vmax: f64) -> Option<f64> {

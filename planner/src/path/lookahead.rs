@@ -1,4 +1,4 @@
-//! Look-ahead over a path (seed 002): corner speeds by backward and forward passes, then
+//! Look-ahead over a path: corner speeds by backward and forward passes, then
 //! the per-segment attack/sustain/release profiles and the corner transitions, assembled
 //! into a multi-axis [`Trajectory`] carrying its [`PathGeometry`].
 //!
@@ -8,7 +8,7 @@
 //! for its transition at speed `v` (the blend distance; half the velocity-jump window for
 //! sharp corners). The straight run of segment `k` is what the two transitions leave,
 //! `l_k = L_k - d_k(v_k) - d_{k+1}(v_{k+1})`, and must hold the speed change:
-//! `l_k >= D(v_k -> v_{k+1})` (the law's change distance, seed 002's minimum length).
+//! `l_k >= D(v_k -> v_{k+1})` (the law's change distance: the minimum segment length).
 //! The backward pass lowers each speed so that the next one can be reached decelerating;
 //! the forward pass lowers each so that it can be reached accelerating. Both are bisections
 //! on monotone conditions (`d` and `D` grow with the higher speed). Caps keep
@@ -26,8 +26,8 @@ use super::geometry::{CornerPlan, CornerTransition, PathGeometry, Primitive};
 use super::junction::Junction;
 use super::law::{self, SpeedLaw, largest};
 use super::pieces::{Piece, VSeg, VState, profiles};
+use super::polyline::{Path, PathPoint, PointKind, interior_angle};
 use super::vector::{axpy, norm, scale, sub};
-use super::{Path, PathPoint, PointKind, interior_angle};
 use crate::{Limits, PlanError, ProfileKind, Trajectory};
 
 /// How control points are passed.
@@ -39,8 +39,9 @@ pub enum CornerStrategy {
     /// change of the velocity vector (written as a constant acceleration over
     /// [`PathOptions::velocity_jump_s`]).
     Junction(Junction),
-    /// Seed 001's jerk-limited blend, at the highest speed whose deviation from the corner
-    /// is at most `max_deviation_m` (m) and whose distance fits half of each segment.
+    /// The jerk-limited corner blend ([`super::blend`]), at the highest speed whose
+    /// deviation from the corner is at most `max_deviation_m` (m) and whose distance fits
+    /// half of each segment.
     Blend {
         /// Largest allowed distance between the corner and the blend (m), >= 0.
         max_deviation_m: f64,

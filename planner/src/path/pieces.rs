@@ -4,7 +4,7 @@
 //! Every piece starts and ends with zero acceleration (a velocity jump resets it), so the
 //! per-axis profiles are the pieces' segments side by side. All axes share every segment
 //! boundary; on a straight run each axis is the path coordinate times the direction
-//! component, which keeps the motion on the line (seed 002's aligned breaks).
+//! component, which keeps the motion on the line (every axis breaks where the path does).
 
 use super::vector::{V3, add, axpy, scale};
 use crate::{PlanError, Profile, Segment, State};

@@ -8,7 +8,7 @@
 //! the planned [`super::CornerPlan::deviation_m`] for one that follows the plan exactly.
 //! Each update is a binary search over the windows, `O(log n)`.
 
-use super::PathGeometry;
+use super::geometry::PathGeometry;
 use super::vector::{dist, from_slice};
 
 /// Streaming corner-rounding accumulator.

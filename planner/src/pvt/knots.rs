@@ -1,10 +1,11 @@
 //! A PVT move: knots `(t, x, v)` joined by linear-acceleration segments, as a [`Profile`].
 //!
 //! Position and velocity are continuous by construction; the acceleration is continuous
-//! at a knot only if the two segments meeting there agree (the seed's moves are designed
-//! so; [`Pvt::accel_jump`] and [`crate::pvt::check`] report it when not). A jump is written
-//! as a zero-duration [`Segment::Accel`] in the profile (a jerk impulse), a segment of
-//! constant acceleration as a [`Segment::Accel`] of its duration.
+//! at a knot only if the two segments meeting there agree (the turnarounds and step moves
+//! of this module are designed so; [`Pvt::accel_jump`] and [`crate::pvt::check()`] report it
+//! when not). A jump is written as a zero-duration [`Segment::Accel`] in the profile (a
+//! jerk impulse), a segment of constant acceleration as a [`Segment::Accel`] of its
+//! duration.
 
 use crate::pvt::segment::accels;
 use crate::{PlanError, Profile, Segment, State};
@@ -32,7 +33,7 @@ impl Knot {
 pub struct Pvt {
     /// The knots, times strictly increasing.
     pub knots: Vec<Knot>,
-    /// `(a_start, a_end)` of each segment (u/s^2), from the seed's formulas.
+    /// `(a_start, a_end)` of each segment (u/s^2), from [`crate::pvt::segment::accels`].
     pub accels: Vec<(f64, f64)>,
     /// Acceleration before the first knot (u/s^2; 0 for a move from rest).
     pub start_accel: f64,
@@ -45,7 +46,7 @@ pub struct Pvt {
 impl Pvt {
     /// A move through `knots` (at least two, times strictly increasing, values finite),
     /// with the acceleration `start_accel` before and `end_accel` after it. Each segment's
-    /// accelerations come from its knots (seed 003's `p_a0_1`, `p_a1_1`).
+    /// accelerations come from its knots ([`crate::pvt::segment::accels`]).
     pub fn new(knots: Vec<Knot>, start_accel: f64, end_accel: f64) -> Result<Self, PlanError> {
         validate(&knots, start_accel, end_accel)?;
         let acc = knots

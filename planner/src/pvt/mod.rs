@@ -1,4 +1,4 @@
-//! PVT moves (seed 003): segments with linear acceleration between knots given by time,
+//! PVT moves: segments with linear acceleration between knots given by time,
 //! position and velocity, their feasibility against limits, the raster turnarounds and the
 //! symmetric and asymmetric step moves. Every move is also a [`crate::Profile`] (one
 //! constant-jerk segment per PVT segment, plus a zero-length acceleration step where the

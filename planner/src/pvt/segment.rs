@@ -1,16 +1,16 @@
-//! The PVT building block (seed 003 §1): over a segment of duration `t` the acceleration is
+//! The PVT building block: over a segment of duration `t` the acceleration is
 //! linear from `a0` to `a1` (constant jerk `(a1 - a0)/t`), so
 //!
-//! - `x1 = x0 + v0 t + a0 t^2/2 + (a1 - a0) t^2/6`, `v1 = v0 + (a0 + a1) t/2` (§1.1);
+//! - `x1 = x0 + v0 t + a0 t^2/2 + (a1 - a0) t^2/6`, `v1 = v0 + (a0 + a1) t/2`;
 //! - given both ends `(x0, v0)`, `(x1, v1)` and `t`:
 //!   `a0 = (6 (x1 - x0) - 4 t v0 - 2 t v1)/t^2`,
-//!   `a1 = -(6 (x1 - x0) - 2 t v0 - 4 t v1)/t^2` (§1.2, `p_a0_1`, `p_a1_1`);
+//!   `a1 = -(6 (x1 - x0) - 2 t v0 - 4 t v1)/t^2`;
 //! - given both ends and `a0`, the duration solves `a0 t^2/6 + (2 v0 + v1) t/3 = x1 - x0`:
-//!   `t = 6 (x1 - x0)/((2 v0 + v1) +- sqrt((2 v0 + v1)^2 + 6 a0 (x1 - x0)))` (§1.2, `s_t1_1`,
-//!   `s_t1_2`; the seed's printout lost the parentheses of the denominators).
+//!   `t = 6 (x1 - x0)/((2 v0 + v1) +- sqrt((2 v0 + v1)^2 + 6 a0 (x1 - x0)))` (the
+//!   quadratic's roots written cancellation free).
 //!
 //! All three are checked against each other and against [`crate::Segment`] integration in
-//! `planner/tests/pvt.rs`.
+//! `planner/tests/all/pvt.rs`.
 
 /// End position and velocity of a segment: `(x1, v1)`.
 pub fn end(x0: f64, v0: f64, a0: f64, a1: f64, t: f64) -> (f64, f64) {
@@ -21,7 +21,7 @@ pub fn end(x0: f64, v0: f64, a0: f64, a1: f64, t: f64) -> (f64, f64) {
 }
 
 /// Start and end acceleration `(a0, a1)` of the segment through `(x0, v0)` and `(x1, v1)`
-/// lasting `t > 0` (seed `p_a0_1`, `p_a1_1`).
+/// lasting `t > 0`.
 pub fn accels(x0: f64, v0: f64, x1: f64, v1: f64, t: f64) -> (f64, f64) {
     let dx = x1 - x0;
     (
@@ -31,7 +31,7 @@ pub fn accels(x0: f64, v0: f64, x1: f64, v1: f64, t: f64) -> (f64, f64) {
 }
 
 /// The durations `t > 0` of segments from `(x0, v0)` with start acceleration `a0` that
-/// arrive at `(x1, v1)` (seed `s_t1_1`, `s_t1_2`): up to two, smallest first. The end
+/// arrive at `(x1, v1)`: up to two, smallest first. The end
 /// acceleration of each is then `2 (v1 - v0)/t - a0`.
 pub fn durations_given_a0(x0: f64, v0: f64, a0: f64, x1: f64, v1: f64) -> Vec<f64> {
     let dx = x1 - x0;

@@ -1,25 +1,25 @@
-//! Rest-to-rest step moves from PVT segments (seed 003 §3 and §4.4).
+//! Rest-to-rest step moves from PVT segments.
 //!
-//! **Symmetric** (§3): the acceleration is `0 -> A` over `t0`, held at `A` over `t1`,
-//! `A -> -A` over `t2`, held at `-A` over `t1`, `-A -> 0` over `t0` (knots at the seed's
-//! `Ki/2`, `Ko/2`, `1 - Ko/2`, `1 - Ki/2` fractions of the step, "a mid PVT move which is
-//! constant acceleration at maximum acceleration"). Within the limits the fastest member is
+//! **Symmetric**: the acceleration is `0 -> A` over `t0`, held at `A` over `t1`,
+//! `A -> -A` over `t2`, held at `-A` over `t1`, `-A -> 0` over `t0` (knots at the
+//! `Ki/2`, `Ko/2`, `1 - Ko/2`, `1 - Ki/2` fractions of the step; the middle segments
+//! hold the maximum acceleration). Within the limits the fastest member is
 //! `t0 = A/jmax`, `t2 = 2 t0`, `A <= amax`: the time-optimal S-curve; when `vmax` would be
-//! exceeded a constant-velocity segment splits the middle one (the seed's "+1"). It is
+//! exceeded a constant-velocity segment splits the middle one (the "+1" segment). It is
 //! planned from [`crate::scurve::timing`] and written as PVT knots.
 //!
-//! **Asymmetric** (§4.4, "asymmetric move in symmetric time frame", `t4 = t0`, continuous
+//! **Asymmetric** (an asymmetric move in a symmetric time frame, `t4 = t0`, continuous
 //! acceleration): four segments `t0, t1, t1, t0` with accelerations `0 -> a0 -> -a0 -> -a0
-//! -> a3 -> 0` (the seed's 5-segment move with `t2 = 0`, `a1 = a2 = -a0`). Peak acceleration
-//! and peak jerk come in the first half ("to improve settling"). With `Ki` the fraction of
-//! the step covered at the first knot times two, the seed's closed form is, in units of the
-//! step `d` and `t1`:
+//! -> a3 -> 0` (a 5-segment move with `t2 = 0`, `a1 = a2 = -a0`). Peak acceleration and
+//! peak jerk come in the first half, so the move ends gently (the intent is less residual
+//! vibration; the scan sweeps measure it). With `Ki` the fraction of the step covered at
+//! the first knot times two, the closed form is, in units of the step `d` and `t1`:
 //! `Ko = (3Ki^2 - Ki)/(Ki + 1)`, `t0 = t4 = 2Ki/(1 - Ki) t1`, `x0 = Ki/2`,
 //! `x1 = -(Ki^2 - 4Ki - 1)/(8Ki)`, `x3 = 1 - Ko/2`, `v0 = v1 = 3(1 - Ki)/4`,
 //! `v3 = -(9Ki^2 - 12Ki + 3)/(4Ki + 4)`, `a0 = (3Ki^2 - 6Ki + 3)/(4Ki)`,
 //! `a3 = -(9Ki^3 - 21Ki^2 + 15Ki - 3)/(4Ki^2 + 4Ki)`. Valid for `1/3 < Ki < 1` (`Ko > 0`,
 //! `a3 < 0`). The shape is fixed by `Ki`; `t1` is the smallest that keeps acceleration,
-//! jerk and velocity within the limits. `planner/tests/pvt.rs` checks the closed form
+//! jerk and velocity within the limits. `planner/tests/all/pvt.rs` checks the closed form
 //! against the PVT equations.
 
 use crate::pvt::{Knot, Pvt};
@@ -102,11 +102,11 @@ pub fn symmetric(x0: f64, d: f64, lim: &Limits) -> Result<Pvt, PlanError> {
     Pvt::with_accels(knots, acc, 0.0, 0.0)?.shifted(x0)
 }
 
-/// The seed's asymmetric shape for one `Ki`, in units of the step `d` and the segment time
+/// The asymmetric shape for one `Ki`, in units of the step `d` and the segment time
 /// `t1` (positions in `d`, times in `t1`, velocities in `d/t1`, accelerations in `d/t1^2`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AsymShape {
-    /// The seed's `Ki` (1/3 < Ki < 1).
+    /// `Ki`: twice the fraction of the step covered at the first knot (1/3 < Ki < 1).
     pub ki: f64,
     /// `Ko = (3Ki^2 - Ki)/(Ki + 1)`.
     pub ko: f64,
@@ -192,8 +192,8 @@ impl AsymShape {
     }
 }
 
-/// The fastest asymmetric PVT step of signed `d` from `x0` with the seed's shape `ki`
-/// (default 0.5, the seed's `Ki: 1/2`) under `lim` (needs jmax).
+/// The fastest asymmetric PVT step of signed `d` from `x0` with the shape `ki` (see
+/// [`AsymShape::ki`]; the kind's default is 0.5) under `lim` (needs jmax).
 pub fn asymmetric(x0: f64, d: f64, ki: f64, lim: &Limits) -> Result<Pvt, PlanError> {
     check_d(d)?;
     let shape = AsymShape::new(ki)?;

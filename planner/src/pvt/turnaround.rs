@@ -1,29 +1,32 @@
-//! Raster turnarounds from PVT segments (seed 003 §1.2.1 and §2.3).
+//! Raster turnarounds and step-axis moves from PVT segments.
 //!
 //! **Symmetric 2-segment turnaround** (fly axis). At the scan-region edge the axis moves at
 //! `v` with zero acceleration; one segment brings it to rest with the acceleration linear
 //! from 0 to the apex value `-a_apex`, the mirror segment takes it back to `-v` with the
 //! acceleration returning to 0. Solving `a0 = 0`, `v1 = 0` with the PVT formulas gives the
-//! seed's `tOut = -2 v0/a1` and the overtravel `d1Out = -4 v0^2/(3 a1)` (`a1 = -a_apex`).
-//! The jerk is `a_apex/tOut` on both halves.
+//! half time `t_out = -2 v0/a1` and the overtravel `d_out = -4 v0^2/(3 a1)`
+//! (`a1 = -a_apex`). The jerk is `a_apex/t_out` on both halves.
 //!
-//! **Symmetric 4(+1)-segment step** (step axis, seed §2.3, `K = 0` so the move is at rest at
-//! both ends). The acceleration rises linearly from 0 to `a_max` over `t_in`, falls to 0
-//! over `t_out`, stays 0 for `t_edge` (constant velocity, the "+1"), falls to `-a_max` over
-//! `t_out` and returns to 0 over `t_in`. For a step `d` the seed's `tInFn` gives
-//! `t_in = sqrt(tau^2 + 3 d/a_max) - tau - t_out` with `tau = (2 t_out + 3 t_edge)/4`, and
-//! `d2In = a_max t_in^2/6`, `v2In = a_max t_in/2`, `d2Out = a_max t_out (2 t_out + 3 t_in)/6`,
-//! `v2Out = a_max (t_out + t_in)/2`. The test suite rederives the quadratic this comes from.
+//! **Symmetric 4(+1)-segment step** (step axis, at rest at both ends). The acceleration
+//! rises linearly from 0 to `a_max` over `t_in`, falls to 0 over `t_out`, stays 0 for
+//! `t_edge` (constant velocity, the "+1"), falls to `-a_max` over `t_out` and returns to 0
+//! over `t_in`. For a step `d` ([`four_plus_one_rise_s`])
+//! `t_in = sqrt(tau^2 + 3 d/a_max) - tau - t_out` with `tau = (2 t_out + 3 t_edge)/4`; the
+//! first rise covers `a_max t_in^2/6` and reaches `a_max t_in/2`, the fall after it covers
+//! `a_max t_out (2 t_out + 3 t_in)/6` and reaches `a_max (t_out + t_in)/2`
+//! ([`FourPlusOne::d_in`], [`FourPlusOne::v_in`], [`FourPlusOne::d_out`],
+//! [`FourPlusOne::v_edge`]). `planner/tests/all/pvt.rs` rederives the quadratic `t_in`
+//! solves.
 
 use crate::PlanError;
 use crate::pvt::{Knot, Pvt};
 
-/// The seed's symmetric 2-segment turnaround.
+/// The symmetric 2-segment turnaround.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TwoSegment {
-    /// Duration of each half (s): edge to apex, apex to edge (seed `tOut`).
+    /// Duration of each half (s): edge to apex, apex to edge.
     pub t_out_s: f64,
-    /// Overtravel beyond the edge (u, a magnitude; seed `d1Out`).
+    /// Overtravel beyond the edge (u, a magnitude).
     pub d_out: f64,
     /// Acceleration magnitude at the apex (u/s^2).
     pub a_apex: f64,
@@ -60,23 +63,24 @@ impl TwoSegment {
     }
 }
 
-/// The seed's symmetric 4(+1)-segment step move.
+/// The symmetric 4(+1)-segment step move.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FourPlusOne {
     /// Step size (u, > 0).
     pub d: f64,
     /// Peak acceleration (u/s^2).
     pub a_max: f64,
-    /// Rise time of the acceleration at the start, and its fall at the end (s; seed `tIn`).
+    /// Rise time of the acceleration at the start, and its fall at the end (s).
     pub t_in_s: f64,
-    /// Fall/rise time around the constant-velocity edge (s; seed `tOut`).
+    /// Fall/rise time around the constant-velocity edge (s).
     pub t_out_s: f64,
-    /// Constant-velocity time (s; seed `tEdgeTotal`).
+    /// Constant-velocity time (s).
     pub t_edge_s: f64,
 }
 
-/// The seed's `tInFn(tOut, tEdgeTotal, a2Max, d2Step)`.
-pub fn t_in_fn(t_out: f64, t_edge: f64, a_max: f64, d: f64) -> f64 {
+/// The rise time `t_in` (s) of a 4(+1)-segment step of `d` (u) with fall/rise time `t_out`
+/// (s), constant-velocity time `t_edge` (s) and peak acceleration `a_max` (u/s^2).
+pub fn four_plus_one_rise_s(t_out: f64, t_edge: f64, a_max: f64, d: f64) -> f64 {
     (t_out * t_out / 4.0
         + 3.0 * t_edge * t_out / 4.0
         + 9.0 * t_edge * t_edge / 16.0
@@ -104,7 +108,7 @@ pub fn four_plus_one(
             return Err(PlanError::InvalidLimit { name, value });
         }
     }
-    let t_in_s = t_in_fn(t_out, t_edge, a_max, d);
+    let t_in_s = four_plus_one_rise_s(t_out, t_edge, a_max, d);
     if t_in_s.is_nan() || t_in_s < 0.0 {
         return Err(PlanError::InfeasibleTarget {
             reason: "step too short for t_out and t_edge at this acceleration",
@@ -120,19 +124,19 @@ pub fn four_plus_one(
 }
 
 impl FourPlusOne {
-    /// Seed `d2In`: distance after the rise (u).
+    /// Distance after the rise (u): `a_max t_in^2/6`.
     pub fn d_in(&self) -> f64 {
         self.a_max * self.t_in_s * self.t_in_s / 6.0
     }
-    /// Seed `v2In`: velocity after the rise (u/s).
+    /// Velocity after the rise (u/s): `a_max t_in/2`.
     pub fn v_in(&self) -> f64 {
         self.a_max * self.t_in_s / 2.0
     }
-    /// Seed `d2Out`: distance covered during the first `t_out` (u).
+    /// Distance covered during the first `t_out` (u).
     pub fn d_out(&self) -> f64 {
         self.a_max * self.t_out_s * (2.0 * self.t_out_s + 3.0 * self.t_in_s) / 6.0
     }
-    /// Seed `v2Out`: the constant edge velocity (u/s).
+    /// The constant edge velocity (u/s).
     pub fn v_edge(&self) -> f64 {
         self.a_max * (self.t_out_s + self.t_in_s) / 2.0
     }

@@ -346,3 +346,6 @@ impl std::str::FromStr for ShaperKind {
         ShaperKind::parse(s)
     }
 }
+
+/// Amplitudes and times (s) of an impulse train.
+pub(super) type Impulses = (Vec<f64>, Vec<f64>);

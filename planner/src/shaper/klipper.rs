@@ -18,7 +18,7 @@
 
 use std::f64::consts::PI;
 
-use super::Impulses;
+use super::kind::Impulses;
 use super::mzv_solve::least_squares_first_column;
 
 /// Klipper's largest damping ratio per shaper (`max_damping_ratio` in `INPUT_SHAPERS`):

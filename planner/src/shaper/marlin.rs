@@ -22,7 +22,7 @@
 
 use std::f64::consts::PI;
 
-use super::Impulses;
+use super::kind::Impulses;
 use super::kind::MarlinShaper;
 
 pub(super) fn impulses(

@@ -40,9 +40,6 @@ use crate::PlanError;
 /// Klipper's vibration tolerance of the EI family: 5% (a 20x reduction).
 pub const VIBRATION_TOLERANCE: f64 = KLIPPER_V_TOL;
 
-/// Amplitudes and times (s) of an impulse train.
-type Impulses = (Vec<f64>, Vec<f64>);
-
 /// A shaper: impulse amplitudes (as its firmware computes them; Klipper's do not sum to
 /// 1, Marlin's and RepRapFirmware's do) and times (s), the first 0.
 #[derive(Debug, Clone, PartialEq)]

@@ -18,7 +18,7 @@
 //! Single precision where the firmware uses `float`, so `P` and the delays round as on the
 //! board; `lrintf` rounds half to even.
 
-use super::Impulses;
+use super::kind::Impulses;
 use super::kind::RrfShaper;
 
 /// `lrintf` of a value the firmware computes in double precision and passes as float.

@@ -2,7 +2,7 @@
 //! largest acceleration whose smoothing stays within 0.12 mm, by doubling and bisection to
 //! 1e-8 mm/s^2, in the same steps as the Python.
 
-use super::TARGET_SMOOTHING_MM;
+use super::options::TARGET_SMOOTHING_MM;
 use crate::shaper::smoothing_mm;
 
 pub(super) fn max_accel_mm_s2(amplitudes: &[f64], times_s: &[f64], scv_mm_s: f64) -> f64 {

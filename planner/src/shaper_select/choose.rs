@@ -1,6 +1,8 @@
 //! Klipper's recommendation across shapers (`find_best_shaper`).
 
-use super::{CalibrationData, SelectOptions, Selection, fit_shaper};
+use super::data::CalibrationData;
+use super::fit::fit_shaper;
+use super::options::{Fit, SelectOptions, Selection};
 use crate::PlanError;
 use crate::shaper::ShaperKind;
 
@@ -10,7 +12,7 @@ pub fn find_best_shaper(
     data: &[CalibrationData],
     opts: &SelectOptions,
 ) -> Result<Selection, PlanError> {
-    let mut best: Option<super::Fit> = None;
+    let mut best: Option<Fit> = None;
     let mut per_shaper = Vec::with_capacity(opts.shapers.len());
     for &kind in &opts.shapers {
         let (mut shaper, results) = fit_shaper(kind, data, opts)?;

@@ -1,8 +1,11 @@
 //! One shaper fitted to calibration data (`fit_shaper`, `_estimate_remaining_vibrations`).
 
 use super::accel::max_accel_mm_s2;
+use super::data::CalibrationData;
 use super::grid::arange;
-use super::{CalibrationData, Fit, MAX_FREQ_HZ, MAX_SHAPER_FREQ_HZ, SelectOptions, ShaperFreqs};
+use super::options::{
+    Fit, MAX_FREQ_HZ, MAX_SHAPER_FREQ_HZ, SelectOptions, ShaperFreqs, TEST_DAMPING_RATIOS,
+};
 use crate::PlanError;
 use crate::shaper::{
     KLIPPER_DEFAULT_DAMPING_RATIO, Shaper, ShaperKind, remaining_vibration, smoothing_mm,
@@ -108,7 +111,7 @@ pub fn fit_shaper(
         opts.damping_ratio
     };
     let test_dr: &[f64] = if opts.test_damping_ratios.is_empty() {
-        &super::TEST_DAMPING_RATIOS
+        &TEST_DAMPING_RATIOS
     } else {
         &opts.test_damping_ratios
     };

@@ -9,7 +9,7 @@
 //! need not line up with the samples, and the last one ends on the last sample. A sample
 //! inside a step gets the coordinates by cubic Hermite interpolation from the coordinates
 //! and rates at the step's ends (error `<= (w h)^4 / 384` of a mode's amplitude at `w`);
-//! the toolhead follows from them and the exact command. `sim/tests/mujoco_lean.rs`
+//! the toolhead follows from them and the exact command. `sim/tests/all/mujoco_lean.rs`
 //! measures both errors against per-sample stepping and a converged reference.
 //!
 //! A sample that fails the plant's checks (a non-finite value, a blow-up) ends the call

@@ -12,6 +12,7 @@
 mod lean;
 mod mjcf;
 mod model;
+mod per_sample;
 mod plant;
 
 pub use mjcf::{COMMAND_MASS_FACTOR, Integrator};

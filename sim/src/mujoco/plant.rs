@@ -19,11 +19,11 @@ use settle_planner::{Sample, State};
 
 use super::{MujocoConfig, MujocoModel, MujocoSim};
 use crate::lumped::{Coupling, Node, Stiffness, Term};
-use crate::rapier::start_equilibrium;
+use crate::numerics::STEP_FRACTION;
 use crate::stepper::{Stepper, StepperState};
-use crate::{AxisModel, DriverMode, Observation, Plant, SimError, advance_sample, check_step};
+use crate::{AxisModel, DriverMode, SimError, advance_sample};
 
-/// The MuJoCo backend as a [`Plant`]: one MuJoCo model per axis, each starting at rest at
+/// The MuJoCo backend as a [`crate::Plant`]: one MuJoCo model per axis, each starting at rest at
 /// its commanded start and following the command through the lumped couplings.
 ///
 /// Driver modes: `linear` (a spring to the continuous command), `spring` (a spring to the
@@ -106,11 +106,11 @@ impl MujocoPlant {
 /// `(w_e h)^2 / 24` on the share of stiffness it carries (`w_e^2 = k_e / J`, `J` the rotor
 /// inertia). Its stiffness `k_e` is at most `2 k_theta + 4 Nr Td` (the sine's slope
 /// departs from the tangent's by at most `2 k_theta`, the detent's slope is at most
-/// `4 Nr Td`), so the step is also held to `w_e h <= STEP_FRACTION` (rapier's bound:
-/// 0.375 % at most on that share). For the printer preset that second bound is 145 us,
-/// above the RK4 step; the detent no longer shortens the step as an RK4 spring (that
-/// took a second MuJoCo step per 10 kHz sample on the printer's Y axis for a frequency
-/// change below 0.01 %, see `sim/tests/mujoco_stepper.rs`).
+/// `4 Nr Td`), so the step is also held to `w_e h <= STEP_FRACTION` (the explicit-force
+/// bound of [`crate::numerics::STEP_FRACTION`]: 0.375 % at most on that share). For the
+/// printer preset that second bound is 145 us, above the RK4 step. (Integrating the detent
+/// as an RK4 spring instead would take a second MuJoCo step per 10 kHz sample on the
+/// printer's Y axis for a frequency change below 0.01 %, see `sim/tests/all/mujoco_stepper.rs`.)
 fn full_driver_model(
     a: &AxisModel,
     sp: &Stepper,
@@ -147,7 +147,7 @@ fn full_driver_model(
 /// The longest step (s) for the driver torque MuJoCo does not integrate itself (see
 /// [`full_driver_model`]): `STEP_FRACTION / w_e`.
 fn explicit_step_s(a: &AxisModel, sp: &Stepper) -> f64 {
-    crate::rapier::STEP_FRACTION / explicit_rate(a, sp)
+    STEP_FRACTION / explicit_rate(a, sp)
 }
 
 /// `w_e = sqrt((2 k_theta + 4 Nr Td) / J)` (rad/s): the rate of the driver torque held
@@ -211,177 +211,4 @@ pub(super) fn full_step(
     model.step(sim, &c0, h)?;
     sp.track_currents(ss, sim.q()[r], advance_sample(c, tau + h).p);
     Ok(())
-}
-
-impl Plant for MujocoPlant {
-    type State = MujocoPlantState;
-
-    fn axes(&self) -> usize {
-        self.axes.len()
-    }
-
-    fn initial_state(&self, start: &[State]) -> Result<MujocoPlantState, SimError> {
-        if start.len() != self.axes.len() {
-            return Err(SimError::AxisCount {
-                expected: self.axes.len(),
-                got: start.len(),
-            });
-        }
-        let mut axes = Vec::with_capacity(start.len());
-        for ((ax, model), s) in self.axes.iter().zip(start) {
-            if ax.mode == DriverMode::Full {
-                // At rest where the magnetic torque balances the detent and the couplings
-                // (rapier starts from the same configuration), moving rigidly with `s.v`.
-                let (q, stepper) = start_equilibrium(ax, s.p)?;
-                let qd = if s.v == 0.0 {
-                    vec![0.0; q.len()]
-                } else {
-                    let dx = 1e-3;
-                    let q1 = start_equilibrium(ax, s.p + dx)?.0;
-                    q.iter().zip(&q1).map(|(a, b)| (b - a) / dx * s.v).collect()
-                };
-                axes.push(AxisState {
-                    sim: model.state(&q, &qd, s)?,
-                    stepper,
-                    base: *s,
-                    idle: s.v == 0.0 && s.a == 0.0,
-                });
-                continue;
-            }
-            let x = ax.command_node_m(s.p);
-            let node = State { p: x, ..*s };
-            let sim = model.state_at_rest(&node);
-            let stepper = ax.stepper.as_ref().map(|sp| {
-                let mut st = sp.at_rest(s.p).0;
-                sp.track_spring(&mut st, sim.q()[sp.rotor], x);
-                st.max_load_angle_rad = st.load_angle_rad.abs();
-                st
-            });
-            axes.push(AxisState {
-                sim,
-                stepper,
-                base: *s,
-                idle: s.v == 0.0 && s.a == 0.0,
-            });
-        }
-        Ok(MujocoPlantState { axes })
-    }
-
-    fn step(
-        &self,
-        state: &mut MujocoPlantState,
-        cmd: &[Sample],
-        dt_s: f64,
-    ) -> Result<(), SimError> {
-        check_step(self.axes.len(), cmd, dt_s)?;
-        if dt_s == 0.0 {
-            return Ok(());
-        }
-        for ((ax, model), (st, c)) in self.axes.iter().zip(state.axes.iter_mut().zip(cmd)) {
-            if st.idle {
-                if c.p == st.base.p && c.v == 0.0 && c.a == 0.0 && c.j == 0.0 {
-                    continue;
-                }
-                st.idle = false;
-            }
-            match (ax.mode, &ax.stepper) {
-                (DriverMode::Full, Some(sp)) => {
-                    let ss = st.stepper.as_mut().ok_or_else(|| SimError::InvalidModel {
-                        what: format!("axis `{}`: the full driver has no state", ax.name),
-                    })?;
-                    let h_max = model.step_at(&st.sim);
-                    let n = ((dt_s / h_max) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
-                    let h = dt_s / n as f64;
-                    for k in 0..n {
-                        full_step(sp, model, &mut st.sim, ss, c, h * k as f64, h, None)?;
-                    }
-                }
-                (DriverMode::Spring, Some(sp)) => {
-                    // The quantised command is piecewise constant: step in equal pieces no
-                    // longer than the model's step, holding the microstep of each piece's
-                    // start.
-                    let h_max = model.step_at(&st.sim);
-                    let n = ((dt_s / h_max) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
-                    let h = dt_s / n as f64;
-                    for k in 0..n {
-                        let x = sp.quantise_m(advance_sample(c, h * k as f64).p);
-                        let hold = Sample {
-                            p: x,
-                            ..Sample::default()
-                        };
-                        model.step(&mut st.sim, &hold, h)?;
-                        if let Some(ss) = st.stepper.as_mut() {
-                            let x1 = sp.quantise_m(advance_sample(c, h * (k + 1) as f64).p);
-                            sp.track_spring(ss, st.sim.q()[sp.rotor], x1);
-                        }
-                    }
-                }
-                _ => {
-                    model.advance(&mut st.sim, c, dt_s)?;
-                    if let (Some(sp), Some(ss)) = (&ax.stepper, st.stepper.as_mut()) {
-                        let x1 = advance_sample(c, dt_s).p;
-                        sp.track_spring(ss, st.sim.q()[sp.rotor], x1);
-                    }
-                }
-            }
-            let e = advance_sample(c, dt_s);
-            st.base = State {
-                p: e.p,
-                v: e.v,
-                a: e.a,
-            };
-        }
-        Ok(())
-    }
-
-    fn positions(
-        &self,
-        state: &MujocoPlantState,
-        commanded_m: &mut [f64],
-        toolhead_m: &mut [f64],
-    ) -> bool {
-        let mut finite = true;
-        for (i, ((ax, _), st)) in self.axes.iter().zip(&state.axes).enumerate() {
-            let q = st.sim.q();
-            commanded_m[i] = st.base.p;
-            toolhead_m[i] = ax.lumped.toolhead_m(q, ax.command_node_m(st.base.p));
-            finite &= st.base.p.is_finite()
-                && toolhead_m[i].is_finite()
-                && q.iter().all(|v| v.is_finite());
-        }
-        finite
-    }
-
-    fn step_samples(
-        &self,
-        state: &mut MujocoPlantState,
-        cmds: &[Sample],
-        dt_s: f64,
-        blowup_m: f64,
-        commanded_m: &mut [f64],
-        toolhead_m: &mut [f64],
-    ) -> Result<Option<usize>, (usize, SimError)> {
-        super::lean::step_samples(self, state, cmds, dt_s, blowup_m, commanded_m, toolhead_m)
-    }
-
-    fn observe(&self, state: &MujocoPlantState, out: &mut [Observation]) {
-        for ((ax, _), (st, o)) in self.axes.iter().zip(state.axes.iter().zip(out.iter_mut())) {
-            let x_node = ax.command_node_m(st.base.p);
-            let q = st.sim.q();
-            *o = Observation {
-                commanded_m: st.base.p,
-                toolhead_m: ax.lumped.toolhead_m(q, x_node),
-                carriage_m: ax.carriage.map(|i| q[i]),
-                motor_angle_rad: ax.stepper.as_ref().map(|s| q[s.rotor]),
-                currents_a: st
-                    .stepper
-                    .as_ref()
-                    .filter(|_| ax.mode == DriverMode::Full)
-                    .map(|s| [s.i_a, s.i_b]),
-                load_angle_rad: st.stepper.as_ref().map(|s| s.load_angle_rad),
-                lost_steps: st.stepper.as_ref().map_or(0, StepperState::lost_steps),
-                max_load_angle_rad: st.stepper.as_ref().map(|s| s.max_load_angle_rad),
-            };
-        }
-    }
 }

@@ -1,0 +1,31 @@
+//! settle-planner's integration tests, one test binary: each module below is one suite;
+//! `common`, `fourjerk_check` and `firmware_common` are shared helpers.
+
+mod any_state;
+mod braked;
+mod common;
+mod corner_blend;
+mod firmware_common;
+mod firmware_klipper;
+mod firmware_marlin;
+mod firmware_profiles;
+mod firmware_rrf;
+mod fourjerk;
+mod fourjerk_check;
+mod fourjerk_oracle;
+mod interfaces;
+mod kinds_scan;
+mod module_graph;
+mod multi_axis;
+mod official_ruckig;
+mod paths;
+mod pvt;
+mod raster;
+mod rest_to_rest;
+mod shaper_klipper;
+mod shaper_marlin_rrf;
+mod shaper_names;
+mod shaper_select;
+mod tmc_5160;
+mod tmc_ramp;
+mod tmc_registers;
