@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8's scale checks, on request (not part of scripts/test.sh: they take minutes).
+# The streaming sweep's scale checks, on request (not part of scripts/test.sh: they take minutes).
 #   scripts/scale.sh memory   a 10,000-run sweep; fails if its peak RSS exceeds 200 MB
 #   scripts/scale.sh planner  the any-state planner's random suite with 2 x 5,000,000 = 1e7
 #                             problems against rsruckig (SETTLE_PLANNER_STATE_CASES)

@@ -71,7 +71,7 @@ enum Command {
     },
     /// Rerun a scenario and compare every metric of every run with a committed baseline.
     #[command(
-        after_help = "Exit status: 0 when every value is within the tolerance, 1 (with a table of run,\nmetric, baseline, now, delta%) when any is not, 2 on bad input.\n\nAny change beyond the tolerance fails, worse or better: settle is deterministic, so a\nchange means behaviour changed, and --update makes accepting it a reviewed commit.\n\nExample:\n  settle check scenarios/ci_quickstart.toml --baseline results/baselines/ci_quickstart.csv\n  settle check scenarios/ci_quickstart.toml --baseline results/baselines/ci_quickstart.csv --update"
+        after_help = "Exit status: 0 when every value is within the tolerance, 1 (with a table of run,\nmetric, baseline, now, delta%) when any is not, 2 on bad input.\n\nAny change beyond the tolerance fails, worse or better: settle is deterministic, so a\nchange means behaviour changed, and --update makes accepting it a reviewed commit.\n\nExample:\n  settle check scenarios/ci_quickstart.toml --backend modal --baseline results/baselines/ci_quickstart.modal.csv\n  settle check scenarios/ci_quickstart.toml --backend modal --baseline results/baselines/ci_quickstart.modal.csv --update"
     )]
     Check {
         /// The scenario file (TOML).
