@@ -84,9 +84,8 @@ fi
 phase "cargo doc --no-deps (warnings are errors)"
 RUSTDOCFLAGS="${RUSTDOCFLAGS:-} -D warnings" cargo doc --workspace --no-deps --locked "${features[@]}"
 
-# Reserved here, in this order, for what the book and the HTML report will need:
-#   - `mdbook build docs` and a check of the book's internal links;
-#   - the HTML report in headless Chromium.
+phase "the book: mdbook build docs and its internal links (scripts/check-docs.sh)"
+scripts/check-docs.sh
 
 phase "cargo test: build (profile ci)"
 cargo test --workspace --profile ci --locked "${features[@]}" --no-run
