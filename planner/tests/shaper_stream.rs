@@ -90,7 +90,11 @@ fn scale(p: &Profile) -> [f64; 3] {
     let n = 2000;
     (0..=n).fold([0.0; 3], |m, k| {
         let s = p.state_at(p.duration_s() * k as f64 / n as f64);
-        [m[0].max(s.p.abs()), m[1].max(s.v.abs()), m[2].max(s.a.abs())]
+        [
+            m[0].max(s.p.abs()),
+            m[1].max(s.v.abs()),
+            m[2].max(s.a.abs()),
+        ]
     })
 }
 
@@ -160,7 +164,10 @@ fn assert_equal(
     }
     // The chunks tile the span without gaps.
     for w in chunks.windows(2) {
-        assert!((w[0].0 + w[0].1.duration_s() - w[1].0).abs() < 1e-12, "{what}: gap");
+        assert!(
+            (w[0].0 + w[0].1.duration_s() - w[1].0).abs() < 1e-12,
+            "{what}: gap"
+        );
     }
 }
 
@@ -210,7 +217,10 @@ fn causal_chunks_equal_whole_profile_shaping() {
             let chunks = stream(&shaper, Alignment::Causal, &p, &cuts);
             let what = format!("{} cut at {cuts:?}", shaper.kind());
             assert_eq!(chunks[0].0, 0.0, "{what}");
-            let end = chunks.last().map(|(t, c)| t + c.duration_s()).expect("some");
+            let end = chunks
+                .last()
+                .map(|(t, c)| t + c.duration_s())
+                .expect("some");
             assert!((end - whole.duration_s()).abs() < 1e-12, "{what}: {end}");
             assert_equal(&what, &chunks, |t| whole.state_at(t), (0.0, end), sc);
         }
@@ -231,14 +241,11 @@ fn centred_chunks_are_the_causal_output_advanced_by_the_centroid() {
         let whole = shaper.apply(&p).expect("apply");
         let chunks = stream(&shaper, Alignment::Centred, &p, &[0.02, 0.0538, 0.09]);
         assert!((chunks[0].0 + c).abs() < 1e-15, "starts c early");
-        let end = chunks.last().map(|(t, c)| t + c.duration_s()).expect("some");
-        assert_equal(
-            "centred",
-            &chunks,
-            |t| whole.state_at(t + c),
-            (-c, end),
-            sc,
-        );
+        let end = chunks
+            .last()
+            .map(|(t, c)| t + c.duration_s())
+            .expect("some");
+        assert_equal("centred", &chunks, |t| whole.state_at(t + c), (-c, end), sc);
     }
 }
 
@@ -272,7 +279,12 @@ fn a_shaper_change_splits_the_motion_between_the_shapers() {
     for switch in [0.11, 0.047] {
         let mut st = ShaperStream::new(Some(a), Alignment::Causal);
         let mut chunks = Vec::new();
-        for (t0, t1) in [(0.0, 0.03), (0.03, switch), (switch, 0.13), (0.13, p.duration_s())] {
+        for (t0, t1) in [
+            (0.0, 0.03),
+            (0.03, switch),
+            (switch, 0.13),
+            (0.13, p.duration_s()),
+        ] {
             st.push(t0, &slice(&p, t0, t1)).expect("push");
             if t1 == switch {
                 st.set_shaper(Some(b)).expect("switch");
@@ -300,14 +312,23 @@ fn a_shaper_change_splits_the_motion_between_the_shapers() {
                 j: x.j + y.j,
             }
         };
-        assert_equal(&format!("switch at {switch}"), &chunks, reference, (0.0, end), sc);
+        assert_equal(
+            &format!("switch at {switch}"),
+            &chunks,
+            reference,
+            (0.0, end),
+            sc,
+        );
         // Whatever the switch, the motion ends where the input ends when the switch is at
         // rest; a switch while cruising moves the end by v (c_b - c_a).
         let last = chunks.last().expect("tail");
         let got_end = last.1.end().p;
         let c_a: f64 = a.weights().zip(a.times_s()).map(|(w, t)| w * t).sum();
         let want_end = p.end().p + s.v * (c_b - c_a);
-        assert!((got_end - want_end).abs() < 1e-12 * sc[0], "{got_end} vs {want_end}");
+        assert!(
+            (got_end - want_end).abs() < 1e-12 * sc[0],
+            "{got_end} vs {want_end}"
+        );
     }
 }
 
@@ -370,7 +391,8 @@ fn a_firmware_corner_bridge_is_shaped_like_the_whole_move() {
         match cuts {
             None => {
                 for c in &chunks {
-                    axes.push(c.start_time_s - t_start, &c.trajectory).expect("push");
+                    axes.push(c.start_time_s - t_start, &c.trajectory)
+                        .expect("push");
                     let until = axes.available_until_s();
                     out.push(axes.emit(until).expect("emit"));
                 }
@@ -422,6 +444,9 @@ fn misuse_is_refused() {
     assert!(st.emit(0.06).is_err(), "emit beyond the input");
     assert!(st.push(0.07, &slice(&p, 0.07, 0.08)).is_err(), "gap");
     st.finish();
-    assert!(st.push(0.05, &slice(&p, 0.05, 0.08)).is_err(), "after finish");
+    assert!(
+        st.push(0.05, &slice(&p, 0.05, 0.08)).is_err(),
+        "after finish"
+    );
     assert!(st.set_shaper(None).is_err(), "change after finish");
 }

@@ -30,6 +30,7 @@ mod pieces;
 mod poly;
 mod rounding;
 pub mod vector;
+pub mod window;
 
 pub use geometry::{CornerPlan, CornerTransition, PathGeometry, Primitive};
 pub use lookahead::{CornerStrategy, Lookahead, PathOptions, plan_path};

@@ -356,11 +356,7 @@ impl ShaperStream {
                 self.regimes[0].becomes_first();
             }
         }
-        let reach = self
-            .regimes
-            .iter()
-            .map(Regime::max_tau)
-            .fold(0.0, f64::max);
+        let reach = self.regimes.iter().map(Regime::max_tau).fold(0.0, f64::max);
         let keep_from = self.cursor_s - reach;
         while self.history.len() > 1 && self.history[0].t1() < keep_from {
             self.history.pop_front();
