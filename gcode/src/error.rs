@@ -209,13 +209,34 @@ pub enum GcodeError {
         /// What is degenerate.
         why: &'static str,
     },
+    /// The firmware's planner or shaper refuses what a line asks for (a move, a limit, a
+    /// shaper setting).
+    #[error("{at}: `{command}`: {source}")]
+    Plan {
+        /// Where.
+        at: Location,
+        /// The command (`G1`, `SET_INPUT_SHAPER`, `M593`).
+        command: String,
+        /// What the planner says.
+        source: settle_planner::PlanError,
+    },
+    /// A job setting (not from the file) that cannot be used.
+    #[error("job setting `{key}`: {reason}")]
+    JobSetting {
+        /// The setting (`layers`, `shaper_x`, `firmware`, ...).
+        key: &'static str,
+        /// What is wrong and what is allowed.
+        reason: String,
+    },
 }
 
 impl GcodeError {
     /// The location of a line error (`None` for I/O errors).
     pub fn location(&self) -> Option<&Location> {
         match self {
-            GcodeError::Io { .. } | GcodeError::UnknownDialect { .. } => None,
+            GcodeError::Io { .. }
+            | GcodeError::UnknownDialect { .. }
+            | GcodeError::JobSetting { .. } => None,
             GcodeError::LineTooLong { at, .. }
             | GcodeError::InvalidUtf8 { at }
             | GcodeError::ControlCharacter { at, .. }
@@ -231,7 +252,8 @@ impl GcodeError {
             | GcodeError::ArcMixedForms { at, .. }
             | GcodeError::ArcRadiusMismatch { at, .. }
             | GcodeError::ArcRadiusTooSmall { at, .. }
-            | GcodeError::ArcDegenerate { at, .. } => Some(at),
+            | GcodeError::ArcDegenerate { at, .. }
+            | GcodeError::Plan { at, .. } => Some(at),
         }
     }
 
