@@ -10,7 +10,7 @@
 use std::collections::VecDeque;
 
 use settle_planner::shaper::Shaper;
-use settle_planner::shaper::stream::{AxesShaper, Alignment};
+use settle_planner::shaper::stream::{Alignment, AxesShaper};
 use settle_planner::{PlanError, Trajectory};
 
 use super::slice::split;
@@ -141,8 +141,8 @@ impl Input {
             Some(s) => s.push(t0, &tr)?,
             None => {
                 self.lookback.push_back(Entry::Chunk(t0, tr));
-                let keep = longest(&self.current).max(longest(&self.lookback_start))
-                    + LOOKBACK_MARGIN_S;
+                let keep =
+                    longest(&self.current).max(longest(&self.lookback_start)) + LOOKBACK_MARGIN_S;
                 // Drop chunks (and the changes before them) that end before the window.
                 loop {
                     let stale = match self.lookback.front() {

@@ -105,12 +105,16 @@ impl<R: BufRead> Job<R> {
     /// Plan what `reader` reads with `cfg` (the reader's dialect is the caller's choice;
     /// [`Job::open`] uses `cfg.dialect`).
     pub fn new(reader: Reader<R>, cfg: JobConfig) -> Result<Self, GcodeError> {
-        let setting = |key: &'static str| move |e: PlanError| GcodeError::JobSetting {
-            key,
-            reason: e.to_string(),
+        let setting = |key: &'static str| {
+            move |e: PlanError| GcodeError::JobSetting {
+                key,
+                reason: e.to_string(),
+            }
         };
         let planner = match &cfg.planner {
-            PlannerConfig::Settle(c) => Planner::Settle(SettlePlanner::new(c).map_err(setting("settle"))?),
+            PlannerConfig::Settle(c) => {
+                Planner::Settle(SettlePlanner::new(c).map_err(setting("settle"))?)
+            }
             other => match Driver::new(other).map_err(setting("planner"))? {
                 Some(d) => Planner::Firmware(
                     d,
@@ -241,7 +245,6 @@ impl<R: BufRead> Job<R> {
         }
     }
 
-
     fn ignore(&mut self, what: String) {
         *self.ignored.entry(what).or_insert(0) += 1;
     }
@@ -312,7 +315,11 @@ impl<R: BufRead> Job<R> {
         self.moves += 1;
         let first = self.seq;
         let extruder_only = mv.kind == MoveKind::Extruder;
-        let n = if extruder_only { 1 } else { points.len() as u64 };
+        let n = if extruder_only {
+            1
+        } else {
+            points.len() as u64
+        };
         self.table.add(info, first, first + n);
         let speed = mv.feed_mm_s * MM;
         let mut prev = mv.start;
@@ -329,7 +336,8 @@ impl<R: BufRead> Job<R> {
                     }
                     Planner::Settle(s) => {
                         let span = s.extrude(de, speed);
-                        let (t0, t1) = span.map_err(|e| plan_error(&self.source, line, command, e))?;
+                        let (t0, t1) =
+                            span.map_err(|e| plan_error(&self.source, line, command, e))?;
                         self.drain(line)?;
                         let seq = self.seq;
                         self.seq += 1;
@@ -346,9 +354,10 @@ impl<R: BufRead> Job<R> {
                 );
                 let seq = self.seq;
                 let r = match &mut self.planner {
-                    Planner::Firmware(d, _) => d
-                        .planner()
-                        .push(&LinearMove::new(a, b, (p.e_mm - prev.e_mm) * MM, speed)),
+                    Planner::Firmware(d, _) => {
+                        d.planner()
+                            .push(&LinearMove::new(a, b, (p.e_mm - prev.e_mm) * MM, speed))
+                    }
                     Planner::Settle(s) => s.push(b, speed, seq),
                 };
                 r.map_err(|e| plan_error(&self.source, line, command, e))?;
@@ -372,7 +381,8 @@ impl<R: BufRead> Job<R> {
         }
         let old = self.shapers.settings();
         let is_shaper = self.shapers.apply(change).map_err(|p| match p {
-            ShaperProblem::UnknownName(name) => plan_error(&self.source, 
+            ShaperProblem::UnknownName(name) => plan_error(
+                &self.source,
                 line,
                 command,
                 PlanError::UnknownKind {
@@ -397,7 +407,10 @@ impl<R: BufRead> Job<R> {
         let Planner::Firmware(d, _) = &mut self.planner else {
             return Ok(());
         };
-        match d.apply(change).map_err(|e| plan_error(&self.source, line, command, e))? {
+        match d
+            .apply(change)
+            .map_err(|e| plan_error(&self.source, line, command, e))?
+        {
             LimitOutcome::Applied => self.limit_changes += 1,
             LimitOutcome::Ignored(why) => self.ignore(format!("{command}: {why}")),
         }
@@ -445,7 +458,8 @@ impl<R: BufRead> Job<R> {
                         break;
                     };
                     if !done {
-                        ps.push(&pm).map_err(|e| plan_error(&self.source, line, "G1", e))?;
+                        ps.push(&pm)
+                            .map_err(|e| plan_error(&self.source, line, "G1", e))?;
                     }
                     self.on_planned(&pm)
                         .map_err(|e| plan_error(&self.source, line, "G1", e))?;
@@ -481,7 +495,7 @@ impl<R: BufRead> Job<R> {
     /// Planned segment `seq` runs from `t0` to `t1`: move timing and the layer range.
     fn on_span(&mut self, seq: u64, t0: f64, t1: f64) -> Result<(), PlanError> {
         let layer = self.table.planned(seq, t0, t1);
-        if self.range != Range::In {
+        if self.layers.is_some() && self.range != Range::In {
             self.table.forget_before(t0);
         }
         let (Some((a, b)), Some(layer)) = (self.layers, layer) else {

@@ -33,7 +33,12 @@ impl SettlePlanner {
     }
 
     /// A straight toolhead move to `to_m` at no more than `speed_m_s`, as move `seq`.
-    pub(crate) fn push(&mut self, to_m: [f64; 3], speed_m_s: f64, seq: u64) -> Result<(), PlanError> {
+    pub(crate) fn push(
+        &mut self,
+        to_m: [f64; 3],
+        speed_m_s: f64,
+        seq: u64,
+    ) -> Result<(), PlanError> {
         self.path.push(to_m, speed_m_s, seq)
     }
 

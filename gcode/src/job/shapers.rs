@@ -218,7 +218,8 @@ impl ShaperState {
                         Some(Some(ShaperKind::rrf(family)))
                     }
                 };
-                let seen = frequency_hz.is_some() || damping_ratio.is_some() || reduction_limit.is_some();
+                let seen =
+                    frequency_hz.is_some() || damping_ratio.is_some() || reduction_limit.is_some();
                 for a in &mut self.axes[..2] {
                     if let Some(f) = frequency_hz {
                         a.frequency_hz = *f;

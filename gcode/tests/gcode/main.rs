@@ -3,6 +3,9 @@
 mod arcs;
 mod dialects;
 mod errors;
+mod job_prints;
+mod job_times;
+mod job_util;
 mod layers;
 mod roundtrip;
 mod segments;
