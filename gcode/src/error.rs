@@ -217,8 +217,8 @@ pub enum GcodeError {
         at: Location,
         /// The command (`G1`, `SET_INPUT_SHAPER`, `M593`).
         command: String,
-        /// What the planner says.
-        source: settle_planner::PlanError,
+        /// What the planner says (boxed: it is large and rare).
+        source: Box<settle_planner::PlanError>,
     },
     /// A job setting (not from the file) that cannot be used.
     #[error("job setting `{key}`: {reason}")]

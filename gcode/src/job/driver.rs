@@ -30,18 +30,18 @@ pub(crate) enum LimitOutcome {
 /// One of the firmware planners.
 #[derive(Debug)]
 pub(crate) enum Driver {
-    Klipper(KlipperPlanner),
-    Marlin(MarlinPlanner),
-    Rrf(RrfPlanner),
+    Klipper(Box<KlipperPlanner>),
+    Marlin(Box<MarlinPlanner>),
+    Rrf(Box<RrfPlanner>),
 }
 
 impl Driver {
     /// The planner of `cfg` (`None` for settle's planner, which is not a firmware).
     pub(crate) fn new(cfg: &PlannerConfig) -> Result<Option<Self>, PlanError> {
         Ok(Some(match cfg {
-            PlannerConfig::Klipper(c) => Driver::Klipper(KlipperPlanner::new(*c)?),
-            PlannerConfig::Marlin(c) => Driver::Marlin(MarlinPlanner::new(*c)?),
-            PlannerConfig::Rrf(c) => Driver::Rrf(RrfPlanner::new(*c)?),
+            PlannerConfig::Klipper(c) => Driver::Klipper(Box::new(KlipperPlanner::new(*c)?)),
+            PlannerConfig::Marlin(c) => Driver::Marlin(Box::new(MarlinPlanner::new(*c)?)),
+            PlannerConfig::Rrf(c) => Driver::Rrf(Box::new(RrfPlanner::new(*c)?)),
             PlannerConfig::Settle(_) => return Ok(None),
         }))
     }
@@ -49,9 +49,9 @@ impl Driver {
     /// The planner.
     pub(crate) fn planner(&mut self) -> &mut dyn FirmwarePlanner {
         match self {
-            Driver::Klipper(p) => p,
-            Driver::Marlin(p) => p,
-            Driver::Rrf(p) => p,
+            Driver::Klipper(p) => p.as_mut(),
+            Driver::Marlin(p) => p.as_mut(),
+            Driver::Rrf(p) => p.as_mut(),
         }
     }
 

@@ -24,7 +24,7 @@ pub(crate) type AxisShapers = [Option<Shaper>; 4];
 #[derive(Debug)]
 enum Entry {
     Chunk(f64, Trajectory),
-    Switch(AxisShapers),
+    Switch(Box<AxisShapers>),
 }
 
 /// The shaping stage (module doc).
@@ -90,12 +90,12 @@ impl Input {
             match e {
                 Entry::Chunk(t0, tr) => shaper.push(t0, &tr)?,
                 Entry::Switch(s) => {
-                    for (i, (old, new)) in shapers.iter().zip(&s).enumerate() {
+                    for (i, (old, new)) in shapers.iter().zip(s.iter()).enumerate() {
                         if old != new {
                             shaper.set_shaper(i, new.as_ref())?;
                         }
                     }
-                    shapers = s;
+                    shapers = *s;
                 }
             }
         }
@@ -156,7 +156,7 @@ impl Input {
                     }
                     self.lookback.pop_front();
                     while let Some(Entry::Switch(sw)) = self.lookback.front() {
-                        self.lookback_start = sw.clone();
+                        self.lookback_start = (**sw).clone();
                         self.lookback.pop_front();
                     }
                 }
@@ -174,7 +174,9 @@ impl Input {
                     }
                 }
             }
-            None => self.lookback.push_back(Entry::Switch(shapers.clone())),
+            None => self
+                .lookback
+                .push_back(Entry::Switch(Box::new(shapers.clone()))),
         }
         self.current = shapers;
         Ok(())
@@ -216,10 +218,8 @@ impl Input {
         if let Some(e) = self.range_end_s {
             target = target.min(e);
         }
-        if self.finished {
-            if let Some(e) = s.end_s() {
-                target = target.min(e);
-            }
+        if let (true, Some(e)) = (self.finished, s.end_s()) {
+            target = target.min(e);
         }
         let mut cursor = s.emitted_until_s();
         if let Some(rs) = self.range_start_s.filter(|rs| cursor < *rs) {

@@ -29,8 +29,8 @@ const MM: f64 = 1e-3;
 
 #[derive(Debug)]
 enum Planner {
-    Firmware(Driver, ProfileStream),
-    Settle(SettlePlanner),
+    Firmware(Driver, Box<ProfileStream>),
+    Settle(Box<SettlePlanner>),
 }
 
 /// Where the job is relative to the layer range.
@@ -86,7 +86,7 @@ fn plan_error(source: &Arc<str>, line: u64, command: &str, e: PlanError) -> Gcod
             column: None,
         },
         command: command.to_string(),
-        source: e,
+        source: Box::new(e),
     }
 }
 
@@ -113,12 +113,12 @@ impl<R: BufRead> Job<R> {
         };
         let planner = match &cfg.planner {
             PlannerConfig::Settle(c) => {
-                Planner::Settle(SettlePlanner::new(c).map_err(setting("settle"))?)
+                Planner::Settle(Box::new(SettlePlanner::new(c).map_err(setting("settle"))?))
             }
             other => match Driver::new(other).map_err(setting("planner"))? {
                 Some(d) => Planner::Firmware(
                     d,
-                    ProfileStream::new(cfg.profiles).map_err(setting("profiles"))?,
+                    Box::new(ProfileStream::new(cfg.profiles).map_err(setting("profiles"))?),
                 ),
                 None => {
                     return Err(GcodeError::JobSetting {

@@ -3,7 +3,9 @@
 mod arcs;
 mod dialects;
 mod errors;
+mod job_changes;
 mod job_prints;
+mod job_settle;
 mod job_times;
 mod job_util;
 mod layers;

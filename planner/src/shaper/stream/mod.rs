@@ -270,6 +270,9 @@ impl ShaperStream {
             });
         }
         let (a, b) = (self.cursor_s, until_s.max(self.cursor_s));
+        if self.regimes.len() == 1 && self.offset == 0.0 && self.regimes[0].is_identity() {
+            return self.pass_through(a, b);
+        }
         let knots = self.knots(a, b);
         let s0 = self.shaped_at(a);
         let start = State {
@@ -311,6 +314,54 @@ impl ShaperStream {
         self.cursor_s = b;
         self.forget();
         Ok((a, Profile::new(start, segments)?))
+    }
+
+    /// The input itself from `a` to `b` (no shaping): its segments, cut at `a` and `b`,
+    /// whole segments copied as they are.
+    fn pass_through(&mut self, a: f64, b: f64) -> Result<(f64, Profile), PlanError> {
+        let s0 = self.input_at(a);
+        let mut segments = Vec::new();
+        let lo = self.history.partition_point(|h| h.t1() <= a && h.t0 < a);
+        let mut covered = a;
+        for h in self.history.range(lo..) {
+            if h.t0 >= b {
+                break;
+            }
+            let inside = h.t0 >= a && h.t1() <= b;
+            let d = if inside {
+                h.seg.duration_s()
+            } else {
+                (h.t1().min(b) - h.t0.max(a)).max(0.0)
+            };
+            covered = covered.max(h.t1().min(b));
+            segments.push(match h.seg {
+                Segment::Jerk { jerk, .. } => Segment::Jerk {
+                    duration_s: d,
+                    jerk,
+                },
+                Segment::Accel { accel, .. } => Segment::Accel {
+                    duration_s: d,
+                    accel,
+                },
+            });
+        }
+        if self.finished && b > covered {
+            // Beyond the input's end: its continuation at constant velocity.
+            segments.push(Segment::Accel {
+                duration_s: b - covered,
+                accel: 0.0,
+            });
+        }
+        let start = State {
+            p: s0.p,
+            v: s0.v,
+            a: s0.a,
+        };
+        let profile = Profile::new(start, segments)?;
+        self.a_now = profile.end().a;
+        self.cursor_s = b;
+        self.forget();
+        Ok((a, profile))
     }
 
     /// Every breakpoint of every shifted copy inside `(a, b)`, with `a` and `b`.

@@ -50,6 +50,11 @@ impl Regime {
         }
     }
 
+    /// Whether this is the only regime and shapes nothing (one impulse of weight 1 at 0).
+    pub(super) fn is_identity(&self) -> bool {
+        !self.corrects && self.weights == [1.0] && self.taus == [0.0]
+    }
+
     /// The impulse times (s), increasing.
     pub(super) fn taus(&self) -> &[f64] {
         &self.taus
