@@ -32,7 +32,8 @@ pub enum MoveGeometry {
 /// One G-code move and when the planner runs it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MoveInfo {
-    /// 0-based index among the file's moves (every G0/G1/G2/G3 that moves something).
+    /// 0-based index among the file's moves (every G0/G1/G2/G3 that moves something, and
+    /// the travel home a `G28` after motion stands for).
     pub index: u64,
     /// 1-based line in the file.
     pub line: u64,

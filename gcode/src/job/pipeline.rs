@@ -19,9 +19,9 @@ use super::moves::MoveTable;
 use super::settle::SettlePlanner;
 use super::shapers::{ShaperProblem, ShaperState};
 use crate::error::{GcodeError, Location};
-use crate::event::{Event, EventKind};
+use crate::event::{Event, EventKind, Note};
 use crate::geometry::{Move, MoveKind, Path, Point};
-use crate::limits::LimitChange;
+use crate::limits::{AxisFlags, LimitChange};
 use crate::reader::{Reader, ReaderOptions};
 
 /// Millimetres to metres.
@@ -58,6 +58,9 @@ pub struct Job<R> {
     out: VecDeque<JobChunk>,
     eof: bool,
     points: Vec<Point>,
+    /// Where the last move ended, and its feed (mm, mm/s).
+    last_end: Point,
+    last_feed_mm_s: f64,
     limit_changes: u64,
     shaper_changes: u64,
     ignored: BTreeMap<String, u64>,
@@ -129,6 +132,7 @@ impl<R: BufRead> Job<R> {
             },
         };
         let initial = build(&cfg.shapers).map_err(setting("shapers"))?;
+        let cfg_feed = cfg.dialect.initial_feed_mm_s();
         Ok(Self {
             reader,
             source: Arc::from("<input>"),
@@ -144,6 +148,8 @@ impl<R: BufRead> Job<R> {
             out: VecDeque::new(),
             eof: false,
             points: Vec::new(),
+            last_end: Point::default(),
+            last_feed_mm_s: cfg_feed,
             limit_changes: 0,
             shaper_changes: 0,
             ignored: BTreeMap::new(),
@@ -274,6 +280,7 @@ impl<R: BufRead> Job<R> {
                 Ok(())
             }
             EventKind::Limits(c) => self.on_limits(ev.line, &c),
+            EventKind::Note(Note::Homed { axes }) => self.on_home(ev.line, ev.layer, axes),
             EventKind::Note(_) => Ok(()),
         }
     }
@@ -313,6 +320,8 @@ impl<R: BufRead> Job<R> {
             geometry,
         };
         self.moves += 1;
+        self.last_end = mv.end;
+        self.last_feed_mm_s = mv.feed_mm_s;
         let first = self.seq;
         let extruder_only = mv.kind == MoveKind::Extruder;
         let n = if extruder_only {
@@ -369,6 +378,35 @@ impl<R: BufRead> Job<R> {
         })();
         self.points = points;
         result
+    }
+
+    /// `G28` after motion: homing is not simulated, but the reader now puts the homed
+    /// axes at 0, so the toolhead travels there in a straight line at the modal feed rate
+    /// (as a `G0` would) to keep the motion continuous.
+    fn on_home(&mut self, line: u64, layer: u32, axes: AxisFlags) -> Result<(), GcodeError> {
+        let from = self.last_end;
+        let mut to = from;
+        for (on, c) in [
+            (axes.x, &mut to.x_mm),
+            (axes.y, &mut to.y_mm),
+            (axes.z, &mut to.z_mm),
+        ] {
+            if on {
+                *c = 0.0;
+            }
+        }
+        if to == from {
+            return Ok(());
+        }
+        let mv = Move {
+            start: from,
+            end: to,
+            feed_mm_s: self.last_feed_mm_s,
+            kind: MoveKind::Travel,
+            rapid: true,
+            path: Path::Line,
+        };
+        self.on_move(line, layer, &mv)
     }
 
     fn on_limits(&mut self, line: u64, change: &LimitChange) -> Result<(), GcodeError> {

@@ -163,3 +163,28 @@ fn a_layer_range_is_the_whole_job_cut_at_its_moves() {
         assert_eq!(sp.layers, sw.layers, "{fw}");
     }
 }
+
+#[test]
+fn homing_after_motion_travels_home_continuously() {
+    // G28 after moves: homing is not simulated, the toolhead travels to 0 on the homed
+    // axes, so the motion stays continuous and the move count includes that travel.
+    let text = "G1 X20 Y10 F6000\nG28 X\nG1 Y30\n";
+    for fw in Firmware::ALL {
+        let (chunks, s) = crate::job_util::run(text, JobConfig::defaults(fw).expect("defaults"));
+        assert_contiguous(&chunks);
+        assert_eq!(s.moves, 3, "{fw}");
+        let end = chunks.last().expect("chunks").trajectory.axes();
+        assert!(end[0].end().p.abs() < 1e-12 && (end[1].end().p - 30.0 * MM).abs() < 1e-12);
+        // No position jump anywhere: bridged over 100 µs it would take ~1e6 m/s^2; corners'
+        // speed jumps (5-15 mm/s) take 50-150 m/s^2.
+        let (t0, t1) = (
+            chunks[0].start_time_s,
+            chunks.last().expect("c").end_time_s(),
+        );
+        let n = ((t1 - t0) / 10e-6) as usize;
+        for k in 0..n {
+            let s = at(&chunks, t0 + k as f64 * 10e-6);
+            assert!(s[..3].iter().all(|s| s.a.abs() < 1000.0), "{fw}: {s:?}");
+        }
+    }
+}
