@@ -9,41 +9,13 @@ use rand_chacha::ChaCha8Rng;
 use settle_planner::firmware::klipper::{KlipperConfig, KlipperPlanner};
 use settle_planner::firmware::profiles::{ProfileOptions, ProfileStream};
 use settle_planner::firmware::{FirmwarePlanner, LinearMove};
-use settle_planner::shaper::stream::{Alignment, AxesShaper, ShaperStream};
+use settle_planner::shaper::stream::{Alignment, AxesShaper, ShaperStream, cut};
 use settle_planner::shaper::{Shaper, ShaperKind};
 use settle_planner::{Profile, Sample, Segment, State, Trajectory};
 
 /// The part of `p` between `t0` and `t1` (s) as a profile starting at `t0`.
 fn slice(p: &Profile, t0: f64, t1: f64) -> Profile {
-    let s = p.state_at(t0);
-    let mut segs = Vec::new();
-    for (ts, _, seg) in p.iter() {
-        let te = ts + seg.duration_s();
-        let (a, b) = (ts.max(t0), te.min(t1));
-        if b < a || (b == a && !(ts >= t0 && ts < t1)) {
-            continue;
-        }
-        let d = b - a;
-        segs.push(match *seg {
-            Segment::Jerk { jerk, .. } => Segment::Jerk {
-                duration_s: d,
-                jerk,
-            },
-            Segment::Accel { accel, .. } => Segment::Accel {
-                duration_s: d,
-                accel,
-            },
-        });
-    }
-    Profile::new(
-        State {
-            p: s.p,
-            v: s.v,
-            a: s.a,
-        },
-        segs,
-    )
-    .expect("slice")
+    cut(p, t0, t1).expect("slice")
 }
 
 /// One axis: an S-curve ramp, a cruise, a 100 µs velocity-jump bridge (two constant

@@ -10,19 +10,7 @@ use settle_planner::firmware::rrf::RrfConfig;
 use settle_planner::firmware::{FirmwarePlanner, LinearMove};
 use settle_planner::shaper::{Shaper, ShaperKind};
 
-use crate::job_util::{assert_contiguous, assert_rel, at, run};
-
-fn job(planner: PlannerConfig) -> JobConfig {
-    let mut c = JobConfig::defaults(planner.firmware()).expect("defaults");
-    c.planner = planner;
-    c
-}
-
-fn leg(l: f64, v: f64, a: f64, v0: f64, v1: f64) -> f64 {
-    (v - v0) / a
-        + (v - v1) / a
-        + (l - (v * v - v0 * v0) / (2.0 * a) - (v * v - v1 * v1) / (2.0 * a)) / v
-}
+use crate::job_util::{assert_contiguous, assert_rel, at, job, leg, run};
 
 #[test]
 fn klipper_set_velocity_limit_and_m204() {

@@ -9,20 +9,7 @@ use settle_planner::firmware::marlin::{MarlinConfig, MarlinJerk, MarlinPlanner};
 use settle_planner::firmware::rrf::{RrfConfig, RrfPlanner};
 use settle_planner::firmware::{FirmwarePlanner, LinearMove};
 
-use crate::job_util::{MM, assert_rel, direct, run};
-
-fn job(planner: PlannerConfig) -> JobConfig {
-    let mut c = JobConfig::defaults(planner.firmware()).expect("defaults");
-    c.planner = planner;
-    c
-}
-
-/// Trapezoid leg of length `l` cruising at `v`, acceleration `a`, from `v0` to `v1`.
-fn leg(l: f64, v: f64, a: f64, v0: f64, v1: f64) -> f64 {
-    (v - v0) / a
-        + (v - v1) / a
-        + (l - (v * v - v0 * v0) / (2.0 * a) - (v * v - v1 * v1) / (2.0 * a)) / v
-}
+use crate::job_util::{MM, assert_rel, direct, job, leg, run};
 
 fn klipper(v_mm_s: f64, a_mm_s2: f64, mcr: f64) -> KlipperConfig {
     let mut c = KlipperConfig::new(v_mm_s * MM, a_mm_s2 * MM);

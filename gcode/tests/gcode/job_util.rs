@@ -1,6 +1,6 @@
 //! Helpers of the job tests: running a job on text, and the same moves planned directly.
 
-use settle_gcode::job::{Job, JobChunk, JobConfig, JobSummary};
+use settle_gcode::job::{Job, JobChunk, JobConfig, JobSummary, PlannerConfig};
 use settle_gcode::{Reader, ReaderOptions};
 use settle_planner::Sample;
 use settle_planner::firmware::{FirmwarePlanner, LinearMove};
@@ -64,4 +64,19 @@ pub fn assert_contiguous(chunks: &[JobChunk]) {
             );
         }
     }
+}
+
+/// The defaults of `planner`'s firmware with `planner` as its configuration.
+pub fn job(planner: PlannerConfig) -> JobConfig {
+    let mut c = JobConfig::defaults(planner.firmware()).expect("defaults");
+    c.planner = planner;
+    c
+}
+
+/// Time of a trapezoid leg of length `l` cruising at `v` with acceleration `a`, from
+/// `v0` to `v1` (any consistent units).
+pub fn leg(l: f64, v: f64, a: f64, v0: f64, v1: f64) -> f64 {
+    (v - v0) / a
+        + (v - v1) / a
+        + (l - (v * v - v0 * v0) / (2.0 * a) - (v * v - v1 * v1) / (2.0 * a)) / v
 }

@@ -26,7 +26,7 @@ use super::geometry::{CornerPlan, CornerTransition, PathGeometry, Primitive};
 use super::junction::Junction;
 use super::law::{self, SpeedLaw, largest};
 use super::pieces::{Piece, VSeg, VState, profiles};
-use super::vector::{axpy, norm, scale, sub};
+use super::vector::{V3, axpy, norm, scale, sub};
 use super::{Path, PathPoint, PointKind, interior_angle};
 use crate::{Limits, PlanError, ProfileKind, Trajectory};
 
@@ -294,7 +294,6 @@ impl Lookahead {
         let pts = self.path.points();
         let n = pts.len();
         let lim = &self.opts.limits;
-        let (amax, jmax, tj) = (lim.amax(), self.opts.jmax(), self.opts.velocity_jump_s);
         let mut pieces: Vec<Piece> = Vec::with_capacity(2 * n);
         let mut prims: Vec<Primitive> = Vec::with_capacity(3 * n);
         let mut corners: Vec<CornerPlan> = Vec::with_capacity(n);
@@ -351,51 +350,8 @@ impl Lookahead {
                     ..stop(c, t, theta)
                 }
             } else {
-                let (piece, transition, deviation) = match self.opts.corners {
-                    CornerStrategy::Blend { .. } => {
-                        let b = Blend::new(corner, u, u_out, v1, amax, jmax);
-                        let segs = b
-                            .shape
-                            .normal_segments(jmax)
-                            .iter()
-                            .map(|s| VSeg::along(s, b.e_n))
-                            .collect();
-                        let start = VState {
-                            p: b.entry(),
-                            v: scale(u, v1),
-                            a: [0.0; 3],
-                        };
-                        let tr = CornerTransition::Blend {
-                            case: b.shape.case,
-                            distance_m: b.shape.distance_m,
-                            duration_s: b.shape.duration_s,
-                        };
-                        (Piece { start, segs }, tr, b.shape.deviation_m)
-                    }
-                    _ => {
-                        let dv = sub(scale(u_out, v1), scale(u, v1));
-                        let segs = vec![
-                            VSeg::Accel {
-                                duration_s: tj,
-                                accel: scale(dv, 1.0 / tj),
-                            },
-                            VSeg::Accel {
-                                duration_s: 0.0,
-                                accel: [0.0; 3],
-                            },
-                        ];
-                        let start = VState {
-                            p: axpy(corner, -d1, u),
-                            v: scale(u, v1),
-                            a: [0.0; 3],
-                        };
-                        let tr = CornerTransition::Jump {
-                            dv: norm(dv),
-                            duration_s: tj,
-                        };
-                        (Piece { start, segs }, tr, norm(dv) * tj / 8.0)
-                    }
-                };
+                let (piece, transition, deviation) =
+                    corner_piece(&self.opts, corner, u, u_out, v1, d1);
                 let dur = piece.duration_s();
                 arcs(&piece, &mut prims);
                 pieces.push(piece);
@@ -435,6 +391,65 @@ fn arcs(piece: &Piece, out: &mut Vec<Primitive>) {
             });
         }
         s = s.advance(seg, d);
+    }
+}
+
+/// The transition at a sharp or blended corner `corner` between the unit directions `u`
+/// (in) and `u_out`, passed at speed `v1` and using `d1` of each segment: its piece, what
+/// kind of transition it is, and how far it deviates from the corner (m).
+pub(crate) fn corner_piece(
+    opts: &PathOptions,
+    corner: V3,
+    u: V3,
+    u_out: V3,
+    v1: f64,
+    d1: f64,
+) -> (Piece, CornerTransition, f64) {
+    let (amax, jmax, tj) = (opts.limits.amax(), opts.jmax(), opts.velocity_jump_s);
+    match opts.corners {
+        CornerStrategy::Blend { .. } => {
+            let b = Blend::new(corner, u, u_out, v1, amax, jmax);
+            let segs = b
+                .shape
+                .normal_segments(jmax)
+                .iter()
+                .map(|s| VSeg::along(s, b.e_n))
+                .collect();
+            let start = VState {
+                p: b.entry(),
+                v: scale(u, v1),
+                a: [0.0; 3],
+            };
+            let tr = CornerTransition::Blend {
+                case: b.shape.case,
+                distance_m: b.shape.distance_m,
+                duration_s: b.shape.duration_s,
+            };
+            (Piece { start, segs }, tr, b.shape.deviation_m)
+        }
+        _ => {
+            let dv = sub(scale(u_out, v1), scale(u, v1));
+            let segs = vec![
+                VSeg::Accel {
+                    duration_s: tj,
+                    accel: scale(dv, 1.0 / tj),
+                },
+                VSeg::Accel {
+                    duration_s: 0.0,
+                    accel: [0.0; 3],
+                },
+            ];
+            let start = VState {
+                p: axpy(corner, -d1, u),
+                v: scale(u, v1),
+                a: [0.0; 3],
+            };
+            let tr = CornerTransition::Jump {
+                dv: norm(dv),
+                duration_s: tj,
+            };
+            (Piece { start, segs }, tr, norm(dv) * tj / 8.0)
+        }
     }
 }
 

@@ -26,8 +26,8 @@ use std::collections::VecDeque;
 use super::blend::{self, Blend};
 use super::interior_angle;
 use super::law::{self, largest};
-use super::lookahead::{CornerStrategy, PathOptions};
-use super::pieces::{Piece, VSeg, VState};
+use super::lookahead::{CornerStrategy, PathOptions, corner_piece};
+use super::pieces::{Piece, VSeg, VState, profiles_from};
 use super::vector::{V3, axpy, dist, norm, scale, sub};
 use crate::{PlanError, Profile, Segment, State, Trajectory};
 
@@ -330,8 +330,6 @@ impl WindowedPath {
     /// point); the window then starts at point `c`.
     fn commit(&mut self, plan: &Plan, c: usize) -> Result<(), PlanError> {
         let last = self.pts.len() - 1;
-        let lim = &self.opts.limits;
-        let (amax, jmax, tj) = (lim.amax(), self.jmax(), self.opts.velocity_jump_s);
         let mut pieces: Vec<Piece> = Vec::with_capacity(2 * c);
         let mut moves = Vec::with_capacity(c);
         let mut t = 0.0;
@@ -366,43 +364,7 @@ impl WindowedPath {
             let mut mid = t;
             if p != last && v1 > 0.0 && d1 > 0.0 {
                 let u_out = self.dir(p);
-                let corner = self.pts[p];
-                let piece = match self.opts.corners {
-                    CornerStrategy::Blend { .. } => {
-                        let b = Blend::new(corner, u, u_out, v1, amax, jmax);
-                        let segs = b
-                            .shape
-                            .normal_segments(jmax)
-                            .iter()
-                            .map(|s| VSeg::along(s, b.e_n))
-                            .collect();
-                        let start = VState {
-                            p: b.entry(),
-                            v: scale(u, v1),
-                            a: [0.0; 3],
-                        };
-                        Piece { start, segs }
-                    }
-                    _ => {
-                        let dv = sub(scale(u_out, v1), scale(u, v1));
-                        let segs = vec![
-                            VSeg::Accel {
-                                duration_s: tj,
-                                accel: scale(dv, 1.0 / tj),
-                            },
-                            VSeg::Accel {
-                                duration_s: 0.0,
-                                accel: [0.0; 3],
-                            },
-                        ];
-                        let start = VState {
-                            p: axpy(corner, -d1, u),
-                            v: scale(u, v1),
-                            a: [0.0; 3],
-                        };
-                        Piece { start, segs }
-                    }
-                };
+                let (piece, _, _) = corner_piece(&self.opts, self.pts[p], u, u_out, v1, d1);
                 let dur = piece.duration_s();
                 mid = t + 0.5 * dur;
                 t += dur;
@@ -418,7 +380,7 @@ impl WindowedPath {
             });
             self.span_start_s = self.time_s + mid;
         }
-        let axes = axis_profiles(start, &pieces)?;
+        let axes = profiles_from(3, start, &pieces)?;
         self.ready.push_back(PathChunk {
             start_time_s: self.time_s,
             trajectory: Trajectory::new(axes)?,
@@ -432,47 +394,4 @@ impl WindowedPath {
         self.seqs.drain(..c);
         Ok(())
     }
-}
-
-/// One profile per axis (X, Y, Z) from the pieces, starting in state `start` (as
-/// [`super::plan_path`] assembles its pieces, from a moving start).
-fn axis_profiles(start: VState, pieces: &[Piece]) -> Result<Vec<Profile>, PlanError> {
-    (0..3)
-        .map(|i| {
-            let s0 = State {
-                p: start.p[i],
-                v: start.v[i],
-                a: 0.0,
-            };
-            let mut segs = Vec::new();
-            let mut st = s0;
-            for (n, piece) in pieces.iter().enumerate() {
-                // Pieces start with zero acceleration: reset a trace of the last one, as
-                // plan_path does, so it cannot integrate into position drift.
-                if n > 0 && matches!(piece.segs.first(), Some(VSeg::Jerk { .. })) {
-                    let reset = Segment::Accel {
-                        duration_s: 0.0,
-                        accel: 0.0,
-                    };
-                    st = reset.end_state(&st);
-                    segs.push(reset);
-                }
-                for vs in &piece.segs {
-                    let seg = match *vs {
-                        VSeg::Jerk { duration_s, jerk } => Segment::Jerk {
-                            duration_s,
-                            jerk: jerk[i],
-                        },
-                        VSeg::Accel { duration_s, accel } => Segment::Accel {
-                            duration_s,
-                            accel: accel[i],
-                        },
-                    };
-                    st = seg.end_state(&st);
-                    segs.push(seg);
-                }
-            }
-            Profile::new(s0, segs)
-        })
-        .collect()
 }

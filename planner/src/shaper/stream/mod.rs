@@ -32,14 +32,17 @@
 //! centred shapers have no such offset.
 
 mod axes;
+mod cut;
 mod regime;
 
 pub use axes::AxesShaper;
+pub use cut::cut;
 
 use std::collections::VecDeque;
 
 use self::regime::Regime;
 use super::Shaper;
+use super::apply::segments_between;
 use crate::{PlanError, Profile, Sample, Segment, State};
 
 /// Where the impulses sit relative to the input (module doc).
@@ -280,37 +283,8 @@ impl ShaperStream {
             v: s0.v,
             a: self.a_now,
         };
-        let mut segments = Vec::with_capacity(knots.len());
-        for pair in knots.windows(2) {
-            let (ta, tb) = (pair[0], pair[1]);
-            let dur = tb - ta;
-            if dur <= 0.0 {
-                continue;
-            }
-            // Right limits on the interval: evaluate just inside it.
-            let mid = self.shaped_at(ta + 0.5 * dur);
-            let a_start = mid.a - mid.j * 0.5 * dur;
-            let jumps =
-                (a_start - self.a_now).abs() > 1e-12 * (1.0 + a_start.abs() + self.a_now.abs());
-            if mid.j == 0.0 {
-                segments.push(Segment::Accel {
-                    duration_s: dur,
-                    accel: a_start,
-                });
-            } else {
-                if jumps {
-                    segments.push(Segment::Accel {
-                        duration_s: 0.0,
-                        accel: a_start,
-                    });
-                }
-                segments.push(Segment::Jerk {
-                    duration_s: dur,
-                    jerk: mid.j,
-                });
-            }
-            self.a_now = a_start + mid.j * dur;
-        }
+        let (segments, a_end) = segments_between(&knots, self.a_now, |t| self.shaped_at(t));
+        self.a_now = a_end;
         self.cursor_s = b;
         self.forget();
         Ok((a, Profile::new(start, segments)?))
