@@ -82,7 +82,7 @@ impl PathOptions {
         })
     }
 
-    fn validate(&self) -> Result<(), PlanError> {
+    pub(crate) fn validate(&self) -> Result<(), PlanError> {
         match self.corners {
             CornerStrategy::ExactStop => {}
             CornerStrategy::Junction(j) => j.validate()?,

@@ -85,25 +85,7 @@ impl WindowedPath {
     /// A planner with `opts` committing at most `window_points` points at a time
     /// (>= 3), at rest at `start_m`.
     pub fn new(opts: PathOptions, window_points: usize, start_m: V3) -> Result<Self, PlanError> {
-        match opts.corners {
-            CornerStrategy::ExactStop => {}
-            CornerStrategy::Junction(j) => j.validate()?,
-            CornerStrategy::Blend { max_deviation_m } => {
-                if !(max_deviation_m >= 0.0) {
-                    return Err(PlanError::InvalidLimit {
-                        name: "max_deviation_m",
-                        value: max_deviation_m,
-                    });
-                }
-            }
-        }
-        let tj = opts.velocity_jump_s;
-        if !(tj.is_finite() && tj > 0.0) {
-            return Err(PlanError::InvalidLimit {
-                name: "velocity_jump_s",
-                value: tj,
-            });
-        }
+        opts.validate()?;
         if window_points < 3 {
             return Err(PlanError::InvalidLimit {
                 name: "window_points (>= 3)",
