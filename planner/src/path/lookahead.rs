@@ -315,18 +315,7 @@ impl Lookahead {
             let from = axpy(pts[k].position, d0, u);
             let to = axpy(pts[k + 1].position, -d1, u);
             let len = self.path.segment_length(k) - d0 - d1;
-            let segs: Vec<VSeg> = law::segment(self.opts.law.as_ref(), v0, v1, len, lim.vmax())
-                .iter()
-                .map(|s| VSeg::along(s, u))
-                .collect();
-            let piece = Piece {
-                start: VState {
-                    p: from,
-                    v: scale(u, v0),
-                    a: [0.0; 3],
-                },
-                segs,
-            };
+            let piece = straight_piece(&self.opts, from, u, v0, v1, len, lim.vmax());
             t += piece.duration_s();
             if len > 0.0 {
                 prims.push(Primitive::Line { a: from, b: to });
@@ -391,6 +380,31 @@ fn arcs(piece: &Piece, out: &mut Vec<Primitive>) {
             });
         }
         s = s.advance(seg, d);
+    }
+}
+
+/// The straight run from `from` along the unit direction `u`, `len` long, from speed `v0`
+/// to `v1` under the speed law of `opts` with top speed `vmax` (m, m/s).
+pub(crate) fn straight_piece(
+    opts: &PathOptions,
+    from: V3,
+    u: V3,
+    v0: f64,
+    v1: f64,
+    len: f64,
+    vmax: f64,
+) -> Piece {
+    let segs = law::segment(opts.law.as_ref(), v0, v1, len, vmax)
+        .iter()
+        .map(|s| VSeg::along(s, u))
+        .collect();
+    Piece {
+        start: VState {
+            p: from,
+            v: scale(u, v0),
+            a: [0.0; 3],
+        },
+        segs,
     }
 }
 

@@ -25,9 +25,9 @@ use std::collections::VecDeque;
 
 use super::blend::{self, Blend};
 use super::interior_angle;
-use super::law::{self, largest};
-use super::lookahead::{CornerStrategy, PathOptions, corner_piece};
-use super::pieces::{Piece, VSeg, VState, profiles_from};
+use super::law::largest;
+use super::lookahead::{CornerStrategy, PathOptions, corner_piece, straight_piece};
+use super::pieces::{Piece, VState, profiles_from};
 use super::vector::{V3, axpy, dist, norm, scale, sub};
 use crate::{PlanError, Profile, Segment, State, Trajectory};
 
@@ -327,19 +327,7 @@ impl WindowedPath {
             let (d0, d1) = (self.used(k, v0), self.used(k + 1, v1));
             let from = axpy(self.pts[k], d0, u);
             let len = self.len(k) - d0 - d1;
-            let segs: Vec<VSeg> =
-                law::segment(self.opts.law.as_ref(), v0, v1, len, self.seg_vmax[k])
-                    .iter()
-                    .map(|s| VSeg::along(s, u))
-                    .collect();
-            let piece = Piece {
-                start: VState {
-                    p: from,
-                    v: scale(u, v0),
-                    a: [0.0; 3],
-                },
-                segs,
-            };
+            let piece = straight_piece(&self.opts, from, u, v0, v1, len, self.seg_vmax[k]);
             t += piece.duration_s();
             pieces.push(piece);
             let p = k + 1;
