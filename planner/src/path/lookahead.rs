@@ -226,20 +226,12 @@ impl Lookahead {
         if k == 0 || k == last || v <= 0.0 {
             return 0.0;
         }
-        let (u_in, u_out) = (self.path.direction(k - 1), self.path.direction(k));
-        if norm(sub(u_out, u_in)) == 0.0 {
-            return 0.0;
-        }
-        match self.opts.corners {
-            CornerStrategy::ExactStop => 0.0,
-            CornerStrategy::Junction(_) => 0.5 * v * self.opts.velocity_jump_s,
-            CornerStrategy::Blend { .. } => {
-                let (amax, jmax) = (self.opts.limits.amax(), self.opts.jmax());
-                Blend::new([0.0; 3], u_in, u_out, v, amax, jmax)
-                    .shape
-                    .distance_m
-            }
-        }
+        corner_used(
+            &self.opts,
+            self.path.direction(k - 1),
+            self.path.direction(k),
+            v,
+        )
     }
 
     /// Does the run of segment `k` hold the change `v0 -> v1` (v0 at point k)?
@@ -380,6 +372,25 @@ fn arcs(piece: &Piece, out: &mut Vec<Primitive>) {
             });
         }
         s = s.advance(seg, d);
+    }
+}
+
+/// Length of each segment used by the transition at a corner from the unit direction
+/// `u_in` to `u_out` passed at speed `v` (m): none for a straight continuation or an exact
+/// stop, half the velocity jump's travel for a junction, the blend's own distance.
+pub(crate) fn corner_used(opts: &PathOptions, u_in: V3, u_out: V3, v: f64) -> f64 {
+    if norm(sub(u_out, u_in)) == 0.0 {
+        return 0.0;
+    }
+    match opts.corners {
+        CornerStrategy::ExactStop => 0.0,
+        CornerStrategy::Junction(_) => 0.5 * v * opts.velocity_jump_s,
+        CornerStrategy::Blend { .. } => {
+            let (amax, jmax) = (opts.limits.amax(), opts.jmax());
+            Blend::new([0.0; 3], u_in, u_out, v, amax, jmax)
+                .shape
+                .distance_m
+        }
     }
 }
 

@@ -23,10 +23,10 @@
 
 use std::collections::VecDeque;
 
-use super::blend::{self, Blend};
+use super::blend;
 use super::interior_angle;
 use super::law::largest;
-use super::lookahead::{CornerStrategy, PathOptions, corner_piece, straight_piece};
+use super::lookahead::{CornerStrategy, PathOptions, corner_piece, corner_used, straight_piece};
 use super::pieces::{Piece, VState, profiles_from};
 use super::vector::{V3, axpy, dist, norm, scale, sub};
 use crate::{PlanError, Profile, Segment, State, Trajectory};
@@ -246,26 +246,7 @@ impl WindowedPath {
         if k == last || v <= 0.0 {
             return 0.0;
         }
-        let (u_in, u_out) = (self.dir(k - 1), self.dir(k));
-        if norm(sub(u_out, u_in)) == 0.0 {
-            return 0.0;
-        }
-        match self.opts.corners {
-            CornerStrategy::ExactStop => 0.0,
-            CornerStrategy::Junction(_) => 0.5 * v * self.opts.velocity_jump_s,
-            CornerStrategy::Blend { .. } => {
-                Blend::new(
-                    [0.0; 3],
-                    u_in,
-                    u_out,
-                    v,
-                    self.opts.limits.amax(),
-                    self.jmax(),
-                )
-                .shape
-                .distance_m
-            }
-        }
+        corner_used(&self.opts, self.dir(k - 1), self.dir(k), v)
     }
 
     /// Does the run of segment `k` hold the change `v0 -> v1`?
