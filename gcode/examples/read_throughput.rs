@@ -13,12 +13,9 @@ use settle_gcode::{Dialect, Reader, ReaderOptions, Summary};
 #[path = "../benches/synth/mod.rs"]
 mod synth;
 
-/// Peak resident set size of this process so far, kB (Linux `VmHWM`).
-fn peak_rss_kb() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    line.split_whitespace().nth(1)?.parse().ok()
-}
+#[path = "support/mod.rs"]
+mod support;
+use support::peak_rss_kb;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mb: u64 = std::env::args()

@@ -272,6 +272,25 @@ pub enum GcodeError {
         /// What is degenerate.
         why: &'static str,
     },
+    /// The firmware's planner or shaper refuses what a line asks for (a move, a limit, a
+    /// shaper setting).
+    #[error("{at}: `{command}`: {source}")]
+    Plan {
+        /// Where.
+        at: Location,
+        /// The command (`G1`, `SET_INPUT_SHAPER`, `M593`).
+        command: String,
+        /// What the planner says (boxed: it is large and rare).
+        source: Box<settle_planner::PlanError>,
+    },
+    /// A job setting (not from the file) that cannot be used.
+    #[error("job setting `{key}`: {reason}")]
+    JobSetting {
+        /// The setting (`layers`, `shaper_x`, `firmware`, ...).
+        key: &'static str,
+        /// What is wrong and what is allowed.
+        reason: String,
+    },
 }
 
 impl GcodeError {
@@ -281,7 +300,8 @@ impl GcodeError {
             GcodeError::Io { .. }
             | GcodeError::UnknownDialect { .. }
             | GcodeError::ConfigMissing { .. }
-            | GcodeError::ExportValue { .. } => None,
+            | GcodeError::ExportValue { .. }
+            | GcodeError::JobSetting { .. } => None,
             GcodeError::LineTooLong { at, .. }
             | GcodeError::InvalidUtf8 { at }
             | GcodeError::ControlCharacter { at, .. }
@@ -301,7 +321,8 @@ impl GcodeError {
             | GcodeError::ConfigSyntax { at, .. }
             | GcodeError::ConfigValue { at, .. }
             | GcodeError::IncludeNotFound { at, .. }
-            | GcodeError::IncludeCycle { at, .. } => Some(at),
+            | GcodeError::IncludeCycle { at, .. }
+            | GcodeError::Plan { at, .. } => Some(at),
         }
     }
 

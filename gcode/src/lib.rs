@@ -58,6 +58,7 @@ mod dialect;
 mod error;
 mod event;
 mod geometry;
+pub mod job;
 mod layers;
 mod lex;
 mod limit_parse;

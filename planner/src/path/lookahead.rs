@@ -27,7 +27,7 @@ use super::junction::Junction;
 use super::law::{self, SpeedLaw, largest};
 use super::pieces::{Piece, VSeg, VState, profiles};
 use super::polyline::{Path, PathPoint, PointKind, interior_angle};
-use super::vector::{axpy, norm, scale, sub};
+use super::vector::{V3, axpy, norm, scale, sub};
 use crate::{Limits, PlanError, ProfileKind, Trajectory};
 
 /// How control points are passed.
@@ -83,7 +83,7 @@ impl PathOptions {
         })
     }
 
-    fn validate(&self) -> Result<(), PlanError> {
+    pub(crate) fn validate(&self) -> Result<(), PlanError> {
         match self.corners {
             CornerStrategy::ExactStop => {}
             CornerStrategy::Junction(j) => j.validate()?,
@@ -227,20 +227,12 @@ impl Lookahead {
         if k == 0 || k == last || v <= 0.0 {
             return 0.0;
         }
-        let (u_in, u_out) = (self.path.direction(k - 1), self.path.direction(k));
-        if norm(sub(u_out, u_in)) == 0.0 {
-            return 0.0;
-        }
-        match self.opts.corners {
-            CornerStrategy::ExactStop => 0.0,
-            CornerStrategy::Junction(_) => 0.5 * v * self.opts.velocity_jump_s,
-            CornerStrategy::Blend { .. } => {
-                let (amax, jmax) = (self.opts.limits.amax(), self.opts.jmax());
-                Blend::new([0.0; 3], u_in, u_out, v, amax, jmax)
-                    .shape
-                    .distance_m
-            }
-        }
+        corner_used(
+            &self.opts,
+            self.path.direction(k - 1),
+            self.path.direction(k),
+            v,
+        )
     }
 
     /// Does the run of segment `k` hold the change `v0 -> v1` (v0 at point k)?
@@ -295,7 +287,6 @@ impl Lookahead {
         let pts = self.path.points();
         let n = pts.len();
         let lim = &self.opts.limits;
-        let (amax, jmax, tj) = (lim.amax(), self.opts.jmax(), self.opts.velocity_jump_s);
         let mut pieces: Vec<Piece> = Vec::with_capacity(2 * n);
         let mut prims: Vec<Primitive> = Vec::with_capacity(3 * n);
         let mut corners: Vec<CornerPlan> = Vec::with_capacity(n);
@@ -317,18 +308,7 @@ impl Lookahead {
             let from = axpy(pts[k].position, d0, u);
             let to = axpy(pts[k + 1].position, -d1, u);
             let len = self.path.segment_length(k) - d0 - d1;
-            let segs: Vec<VSeg> = law::segment(self.opts.law.as_ref(), v0, v1, len, lim.vmax())
-                .iter()
-                .map(|s| VSeg::along(s, u))
-                .collect();
-            let piece = Piece {
-                start: VState {
-                    p: from,
-                    v: scale(u, v0),
-                    a: [0.0; 3],
-                },
-                segs,
-            };
+            let piece = straight_piece(&self.opts, from, u, v0, v1, len, lim.vmax());
             t += piece.duration_s();
             if len > 0.0 {
                 prims.push(Primitive::Line { a: from, b: to });
@@ -352,51 +332,8 @@ impl Lookahead {
                     ..stop(c, t, theta)
                 }
             } else {
-                let (piece, transition, deviation) = match self.opts.corners {
-                    CornerStrategy::Blend { .. } => {
-                        let b = Blend::new(corner, u, u_out, v1, amax, jmax);
-                        let segs = b
-                            .shape
-                            .normal_segments(jmax)
-                            .iter()
-                            .map(|s| VSeg::along(s, b.e_n))
-                            .collect();
-                        let start = VState {
-                            p: b.entry(),
-                            v: scale(u, v1),
-                            a: [0.0; 3],
-                        };
-                        let tr = CornerTransition::Blend {
-                            case: b.shape.case,
-                            distance_m: b.shape.distance_m,
-                            duration_s: b.shape.duration_s,
-                        };
-                        (Piece { start, segs }, tr, b.shape.deviation_m)
-                    }
-                    _ => {
-                        let dv = sub(scale(u_out, v1), scale(u, v1));
-                        let segs = vec![
-                            VSeg::Accel {
-                                duration_s: tj,
-                                accel: scale(dv, 1.0 / tj),
-                            },
-                            VSeg::Accel {
-                                duration_s: 0.0,
-                                accel: [0.0; 3],
-                            },
-                        ];
-                        let start = VState {
-                            p: axpy(corner, -d1, u),
-                            v: scale(u, v1),
-                            a: [0.0; 3],
-                        };
-                        let tr = CornerTransition::Jump {
-                            dv: norm(dv),
-                            duration_s: tj,
-                        };
-                        (Piece { start, segs }, tr, norm(dv) * tj / 8.0)
-                    }
-                };
+                let (piece, transition, deviation) =
+                    corner_piece(&self.opts, corner, u, u_out, v1, d1);
                 let dur = piece.duration_s();
                 arcs(&piece, &mut prims);
                 pieces.push(piece);
@@ -436,6 +373,109 @@ fn arcs(piece: &Piece, out: &mut Vec<Primitive>) {
             });
         }
         s = s.advance(seg, d);
+    }
+}
+
+/// Length of each segment used by the transition at a corner from the unit direction
+/// `u_in` to `u_out` passed at speed `v` (m): none for a straight continuation or an exact
+/// stop, half the velocity jump's travel for a junction, the blend's own distance.
+pub(crate) fn corner_used(opts: &PathOptions, u_in: V3, u_out: V3, v: f64) -> f64 {
+    if norm(sub(u_out, u_in)) == 0.0 {
+        return 0.0;
+    }
+    match opts.corners {
+        CornerStrategy::ExactStop => 0.0,
+        CornerStrategy::Junction(_) => 0.5 * v * opts.velocity_jump_s,
+        CornerStrategy::Blend { .. } => {
+            let (amax, jmax) = (opts.limits.amax(), opts.jmax());
+            Blend::new([0.0; 3], u_in, u_out, v, amax, jmax)
+                .shape
+                .distance_m
+        }
+    }
+}
+
+/// The straight run from `from` along the unit direction `u`, `len` long, from speed `v0`
+/// to `v1` under the speed law of `opts` with top speed `vmax` (m, m/s).
+pub(crate) fn straight_piece(
+    opts: &PathOptions,
+    from: V3,
+    u: V3,
+    v0: f64,
+    v1: f64,
+    len: f64,
+    vmax: f64,
+) -> Piece {
+    let segs = law::segment(opts.law.as_ref(), v0, v1, len, vmax)
+        .iter()
+        .map(|s| VSeg::along(s, u))
+        .collect();
+    Piece {
+        start: VState {
+            p: from,
+            v: scale(u, v0),
+            a: [0.0; 3],
+        },
+        segs,
+    }
+}
+
+/// The transition at a sharp or blended corner `corner` between the unit directions `u`
+/// (in) and `u_out`, passed at speed `v1` and using `d1` of each segment: its piece, what
+/// kind of transition it is, and how far it deviates from the corner (m).
+pub(crate) fn corner_piece(
+    opts: &PathOptions,
+    corner: V3,
+    u: V3,
+    u_out: V3,
+    v1: f64,
+    d1: f64,
+) -> (Piece, CornerTransition, f64) {
+    let (amax, jmax, tj) = (opts.limits.amax(), opts.jmax(), opts.velocity_jump_s);
+    match opts.corners {
+        CornerStrategy::Blend { .. } => {
+            let b = Blend::new(corner, u, u_out, v1, amax, jmax);
+            let segs = b
+                .shape
+                .normal_segments(jmax)
+                .iter()
+                .map(|s| VSeg::along(s, b.e_n))
+                .collect();
+            let start = VState {
+                p: b.entry(),
+                v: scale(u, v1),
+                a: [0.0; 3],
+            };
+            let tr = CornerTransition::Blend {
+                case: b.shape.case,
+                distance_m: b.shape.distance_m,
+                duration_s: b.shape.duration_s,
+            };
+            (Piece { start, segs }, tr, b.shape.deviation_m)
+        }
+        _ => {
+            let dv = sub(scale(u_out, v1), scale(u, v1));
+            let segs = vec![
+                VSeg::Accel {
+                    duration_s: tj,
+                    accel: scale(dv, 1.0 / tj),
+                },
+                VSeg::Accel {
+                    duration_s: 0.0,
+                    accel: [0.0; 3],
+                },
+            ];
+            let start = VState {
+                p: axpy(corner, -d1, u),
+                v: scale(u, v1),
+                a: [0.0; 3],
+            };
+            let tr = CornerTransition::Jump {
+                dv: norm(dv),
+                duration_s: tj,
+            };
+            (Piece { start, segs }, tr, norm(dv) * tj / 8.0)
+        }
     }
 }
 

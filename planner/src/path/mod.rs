@@ -32,6 +32,7 @@ mod pieces;
 mod polyline;
 mod rounding;
 pub mod vector;
+pub mod window;
 
 pub use fault::PathFault;
 pub use geometry::{CornerPlan, CornerTransition, PathGeometry, Primitive};

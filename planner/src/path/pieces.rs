@@ -103,11 +103,26 @@ impl Piece {
 
 /// One profile per axis (`dim` axes) from the pieces, starting at rest at `start`.
 pub(crate) fn profiles(dim: usize, start: V3, pieces: &[Piece]) -> Result<Vec<Profile>, PlanError> {
+    let at_rest = VState {
+        p: start,
+        v: [0.0; 3],
+        a: [0.0; 3],
+    };
+    profiles_from(dim, at_rest, pieces)
+}
+
+/// One profile per axis (`dim` axes) from the pieces, starting at the position and
+/// velocity of `start` (with zero acceleration, as every piece starts).
+pub(crate) fn profiles_from(
+    dim: usize,
+    start: VState,
+    pieces: &[Piece],
+) -> Result<Vec<Profile>, PlanError> {
     (0..dim)
         .map(|i| {
             let s0 = State {
-                p: start[i],
-                v: 0.0,
+                p: start.p[i],
+                v: start.v[i],
                 a: 0.0,
             };
             let mut segs = Vec::new();

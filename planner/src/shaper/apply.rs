@@ -60,38 +60,8 @@ impl Shaper {
         }
         knots.sort_by(f64::total_cmp);
         knots.dedup();
-        let mut segments = Vec::with_capacity(knots.len());
-        let mut a_now = 0.0;
         let s0 = shaped(0.0);
-        for pair in knots.windows(2) {
-            let (ta, tb) = (pair[0], pair[1]);
-            let dur = tb - ta;
-            if dur <= 0.0 {
-                continue;
-            }
-            // Right limits on the interval: evaluate just inside it.
-            let mid = shaped(ta + 0.5 * dur);
-            let a_start = mid.a - mid.j * 0.5 * dur;
-            let jumps = (a_start - a_now).abs() > 1e-12 * (1.0 + a_start.abs() + a_now.abs());
-            if mid.j == 0.0 {
-                segments.push(Segment::Accel {
-                    duration_s: dur,
-                    accel: a_start,
-                });
-            } else {
-                if jumps {
-                    segments.push(Segment::Accel {
-                        duration_s: 0.0,
-                        accel: a_start,
-                    });
-                }
-                segments.push(Segment::Jerk {
-                    duration_s: dur,
-                    jerk: mid.j,
-                });
-            }
-            a_now = a_start + mid.j * dur;
-        }
+        let (segments, _) = segments_between(&knots, 0.0, shaped);
         Profile::new(
             State {
                 p: s0.p,
@@ -101,4 +71,47 @@ impl Shaper {
             segments,
         )
     }
+}
+
+/// The profile segments of a piecewise-polynomial motion `shaped` (right-continuous)
+/// between consecutive `knots` (sorted), where it has constant jerk: each interval's jerk
+/// and start acceleration are read at its middle; an acceleration that differs from the
+/// previous interval's end (`a_now` before the first) by more than rounding starts with
+/// an acceleration step. Returns the segments and the acceleration at the end.
+pub(super) fn segments_between(
+    knots: &[f64],
+    mut a_now: f64,
+    shaped: impl Fn(f64) -> Sample,
+) -> (Vec<Segment>, f64) {
+    let mut segments = Vec::with_capacity(knots.len());
+    for pair in knots.windows(2) {
+        let (ta, tb) = (pair[0], pair[1]);
+        let dur = tb - ta;
+        if dur <= 0.0 {
+            continue;
+        }
+        // Right limits on the interval: evaluate just inside it.
+        let mid = shaped(ta + 0.5 * dur);
+        let a_start = mid.a - mid.j * 0.5 * dur;
+        let jumps = (a_start - a_now).abs() > 1e-12 * (1.0 + a_start.abs() + a_now.abs());
+        if mid.j == 0.0 {
+            segments.push(Segment::Accel {
+                duration_s: dur,
+                accel: a_start,
+            });
+        } else {
+            if jumps {
+                segments.push(Segment::Accel {
+                    duration_s: 0.0,
+                    accel: a_start,
+                });
+            }
+            segments.push(Segment::Jerk {
+                duration_s: dur,
+                jerk: mid.j,
+            });
+        }
+        a_now = a_start + mid.j * dur;
+    }
+    (segments, a_now)
 }

@@ -26,6 +26,7 @@ mod mzv_solve;
 mod name;
 mod response;
 mod rrf;
+pub mod stream;
 #[cfg(test)]
 mod tests;
 

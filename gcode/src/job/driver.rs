@@ -1,0 +1,230 @@
+//! The firmware planners behind one interface, and the limit commands each applies.
+//!
+//! Limit changes take effect for the moves queued after them; moves already queued keep
+//! theirs, as in every firmware (Klipper's `SET_VELOCITY_LIMIT`, Marlin's and
+//! RepRapFirmware's M201/M203/M204/M205/M566 change the settings new moves are planned
+//! with). A command of another firmware's dialect, or one a firmware reads but this model
+//! does not simulate, is counted as ignored with the reason.
+
+use settle_planner::PlanError;
+use settle_planner::firmware::klipper::KlipperPlanner;
+use settle_planner::firmware::marlin::{MarlinJerk, MarlinPlanner};
+use settle_planner::firmware::rrf::RrfPlanner;
+use settle_planner::firmware::{FirmwarePlanner, PlannedMove};
+
+use super::config::PlannerConfig;
+use crate::limits::{AxisValues, LimitChange};
+
+/// Millimetres (and mm/s, mm/s^2) to metres.
+const MM: f64 = 1e-3;
+
+/// What a limit command did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum LimitOutcome {
+    /// The planner's settings changed.
+    Applied,
+    /// Nothing changed, for this reason.
+    Ignored(&'static str),
+}
+
+/// One of the firmware planners.
+#[derive(Debug)]
+pub(crate) enum Driver {
+    Klipper(Box<KlipperPlanner>),
+    Marlin(Box<MarlinPlanner>),
+    Rrf(Box<RrfPlanner>),
+}
+
+impl Driver {
+    /// The planner of `cfg` (`None` for settle's planner, which is not a firmware).
+    pub(crate) fn new(cfg: &PlannerConfig) -> Result<Option<Self>, PlanError> {
+        Ok(Some(match cfg {
+            PlannerConfig::Klipper(c) => Driver::Klipper(Box::new(KlipperPlanner::new(*c)?)),
+            PlannerConfig::Marlin(c) => Driver::Marlin(Box::new(MarlinPlanner::new(*c)?)),
+            PlannerConfig::Rrf(c) => Driver::Rrf(Box::new(RrfPlanner::new(*c)?)),
+            PlannerConfig::Settle(_) => return Ok(None),
+        }))
+    }
+
+    /// The planner.
+    pub(crate) fn planner(&mut self) -> &mut dyn FirmwarePlanner {
+        match self {
+            Driver::Klipper(p) => p.as_mut(),
+            Driver::Marlin(p) => p.as_mut(),
+            Driver::Rrf(p) => p.as_mut(),
+        }
+    }
+
+    /// The print clock (s).
+    pub(crate) fn print_time_s(&self) -> f64 {
+        match self {
+            Driver::Klipper(p) => p.print_time_s(),
+            Driver::Marlin(p) => p.print_time_s(),
+            Driver::Rrf(p) => p.print_time_s(),
+        }
+    }
+
+    /// Take the next planned move.
+    pub(crate) fn pop(&mut self) -> Option<PlannedMove> {
+        self.planner().pop()
+    }
+
+    /// Apply a limit command for the moves queued from now on.
+    pub(crate) fn apply(&mut self, change: &LimitChange) -> Result<LimitOutcome, PlanError> {
+        const OTHER: LimitOutcome = LimitOutcome::Ignored("not a command of this firmware");
+        match self {
+            Driver::Klipper(p) => match change {
+                LimitChange::VelocityLimit {
+                    velocity_mm_s,
+                    accel_mm_s2,
+                    accel_to_decel_mm_s2,
+                    square_corner_velocity_mm_s,
+                    minimum_cruise_ratio,
+                } => {
+                    let mm = |v: &Option<f64>| v.map(|x| x * MM);
+                    if velocity_mm_s.is_none()
+                        && accel_mm_s2.is_none()
+                        && square_corner_velocity_mm_s.is_none()
+                        && minimum_cruise_ratio.is_none()
+                    {
+                        return Ok(LimitOutcome::Ignored(if accel_to_decel_mm_s2.is_some() {
+                            "ACCEL_TO_DECEL was removed from Klipper (docs/Config_Changes.md)"
+                        } else {
+                            "nothing to change"
+                        }));
+                    }
+                    p.set_velocity_limit(
+                        mm(velocity_mm_s),
+                        mm(accel_mm_s2),
+                        mm(square_corner_velocity_mm_s),
+                        *minimum_cruise_ratio,
+                    )?;
+                    Ok(LimitOutcome::Applied)
+                }
+                LimitChange::InputShaper { .. } => Ok(LimitOutcome::Applied),
+                _ => Ok(OTHER),
+            },
+            Driver::Marlin(p) => {
+                let mut c = *p.config();
+                match change {
+                    LimitChange::MaxAccel { per_axis_mm_s2, .. } => {
+                        set_axes(&mut c.max_accel_m_s2, per_axis_mm_s2);
+                    }
+                    LimitChange::MaxFeedrate { per_axis_mm_s, .. } => {
+                        set_axes(&mut c.max_feedrate_m_s, per_axis_mm_s);
+                    }
+                    LimitChange::Accel {
+                        print_mm_s2,
+                        travel_mm_s2,
+                        retract_mm_s2,
+                    } => {
+                        set(&mut c.print_accel_m_s2, print_mm_s2);
+                        set(&mut c.travel_accel_m_s2, travel_mm_s2);
+                        set(&mut c.retract_accel_m_s2, retract_mm_s2);
+                    }
+                    LimitChange::MarlinAdvanced {
+                        junction_deviation_mm,
+                        jerk_mm_s,
+                        min_feedrate_mm_s,
+                        min_travel_feedrate_mm_s,
+                        min_segment_time_s,
+                    } => {
+                        // A Marlin build has either junction deviation (`J`) or classic
+                        // jerk (`X Y Z E`); M205 reads only its own.
+                        match &mut c.jerk {
+                            MarlinJerk::JunctionDeviation { deviation_m, .. } => {
+                                set(deviation_m, junction_deviation_mm);
+                            }
+                            MarlinJerk::Classic { max_jerk_m_s, .. } => {
+                                set_axes(max_jerk_m_s, jerk_mm_s);
+                            }
+                        }
+                        set(&mut c.min_feedrate_m_s, min_feedrate_mm_s);
+                        set(&mut c.min_travel_feedrate_m_s, min_travel_feedrate_mm_s);
+                        if let Some(b) = min_segment_time_s {
+                            c.min_segment_time_s = *b;
+                        }
+                    }
+                    LimitChange::MarlinInputShaping { .. } | LimitChange::FtMotion { .. } => {
+                        return Ok(LimitOutcome::Applied);
+                    }
+                    LimitChange::FtSmoothing { .. } => {
+                        return Ok(LimitOutcome::Ignored(
+                            "FT_MOTION trajectory smoothing (M494) is not modelled",
+                        ));
+                    }
+                    _ => return Ok(OTHER),
+                }
+                p.set_config(c)?;
+                Ok(LimitOutcome::Applied)
+            }
+            Driver::Rrf(p) => {
+                let mut c = *p.config();
+                match change {
+                    LimitChange::MaxAccel { per_axis_mm_s2, .. } => {
+                        set_axes(&mut c.max_accel_m_s2, per_axis_mm_s2);
+                    }
+                    LimitChange::MaxFeedrate {
+                        per_axis_mm_s,
+                        min_speed_mm_s,
+                    } => {
+                        set_axes(&mut c.max_feedrate_m_s, per_axis_mm_s);
+                        set(&mut c.min_movement_speed_m_s, min_speed_mm_s);
+                    }
+                    LimitChange::Accel {
+                        print_mm_s2,
+                        travel_mm_s2,
+                        ..
+                    } => {
+                        set(&mut c.print_accel_m_s2, print_mm_s2);
+                        set(&mut c.travel_accel_m_s2, travel_mm_s2);
+                    }
+                    // `M205` sets the printing moves' jerk below the `M566` limit; this
+                    // model has one jerk per axis (the limit), so it is not applied.
+                    LimitChange::RrfJerk {
+                        sets_maximum: false,
+                        ..
+                    } => {
+                        return Ok(LimitOutcome::Ignored(
+                            "M205 (printing-move jerk below the M566 limit) is not modelled",
+                        ));
+                    }
+                    LimitChange::RrfJerk {
+                        per_axis_mm_s,
+                        policy,
+                        sets_maximum: true,
+                    } => {
+                        set_axes(&mut c.instant_dv_m_s, per_axis_mm_s);
+                        // RepRapFirmware keeps every jerk at least 0.1 mm/s
+                        // (`MinimumJerk` in src/Config/Configuration.h, applied by
+                        // `Platform::SetInstantDv`).
+                        for j in &mut c.instant_dv_m_s {
+                            *j = j.max(0.1 * MM);
+                        }
+                        if let Some(p) = policy {
+                            c.jerk_policy = *p;
+                        }
+                    }
+                    LimitChange::RrfInputShaping { .. } => return Ok(LimitOutcome::Applied),
+                    _ => return Ok(OTHER),
+                }
+                p.set_config(c)?;
+                Ok(LimitOutcome::Applied)
+            }
+        }
+    }
+}
+
+/// Set `to` from a value in mm units, if given.
+fn set(to: &mut f64, from: &Option<f64>) {
+    if let Some(v) = from {
+        *to = v * MM;
+    }
+}
+
+/// Set the X, Y, Z, E entries of `to` from values in mm units, where given.
+fn set_axes(to: &mut [f64; 4], from: &AxisValues) {
+    for (t, f) in to.iter_mut().zip([from.x, from.y, from.z, from.e]) {
+        set(t, &f);
+    }
+}

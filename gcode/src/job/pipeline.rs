@@ -1,0 +1,228 @@
+//! The job: reader events in, shaped chunks out (see the module doc of [`crate::job`]).
+
+use std::collections::{BTreeMap, VecDeque};
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::ops::RangeInclusive;
+use std::path::Path as FsPath;
+use std::sync::Arc;
+
+use settle_planner::PlanError;
+use settle_planner::firmware::profiles::ProfileStream;
+
+use super::chunk::{JobChunk, JobSummary};
+use super::config::{JobConfig, PlannerConfig, ShaperSetting};
+use super::driver::Driver;
+use super::input::{AxisShapers, Input};
+use super::moves::MoveTable;
+use super::settle::SettlePlanner;
+use super::shapers::ShaperState;
+use crate::error::GcodeError;
+use crate::geometry::Point;
+use crate::reader::{Reader, ReaderOptions};
+
+mod events;
+
+/// Millimetres to metres.
+const MM: f64 = 1e-3;
+
+#[derive(Debug)]
+enum Planner {
+    Firmware(Driver, Box<ProfileStream>),
+    Settle(Box<SettlePlanner>),
+}
+
+/// Where the job is relative to the layer range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Range {
+    Before,
+    In,
+    After,
+}
+
+/// A G-code file planned by a firmware and shaped, streaming (see [`crate::job`]).
+#[derive(Debug)]
+pub struct Job<R> {
+    reader: Reader<R>,
+    source: Arc<str>,
+    cfg: JobConfig,
+    planner: Planner,
+    shapers: ShaperState,
+    input: Input,
+    table: MoveTable,
+    layers: Option<(u32, u32)>,
+    range: Range,
+    seq: u64,
+    moves: u64,
+    out: VecDeque<JobChunk>,
+    eof: bool,
+    points: Vec<Point>,
+    /// Where the last move ended, and its feed (mm, mm/s).
+    last_end: Point,
+    last_feed_mm_s: f64,
+    limit_changes: u64,
+    shaper_changes: u64,
+    ignored: BTreeMap<String, u64>,
+}
+
+impl Job<BufReader<File>> {
+    /// Open `path` and plan it with `cfg` (read in `cfg.dialect`).
+    pub fn open(path: impl AsRef<FsPath>, cfg: JobConfig) -> Result<Self, GcodeError> {
+        let path = path.as_ref();
+        let reader = Reader::open(path, ReaderOptions::new(cfg.dialect))?;
+        Ok(Job::new(reader, cfg)?.with_name(path.display().to_string()))
+    }
+}
+
+fn build(s: &[Option<ShaperSetting>; 3]) -> Result<AxisShapers, PlanError> {
+    let b = |i: usize| s[i].as_ref().map(ShaperSetting::build).transpose();
+    Ok([b(0)?, b(1)?, b(2)?, None])
+}
+
+impl<R: BufRead> Job<R> {
+    /// Plan what `reader` reads with `cfg` (the reader's dialect is the caller's choice;
+    /// [`Job::open`] uses `cfg.dialect`).
+    pub fn new(reader: Reader<R>, cfg: JobConfig) -> Result<Self, GcodeError> {
+        let setting = |key: &'static str| {
+            move |e: PlanError| GcodeError::JobSetting {
+                key,
+                reason: e.to_string(),
+            }
+        };
+        let planner = match &cfg.planner {
+            PlannerConfig::Settle(c) => {
+                Planner::Settle(Box::new(SettlePlanner::new(c).map_err(setting("settle"))?))
+            }
+            other => match Driver::new(other).map_err(setting("planner"))? {
+                Some(d) => Planner::Firmware(
+                    d,
+                    Box::new(ProfileStream::new(cfg.profiles).map_err(setting("profiles"))?),
+                ),
+                None => {
+                    return Err(GcodeError::JobSetting {
+                        key: "planner",
+                        reason: "no planner".into(),
+                    });
+                }
+            },
+        };
+        let initial = build(&cfg.shapers).map_err(setting("shapers"))?;
+        let cfg_feed = cfg.dialect.initial_feed_mm_s();
+        Ok(Self {
+            reader,
+            source: Arc::from("<input>"),
+            shapers: ShaperState::new(cfg.firmware(), &cfg.shapers),
+            input: Input::new(cfg.alignment, initial, false),
+            cfg,
+            planner,
+            table: MoveTable::default(),
+            layers: None,
+            range: Range::Before,
+            seq: 0,
+            moves: 0,
+            out: VecDeque::new(),
+            eof: false,
+            points: Vec::new(),
+            last_end: Point::default(),
+            last_feed_mm_s: cfg_feed,
+            limit_changes: 0,
+            shaper_changes: 0,
+            ignored: BTreeMap::new(),
+        })
+    }
+
+    /// Name the input in error messages.
+    pub fn with_name(mut self, name: impl Into<Arc<str>>) -> Self {
+        self.source = name.into();
+        self
+    }
+
+    /// Produce chunks only for the layers `layers` (indices as [`crate::Event::layer`]): every
+    /// move before still plans, and the first chunk starts at the start of the range's
+    /// first move in the exact (shaped) state there; the last ends where the next layer's
+    /// first move starts. Set before the first chunk is taken.
+    pub fn with_layers(mut self, layers: RangeInclusive<u32>) -> Result<Self, GcodeError> {
+        let (a, b) = (*layers.start(), *layers.end());
+        if a > b || self.moves > 0 {
+            return Err(GcodeError::JobSetting {
+                key: "layers",
+                reason: format!(
+                    "the range {a}..={b} must not be empty and must be set before planning starts"
+                ),
+            });
+        }
+        self.layers = Some((a, b));
+        let initial = build(&self.cfg.shapers).map_err(|e| GcodeError::JobSetting {
+            key: "shapers",
+            reason: e.to_string(),
+        })?;
+        self.input = Input::new(self.cfg.alignment, initial, true);
+        Ok(self)
+    }
+
+    /// The reader (for its statistics: ignored commands, lines read).
+    pub fn reader(&self) -> &Reader<R> {
+        &self.reader
+    }
+
+    /// The settings the job started with.
+    pub fn config(&self) -> &JobConfig {
+        &self.cfg
+    }
+
+    /// The print clock so far (s): the planner's sum of move and dwell times.
+    pub fn print_time_s(&self) -> f64 {
+        match &self.planner {
+            Planner::Firmware(d, _) => d.print_time_s(),
+            Planner::Settle(s) => s.print_time_s(),
+        }
+    }
+
+    /// The next chunk of shaped motion, or `None` when the range (or the file) is done.
+    pub fn next_chunk(&mut self) -> Result<Option<JobChunk>, GcodeError> {
+        loop {
+            if let Some(c) = self.out.pop_front() {
+                return Ok(Some(c));
+            }
+            if self.eof || (self.range == Range::After && self.input.done()) {
+                return Ok(None);
+            }
+            self.step()?;
+        }
+    }
+
+    /// Plan the rest of the file without producing chunks (completes the account after a
+    /// layer range).
+    pub fn run_to_end(&mut self) -> Result<(), GcodeError> {
+        while !self.eof {
+            self.step()?;
+            self.out.clear();
+        }
+        self.out.clear();
+        Ok(())
+    }
+
+    /// What the job has done so far.
+    pub fn summary(&self) -> JobSummary {
+        let t = self.print_time_s();
+        JobSummary {
+            firmware: Some(self.cfg.firmware()),
+            print_time_s: t,
+            layers: self.table.layers(t),
+            moves: self.moves,
+            segments: self.seq,
+            limit_changes: self.limit_changes,
+            shaper_changes: self.shaper_changes,
+            ignored: self.ignored.clone(),
+            complete: self.eof,
+        }
+    }
+}
+
+impl<R: BufRead> Iterator for Job<R> {
+    type Item = Result<JobChunk, GcodeError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        self.next_chunk().transpose()
+    }
+}

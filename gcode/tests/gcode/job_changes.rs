@@ -1,0 +1,300 @@
+//! Limit and shaper changes in the middle of a file: the moves after a limit command plan
+//! with the new limits; a shaper command drains the planner (Klipper also pauses for both
+//! shapers' flush delays) and shapes what follows with the new shaper, the motion before
+//! keeping the old one.
+
+use settle_gcode::job::{Firmware, JobChunk, JobConfig, PlannerConfig, ShaperSetting};
+use settle_planner::firmware::klipper::KlipperConfig;
+use settle_planner::firmware::marlin::{MarlinConfig, MarlinPlanner};
+use settle_planner::firmware::rrf::RrfConfig;
+use settle_planner::firmware::{FirmwarePlanner, LinearMove};
+use settle_planner::shaper::{Shaper, ShaperKind};
+
+use crate::job_util::{assert_contiguous, assert_rel, at, job, leg, run};
+
+#[test]
+fn klipper_set_velocity_limit_and_m204() {
+    let k = || job(PlannerConfig::Klipper(KlipperConfig::new(0.1, 3.0)));
+    let (l, v) = (50.0, 100.0);
+    // The reversal stops the toolhead: two rest-to-rest legs at 3000 then 1000 mm/s^2.
+    let (_, s) = run("G1 X50 F6000\nSET_VELOCITY_LIMIT ACCEL=1000\nG1 X0\n", k());
+    assert_rel(
+        "ACCEL",
+        s.print_time_s,
+        l / v + v / 3000.0 + l / v + v / 1000.0,
+        1e-9,
+    );
+    assert_eq!(s.limit_changes, 1);
+    let (_, s) = run("G1 X50 F6000\nM204 S500\nG1 X0\n", k());
+    assert_rel(
+        "M204",
+        s.print_time_s,
+        l / v + v / 3000.0 + l / v + v / 500.0,
+        1e-9,
+    );
+    // A new square corner velocity: the corner at 10 mm/s.
+    let (_, s) = run(
+        "SET_VELOCITY_LIMIT SQUARE_CORNER_VELOCITY=10\nG1 X50 F6000\nG1 Y50\n",
+        k(),
+    );
+    assert_rel(
+        "SCV",
+        s.print_time_s,
+        2.0 * leg(l, v, 3000.0, 0.0, 10.0),
+        1e-9,
+    );
+    // Marlin's commands mean nothing to Klipper: counted, not applied.
+    let (_, s) = run(
+        "G1 X50 F6000\nSET_VELOCITY_LIMIT ACCEL_TO_DECEL=100\nG1 X0\n",
+        k(),
+    );
+    assert_rel("ignored", s.print_time_s, 2.0 * (l / v + v / 3000.0), 1e-9);
+    assert_eq!(s.ignored.values().sum::<u64>(), 1, "{:?}", s.ignored);
+}
+
+#[test]
+fn marlin_m204_m203_m205_mid_file() {
+    let text = "G1 X50 F6000\nM204 S1000\nM203 X60\nM205 J0.05\nG1 Y50\nG1 X0\n";
+    let (_, s) = run(text, job(PlannerConfig::Marlin(MarlinConfig::new())));
+    let mut p = MarlinPlanner::new(MarlinConfig::new()).expect("config");
+    p.push(&LinearMove::new([0.0; 3], [0.05, 0.0, 0.0], 0.0, 0.1))
+        .expect("move");
+    let mut c = MarlinConfig::new();
+    c.print_accel_m_s2 = 1.0;
+    c.travel_accel_m_s2 = 1.0;
+    c.max_feedrate_m_s[0] = 0.06;
+    if let settle_planner::firmware::marlin::MarlinJerk::JunctionDeviation { deviation_m, .. } =
+        &mut c.jerk
+    {
+        *deviation_m = 0.05e-3;
+    }
+    p.set_config(c).expect("config");
+    p.push(&LinearMove::new(
+        [0.05, 0.0, 0.0],
+        [0.05, 0.05, 0.0],
+        0.0,
+        0.1,
+    ))
+    .expect("move");
+    p.push(&LinearMove::new(
+        [0.05, 0.05, 0.0],
+        [0.0, 0.05, 0.0],
+        0.0,
+        0.1,
+    ))
+    .expect("move");
+    p.finish();
+    while p.pop().is_some() {}
+    assert_eq!(s.print_time_s, p.print_time_s());
+    assert_eq!(s.limit_changes, 3);
+}
+
+#[test]
+fn rrf_m201_and_m566_mid_file() {
+    let r = || job(PlannerConfig::Rrf(RrfConfig::new()));
+    let (l, v) = (50.0, 100.0);
+    let (_, s) = run("G1 X50 F6000\nM400\nM201 X500\nG1 X0\n", r());
+    assert_rel(
+        "M201",
+        s.print_time_s,
+        l / v + v / 1000.0 + l / v + v / 500.0,
+        1e-9,
+    );
+    // M566 in mm/min: 1800 = 30 mm/s per axis at the corner.
+    let (_, s) = run("M566 X1800 Y1800\nG1 X50 F6000\nG1 Y50\n", r());
+    assert_rel(
+        "M566",
+        s.print_time_s,
+        2.0 * leg(l, v, 1000.0, 0.0, 30.0),
+        1e-9,
+    );
+}
+
+/// Expected shaped motion of axis `i` at `t`: the old shapers on the unshaped motion `u`
+/// up to `switch_s` (continued at its velocity there), the new ones on the rest (the same
+/// continuation before it), minus the continuation both share; centred impulses
+/// `T_k - c`. (Marlin's blocks end and start at its minimal step rate, so `u` may still
+/// move at the switch.)
+fn expected(
+    u: &[JobChunk],
+    i: usize,
+    t: f64,
+    switch_s: f64,
+    old: &Option<Shaper>,
+    new: &Option<Shaper>,
+) -> f64 {
+    let taus = |s: &Option<Shaper>| -> Vec<(f64, f64)> {
+        match s {
+            None => vec![(1.0, 0.0)],
+            Some(s) => {
+                let c: f64 = s.weights().zip(s.times_s()).map(|(w, t)| w * t).sum();
+                s.weights()
+                    .zip(s.times_s())
+                    .map(|(w, t)| (w, t - c))
+                    .collect()
+            }
+        }
+    };
+    let at_switch = at(u, switch_s)[i];
+    let line = |s: f64| at_switch.p + at_switch.v * (s - switch_s);
+    let p = |s: f64| at(u, s)[i].p;
+    let a: f64 = taus(old)
+        .iter()
+        .map(|(w, tau)| {
+            w * if t - tau <= switch_s {
+                p(t - tau)
+            } else {
+                line(t - tau)
+            }
+        })
+        .sum();
+    let b: f64 = taus(new)
+        .iter()
+        .map(|(w, tau)| {
+            w * if t - tau >= switch_s {
+                p(t - tau)
+            } else {
+                line(t - tau)
+            }
+        })
+        .sum();
+    a + b - line(t)
+}
+
+/// Run `text` (with a shaper command between two moves) and `reference` (the same moves
+/// with the same pause, no shaper command and no shapers); check the print times agree
+/// and the shaped motion is the old shapers' before the switch and the new ones' after.
+fn check_switch(
+    what: &str,
+    cfg: JobConfig,
+    text: &str,
+    reference: &str,
+    new: [Option<ShaperSetting>; 3],
+    switch_after_end_s: f64,
+) {
+    let (chunks, s) = run(text, cfg.clone());
+    assert_contiguous(&chunks);
+    assert_eq!(s.shaper_changes, 1, "{what}");
+    let mut plain = cfg.clone();
+    plain.shapers = [None; 3];
+    let (u, su) = run(reference, plain);
+    assert_rel(what, s.print_time_s, su.print_time_s, 1e-12);
+    let first_end = u[0].moves[0].end_time_s();
+    let switch_s = first_end + switch_after_end_s;
+    let build = |s: &Option<ShaperSetting>| s.map(|s| s.build().expect("shaper"));
+    let end = chunks.last().map(JobChunk::end_time_s).expect("chunks");
+    for i in 0..2 {
+        let (old, new) = (build(&cfg.shapers[i]), build(&new[i]));
+        for k in 0..=3000 {
+            let t = chunks[0].start_time_s + (end - chunks[0].start_time_s) * k as f64 / 3000.0;
+            let got = at(&chunks, t)[i].p;
+            let want = expected(&u, i, t, switch_s, &old, &new);
+            assert!(
+                (got - want).abs() < 1e-12,
+                "{what} axis {i} t {t}: {got} vs {want}"
+            );
+        }
+    }
+}
+
+fn setting(name: &str, f: f64, z: f64) -> Option<ShaperSetting> {
+    Some(ShaperSetting {
+        kind: ShaperKind::parse(name).expect("name"),
+        frequency_hz: f,
+        damping_ratio: z,
+    })
+}
+
+#[test]
+fn klipper_set_input_shaper_pauses_for_both_flush_delays() {
+    let mut cfg = job(PlannerConfig::Klipper(KlipperConfig::new(0.1, 3.0)));
+    cfg.shapers = [setting("mzv", 50.0, 0.1), None, None];
+    // Klipper's mzv at 50 Hz, damping 0.1 (shaper_defs.py, planner/tests/shaper_klipper.rs).
+    let a = [0.2928932188134524, 0.3268741504100068, 0.18239874354058666];
+    let t = [0.0, 0.00753778361444409, 0.01507556722888818];
+    let sum: f64 = a.iter().sum();
+    let c: f64 = a.iter().zip(t).map(|(a, t)| a * t).sum::<f64>() / sum;
+    let old_delay = c.max(t[2] - c);
+    // zvd at 35 Hz, damping 0.1: impulses 1, 2K, K^2 at 0, Td/2, Td; the centroid is
+    // Td K / (1 + K), so the later side, Td / (1 + K), is the flush delay.
+    let z: f64 = 0.1;
+    let td = 1.0 / (35.0 * (1.0 - z * z).sqrt());
+    let kk = (-z * std::f64::consts::PI / (1.0 - z * z).sqrt()).exp();
+    let new_delay = td / (1.0 + kk);
+    let text = "G1 X50 F6000\nSET_INPUT_SHAPER SHAPER_TYPE_X=zvd SHAPER_FREQ_X=35\nG1 X100\n";
+    let (_, s) = run(text, cfg.clone());
+    let (l, v, acc) = (50.0, 100.0, 3000.0);
+    let want = 2.0 * (l / v + v / acc) + old_delay + new_delay;
+    assert_rel("print time", s.print_time_s, want, 1e-9);
+    let pause_ms = (old_delay + new_delay) * 1000.0;
+    let reference = format!("G1 X50 F6000\nG4 P{pause_ms}\nG1 X100\n");
+    check_switch(
+        "klipper",
+        cfg,
+        text,
+        &reference,
+        [setting("zvd", 35.0, 0.1), None, None],
+        old_delay,
+    );
+}
+
+#[test]
+fn marlin_and_rrf_shaper_commands_wait_for_a_standstill() {
+    let marlin = job(PlannerConfig::Marlin(MarlinConfig::new()));
+    check_switch(
+        "marlin M593",
+        marlin.clone(),
+        "G1 X50 F6000\nM593 X F40 D0.1\nG1 X100 Y20\n",
+        "G1 X50 F6000\nM400\nG1 X100 Y20\n",
+        [setting("zv", 40.0, 0.1), None, None],
+        0.0,
+    );
+    let mut ft = marlin;
+    ft.shapers = [
+        setting("marlin:zvd", 45.0, 0.1),
+        setting("marlin:zvd", 45.0, 0.1),
+        None,
+    ];
+    check_switch(
+        "marlin M493",
+        ft,
+        "G1 X50 F6000\nM493 C8 A38 I0.05\nG1 X100 Y20\n",
+        "G1 X50 F6000\nM400\nG1 X100 Y20\n",
+        [
+            setting("marlin:mzv", 38.0, 0.05),
+            setting("marlin:mzv", 38.0, 0.05),
+            None,
+        ],
+        0.0,
+    );
+    check_switch(
+        "rrf M593",
+        job(PlannerConfig::Rrf(RrfConfig::new())),
+        "G1 X50 F6000\nM593 P\"zvd\" F40 S0.1\nG1 X100 Y20\n",
+        "G1 X50 F6000\nM400\nG1 X100 Y20\n",
+        [
+            setting("rrf:zvd", 40.0, 0.1),
+            setting("rrf:zvd", 40.0, 0.1),
+            None,
+        ],
+        0.0,
+    );
+}
+
+#[test]
+fn bad_shaper_commands_name_their_line() {
+    let k = JobConfig::defaults(Firmware::Klipper).expect("defaults");
+    let text = "G1 X10 F6000\nSET_INPUT_SHAPER SHAPER_TYPE=bogus SHAPER_FREQ_X=40\n";
+    let r = settle_gcode::Reader::new(text.as_bytes(), settle_gcode::ReaderOptions::new(k.dialect));
+    let mut job = settle_gcode::job::Job::new(r, k).expect("job");
+    let err = job.by_ref().find_map(Result::err).expect("refused");
+    assert_eq!(err.line(), Some(2), "{err}");
+    assert!(err.to_string().contains("bogus"), "{err}");
+    // A damping ratio Klipper refuses for the shaper.
+    let k = JobConfig::defaults(Firmware::Klipper).expect("defaults");
+    let text = "SET_INPUT_SHAPER SHAPER_TYPE=ei SHAPER_FREQ_X=40 DAMPING_RATIO_X=0.5\n";
+    let r = settle_gcode::Reader::new(text.as_bytes(), settle_gcode::ReaderOptions::new(k.dialect));
+    let mut job = settle_gcode::job::Job::new(r, k).expect("job");
+    let err = job.by_ref().find_map(Result::err).expect("refused");
+    assert_eq!(err.line(), Some(1), "{err}");
+}
