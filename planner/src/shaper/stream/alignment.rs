@@ -4,7 +4,7 @@
 /// Where the impulses sit relative to the input (module doc).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Alignment {
-    /// Impulse times as the shaper defines them, the first at 0 ([`Shaper::apply`]).
+    /// Impulse times as the shaper defines them, the first at 0 ([`Shaper::apply`](crate::shaper::Shaper::apply)).
     Causal,
     /// Impulse times shifted by the centroid (Klipper, Marlin FT_MOTION).
     #[default]

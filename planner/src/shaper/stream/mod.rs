@@ -1,11 +1,11 @@
-//! Shaping a profile that arrives in pieces: the streaming form of [`Shaper::apply`].
+//! Shaping a profile that arrives in pieces: the streaming form of [`Shaper::apply`](crate::shaper::Shaper::apply).
 //!
-//! [`ShaperStream`] takes one axis's motion as consecutive [`Profile`] chunks on a common
+//! [`ShaperStream`] takes one axis's motion as consecutive [`Profile`](crate::Profile) chunks on a common
 //! clock (each chunk starts where the previous one ended, in any state: moving,
 //! accelerating) and gives back the shaped motion over any interval the input already
 //! determines. It keeps the input of the last `T_N` seconds (the shaper's duration) as
 //! history, so memory does not grow with the length of the motion. The output is the same
-//! convolution as [`Shaper::apply`], `q(t) = sum_i w_i p(t - tau_i)`, with the same
+//! convolution as [`Shaper::apply`](crate::shaper::Shaper::apply), `q(t) = sum_i w_i p(t - tau_i)`, with the same
 //! extension of the input (constant velocity before its first and after its last
 //! instant) and the same segment construction (one segment per interval between shifted
 //! input breakpoints, its jerk and acceleration read at the interval's middle), so the
@@ -14,7 +14,7 @@
 //!
 //! **Alignment.** [`Alignment::Causal`] uses the impulse times as given (`tau_i = T_i`,
 //! the first at 0: the shaped motion lags by the shaper's centroid `c = sum w_i T_i`), as
-//! [`Shaper::apply`] does. [`Alignment::Centred`] shifts them to `tau_i = T_i - c`, so that
+//! [`Shaper::apply`](crate::shaper::Shaper::apply) does. [`Alignment::Centred`] shifts them to `tau_i = T_i - c`, so that
 //! constant-velocity motion is left unchanged and axes shaped differently stay in step:
 //! Klipper does this (`shift_pulses` in klippy/chelper/kin_shaper.c), and Marlin's
 //! FT_MOTION delays every axis by the largest centroid minus its own
