@@ -21,7 +21,7 @@ const CORRELATION_LAGS: usize = 12;
 /// `c = 1 + 2 sum_l rho_l` of the residuals (at least 1), the sum cut where Geyer's
 /// initial positive sequence ends (C. J. Geyer, "Practical Markov chain Monte Carlo",
 /// Statistical Science 7, 1992): the pairs `rho_2k + rho_2k+1` (`rho_0 = 1`) are summed
-/// while they stay positive, at most [`CORRELATION_LAGS`] lags. Neighbouring PSD bins share
+/// while they stay positive, at most `CORRELATION_LAGS` (12) lags. Neighbouring PSD bins share
 /// the window's kernel and neighbouring samples share sensor filtering, so `n` residuals
 /// carry about `n / c` independent ones. Multiplies the covariance and divides `n` in the
 /// BIC. Summing a fixed number of lags instead would count the negative correlation that

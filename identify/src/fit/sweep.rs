@@ -12,8 +12,18 @@
 //! a second mode or the sweep's rising input tilts it. No width is read here: the model's
 //! `|T|^2` is the exact power response of the modal model, times the exact energy
 //! spectrum of the test's own command, smoothed by the same kernel as the data, so the
-//! fitted parameters are those of the structure and the statistical uncertainty is the
-//! whole uncertainty (for data the modal model describes).
+//! fitted parameters are those of the structure. On the simulated random sweeps of
+//! `tests/identify/sweep.rs` (`IDENTIFY_SWEEP_CASES=32`: zeta 0.02-0.2, modes 25-128 Hz,
+//! one or two modes) the relative errors average `-1e-5` (frequency), `+5e-5` (damping)
+//! and `+1.8e-4` (weight) with spreads of `8e-5`, `7.5e-4` and `7.7e-4`.
+//!
+//! Known limit of the uncertainties: on those runs `(estimate - truth) / sigma` has a
+//! spread of 1.23 (frequency), 1.22 (damping) and 1.41 (weight) instead of 1, so the
+//! reported sigmas are 20-40 % too small and a 2-sigma interval covers the truth less
+//! often than 95 %. The residual correlation `c` is estimated from residuals the fit has
+//! already smoothed, and the bins' variance model ([`super::sweep_residual`]) treats
+//! overlapping segments as independent, whereas a ringing mode keeps its noise cross term
+//! coherent over several of them; either can account for it.
 //!
 //! Procedure. The bins are first weighted by the measured PSD itself (the weights' limit
 //! where the sweep dominates the noise); the first mode starts at the largest response

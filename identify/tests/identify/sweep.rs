@@ -118,9 +118,10 @@ fn processed_csv(axes: &[Vec<f64>; 3], t_span_s: f64, normalised: bool) -> Strin
 }
 
 #[test]
-#[ignore = "processed files are averaged at Klipper's half-segment hop, which the sweep model \
-            (a dense-hop integral) does not describe: weight and frequency come out within \
-            0.05 % but 2-3.6 sigma from the truth (see identify_spectrum)"]
+#[ignore = "fails its 2-sigma checks: this noise draw puts the 88 Hz mode's frequency \
+            3.4 sigma and the 38 Hz mode's weight 2.1-2.4 sigma from the truth (relative errors \
+            1.2e-4 and 4e-4), at Klipper's half-segment hop and at a quarter-segment hop alike; \
+            the sweep fit's sigmas are about 20-40 % too small (see fit::sweep)"]
 fn klipper_processed_spectra_both_generations() {
     let truth = [(38.0, 0.05, 0.7), (88.0, 0.1, 0.3)];
     let test = fast_test();
@@ -140,6 +141,42 @@ fn klipper_processed_spectra_both_generations() {
         );
         let id = identify_spectrum(&psd, &opts()).expect("identify");
         check_modes(&id, &truth, true);
+    }
+}
+
+/// The processed files of a recording give the modes its raw file gives: every estimate
+/// within twice the processed fit's sigma of the raw fit's (the same samples, so a
+/// reader, normalisation or bin-grid error shows while the noise draw largely cancels),
+/// and within the acceptance tolerances of the truth (0.5 % frequency, 15 % damping).
+#[test]
+fn klipper_processed_spectra_agree_with_raw() {
+    let truth = [(38.0, 0.05, 0.7), (88.0, 0.1, 0.3)];
+    let fs = 3200.0;
+    let axes = sweep_axes(&truth, &fast_test(), fs, 3);
+    let span = (axes[0].len() - 1) as f64 / fs;
+    let text = synth::klipper_raw_csv(&axes, 1234.5, fs);
+    let rec = klipper_raw::parse("raw_data_x.csv", &text).expect("parse");
+    let raw = identify_recording(&rec, &opts()).expect("identify raw");
+    for (name, normalised) in [
+        ("resonances_x.csv", false),
+        ("calibration_data_x.csv", true),
+    ] {
+        let psd = klipper_psd::parse(name, &processed_csv(&axes, span, normalised)).expect("parse");
+        let id = identify_spectrum(&psd, &opts()).expect("identify");
+        let report = format!("{name}\n{:#?}\nraw {:#?}", id.modes, raw.modes);
+        assert_eq!(id.modes.len(), truth.len(), "{report}");
+        assert_eq!(raw.modes.len(), truth.len(), "{report}");
+        for ((m, r), &(f, z, _)) in id.modes.iter().zip(&raw.modes).zip(&truth) {
+            let (mw, rw) = (m.weight.expect("weight"), r.weight.expect("weight"));
+            assert!(m.frequency_hz.covers(r.frequency_hz.value, 2.0), "{report}");
+            assert!(
+                m.damping_ratio.covers(r.damping_ratio.value, 2.0),
+                "{report}"
+            );
+            assert!(mw.covers(rw.value, 2.0), "{report}");
+            assert!((m.frequency_hz.value - f).abs() <= 0.005 * f, "{report}");
+            assert!((m.damping_ratio.value - z).abs() <= 0.15 * z, "{report}");
+        }
     }
 }
 
