@@ -15,6 +15,7 @@
 //! domain ([`fit::ringdown`]).
 
 pub mod direction;
+pub mod energy_spectrum;
 mod error;
 pub mod excitation;
 pub mod fit;

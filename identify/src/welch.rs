@@ -57,6 +57,8 @@ pub fn kaiser(n: usize, beta: f64) -> Vec<f64> {
 /// A Welch estimator with Klipper's settings for one sample rate and segment length.
 pub struct Welch {
     nfft: usize,
+    /// Samples from one segment's start to the next (`nfft / 2` in Klipper).
+    hop: usize,
     sample_rate_hz: f64,
     window: Vec<f64>,
     /// `1 / (fs sum w^2)`.
@@ -68,6 +70,7 @@ impl std::fmt::Debug for Welch {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Welch")
             .field("nfft", &self.nfft)
+            .field("hop", &self.hop)
             .field("sample_rate_hz", &self.sample_rate_hz)
             .finish_non_exhaustive()
     }
@@ -86,11 +89,28 @@ impl Welch {
         let fft = RealFftPlanner::<f64>::new().plan_fft_forward(nfft);
         Self {
             nfft,
+            hop: (nfft / 2).max(1),
             sample_rate_hz,
             window,
             scale: 1.0 / (sample_rate_hz * sum_sq),
             fft,
         }
+    }
+
+    /// The same window and segment length with segments `hop` samples apart (at least 1)
+    /// instead of Klipper's `nfft / 2`. A sweep's spectrum summed over segments is the
+    /// time integral of the short-time spectrum sampled every `hop`; sampling it every
+    /// `nfft / 4` leaves out none of what the window lets through (its main lobe is
+    /// narrower than the `fs / hop = 4` bins such sampling repeats at), while `nfft / 2`
+    /// aliases coherent cross terms ([`crate::fit::sweep_model`]).
+    pub fn with_hop(mut self, hop: usize) -> Self {
+        self.hop = hop.max(1);
+        self
+    }
+
+    /// Samples from one segment's start to the next.
+    pub fn hop(&self) -> usize {
+        self.hop
     }
 
     /// Segment length (samples).
@@ -115,14 +135,13 @@ impl Welch {
             .collect()
     }
 
-    /// Number of segments Klipper uses for `n` samples (0 when `n < nfft`).
+    /// Number of segments for `n` samples: `(n - nfft) / hop + 1` (0 when `n < nfft`),
+    /// Klipper's `(n - nfft / 2) / (nfft / 2)` at its hop.
     pub fn segments(&self, n: usize) -> usize {
-        let overlap = self.nfft / 2;
-        let step = self.nfft - overlap;
         if n < self.nfft {
             0
         } else {
-            (n - overlap) / step
+            (n - self.nfft) / self.hop + 1
         }
     }
 
@@ -144,7 +163,7 @@ impl Welch {
             return None;
         }
         let m = channels.len();
-        let step = self.nfft - self.nfft / 2;
+        let step = self.hop;
         let bins = self.nfft / 2 + 1;
         let mut input = self.fft.make_input_vec();
         let mut scratch = self.fft.make_scratch_vec();

@@ -5,6 +5,7 @@ pub mod lm;
 pub mod ringdown;
 pub mod sweep;
 pub mod sweep_model;
+pub mod sweep_residual;
 
 /// A larger model must lower the Bayesian information criterion by at least this much
 /// (Kass & Raftery's "very strong" evidence: a BIC difference above 10).
@@ -14,13 +15,18 @@ pub const BIC_MARGIN: f64 = 10.0;
 /// damping ratio lie at least this many standard deviations from zero.
 pub const SIGNIFICANCE: f64 = 3.0;
 
-/// Lags (points) over which residual correlation is summed.
-const CORRELATION_LAGS: usize = 6;
+/// Most lags (points) over which residual correlation is summed.
+const CORRELATION_LAGS: usize = 12;
 
-/// `1 + 2 sum_{l=1}^{6} rho_l` of the residuals (at least 1): neighbouring PSD bins share
+/// `c = 1 + 2 sum_l rho_l` of the residuals (at least 1), the sum cut where Geyer's
+/// initial positive sequence ends (C. J. Geyer, "Practical Markov chain Monte Carlo",
+/// Statistical Science 7, 1992): the pairs `rho_2k + rho_2k+1` (`rho_0 = 1`) are summed
+/// while they stay positive, at most `CORRELATION_LAGS` (12) lags. Neighbouring PSD bins share
 /// the window's kernel and neighbouring samples share sensor filtering, so `n` residuals
 /// carry about `n / c` independent ones. Multiplies the covariance and divides `n` in the
-/// BIC.
+/// BIC. Summing a fixed number of lags instead would count the negative correlation that
+/// fitting itself leaves in residuals (it removes their smooth part, the very part `c`
+/// measures) and undercount the noise's.
 pub fn correlation_inflation(r: &[f64]) -> f64 {
     let n = r.len();
     let mean = r.iter().sum::<f64>() / n.max(1) as f64;
@@ -28,12 +34,27 @@ pub fn correlation_inflation(r: &[f64]) -> f64 {
     if var.is_nan() || var <= 0.0 {
         return 1.0;
     }
+    let rho = |l: usize| -> f64 {
+        if l == 0 {
+            return 1.0;
+        }
+        if l >= n {
+            return 0.0;
+        }
+        (0..n - l)
+            .map(|i| (r[i] - mean) * (r[i + l] - mean))
+            .sum::<f64>()
+            / var
+    };
     let mut sum = 0.0;
-    for l in 1..=CORRELATION_LAGS.min(n.saturating_sub(1)) {
-        let c: f64 = (0..n - l).map(|i| (r[i] - mean) * (r[i + l] - mean)).sum();
-        sum += c / var;
+    for k in 0..=CORRELATION_LAGS / 2 {
+        let pair = rho(2 * k) + rho(2 * k + 1);
+        if pair <= 0.0 {
+            break;
+        }
+        sum += pair;
     }
-    (1.0 + 2.0 * sum).max(1.0)
+    (2.0 * sum - 1.0).max(1.0)
 }
 
 /// The Bayesian information criterion `n_eff ln(RSS / n) + p ln(n_eff)` with
@@ -41,4 +62,16 @@ pub fn correlation_inflation(r: &[f64]) -> f64 {
 pub fn bic(rss: f64, n: usize, p: usize, c: f64) -> f64 {
     let n_eff = n as f64 / c;
     n_eff * (rss / n as f64).ln() + p as f64 * n_eff.ln()
+}
+
+/// True when `larger` (with `c` from its own residuals) lowers the BIC of `smaller` by
+/// more than [`BIC_MARGIN`], both scored with that same `c`. The residual correlation
+/// belongs to the noise, which the better model's residuals show: a model that misses a
+/// mode leaves that mode's smooth misfit in its residuals, which would inflate its own
+/// `c` and shrink its `n_eff`, and BICs of different `n_eff` are not comparable (their
+/// `n_eff ln(RSS / n)` terms scale with it).
+pub fn bic_prefers(larger: &lm::LmFit, smaller: &lm::LmFit, n: usize, c: f64) -> bool {
+    let big = bic(larger.rss, n, larger.theta.len(), c);
+    let small = bic(smaller.rss, n, smaller.theta.len(), c);
+    big < small - BIC_MARGIN
 }

@@ -18,7 +18,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::lm::{self, LmFit};
-use super::{BIC_MARGIN, SIGNIFICANCE, bic, correlation_inflation};
+use super::{SIGNIFICANCE, bic, bic_prefers, correlation_inflation};
 use crate::IdentifyError;
 use crate::result::{Diagnostics, Estimate, IdentifiedMode, WeightBasis};
 use crate::welch::Welch;
@@ -125,7 +125,7 @@ pub fn fit(
         candidates.push((m, score));
         let accept = match &best {
             None => true,
-            Some((_, prev)) => score < prev - BIC_MARGIN && significant(&fit, c),
+            Some((prev, _)) => bic_prefers(&fit, prev, y.len(), c) && significant(&fit, c),
         };
         if !accept {
             break;

@@ -12,10 +12,12 @@
 //! smooths it with the window's kernel `K` ([`crate::welch::Welch::kernel_table`]). So the
 //! expected PSD at bin `f` is
 //!
-//! `M(f) = G [ int E(nu) |T(nu)|^2 K(f - nu) dnu + sum_l E_l |T(nu_l)|^2 K(f - nu_l) ] + N`
+//! `M(f) = G int B(nu) |T(nu)|^2 K(f - nu) dnu + N`
 //!
-//! with `E` the sweep's energy density and `E_l` the sweeping lines
-//! ([`crate::excitation::SweepTest`]), `G` an unknown gain (record length, sensor scale,
+//! with `B` the energy spectrum of the test's whole commanded acceleration, computed from
+//! its pieces ([`crate::energy_spectrum`]: the sweep, its start and stop, the square
+//! wave's harmonics and the sweeping wave's lines with their interference), `G` an
+//! unknown gain (record length, sensor scale,
 //! the test's true amplitude) and `N` the sensor's white noise floor. The integral runs on
 //! a grid of `1 / GRID_PER_BIN` bins, fine enough for a half-power width of a fraction of
 //! a bin (the trapezoid rule of a smooth peak converges geometrically once the step is
@@ -24,11 +26,12 @@
 
 use nalgebra::Complex;
 
+use crate::energy_spectrum::EnergySpectrum;
 use crate::excitation::SweepTest;
 use crate::welch::Welch;
 
 /// Fine-grid points per bin.
-pub const GRID_PER_BIN: usize = 16;
+pub const GRID_PER_BIN: usize = 32;
 
 /// Kernel half width (bins): Kaiser(6)'s main lobe is +-2.2 bins, its side lobes below
 /// -44 dB beyond; 6 bins keep what the PSD's dynamic range can show.
@@ -60,13 +63,9 @@ pub fn transmissibility_sq(modes: &[ModeParams], nu_hz: f64) -> f64 {
 pub struct SweepModel {
     /// Fine grid frequencies (Hz).
     grid_hz: Vec<f64>,
-    /// Per fitted bin: first fine-grid index and the weights `K E dnu / bin` over the
+    /// Per fitted bin: first fine-grid index and the weights `K B dnu / bin` over the
     /// following `2 H R + 1` points.
     rows: Vec<(usize, Vec<f64>)>,
-    /// Sweeping lines: frequency (Hz).
-    line_hz: Vec<f64>,
-    /// Per fitted bin: weight of each line `K E_l / bin`.
-    line_rows: Vec<Vec<f64>>,
 }
 
 impl SweepModel {
@@ -82,11 +81,11 @@ impl SweepModel {
         // Fine index g <-> frequency g bin / R; grid from (first - h) to (last + h) bins.
         let g0 = (first * r).saturating_sub(h * r);
         let g1 = (last + h) * r;
-        let grid_hz: Vec<f64> = (g0..=g1).map(|g| g as f64 * bin / r as f64).collect();
         let dnu = bin / r as f64;
-        let energy: Vec<f64> = grid_hz
-            .iter()
-            .map(|&nu| test.sweep_energy_density(nu) * dnu / bin)
+        let spectrum = EnergySpectrum::of_pieces(&test.pieces(), dnu, g1 as f64 * dnu);
+        let grid_hz: Vec<f64> = (g0..=g1).map(|g| g as f64 * dnu).collect();
+        let energy: Vec<f64> = (g0..=g1)
+            .map(|g| spectrum.density().get(g).copied().unwrap_or(0.0) * dnu / bin)
             .collect();
         let rows = bins
             .iter()
@@ -99,34 +98,14 @@ impl SweepModel {
                 (start - g0, weights)
             })
             .collect();
-        let lo = grid_hz.first().copied().unwrap_or(0.0);
-        let hi = grid_hz.last().copied().unwrap_or(0.0);
-        let lines = test.sweeping_lines(lo, hi);
-        let line_hz = lines.iter().map(|l| l.0).collect();
-        let line_rows = bins
-            .iter()
-            .map(|&k| {
-                let f = k as f64 * bin;
-                lines
-                    .iter()
-                    .map(|&(nu, e)| kernel_at(&kernel, (nu - f).abs() / bin) * e / bin)
-                    .collect()
-            })
-            .collect();
-        Self {
-            grid_hz,
-            rows,
-            line_hz,
-            line_rows,
-        }
+        Self { grid_hz, rows }
     }
 
     /// The excitation alone seen through the estimator (`|T| = 1`, `G = 1`, `N = 0`).
     pub fn excitation(&self) -> Vec<f64> {
         self.rows
             .iter()
-            .zip(&self.line_rows)
-            .map(|((_, w), l)| w.iter().sum::<f64>() + l.iter().sum::<f64>())
+            .map(|(_, w)| w.iter().sum::<f64>())
             .collect()
     }
 
@@ -146,26 +125,9 @@ impl SweepModel {
                 .iter()
                 .map(|&nu| transmissibility_sq(modes, nu)),
         );
-        let line_t2: Vec<f64> = self
-            .line_hz
-            .iter()
-            .map(|&nu| transmissibility_sq(modes, nu))
-            .collect();
-        for ((o, (start, w)), l) in out.iter_mut().zip(&self.rows).zip(&self.line_rows) {
+        for (o, (start, w)) in out.iter_mut().zip(&self.rows) {
             let cont: f64 = w.iter().zip(&t2[*start..]).map(|(a, b)| a * b).sum();
-            let lines: f64 = l.iter().zip(&line_t2).map(|(a, b)| a * b).sum();
-            *o = gain * (cont + lines) + noise;
+            *o = gain * cont + noise;
         }
     }
-}
-
-/// Linear interpolation in a kernel table of [`GRID_PER_BIN`] points per bin; 0 beyond.
-fn kernel_at(table: &[f64], d_bins: f64) -> f64 {
-    let x = d_bins * GRID_PER_BIN as f64;
-    let i = x.floor() as usize;
-    if i + 1 >= table.len() {
-        return 0.0;
-    }
-    let t = x - i as f64;
-    table[i] * (1.0 - t) + table[i + 1] * t
 }

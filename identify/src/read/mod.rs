@@ -61,6 +61,24 @@ impl Recording {
         self.time_s.len()
     }
 
+    /// The mean rate of the samples (Hz): `(N - 1) / (t_last - t_first)`, the rate their
+    /// spacing gives (Klipper's `N / (t_last - t_first)`, [`Recording::sample_rate_hz`],
+    /// is `N / (N - 1)` times it, which would shift every frequency by that factor: 1e-5
+    /// for a 100,000-sample sweep, as much as a sweep fit's frequency uncertainty).
+    /// [`Recording::sample_rate_hz`] when the times do not span an interval.
+    pub fn mean_rate_hz(&self) -> f64 {
+        let n = self.time_s.len();
+        let span = match (self.time_s.first(), self.time_s.last()) {
+            (Some(a), Some(b)) => b - a,
+            _ => 0.0,
+        };
+        if n > 1 && span > 0.0 {
+            (n - 1) as f64 / span
+        } else {
+            self.sample_rate_hz
+        }
+    }
+
     /// True when the recording holds no samples (readers never return one).
     pub fn is_empty(&self) -> bool {
         self.time_s.is_empty()
