@@ -94,11 +94,19 @@ pub fn summary_md(
     if !sc.description.is_empty() {
         let _ = writeln!(out, "{}\n", sc.description.trim());
     }
-    let modes: Vec<String> = sc
+    // The modes as written: `[machine] modes` (axis x), then each axis table's (prefixed
+    // with its axis).
+    let axis_modes = sc
         .machine
-        .modes
+        .axis
         .iter()
-        .map(|m| format!("{} Hz, zeta {}", m.frequency_hz, m.damping_ratio))
+        .filter_map(|(name, a)| Some((format!("{name}: "), a.modes.as_ref()?)));
+    let modes: Vec<String> = std::iter::once((String::new(), &sc.machine.modes))
+        .chain(axis_modes)
+        .flat_map(|(p, ms)| {
+            ms.iter()
+                .map(move |m| format!("{p}{} Hz, zeta {}", m.frequency_hz, m.damping_ratio))
+        })
         .collect();
     let machine = match runs.first() {
         Some(r) if r.machine.is_some() => format!(
