@@ -171,7 +171,7 @@ enum Command {
     /// Vibration modes per axis from accelerometer files, with uncertainties: a table, a
     /// figure per axis and (with --out) a machine file.
     #[command(
-        after_help = "Files: Klipper raw CSV (#time,accel_x,accel_y,accel_z), Klipper processed CSV\n(resonances_*.csv, calibration_data_*.csv), RepRapFirmware M956 CSV, Shake&Tune .stdata.\nThe machine axis of each file: --axis, else the x/y/z in its name (raw_data_x_*.csv).\n\nExample:\n  settle identify examples/data/raw_data_x_example.csv examples/data/raw_data_y_example.csv \\\n      --freq-start 20 --freq-end 80 --hz-per-sec 6 --out /tmp/machine.toml"
+        after_help = "Files: Klipper raw CSV (#time,accel_x,accel_y,accel_z), Klipper processed CSV\n(resonances_*.csv, calibration_data_*.csv), RepRapFirmware M956 CSV, Shake&Tune .stdata.\nThe machine axis of each file: --axis, else the x/y/z in its name (raw_data_x_*.csv).\n\nExample:\n  settle identify examples/data/raw_data_x_example.csv examples/data/raw_data_y_example.csv \\\n      --freq-start 30 --freq-end 90 --hz-per-sec 10 --out /tmp/machine.toml"
     )]
     Identify {
         /// The accelerometer files (one recording per machine axis).

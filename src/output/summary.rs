@@ -101,13 +101,22 @@ pub fn summary_md(
         .axis
         .iter()
         .filter_map(|(name, a)| Some((format!("{name}: "), a.modes.as_ref()?)));
-    let modes: Vec<String> = std::iter::once((String::new(), &sc.machine.modes))
+    let mode_text = |p: &str, m: &crate::input::modes::ModeSpec| {
+        format!("{p}{} Hz, zeta {}", m.frequency_hz, m.damping_ratio)
+    };
+    let mut modes: Vec<String> = std::iter::once((String::new(), &sc.machine.modes))
         .chain(axis_modes)
-        .flat_map(|(p, ms)| {
-            ms.iter()
-                .map(move |m| format!("{p}{} Hz, zeta {}", m.frequency_hz, m.damping_ratio))
-        })
+        .flat_map(|(p, ms)| ms.iter().map(move |m| mode_text(&p, m)))
         .collect();
+    // A machine file of modes (`preset = "machine.toml"`): the first run's.
+    if modes.is_empty()
+        && let Some(r) = runs.first()
+    {
+        for a in &r.modes {
+            let p = format!("{}: ", a.axis);
+            modes.extend(a.modes.iter().map(|m| mode_text(&p, m)));
+        }
+    }
     let machine = match runs.first() {
         Some(r) if r.machine.is_some() => format!(
             "Machine: {} (axis {}, {} driver), backend {}",

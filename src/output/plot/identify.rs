@@ -3,7 +3,7 @@
 
 use settle_identify::{AxisIdentification, Method};
 
-use crate::output::plot::{Figure, Line, PALETTE, Panel, Rule, fmt_num};
+use crate::output::plot::{Figure, Line, PALETTE, Panel, Rule};
 
 /// The figure of `axis` identified as `id`.
 pub fn figure(axis: &str, id: &AxisIdentification) -> Figure {
@@ -27,9 +27,8 @@ pub fn figure(axis: &str, id: &AxisIdentification) -> Figure {
         .iter()
         .map(|m| {
             format!(
-                "{} Hz, zeta {}",
-                fmt_num(m.frequency_hz.value),
-                fmt_num(m.damping_ratio.value)
+                "{:.1} Hz, zeta {:.3}",
+                m.frequency_hz.value, m.damping_ratio.value
             )
         })
         .collect();
@@ -38,7 +37,7 @@ pub fn figure(axis: &str, id: &AxisIdentification) -> Figure {
         .iter()
         .map(|&at| Rule {
             at,
-            label: format!("{} Hz", fmt_num(at)),
+            label: format!("{at:.1} Hz"),
         })
         .collect();
     let panel = Panel {

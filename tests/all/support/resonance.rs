@@ -102,11 +102,12 @@ pub fn adxl345(accel: &[f64], axis: usize, yaw_deg: f64, fs: f64, seed: u64) -> 
     out
 }
 
-/// Klipper raw CSV text (`#time,accel_x,accel_y,accel_z`) of the samples, at `fs` from 0.
+/// Klipper raw CSV text (`#time,accel_x,accel_y,accel_z`) of the samples, at `fs` from 0
+/// (accelerations with two decimals: the samples are multiples of 37 mm/s^2 anyway).
 pub fn klipper_raw_csv(axes: &[Vec<f64>; 3], fs: f64) -> String {
     let mut s = String::from("#time,accel_x,accel_y,accel_z\n");
     for (i, ((x, y), z)) in axes[0].iter().zip(&axes[1]).zip(&axes[2]).enumerate() {
-        s.push_str(&format!("{:.6},{x:.3},{y:.3},{z:.3}\n", i as f64 / fs));
+        s.push_str(&format!("{:.6},{x:.2},{y:.2},{z:.2}\n", i as f64 / fs));
     }
     s
 }
