@@ -101,6 +101,10 @@ pub enum Error {
         /// What the planner reported.
         source: settle_planner::PlanError,
     },
+    /// An accelerometer file cannot be read or holds no usable data (settle-identify's
+    /// error names the file and, where one is to blame, the line).
+    #[error(transparent)]
+    Identify(#[from] settle_identify::IdentifyError),
     /// The run was not started: the sweep was interrupted (Ctrl-C or SIGTERM).
     #[error("run {run}: not run, the sweep was interrupted")]
     Interrupted {
@@ -150,6 +154,9 @@ impl Error {
     /// that cannot be read), false for failures while running or writing (exit code 1: a
     /// run that broke down, a full disk).
     pub fn is_input_error(&self) -> bool {
-        matches!(self, Error::Input { .. } | Error::Read { .. })
+        matches!(
+            self,
+            Error::Input { .. } | Error::Read { .. } | Error::Identify(_)
+        )
     }
 }

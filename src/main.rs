@@ -160,6 +160,73 @@ enum Command {
         #[arg(long, default_value = "rapier", value_parser = parse_backend)]
         backend: Backend,
     },
+    /// Print a machine's modes per axis (frequency, damping ratio, weight).
+    #[command(
+        after_help = "FILE is a scenario, a machine file or a preset name. A physical machine prints its\nlinearised modes (linear driver, at axis position 0 mm).\n\nExample:\n  settle machine printer_xy\n  settle machine examples/data/machine.toml"
+    )]
+    Machine {
+        /// A scenario (TOML), a machine file (TOML) or a built-in preset's name.
+        file: String,
+    },
+    /// Vibration modes per axis from accelerometer files, with uncertainties: a table, a
+    /// figure per axis and (with --out) a machine file.
+    #[command(
+        after_help = "Files: Klipper raw CSV (#time,accel_x,accel_y,accel_z), Klipper processed CSV\n(resonances_*.csv, calibration_data_*.csv), RepRapFirmware M956 CSV, Shake&Tune .stdata.\nThe machine axis of each file: --axis, else the x/y/z in its name (raw_data_x_*.csv).\n\nExample:\n  settle identify examples/data/raw_data_x_example.csv examples/data/raw_data_y_example.csv \\\n      --freq-start 30 --freq-end 90 --hz-per-sec 10 --out /tmp/machine.toml"
+    )]
+    Identify {
+        /// The accelerometer files (one recording per machine axis).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// The machine axis every file excited: x, y or z [default: from each file's name].
+        #[arg(long)]
+        axis: Option<String>,
+        /// Write a machine file (modes per axis) here, for `preset = "<file>"` in a scenario.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Folder of the figures identify-<axis>.svg/.png [default: --out's folder, else
+        /// results/identify/].
+        #[arg(long)]
+        figures: Option<PathBuf>,
+        /// Most modes to fit per axis (1 to 4).
+        #[arg(long, default_value_t = 3)]
+        max_modes: usize,
+        /// The fit: auto (a sweep fit for a resonance test, a ring-down fit for a free
+        /// decay), sweep, ringdown.
+        #[arg(long, default_value = "auto", value_parser = parse_method)]
+        method: settle_identify::MethodChoice,
+        /// The resonance test's first frequency (Hz; Klipper's FREQ_START / min_freq)
+        /// [default: Klipper's defaults for this and the five options below].
+        #[arg(long)]
+        freq_start: Option<f64>,
+        /// Its last frequency (Hz; Klipper's FREQ_END / max_freq).
+        #[arg(long)]
+        freq_end: Option<f64>,
+        /// Its sweep rate (Hz/s; Klipper's HZ_PER_SEC).
+        #[arg(long)]
+        hz_per_sec: Option<f64>,
+        /// Its acceleration per Hz (mm/s^2/Hz; Klipper's accel_per_hz).
+        #[arg(long)]
+        accel_per_hz: Option<f64>,
+        /// The slow sweeping motion's acceleration (mm/s^2; Klipper's sweeping_accel; 0
+        /// for the pulse-only test of Klipper before December 2024).
+        #[arg(long)]
+        sweeping_accel: Option<f64>,
+        /// Its period (s; Klipper's sweeping_period).
+        #[arg(long)]
+        sweeping_period: Option<f64>,
+    },
+}
+
+fn parse_method(s: &str) -> Result<settle_identify::MethodChoice, String> {
+    use settle_identify::MethodChoice;
+    match s {
+        "auto" => Ok(MethodChoice::Auto),
+        "sweep" => Ok(MethodChoice::Sweep),
+        "ringdown" => Ok(MethodChoice::RingDown),
+        _ => Err(format!(
+            "unknown method `{s}`; allowed: auto, sweep, ringdown"
+        )),
+    }
 }
 
 /// Recordings a sweep or a run can write.
@@ -306,6 +373,44 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 ..workflows::run::RunOptions::new(scenario, case, backend)
             };
             workflows::run::run(&opts)?.report()
+        }
+        Command::Machine { file } => workflows::machine::machine_modes(&file)?.report(),
+        Command::Identify {
+            files,
+            axis,
+            out,
+            figures,
+            max_modes,
+            method,
+            freq_start,
+            freq_end,
+            hz_per_sec,
+            accel_per_hz,
+            sweeping_accel,
+            sweeping_period,
+        } => {
+            let opts = workflows::identify::IdentifyOptions {
+                axis,
+                out,
+                figures,
+                identify: settle_identify::Options {
+                    test: {
+                        let k = settle_identify::SweepTest::klipper();
+                        settle_identify::SweepTest {
+                            freq_start_hz: freq_start.unwrap_or(k.freq_start_hz),
+                            freq_end_hz: freq_end.unwrap_or(k.freq_end_hz),
+                            accel_per_hz: accel_per_hz.unwrap_or(k.accel_per_hz),
+                            hz_per_sec: hz_per_sec.unwrap_or(k.hz_per_sec),
+                            sweeping_accel_mm_s2: sweeping_accel.unwrap_or(k.sweeping_accel_mm_s2),
+                            sweeping_period_s: sweeping_period.unwrap_or(k.sweeping_period_s),
+                        }
+                    },
+                    max_modes,
+                    method,
+                },
+                ..workflows::identify::IdentifyOptions::new(files)
+            };
+            workflows::identify::identify(&opts)?.report()
         }
     };
     bar.finish_and_clear();

@@ -97,6 +97,9 @@ pub struct LinearResponse {
     /// Static toolhead offset from the commanded end point (m), normally 0.
     offset: f64,
     t_end: f64,
+    /// Each pole's participation weight in the modes form's convention (see
+    /// [`LinearResponse::weighted_modes`]); 0 for real poles.
+    weights: Vec<f64>,
 }
 
 /// `phi_k(z) h^k` with `phi_1 = (e^z - 1)/z`, `phi_2 = (e^z - 1 - z)/z^2`,
@@ -225,12 +228,28 @@ impl LinearResponse {
                 cv * y[k]
             })
             .collect();
+        // The residue of the toolhead error's transfer function from the commanded
+        // acceleration at pole lambda_k (with v = a / s): (c . V_k) (beta_k + gamma_k /
+        // lambda_k). A mode of the modes form, -w / ((s - lambda)(s - conj lambda)), has the
+        // residue -w / (2 i Im lambda) there, so w = -2 i Im(lambda) residue.
+        let weights = (0..dim)
+            .map(|k| {
+                let lk = lambda[k];
+                if lk.im <= 0.0 || lk.norm() == 0.0 {
+                    return 0.0;
+                }
+                let cv: C = (0..n).map(|i| v[(i, k)] * c_out[i]).sum();
+                let residue = cv * (beta[k] + gamma[k] / lk);
+                (C::new(0.0, -2.0 * lk.im) * residue).re
+            })
+            .collect();
         let end = profile.end().p;
         Ok(Self {
             lambda,
             terms,
             offset: (static_gain - 1.0) * end,
             t_end: profile.duration_s(),
+            weights,
         })
     }
 
@@ -264,6 +283,28 @@ impl LinearResponse {
             })
             .collect();
         out.sort_by(|a, b| b.2.total_cmp(&a.2));
+        out
+    }
+
+    /// The oscillatory modes as `(natural frequency Hz, damping ratio, weight)`, lowest
+    /// frequency first, independent of the profile: the weight is the mode's participation
+    /// in the toolhead error in the modes form's convention (settle-sim's `Mode`: error =
+    /// sum weight_k e_k with `e_k'' + 2 zeta_k w_k e_k' + w_k^2 e_k = -a_cmd`), from the
+    /// residue of the error's transfer function at the mode's pole. For an axis built from
+    /// modes it returns them; for a physical axis, its linearised modes at the profile's
+    /// start position.
+    pub fn weighted_modes(&self) -> Vec<(f64, f64, f64)> {
+        let mut out: Vec<(f64, f64, f64)> = self
+            .lambda
+            .iter()
+            .zip(&self.weights)
+            .filter(|(l, _)| l.im > 0.0)
+            .map(|(l, &w)| {
+                let wn = l.norm();
+                (wn / std::f64::consts::TAU, -l.re / wn, w)
+            })
+            .collect();
+        out.sort_by(|a, b| a.0.total_cmp(&b.0));
         out
     }
 

@@ -49,11 +49,15 @@ pub fn sim_options(spec: &RunSpec) -> SimOptions {
 }
 
 /// The axes a run simulates: the machine compiled for the run's driver model, or one axis
-/// `x` from the modes.
+/// per axis of the modes form.
 pub fn axes_of(spec: &RunSpec) -> Result<Vec<AxisModel>, SimError> {
     match &spec.machine {
         Some(m) => m.compile(spec.driver),
-        None => Ok(vec![AxisModel::from_modes("x", &spec.modes_sim()?)?]),
+        None => spec
+            .modes
+            .iter()
+            .map(|a| AxisModel::from_modes(&a.axis, &spec.modes_sim(&a.axis)?))
+            .collect(),
     }
 }
 

@@ -1,21 +1,34 @@
-//! The scenario's machine: its modes, a preset or machine file, or inline axes.
+//! The scenario's machine: its modes per axis, a preset or machine file, or inline axes.
 
 use settle_sim::DriverMode;
 use settle_sim::machine::Machine;
 
 use crate::error::Error;
+use crate::input::machine_file::MachineForm;
+use crate::input::modes::AxisModes;
 use crate::input::scenario::Scenario;
 use crate::input::source::Source;
 
-/// The scenario's machine: `(physical machine or None for the modes form, name, driver
-/// model)`.
-pub fn resolve_machine(
-    sc: &Scenario,
-    src: &Source,
-) -> Result<(Option<Machine>, String, DriverMode), Error> {
+/// The scenario's machine, resolved.
+#[derive(Debug, Clone)]
+pub struct Resolved {
+    /// The physical machine, or `None` for the modes form.
+    pub machine: Option<Machine>,
+    /// The modes per axis (modes form; empty for a physical machine).
+    pub modes: Vec<AxisModes>,
+    /// Its name (the preset's or machine file's, the inline machine's, or `modes`).
+    pub name: String,
+    /// How the motors are driven (`linear` for the modes form).
+    pub driver: DriverMode,
+}
+
+/// The scenario's machine.
+pub fn resolve_machine(sc: &Scenario, src: &Source) -> Result<Resolved, Error> {
     let m = &sc.machine;
+    let axis_modes = m.axis.values().any(|a| a.modes.is_some());
+    let modes_form = !m.modes.is_empty() || axis_modes;
     let inline = !m.axis.is_empty() || m.motor.is_some() || m.driver.is_some();
-    let physical = inline || m.preset.is_some();
+    let physical = (inline && !axis_modes) || m.preset.is_some();
     if !m.modes.is_empty() && physical {
         return Err(src.error_at(
             "machine",
@@ -40,21 +53,72 @@ pub fn resolve_machine(
             )
         })?),
     };
-    if !m.modes.is_empty() {
+    let no_motor = |driver: Option<DriverMode>| {
         if driver.is_some_and(|d| d != DriverMode::Linear) {
             return Err(src.error_at(
                 "machine.driver_model",
                 "a machine given by its modes has no motor: driver_model applies to physical machines only",
             ));
         }
-        return Ok((None, "modes".into(), DriverMode::Linear));
+        Ok(DriverMode::Linear)
+    };
+    let modes_machine = |modes: Vec<AxisModes>, name: String| -> Result<Resolved, Error> {
+        Ok(Resolved {
+            machine: None,
+            modes,
+            name,
+            driver: no_motor(driver)?,
+        })
+    };
+    if modes_form {
+        let mut modes = Vec::new();
+        if !m.modes.is_empty() {
+            if m.axis.get("x").is_some_and(|a| a.modes.is_some()) {
+                return Err(src.error_at(
+                    "machine.modes",
+                    "axis x's modes are given twice: `modes` in [machine] is the shorthand for [machine.axis.x] modes; keep one",
+                ));
+            }
+            modes = crate::input::modes::to_axis_modes(
+                [("x".to_string(), "machine.modes".to_string(), &m.modes[..])],
+                src,
+            )?;
+        }
+        if axis_modes {
+            let MachineForm::Modes(axes) = crate::input::machine_file::to_form(
+                "modes",
+                m.motor.as_ref(),
+                m.driver.as_ref(),
+                &m.axis,
+                src,
+                "machine.",
+            )?
+            else {
+                return Err(src.error_at("machine.axis", "expected every axis given by modes"));
+            };
+            modes.extend(axes);
+            modes.sort_by(|a, b| a.axis.cmp(&b.axis));
+        }
+        // The shorthand alone keeps the name every modes scenario had: `modes`.
+        let name = match (&m.name, axis_modes) {
+            (Some(n), true) => n.clone(),
+            _ => "modes".to_string(),
+        };
+        return modes_machine(modes, name);
+    }
+    if let Some(preset) = &m.preset {
+        let (d, _) = crate::input::machine_file::load_any(preset, &src.path, src)?;
+        return match d.form {
+            MachineForm::Physical(machine) => Ok(Resolved {
+                name: machine.name.clone(),
+                machine: Some(machine),
+                modes: Vec::new(),
+                driver: driver.unwrap_or(DriverMode::Full),
+            }),
+            MachineForm::Modes(modes) => modes_machine(modes, d.name),
+        };
     }
     let driver = driver.unwrap_or(DriverMode::Full);
-    if let Some(preset) = &m.preset {
-        let (machine, _, _) = crate::input::machine_file::load_preset(preset, &src.path, src)?;
-        let name = machine.name.clone();
-        return Ok((Some(machine), name, driver));
-    }
     if inline {
         let name = m.name.clone().unwrap_or_else(|| sc.name.clone());
         let machine = crate::input::machine_file::to_machine(
@@ -65,10 +129,15 @@ pub fn resolve_machine(
             src,
             "machine.",
         )?;
-        return Ok((Some(machine), name, driver));
+        return Ok(Resolved {
+            machine: Some(machine),
+            modes: Vec::new(),
+            name,
+            driver,
+        });
     }
     Err(src.error_at(
         "machine",
-        "give the machine: `modes = [{ frequency_hz, damping_ratio }]`, `preset = \"printer_xy\"` (or a machine file path), or [machine.axis.<name>] tables",
+        "give the machine: `modes = [{ frequency_hz, damping_ratio }]` (axis x) or [machine.axis.<name>] modes = [...] per axis, `preset = \"printer_xy\"` (or a machine file path), or [machine.axis.<name>] tables",
     ))
 }

@@ -149,10 +149,15 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
     let profile_key = path_profile_key.unwrap_or("move.profile");
     let base_profile =
         ProfileKind::parse(&mv.profile).map_err(|e| src.error_at(profile_key, e.to_string()))?;
-    let (machine, machine_name, driver) = machine::resolve_machine(sc, src)?;
+    let machine::Resolved {
+        machine,
+        modes,
+        name: machine_name,
+        driver,
+    } = machine::resolve_machine(sc, src)?;
     let axis_names: Vec<String> = match &machine {
         Some(m) => m.axes.iter().map(|a| a.name.clone()).collect(),
-        None => vec!["x".to_string()],
+        None => modes.iter().map(|a| a.axis.clone()).collect(),
     };
     if !is_path && !axis_names.contains(&mv.axis) {
         return Err(src.error_at(
@@ -172,7 +177,7 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
         vmax_mm_s: sc.limits.vmax_mm_s,
         amax_mm_s2: sc.limits.amax_mm_s2,
         jmax_mm_s3: sc.limits.jmax_mm_s3,
-        modes: sc.machine.modes.clone(),
+        modes,
         machine,
         machine_name,
         driver,

@@ -120,22 +120,26 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
             }
         }
     }
-    for (i, m) in run.modes.iter().enumerate() {
-        if let Err(e) = Mode::new(m.frequency_hz, m.damping_ratio, m.weight) {
-            let field = if !(m.frequency_hz.is_finite() && m.frequency_hz > 0.0) {
-                "frequency_hz"
-            } else if !(0.0..1.0).contains(&m.damping_ratio) {
-                "damping_ratio"
-            } else {
-                "weight"
-            };
-            let swept = format!("machine.modes.{i}.{field}");
-            let key = if run.swept.iter().any(|(p, _)| *p == swept) {
-                format!("sweep.{swept}")
-            } else {
-                "machine.modes".to_string()
-            };
-            return Err(src.error_at(&key, format!("mode {i}: {e}")));
+    // The modes as written were checked when the machine was read; swept values here.
+    for a in &run.modes {
+        for (i, m) in a.modes.iter().enumerate() {
+            if let Err(e) = Mode::new(m.frequency_hz, m.damping_ratio, m.weight) {
+                let field = if !(m.frequency_hz.is_finite() && m.frequency_hz > 0.0) {
+                    "frequency_hz"
+                } else if !(0.0..1.0).contains(&m.damping_ratio) {
+                    "damping_ratio"
+                } else {
+                    "weight"
+                };
+                let key = run
+                    .swept
+                    .iter()
+                    .find(|(p, _)| {
+                        crate::spec::run_spec::mode_param(p) == Some((a.axis.as_str(), i, field))
+                    })
+                    .map_or_else(|| "machine".to_string(), |(p, _)| format!("sweep.{p}"));
+                return Err(src.error_at(&key, format!("axis `{}`, mode {i}: {e}", a.axis)));
+            }
         }
     }
     Ok(())

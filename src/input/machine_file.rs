@@ -1,13 +1,18 @@
 //! Machine files (TOML): what a user writes to describe a gantry, parsed strictly and
 //! reported with file, line and key, then converted to [`settle_sim::machine::Machine`].
 //!
-//! A machine file has a `name`, an optional `description`, machine-wide `[motor]` and
-//! `[driver]` tables (defaults for every axis) and one `[axis.<name>]` table per axis
-//! (`x`, `y`, ...; axes are ordered by name), each with `carriage_kg`, `toolhead_kg`,
-//! optional `beam_kg`, exactly one of `[axis.<name>.belt]` or `[axis.<name>.screw]`, a
-//! `[axis.<name>.mount]`, an optional `[axis.<name>.frame]` and optional `motor` / `driver`
-//! overrides. The same tables can be written inline in a scenario under `[machine]`.
-//! Built-in presets (`scenarios/machines/*.toml`) are compiled into the binary.
+//! A machine file has a `name`, an optional `description` and one `[axis.<name>]` table
+//! per axis (`x`, `y`, ...; axes are ordered by name), in one of two forms:
+//!
+//! - physical: machine-wide `[motor]` and `[driver]` tables (defaults for every axis) and
+//!   per axis `carriage_kg`, `toolhead_kg`, optional `beam_kg`, exactly one of
+//!   `[axis.<name>.belt]` or `[axis.<name>.screw]`, a `[axis.<name>.mount]`, an optional
+//!   `[axis.<name>.frame]` and optional `motor` / `driver` overrides;
+//! - modes: per axis only `modes = [{ frequency_hz, damping_ratio, weight }, ...]`
+//!   ([`crate::input::modes`]; what `settle identify` writes).
+//!
+//! The same tables can be written inline in a scenario under `[machine]`. Built-in
+//! presets (`scenarios/machines/*.toml`) are compiled into the binary.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -19,6 +24,7 @@ use settle_sim::machine::{
 };
 
 use crate::error::Error;
+use crate::input::modes::{AxisModes, ModeSpec};
 use crate::input::source::Source;
 
 /// The built-in presets: name, repository path, text.
@@ -52,23 +58,25 @@ pub struct MachineFile {
     pub axis: BTreeMap<String, AxisSpec>,
 }
 
-/// One axis as written.
+/// One axis as written: its modes, or its parts (a physical axis: `carriage_kg`,
+/// `toolhead_kg`, the transmission and the mount are then required).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AxisSpec {
+    /// The axis's modes (the modes form: no other key).
+    pub modes: Option<Vec<ModeSpec>>,
     /// Carriage mass (kg).
-    pub carriage_kg: f64,
+    pub carriage_kg: Option<f64>,
     /// Toolhead mass (kg).
-    pub toolhead_kg: f64,
-    /// Mass carried rigidly with the carriage (kg), e.g. the X beam on a Y axis.
-    #[serde(default)]
-    pub beam_kg: f64,
+    pub toolhead_kg: Option<f64>,
+    /// Mass carried rigidly with the carriage (kg), e.g. the X beam on a Y axis. Default 0.
+    pub beam_kg: Option<f64>,
     /// A belt drive.
     pub belt: Option<BeltSpec>,
     /// A screw drive.
     pub screw: Option<ScrewSpec>,
     /// Toolhead mount.
-    pub mount: MountSpec,
+    pub mount: Option<MountSpec>,
     /// Optional frame mode.
     pub frame: Option<FrameSpec>,
     /// Motor (else the machine-wide one).
@@ -200,6 +208,20 @@ pub fn to_machine(
     let mut out = Vec::new();
     for (axis, a) in axes {
         let key = |k: &str| format!("{prefix}axis.{axis}.{k}");
+        let missing = |k: &str, what: &str| {
+            src.error_at(
+                &key(k),
+                format!(
+                    "missing `{k}` ({what}): a physical axis needs carriage_kg, toolhead_kg, [belt] or [screw] and [mount]; or give the axis by its `modes = [...]`"
+                ),
+            )
+        };
+        let carriage_kg = a.carriage_kg.ok_or_else(|| missing("carriage_kg", "kg"))?;
+        let toolhead_kg = a.toolhead_kg.ok_or_else(|| missing("toolhead_kg", "kg"))?;
+        let mount = a
+            .mount
+            .as_ref()
+            .ok_or_else(|| missing("mount", "a table"))?;
         let transmission = match (&a.belt, &a.screw) {
             (Some(b), None) => Transmission::Belt(Belt {
                 ea_n: b.ea_n,
@@ -243,13 +265,13 @@ pub fn to_machine(
         };
         let machine_axis = AxisMachine {
             name: axis.clone(),
-            carriage_kg: a.carriage_kg,
-            toolhead_kg: a.toolhead_kg,
-            beam_kg: a.beam_kg,
+            carriage_kg,
+            toolhead_kg,
+            beam_kg: a.beam_kg.unwrap_or(0.0),
             transmission,
             mount: Mount {
-                stiffness_n_per_m: a.mount.stiffness_n_per_m,
-                damping_ratio: a.mount.damping_ratio,
+                stiffness_n_per_m: mount.stiffness_n_per_m,
+                damping_ratio: mount.damping_ratio,
             },
             frame: a.frame.as_ref().map(|f| Frame {
                 mass_kg: f.mass_kg,
@@ -305,11 +327,98 @@ pub fn to_machine(
     Ok(machine)
 }
 
-/// Parse a machine file's text; `path` names it in errors.
-pub fn parse(text: &str, path: &Path) -> Result<(Machine, String), Error> {
+/// A machine as a file or scenario describes it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MachineForm {
+    /// Its parts (motor, driver, transmission, masses), compiled by settle-sim.
+    Physical(Machine),
+    /// Its modes per axis, ordered by axis name.
+    Modes(Vec<AxisModes>),
+}
+
+/// A machine file, read: its name, description and machine.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Described {
+    /// `name`.
+    pub name: String,
+    /// `description`.
+    pub description: String,
+    /// The machine.
+    pub form: MachineForm,
+}
+
+/// Convert parsed axes into a validated machine of either form: every axis given by its
+/// `modes`, or every axis by its parts ([`to_machine`]). Keys as in [`to_machine`].
+pub fn to_form(
+    name: &str,
+    motor: Option<&MotorSpec>,
+    driver: Option<&DriverSpec>,
+    axes: &BTreeMap<String, AxisSpec>,
+    src: &Source,
+    prefix: &str,
+) -> Result<MachineForm, Error> {
+    let with_modes: Vec<&String> = axes
+        .iter()
+        .filter(|(_, a)| a.modes.is_some())
+        .map(|(n, _)| n)
+        .collect();
+    if with_modes.is_empty() {
+        return to_machine(name, motor, driver, axes, src, prefix).map(MachineForm::Physical);
+    }
+    for (axis, a) in axes {
+        let parts = a.carriage_kg.is_some()
+            || a.toolhead_kg.is_some()
+            || a.beam_kg.is_some()
+            || a.belt.is_some()
+            || a.screw.is_some()
+            || a.mount.is_some()
+            || a.frame.is_some()
+            || a.motor.is_some()
+            || a.driver.is_some();
+        match (&a.modes, parts) {
+            (Some(_), true) => {
+                return Err(src.error_at(
+                    &format!("{prefix}axis.{axis}.modes"),
+                    "an axis is given either by its modes or by its parts (carriage_kg, belt, mount, ...), not both",
+                ));
+            }
+            (None, _) => {
+                return Err(src.error_at(
+                    &format!("{prefix}axis.{axis}"),
+                    format!(
+                        "axis `{}` has modes, this one has none: give every axis by its `modes = [...]`, or every axis by its parts",
+                        with_modes[0]
+                    ),
+                ));
+            }
+            (Some(_), false) => {}
+        }
+    }
+    if motor.is_some() || driver.is_some() {
+        let k = if motor.is_some() { "motor" } else { "driver" };
+        return Err(src.error_at(
+            &format!("{prefix}{k}"),
+            "a machine given by its modes has no motor or driver: remove [motor] and [driver]",
+        ));
+    }
+    crate::input::modes::to_axis_modes(
+        axes.iter().map(|(n, a)| {
+            (
+                n.clone(),
+                format!("{prefix}axis.{n}.modes"),
+                a.modes.as_deref().unwrap_or_default(),
+            )
+        }),
+        src,
+    )
+    .map(MachineForm::Modes)
+}
+
+/// Parse a machine file's text (either form); `path` names it in errors.
+pub fn parse_any(text: &str, path: &Path) -> Result<Described, Error> {
     let src = Source::new(text, path);
     let file: MachineFile = src.document(&[])?;
-    let m = to_machine(
+    let form = to_form(
         &file.name,
         file.motor.as_ref(),
         file.driver.as_ref(),
@@ -317,21 +426,37 @@ pub fn parse(text: &str, path: &Path) -> Result<(Machine, String), Error> {
         &src,
         "",
     )?;
-    Ok((m, file.description))
+    Ok(Described {
+        name: file.name,
+        description: file.description,
+        form,
+    })
+}
+
+/// Parse a physical machine file's text; `path` names it in errors.
+pub fn parse(text: &str, path: &Path) -> Result<(Machine, String), Error> {
+    let d = parse_any(text, path)?;
+    match d.form {
+        MachineForm::Physical(m) => Ok((m, d.description)),
+        MachineForm::Modes(_) => Err(Error::input_key(
+            path,
+            "axis",
+            "this machine is given by its modes; a physical machine (motor, belts, masses) is needed here",
+        )),
+    }
 }
 
 /// Resolve `preset = "<value>"` of a scenario at `scenario_path`: a built-in preset name,
-/// or a path to a machine file (relative to the scenario's folder). Returns the machine,
-/// its description and the file it came from.
-pub fn load_preset(
+/// or a path to a machine file (relative to the scenario's folder) of either form.
+/// Returns the machine and the file it came from.
+pub fn load_any(
     value: &str,
     scenario_path: &Path,
     src: &Source,
-) -> Result<(Machine, String, PathBuf), Error> {
+) -> Result<(Described, PathBuf), Error> {
     if let Some((_, path, text)) = PRESETS.iter().find(|(n, _, _)| *n == value) {
         let path = PathBuf::from(path);
-        let (m, d) = parse(text, &path)?;
-        return Ok((m, d, path));
+        return Ok((parse_any(text, &path)?, path));
     }
     let looks_like_path = value.contains('/') || value.ends_with(".toml");
     if !looks_like_path {
@@ -352,6 +477,25 @@ pub fn load_preset(
             format!("cannot read machine file {}: {e}", path.display()),
         )
     })?;
-    let (m, d) = parse(&text, &path)?;
-    Ok((m, d, path))
+    Ok((parse_any(&text, &path)?, path))
+}
+
+/// [`load_any`] for a physical machine: returns the machine, its description and the
+/// file it came from.
+pub fn load_preset(
+    value: &str,
+    scenario_path: &Path,
+    src: &Source,
+) -> Result<(Machine, String, PathBuf), Error> {
+    let (d, path) = load_any(value, scenario_path, src)?;
+    match d.form {
+        MachineForm::Physical(m) => Ok((m, d.description, path)),
+        MachineForm::Modes(_) => Err(src.error_at(
+            "machine.preset",
+            format!(
+                "{} gives the machine by its modes; only physical machines (motor, belts, masses) can be swept as presets",
+                path.display()
+            ),
+        )),
+    }
 }

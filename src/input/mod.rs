@@ -5,6 +5,7 @@
 
 pub mod keys;
 pub mod machine_file;
+pub mod modes;
 pub mod runs_table;
 pub mod scenario;
 pub mod source;

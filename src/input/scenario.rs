@@ -9,6 +9,7 @@ use serde::Deserialize;
 
 use crate::error::Error;
 use crate::input::machine_file::{AxisSpec, DriverSpec, MotorSpec};
+pub use crate::input::modes::ModeSpec;
 use crate::input::source::Source;
 use crate::input::tune_spec::TuneSpec;
 
@@ -57,13 +58,15 @@ pub struct SimSpec {
     pub max_step_s: Option<f64>,
 }
 
-/// The machine, in one of three forms: its modes (`modes = [...]`, one axis `x`), a
-/// preset or machine file (`preset = "printer_xy"` or a path), or inline axes
-/// (`[machine.axis.x]` ... with the machine-file schema, see [`crate::input::machine_file`]).
+/// The machine, in one of three forms: its modes (`[machine.axis.<name>] modes = [...]`
+/// per axis; `modes = [...]` here is the shorthand for axis `x`), a preset or machine file
+/// (`preset = "printer_xy"` or a path), or inline axes (`[machine.axis.x]` ... with the
+/// machine-file schema, see [`crate::input::machine_file`]).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MachineSpec {
-    /// One or more lightly damped modes between command and toolhead (one axis, `x`).
+    /// One or more lightly damped modes between command and toolhead of axis `x` (the
+    /// shorthand for `[machine.axis.x] modes`).
     #[serde(default)]
     pub modes: Vec<ModeSpec>,
     /// A built-in preset name, or a path to a machine file relative to the scenario.
@@ -74,30 +77,13 @@ pub struct MachineSpec {
     pub motor: Option<MotorSpec>,
     /// Inline machine: driver of every axis that does not name its own.
     pub driver: Option<DriverSpec>,
-    /// Inline machine: the axes, by name.
+    /// Inline machine: the axes, by name (physical axes, or `modes = [...]` each).
     #[serde(default)]
     pub axis: BTreeMap<String, AxisSpec>,
     /// How the motors are driven: `full` (stepper driver model, the default), `spring`
     /// (a linear spring to the microstep-quantised command) or `linear` (a linear spring
     /// to the continuous command: the modal backend's model). Physical machines only.
     pub driver_model: Option<String>,
-}
-
-/// One mode of the axis.
-#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct ModeSpec {
-    /// Natural frequency (Hz), > 0.
-    pub frequency_hz: f64,
-    /// Damping ratio, in [0, 1).
-    pub damping_ratio: f64,
-    /// Participation in the toolhead error (weights of a real structure sum to 1).
-    #[serde(default = "one")]
-    pub weight: f64,
-}
-
-fn one() -> f64 {
-    1.0
 }
 
 /// The base move.

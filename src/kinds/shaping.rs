@@ -135,13 +135,15 @@ impl KindState for ShaperSetting {
 }
 
 /// The mode the `remaining_vibration_pct` column is computed for: `(frequency Hz, damping
-/// ratio)`. The modes form: the mode of largest weight (the first among equals). A physical
-/// machine: the strongest mode of the moving axis's (a corner path: its first axis's)
-/// linearised response to the run's unshaped move (from the closed form).
+/// ratio)`. The modes form: the moving axis's (a corner path: its first axis's) mode of
+/// largest weight (the first among equals). A physical machine: the strongest mode of the
+/// moving axis's linearised response to the run's unshaped move (from the closed form).
 pub fn dominant_mode(spec: &RunSpec) -> Option<(f64, f64)> {
+    // A corner path (`x+y`): its first axis, the one the path starts along.
+    let name = spec.axis.split('+').next()?;
     if spec.machine.is_none() {
         let mut best: Option<&ModeSpec> = None;
-        for m in &spec.modes {
+        for m in spec.modes_of(name) {
             if best.is_none_or(|b| m.weight.abs() > b.weight.abs()) {
                 best = Some(m);
             }
@@ -150,8 +152,6 @@ pub fn dominant_mode(spec: &RunSpec) -> Option<(f64, f64)> {
     }
     let machine = spec.machine.as_ref()?;
     let axes = machine.compile(settle_sim::DriverMode::Linear).ok()?;
-    // A corner path (`x+y`): its first axis, the one the path starts along.
-    let name = spec.axis.split('+').next()?;
     let axis = axes.iter().find(|a| a.name == name)?;
     let limits = spec.limits_si().ok()?;
     let profile = spec

@@ -37,7 +37,14 @@ impl RunsCsv {
     /// The columns of the sweep `runs`.
     pub fn new(runs: &[RunSpec]) -> Self {
         let bands_um = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
-        let n_modes = runs.first().map_or(0, |r| r.modes.len());
+        // The modes form's modes: axis x's as `mode<i>_*`, another axis's as
+        // `<axis>_mode<i>_*`.
+        let mode_axes: Vec<(String, usize)> = runs.first().map_or(Vec::new(), |r| {
+            r.modes
+                .iter()
+                .map(|a| (a.axis.clone(), a.modes.len()))
+                .collect()
+        });
         let mut header: Vec<String> = [
             "run",
             "profile",
@@ -49,12 +56,19 @@ impl RunsCsv {
         ]
         .map(String::from)
         .to_vec();
-        for i in 0..n_modes {
-            header.extend([
-                format!("mode{i}_frequency_hz"),
-                format!("mode{i}_damping_ratio"),
-                format!("mode{i}_weight"),
-            ]);
+        for (axis, n) in &mode_axes {
+            let p = if axis == "x" {
+                String::new()
+            } else {
+                format!("{axis}_")
+            };
+            for i in 0..*n {
+                header.extend([
+                    format!("{p}mode{i}_frequency_hz"),
+                    format!("{p}mode{i}_damping_ratio"),
+                    format!("{p}mode{i}_weight"),
+                ]);
+            }
         }
         header.extend(
             [
@@ -78,9 +92,12 @@ impl RunsCsv {
             header.push(format!("move_and_settle_s_{}", band_label(*b)));
         }
         header.extend(["overshoot_um", "max_following_error_um"].map(String::from));
-        // Per-axis metrics for physical machines (the modes form has one axis: the above).
-        // A swept preset can change the axes: the union, in first-seen order.
+        // Per-axis metrics for physical machines and modes forms of several axes (one axis:
+        // the above). A swept preset can change the axes: the union, in first-seen order.
         let mut axis_names: Vec<String> = Vec::new();
+        if mode_axes.len() > 1 {
+            axis_names = mode_axes.iter().map(|(a, _)| a.clone()).collect();
+        }
         if runs.first().is_some_and(|r| r.machine.is_some()) {
             for a in runs
                 .iter()
@@ -141,7 +158,7 @@ impl RunsCsv {
             r.amax_mm_s2.to_string(),
             r.jmax_mm_s3.map_or(String::new(), |j| j.to_string()),
         ]);
-        for md in &r.modes {
+        for md in r.modes.iter().flat_map(|a| &a.modes) {
             c.extend([
                 md.frequency_hz.to_string(),
                 md.damping_ratio.to_string(),

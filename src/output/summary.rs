@@ -94,12 +94,29 @@ pub fn summary_md(
     if !sc.description.is_empty() {
         let _ = writeln!(out, "{}\n", sc.description.trim());
     }
-    let modes: Vec<String> = sc
+    // The modes as written: `[machine] modes` (axis x), then each axis table's (prefixed
+    // with its axis).
+    let axis_modes = sc
         .machine
-        .modes
+        .axis
         .iter()
-        .map(|m| format!("{} Hz, zeta {}", m.frequency_hz, m.damping_ratio))
+        .filter_map(|(name, a)| Some((format!("{name}: "), a.modes.as_ref()?)));
+    let mode_text = |p: &str, m: &crate::input::modes::ModeSpec| {
+        format!("{p}{} Hz, zeta {}", m.frequency_hz, m.damping_ratio)
+    };
+    let mut modes: Vec<String> = std::iter::once((String::new(), &sc.machine.modes))
+        .chain(axis_modes)
+        .flat_map(|(p, ms)| ms.iter().map(move |m| mode_text(&p, m)))
         .collect();
+    // A machine file of modes (`preset = "machine.toml"`): the first run's.
+    if modes.is_empty()
+        && let Some(r) = runs.first()
+    {
+        for a in &r.modes {
+            let p = format!("{}: ", a.axis);
+            modes.extend(a.modes.iter().map(|m| mode_text(&p, m)));
+        }
+    }
     let machine = match runs.first() {
         Some(r) if r.machine.is_some() => format!(
             "Machine: {} (axis {}, {} driver), backend {}",

@@ -7,7 +7,7 @@ use settle_planner::{Limits, ProfileKind};
 use settle_sim::machine::Machine;
 use settle_sim::{DriverMode, Mode};
 
-use crate::input::scenario::ModeSpec;
+use crate::input::modes::{AxisModes, ModeSpec};
 use crate::spec::backend::Backend;
 use crate::spec::value::Value;
 
@@ -77,8 +77,9 @@ pub struct RunSpec {
     pub amax_mm_s2: f64,
     /// Maximum jerk (mm/s^3), if given.
     pub jmax_mm_s3: Option<f64>,
-    /// The machine's modes (modes form; empty for a physical machine).
-    pub modes: Vec<ModeSpec>,
+    /// The machine's modes per axis, ordered by axis name (modes form; empty for a
+    /// physical machine).
+    pub modes: Vec<AxisModes>,
     /// The physical machine (preset, machine file or inline), if not given by modes.
     pub machine: Option<Machine>,
     /// The machine's name (the preset's, or `modes`).
@@ -109,7 +110,8 @@ pub struct RunSpec {
 /// The parameters every scenario can sweep, for messages (the run kinds add theirs).
 pub const SWEEPABLE: &str = "profile, move.distance_mm, move.start_mm, limits.vmax_mm_s, \
 limits.amax_mm_s2, limits.jmax_mm_s3, machine.modes.N.frequency_hz, machine.modes.N.damping_ratio, \
-machine.modes.N.weight (N = 0-based mode index), and for physical machines \
+machine.modes.N.weight (N = 0-based mode index of axis x), machine.axis.<axis>.modes.N.<field> \
+(the same for any axis), and for physical machines \
 machine.axis.<axis>.<field> (e.g. machine.axis.x.mount.stiffness_n_per_m), machine.motor.<field> \
 and machine.driver.<field> (every axis), machine.preset (preset names or machine files)";
 
@@ -128,9 +130,23 @@ impl RunSpec {
         )
     }
 
-    /// The modes as sim types.
-    pub fn modes_sim(&self) -> Result<Vec<Mode>, settle_sim::SimError> {
-        self.modes
+    /// The modes of `axis` (modes form; empty when it has none or the machine is
+    /// physical).
+    pub fn modes_of(&self, axis: &str) -> &[ModeSpec] {
+        crate::input::modes::modes_of(&self.modes, axis).unwrap_or_default()
+    }
+
+    /// The names of the machine's axes (physical or modes form), in order.
+    pub fn axis_names(&self) -> Vec<String> {
+        match &self.machine {
+            Some(m) => m.axes.iter().map(|a| a.name.clone()).collect(),
+            None => self.modes.iter().map(|a| a.axis.clone()).collect(),
+        }
+    }
+
+    /// The modes of `axis` as sim types.
+    pub fn modes_sim(&self, axis: &str) -> Result<Vec<Mode>, settle_sim::SimError> {
+        self.modes_of(axis)
             .iter()
             .map(|m| Mode::new(m.frequency_hz, m.damping_ratio, m.weight))
             .collect()
@@ -211,6 +227,30 @@ impl RunSpec {
             // Resolved by the expander (it reads the preset); nothing to set here.
             "machine.preset" => {}
             other => {
+                if let Some((axis, i, field)) = mode_param(other) {
+                    let x = num(value)?;
+                    let names = self.axis_names().join(", ");
+                    let Some(a) = self.modes.iter_mut().find(|a| a.axis == axis) else {
+                        return Err(if self.machine.is_some() {
+                            format!(
+                                "`{other}` needs a machine given by its modes, not a physical one"
+                            )
+                        } else {
+                            format!("no axis `{axis}` with modes; the machine has {names}")
+                        });
+                    };
+                    let n = a.modes.len();
+                    let mode = a.modes.get_mut(i).ok_or_else(|| {
+                        format!("mode index {i} out of range: axis `{axis}` has {n} mode(s)")
+                    })?;
+                    match field {
+                        "frequency_hz" => mode.frequency_hz = x,
+                        "damping_ratio" => mode.damping_ratio = x,
+                        "weight" => mode.weight = x,
+                        _ => return Ok(false),
+                    }
+                    return Ok(true);
+                }
                 if let Some(rest) = ["axis.", "motor.", "driver."]
                     .iter()
                     .find_map(|p| other.strip_prefix("machine.").filter(|r| r.starts_with(p)))
@@ -224,26 +264,24 @@ impl RunSpec {
                     crate::spec::machine::set_machine_field(m, other, rest, x)?;
                     return Ok(true);
                 }
-                let mode_param = other
-                    .strip_prefix("machine.modes.")
-                    .and_then(|rest| rest.split_once('.'))
-                    .and_then(|(i, field)| Some((i.parse::<usize>().ok()?, field)));
-                let Some((i, field)) = mode_param else {
-                    return Ok(false);
-                };
-                let n = self.modes.len();
-                let mode = self.modes.get_mut(i).ok_or_else(|| {
-                    format!("mode index {i} out of range: the machine has {n} mode(s)")
-                })?;
-                let x = num(value)?;
-                match field {
-                    "frequency_hz" => mode.frequency_hz = x,
-                    "damping_ratio" => mode.damping_ratio = x,
-                    "weight" => mode.weight = x,
-                    _ => return Ok(false),
-                }
+                return Ok(false);
             }
         }
         Ok(true)
     }
+}
+
+/// A swept mode key: `machine.modes.N.<field>` (axis `x`) or
+/// `machine.axis.<axis>.modes.N.<field>`, as `(axis, N, field)`.
+pub fn mode_param(param: &str) -> Option<(&str, usize, &str)> {
+    let (axis, rest) = match param.strip_prefix("machine.modes.") {
+        Some(rest) => ("x", rest),
+        None => {
+            let rest = param.strip_prefix("machine.axis.")?;
+            let (axis, rest) = rest.split_once('.')?;
+            (axis, rest.strip_prefix("modes.")?)
+        }
+    };
+    let (i, field) = rest.split_once('.')?;
+    Some((axis, i.parse().ok()?, field))
 }

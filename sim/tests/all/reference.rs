@@ -259,3 +259,29 @@ fn free_decay_has_the_analytic_frequency_and_damping() {
     // (27.5 periods) would show above.
     assert!((TAU / wd - 1.0 / 55.0 / (1.0 - z * z).sqrt()).abs() < 1e-15 && PI > 3.0);
 }
+
+/// The weights the closed form reads off the poles' residues are the modes form's own:
+/// an axis built from modes gives them back (frequency, damping and weight), at rest or
+/// after any move.
+#[test]
+fn weighted_modes_of_a_modes_axis_are_its_modes() {
+    let modes = [
+        Mode::new(38.0, 0.04, 0.7).expect("mode"),
+        Mode::new(95.0, 0.12, 0.3).expect("mode"),
+    ];
+    let axis = AxisModel::from_modes("y", &modes).expect("axis");
+    let limits = Limits::new(0.3, 5.0, Some(200.0)).expect("limits");
+    for profile in [
+        Profile::empty(State::default()),
+        scurve::rest_to_rest(0.0, 0.01, &limits).expect("profile"),
+    ] {
+        let lr = settle_sim::closed_form::LinearResponse::new(&axis, &profile).expect("lr");
+        let got = lr.weighted_modes();
+        assert_eq!(got.len(), 2, "{got:?}");
+        for ((f, z, w), m) in got.iter().zip(&modes) {
+            assert!((f - m.omega() / TAU).abs() < 1e-9 * f, "{got:?}");
+            assert!((z - m.damping_ratio()).abs() < 1e-9, "{got:?}");
+            assert!((w - m.weight()).abs() < 1e-9, "{got:?}");
+        }
+    }
+}

@@ -12,7 +12,6 @@ use serde::Deserialize;
 use settle_planner::path::junction::Junction;
 use settle_planner::path::{CornerStrategy, Path, PathPoint};
 use settle_planner::{PlanError, ProfileKind};
-use settle_sim::machine::Machine;
 
 use crate::error::Error;
 use crate::input::source::Source;
@@ -286,13 +285,10 @@ impl Corner {
                 ),
             ));
         }
+        check_machine(self, &run.machine_name, &run.axis_names()).map_err(|m| (key("axes"), m))?;
         let Some(machine) = &run.machine else {
-            return Err((
-                "machine".into(),
-                "a corner path needs a physical machine with 2 or 3 axes (e.g. `preset = \"printer_xy\"`), not `modes`".into(),
-            ));
+            return Ok(());
         };
-        check_machine(self, machine).map_err(|m| (key("axes"), m))?;
         // Every point inside every axis's belt travel.
         for (k, p) in self.points_mm().iter().enumerate() {
             for (axis, x) in self.axes.iter().zip(p) {
@@ -368,17 +364,15 @@ fn cos_sin_deg(deg: f64) -> (f64, f64) {
     }
 }
 
-fn check_machine(c: &Corner, machine: &Machine) -> Result<(), String> {
-    let names: Vec<&str> = machine.axes.iter().map(|a| a.name.as_str()).collect();
+fn check_machine(c: &Corner, machine_name: &str, names: &[String]) -> Result<(), String> {
     if !(2..=3).contains(&names.len()) {
         return Err(format!(
-            "a corner path needs a machine with 2 or 3 axes; `{}` has {}",
-            machine.name,
+            "a corner path needs a machine with 2 or 3 axes (a preset such as `printer_xy`, or [machine.axis.<name>] modes for two axes); `{machine_name}` has {}",
             names.len()
         ));
     }
     for a in &c.axes {
-        if !names.contains(&a.as_str()) {
+        if !names.contains(a) {
             return Err(format!(
                 "no axis `{a}`; the machine has {}",
                 names.join(", ")

@@ -5,8 +5,10 @@
 //! installed font is needed. SVGs name the family `sans-serif` and let the viewer render it.
 //!
 //! A figure is plain data ([`Figure`] of [`Panel`]s of [`Line`]s) drawn by one renderer;
-//! [`sweep`] and [`trace`] build figures from a sweep's runs table and from one run's series.
+//! [`sweep`] and [`trace`] build figures from a sweep's runs table and from one run's series,
+//! [`identify`] from identified modes and their measured spectrum.
 
+pub mod identify;
 pub mod sweep;
 pub mod trace;
 

@@ -264,17 +264,25 @@ pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error
     })
 }
 
-/// The modes shapers are tuned to: the scenario's modes (by weight, at most two), or the
-/// two strongest modes of the moving axis's linearised response.
+/// The modes shapers are tuned to: the moving axis's modes (by weight, at most two; a
+/// corner path: the strongest of each of its axes), or the two strongest modes of the
+/// moving axis's linearised response.
 pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
     if base.machine.is_none() {
-        let mut m: Vec<_> = base.modes.clone();
-        m.sort_by(|a, b| b.weight.abs().total_cmp(&a.weight.abs()));
-        return m
-            .iter()
-            .take(2)
-            .map(|m| (m.frequency_hz, m.damping_ratio))
-            .collect();
+        let names: Vec<&str> = base.axis.split('+').collect();
+        let per_axis = if names.len() > 1 { 1 } else { 2 };
+        let mut out: Vec<(f64, f64)> = Vec::new();
+        for name in names {
+            let mut m: Vec<_> = base.modes_of(name).to_vec();
+            m.sort_by(|a, b| b.weight.abs().total_cmp(&a.weight.abs()));
+            for m in m.iter().take(per_axis) {
+                let f = m.frequency_hz;
+                if !out.iter().any(|(g, _)| (g - f).abs() < 1e-6 * f) {
+                    out.push((f, m.damping_ratio));
+                }
+            }
+        }
+        return out;
     }
     let Some(machine) = &base.machine else {
         return Vec::new();

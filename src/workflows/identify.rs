@@ -1,0 +1,271 @@
+//! `settle identify FILE...`: vibration modes per machine axis from accelerometer files
+//! (Klipper raw and processed CSV, RepRapFirmware M956 CSV, Shake&Tune `.stdata`; read and
+//! fitted by settle-identify), a table with uncertainties, a figure per axis and a
+//! machine file in the modes form that `settle sweep` and `settle tune` take
+//! (`preset = "machine.toml"` in a scenario's `[machine]`).
+//!
+//! Which machine axis a file excited: `--axis` when given, else the file name's own token
+//! `x`, `y` or `z` (Klipper names its files `raw_data_x_*.csv`, `resonances_y_*.csv`,
+//! `calibration_data_x_*.csv`), else the Shake&Tune measurement's name.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use settle_identify::{AxisIdentification, Options, WeightBasis};
+
+use crate::error::Error;
+use crate::input::modes::{AxisModes, ModeSpec, machine_file_text};
+use crate::workflows::{Exit, Report};
+
+/// What `settle identify` does.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IdentifyOptions {
+    /// The accelerometer files.
+    pub files: Vec<PathBuf>,
+    /// The machine axis every file excited (`x`, `y` or `z`), instead of the file names'.
+    pub axis: Option<String>,
+    /// Where to write the machine file, if anywhere.
+    pub out: Option<PathBuf>,
+    /// Folder of the figures `identify-<axis>.svg` / `.png` [default: the machine file's
+    /// folder, else `results/identify/`].
+    pub figures: Option<PathBuf>,
+    /// settle-identify's options (the resonance test's parameters, modes per axis, fit).
+    pub identify: Options,
+}
+
+impl IdentifyOptions {
+    /// Identify `files` with settle-identify's defaults (Klipper's resonance test).
+    pub fn new(files: Vec<PathBuf>) -> Self {
+        Self {
+            files,
+            axis: None,
+            out: None,
+            figures: None,
+            identify: Options::default(),
+        }
+    }
+}
+
+/// One machine axis, identified.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IdentifiedAxis {
+    /// The machine axis.
+    pub axis: String,
+    /// The file it came from.
+    pub file: PathBuf,
+    /// settle-identify's result.
+    pub id: AxisIdentification,
+}
+
+/// The outcome of `settle identify`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Identified {
+    /// Per machine axis, ordered by axis name.
+    pub axes: Vec<IdentifiedAxis>,
+    /// The modes per axis as the machine file holds them (a weight the data do not
+    /// determine is shared equally among the axis's modes, see [`modes_of`]).
+    pub modes: Vec<AxisModes>,
+    /// The machine file written, if asked for.
+    pub machine_file: Option<PathBuf>,
+    /// The figures written (`.svg`; a `.png` beside each).
+    pub figures: Vec<PathBuf>,
+}
+
+/// The machine axis `file` (recording `source`) excited: `axis` if given, else a token
+/// `x`, `y` or `z` of the file's name (split at `_`, `-`, `.` and spaces), else of the
+/// measurement's name.
+fn axis_of(file: &Path, source: &str, axis: Option<&str>) -> Result<String, Error> {
+    if let Some(a) = axis {
+        return Ok(a.to_string());
+    }
+    let token = |s: &str| {
+        s.to_ascii_lowercase()
+            .split(['_', '-', '.', ' ', '(', ')'])
+            .find(|t| matches!(*t, "x" | "y" | "z"))
+            .map(str::to_string)
+    };
+    let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned());
+    stem.as_deref()
+        .and_then(token)
+        .or_else(|| token(source))
+        .ok_or_else(|| {
+            Error::input(
+                file,
+                "cannot tell which machine axis this file excited (its name holds no `x`, `y` or `z` token as in Klipper's raw_data_x_*.csv): give --axis x|y|z",
+            )
+        })
+}
+
+/// The modes a machine file gets from `id`: each mode's estimate; a weight the data do
+/// not determine ([`WeightBasis::NotIdentified`]) becomes `1 / n` for `n` modes.
+pub fn modes_of(id: &AxisIdentification) -> Vec<ModeSpec> {
+    let n = id.modes.len().max(1) as f64;
+    id.modes
+        .iter()
+        .map(|m| ModeSpec {
+            frequency_hz: m.frequency_hz.value,
+            damping_ratio: m.damping_ratio.value,
+            weight: m.weight.map_or(1.0 / n, |w| w.value),
+        })
+        .collect()
+}
+
+/// Identify every file, write the figures and (if asked) the machine file.
+pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
+    if let Some(a) = opts.axis.as_deref()
+        && !matches!(a, "x" | "y" | "z")
+    {
+        return Err(Error::input(
+            "--axis",
+            format!("unknown axis `{a}`; allowed: x, y, z"),
+        ));
+    }
+    if opts.files.is_empty() {
+        return Err(Error::input("FILE", "give one or more accelerometer files"));
+    }
+    let mut axes: Vec<IdentifiedAxis> = Vec::new();
+    for file in &opts.files {
+        for id in settle_identify::identify_file(file, &opts.identify)? {
+            let axis = axis_of(file, &id.source, opts.axis.as_deref())?;
+            if let Some(prev) = axes.iter().find(|a| a.axis == axis) {
+                return Err(Error::input(
+                    file,
+                    format!(
+                        "a second recording of axis `{axis}` ({} has one): give one recording per axis, or name the axis of each with --axis in separate runs",
+                        prev.id.source
+                    ),
+                ));
+            }
+            axes.push(IdentifiedAxis {
+                axis,
+                file: file.clone(),
+                id,
+            });
+        }
+    }
+    axes.sort_by(|a, b| a.axis.cmp(&b.axis));
+    let modes: Vec<AxisModes> = axes
+        .iter()
+        .map(|a| AxisModes {
+            axis: a.axis.clone(),
+            modes: modes_of(&a.id),
+        })
+        .collect();
+    let dir = match (&opts.figures, &opts.out) {
+        (Some(d), _) => d.clone(),
+        (None, Some(out)) => out
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+        (None, None) => PathBuf::from("results/identify"),
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| Error::write(&dir, e))?;
+    let mut figures = Vec::new();
+    for a in &axes {
+        let stem = format!("identify-{}", a.axis);
+        crate::output::plot::write(
+            &crate::output::plot::identify::figure(&a.axis, &a.id),
+            &dir,
+            &stem,
+        )?;
+        figures.push(dir.join(format!("{stem}.svg")));
+    }
+    let machine_file = match &opts.out {
+        Some(out) => {
+            let sources: Vec<String> = axes.iter().map(|a| a.id.source.clone()).collect();
+            let text = machine_file_text(
+                "identified",
+                &format!(
+                    "Modes identified by `settle identify` from {}",
+                    sources.join(", ")
+                ),
+                &modes,
+            );
+            crate::output::atomic::write_atomic(out, text.as_bytes())?;
+            Some(out.clone())
+        }
+        None => None,
+    };
+    Ok(Identified {
+        axes,
+        modes,
+        machine_file,
+        figures,
+    })
+}
+
+/// `value ± sigma` with `digits` decimals.
+fn pm(value: f64, sigma: f64, digits: usize) -> String {
+    format!("{value:.digits$} ± {sigma:.digits$}")
+}
+
+impl Identified {
+    /// The table `settle identify` prints: per axis and mode the frequency, damping ratio
+    /// and weight with one standard deviation, and where the motion showed in the sensor.
+    pub fn table(&self) -> String {
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            "{:<4} {:<16} {:>4} {:>18} {:>18} {:>16}  method",
+            "axis", "sensor", "mode", "frequency_hz", "damping_ratio", "weight"
+        );
+        for a in &self.axes {
+            let sensor = match (&a.id.direction, a.id.dominant_sensor_axis) {
+                (Some(d), _) => d.describe(),
+                (None, Some(k)) => format!("psd_{} (PSD)", ["x", "y", "z"][k.min(2)]),
+                (None, None) => "-".to_string(),
+            };
+            let method = match a.id.method {
+                settle_identify::Method::SweepFit => "sweep fit",
+                settle_identify::Method::RingDownFit => "ring-down fit",
+            };
+            for (i, m) in a.id.modes.iter().enumerate() {
+                let weight = match (m.weight, m.weight_basis) {
+                    (Some(w), WeightBasis::Fitted) => pm(w.value, w.sigma, 3),
+                    (Some(w), _) => format!("{:.3} (assumed)", w.value),
+                    (None, _) => "not identified".to_string(),
+                };
+                let _ = writeln!(
+                    out,
+                    "{:<4} {:<16} {:>4} {:>18} {:>18} {:>16}  {method}",
+                    a.axis,
+                    sensor,
+                    i,
+                    pm(m.frequency_hz.value, m.frequency_hz.sigma, 2),
+                    pm(m.damping_ratio.value, m.damping_ratio.sigma, 4),
+                    weight,
+                );
+            }
+        }
+        if self
+            .axes
+            .iter()
+            .flat_map(|a| &a.id.modes)
+            .any(|m| m.weight.is_none())
+        {
+            let _ = writeln!(
+                out,
+                "A free decay does not show how strongly each mode takes part: the machine file shares the weight equally among such an axis's modes."
+            );
+        }
+        out
+    }
+
+    /// What the binary prints: the table on stdout, the files written on stderr.
+    pub fn report(&self) -> Report {
+        let mut r = Report::new(Exit::Ok);
+        r.stdout = self.table();
+        for f in &self.figures {
+            r.err(format!("wrote {} (and .png)", f.display()));
+        }
+        if let Some(m) = &self.machine_file {
+            r.err(format!(
+                "wrote {}: use it with `preset = \"{}\"` in a scenario's [machine], or `settle machine {}`",
+                m.display(),
+                m.display(),
+                m.display()
+            ));
+        }
+        r
+    }
+}

@@ -1,0 +1,113 @@
+//! `settle machine FILE`: a preset's linearised modes (against the undamped eigenvalues of
+//! its linearised axes, computed by settle-sim's `natural_frequencies_hz`), a machine file
+//! in the modes form printed as written, a scenario's machine, and bad input.
+
+use std::path::Path;
+
+use settle::workflows::machine::machine_modes;
+use settle_sim::DriverMode;
+
+use crate::support::{settle, write};
+
+#[test]
+fn a_presets_modes_are_its_linearised_axes_modes() {
+    let got = machine_modes("printer_xy").expect("preset");
+    assert!(got.linearised);
+    let (_, path, text) = settle::input::machine_file::PRESETS[0];
+    let (m, _) = settle::input::machine_file::parse(text, Path::new(path)).expect("preset");
+    let axes = m.compile(DriverMode::Linear).expect("compiles");
+    assert_eq!(got.axes.len(), axes.len());
+    for ((name, rows), axis) in got.axes.iter().zip(&axes) {
+        assert_eq!(name, &axis.name);
+        let q = axis.lumped.equilibrium(0.0, None).expect("equilibrium");
+        let f = axis.lumped.natural_frequencies_hz(&q);
+        // Every undamped natural frequency above 0.5 Hz appears, within the shift
+        // non-proportional damping gives |lambda| against the undamped eigenvalue (second
+        // order in the damping ratio).
+        let want: Vec<f64> = f.iter().copied().filter(|f| *f >= 0.5).collect();
+        assert_eq!(rows.len(), want.len(), "{name}: {rows:?} vs {want:?}");
+        for (r, w) in rows.iter().zip(&want) {
+            let tol = r.damping_ratio.powi(2) + 1e-3;
+            assert!(
+                (r.frequency_hz - w).abs() < tol * w,
+                "{name}: {rows:?} vs {want:?}"
+            );
+            assert!((0.0..0.5).contains(&r.damping_ratio), "{rows:?}");
+        }
+        // The toolhead sits behind springs: at high frequency it stands still, so its
+        // error follows -a_cmd / s^2 and the weights (the modes form's high-frequency
+        // limit is -sum w / s^2) sum to 1, up to the imaginary parts of the residues that
+        // non-proportional damping leaves out of the real weights.
+        let sum: f64 = rows.iter().map(|r| r.weight).sum();
+        assert!(
+            (sum - 1.0).abs() < 0.01,
+            "{name}: weights sum to {sum}: {rows:?}"
+        );
+        // The preset's comment: first modes about 48 Hz (X) and 39 Hz (Y).
+        let first = rows[0].frequency_hz;
+        let expect = if name == "x" { 48.0 } else { 39.0 };
+        assert!((first - expect).abs() < 2.0, "{name}: {first}");
+        // The belt mode carries most of the toolhead's motion.
+        let strongest = rows
+            .iter()
+            .max_by(|a, b| a.weight.abs().total_cmp(&b.weight.abs()))
+            .expect("modes");
+        assert_eq!(strongest.frequency_hz, first, "{rows:?}");
+    }
+}
+
+#[test]
+fn settle_machine_prints_a_modes_file_as_written_and_a_scenarios_machine() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let file = write(
+        dir.path(),
+        "machine.toml",
+        "name = \"mine\"\n[axis.x]\nmodes = [{ frequency_hz = 52.5, damping_ratio = 0.07, weight = 0.9 }, { frequency_hz = 110.0, damping_ratio = 0.1, weight = 0.1 }]\n[axis.y]\nmodes = [{ frequency_hz = 38.25, damping_ratio = 0.05 }]\n",
+    );
+    let out = settle()
+        .args(["machine", file.to_str().expect("utf-8")])
+        .output()
+        .expect("runs");
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8(out.stdout).expect("utf-8");
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(2)
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    assert_eq!(
+        rows,
+        [
+            ["x", "0", "52.500", "0.0700", "0.9000"],
+            ["x", "1", "110.000", "0.1000", "0.1000"],
+            ["y", "0", "38.250", "0.0500", "1.0000"],
+        ],
+        "{text}"
+    );
+    // A scenario naming that file gives the same machine.
+    let scenario = write(
+        dir.path(),
+        "s.toml",
+        "name = \"s\"\n[machine]\npreset = \"machine.toml\"\n[move]\ndistance_mm = 5.0\naxis = \"y\"\n[limits]\nvmax_mm_s = 100.0\namax_mm_s2 = 1000.0\njmax_mm_s3 = 1e5\n",
+    );
+    let from_scenario = machine_modes(scenario.to_str().expect("utf-8")).expect("scenario");
+    let from_file = machine_modes(file.to_str().expect("utf-8")).expect("file");
+    assert_eq!(from_scenario.axes, from_file.axes);
+    assert_eq!(from_scenario.name, "mine");
+    // Bad input: exit 2, the file, line and key.
+    let bad = write(
+        dir.path(),
+        "bad.toml",
+        "name = \"bad\"\n[axis.x]\nmodes = [{ frequency_hz = -5.0, damping_ratio = 0.05 }]\n",
+    );
+    let out = settle()
+        .args(["machine", bad.to_str().expect("utf-8")])
+        .output()
+        .expect("runs");
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).expect("utf-8");
+    assert!(
+        err.contains("bad.toml:3:1: key `axis.x.modes`") && err.contains("frequency_hz"),
+        "{err}"
+    );
+}
