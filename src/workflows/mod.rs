@@ -1,10 +1,12 @@
 //! The commands as library functions with typed results: [`sweep`] (with its [`journal`],
 //! `--resume` and [`shard`]s), [`run`] (one case in detail), [`check`] (the regression
 //! gate), [`merge`] (sharded sweeps), [`validate`] (backends against the closed form),
-//! [`tune`] (the profile search) and [`plan`] (JSON lines). Each returns an outcome whose
+//! [`tune`] (the profile search), [`import`] (firmware configurations in) and [`plan`]
+//! (JSON lines). Each returns an outcome whose
 //! [`Report`] is what the binary prints and the exit status it maps to a code.
 
 pub mod check;
+pub mod import;
 pub mod journal;
 pub mod merge;
 pub mod plan;
