@@ -238,6 +238,9 @@ fn around(x: f64, scales: &[f64], step: f64) -> Vec<f64> {
         .map(|k| {
             if *k == 1.0 {
                 x
+            } else if step < 1.0 {
+                // n / 10 rather than n * 0.1: the double nearest the decimal.
+                (x * k / step).round() / (1.0 / step).round()
             } else {
                 (x * k / step).round() * step
             }

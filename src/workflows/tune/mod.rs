@@ -223,10 +223,10 @@ pub fn check_text(o: &Outcome) -> String {
         "\n## Checked on a second backend: {b}\n\n| | candidate | {h_move} | {h_res} | {h_score} | into {band} um (ms) |\n|---|---|---:|---:|---:|---:|"
     );
     report::default_and_winner_rows(&mut out, d, w, "winner");
-    let verdict = if w.move_and_settle_s < d.move_and_settle_s {
+    let verdict = if w.move_and_settle_s < d.simulated_move_and_settle_s {
         format!(
             "the winner still beats the current settings on {b}: {:.1}% better",
-            100.0 * (1.0 - w.move_and_settle_s / d.move_and_settle_s)
+            100.0 * (1.0 - w.move_and_settle_s / d.simulated_move_and_settle_s)
         )
     } else {
         format!("the winner does NOT beat the current settings on {b}")

@@ -110,23 +110,32 @@ pub fn current_to_recommended(axes: &[(String, Outcome)]) -> String {
     );
     let _ = writeln!(
         out,
-        "| axis | | profile | shaper | accel (mm/s^2) | smoothing (mm) | max_accel (mm/s^2) | move+settle (ms) | gain |"
+        "| axis | | profile | shaper | accel (mm/s^2) | smoothing (mm) | max_accel (mm/s^2) | move+settle (ms) | gain over current |"
     );
     let _ = writeln!(out, "|---|---|---|---|---:|---:|---:|---:|---|");
     for (axis, o) in axes {
         let (c, w) = (&o.scores[0], &o.scores[o.winner]);
-        let gain = if c.move_and_settle_s.is_finite() {
+        let base = c.simulated_move_and_settle_s;
+        let gain = if base.is_finite() && w.move_and_settle_s.is_finite() {
             format!(
                 "{:.1}% faster ({:.1} ms saved)",
-                100.0 * (1.0 - w.move_and_settle_s / c.move_and_settle_s),
-                (c.move_and_settle_s - w.move_and_settle_s) * 1e3
+                100.0 * (1.0 - w.move_and_settle_s / base),
+                (base - w.move_and_settle_s) * 1e3
             )
-        } else if c.smoothing_mm > o.plan.max_smoothing_mm {
-            "current smooths more than the limit".into()
-        } else {
+        } else if w.move_and_settle_s.is_finite() {
             "current does not settle in the window".into()
+        } else {
+            "no candidate settles within the limits".into()
         };
-        for (tag, s, g) in [("current", c, String::new()), ("**recommended**", w, gain)] {
+        let over = if c.smoothing_mm > o.plan.max_smoothing_mm {
+            format!(
+                " (smooths {:.3} mm > {} mm)",
+                c.smoothing_mm, o.plan.max_smoothing_mm
+            )
+        } else {
+            String::new()
+        };
+        for (tag, s, g) in [("current", c, over), ("**recommended**", w, gain)] {
             let _ = writeln!(
                 out,
                 "| {axis} | {tag} | {} | {} | {} | {:.3} | {} | {} | {g} |",
@@ -139,7 +148,7 @@ pub fn current_to_recommended(axes: &[(String, Outcome)]) -> String {
                 } else {
                     "-".into()
                 },
-                ms(s.move_and_settle_s)
+                ms(s.simulated_move_and_settle_s)
             );
         }
     }
@@ -243,7 +252,7 @@ pub(crate) fn default_and_winner_rows(out: &mut String, d: &Score, w: &Score, wi
             s.candidate.label(),
             ms(s.move_time_s),
             s.residual_peak_um,
-            ms(s.move_and_settle_s),
+            ms(s.simulated_move_and_settle_s),
             ms(s.at_band_s)
         );
     }
@@ -282,16 +291,16 @@ pub fn markdown(
         score_text(plan),
         scores.len()
     );
-    let gain = if w.move_and_settle_s.is_finite() && d.move_and_settle_s.is_finite() {
+    let gain = if w.move_and_settle_s.is_finite() && d.simulated_move_and_settle_s.is_finite() {
         format!(
             "{:.1}% {} ({:.1} ms saved{})",
-            100.0 * (1.0 - w.move_and_settle_s / d.move_and_settle_s),
+            100.0 * (1.0 - w.move_and_settle_s / d.simulated_move_and_settle_s),
             if plan.base.state::<ScanSpec>().is_some() {
                 "less overhead per line"
             } else {
                 "faster"
             },
-            (d.move_and_settle_s - w.move_and_settle_s) * 1e3,
+            (d.simulated_move_and_settle_s - w.move_and_settle_s) * 1e3,
             if plan.base.state::<ScanSpec>().is_some() {
                 " per line"
             } else {
@@ -377,9 +386,15 @@ pub fn pareto_figure(
     let [h_move, h_res, _] = headings(plan);
     let pt = |s: &Score| (s.move_time_s * 1e3, s.residual_peak_um.max(1e-3));
     let mut lines = Vec::new();
-    let groups: Vec<(String, Option<ShaperKind>)> = std::iter::once(("unshaped".into(), None))
-        .chain(ShaperKind::ALL.map(|k| (k.name().to_string(), Some(k))))
-        .collect();
+    // One group per shaper the search holds (any firmware's), in order of appearance.
+    let mut groups: Vec<(String, Option<ShaperKind>)> = vec![("unshaped".into(), None)];
+    for s in scores {
+        if let Some(k) = s.candidate.shaper.and_then(|sh| sh.kind)
+            && !groups.iter().any(|(_, g)| *g == Some(k))
+        {
+            groups.push((k.name(), Some(k)));
+        }
+    }
     for (gi, (label, kind)) in groups.iter().enumerate() {
         let points: Vec<(f64, f64)> = scores
             .iter()

@@ -128,6 +128,9 @@ pub struct Score {
     /// Klipper's largest acceleration keeping the smoothing within the plan's
     /// `max_smoothing_mm` (mm/s^2); infinite unshaped.
     pub max_accel_mm_s2: f64,
+    /// `move_and_settle_s` as simulated, before the smoothing limit (which makes a
+    /// candidate smoothing more infeasible: `move_and_settle_s` infinite).
+    pub simulated_move_and_settle_s: f64,
     /// Mean commanded move time (s).
     pub move_time_s: f64,
     /// Mean residual peak (um).
@@ -270,6 +273,7 @@ impl Plan {
                 let (smoothing, max_accel) = self.smoothing(c, s.accel_mm_s2);
                 s.smoothing_mm = smoothing;
                 s.max_accel_mm_s2 = max_accel;
+                s.simulated_move_and_settle_s = s.move_and_settle_s;
                 if smoothing > self.max_smoothing_mm {
                     s.move_and_settle_s = f64::INFINITY;
                     s.at_band_s = f64::INFINITY;
@@ -335,6 +339,7 @@ impl Plan {
             accel_mm_s2: c.amax_mm_s2.unwrap_or(self.base.amax_mm_s2),
             smoothing_mm: 0.0,
             max_accel_mm_s2: f64::INFINITY,
+            simulated_move_and_settle_s: mas / k,
             move_time_s: t / k,
             residual_peak_um: r / k,
             move_and_settle_s: mas / k,
