@@ -51,7 +51,7 @@ pub struct ImportOptions {
     pub config: PathBuf,
     /// The machine file (`settle identify`'s, or written by hand).
     pub machine: Option<PathBuf>,
-    /// The scenario to write [default: `<config name>_import.toml` beside the config].
+    /// The scenario to write (default: `<config name>_import.toml` beside the config).
     pub out: Option<PathBuf>,
 }
 
