@@ -120,11 +120,24 @@ enum Command {
     /// Search the profile parameters (kind, jerk, PVT asymmetry, BOW1..4, input shaper)
     /// that minimise move-and-settle on the scenario's machine; export the winner.
     #[command(
-        after_help = "Example:\n  settle tune scenarios/tune_printer.toml --check-on rapier\n  (writes results/tune_printer-tune/tune.md, candidates.csv, pareto.svg/png,\n  klipper.cfg and tmc5160.txt)"
+        after_help = "Example:\n  settle tune scenarios/tune_printer.toml --check-on rapier\n  (writes results/tune_printer-tune/tune.md, candidates.csv, pareto.svg/png,\n  klipper.cfg, rrf.g and tmc4361a.txt)\n  settle tune printer_import.toml --firmware klipper --frequency-tolerance 5\n  settle tune --criterion klipper calibration_data_x.csv\n  (Klipper's own choice, as scripts/calibrate_shaper.py prints it)"
     )]
     Tune {
-        /// The scenario file (TOML) with [move], [limits] and an optional [tune] table.
+        /// The scenario file (TOML) with [move], [limits] and an optional [tune] table; with
+        /// `--criterion klipper`, a Klipper resonance CSV.
         scenario: PathBuf,
+        /// Only candidates this firmware runs: klipper, marlin, rrf, tmc4361a, any
+        /// [default: the scenario's `[tune] firmware`, else any].
+        #[arg(long)]
+        firmware: Option<String>,
+        /// Score shaped candidates on their worst case with the shaper this many percent
+        /// off its frequency either way [default: `[tune] frequency_tolerance_pct`, else 0].
+        #[arg(long, value_name = "PCT")]
+        frequency_tolerance: Option<f64>,
+        /// `settle` (simulate move-and-settle on the machine) or `klipper` (Klipper's
+        /// calibrate_shaper.py choice on a processed resonance CSV).
+        #[arg(long, default_value = "settle", value_parser = ["settle", "klipper"])]
+        criterion: String,
         /// Output folder [default: results/<scenario name>-tune/].
         #[arg(long)]
         out: Option<PathBuf>,
@@ -137,6 +150,25 @@ enum Command {
         /// Worker threads [default: all cores].
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
         jobs: Option<u16>,
+    },
+    /// Read a firmware configuration (Klipper printer.cfg, RepRapFirmware config.g) into a
+    /// scenario with your current settings as its baseline and a search around them.
+    #[command(
+        after_help = "Example:\n  settle import klipper printer.cfg --machine machine.toml --out printer.toml\n  settle tune printer.toml\n  (klipper.cfg in results/printer_import-tune/ holds the recommendation)"
+    )]
+    Import {
+        /// The firmware: klipper or rrf.
+        #[arg(value_parser = ["klipper", "rrf"])]
+        firmware: String,
+        /// printer.cfg (with its includes) or config.g.
+        config: PathBuf,
+        /// The machine file (from `settle identify`, or written by hand) [default: the
+        /// preset printer_xy stands in, with a note].
+        #[arg(long)]
+        machine: Option<PathBuf>,
+        /// The scenario to write [default: <config name>_import.toml beside the config].
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Run one point of a sweep in detail: print its metrics, write its full trace as CSV.
     #[command(
@@ -349,8 +381,38 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             backend,
             check_on,
             jobs: j,
-        } => workflows::tune::tune_to(&scenario, out, backend, check_on, jobs(j), &progress)?
-            .report(),
+            firmware,
+            frequency_tolerance,
+            criterion,
+        } => {
+            if criterion == "klipper" {
+                workflows::tune::klipper_criterion::report(&scenario)?
+            } else {
+                let opts = workflows::tune::Options {
+                    check_on,
+                    jobs: jobs(j),
+                    firmware,
+                    frequency_tolerance_pct: frequency_tolerance,
+                    ..workflows::tune::Options::new(backend)
+                };
+                workflows::tune::tune_with(&scenario, out, &opts, &progress)?.report()
+            }
+        }
+        Command::Import {
+            firmware,
+            config,
+            machine,
+            out,
+        } => {
+            let opts = workflows::import::ImportOptions {
+                firmware: workflows::tune::firmware::Firmware::parse(&firmware)
+                    .map_err(|m| Error::input_key(&config, "firmware", m))?,
+                config,
+                machine,
+                out,
+            };
+            workflows::import::import(&opts)?.report()
+        }
         Command::Plan { jobs: j } => {
             let stdin = std::io::stdin().lock();
             let stdout = std::io::BufWriter::new(std::io::stdout().lock());

@@ -41,6 +41,10 @@ pub struct Scenario {
     /// The cartesian product of all axes, in the order written, gives the runs.
     #[serde(default)]
     pub sweep: toml::Table,
+    /// The user's current settings among the sweep's points: one value per swept key,
+    /// the same key names as in `[sweep]` (written by `settle import`).
+    #[serde(default)]
+    pub current: Option<toml::Table>,
     /// Numerical settings of the simulation (expert; the defaults are the validated ones).
     #[serde(default)]
     pub sim: SimSpec,

@@ -1,6 +1,8 @@
 //! The `[tune]` table of a scenario: the search of `settle tune` (see
 //! `crate::workflows::tune`), as written.
 
+use std::collections::BTreeMap;
+
 use serde::Deserialize;
 
 /// The `[tune]` table of a scenario (every key optional).
@@ -36,8 +38,46 @@ pub struct TuneSpec {
     /// frequency and the jerk with halving steps; 0 = grid only) [default
     /// `crate::workflows::tune::rank::DEFAULT_REFINE_ROUNDS`].
     pub refine_rounds: Option<usize>,
-    /// Microsteps per mm for the Trinamic export [default 1280 = 80 full steps/mm x 16].
+    /// Microsteps per mm of every axis for the TMC4361A export, where `[tune.axis.<name>]`
+    /// does not give the axis's own [default: none; the register file needs the machine's
+    /// own resolution and is not written without it].
     pub usteps_per_mm: Option<f64>,
-    /// TMC5160 clock (Hz) for the Trinamic export [default 12 MHz, the internal clock].
+    /// TMC4361A clock (Hz) for the register export [default 16 MHz, the evaluation
+    /// board's crystal; the chip takes 4 to 32 MHz].
     pub tmc_clock_hz: Option<u32>,
+    /// Axes to tune, each on its own with its own shaper and frequency [default: the
+    /// move's axis].
+    pub axes: Option<Vec<String>>,
+    /// Restrict candidates to what one firmware runs: `klipper`, `marlin`, `rrf` (planned
+    /// trapezoids with that firmware's shapers), `tmc4361a` (the chip's S-ramps, no
+    /// shaper) or `any` [default `any`].
+    pub firmware: Option<String>,
+    /// Accelerations searched (mm/s^2) [default: `limits.amax_mm_s2` alone].
+    pub accelerations_mm_s2: Option<Vec<f64>>,
+    /// Largest shaper smoothing a candidate may have at its acceleration (mm, Klipper's
+    /// figure at the square-corner velocity of 5 mm/s); shaped candidates above it are
+    /// infeasible [default 0.12 mm, the target of Klipper's suggested max_accel].
+    pub max_smoothing_mm: Option<f64>,
+    /// Robustness: shaped candidates are scored on the worst of their shaper at its
+    /// frequency and detuned by this many percent either way (the real mode a few percent
+    /// off the identified one) [default 0: the nominal frequency alone].
+    pub frequency_tolerance_pct: Option<f64>,
+    /// The user's current settings per axis (`[tune.axis.x]`): the baseline candidate of
+    /// that axis and the machine's resolution for the register export.
+    pub axis: Option<BTreeMap<String, AxisCurrent>>,
+}
+
+/// `[tune.axis.<name>]`: one axis's current firmware settings.
+#[derive(Debug, Clone, Deserialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct AxisCurrent {
+    /// The current shaper (`shaper.type` names; `none` for no shaping) [default: the
+    /// scenario's `[shaper]`].
+    pub shaper: Option<String>,
+    /// Its frequency (Hz).
+    pub frequency_hz: Option<f64>,
+    /// Its damping ratio [default 0.1].
+    pub damping_ratio: Option<f64>,
+    /// The axis's microsteps per mm (firmware steps per mm x microstepping).
+    pub usteps_per_mm: Option<f64>,
 }

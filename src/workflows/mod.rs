@@ -1,12 +1,14 @@
 //! The commands as library functions with typed results: [`sweep`] (with its [`journal`],
 //! `--resume` and [`shard`]s), [`run`] (one case in detail), [`check`] (the regression
 //! gate), [`merge`] (sharded sweeps), [`validate`] (backends against the closed form),
-//! [`tune`] (the profile search), [`plan`] (JSON lines), [`machine`] (a machine's modes per
-//! axis) and [`identify`] (modes from accelerometer data). Each returns an outcome whose
-//! [`Report`] is what the binary prints and the exit status it maps to a code.
+//! [`tune`] (the profile search), [`import`] (firmware configurations in), [`plan`] (JSON
+//! lines), [`machine`] (a machine's modes per axis) and [`identify`] (modes from
+//! accelerometer data). Each returns an outcome whose [`Report`] is what the binary prints
+//! and the exit status it maps to a code.
 
 pub mod check;
 pub mod identify;
+pub mod import;
 pub mod journal;
 pub mod machine;
 pub mod merge;

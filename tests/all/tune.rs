@@ -108,9 +108,30 @@ fn tuned_on_modal_still_beats_the_default_on_rapier() {
     }
     assert_eq!(pareto(&o.scores), *front);
 
-    // Klipper export names the winner's shaper on the moving axis.
-    let k = settle::workflows::tune::report::klipper(&o.plan, w);
-    assert!(k.contains("max_accel: 3000"), "{k}");
+    // Klipper's export needs both X and Y: only Y was tuned and X's current shaper is not
+    // known, so it says what is missing rather than switching X's shaper off.
+    let axes = vec![("y".to_string(), o.clone())];
+    let k = settle::workflows::tune::export::klipper(&axes, "a test");
+    assert!(
+        k.contains("# no Klipper configuration: axis x was not tuned"),
+        "{k}"
+    );
+    // With X's current settings known, Y's recommendation is written next to them.
+    let mut with_x = o.clone();
+    with_x.plan.spec.axis = Some(
+        [(
+            "x".to_string(),
+            settle::input::tune_spec::AxisCurrent {
+                shaper: Some("mzv".into()),
+                frequency_hz: Some(52.0),
+                ..Default::default()
+            },
+        )]
+        .into(),
+    );
+    let k = settle::workflows::tune::export::klipper(&[("y".to_string(), with_x)], "a test");
+    assert!(k.contains("shaper_type_x: mzv\nshaper_freq_x: 52\n"), "{k}");
+    assert!(!k.contains("max_accel"), "acceleration unchanged: {k}");
     match w.candidate.shaper.and_then(|s| s.kind) {
         Some(kind) => {
             assert!(
@@ -138,12 +159,15 @@ fn tmc_export_of_an_scurve_reads_back_to_its_jerk() {
     )
     .expect("tunes");
     let w = &o.scores[o.winner];
-    let text = settle::workflows::tune::report::tmc(&o.plan, w);
+    assert!(w.candidate.shaper.is_none_or(|s| s.kind.is_none()));
+    let text = settle::workflows::tune::export::tmc4361a(&[("y".to_string(), o.clone())]);
+    // `NAME 0xAA = value ; note`
     let reg = |name: &str| -> u32 {
         text.lines()
-            .find(|l| l.starts_with(name))
-            .and_then(|l| l.rsplit(' ').next())
-            .and_then(|v| v.parse().ok())
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .and_then(|l| l.split('=').nth(1))
+            .and_then(|v| v.split(';').next())
+            .and_then(|v| v.trim().parse().ok())
             .unwrap_or_else(|| panic!("{name} in {text}"))
     };
     let r = RegisterSet {
@@ -157,7 +181,7 @@ fn tmc_export_of_an_scurve_reads_back_to_its_jerk() {
         clk_freq: reg("CLK_FREQ"),
     };
     let u = TmcUnits {
-        f_clk_hz: 12_000_000,
+        f_clk_hz: settle::workflows::tune::export::DEFAULT_TMC_CLOCK_HZ,
         usteps_per_unit: 80.0,
         direct_acc: false,
         direct_bow: false,
@@ -295,7 +319,10 @@ max_contour_error_um = 25.0
         rw.move_and_settle_s < rd.move_and_settle_s || rd.move_and_settle_s.is_infinite(),
         "rapier: winner {rw:?} default {rd:?}"
     );
-    let k = settle::workflows::tune::report::klipper(&o.plan, w);
+    let k = settle::workflows::tune::export::klipper(
+        &[(o.plan.base.axis.clone(), o.clone())],
+        "a test",
+    );
     assert!(
         k.contains("shaper_freq_x:") && k.contains("shaper_freq_y:"),
         "{k}"
@@ -324,7 +351,13 @@ fn tune_command_writes_report_table_plot_and_exports() {
     );
     let csv = std::fs::read_to_string(out.join("candidates.csv")).expect("csv");
     assert_eq!(csv.lines().count(), 1 + 40); // header + the 40 candidates of SMALL
-    for f in ["tune.md", "klipper.cfg", "tmc5160.txt", "pareto.svg"] {
+    for f in [
+        "tune.md",
+        "klipper.cfg",
+        "rrf.g",
+        "tmc4361a.txt",
+        "pareto.svg",
+    ] {
         assert!(out.join(f).is_file(), "{f}");
     }
     let png = image::open(out.join("pareto.png")).expect("decodes");
@@ -403,6 +436,7 @@ fn neighbours_step_the_frequency_and_cap_the_jerk() {
             frequency_hz: 40.0,
             damping_ratio: 0.1,
         }),
+        amax_mm_s2: None,
     };
     let n = neighbours(&c, 0.025, 2.0, 1e5);
     let f: Vec<f64> = n

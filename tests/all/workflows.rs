@@ -232,7 +232,7 @@ frequency_scales = [1.0]\njerk_steps = 2\n",
         "tune.md",
         "candidates.csv",
         "klipper.cfg",
-        "tmc5160.txt",
+        "tmc4361a.txt",
         "pareto.svg",
     ] {
         assert!(out.join(f).is_file(), "{f}");

@@ -4,7 +4,8 @@ use super::accel::max_accel_mm_s2;
 use super::data::CalibrationData;
 use super::grid::arange;
 use super::options::{
-    Fit, MAX_FREQ_HZ, MAX_SHAPER_FREQ_HZ, SelectOptions, ShaperFreqs, TEST_DAMPING_RATIOS,
+    Fit, MAX_FREQ_HZ, MAX_SHAPER_FREQ_HZ, SelectOptions, ShaperFreqs, TARGET_SMOOTHING_MM,
+    TEST_DAMPING_RATIOS,
 };
 use crate::PlanError;
 use crate::shaper::{
@@ -144,7 +145,7 @@ pub fn fit_shaper(
         {
             return Ok((b, results));
         }
-        let max_accel = max_accel_mm_s2(a, t, opts.scv_mm_s);
+        let max_accel = max_accel_mm_s2(a, t, opts.scv_mm_s, TARGET_SMOOTHING_MM);
         let mut vibrations = 0.0;
         for (bins, psd) in &sets {
             for &dr in test_dr {

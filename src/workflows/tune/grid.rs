@@ -10,6 +10,7 @@ use crate::input::source::Source;
 use crate::kinds::corner::Corner;
 use crate::kinds::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
 use crate::spec::run_spec::RunSpec;
+use crate::workflows::tune::firmware::Firmware;
 use crate::workflows::tune::search::{Candidate, Plan};
 
 /// Four-jerk BOW1..4 patterns searched (multiples of jmax; each <= 1).
@@ -35,25 +36,47 @@ pub const FREQUENCY_SCALES: [f64; 7] = [0.8, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2];
 /// another engine; 0.8 keeps that 20% inside it.
 pub const DEFAULT_MARGIN: f64 = 0.8;
 
-/// Resolve the scenario's search. Errors name the `[tune]` key.
-pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error> {
+/// Klipper's smoothing target (mm): its suggested max_accel keeps the smoothing within it
+/// (`TARGET_SMOOTHING` of shaper_calibrate.py); the default `max_smoothing_mm`.
+pub const DEFAULT_MAX_SMOOTHING_MM: f64 = settle_planner::shaper_select::TARGET_SMOOTHING_MM;
+
+/// Resolve the scenario's search on `axis` (default: the move's axis), with `axis`'s
+/// current settings (`[tune.axis.<name>]`) as the baseline candidate. Errors name the
+/// `[tune]` key. A `[sweep]` is refused unless the scenario marks a `[current]` point (an
+/// imported scenario: its sweep is for `settle sweep`; tune searches from `[tune]`).
+pub fn plan(
+    sc: &Scenario,
+    src: &Source,
+    runs: &[RunSpec],
+    axis: Option<&str>,
+) -> Result<Plan, Error> {
     let spec = sc.tune.clone().unwrap_or_default();
-    if !sc.sweep.is_empty() {
+    if !sc.sweep.is_empty() && sc.current.is_none() {
         return Err(src.error_at(
             "sweep",
             "settle tune does its own search: remove [sweep] (give the move family in [tune] distances_mm)",
         ));
     }
-    let base = runs
+    let mut base = runs
         .first()
         .cloned()
         .ok_or_else(|| src.error_at("name", "the scenario has no run"))?;
-    let jmax = base.jmax_mm_s3.ok_or_else(|| {
-        src.error_at(
-            "limits",
-            "settle tune needs `jmax_mm_s3` in [limits]: the machine's jerk limit bounds the jerk search",
-        )
-    })?;
+    if let Some(a) = axis {
+        base.axis = a.to_string();
+    }
+    let firmware = match &spec.firmware {
+        None => Firmware::Any,
+        Some(f) => Firmware::parse(f).map_err(|m| src.error_at("tune.firmware", m))?,
+    };
+    if let Some(cur) = spec.axis.as_ref().and_then(|m| m.get(&base.axis)) {
+        let current = current_shaper(cur, base.state::<ShaperSetting>())
+            .map_err(|m| src.error_at(&format!("tune.axis.{}.shaper", base.axis), m))?;
+        match current {
+            Some(sh) => base.put_state(Box::new(sh)),
+            None => base.remove_state("shaper"),
+        }
+    }
+
     let distances_mm = spec
         .distances_mm
         .clone()
@@ -129,18 +152,25 @@ pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error
         }
     };
     let kinds = match &spec.kinds {
-        None => ProfileKind::ALL.to_vec(),
+        None => firmware.kinds(),
         Some(list) if list.is_empty() => {
             return Err(src.error_at("tune.kinds", "give at least one profile kind"));
         }
         Some(list) => list
             .iter()
-            .map(|k| ProfileKind::parse(k).map_err(|e| src.error_at("tune.kinds", e.to_string())))
+            .map(|k| {
+                let kind =
+                    ProfileKind::parse(k).map_err(|e| src.error_at("tune.kinds", e.to_string()))?;
+                firmware
+                    .check_kind(kind)
+                    .map(|()| kind)
+                    .map_err(|m| src.error_at("tune.kinds", m))
+            })
             .collect::<Result<_, _>>()?,
     };
     let shapers: Vec<Option<ShaperKind>> = match &spec.shapers {
         None => std::iter::once(None)
-            .chain(ShaperKind::ALL.map(Some))
+            .chain(firmware.shapers().into_iter().map(Some))
             .collect(),
         Some(list) if list.is_empty() => {
             return Err(src.error_at(
@@ -151,10 +181,38 @@ pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error
         Some(list) => list
             .iter()
             .map(|s| {
-                crate::kinds::shaping::parse_type(s).map_err(|m| src.error_at("tune.shapers", m))
+                let k = crate::kinds::shaping::parse_type(s)
+                    .map_err(|m| src.error_at("tune.shapers", m))?;
+                firmware
+                    .check_shaper(k)
+                    .map(|()| k)
+                    .map_err(|m| src.error_at("tune.shapers", m))
             })
             .collect::<Result<_, _>>()?,
     };
+    let accels: Vec<Option<f64>> = match &spec.accelerations_mm_s2 {
+        None => vec![None],
+        Some(list) => {
+            if list.is_empty() || list.iter().any(|a| !(a.is_finite() && *a > 0.0)) {
+                return Err(src.error_at(
+                    "tune.accelerations_mm_s2",
+                    "give one or more finite accelerations > 0 (mm/s^2)",
+                ));
+            }
+            list.iter().copied().map(Some).collect()
+        }
+    };
+    let max_smoothing_mm = spec.max_smoothing_mm.unwrap_or(DEFAULT_MAX_SMOOTHING_MM);
+    if !(max_smoothing_mm.is_finite() && max_smoothing_mm > 0.0) {
+        return Err(src.error_at("tune.max_smoothing_mm", "must be a finite number > 0 (mm)"));
+    }
+    let tolerance_pct = spec.frequency_tolerance_pct.unwrap_or(0.0);
+    if !(tolerance_pct.is_finite() && (0.0..50.0).contains(&tolerance_pct)) {
+        return Err(src.error_at(
+            "tune.frequency_tolerance_pct",
+            "must be 0 to under 50 (percent)",
+        ));
+    }
     let scales = spec
         .frequency_scales
         .clone()
@@ -168,6 +226,17 @@ pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error
     if spec.refine_rounds.is_some_and(|r| r > 20) {
         return Err(src.error_at("tune.refine_rounds", "must be 0 to 20"));
     }
+    let jmax = match base.jmax_mm_s3 {
+        Some(j) => j,
+        // Only trapezoids: no jerk to search.
+        None if kinds.iter().all(|k| *k == ProfileKind::Trapezoid) => 0.0,
+        None => {
+            return Err(src.error_at(
+                "limits",
+                "settle tune needs `jmax_mm_s3` in [limits]: the machine's jerk limit bounds the jerk search",
+            ));
+        }
+    };
     let steps = spec.jerk_steps.unwrap_or(6);
     if !(1..=100).contains(&steps) {
         return Err(src.error_at("tune.jerk_steps", "must be 1 to 100"));
@@ -186,7 +255,10 @@ pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error
             }
         })
         .collect();
-    let modes = tuning_modes(&base);
+    let mut modes = tuning_modes(&base);
+    if matches!(firmware, Firmware::Tmc4361a) {
+        modes.clear();
+    }
     if modes.is_empty() && shapers.iter().any(Option::is_some) {
         return Err(src.error_at(
             "machine",
@@ -200,11 +272,17 @@ pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error
             Some(k) => {
                 for (f, _) in &modes {
                     for x in &scales {
-                        shaper_settings.push(Some(ShaperSetting {
+                        // To 0.1 Hz, as firmware configurations write it (Klipper's
+                        // calibrate_shaper.py prints `%.1f`): the exported value is the
+                        // simulated one.
+                        let s = ShaperSetting {
                             kind: Some(*k),
-                            frequency_hz: f * x,
+                            frequency_hz: (f * x * 10.0).round() / 10.0,
                             damping_ratio: DEFAULT_DAMPING_RATIO,
-                        }));
+                        };
+                        if !shaper_settings.contains(&Some(s)) {
+                            shaper_settings.push(Some(s));
+                        }
                     }
                 }
             }
@@ -240,12 +318,15 @@ pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error
         for j in &jerk_list {
             for p in &params {
                 for sh in &shaper_settings {
-                    candidates.push(Candidate {
-                        kind,
-                        jmax_mm_s3: *j,
-                        params: *p,
-                        shaper: *sh,
-                    });
+                    for a in &accels {
+                        candidates.push(Candidate {
+                            kind,
+                            jmax_mm_s3: *j,
+                            params: *p,
+                            shaper: *sh,
+                            amax_mm_s2: *a,
+                        });
+                    }
                 }
             }
         }
@@ -261,7 +342,37 @@ pub fn plan(sc: &Scenario, src: &Source, runs: &[RunSpec]) -> Result<Plan, Error
         candidates,
         modes,
         spec,
+        frequency_tolerance: tolerance_pct / 100.0,
+        max_smoothing_mm,
     })
+}
+
+/// An axis's current shaper from `[tune.axis.<name>]`, the scenario's `[shaper]` filling
+/// what it leaves out; `None` for no shaping.
+fn current_shaper(
+    cur: &crate::input::tune_spec::AxisCurrent,
+    scenario: Option<&ShaperSetting>,
+) -> Result<Option<ShaperSetting>, String> {
+    let kind = match &cur.shaper {
+        Some(name) => crate::kinds::shaping::parse_type(name)?,
+        None => scenario.and_then(|s| s.kind),
+    };
+    let Some(kind) = kind else {
+        return Ok(None);
+    };
+    let s = ShaperSetting {
+        kind: Some(kind),
+        frequency_hz: cur
+            .frequency_hz
+            .or(scenario.map(|s| s.frequency_hz))
+            .ok_or("a current shaper needs `frequency_hz`")?,
+        damping_ratio: cur
+            .damping_ratio
+            .or(scenario.map(|s| s.damping_ratio))
+            .unwrap_or(DEFAULT_DAMPING_RATIO),
+    };
+    s.validate().map_err(|(_, m)| m)?;
+    Ok(Some(s))
 }
 
 /// The modes shapers are tuned to: the moving axis's modes (by weight, at most two; a

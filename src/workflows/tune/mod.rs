@@ -1,8 +1,13 @@
 //! `settle tune SCENARIO.toml`: the search grid ([`grid`], candidates and scores in
-//! [`search`]), evaluated and refined ([`rank`]), optionally re-checked on a second backend,
-//! and the outputs ([`report`]).
+//! [`search`], restricted to a [`firmware`]), evaluated and refined ([`rank`]), optionally
+//! re-checked on a second backend, per axis; the outputs ([`report`], the firmware
+//! configurations in [`export`]); and Klipper's own choice on a resonance CSV
+//! ([`klipper_criterion`]).
 
+pub mod export;
+pub mod firmware;
 pub mod grid;
+pub mod klipper_criterion;
 pub mod rank;
 pub mod report;
 pub mod scan_figures;
@@ -13,6 +18,8 @@ use std::path::{Path, PathBuf};
 
 use crate::error::Error;
 use crate::execute::pool::{Progress, quiet};
+use crate::input::scenario::Scenario;
+use crate::input::source::Source;
 use crate::output::atomic::{create_dir, write_atomic};
 use crate::spec::backend::Backend;
 use crate::workflows::{Exit, Report};
@@ -23,7 +30,7 @@ use search::{Plan, Score};
 pub struct Outcome {
     /// The resolved search.
     pub plan: Plan,
-    /// Every candidate's score; index 0 is the untuned default.
+    /// Every candidate's score; index 0 is the scenario's own point (the user's current settings).
     pub scores: Vec<Score>,
     /// Index of the winner in `scores` (after refinement).
     pub winner: usize,
@@ -31,11 +38,41 @@ pub struct Outcome {
     pub grid_winner: usize,
     /// Indices of the Pareto front.
     pub front: Vec<usize>,
-    /// `(backend, default, winner)` re-run on a second backend, if asked.
+    /// `(backend, current, winner)` re-run on a second backend, if asked.
     pub check: Option<(Backend, Score, Score)>,
 }
 
-/// Load `path`, search on `backend`, and re-check on `check_on` if given.
+/// How `settle tune` runs: the backends, the workers, and what the command line sets over
+/// the scenario's `[tune]` table.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Backend of the search.
+    pub backend: Backend,
+    /// Re-run the current and the winner on this backend.
+    pub check_on: Option<Backend>,
+    /// Worker threads (`None`: all cores).
+    pub jobs: Option<usize>,
+    /// `--firmware`: over `[tune] firmware`.
+    pub firmware: Option<String>,
+    /// `--frequency-tolerance PCT`: over `[tune] frequency_tolerance_pct`.
+    pub frequency_tolerance_pct: Option<f64>,
+}
+
+impl Options {
+    /// Search on `backend`, nothing else set.
+    pub fn new(backend: Backend) -> Self {
+        Self {
+            backend,
+            check_on: None,
+            jobs: None,
+            firmware: None,
+            frequency_tolerance_pct: None,
+        }
+    }
+}
+
+/// Load `path`, search on `backend`, and re-check on `check_on` if given (the move's axis,
+/// or the first of `[tune] axes`).
 pub fn tune(
     path: &Path,
     backend: Backend,
@@ -43,10 +80,60 @@ pub fn tune(
     jobs: Option<usize>,
     progress: Progress,
 ) -> Result<Outcome, Error> {
-    let (sc, src) = crate::expand::load(path)?;
-    let mut runs = crate::expand::expand(&sc, &src)?;
+    let opts = Options {
+        check_on,
+        jobs,
+        ..Options::new(backend)
+    };
+    tune_axis(path, None, &opts, progress)
+}
+
+/// The scenario with the command line's settings over its `[tune]` table.
+fn load(path: &Path, opts: &Options) -> Result<(Scenario, Source), Error> {
+    let (mut sc, src) = crate::expand::load(path)?;
+    let mut t = sc.tune.take().unwrap_or_default();
+    if let Some(f) = &opts.firmware {
+        firmware::Firmware::parse(f).map_err(|m| Error::input_key(path, "--firmware", m))?;
+        t.firmware = Some(f.clone());
+    }
+    if let Some(p) = opts.frequency_tolerance_pct {
+        if !(p.is_finite() && (0.0..50.0).contains(&p)) {
+            return Err(Error::input_key(
+                path,
+                "--frequency-tolerance",
+                format!("must be 0 to under 50 (percent), got {p}"),
+            ));
+        }
+        t.frequency_tolerance_pct = Some(p);
+    }
+    sc.tune = Some(t);
+    Ok((sc, src))
+}
+
+/// The axes `[tune] axes` names (`[None]`: the move's axis).
+fn axes(sc: &Scenario) -> Vec<Option<String>> {
+    match sc.tune.as_ref().and_then(|t| t.axes.clone()) {
+        Some(list) if !list.is_empty() => list.into_iter().map(Some).collect(),
+        _ => vec![None],
+    }
+}
+
+/// Tune one axis of `path` (`None`: the move's axis).
+pub fn tune_axis(
+    path: &Path,
+    axis: Option<&str>,
+    opts: &Options,
+    progress: Progress,
+) -> Result<Outcome, Error> {
+    let (sc, src) = load(path, opts)?;
+    let (backend, check_on, jobs) = (opts.backend, opts.check_on, opts.jobs);
+    // An imported scenario's [sweep] is for `settle sweep`; the search starts from the
+    // scenario's own point, the user's current settings.
+    let mut point = sc.clone();
+    point.sweep.clear();
+    let mut runs = crate::expand::expand(&point, &src)?;
     crate::execute::set_backend(path, &mut runs, backend)?;
-    let plan = grid::plan(&sc, &src, &runs)?;
+    let plan = grid::plan(&sc, &src, &runs, axis)?;
     let mut scores = rank::evaluate(&plan, &plan.candidates, jobs, progress)?;
     let grid_winner = rank::best(&scores).ok_or_else(|| {
         Error::input_key(
@@ -136,13 +223,13 @@ pub fn check_text(o: &Outcome) -> String {
         "\n## Checked on a second backend: {b}\n\n| | candidate | {h_move} | {h_res} | {h_score} | into {band} um (ms) |\n|---|---|---:|---:|---:|---:|"
     );
     report::default_and_winner_rows(&mut out, d, w, "winner");
-    let verdict = if w.move_and_settle_s < d.move_and_settle_s {
+    let verdict = if w.move_and_settle_s < d.simulated_move_and_settle_s {
         format!(
-            "the winner still beats the default on {b}: {:.1}% better",
-            100.0 * (1.0 - w.move_and_settle_s / d.move_and_settle_s)
+            "the winner still beats the current settings on {b}: {:.1}% better",
+            100.0 * (1.0 - w.move_and_settle_s / d.simulated_move_and_settle_s)
         )
     } else {
-        format!("the winner does NOT beat the default on {b}")
+        format!("the winner does NOT beat the current settings on {b}")
     };
     let _ = writeln!(out, "\nVerdict: {verdict}.");
     let searched = &o.scores[o.winner];
@@ -164,8 +251,11 @@ pub fn check_text(o: &Outcome) -> String {
 /// What `settle tune` found and wrote.
 #[derive(Debug, Clone)]
 pub struct Tuned {
-    /// The search and its result.
+    /// The search and its result, per axis (the first: the move's axis or the first of
+    /// `[tune] axes`).
     pub outcome: Outcome,
+    /// Every tuned axis's outcome, with the axis name, in order.
+    pub axes: Vec<(String, Outcome)>,
     /// The report (`tune.md`).
     pub markdown: String,
     /// The output folder.
@@ -183,9 +273,8 @@ impl Tuned {
     }
 }
 
-/// Tune `path` on `backend` (re-checked on `check_on`), and write `OUT/tune.md`,
-/// `candidates.csv`, `pareto.svg/png`, `klipper.cfg` and `tmc5160.txt` into `out`
-/// (default: `results/<name>-tune/`).
+/// Tune `path` on `backend` (re-checked on `check_on`), and write its outputs into `out`
+/// (default: `results/<name>-tune/`); see [`tune_with`].
 pub fn tune_to(
     path: &Path,
     out: Option<PathBuf>,
@@ -194,29 +283,71 @@ pub fn tune_to(
     jobs: Option<usize>,
     progress: Progress,
 ) -> Result<Tuned, Error> {
-    let (sc, _) = crate::expand::load(path)?;
-    let o = tune(path, backend, check_on, jobs, progress)?;
+    let opts = Options {
+        check_on,
+        jobs,
+        ..Options::new(backend)
+    };
+    tune_with(path, out, &opts, progress)
+}
+
+/// Tune every axis of `[tune] axes` (default: the move's axis) of `path`, and write into
+/// `out` (default: `results/<name>-tune/`): `tune.md` (your current settings ->
+/// recommended per axis, then each axis's search), `candidates.csv` (every candidate of
+/// every axis with its smoothing and max_accel), `pareto.svg/png` (the first axis),
+/// `klipper.cfg`, `rrf.g` and `tmc4361a.txt` (see [`export`]).
+pub fn tune_with(
+    path: &Path,
+    out: Option<PathBuf>,
+    opts: &Options,
+    progress: Progress,
+) -> Result<Tuned, Error> {
+    let (sc, _) = load(path, opts)?;
+    let mut done: Vec<(String, Outcome)> = Vec::new();
+    for axis in axes(&sc) {
+        let o = tune_axis(path, axis.as_deref(), opts, progress)?;
+        done.push((o.plan.base.axis.clone(), o));
+    }
     let out = out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-tune", sc.name)));
     create_dir(&out)?;
-    let mut md = report::markdown(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
-    md.push_str(&refine_text(&o));
-    md.push_str(&check_text(&o));
-    let w = &o.scores[o.winner];
-    let klipper = report::klipper(&o.plan, w);
-    let tmc = report::tmc(&o.plan, w);
+    let mut md = format!("# settle tune: {}\n\n", sc.name);
+    md.push_str(&report::current_to_recommended(&done));
+    let several = done.len() > 1;
+    for (axis, o) in &done {
+        let mut body = report::markdown(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
+        body.push_str(&refine_text(o));
+        body.push_str(&check_text(o));
+        let body = body
+            .split_once('\n')
+            .map_or(body.as_str(), |(_, rest)| rest)
+            .to_string();
+        if several {
+            let _ = write!(md, "\n## Axis {axis}\n{}", report::demote(&body));
+        } else {
+            md.push_str(&body);
+        }
+    }
+    let produced_by = format!("settle tune {}", path.display());
+    let klipper = export::klipper(&done, &produced_by);
+    let rrf = export::rrf(&done, &produced_by);
+    let tmc = export::tmc4361a(&done);
     let _ = write!(
         md,
-        "\n## Export\n\nKlipper (`klipper.cfg`):\n\n```ini\n{klipper}```\n\nTrinamic TMC5160 (`tmc5160.txt`):\n\n```\n{tmc}```\n\n![Pareto front](pareto.svg)\n"
+        "\n## Export\n\nKlipper (`klipper.cfg`; paste at the end of printer.cfg, above any SAVE_CONFIG block):\n\n```ini\n{klipper}```\n\nRepRapFirmware (`rrf.g`; config.g lines):\n\n```\n{rrf}```\n\nTMC4361A ramp registers (`tmc4361a.txt`):\n\n```\n{tmc}```\n\n![Pareto front](pareto.svg)\n"
     );
     let write = |name: &str, text: &str| write_atomic(&out.join(name), text.as_bytes());
     write("tune.md", &md)?;
-    write("candidates.csv", &report::candidates_csv(&o.scores))?;
+    write("candidates.csv", &report::candidates_csv(&done))?;
     write("klipper.cfg", &klipper)?;
-    write("tmc5160.txt", &tmc)?;
+    write("rrf.g", &rrf)?;
+    write("tmc4361a.txt", &tmc)?;
+    let o = &done[0].1;
     let fig = report::pareto_figure(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
     crate::output::plot::write(&fig, &out, "pareto")?;
+    let outcome = o.clone();
     Ok(Tuned {
-        outcome: o,
+        outcome,
+        axes: done,
         markdown: md,
         out,
     })

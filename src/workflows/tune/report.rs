@@ -1,146 +1,24 @@
-//! Outputs of `settle tune`: the report (Markdown), the candidates table (CSV), the Pareto
-//! plot, and the winner exported as Klipper config lines and Trinamic TMC5160 registers.
+//! Outputs of `settle tune`: the report (Markdown, headed by "your current settings ->
+//! recommended"), the candidates table (CSV) and the Pareto plot. The firmware exports are
+//! in [`super::export`].
 
 use std::fmt::Write as _;
 
-use settle_planner::ProfileKind;
-use settle_planner::shaper::ShaperKind;
-use settle_planner::tmc::ramp::SRampParams;
-use settle_planner::tmc::registers::{TmcUnits, export};
-
+use super::Outcome;
 use super::search::{Plan, Score};
 use crate::input::runs_table::record;
 use crate::kinds::corner::Corner;
 use crate::kinds::scan::ScanSpec;
 use crate::output::plot::{Figure, Line, Marker, PALETTE, Panel};
+use settle_planner::ProfileKind;
+use settle_planner::shaper::ShaperKind;
 
-/// Klipper's `[printer]` / `[input_shaper]` lines for the winner on axis `axis`. Klipper
-/// plans trapezoids: a jerk-limited winner is exported with its shaper and acceleration and
-/// a comment that Klipper cannot express its jerk.
-pub fn klipper(plan: &Plan, s: &Score) -> String {
-    let c = &s.candidate;
-    let b = &plan.base;
-    let mut out = String::new();
-    let _ = writeln!(out, "# settle tune: winner {}", c.label());
-    if c.kind != ProfileKind::Trapezoid {
-        let _ = writeln!(
-            out,
-            "# note: Klipper plans trapezoids; the winner's {} jerk ({} mm/s^3) has no Klipper setting",
-            c.kind,
-            c.jmax_mm_s3.map_or("-".into(), |j| format!("{j:.0}"))
-        );
-    }
-    let _ = writeln!(out, "[printer]");
-    let _ = writeln!(out, "max_velocity: {}", b.vmax_mm_s);
-    let _ = writeln!(out, "max_accel: {}", b.amax_mm_s2);
-    let _ = writeln!(out);
-    let _ = writeln!(out, "[input_shaper]");
-    // One line set per moving axis (a corner path moves two; settle applies one shaper
-    // to both).
-    for axis in b.axis.split('+') {
-        match c.shaper.and_then(|sh| sh.kind.map(|k| (k, sh))) {
-            Some((k, sh)) => {
-                let _ = writeln!(out, "shaper_type_{axis}: {}", k.name());
-                let _ = writeln!(out, "shaper_freq_{axis}: {:.1}", sh.frequency_hz);
-                let _ = writeln!(out, "damping_ratio_{axis}: {}", sh.damping_ratio);
-            }
-            None => {
-                let _ = writeln!(out, "# no shaper in the winner: shaping off on {axis}");
-                let _ = writeln!(out, "shaper_freq_{axis}: 0");
-            }
-        }
-    }
-    if let Some(corner) = b.state::<Corner>()
-        && corner.strategy.name() == "square_corner_velocity"
-    {
-        let _ = writeln!(out, "\n[printer]");
-        let _ = writeln!(
-            out,
-            "square_corner_velocity: {}",
-            corner.square_corner_velocity_mm_s
-        );
-    }
-    out
-}
-
-/// The TMC5160 ramp registers of the winner's move (the first of the family), for
-/// `usteps_per_mm` and the chip clock. The chip's ramp is the four-jerk S-ramp: a
-/// trapezoid's bows would be infinite, so trapezoids and shaped winners (the chip cannot
-/// shape) export nothing but the reason.
-pub fn tmc(plan: &Plan, s: &Score) -> String {
-    let c = &s.candidate;
-    let b = &plan.base;
-    let mut out = String::new();
-    let units = TmcUnits {
-        f_clk_hz: plan.spec.tmc_clock_hz.unwrap_or(12_000_000),
-        usteps_per_unit: plan.spec.usteps_per_mm.unwrap_or(1280.0),
-        direct_acc: false,
-        direct_bow: false,
-    };
-    let _ = writeln!(
-        out,
-        "# settle tune: winner {} as TMC5160 ramp registers ({} usteps/mm, fCLK {} Hz)",
-        c.label(),
-        units.usteps_per_unit,
-        units.f_clk_hz
-    );
-    if c.shaper.is_some_and(|sh| sh.kind.is_some()) {
-        let _ = writeln!(
-            out,
-            "# the winner is input-shaped; the TMC5160 ramp generator cannot shape: registers of its unshaped ramp follow"
-        );
-    }
-    let Some(j) = c.jmax_mm_s3 else {
-        let _ = writeln!(
-            out,
-            "# a trapezoid has infinite bows; the TMC5160 S-ramp cannot express it"
-        );
-        return out;
-    };
-    let scale = match c.kind {
-        ProfileKind::FourJerk => c.params.fourjerk_jerk_scale,
-        _ => [1.0; 4],
-    };
-    let dmax = match c.kind {
-        ProfileKind::FourJerk => b.amax_mm_s2 * c.params.fourjerk_dmax_scale,
-        _ => b.amax_mm_s2,
-    };
-    let p = SRampParams {
-        vstart: 0.0,
-        vmax: b.vmax_mm_s,
-        vstop: 0.0,
-        amax: b.amax_mm_s2,
-        dmax,
-        bow: [j * scale[0], j * scale[1], j * scale[2], j * scale[3]],
-    };
-    if c.kind == ProfileKind::PvtAsym || c.kind == ProfileKind::PvtSym {
-        let _ = writeln!(
-            out,
-            "# {} is a PVT profile; the nearest S-ramp (same vmax, amax, jerk) follows",
-            c.kind
-        );
-    }
-    let target = b.start_mm + plan.distances_mm[0];
-    match export(target, &p, &units) {
-        Ok(r) => {
-            let names = [
-                "VMAX", "VSTART", "VSTOP", "AMAX", "DMAX", "BOW1", "BOW2", "BOW3", "BOW4",
-                "CLK_FREQ", "XTARGET",
-            ];
-            for ((addr, value), name) in r.writes().iter().zip(names) {
-                let _ = writeln!(out, "{name:<8} 0x{addr:02X} = {value}");
-            }
-        }
-        Err(e) => {
-            let _ = writeln!(out, "# cannot export: {e}");
-        }
-    }
-    out
-}
-
-/// The candidates table (one row per candidate).
-pub fn candidates_csv(scores: &[Score]) -> String {
+/// The candidates table: one row per candidate of every tuned axis, with its
+/// acceleration, Klipper's smoothing and the largest acceleration within the smoothing
+/// limit.
+pub fn candidates_csv(axes: &[(String, Outcome)]) -> String {
     let mut out = record(&[
+        "axis",
         "candidate",
         "profile",
         "jmax_mm_s3",
@@ -148,38 +26,144 @@ pub fn candidates_csv(scores: &[Score]) -> String {
         "bow_scales",
         "shaper_type",
         "shaper_frequency_hz",
+        "accel_mm_s2",
+        "smoothing_mm",
+        "max_accel_mm_s2",
         "move_time_s",
         "residual_peak_um",
         "move_and_settle_s",
         "max_contour_error_um",
     ]);
-    for (i, s) in scores.iter().enumerate() {
-        let c = &s.candidate;
-        let b = c.params.fourjerk_jerk_scale;
-        let (st, sf) = match c
-            .shaper
-            .and_then(|sh| sh.kind.map(|k| (k, sh.frequency_hz)))
-        {
-            Some((k, f)) => (k.name().to_string(), f.to_string()),
-            None => ("none".to_string(), String::new()),
+    for (axis, o) in axes {
+        for (i, s) in o.scores.iter().enumerate() {
+            let c = &s.candidate;
+            let b = c.params.fourjerk_jerk_scale;
+            let (st, sf) = match c
+                .shaper
+                .and_then(|sh| sh.kind.map(|k| (k, sh.frequency_hz)))
+            {
+                Some((k, f)) => (k.name().to_string(), f.to_string()),
+                None => ("none".to_string(), String::new()),
+            };
+            out.push_str(&record(&[
+                axis.clone(),
+                i.to_string(),
+                c.kind.to_string(),
+                c.jmax_mm_s3.map_or(String::new(), |j| j.to_string()),
+                c.params.pvt_asym_ki.to_string(),
+                format!("{}/{}/{}/{}", b[0], b[1], b[2], b[3]),
+                st.to_string(),
+                sf,
+                s.accel_mm_s2.to_string(),
+                s.smoothing_mm.to_string(),
+                s.max_accel_mm_s2.to_string(),
+                s.move_time_s.to_string(),
+                s.residual_peak_um.to_string(),
+                s.move_and_settle_s.to_string(),
+                if s.max_contour_error_um.is_nan() {
+                    String::new()
+                } else {
+                    s.max_contour_error_um.to_string()
+                },
+            ]));
+        }
+    }
+    out
+}
+
+/// A candidate's shaper in words: `mzv @ 52.0 Hz (zeta 0.1)` or `none`.
+pub fn shaper_text(s: &Score) -> String {
+    match s.candidate.shaper.and_then(|sh| sh.kind.map(|k| (k, sh))) {
+        Some((k, sh)) => format!(
+            "{} @ {:.1} Hz (zeta {})",
+            k.name(),
+            sh.frequency_hz,
+            sh.damping_ratio
+        ),
+        None => "none".into(),
+    }
+}
+
+/// The head of the report: per axis, the user's current settings (the scenario's point,
+/// `[tune.axis.<name>]`) and the recommendation, with smoothing, max_accel and the gain
+/// against the current settings.
+pub fn current_to_recommended(axes: &[(String, Outcome)]) -> String {
+    let mut out = String::from("## Your current settings -> recommended\n\n");
+    let Some((_, first)) = axes.first() else {
+        return out;
+    };
+    let p = &first.plan;
+    let _ = writeln!(
+        out,
+        "Firmware: {}. Score: {}. Shaped candidates smoothing more than {} mm (Klipper's figure at 5 mm/s) are infeasible{}.\n",
+        p.spec.firmware.as_deref().unwrap_or("any"),
+        score_text(p),
+        p.max_smoothing_mm,
+        if p.frequency_tolerance > 0.0 {
+            format!(
+                "; shaped candidates are scored on the worst of their shaper at its frequency and {}% either side",
+                p.frequency_tolerance * 100.0
+            )
+        } else {
+            String::new()
+        }
+    );
+    let _ = writeln!(
+        out,
+        "| axis | | profile | shaper | accel (mm/s^2) | smoothing (mm) | max_accel (mm/s^2) | move+settle (ms) | gain over current |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---:|---:|---:|---:|---|");
+    for (axis, o) in axes {
+        let (c, w) = (&o.scores[0], &o.scores[o.winner]);
+        let base = c.simulated_move_and_settle_s;
+        let gain = if base.is_finite() && w.move_and_settle_s.is_finite() {
+            format!(
+                "{:.1}% faster ({:.1} ms saved)",
+                100.0 * (1.0 - w.move_and_settle_s / base),
+                (base - w.move_and_settle_s) * 1e3
+            )
+        } else if w.move_and_settle_s.is_finite() {
+            "current does not settle in the window".into()
+        } else {
+            "no candidate settles within the limits".into()
         };
-        out.push_str(&record(&[
-            i.to_string(),
-            c.kind.to_string(),
-            c.jmax_mm_s3.map_or(String::new(), |j| j.to_string()),
-            c.params.pvt_asym_ki.to_string(),
-            format!("{}/{}/{}/{}", b[0], b[1], b[2], b[3]),
-            st.to_string(),
-            sf,
-            s.move_time_s.to_string(),
-            s.residual_peak_um.to_string(),
-            s.move_and_settle_s.to_string(),
-            if s.max_contour_error_um.is_nan() {
-                String::new()
-            } else {
-                s.max_contour_error_um.to_string()
-            },
-        ]));
+        let over = if c.smoothing_mm > o.plan.max_smoothing_mm {
+            format!(
+                " (smooths {:.3} mm > {} mm)",
+                c.smoothing_mm, o.plan.max_smoothing_mm
+            )
+        } else {
+            String::new()
+        };
+        for (tag, s, g) in [("current", c, over), ("**recommended**", w, gain)] {
+            let _ = writeln!(
+                out,
+                "| {axis} | {tag} | {} | {} | {} | {:.3} | {} | {} | {g} |",
+                s.candidate.kind,
+                shaper_text(s),
+                s.accel_mm_s2,
+                s.smoothing_mm,
+                if s.max_accel_mm_s2.is_finite() {
+                    format!("{:.0}", s.max_accel_mm_s2)
+                } else {
+                    "-".into()
+                },
+                ms(s.simulated_move_and_settle_s)
+            );
+        }
+    }
+    out
+}
+
+/// Markdown headings one level deeper (`#` -> `##`), to nest a report under an axis.
+pub fn demote(md: &str) -> String {
+    let mut out = String::with_capacity(md.len() + 64);
+    for line in md.lines() {
+        if line.starts_with('#') {
+            out.push('#');
+        }
+        out.push_str(line);
+        out.push('\n');
     }
     out
 }
@@ -258,23 +242,23 @@ pub(crate) fn ms(x: f64) -> String {
     }
 }
 
-/// The default's and the winner's rows of a `| | candidate | move | residual | score | into
+/// The current settings' and the winner's rows of a `| | candidate | move | residual | score | into
 /// the band |` table; `winner_tag` is how the winner's row is labelled.
 pub(crate) fn default_and_winner_rows(out: &mut String, d: &Score, w: &Score, winner_tag: &str) {
-    for (tag, s) in [("default", d), (winner_tag, w)] {
+    for (tag, s) in [("current", d), (winner_tag, w)] {
         let _ = writeln!(
             out,
             "| {tag} | {} | {} | {:.2} | {} | {} |",
             s.candidate.label(),
             ms(s.move_time_s),
             s.residual_peak_um,
-            ms(s.move_and_settle_s),
+            ms(s.simulated_move_and_settle_s),
             ms(s.at_band_s)
         );
     }
 }
 
-/// The Markdown report: winner, gain over the default, per-kind bests and the Pareto front.
+/// The Markdown report: winner, gain over the current settings, per-kind bests and the Pareto front.
 pub fn markdown(
     name: &str,
     plan: &Plan,
@@ -307,16 +291,16 @@ pub fn markdown(
         score_text(plan),
         scores.len()
     );
-    let gain = if w.move_and_settle_s.is_finite() && d.move_and_settle_s.is_finite() {
+    let gain = if w.move_and_settle_s.is_finite() && d.simulated_move_and_settle_s.is_finite() {
         format!(
             "{:.1}% {} ({:.1} ms saved{})",
-            100.0 * (1.0 - w.move_and_settle_s / d.move_and_settle_s),
+            100.0 * (1.0 - w.move_and_settle_s / d.simulated_move_and_settle_s),
             if plan.base.state::<ScanSpec>().is_some() {
                 "less overhead per line"
             } else {
                 "faster"
             },
-            (d.move_and_settle_s - w.move_and_settle_s) * 1e3,
+            (d.simulated_move_and_settle_s - w.move_and_settle_s) * 1e3,
             if plan.base.state::<ScanSpec>().is_some() {
                 " per line"
             } else {
@@ -324,7 +308,7 @@ pub fn markdown(
             }
         )
     } else {
-        "the default does not settle in the window".into()
+        "the current settings do not settle in the window".into()
     };
     let _ = writeln!(
         out,
@@ -335,11 +319,14 @@ pub fn markdown(
     if plan.base.state::<Corner>().is_some() {
         let _ = writeln!(
             out,
-            "\nLargest contour error over the corners: default {:.1} um, winner {:.1} um.",
+            "\nLargest contour error over the corners: current {:.1} um, winner {:.1} um.",
             d.max_contour_error_um, w.max_contour_error_um
         );
     }
-    let _ = writeln!(out, "\nGain of the winner over the default: {gain}.\n");
+    let _ = writeln!(
+        out,
+        "\nGain of the winner over the current settings: {gain}.\n"
+    );
     let _ = writeln!(out, "## Best per profile kind\n");
     let _ = writeln!(
         out,
@@ -388,7 +375,7 @@ pub fn markdown(
 }
 
 /// The Pareto plot: every candidate (grey, shaped ones by shaper colour), the front, the
-/// default and the winner.
+/// current settings and the winner.
 pub fn pareto_figure(
     name: &str,
     plan: &Plan,
@@ -399,9 +386,15 @@ pub fn pareto_figure(
     let [h_move, h_res, _] = headings(plan);
     let pt = |s: &Score| (s.move_time_s * 1e3, s.residual_peak_um.max(1e-3));
     let mut lines = Vec::new();
-    let groups: Vec<(String, Option<ShaperKind>)> = std::iter::once(("unshaped".into(), None))
-        .chain(ShaperKind::ALL.map(|k| (k.name().to_string(), Some(k))))
-        .collect();
+    // One group per shaper the search holds (any firmware's), in order of appearance.
+    let mut groups: Vec<(String, Option<ShaperKind>)> = vec![("unshaped".into(), None)];
+    for s in scores {
+        if let Some(k) = s.candidate.shaper.and_then(|sh| sh.kind)
+            && !groups.iter().any(|(_, g)| *g == Some(k))
+        {
+            groups.push((k.name(), Some(k)));
+        }
+    }
     for (gi, (label, kind)) in groups.iter().enumerate() {
         let points: Vec<(f64, f64)> = scores
             .iter()
@@ -425,7 +418,7 @@ pub fn pareto_figure(
     f.width = 2;
     lines.push(f);
     for (label, i, marker) in [
-        ("default", 0, Marker::Square),
+        ("current", 0, Marker::Square),
         ("winner", winner, Marker::Triangle),
     ] {
         let mut l = Line::new(

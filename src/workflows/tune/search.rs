@@ -10,7 +10,14 @@
 //! - `pvt_asym`: the asymmetry `Ki` (`pvt_asym_ki`), `fourjerk`: BOW1..4 patterns (each
 //!   scale <= 1, so no bow exceeds jmax),
 //! - input shaper: `none` or each type at each mode frequency times `frequency_scales`
-//!   (the modes: the scenario's, or the moving axis's two strongest linearised modes).
+//!   (the modes: the scenario's, or the moving axis's two strongest linearised modes),
+//! - acceleration (`accelerations_mm_s2`, default the scenario's `amax_mm_s2`),
+//!
+//! restricted to what the `firmware` runs. A shaped candidate's smoothing (Klipper's figure
+//! at its acceleration and 5 mm/s) and the largest acceleration keeping it within
+//! `max_smoothing_mm` (Klipper's bisection) are part of its score; a candidate smoothing
+//! more is infeasible. With `frequency_tolerance_pct`, a shaped candidate is also run with
+//! its shaper detuned by that much either way and scored on the worst of the three.
 //!
 //! A candidate's score is the mean `move_and_settle_s` over the move family
 //! (`distances_mm`, or a corner scenario's `angles_deg`) into the tighter band
@@ -20,13 +27,15 @@
 //! per line at which the step is settled (see [`super::scan_figures`]). Ties break on the lower
 //! residual, then grid order, so the result is deterministic.
 
+use settle_planner::shaper::Shaper;
+use settle_planner::shaper_select::max_accel_mm_s2;
 use settle_planner::{KindParams, ProfileKind};
 
 use crate::error::Error;
 use crate::input::tune_spec::TuneSpec;
 use crate::kinds::corner::Corner;
 use crate::kinds::scan::ScanSpec;
-use crate::kinds::shaping::ShaperSetting;
+use crate::kinds::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::workflows::tune::scan_figures::scan_figures;
@@ -42,6 +51,8 @@ pub struct Candidate {
     pub params: KindParams,
     /// Input shaper (`None`: unshaped).
     pub shaper: Option<ShaperSetting>,
+    /// Acceleration limit (mm/s^2), `None` for the scenario's.
+    pub amax_mm_s2: Option<f64>,
 }
 
 impl Candidate {
@@ -59,6 +70,9 @@ impl Candidate {
             }
             _ => {}
         }
+        if let Some(a) = self.amax_mm_s2 {
+            s.push_str(&format!(" a={a}"));
+        }
         if let Some(sh) = self.shaper.filter(|s| s.kind.is_some()) {
             s.push_str(&format!(
                 " +{}@{:.1}Hz",
@@ -70,11 +84,20 @@ impl Candidate {
         s
     }
 
+    /// The shaper, when the candidate is shaped (`None` also for a setting the planner
+    /// refuses, which fails its runs).
+    pub fn shaper(&self) -> Option<Shaper> {
+        self.shaper.and_then(|sh| sh.shaper().ok()).flatten()
+    }
+
     /// Apply to a run (its move length is left alone).
     pub fn apply(&self, run: &mut RunSpec) {
         run.profile = self.kind;
         run.jmax_mm_s3 = self.jmax_mm_s3.or(run.jmax_mm_s3);
         run.kind_params = self.params;
+        if let Some(a) = self.amax_mm_s2 {
+            run.amax_mm_s2 = a;
+        }
         match self.shaper {
             Some(sh) => run.put_state(Box::new(sh)),
             None => run.remove_state("shaper"),
@@ -88,6 +111,7 @@ impl Candidate {
             jmax_mm_s3: run.jmax_mm_s3,
             params: run.kind_params,
             shaper: run.state::<ShaperSetting>().copied(),
+            amax_mm_s2: None,
         }
     }
 }
@@ -97,6 +121,16 @@ impl Candidate {
 pub struct Score {
     /// The candidate.
     pub candidate: Candidate,
+    /// Acceleration (mm/s^2) the candidate moves at.
+    pub accel_mm_s2: f64,
+    /// Klipper's smoothing of its shaper at that acceleration and 5 mm/s (mm); 0 unshaped.
+    pub smoothing_mm: f64,
+    /// Klipper's largest acceleration keeping the smoothing within the plan's
+    /// `max_smoothing_mm` (mm/s^2); infinite unshaped.
+    pub max_accel_mm_s2: f64,
+    /// `move_and_settle_s` as simulated, before the smoothing limit (which makes a
+    /// candidate smoothing more infeasible: `move_and_settle_s` infinite).
+    pub simulated_move_and_settle_s: f64,
     /// Mean commanded move time (s).
     pub move_time_s: f64,
     /// Mean residual peak (um).
@@ -136,6 +170,10 @@ pub struct Plan {
     pub modes: Vec<(f64, f64)>,
     /// The `[tune]` table.
     pub spec: TuneSpec,
+    /// Detuning of the robustness check, a fraction (0: none).
+    pub frequency_tolerance: f64,
+    /// Largest smoothing a shaped candidate may have (mm).
+    pub max_smoothing_mm: f64,
 }
 
 impl Plan {
@@ -143,19 +181,58 @@ impl Plan {
     pub fn runs(&self, candidates: &[Candidate]) -> Vec<RunSpec> {
         let mut out = Vec::with_capacity(candidates.len() * self.family_len());
         for c in candidates {
-            for i in 0..self.family_len() {
-                let mut r = self.base.clone();
-                r.id = out.len();
-                r.bands_um = self.bands_um.clone();
-                match r.state_mut::<Corner>() {
-                    Some(corner) => corner.angle_deg = self.angles_deg[i],
-                    None => r.distance_mm = self.distances_mm[i],
+            for v in self.variants(c) {
+                for i in 0..self.family_len() {
+                    let mut r = self.base.clone();
+                    r.id = out.len();
+                    r.bands_um = self.bands_um.clone();
+                    match r.state_mut::<Corner>() {
+                        Some(corner) => corner.angle_deg = self.angles_deg[i],
+                        None => r.distance_mm = self.distances_mm[i],
+                    }
+                    v.apply(&mut r);
+                    out.push(r);
                 }
-                c.apply(&mut r);
-                out.push(r);
             }
         }
         out
+    }
+
+    /// The candidate as run: itself, and for a shaped candidate under a frequency
+    /// tolerance `t` also its shaper at `(1 - t)` and `(1 + t)` times its frequency.
+    pub fn variants(&self, c: &Candidate) -> Vec<Candidate> {
+        let t = self.frequency_tolerance;
+        match c.shaper.filter(|s| s.kind.is_some()) {
+            Some(sh) if t > 0.0 => [1.0, 1.0 - t, 1.0 + t]
+                .into_iter()
+                .map(|k| Candidate {
+                    shaper: Some(ShaperSetting {
+                        frequency_hz: sh.frequency_hz * k,
+                        ..sh
+                    }),
+                    ..*c
+                })
+                .collect(),
+            _ => vec![*c],
+        }
+    }
+
+    /// The smoothing (mm) and the largest acceleration within `max_smoothing_mm`
+    /// (mm/s^2) of a candidate at acceleration `accel_mm_s2`, as Klipper computes them
+    /// (at its square-corner velocity of 5 mm/s); `(0, inf)` unshaped.
+    pub fn smoothing(&self, c: &Candidate, accel_mm_s2: f64) -> (f64, f64) {
+        match c.shaper() {
+            None => (0.0, f64::INFINITY),
+            Some(s) => (
+                s.smoothing_mm(accel_mm_s2, SMOOTHING_SCV_MM_S),
+                max_accel_mm_s2(
+                    s.amplitudes(),
+                    s.times_s(),
+                    SMOOTHING_SCV_MM_S,
+                    self.max_smoothing_mm,
+                ),
+            ),
+        }
     }
 
     /// Moves per candidate: the corner angles, or the move lengths.
@@ -175,65 +252,99 @@ impl Plan {
         results: &[Result<Metrics, Error>],
     ) -> Vec<Score> {
         let n = self.family_len();
-        let limit = self.spec.max_contour_error_um.unwrap_or(f64::INFINITY);
+        let mut at = 0;
         candidates
             .iter()
-            .zip(results.chunks(n))
-            .map(|(c, rs)| {
-                let (mut t, mut r, mut mas, mut at_band) = (0.0, 0.0, 0.0, 0.0);
-                let mut contour = f64::NAN;
-                for m in rs {
-                    match m {
-                        Ok(m) if m.is_ok() => {
-                            let (time, residual, scored, nominal) =
-                                match self.base.state::<ScanSpec>() {
-                                    Some(scan) => {
-                                        let f = scan_figures(scan, m, &self.bands_um);
-                                        (
-                                            f.step_s,
-                                            f.line_residual_peak_um,
-                                            f.overhead_s[self.score_band_index],
-                                            f.overhead_s[self.band_index],
-                                        )
-                                    }
-                                    None => (
-                                        m.move_time_s,
-                                        m.residual_peak_um,
-                                        m.move_and_settle_s(self.score_band_index)
-                                            .unwrap_or(f64::INFINITY),
-                                        m.move_and_settle_s(self.band_index)
-                                            .unwrap_or(f64::INFINITY),
-                                    ),
-                                };
-                            t += time;
-                            r += residual;
-                            mas += scored;
-                            at_band += nominal;
-                            if let Some(p) = &m.path {
-                                contour = contour.max(p.max_contour_error_um);
-                                if p.max_contour_error_um > limit {
-                                    mas = f64::INFINITY;
-                                    at_band = f64::INFINITY;
-                                }
-                            }
+            .map(|c| {
+                let variants = self.variants(c);
+                let mut worst: Option<Score> = None;
+                for v in &variants {
+                    let s = self.score_one(v, &results[at..at + n]);
+                    at += n;
+                    if worst.as_ref().is_none_or(|w| {
+                        s.move_and_settle_s > w.move_and_settle_s || s.move_and_settle_s.is_nan()
+                    }) {
+                        worst = Some(s);
+                    }
+                }
+                let mut s = worst.unwrap_or_else(|| self.score_one(c, &[]));
+                // The candidate is the nominal one; its smoothing too.
+                s.candidate = *c;
+                let (smoothing, max_accel) = self.smoothing(c, s.accel_mm_s2);
+                s.smoothing_mm = smoothing;
+                s.max_accel_mm_s2 = max_accel;
+                s.simulated_move_and_settle_s = s.move_and_settle_s;
+                if smoothing > self.max_smoothing_mm {
+                    s.move_and_settle_s = f64::INFINITY;
+                    s.at_band_s = f64::INFINITY;
+                }
+                s
+            })
+            .collect()
+    }
+
+    /// One candidate's score over the runs of its move family.
+    fn score_one(&self, c: &Candidate, rs: &[Result<Metrics, Error>]) -> Score {
+        let n = self.family_len();
+        let limit = self.spec.max_contour_error_um.unwrap_or(f64::INFINITY);
+        let (mut t, mut r, mut mas, mut at_band) = (0.0, 0.0, 0.0, 0.0);
+        let mut contour = f64::NAN;
+        if rs.len() != n {
+            (t, mas, at_band) = (f64::NAN, f64::INFINITY, f64::INFINITY);
+        }
+        for m in rs {
+            match m {
+                Ok(m) if m.is_ok() => {
+                    let (time, residual, scored, nominal) = match self.base.state::<ScanSpec>() {
+                        Some(scan) => {
+                            let f = scan_figures(scan, m, &self.bands_um);
+                            (
+                                f.step_s,
+                                f.line_residual_peak_um,
+                                f.overhead_s[self.score_band_index],
+                                f.overhead_s[self.band_index],
+                            )
                         }
-                        _ => {
-                            t = f64::NAN;
+                        None => (
+                            m.move_time_s,
+                            m.residual_peak_um,
+                            m.move_and_settle_s(self.score_band_index)
+                                .unwrap_or(f64::INFINITY),
+                            m.move_and_settle_s(self.band_index)
+                                .unwrap_or(f64::INFINITY),
+                        ),
+                    };
+                    t += time;
+                    r += residual;
+                    mas += scored;
+                    at_band += nominal;
+                    if let Some(p) = &m.path {
+                        contour = contour.max(p.max_contour_error_um);
+                        if p.max_contour_error_um > limit {
                             mas = f64::INFINITY;
                             at_band = f64::INFINITY;
                         }
                     }
                 }
-                let k = n as f64;
-                Score {
-                    candidate: *c,
-                    move_time_s: t / k,
-                    residual_peak_um: r / k,
-                    move_and_settle_s: mas / k,
-                    max_contour_error_um: contour,
-                    at_band_s: at_band / k,
+                _ => {
+                    t = f64::NAN;
+                    mas = f64::INFINITY;
+                    at_band = f64::INFINITY;
                 }
-            })
-            .collect()
+            }
+        }
+        let k = n as f64;
+        Score {
+            candidate: *c,
+            accel_mm_s2: c.amax_mm_s2.unwrap_or(self.base.amax_mm_s2),
+            smoothing_mm: 0.0,
+            max_accel_mm_s2: f64::INFINITY,
+            simulated_move_and_settle_s: mas / k,
+            move_time_s: t / k,
+            residual_peak_um: r / k,
+            move_and_settle_s: mas / k,
+            max_contour_error_um: contour,
+            at_band_s: at_band / k,
+        }
     }
 }

@@ -1,0 +1,457 @@
+//! `settle import klipper printer.cfg` / `settle import rrf config.g`: a scenario that
+//! reproduces the user's current settings as its baseline, and a search around them.
+//!
+//! Read through settle-gcode's configuration readers (Klipper's includes and SAVE_CONFIG,
+//! RepRapFirmware's macros; a present but malformed value is an error naming the file,
+//! line and key; sections and commands settle does not need are ignored):
+//! - limits: Klipper `[printer]` `max_velocity`, `max_accel`; RepRapFirmware `M203` and
+//!   the lower of `M201` (per axis) and `M204 P` (printing moves);
+//! - the shaper per axis: Klipper `[input_shaper]` `shaper_type_x/y`, `shaper_freq_x/y`,
+//!   `damping_ratio_x/y` (frequency 0: off); RepRapFirmware's one `M593` for all axes;
+//! - microsteps per mm per axis (Klipper `[stepper_*]`, RepRapFirmware `M92`/`M350`), for
+//!   the TMC4361A export.
+//!
+//! The scenario written runs the current settings as its own point (`[move]` trapezoids,
+//! `[limits]`, `[shaper]` of the first axis), marks them in `[current]` among a `[sweep]`
+//! of shapers, frequencies and accelerations around them (for `settle sweep`), and holds a
+//! `[tune]` table for `settle tune` (the firmware's candidates, every axis with its current
+//! settings in `[tune.axis.<name>]`, a 5 % frequency tolerance). The machine is the one
+//! given (`--machine`, a machine file from `settle identify` or written by hand); without
+//! it the preset `printer_xy` stands in, and the report says so.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use settle_gcode::Dialect;
+use settle_gcode::config::{KlipperConfig, RrfConfig, ShaperSetting as FirmwareShaper};
+
+use crate::error::{Error, Location};
+use crate::output::atomic::write_atomic;
+use crate::workflows::tune::firmware::Firmware;
+use crate::workflows::tune::grid::tuning_modes;
+use crate::workflows::{Exit, Report};
+
+/// Shaper frequencies of the search, as multiples of the current one.
+pub const FREQUENCY_SCALES: [f64; 5] = [0.9, 0.95, 1.0, 1.05, 1.1];
+/// Accelerations of the search, as multiples of the current one (never above it: the
+/// current `max_accel` is what the user's motors are known to reach).
+pub const ACCEL_SCALES: [f64; 3] = [0.5, 0.75, 1.0];
+/// Robustness of the imported search (percent): a winner must still work with the real
+/// mode this far off the identified one.
+pub const FREQUENCY_TOLERANCE_PCT: f64 = 5.0;
+/// The preset that stands in when no machine is given.
+pub const STAND_IN_PRESET: &str = "printer_xy";
+
+/// What `settle import` reads and writes.
+#[derive(Debug, Clone)]
+pub struct ImportOptions {
+    /// `klipper` or `rrf`.
+    pub firmware: Firmware,
+    /// printer.cfg or config.g.
+    pub config: PathBuf,
+    /// The machine file (`settle identify`'s, or written by hand).
+    pub machine: Option<PathBuf>,
+    /// The scenario to write (default: `<config name>_import.toml` beside the config).
+    pub out: Option<PathBuf>,
+}
+
+/// One axis's current settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxisNow {
+    /// `x`, `y`.
+    pub name: String,
+    /// The shaper in `shaper.type` syntax with frequency (Hz) and damping ratio; `None`:
+    /// not shaped.
+    pub shaper: Option<(String, f64, f64)>,
+    /// Microsteps per mm.
+    pub usteps_per_mm: Option<f64>,
+}
+
+/// The settings read from a firmware configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Current {
+    /// The firmware.
+    pub firmware: Firmware,
+    /// Highest speed (mm/s).
+    pub vmax_mm_s: f64,
+    /// Acceleration of printing moves (mm/s^2).
+    pub amax_mm_s2: f64,
+    /// X and Y.
+    pub axes: Vec<AxisNow>,
+    /// What the reader noted.
+    pub notes: Vec<String>,
+}
+
+/// What `settle import` wrote.
+#[derive(Debug, Clone)]
+pub struct Imported {
+    /// The settings read.
+    pub current: Current,
+    /// The scenario text.
+    pub scenario: String,
+    /// Where it was written.
+    pub out: PathBuf,
+    /// The axes the scenario tunes (those the machine has).
+    pub axes: Vec<String>,
+    /// Notes for the user (the stand-in machine, what the reader skipped).
+    pub notes: Vec<String>,
+}
+
+impl Imported {
+    /// What the command prints.
+    pub fn report(&self) -> Report {
+        let mut r = Report::new(Exit::Ok);
+        r.out(format!("Wrote {}", self.out.display()));
+        for a in &self.current.axes {
+            let sh = a
+                .shaper
+                .as_ref()
+                .map_or("no shaper".to_string(), |(n, f, z)| {
+                    format!("{n} @ {f} Hz (zeta {z})")
+                });
+            r.out(format!(
+                "current {}: {sh}, {} mm/s^2, {} mm/s",
+                a.name, self.current.amax_mm_s2, self.current.vmax_mm_s
+            ));
+        }
+        r.out(format!(
+            "next: settle tune {} (axes {})",
+            self.out.display(),
+            self.axes.join(", ")
+        ));
+        for n in &self.notes {
+            r.err(format!("note: {n}"));
+        }
+        r
+    }
+}
+
+/// A configuration reader's error as the harness's, at its file, line and key.
+fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
+    if let settle_gcode::GcodeError::Io { source, .. } = e {
+        return Error::read(path, source);
+    }
+    let text = e.to_string();
+    match e.location() {
+        Some(at) => {
+            let prefix = format!("{at}: ");
+            let key = match &e {
+                settle_gcode::GcodeError::ConfigValue { section, key, .. } => {
+                    Some(format!("{section}.{key}"))
+                }
+                _ => None,
+            };
+            Error::Input {
+                at: Location {
+                    file: PathBuf::from(at.source_name.as_ref()),
+                    line: usize::try_from(at.line).ok(),
+                    column: at.column,
+                    key,
+                },
+                message: text.strip_prefix(&prefix).unwrap_or(&text).to_string(),
+            }
+        }
+        None => Error::input(path, text),
+    }
+}
+
+fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)> {
+    s.kind_name(dialect)
+        .map(|n| (n, s.frequency_hz, s.damping_ratio))
+}
+
+/// Read the current settings of a firmware configuration.
+pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
+    let note = |n: &settle_gcode::config::ConfigNote| match &n.at {
+        Some(at) => format!("{at}: {}", n.text),
+        None => n.text.clone(),
+    };
+    match firmware {
+        Firmware::Klipper => {
+            let c = KlipperConfig::read(path).map_err(|e| config_error(path, e))?;
+            let axes = [("x", &c.steppers.x), ("y", &c.steppers.y)]
+                .into_iter()
+                .map(|(name, st)| AxisNow {
+                    name: name.into(),
+                    shaper: c.input_shaper.as_ref().and_then(|s| {
+                        shaper_now(if name == "x" { &s.x } else { &s.y }, Dialect::Klipper)
+                    }),
+                    usteps_per_mm: st.as_ref().map(|s| s.drive.microsteps_per_mm),
+                })
+                .collect();
+            Ok(Current {
+                firmware,
+                vmax_mm_s: c.printer.max_velocity_mm_s,
+                amax_mm_s2: c.printer.max_accel_mm_s2,
+                axes,
+                notes: c.notes.iter().map(note).collect(),
+            })
+        }
+        Firmware::Rrf => {
+            let c = RrfConfig::read(path).map_err(|e| config_error(path, e))?;
+            let shaper = shaper_now(&c.input_shaper, Dialect::Rrf);
+            let axes = [("x", &c.axes.x), ("y", &c.axes.y)]
+                .into_iter()
+                .map(|(name, a)| AxisNow {
+                    name: name.into(),
+                    shaper: shaper.clone(),
+                    usteps_per_mm: Some(a.drive.microsteps_per_mm),
+                })
+                .collect();
+            Ok(Current {
+                firmware,
+                vmax_mm_s: c.axes.x.max_speed_mm_s.min(c.axes.y.max_speed_mm_s),
+                amax_mm_s2: c
+                    .print_accel_mm_s2
+                    .min(c.axes.x.max_accel_mm_s2)
+                    .min(c.axes.y.max_accel_mm_s2),
+                axes,
+                notes: c.notes.iter().map(note).collect(),
+            })
+        }
+        other => Err(Error::input_key(
+            path,
+            "firmware",
+            format!(
+                "settle import reads klipper (printer.cfg) and rrf (config.g), not {}",
+                other.name()
+            ),
+        )),
+    }
+}
+
+/// A TOML string.
+fn q(s: &str) -> String {
+    toml::Value::String(s.to_string()).to_string()
+}
+
+/// A list of numbers in TOML.
+fn list(xs: &[f64]) -> String {
+    let items: Vec<String> = xs.iter().map(|x| format!("{x:?}")).collect();
+    format!("[{}]", items.join(", "))
+}
+
+/// `x * k` for each `k`, rounded to `step`, with `x` itself exact, sorted, deduplicated.
+fn around(x: f64, scales: &[f64], step: f64) -> Vec<f64> {
+    let mut v: Vec<f64> = scales
+        .iter()
+        .map(|k| {
+            if *k == 1.0 {
+                x
+            } else if step < 1.0 {
+                // n / 10 rather than n * 0.1: the double nearest the decimal.
+                (x * k / step).round() / (1.0 / step).round()
+            } else {
+                (x * k / step).round() * step
+            }
+        })
+        .filter(|v| *v > 0.0)
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
+}
+
+/// The scenario's text; `frequency_hz` is the sweep's centre for an unshaped first axis.
+fn scenario_text(
+    name: &str,
+    machine: &str,
+    cur: &Current,
+    axes: &[&AxisNow],
+    frequency_hz: f64,
+    source: &str,
+) -> String {
+    let first = axes.first().copied().unwrap_or(&cur.axes[0]);
+    let fw = cur.firmware;
+    let (type_now, f_now, z_now) = first.shaper.clone().unwrap_or_else(|| {
+        (
+            "none".into(),
+            frequency_hz,
+            crate::kinds::shaping::DEFAULT_DAMPING_RATIO,
+        )
+    });
+    let accels = around(cur.amax_mm_s2, &ACCEL_SCALES, 100.0);
+    let freqs = around(f_now, &FREQUENCY_SCALES, 0.1);
+    let mut types = vec![q("none")];
+    types.extend(fw.shapers().iter().map(|k| q(&k.name())));
+    if !types.contains(&q(&type_now)) {
+        types.push(q(&type_now));
+    }
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "# Written by `settle import {} {source}`: the current settings as this scenario's own\n\
+         # point (marked in [current] among the [sweep]) and a search around them in [tune].\n\
+         #   settle sweep THIS.toml   # the sweep around the current settings\n\
+         #   settle tune THIS.toml    # the recommendation per axis, with klipper.cfg / rrf.g\n\
+         name = {}\n\
+         description = {}\n",
+        fw.name(),
+        q(name),
+        q(&format!("Imported from {source} ({})", fw.name()))
+    );
+    let _ = writeln!(
+        t,
+        "[machine]\npreset = {}\ndriver_model = \"linear\"   # the stiff-spring driver: the exact modal backend can score every candidate\n",
+        q(machine)
+    );
+    let _ = writeln!(
+        t,
+        "[move]\naxis = {}\ndistance_mm = 20.0\nprofile = \"trapezoid\"   # {} plans trapezoids\n",
+        q(&first.name),
+        fw.name()
+    );
+    let _ = writeln!(
+        t,
+        "[limits]\nvmax_mm_s = {:?}\namax_mm_s2 = {:?}\n",
+        cur.vmax_mm_s, cur.amax_mm_s2
+    );
+    let _ = writeln!(
+        t,
+        "[shaper]   # axis {}'s current shaper\ntype = {}\nfrequency_hz = {f_now:?}\ndamping_ratio = {z_now:?}\n",
+        first.name,
+        q(&type_now)
+    );
+    let _ = writeln!(
+        t,
+        "[observe]\nwindow_s = 0.4\nsample_rate_hz = 5000\nbands_um = [10.0, 50.0]\n"
+    );
+    let _ = writeln!(
+        t,
+        "[sweep]   # on axis {}\n\"shaper.type\" = [{}]\n\"shaper.frequency_hz\" = {}\n\"limits.amax_mm_s2\" = {}\n",
+        first.name,
+        types.join(", "),
+        list(&freqs),
+        list(&accels)
+    );
+    let _ = writeln!(
+        t,
+        "[current]\n\"shaper.type\" = {}\n\"shaper.frequency_hz\" = {f_now:?}\n\"limits.amax_mm_s2\" = {:?}\n",
+        q(&type_now),
+        cur.amax_mm_s2
+    );
+    let names: Vec<String> = axes.iter().map(|a| q(&a.name)).collect();
+    let _ = writeln!(
+        t,
+        "[tune]\nfirmware = {}\naxes = [{}]\ndistances_mm = [5.0, 20.0]\nband_um = 10.0\nfrequency_scales = {}\naccelerations_mm_s2 = {}\nfrequency_tolerance_pct = {FREQUENCY_TOLERANCE_PCT:?}",
+        q(fw.name()),
+        names.join(", "),
+        list(&FREQUENCY_SCALES),
+        list(&accels)
+    );
+    for a in axes {
+        let _ = writeln!(t, "\n[tune.axis.{}]", a.name);
+        match &a.shaper {
+            Some((n, f, z)) => {
+                let _ = writeln!(
+                    t,
+                    "shaper = {}\nfrequency_hz = {f:?}\ndamping_ratio = {z:?}",
+                    q(n)
+                );
+            }
+            None => {
+                let _ = writeln!(t, "shaper = \"none\"");
+            }
+        }
+        if let Some(u) = a.usteps_per_mm {
+            let _ = writeln!(t, "usteps_per_mm = {u:?}");
+        }
+    }
+    t
+}
+
+/// A scenario name from the configuration's file name.
+fn name_of(config: &Path) -> String {
+    let stem = config
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let clean: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!(
+        "{}_import",
+        if clean.is_empty() { "config" } else { &clean }
+    )
+}
+
+/// Import: read the configuration, find the axes the machine has and its modes, write
+/// the scenario.
+pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
+    let cur = read_current(opts.firmware, &opts.config)?;
+    let name = name_of(&opts.config);
+    let out = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| opts.config.with_file_name(format!("{name}.toml")));
+    let mut notes = cur.notes.clone();
+    let machine = match &opts.machine {
+        Some(m) => std::path::absolute(m)
+            .map_err(|e| Error::read(m, e))?
+            .display()
+            .to_string(),
+        None => {
+            notes.push(format!(
+                "no --machine given: the preset `{STAND_IN_PRESET}` stands in for your printer, so the numbers are for it, not for your machine. Measure your modes (`settle identify` on a TEST_RESONANCES or M956 file) and import again with --machine machine.toml"
+            ));
+            STAND_IN_PRESET.to_string()
+        }
+    };
+    // The axes the machine has, and the first one's strongest mode (the sweep's centre
+    // when it has no shaper yet).
+    let source = opts.config.display().to_string();
+    let mut axes: Vec<&AxisNow> = Vec::new();
+    let mut centre_hz = None;
+    for a in &cur.axes {
+        let text = scenario_text(&name, &machine, &cur, &[a], 40.0, &source);
+        let probe = out.with_file_name(format!("{name}.probe.toml"));
+        if let Ok((_, runs)) = crate::expand::parse_runs(&text, &probe)
+            && let Some(run) = runs.first()
+        {
+            if centre_hz.is_none() {
+                centre_hz = tuning_modes(run)
+                    .first()
+                    .map(|(f, _)| (f * 10.0).round() / 10.0);
+            }
+            axes.push(a);
+        } else {
+            notes.push(format!(
+                "the machine has no axis `{}`: it is not tuned",
+                a.name
+            ));
+        }
+    }
+    if axes.is_empty() {
+        return Err(Error::input(
+            opts.machine
+                .clone()
+                .unwrap_or_else(|| PathBuf::from(STAND_IN_PRESET)),
+            "the machine has neither an x nor a y axis to tune",
+        ));
+    }
+    let text = scenario_text(
+        &name,
+        &machine,
+        &cur,
+        &axes,
+        centre_hz.unwrap_or(40.0),
+        &source,
+    );
+    // What is written must load.
+    crate::expand::parse_runs(&text, &out)?;
+    write_atomic(&out, text.as_bytes())?;
+    Ok(Imported {
+        axes: axes.iter().map(|a| a.name.clone()).collect(),
+        current: cur,
+        scenario: text,
+        out,
+        notes,
+    })
+}

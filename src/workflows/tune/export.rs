@@ -1,0 +1,282 @@
+//! The recommendation as firmware configuration that pastes cleanly, each parsed back by
+//! `settle import` in `tests/all/import_roundtrip.rs`:
+//!
+//! - `klipper.cfg`: one `[input_shaper]` section with per-axis `shaper_type_x/y`,
+//!   `shaper_freq_x/y`, `damping_ratio_x/y`, and `[printer]` `max_accel` only when the
+//!   recommended acceleration differs from the current one (settle-gcode's
+//!   `KlipperExport`). Written when both X and Y are known: tuned, or their current
+//!   settings given in `[tune.axis.<name>]` (an axis left out would be written as "off").
+//! - `rrf.g`: RepRapFirmware's one `M593` line (one shaper for every axis; settle-gcode's
+//!   `RrfExport`), the shaper of the lowest-frequency tuned axis, since a shaper tuned
+//!   below a mode still reduces it, one tuned above it much less (the responses in
+//!   `planner/src/shaper/response.rs`); `M204` when the acceleration changes.
+//! - `tmc4361a.txt`: per axis, the TMC4361A ramp registers of the recommended move, from
+//!   the axis's own microsteps per mm; refused, with the reason, for what the chip cannot
+//!   run (a trapezoid's infinite bows, an input shaper, a value outside a register).
+
+use std::fmt::Write as _;
+
+use settle_gcode::config::{KlipperExport, RrfExport, ShaperSetting as FirmwareShaper};
+use settle_planner::ProfileKind;
+use settle_planner::shaper::Firmware as ShaperFirmware;
+use settle_planner::tmc::ramp::SRampParams;
+use settle_planner::tmc::registers::{TmcUnits, export};
+
+use super::Outcome;
+use super::search::Score;
+use crate::kinds::corner::Corner;
+use crate::kinds::shaping::DEFAULT_DAMPING_RATIO;
+
+/// The TMC4361A clock assumed when `[tune] tmc_clock_hz` is not given (Hz). In the chip's
+/// default (frequency) mode the clock appears only in CLK_FREQ, so the ramp registers do
+/// not depend on it; give the board's clock to have CLK_FREQ right.
+pub const DEFAULT_TMC_CLOCK_HZ: u32 = 16_000_000;
+
+/// The winner of the axis `letter` (`x`, `y`), from an outcome tuned on it (a corner path
+/// `x+y` moves both).
+fn winner_of<'a>(axes: &'a [(String, Outcome)], letter: &str) -> Option<&'a Outcome> {
+    axes.iter()
+        .find(|(a, _)| a.split('+').any(|x| x == letter))
+        .map(|(_, o)| o)
+}
+
+/// The firmware shaper of a score: `None` when the candidate is unshaped.
+fn shaper_of(s: &Score) -> Option<FirmwareShaper> {
+    let sh = s.candidate.shaper?;
+    let k = sh.kind?;
+    Some(FirmwareShaper {
+        name: k.name(),
+        frequency_hz: sh.frequency_hz,
+        damping_ratio: sh.damping_ratio,
+    })
+}
+
+/// Klipper's "no shaping" on an axis: frequency 0 (`klippy/extras/input_shaper.py`).
+fn klipper_off() -> FirmwareShaper {
+    FirmwareShaper {
+        name: "mzv".into(),
+        frequency_hz: 0.0,
+        damping_ratio: DEFAULT_DAMPING_RATIO,
+    }
+}
+
+/// Axis `letter`'s shaper for Klipper: the tuned winner's, else the current one from
+/// `[tune.axis.<letter>]`; `Err` names what is missing.
+fn klipper_axis(axes: &[(String, Outcome)], letter: &str) -> Result<FirmwareShaper, String> {
+    if let Some(o) = winner_of(axes, letter) {
+        let w = &o.scores[o.winner];
+        let Some(s) = shaper_of(w) else {
+            return Ok(klipper_off());
+        };
+        return match w.candidate.shaper.and_then(|sh| sh.kind) {
+            Some(k) if k.firmware() == ShaperFirmware::Klipper => Ok(s),
+            _ => Err(format!(
+                "the recommended shaper on {letter}, {}, is not one of Klipper's; tune with --firmware klipper",
+                s.name
+            )),
+        };
+    }
+    let current = axes
+        .first()
+        .and_then(|(_, o)| o.plan.spec.axis.as_ref())
+        .and_then(|m| m.get(letter));
+    match current {
+        Some(c) => match (c.shaper.as_deref(), c.frequency_hz) {
+            (Some("none"), _) | (_, None) => Ok(klipper_off()),
+            (name, Some(f)) => Ok(FirmwareShaper {
+                name: name.unwrap_or("mzv").to_string(),
+                frequency_hz: f,
+                damping_ratio: c.damping_ratio.unwrap_or(DEFAULT_DAMPING_RATIO),
+            }),
+        },
+        None => Err(format!(
+            "axis {letter} was not tuned and its current shaper is not known: tune it too ([tune] axes = [\"x\", \"y\"]) or give [tune.axis.{letter}]"
+        )),
+    }
+}
+
+/// The recommended acceleration: the lowest of the axes' winners (Klipper and
+/// RepRapFirmware have one for all axes), and whether it differs from the current one.
+fn accel(axes: &[(String, Outcome)]) -> Option<(f64, bool)> {
+    let rec = axes
+        .iter()
+        .map(|(_, o)| o.scores[o.winner].accel_mm_s2)
+        .fold(f64::INFINITY, f64::min);
+    let cur = axes
+        .iter()
+        .map(|(_, o)| o.scores[0].accel_mm_s2)
+        .fold(f64::INFINITY, f64::min);
+    rec.is_finite().then_some((rec, rec != cur))
+}
+
+/// `klipper.cfg`: the snippet, or comments saying why it is not written.
+pub fn klipper(axes: &[(String, Outcome)], produced_by: &str) -> String {
+    let mut head = String::new();
+    for (axis, o) in axes {
+        let w = &o.scores[o.winner];
+        if w.candidate.kind != ProfileKind::Trapezoid {
+            let _ = writeln!(
+                head,
+                "# note: Klipper plans trapezoids; the winner on {axis} is a {} move whose jerk has no Klipper setting",
+                w.candidate.kind
+            );
+        }
+    }
+    let (x, y) = match (klipper_axis(axes, "x"), klipper_axis(axes, "y")) {
+        (Ok(x), Ok(y)) => (x, y),
+        (Err(e), _) | (_, Err(e)) => return format!("{head}# no Klipper configuration: {e}\n"),
+    };
+    let scv = axes.iter().find_map(|(_, o)| {
+        o.plan
+            .base
+            .state::<Corner>()
+            .filter(|c| c.strategy.name() == "square_corner_velocity")
+            .map(|c| c.square_corner_velocity_mm_s)
+    });
+    let e = KlipperExport {
+        produced_by: produced_by.to_string(),
+        x,
+        y,
+        max_accel_mm_s2: accel(axes).and_then(|(a, changed)| changed.then_some(a)),
+        minimum_cruise_ratio: None,
+        square_corner_velocity_mm_s: scv,
+    };
+    match e.to_config() {
+        Ok(text) => format!("{head}{text}"),
+        Err(err) => format!("{head}# no Klipper configuration: {err}\n"),
+    }
+}
+
+/// `rrf.g`: the `M593` line (and `M204` when the acceleration changes), or comments saying
+/// why it is not written.
+pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
+    let mut shaped: Vec<(&str, &Score)> = axes
+        .iter()
+        .map(|(a, o)| (a.as_str(), &o.scores[o.winner]))
+        .collect();
+    shaped.sort_by(|a, b| {
+        let f = |s: &Score| {
+            s.candidate
+                .shaper
+                .filter(|sh| sh.kind.is_some())
+                .map_or(f64::INFINITY, |sh| sh.frequency_hz)
+        };
+        f(a.1).total_cmp(&f(b.1))
+    });
+    let Some((axis, w)) = shaped.first() else {
+        return "# no RepRapFirmware configuration: nothing was tuned\n".into();
+    };
+    let shaper = match (shaper_of(w), w.candidate.shaper.and_then(|s| s.kind)) {
+        (None, _) => FirmwareShaper {
+            name: "none".into(),
+            frequency_hz: 40.0,
+            damping_ratio: 0.1,
+        },
+        (Some(s), Some(k)) if k.firmware() == ShaperFirmware::Rrf => s,
+        (Some(s), _) => {
+            return format!(
+                "# no RepRapFirmware configuration: the recommended shaper on {axis}, {}, is not one of RepRapFirmware's; tune with --firmware rrf\n",
+                s.name
+            );
+        }
+    };
+    let mut head = String::new();
+    for (a, s) in shaped.iter().skip(1) {
+        let _ = writeln!(
+            head,
+            "; axis {a} alone would take {} (RepRapFirmware has one shaper for all axes: the lowest-frequency axis's is written)",
+            super::report::shaper_text(s)
+        );
+    }
+    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    let e = RrfExport {
+        produced_by: produced_by.to_string(),
+        shaper,
+        print_accel_mm_s2: a,
+        travel_accel_mm_s2: a,
+    };
+    match e.to_config() {
+        Ok(text) => format!("{head}{text}"),
+        Err(err) => format!("{head}; no RepRapFirmware configuration: {err}\n"),
+    }
+}
+
+/// `tmc4361a.txt`: per axis, the register file of the recommended move (the first of the
+/// move family), or why the chip cannot run it.
+pub fn tmc4361a(axes: &[(String, Outcome)]) -> String {
+    let mut out = String::new();
+    for (axis, o) in axes {
+        let _ = writeln!(out, "# axis {axis}");
+        match tmc_axis(axis, o) {
+            Ok(text) => out.push_str(&text),
+            Err(why) => {
+                let _ = writeln!(out, "# not written: {why}");
+            }
+        }
+    }
+    out
+}
+
+fn tmc_axis(axis: &str, o: &Outcome) -> Result<String, String> {
+    let plan = &o.plan;
+    let w = &o.scores[o.winner];
+    let c = &w.candidate;
+    let b = &plan.base;
+    if c.shaper.is_some_and(|sh| sh.kind.is_some()) {
+        return Err(format!(
+            "the recommendation {} is input-shaped; the TMC4361A's ramp generator cannot shape (tune with --firmware tmc4361a)",
+            c.label()
+        ));
+    }
+    let Some(j) = c.jmax_mm_s3 else {
+        return Err(
+            "the recommendation is a trapezoid, whose bows are infinite; the TMC4361A runs S-shaped ramps (tune with --firmware tmc4361a)".into(),
+        );
+    };
+    if matches!(c.kind, ProfileKind::PvtAsym | ProfileKind::PvtSym) {
+        return Err(format!(
+            "{} is a PVT profile; the TMC4361A runs S-shaped ramps (tune with --firmware tmc4361a)",
+            c.kind
+        ));
+    }
+    let usteps = plan
+        .spec
+        .axis
+        .as_ref()
+        .and_then(|m| m.get(axis))
+        .and_then(|a| a.usteps_per_mm)
+        .or(plan.spec.usteps_per_mm)
+        .ok_or_else(|| {
+            format!(
+                "the machine's microsteps per mm on {axis} are not known: give [tune.axis.{axis}] usteps_per_mm (settle import reads them from the firmware configuration)"
+            )
+        })?;
+    let units = TmcUnits {
+        f_clk_hz: plan.spec.tmc_clock_hz.unwrap_or(DEFAULT_TMC_CLOCK_HZ),
+        usteps_per_unit: usteps,
+        direct_acc: false,
+        direct_bow: false,
+    };
+    let (scale, dmax) = match c.kind {
+        ProfileKind::FourJerk => (
+            c.params.fourjerk_jerk_scale,
+            w.accel_mm_s2 * c.params.fourjerk_dmax_scale,
+        ),
+        _ => ([1.0; 4], w.accel_mm_s2),
+    };
+    let p = SRampParams {
+        vstart: 0.0,
+        vmax: b.vmax_mm_s,
+        vstop: 0.0,
+        amax: w.accel_mm_s2,
+        dmax,
+        bow: scale.map(|s| j * s),
+    };
+    let target = b.start_mm + plan.distances_mm.first().copied().unwrap_or(b.distance_mm);
+    let r = export(target, &p, &units).map_err(|e| e.to_string())?;
+    Ok(format!(
+        "# the recommendation {} as a move to {target} mm\n{}",
+        c.label(),
+        r.register_file_text(&units)
+    ))
+}

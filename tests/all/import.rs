@@ -1,0 +1,178 @@
+//! `settle import`: a Klipper printer.cfg and a RepRapFirmware config.g become a scenario
+//! whose own point is the user's current settings, marked in `[current]` among a sweep
+//! around them. The configurations are settle-gcode's test files, whose values were
+//! checked against the firmwares' own code (gcode/tests/gcode/config_klipper.rs,
+//! config_rrf.rs); malformed keys are errors naming file, line and key.
+
+use std::path::{Path, PathBuf};
+
+use settle::error::Error;
+use settle::workflows::import::{ImportOptions, import};
+use settle::workflows::tune::firmware::Firmware;
+
+use crate::support::root;
+
+fn voron() -> PathBuf {
+    root().join("gcode/tests/data/klipper/voron/printer.cfg")
+}
+
+fn mini5plus() -> PathBuf {
+    root().join("gcode/tests/data/rrf/mini5plus/sys/config.g")
+}
+
+fn opts(firmware: Firmware, config: PathBuf, out: &Path) -> ImportOptions {
+    ImportOptions {
+        firmware,
+        config,
+        machine: None,
+        out: Some(out.to_path_buf()),
+    }
+}
+
+fn current(sc: &settle::input::scenario::Scenario, key: &str) -> toml::Value {
+    sc.current
+        .as_ref()
+        .and_then(|c| c.get(key))
+        .cloned()
+        .unwrap_or_else(|| panic!("[current] {key}"))
+}
+
+fn swept(sc: &settle::input::scenario::Scenario, key: &str) -> Vec<toml::Value> {
+    sc.sweep
+        .get(key)
+        .and_then(|v| v.as_array())
+        .cloned()
+        .unwrap_or_else(|| panic!("[sweep] {key}"))
+}
+
+#[test]
+fn klipper_config_becomes_a_scenario_of_the_current_settings() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("voron.toml");
+    let i = import(&opts(Firmware::Klipper, voron(), &out)).expect("imports");
+    // The Voron's values as Klipper reads them (user_overrides.cfg's max_accel,
+    // SAVE_CONFIG's per-axis shapers, 200 x 32 / 40 mm microsteps per mm).
+    let c = &i.current;
+    assert_eq!((c.vmax_mm_s, c.amax_mm_s2), (300.0, 4000.0));
+    assert_eq!(c.axes[0].shaper, Some(("mzv".into(), 54.2, 0.08)));
+    assert_eq!(c.axes[1].shaper, Some(("ei".into(), 41.4, 0.1)));
+    assert_eq!(c.axes[0].usteps_per_mm, Some(160.0));
+    assert_eq!(i.axes, ["x", "y"]);
+    assert!(
+        i.notes
+            .iter()
+            .any(|n| n.contains("no --machine") && n.contains("printer_xy")),
+        "{:?}",
+        i.notes
+    );
+    // The written scenario loads; its own point is the current X settings...
+    let (sc, runs) = settle::load_runs(&out).expect("loads");
+    assert_eq!(std::fs::read_to_string(&out).expect("written"), i.scenario);
+    assert_eq!(current(&sc, "shaper.type").as_str(), Some("mzv"));
+    assert_eq!(current(&sc, "shaper.frequency_hz").as_float(), Some(54.2));
+    assert_eq!(current(&sc, "limits.amax_mm_s2").as_float(), Some(4000.0));
+    // ...every [current] value is among the swept ones...
+    for key in ["shaper.type", "shaper.frequency_hz", "limits.amax_mm_s2"] {
+        assert!(swept(&sc, key).contains(&current(&sc, key)), "{key}");
+    }
+    // ...with Klipper's six shapers and no shaping, 5 frequencies, 3 accelerations.
+    assert_eq!(swept(&sc, "shaper.type").len(), 7);
+    assert_eq!(runs.len(), 7 * 5 * 3);
+    let t = sc.tune.as_ref().expect("[tune]");
+    assert_eq!(t.firmware.as_deref(), Some("klipper"));
+    let y = &t.axis.as_ref().expect("[tune.axis]")["y"];
+    assert_eq!(
+        (
+            y.shaper.as_deref(),
+            y.frequency_hz,
+            y.damping_ratio,
+            y.usteps_per_mm
+        ),
+        (Some("ei"), Some(41.4), Some(0.1), Some(160.0))
+    );
+    // The report names the next command.
+    let r = i.report();
+    assert!(r.stdout.contains("next: settle tune"), "{}", r.stdout);
+}
+
+#[test]
+fn rrf_config_has_one_shaper_for_every_axis() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("mini.toml");
+    let i = import(&opts(Firmware::Rrf, mini5plus(), &out)).expect("imports");
+    let c = &i.current;
+    // M203 X300 (mm/min / 60 applied by the reader); printing moves at the lower of
+    // M204 P2000 and M201 X3000/Y3000.
+    assert_eq!((c.vmax_mm_s, c.amax_mm_s2), (300.0, 2000.0));
+    for a in &c.axes {
+        assert_eq!(a.shaper, Some(("rrf:mzv".into(), 42.5, 0.1)));
+        assert_eq!(a.usteps_per_mm, Some(160.0));
+    }
+    let (sc, _) = settle::load_runs(&out).expect("loads");
+    assert_eq!(current(&sc, "shaper.type").as_str(), Some("rrf:mzv"));
+    // RepRapFirmware's shapers are the ones swept.
+    let types = swept(&sc, "shaper.type");
+    assert!(
+        types.iter().any(|t| t.as_str() == Some("rrf:ei2")),
+        "{types:?}"
+    );
+    assert!(!types.iter().any(|t| t.as_str() == Some("zv")), "{types:?}");
+}
+
+#[test]
+fn malformed_key_names_file_line_and_key_unknown_sections_are_ignored() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cfg = dir.path().join("printer.cfg");
+    std::fs::write(
+        &cfg,
+        "[some_plugin]\nanything: goes\n[printer]\nkinematics: cartesian\nmax_velocity: 300\nmax_accel: fast\n",
+    )
+    .expect("writes");
+    let e = import(&opts(
+        Firmware::Klipper,
+        cfg.clone(),
+        &dir.path().join("o.toml"),
+    ))
+    .expect_err("malformed max_accel");
+    assert!(e.is_input_error());
+    let Error::Input { at, message } = &e else {
+        panic!("{e}")
+    };
+    assert_eq!(at.file, cfg);
+    assert_eq!(at.line, Some(6));
+    assert_eq!(at.key.as_deref(), Some("printer.max_accel"));
+    assert!(message.contains("fast"), "{message}");
+    // The unknown section alone is no error.
+    std::fs::write(
+        &cfg,
+        "[some_plugin]\nanything: goes\n[printer]\nkinematics: cartesian\nmax_velocity: 300\nmax_accel: 3000\n",
+    )
+    .expect("writes");
+    let i = import(&opts(Firmware::Klipper, cfg, &dir.path().join("o.toml"))).expect("imports");
+    assert_eq!(i.current.amax_mm_s2, 3000.0);
+    // No [input_shaper]: not shaped, and the sweep centres on the machine's mode.
+    assert_eq!(i.current.axes[0].shaper, None);
+    let (sc, _) = settle::load_runs(&dir.path().join("o.toml")).expect("loads");
+    assert_eq!(current(&sc, "shaper.type").as_str(), Some("none"));
+}
+
+#[test]
+fn import_command_exit_codes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("v.toml");
+    let r = crate::support::settle()
+        .args(["import", "klipper"])
+        .arg(voron())
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("runs");
+    assert!(r.status.success(), "{r:?}");
+    assert!(out.is_file());
+    let r = crate::support::settle()
+        .args(["import", "klipper"])
+        .arg(dir.path().join("missing.cfg"))
+        .output()
+        .expect("runs");
+    assert_eq!(r.status.code(), Some(2), "{r:?}");
+}

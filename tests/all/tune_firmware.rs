@@ -1,0 +1,261 @@
+//! `settle tune` as a printer user needs it: candidates restricted to what a firmware runs,
+//! Klipper's smoothing and max_accel per candidate (checked against numbers Klipper's own
+//! code printed) used as a constraint, the frequency-tolerance worst case, and
+//! `--criterion klipper` reproducing calibrate_shaper.py's lines on its calibration files.
+
+use std::path::{Path, PathBuf};
+
+use settle::spec::backend::Backend;
+use settle::workflows::tune::{Options, tune_axis};
+use settle_planner::ProfileKind;
+use settle_planner::shaper::Firmware as ShaperFirmware;
+
+use crate::support::{root, write};
+
+/// One mode at 47.2 Hz (the `one_peak` calibration file's MZV frequency), Klipper-style
+/// trapezoids.
+fn scenario(tune: &str) -> String {
+    format!(
+        r#"name = "fw_test"
+[machine]
+modes = [{{ frequency_hz = 47.2, damping_ratio = 0.05 }}]
+[move]
+distance_mm = 20.0
+profile = "trapezoid"
+[limits]
+vmax_mm_s = 300.0
+amax_mm_s2 = 3000.0
+jmax_mm_s3 = 100000.0
+[observe]
+window_s = 0.4
+sample_rate_hz = 5000
+bands_um = [10.0]
+[tune]
+{tune}
+"#
+    )
+}
+
+fn run(dir: &Path, tune: &str, opts: &Options) -> settle::workflows::tune::Outcome {
+    let p = write(dir, "fw_test.toml", &scenario(tune));
+    tune_axis(&p, None, opts, &settle::execute::pool::quiet).expect("tunes")
+}
+
+fn modal() -> Options {
+    Options {
+        jobs: Some(2),
+        ..Options::new(Backend::Modal)
+    }
+}
+
+#[test]
+fn firmware_restricts_the_candidates() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let small = "frequency_scales = [1.0]\njerk_steps = 1\n";
+    for (fw, shaper_fw) in [
+        ("klipper", Some(ShaperFirmware::Klipper)),
+        ("marlin", Some(ShaperFirmware::Marlin)),
+        ("rrf", Some(ShaperFirmware::Rrf)),
+        ("tmc4361a", None),
+    ] {
+        let o = run(
+            dir.path(),
+            small,
+            &Options {
+                firmware: Some(fw.into()),
+                ..modal()
+            },
+        );
+        let grid = &o.scores[1..o.plan.candidates.len()];
+        assert!(!grid.is_empty());
+        for s in grid {
+            let c = &s.candidate;
+            let kind = c.shaper.and_then(|sh| sh.kind);
+            match shaper_fw {
+                Some(f) => {
+                    assert_eq!(c.kind, ProfileKind::Trapezoid, "{fw}: {}", c.label());
+                    assert!(
+                        kind.is_none_or(|k| k.firmware() == f),
+                        "{fw}: {}",
+                        c.label()
+                    );
+                }
+                None => {
+                    assert!(
+                        matches!(c.kind, ProfileKind::SCurve | ProfileKind::FourJerk),
+                        "{fw}: {}",
+                        c.label()
+                    );
+                    assert!(kind.is_none(), "{fw}: {}", c.label());
+                }
+            }
+        }
+        // Klipper: none + its six shapers at the one mode frequency.
+        if fw == "klipper" {
+            assert_eq!(grid.len(), 7);
+        }
+    }
+    // A shaper the firmware does not run: the key is named.
+    let p = write(
+        dir.path(),
+        "bad.toml",
+        &scenario("firmware = \"klipper\"\nshapers = [\"rrf:ei2\"]\n"),
+    );
+    let e = tune_axis(&p, None, &modal(), &settle::execute::pool::quiet).expect_err("refused");
+    let text = e.to_string();
+    assert!(
+        text.contains("tune.shapers") && text.contains("klipper"),
+        "{text}"
+    );
+}
+
+#[test]
+fn smoothing_and_max_accel_are_klippers_and_bound_the_acceleration() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = run(
+        dir.path(),
+        "firmware = \"klipper\"\nshapers = [\"mzv\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [5000.0, 7000.0]\n",
+        &modal(),
+    );
+    // Klipper's numbers for MZV at 47.19999999999992 Hz, damping 0.1, at 5000 mm/s^2 and
+    // 5 mm/s (calibrate_shaper.py on planner/tests/data/klipper_one_peak.csv, see
+    // planner/tests/all/shaper_select.rs): smoothing 0.09142074090152724 mm, max_accel
+    // 6563.062102569528 mm/s^2 (smoothing <= 0.12 mm). settle's grid has 47.2 Hz exactly.
+    let at = |a: f64| {
+        o.scores
+            .iter()
+            .find(|s| s.candidate.amax_mm_s2 == Some(a))
+            .expect("candidate")
+    };
+    let s5 = at(5000.0);
+    assert!(
+        (s5.smoothing_mm - 0.09142074090152724).abs() < 1e-9,
+        "{s5:?}"
+    );
+    assert!(
+        (s5.max_accel_mm_s2 - 6563.062102569528).abs() < 1e-5,
+        "{s5:?}"
+    );
+    assert!(s5.move_and_settle_s.is_finite(), "{s5:?}");
+    // 7000 mm/s^2 is above max_accel: the smoothing passes 0.12 mm, the candidate is out.
+    let s7 = at(7000.0);
+    assert!(s7.smoothing_mm > 0.12, "{s7:?}");
+    assert!(s7.move_and_settle_s.is_infinite(), "{s7:?}");
+    // A looser limit lets it in.
+    let o = run(
+        dir.path(),
+        "firmware = \"klipper\"\nshapers = [\"mzv\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [7000.0]\nmax_smoothing_mm = 0.2\n",
+        &modal(),
+    );
+    assert!(
+        o.scores[1].move_and_settle_s.is_finite(),
+        "{:?}",
+        o.scores[1]
+    );
+}
+
+#[test]
+fn frequency_tolerance_scores_the_worst_detuned_case() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let t =
+        "firmware = \"klipper\"\nshapers = [\"none\", \"zv\", \"ei\"]\nfrequency_scales = [1.0]\n";
+    let nominal = run(dir.path(), t, &modal());
+    let robust = run(
+        dir.path(),
+        t,
+        &Options {
+            frequency_tolerance_pct: Some(10.0),
+            ..modal()
+        },
+    );
+    assert_eq!(nominal.scores.len(), robust.scores.len());
+    for (n, r) in nominal.scores.iter().zip(&robust.scores) {
+        assert_eq!(n.candidate, r.candidate);
+        if n.candidate.shaper.and_then(|s| s.kind).is_some() {
+            // The worst of nominal, -10 % and +10 %: never better than nominal.
+            assert!(r.move_and_settle_s >= n.move_and_settle_s, "{n:?} {r:?}");
+        } else {
+            assert_eq!(r.move_and_settle_s, n.move_and_settle_s);
+        }
+    }
+    // Detuned by 10 %, ZV (zero vibration at one frequency) leaves more than EI (designed
+    // for <= 5 % over a band): the worst cases say so.
+    let worst = |name: &str| {
+        robust
+            .scores
+            .iter()
+            .find(|s| {
+                s.candidate
+                    .shaper
+                    .and_then(|sh| sh.kind)
+                    .map(|k| k.name())
+                    .as_deref()
+                    == Some(name)
+            })
+            .expect("shaped candidate")
+            .residual_peak_um
+    };
+    assert!(
+        worst("zv") > worst("ei"),
+        "zv {} ei {}",
+        worst("zv"),
+        worst("ei")
+    );
+    // A bad tolerance names the option.
+    let p = write(dir.path(), "x.toml", &scenario(t));
+    let e = tune_axis(
+        &p,
+        None,
+        &Options {
+            frequency_tolerance_pct: Some(80.0),
+            ..modal()
+        },
+        &settle::execute::pool::quiet,
+    )
+    .expect_err("refused");
+    assert!(e.to_string().contains("--frequency-tolerance"), "{e}");
+}
+
+fn calibration(file: &str) -> PathBuf {
+    root().join("planner/tests/data").join(file)
+}
+
+#[test]
+fn klipper_criterion_prints_what_calibrate_shaper_printed() {
+    // The recommendations calibrate_shaper.py printed for these files (Klipper 84104bbbd762,
+    // planner/tests/all/shaper_select.rs).
+    for (file, want) in [
+        (
+            "klipper_one_peak.csv",
+            "Recommended shaper is mzv @ 47.2 Hz",
+        ),
+        (
+            "klipper_two_peaks.csv",
+            "Recommended shaper is mzv @ 39.0 Hz",
+        ),
+        (
+            "klipper_low_peak.csv",
+            "Recommended shaper is mzv @ 25.6 Hz",
+        ),
+    ] {
+        let r = settle::workflows::tune::klipper_criterion::report(&calibration(file))
+            .expect("chooses");
+        assert_eq!(r.stdout.lines().last(), Some(want), "{file}:\n{}", r.stdout);
+    }
+    // The per-shaper lines, from the same run's numbers for one_peak (zv: 46.0 Hz,
+    // vibrations 1.49 %, smoothing 0.0783, max_accel 8246 -> 8200).
+    let r = crate::support::settle()
+        .args(["tune", "--criterion", "klipper"])
+        .arg(calibration("klipper_one_peak.csv"))
+        .output()
+        .expect("runs");
+    assert!(r.status.success(), "{r:?}");
+    let out = String::from_utf8_lossy(&r.stdout);
+    for want in [
+        "Fitted shaper 'zv' frequency = 46.0 Hz (vibrations = 1.5%, smoothing ~= 0.078)",
+        "To avoid too much smoothing with 'zv', suggested max_accel <= 8200 mm/sec^2",
+        "To avoid too much smoothing with 'mzv', suggested max_accel <= 6600 mm/sec^2",
+    ] {
+        assert!(out.contains(want), "missing `{want}` in\n{out}");
+    }
+}
