@@ -24,6 +24,7 @@ pub mod tune_report;
 pub mod validate;
 // Outputs people keep (issue 7).
 pub mod check;
+pub mod html;
 pub mod outputs;
 pub mod plot;
 pub mod shard;
