@@ -1,0 +1,536 @@
+//! `report.html` (settle::html): deterministic, escaped, and working in a real browser.
+//!
+//! The browser tests drive headless Chromium (`/usr/bin/chromium`, Debian's `chromium`
+//! package; `scripts/browser-test.sh` installs it) through the page's `#selftest` hook: it
+//! clicks a header through the real click handler, types into the filters and writes what
+//! the page then shows into the DOM, which `--dump-dom` prints. `SETTLE_SKIP_BROWSER=1`
+//! skips them with a notice; otherwise a missing browser fails them.
+//! `SETTLE_HTML_ROWS` sets the rows of the generated large table (default 6,000: just above
+//! the size at which the script pages the table from its text).
+
+#[path = "support/html/chromium.rs"]
+mod chromium;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use chromium::{Rect, browser, console_clean, region_spread, selftest_result, visit};
+use settle::html::{
+    BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, LAZY_ROWS, Provenance, Reference,
+    Report, Stat, Table, render,
+};
+
+fn repo_file(rel: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// A column of `t` as numbers (`inf` for not settled).
+fn column(t: &Table, name: &str) -> Vec<f64> {
+    let j = t.header.iter().position(|h| h == name).expect("column");
+    t.rows
+        .iter()
+        .map(|r| match &r[j] {
+            Cell::Number { value, .. } => *value,
+            other => panic!("{name}: not a number: {other:?}"),
+        })
+        .collect()
+}
+
+/// The shown texts of column `name` in the order a correct sort gives: by value, ascending
+/// or descending, non-finite values last either way, ties in row order.
+fn sorted_texts(t: &Table, name: &str, ascending: bool) -> Vec<String> {
+    let j = t.header.iter().position(|h| h == name).expect("column");
+    let values = column(t, name);
+    let mut idx: Vec<usize> = (0..values.len()).collect();
+    idx.sort_by(|&a, &b| {
+        let (x, y) = (values[a], values[b]);
+        match (x.is_finite(), y.is_finite()) {
+            (true, true) if ascending => x.total_cmp(&y),
+            (true, true) => y.total_cmp(&x),
+            (fx, fy) => fy.cmp(&fx),
+        }
+        .then(a.cmp(&b))
+    });
+    idx.iter()
+        .map(|&i| t.rows[i][j].shown().to_string())
+        .collect()
+}
+
+/// `Ok` when the page showed exactly `expected`.
+fn check_order(shown: &serde_json::Value, expected: &[String]) -> Result<(), String> {
+    let shown: Vec<String> = shown
+        .as_array()
+        .ok_or("no column in the selftest result")?
+        .iter()
+        .map(|v| v.as_str().unwrap_or_default().to_string())
+        .collect();
+    if shown == expected {
+        Ok(())
+    } else {
+        Err(format!("shown {shown:?}, expected {expected:?}"))
+    }
+}
+
+/// A bar chart of the move-and-settle times, written here as a small SVG (the crate's own
+/// plots are wired in by the sweep's output code).
+fn bar_svg(labels: &[String], ms: &[f64]) -> String {
+    let mut s = String::from(
+        "<?xml version=\"1.0\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"640\" \
+         height=\"260\" viewBox=\"0 0 640 260\"><rect width=\"640\" height=\"260\" \
+         fill=\"#fff\"/><line x1=\"60\" y1=\"220\" x2=\"620\" y2=\"220\" stroke=\"#333\"/>",
+    );
+    let top = ms
+        .iter()
+        .cloned()
+        .filter(|x| x.is_finite())
+        .fold(1.0, f64::max);
+    for (i, (label, &v)) in labels.iter().zip(ms).enumerate() {
+        let h = if v.is_finite() {
+            180.0 * v / top
+        } else {
+            200.0
+        };
+        let x = 70.0 + 90.0 * i as f64;
+        let fill = if v.is_finite() { "#3b78d8" } else { "#c0392b" };
+        s.push_str(&format!(
+            "<rect x=\"{x}\" y=\"{}\" width=\"60\" height=\"{h}\" fill=\"{fill}\"/><text \
+             x=\"{x}\" y=\"240\" font-size=\"12\">{label}</text>",
+            220.0 - h
+        ));
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// The committed quickstart baseline as a report: its runs, per-band winners among the
+/// 10 mm moves (against the slowest), a table of totals in ms, an SVG and a PNG figure.
+fn quickstart_report() -> Report {
+    let csv = repo_file("results/baselines/ci_quickstart.modal.csv");
+    let mut runs = Table::from_csv("All runs", &csv).expect("baseline CSV");
+    runs.note = "One row per run, as in runs.csv; times in s, lengths in um.".into();
+    let profile = |i: usize| runs.rows[i][1].shown().to_string();
+    let distance = column(&runs, "distance_mm");
+    let mut winners = Vec::new();
+    for band in ["10um", "50um"] {
+        let totals = column(&runs, &format!("move_and_settle_s_{band}"));
+        let at_10: Vec<usize> = (0..totals.len()).filter(|&i| distance[i] == 10.0).collect();
+        let best = *at_10
+            .iter()
+            .min_by(|&&a, &&b| totals[a].total_cmp(&totals[b]))
+            .expect("runs at 10 mm");
+        let slowest = *at_10
+            .iter()
+            .max_by(|&&a, &&b| totals[a].total_cmp(&totals[b]))
+            .expect("runs at 10 mm");
+        winners.push(BandWinner {
+            band: format!("10 mm move, within {}", band.replace("um", " um")),
+            winner: profile(best),
+            numbers: vec![Stat {
+                label: "move and settle".into(),
+                value: format!("{:.1} ms", totals[best] * 1e3),
+            }],
+            gain: Some(Gain {
+                reference: Reference::Slowest {
+                    label: profile(slowest),
+                },
+                ratio: totals[slowest] / totals[best],
+                detail: format!(
+                    "{:.1} ms vs {:.1} ms",
+                    totals[best] * 1e3,
+                    totals[slowest] * 1e3
+                ),
+            }),
+        });
+    }
+    let totals = column(&runs, "move_and_settle_s_10um");
+    let ms = |s: f64| Cell::Number {
+        value: s * 1e3,
+        text: if s.is_finite() {
+            format!("{:.1}", s * 1e3)
+        } else {
+            "not settled".into()
+        },
+    };
+    let table = Table {
+        title: "Move and settle to within 10 um (ms)".into(),
+        note: "Trapezoid and S-curve side by side per move length.".into(),
+        header: vec!["distance_mm".into(), "trapezoid".into(), "scurve".into()],
+        rows: (0..totals.len() / 2)
+            .map(|k| {
+                vec![
+                    Cell::number(distance[2 * k]),
+                    ms(totals[2 * k]),
+                    ms(totals[2 * k + 1]),
+                ]
+            })
+            .collect(),
+    };
+    let labels: Vec<String> = (0..totals.len())
+        .map(|i| format!("{} {}", profile(i), distance[i]))
+        .collect();
+    let ms_all: Vec<f64> = totals.iter().map(|s| s * 1e3).collect();
+    let gradient = image::RgbImage::from_fn(200, 40, |x, y| {
+        image::Rgb([(x * 255 / 199) as u8, (y * 6) as u8, 128])
+    });
+    let mut png = Vec::new();
+    image::DynamicImage::ImageRgb8(gradient)
+        .write_to(
+            &mut std::io::Cursor::new(&mut png),
+            image::ImageOutputFormat::Png,
+        )
+        .expect("PNG encodes");
+    Report {
+        title: "ci_quickstart".into(),
+        intro: vec![
+            "CI gate: 40 Hz, zeta 0.05 axis; trapezoid vs S-curve at 0.5, 2 and 10 mm.".into(),
+            "Backend modal, 6 runs, 0.2 s observation windows.".into(),
+        ],
+        winners,
+        tables: vec![table],
+        figures: vec![
+            Figure {
+                title: "Move and settle to within 10 um (ms; red: not settled)".into(),
+                image: Image::Svg(bar_svg(&labels, &ms_all)),
+            },
+            Figure {
+                title: "A PNG figure (colour gradient)".into(),
+                image: Image::Png(png),
+            },
+        ],
+        runs: Some(runs),
+        failed: Vec::new(),
+        provenance: Provenance {
+            settle_version: "0.1.0".into(),
+            backend: "modal".into(),
+            command_line: "settle sweep scenarios/ci_quickstart.toml --out results/quick".into(),
+            date: "2025-01-01".into(),
+            inputs: vec![InputFile {
+                name: "scenarios/ci_quickstart.toml".into(),
+                text: repo_file("scenarios/ci_quickstart.toml"),
+            }],
+        },
+    }
+}
+
+/// Write `html` as `report.html` in a new temporary folder (and as `NAME.html` in the folder
+/// `SETTLE_HTML_KEEP` names, when set, to look at).
+fn write_page(name: &str, html: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let path = dir.path().join("report.html");
+    std::fs::write(&path, html).expect("write report.html");
+    if let Some(keep) = std::env::var_os("SETTLE_HTML_KEEP") {
+        std::fs::write(Path::new(&keep).join(format!("{name}.html")), html).expect("keep page");
+    }
+    (dir, path)
+}
+
+#[test]
+fn render_is_deterministic() {
+    let r = quickstart_report();
+    let a = render(&r);
+    let b = render(&r.clone());
+    assert!(a == b, "two renders of the same report differ");
+    // One file: no reference to anything outside it.
+    for outside in [
+        "http://",
+        "https://",
+        "<link",
+        "src=\"http",
+        "@import",
+        "url(",
+    ] {
+        let hits: Vec<&str> = a
+            .lines()
+            .filter(|l| l.contains(outside) && !l.contains("xmlns=\"http://www.w3.org"))
+            .collect();
+        assert!(hits.is_empty(), "{outside}: {hits:?}");
+    }
+}
+
+#[test]
+fn every_text_is_escaped() {
+    let evil = "</pre></noscript><script>alert('x')</script> & \"q\"";
+    let mut r = quickstart_report();
+    r.title = evil.into();
+    r.intro = vec![evil.into()];
+    r.winners[0].winner = evil.into();
+    r.winners[0].numbers[0].label = evil.into();
+    r.tables[0].header[0] = evil.into();
+    r.tables[0].rows[0][0] = Cell::Link {
+        text: evil.into(),
+        href: evil.into(),
+    };
+    r.figures[0].title = evil.into();
+    r.failed = vec![FailedRun {
+        run: "7".into(),
+        status: "lost_steps".into(),
+        reason: evil.into(),
+    }];
+    r.provenance.command_line = evil.into();
+    r.provenance.inputs[0].text = format!("name = \"a<b & c\"\n{evil}\n");
+    // A large plain table goes inside <noscript>: its text must not close it either.
+    let mut big = Table {
+        title: evil.into(),
+        note: evil.into(),
+        header: vec!["v".into(), evil.into()],
+        rows: Vec::new(),
+    };
+    big.rows = (0..=LAZY_ROWS)
+        .map(|i| vec![Cell::number(i as f64), Cell::text(evil)])
+        .collect();
+    r.runs = Some(big);
+    let html = render(&r);
+    assert_eq!(
+        html.matches("<script").count(),
+        1,
+        "only the page's own script"
+    );
+    assert_eq!(html.matches("</noscript>").count(), 1);
+    assert_eq!(html.matches("</pre>").count(), 1);
+    let escaped = "&lt;/pre&gt;&lt;/noscript&gt;&lt;script&gt;alert(&#39;x&#39;)\
+                   &lt;/script&gt; &amp; &quot;q&quot;";
+    // Title (twice), intro, winner, stat, header, link text and href, figure, failed
+    // reason, command line, input text, and the large table's title, note, header and
+    // every row.
+    assert_eq!(html.matches(escaped).count(), 15 + LAZY_ROWS + 1);
+    assert!(html.contains("name = &quot;a&lt;b &amp; c&quot;"));
+}
+
+#[test]
+fn report_renders_sorts_and_logs_nothing_in_chromium() {
+    let Some(chrome) = browser() else { return };
+    let start = Instant::now();
+    let report = quickstart_report();
+    let (_dir, page) = write_page("quickstart", &render(&report));
+    let runs = report.runs.as_ref().expect("runs");
+    let col = "move_and_settle_s_10um";
+    // The screenshot (a plain visit) runs beside the selftest visit.
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let shot = dir.path().join("shot.png");
+    let screenshot = {
+        let (chrome, page) = (chrome.clone(), page.clone());
+        let arg = format!("--screenshot={}", shot.display());
+        std::thread::spawn(move || visit(&chrome, &page, "", &[&arg]))
+    };
+    let v = visit(
+        &chrome,
+        &page,
+        &format!("#selftest&col={col}"),
+        &["--dump-dom"],
+    );
+    console_clean(&v).expect("no console messages");
+    let res = selftest_result(&v.stdout).expect("the selftest ran to its end");
+    assert_eq!(res["errors"], serde_json::json!([]));
+    assert_eq!(res["rows"], 6);
+    assert_eq!(res["lazy"], false);
+    check_order(&res["asc"], &sorted_texts(runs, col, true)).expect("ascending order");
+    check_order(&res["desc"], &sorted_texts(runs, col, false)).expect("descending order");
+    assert_eq!(res["asc_aria"], "ascending");
+    assert_eq!(res["desc_aria"], "descending");
+    assert_eq!(res["images"], serde_json::json!([200]), "the PNG decodes");
+    assert_eq!(
+        res["columns"],
+        serde_json::json!(runs.header),
+        "every column"
+    );
+    let table = Rect::from_json(&res["rects"]["table"]).expect("table box");
+    let figure = Rect::from_json(&res["rects"]["figure"]).expect("figure box");
+
+    let s = screenshot.join().expect("screenshot visit");
+    console_clean(&s).expect("no console messages");
+    let img = image::open(&shot).expect("screenshot PNG").to_rgba8();
+    assert_eq!((img.width(), img.height()), (1280, 2000));
+    for (name, rect) in [("runs table", table), ("figure", figure)] {
+        let (spread, share) = region_spread(&img, rect);
+        eprintln!("{name}: {rect:?}, {share:.2} visible, luminance deviation {spread:.1}");
+        assert!(share > 0.3, "{name} is off screen: {rect:?}");
+        assert!(spread > 20.0, "{name} looks blank: deviation {spread:.1}");
+    }
+    eprintln!(
+        "browser test: {:.2} s (dump {:.2} s, screenshot {:.2} s)",
+        start.elapsed().as_secs_f64(),
+        v.elapsed.as_secs_f64(),
+        s.elapsed.as_secs_f64()
+    );
+}
+
+#[test]
+fn a_broken_script_fails_the_console_check() {
+    let Some(chrome) = browser() else { return };
+    let html = render(&quickstart_report());
+    let broken = html.replacen("'use strict';", "'use strict'; var broken = ;", 1);
+    assert_ne!(broken, html, "the script has its strict-mode line");
+    let (_dir, page) = write_page("broken_script", &broken);
+    let v = visit(&chrome, &page, "#selftest", &["--dump-dom"]);
+    let err = console_clean(&v).expect_err("a syntax error shows on the console");
+    assert!(err.contains("SyntaxError"), "{err}");
+    assert!(selftest_result(&v.stdout).is_none());
+}
+
+#[test]
+fn a_broken_sort_fails_the_order_check() {
+    let Some(chrome) = browser() else { return };
+    let report = quickstart_report();
+    let html = render(&report);
+    let head = "function cmpNum(x, y, dir) {";
+    let broken = html.replacen(head, &format!("{head} return 0;"), 1);
+    assert_ne!(broken, html, "the script has its number comparison");
+    let (_dir, page) = write_page("broken_sort", &broken);
+    let col = "move_and_settle_s_10um";
+    let v = visit(
+        &chrome,
+        &page,
+        &format!("#selftest&col={col}"),
+        &["--dump-dom"],
+    );
+    let res = selftest_result(&v.stdout).expect("the selftest ran to its end");
+    let runs = report.runs.as_ref().expect("runs");
+    assert!(check_order(&res["asc"], &sorted_texts(runs, col, true)).is_err());
+    assert!(check_order(&res["desc"], &sorted_texts(runs, col, false)).is_err());
+}
+
+/// Deterministic pseudo-random numbers (SplitMix64).
+fn splitmix(state: &mut u64) -> u64 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// A table like the quickstart's runs.csv (the same 26 columns) with `n` generated runs:
+/// three profiles, 5 % lost steps, 5 % faults, random numbers, 10 % of the settling times
+/// `inf` (not settled).
+fn generated_csv(n: usize) -> String {
+    let baseline = repo_file("results/baselines/ci_quickstart.modal.csv");
+    let header: Vec<&str> = baseline
+        .lines()
+        .next()
+        .expect("header")
+        .split(',')
+        .collect();
+    let mut s = 1u64;
+    let mut csv = format!("{}\n", header.join(","));
+    for i in 0..n {
+        let (status, reason) = match splitmix(&mut s) % 20 {
+            0 => ("lost_steps", "lost 4 steps (load angle past 90 deg)"),
+            1 => ("fault", "simulation diverged"),
+            _ => ("ok", ""),
+        };
+        let cells: Vec<String> = header
+            .iter()
+            .map(|&name| {
+                let r = splitmix(&mut s);
+                let unit = (r >> 11) as f64 / (1u64 << 53) as f64;
+                match name {
+                    "run" => i.to_string(),
+                    "profile" => ["trapezoid", "scurve", "fourjerk"][(r % 3) as usize].into(),
+                    "machine" => "modes".into(),
+                    "axis" => "x".into(),
+                    "driver" => "linear".into(),
+                    "backend" => "modal".into(),
+                    "status" => status.into(),
+                    "reason" => reason.into(),
+                    "lost_steps" => u64::from(status == "lost_steps").to_string(),
+                    n if n.starts_with("settle_time") || n.starts_with("move_and_settle") => {
+                        if r % 10 == 0 {
+                            "inf".into()
+                        } else {
+                            (unit * 0.3).to_string()
+                        }
+                    }
+                    _ => (unit * 100.0).to_string(),
+                }
+            })
+            .collect();
+        csv.push_str(&cells.join(","));
+        csv.push('\n');
+    }
+    csv
+}
+
+#[test]
+fn a_large_table_is_paged_sorted_and_filtered_in_chromium() {
+    let Some(chrome) = browser() else { return };
+    let n: usize = std::env::var("SETTLE_HTML_ROWS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(LAZY_ROWS + 1_000);
+    let runs = Table::from_csv("All runs", &generated_csv(n)).expect("generated CSV");
+    let report = Report {
+        title: format!("{n} generated runs"),
+        runs: Some(runs.clone()),
+        ..Report::default()
+    };
+    let html = render(&report);
+    assert_eq!(html.contains("data-lazy"), n > LAZY_ROWS);
+    let (_dir, page) = write_page("large", &html);
+    // Without JavaScript the same rows are a real table (checked beside the selftest).
+    let plain = {
+        let (chrome, html) = (chrome.clone(), html.clone());
+        std::thread::spawn(move || parsed_without_scripts(&chrome, &html))
+    };
+    let col = "settle_time_s_10um";
+    let v = visit(
+        &chrome,
+        &page,
+        &format!("#selftest&col={col}&filter=SCURVE&colfilter=status:lost_steps"),
+        &["--dump-dom"],
+    );
+    console_clean(&v).expect("no console messages");
+    let res = selftest_result(&v.stdout).expect("the selftest ran to its end");
+    assert_eq!(res["errors"], serde_json::json!([]));
+    assert_eq!(res["rows"], n);
+    let page_of = |mut all: Vec<String>| {
+        all.truncate(100);
+        all
+    };
+    check_order(&res["asc"], &page_of(sorted_texts(&runs, col, true))).expect("ascending");
+    check_order(&res["desc"], &page_of(sorted_texts(&runs, col, false))).expect("descending");
+    let at = |name: &str| runs.header.iter().position(|h| h == name).expect("column");
+    let (profile, status) = (at("profile"), at("status"));
+    let matched = runs
+        .rows
+        .iter()
+        .filter(|r| r[profile].shown() == "scurve" && r[status].shown() == "lost_steps")
+        .count();
+    assert!(matched > 0);
+    assert_eq!(res["matched"], matched);
+    assert_eq!(res["shown"], matched.min(100));
+    eprintln!(
+        "{n} rows ({:.1} MB): browser run {:.2} s; in the page: init {:.0} ms, sort {:.0} ms, \
+         filter {:.0} ms",
+        html.len() as f64 / 1e6,
+        v.elapsed.as_secs_f64(),
+        res["init_ms"].as_f64().unwrap_or(f64::NAN),
+        res["sort_ms"].as_f64().unwrap_or(f64::NAN),
+        res["filter_ms"].as_f64().unwrap_or(f64::NAN),
+    );
+
+    let plain = plain.join().expect("probe without scripts");
+    assert_eq!(plain["rows"], n);
+    assert_eq!(plain["first"], serde_json::json!(runs.header));
+}
+
+/// What an HTML parser with scripting off (the browser's `DOMParser`, as with JavaScript
+/// disabled: `<noscript>` holds markup) finds in the page: the runs table's body rows and
+/// header cells.
+fn parsed_without_scripts(chrome: &Path, html: &str) -> serde_json::Value {
+    let source = serde_json::to_string(html)
+        .expect("page as a JSON string")
+        .replace("</", "<\\/");
+    let probe = format!(
+        "<!DOCTYPE html><meta charset=\"utf-8\"><body><script>\
+         var d = new DOMParser().parseFromString({source}, 'text/html');\
+         var t = d.querySelector('#runs table');\
+         var pre = document.createElement('pre'); pre.id = 'selftest-result';\
+         pre.textContent = JSON.stringify({{rows: t ? t.tBodies[0].rows.length : -1,\
+           first: t ? Array.from(t.tHead.rows[0].cells, function (c) {{ return c.textContent; }}) : []}});\
+         document.body.appendChild(pre);</script>"
+    );
+    let (_dir, page) = write_page("no_script_probe", &probe);
+    let v = visit(chrome, &page, "", &["--dump-dom"]);
+    console_clean(&v).expect("no console messages");
+    selftest_result(&v.stdout).expect("the probe ran")
+}
