@@ -434,7 +434,7 @@ fn generated_csv(n: usize) -> String {
                     "reason" => reason.into(),
                     "lost_steps" => u64::from(status == "lost_steps").to_string(),
                     n if n.starts_with("settle_time") || n.starts_with("move_and_settle") => {
-                        if r % 10 == 0 {
+                        if r.is_multiple_of(10) {
                             "inf".into()
                         } else {
                             (unit * 0.3).to_string()

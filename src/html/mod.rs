@@ -18,6 +18,24 @@
 //! the script splits into rows and shows a page at a time, building no DOM rows beyond the
 //! page, so 100,000 runs open, sort and filter without hanging the page.
 //!
+//! ```
+//! use settle::html::{Provenance, Report, Table, render};
+//!
+//! let runs = Table::from_csv("All runs", "run,status,move_time_s\n0,ok,0.05\n1,ok,inf\n")?;
+//! let page = render(&Report {
+//!     title: "demo".into(),
+//!     runs: Some(runs),
+//!     provenance: Provenance {
+//!         date: "2025-01-01".into(),
+//!         ..Provenance::default()
+//!     },
+//!     ..Report::default()
+//! });
+//! assert!(page.starts_with("<!DOCTYPE html>"));
+//! assert!(page.contains("<th data-type=\"num\">move_time_s</th>"));
+//! # Ok::<(), settle::html::CsvError>(())
+//! ```
+//!
 //! # Script hooks
 //!
 //! Opening the page with a fragment `#selftest` (parameters joined by `&`) drives one table

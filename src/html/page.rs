@@ -139,10 +139,10 @@ longer the reference takes than the winner.</p>\n<div class=\"cards\">\n",
 fn inline_svg(svg: &str) -> &str {
     let mut s = svg.trim_start();
     for opener in ["<?xml", "<!DOCTYPE", "<!doctype"] {
-        if s.starts_with(opener) {
-            if let Some(end) = s.find('>') {
-                s = s[end + 1..].trim_start();
-            }
+        if s.starts_with(opener)
+            && let Some(end) = s.find('>')
+        {
+            s = s[end + 1..].trim_start();
         }
     }
     s
