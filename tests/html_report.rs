@@ -14,7 +14,7 @@ mod chromium;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use chromium::{Rect, browser, console_clean, region_spread, selftest_result, visit};
+use chromium::{Rect, browser, console_clean, region_spread, selftest, selftest_result, visit};
 use settle::html::{
     BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, LAZY_ROWS, Provenance, Reference,
     Report, Stat, Table, render,
@@ -313,15 +313,7 @@ fn report_renders_sorts_and_logs_nothing_in_chromium() {
         let arg = format!("--screenshot={}", shot.display());
         std::thread::spawn(move || visit(&chrome, &page, "", &[&arg]))
     };
-    let v = visit(
-        &chrome,
-        &page,
-        &format!("#selftest&col={col}"),
-        &["--dump-dom"],
-    );
-    console_clean(&v).expect("no console messages");
-    let res = selftest_result(&v.stdout).expect("the selftest ran to its end");
-    assert_eq!(res["errors"], serde_json::json!([]));
+    let (res, dump_time) = selftest(&chrome, &page, &format!("&col={col}"));
     assert_eq!(res["rows"], 6);
     assert_eq!(res["lazy"], false);
     check_order(&res["asc"], &sorted_texts(runs, col, true)).expect("ascending order");
@@ -350,7 +342,7 @@ fn report_renders_sorts_and_logs_nothing_in_chromium() {
     eprintln!(
         "browser test: {:.2} s (dump {:.2} s, screenshot {:.2} s)",
         start.elapsed().as_secs_f64(),
-        v.elapsed.as_secs_f64(),
+        dump_time.as_secs_f64(),
         s.elapsed.as_secs_f64()
     );
 }
@@ -378,13 +370,7 @@ fn a_broken_sort_fails_the_order_check() {
     assert_ne!(broken, html, "the script has its number comparison");
     let (_dir, page) = write_page("broken_sort", &broken);
     let col = "move_and_settle_s_10um";
-    let v = visit(
-        &chrome,
-        &page,
-        &format!("#selftest&col={col}"),
-        &["--dump-dom"],
-    );
-    let res = selftest_result(&v.stdout).expect("the selftest ran to its end");
+    let (res, _) = selftest(&chrome, &page, &format!("&col={col}"));
     let runs = report.runs.as_ref().expect("runs");
     assert!(check_order(&res["asc"], &sorted_texts(runs, col, true)).is_err());
     assert!(check_order(&res["desc"], &sorted_texts(runs, col, false)).is_err());
@@ -472,15 +458,11 @@ fn a_large_table_is_paged_sorted_and_filtered_in_chromium() {
         std::thread::spawn(move || parsed_without_scripts(&chrome, &html))
     };
     let col = "settle_time_s_10um";
-    let v = visit(
+    let (res, dump_time) = selftest(
         &chrome,
         &page,
-        &format!("#selftest&col={col}&filter=SCURVE&colfilter=status:lost_steps"),
-        &["--dump-dom"],
+        &format!("&col={col}&filter=SCURVE&colfilter=status:lost_steps"),
     );
-    console_clean(&v).expect("no console messages");
-    let res = selftest_result(&v.stdout).expect("the selftest ran to its end");
-    assert_eq!(res["errors"], serde_json::json!([]));
     assert_eq!(res["rows"], n);
     let page_of = |mut all: Vec<String>| {
         all.truncate(100);
@@ -502,7 +484,7 @@ fn a_large_table_is_paged_sorted_and_filtered_in_chromium() {
         "{n} rows ({:.1} MB): browser run {:.2} s; in the page: init {:.0} ms, sort {:.0} ms, \
          filter {:.0} ms",
         html.len() as f64 / 1e6,
-        v.elapsed.as_secs_f64(),
+        dump_time.as_secs_f64(),
         res["init_ms"].as_f64().unwrap_or(f64::NAN),
         res["sort_ms"].as_f64().unwrap_or(f64::NAN),
         res["filter_ms"].as_f64().unwrap_or(f64::NAN),

@@ -132,6 +132,22 @@ pub fn selftest_result(dom: &str) -> Option<serde_json::Value> {
     Some(serde_json::from_str(&text).expect("selftest result is JSON"))
 }
 
+/// Load `page` with `#selftest` and the hook's `parameters` (e.g. `&col=run`, see
+/// `settle::html`), require a clean console and no script errors, and return the hook's
+/// result and the visit's wall time.
+pub fn selftest(browser: &Path, page: &Path, parameters: &str) -> (serde_json::Value, Duration) {
+    let v = visit(
+        browser,
+        page,
+        &format!("#selftest{parameters}"),
+        &["--dump-dom"],
+    );
+    console_clean(&v).expect("no console messages");
+    let res = selftest_result(&v.stdout).expect("the selftest ran to its end");
+    assert_eq!(res["errors"], serde_json::json!([]), "script errors");
+    (res, v.elapsed)
+}
+
 /// A box of the page in CSS pixels, as the selftest reports it.
 #[derive(Debug, Clone, Copy)]
 pub struct Rect {
