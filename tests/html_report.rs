@@ -219,39 +219,60 @@ fn a_broken_sort_fails_the_order_check() {
 }
 
 #[test]
-fn a_large_table_is_paged_sorted_and_filtered_in_chromium() {
+fn large_tables_are_paged_sorted_and_filtered_in_chromium() {
     let Some(chrome) = browser() else { return };
     let n: usize = std::env::var("SETTLE_HTML_ROWS")
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(LAZY_ROWS + 1_000);
     let runs = Table::from_csv("All runs", &generated_csv(n)).expect("generated CSV");
-    let report = Report {
+    let html = render(&Report {
         title: format!("{n} generated runs"),
         runs: Some(runs.clone()),
         ..Report::default()
-    };
-    let html = render(&report);
+    });
     assert_eq!(html.contains("data-lazy"), n > LAZY_ROWS);
-    let (_dir, page) = write_page("large", &html);
-    // Without JavaScript the same rows are a real table (checked beside the selftest).
+    // Beside it: the same without JavaScript, and a table of DOM rows (the first 300).
     let plain = {
         let (chrome, html) = (chrome.clone(), html.clone());
         std::thread::spawn(move || parsed_without_scripts(&chrome, &html))
     };
+    let dom_rows = {
+        let chrome = chrome.clone();
+        let mut few = runs.clone();
+        few.rows.truncate(300);
+        std::thread::spawn(move || check_paging(&chrome, "dom_rows", &few))
+    };
+    check_paging(&chrome, "large", &runs);
+    dom_rows.join().expect("DOM rows checked");
+    let plain = plain.join().expect("probe without scripts");
+    assert_eq!(plain["rows"], n);
+    assert_eq!(plain["first"], serde_json::json!(runs.header));
+}
+
+/// Sort `runs` by a settling time both ways, then filter it by a word over all cells and by
+/// status, and check the first page and the counts against the table itself.
+fn check_paging(chrome: &Path, name: &str, runs: &Table) {
+    let html = render(&Report {
+        title: format!("{} generated runs", runs.rows.len()),
+        runs: Some(runs.clone()),
+        ..Report::default()
+    });
+    let (_dir, page) = write_page(name, &html);
     let col = "settle_time_s_10um";
     let (res, dump_time) = selftest(
-        &chrome,
+        chrome,
         &page,
         &format!("&col={col}&filter=SCURVE&colfilter=status:lost_steps"),
     );
-    assert_eq!(res["rows"], n);
+    assert_eq!(res["rows"], runs.rows.len());
+    assert_eq!(res["lazy"], runs.rows.len() > LAZY_ROWS);
     let page_of = |mut all: Vec<String>| {
         all.truncate(100);
         all
     };
-    check_order(&res["asc"], &page_of(sorted_texts(&runs, col, true))).expect("ascending");
-    check_order(&res["desc"], &page_of(sorted_texts(&runs, col, false))).expect("descending");
+    check_order(&res["asc"], &page_of(sorted_texts(runs, col, true))).expect("ascending");
+    check_order(&res["desc"], &page_of(sorted_texts(runs, col, false))).expect("descending");
     let at = |name: &str| runs.header.iter().position(|h| h == name).expect("column");
     let (profile, status) = (at("profile"), at("status"));
     let matched = runs
@@ -263,18 +284,15 @@ fn a_large_table_is_paged_sorted_and_filtered_in_chromium() {
     assert_eq!(res["matched"], matched);
     assert_eq!(res["shown"], matched.min(100));
     eprintln!(
-        "{n} rows ({:.1} MB): browser run {:.2} s; in the page: init {:.0} ms, sort {:.0} ms, \
+        "{} rows ({:.1} MB): browser run {:.2} s; in the page: init {:.0} ms, sort {:.0} ms, \
          filter {:.0} ms",
+        runs.rows.len(),
         html.len() as f64 / 1e6,
         dump_time.as_secs_f64(),
         res["init_ms"].as_f64().unwrap_or(f64::NAN),
         res["sort_ms"].as_f64().unwrap_or(f64::NAN),
         res["filter_ms"].as_f64().unwrap_or(f64::NAN),
     );
-
-    let plain = plain.join().expect("probe without scripts");
-    assert_eq!(plain["rows"], n);
-    assert_eq!(plain["first"], serde_json::json!(runs.header));
 }
 
 /// What an HTML parser with scripting off (the browser's `DOMParser`, as with JavaScript
