@@ -50,8 +50,9 @@
 //!
 //! The result also holds `rows` (the table's row count), `columns` (its header), `lazy`,
 //! `errors` (script errors caught on the page), `images` (the natural width of every
-//! `<img>`, 0 when it did not decode), `rects` (the page-space boxes, in CSS pixels, of the table and the
-//! first figure: `x`, `y`, `w`, `h`) and timings in ms (`init_ms`, `sort_ms`, `filter_ms`).
+//! `<img>`, 0 when it did not decode), `rects` (page-space boxes in CSS pixels, `x`, `y`,
+//! `w`, `h`: `table`, the table's visible box, and `figure`, the first figure's image) and
+//! timings in ms (`init_ms`, `sort_ms`, `filter_ms`).
 
 mod csv;
 mod escape;
