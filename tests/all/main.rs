@@ -6,6 +6,7 @@ mod support;
 mod cli;
 mod corners;
 mod faults;
+mod html_report;
 mod layers;
 mod machines;
 mod outputs_check;

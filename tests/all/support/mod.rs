@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+pub mod html;
+
 /// The `settle` binary, run from the repository root.
 pub fn settle() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_settle"));
