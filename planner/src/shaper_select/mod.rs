@@ -35,6 +35,7 @@ mod fit;
 mod grid;
 mod options;
 
+pub use accel::max_accel_mm_s2;
 pub use choose::find_best_shaper;
 pub use data::CalibrationData;
 pub use fit::fit_shaper;
