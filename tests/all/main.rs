@@ -12,6 +12,7 @@ mod machines;
 mod outputs_check;
 mod outputs_mcap;
 mod outputs_plots;
+mod outputs_ranking;
 mod outputs_shard;
 mod pipeline_reference;
 mod plan_cli;
