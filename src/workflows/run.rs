@@ -187,6 +187,37 @@ impl RunOutcome {
                 );
             }
         }
+        if let Some((_, e)) = m.extra.iter().find(|(n, _)| n == "scan_reentry_error_um") {
+            let _ = writeln!(
+                s,
+                "  scan: |error| of the step axis when the next line starts (re-entry) {e:.4} um (worst turnaround)"
+            );
+        }
+        let extra = |n: &str| m.extra.iter().find(|(k, _)| k == n).map(|(_, v)| *v);
+        if let (Some(w), Some(step)) = (extra("scan_window_s"), extra("scan_step_s")) {
+            for b in &m.bands_um {
+                if let Some(t) = extra(&format!("scan_step_settle_time_s_{b}um")) {
+                    let _ = writeln!(
+                        s,
+                        "  scan: inside {b} um for good {} after the step's end, re-entry {:.1} ms after it: {}",
+                        if t.is_finite() {
+                            format!("{:.1} ms", t * 1e3)
+                        } else {
+                            "never (not before the next exit)".to_string()
+                        },
+                        (w - step) * 1e3,
+                        if t <= w - step {
+                            "settled before re-entry"
+                        } else {
+                            "NOT settled before re-entry"
+                        }
+                    );
+                }
+            }
+        }
+        for (name, v) in &m.extra {
+            let _ = writeln!(s, "  {name:<22} {v}");
+        }
         if let Status::LostSteps { axis, steps } = &m.status {
             let _ = writeln!(
                 s,

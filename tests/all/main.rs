@@ -20,6 +20,7 @@ mod plan_cli;
 mod rerun;
 mod scan_asym;
 mod scan_reference;
+mod scan_views;
 mod scenarios;
 mod shaping_sweep;
 mod step_samples;
