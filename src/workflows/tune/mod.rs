@@ -215,6 +215,26 @@ pub fn tune_to(
     write("tmc5160.txt", &tmc)?;
     let fig = report::pareto_figure(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
     crate::output::plot::write(&fig, &out, "pareto")?;
+    // report.html: tune.md's tables, every candidate, the Pareto figure, the provenance.
+    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let file = crate::output::report::ScenarioFile { path, text: &text };
+    let svg_path = out.join("pareto.svg");
+    let svg = std::fs::read_to_string(&svg_path).map_err(|e| Error::read(&svg_path, e))?;
+    let html = crate::output::report::markdown_report(
+        &format!("{} (tune)", sc.name),
+        &md,
+        &report::candidates_csv(&o.scores),
+        &[("Pareto front".to_string(), svg)],
+        crate::output::report::provenance(
+            file,
+            backend.name(),
+            format!("settle tune {}", path.display()),
+        ),
+    );
+    write(
+        crate::output::sweep_files::REPORT,
+        &crate::output::html::render(&html),
+    )?;
     Ok(Tuned {
         outcome: o,
         markdown: md,
