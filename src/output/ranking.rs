@@ -356,6 +356,14 @@ impl Ranking {
     }
 }
 
+/// The headers of the shaper columns (where shapers are swept) in summary.md and
+/// report.html: [`Ranked::shaper`]'s figures.
+pub const SHAPER_COLUMNS: [&str; 3] = [
+    "smoothing (mm)",
+    "remaining vibration (%)",
+    "max_accel (mm/s^2)",
+];
+
 /// A gain as shown: `+38 %`, `-5.2 %`, `reference not settled`, or `-`.
 pub fn gain_text(gain: Option<f64>) -> String {
     match gain {

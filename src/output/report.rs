@@ -13,7 +13,7 @@ use crate::output::html::{
     BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, Provenance, Reference, Report,
     Stat, Table,
 };
-use crate::output::ranking::{Ranking, gain_text, rank, run_command};
+use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, rank, run_command};
 use crate::output::summary::{machines_line, ms};
 use crate::spec::run_spec::RunSpec;
 
@@ -24,6 +24,17 @@ pub struct ScenarioFile<'a> {
     pub path: &'a std::path::Path,
     /// Its text.
     pub text: &'a str,
+}
+
+/// The figures (caption, SVG markup) as the page embeds them.
+fn embedded(figures: &[(String, String)]) -> Vec<Figure> {
+    figures
+        .iter()
+        .map(|(title, svg)| Figure {
+            title: title.clone(),
+            image: Image::Svg(svg.clone()),
+        })
+        .collect()
 }
 
 /// A number cell with `text` shown (`value` non-finite for `not settled`).
@@ -107,13 +118,7 @@ fn ranking_tables(ranking: &Ranking, runs: &[RunSpec], file: ScenarioFile<'_>) -
             }
             header.push(format!("gain {} (%)", ranking.reference_name()));
             if ranking.shapers {
-                for h in [
-                    "smoothing (mm)",
-                    "remaining vibration (%)",
-                    "max_accel (mm/s^2)",
-                ] {
-                    header.push(h.into());
-                }
+                header.extend(SHAPER_COLUMNS.map(String::from));
             }
             header.push("run".into());
             header.push("command".into());
@@ -224,19 +229,13 @@ pub fn sweep_report(
         intro,
         winners,
         tables,
-        figures: figures
-            .iter()
-            .map(|(title, svg)| Figure {
-                title: title.clone(),
-                image: Image::Svg(svg.clone()),
-            })
-            .collect(),
+        figures: embedded(figures),
         runs: Table::from_csv("All runs (runs.csv)", csv).ok(),
         failed,
-        provenance: Provenance {
-            settle_version: env!("CARGO_PKG_VERSION").to_string(),
-            backend: backend.clone(),
-            command_line: format!(
+        provenance: provenance(
+            file,
+            &backend,
+            format!(
                 "settle sweep {}{}",
                 file.path.display(),
                 if backend.is_empty() || backend == crate::spec::backend::Backend::default().name()
@@ -246,12 +245,43 @@ pub fn sweep_report(
                     format!(" --backend {backend}")
                 }
             ),
-            date: String::new(),
-            inputs: vec![InputFile {
-                name: file.path.display().to_string(),
-                text: file.text.to_string(),
-            }],
-        },
+        ),
+    }
+}
+
+/// A report from a Markdown summary (e.g. `settle tune`'s tune.md): its tables (each under
+/// its heading, see [`markdown_tables`]), the candidates table `csv` as the sortable,
+/// filterable table of every run, the `figures` (caption, SVG markup) and the provenance.
+pub fn markdown_report(
+    title: &str,
+    markdown: &str,
+    csv: &str,
+    figures: &[(String, String)],
+    provenance: Provenance,
+) -> Report {
+    Report {
+        title: title.to_string(),
+        intro: Vec::new(),
+        winners: Vec::new(),
+        tables: markdown_tables(markdown),
+        figures: embedded(figures),
+        runs: Table::from_csv("Every candidate", csv).ok(),
+        failed: Vec::new(),
+        provenance,
+    }
+}
+
+/// The provenance of a run of settle on `file` with `backend`, `command` as typed.
+pub fn provenance(file: ScenarioFile<'_>, backend: &str, command: String) -> Provenance {
+    Provenance {
+        settle_version: env!("CARGO_PKG_VERSION").to_string(),
+        backend: backend.to_string(),
+        command_line: command,
+        date: String::new(),
+        inputs: vec![InputFile {
+            name: file.path.display().to_string(),
+            text: file.text.to_string(),
+        }],
     }
 }
 

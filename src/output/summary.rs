@@ -10,7 +10,7 @@ use std::path::Path;
 
 use crate::input::runs_table::RunsTable;
 use crate::input::scenario::Scenario;
-use crate::output::ranking::{Ranking, gain_text, rank, run_command};
+use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, rank, run_command};
 use crate::spec::run_spec::RunSpec;
 
 /// A time in ms with one decimal, `not settled` for none.
@@ -209,13 +209,7 @@ fn push_ranking(out: &mut String, ranking: &Ranking, runs: &[RunSpec], scenario:
         }
         header.push(format!("gain {reference}"));
         if ranking.shapers {
-            for h in [
-                "smoothing (mm)",
-                "remaining vibration (%)",
-                "max_accel (mm/s^2)",
-            ] {
-                header.push(h.into());
-            }
+            header.extend(SHAPER_COLUMNS.map(String::from));
         }
         header.push("run".into());
         header.push("command".into());

@@ -11,28 +11,23 @@ use settle::input::runs_table::RunsTable;
 use crate::support::html::chromium::{
     Rect, browser, console_clean, region_spread, selftest, visit,
 };
-use crate::support::{settle, write};
+use crate::support::{run_ok, settle, write};
 
 /// Sweep `scenario` on the modal backend into a new folder; the folder.
 fn sweep(scenario: &str) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("tempdir");
-    let out = settle()
-        .args([
-            "sweep",
-            scenario,
-            "--backend",
-            "modal",
-            "--jobs",
-            "2",
-            "--out",
-        ])
-        .arg(dir.path())
-        .output()
-        .expect("runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    run_ok(
+        settle()
+            .args([
+                "sweep",
+                scenario,
+                "--backend",
+                "modal",
+                "--jobs",
+                "2",
+                "--out",
+            ])
+            .arg(dir.path()),
     );
     dir
 }
