@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite, used verbatim by CI (.ci/run): formatting, lints, API docs, every
-# test, the regression gate, a fuzz smoke run and the `rerun` feature. Installs what it
+# test, the regression gate, every command of the README and the book
+# (scripts/check-commands.sh), a fuzz smoke run and the `rerun` feature. Installs what it
 # needs without root: crates from crates.io through cargo, libmujoco 3.17.0 from its PyPI
 # wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), cargo-fuzz into ~/.cargo/bin once
 # (scripts/fuzz.sh), the official MCAP reader from PyPI into .deps/ (scripts/mcap-python,
@@ -123,6 +124,9 @@ for scenario in scenarios/ci_*.toml; do
     "$settle_bin" check "$scenario" --backend "$backend" --baseline "$baseline"
   done
 done
+
+phase "every command in the README and the book, in fresh clones (scripts/check-commands.sh)"
+SETTLE_BIN="$settle_bin" scripts/check-commands.sh
 
 phase "fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
 scripts/fuzz.sh "${SETTLE_FUZZ_SECONDS:-15}"
