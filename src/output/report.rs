@@ -250,8 +250,9 @@ pub fn sweep_report(
 }
 
 /// A report from a Markdown summary (e.g. `settle tune`'s tune.md): its tables (each under
-/// its heading, see [`markdown_tables`]), the candidates table `csv` as the sortable,
-/// filterable table of every run, the `figures` (caption, SVG markup) and the provenance.
+/// its heading, the paragraph under it as its note), the candidates table `csv` as the
+/// sortable, filterable table of every run, the `figures` (caption, SVG markup) and the
+/// provenance.
 pub fn markdown_report(
     title: &str,
     markdown: &str,
