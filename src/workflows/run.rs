@@ -119,7 +119,8 @@ pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
             |s| s.to_string_lossy().into_owned(),
         );
         let title = format!("{} run {case}: {}", sc.name, spec.swept_text(", "));
-        let fig = crate::output::plot::trace::figure(&title, &record);
+        let mut fig = crate::output::plot::trace::figure(&title, &record);
+        crate::output::plot::scan_trace::scan_view(&record, &mut fig.panels);
         crate::output::plot::write(&fig, &dir, &stem)?;
         written.push(dir.join(format!("{stem}.svg")));
         written.push(dir.join(format!("{stem}.png")));

@@ -5,8 +5,8 @@
 //! one time axis, with the end of the move marked. Every channel whose name ends in `error`
 //! (in m) gets a second panel zoomed on the time after the move, in um, with the settling
 //! bands and where the error settled into each. Lengths are shown in mm (um when the
-//! signal stays below 1 mm). A raster scan's run gets its scan view
-//! ([`super::scan_trace`]). Long traces are reduced to at most [`MAX_POINTS`] per line by
+//! signal stays below 1 mm). A raster scan's run adds its scan view
+//! (`super::scan_trace`). Long traces are reduced to at most [`MAX_POINTS`] per line by
 //! keeping each bucket's minimum and maximum, so peaks survive.
 
 use super::{Figure, Line, PALETTE, Panel, Rule, fmt_num};
@@ -174,7 +174,6 @@ pub fn figure(title: &str, rec: &RunRecord) -> Figure {
             ..Panel::default()
         });
     }
-    super::scan_trace::scan_view(rec, &mut panels);
     Figure {
         title: title.to_string(),
         panels,
