@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # The whole test suite, used verbatim by CI (.ci/run): formatting, lints, API docs, every
-# test, the regression gate, a fuzz smoke run and the `rerun` feature. Installs what it
+# test, the regression gate, every command of the README and the book
+# (scripts/check-commands.sh), a fuzz smoke run and the `rerun` feature. Installs what it
 # needs without root: crates from crates.io through cargo, libmujoco 3.17.0 from its PyPI
 # wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), cargo-fuzz into ~/.cargo/bin once
 # (scripts/fuzz.sh), the official MCAP reader from PyPI into .deps/ (scripts/mcap-python,
-# for the MCAP tests).
+# for the MCAP tests); with root (or sudo), headless Chromium from Debian's `chromium`
+# package when missing (scripts/browser-test.sh, for the report.html tests).
 #
 # Builds, and what they share (the cargo profiles are in Cargo.toml):
 #   - clippy (default features), clippy with MuJoCo (only settle-sim and the crates that
@@ -29,6 +31,8 @@
 #                         every test runs with the `mujoco` feature)
 #   SETTLE_FUZZ_SECONDS   fuzz smoke time per target (default 15)
 #   SETTLE_SKIP_RERUN=1   skip building and testing the `rerun` feature
+#   SETTLE_SKIP_BROWSER=1 skip the report's browser checks (otherwise Debian's chromium is
+#                         installed with apt-get when /usr/bin/chromium is missing)
 #   SETTLE_MCAP_PY_VERSION  the MCAP reader's version (scripts/mcap-python)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -87,6 +91,13 @@ RUSTDOCFLAGS="${RUSTDOCFLAGS:-} -D warnings" cargo doc --workspace --no-deps --l
 phase "the book: mdbook build docs and its internal links (scripts/check-docs.sh)"
 scripts/check-docs.sh
 
+# report.html is checked in a real browser by tests in tests/all (html_report,
+# outputs_ranking): they fail without one, so it is installed here when missing.
+if [[ "${SETTLE_SKIP_BROWSER:-0}" != 1 ]]; then
+  phase "headless Chromium for the report's browser tests (scripts/browser-test.sh --install-only)"
+  scripts/browser-test.sh --install-only
+fi
+
 phase "cargo test: build (profile ci)"
 cargo test --workspace --profile ci --locked "${features[@]}" --no-run
 
@@ -113,6 +124,9 @@ for scenario in scenarios/ci_*.toml; do
     "$settle_bin" check "$scenario" --backend "$backend" --baseline "$baseline"
   done
 done
+
+phase "every command in the README and the book, in fresh clones (scripts/check-commands.sh)"
+SETTLE_BIN="$settle_bin" scripts/check-commands.sh
 
 phase "fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
 scripts/fuzz.sh "${SETTLE_FUZZ_SECONDS:-15}"

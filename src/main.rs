@@ -31,7 +31,7 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run every point of a scenario's sweep and write runs.csv, summary.md and plots.
+    /// Run every point of a scenario's sweep and write runs.csv, summary.md, report.html and plots.
     #[command(
         after_help = "Example:\n  settle sweep scenarios/quickstart.toml --out /tmp/qs --jobs 2"
     )]
@@ -56,6 +56,9 @@ enum Command {
         /// Continue an interrupted sweep: keep the runs in OUT/journal.csv, run the rest.
         #[arg(long)]
         resume: bool,
+        /// Overwrite the results of an earlier sweep in OUT (refused without it).
+        #[arg(long, conflicts_with = "resume")]
+        force: bool,
     },
     /// Check every backend against the closed form and against each other; print a table.
     #[command(
@@ -339,6 +342,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             outputs,
             shard,
             resume,
+            force,
         } => {
             install_interrupt()?;
             let opts = workflows::sweep::SweepOptions {
@@ -348,6 +352,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 rerun: outputs.rerun,
                 shard,
                 resume,
+                force,
                 ..workflows::sweep::SweepOptions::new(scenario, backend)
             };
             workflows::sweep::sweep(&opts, &note, &progress)?.report()

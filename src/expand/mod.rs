@@ -7,6 +7,7 @@
 //! the last axis fastest, and every run is checked ([`validate`]).
 
 pub mod axes;
+pub mod current;
 pub mod machine;
 pub mod validate;
 
@@ -193,6 +194,7 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
     };
     validate::validate_observe(&base, src)?;
     let axes = axes::axes(sc, src, &base)?;
+    current::check(sc, src, &axes)?;
     let total = axes
         .iter()
         .try_fold(1usize, |acc, a| acc.checked_mul(a.values.len()))

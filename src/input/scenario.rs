@@ -41,10 +41,12 @@ pub struct Scenario {
     /// The cartesian product of all axes, in the order written, gives the runs.
     #[serde(default)]
     pub sweep: toml::Table,
-    /// The user's current settings among the sweep's points: one value per swept key,
-    /// the same key names as in `[sweep]` (written by `settle import`).
+    /// `[current]`: the user's current settings among the swept ones (one value per swept
+    /// key, the keys as in `[sweep]`), e.g. written by `settle import`. The summary and
+    /// report.html give every gain against the runs with these values; without it, against
+    /// the slowest. Checked against the sweep when it is expanded (`crate::expand`).
     #[serde(default)]
-    pub current: Option<toml::Table>,
+    pub current: toml::Table,
     /// Numerical settings of the simulation (expert; the defaults are the validated ones).
     #[serde(default)]
     pub sim: SimSpec,

@@ -1,9 +1,13 @@
-//! Outputs: runs.csv ([`runs_csv`]), summary.md ([`summary`]), the figures ([`plot`]), the
-//! per-run recordings ([`sink`]: MCAP, rerun), all written whole ([`atomic`]); and the
-//! files of a sweep's output folder together ([`sweep_files`]).
+//! Outputs: runs.csv ([`runs_csv`]), the ranking ([`ranking`]) that summary.md
+//! ([`summary`]) and report.html ([`report`], rendered by [`html`]) show, the figures
+//! ([`plot`]), the per-run recordings ([`sink`]: MCAP, rerun), all written whole
+//! ([`atomic`]); and the files of a sweep's output folder together ([`sweep_files`]).
 
 pub mod atomic;
+pub mod html;
 pub mod plot;
+pub mod ranking;
+pub mod report;
 pub mod runs_csv;
 pub mod sink;
 pub mod summary;

@@ -3,14 +3,17 @@
 //!
 //! ```text
 //! DIR/runs.csv            one row per run: parameters, then metrics
-//! DIR/summary.md          profile kinds side by side per swept point; links the figures
+//! DIR/summary.md          winner per band, every swept setting ranked per swept point;
+//!                         links the figures
+//! DIR/report.html         the same with the figures embedded, every run (sortable,
+//!                         filterable), failed runs, provenance: one self-contained file
 //! DIR/plots/vs_<P>.svg    settle time and residual against each swept numeric parameter P
 //! DIR/plots/vs_<P>.png    the same as PNG
 //! DIR/recordings/run-<id>.mcap / .rrd   with --mcap / --rerun
 //! ```
 //!
-//! `summary.md` and the plots are functions of `runs.csv` and the scenario alone, which is
-//! what makes a merged sweep byte-identical to an unsharded one.
+//! `summary.md`, `report.html` and the plots are functions of `runs.csv` and the scenario
+//! alone, which is what makes a merged sweep byte-identical to an unsharded one.
 
 use std::path::Path;
 
@@ -18,6 +21,7 @@ use crate::error::Error;
 use crate::input::runs_table::RunsTable;
 use crate::input::scenario::Scenario;
 use crate::output::atomic::write_atomic;
+use crate::output::report::{ScenarioFile, sweep_report};
 use crate::output::summary::summary_md;
 use crate::spec::run_spec::RunSpec;
 
@@ -28,14 +32,35 @@ pub const PLOTS: &str = "plots";
 pub const RECORDINGS: &str = "recordings";
 
 /// Write `runs.csv` (the text `csv`, as written by [`crate::output::runs_csv`]), the
-/// figures and `summary.md` into `out`.
-pub fn write_sweep(out: &Path, sc: &Scenario, runs: &[RunSpec], csv: &str) -> Result<(), Error> {
+/// figures, `summary.md` and `report.html` into `out`; `file` is the scenario the runs come
+/// from (its path as the commands in the summary name it, and its text).
+pub fn write_sweep(
+    out: &Path,
+    sc: &Scenario,
+    file: ScenarioFile<'_>,
+    runs: &[RunSpec],
+    csv: &str,
+) -> Result<(), Error> {
     let table =
         RunsTable::parse(csv).map_err(|message| Error::input(out.join("runs.csv"), message))?;
     write_atomic(&out.join("runs.csv"), csv.as_bytes())?;
     let figures = crate::output::plot::sweep::write_all(&out.join(PLOTS), &sc.name, runs, &table)?;
     write_atomic(
         &out.join("summary.md"),
-        summary_md(sc, runs, &table, &figures).as_bytes(),
+        summary_md(sc, file.path, runs, &table, &figures).as_bytes(),
+    )?;
+    let mut svgs = Vec::new();
+    for f in &figures {
+        let p = out.join(&f.svg);
+        let svg = std::fs::read_to_string(&p).map_err(|e| Error::read(&p, e))?;
+        svgs.push((f.title.clone(), svg));
+    }
+    let report = sweep_report(sc, file, runs, &table, csv, &svgs);
+    write_atomic(
+        &out.join(REPORT),
+        crate::output::html::render(&report).as_bytes(),
     )
 }
+
+/// The report's file name inside the output folder.
+pub const REPORT: &str = "report.html";

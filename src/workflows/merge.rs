@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use crate::error::Error;
 use crate::output::atomic::create_dir;
+use crate::output::report::ScenarioFile;
 use crate::output::sweep_files::{RECORDINGS, write_sweep};
 use crate::spec::backend::Backend;
 use crate::workflows::{Exit, Report};
@@ -40,7 +41,11 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> Result<MergeOutcome, Err
     }
     let out = out.unwrap_or_else(|| PathBuf::from("results").join(&m.scenario.name));
     create_dir(&out)?;
-    write_sweep(&out, &m.scenario, &m.runs, &m.csv)?;
+    let file = ScenarioFile {
+        path: std::path::Path::new(&m.manifest.scenario_file),
+        text: &m.manifest.scenario,
+    };
+    write_sweep(&out, &m.scenario, file, &m.runs, &m.csv)?;
     // Recordings: gathered into one folder, as an unsharded sweep leaves them.
     let mut copied = 0usize;
     for d in dirs {

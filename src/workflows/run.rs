@@ -119,7 +119,8 @@ pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
             |s| s.to_string_lossy().into_owned(),
         );
         let title = format!("{} run {case}: {}", sc.name, spec.swept_text(", "));
-        let fig = crate::output::plot::trace::figure(&title, &record);
+        let mut fig = crate::output::plot::trace::figure(&title, &record);
+        crate::output::plot::scan_trace::scan_view(&record, &mut fig.panels);
         crate::output::plot::write(&fig, &dir, &stem)?;
         written.push(dir.join(format!("{stem}.svg")));
         written.push(dir.join(format!("{stem}.png")));
@@ -186,6 +187,37 @@ impl RunOutcome {
                     a.name
                 );
             }
+        }
+        if let Some((_, e)) = m.extra.iter().find(|(n, _)| n == "scan_reentry_error_um") {
+            let _ = writeln!(
+                s,
+                "  scan: |error| of the step axis when the next line starts (re-entry) {e:.4} um (worst turnaround)"
+            );
+        }
+        let extra = |n: &str| m.extra.iter().find(|(k, _)| k == n).map(|(_, v)| *v);
+        if let (Some(w), Some(step)) = (extra("scan_window_s"), extra("scan_step_s")) {
+            for b in &m.bands_um {
+                if let Some(t) = extra(&format!("scan_step_settle_time_s_{b}um")) {
+                    let _ = writeln!(
+                        s,
+                        "  scan: inside {b} um for good {} after the step's end, re-entry {:.1} ms after it: {}",
+                        if t.is_finite() {
+                            format!("{:.1} ms", t * 1e3)
+                        } else {
+                            "never (not before the next exit)".to_string()
+                        },
+                        (w - step) * 1e3,
+                        if t <= w - step {
+                            "settled before re-entry"
+                        } else {
+                            "NOT settled before re-entry"
+                        }
+                    );
+                }
+            }
+        }
+        for (name, v) in &m.extra {
+            let _ = writeln!(s, "  {name:<22} {v}");
         }
         if let Status::LostSteps { axis, steps } = &m.status {
             let _ = writeln!(

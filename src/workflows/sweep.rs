@@ -12,6 +12,7 @@ use crate::execute::pool::{Progress, run_all_with};
 use crate::input::runs_table::RunsTable;
 use crate::measure::metrics::Metrics;
 use crate::output::atomic::{create_dir, write_atomic};
+use crate::output::report::ScenarioFile;
 use crate::output::runs_csv::RunsCsv;
 use crate::output::sink::{Provenance, Recorder};
 use crate::output::sweep_files::{PLOTS, RECORDINGS, write_sweep};
@@ -41,6 +42,9 @@ pub struct SweepOptions {
     pub shard: Option<Shard>,
     /// Continue an interrupted sweep from its journal.
     pub resume: bool,
+    /// Overwrite the results of an earlier sweep in the output folder (without it, a folder
+    /// holding `runs.csv`, `summary.md`, `report.html` or a journal is refused).
+    pub force: bool,
 }
 
 impl SweepOptions {
@@ -55,6 +59,7 @@ impl SweepOptions {
             rerun: false,
             shard: None,
             resume: false,
+            force: false,
         }
     }
 }
@@ -150,6 +155,9 @@ pub fn sweep(
         Some(s) => s.select(&all_runs),
         None => all_runs.clone(),
     };
+    if !opts.resume && !opts.force {
+        refuse_overwrite(&out)?;
+    }
     create_dir(&out)?;
     if let Some(r) = &rec {
         create_dir(&r.dir)?;
@@ -177,7 +185,7 @@ pub fn sweep(
     let ids: Vec<usize> = runs.iter().map(|r| r.id).collect();
     let (journal, done) = match journal::existing(&out) {
         Some(_) if opts.resume => Journal::resume(&out, &key, &header, &ids)?,
-        Some(p) => {
+        Some(p) if !opts.force => {
             return Err(Error::input(
                 "--resume",
                 format!(
@@ -186,7 +194,7 @@ pub fn sweep(
                 ),
             ));
         }
-        None => (Journal::start(&out, &key, &header)?, Default::default()),
+        _ => (Journal::start(&out, &key, &header)?, Default::default()),
     };
     if opts.resume {
         note(&format!(
@@ -262,12 +270,56 @@ pub fn sweep(
                 },
             )?;
         }
-        None => write_sweep(&out, &sc, &runs, &csv)?,
+        None => {
+            let file = ScenarioFile {
+                path,
+                text: &scenario_text,
+            };
+            write_sweep(&out, &sc, file, &runs, &csv)?
+        }
     }
     outcome.elapsed_s = started.elapsed().as_secs_f64();
     journal.finish()?;
     outcome.failed = failures(&runs, &csv);
     Ok(outcome)
+}
+
+/// The files of an earlier sweep that `settle sweep` refuses to overwrite without `--force`.
+pub const KEPT: [&str; 4] = [
+    "runs.csv",
+    "summary.md",
+    crate::output::sweep_files::REPORT,
+    journal::FILE,
+];
+
+/// An error when `out` holds the results of an earlier sweep ([`KEPT`]).
+fn refuse_overwrite(out: &Path) -> Result<(), Error> {
+    let found: Vec<&str> = KEPT
+        .iter()
+        .copied()
+        .filter(|f| out.join(f).exists())
+        .collect();
+    if found.is_empty() {
+        return Ok(());
+    }
+    let interrupted = found.contains(&journal::FILE);
+    Err(Error::input(
+        "--force",
+        format!(
+            "{} already holds {}: pass --force to overwrite it, --out DIR to write elsewhere{}",
+            out.display(),
+            if interrupted {
+                "an interrupted sweep"
+            } else {
+                "the results of a sweep"
+            },
+            if interrupted {
+                ", or --resume to continue it"
+            } else {
+                ""
+            }
+        ),
+    ))
 }
 
 /// The failed runs, from runs.csv's `status` and `reason` columns.
@@ -317,9 +369,10 @@ impl SweepOutcome {
                 self.elapsed_s
             )),
             None => r.err(format!(
-                "wrote {}, {} and {}/ ({} runs in {:.2} s){}",
+                "wrote {}, {}, {} and {}/ ({} runs in {:.2} s){}",
                 out.join("runs.csv").display(),
                 out.join("summary.md").display(),
+                out.join(crate::output::sweep_files::REPORT).display(),
                 out.join(PLOTS).display(),
                 self.runs,
                 self.elapsed_s,

@@ -81,7 +81,7 @@ fn a_toy_kind_goes_through_expand_run_csv_and_summary() {
     assert!(csv.lines().nth(3).expect("run 2").contains(",3,"), "{csv}");
     let summary = std::fs::read_to_string(dir.path().join("out/summary.md")).expect("summary");
     assert!(summary.contains("## Toy shuttle"), "{summary}");
-    assert!(summary.contains("## Move and settle"), "{summary}");
+    assert!(summary.contains("## Ranking: move and settle"), "{summary}");
     let plot =
         std::fs::read_to_string(dir.path().join("out/plots/vs_toy_legs.svg")).expect("figure");
     assert!(plot.contains("shuttle: largest error during the move"));

@@ -31,8 +31,7 @@ fn opts(firmware: Firmware, config: PathBuf, out: &Path) -> ImportOptions {
 
 fn current(sc: &settle::input::scenario::Scenario, key: &str) -> toml::Value {
     sc.current
-        .as_ref()
-        .and_then(|c| c.get(key))
+        .get(key)
         .cloned()
         .unwrap_or_else(|| panic!("[current] {key}"))
 }

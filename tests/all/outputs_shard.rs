@@ -1,5 +1,5 @@
 //! Sharded sweeps: shards merged in any order equal the unsharded sweep byte for byte
-//! (runs.csv, summary.md, every plot, every recording); bad merges are clear errors.
+//! (runs.csv, summary.md, report.html, every plot, every recording); bad merges are clear errors.
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -96,6 +96,7 @@ fn merged_shards_equal_the_unsharded_sweep_byte_for_byte() {
     let want = files(&whole);
     assert!(want.iter().any(|p| p.ends_with("runs.csv")));
     assert!(want.iter().any(|p| p.ends_with("summary.md")));
+    assert!(want.iter().any(|p| p.ends_with("report.html")));
     assert!(
         want.iter()
             .any(|p| p.extension().is_some_and(|e| e == "png"))

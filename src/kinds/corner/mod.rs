@@ -179,7 +179,7 @@ impl Kind for CornerPath {
     }
 }
 
-/// The summary's corner section: per angle, strategy and kind, the planned corner speed,
+/// The summary's corner section: per run (angle, strategy, kind, shaper), the planned corner speed,
 /// the commanded corner rounding and the toolhead's contour error.
 fn summary_section(runs: &[RunSpec], table: &RunsTable) -> String {
     let mut out = String::new();
@@ -193,9 +193,18 @@ the corner point.\n"
     );
     let _ = writeln!(
         out,
-        "| angle (deg) | strategy | kind | corner speed (mm/s) | commanded rounding (um) | contour error during (um) | contour error after (um) | toolhead rounding (um) |"
+        "| run | angle (deg) | strategy | kind | shaper | corner speed (mm/s) | commanded rounding (um) | contour error during (um) | contour error after (um) | toolhead rounding (um) |"
     );
-    let _ = writeln!(out, "|---:|---|---|---:|---:|---:|---:|---:|");
+    let _ = writeln!(out, "|---:|---:|---|---|---|---:|---:|---:|---:|---:|");
+    // The shaper of a run: its type and frequency, `none` without a [shaper] table.
+    let shaper = |row: usize| match (
+        table.cell(row, "shaper_type"),
+        table.cell(row, "shaper_frequency_hz"),
+    ) {
+        (Some("none"), _) | (None, _) => "none".to_string(),
+        (Some(t), Some(f)) => format!("{t} {f} Hz"),
+        (Some(t), None) => t.to_string(),
+    };
     let f = |row: usize, c: &str, prec: usize| {
         table
             .num(row, c)
@@ -208,19 +217,23 @@ the corner point.\n"
         if table.cell(i, "status").is_some_and(|s| s != "ok") {
             let _ = writeln!(
                 out,
-                "| {} | {} | {} | lost steps | - | - | - | - |",
+                "| {} | {} | {} | {} | {} | lost steps | - | - | - | - |",
+                r.id,
                 c.angle_deg,
                 c.strategy.name(),
-                r.profile
+                r.profile,
+                shaper(i)
             );
             continue;
         }
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            r.id,
             c.angle_deg,
             c.strategy.name(),
             r.profile,
+            shaper(i),
             f(i, col::CORNER_SPEED, 2),
             f(i, col::CORNER_ROUNDING, 3),
             f(i, col::MAX_CONTOUR, 2),

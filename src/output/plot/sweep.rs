@@ -7,9 +7,9 @@
 //! values > 0), the residual axes when they span more than a factor of 20.
 //!
 //! When other parameters are swept too, each point of `P` has several runs per kind: up to
-//! four combinations of the other parameters are drawn as separate lines (same colour per
-//! kind, one marker per combination); beyond that each kind shows the median over the other
-//! parameters with a shaded min-max band. Not-settled runs (`inf`) are hollow triangles at
+//! sixteen candidates (a kind with one combination of the other swept values, e.g.
+//! `trapezoid, mzv`) are drawn as lines of their own; beyond that each kind shows the median
+//! over the other parameters (named in its label) with a shaded min-max band. Not-settled runs (`inf`) are hollow triangles at
 //! the top edge of their panel.
 
 use std::path::Path;
@@ -103,6 +103,9 @@ pub fn numeric_params(runs: &[RunSpec]) -> Vec<String> {
         .unwrap_or_default()
 }
 
+/// Lines drawn one per candidate at most; beyond, one median line per profile kind.
+const MAX_LINES: usize = 16;
+
 /// The lines of one metric against `param`.
 fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &PlotColumn) -> Vec<Line> {
     let mut kinds: Vec<ProfileKind> = Vec::new();
@@ -124,10 +127,11 @@ fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &PlotColumn) -> Ve
             .and_then(|(_, v)| number(v))
     };
     let mut out = Vec::new();
-    for (ki, k) in kinds.iter().enumerate() {
-        let color = PALETTE[ki % PALETTE.len()];
-        if combos.len() <= Marker::ALL.len() {
-            for (ci, c) in combos.iter().enumerate() {
+    // Few enough candidates: one line each (every swept value but `param`), a colour each.
+    if kinds.len() * combos.len() <= MAX_LINES {
+        let mut n = 0usize;
+        for k in &kinds {
+            for c in &combos {
                 let mut pts: Vec<(f64, f64)> = runs
                     .iter()
                     .enumerate()
@@ -140,68 +144,72 @@ fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &PlotColumn) -> Ve
                 } else {
                     format!("{k}, {c}")
                 };
-                let mut l = Line::new(Some(label), color, pts);
-                l.marker = Some(Marker::ALL[ci]);
+                let mut l = Line::new(Some(label), PALETTE[n % PALETTE.len()], pts);
+                l.marker = Some(Marker::ALL[(n / PALETTE.len()) % Marker::ALL.len()]);
                 out.push(l);
+                n += 1;
             }
-        } else {
-            // Median over the other parameters, min-max band.
-            let mut xs: Vec<f64> = runs.iter().filter_map(x_of).collect();
-            xs.sort_by(f64::total_cmp);
-            xs.dedup();
-            let mut pts = Vec::new();
-            let mut band = Vec::new();
-            for x in xs {
-                let mut ys: Vec<f64> = runs
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, r)| r.profile == *k && x_of(r) == Some(x))
-                    .filter_map(|(i, _)| value(i))
-                    .collect();
-                if ys.is_empty() {
-                    continue;
-                }
-                ys.sort_by(f64::total_cmp);
-                let n = ys.len();
-                let median = if n % 2 == 1 {
-                    ys[n / 2]
-                } else {
-                    0.5 * (ys[n / 2 - 1] + ys[n / 2])
-                };
-                pts.push((x, median));
-                let finite: Vec<f64> = ys.iter().copied().filter(|y| y.is_finite()).collect();
-                if let (Some(lo), Some(hi)) = (finite.first(), finite.last()) {
-                    band.push((x, *lo, *hi));
-                }
-            }
-            let others: Vec<&str> = runs
-                .first()
-                .map(|r| {
-                    r.swept
-                        .iter()
-                        .filter(|(p, v)| p != param && number(v).is_some())
-                        .map(|(p, _)| p.rsplit('.').next().unwrap_or(p))
-                        .collect()
-                })
-                .unwrap_or_default();
-            let what = if others.len() == 1 {
-                "values of"
-            } else {
-                "combinations of"
-            };
-            let mut l = Line::new(
-                Some(format!(
-                    "{k}: median over {} {what} {} (band: min-max)",
-                    combos.len(),
-                    others.join(", ")
-                )),
-                color,
-                pts,
-            );
-            l.marker = Some(Marker::Circle);
-            l.band = band;
-            out.push(l);
         }
+        return out;
+    }
+    for (ki, k) in kinds.iter().enumerate() {
+        let color = PALETTE[ki % PALETTE.len()];
+        // Median over the other parameters, min-max band.
+        let mut xs: Vec<f64> = runs.iter().filter_map(x_of).collect();
+        xs.sort_by(f64::total_cmp);
+        xs.dedup();
+        let mut pts = Vec::new();
+        let mut band = Vec::new();
+        for x in xs {
+            let mut ys: Vec<f64> = runs
+                .iter()
+                .enumerate()
+                .filter(|(_, r)| r.profile == *k && x_of(r) == Some(x))
+                .filter_map(|(i, _)| value(i))
+                .collect();
+            if ys.is_empty() {
+                continue;
+            }
+            ys.sort_by(f64::total_cmp);
+            let n = ys.len();
+            let median = if n % 2 == 1 {
+                ys[n / 2]
+            } else {
+                0.5 * (ys[n / 2 - 1] + ys[n / 2])
+            };
+            pts.push((x, median));
+            let finite: Vec<f64> = ys.iter().copied().filter(|y| y.is_finite()).collect();
+            if let (Some(lo), Some(hi)) = (finite.first(), finite.last()) {
+                band.push((x, *lo, *hi));
+            }
+        }
+        let others: Vec<&str> = runs
+            .first()
+            .map(|r| {
+                r.swept
+                    .iter()
+                    .filter(|(p, v)| p != param && !matches!(v, Value::Kind(_)))
+                    .map(|(p, _)| p.as_str())
+                    .collect()
+            })
+            .unwrap_or_default();
+        let what = if others.len() == 1 {
+            "values of"
+        } else {
+            "combinations of"
+        };
+        let mut l = Line::new(
+            Some(format!(
+                "{k}: median over {} {what} {} (band: min-max)",
+                combos.len(),
+                others.join(", ")
+            )),
+            color,
+            pts,
+        );
+        l.marker = Some(Marker::Circle);
+        l.band = band;
+        out.push(l);
     }
     out
 }

@@ -5,7 +5,8 @@
 //! one time axis, with the end of the move marked. Every channel whose name ends in `error`
 //! (in m) gets a second panel zoomed on the time after the move, in um, with the settling
 //! bands and where the error settled into each. Lengths are shown in mm (um when the
-//! signal stays below 1 mm). Long traces are reduced to at most [`MAX_POINTS`] per line by
+//! signal stays below 1 mm). A raster scan's run adds its scan view
+//! (`super::scan_trace`). Long traces are reduced to at most [`MAX_POINTS`] per line by
 //! keeping each bucket's minimum and maximum, so peaks survive.
 
 use super::{Figure, Line, PALETTE, Panel, Rule, fmt_num};
@@ -35,7 +36,7 @@ fn display_unit(unit: &str, max_abs: f64) -> (String, f64) {
 }
 
 /// Min-max decimation of `(t, y)` to about `max` points.
-fn decimate(t: &[f64], y: &[f64], max: usize) -> Vec<(f64, f64)> {
+pub fn decimate(t: &[f64], y: &[f64], max: usize) -> Vec<(f64, f64)> {
     let n = t.len().min(y.len());
     if n <= max {
         return t.iter().copied().zip(y.iter().copied()).take(n).collect();

@@ -51,7 +51,7 @@ pub fn plan(
     axis: Option<&str>,
 ) -> Result<Plan, Error> {
     let spec = sc.tune.clone().unwrap_or_default();
-    if !sc.sweep.is_empty() && sc.current.is_none() {
+    if !sc.sweep.is_empty() && sc.current.is_empty() {
         return Err(src.error_at(
             "sweep",
             "settle tune does its own search: remove [sweep] (give the move family in [tune] distances_mm)",

@@ -128,9 +128,11 @@ pub fn tune_axis(
     let (sc, src) = load(path, opts)?;
     let (backend, check_on, jobs) = (opts.backend, opts.check_on, opts.jobs);
     // An imported scenario's [sweep] is for `settle sweep`; the search starts from the
-    // scenario's own point, the user's current settings.
+    // scenario's own point, the user's current settings (its [current] marks a point of
+    // that sweep, so it goes with it).
     let mut point = sc.clone();
     point.sweep.clear();
+    point.current.clear();
     let mut runs = crate::expand::expand(&point, &src)?;
     crate::execute::set_backend(path, &mut runs, backend)?;
     let plan = grid::plan(&sc, &src, &runs, axis)?;
@@ -344,6 +346,26 @@ pub fn tune_with(
     let o = &done[0].1;
     let fig = report::pareto_figure(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
     crate::output::plot::write(&fig, &out, "pareto")?;
+    // report.html: tune.md's tables, every candidate, the Pareto figure, the provenance.
+    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let file = crate::output::report::ScenarioFile { path, text: &text };
+    let svg_path = out.join("pareto.svg");
+    let svg = std::fs::read_to_string(&svg_path).map_err(|e| Error::read(&svg_path, e))?;
+    let html = crate::output::report::markdown_report(
+        &format!("{} (tune)", sc.name),
+        &md,
+        &report::candidates_csv(&done),
+        &[("Pareto front".to_string(), svg)],
+        crate::output::report::provenance(
+            file,
+            opts.backend.name(),
+            format!("settle tune {}", path.display()),
+        ),
+    );
+    write(
+        crate::output::sweep_files::REPORT,
+        &crate::output::html::render(&html),
+    )?;
     let outcome = o.clone();
     Ok(Tuned {
         outcome,

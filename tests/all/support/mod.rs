@@ -3,11 +3,24 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+pub mod html;
+
 /// The `settle` binary, run from the repository root.
 pub fn settle() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_settle"));
     c.current_dir(env!("CARGO_MANIFEST_DIR"));
     c
+}
+
+/// Run `cmd` and require success (the message shows its standard error); its output.
+pub fn run_ok(cmd: &mut Command) -> std::process::Output {
+    let out = cmd.output().expect("runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
 }
 
 /// The repository root.

@@ -1,0 +1,209 @@
+//! The page around the tables: head (inline style, a content policy that forbids any
+//! fetch), title and intro, winner cards, figures, failed runs, provenance, inline script.
+
+use std::fmt::Write as _;
+
+use super::escape::{base64, escaped, push_escaped};
+use super::grid::push_table;
+use super::model::{BandWinner, Cell, Figure, Image, Provenance, Reference, Report, Table};
+
+const STYLE: &str = include_str!("style.css");
+const SCRIPT: &str = include_str!("script.js");
+
+/// Everything the page may load: nothing from the network; images only as `data:` URIs;
+/// style and script only inline. A blocked load shows as a console error.
+const CONTENT_POLICY: &str =
+    "default-src 'none'; img-src data:; style-src 'unsafe-inline'; script-src 'unsafe-inline'";
+
+/// The whole page.
+pub(crate) fn page(r: &Report) -> String {
+    let mut out = String::with_capacity(64 * 1024);
+    out.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
+    let _ = writeln!(
+        out,
+        "<meta http-equiv=\"Content-Security-Policy\" content=\"{CONTENT_POLICY}\">"
+    );
+    out.push_str("<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n");
+    let _ = writeln!(
+        out,
+        "<meta name=\"generator\" content=\"settle {}\">",
+        escaped(&r.provenance.settle_version)
+    );
+    let _ = writeln!(out, "<title>{}</title>", escaped(&r.title));
+    let _ = writeln!(out, "<style>\n{STYLE}</style>\n</head>\n<body>");
+    let _ = writeln!(out, "<header>\n<h1>{}</h1>", escaped(&r.title));
+    for line in &r.intro {
+        let _ = writeln!(out, "<p>{}</p>", escaped(line));
+    }
+    out.push_str("</header>\n");
+    push_winners(&mut out, &r.winners);
+    for (i, t) in r.tables.iter().enumerate() {
+        push_table(&mut out, &format!("table-{}", i + 1), t);
+    }
+    push_figures(&mut out, &r.figures);
+    if let Some(runs) = &r.runs {
+        push_table(&mut out, "runs", runs);
+    }
+    if !r.failed.is_empty() {
+        let failed = Table {
+            title: format!("Failed runs ({})", r.failed.len()),
+            note: "These runs produced no numbers and are never compared or averaged.".into(),
+            header: vec!["run".into(), "status".into(), "reason".into()],
+            rows: r
+                .failed
+                .iter()
+                .map(|f| {
+                    vec![
+                        Cell::text(f.run.as_str()),
+                        Cell::text(f.status.as_str()),
+                        Cell::text(f.reason.as_str()),
+                    ]
+                })
+                .collect(),
+        };
+        push_table(&mut out, "failed", &failed);
+    }
+    push_provenance(&mut out, &r.provenance);
+    let _ = write!(out, "<script>\n{SCRIPT}</script>\n</body>\n</html>\n");
+    out
+}
+
+/// The gain as shown large, and the sentence naming the reference.
+fn gain_text(ratio: f64, reference: &Reference) -> (String, String) {
+    let (who, label) = match reference {
+        Reference::Current { label } => ("your current settings", label),
+        Reference::Slowest { label } => ("the slowest candidate", label),
+    };
+    let headline = if ratio.is_infinite() && ratio > 0.0 {
+        "reference never settles".to_string()
+    } else if ratio > 1.0 {
+        let pct = (ratio - 1.0) * 100.0;
+        if pct < 10.0 {
+            format!("+{pct:.1} %")
+        } else {
+            format!("+{pct:.0} %")
+        }
+    } else {
+        "no gain".to_string()
+    };
+    (headline, format!("vs {who}: {label}"))
+}
+
+fn push_winners(out: &mut String, winners: &[BandWinner]) {
+    if winners.is_empty() {
+        return;
+    }
+    out.push_str(
+        "<section id=\"winners\">\n<h2>Winner per band</h2>\n<p class=\"note\">Gain: how much \
+longer the reference takes than the winner.</p>\n<div class=\"cards\">\n",
+    );
+    for w in winners {
+        let _ = write!(
+            out,
+            "<article class=\"card\">\n<h3>{}</h3>\n<p class=\"winner\">{}</p>\n",
+            escaped(&w.band),
+            escaped(&w.winner)
+        );
+        if !w.numbers.is_empty() {
+            out.push_str("<dl class=\"stats\">");
+            for s in &w.numbers {
+                let _ = write!(
+                    out,
+                    "<dt>{}</dt><dd>{}</dd>",
+                    escaped(&s.label),
+                    escaped(&s.value)
+                );
+            }
+            out.push_str("</dl>\n");
+        }
+        if let Some(g) = &w.gain {
+            let (headline, reference) = gain_text(g.ratio, &g.reference);
+            let class = if g.ratio > 1.0 { "gain" } else { "gain none" };
+            let _ = writeln!(
+                out,
+                "<p class=\"{class}\">{}</p>\n<p class=\"ref\">{}</p>",
+                escaped(&headline),
+                escaped(&reference)
+            );
+            if !g.detail.is_empty() {
+                let _ = writeln!(out, "<p class=\"detail\">{}</p>", escaped(&g.detail));
+            }
+        }
+        out.push_str("</article>\n");
+    }
+    out.push_str("</div>\n</section>\n");
+}
+
+/// SVG markup without a leading XML declaration or doctype (both are out of place inside
+/// HTML).
+fn inline_svg(svg: &str) -> &str {
+    let mut s = svg.trim_start();
+    for opener in ["<?xml", "<!DOCTYPE", "<!doctype"] {
+        if s.starts_with(opener)
+            && let Some(end) = s.find('>')
+        {
+            s = s[end + 1..].trim_start();
+        }
+    }
+    s
+}
+
+fn push_figures(out: &mut String, figures: &[Figure]) {
+    if figures.is_empty() {
+        return;
+    }
+    out.push_str("<section id=\"figures\">\n<h2>Figures</h2>\n");
+    for (i, f) in figures.iter().enumerate() {
+        let _ = write!(out, "<figure id=\"figure-{}\">\n<div class=\"img\">", i + 1);
+        match &f.image {
+            Image::Svg(svg) => out.push_str(inline_svg(svg)),
+            Image::Png(bytes) => {
+                let _ = write!(
+                    out,
+                    "<img alt=\"{}\" src=\"data:image/png;base64,{}\">",
+                    escaped(&f.title),
+                    base64(bytes)
+                );
+            }
+        }
+        let _ = writeln!(
+            out,
+            "</div>\n<figcaption>{}</figcaption>\n</figure>",
+            escaped(&f.title)
+        );
+    }
+    out.push_str("</section>\n");
+}
+
+fn push_provenance(out: &mut String, p: &Provenance) {
+    out.push_str("<section id=\"provenance\">\n<h2>Provenance</h2>\n<dl class=\"prov\">\n");
+    for (label, value, code) in [
+        ("settle version", &p.settle_version, false),
+        ("backend", &p.backend, false),
+        ("command line", &p.command_line, true),
+        ("date", &p.date, false),
+    ] {
+        if value.is_empty() {
+            continue;
+        }
+        let _ = write!(out, "<dt>{label}</dt><dd>");
+        if code {
+            out.push_str("<code>");
+        }
+        push_escaped(out, value);
+        out.push_str(if code { "</code></dd>\n" } else { "</dd>\n" });
+    }
+    out.push_str("</dl>\n");
+    // The newline after `<pre>` is dropped by every HTML parser: a text starting with a
+    // line break keeps it.
+    for f in &p.inputs {
+        let _ = write!(
+            out,
+            "<details>\n<summary>{}</summary>\n<pre>\n",
+            escaped(&f.name)
+        );
+        push_escaped(out, &f.text);
+        out.push_str("</pre>\n</details>\n");
+    }
+    out.push_str("</section>\n");
+}

@@ -1,0 +1,339 @@
+//! `report.html` of a sweep: the same data summary.md shows ([`crate::output::ranking`]),
+//! as a [`Report`] for [`crate::output::html::render`]: the winner per band, one ranking
+//! table per band, the figures embedded, every run (runs.csv, sortable and filterable),
+//! the failed runs with their reasons and the provenance (scenario text, settle version,
+//! backend, the command that reruns it).
+//!
+//! No clock is read: the same runs give the same page, so a merged sweep's report is the
+//! unsharded one's.
+
+use crate::input::runs_table::RunsTable;
+use crate::input::scenario::Scenario;
+use crate::output::html::{
+    BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, Provenance, Reference, Report,
+    Stat, Table,
+};
+use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, rank, run_command};
+use crate::output::summary::{machines_line, ms};
+use crate::spec::run_spec::RunSpec;
+
+/// The scenario a sweep ran, as the report names it.
+#[derive(Debug, Clone, Copy)]
+pub struct ScenarioFile<'a> {
+    /// The path, as given on the command line (the commands in the report use it).
+    pub path: &'a std::path::Path,
+    /// Its text.
+    pub text: &'a str,
+}
+
+/// The figures (caption, SVG markup) as the page embeds them.
+fn embedded(figures: &[(String, String)]) -> Vec<Figure> {
+    figures
+        .iter()
+        .map(|(title, svg)| Figure {
+            title: title.clone(),
+            image: Image::Svg(svg.clone()),
+        })
+        .collect()
+}
+
+/// A number cell with `text` shown (`value` non-finite for `not settled`).
+fn num(value: f64, text: String) -> Cell {
+    Cell::Number { value, text }
+}
+
+fn winners(ranking: &Ranking) -> Vec<BandWinner> {
+    ranking
+        .bands
+        .iter()
+        .map(|b| {
+            let band = format!("within {} um", b.band_um);
+            let Some(w) = &b.winner else {
+                return BandWinner {
+                    band,
+                    winner: "no candidate settles at every point".into(),
+                    ..BandWinner::default()
+                };
+            };
+            let mut numbers = vec![Stat {
+                label: if w.points > 1 {
+                    format!("move and settle, sum over {} points", w.points)
+                } else {
+                    "move and settle".into()
+                },
+                value: format!("{:.1} ms", w.total_s * 1e3),
+            }];
+            if let Some((label, t)) = &w.reference {
+                numbers.push(Stat {
+                    label: format!("{} ({label})", ranking.reference_name()),
+                    value: if t.is_finite() {
+                        format!("{:.1} ms", t * 1e3)
+                    } else {
+                        "not settled everywhere".into()
+                    },
+                });
+            }
+            let gain = w.reference.as_ref().map(|(label, t)| Gain {
+                reference: if ranking.has_current {
+                    Reference::Current {
+                        label: label.clone(),
+                    }
+                } else {
+                    Reference::Slowest {
+                        label: label.clone(),
+                    }
+                },
+                ratio: t / w.total_s,
+                detail: format!(
+                    "move and settle {} ms vs {} ms",
+                    ms(Some(w.total_s)),
+                    ms(Some(*t).filter(|t| t.is_finite()))
+                ),
+            });
+            BandWinner {
+                band,
+                winner: w.label.clone(),
+                numbers,
+                gain,
+            }
+        })
+        .collect()
+}
+
+fn ranking_tables(ranking: &Ranking, runs: &[RunSpec], file: ScenarioFile<'_>) -> Vec<Table> {
+    ranking
+        .bands
+        .iter()
+        .map(|b| {
+            let mut header: Vec<String> = ranking.workload_keys.clone();
+            header.push("rank".into());
+            header.push("candidate".into());
+            for h in [
+                "move (ms)",
+                "settle (ms)",
+                "total (ms)",
+                "residual peak (um)",
+            ] {
+                header.push(h.into());
+            }
+            header.push(format!("gain {} (%)", ranking.reference_name()));
+            if ranking.shapers {
+                header.extend(SHAPER_COLUMNS.map(String::from));
+            }
+            header.push("run".into());
+            header.push("command".into());
+            let mut rows = Vec::new();
+            for p in &b.points {
+                for r in &p.runs {
+                    let mut row: Vec<Cell> = p.workload.iter().map(Cell::text).collect();
+                    row.push(match r.rank {
+                        Some(n) => num(n as f64, n.to_string()),
+                        None => num(f64::INFINITY, "-".into()),
+                    });
+                    row.push(Cell::text(if r.current {
+                        format!("{} (current)", r.label)
+                    } else {
+                        r.label.clone()
+                    }));
+                    let t = |x: Option<f64>| num(x.map_or(f64::INFINITY, |x| x * 1e3), ms(x));
+                    match &r.failure {
+                        Some(f) => {
+                            row.push(num(r.move_s * 1e3, format!("{:.1}", r.move_s * 1e3)));
+                            row.push(Cell::text(f.clone()));
+                            row.push(num(f64::INFINITY, "failed".into()));
+                            row.push(num(f64::NAN, "-".into()));
+                        }
+                        None => {
+                            row.push(num(r.move_s * 1e3, format!("{:.1}", r.move_s * 1e3)));
+                            row.push(t(r.settle_s));
+                            row.push(t(r.total_s));
+                            row.push(num(
+                                r.residual_peak_um,
+                                format!("{:.2}", r.residual_peak_um),
+                            ));
+                        }
+                    }
+                    row.push(num(
+                        r.gain.map_or(f64::NAN, |g| g * 100.0),
+                        gain_text(r.gain),
+                    ));
+                    if let Some(sh) = &r.shaper {
+                        for (x, prec) in sh.iter().zip([3usize, 1, 0]) {
+                            row.push(x.map_or(num(f64::NAN, "-".into()), |x| {
+                                num(x, format!("{x:.prec$}"))
+                            }));
+                        }
+                    }
+                    row.push(num(r.id as f64, r.id.to_string()));
+                    row.push(Cell::text(run_command(file.path, &runs[r.row])));
+                    rows.push(row);
+                }
+            }
+            Table {
+                title: format!("Ranking: move and settle to within {} um", b.band_um),
+                note: format!(
+                    "Per swept point of the workload, fastest first. Gain {}: how much longer the reference takes.",
+                    ranking.reference_name()
+                ),
+                header,
+                rows,
+            }
+        })
+        .collect()
+}
+
+/// The report of a sweep: `csv` is its runs.csv (row `i` = `runs[i]`, read into `table`),
+/// `figures` the figures' captions and SVG markup, `sections` the run kinds' summary
+/// sections (shown as text).
+pub fn sweep_report(
+    sc: &Scenario,
+    file: ScenarioFile<'_>,
+    runs: &[RunSpec],
+    table: &RunsTable,
+    csv: &str,
+    figures: &[(String, String)],
+) -> Report {
+    let mut intro = vec![format!("{}. {} runs.", machines_line(runs), runs.len())];
+    if !sc.description.trim().is_empty() {
+        intro.insert(0, sc.description.trim().to_string());
+    }
+    let mut replaced = false;
+    let mut kind_tables = Vec::new();
+    for k in crate::kinds::all() {
+        if let Some(section) = k.summary(runs, table) {
+            replaced |= k.replaces_move_tables();
+            kind_tables.extend(markdown_tables(&section));
+        }
+    }
+    let (winners, mut tables) = if replaced {
+        (Vec::new(), Vec::new())
+    } else {
+        let ranking = rank(sc, runs, table);
+        (winners(&ranking), ranking_tables(&ranking, runs, file))
+    };
+    tables.extend(kind_tables);
+    let failed = (0..runs.len())
+        .filter(|&i| table.cell(i, "status").is_some_and(|s| s != "ok"))
+        .map(|i| FailedRun {
+            run: format!("run {}", runs[i].id),
+            status: table.cell(i, "status").unwrap_or_default().to_string(),
+            reason: table.cell(i, "reason").unwrap_or_default().to_string(),
+        })
+        .collect();
+    let backend = runs
+        .first()
+        .map(|r| r.backend.to_string())
+        .unwrap_or_default();
+    Report {
+        title: sc.name.clone(),
+        intro,
+        winners,
+        tables,
+        figures: embedded(figures),
+        runs: Table::from_csv("All runs (runs.csv)", csv).ok(),
+        failed,
+        provenance: provenance(
+            file,
+            &backend,
+            format!(
+                "settle sweep {}{}",
+                file.path.display(),
+                if backend.is_empty() || backend == crate::spec::backend::Backend::default().name()
+                {
+                    String::new()
+                } else {
+                    format!(" --backend {backend}")
+                }
+            ),
+        ),
+    }
+}
+
+/// A report from a Markdown summary (e.g. `settle tune`'s tune.md): its tables (each under
+/// its heading, the paragraph under it as its note), the candidates table `csv` as the
+/// sortable, filterable table of every run, the `figures` (caption, SVG markup) and the
+/// provenance.
+pub fn markdown_report(
+    title: &str,
+    markdown: &str,
+    csv: &str,
+    figures: &[(String, String)],
+    provenance: Provenance,
+) -> Report {
+    Report {
+        title: title.to_string(),
+        intro: Vec::new(),
+        winners: Vec::new(),
+        tables: markdown_tables(markdown),
+        figures: embedded(figures),
+        runs: Table::from_csv("Every candidate", csv).ok(),
+        failed: Vec::new(),
+        provenance,
+    }
+}
+
+/// The provenance of a run of settle on `file` with `backend`, `command` as typed.
+pub fn provenance(file: ScenarioFile<'_>, backend: &str, command: String) -> Provenance {
+    Provenance {
+        settle_version: env!("CARGO_PKG_VERSION").to_string(),
+        backend: backend.to_string(),
+        command_line: command,
+        date: String::new(),
+        inputs: vec![InputFile {
+            name: file.path.display().to_string(),
+            text: file.text.to_string(),
+        }],
+    }
+}
+
+/// The tables of a summary section (Markdown): each `## heading`, the paragraph under it
+/// as the note, and its `| ... |` rows (bold marks dropped; numbers sort as numbers).
+fn markdown_tables(section: &str) -> Vec<Table> {
+    let mut out: Vec<Table> = Vec::new();
+    let mut title = String::new();
+    let mut note = String::new();
+    let mut current: Option<Table> = None;
+    let cells = |line: &str| -> Vec<String> {
+        line.trim()
+            .trim_matches('|')
+            .split('|')
+            .map(|c| c.trim().replace("**", ""))
+            .collect()
+    };
+    for line in section.lines() {
+        let is_row = line.trim_start().starts_with('|');
+        if !is_row && let Some(t) = current.take() {
+            out.push(t);
+        }
+        if let Some(h) = line.strip_prefix("## ") {
+            title = h.trim().to_string();
+            note.clear();
+        } else if is_row {
+            let row = cells(line);
+            match current.as_mut() {
+                None => {
+                    current = Some(Table {
+                        title: title.clone(),
+                        note: note.trim().to_string(),
+                        header: row,
+                        rows: Vec::new(),
+                    });
+                }
+                Some(_) if row.iter().all(|c| c.chars().all(|ch| "-:".contains(ch))) => {}
+                Some(t) => t.rows.push(
+                    row.into_iter()
+                        .map(|c| match c.parse::<f64>() {
+                            Ok(x) => num(x, c),
+                            Err(_) => Cell::text(c),
+                        })
+                        .collect(),
+                ),
+            }
+        } else if !line.trim().is_empty() {
+            note.push_str(line.trim());
+            note.push(' ');
+        }
+    }
+    out.extend(current);
+    out
+}
