@@ -6,6 +6,7 @@
 
 pub mod check;
 pub mod journal;
+pub mod lock;
 pub mod merge;
 pub mod plan;
 pub mod run;

@@ -129,10 +129,7 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
             ),
         ));
     }
-    let text = std::fs::read_to_string(&path).map_err(|source| Error::Read {
-        path: path.clone(),
-        source,
-    })?;
+    let text = crate::input::file::read_text(&path)?;
     let m: Manifest =
         toml::from_str(&text).map_err(|e| input_error(&path, e.message().trim().to_string()))?;
     if m.format != FORMAT {
@@ -145,10 +142,7 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
         ));
     }
     let csv_path = dir.join("runs.csv");
-    let csv = std::fs::read_to_string(&csv_path).map_err(|source| Error::Read {
-        path: csv_path.clone(),
-        source,
-    })?;
+    let csv = crate::input::file::read_text(&csv_path)?;
     let table = RunsTable::parse(&csv).map_err(|e| input_error(&csv_path, e))?;
     Ok((m, table))
 }

@@ -18,6 +18,7 @@ use crate::output::sweep_files::{PLOTS, RECORDINGS, write_sweep};
 use crate::spec::backend::Backend;
 use crate::spec::run_spec::RunSpec;
 use crate::workflows::journal::{self, Journal};
+use crate::workflows::lock::FolderLock;
 use crate::workflows::shard::{self, Manifest, Shard};
 use crate::workflows::{Exit, Report};
 
@@ -128,7 +129,9 @@ pub fn sweep(
 ) -> Result<SweepOutcome, Error> {
     let started = Instant::now();
     let path = &opts.scenario;
-    let (sc, mut all_runs) = crate::expand::load_runs(path)?;
+    let (sc, src) = crate::expand::load(path)?;
+    let mut all_runs = crate::expand::expand(&sc, &src)?;
+    let inputs = crate::expand::machine::inputs_identity(&sc, &src)?;
     crate::execute::set_backend(path, &mut all_runs, opts.backend)?;
     let base = PathBuf::from("results").join(&sc.name);
     let out = opts.out.clone().unwrap_or_else(|| match opts.shard {
@@ -151,6 +154,7 @@ pub fn sweep(
         None => all_runs.clone(),
     };
     create_dir(&out)?;
+    let _lock = FolderLock::take(&out)?;
     if let Some(r) = &rec {
         create_dir(&r.dir)?;
     }
@@ -167,16 +171,41 @@ pub fn sweep(
     ));
     let layout = RunsCsv::new(&runs);
     let header = layout.header();
-    let scenario_text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let scenario_text = src.text().to_string();
     let key = journal::key_line(
         &scenario_text,
+        &inputs,
         &sc.name,
         opts.backend.name(),
         &opts.shard.map_or(String::new(), |s| s.to_string()),
     );
     let ids: Vec<usize> = runs.iter().map(|r| r.id).collect();
+    // The leading cells of each run's row: its parameters, up to its status.
+    let n_params = layout
+        .columns()
+        .iter()
+        .position(|c| c == "status")
+        .unwrap_or(0);
+    let params = |id: usize| {
+        let spec = match opts.shard {
+            Some(s) if !s.contains(id) => return None,
+            Some(s) => runs.get((id - (s.k - 1)) / s.n)?,
+            None => runs.get(id)?,
+        };
+        let cells = layout.cells(spec, &Metrics::failed(&spec.bands_um, String::new()));
+        let mut prefix = crate::input::runs_table::record(&cells[..n_params]);
+        prefix.pop();
+        prefix.push(',');
+        Some(prefix)
+    };
     let (journal, done) = match journal::existing(&out) {
-        Some(_) if opts.resume => Journal::resume(&out, &key, &header, &ids)?,
+        Some(_) if opts.resume => {
+            let (j, done, notes) = Journal::resume(&out, &key, &header, &params)?;
+            for n in notes {
+                note(&format!("{}: {n}", out.join(journal::FILE).display()));
+            }
+            (j, done)
+        }
         Some(p) => {
             return Err(Error::input(
                 "--resume",
@@ -201,11 +230,15 @@ pub fn sweep(
         .cloned()
         .collect();
     let run_one = |spec: &RunSpec| -> Result<String, Error> {
-        let m = match &rec {
+        let m = match match &rec {
             Some(r) => r.run(spec),
             None => crate::execute::execute(spec, None),
-        }
-        .unwrap_or_else(|e| Metrics::failed(&spec.bands_um, format!("{e}")));
+        } {
+            Ok(m) => m,
+            // Not a result of the run: nothing goes to the journal.
+            Err(e @ Error::Interrupted { .. }) => return Err(e),
+            Err(e) => Metrics::failed(&spec.bands_um, format!("{e}")),
+        };
         let row = layout.row(spec, &m);
         journal.append(&row)?;
         Ok(row)
