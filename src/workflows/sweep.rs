@@ -92,6 +92,8 @@ pub struct SweepOutcome {
     pub recordings: Option<PathBuf>,
     /// Wall-clock time (s).
     pub elapsed_s: f64,
+    /// The options it ran with (for the command that resumes it).
+    pub options: SweepOptions,
 }
 
 /// The recorder the flags ask for, checked before any work (a missing feature costs no
@@ -155,6 +157,10 @@ pub fn sweep(
     };
     create_dir(&out)?;
     let _lock = FolderLock::take(&out)?;
+    // What a killed sweep was writing (`.NAME.tmpPID` beside NAME): nobody else writes here.
+    for dir in [out.clone(), out.join(PLOTS), out.join(RECORDINGS)] {
+        remove_stale_temps(&dir)?;
+    }
     if let Some(r) = &rec {
         create_dir(&r.dir)?;
     }
@@ -229,7 +235,13 @@ pub fn sweep(
         .filter(|r| !done.contains_key(&r.id))
         .cloned()
         .collect();
+    // An output that cannot be written (a full disk) is not a result of a run: the sweep
+    // stops, the journal keeps what finished, and `--resume` completes it.
+    let write_failed = std::sync::atomic::AtomicBool::new(false);
     let run_one = |spec: &RunSpec| -> Result<String, Error> {
+        if write_failed.load(std::sync::atomic::Ordering::SeqCst) {
+            return Err(Error::Interrupted { run: spec.id });
+        }
         let m = match match &rec {
             Some(r) => r.run(spec),
             None => crate::execute::execute(spec, None),
@@ -237,23 +249,36 @@ pub fn sweep(
             Ok(m) => m,
             // Not a result of the run: nothing goes to the journal.
             Err(e @ Error::Interrupted { .. }) => return Err(e),
+            Err(e @ Error::Write { .. }) => {
+                write_failed.store(true, std::sync::atomic::Ordering::SeqCst);
+                return Err(e);
+            }
             Err(e) => Metrics::failed(&spec.bands_um, format!("{e}")),
         };
         let row = layout.row(spec, &m);
-        journal.append(&row)?;
+        if let Err(e) = journal.append(&row) {
+            write_failed.store(true, std::sync::atomic::Ordering::SeqCst);
+            return Err(e);
+        }
         Ok(row)
     };
     let results = run_all_with(&todo, opts.jobs, progress, run_one)?;
     let mut rows = done;
     let mut interrupted = 0usize;
+    let mut write_error = None;
     for (spec, r) in todo.iter().zip(results) {
         match r {
             Ok(row) => {
                 rows.insert(spec.id, row);
             }
             Err(Error::Interrupted { .. }) => interrupted += 1,
-            Err(e) => return Err(e),
+            Err(e) => {
+                write_error.get_or_insert(e);
+            }
         }
+    }
+    if let Some(e) = write_error {
+        return Err(e);
     }
     let mut outcome = SweepOutcome {
         scenario: path.clone(),
@@ -264,6 +289,7 @@ pub fn sweep(
         interrupted: None,
         recordings: rec.as_ref().map(|r| r.dir.clone()),
         elapsed_s: 0.0,
+        options: opts.clone(),
     };
     if interrupted > 0 || crate::execute::interrupt::requested() {
         outcome.interrupted = Some(rows.len());
@@ -287,10 +313,24 @@ pub fn sweep(
                     shard: s.k,
                     shards: s.n,
                     total_runs: all_runs.len(),
-                    runs: ids,
+                    runs: ids.clone(),
                     settings: [("backend".to_string(), opts.backend.name().to_string())]
                         .into_iter()
                         .collect(),
+                    inputs: inputs.clone(),
+                    runs_digest: shard::runs_digest(&csv),
+                    recordings: match &rec {
+                        Some(r) => ids
+                            .iter()
+                            .flat_map(|&id| {
+                                [(r.mcap, "mcap"), (r.rerun, "rrd")]
+                                    .into_iter()
+                                    .filter(|(on, _)| *on)
+                                    .map(move |(_, ext)| format!("run-{id}.{ext}"))
+                            })
+                            .collect(),
+                        None => Vec::new(),
+                    },
                     scenario: scenario_text,
                 },
             )?;
@@ -301,6 +341,22 @@ pub fn sweep(
     journal.finish()?;
     outcome.failed = failures(&runs, &csv);
     Ok(outcome)
+}
+
+/// Remove the temporary files of atomic writes ([`crate::output::atomic::tmp_path`]) left
+/// in `dir` by a sweep that was killed while writing.
+fn remove_stale_temps(dir: &Path) -> Result<(), Error> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(()); // no such folder yet
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        if name.starts_with('.') && name.contains(".tmp") && e.path().is_file() {
+            std::fs::remove_file(e.path()).map_err(|err| Error::write(e.path(), err))?;
+        }
+    }
+    Ok(())
 }
 
 /// The failed runs, from runs.csv's `status` and `reason` columns.
@@ -320,6 +376,43 @@ fn failures(runs: &[RunSpec], csv: &str) -> Vec<FailedRun> {
 }
 
 impl SweepOutcome {
+    /// The command that resumes this sweep: the same scenario, folder, backend, shard and
+    /// recordings (everything the journal's key or the outputs depend on), and `--jobs`
+    /// when it was given.
+    pub fn resume_command(&self) -> String {
+        let o = &self.options;
+        let quote = |p: &Path| {
+            let s = p.display().to_string();
+            if s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || "/._-+".contains(c))
+            {
+                s
+            } else {
+                format!("'{}'", s.replace('\'', "'\\''"))
+            }
+        };
+        let mut cmd = format!(
+            "settle sweep {} --out {} --backend {}",
+            quote(&self.scenario),
+            quote(&self.out),
+            o.backend.name()
+        );
+        if let Some(s) = o.shard {
+            cmd.push_str(&format!(" --shard {s}"));
+        }
+        if let Some(j) = o.jobs {
+            cmd.push_str(&format!(" --jobs {j}"));
+        }
+        if o.mcap {
+            cmd.push_str(" --mcap");
+        }
+        if o.rerun {
+            cmd.push_str(" --rerun");
+        }
+        cmd.push_str(" --resume");
+        cmd
+    }
+
     /// What `settle sweep` prints: where the outputs are, and the failed runs (at most 20,
     /// then a count).
     pub fn report(&self) -> Report {
@@ -327,12 +420,10 @@ impl SweepOutcome {
         if let Some(kept) = self.interrupted {
             let mut r = Report::new(Exit::Interrupted);
             r.err(format!(
-                "interrupted: {kept} of {} runs finished and kept in {}; continue with\n  settle sweep {} --out {} --resume{}",
+                "interrupted: {kept} of {} runs finished and kept in {}; continue with\n  {}",
                 self.runs,
                 out.join(journal::FILE).display(),
-                self.scenario.display(),
-                out.display(),
-                self.shard.map_or(String::new(), |s| format!(" --shard {s}"))
+                self.resume_command()
             ));
             return r;
         }
