@@ -74,7 +74,7 @@ pub fn resolve_machine(
 }
 
 /// The identity of the files a scenario reads besides itself (its machine files, given by
-/// `preset` in [machine] or swept as `machine.preset`), by content: one `path=digest` per
+/// `preset` in `[machine]` or swept as `machine.preset`), by content: one `path=digest` per
 /// file, in the order named, empty when it reads none. A sweep's journal and a shard's
 /// manifest carry it, so that a machine file edited between an interruption and
 /// `--resume`, or between two shards, is noticed.

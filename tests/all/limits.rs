@@ -72,7 +72,7 @@ fn a_move_that_would_never_end_is_refused_with_its_key() {
 
 /// One rapier run of a 40 Hz mode observed for 5,000 s at 10 kHz (5e7 samples, a minute
 /// or more of work): Ctrl-C must end it within seconds, not after the run.
-const LONG_RUN: &str = r#"name = "long"
+pub const LONG_RUN: &str = r#"name = "long"
 [machine]
 modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]
 [move]

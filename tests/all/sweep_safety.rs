@@ -8,23 +8,6 @@ use std::time::{Duration, Instant};
 
 use crate::support::{settle, write};
 
-/// One long rapier run (see `limits::LONG_RUN`'s twin): a sweep that is still running
-/// when the test looks at it.
-const LONG_RUN: &str = r#"name = "long"
-[machine]
-modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]
-[move]
-distance_mm = 10.0
-profile = "trapezoid"
-[limits]
-vmax_mm_s = 300.0
-amax_mm_s2 = 3000.0
-[observe]
-window_s = 5000.0
-sample_rate_hz = 10000
-bands_um = [10.0]
-"#;
-
 /// Start a sweep of `scenario` into `out`; returns once its journal exists.
 fn start_long(scenario: &Path, out: &Path) -> Child {
     let child = settle()
@@ -46,7 +29,7 @@ fn start_long(scenario: &Path, out: &Path) -> Child {
 #[test]
 fn a_second_sweep_on_a_busy_folder_is_refused_and_names_the_holder() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let scenario = write(dir.path(), "long.toml", LONG_RUN);
+    let scenario = write(dir.path(), "long.toml", crate::limits::LONG_RUN);
     let out = dir.path().join("out");
     let mut first = start_long(&scenario, &out);
     let journal = std::fs::read(out.join("journal.csv")).expect("journal");
