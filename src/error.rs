@@ -56,6 +56,18 @@ impl std::fmt::Display for Location {
     }
 }
 
+/// The most characters of an input value an error message repeats.
+pub const ECHO_CHARS: usize = 60;
+
+/// `value` as an error message repeats it: at most [`ECHO_CHARS`] characters, then how
+/// many more there are (a 10 MB value in a file is not printed back).
+pub fn echo(value: &str) -> String {
+    match value.char_indices().nth(ECHO_CHARS) {
+        None => value.to_string(),
+        Some((i, _)) => format!("{}... ({} characters)", &value[..i], value.chars().count()),
+    }
+}
+
 /// Everything the harness reports. Bad input (exit code 2) is told apart from failures
 /// while running or writing (exit code 1) by [`Error::is_input_error`].
 #[derive(Debug, thiserror::Error)]

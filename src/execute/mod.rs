@@ -80,17 +80,39 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
     let options = sim_options(spec);
     let observe = observe_of(spec);
     let traj = &planned.trajectory;
+    let samples = (traj.duration_s() + spec.window_s) * spec.sample_rate_hz;
+    if !(samples.is_finite() && samples <= crate::expand::validate::MAX_SAMPLES_PER_RUN) {
+        return Ok(Metrics::failed(
+            &spec.bands_um,
+            format!(
+                "the planned move takes {:.3e} s: with the {} s window at {} Hz that is {samples:.3e} samples, over the limit of {:e} per run",
+                traj.duration_s(),
+                spec.window_s,
+                spec.sample_rate_hz,
+                crate::expand::validate::MAX_SAMPLES_PER_RUN
+            ),
+        ));
+    }
+    let interrupted = |m: Result<Metrics, Error>| {
+        if interrupt::requested() {
+            Err(Error::Interrupted { run: spec.id })
+        } else {
+            m
+        }
+    };
     let Some(probe) = planned.probe else {
-        return run_trajectory(axes, spec.backend, &options, traj, &observe, record)
-            .map_err(sim_err);
+        return interrupted(
+            run_trajectory(axes, spec.backend, &options, traj, &observe, record).map_err(sim_err),
+        );
     };
     let mut local = Series::default();
     let series = match record {
         Some(s) => s,
         None => &mut local,
     };
-    let mut m = run_trajectory(axes, spec.backend, &options, traj, &observe, Some(series))
-        .map_err(sim_err)?;
+    let mut m = interrupted(
+        run_trajectory(axes, spec.backend, &options, traj, &observe, Some(series)).map_err(sim_err),
+    )?;
     if m.is_ok() {
         probe.measure(spec, series, &mut m)?;
     }

@@ -177,10 +177,19 @@ pub fn simulate<P: Plant>(
             }
         };
     }
+    // An interruption (Ctrl-C, SIGTERM) ends a run in progress: polled every
+    // `INTERRUPT_POLL` evaluated samples (a batch of up to `CHUNK` samples counts once), a
+    // few milliseconds of work on any backend. The caller sees the interruption and drops
+    // the run (`crate::execute::execute`).
+    let mut polls = 0usize;
     macro_rules! sample {
         ($t:expr, $cmd:expr) => {
             if let Err(reason) = sample($t, $cmd, &state, &mut obs, &mut acc, &mut path_acc) {
                 fault!(reason);
+            }
+            polls += 1;
+            if polls % INTERRUPT_POLL == 0 && crate::execute::interrupt::requested() {
+                fault!(INTERRUPTED.to_string());
             }
         };
     }
@@ -353,6 +362,12 @@ pub fn simulate<P: Plant>(
     metrics.path = path_acc.map(|p| p.finish());
     Ok(metrics)
 }
+
+/// Samples between two looks at [`crate::execute::interrupt::requested`].
+const INTERRUPT_POLL: usize = 64;
+
+/// The fault reason of a run ended by an interruption.
+pub const INTERRUPTED: &str = "interrupted";
 
 /// Samples per [`Plant::step_samples`] call: long enough to make the per-call cost
 /// negligible, short enough that the buffers stay in the first-level cache.

@@ -10,8 +10,9 @@ use crate::input::source::Source;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::value::Value;
 
-/// Upper bound on the number of runs one scenario may expand to.
-pub const MAX_RUNS: usize = 10_000_000;
+/// Upper bound on the number of runs one scenario may expand to: ten times the largest
+/// sweep `scripts/scale.sh` checks (100,000 runs), a few hundred MB of run specs.
+pub const MAX_RUNS: usize = 1_000_000;
 
 /// One sweep axis: a parameter and its values.
 #[derive(Debug, Clone, PartialEq)]

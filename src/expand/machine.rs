@@ -141,3 +141,31 @@ pub fn resolve_machine(sc: &Scenario, src: &Source) -> Result<Resolved, Error> {
         "give the machine: `modes = [{ frequency_hz, damping_ratio }]` (axis x) or [machine.axis.<name>] modes = [...] per axis, `preset = \"printer_xy\"` (or a machine file path), or [machine.axis.<name>] tables",
     ))
 }
+
+/// The identity of the files a scenario reads besides itself (its machine files, given by
+/// `preset` in `[machine]` or swept as `machine.preset`), by content: one `path=digest` per
+/// file, in the order named, empty when it reads none. A sweep's journal and a shard's
+/// manifest carry it, so that a machine file edited between an interruption and
+/// `--resume`, or between two shards, is noticed.
+pub fn inputs_identity(sc: &Scenario, src: &Source) -> Result<String, Error> {
+    let mut values: Vec<&str> = sc.machine.preset.iter().map(String::as_str).collect();
+    if let Some(list) = sc.sweep.get("machine.preset").and_then(|v| v.as_array()) {
+        values.extend(list.iter().filter_map(|v| v.as_str()));
+    }
+    let mut out = Vec::new();
+    for v in values {
+        let Some(path) = crate::input::machine_file::preset_file(v, &src.path) else {
+            continue;
+        };
+        let bytes = crate::input::file::read_bytes(&path)?;
+        let entry = format!(
+            "{}={:016x}",
+            path.display(),
+            crate::input::file::digest(&[&bytes])
+        );
+        if !out.contains(&entry) {
+            out.push(entry);
+        }
+    }
+    Ok(out.join(";"))
+}

@@ -193,6 +193,16 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
         kinds: states,
     };
     validate::validate_observe(&base, src)?;
+    if sc.sweep.len() > validate::MAX_SWEEP_AXES {
+        return Err(src.error_at(
+            "sweep",
+            format!(
+                "{} sweep axes; at most {}",
+                sc.sweep.len(),
+                validate::MAX_SWEEP_AXES
+            ),
+        ));
+    }
     let axes = axes::axes(sc, src, &base)?;
     current::check(sc, src, &axes)?;
     let total = axes
@@ -220,6 +230,13 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
     let Sweep { base, axes, total } = sweep_of(sc, src)?;
     let mut presets: Vec<(String, Machine, String)> = Vec::new();
     let mut runs = Vec::with_capacity(total);
+    type ModesKey = (
+        Option<Machine>,
+        Vec<crate::input::modes::AxisModes>,
+        f64,
+        String,
+    );
+    let mut last_modes: Option<(ModesKey, Option<(f64, f64)>)> = None;
     for id in 0..total {
         let mut run = base.clone();
         run.id = id;
@@ -270,6 +287,30 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
             run.distance_mm = d;
         }
         validate::validate_run(&run, src)?;
+        // The modes change only with the machine, its modes, the moved axis or where the
+        // move starts: most sweeps linearise the machine once.
+        let range = match &last_modes {
+            Some(((m, modes, start, axis), r))
+                if *m == run.machine
+                    && *modes == run.modes
+                    && *start == run.start_mm
+                    && *axis == run.axis =>
+            {
+                *r
+            }
+            _ => {
+                let r = validate::mode_range_hz(&run);
+                let key = (
+                    run.machine.clone(),
+                    run.modes.clone(),
+                    run.start_mm,
+                    run.axis.clone(),
+                );
+                last_modes = Some((key, r));
+                r
+            }
+        };
+        validate::validate_sampling(&run, range, src)?;
         runs.push(run);
     }
     Ok(runs)

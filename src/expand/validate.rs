@@ -9,6 +9,124 @@ use crate::input::source::Source;
 use crate::kinds::{self, Role};
 use crate::spec::run_spec::{RunSpec, needs_jerk};
 
+/// The most samples one run may simulate, move and observation window together: at the
+/// default 10 kHz that is 10,000 s of simulated time, far beyond any settling question, and
+/// about a minute of work on the fastest backend. A longer run is a mistake in the input
+/// (a distance in metres written as millimetres, a speed limit of `1e-9`), not a run to wait
+/// for.
+pub const MAX_SAMPLES_PER_RUN: f64 = 1e8;
+
+/// The most settling bands a scenario may give: each is a column of runs.csv and a panel
+/// of every figure, and a handful (a tolerance and a few looser or tighter ones) answers
+/// every settling question.
+pub const MAX_BANDS: usize = 16;
+
+/// The most sweep axes a scenario may give: a figure draws one line per combination of
+/// the axes other than its x axis, and a report compares the axes side by side.
+pub const MAX_SWEEP_AXES: usize = 8;
+
+/// The shortest time (s) a move of `distance_mm` can take at `vmax_mm_s` and `amax_mm_s2`:
+/// the trapezoid's, exact for it and a lower bound for every jerk-limited kind.
+pub fn min_move_time_s(distance_mm: f64, vmax_mm_s: f64, amax_mm_s2: f64) -> f64 {
+    let d = distance_mm.abs();
+    if d * amax_mm_s2 <= vmax_mm_s * vmax_mm_s {
+        2.0 * (d / amax_mm_s2).sqrt()
+    } else {
+        d / vmax_mm_s + vmax_mm_s / amax_mm_s2
+    }
+}
+
+/// Check that a run's simulated time (its move at the fastest the limits allow, plus the
+/// observation window) stays within [`MAX_SAMPLES_PER_RUN`] samples, before any work.
+fn validate_duration(run: &RunSpec, src: &Source) -> Result<(), Error> {
+    let move_s = min_move_time_s(run.distance_mm, run.vmax_mm_s, run.amax_mm_s2);
+    let samples = (move_s + run.window_s) * run.sample_rate_hz;
+    if samples.is_finite() && samples <= MAX_SAMPLES_PER_RUN {
+        return Ok(());
+    }
+    let key = ["move.distance_mm", "limits.vmax_mm_s", "limits.amax_mm_s2"]
+        .into_iter()
+        .map(|k| run.blame(k))
+        .find(|k| k.starts_with("sweep."))
+        .unwrap_or_else(|| "move.distance_mm".to_string());
+    Err(src.error_at(
+        &key,
+        format!(
+            "run {}: a move of {} mm at vmax_mm_s = {} and amax_mm_s2 = {} takes at least {move_s:.3e} s; with the {} s window at {} Hz that is {samples:.3e} samples, over the limit of {MAX_SAMPLES_PER_RUN:e} per run: shorten the move, raise the limits or lower observe.sample_rate_hz",
+            run.id, run.distance_mm, run.vmax_mm_s, run.amax_mm_s2, run.window_s, run.sample_rate_hz
+        ),
+    ))
+}
+
+/// The slowest and fastest vibration modes (Hz) a run's axes have: the modes given, or a
+/// physical machine's undamped natural frequencies linearised at the move's start (rigid
+/// rotations at 0 Hz left out). `None` when there are none or the machine cannot be
+/// linearised (its own checks report why).
+pub fn mode_range_hz(run: &RunSpec) -> Option<(f64, f64)> {
+    let freqs: Vec<f64> = match &run.machine {
+        None => run
+            .axis
+            .split('+')
+            .flat_map(|a| run.modes_of(a).iter().map(|m| m.frequency_hz))
+            .collect(),
+        Some(machine) => {
+            let axes = machine.compile(settle_sim::DriverMode::Linear).ok()?;
+            let moved: Vec<&str> = run.axis.split('+').collect();
+            let mut out = Vec::new();
+            for a in axes.iter().filter(|a| moved.contains(&a.name.as_str())) {
+                let q = a.lumped.equilibrium(run.start_mm * 1e-3, None).ok()?;
+                out.extend(a.lumped.natural_frequencies_hz(&q));
+            }
+            out
+        }
+    };
+    let freqs = freqs.into_iter().filter(|f| f.is_finite() && *f > 1e-6);
+    freqs.fold(None, |r, f| match r {
+        None => Some((f, f)),
+        Some((lo, hi)) => Some((f64::min(lo, f), f64::max(hi, f))),
+    })
+}
+
+/// Check that the observation can see the run's modes (`range`: [`mode_range_hz`]): a
+/// window of at least half a period of the slowest mode (the first residual peak lies
+/// inside it) and at least two samples per period of the fastest (Nyquist: fewer alias it
+/// and the settling time lands between samples far apart).
+pub fn validate_sampling(
+    run: &RunSpec,
+    range: Option<(f64, f64)>,
+    src: &Source,
+) -> Result<(), Error> {
+    let Some((slowest_hz, fastest_hz)) = range else {
+        return Ok(());
+    };
+    let what = if run.machine.is_some() {
+        "the machine's linearised modes"
+    } else {
+        "machine.modes"
+    };
+    if run.window_s < 0.5 / slowest_hz {
+        return Err(src.error_at(
+            "observe.window_s",
+            format!(
+                "{} s is shorter than half a period of the slowest mode ({slowest_hz:.4} Hz in {what}): the residual vibration is not seen; give at least {:.4} s (ten decay time constants, 1 / (zeta 2 pi f), is the usual choice)",
+                run.window_s,
+                0.5 / slowest_hz
+            ),
+        ));
+    }
+    if run.sample_rate_hz < 2.0 * fastest_hz {
+        return Err(src.error_at(
+            "observe.sample_rate_hz",
+            format!(
+                "{} Hz gives fewer than two samples per period of the fastest mode ({fastest_hz:.4} Hz in {what}): give at least {:.4} Hz (twenty or more samples per period for settling times to a few percent)",
+                run.sample_rate_hz,
+                2.0 * fastest_hz
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Check the observation and simulation settings of the base run.
 pub fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
     if !(run.window_s.is_finite() && run.window_s > 0.0) {
@@ -26,10 +144,12 @@ pub fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
             ),
         ));
     }
-    if run.window_s * run.sample_rate_hz > 1e8 {
+    if run.window_s * run.sample_rate_hz > MAX_SAMPLES_PER_RUN {
         return Err(src.error_at(
             "observe.sample_rate_hz",
-            "window_s * sample_rate_hz exceeds 1e8 samples; lower one of them",
+            format!(
+                "window_s * sample_rate_hz exceeds {MAX_SAMPLES_PER_RUN:e} samples; lower one of them"
+            ),
         ));
     }
     if let Some(h) = run.max_step_s
@@ -44,6 +164,26 @@ pub fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
         return Err(src.error_at(
             "observe.bands_um",
             "give one or more bands, each a finite number > 0 (um)",
+        ));
+    }
+    let mut sorted = run.bands_um.clone();
+    sorted.sort_by(f64::total_cmp);
+    if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+        return Err(src.error_at(
+            "observe.bands_um",
+            format!(
+                "band {} um is given twice; each band is a column of runs.csv, give each once",
+                w[0]
+            ),
+        ));
+    }
+    if run.bands_um.len() > MAX_BANDS {
+        return Err(src.error_at(
+            "observe.bands_um",
+            format!(
+                "{} bands; at most {MAX_BANDS} (each band is a column of runs.csv and a panel of the figures)",
+                run.bands_um.len()
+            ),
         ));
     }
     Ok(())
@@ -142,5 +282,5 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
             }
         }
     }
-    Ok(())
+    validate_duration(run, src)
 }

@@ -189,6 +189,10 @@ fn bandwidth() -> f64 {
     20_000.0
 }
 
+/// The most axes a machine may have: a gantry has two or three, a machine with its
+/// extruder and rotary axes a few more.
+pub const MAX_AXES: usize = 8;
+
 /// Convert parsed axes into a validated machine. `prefix` is the key path of the tables
 /// in `src` (`""` in a machine file, `"machine."` inline in a scenario), for errors.
 pub fn to_machine(
@@ -199,10 +203,13 @@ pub fn to_machine(
     src: &Source,
     prefix: &str,
 ) -> Result<Machine, Error> {
-    if axes.is_empty() {
+    if axes.is_empty() || axes.len() > MAX_AXES {
         return Err(src.error_at(
             &format!("{prefix}axis"),
-            "a machine needs at least one [axis.<name>] table",
+            format!(
+                "a machine needs one to {MAX_AXES} [axis.<name>] tables, got {}",
+                axes.len()
+            ),
         ));
     }
     let mut out = Vec::new();
@@ -446,6 +453,17 @@ pub fn parse(text: &str, path: &Path) -> Result<(Machine, String), Error> {
     }
 }
 
+/// The machine file `preset = "<value>"` of a scenario at `scenario_path` names, `None`
+/// for a built-in preset (or a value that is neither; [`load_preset`] says why).
+pub fn preset_file(value: &str, scenario_path: &Path) -> Option<PathBuf> {
+    if PRESETS.iter().any(|(n, _, _)| *n == value)
+        || !(value.contains('/') || value.ends_with(".toml"))
+    {
+        return None;
+    }
+    Some(scenario_path.parent().unwrap_or(Path::new(".")).join(value))
+}
+
 /// Resolve `preset = "<value>"` of a scenario at `scenario_path`: a built-in preset name,
 /// or a path to a machine file (relative to the scenario's folder) of either form.
 /// Returns the machine and the file it came from.
@@ -471,10 +489,15 @@ pub fn load_any(
     }
     let base = scenario_path.parent().unwrap_or(Path::new("."));
     let path = base.join(value);
-    let text = std::fs::read_to_string(&path).map_err(|e| {
+    let text = crate::input::file::read_text(&path).map_err(|e| {
+        let why = match e {
+            Error::Read { source, .. } => source.to_string(),
+            Error::Input { message, .. } => message,
+            other => other.to_string(),
+        };
         src.error_at(
             "machine.preset",
-            format!("cannot read machine file {}: {e}", path.display()),
+            format!("cannot read machine file {}: {why}", path.display()),
         )
     })?;
     Ok((parse_any(&text, &path)?, path))

@@ -3,6 +3,7 @@
 //! shard folders are inputs too). [`source::Source`] is where every input error gets its
 //! file, line and key.
 
+pub mod file;
 pub mod keys;
 pub mod machine_file;
 pub mod modes;

@@ -181,6 +181,10 @@ pub fn parse(text: &str, path: &Path, claimed: &[&str]) -> Result<(Scenario, Sou
     Ok((scenario, source))
 }
 
+/// The longest scenario name: it names the output folder, and file systems allow 255
+/// bytes per name (a shard folder adds its `shard-K-of-N` beside it).
+pub const MAX_NAME_CHARS: usize = 64;
+
 fn parse_source(source: &Source, claimed: &[&str]) -> Result<Scenario, Error> {
     let scenario: Scenario = source.document(claimed).map_err(|e| match e {
         // The strict parse names the core keys; the claimed tables are allowed too.
@@ -196,6 +200,7 @@ fn parse_source(source: &Source, claimed: &[&str]) -> Result<Scenario, Error> {
         other => other,
     })?;
     if scenario.name.is_empty()
+        || scenario.name.len() > MAX_NAME_CHARS
         || !scenario
             .name
             .chars()
@@ -204,8 +209,8 @@ fn parse_source(source: &Source, claimed: &[&str]) -> Result<Scenario, Error> {
         return Err(source.error_at(
             "name",
             format!(
-                "`{}` is not a valid scenario name; allowed: letters, digits, `-` and `_` (it names the output folder)",
-                scenario.name
+                "`{}` is not a valid scenario name; allowed: 1 to {MAX_NAME_CHARS} letters, digits, `-` and `_` (it names the output folder)",
+                crate::error::echo(&scenario.name)
             ),
         ));
     }

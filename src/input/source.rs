@@ -38,7 +38,7 @@ impl Source {
 
     /// Read the file at `path`.
     pub fn load(path: &Path) -> Result<Self, Error> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+        let text = crate::input::file::read_text(path)?;
         Ok(Self::new(&text, path))
     }
 

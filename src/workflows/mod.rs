@@ -10,6 +10,7 @@ pub mod check;
 pub mod identify;
 pub mod import;
 pub mod journal;
+pub mod lock;
 pub mod machine;
 pub mod merge;
 pub mod plan;

@@ -6,10 +6,13 @@
 //! whatever the order of the sweep axes. A shard folder holds its rows of `runs.csv`
 //! (the same header as an unsharded sweep), its recordings if asked, and `shard.toml`, the
 //! manifest that identifies it: format, settle version, the scenario's full text, `K`, `N`,
-//! the total number of runs and the runs it holds, and the settings that change results.
+//! the total number of runs and the runs it holds, the settings that change results, the
+//! content identity of the files the scenario reads, the digest of its runs.csv and the
+//! recordings it wrote.
 //!
-//! `merge` checks that every shard comes from the same scenario text, settle version, `N`
-//! and settings, that each of `1..=N` is present exactly once and holds exactly its runs,
+//! `merge` checks that every shard comes from the same scenario text, files it reads,
+//! settle version, `N` and settings, that its runs.csv is as written and its recordings
+//! exist, that each of `1..=N` is present exactly once and holds exactly its runs,
 //! then rebuilds `runs.csv` in run order. Because `runs.csv` rows are formatted per run and
 //! the summary and plots are functions of `runs.csv` and the scenario, the merged files are
 //! byte-identical to an unsharded sweep's.
@@ -28,7 +31,7 @@ use crate::spec::run_spec::RunSpec;
 pub const MANIFEST: &str = "shard.toml";
 
 /// The manifest format this version writes and reads.
-pub const FORMAT: &str = "settle-shard-1";
+pub const FORMAT: &str = "settle-shard-2";
 
 /// Shard `k` of `n` (1-based).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,8 +113,21 @@ pub struct Manifest {
     pub runs: Vec<usize>,
     /// Command-line settings that change results (e.g. a backend); must agree across shards.
     pub settings: BTreeMap<String, String>,
+    /// The identity of the other files the scenario reads, by content
+    /// ([`crate::expand::machine::inputs_identity`]): must agree across shards.
+    pub inputs: String,
+    /// The digest of the shard's runs.csv as written ([`crate::input::file::digest`], 16
+    /// hex digits): a runs.csv edited or damaged since is not merged.
+    pub runs_digest: String,
+    /// The recordings the shard wrote (file names in its recordings folder).
+    pub recordings: Vec<String>,
     /// The scenario file's full text.
     pub scenario: String,
+}
+
+/// The digest of a shard's runs.csv text, as [`Manifest::runs_digest`] holds it.
+pub fn runs_digest(csv: &str) -> String {
+    format!("{:016x}", crate::input::file::digest(&[csv.as_bytes()]))
 }
 
 fn input_error(file: &Path, message: String) -> Error {
@@ -129,10 +145,7 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
             ),
         ));
     }
-    let text = std::fs::read_to_string(&path).map_err(|source| Error::Read {
-        path: path.clone(),
-        source,
-    })?;
+    let text = crate::input::file::read_text(&path)?;
     let m: Manifest =
         toml::from_str(&text).map_err(|e| input_error(&path, e.message().trim().to_string()))?;
     if m.format != FORMAT {
@@ -145,10 +158,26 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
         ));
     }
     let csv_path = dir.join("runs.csv");
-    let csv = std::fs::read_to_string(&csv_path).map_err(|source| Error::Read {
-        path: csv_path.clone(),
-        source,
-    })?;
+    let csv = crate::input::file::read_text(&csv_path)?;
+    if runs_digest(&csv) != m.runs_digest {
+        return Err(input_error(
+            &csv_path,
+            format!(
+                "its content differs from what `settle sweep --shard {}/{}` wrote (edited or damaged since): rerun that shard",
+                m.shard, m.shards
+            ),
+        ));
+    }
+    let rec_dir = dir.join(crate::output::sweep_files::RECORDINGS);
+    if let Some(missing) = m.recordings.iter().find(|r| !rec_dir.join(r).is_file()) {
+        return Err(input_error(
+            &rec_dir.join(missing),
+            format!(
+                "a recording {MANIFEST} lists is missing: rerun `settle sweep --shard {}/{}`",
+                m.shard, m.shards
+            ),
+        ));
+    }
     let table = RunsTable::parse(&csv).map_err(|e| input_error(&csv_path, e))?;
     Ok((m, table))
 }
@@ -205,6 +234,12 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, Error> {
         };
         if m.scenario != first.scenario || m.scenario_name != first.scenario_name {
             return Err(differs("the scenario"));
+        }
+        if m.inputs != first.inputs {
+            return Err(differs(&format!(
+                "the content of the files the scenario reads ({} vs {})",
+                m.inputs, first.inputs
+            )));
         }
         if m.settle_version != first.settle_version {
             return Err(differs(&format!(

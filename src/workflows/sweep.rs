@@ -19,6 +19,7 @@ use crate::output::sweep_files::{PLOTS, RECORDINGS, write_sweep};
 use crate::spec::backend::Backend;
 use crate::spec::run_spec::RunSpec;
 use crate::workflows::journal::{self, Journal};
+use crate::workflows::lock::FolderLock;
 use crate::workflows::shard::{self, Manifest, Shard};
 use crate::workflows::{Exit, Report};
 
@@ -96,6 +97,8 @@ pub struct SweepOutcome {
     pub recordings: Option<PathBuf>,
     /// Wall-clock time (s).
     pub elapsed_s: f64,
+    /// The options it ran with (for the command that resumes it).
+    pub options: SweepOptions,
 }
 
 /// The recorder the flags ask for, checked before any work (a missing feature costs no
@@ -133,7 +136,9 @@ pub fn sweep(
 ) -> Result<SweepOutcome, Error> {
     let started = Instant::now();
     let path = &opts.scenario;
-    let (sc, mut all_runs) = crate::expand::load_runs(path)?;
+    let (sc, src) = crate::expand::load(path)?;
+    let mut all_runs = crate::expand::expand(&sc, &src)?;
+    let inputs = crate::expand::machine::inputs_identity(&sc, &src)?;
     crate::execute::set_backend(path, &mut all_runs, opts.backend)?;
     let base = PathBuf::from("results").join(&sc.name);
     let out = opts.out.clone().unwrap_or_else(|| match opts.shard {
@@ -155,10 +160,16 @@ pub fn sweep(
         Some(s) => s.select(&all_runs),
         None => all_runs.clone(),
     };
+    create_dir(&out)?;
+    // The lock first: a folder another sweep is writing is refused as such.
+    let _lock = FolderLock::take(&out)?;
     if !opts.resume && !opts.force {
         refuse_overwrite(&out)?;
     }
-    create_dir(&out)?;
+    // What a killed sweep was writing (`.NAME.tmpPID` beside NAME): nobody else writes here.
+    for dir in [out.clone(), out.join(PLOTS), out.join(RECORDINGS)] {
+        remove_stale_temps(&dir)?;
+    }
     if let Some(r) = &rec {
         create_dir(&r.dir)?;
     }
@@ -175,16 +186,41 @@ pub fn sweep(
     ));
     let layout = RunsCsv::new(&runs);
     let header = layout.header();
-    let scenario_text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let scenario_text = src.text().to_string();
     let key = journal::key_line(
         &scenario_text,
+        &inputs,
         &sc.name,
         opts.backend.name(),
         &opts.shard.map_or(String::new(), |s| s.to_string()),
     );
     let ids: Vec<usize> = runs.iter().map(|r| r.id).collect();
+    // The leading cells of each run's row: its parameters, up to its status.
+    let n_params = layout
+        .columns()
+        .iter()
+        .position(|c| c == "status")
+        .unwrap_or(0);
+    let params = |id: usize| {
+        let spec = match opts.shard {
+            Some(s) if !s.contains(id) => return None,
+            Some(s) => runs.get((id - (s.k - 1)) / s.n)?,
+            None => runs.get(id)?,
+        };
+        let cells = layout.cells(spec, &Metrics::failed(&spec.bands_um, String::new()));
+        let mut prefix = crate::input::runs_table::record(&cells[..n_params]);
+        prefix.pop();
+        prefix.push(',');
+        Some(prefix)
+    };
     let (journal, done) = match journal::existing(&out) {
-        Some(_) if opts.resume => Journal::resume(&out, &key, &header, &ids)?,
+        Some(_) if opts.resume => {
+            let (j, done, notes) = Journal::resume(&out, &key, &header, &params)?;
+            for n in notes {
+                note(&format!("{}: {n}", out.join(journal::FILE).display()));
+            }
+            (j, done)
+        }
         Some(p) if !opts.force => {
             return Err(Error::input(
                 "--resume",
@@ -208,27 +244,50 @@ pub fn sweep(
         .filter(|r| !done.contains_key(&r.id))
         .cloned()
         .collect();
+    // An output that cannot be written (a full disk) is not a result of a run: the sweep
+    // stops, the journal keeps what finished, and `--resume` completes it.
+    let write_failed = std::sync::atomic::AtomicBool::new(false);
     let run_one = |spec: &RunSpec| -> Result<String, Error> {
-        let m = match &rec {
+        if write_failed.load(std::sync::atomic::Ordering::SeqCst) {
+            return Err(Error::Interrupted { run: spec.id });
+        }
+        let m = match match &rec {
             Some(r) => r.run(spec),
             None => crate::execute::execute(spec, None),
-        }
-        .unwrap_or_else(|e| Metrics::failed(&spec.bands_um, format!("{e}")));
+        } {
+            Ok(m) => m,
+            // Not a result of the run: nothing goes to the journal.
+            Err(e @ Error::Interrupted { .. }) => return Err(e),
+            Err(e @ Error::Write { .. }) => {
+                write_failed.store(true, std::sync::atomic::Ordering::SeqCst);
+                return Err(e);
+            }
+            Err(e) => Metrics::failed(&spec.bands_um, format!("{e}")),
+        };
         let row = layout.row(spec, &m);
-        journal.append(&row)?;
+        if let Err(e) = journal.append(&row) {
+            write_failed.store(true, std::sync::atomic::Ordering::SeqCst);
+            return Err(e);
+        }
         Ok(row)
     };
     let results = run_all_with(&todo, opts.jobs, progress, run_one)?;
     let mut rows = done;
     let mut interrupted = 0usize;
+    let mut write_error = None;
     for (spec, r) in todo.iter().zip(results) {
         match r {
             Ok(row) => {
                 rows.insert(spec.id, row);
             }
             Err(Error::Interrupted { .. }) => interrupted += 1,
-            Err(e) => return Err(e),
+            Err(e) => {
+                write_error.get_or_insert(e);
+            }
         }
+    }
+    if let Some(e) = write_error {
+        return Err(e);
     }
     let mut outcome = SweepOutcome {
         scenario: path.clone(),
@@ -239,6 +298,7 @@ pub fn sweep(
         interrupted: None,
         recordings: rec.as_ref().map(|r| r.dir.clone()),
         elapsed_s: 0.0,
+        options: opts.clone(),
     };
     if interrupted > 0 || crate::execute::interrupt::requested() {
         outcome.interrupted = Some(rows.len());
@@ -262,10 +322,24 @@ pub fn sweep(
                     shard: s.k,
                     shards: s.n,
                     total_runs: all_runs.len(),
-                    runs: ids,
+                    runs: ids.clone(),
                     settings: [("backend".to_string(), opts.backend.name().to_string())]
                         .into_iter()
                         .collect(),
+                    inputs: inputs.clone(),
+                    runs_digest: shard::runs_digest(&csv),
+                    recordings: match &rec {
+                        Some(r) => ids
+                            .iter()
+                            .flat_map(|&id| {
+                                [(r.mcap, "mcap"), (r.rerun, "rrd")]
+                                    .into_iter()
+                                    .filter(|(on, _)| *on)
+                                    .map(move |(_, ext)| format!("run-{id}.{ext}"))
+                            })
+                            .collect(),
+                        None => Vec::new(),
+                    },
                     scenario: scenario_text,
                 },
             )?;
@@ -322,6 +396,22 @@ fn refuse_overwrite(out: &Path) -> Result<(), Error> {
     ))
 }
 
+/// Remove the temporary files of atomic writes ([`crate::output::atomic::tmp_path`]) left
+/// in `dir` by a sweep that was killed while writing.
+fn remove_stale_temps(dir: &Path) -> Result<(), Error> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(()); // no such folder yet
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let name = name.to_string_lossy();
+        if name.starts_with('.') && name.contains(".tmp") && e.path().is_file() {
+            std::fs::remove_file(e.path()).map_err(|err| Error::write(e.path(), err))?;
+        }
+    }
+    Ok(())
+}
+
 /// The failed runs, from runs.csv's `status` and `reason` columns.
 fn failures(runs: &[RunSpec], csv: &str) -> Vec<FailedRun> {
     let Ok(table) = RunsTable::parse(csv) else {
@@ -339,6 +429,43 @@ fn failures(runs: &[RunSpec], csv: &str) -> Vec<FailedRun> {
 }
 
 impl SweepOutcome {
+    /// The command that resumes this sweep: the same scenario, folder, backend, shard and
+    /// recordings (everything the journal's key or the outputs depend on), and `--jobs`
+    /// when it was given.
+    pub fn resume_command(&self) -> String {
+        let o = &self.options;
+        let quote = |p: &Path| {
+            let s = p.display().to_string();
+            if s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || "/._-+".contains(c))
+            {
+                s
+            } else {
+                format!("'{}'", s.replace('\'', "'\\''"))
+            }
+        };
+        let mut cmd = format!(
+            "settle sweep {} --out {} --backend {}",
+            quote(&self.scenario),
+            quote(&self.out),
+            o.backend.name()
+        );
+        if let Some(s) = o.shard {
+            cmd.push_str(&format!(" --shard {s}"));
+        }
+        if let Some(j) = o.jobs {
+            cmd.push_str(&format!(" --jobs {j}"));
+        }
+        if o.mcap {
+            cmd.push_str(" --mcap");
+        }
+        if o.rerun {
+            cmd.push_str(" --rerun");
+        }
+        cmd.push_str(" --resume");
+        cmd
+    }
+
     /// What `settle sweep` prints: where the outputs are, and the failed runs (at most 20,
     /// then a count).
     pub fn report(&self) -> Report {
@@ -346,12 +473,10 @@ impl SweepOutcome {
         if let Some(kept) = self.interrupted {
             let mut r = Report::new(Exit::Interrupted);
             r.err(format!(
-                "interrupted: {kept} of {} runs finished and kept in {}; continue with\n  settle sweep {} --out {} --resume{}",
+                "interrupted: {kept} of {} runs finished and kept in {}; continue with\n  {}",
                 self.runs,
                 out.join(journal::FILE).display(),
-                self.scenario.display(),
-                out.display(),
-                self.shard.map_or(String::new(), |s| format!(" --shard {s}"))
+                self.resume_command()
             ));
             return r;
         }

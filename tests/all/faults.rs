@@ -6,9 +6,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// Two modes through rapier with a forced 2 ms step: symplectic Euler is stable for
-/// `w h < 2`, so the 40 Hz mode (`w h = 0.50`) runs and the 400 Hz one (`w h = 5.0`)
-/// grows by a factor of about 4.8 per step until it is caught.
+/// Two modes through rapier with a forced 1 ms step (`max_step_s = 2 ms` does not cut the
+/// 1 kHz sample interval; 1 kHz is above the 960 Hz Nyquist rate of the 480 Hz mode, the
+/// least a scenario may ask for): symplectic Euler is stable for `w h < 2`, so the 40 Hz
+/// mode (`w h = 0.25`) runs and the 480 Hz one (`w h = 3.0`) grows by a factor of about 7
+/// per step until it is caught.
 const BLOW_UP: &str = r#"name = "blowup"
 [machine]
 modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]
@@ -20,11 +22,11 @@ vmax_mm_s = 300.0
 amax_mm_s2 = 3000.0
 [observe]
 window_s = 0.3
-sample_rate_hz = 500
+sample_rate_hz = 1000
 [sim]
 max_step_s = 0.002
 [sweep]
-"machine.modes.0.frequency_hz" = [40.0, 400.0]
+"machine.modes.0.frequency_hz" = [40.0, 480.0]
 "#;
 
 #[test]
@@ -252,8 +254,8 @@ fn sigterm_and_sigkill_with_a_cut_row_resume_identical() {
     assert_same_outputs(&killed, &full);
 }
 
-/// The same forced step on MuJoCo: RK4 is stable for `w h` up to about 2.8, so 400 Hz at
-/// 2 ms (`w h = 5.0`) diverges and 40 Hz runs.
+/// The same forced step on MuJoCo: RK4 is stable for `w h` up to about 2.8, so 480 Hz at
+/// 1 ms (`w h = 3.0`) diverges and 40 Hz runs.
 #[cfg(feature = "mujoco")]
 #[test]
 fn a_mujoco_blow_up_is_a_fault_too() {
@@ -274,15 +276,15 @@ fn a_mujoco_blow_up_is_a_fault_too() {
     assert!(rows[1].contains(",fault,0,"), "{}", rows[1]);
 }
 
-/// A raster scan's step on one 400 Hz mode through rapier: with `[sim] max_step_s = 2 ms`
-/// (`w h = 5.0`, past symplectic Euler's limit of 2) the run blows up and is a fault; with
+/// A raster scan's step on one 480 Hz mode through rapier: with `[sim] max_step_s = 2 ms`
+/// at 1 kHz sampling (a 1 ms step, `w h = 3.0`, past symplectic Euler's limit of 2) the run blows up and is a fault; with
 /// rapier's own step it runs. Every run kind is simulated with the scenario's `[sim]`
 /// settings (`settle::execute::sim_options`), the scan step included.
 #[test]
 fn a_scan_step_honours_the_sim_max_step() {
     const SCAN: &str = r#"name = "scan_blowup"
 [machine]
-modes = [{ frequency_hz = 400.0, damping_ratio = 0.05 }]
+modes = [{ frequency_hz = 480.0, damping_ratio = 0.05 }]
 [move]
 distance_mm = 0.5
 profile = "trapezoid"
@@ -295,7 +297,7 @@ fly_amax_mm_s2 = 10000.0
 width_mm = 10.0
 [observe]
 window_s = 0.05
-sample_rate_hz = 500
+sample_rate_hz = 1000
 [sim]
 max_step_s = 0.002
 "#;

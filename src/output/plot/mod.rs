@@ -686,8 +686,26 @@ fn height(f: &Figure) -> u32 {
     rows * f.row_height + 50 + legend_height(f)
 }
 
-/// Write `f` as `<stem>.svg` and `<stem>.png` in `dir`.
+/// The most panels a figure draws (the rest are left out): with [`MAX_LEGEND`] this keeps
+/// every figure a few thousand pixels high whatever the sweep.
+pub const MAX_PANELS: usize = 32;
+
+/// The most entries a figure's legend draws (the rest are left out).
+pub const MAX_LEGEND: usize = 64;
+
+/// Write `f` as `<stem>.svg` and `<stem>.png` in `dir` (at most [`MAX_PANELS`] panels and
+/// [`MAX_LEGEND`] legend entries of it).
 pub fn write(f: &Figure, dir: &Path, stem: &str) -> Result<(), Error> {
+    let bounded;
+    let f = if f.panels.len() > MAX_PANELS || f.legend.len() > MAX_LEGEND {
+        let mut b = f.clone();
+        b.panels.truncate(MAX_PANELS);
+        b.legend.truncate(MAX_LEGEND);
+        bounded = b;
+        &bounded
+    } else {
+        f
+    };
     init_fonts();
     let size = (f.width, height(f));
     let fail = |path: &Path, e: String| Error::Write {

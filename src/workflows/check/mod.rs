@@ -92,10 +92,14 @@ pub fn check(opts: &CheckOptions, progress: Progress) -> Result<Checked, Error> 
         ));
     }
     let (sc, mut runs) = crate::expand::load_runs(path)?;
-    let old = match std::fs::read_to_string(baseline) {
+    let old = match crate::input::file::read_text(baseline) {
         Ok(text) => Some(text),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound && opts.update => None,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+        Err(Error::Read { source, .. })
+            if source.kind() == std::io::ErrorKind::NotFound && opts.update =>
+        {
+            None
+        }
+        Err(Error::Read { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
             return Err(baseline_error(
                 baseline,
                 format!(
@@ -105,7 +109,7 @@ pub fn check(opts: &CheckOptions, progress: Progress) -> Result<Checked, Error> 
                 ),
             ));
         }
-        Err(e) => return Err(Error::read(baseline, e)),
+        Err(e) => return Err(e),
     };
     let old_table = old
         .as_deref()
