@@ -446,6 +446,9 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
     );
     // What is written must load.
     crate::expand::parse_runs(&text, &out)?;
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        crate::output::atomic::create_dir(dir)?;
+    }
     write_atomic(&out, text.as_bytes())?;
     Ok(Imported {
         axes: axes.iter().map(|a| a.name.clone()).collect(),
