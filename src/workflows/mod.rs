@@ -5,6 +5,7 @@
 //! [`Report`] is what the binary prints and the exit status it maps to a code.
 
 pub mod check;
+pub mod gcode;
 pub mod journal;
 pub mod merge;
 pub mod plan;

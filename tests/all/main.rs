@@ -6,6 +6,7 @@ mod support;
 mod cli;
 mod corners;
 mod faults;
+mod gcode_job;
 mod layers;
 mod machines;
 mod outputs_check;

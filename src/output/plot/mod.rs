@@ -7,6 +7,7 @@
 //! A figure is plain data ([`Figure`] of [`Panel`]s of [`Line`]s) drawn by one renderer;
 //! [`sweep`] and [`trace`] build figures from a sweep's runs table and from one run's series.
 
+pub mod ringing;
 pub mod sweep;
 pub mod trace;
 
