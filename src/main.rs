@@ -190,6 +190,13 @@ enum Command {
         /// Ringing maps to draw: the layers with the largest contour error.
         #[arg(long, default_value_t = 1)]
         maps: usize,
+        /// Also run FIRMWARE[:SHAPER] (e.g. settle:none, klipper:ei@48) and compare: the
+        /// worst layer under both (compare-layer-<n>.svg/png) and compare.md.
+        #[arg(long, value_name = "FIRMWARE[:SHAPER]", value_parser = workflows::gcode::compare::parse_setting)]
+        versus: Option<(
+            settle_gcode::job::Firmware,
+            Option<settle_gcode::job::ShaperSetting>,
+        )>,
     },
     /// Run one point of a sweep in detail: print its metrics, write its full trace as CSV.
     #[command(
@@ -355,6 +362,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             skip_bad_lines,
             sample_rate_hz,
             maps,
+            versus,
         } => {
             let opts = workflows::gcode::GcodeOptions {
                 layers,
@@ -364,6 +372,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 skip_bad_lines,
                 sample_rate_hz,
                 maps,
+                versus,
                 ..workflows::gcode::GcodeOptions::new(file, &machine, firmware)?.with_shaper(shaper)
             };
             workflows::gcode::gcode(&opts)?.report()

@@ -7,7 +7,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{DrawResult, FONT, err, fmt_num, init_fonts};
+use super::{DrawResult, FONT, err, init_fonts};
 use crate::error::Error;
 pub use crate::kinds::gcode::stats::MapPoint;
 
@@ -173,7 +173,7 @@ impl RingingMap {
             .map_err(err)?;
         for (i, s) in p.spots.iter().enumerate() {
             let at = (s.x_mm, s.y_mm);
-            let label = format!("{} um (line {})", fmt_num(s.error_um), s.line);
+            let label = format!("{:.1} um (line {})", s.error_um, s.line);
             let dy = 14 + 16 * (i as i32 % 3);
             chart
                 .draw_series(std::iter::once(

@@ -9,6 +9,7 @@
 //! `layers.csv`, `summary.md` and the ringing maps of the worst layers ([`report`]).
 //! Everything is computed before anything is written: a bad file writes nothing.
 
+pub mod compare;
 pub mod report;
 pub mod stream;
 
@@ -54,6 +55,8 @@ pub struct GcodeOptions {
     pub sample_rate_hz: f64,
     /// Ringing maps to draw (the worst layers).
     pub maps: usize,
+    /// A second setting to compare with (`--versus`): firmware and X/Y shaper.
+    pub versus: Option<(Firmware, Option<ShaperSetting>)>,
 }
 
 impl GcodeOptions {
@@ -72,6 +75,7 @@ impl GcodeOptions {
             skip_bad_lines: false,
             sample_rate_hz: DEFAULT_SAMPLE_RATE_HZ,
             maps: 1,
+            versus: None,
         })
     }
 
@@ -107,6 +111,8 @@ pub struct GcodeOutcome {
     pub file: PathBuf,
     /// The planner.
     pub firmware: Firmware,
+    /// The planner and the shapers on X and Y, in words (`klipper + mzv@48 Hz`).
+    pub setting: String,
     /// The machine's name.
     pub machine: String,
     /// The backend.
@@ -128,6 +134,8 @@ pub struct GcodeOutcome {
     pub ignored: BTreeMap<String, u64>,
     /// Files written.
     pub files: Vec<PathBuf>,
+    /// The outcome of the `--versus` setting.
+    pub versus: Option<Box<GcodeOutcome>>,
 }
 
 impl GcodeOutcome {
@@ -160,6 +168,9 @@ impl GcodeOutcome {
                 "worst at line {} (layer {}, X {:.2} Y {:.2} mm)",
                 s.line, s.layer, s.x_mm, s.y_mm
             ));
+        }
+        if let Some(b) = &self.versus {
+            r.out(compare::table(&[self, b]));
         }
         for f in &self.files {
             r.out(format!("wrote {}", f.display()));
@@ -365,6 +376,7 @@ pub fn measure(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
     Ok(GcodeOutcome {
         file: opts.file.clone(),
         firmware: opts.job.firmware(),
+        setting: setting_name(&opts.job),
         machine: machine.name.clone(),
         backend: opts.backend,
         print_time_s: summary.print_time_s,
@@ -375,7 +387,25 @@ pub fn measure(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
         skipped_lines: job.reader().skipped().count,
         ignored: summary.ignored,
         files: Vec::new(),
+        versus: None,
     })
+}
+
+/// The planner and the X and Y shapers in words: `klipper + mzv@48 Hz`, `settle` when
+/// unshaped, both shapers when they differ.
+pub fn setting_name(job: &JobConfig) -> String {
+    let name =
+        |s: &Option<ShaperSetting>| s.map(|s| format!("{}@{} Hz", s.kind.name(), s.frequency_hz));
+    match (name(&job.shapers[0]), name(&job.shapers[1])) {
+        (None, None) => job.firmware().to_string(),
+        (x, y) if x == y => format!("{} + {}", job.firmware(), x.unwrap_or_default()),
+        (x, y) => format!(
+            "{} + X {}, Y {}",
+            job.firmware(),
+            x.unwrap_or_else(|| "none".into()),
+            y.unwrap_or_else(|| "none".into())
+        ),
+    }
 }
 
 /// `settle gcode`: simulate, then write layers.csv, summary.md and the ringing maps into
@@ -392,7 +422,20 @@ pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
             PathBuf::from("results").join(format!("{stem}-gcode"))
         }
     };
+    let b_opts = match opts.versus {
+        Some((fw, shaper)) => Some(compare::versus(opts, fw, shaper)?),
+        None => None,
+    };
+    let b = match &b_opts {
+        Some(b_opts) => Some(measure(b_opts)?),
+        None => None,
+    };
     outcome.files = report::write(&outcome, &dir)?;
+    if let (Some(b_opts), Some(b)) = (&b_opts, &b) {
+        let files = compare::compare((&outcome, opts), (b, b_opts), &dir)?;
+        outcome.files.extend(files);
+        outcome.versus = Some(Box::new(b.clone()));
+    }
     Ok(outcome)
 }
 

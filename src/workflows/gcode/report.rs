@@ -70,7 +70,7 @@ pub fn summary_md(o: &GcodeOutcome, maps: &[String]) -> String {
     let _ = writeln!(
         s,
         "{} planner on `{}` ({} backend).\n",
-        o.firmware,
+        o.setting,
         o.machine,
         o.backend.name()
     );
@@ -176,7 +176,7 @@ pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     let bytes = layers_csv(o).map_err(|e| Error::write(&csv_path, std::io::Error::other(e)))?;
     write_atomic(&csv_path, &bytes)?;
     files.push(csv_path);
-    let setting = format!("{} on {}", o.firmware, o.machine);
+    let setting = format!("{} on {}", o.setting, o.machine);
     let mut stems = Vec::new();
     for m in o.maps() {
         let stem = format!("ringing-layer-{}", m.layer);

@@ -172,6 +172,9 @@ impl Account {
     }
 }
 
+/// Samples per [`Plant::step_samples`] call (as the harness's simulation loop).
+const BATCH: usize = 256;
+
 /// Simulate `job`'s chunks on `plant` (see the module doc).
 pub fn simulate_job<R: BufRead, P: Plant>(
     job: &mut Job<R>,
@@ -190,6 +193,41 @@ pub fn simulate_job<R: BufRead, P: Plant>(
     let mut obs = vec![Observation::default(); n];
     let (mut t, mut k, mut t_first) = (0.0_f64, 0_u64, 0.0_f64);
     let sim_err = |source| Error::Sim { run: 0, source };
+    // Runs of whole samples go to the plant in one call while it implements it.
+    let mut batch = true;
+    let mut cmds = vec![Sample::default(); BATCH * n];
+    let (mut bcmd_p, mut btool) = (vec![0.0; BATCH * n], vec![0.0; BATCH * n]);
+    // The sample at `t` (state `st`), checked in full: `true` when the plant faulted (the
+    // fault is recorded and the simulation ends).
+    macro_rules! sample_at {
+        ($st:expr, $t:expr) => {{
+            let t = $t;
+            let ok = plant.positions($st, &mut cmd_p, &mut toolhead)
+                && cmd_p
+                    .iter()
+                    .zip(&toolhead)
+                    .all(|(c, h)| (h - c).abs() <= BLOWUP_M);
+            let mut fault = false;
+            if !ok {
+                plant.observe($st, &mut obs);
+                match crate::execute::simulate::fault_in(t, &acc.opts.names, &obs) {
+                    Some(reason) => {
+                        acc.out.fault = Some(reason);
+                        fault = true;
+                    }
+                    None => {
+                        for (h, o) in toolhead.iter_mut().zip(&obs) {
+                            *h = o.toolhead_m;
+                        }
+                    }
+                }
+            }
+            if !fault {
+                acc.sample(k, t, &toolhead);
+            }
+            fault
+        }};
+    }
     'chunks: while let Some(chunk) = job.next_chunk().map_err(super::gcode_error(file))? {
         acc.active.add(&chunk.moves);
         let axes: Vec<Profile> = job_axes
@@ -197,55 +235,80 @@ pub fn simulate_job<R: BufRead, P: Plant>(
             .map(|&i| chunk.trajectory.axes()[i].clone())
             .collect();
         let sub = Trajectory::new(axes).map_err(|source| Error::Plan { run: 0, source })?;
+        // The chunk is stepped in its own time (`tau`, s from its start), so that a step
+        // ends exactly on each breakpoint and the next step's command comes from the next
+        // piece (a print-clock time `t0 + bp` taken back to the chunk's time can fall a
+        // rounding error before the breakpoint: the previous piece's acceleration, held
+        // for a whole step, would be a large error of the command). Samples are on the
+        // print clock: sample `k` is at `k dt`, `k dt - t0` in the chunk.
         let t0 = chunk.start_time_s;
-        let t1 = t0 + sub.duration_s();
+        let t1 = sub.duration_s();
         let mut cursor = Cursor::new(&sub);
+        let mut tau = 0.0_f64;
         let st = match state.as_mut() {
             Some(s) => s,
             None => {
                 let starts: Vec<_> = sub.axes().iter().map(Profile::start).collect();
-                t = t0;
                 t_first = t0;
                 k = (t0 / dt).ceil() as u64;
                 state.insert(plant.initial_state(&starts).map_err(sim_err)?)
             }
         };
-        let bps: Vec<f64> = sub.breakpoints().into_iter().map(|b| t0 + b).collect();
+        let local = |k: u64| k as f64 * dt - t0;
+        let bps = sub.breakpoints();
         let mut next_bp = 0;
-        while t < t1 {
-            while next_bp < bps.len() && bps[next_bp] <= t {
+        while tau < t1 {
+            while next_bp < bps.len() && bps[next_bp] <= tau {
                 next_bp += 1;
             }
-            let t_sample = k as f64 * dt;
-            let next = t_sample
-                .min(bps.get(next_bp).copied().unwrap_or(t1))
-                .min(t1);
-            cursor.at(t - t0, &mut cmd);
-            let whole = next == t_sample && t == (k - 1) as f64 * dt;
-            let h = if whole { dt } else { next - t };
+            let t_sample = local(k);
+            let bp = bps.get(next_bp).copied().unwrap_or(t1).min(t1);
+            let next = t_sample.min(bp);
+            let whole = next == t_sample && k > 0 && tau == local(k - 1);
+            if whole && batch {
+                // Whole samples k, k + 1, ... before the breakpoint: one call.
+                let mut m = 1;
+                while m < BATCH && local(k + m as u64) <= bp {
+                    m += 1;
+                }
+                if m > 1 {
+                    for i in 0..m {
+                        cursor.at(local(k - 1 + i as u64), &mut cmds[i * n..(i + 1) * n]);
+                    }
+                    let (cp, th) = (&mut bcmd_p[..m * n], &mut btool[..m * n]);
+                    match plant.step_samples(st, &cmds[..m * n], dt, BLOWUP_M, cp, th) {
+                        Ok(Some(done)) if (1..=m).contains(&done) => {
+                            for i in 0..done - 1 {
+                                let ki = k + i as u64;
+                                acc.sample(ki, ki as f64 * dt, &th[i * n..(i + 1) * n]);
+                            }
+                            k += done as u64 - 1;
+                            tau = local(k);
+                            t = k as f64 * dt;
+                            // The last sample of the call is evaluated in full.
+                            if sample_at!(st, t) {
+                                break 'chunks;
+                            }
+                            k += 1;
+                            continue;
+                        }
+                        Ok(_) => batch = false,
+                        Err((_, source)) => return Err(sim_err(source)),
+                    }
+                }
+            }
+            cursor.at(tau, &mut cmd);
+            let h = if whole { dt } else { next - tau };
             if h > 0.0 {
                 plant.step(st, &cmd, h).map_err(sim_err)?;
             }
-            t = next;
-            if t == t_sample {
-                let ok = plant.positions(st, &mut cmd_p, &mut toolhead)
-                    && cmd_p
-                        .iter()
-                        .zip(&toolhead)
-                        .all(|(c, h)| (h - c).abs() <= BLOWUP_M);
-                if !ok {
-                    plant.observe(st, &mut obs);
-                    if let Some(reason) =
-                        crate::execute::simulate::fault_in(t, &acc.opts.names, &obs)
-                    {
-                        acc.out.fault = Some(reason);
-                        break 'chunks;
-                    }
-                    for (h, o) in toolhead.iter_mut().zip(&obs) {
-                        *h = o.toolhead_m;
-                    }
+            tau = next;
+            t = t0 + tau;
+            if next == t_sample {
+                t = k as f64 * dt;
+                if sample_at!(st, t) {
+                    break 'chunks;
                 }
-                acc.sample(k, t, &toolhead);
                 k += 1;
             }
         }
