@@ -71,17 +71,18 @@ pub fn compare(
 ) -> Result<Vec<PathBuf>, Error> {
     let mut files = Vec::new();
     if let Some(layer) = a.maps().first().map(|m| m.layer) {
+        // The whole job again under each setting, keeping this layer's map: the layer as
+        // printed after the layers before it (a layer range would start it at rest).
         let one = |o: &GcodeOptions| {
             measure(&GcodeOptions {
-                layers: Some((layer, layer)),
-                maps: 1,
+                map_layer: Some(layer),
                 ..o.clone()
             })
         };
         let (ma, mb) = (one(a_opts)?, one(b_opts)?);
         let panels = [(&ma, a), (&mb, b)]
             .iter()
-            .filter_map(|(m, o)| m.maps().first().map(|l| map_panel(l, &o.setting)))
+            .filter_map(|(m, o)| m.streamed.chosen.as_ref().map(|l| map_panel(l, &o.setting)))
             .collect();
         let stem = format!("compare-layer-{layer}");
         RingingMap {

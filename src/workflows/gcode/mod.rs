@@ -55,6 +55,8 @@ pub struct GcodeOptions {
     pub sample_rate_hz: f64,
     /// Ringing maps to draw (the worst layers).
     pub maps: usize,
+    /// A layer whose ringing map is kept besides the worst ones (the comparison's).
+    pub map_layer: Option<u32>,
     /// A second setting to compare with (`--versus`): firmware and X/Y shaper.
     pub versus: Option<(Firmware, Option<ShaperSetting>)>,
 }
@@ -75,6 +77,7 @@ impl GcodeOptions {
             skip_bad_lines: false,
             sample_rate_hz: DEFAULT_SAMPLE_RATE_HZ,
             maps: 1,
+            map_layer: None,
             versus: None,
         })
     }
@@ -306,6 +309,7 @@ pub fn measure(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
         xy,
         top_spots: 10,
         maps: opts.maps,
+        map_layer: opts.map_layer,
     };
     let err = gcode_error(&opts.file);
     let reader = Reader::open(

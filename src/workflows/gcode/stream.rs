@@ -34,6 +34,8 @@ pub struct StreamOptions {
     pub top_spots: usize,
     /// Ringing maps kept (the layers with the largest errors).
     pub maps: usize,
+    /// A layer whose map is kept whatever its errors ([`Streamed::chosen`]).
+    pub map_layer: Option<u32>,
 }
 
 /// What the simulation measured.
@@ -47,6 +49,8 @@ pub struct Streamed {
     pub worst: Vec<Spot>,
     /// The ringing maps of the worst layers, largest error first.
     pub maps: Vec<LayerMap>,
+    /// The map of [`StreamOptions::map_layer`].
+    pub chosen: Option<LayerMap>,
     /// Print time simulated (s).
     pub simulated_s: f64,
     /// Samples taken.
@@ -112,6 +116,9 @@ impl Account {
                 .spots()
                 .to_vec(),
         };
+        if self.opts.map_layer == Some(map.layer) {
+            self.out.chosen = Some(map.clone());
+        }
         let maps = &mut self.out.maps;
         let at = maps.partition_point(|m| m.worst_um() >= map.worst_um());
         if at < self.opts.maps {
