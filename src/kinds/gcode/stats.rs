@@ -146,8 +146,10 @@ pub struct LayerStats {
     pub layer: u32,
     /// Its largest error.
     pub worst: Option<Spot>,
-    /// Its errors.
-    pub hist: Histogram,
+    /// The 95th percentile of its errors (um; [`Histogram::quantile_um`]), set when the
+    /// layer ends (the layer's histogram is then merged into the job's and dropped, so
+    /// memory does not grow with the number of layers).
+    pub p95_um: f64,
     /// Printing moves in it that were simulated.
     pub print_moves: u64,
     /// Mean over its printing moves of each move's largest error (um): the typical
@@ -161,7 +163,7 @@ impl LayerStats {
         Self {
             layer,
             worst: None,
-            hist: Histogram::default(),
+            p95_um: 0.0,
             print_moves: 0,
             mean_move_worst_um: 0.0,
         }

@@ -47,7 +47,7 @@ pub struct GcodeOptions {
     pub backend: Backend,
     /// The driver model of a physical machine.
     pub driver: DriverMode,
-    /// Output folder (`None`: results/<file stem>-gcode/).
+    /// Output folder (`None`: `results/<file stem>-gcode/`).
     pub out: Option<PathBuf>,
     /// Count and skip bad lines instead of stopping at the first.
     pub skip_bad_lines: bool,

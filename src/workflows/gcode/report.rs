@@ -46,7 +46,7 @@ pub fn layers_csv(o: &GcodeOutcome) -> Result<Vec<u8>, csv::Error> {
                 row.push("true".into());
                 row.push(s.print_moves.to_string());
                 row.push(num(s.worst_um()));
-                row.push(num(s.hist.quantile_um(0.95)));
+                row.push(num(s.p95_um));
                 row.push(num(s.mean_move_worst_um));
                 match &s.worst {
                     Some(w) => row.extend([w.line.to_string(), num(w.x_mm), num(w.y_mm)]),
@@ -121,7 +121,7 @@ printing samples.\n"
         let (w, p, line) = match &l.stats {
             Some(st) => (
                 format!("{:.2}", st.worst_um()),
-                format!("{:.2}", st.hist.quantile_um(0.95)),
+                format!("{:.2}", st.p95_um),
                 st.worst
                     .as_ref()
                     .map_or(String::new(), |w| w.line.to_string()),

@@ -41,7 +41,8 @@ pub struct StreamOptions {
 /// What the simulation measured.
 #[derive(Debug, Clone, Default)]
 pub struct Streamed {
-    /// Every simulated layer's account, in order.
+    /// Every simulated layer's account, in order (moved into [`super::GcodeOutcome::layers`] by
+    /// [`super::measure`]).
     pub layers: Vec<LayerStats>,
     /// Every printing sample's contour error.
     pub all: Histogram,
@@ -69,6 +70,8 @@ struct Account {
     out: Streamed,
     top: TopSpots,
     layer: Option<LayerStats>,
+    /// The current layer's errors.
+    hist: Histogram,
     map: Vec<MapPoint>,
     layer_top: TopSpots,
     /// The move the last sample belonged to: index, kind, layer, line, worst spot.
@@ -87,6 +90,7 @@ impl Account {
             active: ActiveMoves::default(),
             out: Streamed::default(),
             layer: None,
+            hist: Histogram::default(),
             map: Vec::new(),
             owner: None,
             map_every,
@@ -105,10 +109,12 @@ impl Account {
 
     fn end_layer(&mut self) {
         self.end_move();
-        let Some(l) = self.layer.take() else {
+        let Some(mut l) = self.layer.take() else {
             return;
         };
-        self.out.all.merge(&l.hist);
+        l.p95_um = self.hist.quantile_um(0.95);
+        self.out.all.merge(&self.hist);
+        self.hist = Histogram::default();
         let map = LayerMap {
             layer: l.layer,
             points: std::mem::take(&mut self.map),
@@ -151,9 +157,7 @@ impl Account {
         let err_um = err_mm * 1e3;
         let print = m.kind == MoveKind::Print;
         if print {
-            if let Some(l) = self.layer.as_mut() {
-                l.hist.push(err_um);
-            }
+            self.hist.push(err_um);
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
             {
