@@ -17,6 +17,20 @@ fn parse_backend(s: &str) -> Result<Backend, String> {
     Backend::parse(s).ok_or_else(|| format!("unknown backend `{s}`; allowed: {}", Backend::ALLOWED))
 }
 
+fn parse_firmware(s: &str) -> Result<settle_gcode::job::Firmware, String> {
+    s.parse()
+        .map_err(|e: settle_gcode::GcodeError| e.to_string())
+}
+
+fn parse_driver(s: &str) -> Result<settle_sim::DriverMode, String> {
+    settle_sim::DriverMode::parse(s).ok_or_else(|| {
+        format!(
+            "unknown driver model `{s}`; allowed: {}",
+            settle_sim::DriverMode::ALLOWED
+        )
+    })
+}
+
 #[derive(Parser, Debug)]
 #[command(
     name = "settle",
@@ -172,6 +186,52 @@ enum Command {
         /// The scenario to write [default: <config name>_import.toml beside the config].
         #[arg(long)]
         out: Option<PathBuf>,
+    },
+    /// Replay a G-code file through a firmware's planner on a machine: print time, contour
+    /// error per layer, the worst spots with their lines, the ringing map.
+    #[command(
+        after_help = "Example:\n  settle gcode gcode/prints/cube_layer.gcode --machine printer_xy --firmware klipper --shaper mzv@48 --out /tmp/cube\n  (writes /tmp/cube/layers.csv, summary.md and ringing-layer-<n>.svg/png)"
+    )]
+    Gcode {
+        /// The G-code file.
+        file: PathBuf,
+        /// The machine: a preset (printer_xy), a machine file, or a scenario file (its [machine]).
+        #[arg(long)]
+        machine: String,
+        /// The planner: klipper, marlin, rrf or settle.
+        #[arg(long, default_value = "klipper", value_parser = parse_firmware)]
+        firmware: settle_gcode::job::Firmware,
+        /// Only these layers, A..B (both included) or A; the rest is planned, not simulated.
+        #[arg(long, value_name = "A..B", value_parser = workflows::gcode::parse_layers)]
+        layers: Option<(u32, u32)>,
+        /// Input shaper on X and Y: KIND@FREQ_HZ[/DAMPING], e.g. mzv@48 [default: none].
+        #[arg(long, value_parser = workflows::gcode::parse_shaper)]
+        shaper: Option<settle_gcode::job::ShaperSetting>,
+        /// Simulation backend: modal (exact, linear driver only), rapier, mujoco.
+        #[arg(long, default_value = "modal", value_parser = parse_backend)]
+        backend: Backend,
+        /// Driver model: linear, spring or full (modal: linear only).
+        #[arg(long, default_value = "linear", value_parser = parse_driver)]
+        driver: settle_sim::DriverMode,
+        /// Output folder [default: results/<file stem>-gcode/].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Count and skip bad lines instead of stopping at the first.
+        #[arg(long)]
+        skip_bad_lines: bool,
+        /// Sample rate (Hz).
+        #[arg(long, default_value_t = workflows::gcode::DEFAULT_SAMPLE_RATE_HZ)]
+        sample_rate_hz: f64,
+        /// Ringing maps to draw: the layers with the largest contour error.
+        #[arg(long, default_value_t = 1)]
+        maps: usize,
+        /// Also run FIRMWARE[:SHAPER] (e.g. settle:none, klipper:ei@48) and compare: the
+        /// worst layer under both (compare-layer-<n>.svg/png) and compare.md.
+        #[arg(long, value_name = "FIRMWARE[:SHAPER]", value_parser = workflows::gcode::compare::parse_setting)]
+        versus: Option<(
+            settle_gcode::job::Firmware,
+            Option<settle_gcode::job::ShaperSetting>,
+        )>,
     },
     /// Run one point of a sweep in detail: print its metrics, write its full trace as CSV.
     #[command(
@@ -423,6 +483,33 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             let stdout = std::io::BufWriter::new(std::io::stdout().lock());
             workflows::plan::plan_stream(stdin, stdout, jobs(j))?;
             Report::new(Exit::Ok)
+        }
+        Command::Gcode {
+            file,
+            machine,
+            firmware,
+            layers,
+            shaper,
+            backend,
+            driver,
+            out,
+            skip_bad_lines,
+            sample_rate_hz,
+            maps,
+            versus,
+        } => {
+            let opts = workflows::gcode::GcodeOptions {
+                layers,
+                backend,
+                driver,
+                out,
+                skip_bad_lines,
+                sample_rate_hz,
+                maps,
+                versus,
+                ..workflows::gcode::GcodeOptions::new(file, &machine, firmware)?.with_shaper(shaper)
+            };
+            workflows::gcode::gcode(&opts)?.report()
         }
         Command::Run {
             scenario,

@@ -63,6 +63,7 @@ register! {
     corner::CornerPath,
     shaping::Shaping,
     scan::ScanStep,
+    gcode::GcodeRun,
     #[cfg(test)]
     toy::Toy,
 }

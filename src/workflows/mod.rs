@@ -7,6 +7,7 @@
 //! and the exit status it maps to a code.
 
 pub mod check;
+pub mod gcode;
 pub mod identify;
 pub mod import;
 pub mod journal;

@@ -6,6 +6,7 @@ mod support;
 mod cli;
 mod corners;
 mod faults;
+mod gcode_job;
 mod html_report;
 mod identify_cmd;
 mod import;

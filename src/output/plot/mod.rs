@@ -9,6 +9,7 @@
 //! [`identify`] from identified modes and their measured spectrum.
 
 pub mod identify;
+pub mod ringing;
 pub mod scan_trace;
 pub mod sweep;
 pub mod trace;

@@ -1,0 +1,100 @@
+//! `settle gcode` speed: a shipped print through Klipper's planner with MZV shaping on the
+//! printer_xy machine (linear driver), streaming, on the modal backend (the whole file)
+//! and on rapier (one layer).
+//!
+//! Throughput is in elements per second with one element = one simulated microsecond of
+//! print, so criterion's "Melem/s" reads as *simulated seconds per wall second*. Targets
+//! per core: modal >= 1,000, rapier >= 20. After criterion's measurement each case also
+//! runs timed by the thread's own CPU clock (`/proc/thread-self/schedstat`, Linux) and
+//! prints simulated seconds per CPU second (wall time overstates the cost on a shared
+//! machine).
+//!
+//! With `SETTLE_SYNTH_GCODE=PATH` (and optionally `SETTLE_SYNTH_MB`, default 100) the bench
+//! first writes settle-gcode's synthetic slicer-like file of that size to PATH, for
+//! measuring the peak memory of `settle gcode` on it with `/usr/bin/time -v`.
+
+use std::hint::black_box;
+use std::path::PathBuf;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use settle::spec::backend::Backend;
+use settle::workflows::gcode::{GcodeOptions, measure, parse_shaper};
+use settle_gcode::job::Firmware;
+
+#[path = "../gcode/benches/synth/mod.rs"]
+mod synth;
+
+fn options(backend: Backend, layers: Option<(u32, u32)>) -> GcodeOptions {
+    let file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("gcode/prints/ringing_tower.gcode");
+    let shaper = parse_shaper("mzv@48").expect("shaper");
+    GcodeOptions {
+        backend,
+        layers,
+        ..GcodeOptions::new(file, "printer_xy", Firmware::Klipper)
+            .expect("options")
+            .with_shaper(Some(shaper))
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    if let Ok(path) = std::env::var("SETTLE_SYNTH_GCODE") {
+        let mb: u64 = std::env::var("SETTLE_SYNTH_MB")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(100);
+        let mut w = std::io::BufWriter::new(std::fs::File::create(&path).expect("create"));
+        let n = synth::write_gcode(&mut w, mb * 1_000_000).expect("write");
+        println!("wrote {path}: {:.1} MB", n as f64 / 1e6);
+    }
+    let cases = [
+        ("modal_ringing_tower", options(Backend::Modal, None)),
+        (
+            "rapier_ringing_tower_layer_1",
+            options(Backend::Rapier, Some((1, 1))),
+        ),
+    ];
+    let mut group = c.benchmark_group("gcode");
+    group.sample_size(10);
+    for (name, opts) in &cases {
+        let sim_s = measure(opts).expect("job").streamed.simulated_s;
+        group.throughput(Throughput::Elements((sim_s * 1e6).round() as u64));
+        group.bench_function(*name, |b| b.iter(|| black_box(measure(opts).expect("job"))));
+    }
+    group.finish();
+    let filter: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    for (name, opts) in &cases {
+        if !filter.is_empty() && !filter.iter().any(|f| name.contains(f.as_str())) {
+            continue;
+        }
+        let (Some(a), mut sim, mut runs) = (thread_cpu_ns(), 0.0, 0) else {
+            continue;
+        };
+        let mut b = a;
+        while b - a < 3_000_000_000 {
+            sim += measure(opts).expect("job").streamed.simulated_s;
+            runs += 1;
+            b = thread_cpu_ns().unwrap_or(u64::MAX);
+        }
+        let cpu_s = (b - a) as f64 * 1e-9;
+        println!(
+            "gcode/{name}: {runs} runs, {sim:.1} s simulated in {cpu_s:.2} CPU s: {:.0} simulated s per CPU s",
+            sim / cpu_s
+        );
+    }
+}
+
+/// This thread's time on a CPU (ns), from `/proc/thread-self/schedstat`.
+fn thread_cpu_ns() -> Option<u64> {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

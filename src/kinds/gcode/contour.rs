@@ -1,0 +1,121 @@
+//! Contour error on a G-code job: the distance (in the XY plane, mm) from the toolhead to
+//! the commanded geometry of the moves active at that time, and which move a sample
+//! belongs to.
+//!
+//! - A move is *active* at time `t` when `t` lies in its planned span widened by
+//!   [`ACTIVE_WINDOW_S`] on both sides; the contour error is the distance to the nearest
+//!   active move's geometry (lines as written; arcs as the firmware cuts them, the path the
+//!   machine is commanded along). The widening lets a toolhead that lags its command (or a
+//!   shaped command that leads it by up to half a shaper's duration) be measured against
+//!   the move it is still on, not the next one, after a corner.
+//! - A sample *belongs* to the latest move that has started (`start_time_s <= t`, moves of
+//!   zero duration skipped): the error while a move runs is the ringing left by the corner
+//!   at its start plus the move's own following error.
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+use settle_gcode::job::{MoveGeometry, MoveInfo};
+
+/// How far (s) a move's span is widened for [`ActiveMoves::error_mm`]: 20 ms is longer
+/// than half the longest Klipper shaper at 20 Hz (2DHUMP_EI at 20 Hz lasts 75 ms: the
+/// shaped command leads by at most half of it, 37 ms, only on shapers tuned below 40 Hz)
+/// and than a quarter period of the printer modes (30-120 Hz): the lag of the toolhead.
+pub const ACTIVE_WINDOW_S: f64 = 0.02;
+
+/// Distance (mm) from `p` to the segment `a`-`b` (XY).
+pub fn segment_distance_mm(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let (px, py) = (p[0] - a[0], p[1] - a[1]);
+    let l2 = dx * dx + dy * dy;
+    let s = if l2 > 0.0 {
+        ((px * dx + py * dy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (ex, ey) = (px - s * dx, py - s * dy);
+    (ex * ex + ey * ey).sqrt()
+}
+
+/// Distance (mm) from `p` to a move's commanded geometry (XY).
+pub fn geometry_distance_mm(g: &MoveGeometry, p: [f64; 2]) -> f64 {
+    match g {
+        MoveGeometry::Line { from_mm, to_mm } => {
+            segment_distance_mm(p, [from_mm[0], from_mm[1]], [to_mm[0], to_mm[1]])
+        }
+        MoveGeometry::Arc { points_mm, .. } => points_mm
+            .windows(2)
+            .map(|w| segment_distance_mm(p, [w[0][0], w[0][1]], [w[1][0], w[1][1]]))
+            .fold(f64::INFINITY, f64::min),
+    }
+}
+
+/// The moves of the chunks seen so far that can still be active (module doc).
+#[derive(Debug, Default)]
+pub struct ActiveMoves {
+    moves: VecDeque<Arc<MoveInfo>>,
+    last_index: Option<u64>,
+}
+
+impl ActiveMoves {
+    /// Take a chunk's moves (those already taken from an earlier chunk are skipped).
+    pub fn add(&mut self, moves: &[Arc<MoveInfo>]) {
+        for m in moves {
+            if self.last_index.is_none_or(|i| m.index > i) {
+                self.last_index = Some(m.index);
+                self.moves.push_back(Arc::clone(m));
+            }
+        }
+    }
+
+    /// The move a sample at `t_s` belongs to (module doc), if any has started.
+    pub fn owner(&self, t_s: f64) -> Option<&Arc<MoveInfo>> {
+        self.moves
+            .iter()
+            .rev()
+            .find(|m| m.duration_s > 0.0 && m.start_time_s <= t_s)
+    }
+
+    /// Forget the moves that can no longer be active after `t_s` (keeping the latest
+    /// started one: a sample during a pause still belongs to it).
+    pub fn retire(&mut self, t_s: f64) {
+        while self.moves.len() > 1
+            && self.moves[0].end_time_s() + ACTIVE_WINDOW_S < t_s
+            && self.moves[1].start_time_s <= t_s
+        {
+            self.moves.pop_front();
+        }
+    }
+
+    /// The contour error (mm) of a toolhead at `p` (XY, mm) at `t_s`: the distance to the
+    /// nearest active move, or to the move the sample belongs to when none is active (a
+    /// pause), `None` before the first move.
+    pub fn error_mm(&self, t_s: f64, p: [f64; 2]) -> Option<f64> {
+        let mut best: Option<f64> = None;
+        for m in &self.moves {
+            if m.start_time_s - ACTIVE_WINDOW_S > t_s {
+                break;
+            }
+            if m.end_time_s() + ACTIVE_WINDOW_S < t_s {
+                continue;
+            }
+            let d = geometry_distance_mm(&m.geometry, p);
+            best = Some(best.map_or(d, |b: f64| b.min(d)));
+        }
+        best.or_else(|| self.owner(t_s).map(|m| geometry_distance_mm(&m.geometry, p)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distances_to_a_segment_and_its_ends() {
+        let (a, b) = ([0.0, 0.0], [10.0, 0.0]);
+        assert_eq!(segment_distance_mm([5.0, 3.0], a, b), 3.0);
+        assert_eq!(segment_distance_mm([13.0, 4.0], a, b), 5.0);
+        assert_eq!(segment_distance_mm([-3.0, -4.0], a, b), 5.0);
+        assert_eq!(segment_distance_mm([1.0, 1.0], a, a), 2f64.sqrt());
+    }
+}

@@ -1,0 +1,396 @@
+//! G-code jobs in sweeps, a path kind: the scenario's `[gcode]` table names a G-code file
+//! (relative to the scenario), the firmware whose planner runs it and the layers to
+//! simulate; the sweep varies `gcode.firmware`, the existing `shaper.*` keys (the shaper
+//! goes into the job, on X and Y, as the firmware shapes) and the `[limits]` keys (the
+//! firmware's velocity and acceleration limits; settle's planner also takes the jerk and
+//! the profile kind).
+//!
+//! ```toml
+//! [gcode]
+//! file = "../gcode/prints/cube_layer.gcode"
+//! firmware = "klipper"
+//! layers = "0..0"
+//! ```
+//!
+//! The run's motion is the job's shaped X and Y (and Z) over the layer range, one
+//! trajectory from the range's first move (`t = 0`) to its end; the common metrics are
+//! those of any run (residual after the end, settle time). The kind's probe measures the
+//! contour error against the G-code's own geometry ([`contour`]) and adds to runs.csv
+//! `print_time_s` (the whole file's, by the firmware's planner),
+//! `contour_worst_um`, `contour_p95_um` (printing samples, during the job) and
+//! `contour_worst_line`. Bad G-code is reported when the sweep is checked, with the file
+//! and line.
+
+pub mod contour;
+pub mod stats;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use serde::Deserialize;
+use settle_gcode::job::{Firmware, Job, JobConfig, MoveInfo, PlannerConfig, ShaperSetting};
+use settle_gcode::{GcodeError, MoveKind};
+use settle_planner::path::CornerStrategy;
+use settle_planner::path::junction::Junction;
+use settle_planner::{PlanError, Profile, Segment, Trajectory};
+
+use crate::error::Error;
+use crate::input::source::Source;
+use crate::kinds::{Kind, KindState, PathMove, PlanContext, Planned, Probe, Role, any_has};
+use crate::measure::metrics::Metrics;
+use crate::measure::series::Series;
+use crate::spec::run_spec::RunSpec;
+use crate::spec::value::Value;
+use contour::ActiveMoves;
+use stats::Histogram;
+
+/// runs.csv columns of a G-code run.
+pub const COLUMNS: [&str; 6] = [
+    "gcode_file",
+    "firmware",
+    "print_time_s",
+    "contour_worst_um",
+    "contour_p95_um",
+    "contour_worst_line",
+];
+
+/// The `[gcode]` table.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct GcodeSpec {
+    /// The G-code file, relative to the scenario.
+    pub file: String,
+    /// `klipper`, `marlin`, `rrf` or `settle`.
+    pub firmware: String,
+    /// Layers to simulate, `A..B` or `A` (default: all).
+    pub layers: Option<String>,
+    /// The speed law of settle's planner (`scurve`, `trapezoid`, ...; default `scurve`).
+    #[serde(default = "default_profile")]
+    pub profile: String,
+    /// settle's planner: Klipper's corner rule at this speed (mm/s; default 5, Klipper's
+    /// `square_corner_velocity`); 0 stops at every corner.
+    #[serde(default = "default_scv")]
+    pub square_corner_velocity_mm_s: f64,
+}
+
+fn default_profile() -> String {
+    "scurve".into()
+}
+
+fn default_scv() -> f64 {
+    5.0
+}
+
+/// A run's G-code job.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GcodeJob {
+    /// The file (resolved against the scenario's folder).
+    pub file: PathBuf,
+    /// The planner.
+    pub firmware: Firmware,
+    /// Layer range (inclusive).
+    pub layers: Option<(u32, u32)>,
+    /// Profile name (settle's planner), as written.
+    pub profile: String,
+    /// settle's planner: square-corner velocity (mm/s).
+    pub square_corner_velocity_mm_s: f64,
+}
+
+impl KindState for GcodeJob {
+    fn table(&self) -> &'static str {
+        "gcode"
+    }
+
+    fn set(&mut self, key: &str, value: &Value) -> Result<(), String> {
+        match (key, value) {
+            ("firmware", Value::Text(t)) => {
+                self.firmware = t.parse().map_err(|e: GcodeError| e.to_string())?;
+            }
+            ("firmware", _) => {
+                return Err("`gcode.firmware` takes names: klipper, marlin, rrf, settle".into());
+            }
+            _ => {
+                return Err(format!(
+                    "`gcode.{key}` cannot be swept; allowed: gcode.firmware"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The layer range syntax of `[gcode] layers` and `--layers`: `A..B` (both included) or
+/// `A`.
+pub fn parse_layers(s: &str) -> Result<(u32, u32), String> {
+    let num = |t: &str| {
+        t.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{s}`: layers are `A..B` or `A` with whole numbers >= 0"))
+    };
+    let (a, b) = match s.split_once("..") {
+        Some((a, b)) => (num(a)?, num(b.trim_start_matches('='))?),
+        None => (num(s)?, num(s)?),
+    };
+    if a > b {
+        return Err(format!("`{s}`: the first layer is after the last"));
+    }
+    Ok((a, b))
+}
+
+/// The job configuration of `run`: its firmware's defaults, the run's limits, and
+/// `shaper` on X and Y.
+pub fn job_config(run: &RunSpec, job: &GcodeJob, shaper: Option<ShaperSetting>) -> Result<JobConfig, String> {
+    let mut cfg = JobConfig::defaults(job.firmware).map_err(|e| e.to_string())?;
+    let (v, a) = (run.vmax_mm_s * 1e-3, run.amax_mm_s2 * 1e-3);
+    match &mut cfg.planner {
+        PlannerConfig::Klipper(c) => {
+            c.max_velocity_m_s = v;
+            c.max_accel_m_s2 = a;
+        }
+        PlannerConfig::Marlin(c) => {
+            for i in 0..3 {
+                c.max_feedrate_m_s[i] = v;
+                c.max_accel_m_s2[i] = a;
+            }
+            c.print_accel_m_s2 = a;
+            c.travel_accel_m_s2 = a;
+            c.retract_accel_m_s2 = c.retract_accel_m_s2.min(a);
+        }
+        PlannerConfig::Rrf(c) => {
+            for i in 0..3 {
+                c.max_feedrate_m_s[i] = v;
+                c.max_accel_m_s2[i] = a;
+            }
+            c.print_accel_m_s2 = a;
+            c.travel_accel_m_s2 = a;
+        }
+        PlannerConfig::Settle(c) => {
+            c.limits = run.limits_si().map_err(|e| e.to_string())?;
+            c.kind = settle_planner::ProfileKind::parse(&job.profile).map_err(|e| e.to_string())?;
+            c.corners = if job.square_corner_velocity_mm_s > 0.0 {
+                CornerStrategy::Junction(Junction::Klipper {
+                    square_corner_velocity: job.square_corner_velocity_mm_s * 1e-3,
+                })
+            } else {
+                CornerStrategy::ExactStop
+            };
+        }
+    }
+    cfg.shapers[0] = shaper;
+    cfg.shapers[1] = shaper;
+    Ok(cfg)
+}
+
+/// The shaper the run's `[shaper]` sets, as a job setting.
+fn shaper_setting(s: Option<&settle_planner::shaper::Shaper>) -> Option<ShaperSetting> {
+    s.map(|s| ShaperSetting {
+        kind: s.kind(),
+        frequency_hz: s.frequency_hz(),
+        damping_ratio: s.damping_ratio(),
+    })
+}
+
+/// The job of `run` opened, limited to its layers.
+fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<std::io::BufReader<std::fs::File>>, String> {
+    let shaper = crate::kinds::shaper(run).map_err(|e| e.to_string())?;
+    let cfg = job_config(run, job, shaper_setting(shaper.as_ref()))?;
+    let j = Job::open(&job.file, cfg).map_err(|e| e.to_string())?;
+    match job.layers {
+        Some((a, b)) => j.with_layers(a..=b).map_err(|e| e.to_string()),
+        None => Ok(j),
+    }
+}
+
+/// One profile per machine axis (X, Y, Z of the job by name), the chunks joined.
+fn join(axes: &[String], chunks: &[Trajectory]) -> Result<Trajectory, PlanError> {
+    let mut out = Vec::new();
+    for name in axes {
+        let i = match name.as_str() {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            _ => {
+                return Err(PlanError::InvalidInput {
+                    reason: "a G-code job drives machine axes named x, y and z only",
+                });
+            }
+        };
+        let start = chunks.first().map(|c| c.axes()[i].start()).unwrap_or_default();
+        let segs: Vec<Segment> = chunks
+            .iter()
+            .flat_map(|c| c.axes()[i].segments().iter().copied())
+            .collect();
+        out.push(Profile::new(start, segs)?);
+    }
+    Trajectory::new(out)
+}
+
+/// The kind's probe: contour error of the recorded toolhead against the job's moves.
+#[derive(Debug)]
+struct GcodeProbe {
+    moves: Vec<Arc<MoveInfo>>,
+    /// Print-clock time of the run's `t = 0` (s).
+    t0_s: f64,
+    print_time_s: f64,
+}
+
+impl Probe for GcodeProbe {
+    fn measure(&self, _run: &RunSpec, series: &Series, m: &mut Metrics) -> Result<(), Error> {
+        let (Some(x), Some(y)) = (series.channel("toolhead_x"), series.channel("toolhead_y"))
+        else {
+            return Ok(());
+        };
+        let mut active = ActiveMoves::default();
+        active.add(&self.moves);
+        let mut hist = Histogram::default();
+        let (mut worst, mut line) = (0.0_f64, f64::NAN);
+        let t_end = m.move_time_s;
+        for (k, &t) in series.t_s.iter().enumerate() {
+            if t > t_end {
+                break;
+            }
+            let tp = t + self.t0_s;
+            let p = [x.data[k] * 1e3, y.data[k] * 1e3];
+            let (Some(e), Some(owner)) = (active.error_mm(tp, p), active.owner(tp)) else {
+                continue;
+            };
+            if owner.kind != MoveKind::Print {
+                continue;
+            }
+            let e_um = e * 1e3;
+            hist.push(e_um);
+            if e_um > worst {
+                (worst, line) = (e_um, owner.line as f64);
+            }
+        }
+        m.extra.push(("print_time_s".into(), self.print_time_s));
+        m.extra.push(("contour_worst_um".into(), worst));
+        m.extra.push(("contour_p95_um".into(), hist.quantile_um(0.95)));
+        m.extra.push(("contour_worst_line".into(), line));
+        Ok(())
+    }
+}
+
+/// The G-code job kind.
+#[derive(Debug, Clone, Copy)]
+pub struct GcodeRun;
+
+impl Kind for GcodeRun {
+    fn name(&self) -> &'static str {
+        "G-code job"
+    }
+
+    fn table(&self) -> Option<&'static str> {
+        Some("gcode")
+    }
+
+    fn role(&self) -> Role {
+        Role::Path
+    }
+
+    fn sweepable(&self) -> &'static str {
+        "gcode.firmware"
+    }
+
+    fn parse(&self, src: &Source) -> Result<Option<Box<dyn KindState>>, Error> {
+        let Some(spec) = src.table::<GcodeSpec>("gcode")? else {
+            return Ok(None);
+        };
+        let firmware = spec
+            .firmware
+            .parse()
+            .map_err(|e: GcodeError| src.error_at("gcode.firmware", e.to_string()))?;
+        let layers = spec
+            .layers
+            .as_deref()
+            .map(parse_layers)
+            .transpose()
+            .map_err(|m| src.error_at("gcode.layers", m))?;
+        settle_planner::ProfileKind::parse(&spec.profile)
+            .map_err(|e| src.error_at("gcode.profile", e.to_string()))?;
+        let base = src.path.parent().unwrap_or(std::path::Path::new("."));
+        Ok(Some(Box::new(GcodeJob {
+            file: base.join(&spec.file),
+            firmware,
+            layers,
+            profile: spec.profile,
+            square_corner_velocity_mm_s: spec.square_corner_velocity_mm_s,
+        })))
+    }
+
+    fn path_move(&self, state: &dyn KindState) -> Option<PathMove> {
+        let job = (state as &dyn std::any::Any).downcast_ref::<GcodeJob>()?;
+        Some(PathMove {
+            profile: job.profile.clone(),
+            profile_key: "gcode.profile",
+            axis: "x+y".into(),
+        })
+    }
+
+    /// Plans the whole file once: bad G-code is an error naming its file and line.
+    fn validate(&self, run: &RunSpec) -> Result<(), (String, String)> {
+        let Some(job) = run.state::<GcodeJob>() else {
+            return Ok(());
+        };
+        if run.machine.is_none() {
+            return Err((
+                "machine".into(),
+                "a G-code job needs a physical machine with axes x and y (e.g. `preset = \"printer_xy\"`)".into(),
+            ));
+        }
+        let mut j = open(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
+        j.run_to_end()
+            .map_err(|e| (run.blame("gcode.file"), e.to_string()))
+    }
+
+    fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {
+        let job = run.state::<GcodeJob>().ok_or(PlanError::InvalidInput {
+            reason: "not a G-code run",
+        })?;
+        let failed = |_| PlanError::InvalidInput {
+            reason: "the G-code job failed to plan (checked when the sweep was validated)",
+        };
+        let mut j = open(run, job).map_err(failed)?;
+        let (mut chunks, mut moves, mut t0) = (Vec::new(), Vec::<Arc<MoveInfo>>::new(), None);
+        while let Some(c) = j.next_chunk().map_err(|e| failed(e.to_string()))? {
+            t0.get_or_insert(c.start_time_s);
+            for m in &c.moves {
+                if moves.last().is_none_or(|l| m.index > l.index) {
+                    moves.push(Arc::clone(m));
+                }
+            }
+            chunks.push(c.trajectory);
+        }
+        j.run_to_end().map_err(|e| failed(e.to_string()))?;
+        let trajectory = join(ctx.axes, &chunks)?;
+        Ok(Planned {
+            trajectory,
+            probe: Some(Box::new(GcodeProbe {
+                moves,
+                t0_s: t0.unwrap_or(0.0),
+                print_time_s: j.print_time_s(),
+            })),
+        })
+    }
+
+    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+        if !any_has::<GcodeJob>(runs) {
+            return Vec::new();
+        }
+        COLUMNS.iter().map(|c| c.to_string()).collect()
+    }
+
+    fn cells(&self, run: &RunSpec, m: &Metrics) -> Vec<String> {
+        let Some(job) = run.state::<GcodeJob>() else {
+            return Vec::new();
+        };
+        let mut out = vec![job.file.display().to_string(), job.firmware.to_string()];
+        if m.is_ok() {
+            for c in &COLUMNS[2..] {
+                let v = m.extra.iter().find(|(n, _)| n == c).map(|(_, v)| *v);
+                out.push(v.map(|v| v.to_string()).unwrap_or_default());
+            }
+        }
+        out
+    }
+}

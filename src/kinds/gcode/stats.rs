@@ -1,0 +1,240 @@
+//! What a G-code job's simulation adds up: per-layer contour-error statistics (worst,
+//! 95th percentile from a bounded histogram), the worst spots (one per move) and the
+//! toolpath points of the ringing maps.
+
+/// A point of a ringing map: the toolhead (mm) and its contour error (um); `print` false
+/// breaks the drawn path (travel, pauses).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapPoint {
+    /// X (mm).
+    pub x_mm: f32,
+    /// Y (mm).
+    pub y_mm: f32,
+    /// Contour error (um).
+    pub error_um: f32,
+    /// Whether the toolhead is printing here.
+    pub print: bool,
+}
+
+/// Contour errors below this are counted in the first bin (um).
+const HIST_MIN_UM: f64 = 1e-3;
+/// Relative width of a bin: a percentile is reported as its bin's upper edge, at most
+/// 0.1 % above the exact sample quantile.
+const HIST_RATIO: f64 = 1.001;
+/// Bins from 1e-3 um to 1e5 um (100 mm: beyond is a blow-up, counted in the last bin).
+const HIST_BINS: usize = 18_432;
+
+/// A histogram of contour errors with log-spaced bins (bounded memory whatever the job's
+/// length).
+#[derive(Debug, Clone)]
+pub struct Histogram {
+    counts: Vec<u64>,
+    total: u64,
+}
+
+impl Default for Histogram {
+    fn default() -> Self {
+        Self {
+            counts: vec![0; HIST_BINS],
+            total: 0,
+        }
+    }
+}
+
+impl Histogram {
+    /// Count one error (um).
+    pub fn push(&mut self, err_um: f64) {
+        let i = if err_um <= HIST_MIN_UM {
+            0
+        } else {
+            ((err_um / HIST_MIN_UM).ln() / HIST_RATIO.ln()).ceil() as usize
+        };
+        self.counts[i.min(HIST_BINS - 1)] += 1;
+        self.total += 1;
+    }
+
+    /// Add another histogram's counts.
+    pub fn merge(&mut self, other: &Histogram) {
+        for (a, b) in self.counts.iter_mut().zip(&other.counts) {
+            *a += b;
+        }
+        self.total += other.total;
+    }
+
+    /// Samples counted.
+    pub fn total(&self) -> u64 {
+        self.total
+    }
+
+    /// The `q` quantile (0..=1) as the upper edge of its bin (um); 0 when empty.
+    pub fn quantile_um(&self, q: f64) -> f64 {
+        if self.total == 0 {
+            return 0.0;
+        }
+        let rank = ((q * self.total as f64).ceil() as u64).clamp(1, self.total);
+        let mut seen = 0;
+        for (i, c) in self.counts.iter().enumerate() {
+            seen += c;
+            if seen >= rank {
+                return HIST_MIN_UM * HIST_RATIO.powi(i as i32);
+            }
+        }
+        HIST_MIN_UM * HIST_RATIO.powi(HIST_BINS as i32 - 1)
+    }
+}
+
+/// Where a large contour error is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spot {
+    /// The error (um).
+    pub error_um: f64,
+    /// When (s, print clock).
+    pub time_s: f64,
+    /// The toolhead there (mm).
+    pub x_mm: f64,
+    /// The toolhead there (mm).
+    pub y_mm: f64,
+    /// The G-code line of the move it belongs to (1-based).
+    pub line: u64,
+    /// Its layer.
+    pub layer: u32,
+    /// The move's index in the file.
+    pub move_index: u64,
+}
+
+/// The largest `n` spots, at most one per move, largest first.
+#[derive(Debug, Clone)]
+pub struct TopSpots {
+    n: usize,
+    spots: Vec<Spot>,
+}
+
+impl TopSpots {
+    /// Keep `n`.
+    pub fn new(n: usize) -> Self {
+        Self {
+            n,
+            spots: Vec::with_capacity(n + 1),
+        }
+    }
+
+    /// Offer a move's worst spot.
+    pub fn offer(&mut self, s: Spot) {
+        if self.spots.len() == self.n
+            && self
+                .spots
+                .last()
+                .is_some_and(|last| last.error_um >= s.error_um)
+        {
+            return;
+        }
+        let at = self.spots.partition_point(|x| x.error_um >= s.error_um);
+        self.spots.insert(at, s);
+        self.spots.truncate(self.n);
+    }
+
+    /// The spots, largest first.
+    pub fn spots(&self) -> &[Spot] {
+        &self.spots
+    }
+}
+
+/// One layer's contour-error account (printing samples only).
+#[derive(Debug, Clone)]
+pub struct LayerStats {
+    /// Layer index.
+    pub layer: u32,
+    /// Its largest error.
+    pub worst: Option<Spot>,
+    /// The 95th percentile of its errors (um; [`Histogram::quantile_um`]), set when the
+    /// layer ends (the layer's histogram is then merged into the job's and dropped, so
+    /// memory does not grow with the number of layers).
+    pub p95_um: f64,
+    /// Printing moves in it that were simulated.
+    pub print_moves: u64,
+    /// Mean over its printing moves of each move's largest error (um): the typical
+    /// ringing after a corner.
+    pub mean_move_worst_um: f64,
+}
+
+impl LayerStats {
+    /// An empty account of `layer`.
+    pub fn new(layer: u32) -> Self {
+        Self {
+            layer,
+            worst: None,
+            p95_um: 0.0,
+            print_moves: 0,
+            mean_move_worst_um: 0.0,
+        }
+    }
+
+    /// Its largest error (um), 0 without printing samples.
+    pub fn worst_um(&self) -> f64 {
+        self.worst.as_ref().map_or(0.0, |s| s.error_um)
+    }
+
+    /// Count a printing move whose largest error was `spot`.
+    pub fn add_move(&mut self, spot: &Spot) {
+        self.print_moves += 1;
+        let n = self.print_moves as f64;
+        self.mean_move_worst_um += (spot.error_um - self.mean_move_worst_um) / n;
+        if self.worst.as_ref().is_none_or(|w| spot.error_um > w.error_um) {
+            self.worst = Some(spot.clone());
+        }
+    }
+}
+
+/// A layer's ringing map: its toolpath points and worst spots.
+#[derive(Debug, Clone)]
+pub struct LayerMap {
+    /// Layer index.
+    pub layer: u32,
+    /// The toolpath as simulated, sampled at about 1 kHz.
+    pub points: Vec<MapPoint>,
+    /// Its worst spots (one per move), largest first.
+    pub spots: Vec<Spot>,
+}
+
+impl LayerMap {
+    /// Its largest error (um).
+    pub fn worst_um(&self) -> f64 {
+        self.spots.first().map_or(0.0, |s| s.error_um)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles_are_within_a_bin_above_the_sample_quantile() {
+        let mut h = Histogram::default();
+        // 1..=1000 um: the 95th percentile (rank 950) is 950 um.
+        for i in 1..=1000 {
+            h.push(f64::from(i));
+        }
+        let q = h.quantile_um(0.95);
+        assert!((950.0..=950.0 * HIST_RATIO).contains(&q), "{q}");
+        assert!((1000.0..=1000.0 * HIST_RATIO).contains(&h.quantile_um(1.0)));
+        assert_eq!(Histogram::default().quantile_um(0.95), 0.0);
+    }
+
+    #[test]
+    fn top_spots_keep_the_largest_in_order() {
+        let mut t = TopSpots::new(2);
+        for (i, e) in [3.0, 1.0, 5.0, 4.0].into_iter().enumerate() {
+            t.offer(Spot {
+                error_um: e,
+                time_s: 0.0,
+                x_mm: 0.0,
+                y_mm: 0.0,
+                line: i as u64,
+                layer: 0,
+                move_index: i as u64,
+            });
+        }
+        let e: Vec<f64> = t.spots().iter().map(|s| s.error_um).collect();
+        assert_eq!(e, [5.0, 4.0]);
+    }
+}

@@ -1,0 +1,194 @@
+//! `settle gcode` and the `[gcode]` run kind: a G-code job simulated on printer_xy.
+
+use std::path::{Path, PathBuf};
+
+use settle::spec::backend::Backend;
+use settle::workflows::gcode::{GcodeOptions, gcode, measure, parse_shaper};
+use settle_gcode::job::Firmware;
+
+use crate::support::{extra, root, settle, write};
+
+fn options(file: PathBuf, firmware: Firmware) -> GcodeOptions {
+    GcodeOptions::new(file, "printer_xy", firmware).expect("options")
+}
+
+/// One straight printing move along X: the Y axis is commanded to stay at 0 and the modal
+/// plant keeps an axis at rest exactly at rest, so the toolhead never leaves the line
+/// `y = 0` and its contour error is how far it runs past the line's ends (the overshoot
+/// of the stop, or a lag behind the start). Klipper's trapezoid at 100 mm/s and
+/// 3000 mm/s^2 over 30 mm takes d/v + v/a = 0.3 + 1/30 s.
+#[test]
+fn a_straight_line_errs_only_past_its_ends_and_takes_its_trapezoid_time() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let file = write(dir.path(), "line.gcode", "G90\nM83\nG1 X30 E1 F6000\n");
+    let o = measure(&options(file, Firmware::Klipper)).expect("runs");
+    let t = 0.3 + 100.0 / 3000.0;
+    assert!(
+        (o.print_time_s - t).abs() <= 1e-12 * t,
+        "{}",
+        o.print_time_s
+    );
+    let w = &o.worst()[0];
+    assert_eq!((w.line, w.y_mm), (3, 0.0));
+    let past = (w.x_mm - 30.0).max(-w.x_mm) * 1e3;
+    assert!(
+        past > 0.0 && (o.worst_um - past).abs() <= 1e-9 * past,
+        "{w:?}"
+    );
+    assert!(o.streamed.samples as f64 >= t * 2000.0 - 1.0);
+    assert!(o.streamed.fault.is_none() && o.streamed.lost_steps == 0);
+}
+
+/// The cube layer through Klipper with MZV: outputs written, one layers.csv row per layer,
+/// the worst spot on a printing line of the file, p95 below the worst, and the print time
+/// the job's own planner reports.
+#[test]
+fn the_cube_layer_writes_layers_summary_and_a_ringing_map() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let file = root().join("gcode/prints/cube_layer.gcode");
+    let opts = GcodeOptions {
+        out: Some(dir.path().join("out")),
+        ..options(file.clone(), Firmware::Klipper)
+            .with_shaper(Some(parse_shaper("mzv@48").expect("shaper")))
+    };
+    let o = gcode(&opts).expect("runs");
+    let text = std::fs::read_to_string(&file).expect("file");
+    let lines: Vec<&str> = text.lines().collect();
+    let worst = &o.worst()[0];
+    let line = lines[worst.line as usize - 1];
+    assert!(line.starts_with("G1 ") && line.contains(" E"), "{line}");
+    assert!(o.worst_um > 0.0 && o.p95_um > 0.0 && o.p95_um <= o.worst_um * 1.001);
+    let csv = std::fs::read_to_string(dir.path().join("out/layers.csv")).expect("csv");
+    assert_eq!(csv.lines().count(), 1 + o.layers.len());
+    let md = std::fs::read_to_string(dir.path().join("out/summary.md")).expect("md");
+    assert!(md.contains(&format!("| {} |", worst.line)), "{md}");
+    let layer = o.maps()[0].layer;
+    for ext in ["svg", "png"] {
+        let p = dir.path().join(format!("out/ringing-layer-{layer}.{ext}"));
+        assert!(std::fs::metadata(&p).expect("map").len() > 1000, "{p:?}");
+    }
+    // The print time is the planner's, whatever is simulated.
+    let one = measure(&GcodeOptions {
+        layers: Some((0, 0)),
+        ..opts.clone()
+    })
+    .expect("runs");
+    assert_eq!(one.print_time_s.to_bits(), o.print_time_s.to_bits());
+}
+
+/// The same corner as G-code through settle's planner (`[gcode]`) and as a `[corner]` run
+/// (same machine, planner, limits, sample clock): the same metrics. The windowed planner
+/// cuts its chunks at other instants than `plan_path` ends its segments, so the plant's
+/// steps split at different times; the modal plant is exact for any split, so the
+/// results differ by rounding only: 1e-9 relative is far above that (1e-16 per step,
+/// 1e4 steps).
+#[test]
+fn a_gcode_corner_gives_the_metrics_of_the_corner_kind() {
+    let run = |name: &str| {
+        let (_, mut runs) = settle::load_runs(&root().join("scenarios").join(name)).expect("loads");
+        settle::execute::set_backend(Path::new(name), &mut runs, Backend::Modal).expect("modal");
+        assert_eq!(runs.len(), 1);
+        settle::execute::execute(&runs[0], None).expect("runs")
+    };
+    let g = run("gcode_corner.toml");
+    let c = run("gcode_corner_reference.toml");
+    let close = |a: f64, b: f64, what: &str| {
+        assert!(
+            (a - b).abs() <= 1e-9 * a.abs().max(b.abs()),
+            "{what}: gcode {a} vs corner {b}"
+        );
+    };
+    close(g.move_time_s, c.move_time_s, "move_time_s");
+    close(g.residual_peak_um, c.residual_peak_um, "residual_peak_um");
+    close(g.residual_rms_um, c.residual_rms_um, "residual_rms_um");
+    close(
+        g.max_following_error_um,
+        c.max_following_error_um,
+        "max_following_error_um",
+    );
+    for (a, b) in g.settle_time_s.iter().zip(&c.settle_time_s) {
+        close(
+            a.unwrap_or(f64::INFINITY),
+            b.unwrap_or(f64::INFINITY),
+            "settle_time_s",
+        );
+    }
+    // Contour error against the G-code's lines = the corner kind's error to the sharp path.
+    let sharp = c.path.as_ref().expect("path metrics").max_sharp_error_um;
+    close(
+        extra(&g, "contour_worst_um"),
+        sharp,
+        "contour vs sharp error",
+    );
+    close(extra(&g, "print_time_s"), c.move_time_s, "print time");
+}
+
+/// Bad G-code: exit 2, the file and line in the message, nothing written.
+#[test]
+fn bad_gcode_exits_2_with_file_and_line_and_writes_nothing() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let long = format!("G1 X1 ;{}\n", "x".repeat(10_000_000));
+    let cases: [(&str, Vec<u8>, &str); 5] = [
+        (
+            "garbage.gcode",
+            (0..=255u8).cycle().take(4096).collect(),
+            "garbage.gcode:1",
+        ),
+        (
+            "long.gcode",
+            format!("G90\n{long}").into_bytes(),
+            "long.gcode:2",
+        ),
+        (
+            "nan.gcode",
+            b"G90\nG1 X1 F600\nG1 XNaN Y2\n".to_vec(),
+            "nan.gcode:3",
+        ),
+        (
+            "arc.gcode",
+            b"G90\nG1 X0 Y0 F600\nG2 X10 Y0 I3 J0\n".to_vec(),
+            "arc.gcode:3",
+        ),
+        ("feed.gcode", b"G90\nG1 X5 F0\n".to_vec(), "feed.gcode:2"),
+    ];
+    for (name, bytes, expect) in cases {
+        let file = dir.path().join(name);
+        std::fs::write(&file, bytes).expect("writes");
+        let out_dir = dir.path().join(format!("out-{name}"));
+        let out = settle()
+            .args(["gcode", "--machine", "printer_xy", "--out"])
+            .arg(&out_dir)
+            .arg(&file)
+            .output()
+            .expect("runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {stderr}");
+        assert!(
+            stderr.contains(expect),
+            "{name}: expected `{expect}` in {stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(!out_dir.exists(), "{name}: nothing written");
+    }
+}
+
+/// Regression: settle's planner turns a corner with a velocity jump (a 1 us piece of
+/// 5000 m/s^2); the chunk is stepped in its own time so that no step starts a rounding
+/// error before such a piece and holds its acceleration for a whole sample. The worst
+/// error is then a property of the machine, not of the sample rate (2 vs 10 kHz: the
+/// worst sample moves by less than a sample interval of the ~50 Hz ringing, < 1 %).
+#[test]
+fn the_contour_error_does_not_depend_on_the_sample_rate() {
+    let file = root().join("gcode/prints/ringing_tower.gcode");
+    let at = |rate: f64| {
+        measure(&GcodeOptions {
+            sample_rate_hz: rate,
+            ..options(file.clone(), Firmware::Settle)
+        })
+        .expect("runs")
+        .worst_um
+    };
+    let (a, b) = (at(2000.0), at(10_000.0));
+    assert!((a - b).abs() <= 0.01 * b, "{a} vs {b}");
+    assert!(b < 100.0, "{b}");
+}
