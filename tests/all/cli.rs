@@ -342,6 +342,7 @@ window_s = 0.05
     assert_eq!(rows[0][1..], rows[2][1..]);
 }
 
+#[cfg(not(feature = "rerun"))]
 fn settle_output(args: &[&str]) -> std::process::Output {
     settle().args(args).output().expect("settle runs")
 }
