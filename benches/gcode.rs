@@ -86,15 +86,9 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-/// This thread's time on a CPU (ns), from `/proc/thread-self/schedstat`.
-fn thread_cpu_ns() -> Option<u64> {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
+#[path = "support/cpu.rs"]
+mod cpu;
+use cpu::thread_cpu_ns;
 
 criterion_group!(benches, bench);
 criterion_main!(benches);
