@@ -32,7 +32,8 @@ trap 'rm -rf "$work"' EXIT
 mkdir -p "$work/bin"
 ln -s "$bin" "$work/bin/settle"
 
-# The commands, one record per line: FILE, LINE, SKIP-REASON (empty: run it) and COMMAND,
+# The commands, one NUL-terminated record each (a heredoc that writes a file the page uses
+# next is one multi-line command): FILE, LINE, SKIP-REASON (empty: run it) and COMMAND,
 # separated by the ASCII unit separator (a tab would merge with an empty field).
 python3 - "$root" >"$work/commands.tsv" <<'EOF'
 import glob, os, re, sys
@@ -62,7 +63,7 @@ for f in files:
             if cmd:
                 cmd += " " + line.strip().rstrip("\\").strip()
                 if not line.endswith("\\"):
-                    print(f"{f}\x1f{start}\x1f{reason}\x1f{cmd}")
+                    print(f"{f}\x1f{start}\x1f{reason}\x1f{cmd}", end="\0")
                     cmd = ""
                 continue
             c = line.strip()
@@ -70,13 +71,25 @@ for f in files:
                 if not c.startswith("$ "):
                     continue
                 c = c[2:]
+            h = re.match(r"^cat\s*>\s*\S+\s*<<-?\s*'?(\w+)'?\s*$", c) if lang == "sh" else None
+            if h:
+                # A file the page writes with a heredoc: one command, run with the rest.
+                body = [c]
+                start = j
+                while j < len(lines) and lines[j].strip() != h.group(1):
+                    body.append(lines[j])
+                    j += 1
+                body.append(h.group(1))
+                j += 1
+                print(f"{f}\x1f{start}\x1f{reason}\x1f" + "\n".join(body), end="\0")
+                continue
             if not re.match(r"^(settle|cargo run|scripts/)", c):
                 continue
             start = j
             if c.endswith("\\"):
                 cmd = c.rstrip("\\").strip()
             else:
-                print(f"{f}\x1f{start}\x1f{reason}\x1f{c}")
+                print(f"{f}\x1f{start}\x1f{reason}\x1f{c}", end="\0")
         i = j + 1
 EOF
 
@@ -98,7 +111,7 @@ failed=0
 skipped=()
 page=""
 dir=""
-while IFS=$'\x1f' read -r file line reason cmd; do
+while IFS=$'\x1f' read -r -d '' file line reason cmd; do
   if [[ -n $reason ]]; then
     skipped+=("$file:$line: $cmd  (skipped: $reason)")
     continue
