@@ -47,7 +47,7 @@ pub fn is_setting(key: &str) -> bool {
 
 /// A value as a candidate's label shows it: names as they are, numbers as `key=value` with
 /// the key's last part (`frequency_hz=52`).
-fn label_part(key: &str, v: &Value) -> String {
+pub fn label_part(key: &str, v: &Value) -> String {
     match v {
         Value::Number(x) => format!("{}={x}", key.rsplit('.').next().unwrap_or(key)),
         other => other.to_string(),
@@ -119,6 +119,26 @@ pub struct Band {
     pub points: Vec<Point>,
     /// The overall winner; `None` when no candidate settles at every point.
     pub winner: Option<Winner>,
+    /// Every candidate with its move-and-settle time summed over the workload points, in
+    /// the order of the overall ranking: those that settle at every point by that sum
+    /// (ties: the lower run number first), then the others, then those with a failed run.
+    pub candidates: Vec<Candidate>,
+}
+
+/// One candidate of a band, over every workload point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate {
+    /// Its label (the settings joined by `, `).
+    pub label: String,
+    /// Move and settle summed over every workload point (s); `None` when it does not
+    /// settle at one of them, or a run failed.
+    pub total_s: Option<f64>,
+    /// Its runs' ids, in workload order.
+    pub runs: Vec<usize>,
+    /// Whether it is the scenario's `[current]` candidate.
+    pub current: bool,
+    /// Whether one of its runs failed.
+    pub failed: bool,
 }
 
 /// The ranking of a sweep.
@@ -228,6 +248,7 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Ranking {
         let b = band_label(band);
         let mut points = Vec::new();
         let mut sums: Vec<(String, f64, usize)> = Vec::new();
+        let mut candidates: Vec<Candidate> = Vec::new();
         for (workload, idx) in &groups {
             let mut ranked: Vec<Ranked> = idx
                 .iter()
@@ -301,6 +322,20 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Ranking {
                     }
                     None => sums.push((r.label.clone(), t, 1)),
                 }
+                match candidates.iter_mut().find(|c| c.label == r.label) {
+                    Some(c) => {
+                        c.total_s = c.total_s.zip(r.total_s).map(|(a, b)| a + b);
+                        c.runs.push(r.id);
+                        c.failed |= r.failure.is_some();
+                    }
+                    None => candidates.push(Candidate {
+                        label: r.label.clone(),
+                        total_s: r.total_s,
+                        runs: vec![r.id],
+                        current: r.current,
+                        failed: r.failure.is_some(),
+                    }),
+                }
             }
             points.push(Point {
                 workload: workload.clone(),
@@ -329,10 +364,28 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Ranking {
                     reference,
                 }
             });
+        for c in &mut candidates {
+            if c.runs.len() < n_points {
+                c.total_s = None;
+            }
+        }
+        candidates.sort_by(|a, b| {
+            let key = |c: &Candidate| {
+                (
+                    c.failed,
+                    c.total_s.unwrap_or(f64::INFINITY),
+                    c.runs.iter().min().copied().unwrap_or(usize::MAX),
+                )
+            };
+            let (fa, ta, ia) = key(a);
+            let (fb, tb, ib) = key(b);
+            fa.cmp(&fb).then(ta.total_cmp(&tb)).then(ia.cmp(&ib))
+        });
         bands.push(Band {
             band_um: band,
             points,
             winner,
+            candidates,
         });
     }
     Ranking {

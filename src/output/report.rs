@@ -13,6 +13,7 @@ use crate::output::html::{
     BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, Provenance, Reference, Report,
     Stat, Table,
 };
+use crate::output::jobs::{self, Jobs};
 use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, rank, run_command};
 use crate::output::summary::{machines_line, ms};
 use crate::spec::run_spec::RunSpec;
@@ -182,6 +183,60 @@ fn ranking_tables(ranking: &Ranking, runs: &[RunSpec], file: ScenarioFile<'_>) -
         .collect()
 }
 
+/// The G-code jobs' table ([`crate::output::jobs`]): the headline lines as its note.
+fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
+    let opt = |x: Option<f64>, prec: usize| match x {
+        Some(x) => num(x, format!("{x:.prec$}")),
+        None => num(f64::NAN, "-".into()),
+    };
+    let change = |x: Option<f64>| match x {
+        Some(x) if x.is_finite() => num(x * 100.0, jobs::change(Some(x))),
+        _ => num(f64::NAN, "-".into()),
+    };
+    let rows = j
+        .rows
+        .iter()
+        .map(|r| {
+            let mut row = vec![match r.rank {
+                Some(n) if r.current => num(n as f64, format!("{n} (current)")),
+                Some(n) => num(n as f64, n.to_string()),
+                None => num(f64::INFINITY, "-".into()),
+            }];
+            row.extend(r.values.iter().map(|v| Cell::text(v.as_str())));
+            match &r.failure {
+                Some(f) => {
+                    row.push(Cell::text(f.as_str()));
+                    row.extend((0..3).map(|_| num(f64::NAN, "-".into())));
+                }
+                None => {
+                    row.push(opt(r.print_time_s, 2));
+                    row.push(opt(r.worst_um, 2));
+                    row.push(opt(r.p95_um, 2));
+                    row.push(opt(r.worst_line.map(|l| l as f64), 0));
+                }
+            }
+            if j.current().is_some() {
+                row.push(change(r.time_vs_current));
+                row.push(change(r.worst_vs_current));
+            }
+            row.push(Cell::text(if r.pareto { "yes" } else { "" }));
+            row.push(num(r.id as f64, r.id.to_string()));
+            row.push(Cell::text(run_command(file.path, &runs[r.row])));
+            row
+        })
+        .collect();
+    let lines: Vec<String> = jobs::headline(j)
+        .iter()
+        .map(|l| l.replace("**", ""))
+        .collect();
+    Table {
+        title: format!("G-code jobs: print time and contour error ({})", j.file),
+        note: format!("{} {}.", jobs::NOTE, lines.join("; ")),
+        header: jobs::header(j),
+        rows,
+    }
+}
+
 /// The report of a sweep: `csv` is its runs.csv (row `i` = `runs[i]`, read into `table`),
 /// `figures` the figures' captions and SVG markup, `sections` the run kinds' summary
 /// sections (shown as text).
@@ -211,6 +266,9 @@ pub fn sweep_report(
         let ranking = rank(sc, runs, table);
         (winners(&ranking), ranking_tables(&ranking, runs, file))
     };
+    if let Some(j) = crate::output::jobs::jobs(sc, runs, table) {
+        tables.insert(0, jobs_table(&j, runs, file));
+    }
     tables.extend(kind_tables);
     let failed = (0..runs.len())
         .filter(|&i| table.cell(i, "status").is_some_and(|s| s != "ok"))
@@ -279,6 +337,7 @@ pub fn provenance(file: ScenarioFile<'_>, backend: &str, command: String) -> Pro
         backend: backend.to_string(),
         command_line: command,
         date: String::new(),
+        facts: Vec::new(),
         inputs: vec![InputFile {
             name: file.path.display().to_string(),
             text: file.text.to_string(),

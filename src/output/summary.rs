@@ -110,6 +110,10 @@ pub fn summary_md(
         }
         out.push('\n');
     }
+    if let Some(j) = crate::output::jobs::jobs(sc, runs, table) {
+        out.push_str(&crate::output::jobs::section(&j, scenario, runs));
+        out.push('\n');
+    }
     // The run kinds' sections: those that replace the move-and-settle tables (which would
     // not measure what the kind is about) stand in their place, the others follow them.
     let mut replaced = false;
@@ -141,6 +145,14 @@ pub fn summary_md(
         }
     }
     out
+}
+
+/// Whether the summary ranks candidates by move-and-settle time: no run kind's section
+/// replaces the ranking (a raster scan's does).
+pub fn ranks_candidates(runs: &[RunSpec], table: &RunsTable) -> bool {
+    !crate::kinds::all()
+        .iter()
+        .any(|k| k.replaces_move_tables() && k.summary(runs, table).is_some())
 }
 
 /// The winners and the ranking tables.

@@ -9,6 +9,8 @@
 //!                         filterable), failed runs, provenance: one self-contained file
 //! DIR/plots/vs_<P>.svg    settle time and residual against each swept numeric parameter P
 //! DIR/plots/vs_<P>.png    the same as PNG
+//! DIR/plots/ranking.svg   every candidate's move-and-settle time per band, ranked (bars)
+//! DIR/plots/gcode_jobs.svg  G-code sweeps: print time against contour error, Pareto front
 //! DIR/recordings/run-<id>.mcap / .rrd   with --mcap / --rerun
 //! ```
 //!
@@ -44,7 +46,17 @@ pub fn write_sweep(
     let table =
         RunsTable::parse(csv).map_err(|message| Error::input(out.join("runs.csv"), message))?;
     write_atomic(&out.join("runs.csv"), csv.as_bytes())?;
-    let figures = crate::output::plot::sweep::write_all(&out.join(PLOTS), &sc.name, runs, &table)?;
+    let plots = out.join(PLOTS);
+    let mut figures = crate::output::plot::sweep::write_all(&plots, &sc.name, runs, &table)?;
+    if crate::output::summary::ranks_candidates(runs, &table) {
+        let ranking = crate::output::ranking::rank(sc, runs, &table);
+        figures.extend(crate::output::plot::bars::write(
+            &plots, &sc.name, &ranking,
+        )?);
+    }
+    if let Some(j) = crate::output::jobs::jobs(sc, runs, &table) {
+        figures.extend(crate::output::plot::jobs::write(&plots, &sc.name, &j)?);
+    }
     write_atomic(
         &out.join("summary.md"),
         summary_md(sc, file.path, runs, &table, &figures).as_bytes(),

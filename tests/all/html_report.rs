@@ -313,3 +313,99 @@ fn parsed_without_scripts(chrome: &Path, html: &str) -> serde_json::Value {
     console_clean(&v).expect("no console messages");
     selftest_result(&v.stdout).expect("the probe ran")
 }
+
+/// `settle gcode`'s report.html: the layers (layers.csv) sort as numbers, the worst spot
+/// shows its G-code line's text, the provenance gives the file's SHA-256 as `sha256sum`
+/// prints it, the page logs nothing, and the figures and tables are drawn.
+#[test]
+fn the_gcode_report_renders_sorts_and_logs_nothing_in_chromium() {
+    use crate::support::{root, run_ok, settle};
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let out = dir.path().join("out");
+    let file = "gcode/prints/ringing_tower.gcode";
+    run_ok(
+        settle()
+            .args([
+                "gcode",
+                file,
+                "--machine",
+                "printer_xy",
+                "--firmware",
+                "klipper",
+                "--shaper",
+                "mzv@48",
+                "--versus",
+                "settle:none",
+                "--out",
+            ])
+            .arg(&out),
+    );
+    let html = std::fs::read_to_string(out.join("report.html")).expect("report.html");
+    let csv = std::fs::read_to_string(out.join("layers.csv")).expect("layers.csv");
+    let layers = Table::from_csv("layers", &csv).expect("layers.csv");
+    // The provenance: the file, its digest by coreutils, the command.
+    let sha = std::process::Command::new("sha256sum")
+        .arg(root().join(file))
+        .output()
+        .expect("sha256sum runs");
+    let sha = String::from_utf8_lossy(&sha.stdout)
+        .split_whitespace()
+        .next()
+        .expect("a digest")
+        .to_string();
+    assert_eq!(sha.len(), 64);
+    assert!(html.contains(&format!("<dd>{sha}</dd>")), "SHA-256 {sha}");
+    assert!(html.contains(&format!(
+        "settle gcode {file} --machine printer_xy --firmware klipper --shaper mzv@48 --versus settle:none --out {}",
+        out.display()
+    )));
+    // The worst spot: the layer with the largest worst error, its line's text.
+    let rows = settle::input::runs_table::RunsTable::parse(&csv).expect("layers.csv");
+    let worst = column(&layers, "worst_um");
+    let k = (0..worst.len())
+        .max_by(|&a, &b| worst[a].total_cmp(&worst[b]))
+        .expect("a layer");
+    let line: usize = rows
+        .cell(k, "worst_line")
+        .and_then(|l| l.parse().ok())
+        .expect("the worst layer's line");
+    let text = std::fs::read_to_string(root().join(file)).expect("G-code");
+    let gcode_line = text.lines().nth(line - 1).expect("the line").trim_end();
+    let spots = &html[html.find("<h2>Worst spots</h2>").expect("worst spots")..];
+    let first_row = &spots[spots.find("<tbody>").expect("rows")..];
+    let first_row = &first_row[..first_row.find("</tr>").expect("row end")];
+    assert!(
+        first_row.contains(&format!("{line}<td>{gcode_line}")),
+        "line {line} `{gcode_line}` in {first_row}"
+    );
+    // Two figures: the ringing map and the comparison.
+    assert_eq!(html.matches("<figure id=").count(), 2);
+
+    let Some(chrome) = browser() else { return };
+    let (_keep, page) = write_page("gcode", &html);
+    let (res, _) = selftest(&chrome, &page, "&col=worst_um");
+    assert_eq!(res["rows"], layers.rows.len());
+    assert_eq!(res["columns"], serde_json::json!(layers.header));
+    check_order(&res["asc"], &sorted_texts(&layers, "worst_um", true)).expect("ascending");
+    check_order(&res["desc"], &sorted_texts(&layers, "worst_um", false)).expect("descending");
+    // The worst spots (the first table) and the first figure are drawn, not blank.
+    let (spots, _) = selftest(&chrome, &page, "&grid=table-1");
+    let shot = dir.path().join("shot.png");
+    let v = visit(
+        &chrome,
+        &page,
+        "",
+        &[&format!("--screenshot={}", shot.display())],
+    );
+    console_clean(&v).expect("no console messages");
+    let img = image::open(&shot).expect("screenshot PNG").to_rgba8();
+    for (name, rect) in [
+        ("worst spots", &spots["rects"]["table"]),
+        ("figure", &spots["rects"]["figure"]),
+    ] {
+        let rect = Rect::from_json(rect).expect("box");
+        let (spread, share) = region_spread(&img, rect);
+        assert!(share > 0.3, "{name} is off screen: {rect:?}");
+        assert!(spread > 20.0, "{name} looks blank: deviation {spread:.1}");
+    }
+}

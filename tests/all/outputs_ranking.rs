@@ -324,3 +324,296 @@ fn the_sweep_report_renders_and_sorts_in_chromium() {
     assert!(share > 0.3, "the table is off screen: {table:?}");
     assert!(spread > 20.0, "the table looks blank: {spread:.1}");
 }
+
+/// `x / reference - 1` as the G-code table shows it.
+fn change_text(x: f64) -> String {
+    gain_text(x)
+}
+
+#[test]
+fn a_gcode_sweep_ranks_firmware_shaper_and_limits_by_contour_error() {
+    let dir = sweep("scenarios/gcode_cube.toml");
+    let runs = RunsTable::parse(&read(dir.path(), "runs.csv")).expect("runs.csv");
+    let summary = read(dir.path(), "summary.md");
+    let n = runs.rows.len();
+    assert_eq!(n, 16, "4 firmwares x 2 shapers x 2 accelerations");
+    let num = |i: usize, c: &str| runs.num(i, c).unwrap_or_else(|| panic!("{c} of row {i}"));
+    let (time, worst) = (
+        |i: usize| num(i, "print_time_s"),
+        |i: usize| num(i, "contour_worst_um"),
+    );
+    // From runs.csv: the order (worst error, then print time, then run number), the
+    // current run (klipper, no shaper, 3000 mm/s^2) and the Pareto front.
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| {
+        worst(a)
+            .total_cmp(&worst(b))
+            .then(time(a).total_cmp(&time(b)))
+            .then(a.cmp(&b))
+    });
+    let current = (0..n)
+        .find(|&i| {
+            runs.cell(i, "firmware") == Some("klipper")
+                && runs.cell(i, "shaper_type") == Some("none")
+                && runs.num(i, "amax_mm_s2") == Some(3000.0)
+        })
+        .expect("the current run");
+    let on_front = |i: usize| {
+        !(0..n).any(|k| {
+            time(k) <= time(i) && worst(k) <= worst(i) && (time(k) < time(i) || worst(k) < worst(i))
+        })
+    };
+    let t = md_table(
+        &summary,
+        "## G-code jobs: print time and contour error (cube_layer.gcode)",
+    );
+    assert_eq!(t.len(), n + 1, "one row per run: {t:?}");
+    assert_eq!(
+        &t[0][1..4],
+        ["gcode.firmware", "shaper.type", "limits.amax_mm_s2"]
+    );
+    let fronts = order.iter().filter(|&&i| on_front(i)).count();
+    assert!(fronts >= 2, "a trade-off between time and error: {fronts}");
+    for (k, &i) in order.iter().enumerate() {
+        let row = k + 1;
+        let id = runs.run_id(i).expect("id");
+        assert_eq!(cell(&t, row, "run"), id.to_string(), "rank {row}");
+        let rank = if i == current {
+            format!("{row} (current)")
+        } else {
+            row.to_string()
+        };
+        assert_eq!(cell(&t, row, "rank"), rank);
+        assert_eq!(
+            cell(&t, row, "gcode.firmware"),
+            runs.cell(i, "firmware").expect("firmware")
+        );
+        assert_eq!(
+            cell(&t, row, "shaper.type"),
+            runs.cell(i, "shaper_type").expect("shaper")
+        );
+        assert_eq!(cell(&t, row, "print time (s)"), format!("{:.2}", time(i)));
+        assert_eq!(
+            cell(&t, row, "worst (um)").trim_matches('*'),
+            format!("{:.2}", worst(i))
+        );
+        assert_eq!(
+            cell(&t, row, "p95 (um)"),
+            format!("{:.2}", num(i, "contour_p95_um"))
+        );
+        assert_eq!(
+            cell(&t, row, "worst line"),
+            format!("{}", num(i, "contour_worst_line"))
+        );
+        assert_eq!(
+            cell(&t, row, "time vs current"),
+            change_text(time(i) / time(current) - 1.0),
+            "run {id}"
+        );
+        assert_eq!(
+            cell(&t, row, "worst vs current"),
+            change_text(worst(i) / worst(current) - 1.0),
+            "run {id}"
+        );
+        assert_eq!(
+            cell(&t, row, "Pareto"),
+            if on_front(i) { "yes" } else { "" },
+            "run {id}"
+        );
+        assert_eq!(
+            cell(&t, row, "command"),
+            format!("`settle run scenarios/gcode_cube.toml --case {id} --backend modal`")
+        );
+    }
+    // The headline: least error and fastest, with cost and gain against current.
+    let label = |i: usize| {
+        format!(
+            "{}, {}, amax_mm_s2={}",
+            runs.cell(i, "firmware").expect("firmware"),
+            runs.cell(i, "shaper_type").expect("shaper"),
+            num(i, "amax_mm_s2")
+        )
+    };
+    let words = |i: usize| {
+        format!(
+            "{}: {:.2} s, {:.1} um worst (p95 {:.1} um)",
+            label(i),
+            time(i),
+            worst(i),
+            num(i, "contour_p95_um")
+        )
+    };
+    let best = order[0];
+    let line = format!(
+        "- least contour error: **{}**; print time {}, worst error {} vs current",
+        words(best),
+        change_text(time(best) / time(current) - 1.0),
+        change_text(worst(best) / worst(current) - 1.0)
+    );
+    assert!(summary.contains(&line), "{line}\nnot in\n{summary}");
+    assert!(summary.contains(&format!("- current: {}", words(current))));
+    // The figure, linked from the summary and embedded in the report, and the table in
+    // the report with every run's command.
+    for ext in ["svg", "png"] {
+        let p = dir.path().join(format!("plots/gcode_jobs.{ext}"));
+        assert!(std::fs::metadata(&p).expect("figure").len() > 1000, "{p:?}");
+    }
+    assert!(summary.contains("](plots/gcode_jobs.svg)"));
+    let svg = read(dir.path(), "plots/gcode_jobs.svg");
+    for i in 0..n {
+        let entry = format!("run {}: {}", runs.run_id(i).expect("id"), label(i));
+        assert!(svg.contains(&entry), "legend entry `{entry}`");
+    }
+    let html = read(dir.path(), "report.html");
+    assert!(html.contains("G-code jobs: print time and contour error (cube_layer.gcode)"));
+    assert!(html.contains("Print time against worst and p95 contour error"));
+    for i in 0..n {
+        let c = format!(
+            "settle run scenarios/gcode_cube.toml --case {} --backend modal",
+            runs.run_id(i).expect("id")
+        );
+        assert!(html.contains(&c), "{c}");
+    }
+}
+
+/// The label texts of the ranking chart's bars, per panel in drawing order: `(rank, label,
+/// run)` from `1. zv, frequency_hz=40 (run 3)`.
+fn bar_labels(svg: &str) -> Vec<(usize, String, usize)> {
+    let mut out = Vec::new();
+    for piece in svg.split("<text").skip(1) {
+        let Some(text) = piece
+            .split_once('>')
+            .and_then(|(_, rest)| rest.split_once("</text>"))
+            .map(|(t, _)| t.trim())
+        else {
+            continue;
+        };
+        let Some((rank, rest)) = text.split_once(". ") else {
+            continue;
+        };
+        let (Ok(rank), Some((label, run))) = (rank.parse::<usize>(), rest.rsplit_once(" (")) else {
+            continue;
+        };
+        let run = run.trim_end_matches(')');
+        let run = run.strip_prefix("current, ").unwrap_or(run);
+        if let Some(id) = run.strip_prefix("run ").and_then(|r| r.parse().ok()) {
+            out.push((rank, label.to_string(), id));
+        }
+    }
+    out
+}
+
+#[test]
+fn a_shaper_sweep_without_a_numeric_axis_gets_a_ranking_chart() {
+    let dir = sweep("scenarios/shapers.toml");
+    let runs = RunsTable::parse(&read(dir.path(), "runs.csv")).expect("runs.csv");
+    let n = runs.rows.len();
+    assert_eq!(n, 14, "2 profiles x 7 shapers");
+    for ext in ["svg", "png"] {
+        let p = dir.path().join(format!("plots/ranking.{ext}"));
+        assert!(std::fs::metadata(&p).expect("chart").len() > 1000, "{p:?}");
+    }
+    let svg = read(dir.path(), "plots/ranking.svg");
+    let bars = bar_labels(&svg);
+    assert_eq!(bars.len(), 2 * n, "one bar per candidate per band");
+    let mut unsettled = 0;
+    for (panel, band) in ["10", "50"].iter().enumerate() {
+        // From runs.csv: settled runs by move-and-settle time (ties: run number), then
+        // the unsettled ones by run number.
+        let total = |i: usize| {
+            runs.num(i, &format!("move_and_settle_s_{band}um"))
+                .expect("total")
+        };
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| {
+            let key = |i: usize| (!total(i).is_finite(), total(i));
+            let (ua, ta) = key(a);
+            let (ub, tb) = key(b);
+            ua.cmp(&ub)
+                .then(if ua {
+                    std::cmp::Ordering::Equal
+                } else {
+                    ta.total_cmp(&tb)
+                })
+                .then(a.cmp(&b))
+        });
+        unsettled += order.iter().filter(|&&i| !total(i).is_finite()).count();
+        let shown = &bars[panel * n..(panel + 1) * n];
+        for (k, &i) in order.iter().enumerate() {
+            let (rank, label, id) = &shown[k];
+            assert_eq!(*rank, k + 1, "band {band}");
+            assert_eq!(*id, runs.run_id(i).expect("id"), "band {band}, rank {rank}");
+            assert_eq!(
+                *label,
+                format!(
+                    "{}, {}",
+                    runs.cell(i, "profile").expect("profile"),
+                    runs.cell(i, "shaper_type").expect("shaper")
+                )
+            );
+        }
+    }
+    assert_eq!(
+        svg.matches(">\nnot settled in the window\n</text>").count(),
+        unsettled
+    );
+    assert_eq!(
+        svg.matches(" ms  winner\n</text>").count(),
+        2,
+        "one winner per band"
+    );
+    // The only figure: linked from the summary, embedded in the report.
+    let summary = read(dir.path(), "summary.md");
+    assert!(summary.contains("](plots/ranking.svg)"), "{summary}");
+    assert!(
+        !summary.contains("plots/vs_"),
+        "no numeric axis, no line figure"
+    );
+    let html = read(dir.path(), "report.html");
+    assert!(html.contains("Every candidate ranked by move-and-settle time, per band"));
+    assert!(
+        html.contains(">\n1. "),
+        "the chart's labels are in the page"
+    );
+}
+
+#[test]
+fn a_scan_summary_names_every_swept_machine() {
+    let dir = sweep("scenarios/scan_machines.toml");
+    let runs = RunsTable::parse(&read(dir.path(), "runs.csv")).expect("runs.csv");
+    let summary = read(dir.path(), "summary.md");
+    let html = read(dir.path(), "report.html");
+    let mut machines: Vec<&str> = (0..runs.rows.len())
+        .map(|i| runs.cell(i, "machine").expect("machine"))
+        .collect();
+    machines.dedup();
+    machines.sort_unstable();
+    machines.dedup();
+    assert_eq!(machines, ["leadscrew_stage", "printer_xy"]);
+    let line = summary
+        .lines()
+        .find(|l| l.starts_with("Machines: "))
+        .unwrap_or_else(|| panic!("no machines line in\n{summary}"));
+    let t = md_table(&summary, "## Scan steps");
+    for m in &machines {
+        assert!(
+            line.contains(&format!("{m} (axis x, linear driver)")),
+            "{line}"
+        );
+        assert!(
+            html.contains(&format!("{m} (axis x, linear driver)")),
+            "{m}"
+        );
+        // Every machine's rows in the scan table.
+        let rows = t
+            .iter()
+            .skip(1)
+            .filter(|r| r.contains(&m.to_string()))
+            .count();
+        let expected = (0..runs.rows.len())
+            .filter(|&i| runs.cell(i, "machine") == Some(m))
+            .count()
+            / 2;
+        assert_eq!(rows, expected, "{m}: one row per step-over: {t:?}");
+    }
+}

@@ -175,6 +175,9 @@ pub struct Provenance {
     pub command_line: String,
     /// When the numbers were produced, as the caller formats it.
     pub date: String,
+    /// More facts about the inputs, shown after the date (e.g. a G-code file's digest,
+    /// the machine, the firmware).
+    pub facts: Vec<Stat>,
     /// Input files (scenario, machine, firmware config) with their text, each shown in a
     /// collapsible block.
     pub inputs: Vec<InputFile>,

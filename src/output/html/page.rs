@@ -193,6 +193,14 @@ fn push_provenance(out: &mut String, p: &Provenance) {
         push_escaped(out, value);
         out.push_str(if code { "</code></dd>\n" } else { "</dd>\n" });
     }
+    for f in &p.facts {
+        let _ = writeln!(
+            out,
+            "<dt>{}</dt><dd>{}</dd>",
+            escaped(&f.label),
+            escaped(&f.value)
+        );
+    }
     out.push_str("</dl>\n");
     // The newline after `<pre>` is dropped by every HTML parser: a text starting with a
     // line break keeps it.

@@ -8,7 +8,9 @@
 //! [`sweep`] and [`trace`] build figures from a sweep's runs table and from one run's series,
 //! [`identify`] from identified modes and their measured spectrum.
 
+pub mod bars;
 pub mod identify;
+pub mod jobs;
 pub mod ringing;
 pub mod scan_trace;
 pub mod sweep;

@@ -440,6 +440,8 @@ pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
         outcome.files.extend(files);
         outcome.versus = Some(Box::new(b.clone()));
     }
+    let html = report::write_html(&outcome, opts, &dir)?;
+    outcome.files.push(html);
     Ok(outcome)
 }
 

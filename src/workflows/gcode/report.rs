@@ -1,15 +1,27 @@
 //! The outputs of `settle gcode`: `layers.csv` (one row per layer), `summary.md` (print
 //! time, worst and 95th-percentile contour error, the worst spots with their G-code
-//! lines, the layers) and `ringing-layer-<n>.svg/.png` (the maps of the worst layers).
+//! lines, the layers), `ringing-layer-<n>.svg/.png` (the maps of the worst layers) and,
+//! written last, `report.html` ([`write_html`]): the same in one self-contained page with
+//! the figures embedded, the layers in a sortable, filterable table, the worst spots with
+//! the text of their G-code lines, and the provenance (the file's SHA-256, the machine,
+//! the planner, settle's version, the backend).
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::GcodeOutcome;
+use settle_gcode::job::ShaperSetting;
+
+use std::io::BufRead as _;
+
+use super::{DEFAULT_SAMPLE_RATE_HZ, GcodeOptions, GcodeOutcome};
 use crate::error::Error;
 use crate::kinds::gcode::stats::LayerMap;
 use crate::output::atomic::{create_dir, write_atomic};
+use crate::output::html::{Cell, Figure, Image, InputFile, Provenance, Report, Stat, Table};
 use crate::output::plot::ringing::{MapPanel, MapSpot, RingingMap};
+use crate::output::sha256::Sha256;
+use crate::spec::backend::Backend;
 
 /// layers.csv's columns.
 pub const LAYER_COLUMNS: [&str; 13] = [
@@ -193,4 +205,291 @@ pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     write_atomic(&md, summary_md(o, &stems).as_bytes())?;
     files.push(md);
     Ok(files)
+}
+
+/// The report page's file name in the output folder.
+pub const REPORT: &str = "report.html";
+
+/// The longest G-code line text the report shows (characters); longer lines end in `...`.
+const LINE_CHARS: usize = 160;
+
+/// One pass over `file`: its SHA-256 and the text of the lines `wanted` (1-based).
+fn digest_and_lines(file: &Path, wanted: &[u64]) -> Result<(String, BTreeMap<u64, String>), Error> {
+    let f = std::fs::File::open(file).map_err(|e| Error::read(file, e))?;
+    let mut reader = std::io::BufReader::new(f);
+    let mut sha = Sha256::default();
+    let mut lines = BTreeMap::new();
+    let mut buf = Vec::new();
+    let mut n = 0u64;
+    loop {
+        buf.clear();
+        let read = reader
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| Error::read(file, e))?;
+        if read == 0 {
+            break;
+        }
+        sha.update(&buf);
+        n += 1;
+        if wanted.contains(&n) {
+            let text = String::from_utf8_lossy(&buf);
+            let text = text.trim_end_matches(['\n', '\r']);
+            let shown: String = text.chars().take(LINE_CHARS).collect();
+            let shown = if shown.len() < text.len() {
+                format!("{shown}...")
+            } else {
+                shown
+            };
+            lines.insert(n, shown);
+        }
+    }
+    Ok((sha.hex(), lines))
+}
+
+/// A shaper as `--shaper` takes it: `mzv@48`, `ei@52/0.08`.
+fn shaper_arg(s: &ShaperSetting) -> String {
+    if s.damping_ratio == 0.1 {
+        format!("{}@{}", s.kind.name(), s.frequency_hz)
+    } else {
+        format!("{}@{}/{}", s.kind.name(), s.frequency_hz, s.damping_ratio)
+    }
+}
+
+/// The command that runs `opts` again.
+pub fn command_line(opts: &GcodeOptions, dir: &Path) -> String {
+    let mut c = format!(
+        "settle gcode {} --machine {} --firmware {}",
+        opts.file.display(),
+        opts.machine,
+        opts.job.firmware()
+    );
+    if let Some(s) = &opts.job.shapers[0] {
+        let _ = write!(c, " --shaper {}", shaper_arg(s));
+    }
+    if let Some((a, b)) = opts.layers {
+        let _ = write!(c, " --layers {a}..{b}");
+    }
+    if opts.backend != Backend::Modal {
+        let _ = write!(c, " --backend {}", opts.backend.name());
+    }
+    if opts.driver != settle_sim::DriverMode::Linear {
+        let _ = write!(c, " --driver {}", opts.driver);
+    }
+    if opts.skip_bad_lines {
+        c.push_str(" --skip-bad-lines");
+    }
+    if opts.sample_rate_hz != DEFAULT_SAMPLE_RATE_HZ {
+        let _ = write!(c, " --sample-rate-hz {}", opts.sample_rate_hz);
+    }
+    if opts.maps != 1 {
+        let _ = write!(c, " --maps {}", opts.maps);
+    }
+    if let Some((fw, shaper)) = &opts.versus {
+        let _ = write!(
+            c,
+            " --versus {fw}:{}",
+            shaper.as_ref().map_or("none".into(), shaper_arg)
+        );
+    }
+    let _ = write!(c, " --out {}", dir.display());
+    c
+}
+
+/// A number cell shown with `prec` decimals.
+fn num(value: f64, prec: usize) -> Cell {
+    Cell::Number {
+        value,
+        text: format!("{value:.prec$}"),
+    }
+}
+
+/// The page of `o` (run with `opts`, written into `dir`, whose figures `figures` are given
+/// as caption and SVG markup).
+pub fn html_report(
+    o: &GcodeOutcome,
+    opts: &GcodeOptions,
+    dir: &Path,
+    figures: Vec<(String, String)>,
+) -> Result<Report, Error> {
+    let wanted: Vec<u64> = o.worst().iter().map(|w| w.line).collect();
+    let (sha, texts) = digest_and_lines(&o.file, &wanted)?;
+    let mut intro = vec![format!(
+        "{} planner on {} ({} backend): print time {:.2} s{}, contour error worst {:.2} um, p95 {:.2} um; {:.1} s of print simulated.",
+        o.setting,
+        o.machine,
+        o.backend.name(),
+        o.print_time_s,
+        if o.print_time_s >= 120.0 {
+            format!(" ({})", crate::output::jobs::duration(o.print_time_s))
+        } else {
+            String::new()
+        },
+        o.worst_um,
+        o.p95_um,
+        o.streamed.simulated_s
+    )];
+    if let Some(w) = o.worst().first() {
+        intro.push(format!(
+            "Worst at line {} (layer {}, X {:.2} Y {:.2} mm): {}",
+            w.line,
+            w.layer,
+            w.x_mm,
+            w.y_mm,
+            texts.get(&w.line).map_or("", String::as_str)
+        ));
+    }
+    if let Some(f) = &o.streamed.fault {
+        intro.push(format!("Simulation fault: {f}"));
+    }
+    let mut tables = vec![Table {
+        title: "Worst spots".into(),
+        note: "The largest contour errors, at most one per move, with the G-code line of the move. Contour error: distance in XY from the simulated toolhead to the commanded path of the moves active at that time, over printing moves.".into(),
+        header: ["error (um)", "line", "G-code", "layer", "X (mm)", "Y (mm)", "time (s)"]
+            .map(String::from)
+            .to_vec(),
+        rows: o
+            .worst()
+            .iter()
+            .map(|w| {
+                vec![
+                    num(w.error_um, 2),
+                    Cell::number(w.line as f64),
+                    Cell::text(texts.get(&w.line).cloned().unwrap_or_default()),
+                    Cell::number(f64::from(w.layer)),
+                    num(w.x_mm, 2),
+                    num(w.y_mm, 2),
+                    num(w.time_s, 3),
+                ]
+            })
+            .collect(),
+    }];
+    if let Some(b) = &o.versus {
+        tables.push(Table {
+            title: "Two settings compared".into(),
+            note: "The same file under both settings (--versus).".into(),
+            header: [
+                "setting",
+                "print time (s)",
+                "worst contour error (um)",
+                "p95 (um)",
+                "worst line",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows: [o, b.as_ref()]
+                .iter()
+                .map(|x| {
+                    vec![
+                        Cell::text(x.setting.as_str()),
+                        num(x.print_time_s, 2),
+                        num(x.worst_um, 2),
+                        num(x.p95_um, 2),
+                        x.worst()
+                            .first()
+                            .map_or(Cell::text(""), |w| Cell::number(w.line as f64)),
+                    ]
+                })
+                .collect(),
+        });
+    }
+    if !o.ignored.is_empty() {
+        tables.push(Table {
+            title: "Commands not followed".into(),
+            note: String::new(),
+            header: vec!["command".into(), "times".into()],
+            rows: o
+                .ignored
+                .iter()
+                .map(|(what, n)| vec![Cell::text(what.as_str()), Cell::number(*n as f64)])
+                .collect(),
+        });
+    }
+    let csv = layers_csv(o)
+        .map_err(|e| Error::write(dir.join("layers.csv"), std::io::Error::other(e)))?;
+    let layers = Table::from_csv("Layers (layers.csv)", &String::from_utf8_lossy(&csv)).ok();
+    let file_name = o.file.display().to_string();
+    let mut inputs = Vec::new();
+    let machine = Path::new(&opts.machine);
+    if opts.machine.ends_with(".toml") && machine.is_file() {
+        inputs.push(InputFile {
+            name: opts.machine.clone(),
+            text: crate::input::file::read_text(machine)?,
+        });
+    }
+    Ok(Report {
+        title: format!("settle gcode: {}", o.file.display()),
+        intro,
+        winners: Vec::new(),
+        tables,
+        figures: figures
+            .into_iter()
+            .map(|(title, svg)| Figure {
+                title,
+                image: Image::Svg(svg),
+            })
+            .collect(),
+        runs: layers,
+        failed: Vec::new(),
+        provenance: Provenance {
+            settle_version: env!("CARGO_PKG_VERSION").to_string(),
+            backend: o.backend.name().to_string(),
+            command_line: command_line(opts, dir),
+            date: String::new(),
+            facts: vec![
+                Stat {
+                    label: "G-code file".into(),
+                    value: file_name,
+                },
+                Stat {
+                    label: "its SHA-256".into(),
+                    value: sha,
+                },
+                Stat {
+                    label: "machine".into(),
+                    value: o.machine.clone(),
+                },
+                Stat {
+                    label: "firmware (planner)".into(),
+                    value: o.setting.clone(),
+                },
+                Stat {
+                    label: "driver model".into(),
+                    value: opts.driver.to_string(),
+                },
+            ],
+            inputs,
+        },
+    })
+}
+
+/// Write `report.html` into `dir`, after every other output (it embeds the figures
+/// written there: the ringing maps and the comparison's); returns its path.
+pub fn write_html(o: &GcodeOutcome, opts: &GcodeOptions, dir: &Path) -> Result<PathBuf, Error> {
+    let mut figures = Vec::new();
+    for f in o
+        .files
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "svg"))
+    {
+        let stem = f
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let title = match stem.strip_prefix("ringing-layer-") {
+            Some(n) => format!(
+                "Ringing map of layer {n}: contour error along the toolpath, worst spots labelled ({})",
+                o.setting
+            ),
+            None => match stem.strip_prefix("compare-layer-") {
+                Some(n) => format!("Layer {n} under both settings, on one colour scale"),
+                None => stem.clone(),
+            },
+        };
+        let svg = std::fs::read_to_string(f).map_err(|e| Error::read(f, e))?;
+        figures.push((title, svg));
+    }
+    let report = html_report(o, opts, dir, figures)?;
+    let path = dir.join(REPORT);
+    write_atomic(&path, crate::output::html::render(&report).as_bytes())?;
+    Ok(path)
 }

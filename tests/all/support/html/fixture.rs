@@ -158,6 +158,7 @@ pub fn quickstart_report() -> Report {
             backend: "modal".into(),
             command_line: "settle sweep scenarios/ci_quickstart.toml --out results/quick".into(),
             date: "2025-01-01".into(),
+            facts: Vec::new(),
             inputs: vec![InputFile {
                 name: "scenarios/ci_quickstart.toml".into(),
                 text: repo_file("scenarios/ci_quickstart.toml"),
