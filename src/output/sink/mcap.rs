@@ -190,7 +190,7 @@ pub fn write<W: Write + Seek>(
 }
 
 /// A recording written sample by sample (bounded memory: the writer holds one chunk),
-/// in the layout of [`write`]: one channel per signal group of the channels named at
+/// in the layout of [`write()`]: one channel per signal group of the channels named at
 /// [`Stream::new`], one message per sample, a `/metrics` message at the end (a JSON
 /// object given by the caller), a metadata record `settle`.
 pub struct Stream<W: Write + Seek> {

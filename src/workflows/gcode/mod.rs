@@ -422,7 +422,15 @@ fn simulate(
     rec: Option<record::Recorder>,
 ) -> Result<(GcodeOutcome, Option<record::Recorder>), Error> {
     let (machine_name, axes, linear_axes) = resolve_axes(&opts.machine, opts.driver)?;
-    let sigma = slowest_decay_per_s(&linear_axes)?;
+    // A machine with an undamped mode never settles: no tail, and a layer range cannot
+    // start from the state the layers before leave.
+    let sigma = slowest_decay_per_s(&linear_axes);
+    if opts.layers.is_some() && sigma.is_err() {
+        return Err(Error::input(
+            "--layers",
+            "the machine has an undamped mode: its vibration never decays, so a layer range cannot start from the state the layers before leave; simulate the whole file",
+        ));
+    }
     let (job_axes, xy) = axis_map(&axes).map_err(|m| Error::input("--machine", m))?;
     if opts.backend == Backend::Modal && opts.driver != DriverMode::Linear {
         return Err(Error::input(
@@ -449,7 +457,7 @@ fn simulate(
         maps: opts.maps,
         map_layer: opts.map_layer,
         layers: opts.layers,
-        tail_s: tail_s(sigma),
+        tail_s: sigma.as_ref().map_or(0.0, |&s| tail_s(s)),
         tail_hold_s: longest_period_s(&linear_axes),
     };
     let err = gcode_error(&opts.file);
@@ -467,7 +475,7 @@ fn simulate(
     if let Some((a, b)) = opts.layers {
         job = job
             .with_layers(a..=b)
-            .and_then(|j| j.with_preroll_s(preroll_s(sigma)))
+            .and_then(|j| j.with_preroll_s(sigma.as_ref().map_or(0.0, |&s| preroll_s(s))))
             .map_err(&err)?;
     }
     let sim_err = |source| Error::Sim { run: 0, source };
