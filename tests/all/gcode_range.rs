@@ -32,7 +32,8 @@ fn tower(firmware: Firmware) -> GcodeOptions {
 /// bins, or neighbours (a value within 1e-3 um of an edge).
 ///
 /// Checked to fail on the code before the pre-roll (a range started at rest in the
-/// commanded state of its first move): layer 1's worst error differs by tens of um.
+/// commanded state of its first move, linearised there): layer 1 then shows 44 mm of
+/// contour error against 0.19 mm in the whole run.
 #[test]
 fn a_layer_range_gives_the_numbers_of_the_whole_run() {
     let whole = measure(&tower(Firmware::Klipper)).expect("runs");
