@@ -25,9 +25,9 @@ fn tower(firmware: Firmware) -> GcodeOptions {
 /// move (`sigma` the slowest decay rate of printer_xy's linearised modes): what the
 /// layers before left in the machine is then at most 1e-6 of what it was when the
 /// pre-roll started (the modal plant is linear: the difference of the two runs is a free
-/// vibration), times the conditioning of the modes (order 1 here; the rotor and
-/// carriage modes are close to orthogonal in the mass metric). Unshaped Klipper leaves
-/// at most 200 um of ringing, so the layers' worst errors agree to 2e-4 um and more;
+/// vibration), times a constant of the modes' eigenvectors. Unshaped Klipper leaves at
+/// most 200 um of ringing, so the layers' worst errors agree to 2e-4 um times that
+/// constant;
 /// 1e-3 um is the stated tolerance. The 95th percentile is a histogram bin's edge: equal
 /// bins, or neighbours (a value within 1e-3 um of an edge).
 ///
