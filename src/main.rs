@@ -225,6 +225,10 @@ enum Command {
         /// Ringing maps to draw: the layers with the largest contour error.
         #[arg(long, default_value_t = 1)]
         maps: usize,
+        /// Also write recording.mcap into the output folder: every simulated sample of
+        /// the layers (commanded and toolhead XY, contour error, line), streaming.
+        #[arg(long)]
+        mcap: bool,
         /// Also run FIRMWARE[:SHAPER] (e.g. settle:none, klipper:ei@48) and compare: the
         /// worst layer under both (compare-layer-<n>.svg/png) and compare.md.
         #[arg(long, value_name = "FIRMWARE[:SHAPER]", value_parser = workflows::gcode::compare::parse_setting)]
@@ -496,9 +500,11 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             skip_bad_lines,
             sample_rate_hz,
             maps,
+            mcap,
             versus,
         } => {
             let opts = workflows::gcode::GcodeOptions {
+                mcap,
                 layers,
                 backend,
                 driver,

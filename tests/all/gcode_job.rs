@@ -192,3 +192,43 @@ fn the_contour_error_does_not_depend_on_the_sample_rate() {
     assert!((a - b).abs() <= 0.01 * b, "{a} vs {b}");
     assert!(b < 100.0, "{b}");
 }
+
+/// A result, not a tool failure: two 2 mm arcs at 50 mm/s after a travel, at 6000 mm/s^2
+/// (the synthetic slicer file's fastest layer, where the 100 MB run lost its step). Klipper
+/// cuts the arcs into 1 mm chords and passes each junction with a velocity jump, 50 per
+/// second, near printer_xy's modes: the rotor's load angle passes 90 electrical degrees on
+/// the linear driver (and the full driver on rapier slips poles on the same file). The
+/// run exits 1 as a failed run with a message saying what happened and where, and writes
+/// its outputs.
+#[test]
+fn lost_steps_are_reported_as_a_result_with_where_they_happen() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let file = write(
+        dir.path(),
+        "arcs.gcode",
+        "G90\nM83\nM204 S6000\nG0 X100 Y100 F9000\nG2 X102 Y102 I2 J0 E0.1 F3000\nG3 X100 Y100 I-2 J0 E0.1\n",
+    );
+    let out_dir = dir.path().join("out");
+    let out = settle()
+        .args(["gcode", "--machine", "printer_xy", "--out"])
+        .arg(&out_dir)
+        .arg(&file)
+        .output()
+        .expect("runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("result: the machine loses steps")
+            && stderr.contains("load angle passed 90 electrical degrees"),
+        "{stderr}"
+    );
+    let o = measure(&options(file, Firmware::Klipper)).expect("runs");
+    let l = o.streamed.first_lost_step.as_ref().expect("where");
+    assert!(
+        l.max_load_angle_deg > 90.0 && (5..=6).contains(&l.line),
+        "{l:?}"
+    );
+    assert!(stderr.contains(&format!("line {}", l.line)), "{stderr}");
+    let md = std::fs::read_to_string(out_dir.join("summary.md")).expect("summary");
+    assert!(md.contains("**Lost steps**"), "{md}");
+}

@@ -7,6 +7,7 @@ mod cli;
 mod corners;
 mod faults;
 mod gcode_job;
+mod gcode_range;
 mod html_report;
 mod identify_cmd;
 mod import;

@@ -6,6 +6,10 @@
 //! shaped (so the shaped state at the range start is exact: the shaper's output there
 //! depends on the input up to a shaper's duration earlier) and the output is cut at the
 //! range start. After the range's last move the output is cut at its end.
+//!
+//! A pre-roll ([`Input::set_preroll`]) starts the output that long before the range's
+//! first move (no earlier than the input's start), so that a simulation of the range
+//! starts from the motion before it; the look-back then also keeps the pre-roll.
 
 use std::collections::VecDeque;
 
@@ -45,6 +49,8 @@ pub(crate) struct Input {
     range_end_s: Option<f64>,
     input_end_s: f64,
     finished: bool,
+    /// How long before the range's first move the output starts (s).
+    preroll_s: f64,
 }
 
 fn longest(s: &AxisShapers) -> f64 {
@@ -70,7 +76,27 @@ impl Input {
             range_end_s: None,
             input_end_s: f64::NEG_INFINITY,
             finished: false,
+            preroll_s: 0.0,
         }
+    }
+
+    /// Start the output `preroll_s` before the range's first move (module doc).
+    pub(crate) fn set_preroll(&mut self, preroll_s: f64) {
+        self.preroll_s = preroll_s;
+    }
+
+    /// The pre-roll (s).
+    pub(crate) fn preroll_s(&self) -> f64 {
+        self.preroll_s
+    }
+
+    /// How far back (s) from the end of the input the look-back reaches: the longest
+    /// shaper's duration, a margin and the pre-roll. Moves ending before that can no
+    /// longer meet an emitted chunk.
+    pub(crate) fn lookback_s(&self) -> f64 {
+        longest(&self.current).max(longest(&self.lookback_start))
+            + LOOKBACK_MARGIN_S
+            + self.preroll_s
     }
 
     /// The shapers become `shapers` at `at_s` (no earlier than the input so far).
@@ -83,7 +109,7 @@ impl Input {
         if self.range_start_s.is_some() {
             return Ok(());
         }
-        self.range_start_s = Some(at_s);
+        self.range_start_s = Some(at_s - self.preroll_s);
         let mut shaper = AxesShaper::new(&self.lookback_start, self.alignment);
         let mut shapers = self.lookback_start.clone();
         for e in self.lookback.drain(..) {
@@ -141,8 +167,7 @@ impl Input {
             Some(s) => s.push(t0, &tr)?,
             None => {
                 self.lookback.push_back(Entry::Chunk(t0, tr));
-                let keep =
-                    longest(&self.current).max(longest(&self.lookback_start)) + LOOKBACK_MARGIN_S;
+                let keep = self.lookback_s();
                 // Drop chunks (and the changes before them) that end before the window.
                 loop {
                     let stale = match self.lookback.front() {

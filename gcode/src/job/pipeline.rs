@@ -156,8 +156,34 @@ impl<R: BufRead> Job<R> {
             key: "shapers",
             reason: e.to_string(),
         })?;
+        let preroll = self.input.preroll_s();
         self.input = Input::new(self.cfg.alignment, initial, true);
+        self.input.set_preroll(preroll);
         Ok(self)
+    }
+
+    /// With a layer range: start the chunks `preroll_s` before the range's first move (no
+    /// earlier than the start of the file), so that a simulation of the range starts from
+    /// the motion the layers before leave; the chunks before the range's first move list
+    /// the moves they carry like any other. Set before the first chunk is taken.
+    pub fn with_preroll_s(mut self, preroll_s: f64) -> Result<Self, GcodeError> {
+        if !(preroll_s.is_finite() && preroll_s >= 0.0) || self.moves > 0 {
+            return Err(GcodeError::JobSetting {
+                key: "preroll",
+                reason: format!(
+                    "the pre-roll ({preroll_s} s) must be a finite number >= 0, set before planning starts"
+                ),
+            });
+        }
+        self.input.set_preroll(preroll_s);
+        Ok(self)
+    }
+
+    /// Whether the last chunk has been taken and it ended the file's motion (not a layer
+    /// range that ends before the file does): the machine is then commanded to stand
+    /// still at the end of the print from the end of that chunk on.
+    pub fn ended_at_end_of_file(&self) -> bool {
+        self.eof && self.range != Range::After && self.out.is_empty()
     }
 
     /// The reader (for its statistics: ignored commands, lines read).

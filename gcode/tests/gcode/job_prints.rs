@@ -164,6 +164,70 @@ fn a_layer_range_is_the_whole_job_cut_at_its_moves() {
     }
 }
 
+/// With a pre-roll the range's chunks start that long before its first move (layer 3 of
+/// the ringing tower starts 6.8 s in, so 1.5 s fit), list the moves they carry, and are the
+/// whole job's motion throughout; the pre-roll of the first layers is cut at the start
+/// of the file.
+#[test]
+fn a_pre_roll_starts_the_range_earlier_with_the_whole_jobs_motion() {
+    for fw in Firmware::ALL {
+        let cfg = shaped(fw);
+        let (whole, _) = run_file("ringing_tower.gcode", cfg.clone(), None);
+        let moves: Vec<_> = whole.iter().flat_map(|c| c.moves.iter().cloned()).collect();
+        let start = |layer: u32| {
+            moves
+                .iter()
+                .filter(|m| m.layer == layer)
+                .map(|m| m.start_time_s)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let (t0, t1) = (start(3), start(4));
+        let pre = 1.5;
+        let mut job = Job::open(print_path("ringing_tower.gcode"), cfg.clone())
+            .expect("open")
+            .with_layers(3..=3)
+            .and_then(|j| j.with_preroll_s(pre))
+            .expect("range");
+        let part = job.by_ref().collect::<Result<Vec<_>, _>>().expect("chunks");
+        assert_contiguous(&part);
+        let first = part.first().expect("chunks");
+        assert!((first.start_time_s - (t0 - pre)).abs() < 1e-12, "{fw}");
+        assert!((part.last().expect("chunks").end_time_s() - t1).abs() < 1e-12);
+        assert!(first.moves.iter().any(|m| m.layer == 2), "{fw}");
+        // The range's chunks start inside a stretch the whole job emits in one piece, so
+        // positions are summed from another start: they differ by rounding, at most a few
+        // pm over the 1.5 s (settle's planner); 1 nm is far above that and far below any
+        // vibration measured on them.
+        for k in 0..=2000 {
+            let t = t0 - pre + (t1 - t0 + pre) * k as f64 / 2000.0;
+            let (a, b) = (at(&part, t), at(&whole, t));
+            for i in 0..3 {
+                assert!(
+                    (a[i].p - b[i].p).abs() < 1e-9 && (a[i].v - b[i].v).abs() < 1e-9,
+                    "{fw} t {t} axis {i}: {:?} vs {:?}",
+                    a[i],
+                    b[i]
+                );
+            }
+        }
+        // Layer 1 starts earlier than 10 s: its pre-roll starts with the file.
+        let (part, _) = {
+            let mut job = Job::open(print_path("ringing_tower.gcode"), cfg)
+                .expect("open")
+                .with_preroll_s(10.0)
+                .and_then(|j| j.with_layers(1..=1))
+                .expect("range");
+            let c = job.by_ref().collect::<Result<Vec<_>, _>>().expect("chunks");
+            (c, job)
+        };
+        assert_eq!(
+            part[0].start_time_s.to_bits(),
+            whole[0].start_time_s.to_bits(),
+            "{fw}"
+        );
+    }
+}
+
 #[test]
 fn homing_after_motion_travels_home_continuously() {
     // G28 after moves: homing is not simulated, the toolhead travels to 0 on the homed

@@ -155,6 +155,10 @@ pub struct LayerStats {
     /// Mean over its printing moves of each move's largest error (um): the typical
     /// ringing after a corner.
     pub mean_move_worst_um: f64,
+    /// The last layer of a job that ends the file: the largest distance in XY (um) from
+    /// the toolhead to the end point after the last command (the ringing after the final
+    /// stop).
+    pub end_residual_um: Option<f64>,
 }
 
 impl LayerStats {
@@ -166,6 +170,7 @@ impl LayerStats {
             p95_um: 0.0,
             print_moves: 0,
             mean_move_worst_um: 0.0,
+            end_residual_um: None,
         }
     }
 

@@ -189,6 +189,152 @@ pub fn write<W: Write + Seek>(
     Ok(info)
 }
 
+/// A recording written sample by sample (bounded memory: the writer holds one chunk),
+/// in the layout of [`write()`]: one channel per signal group of the channels named at
+/// [`Stream::new`], one message per sample, a `/metrics` message at the end (a JSON
+/// object given by the caller), a metadata record `settle`.
+pub struct Stream<W: Write + Seek> {
+    out: mcap::Writer<W>,
+    ids: Vec<(u16, Group)>,
+    info: Vec<ChannelInfo>,
+    buf: Vec<u8>,
+    sequence: u32,
+    last_ns: u64,
+}
+
+impl<W: Write + Seek> std::fmt::Debug for Stream<W> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Stream")
+            .field("channels", &self.info)
+            .field("sequence", &self.sequence)
+            .finish()
+    }
+}
+
+impl<W: Write + Seek> Stream<W> {
+    /// A recording of the channels `names` (with `units`) into `w`, with the metadata
+    /// record `settle` holding `metadata`.
+    pub fn new(
+        w: W,
+        version: &str,
+        metadata: BTreeMap<String, String>,
+        names: &[&str],
+        units: &[&str],
+    ) -> Result<Self, mcap::McapError> {
+        let mut out = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .compression_threads(0)
+            .library(format!("settle {version}"))
+            .create(w)?;
+        out.write_metadata(&mcap::records::Metadata {
+            name: "settle".to_string(),
+            metadata,
+        })?;
+        let mut ids = Vec::new();
+        let mut info = Vec::new();
+        for g in super::groups::group_names(names, units) {
+            let schema = group_schema(&g).to_string();
+            let name = format!("settle.{}", g.name);
+            let schema_id = out.add_schema(&name, "jsonschema", schema.as_bytes())?;
+            let topic = format!("/{}", g.name);
+            let id = out.add_channel(schema_id, &topic, "json", &BTreeMap::new())?;
+            ids.push((id, g));
+            info.push(ChannelInfo {
+                topic,
+                schema_name: name,
+                schema,
+                messages: 0,
+            });
+        }
+        Ok(Self {
+            out,
+            ids,
+            info,
+            buf: Vec::with_capacity(256),
+            sequence: 0,
+            last_ns: 0,
+        })
+    }
+
+    /// One sample at `t_s`: `values[i]` is channel `names[i]`'s.
+    pub fn sample(&mut self, t_s: f64, values: &[f64]) -> Result<(), mcap::McapError> {
+        let time = ns(t_s);
+        for ((id, g), info) in self.ids.iter().zip(&mut self.info) {
+            let buf = &mut self.buf;
+            buf.clear();
+            buf.push(b'{');
+            for (k, f) in g.fields.iter().enumerate() {
+                if k > 0 {
+                    buf.push(b',');
+                }
+                serde_json::to_writer(&mut *buf, &f.key).map_err(std::io::Error::from)?;
+                buf.push(b':');
+                serde_json::to_writer(&mut *buf, &values[f.channel])
+                    .map_err(std::io::Error::from)?;
+            }
+            buf.push(b'}');
+            self.out.write_to_known_channel(
+                &mcap::records::MessageHeader {
+                    channel_id: *id,
+                    sequence: self.sequence,
+                    log_time: time,
+                    publish_time: time,
+                },
+                buf,
+            )?;
+            info.messages += 1;
+        }
+        self.sequence = self.sequence.wrapping_add(1);
+        self.last_ns = time;
+        Ok(())
+    }
+
+    /// End the recording with the `/metrics` message `metrics` (a JSON object; numbers
+    /// and strings) at the last sample's time; returns what each channel holds and the
+    /// writer.
+    #[allow(clippy::type_complexity)]
+    pub fn finish(
+        mut self,
+        metrics: Map<String, Value>,
+    ) -> Result<(Vec<ChannelInfo>, W), mcap::McapError> {
+        let mut props = Map::new();
+        for (k, v) in &metrics {
+            let t = if v.is_string() { "string" } else { "number" };
+            props.insert(k.clone(), json!({ "type": [t, "null"] }));
+        }
+        let schema = json!({
+            "title": "settle.metrics",
+            "description": "the recording's metrics (units in the names)",
+            "type": "object",
+            "properties": props,
+        })
+        .to_string();
+        let schema_id = self
+            .out
+            .add_schema("settle.metrics", "jsonschema", schema.as_bytes())?;
+        let id = self
+            .out
+            .add_channel(schema_id, METRICS_TOPIC, "json", &BTreeMap::new())?;
+        self.out.write_to_known_channel(
+            &mcap::records::MessageHeader {
+                channel_id: id,
+                sequence: 0,
+                log_time: self.last_ns,
+                publish_time: self.last_ns,
+            },
+            Value::Object(metrics).to_string().as_bytes(),
+        )?;
+        self.info.push(ChannelInfo {
+            topic: METRICS_TOPIC.to_string(),
+            schema_name: "settle.metrics".to_string(),
+            schema,
+            messages: 1,
+        });
+        self.out.finish()?;
+        Ok((self.info, self.out.into_inner()))
+    }
+}
+
 /// Write one run to the file `path` (atomically: a temporary file, then a rename).
 pub fn write_file(path: &Path, p: &Provenance, rec: &RunRecord) -> Result<Vec<ChannelInfo>, Error> {
     let err = |source| Error::Write {

@@ -10,6 +10,7 @@
 //! Everything is computed before anything is written: a bad file writes nothing.
 
 pub mod compare;
+pub mod record;
 pub mod report;
 pub mod stream;
 
@@ -18,10 +19,16 @@ use std::path::{Path, PathBuf};
 
 use settle_gcode::job::{Firmware, Job, JobConfig, ShaperSetting};
 use settle_gcode::{GcodeError, Reader, ReaderOptions};
+use settle_planner::{Profile, State};
+use settle_sim::closed_form::LinearResponse;
 use settle_sim::machine::Machine;
-use settle_sim::{AxisModel, DriverMode, ModalPlant, RapierOptions, RapierPlant};
+use settle_sim::{
+    AxisModel, DriverMode, ModalPlant, ModalState, Mode, Plant, RapierOptions, RapierPlant,
+    SimError,
+};
 
 use crate::error::{Error, Location};
+use crate::input::machine_file::MachineForm;
 use crate::kinds::gcode::stats::{self, LayerMap, Spot};
 use crate::spec::backend::{Backend, NO_MUJOCO};
 use crate::workflows::{Exit, Report};
@@ -59,6 +66,8 @@ pub struct GcodeOptions {
     pub map_layer: Option<u32>,
     /// A second setting to compare with (`--versus`): firmware and X/Y shaper.
     pub versus: Option<(Firmware, Option<ShaperSetting>)>,
+    /// Write `recording.mcap` into the output folder ([`record`]).
+    pub mcap: bool,
 }
 
 impl GcodeOptions {
@@ -79,6 +88,7 @@ impl GcodeOptions {
             maps: 1,
             map_layer: None,
             versus: None,
+            mcap: false,
         })
     }
 
@@ -139,6 +149,8 @@ pub struct GcodeOutcome {
     pub files: Vec<PathBuf>,
     /// The outcome of the `--versus` setting.
     pub versus: Option<Box<GcodeOutcome>>,
+    /// The MCAP recording's channels, when one was written.
+    pub recording: Option<Vec<crate::output::sink::mcap::ChannelInfo>>,
 }
 
 impl GcodeOutcome {
@@ -172,6 +184,12 @@ impl GcodeOutcome {
                 s.line, s.layer, s.x_mm, s.y_mm
             ));
         }
+        if let Some(t) = &self.streamed.tail {
+            r.out(format!(
+                "ringing after the last move: {:.2} um at most, {:.3} um after {:.2} s",
+                t.residual_peak_um, t.residual_last_um, t.duration_s
+            ));
+        }
         if let Some(b) = &self.versus {
             r.out(compare::table(&[self, b]));
         }
@@ -182,7 +200,16 @@ impl GcodeOutcome {
             r.err(format!("simulation fault: {fault}"));
         }
         if self.streamed.lost_steps > 0 {
-            r.err(format!("lost steps: {}", self.streamed.lost_steps));
+            let at = self.streamed.first_lost_step.as_ref().map_or(String::new(), |l| {
+                format!(
+                    "; first seen on axis {} at {:.3} s (line {}, layer {}), load angle {:.0} electrical degrees",
+                    l.axis, l.time_s, l.line, l.layer, l.max_load_angle_deg
+                )
+            });
+            r.err(format!(
+                "result: the machine loses steps ({} full steps{at}): the motion asks more of a motor than its torque gives (its load angle passed 90 electrical degrees); what it prints after that is not this simulation's toolpath (exit 1: a failed run, not a tool error)",
+                self.streamed.lost_steps
+            ));
         }
         if self.skipped_lines > 0 {
             r.err(format!("skipped {} bad lines", self.skipped_lines));
@@ -226,6 +253,17 @@ pub fn gcode_error(file: &Path) -> impl Fn(GcodeError) -> Error + '_ {
 /// The machine `--machine` names: a built-in preset, a machine file, or a scenario file
 /// (its `[machine]`).
 pub fn resolve_machine(name: &str) -> Result<Machine, Error> {
+    match resolve_form(name)? {
+        (_, MachineForm::Physical(m)) => Ok(m),
+        (_, MachineForm::Modes(_)) => Err(Error::input(
+            "--machine",
+            format!("`{name}` gives the machine by its modes; a physical machine is needed here"),
+        )),
+    }
+}
+
+/// The machine `--machine` names, in either form, with its name.
+fn resolve_form(name: &str) -> Result<(String, MachineForm), Error> {
     let here = Path::new("--machine");
     let src = crate::input::source::Source::new("", here);
     let path = Path::new(name);
@@ -236,24 +274,118 @@ pub fn resolve_machine(name: &str) -> Result<Machine, Error> {
             .is_some_and(|t| t.contains_key("machine"));
     if is_scenario {
         let (sc, src) = crate::expand::load(path)?;
-        let m = crate::expand::machine::resolve_machine(&sc, &src)?.machine;
-        return m.ok_or_else(|| {
-            Error::input_key(
-                path,
-                "machine",
-                "a G-code job needs a physical machine (a preset, machine file or axis tables), not `modes`",
-            )
-        });
+        let r = crate::expand::machine::resolve_machine(&sc, &src)?;
+        let form = match r.machine {
+            Some(m) => MachineForm::Physical(m),
+            None => MachineForm::Modes(r.modes),
+        };
+        return Ok((r.name, form));
     }
     let base = std::env::current_dir().unwrap_or_default().join("here");
-    crate::input::machine_file::load_preset(name, &base, &src)
-        .map(|(m, _, _)| m)
+    crate::input::machine_file::load_any(name, &base, &src)
+        .map(|(d, _)| (d.name, d.form))
         .map_err(|e| match e {
             Error::Input { message, .. } if !name.ends_with(".toml") => {
                 Error::input(here, message.replace("machine.preset", "--machine"))
             }
             other => other,
         })
+}
+
+/// The machine's axes for `driver`, and the same axes with the linear driver (whose
+/// modes bound how fast a disturbance decays), and the machine's name. A machine given by
+/// its modes has no driver: its axes are the modes (`driver` must be linear).
+pub fn resolve_axes(
+    name: &str,
+    driver: DriverMode,
+) -> Result<(String, Vec<AxisModel>, Vec<AxisModel>), Error> {
+    let bad = |e: settle_sim::SimError| Error::input("--machine", e.to_string());
+    match resolve_form(name)? {
+        (n, MachineForm::Physical(m)) => {
+            let axes = m.compile(driver).map_err(bad)?;
+            let linear = m.compile(DriverMode::Linear).map_err(bad)?;
+            let _ = n;
+            Ok((m.name.clone(), axes, linear))
+        }
+        (n, MachineForm::Modes(axes)) => {
+            if driver != DriverMode::Linear {
+                return Err(Error::input(
+                    "--driver",
+                    format!(
+                        "`{name}` gives the machine by its modes: it has no driver model but the linear one"
+                    ),
+                ));
+            }
+            let axes = axes
+                .iter()
+                .map(|a| {
+                    let modes = a
+                        .modes
+                        .iter()
+                        .map(|m| Mode::new(m.frequency_hz, m.damping_ratio, m.weight))
+                        .collect::<Result<Vec<_>, _>>()?;
+                    AxisModel::from_modes(&a.axis, &modes)
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(bad)?;
+            Ok((n, axes.clone(), axes))
+        }
+    }
+}
+
+/// The slowest decay rate (1/s) of the axes' free vibration: the least `-Re(p)` over the
+/// poles `p` of every axis linearised at rest at the origin (a mode's `zeta w`; a real
+/// pole's rate). Every disturbance of the linear model decays at least this fast, up to a
+/// constant of its eigenvectors.
+pub fn slowest_decay_per_s(linear_axes: &[AxisModel]) -> Result<f64, Error> {
+    let rest = Profile::empty(State::default());
+    let mut slowest = f64::INFINITY;
+    for a in linear_axes {
+        let lr =
+            LinearResponse::new(a, &rest).map_err(|e| Error::input("--machine", e.to_string()))?;
+        for p in lr.poles() {
+            slowest = slowest.min(-p.re);
+        }
+    }
+    if !(slowest.is_finite() && slowest > 0.0) {
+        return Err(Error::input(
+            "--machine",
+            "the machine has an undamped or unstable mode: its vibration never decays",
+        ));
+    }
+    Ok(slowest)
+}
+
+/// The longest period (s) of the axes' oscillatory modes (their damped periods).
+fn longest_period_s(linear_axes: &[AxisModel]) -> f64 {
+    let rest = Profile::empty(State::default());
+    linear_axes
+        .iter()
+        .filter_map(|a| LinearResponse::new(a, &rest).ok())
+        .flat_map(|lr| lr.poles().to_vec())
+        .filter(|p| p.im > 0.0)
+        .map(|p| std::f64::consts::TAU / p.im)
+        .fold(0.0, f64::max)
+}
+
+/// How much smaller the vibration present when a layer range's pre-roll starts must
+/// become by the range's first move: 1e-6 (the envelope `exp(-sigma t)`, `sigma` the
+/// slowest decay rate).
+pub const PREROLL_DECAY: f64 = 1e-6;
+
+/// How much the ringing after the last move decays over the longest tail: 1e-3.
+pub const TAIL_DECAY: f64 = 1e-3;
+
+/// The pre-roll of a layer range (s): the time the slowest mode needs to decay by
+/// [`PREROLL_DECAY`], `ln(1 / PREROLL_DECAY) / sigma`.
+pub fn preroll_s(slowest_decay_per_s: f64) -> f64 {
+    (1.0 / PREROLL_DECAY).ln() / slowest_decay_per_s
+}
+
+/// The longest simulation after the last move (s): the time the slowest mode needs to
+/// decay by [`TAIL_DECAY`].
+pub fn tail_s(slowest_decay_per_s: f64) -> f64 {
+    (1.0 / TAIL_DECAY).ln() / slowest_decay_per_s
 }
 
 /// Which job axis (0 X, 1 Y, 2 Z) each machine axis follows, and the machine indices of
@@ -281,10 +413,24 @@ fn axis_map(axes: &[AxisModel]) -> Result<(Vec<usize>, [usize; 2]), String> {
 
 /// Simulate the job without writing anything.
 pub fn measure(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
-    let machine = resolve_machine(&opts.machine)?;
-    let axes = machine
-        .compile(opts.driver)
-        .map_err(|e| Error::input("--machine", e.to_string()))?;
+    simulate(opts, None).map(|(o, _)| o)
+}
+
+/// Simulate the job, recording the counted samples into `rec` when given.
+fn simulate(
+    opts: &GcodeOptions,
+    rec: Option<record::Recorder>,
+) -> Result<(GcodeOutcome, Option<record::Recorder>), Error> {
+    let (machine_name, axes, linear_axes) = resolve_axes(&opts.machine, opts.driver)?;
+    // A machine with an undamped mode never settles: no tail, and a layer range cannot
+    // start from the state the layers before leave.
+    let sigma = slowest_decay_per_s(&linear_axes);
+    if opts.layers.is_some() && sigma.is_err() {
+        return Err(Error::input(
+            "--layers",
+            "the machine has an undamped mode: its vibration never decays, so a layer range cannot start from the state the layers before leave; simulate the whole file",
+        ));
+    }
     let (job_axes, xy) = axis_map(&axes).map_err(|m| Error::input("--machine", m))?;
     if opts.backend == Backend::Modal && opts.driver != DriverMode::Linear {
         return Err(Error::input(
@@ -310,6 +456,9 @@ pub fn measure(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
         top_spots: 10,
         maps: opts.maps,
         map_layer: opts.map_layer,
+        layers: opts.layers,
+        tail_s: sigma.as_ref().map_or(0.0, |&s| tail_s(s)),
+        tail_hold_s: longest_period_s(&linear_axes),
     };
     let err = gcode_error(&opts.file);
     let reader = Reader::open(
@@ -324,37 +473,52 @@ pub fn measure(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
         .map_err(&err)?
         .with_name(opts.file.display().to_string());
     if let Some((a, b)) = opts.layers {
-        job = job.with_layers(a..=b).map_err(&err)?;
+        job = job
+            .with_layers(a..=b)
+            .and_then(|j| j.with_preroll_s(sigma.as_ref().map_or(0.0, |&s| preroll_s(s))))
+            .map_err(&err)?;
     }
     let sim_err = |source| Error::Sim { run: 0, source };
     let dt = 1.0 / opts.sample_rate_hz;
-    let streamed = match opts.backend {
-        Backend::Modal => simulate_job(
-            &mut job,
-            &ModalPlant::new(axes, dt).map_err(sim_err)?,
-            sopts,
-            &opts.file,
-        )?,
-        Backend::Rapier => simulate_job(
-            &mut job,
-            &RapierPlant::new(
+    let (streamed, rec) = match opts.backend {
+        Backend::Modal => {
+            let plant = ModalPlant::new(axes, dt).map_err(sim_err)?;
+            // A layer range starts at rest in the commanded state of its pre-roll, with
+            // the machine linearised where the whole job starts (at rest at the origin,
+            // as every planner starts), so that it computes the whole job's numbers.
+            let at_origin = |starts: &[State]| {
+                let mut st = plant.initial_state(&vec![State::default(); starts.len()])?;
+                for (a, s) in st.axes.iter_mut().zip(starts) {
+                    a.base = *s;
+                }
+                Ok(st)
+            };
+            let at_start = |starts: &[State]| plant.initial_state(starts);
+            let init: &dyn Fn(&[State]) -> Result<ModalState, SimError> = match opts.layers {
+                Some(_) => &at_origin,
+                None => &at_start,
+            };
+            simulate_job(&mut job, &plant, init, sopts, rec, &opts.file)?
+        }
+        Backend::Rapier => {
+            let plant = RapierPlant::new(
                 axes,
                 RapierOptions {
                     max_step_s: None,
                     belt: Default::default(),
                 },
             )
-            .map_err(sim_err)?,
-            sopts,
-            &opts.file,
-        )?,
+            .map_err(sim_err)?;
+            let init = |starts: &[State]| plant.initial_state(starts);
+            simulate_job(&mut job, &plant, &init, sopts, rec, &opts.file)?
+        }
         #[cfg(feature = "mujoco")]
-        Backend::Mujoco => simulate_job(
-            &mut job,
-            &settle_sim::mujoco::MujocoPlant::new(axes, Default::default()).map_err(sim_err)?,
-            sopts,
-            &opts.file,
-        )?,
+        Backend::Mujoco => {
+            let plant =
+                settle_sim::mujoco::MujocoPlant::new(axes, Default::default()).map_err(sim_err)?;
+            let init = |starts: &[State]| plant.initial_state(starts);
+            simulate_job(&mut job, &plant, &init, sopts, rec, &opts.file)?
+        }
         #[cfg(not(feature = "mujoco"))]
         Backend::Mujoco => return Err(Error::input("--backend", NO_MUJOCO)),
     };
@@ -377,11 +541,11 @@ pub fn measure(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
             stats: by_layer.remove(&l.layer),
         })
         .collect();
-    Ok(GcodeOutcome {
+    let outcome = GcodeOutcome {
         file: opts.file.clone(),
         firmware: opts.job.firmware(),
         setting: setting_name(&opts.job),
-        machine: machine.name.clone(),
+        machine: machine_name,
         backend: opts.backend,
         print_time_s: summary.print_time_s,
         layers,
@@ -392,7 +556,9 @@ pub fn measure(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
         ignored: summary.ignored,
         files: Vec::new(),
         versus: None,
-    })
+        recording: None,
+    };
+    Ok((outcome, rec))
 }
 
 /// The planner and the X and Y shapers in words: `klipper + mzv@48 Hz`, `settle` when
@@ -415,7 +581,11 @@ pub fn setting_name(job: &JobConfig) -> String {
 /// `settle gcode`: simulate, then write layers.csv, summary.md and the ringing maps into
 /// the output folder.
 pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
-    let mut outcome = measure(opts)?;
+    let rec = match opts.mcap {
+        true => Some(record::Recorder::start(recording_metadata(opts))?),
+        false => None,
+    };
+    let (mut outcome, rec) = simulate(opts, rec)?;
     let dir = match &opts.out {
         Some(d) => d.clone(),
         None => {
@@ -435,6 +605,11 @@ pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
         None => None,
     };
     outcome.files = report::write(&outcome, &dir)?;
+    if let Some(rec) = rec {
+        let path = dir.join("recording.mcap");
+        outcome.recording = Some(rec.finish(recording_metrics(&outcome), &path)?);
+        outcome.files.push(path);
+    }
     if let (Some(b_opts), Some(b)) = (&b_opts, &b) {
         let files = compare::compare((&outcome, opts), (b, b_opts), &dir)?;
         outcome.files.extend(files);
@@ -443,6 +618,51 @@ pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
     let html = report::write_html(&outcome, opts, &dir)?;
     outcome.files.push(html);
     Ok(outcome)
+}
+
+/// The `settle` metadata record of `--mcap`'s recording.
+fn recording_metadata(opts: &GcodeOptions) -> BTreeMap<String, String> {
+    let layers = opts
+        .layers
+        .map_or("all".to_string(), |(a, b)| format!("{a}..{b}"));
+    BTreeMap::from([
+        (
+            "settle_version".to_string(),
+            env!("CARGO_PKG_VERSION").to_string(),
+        ),
+        ("gcode_file".to_string(), opts.file.display().to_string()),
+        ("machine".to_string(), opts.machine.clone()),
+        ("setting".to_string(), setting_name(&opts.job)),
+        ("backend".to_string(), opts.backend.name().to_string()),
+        ("layers".to_string(), layers),
+        (
+            "sample_rate_hz".to_string(),
+            opts.sample_rate_hz.to_string(),
+        ),
+    ])
+}
+
+/// The `/metrics` message of `--mcap`'s recording.
+fn recording_metrics(o: &GcodeOutcome) -> serde_json::Map<String, serde_json::Value> {
+    use serde_json::json;
+    let mut m = record::metrics(&[
+        ("gcode_file", json!(o.file.display().to_string())),
+        ("setting", json!(o.setting)),
+        ("machine", json!(o.machine)),
+        ("backend", json!(o.backend.name())),
+        ("print_time_s", record::num(o.print_time_s)),
+        ("contour_worst_um", record::num(o.worst_um)),
+        ("contour_p95_um", record::num(o.p95_um)),
+        ("simulated_s", record::num(o.streamed.simulated_s)),
+        ("preroll_s", record::num(o.streamed.preroll_s)),
+    ]);
+    if let Some(t) = &o.streamed.tail {
+        m.insert("end_residual_um".into(), record::num(t.residual_peak_um));
+    }
+    if let Some(w) = o.worst().first() {
+        m.insert("contour_worst_line".into(), json!(w.line));
+    }
+    m
 }
 
 pub use crate::kinds::gcode::parse_layers;

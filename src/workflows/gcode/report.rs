@@ -24,7 +24,7 @@ use crate::output::sha256::Sha256;
 use crate::spec::backend::Backend;
 
 /// layers.csv's columns.
-pub const LAYER_COLUMNS: [&str; 13] = [
+pub const LAYER_COLUMNS: [&str; 14] = [
     "layer",
     "z_mm",
     "start_s",
@@ -38,6 +38,7 @@ pub const LAYER_COLUMNS: [&str; 13] = [
     "worst_line",
     "worst_x_mm",
     "worst_y_mm",
+    "end_residual_um",
 ];
 
 /// layers.csv as bytes.
@@ -64,10 +65,11 @@ pub fn layers_csv(o: &GcodeOutcome) -> Result<Vec<u8>, csv::Error> {
                     Some(w) => row.extend([w.line.to_string(), num(w.x_mm), num(w.y_mm)]),
                     None => row.extend([String::new(), String::new(), String::new()]),
                 }
+                row.push(s.end_residual_um.map(num).unwrap_or_default());
             }
             None => {
                 row.push("false".into());
-                row.extend(std::iter::repeat_n(String::new(), 7));
+                row.extend(std::iter::repeat_n(String::new(), 8));
             }
         }
         w.write_record(&row)?;
@@ -106,8 +108,43 @@ pub fn summary_md(o: &GcodeOutcome, maps: &[String]) -> String {
 the moves active at that time, over printing moves; p95 is the 95th percentile of all \
 printing samples.\n"
     );
+    if o.streamed.preroll_s > 0.0 {
+        let _ = writeln!(
+            s,
+            "The layer range was simulated from {:.2} s before its first move (the pre-roll, \
+not counted), so that it starts from the vibration the layers before leave.\n",
+            o.streamed.preroll_s
+        );
+    }
+    if let Some(t) = &o.streamed.tail {
+        let _ = writeln!(
+            s,
+            "Ringing after the last move: {:.2} um at most from the end point, {:.3} um after \
+{:.2} s.\n",
+            t.residual_peak_um, t.residual_last_um, t.duration_s
+        );
+    }
     if let Some(f) = &o.streamed.fault {
         let _ = writeln!(s, "**Simulation fault**: {f}\n");
+    }
+    if o.streamed.lost_steps > 0 {
+        let _ = write!(
+            s,
+            "**Lost steps**: {} full steps: a motor's load angle passed 90 electrical degrees, \
+more torque than it has",
+            o.streamed.lost_steps
+        );
+        if let Some(l) = &o.streamed.first_lost_step {
+            let _ = write!(
+                s,
+                " (first seen on axis {} at {:.3} s, line {}, layer {})",
+                l.axis, l.time_s, l.line, l.layer
+            );
+        }
+        let _ = writeln!(
+            s,
+            "; the part would differ from this toolpath after that.\n"
+        );
     }
     let _ = writeln!(s, "## Worst spots\n");
     let _ = writeln!(

@@ -4,15 +4,26 @@
 //! breakpoint of the command (the modal plant is then exact). Each sample's contour error
 //! ([`crate::kinds::gcode::contour`]) feeds the per-move, per-layer and whole-job account
 //! ([`crate::kinds::gcode::stats`]).
+//!
+//! - With a layer range the job's chunks start a pre-roll before the range (see
+//!   [`super::preroll_s`]): the plant is stepped through it, but only samples of moves in
+//!   the range are counted.
+//! - When the job's motion ends the file, the machine is simulated on with the command
+//!   standing at the end point for [`StreamOptions::tail_s`] (or until the residual has
+//!   stayed in [`TAIL_BAND_UM`] for [`StreamOptions::tail_hold_s`]): the ringing after the
+//!   last move. Its samples belong to the last move (its contour error, as any sample),
+//!   and the largest distance from the end point is the last layer's
+//!   [`LayerStats::end_residual_um`].
 
 use std::io::BufRead;
 use std::path::Path;
 
 use settle_gcode::MoveKind;
 use settle_gcode::job::Job;
-use settle_planner::{Profile, Sample, Trajectory};
-use settle_sim::{Observation, Plant};
+use settle_planner::{Profile, Sample, State, Trajectory};
+use settle_sim::{Observation, Plant, SimError};
 
+use super::record::Recorder;
 use crate::error::Error;
 use crate::execute::cursor::Cursor;
 use crate::kinds::gcode::contour::ActiveMoves;
@@ -36,6 +47,28 @@ pub struct StreamOptions {
     pub maps: usize,
     /// A layer whose map is kept whatever its errors ([`Streamed::chosen`]).
     pub map_layer: Option<u32>,
+    /// Only samples of moves in these layers count (the rest is the pre-roll).
+    pub layers: Option<(u32, u32)>,
+    /// Longest simulation after the end of the file's motion (s; 0: none).
+    pub tail_s: f64,
+    /// The tail ends early once the residual has stayed within [`TAIL_BAND_UM`] this
+    /// long (s).
+    pub tail_hold_s: f64,
+}
+
+/// The band (um) the residual after the last move must stay in to end the tail early.
+pub const TAIL_BAND_UM: f64 = 0.1;
+
+/// The ringing after the last move.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Tail {
+    /// Simulated after the last command (s).
+    pub duration_s: f64,
+    /// Largest distance in XY (um) from the toolhead to the end point after the last
+    /// command.
+    pub residual_peak_um: f64,
+    /// Its last value (um).
+    pub residual_last_um: f64,
 }
 
 /// What the simulation measured.
@@ -52,7 +85,8 @@ pub struct Streamed {
     pub maps: Vec<LayerMap>,
     /// The map of [`StreamOptions::map_layer`].
     pub chosen: Option<LayerMap>,
-    /// Print time simulated (s).
+    /// Print time simulated (s): from the first chunk (the pre-roll included) to the last
+    /// command; the ringing after it is [`Tail::duration_s`].
     pub simulated_s: f64,
     /// Samples taken.
     pub samples: u64,
@@ -60,6 +94,29 @@ pub struct Streamed {
     pub fault: Option<String>,
     /// Lost steps per axis (driver models that have them).
     pub lost_steps: u32,
+    /// Simulated before the layer range's first move, not counted (s).
+    pub preroll_s: f64,
+    /// The ringing after the last move, when the job ended the file.
+    pub tail: Option<Tail>,
+    /// Where a motor was first seen past its stability limit (see [`LostStep`]).
+    pub first_lost_step: Option<LostStep>,
+}
+
+/// Where a motor's load angle was first seen past 90 electrical degrees (the driver
+/// model's lost step): checked at every sample evaluated in full, so at least once per
+/// 256 samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LostStep {
+    /// When it was seen (s, print clock).
+    pub time_s: f64,
+    /// The machine axis.
+    pub axis: String,
+    /// Its largest |load angle| so far (electrical degrees).
+    pub max_load_angle_deg: f64,
+    /// The G-code line and layer of the move the sample belongs to.
+    pub line: u64,
+    /// Its layer.
+    pub layer: u32,
 }
 
 /// The running account (module doc).
@@ -77,10 +134,12 @@ struct Account {
     /// The move the last sample belonged to: index, kind, layer, line, worst spot.
     owner: Option<(u64, MoveKind, u32, u64, Option<Spot>)>,
     map_every: u64,
+    /// The MCAP recording of the counted samples.
+    rec: Option<Recorder>,
 }
 
 impl Account {
-    fn new(opts: StreamOptions) -> Self {
+    fn new(opts: StreamOptions, rec: Option<Recorder>) -> Self {
         // About 1 kHz of map points.
         let map_every = (opts.sample_rate_hz / 1000.0).round().max(1.0) as u64;
         Self {
@@ -94,7 +153,23 @@ impl Account {
             map: Vec::new(),
             owner: None,
             map_every,
+            rec,
         }
+    }
+
+    /// Record where a lost step is first seen in `obs` (at `t`).
+    fn lost_step_check(&mut self, t: f64, obs: &[Observation]) {
+        let Some((i, o)) = obs.iter().enumerate().find(|(_, o)| o.lost_steps > 0) else {
+            return;
+        };
+        let (line, layer) = self.active.owner(t).map_or((0, 0), |m| (m.line, m.layer));
+        self.out.first_lost_step = Some(LostStep {
+            time_s: t,
+            axis: self.opts.names.get(i).cloned().unwrap_or_default(),
+            max_load_angle_deg: o.max_load_angle_rad.unwrap_or(f64::NAN).to_degrees(),
+            line,
+            layer,
+        });
     }
 
     fn end_move(&mut self) {
@@ -134,7 +209,7 @@ impl Account {
         self.out.layers.push(l);
     }
 
-    fn sample(&mut self, k: u64, t: f64, toolhead_m: &[f64]) {
+    fn sample(&mut self, k: u64, t: f64, cmd_m: &[f64], toolhead_m: &[f64]) {
         self.out.samples += 1;
         self.active.retire(t);
         let [ix, iy] = self.opts.xy;
@@ -145,6 +220,13 @@ impl Account {
         let Some(m) = self.active.owner(t).cloned() else {
             return;
         };
+        if self
+            .opts
+            .layers
+            .is_some_and(|(a, b)| !(a..=b).contains(&m.layer))
+        {
+            return;
+        }
         if self.owner.as_ref().is_none_or(|o| o.0 != m.index) {
             if self.layer.as_ref().is_none_or(|l| l.layer != m.layer) {
                 self.end_layer();
@@ -155,6 +237,20 @@ impl Account {
             self.owner = Some((m.index, m.kind, m.layer, m.line, None));
         }
         let err_um = err_mm * 1e3;
+        if let Some(r) = self.rec.as_mut() {
+            r.sample(
+                t,
+                &[
+                    cmd_m[ix],
+                    cmd_m[iy],
+                    toolhead_m[ix],
+                    toolhead_m[iy],
+                    err_mm * 1e-3,
+                    m.line as f64,
+                    f64::from(m.layer),
+                ],
+            );
+        }
         let print = m.kind == MoveKind::Print;
         if print {
             self.hist.push(err_um);
@@ -183,20 +279,63 @@ impl Account {
     }
 }
 
+impl Tail {
+    fn add(&mut self, residual_um: f64) {
+        self.residual_peak_um = self.residual_peak_um.max(residual_um);
+        self.residual_last_um = residual_um;
+    }
+}
+
+/// When the residual after the last move has stayed in [`TAIL_BAND_UM`] long enough.
+#[derive(Debug)]
+struct Band {
+    hold_s: f64,
+    since: Option<f64>,
+}
+
+impl Band {
+    fn new(hold_s: f64) -> Self {
+        Self {
+            hold_s,
+            since: None,
+        }
+    }
+
+    /// The residual is `r_um` at `t`: whether the tail can end here.
+    fn stops(&mut self, t: f64, r_um: f64) -> bool {
+        if r_um > TAIL_BAND_UM {
+            self.since = None;
+            return false;
+        }
+        t - *self.since.get_or_insert(t) >= self.hold_s
+    }
+}
+
 /// Samples per [`Plant::step_samples`] call (as the harness's simulation loop).
 const BATCH: usize = 256;
 
-/// Simulate `job`'s chunks on `plant` (see the module doc).
+/// How [`simulate_job`] makes the plant's state at the first chunk's start state.
+pub type Init<'a, S> = &'a dyn Fn(&[State]) -> Result<S, SimError>;
+
+/// Simulate `job`'s chunks on `plant` (see the module doc); `init` makes the plant's
+/// state at the first chunk's start state (usually [`Plant::initial_state`]).
 pub fn simulate_job<R: BufRead, P: Plant>(
     job: &mut Job<R>,
     plant: &P,
+    init: Init<'_, P::State>,
     opts: StreamOptions,
+    rec: Option<Recorder>,
     file: &Path,
-) -> Result<Streamed, Error> {
+) -> Result<(Streamed, Option<Recorder>), Error> {
     let n = opts.job_axes.len();
     let dt = 1.0 / opts.sample_rate_hz;
     let job_axes = opts.job_axes.clone();
-    let mut acc = Account::new(opts);
+    let (tail_s, tail_hold_s) = (opts.tail_s, opts.tail_hold_s);
+    // The end state of the last chunk, per axis.
+    let mut end = vec![State::default(); n];
+    let mut range_start: Option<f64> = None;
+    let mut faulted = false;
+    let mut acc = Account::new(opts, rec);
     let mut state: Option<P::State> = None;
     let mut cmd = vec![Sample::default(); n];
     let mut cmd_p = vec![0.0; n];
@@ -227,14 +366,19 @@ pub fn simulate_job<R: BufRead, P: Plant>(
                         fault = true;
                     }
                     None => {
-                        for (h, o) in toolhead.iter_mut().zip(&obs) {
+                        for ((h, c), o) in toolhead.iter_mut().zip(cmd_p.iter_mut()).zip(&obs) {
                             *h = o.toolhead_m;
+                            *c = o.commanded_m;
                         }
                     }
                 }
             }
             if !fault {
-                acc.sample(k, t, &toolhead);
+                acc.sample(k, t, &cmd_p, &toolhead);
+                if acc.out.first_lost_step.is_none() {
+                    plant.observe($st, &mut obs);
+                    acc.lost_step_check(t, &obs);
+                }
             }
             fault
         }};
@@ -262,9 +406,21 @@ pub fn simulate_job<R: BufRead, P: Plant>(
                 let starts: Vec<_> = sub.axes().iter().map(Profile::start).collect();
                 t_first = t0;
                 k = (t0 / dt).ceil() as u64;
-                state.insert(plant.initial_state(&starts).map_err(sim_err)?)
+                state.insert(init(&starts).map_err(sim_err)?)
             }
         };
+        if range_start.is_none()
+            && let Some((a, _)) = acc.opts.layers
+        {
+            range_start = chunk
+                .moves
+                .iter()
+                .find(|m| m.layer >= a && m.duration_s > 0.0)
+                .map(|m| m.start_time_s);
+        }
+        for (e, p) in end.iter_mut().zip(sub.axes()) {
+            *e = p.end();
+        }
         let local = |k: u64| k as f64 * dt - t0;
         let bps = sub.breakpoints();
         let mut next_bp = 0;
@@ -291,13 +447,15 @@ pub fn simulate_job<R: BufRead, P: Plant>(
                         Ok(Some(done)) if (1..=m).contains(&done) => {
                             for i in 0..done - 1 {
                                 let ki = k + i as u64;
-                                acc.sample(ki, ki as f64 * dt, &th[i * n..(i + 1) * n]);
+                                let r = i * n..(i + 1) * n;
+                                acc.sample(ki, ki as f64 * dt, &cp[r.clone()], &th[r]);
                             }
                             k += done as u64 - 1;
                             tau = local(k);
                             t = k as f64 * dt;
                             // The last sample of the call is evaluated in full.
                             if sample_at!(st, t) {
+                                faulted = true;
                                 break 'chunks;
                             }
                             k += 1;
@@ -318,18 +476,117 @@ pub fn simulate_job<R: BufRead, P: Plant>(
             if next == t_sample {
                 t = k as f64 * dt;
                 if sample_at!(st, t) {
+                    faulted = true;
                     break 'chunks;
                 }
                 k += 1;
             }
         }
     }
+    // The print time simulated: to the last command (the tail is counted apart).
+    acc.out.simulated_s = t - t_first;
+    if let Some(st) = state.as_mut().filter(|_| !faulted && tail_s > 0.0)
+        && job.ended_at_end_of_file()
+    {
+        // The ringing after the last move: the command stands at the end point.
+        let hold: Vec<Sample> = end
+            .iter()
+            .map(|e| Sample {
+                p: e.p,
+                ..Sample::default()
+            })
+            .collect();
+        let [ix, iy] = acc.opts.xy;
+        let (t_end, mut tail) = (t, Tail::default());
+        let mut band = Band::new(tail_hold_s);
+        for c in cmds.chunks_exact_mut(n) {
+            c.copy_from_slice(&hold);
+        }
+        let residual_um = |th: &[f64]| (th[ix] - hold[ix].p).hypot(th[iy] - hold[iy].p) * 1e6;
+        let last_k = ((t_end + tail_s) / dt).floor() as u64;
+        // To the first sample after the end (a partial step), then whole samples.
+        let h0 = k as f64 * dt - t;
+        if k <= last_k {
+            if h0 > 0.0 {
+                plant.step(st, &hold, h0).map_err(sim_err)?;
+            }
+            t = k as f64 * dt;
+            let stop = sample_at!(st, t) || {
+                let r = residual_um(&toolhead);
+                tail.add(r);
+                band.stops(t, r)
+            };
+            k += 1;
+            while !stop && k <= last_k {
+                let m = if batch {
+                    (last_k - k + 1).min(BATCH as u64) as usize
+                } else {
+                    1
+                };
+                if m > 1 {
+                    let (cp, th) = (&mut bcmd_p[..m * n], &mut btool[..m * n]);
+                    match plant.step_samples(st, &cmds[..m * n], dt, BLOWUP_M, cp, th) {
+                        Ok(Some(done)) if (1..=m).contains(&done) => {
+                            let mut stop = false;
+                            for i in 0..done - 1 {
+                                let ki = k + i as u64;
+                                let ti = ki as f64 * dt;
+                                let th_i = &th[i * n..(i + 1) * n];
+                                acc.sample(ki, ti, &cp[i * n..(i + 1) * n], th_i);
+                                let r = residual_um(th_i);
+                                tail.add(r);
+                                t = ti;
+                                if band.stops(ti, r) {
+                                    stop = true;
+                                    break;
+                                }
+                            }
+                            if stop {
+                                break;
+                            }
+                            // The last sample of the call is evaluated in full.
+                            k += done as u64 - 1;
+                            t = k as f64 * dt;
+                            let stop = sample_at!(st, t) || {
+                                let r = residual_um(&toolhead);
+                                tail.add(r);
+                                band.stops(t, r)
+                            };
+                            k += 1;
+                            if stop {
+                                break;
+                            }
+                            continue;
+                        }
+                        Ok(_) => batch = false,
+                        Err((_, source)) => return Err(sim_err(source)),
+                    }
+                }
+                plant.step(st, &hold, dt).map_err(sim_err)?;
+                t = k as f64 * dt;
+                let stop = sample_at!(st, t) || {
+                    let r = residual_um(&toolhead);
+                    tail.add(r);
+                    band.stops(t, r)
+                };
+                k += 1;
+                if stop {
+                    break;
+                }
+            }
+        }
+        tail.duration_s = t - t_end;
+        if let Some(l) = acc.layer.as_mut() {
+            l.end_residual_um = Some(tail.residual_peak_um);
+        }
+        acc.out.tail = Some(tail);
+    }
+    acc.out.preroll_s = range_start.map_or(0.0, |r| (r - t_first).max(0.0));
     acc.end_layer();
     if let Some(st) = state.as_ref() {
         plant.observe(st, &mut obs);
         acc.out.lost_steps = obs.iter().map(|o| o.lost_steps).sum();
     }
-    acc.out.simulated_s = t - t_first;
     acc.out.worst = acc.top.spots().to_vec();
-    Ok(acc.out)
+    Ok((acc.out, acc.rec))
 }

@@ -337,7 +337,7 @@ impl<R: BufRead> Job<R> {
     fn on_span(&mut self, seq: u64, t0: f64, t1: f64) -> Result<(), PlanError> {
         let layer = self.table.planned(seq, t0, t1);
         if self.layers.is_some() && self.range != Range::In {
-            self.table.forget_before(t0);
+            self.table.forget_before(t0 - self.input.lookback_s());
         }
         let (Some((a, b)), Some(layer)) = (self.layers, layer) else {
             return Ok(());

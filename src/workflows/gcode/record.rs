@@ -1,0 +1,155 @@
+//! `settle gcode --mcap`: an MCAP recording of the simulated samples (of the layer range
+//! when one is given; the pre-roll is not recorded, the ringing after the last move is),
+//! written while the job streams through the MCAP sink
+//! ([`crate::output::sink::mcap::Stream`]): memory stays bounded however long the job.
+//!
+//! Topics (the sink's signal groups): `/cmd` (`x_m`, `y_m`: the commanded XY position),
+//! `/toolhead` (`x_m`, `y_m`), `/contour` (`error_m`: the contour error, see
+//! [`crate::kinds::gcode::contour`]), `/move` (`line`, `layer`: the G-code line and layer
+//! of the move the sample belongs to); `/metrics` at the end: file, setting, machine,
+//! backend, print time, worst and p95 contour error.
+//!
+//! The file is written to a temporary file in the system's temporary folder while the
+//! job runs and moved into the output folder only when the job has succeeded: bad G-code
+//! found halfway writes nothing.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use serde_json::{Map, Value, json};
+
+use crate::error::Error;
+use crate::output::sink::mcap::{ChannelInfo, Stream};
+
+/// Channel names of a recording, in the order of [`Recorder::sample`]'s values.
+pub const CHANNELS: [&str; 7] = [
+    "cmd_x",
+    "cmd_y",
+    "toolhead_x",
+    "toolhead_y",
+    "contour_error",
+    "move_line",
+    "move_layer",
+];
+
+/// Their units.
+const UNITS: [&str; 7] = ["m", "m", "m", "m", "m", "", ""];
+
+/// The recording in progress.
+pub struct Recorder {
+    stream: Option<Stream<BufWriter<File>>>,
+    tmp: PathBuf,
+    error: Option<String>,
+}
+
+impl std::fmt::Debug for Recorder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Recorder")
+            .field("tmp", &self.tmp)
+            .field("error", &self.error)
+            .finish()
+    }
+}
+
+impl Drop for Recorder {
+    fn drop(&mut self) {
+        // Not finished (an error): leave nothing behind.
+        if self.stream.take().is_some() || self.error.is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+impl Recorder {
+    /// Start a recording in a temporary file, with `metadata` in its `settle` record.
+    pub fn start(metadata: BTreeMap<String, String>) -> Result<Self, Error> {
+        let tmp = std::env::temp_dir().join(format!(
+            "settle-gcode-{}-{}.mcap.tmp",
+            std::process::id(),
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_nanos())
+        ));
+        let file = File::create(&tmp).map_err(|e| Error::write(&tmp, e))?;
+        let stream = Stream::new(
+            BufWriter::new(file),
+            env!("CARGO_PKG_VERSION"),
+            metadata,
+            &CHANNELS,
+            &UNITS,
+        )
+        .map_err(|e| Error::write(&tmp, std::io::Error::other(e)))?;
+        Ok(Self {
+            stream: Some(stream),
+            tmp,
+            error: None,
+        })
+    }
+
+    /// One sample at `t_s` (values as [`CHANNELS`]). A write error stops the recording
+    /// and is reported by [`Recorder::finish`].
+    pub fn sample(&mut self, t_s: f64, values: &[f64; 7]) {
+        if let Some(s) = self.stream.as_mut()
+            && let Err(e) = s.sample(t_s, values)
+        {
+            self.error = Some(e.to_string());
+            self.stream = None;
+        }
+    }
+
+    /// End the recording with `metrics` and move it to `path`; returns what each channel
+    /// holds.
+    pub fn finish(
+        mut self,
+        metrics: Map<String, Value>,
+        path: &Path,
+    ) -> Result<Vec<ChannelInfo>, Error> {
+        let fail = |m: String| Error::write(path, std::io::Error::other(m));
+        if let Some(e) = &self.error {
+            return Err(fail(e.clone()));
+        }
+        let Some(stream) = self.stream.take() else {
+            return Err(fail("the recording was not started".into()));
+        };
+        let finished = stream
+            .finish(metrics)
+            .map_err(|e| fail(e.to_string()))
+            .and_then(|(info, w)| {
+                w.into_inner().map_err(|e| fail(e.error().to_string()))?;
+                Ok(info)
+            });
+        let info = finished.inspect_err(|e| self.error = Some(e.to_string()))?;
+        move_file(&self.tmp, path).inspect_err(|e| self.error = Some(e.to_string()))?;
+        Ok(info)
+    }
+}
+
+/// Move `from` to `to`: a rename, or a copy into a temporary file beside `to` and a rename
+/// when they are on different file systems.
+fn move_file(from: &Path, to: &Path) -> Result<(), Error> {
+    if std::fs::rename(from, to).is_ok() {
+        return Ok(());
+    }
+    let tmp = crate::output::atomic::tmp_path(to);
+    let copied = std::fs::copy(from, &tmp).and_then(|_| std::fs::rename(&tmp, to));
+    let _ = std::fs::remove_file(from);
+    copied.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        Error::write(to, e)
+    })
+}
+
+/// The `/metrics` message of a recording.
+pub fn metrics(fields: &[(&str, Value)]) -> Map<String, Value> {
+    fields
+        .iter()
+        .map(|(k, v)| ((*k).to_string(), v.clone()))
+        .collect()
+}
+
+/// A number as a metrics value (`null` when not finite).
+pub fn num(x: f64) -> Value {
+    if x.is_finite() { json!(x) } else { Value::Null }
+}
