@@ -96,16 +96,21 @@ fn axis_of(file: &Path, source: &str, axis: Option<&str>) -> Result<String, Erro
         })
 }
 
-/// The modes a machine file gets from `id`: each mode's estimate; a weight the data do
-/// not determine ([`WeightBasis::NotIdentified`]) becomes `1 / n` for `n` modes.
+/// The modes a machine file gets from `id`: each mode's estimate with the standard
+/// deviations of its frequency and damping ratio (what `settle tune` takes as the
+/// frequency's uncertainty band); a weight the data do not determine
+/// ([`WeightBasis::NotIdentified`]) becomes `1 / n` for `n` modes.
 pub fn modes_of(id: &AxisIdentification) -> Vec<ModeSpec> {
     let n = id.modes.len().max(1) as f64;
+    let sigma = |s: f64| s.is_finite().then_some(s);
     id.modes
         .iter()
         .map(|m| ModeSpec {
             frequency_hz: m.frequency_hz.value,
             damping_ratio: m.damping_ratio.value,
             weight: m.weight.map_or(1.0 / n, |w| w.value),
+            frequency_sigma_hz: sigma(m.frequency_hz.sigma),
+            damping_ratio_sigma: sigma(m.damping_ratio.sigma),
         })
         .collect()
 }
