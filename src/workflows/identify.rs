@@ -199,9 +199,15 @@ pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
     })
 }
 
-/// `value ± sigma` with `digits` decimals.
+/// `value ± sigma` with at least `digits` decimals, and as many more as show the
+/// sigma's first two significant digits.
 fn pm(value: f64, sigma: f64, digits: usize) -> String {
-    format!("{value:.digits$} ± {sigma:.digits$}")
+    let shown = if sigma.is_finite() && sigma > 0.0 {
+        digits.max((1.0 - sigma.log10().floor()).max(0.0) as usize)
+    } else {
+        digits
+    };
+    format!("{value:.shown$} ± {sigma:.shown$}")
 }
 
 impl Identified {
@@ -211,7 +217,7 @@ impl Identified {
         let mut out = String::new();
         let _ = writeln!(
             out,
-            "{:<4} {:<16} {:>4} {:>18} {:>18} {:>16}  method",
+            "{:<4} {:<16} {:>4} {:>20} {:>20} {:>18}  method",
             "axis", "sensor", "mode", "frequency_hz", "damping_ratio", "weight"
         );
         for a in &self.axes {
@@ -232,7 +238,7 @@ impl Identified {
                 };
                 let _ = writeln!(
                     out,
-                    "{:<4} {:<16} {:>4} {:>18} {:>18} {:>16}  {method}",
+                    "{:<4} {:<16} {:>4} {:>20} {:>20} {:>18}  {method}",
                     a.axis,
                     sensor,
                     i,

@@ -26,7 +26,7 @@
 //! between bins from the window and the hop (checked against 200 noise draws in
 //! `tests/identify/statistics.rs`: the whitened deviations have a chi-square of 77.0 for 77
 //! bins); the parameters' covariance is the sandwich of the least-squares fit with it,
-//! scaled by its generalised chi-square ([`covariance`]). On the random sweeps above,
+//! scaled by its generalised chi-square (the private `covariance` below). On the random sweeps above,
 //! `(estimate - truth) / sigma` then has a spread of 1.05 (frequency), 1.11 (damping) and
 //! 1.23 (weight), and the 2-sigma intervals cover the truth for 47, 45 and 45 of the 48
 //! modes (a normal error would give 45.8 +- 1.4). The former covariance, `s^2 (J^T J)^-1`
