@@ -148,7 +148,9 @@ enum Command {
         #[arg(long)]
         firmware: Option<String>,
         /// Score shaped candidates on their worst case with the shaper this many percent
-        /// off its frequency either way [default: `[tune] frequency_tolerance_pct`, else 0].
+        /// off its frequency either way [default: `[tune] frequency_tolerance_pct`, else 0];
+        /// a machine whose modes carry `frequency_sigma_hz` is checked over the wider of
+        /// this and their 2-sigma band.
         #[arg(long, value_name = "PCT")]
         frequency_tolerance: Option<f64>,
         /// `settle` (simulate move-and-settle on the machine) or `klipper` (Klipper's

@@ -145,7 +145,15 @@ pub fn identify_recording(
     if use_sweep {
         let psd = direction::project(&cross, &axes, &dir.vector);
         let ones = vec![1.0; psd.len()];
-        let fit = sweep::fit(&source, &welch, &psd, &ones, &opts.test, opts.max_modes)?;
+        let fit = sweep::fit(
+            &source,
+            &welch,
+            &psd,
+            &ones,
+            &opts.test,
+            opts.max_modes,
+            None,
+        )?;
         let shown = ((1.5 * opts.test.freq_end_hz).min(fs / 2.0) / bin) as usize + 1;
         let figure = spectrum_figure(
             &welch.freqs_hz()[..shown.min(psd.len())],
@@ -186,6 +194,10 @@ pub fn identify_recording(
     })
 }
 
+/// Significant digits of the PSD values in Klipper's processed files (`%.3e`,
+/// `save_calibration_data` in `klippy/extras/shaper_calibrate.py`).
+const KLIPPER_DIGITS: i32 = 4;
+
 /// Identify the modes from a Klipper processed spectrum (`psd_xyz`, which does not
 /// depend on how the sensor is mounted).
 ///
@@ -202,7 +214,7 @@ pub fn identify_spectrum(
     opts: &Options,
 ) -> Result<AxisIdentification, IdentifyError> {
     opts.check()?;
-    let (first_bin, bin_hz) = bin_grid(psd)?;
+    let (first_bin, bin_hz, bin_sigma_hz) = bin_grid(psd)?;
     // Klipper's 0.5 s segment: the kernel's shape in bins barely depends on the length.
     let welch = Welch::new(bin_hz * 2048.0, 2048);
     let len = first_bin + psd.freq_hz.len();
@@ -217,14 +229,21 @@ pub fn identify_spectrum(
             }
         })
         .collect();
-    let fit = sweep::fit(
+    let mut fit = sweep::fit(
         &psd.source,
         &welch,
         &stored,
         &factor,
         &opts.test,
         opts.max_modes,
+        Some(KLIPPER_DIGITS),
     )?;
+    // Every frequency is a multiple of the bin width, which the file gives only through
+    // its rounded frequencies: that uncertainty scales them all.
+    for m in &mut fit.modes {
+        let f = &mut m.frequency_hz;
+        f.sigma = f.sigma.hypot(f.value * bin_sigma_hz / bin_hz);
+    }
     let dominant = fit.modes.first().and_then(|m| {
         let row = ((m.frequency_hz.value / bin_hz).round() as usize).checked_sub(first_bin)?;
         (0..3)
@@ -297,8 +316,10 @@ fn short_nfft(n: usize) -> usize {
 
 /// The bins of a processed spectrum: Klipper writes `k fs / nfft` rounded to 0.1 Hz, so
 /// the rows are fitted with `f0 + j bin` and `f0` must be a whole number of bins. Returns
-/// the first row's bin index and the bin width (Hz).
-fn bin_grid(psd: &ProcessedPsd) -> Result<(usize, f64), IdentifyError> {
+/// the first row's bin index, the bin width (Hz) and its standard deviation from the
+/// rounding (uniform over 0.1 Hz, a variance of `0.01 / 12` per row, through the
+/// regression's slope: `sqrt(0.01 / 12 / sum (j - mean j)^2)`).
+fn bin_grid(psd: &ProcessedPsd) -> Result<(usize, f64, f64), IdentifyError> {
     let f = &psd.freq_hz;
     let n = f.len() as f64;
     let mean_j = (n - 1.0) / 2.0;
@@ -332,5 +353,5 @@ fn bin_grid(psd: &ProcessedPsd) -> Result<(usize, f64), IdentifyError> {
             ));
         }
     }
-    Ok((first as usize, bin))
+    Ok((first as usize, bin, (0.01 / 12.0 / sxx).sqrt()))
 }

@@ -67,8 +67,10 @@ pub struct Diagnostics {
     /// Root mean square of the fit's residuals (sweep fit: natural log of PSD; ring-down
     /// fit: mm/s^2).
     pub residual_rms: f64,
-    /// Factor by which the covariance was inflated for correlated residuals
-    /// (`1 + 2 sum rho_l` over the first lags, at least 1).
+    /// The residuals' correlation `1 + 2 sum rho_l` over the first lags (at least 1):
+    /// ring-down fit, the factor the covariance was inflated by; sweep fit, the factor
+    /// its model selection counts the bins by (its covariance comes from the Welch
+    /// estimate's own, see [`crate::fit::sweep`]).
     pub residual_correlation: f64,
     /// Number of frequency bins (sweep) or samples (ring-down) fitted.
     pub points: usize,

@@ -211,21 +211,39 @@ impl Welch {
     /// `half_width_bins`, from `d = 0`.
     pub fn kernel_table(&self, half_width_bins: usize, per_bin: usize) -> Vec<f64> {
         let n = self.nfft as f64;
-        let centre = (n - 1.0) / 2.0;
         let sum_sq: f64 = self.window.iter().map(|w| w * w).sum();
         (0..=half_width_bins * per_bin)
             .map(|i| {
-                let d = i as f64 / per_bin as f64;
-                let w: f64 = self
-                    .window
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &wk)| {
-                        wk * (std::f64::consts::TAU * d * (k as f64 - centre) / n).cos()
-                    })
-                    .sum();
+                let w = self.window_transform(i as f64 / per_bin as f64);
                 w * w / (n * sum_sq)
             })
+            .collect()
+    }
+
+    /// The window's transform at an offset of `d` bins, `W(d) = sum_k w_k cos(2 pi d
+    /// (k - c) / nfft)` about the window's centre `c` (real: the window is symmetric).
+    fn window_transform(&self, d: f64) -> f64 {
+        let n = self.nfft as f64;
+        let centre = (n - 1.0) / 2.0;
+        self.window
+            .iter()
+            .enumerate()
+            .map(|(k, &wk)| wk * (std::f64::consts::TAU * d * (k as f64 - centre) / n).cos())
+            .sum()
+    }
+
+    /// The signed amplitude kernel `a(d) = W(d) / sqrt(nfft sum w^2)`, so that
+    /// [`Welch::kernel_table`] is `a^2`: one segment's transform of white noise at two
+    /// frequencies `d1` and `d2` bins from a point correlates as `a(d1) a(d2)`, which is
+    /// what the covariance of the estimate between bins is built from
+    /// ([`crate::fit::sweep_model::SweepModel::psd_covariance`]). Tabulated like
+    /// [`Welch::kernel_table`].
+    pub fn amplitude_kernel_table(&self, half_width_bins: usize, per_bin: usize) -> Vec<f64> {
+        let n = self.nfft as f64;
+        let sum_sq: f64 = self.window.iter().map(|w| w * w).sum();
+        let norm = (n * sum_sq).sqrt();
+        (0..=half_width_bins * per_bin)
+            .map(|i| self.window_transform(i as f64 / per_bin as f64) / norm)
             .collect()
     }
 }

@@ -22,6 +22,14 @@ pub struct ModeSpec {
     /// Participation in the toolhead error (weights of a real structure sum to 1).
     #[serde(default = "one")]
     pub weight: f64,
+    /// One standard deviation of the frequency (Hz), >= 0, when it was measured
+    /// (`settle identify` writes it): `settle tune` then checks its shapers over the
+    /// frequency's uncertainty band.
+    #[serde(default)]
+    pub frequency_sigma_hz: Option<f64>,
+    /// One standard deviation of the damping ratio, >= 0, when it was measured.
+    #[serde(default)]
+    pub damping_ratio_sigma: Option<f64>,
 }
 
 fn one() -> f64 {
@@ -48,7 +56,7 @@ pub fn modes_of<'a>(axes: &'a [AxisModes], axis: &str) -> Option<&'a [ModeSpec]>
 /// writes and `settle sweep` / `settle tune` read through `preset = "<file>"`): `name`,
 /// `description`, then one `[axis.<name>]` table per axis with its `modes`, each mode on
 /// its own line with every digit of its numbers (so a file read back gives the same
-/// modes bit for bit).
+/// modes bit for bit), its standard deviations when it has them.
 pub fn machine_file_text(name: &str, description: &str, axes: &[AxisModes]) -> String {
     let quote = |s: &str| toml::Value::String(s.to_string()).to_string();
     let mut out = format!(
@@ -59,8 +67,15 @@ pub fn machine_file_text(name: &str, description: &str, axes: &[AxisModes]) -> S
     for a in axes {
         out.push_str(&format!("\n[axis.{}]\nmodes = [\n", a.axis));
         for m in &a.modes {
+            let mut sigmas = String::new();
+            if let Some(s) = m.frequency_sigma_hz {
+                sigmas.push_str(&format!(", frequency_sigma_hz = {s:?}"));
+            }
+            if let Some(s) = m.damping_ratio_sigma {
+                sigmas.push_str(&format!(", damping_ratio_sigma = {s:?}"));
+            }
             out.push_str(&format!(
-                "  {{ frequency_hz = {:?}, damping_ratio = {:?}, weight = {:?} }},\n",
+                "  {{ frequency_hz = {:?}, damping_ratio = {:?}, weight = {:?}{sigmas} }},\n",
                 m.frequency_hz, m.damping_ratio, m.weight
             ));
         }
@@ -86,6 +101,19 @@ pub fn to_axis_modes<'a>(
         for (i, m) in modes.iter().enumerate() {
             Mode::new(m.frequency_hz, m.damping_ratio, m.weight)
                 .map_err(|e| src.error_at(&key, format!("mode {i}: {e}")))?;
+            for (name, sigma) in [
+                ("frequency_sigma_hz", m.frequency_sigma_hz),
+                ("damping_ratio_sigma", m.damping_ratio_sigma),
+            ] {
+                if let Some(s) = sigma
+                    && !(s.is_finite() && s >= 0.0)
+                {
+                    return Err(src.error_at(
+                        &key,
+                        format!("mode {i}: `{name}` = {s}: a standard deviation must be a finite number >= 0"),
+                    ));
+                }
+            }
         }
         out.push(AxisModes {
             axis,

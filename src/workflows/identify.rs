@@ -96,16 +96,21 @@ fn axis_of(file: &Path, source: &str, axis: Option<&str>) -> Result<String, Erro
         })
 }
 
-/// The modes a machine file gets from `id`: each mode's estimate; a weight the data do
-/// not determine ([`WeightBasis::NotIdentified`]) becomes `1 / n` for `n` modes.
+/// The modes a machine file gets from `id`: each mode's estimate with the standard
+/// deviations of its frequency and damping ratio (what `settle tune` takes as the
+/// frequency's uncertainty band); a weight the data do not determine
+/// ([`WeightBasis::NotIdentified`]) becomes `1 / n` for `n` modes.
 pub fn modes_of(id: &AxisIdentification) -> Vec<ModeSpec> {
     let n = id.modes.len().max(1) as f64;
+    let sigma = |s: f64| s.is_finite().then_some(s);
     id.modes
         .iter()
         .map(|m| ModeSpec {
             frequency_hz: m.frequency_hz.value,
             damping_ratio: m.damping_ratio.value,
             weight: m.weight.map_or(1.0 / n, |w| w.value),
+            frequency_sigma_hz: sigma(m.frequency_hz.sigma),
+            damping_ratio_sigma: sigma(m.damping_ratio.sigma),
         })
         .collect()
 }
@@ -194,9 +199,15 @@ pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
     })
 }
 
-/// `value ± sigma` with `digits` decimals.
+/// `value ± sigma` with at least `digits` decimals, and as many more as show the
+/// sigma's first two significant digits.
 fn pm(value: f64, sigma: f64, digits: usize) -> String {
-    format!("{value:.digits$} ± {sigma:.digits$}")
+    let shown = if sigma.is_finite() && sigma > 0.0 {
+        digits.max((1.0 - sigma.log10().floor()).max(0.0) as usize)
+    } else {
+        digits
+    };
+    format!("{value:.shown$} ± {sigma:.shown$}")
 }
 
 impl Identified {
@@ -206,7 +217,7 @@ impl Identified {
         let mut out = String::new();
         let _ = writeln!(
             out,
-            "{:<4} {:<16} {:>4} {:>18} {:>18} {:>16}  method",
+            "{:<4} {:<16} {:>4} {:>20} {:>20} {:>18}  method",
             "axis", "sensor", "mode", "frequency_hz", "damping_ratio", "weight"
         );
         for a in &self.axes {
@@ -227,7 +238,7 @@ impl Identified {
                 };
                 let _ = writeln!(
                     out,
-                    "{:<4} {:<16} {:>4} {:>18} {:>18} {:>16}  {method}",
+                    "{:<4} {:<16} {:>4} {:>20} {:>20} {:>18}  {method}",
                     a.axis,
                     sensor,
                     i,

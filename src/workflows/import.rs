@@ -15,7 +15,9 @@
 //! `[limits]`, `[shaper]` of the first axis), marks them in `[current]` among a `[sweep]`
 //! of shapers, frequencies and accelerations around them (for `settle sweep`), and holds a
 //! `[tune]` table for `settle tune` (the firmware's candidates, every axis with its current
-//! settings in `[tune.axis.<name>]`, a 5 % frequency tolerance). The machine is the one
+//! settings in `[tune.axis.<name>]`, a 5 % frequency tolerance unless the machine's modes
+//! carry their identified `frequency_sigma_hz`, whose 2-sigma band `settle tune` then
+//! uses). The machine is the one
 //! given (`--machine`, a machine file from `settle identify` or written by hand); without
 //! it the preset `printer_xy` stands in, and the report says so.
 
@@ -28,7 +30,7 @@ use settle_gcode::config::{KlipperConfig, RrfConfig, ShaperSetting as FirmwareSh
 use crate::error::{Error, Location};
 use crate::output::atomic::write_atomic;
 use crate::workflows::tune::firmware::Firmware;
-use crate::workflows::tune::grid::tuning_modes;
+use crate::workflows::tune::grid::{identified_band, tuning_modes};
 use crate::workflows::{Exit, Report};
 
 /// Shaper frequencies of the search, as multiples of the current one.
@@ -260,6 +262,7 @@ fn scenario_text(
     axes: &[&AxisNow],
     frequency_hz: f64,
     source: &str,
+    identified_band: bool,
 ) -> String {
     let first = axes.first().copied().unwrap_or(&cur.axes[0]);
     let fw = cur.firmware;
@@ -333,11 +336,16 @@ fn scenario_text(
     let names: Vec<String> = axes.iter().map(|a| q(&a.name)).collect();
     let _ = writeln!(
         t,
-        "[tune]\nfirmware = {}\naxes = [{}]\ndistances_mm = [5.0, 20.0]\nband_um = 10.0\nfrequency_scales = {}\naccelerations_mm_s2 = {}\nfrequency_tolerance_pct = {FREQUENCY_TOLERANCE_PCT:?}",
+        "[tune]\nfirmware = {}\naxes = [{}]\ndistances_mm = [5.0, 20.0]\nband_um = 10.0\nfrequency_scales = {}\naccelerations_mm_s2 = {}\n{}",
         q(fw.name()),
         names.join(", "),
         list(&FREQUENCY_SCALES),
-        list(&accels)
+        list(&accels),
+        if identified_band {
+            "# frequency_tolerance_pct: not set, the machine file's frequency_sigma_hz gives\n# each axis its band (2 sigma); a tolerance set here counts where it is wider".to_string()
+        } else {
+            format!("frequency_tolerance_pct = {FREQUENCY_TOLERANCE_PCT:?}")
+        }
     );
     for a in axes {
         let _ = writeln!(t, "\n[tune.axis.{}]", a.name);
@@ -409,8 +417,9 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
     let source = opts.config.display().to_string();
     let mut axes: Vec<&AxisNow> = Vec::new();
     let mut centre_hz = None;
+    let mut band = false;
     for a in &cur.axes {
-        let text = scenario_text(&name, &machine, &cur, &[a], 40.0, &source);
+        let text = scenario_text(&name, &machine, &cur, &[a], 40.0, &source, false);
         let probe = out.with_file_name(format!("{name}.probe.toml"));
         if let Ok((_, runs)) = crate::expand::parse_runs(&text, &probe)
             && let Some(run) = runs.first()
@@ -420,6 +429,7 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
                     .first()
                     .map(|(f, _)| (f * 10.0).round() / 10.0);
             }
+            band |= identified_band(run).is_some();
             axes.push(a);
         } else {
             notes.push(format!(
@@ -443,6 +453,7 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
         &axes,
         centre_hz.unwrap_or(40.0),
         &source,
+        band,
     );
     // What is written must load.
     crate::expand::parse_runs(&text, &out)?;

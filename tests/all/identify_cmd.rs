@@ -51,6 +51,10 @@ fn identified_modes_go_into_a_machine_file_that_a_sweep_takes() {
     assert_eq!(axes, got.modes);
     assert_eq!(axes[0].modes[0].frequency_hz, f.value);
     assert_eq!(axes[0].modes[0].damping_ratio, z.value);
+    // With the standard deviations, which `settle tune` takes as the frequency's band.
+    assert_eq!(axes[0].modes[0].frequency_sigma_hz, Some(f.sigma));
+    assert_eq!(axes[0].modes[0].damping_ratio_sigma, Some(z.sigma));
+    assert!(written.contains("frequency_sigma_hz = "), "{written}");
     for fig in &got.figures {
         assert!(
             fig.exists() && fig.with_extension("png").exists(),

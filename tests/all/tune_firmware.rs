@@ -216,6 +216,140 @@ fn frequency_tolerance_scores_the_worst_detuned_case() {
     assert!(e.to_string().contains("--frequency-tolerance"), "{e}");
 }
 
+/// A machine file (`settle identify`'s form) with one mode at 47.2 Hz, zeta 0.05, and the
+/// frequency's standard deviation `sigma_hz` when given; the scenario of [`scenario`] on
+/// it, with a 4 um band.
+fn identified_machine(dir: &Path, sigma_hz: Option<f64>) -> PathBuf {
+    let sigma = sigma_hz.map_or(String::new(), |s| {
+        format!(", frequency_sigma_hz = {s:?}, damping_ratio_sigma = 0.004")
+    });
+    write(
+        dir,
+        "machine.toml",
+        &format!(
+            "name = \"identified\"\n[axis.x]\nmodes = [\n  {{ frequency_hz = 47.2, damping_ratio = 0.05, weight = 1.0{sigma} }},\n]\n"
+        ),
+    );
+    let text = scenario("firmware = \"klipper\"\nshapers = [\"none\", \"zv\", \"mzv\", \"ei\"]\nfrequency_scales = [1.0]\n")
+        .replace(
+            "[machine]\nmodes = [{ frequency_hz = 47.2, damping_ratio = 0.05 }]",
+            "[machine]\npreset = \"machine.toml\"",
+        )
+        // A 4 um band: the detuned ZV's residual (4.2 um) leaves it, the exact one's
+        // (1.6 um) does not.
+        .replace("bands_um = [10.0]", "bands_um = [4.0]");
+    write(dir, "identified.toml", &text)
+}
+
+/// The score of the candidate shaped by `name`.
+fn shaped<'a>(
+    o: &'a settle::workflows::tune::Outcome,
+    name: &str,
+) -> &'a settle::workflows::tune::search::Score {
+    o.scores
+        .iter()
+        .find(|s| {
+            s.candidate
+                .shaper
+                .and_then(|sh| sh.kind)
+                .map(|k| k.name())
+                .as_deref()
+                == Some(name)
+        })
+        .expect("shaped candidate")
+}
+
+#[test]
+fn identified_frequency_band_makes_tune_prefer_a_robust_shaper() {
+    use settle::workflows::tune::search::BandSource;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let tune = |sigma: Option<f64>, tolerance: Option<f64>| {
+        let p = identified_machine(dir.path(), sigma);
+        let opts = Options {
+            frequency_tolerance_pct: tolerance,
+            ..modal()
+        };
+        tune_axis(&p, None, &opts, &settle::execute::pool::quiet).expect("tunes")
+    };
+    let name = |o: &settle::workflows::tune::Outcome| {
+        o.scores[o.winner]
+            .candidate
+            .shaper
+            .and_then(|s| s.kind)
+            .map(|k| k.name())
+    };
+    // Known exactly (no sigma): no band, and ZV, the shortest shaper, wins at 47.2 Hz.
+    let exact = tune(None, None);
+    assert_eq!(exact.plan.frequency_tolerance, 0.0);
+    assert_eq!(exact.plan.band_source, BandSource::None);
+    assert_eq!(
+        name(&exact).as_deref(),
+        Some("zv"),
+        "{:?}",
+        exact.scores[exact.winner]
+    );
+    // Identified as 47.2 +- 2.36 Hz (5 %): the band is 2 sigma = +-10 %, and ZV's worst
+    // case over it collapses while a robust shaper holds.
+    let wide = tune(Some(2.36), None);
+    assert!(
+        (wide.plan.frequency_tolerance - 0.1).abs() < 1e-12,
+        "{}",
+        wide.plan.frequency_tolerance
+    );
+    assert_eq!(wide.plan.band_source, BandSource::Identified(47.2, 2.36));
+    let winner = name(&wide);
+    assert!(
+        matches!(winner.as_deref(), Some("mzv" | "ei")),
+        "{winner:?} {:?}",
+        wide.scores[wide.winner]
+    );
+    let (zv_exact, zv_wide) = (shaped(&exact, "zv"), shaped(&wide, "zv"));
+    let w = &wide.scores[wide.winner];
+    eprintln!(
+        "zv: {:.2} um, {:.1} ms exact; {:.2} um, {:.1} ms worst over the band; winner {winner:?}: {:.2} um, {:.1} ms (exact {:.1} ms)",
+        zv_exact.residual_peak_um,
+        zv_exact.move_and_settle_s * 1e3,
+        zv_wide.residual_peak_um,
+        zv_wide.move_and_settle_s * 1e3,
+        w.residual_peak_um,
+        w.move_and_settle_s * 1e3,
+        shaped(&exact, winner.as_deref().expect("shaped")).move_and_settle_s * 1e3,
+    );
+    // Measured: ZV 1.61 um and 173.9 ms exactly tuned, 4.17 um and 191.3 ms at worst over
+    // the band; MZV 2.23 um and 181.0 ms at worst (179.3 ms exactly tuned).
+    assert!(zv_wide.residual_peak_um > 2.0 * zv_exact.residual_peak_um);
+    assert!(zv_wide.move_and_settle_s > w.move_and_settle_s);
+    assert!(
+        zv_exact.move_and_settle_s
+            < shaped(&exact, winner.as_deref().expect("shaped")).move_and_settle_s
+    );
+    // The report says which band it used.
+    let md = settle::workflows::tune::report::markdown(
+        "t",
+        &wide.plan,
+        &wide.scores,
+        wide.winner,
+        &wide.front,
+    );
+    assert!(
+        md.contains("Frequency band: +-10.000% (2 sigma of the identified 47.20 +- 2.360 Hz mode"),
+        "{md}"
+    );
+    // A given tolerance counts where it is wider than the identified band, not where it is narrower.
+    let given = tune(Some(2.36), Some(20.0));
+    assert!((given.plan.frequency_tolerance - 0.2).abs() < 1e-12);
+    assert_eq!(
+        given.plan.band_source,
+        BandSource::GivenOverIdentified(47.2, 2.36)
+    );
+    let narrow = tune(Some(2.36), Some(1.0));
+    assert!((narrow.plan.frequency_tolerance - 0.1).abs() < 1e-12);
+    // A negative sigma is an input error naming the key.
+    let p = identified_machine(dir.path(), Some(-1.0));
+    let e = tune_axis(&p, None, &modal(), &settle::execute::pool::quiet).expect_err("refused");
+    assert!(e.to_string().contains("frequency_sigma_hz"), "{e}");
+}
+
 fn calibration(file: &str) -> PathBuf {
     root().join("planner/tests/data").join(file)
 }

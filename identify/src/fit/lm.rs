@@ -19,6 +19,9 @@ pub struct LmFit {
     /// `(J^T J)^-1` at the optimum (multiply by `s^2` for the covariance); `None` when
     /// `J^T J` is singular (a parameter the data do not determine).
     pub inv_normal: Option<DMatrix<f64>>,
+    /// The Jacobian `J` of the residuals at the optimum (rows: residuals, columns:
+    /// parameters).
+    pub jacobian: DMatrix<f64>,
     /// Iterations taken.
     pub iterations: usize,
 }
@@ -41,6 +44,17 @@ impl LmFit {
                 (v.is_finite() && v >= 0.0).then(|| v.sqrt())
             })
             .collect()
+    }
+
+    /// The parameters' covariance when the residuals have the covariance `cov_r`
+    /// (not a multiple of the identity): the sandwich `(J^T J)^-1 J^T cov_r J (J^T J)^-1`
+    /// of the linearised least-squares estimate, which holds whatever the residuals'
+    /// correlation and for any weighting. `None` when `J^T J` is singular.
+    pub fn sandwich(&self, cov_r: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+        let inv = self.inv_normal.as_ref()?;
+        let jt = self.jacobian.transpose();
+        let meat = &jt * cov_r * &self.jacobian;
+        Some(inv * meat * inv)
     }
 }
 
@@ -132,6 +146,7 @@ where
         residuals: r,
         rss,
         inv_normal,
+        jacobian: j,
         iterations,
     })
 }

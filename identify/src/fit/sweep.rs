@@ -17,17 +17,24 @@
 //! one or two modes) the relative errors average `-1e-5` (frequency), `+5e-5` (damping)
 //! and `+1.8e-4` (weight) with spreads of `8e-5`, `7.5e-4` and `7.7e-4`.
 //!
-//! Known limit of the uncertainties: on those runs `(estimate - truth) / sigma` has a
-//! spread of 1.23 (frequency), 1.22 (damping) and 1.41 (weight) instead of 1, so a 2-sigma
-//! interval covers the truth less often than 95 %. Repeating single cases over 24-30
-//! noise draws separates the two parts: the scatter of the estimates is 0.85-1.24 times
-//! the mean reported sigma (1.03-1.11 for one mode under white noise alone), and what
-//! bias remains is at most 0.66 of that scatter (a relative `-2.3e-4` on the damping of a
-//! zeta 0.15 mode at the band's 105 Hz next to a zeta 0.14 one). The residual
-//! correlation `c` is estimated from residuals the fit has already smoothed, and the
-//! bins' variance model ([`super::sweep_residual`]) treats overlapping segments as
-//! independent, whereas a ringing mode keeps its noise cross term coherent over several
-//! of them; either can account for the excess.
+//! Uncertainties. The residuals are neither independent nor of one variance: the window
+//! correlates neighbouring bins (0.47 between adjacent bins at Klipper's Kaiser window and
+//! a quarter-segment hop), overlapping segments correlate the estimate in time, and where
+//! the spectrum is peaked within the window's kernel (a lightly damped mode) the cross
+//! term of the response with the noise adds coherently across overlapping segments.
+//! [`super::sweep_model::SweepModel::psd_covariance`] derives the covariance of the PSD
+//! between bins from the window and the hop (checked against 200 noise draws in
+//! `tests/identify/statistics.rs`: the whitened deviations have a chi-square of 77.0 for 77
+//! bins); the parameters' covariance is the sandwich of the least-squares fit with it,
+//! scaled by its generalised chi-square (the private `covariance` below). On the random sweeps above,
+//! `(estimate - truth) / sigma` then has a spread of 1.05 (frequency), 1.11 (damping) and
+//! 1.23 (weight), and the 2-sigma intervals cover the truth for 47, 45 and 45 of the 48
+//! modes (a normal error would give 45.8 +- 1.4). The former covariance, `s^2 (J^T J)^-1`
+//! inflated by the residuals' own correlation `c`, gave spreads of 1.23, 1.22 and 1.41
+//! (44, 43 and 39 of 48 covered): `c` measured from residuals the fit has already
+//! smoothed undercounts the bins' correlation, and a common inflation is exact only for
+//! parameters whose derivative is smooth over the correlation length, which a mode's
+//! frequency and damping at a narrow peak are not.
 //!
 //! Procedure. The bins are first weighted by the measured PSD itself (the weights' limit
 //! where the sweep dominates the noise); the first mode starts at the largest response
@@ -40,7 +47,9 @@
 //! [`super::BIC_MARGIN`] and every mode stays significant (weight and damping at least
 //! [`super::SIGNIFICANCE`] standard deviations from 0, frequencies a bin apart). The
 //! chosen model is refitted with the weights of its own expected PSD and noise floor; the
-//! uncertainties are that fit's Gauss-Newton covariance `s^2 (J^T J)^-1` inflated by `c`.
+//! uncertainties are that fit's sandwich covariance (see the notes on uncertainties).
+
+use nalgebra::{DMatrix, DVector};
 
 use super::lm::{self, LmFit};
 use super::sweep_model::SweepModel;
@@ -86,7 +95,9 @@ pub struct SweepFit {
 
 /// Fit the PSD `psd` (per bin of `welch`, stored units) whose stored values are
 /// `factor` x the recording's PSD (1 for raw data; 0 where the file holds nothing),
-/// measured under `test`, with up to `max_modes` modes.
+/// measured under `test`, with up to `max_modes` modes; `digits`: the significant digits
+/// a file kept of each value (its rounding is part of the uncertainty), `None` for a PSD
+/// computed here.
 pub fn fit(
     source: &str,
     welch: &Welch,
@@ -94,6 +105,7 @@ pub fn fit(
     factor: &[f64],
     test: &SweepTest,
     max_modes: usize,
+    digits: Option<i32>,
 ) -> Result<SweepFit, IdentifyError> {
     let bin = welch.bin_hz();
     let lo_hz = test.freq_start_hz.max(5.0) + EDGE_BINS * bin;
@@ -223,8 +235,21 @@ pub fn fit(
     residual.set_weights(&residual.expected(&searched.theta), noise);
     let fit = run(&residual, std::slice::from_ref(&searched.theta)).unwrap_or(searched);
     let c = correlation_inflation(&fit.residuals);
-    let sig = fit
-        .sigmas(c)
+    // A file's rounding: uniform over one unit of the last digit kept, a variance of
+    // `unit^2 / 12`, independent from bin to bin, relative to the value for `ln P`.
+    let rounding: Vec<f64> = match digits {
+        None => vec![0.0; n],
+        Some(d) => bins
+            .iter()
+            .map(|&k| {
+                let v = psd[k].abs();
+                let unit = 10f64.powi(v.log10().floor() as i32 - (d - 1));
+                (unit / v).powi(2) / 12.0
+            })
+            .collect(),
+    };
+    let sig = covariance(&fit, &residual, &model, &rounding)
+        .map(|v| (0..v.nrows()).map(|i| v[(i, i)].max(0.0).sqrt()).collect())
         .unwrap_or_else(|| vec![f64::NAN; fit.theta.len()]);
     let mut modes: Vec<IdentifiedMode> = (0..(fit.theta.len() - 2) / 3)
         .map(|k| {
@@ -341,6 +366,81 @@ fn significant(fit: &LmFit, c: f64, bin: f64) -> bool {
     (0..m)
         .all(|k| sig[2 + 3 * k + 1] * SIGNIFICANCE < 1.0 && sig[2 + 3 * k + 2] * SIGNIFICANCE < 1.0)
         && (0..m).all(|a| (a + 1..m).all(|b| (f[a] - f[b]).abs() > bin))
+}
+
+/// The covariance of the fitted parameters: the sandwich ([`LmFit::sandwich`]) with the
+/// residuals' covariance `C` from the Welch estimate's own ([`SweepModel::psd_covariance`],
+/// through `d ln P = d P / M` and the bins' weights), which holds the correlation of
+/// neighbouring bins and the excess variance at narrow peaks.
+///
+/// `C` is known up to one factor: the noise that drives it (the cross term, which
+/// dominates wherever the sweep stands above the floor, scales with the noise floor `N`
+/// over the number of segments, and `N` is poorly determined exactly there: on the
+/// simulated sweeps of `tests/identify/sweep.rs` the fitted floor ranges from 0 to 3 times
+/// the sensor's). The factor is estimated from the residuals by generalised least
+/// squares: `r^T C^-1 r` over its expectation `tr(C^-1 (I - H) C (I - H)^T)` with the fit's
+/// hat matrix `H = J (J^T J)^-1 J^T` (the residuals of a fit are `(I - H)` times the
+/// noise). A file's rounding (`rounding`: the variance it adds to each bin's `ln P`) is a
+/// known, fixed part added to the scaled one, the factor then solving the same equation. On those sweeps the factor times the fitted floor recovers the sensor's noise
+/// density to within the factor's own scatter, and any misfit of the model shows as a
+/// larger factor, so it widens the sigmas too.
+fn covariance(
+    fit: &LmFit,
+    residual: &SweepResidual,
+    model: &SweepModel,
+    rounding: &[f64],
+) -> Option<DMatrix<f64>> {
+    let expected = residual.expected(&fit.theta);
+    let (gain, noise) = residual.gain_and_noise(&fit.theta);
+    // The floor the weights assume where the data do not resolve one
+    // (`SweepResidual::set_weights`).
+    let smallest = expected.iter().copied().fold(f64::INFINITY, f64::min);
+    let noise = noise.max(1e-9 * smallest);
+    let cov_p = model.psd_covariance(gain, noise, &SweepResidual::modes(&fit.theta));
+    let sw = residual.sqrt_weights();
+    let n = expected.len();
+    let shape = DMatrix::from_fn(n, n, |i, j| {
+        sw[i] * sw[j] * cov_p[(i, j)] / (expected[i] * expected[j])
+    });
+    let fixed = DMatrix::from_diagonal(&DVector::from_iterator(
+        n,
+        (0..n).map(|i| sw[i] * sw[i] * rounding[i]),
+    ));
+    let inv = fit.inv_normal.as_ref()?;
+    let resid = DMatrix::identity(n, n) - &fit.jacobian * inv * fit.jacobian.transpose();
+    let r = DVector::from_column_slice(&fit.residuals);
+    // Observed minus expected generalised chi-square for the scale `s`.
+    let excess = |s: f64| -> Option<f64> {
+        let total = &shape * s + &fixed;
+        let chol = total.clone().cholesky()?;
+        let chi2 = r.dot(&chol.solve(&r));
+        let expectation = chol.solve(&(&resid * &total * resid.transpose())).trace();
+        Some(chi2 - expectation)
+    };
+    // Without a fixed part the equation is linear in `s`; with one, bisect (on a log
+    // scale) below that value, which the fixed part can only lower.
+    let chol = shape.clone().cholesky()?;
+    let chi2 = r.dot(&chol.solve(&r));
+    let s0 = chi2 / chol.solve(&(&resid * &shape * resid.transpose())).trace();
+    let scale = if rounding.iter().all(|&v| v == 0.0) {
+        s0
+    } else {
+        let (mut lo, mut hi) = (s0 * 1e-6, s0);
+        if excess(lo)? <= 0.0 {
+            lo
+        } else {
+            for _ in 0..60 {
+                let mid = (lo * hi).sqrt();
+                if excess(mid)? > 0.0 {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            (lo * hi).sqrt()
+        }
+    };
+    fit.sandwich(&(&shape * scale + &fixed))
 }
 
 /// The `q` quantile of `v` (nearest rank).

@@ -68,6 +68,11 @@ impl<'a> SweepResidual<'a> {
         self.sqrt_w = w.iter().map(|v| (v / mean).sqrt()).collect();
     }
 
+    /// The square roots of the bins' weights (mean weight 1).
+    pub fn sqrt_weights(&self) -> &[f64] {
+        &self.sqrt_w
+    }
+
     /// The gain `G` and noise floor `N` ((mm/s^2)^2/Hz) of `theta`.
     pub fn gain_and_noise(&self, theta: &[f64]) -> (f64, f64) {
         (theta[0].exp(), theta[1] * self.noise_unit)

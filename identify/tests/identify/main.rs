@@ -4,6 +4,7 @@
 mod common;
 mod readers;
 mod ringdown;
+mod statistics;
 mod sweep;
 mod synth;
 mod welch_klipper;

@@ -11,7 +11,7 @@ use crate::kinds::corner::Corner;
 use crate::kinds::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
 use crate::spec::run_spec::RunSpec;
 use crate::workflows::tune::firmware::Firmware;
-use crate::workflows::tune::search::{Candidate, Plan};
+use crate::workflows::tune::search::{BandSource, Candidate, Plan};
 
 /// Four-jerk BOW1..4 patterns searched (multiples of jmax; each <= 1).
 pub const BOW_PATTERNS: [[f64; 4]; 5] = [
@@ -206,13 +206,17 @@ pub fn plan(
     if !(max_smoothing_mm.is_finite() && max_smoothing_mm > 0.0) {
         return Err(src.error_at("tune.max_smoothing_mm", "must be a finite number > 0 (mm)"));
     }
-    let tolerance_pct = spec.frequency_tolerance_pct.unwrap_or(0.0);
-    if !(tolerance_pct.is_finite() && (0.0..50.0).contains(&tolerance_pct)) {
+    let given_pct = spec.frequency_tolerance_pct;
+    if let Some(p) = given_pct
+        && !(p.is_finite() && (0.0..50.0).contains(&p))
+    {
         return Err(src.error_at(
             "tune.frequency_tolerance_pct",
             "must be 0 to under 50 (percent)",
         ));
     }
+    let identified = identified_band(&base);
+    let (tolerance_pct, band_source) = frequency_band(given_pct, identified);
     let scales = spec
         .frequency_scales
         .clone()
@@ -343,8 +347,70 @@ pub fn plan(
         modes,
         spec,
         frequency_tolerance: tolerance_pct / 100.0,
+        band_source,
         max_smoothing_mm,
     })
+}
+
+/// The band (percent) a search scores its shapers over and where it came from: the
+/// larger of the given tolerance and the identified band (`(percent, frequency_hz,
+/// sigma_hz)`, [`identified_band`]). Both bound how far the real mode may lie from the
+/// shaper's frequency: the identified band what the measurement cannot rule out, the
+/// given one what the user knows beyond it (the frequency moving with the toolhead's
+/// position, load or temperature), so a winner must hold over the wider. Without either,
+/// no band.
+pub fn frequency_band(
+    given_pct: Option<f64>,
+    identified: Option<(f64, f64, f64)>,
+) -> (f64, BandSource) {
+    match (given_pct, identified) {
+        (None, None) => (0.0, BandSource::None),
+        (Some(p), None) => (
+            p,
+            if p > 0.0 {
+                BandSource::Given
+            } else {
+                BandSource::None
+            },
+        ),
+        (None, Some((p, f, s))) => (p, BandSource::Identified(f, s)),
+        (Some(g), Some((p, f, s))) if g >= p => (g, BandSource::GivenOverIdentified(f, s)),
+        (Some(_), Some((p, f, s))) => (p, BandSource::Identified(f, s)),
+    }
+}
+
+/// Largest identified band allowed (percent), as for `frequency_tolerance_pct`.
+pub const MAX_BAND_PCT: f64 = 49.0;
+
+/// The identified frequency band of the modes the shapers are tuned to
+/// ([`tuning_modes`] of a machine given by its modes, each with `frequency_sigma_hz`):
+/// the widest `2 sigma / f` among them, as `(percent, frequency_hz, sigma_hz)` (at most
+/// [`MAX_BAND_PCT`]). Two standard deviations: the interval that covers the true
+/// frequency in 95 % of identifications when the sigmas are right (they are checked so
+/// in settle-identify's `random_sweeps_from_env`). `None` without sigmas or for a
+/// physical machine.
+pub fn identified_band(base: &RunSpec) -> Option<(f64, f64, f64)> {
+    if base.machine.is_some() {
+        return None;
+    }
+    let tuned = tuning_modes(base);
+    let mut best: Option<(f64, f64, f64)> = None;
+    for name in base.axis.split('+') {
+        for m in base.modes_of(name) {
+            let Some(s) = m.frequency_sigma_hz else {
+                continue;
+            };
+            let f = m.frequency_hz;
+            if !tuned.iter().any(|(g, _)| (g - f).abs() < 1e-6 * f) {
+                continue;
+            }
+            let pct = (200.0 * s / f).min(MAX_BAND_PCT);
+            if best.is_none_or(|b| pct > b.0) {
+                best = Some((pct, f, s));
+            }
+        }
+    }
+    best
 }
 
 /// An axis's current shaper from `[tune.axis.<name>]`, the scenario's `[shaper]` filling

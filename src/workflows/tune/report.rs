@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::Outcome;
-use super::search::{Plan, Score};
+use super::search::{BandSource, Plan, Score};
 use crate::input::runs_table::record;
 use crate::kinds::corner::Corner;
 use crate::kinds::scan::ScanSpec;
@@ -99,7 +99,13 @@ pub fn current_to_recommended(axes: &[(String, Outcome)]) -> String {
         p.spec.firmware.as_deref().unwrap_or("any"),
         score_text(p),
         p.max_smoothing_mm,
-        if p.frequency_tolerance > 0.0 {
+        if axes
+            .iter()
+            .any(|(_, o)| o.plan.band_source != BandSource::Given
+                && o.plan.frequency_tolerance > 0.0)
+        {
+            "; shaped candidates are scored on the worst of their shaper at its frequency and at either edge of their axis's frequency band (given with each axis below)".to_string()
+        } else if p.frequency_tolerance > 0.0 {
             format!(
                 "; shaped candidates are scored on the worst of their shaper at its frequency and {}% either side",
                 p.frequency_tolerance * 100.0
@@ -291,6 +297,13 @@ pub fn markdown(
         score_text(plan),
         scores.len()
     );
+    if plan.frequency_tolerance > 0.0 {
+        let _ = writeln!(
+            out,
+            "Frequency band: {}; a shaped candidate scores the worst of its shaper at its frequency and at either edge.\n",
+            plan.band_source.describe(plan.frequency_tolerance)
+        );
+    }
     let gain = if w.move_and_settle_s.is_finite() && d.simulated_move_and_settle_s.is_finite() {
         format!(
             "{:.1}% {} ({:.1} ms saved{})",

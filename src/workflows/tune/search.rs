@@ -16,8 +16,11 @@
 //! restricted to what the `firmware` runs. A shaped candidate's smoothing (Klipper's figure
 //! at its acceleration and 5 mm/s) and the largest acceleration keeping it within
 //! `max_smoothing_mm` (Klipper's bisection) are part of its score; a candidate smoothing
-//! more is infeasible. With `frequency_tolerance_pct`, a shaped candidate is also run with
-//! its shaper detuned by that much either way and scored on the worst of the three.
+//! more is infeasible. With `frequency_tolerance_pct`, or a machine whose modes carry the
+//! standard deviation of their frequency (`frequency_sigma_hz`, as `settle identify`
+//! writes it), a shaped candidate is also run with its shaper detuned either way by the
+//! larger of that tolerance and the modes' 2-sigma band ([`super::grid::frequency_band`])
+//! and scored on the worst of the three.
 //!
 //! A candidate's score is the mean `move_and_settle_s` over the move family
 //! (`distances_mm`, or a corner scenario's `angles_deg`) into the tighter band
@@ -172,6 +175,8 @@ pub struct Plan {
     pub spec: TuneSpec,
     /// Detuning of the robustness check, a fraction (0: none).
     pub frequency_tolerance: f64,
+    /// Where that detuning came from ([`super::grid::frequency_band`]).
+    pub band_source: BandSource,
     /// Largest smoothing a shaped candidate may have (mm).
     pub max_smoothing_mm: f64,
 }
@@ -345,6 +350,38 @@ impl Plan {
             move_and_settle_s: mas / k,
             max_contour_error_um: contour,
             at_band_s: at_band / k,
+        }
+    }
+}
+
+/// Where the robustness band of a search came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BandSource {
+    /// No band: the shapers are scored at their frequency alone.
+    None,
+    /// `--frequency-tolerance` / `[tune] frequency_tolerance_pct`.
+    Given,
+    /// Twice the identified standard deviation of a mode's frequency (the machine file's
+    /// `frequency_sigma_hz`): `(frequency_hz, sigma_hz)` of the mode with the widest band.
+    Identified(f64, f64),
+    /// The given tolerance, which is at least the identified band `(frequency_hz,
+    /// sigma_hz)`.
+    GivenOverIdentified(f64, f64),
+}
+
+impl BandSource {
+    /// A sentence for the report: which band and why.
+    pub fn describe(&self, tolerance: f64) -> String {
+        let pct = tolerance * 100.0;
+        match *self {
+            BandSource::None => "no frequency band (the shapers' own frequencies only)".into(),
+            BandSource::Given => format!("+-{pct:.3}% (the given frequency tolerance)"),
+            BandSource::Identified(f, s) => format!(
+                "+-{pct:.3}% (2 sigma of the identified {f:.2} +- {s:.3} Hz mode, from the machine file)"
+            ),
+            BandSource::GivenOverIdentified(f, s) => format!(
+                "+-{pct:.3}% (the given frequency tolerance; the identified {f:.2} +- {s:.3} Hz mode's 2 sigma band is narrower)"
+            ),
         }
     }
 }
