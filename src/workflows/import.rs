@@ -15,9 +15,9 @@
 //! `[limits]`, `[shaper]` of the first axis), marks them in `[current]` among a `[sweep]`
 //! of shapers, frequencies and accelerations around them (for `settle sweep`), and holds a
 //! `[tune]` table for `settle tune` (the firmware's candidates, every axis with its current
-//! settings in `[tune.axis.<name>]`, a 5 % frequency tolerance unless the machine's modes
-//! carry their identified `frequency_sigma_hz`, whose 2-sigma band `settle tune` then
-//! uses). The machine is the one
+//! settings in `[tune.axis.<name>]`, a 5 % frequency tolerance; where the machine's modes
+//! carry their identified `frequency_sigma_hz`, `settle tune` uses the wider of that and
+//! their 2-sigma band). The machine is the one
 //! given (`--machine`, a machine file from `settle identify` or written by hand); without
 //! it the preset `printer_xy` stands in, and the report says so.
 
@@ -39,7 +39,10 @@ pub const FREQUENCY_SCALES: [f64; 5] = [0.9, 0.95, 1.0, 1.05, 1.1];
 /// current `max_accel` is what the user's motors are known to reach).
 pub const ACCEL_SCALES: [f64; 3] = [0.5, 0.75, 1.0];
 /// Robustness of the imported search (percent): a winner must still work with the real
-/// mode this far off the identified one.
+/// mode this far off the identified one. Kept when the machine's modes carry their
+/// identified sigmas: those are the statistical uncertainty of one measurement (often
+/// under 0.1 %), while a gantry's modes move by percents with the toolhead's position,
+/// the load and the belt tension.
 pub const FREQUENCY_TOLERANCE_PCT: f64 = 5.0;
 /// The preset that stands in when no machine is given.
 pub const STAND_IN_PRESET: &str = "printer_xy";
@@ -342,7 +345,9 @@ fn scenario_text(
         list(&FREQUENCY_SCALES),
         list(&accels),
         if identified_band {
-            "# frequency_tolerance_pct: not set, the machine file's frequency_sigma_hz gives\n# each axis its band (2 sigma); a tolerance set here counts where it is wider".to_string()
+            format!(
+                "# The machine file's frequency_sigma_hz gives each axis a 2-sigma band; tune uses\n# the wider of that band and this tolerance (the drift one measurement does not see).\nfrequency_tolerance_pct = {FREQUENCY_TOLERANCE_PCT:?}"
+            )
         } else {
             format!("frequency_tolerance_pct = {FREQUENCY_TOLERANCE_PCT:?}")
         }
