@@ -68,6 +68,31 @@ pub fn echo(value: &str) -> String {
     }
 }
 
+/// `message` with every `` `quoted` `` part longer than [`ECHO_CHARS`] shortened by
+/// [`echo`]: the messages of the TOML parser and of the checks quote the input they reject
+/// (an unknown name, a key), and a 10 MB name is not printed back.
+pub fn echo_quoted(message: &str) -> String {
+    let parts: Vec<&str> = message.split('`').collect();
+    if parts.len() < 3 || parts.iter().all(|p| p.chars().count() <= ECHO_CHARS) {
+        return message.to_string();
+    }
+    let last = parts.len() - 1;
+    parts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            // Odd parts lie between two backticks (a last one without its closing backtick
+            // is plain text).
+            if i % 2 == 1 && i < last {
+                echo(p)
+            } else {
+                (*p).to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("`")
+}
+
 /// Everything the harness reports. Bad input (exit code 2) is told apart from failures
 /// while running or writing (exit code 1) by [`Error::is_input_error`].
 #[derive(Debug, thiserror::Error)]
@@ -130,7 +155,7 @@ impl Error {
     pub fn input(file: impl Into<PathBuf>, message: impl Into<String>) -> Self {
         Error::Input {
             at: Location::file(file),
-            message: message.into(),
+            message: echo_quoted(&message.into()),
         }
     }
 
@@ -141,8 +166,8 @@ impl Error {
         message: impl Into<String>,
     ) -> Self {
         Error::Input {
-            at: Location::key(file, key),
-            message: message.into(),
+            at: Location::key(file, echo(&key.into())),
+            message: echo_quoted(&message.into()),
         }
     }
 

@@ -7,6 +7,7 @@ mod cli;
 mod corners;
 mod faults;
 mod gcode_job;
+mod hardening_input;
 mod html_report;
 mod identify_cmd;
 mod import;
