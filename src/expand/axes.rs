@@ -180,7 +180,7 @@ fn numbers(raw: &toml::Value, max_values: usize) -> Result<Vec<f64>, String> {
                     // The count is checked as a float first: a tiny step gives a count far
                     // beyond usize, and the values are not made unless it passes.
                     let n = ((to - from).abs() / s + 1e-9).floor() + 1.0;
-                    if !(n <= max_values as f64) {
+                    if n > max_values as f64 {
                         return Err(too_many(n));
                     }
                     let dir = if to >= from { 1.0 } else { -1.0 };
