@@ -68,12 +68,16 @@ pub fn echo(value: &str) -> String {
     }
 }
 
-/// `message` with every `` `quoted` `` part longer than [`ECHO_CHARS`] shortened by
+/// The longest `` `quoted` `` part of a message [`echo_quoted`] leaves whole: far above a
+/// command or a path settle suggests, far below input that is not worth printing back.
+pub const QUOTED_CHARS: usize = 1000;
+
+/// `message` with every `` `quoted` `` part longer than [`QUOTED_CHARS`] shortened by
 /// [`echo`]: the messages of the TOML parser and of the checks quote the input they reject
 /// (an unknown name, a key), and a 10 MB name is not printed back.
 pub fn echo_quoted(message: &str) -> String {
     let parts: Vec<&str> = message.split('`').collect();
-    if parts.len() < 3 || parts.iter().all(|p| p.chars().count() <= ECHO_CHARS) {
+    if parts.len() < 3 || parts.iter().all(|p| p.chars().count() <= QUOTED_CHARS) {
         return message.to_string();
     }
     let last = parts.len() - 1;
@@ -83,7 +87,7 @@ pub fn echo_quoted(message: &str) -> String {
         .map(|(i, p)| {
             // Odd parts lie between two backticks (a last one without its closing backtick
             // is plain text).
-            if i % 2 == 1 && i < last {
+            if i % 2 == 1 && i < last && p.chars().count() > QUOTED_CHARS {
                 echo(p)
             } else {
                 (*p).to_string()
@@ -91,6 +95,15 @@ pub fn echo_quoted(message: &str) -> String {
         })
         .collect::<Vec<_>>()
         .join("`")
+}
+
+/// `text` (a key path) whole up to [`QUOTED_CHARS`] characters, else shortened by [`echo`].
+pub fn echo_long(text: &str) -> String {
+    if text.chars().count() > QUOTED_CHARS {
+        echo(text)
+    } else {
+        text.to_string()
+    }
 }
 
 /// Everything the harness reports. Bad input (exit code 2) is told apart from failures
@@ -166,7 +179,7 @@ impl Error {
         message: impl Into<String>,
     ) -> Self {
         Error::Input {
-            at: Location::key(file, echo(&key.into())),
+            at: Location::key(file, echo_long(&key.into())),
             message: echo_quoted(&message.into()),
         }
     }

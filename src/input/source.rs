@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use serde::de::DeserializeOwned;
 use toml::de::{DeTable, ValueDeserializer};
 
-use crate::error::{Error, Location, echo, echo_quoted};
+use crate::error::{Error, Location, echo_long, echo_quoted};
 use crate::input::keys::KeyIndex;
 
 /// An input file's text, path and key index.
@@ -55,7 +55,7 @@ impl Source {
             at: Location {
                 line,
                 column,
-                ..Location::key(&self.path, echo(key))
+                ..Location::key(&self.path, echo_long(key))
             },
             message: echo_quoted(&message.into()),
         }
@@ -104,7 +104,7 @@ impl Source {
             at: Location {
                 line,
                 column,
-                key: key.map(|k| echo(&k)),
+                key: key.map(|k| echo_long(&k)),
                 ..Location::file(&self.path)
             },
             message: echo_quoted(message),
