@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerate docs/performance.md from measurements on this machine: the criterion benches
 # (planner, four-jerk, paths, the simulation loop per backend, the sweep, MuJoCo), the
-# shipped sweeps timed with /usr/bin/time, and `scripts/scale.sh memory`. The page starts
+# shipped sweeps timed with /usr/bin/time, and `scripts/scale.sh memory` and `flat`. The page starts
 # with the date, the commit and the machine (CPU, cores, memory, rustc, load average).
 #
 #   scripts/perf-page.sh            everything (about 30 minutes on a busy 2-core machine with
@@ -103,6 +103,8 @@ if [[ $quick == 0 ]]; then
   timed "scale_10k, modal (10,000 runs)" sweep scenarios/scale_10k.toml --backend modal
   echo "== scripts/scale.sh memory" | tee -a "$log"
   scripts/scale.sh memory 2>&1 | tee -a "$log"
+  echo "== scripts/scale.sh flat" | tee -a "$log"
+  SETTLE="$bin" scripts/scale.sh flat 2>&1 | tee -a "$log"
 fi
 
 load_after=$(cut -d' ' -f1-3 /proc/loadavg)
@@ -110,7 +112,7 @@ commit=$(git rev-parse --short=12 HEAD)
 git diff --quiet HEAD -- . ':!docs/performance.md' || commit="$commit (with uncommitted changes)"
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
 mem=$(awk '/MemTotal/ { printf "%.0f GiB", $2 / 1048576 }' /proc/meminfo)
-mode="full run (every bench, the shipped sweeps, scripts/scale.sh memory)"
+mode="full run (every bench, the shipped sweeps, scripts/scale.sh memory and flat)"
 [[ $quick == 1 ]] && mode="quick run (scripts/perf-page.sh --quick): the cheapest subset only; regenerate with scripts/perf-page.sh for every bench"
 [[ $quick == 0 && ${#features[@]} -eq 0 ]] && mode="$mode, without MuJoCo"
 
@@ -172,9 +174,9 @@ def fmt_time(x):
 sections, current, last_name = [], None, None
 for raw in open(log_path, encoding="utf-8", errors="replace"):
     line = raw.rstrip()
-    m = re.match(r"== (cargo bench -p \S+ --bench (\S+).*|scripts/scale\.sh memory)$", line)
+    m = re.match(r"== (cargo bench -p \S+ --bench (\S+).*|scripts/scale\.sh (memory|flat))$", line)
     if m:
-        bench = m.group(2) or "scale"
+        bench = m.group(2) or ("scale_flat" if m.group(3) == "flat" else "scale")
         current = next((s for s in sections if s["bench"] == bench), None)
         if current is None:
             current = {"cmds": [], "bench": bench, "rows": [], "notes": []}
@@ -182,6 +184,11 @@ for raw in open(log_path, encoding="utf-8", errors="replace"):
         current["cmds"].append(m.group(1))
         continue
     if current is None or not line.strip():
+        continue
+    if current["bench"] == "scale_flat":
+        # scale.sh flat prints its table as markdown rows.
+        if line.startswith("|"):
+            current["notes"].append(line.strip())
         continue
     if "time:" in line:
         name = line.split("time:")[0].strip() or last_name
@@ -289,6 +296,19 @@ if scale:
     w("```text")
     out.extend(scale[0]["notes"])
     w("```")
+flat = [s for s in sections if s["bench"] == "scale_flat"]
+if flat:
+    w("")
+    w("## Time and memory per run at scale")
+    w("")
+    w("`scripts/scale.sh flat`: `scenarios/scale_10k.toml` with 1,000, 10,000 and 100,000 "
+      "runs (modal backend, all cores, every output written), timed with `/usr/bin/time`. "
+      "CPU time is user + system (the wall time of a shared machine says little). The check "
+      "fails if the CPU time per run at 100,000 runs is more than 20 % above that at 1,000 "
+      "or 10,000 runs, or the peak RSS per run grows by more than 20 % from 10,000 to "
+      "100,000.")
+    w("")
+    out.extend(flat[0]["notes"])
 w("")
 w("Not measured here: `scripts/scale.sh planner` (1e7 random planner problems against "
   "rsruckig; a correctness check at scale that takes minutes) and the test suite's own "

@@ -3,8 +3,14 @@
 #   scripts/scale.sh memory   a 10,000-run sweep; fails if its peak RSS exceeds 200 MB
 #   scripts/scale.sh planner  the any-state planner's random suite with 2 x 5,000,000 = 1e7
 #                             problems against rsruckig (SETTLE_PLANNER_STATE_CASES)
-#   scripts/scale.sh          both
-# BACKEND (default modal) picks the sweep's backend; LIMIT_MB (default 200) the bound.
+#   scripts/scale.sh flat     sweeps of 1,000, 10,000 and 100,000 runs (scale_10k.toml with
+#                             more or fewer distances); fails if the CPU time (user + sys,
+#                             not wall: the machine may be shared) per run at 100,000 is
+#                             more than 20 % above that at 1,000 or at 10,000, or if the
+#                             peak RSS per run grows by more than 20 % from 10,000 to 100,000
+#   scripts/scale.sh          all three
+# BACKEND (default modal) picks the sweep's backend; LIMIT_MB (default 200) the bound;
+# SETTLE=path/to/settle uses that binary instead of building the release one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what="${1:-all}"
@@ -32,6 +38,65 @@ memory() {
     rm -rf "$out"
 }
 
+# One sweep of $1 runs: prints "runs cpu_s peak_kb".
+sweep_of() {
+    local n="$1" dir="$2" scenario
+    scenario="$dir/scale_$n.toml"
+    sed -e "s/steps = 5000,/steps = $((n / 2)),/" -e "s/^name = .*/name = \"scale_$n\"/" \
+        scenarios/scale_10k.toml > "$scenario"
+    /usr/bin/time -v "$(settle_bin)" sweep "$scenario" \
+        --backend "$backend" --out "$dir/out_$n" 2> "$dir/time_$n.txt" \
+        || { cat "$dir/time_$n.txt" >&2; exit 1; }
+    local rows
+    rows="$(($(wc -l < "$dir/out_$n/runs.csv") - 1))"
+    [ "$rows" -eq "$n" ] || { echo "scale.sh: expected $n runs, got $rows" >&2; exit 1; }
+    awk -v n="$n" -F: '
+        /User time/ { cpu += $2 } /System time/ { cpu += $2 }
+        /Maximum resident set size/ { kb = $2 }
+        END { printf "%d %.2f %d\n", n, cpu, kb }' "$dir/time_$n.txt"
+    rm -rf "$dir/out_$n"
+}
+
+# The binary to measure: $SETTLE, else the release build (built here).
+settle_bin() {
+    echo "${SETTLE:-${CARGO_TARGET_DIR:-target}/release/settle}"
+}
+
+flat() {
+    [ -n "${SETTLE:-}" ] || cargo build --release --locked --bin settle
+    if [ ! -x /usr/bin/time ]; then
+        echo "scale.sh: needs /usr/bin/time (Debian: apt-get install time)" >&2
+        exit 2
+    fi
+    local dir
+    dir="$(mktemp -d)"
+    for n in 1000 10000 100000; do
+        sweep_of "$n" "$dir"
+    done | tee "$dir/table.txt"
+    rm -rf "$dir/"*.toml "$dir/"time_*.txt
+    local status=0
+    awk -v backend="$backend" '
+        { n[NR] = $1; cpu[NR] = $2 / $1 * 1e3; kb[NR] = $3 / $1 }
+        END {
+            printf "| runs | CPU time (s) | per run (ms) | peak RSS (MB) | per run (KB) |\n"
+            printf "|---:|---:|---:|---:|---:|\n"
+            for (i = 1; i <= NR; i++)
+                printf "| %d | %.2f | %.3f | %.0f | %.1f |\n", n[i], cpu[i] * n[i] / 1e3, cpu[i], kb[i] * n[i] / 1024, kb[i]
+            bad = 0
+            if (cpu[3] > 1.2 * cpu[1] || cpu[3] > 1.2 * cpu[2]) {
+                printf "scale.sh: CPU time per run at %d runs is more than 20 %% above that at %d or %d runs (%s)\n", n[3], n[1], n[2], backend > "/dev/stderr"
+                bad = 1
+            }
+            if (kb[3] > 1.2 * kb[2]) {
+                printf "scale.sh: peak RSS per run grows by more than 20 %% from %d to %d runs\n", n[2], n[3] > "/dev/stderr"
+                bad = 1
+            }
+            exit bad
+        }' "$dir/table.txt" || status=1
+    rm -rf "$dir"
+    return "$status"
+}
+
 planner() {
     SETTLE_PLANNER_STATE_CASES=5000000 cargo test --release --locked -p settle-planner \
         --test any_state -- --nocapture
@@ -40,6 +105,7 @@ planner() {
 case "$what" in
     memory) memory ;;
     planner) planner ;;
-    all) memory; planner ;;
-    *) echo "usage: scripts/scale.sh [memory|planner|all]" >&2; exit 2 ;;
+    flat) flat ;;
+    all) memory; flat; planner ;;
+    *) echo "usage: scripts/scale.sh [memory|flat|planner|all]" >&2; exit 2 ;;
 esac

@@ -68,6 +68,44 @@ pub fn echo(value: &str) -> String {
     }
 }
 
+/// The longest `` `quoted` `` part of a message [`echo_quoted`] leaves whole: far above a
+/// command or a path settle suggests, far below input that is not worth printing back.
+pub const QUOTED_CHARS: usize = 1000;
+
+/// `message` with every `` `quoted` `` part longer than [`QUOTED_CHARS`] shortened by
+/// [`echo`]: the messages of the TOML parser and of the checks quote the input they reject
+/// (an unknown name, a key), and a 10 MB name is not printed back.
+pub fn echo_quoted(message: &str) -> String {
+    let parts: Vec<&str> = message.split('`').collect();
+    if parts.len() < 3 || parts.iter().all(|p| p.chars().count() <= QUOTED_CHARS) {
+        return message.to_string();
+    }
+    let last = parts.len() - 1;
+    parts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            // Odd parts lie between two backticks (a last one without its closing backtick
+            // is plain text).
+            if i % 2 == 1 && i < last && p.chars().count() > QUOTED_CHARS {
+                echo(p)
+            } else {
+                (*p).to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("`")
+}
+
+/// `text` (a key path) whole up to [`QUOTED_CHARS`] characters, else shortened by [`echo`].
+pub fn echo_long(text: &str) -> String {
+    if text.chars().count() > QUOTED_CHARS {
+        echo(text)
+    } else {
+        text.to_string()
+    }
+}
+
 /// Everything the harness reports. Bad input (exit code 2) is told apart from failures
 /// while running or writing (exit code 1) by [`Error::is_input_error`].
 #[derive(Debug, thiserror::Error)]
@@ -130,7 +168,7 @@ impl Error {
     pub fn input(file: impl Into<PathBuf>, message: impl Into<String>) -> Self {
         Error::Input {
             at: Location::file(file),
-            message: message.into(),
+            message: echo_quoted(&message.into()),
         }
     }
 
@@ -141,8 +179,8 @@ impl Error {
         message: impl Into<String>,
     ) -> Self {
         Error::Input {
-            at: Location::key(file, key),
-            message: message.into(),
+            at: Location::key(file, echo_long(&key.into())),
+            message: echo_quoted(&message.into()),
         }
     }
 

@@ -485,9 +485,17 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             workflows::import::import(&opts)?.report()
         }
         Command::Plan { jobs: j } => {
-            let stdin = std::io::stdin().lock();
+            use std::io::IsTerminal;
+            let stdin = std::io::stdin();
+            // Typed lines are answered one by one; piped input in batches that never wait
+            // for more input (see `plan_stream`).
+            let batch = if stdin.is_terminal() {
+                1
+            } else {
+                workflows::plan::BATCH
+            };
             let stdout = std::io::BufWriter::new(std::io::stdout().lock());
-            workflows::plan::plan_stream(stdin, stdout, jobs(j))?;
+            workflows::plan::plan_stream(stdin.lock(), stdout, jobs(j), batch)?;
             Report::new(Exit::Ok)
         }
         Command::Gcode {

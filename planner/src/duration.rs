@@ -9,7 +9,9 @@
 //! `branch_starts` or lies above one of them. Jerk unlimited: the same with `second_order`.
 
 use crate::brake::BrakeLaw;
-use crate::position::{How, Planned, Shape, assemble, finish, pre, validate, verify};
+use crate::position::{
+    How, Planned, Shape, assemble, at_rest_on, finish, hold, pre, validate, verify,
+};
 use crate::segs::Segs;
 use crate::unit::{Scale, Unit};
 use crate::velocity::Bounds;
@@ -25,6 +27,10 @@ pub fn branch_starts(
     shape: Shape,
 ) -> Result<Vec<f64>, PlanError> {
     let b = validate(&start, &target, lim, shape)?;
+    if at_rest_on(&start, &target) {
+        // Standing still lasts any duration.
+        return Ok(vec![0.0]);
+    }
     let mut out = Vec::new();
     if b.jmax.is_infinite() {
         let (pre_segs, s) = pre(start, lim, &b);
@@ -69,6 +75,7 @@ pub(crate) fn lasting(plan: &Planned, duration_s: f64) -> Result<Option<Profile>
             Shape::Trapezoid,
             duration_s,
         ),
+        How::Rest => rest_lasting(plan.start, duration_s),
     }
 }
 
@@ -82,6 +89,9 @@ pub fn with_duration(
     duration_s: f64,
 ) -> Result<Option<Profile>, PlanError> {
     let b = validate(&start, &target, lim, shape)?;
+    if at_rest_on(&start, &target) {
+        return rest_lasting(start, duration_s);
+    }
     let mut segs = Vec::with_capacity(16);
     if b.jmax.is_infinite() {
         let (pre_segs, s) = pre(start, lim, &b);
@@ -120,6 +130,15 @@ pub fn with_duration(
         }
     }
     Ok(None)
+}
+
+/// An axis at rest on its target standing still for `duration_s` (`None` for a negative or
+/// non-finite duration).
+fn rest_lasting(start: State, duration_s: f64) -> Result<Option<Profile>, PlanError> {
+    if !(duration_s >= 0.0 && duration_s.is_finite()) {
+        return Ok(None);
+    }
+    Profile::new(start, hold(duration_s)).map(Some)
 }
 
 /// Velocity interface, step 2: a velocity change from `start` to `(vf, af)` lasting exactly

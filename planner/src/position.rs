@@ -185,6 +185,9 @@ pub fn to_state(
     shape: Shape,
 ) -> Result<Profile, PlanError> {
     let b = validate(&start, &target, lim, shape)?;
+    if at_rest_on(&start, &target) {
+        return Profile::new(start, Vec::new());
+    }
     if b.jmax.is_finite() && !crate::brake::needed(&start, lim, b.jmax) {
         // The common case, written out straight from the candidate: no `Planned` (its
         // step-2 data is not needed here), which saves copying it.
@@ -197,6 +200,30 @@ pub fn to_state(
         return verify(finish(start, segs)?, &target, lim, true);
     }
     plan_then(start, target, lim, shape, |p| p.profile())?
+}
+
+/// Is `start` at rest on `target` (same position, velocity and acceleration zero at both)?
+/// Then the fastest profile has no segments, and one lasting `T` is [`hold`]`(T)`. The case
+/// polynomials degenerate there (every coefficient zero), so it is answered before them. A
+/// start on the target's position that is moving or accelerating is an ordinary problem.
+pub(crate) fn at_rest_on(start: &State, target: &State) -> bool {
+    start.p == target.p
+        && [start.v, start.a, target.v, target.a]
+            .iter()
+            .all(|x| *x == 0.0)
+}
+
+/// Standing still for `duration_s`: one segment holding the acceleration at exactly zero
+/// (as a cruise does), or none for a zero duration.
+pub(crate) fn hold(duration_s: f64) -> Vec<Segment> {
+    if duration_s > 0.0 {
+        vec![Segment::Accel {
+            duration_s,
+            accel: 0.0,
+        }]
+    } else {
+        Vec::new()
+    }
 }
 
 const NO_PEAK: PlanError = PlanError::NoSolution {
@@ -249,6 +276,8 @@ pub(crate) enum How {
     },
     /// Jerk unlimited: clamp the velocity, then `trap`.
     Trap(crate::second_order::Trap),
+    /// At rest on the target ([`at_rest_on`]): no segments.
+    Rest,
 }
 
 impl Planned {
@@ -274,6 +303,7 @@ impl Planned {
                 segs.extend_from_slice(pre(self.start, &self.lim, &b).0.as_slice());
                 trap.segments(&mut segs);
             }
+            How::Rest => {}
         }
         verify(finish(self.start, segs)?, &self.target, &self.lim, true)
     }
@@ -310,6 +340,9 @@ fn plan_then<R>(
         how,
     };
     let then = |p: Planned| then(&p);
+    if at_rest_on(&start, &target) {
+        return Ok(then(planned(0.0, How::Rest)));
+    }
     if b.jmax.is_infinite() {
         let (pre_segs, s) = pre(start, lim, &b);
         let trap = crate::second_order::fastest(&s, &target, lim).ok_or(none)?;

@@ -128,6 +128,11 @@ fn phase(axes: &[Axis], fastest: &[Profile]) -> Option<Vec<Profile>> {
     }
     let mut out = Vec::with_capacity(axes.len());
     for a in axes {
+        if crate::position::at_rest_on(&a.start, &a.target) {
+            // On the line whatever it is: stands still for the lead's duration.
+            out.push(Profile::new(a.start, crate::position::hold(lead_prof.duration_s())).ok()?);
+            continue;
+        }
         let d = a.target.p - a.start.p;
         let k = d / d_lead;
         // Collinear: every state component scales with the displacement.

@@ -28,6 +28,9 @@ pub struct Axis {
 /// in the scenario and take every value.
 pub fn axes(sc: &Scenario, src: &Source, base: &RunSpec) -> Result<Vec<Axis>, Error> {
     let mut out = Vec::new();
+    // Runs so far (the product of the axes read): each axis may multiply it up to
+    // MAX_RUNS, checked before its values are made.
+    let mut runs = 1usize;
     for (param, raw) in &sc.sweep {
         let key = format!("sweep.{param}");
         let err = |m: String| src.error_at(&key, m);
@@ -69,7 +72,7 @@ pub fn axes(sc: &Scenario, src: &Source, base: &RunSpec) -> Result<Vec<Axis>, Er
                 .filter_map(|v| v.as_str().map(|s| Value::Text(s.to_string())))
                 .collect()
         } else {
-            numbers(raw)
+            numbers(raw, MAX_RUNS / runs)
                 .map_err(err)?
                 .into_iter()
                 .map(Value::Number)
@@ -78,6 +81,15 @@ pub fn axes(sc: &Scenario, src: &Source, base: &RunSpec) -> Result<Vec<Axis>, Er
         if values.is_empty() {
             return Err(err("empty sweep axis: give at least one value".into()));
         }
+        runs = runs
+            .checked_mul(values.len())
+            .filter(|&n| n <= MAX_RUNS)
+            .ok_or_else(|| {
+                err(format!(
+                    "the sweep expands to more than {MAX_RUNS} runs ({} values here, {runs} runs from the axes before)",
+                    values.len()
+                ))
+            })?;
         check_kind_values(param, &values, base).map_err(err)?;
         out.push(Axis {
             param: param.clone(),
@@ -105,8 +117,19 @@ fn check_kind_values(param: &str, values: &[Value], base: &RunSpec) -> Result<()
     Ok(())
 }
 
-/// A list of numbers, or a range table `{ from, to, steps | step, scale = "linear" | "log" }`.
-fn numbers(raw: &toml::Value) -> Result<Vec<f64>, String> {
+/// A count of values as a message gives it: the integer, or its order of magnitude when
+/// it is beyond any sweep (`1e-300` as a step gives some 1e300 values).
+fn count_text(n: f64) -> String {
+    if n < 1e15 {
+        format!("{n:.0}")
+    } else {
+        format!("about {n:.1e}")
+    }
+}
+
+/// A list of numbers, or a range table `{ from, to, steps | step, scale = "linear" | "log" }`
+/// of at most `max_values` values (checked before the values are made).
+fn numbers(raw: &toml::Value, max_values: usize) -> Result<Vec<f64>, String> {
     let as_f64 = |v: &toml::Value| {
         v.as_float()
             .or_else(|| v.as_integer().map(|i| i as f64))
@@ -135,14 +158,30 @@ fn numbers(raw: &toml::Value) -> Result<Vec<f64>, String> {
             if log && (from <= 0.0 || to <= 0.0) {
                 return Err("a log range needs `from` and `to` > 0".into());
             }
+            let too_many = |n: f64| {
+                format!(
+                    "the range has {} values; the sweep may have at most {MAX_RUNS} runs{}",
+                    count_text(n),
+                    if max_values < MAX_RUNS {
+                        format!(" (at most {max_values} values here, with the axes before it)")
+                    } else {
+                        String::new()
+                    }
+                )
+            };
             let count = match (get("steps")?, get("step")?) {
-                (Some(n), None) if n >= 1.0 && n.fract() == 0.0 && n <= MAX_RUNS as f64 => {
+                (Some(n), None) if n >= 1.0 && n.fract() == 0.0 => {
+                    if n > max_values as f64 {
+                        return Err(too_many(n));
+                    }
                     n as usize
                 }
                 (None, Some(s)) if !log && s > 0.0 && s.is_finite() => {
+                    // The count is checked as a float first: a tiny step gives a count far
+                    // beyond usize, and the values are not made unless it passes.
                     let n = ((to - from).abs() / s + 1e-9).floor() + 1.0;
-                    if n > MAX_RUNS as f64 {
-                        return Err(format!("range has {n} values; at most {MAX_RUNS}"));
+                    if n > max_values as f64 {
+                        return Err(too_many(n));
                     }
                     let dir = if to >= from { 1.0 } else { -1.0 };
                     return Ok((0..n as usize).map(|i| from + dir * s * i as f64).collect());

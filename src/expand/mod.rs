@@ -313,5 +313,8 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
         validate::validate_sampling(&run, range, src)?;
         runs.push(run);
     }
+    // The values as written, which the sweep may have overridden in every run (checked
+    // after the runs, whose errors name the sweep axis to blame).
+    validate::validate_base(&base, src)?;
     Ok(runs)
 }

@@ -52,8 +52,13 @@ fn validate_duration(run: &RunSpec, src: &Source) -> Result<(), Error> {
     Err(src.error_at(
         &key,
         format!(
-            "run {}: a move of {} mm at vmax_mm_s = {} and amax_mm_s2 = {} takes at least {move_s:.3e} s; with the {} s window at {} Hz that is {samples:.3e} samples, over the limit of {MAX_SAMPLES_PER_RUN:e} per run: shorten the move, raise the limits or lower observe.sample_rate_hz",
-            run.id, run.distance_mm, run.vmax_mm_s, run.amax_mm_s2, run.window_s, run.sample_rate_hz
+            "{}: a move of {} mm at vmax_mm_s = {} and amax_mm_s2 = {} takes at least {move_s:.3e} s; with the {} s window at {} Hz that is {samples:.3e} samples, over the limit of {MAX_SAMPLES_PER_RUN:e} per run: shorten the move, raise the limits or lower observe.sample_rate_hz",
+            if run.swept.is_empty() && run.id == 0 {
+                "the move as written".to_string()
+            } else {
+                format!("run {}", run.id)
+            },
+            run.distance_mm, run.vmax_mm_s, run.amax_mm_s2, run.window_s, run.sample_rate_hz
         ),
     ))
 }
@@ -187,6 +192,34 @@ pub fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
         ));
     }
     Ok(())
+}
+
+/// Check the base values of the move and the limits as written, whether or not a sweep
+/// overrides them: a value that is not a number, not finite, or (with the others) gives a
+/// move beyond [`MAX_SAMPLES_PER_RUN`] is a mistake in the file even when every run takes
+/// a swept value instead. A path kind's move is checked per run (its length is its path's).
+pub fn validate_base(base: &RunSpec, src: &Source) -> Result<(), Error> {
+    for (key, value) in [
+        ("move.distance_mm", base.distance_mm),
+        ("move.start_mm", base.start_mm),
+    ] {
+        if !value.is_finite() {
+            return Err(src.error_at(key, format!("must be finite, got {value}")));
+        }
+    }
+    for (key, value, unit) in [
+        ("limits.vmax_mm_s", Some(base.vmax_mm_s), "mm/s"),
+        ("limits.amax_mm_s2", Some(base.amax_mm_s2), "mm/s^2"),
+        ("limits.jmax_mm_s3", base.jmax_mm_s3, "mm/s^3"),
+    ] {
+        if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(src.error_at(
+                key,
+                format!("must be a finite number > 0 ({unit}), got {v}"),
+            ));
+        }
+    }
+    validate_duration(base, src)
 }
 
 /// Check one run: its path kind first (a corner path checks its profile kind and machine

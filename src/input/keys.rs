@@ -118,6 +118,22 @@ impl KeyIndex {
         }
     }
 
+    /// The table (dotted path, empty for the top level) whose header is the last at or
+    /// before byte `offset` of `text`: where a value spanning from `offset` belongs.
+    pub fn table_at(&self, offset: usize, text: &str) -> String {
+        let (line, _) = self.line_col(offset);
+        let header = |l: usize| {
+            text.lines()
+                .nth(l - 1)
+                .is_some_and(|t| t.trim_start().starts_with('['))
+        };
+        self.keys
+            .iter()
+            .rev()
+            .find(|k| k.line <= line && header(k.line))
+            .map_or_else(String::new, |k| k.path.clone())
+    }
+
     /// The key set on `line` (1-based), if that line holds one.
     pub fn key_at_line(&self, line: usize) -> Option<&str> {
         self.keys

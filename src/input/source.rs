@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use serde::de::DeserializeOwned;
 use toml::de::{DeTable, ValueDeserializer};
 
-use crate::error::{Error, Location};
+use crate::error::{Error, Location, echo_long, echo_quoted};
 use crate::input::keys::KeyIndex;
 
 /// An input file's text, path and key index.
@@ -55,27 +55,59 @@ impl Source {
             at: Location {
                 line,
                 column,
-                ..Location::key(&self.path, key)
+                ..Location::key(&self.path, echo_long(key))
             },
-            message: message.into(),
+            message: echo_quoted(&message.into()),
         }
     }
 
     /// A TOML error located by its span: the line and column, and the key set on that line
     /// (the message names an unknown key itself; a wrong type is named by the key line).
+    /// A missing key is named as such: the table the span covers, and the key in it. An
+    /// error without a span (nesting beyond the parser's recursion limit) is put on the
+    /// most deeply nested line.
     fn located(&self, e: &toml::de::Error) -> Error {
-        let (line, column) = e.span().map(|s| self.keys.line_col(s.start)).unzip();
-        let key = line
-            .and_then(|l| self.keys.key_at_line(l))
-            .map(str::to_string);
+        let message = e.message().trim();
+        let (line, column) = match e.span() {
+            Some(s) => Some(self.keys.line_col(s.start)),
+            None => deepest_line(&self.text).map(|l| (l, 1)),
+        }
+        .unzip();
+        let missing = message
+            .strip_prefix("missing field `")
+            .and_then(|m| m.strip_suffix('`'));
+        let key = match (missing, e.span()) {
+            (Some(field), Some(s)) => {
+                // The span is the table missing the field: the document (from 0), an
+                // inline table (from its brace, on its key's line) or a `[table]`.
+                let table = if s.start == 0 {
+                    String::new()
+                } else if self.text.as_bytes().get(s.start) == Some(&b'{') {
+                    line.and_then(|l| self.keys.key_at_line(l))
+                        .unwrap_or_default()
+                        .to_string()
+                } else {
+                    self.keys.table_at(s.start, &self.text)
+                };
+                Some(if table.is_empty() {
+                    field.to_string()
+                } else {
+                    format!("{table}.{field}")
+                })
+            }
+            (Some(field), None) => Some(field.to_string()),
+            (None, _) => line
+                .and_then(|l| self.keys.key_at_line(l))
+                .map(str::to_string),
+        };
         Error::Input {
             at: Location {
                 line,
                 column,
-                key,
+                key: key.map(|k| echo_long(&k)),
                 ..Location::file(&self.path)
             },
-            message: e.message().trim().to_string(),
+            message: echo_quoted(message),
         }
     }
 
@@ -109,4 +141,39 @@ impl Source {
         self.parse()
             .is_ok_and(|doc| doc.get_ref().contains_key(name))
     }
+}
+
+/// The line (1-based) nested most deeply: the most brackets and braces open at once plus
+/// the parts of a dotted key (outside strings, roughly: enough to point at the line that
+/// breaks a recursion limit). `None` for an empty text.
+fn deepest_line(text: &str) -> Option<usize> {
+    let mut depth: i64 = 0;
+    let mut best: Option<(i64, usize)> = None;
+    for (n, raw) in text.lines().enumerate() {
+        let mut peak = depth;
+        let mut quote: Option<char> = None;
+        let mut dots = 0;
+        let mut in_key = true;
+        for c in raw.chars() {
+            match (quote, c) {
+                (Some(q), c) if c == q => quote = None,
+                (Some(_), _) => {}
+                (None, '"' | '\'') => quote = Some(c),
+                (None, '#') => break,
+                (None, '=') => in_key = false,
+                (None, '.') if in_key => dots += 1,
+                (None, '[' | '{') => {
+                    depth += 1;
+                    peak = peak.max(depth);
+                }
+                (None, ']' | '}') => depth -= 1,
+                _ => {}
+            }
+        }
+        let score = peak + dots;
+        if best.is_none_or(|(b, _)| score > b) {
+            best = Some((score, n + 1));
+        }
+    }
+    best.map(|(_, line)| line)
 }

@@ -230,13 +230,19 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Ranking {
             s.join(", ")
         }
     };
-    // Workload points, first-seen order.
+    // Workload points, first-seen order (found through an index: a sweep of many points
+    // must not search them all for every run).
     let mut groups: Vec<(Vec<String>, Vec<usize>)> = Vec::new();
+    let mut group_of: std::collections::HashMap<Vec<String>, usize> =
+        std::collections::HashMap::new();
     for (i, r) in runs.iter().enumerate() {
         let w = values(r, false);
-        match groups.iter_mut().find(|(k, _)| *k == w) {
-            Some((_, v)) => v.push(i),
-            None => groups.push((w, vec![i])),
+        match group_of.get(&w) {
+            Some(&g) => groups[g].1.push(i),
+            None => {
+                group_of.insert(w.clone(), groups.len());
+                groups.push((w, vec![i]));
+            }
         }
     }
     let shapers = setting_keys.iter().any(|k| k.starts_with("shaper."))
@@ -248,7 +254,9 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Ranking {
         let b = band_label(band);
         let mut points = Vec::new();
         let mut sums: Vec<(String, f64, usize)> = Vec::new();
+        // `sums` and `candidates` list the same labels in the same order; `sum_of` indexes both.
         let mut candidates: Vec<Candidate> = Vec::new();
+        let mut sum_of: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
         for (workload, idx) in &groups {
             let mut ranked: Vec<Ranked> = idx
                 .iter()
@@ -315,26 +323,26 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Ranking {
             }
             for r in &ranked {
                 let t = r.total_s.unwrap_or(f64::INFINITY);
-                match sums.iter_mut().find(|(l, _, _)| *l == r.label) {
-                    Some(s) => {
-                        s.1 += t;
-                        s.2 += 1;
-                    }
-                    None => sums.push((r.label.clone(), t, 1)),
-                }
-                match candidates.iter_mut().find(|c| c.label == r.label) {
-                    Some(c) => {
+                match sum_of.get(&r.label) {
+                    Some(&k) => {
+                        sums[k].1 += t;
+                        sums[k].2 += 1;
+                        let c = &mut candidates[k];
                         c.total_s = c.total_s.zip(r.total_s).map(|(a, b)| a + b);
                         c.runs.push(r.id);
                         c.failed |= r.failure.is_some();
                     }
-                    None => candidates.push(Candidate {
-                        label: r.label.clone(),
-                        total_s: r.total_s,
-                        runs: vec![r.id],
-                        current: r.current,
-                        failed: r.failure.is_some(),
-                    }),
+                    None => {
+                        sum_of.insert(r.label.clone(), sums.len());
+                        sums.push((r.label.clone(), t, 1));
+                        candidates.push(Candidate {
+                            label: r.label.clone(),
+                            total_s: r.total_s,
+                            runs: vec![r.id],
+                            current: r.current,
+                            failed: r.failure.is_some(),
+                        });
+                    }
                 }
             }
             points.push(Point {

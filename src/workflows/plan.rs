@@ -59,7 +59,8 @@ fn default_interface() -> String {
 pub fn answer(line: &str) -> String {
     match solve(line) {
         Ok(v) => v.to_string(),
-        Err(e) => json!({ "error": e }).to_string(),
+        // The problem's own text (a name, a key) is quoted in the message: never 10 MB of it.
+        Err(e) => json!({ "error": crate::error::echo_quoted(&e) }).to_string(),
     }
 }
 
@@ -158,31 +159,78 @@ fn axis_json(p: &Profile) -> Value {
     json!({ "p0": s.p, "v0": s.v, "a0": s.a, "segments": segs })
 }
 
-/// Answer the JSON lines of `input` on `output`, in order, in parallel chunks of 8192 lines
-/// on `jobs` threads (all cores when `None`).
+/// Answer one input line given as bytes (without its newline): [`answer`] of the text, or
+/// an error naming the line (`number`, from 1) and the byte where it stops being UTF-8.
+pub fn answer_bytes(number: u64, line: &[u8]) -> String {
+    match std::str::from_utf8(line) {
+        Ok(text) => answer(text),
+        Err(e) => json!({
+            "error": format!(
+                "line {number}: not UTF-8 (invalid byte at offset {} of the line, counted from 0)",
+                e.valid_up_to()
+            )
+        })
+        .to_string(),
+    }
+}
+
+/// Lines answered together, in parallel, at most.
+pub const BATCH: usize = 8192;
+
+/// Answer the JSON lines of `input` on `output`, in order, in parallel batches on `jobs`
+/// threads (all cores when `None`).
+///
+/// Lines are split on `\n` (a `\r` before it is dropped); a line that is not UTF-8 is
+/// answered with an error and the stream goes on. A batch holds up to [`BATCH`] lines
+/// (`max_batch` lower, e.g. 1 for a terminal), but never waits for input: it ends as soon
+/// as the lines read so far are all that `input` has delivered (no complete line left in
+/// the read buffer), then its answers are written and flushed. So a client that writes one
+/// line and waits for its answer gets it, and a file is still answered in large batches.
 pub fn plan_stream(
-    input: impl std::io::BufRead,
+    input: impl std::io::Read,
     mut output: impl std::io::Write,
     jobs: Option<usize>,
+    max_batch: usize,
 ) -> Result<(), crate::error::Error> {
     use rayon::prelude::*;
+    use std::io::BufRead;
     let pool = crate::execute::pool::thread_pool(jobs)?;
     let read_err = |e| crate::error::Error::read("stdin", e);
     let write_err = |e| crate::error::Error::write("stdout", e);
-    let mut lines = input.lines();
+    let mut input = std::io::BufReader::with_capacity(1 << 16, input);
+    let max_batch = max_batch.clamp(1, BATCH);
+    let mut number = 0u64;
+    let mut batch: Vec<(u64, Vec<u8>)> = Vec::new();
     loop {
-        let chunk: Vec<String> = lines
-            .by_ref()
-            .take(8192)
-            .collect::<Result<_, _>>()
-            .map_err(read_err)?;
-        if chunk.is_empty() {
-            break;
+        batch.clear();
+        let mut eof = false;
+        while batch.len() < max_batch {
+            // Reading on would wait for input: answer what is here first.
+            if !batch.is_empty() && !input.buffer().contains(&b'\n') {
+                break;
+            }
+            let mut line = Vec::new();
+            if input.read_until(b'\n', &mut line).map_err(read_err)? == 0 {
+                eof = true;
+                break;
+            }
+            if line.last() == Some(&b'\n') {
+                line.pop();
+                if line.last() == Some(&b'\r') {
+                    line.pop();
+                }
+            }
+            number += 1;
+            batch.push((number, line));
         }
-        let answers: Vec<String> = pool.install(|| chunk.par_iter().map(|l| answer(l)).collect());
+        let answers: Vec<String> =
+            pool.install(|| batch.par_iter().map(|(n, l)| answer_bytes(*n, l)).collect());
         for a in answers {
             writeln!(output, "{a}").map_err(write_err)?;
         }
+        output.flush().map_err(write_err)?;
+        if eof {
+            return Ok(());
+        }
     }
-    output.flush().map_err(write_err)
 }

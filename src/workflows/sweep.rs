@@ -156,9 +156,12 @@ pub fn sweep(
         ));
     }
     let rec = recorder(opts.mcap, opts.rerun, out.join(RECORDINGS), path, &sc.name)?;
+    // The runs of this sweep, kept once (a clone of every run spec would double the memory
+    // a large sweep holds while it runs).
+    let total_runs = all_runs.len();
     let runs = match opts.shard {
         Some(s) => s.select(&all_runs),
-        None => all_runs.clone(),
+        None => all_runs,
     };
     create_dir(&out)?;
     // The lock first: a folder another sweep is writing is refused as such.
@@ -180,7 +183,7 @@ pub fn sweep(
         opts.backend,
         opts.shard.map_or(String::new(), |s| format!(
             " (shard {s} of {} runs)",
-            all_runs.len()
+            total_runs
         )),
         out.display()
     ));
@@ -239,11 +242,15 @@ pub fn sweep(
             runs.len()
         ));
     }
-    let todo: Vec<RunSpec> = runs
-        .iter()
-        .filter(|r| !done.contains_key(&r.id))
-        .cloned()
-        .collect();
+    // What is left to run: every run unless resuming (no copy then).
+    let todo: std::borrow::Cow<'_, [RunSpec]> = if done.is_empty() {
+        std::borrow::Cow::Borrowed(&runs)
+    } else {
+        runs.iter()
+            .filter(|r| !done.contains_key(&r.id))
+            .cloned()
+            .collect()
+    };
     // An output that cannot be written (a full disk) is not a result of a run: the sweep
     // stops, the journal keeps what finished, and `--resume` completes it.
     let write_failed = std::sync::atomic::AtomicBool::new(false);
@@ -321,7 +328,7 @@ pub fn sweep(
                     scenario_file: path.display().to_string(),
                     shard: s.k,
                     shards: s.n,
-                    total_runs: all_runs.len(),
+                    total_runs,
                     runs: ids.clone(),
                     settings: [("backend".to_string(), opts.backend.name().to_string())]
                         .into_iter()

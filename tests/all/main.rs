@@ -8,6 +8,7 @@ mod corners;
 mod faults;
 mod gcode_job;
 mod gcode_range;
+mod hardening_input;
 mod html_report;
 mod identify_cmd;
 mod import;

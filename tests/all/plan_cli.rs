@@ -117,3 +117,176 @@ this is not json
             .contains("has 1 values, expected 2")
     );
 }
+
+/// `settle plan` on raw bytes: the exit status and the answers, one per output line.
+fn plan_bytes(input: &[u8]) -> (bool, Vec<Value>) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_settle"))
+        .args(["plan", "--jobs", "2"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("starts");
+    let mut stdin = child.stdin.take().expect("stdin");
+    let input = input.to_vec();
+    // Written from a thread: the answers come back while the input is still being written.
+    let writer = std::thread::spawn(move || stdin.write_all(&input));
+    let out = child.wait_with_output().expect("runs");
+    writer.join().expect("joins").expect("writes");
+    let answers = String::from_utf8(out.stdout)
+        .expect("utf8")
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("each line is JSON"))
+        .collect();
+    (out.status.success(), answers)
+}
+
+/// A line that is not UTF-8 is answered with an error naming it, and the lines around it,
+/// in batches before it and after it, are answered as usual.
+#[test]
+fn a_line_that_is_not_utf8_is_answered_and_the_stream_goes_on() {
+    let good = r#"{"p0":[0],"pf":[1],"vmax":[1],"amax":[2],"jmax":[10]}"#;
+    let mut input = Vec::new();
+    for _ in 0..20_000 {
+        input.extend_from_slice(good.as_bytes());
+        input.push(b'\n');
+    }
+    // Line 20,001: valid up to byte offset 7, then a lone continuation byte.
+    input.extend_from_slice(b"{\"p0\":[\xff0]}\n");
+    for _ in 0..3 {
+        input.extend_from_slice(good.as_bytes());
+        input.push(b'\n');
+    }
+    let (ok, out) = plan_bytes(&input);
+    assert!(ok);
+    assert_eq!(out.len(), 20_004, "one answer per line");
+    for (i, a) in out.iter().enumerate() {
+        if i == 20_000 {
+            let e = a["error"].as_str().expect("an error");
+            assert!(e.contains("line 20001") && e.contains("offset 7"), "{e}");
+        } else {
+            assert_eq!(a["duration"].as_f64(), Some(1.7), "line {}: {a}", i + 1);
+        }
+    }
+    // The corpus file: a good line, a line of one 0xff byte, a good line.
+    let corpus = std::fs::read(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fuzz/corpus/plan/hardening_bad_utf8.jsonl"),
+    )
+    .expect("corpus file");
+    let (ok, out) = plan_bytes(&corpus);
+    assert!(ok);
+    assert_eq!(out.len(), 3);
+    assert!(
+        out[1]["error"]
+            .as_str()
+            .is_some_and(|e| e.contains("line 2") && e.contains("offset 0")),
+        "{}",
+        out[1]
+    );
+    assert_eq!(out[2]["duration"].as_f64(), Some(1.7));
+}
+
+/// Request and response through a pipe: each line's answer arrives before the next line is
+/// written, so `settle plan` never holds an answer while it waits for input. A stalled
+/// answer fails the test after 20 s instead of hanging it.
+#[test]
+fn each_answer_arrives_before_the_next_line_is_written() {
+    use std::io::BufRead;
+    use std::sync::mpsc;
+    use std::time::Duration;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_settle"))
+        .args(["plan", "--jobs", "2"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("starts");
+    let mut stdin = child.stdin.take().expect("stdin");
+    let stdout = child.stdout.take().expect("stdout");
+    let (tx, rx) = mpsc::channel();
+    let reader = std::thread::spawn(move || {
+        for line in std::io::BufReader::new(stdout).lines() {
+            if tx.send(line.expect("reads")).is_err() {
+                break;
+            }
+        }
+    });
+    for k in 1..=5 {
+        writeln!(
+            stdin,
+            r#"{{"p0":[0],"pf":[{k}],"vmax":[1],"amax":[2],"jmax":[10]}}"#
+        )
+        .expect("writes");
+        stdin.flush().expect("flushes");
+        let answer = match rx.recv_timeout(Duration::from_secs(20)) {
+            Ok(a) => a,
+            Err(e) => {
+                let _ = child.kill();
+                panic!("no answer to line {k} within 20 s: {e}");
+            }
+        };
+        let v: Value = serde_json::from_str(&answer).expect("JSON");
+        let (p, _, _) = integrate(&v["axes"][0]);
+        assert!((p - f64::from(k)).abs() < 1e-9, "line {k}: {answer}");
+    }
+    drop(stdin);
+    assert!(child.wait().expect("exits").success());
+    reader.join().expect("joins");
+}
+
+/// An axis already at its target, in every sync mode and both kinds: the other axis's
+/// profile as alone (1.7 s jerk limited, 1.5 s trapezoid: see `answers_each_line_in_order`),
+/// the resting axis standing still for that long (time, phase) or without segments (none).
+#[test]
+fn an_axis_already_at_its_target_is_answered() {
+    let mut input = String::new();
+    let corpus = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fuzz/corpus/plan/hardening_axis_at_target.jsonl"),
+    )
+    .expect("corpus file");
+    input.push_str(&corpus);
+    let modes = ["time", "phase", "none"];
+    for sync in modes {
+        input.push_str(&format!(
+            r#"{{"p0":[0,0],"pf":[0,1],"vmax":[1,1],"amax":[2,2],"jmax":[10,10],"sync":"{sync}"}}"#
+        ));
+        input.push('\n');
+        input.push_str(&format!(
+            r#"{{"p0":[3,0],"pf":[3,1],"vmax":[1,1],"amax":[2,2],"kind":"trapezoid","sync":"{sync}"}}"#
+        ));
+        input.push('\n');
+    }
+    input.push_str(r#"{"p0":[5],"pf":[5],"vmax":[1],"amax":[2],"jmax":[10]}"#);
+    input.push('\n');
+    let out = plan(&input);
+    assert_eq!(out.len(), 8);
+    for (i, a) in out.iter().enumerate().take(7) {
+        assert!(a.get("error").is_none(), "line {}: {a}", i + 1);
+        let (sync, t, p) = match i {
+            0 => ("time", 1.7, 0.0),
+            _ => (
+                modes[(i - 1) / 2],
+                [1.7, 1.5][(i - 1) % 2],
+                [0.0, 3.0][(i - 1) % 2],
+            ),
+        };
+        let d = a["duration"].as_f64().expect("duration");
+        assert!((d - t).abs() < 1e-12, "line {}: {a}", i + 1);
+        let (p1, v1, _) = integrate(&a["axes"][1]);
+        assert!((p1 - 1.0).abs() < 1e-12 && v1.abs() < 1e-12, "{a}");
+        let rest = &a["axes"][0];
+        assert_eq!(integrate(rest), (p, 0.0, 0.0), "line {}: {a}", i + 1);
+        let segs = rest["segments"].as_array().expect("segments");
+        if sync == "none" {
+            assert!(segs.is_empty(), "{a}");
+        } else {
+            // One hold at exactly zero acceleration, as long as the move.
+            assert_eq!(segs.len(), 1, "{a}");
+            assert_eq!(segs[0][1].as_f64(), Some(0.0));
+            assert_eq!(segs[0][2].as_f64(), Some(0.0));
+            assert!((segs[0][0].as_f64().expect("t") - d).abs() < 1e-12, "{a}");
+        }
+    }
+    assert_eq!(out[7]["duration"].as_f64(), Some(0.0), "{}", out[7]);
+    assert_eq!(out[7]["axes"][0]["segments"], serde_json::json!([]));
+}

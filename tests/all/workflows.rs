@@ -251,7 +251,7 @@ fn plan_answers_every_line_in_order() {
 not json\n\
 {\"p0\":[0],\"pf\":[2],\"vmax\":[1],\"amax\":[2],\"jmax\":[10],\"sync\":\"time\"}\n";
     let mut out = Vec::new();
-    plan::plan_stream(input.as_bytes(), &mut out, Some(2)).expect("answers");
+    plan::plan_stream(input.as_bytes(), &mut out, Some(2), plan::BATCH).expect("answers");
     let out = String::from_utf8(out).expect("utf-8");
     let lines: Vec<&str> = out.lines().collect();
     assert_eq!(lines.len(), 3);

@@ -2,6 +2,7 @@
 //! `common`, `fourjerk_check` and `firmware_common` are shared helpers.
 
 mod any_state;
+mod at_target;
 mod braked;
 mod common;
 mod corner_blend;

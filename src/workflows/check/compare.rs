@@ -215,9 +215,23 @@ the outputs changed shape; if intended, rewrite the baseline with --update",
     let run_col = now
         .column("run")
         .ok_or("no `run` column: a baseline is a runs.csv written by settle")?;
-    let ids =
-        |t: &RunsTable| -> Vec<String> { t.rows.iter().map(|r| r[run_col].clone()).collect() };
-    let (b_ids, n_ids) = (ids(baseline), ids(now));
+    // Rows are matched by run, whatever their order in the file.
+    let mut by_run: std::collections::HashMap<&str, &Vec<String>> =
+        std::collections::HashMap::with_capacity(baseline.rows.len());
+    for r in &baseline.rows {
+        if by_run.insert(r[run_col].as_str(), r).is_some() {
+            return Err(format!(
+                "the baseline has run {} twice: a baseline is a runs.csv written by settle",
+                crate::error::echo(&r[run_col])
+            ));
+        }
+    }
+    let sorted_ids = |t: &RunsTable| -> Vec<String> {
+        let mut ids: Vec<String> = t.rows.iter().map(|r| r[run_col].clone()).collect();
+        ids.sort_by_cached_key(|id| (id.parse::<u64>().ok(), id.clone()));
+        ids
+    };
+    let (b_ids, n_ids) = (sorted_ids(baseline), sorted_ids(now));
     if b_ids != n_ids {
         return Err(format!(
             "the baseline has {} runs ({}), this scenario has {} ({}): the sweep changed; \
@@ -230,7 +244,8 @@ if intended, rewrite the baseline with --update",
     }
     let tol = tolerance_pct / 100.0;
     let mut changes = Vec::new();
-    for (b_row, n_row) in baseline.rows.iter().zip(&now.rows) {
+    for n_row in &now.rows {
+        let b_row = by_run[n_row[run_col].as_str()];
         for (c, column) in now.header.iter().enumerate() {
             if c == run_col {
                 continue;
@@ -423,6 +438,43 @@ mod tests {
         )
         .expect_err("runs differ");
         assert!(e.contains("2 runs") && e.contains("has 1"), "{e}");
+    }
+
+    /// The baseline's rows in another order are the same runs: matched by `run`, a change
+    /// is reported on its own run, and a run listed twice is an error.
+    #[test]
+    fn rows_are_matched_by_run_in_any_order() {
+        let reordered = "run,profile,distance_mm,move_time_s,residual_peak_um,settle_time_s_10um\n\
+1,scurve,1,0.07,20,inf\n0,trapezoid,1,0.05,80,0.2\n";
+        let c = cmp(reordered, 0.1).expect("the same runs");
+        assert_eq!(c.changes, vec![]);
+        assert_eq!((c.runs, c.cells), (2, 10));
+        let c = cmp(&reordered.replace(",20,inf", ",22,inf"), 0.1).expect("the same runs");
+        let got: Vec<(&str, &str, &str, &str)> = c
+            .changes
+            .iter()
+            .map(|x| {
+                (
+                    x.run.as_str(),
+                    x.column.as_str(),
+                    x.baseline.as_str(),
+                    x.now.as_str(),
+                )
+            })
+            .collect();
+        assert_eq!(got, vec![("1", "residual_peak_um", "20", "22")]);
+        let twice = "run,profile,distance_mm,move_time_s,residual_peak_um,settle_time_s_10um\n\
+0,trapezoid,1,0.05,80,0.2\n0,trapezoid,1,0.05,80,0.2\n";
+        let e = compare(
+            &RunsTable::parse(twice).expect("table"),
+            &RunsTable::parse(BASE).expect("table"),
+            0.1,
+        )
+        .expect_err("run 0 twice");
+        assert!(e.contains("run 0 twice"), "{e}");
+        // Another run set is still the sweep changing.
+        let e = cmp(&BASE.replace("\n1,scurve", "\n2,scurve"), 0.1).expect_err("runs differ");
+        assert!(e.contains("the sweep changed"), "{e}");
     }
 
     #[test]
