@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Fuzz settle's two text inputs (scenario files, `settle plan` JSON lines) with cargo-fuzz
-# (libFuzzer) for a bounded time each. Installs cargo-fuzz when missing. Works on stable
-# Rust (no sanitizer; libFuzzer's coverage instrumentation only). A crash or panic fails
+# Fuzz settle's two text inputs (scenario files, `settle plan` JSON lines) with libFuzzer
+# (the cargo-fuzz layout in fuzz/) for a bounded time each. Works on stable Rust (no
+# sanitizer; libFuzzer's coverage instrumentation only). A crash or panic fails
 # the run and leaves the input in fuzz/artifacts/<target>/.
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]    (default: 60 s, all targets)
@@ -15,29 +15,30 @@ shift || true
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(scenario plan)
 
-if ! cargo fuzz --version >/dev/null 2>&1; then
-  echo "== installing cargo-fuzz (once)"
-  cargo install cargo-fuzz --locked --version 0.13.2
-fi
+# libFuzzer's coverage comes from LLVM's SanitizerCoverage (the flags libFuzzer's documentation
+# names: inline 8-bit counters, the PC table, compare tracing), applied by rustc to every crate
+# built for the target. Building for the host triple given explicitly keeps build scripts
+# and proc macros uninstrumented. No cargo-fuzz: it would be built from source first, and
+# the targets need nothing but these flags (libfuzzer-sys links libFuzzer itself).
+host=$(rustc -vV | sed -n 's/^host: //p')
+export RUSTFLAGS="${RUSTFLAGS:-} --cfg fuzzing -Cpasses=sancov-module \
+  -Cllvm-args=-sanitizer-coverage-level=4 -Cllvm-args=-sanitizer-coverage-inline-8bit-counters \
+  -Cllvm-args=-sanitizer-coverage-pc-table -Cllvm-args=-sanitizer-coverage-trace-compares"
 # Keep fuzz builds apart from the workspace's (different instrumentation flags).
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}-fuzz"
-# Optimised, no sanitizer; 16 codegen units instead of cargo-fuzz's default of 1 build
-# the instrumented harness faster, for somewhat fewer executions a second.
-build=(--sanitizer none -O --codegen-units 16)
-# Build every target in one cargo invocation (their shared dependencies once, the targets'
-# own code in parallel); `cargo fuzz run` below then finds them built.
+# Profile `fuzz` (fuzz/Cargo.toml): optimisation level 1 with debug assertions and overflow
+# checks: a smoke run needs coverage and checks, and opt-level 3 costs most of the build.
 echo "== fuzz build (${targets[*]})"
-if [ "$#" -eq 0 ]; then
-  cargo fuzz build "${build[@]}"
-else
-  for t in "${targets[@]}"; do cargo fuzz build "${build[@]}" "$t"; done
-fi
+bins=()
+for t in "${targets[@]}"; do bins+=(--bin "$t"); done
+cargo build --profile fuzz --target "$host" "${bins[@]}"
 for t in "${targets[@]}"; do
   echo "== fuzz $t for ${secs}s"
   mkdir -p "corpus/$t"
   log="$(mktemp)"
   status=0
-  cargo fuzz run "${build[@]}" "$t" "corpus/$t" -- \
+  mkdir -p "artifacts/$t"
+  "$CARGO_TARGET_DIR/$host/fuzz/$t" "corpus/$t" -artifact_prefix="artifacts/$t/" \
     -max_total_time="$secs" -max_len=4096 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
     >"$log" 2>&1 || status=$?
   # Show libFuzzer's summary, and everything on failure.

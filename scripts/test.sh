@@ -3,8 +3,7 @@
 # test, the regression gate, every command of the README and the book
 # (scripts/check-commands.sh), a fuzz smoke run and the `rerun` feature. Installs what it
 # needs without root: crates from crates.io through cargo, libmujoco 3.17.0 from its PyPI
-# wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), cargo-fuzz into ~/.cargo/bin once
-# (scripts/fuzz.sh), the official MCAP reader from PyPI into .deps/ (scripts/mcap-python,
+# wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), the official MCAP reader from PyPI into .deps/ (scripts/mcap-python,
 # for the MCAP tests); with root (or sudo), headless Chromium from Debian's `chromium`
 # package when missing (scripts/browser-test.sh, for the report.html tests).
 #
