@@ -8,7 +8,10 @@
 //! exactly the matrix exponential of the augmented system. The exponential is taken in
 //! mass-normalised, frequency-scaled coordinates (`w0^2 M^1/2 r`, `w0 M^1/2 r'`, `w0 v`,
 //! `a`, `j / w0`, with `w0` the highest natural frequency), which balances the matrix, and
-//! mapped back to physical coordinates once.
+//! mapped back to physical coordinates once. A step that a profile breakpoint cuts short
+//! (a partial step) applies the exponential's Taylor series to the state instead, halved
+//! and squared when longer than `1 / |A|`: equal to the exponential to rounding
+//! (sim/tests/all/modal_transition.rs).
 //!
 //! Position-dependent stiffness (a belt's spans) is **linearised at the start position**
 //! of each run: the model is exactly linear, which is what makes it the reference. What
@@ -348,7 +351,7 @@ pub struct ModalAxis {
     pub stepper: Option<StepperState>,
     disc: std::sync::Arc<Discrete>,
     scratch: Vec<f64>,
-    /// The transition of the last partial step (reused buffer).
+    /// Reused buffer of the partial steps ([`Discrete::advance_partial`]).
     partial: Vec<f64>,
     /// `(x, toolhead, probe)` of [`axis_positions`] at the start (`z` zero): what an
     /// axis that is still idle at the same command reports, computed once.
