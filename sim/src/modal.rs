@@ -240,6 +240,16 @@ impl Discrete {
             degree += 1;
             term *= x_norm / degree as f64;
         }
+        // Fixed sizes for the usual state sizes: the loops unroll, the state stays in
+        // registers (the same operations in the same order as the loop below).
+        let rows = &self.accel_rows;
+        match n {
+            1 => return horner::<1, 5>(rows, z, cmd, dt_s, degree),
+            2 => return horner::<2, 7>(rows, z, cmd, dt_s, degree),
+            3 => return horner::<3, 9>(rows, z, cmd, dt_s, degree),
+            4 => return horner::<4, 11>(rows, z, cmd, dt_s, degree),
+            _ => {}
+        }
         buf.clear();
         buf.extend_from_slice(&z[..n2]);
         buf.extend_from_slice(&cmd);
@@ -292,6 +302,45 @@ impl Discrete {
         }
         out
     }
+}
+
+/// [`Discrete::advance_short`]'s Horner loop for `N` bodies (`D = 2N + 3` augmented
+/// states), with `accel_rows` its [`Discrete::accel_rows`]: the same operations in the
+/// same order, in fixed-size arrays.
+#[inline(always)]
+fn horner<const N: usize, const D: usize>(
+    accel_rows: &[f64],
+    z: &mut [f64],
+    cmd: [f64; 3],
+    dt_s: f64,
+    degree: usize,
+) -> f64 {
+    let n2 = 2 * N;
+    let mut x = [0.0f64; D];
+    x[..n2].copy_from_slice(&z[..n2]);
+    x[n2..].copy_from_slice(&cmd);
+    let mut y = x;
+    let rows: &[f64] = &accel_rows[..N * (n2 + 2)];
+    for k in (1..=degree).rev() {
+        let h = dt_s / k as f64;
+        let mut t = [0.0f64; N];
+        for (i, ti) in t.iter_mut().enumerate() {
+            let row = &rows[i * (n2 + 2)..(i + 1) * (n2 + 2)];
+            let mut acc = 0.0;
+            for (p, yj) in row.iter().zip(&y[..n2 + 2]) {
+                acc += p * yj;
+            }
+            *ti = x[N + i] + h * acc;
+        }
+        for i in 0..N {
+            y[i] = x[i] + h * y[N + i];
+        }
+        y[N..n2].copy_from_slice(&t);
+        y[n2] = x[n2] + h * y[n2 + 1];
+        y[n2 + 1] = x[n2 + 1] + h * y[n2 + 2];
+    }
+    z[..n2].copy_from_slice(&y[..n2]);
+    z[..n2].iter().fold(0.0, |s, v| s + v * 0.0)
 }
 
 /// `Phi(2 tau)` from `Phi(tau)`: the first `n2` rows of the transition over `tau`

@@ -25,8 +25,9 @@ fn leadscrew_preset() -> AxisMachine {
 }
 
 /// The axes to check, by name: the two presets' axes (linear driver) and the single
-/// 40 Hz mode of the mode-described scenarios (scenarios/quickstart.toml), with two
-/// modes of different damping for a coupled case.
+/// 40 Hz mode of the mode-described scenarios (scenarios/quickstart.toml), two modes of
+/// different damping and five modes (every state size the step handles apart, and one
+/// beyond).
 fn axes() -> Vec<(String, AxisModel)> {
     let mut out = Vec::new();
     for (name, m) in [
@@ -44,7 +45,15 @@ fn axes() -> Vec<(String, AxisModel)> {
         Mode::new(39.0, 0.05, 0.7).expect("mode"),
         Mode::new(145.0, 0.1, 0.3).expect("mode"),
     ];
-    for (name, modes) in [("40 Hz mode", &one[..]), ("39 + 145 Hz modes", &two[..])] {
+    // More bodies than the fixed-size paths take.
+    let five: Vec<Mode> = (0..5)
+        .map(|i| Mode::new(30.0 + 70.0 * i as f64, 0.03 + 0.02 * i as f64, 0.2).expect("mode"))
+        .collect();
+    for (name, modes) in [
+        ("40 Hz mode", &one[..]),
+        ("39 + 145 Hz modes", &two[..]),
+        ("five modes", &five[..]),
+    ] {
         out.push((
             name.to_string(),
             AxisModel::from_modes("x", modes).expect("axis"),
