@@ -8,7 +8,10 @@
 //! exactly the matrix exponential of the augmented system. The exponential is taken in
 //! mass-normalised, frequency-scaled coordinates (`w0^2 M^1/2 r`, `w0 M^1/2 r'`, `w0 v`,
 //! `a`, `j / w0`, with `w0` the highest natural frequency), which balances the matrix, and
-//! mapped back to physical coordinates once.
+//! mapped back to physical coordinates once. A step that a profile breakpoint cuts short
+//! (a partial step) applies the exponential's Taylor series to the state instead, halved
+//! and squared when longer than `1 / |A|`: equal to the exponential to rounding
+//! (sim/tests/all/modal_transition.rs).
 //!
 //! Position-dependent stiffness (a belt's spans) is **linearised at the start position**
 //! of each run: the model is exactly linear, which is what makes it the reference. What
@@ -50,17 +53,25 @@ struct Discrete {
     /// The first `2n` rows of `a_scaled^k / k!` in physical coordinates (by column), for
     /// partial steps ([`Discrete::partial`]); built at the first partial step.
     powers: std::sync::OnceLock<Vec<Vec<f64>>>,
+    /// Rows `n..2n` of the augmented matrix in physical coordinates (`r''` in terms of
+    /// `r, r', v, a`; the jerk enters through `a` only), row by row: what a short partial
+    /// step multiplies the state by ([`Discrete::advance_short`]).
+    accel_rows: Vec<f64>,
 }
 
-/// Largest `|A h|` (infinity norm, scaled coordinates) for which partial steps use the
-/// Taylor series of the exponential instead of `expm`: every term is then below the
-/// previous one and [`TAYLOR_TERMS`] terms leave a remainder below
-/// `1^31/31! e^1 = 3e-34`, far below rounding.
+/// Largest `|A h|` (infinity norm, scaled coordinates) over which partial steps sum the
+/// Taylor series of the exponential (longer ones are halved first, then squared): every
+/// term is then below the previous one and [`TAYLOR_TERMS`] terms leave a remainder below
+/// `e^1 / 24! = 4e-24`, far below rounding.
 const TAYLOR_MAX_NORM: f64 = 1.0;
 
 /// Terms of the Taylor series (degree 0 to `TAYLOR_TERMS - 1`); at `|A h| <= 0.3` (the
 /// printer preset at 10 kHz) the last ones are far below rounding and cost little.
 const TAYLOR_TERMS: usize = 24;
+
+/// Bound on the first omitted Taylor term, relative, of a short partial step
+/// ([`Discrete::advance_short`]).
+const TAYLOR_OMITTED: f64 = 1e-18;
 
 impl Discrete {
     fn new(axis: &AxisModel, start_m: f64, nominal_dt_s: f64) -> Result<Self, SimError> {
@@ -111,6 +122,10 @@ impl Discrete {
         scale.extend(sq.iter().map(|s| w0 * w0 * s));
         scale.extend(sq.iter().map(|s| w0 * s));
         scale.extend([w0, 1.0, 1.0 / w0]);
+        let accel_rows = (n..2 * n)
+            .flat_map(|i| (0..2 * n + 2).map(move |j| (i, j)))
+            .map(|(i, j)| a_scaled[(i, j)] * scale[j] / scale[i])
+            .collect();
         let norm_per_s = (0..dim)
             .map(|i| (0..dim).map(|j| a_scaled[(i, j)].abs()).sum::<f64>())
             .fold(0.0, f64::max);
@@ -124,6 +139,7 @@ impl Discrete {
             nominal: std::sync::OnceLock::new(),
             norm_per_s,
             powers: std::sync::OnceLock::new(),
+            accel_rows,
         })
     }
 
@@ -155,26 +171,115 @@ impl Discrete {
     }
 
     /// The first `2n` rows of the transition over a partial step `dt_s` (a profile
-    /// breakpoint falls inside a sample interval). Short steps (`|A dt| <= 1`) sum the
-    /// Taylor series `sum_k (A dt)^k / k!` from powers of `A` computed once per run:
-    /// `O(K n^2)` per step instead of a Pade `expm` with its matrix products and solve.
-    /// Longer steps use [`Discrete::transition`].
+    /// breakpoint falls inside a sample interval), by column as [`Discrete::transition`]
+    /// gives them. The step is halved `s` times until `|A dt / 2^s| <= 1`; the Taylor
+    /// series `sum_k (A tau)^k / k!` over `tau = dt / 2^s` is summed from powers of `A`
+    /// computed once per run, and squared `s` times (`Phi(2 tau) = Phi(tau)^2`, see
+    /// [`square`]): `O(K n^2 + s n^3)` per step instead of a Pade `expm` with its matrix
+    /// products, solve and allocations (the same scaling and squaring, on a series whose
+    /// remainder is below rounding).
     fn partial(&self, dt_s: f64, out: &mut Vec<f64>) {
-        if self.norm_per_s * dt_s > TAYLOR_MAX_NORM {
-            *out = self.transition(dt_s);
-            return;
-        }
         let powers = self.powers.get_or_init(|| self.taylor_powers());
+        // Halving is exact (a power of two), so `tau * 2^s` is `dt_s` again.
+        let mut tau = dt_s;
+        let mut halvings = 0;
+        while self.norm_per_s * tau > TAYLOR_MAX_NORM {
+            tau /= 2.0;
+            halvings += 1;
+        }
         let len = powers[0].len();
         out.clear();
         out.resize(len, 0.0);
         // Horner-free sum, smallest terms first (they only matter near rounding).
         for (k, p) in powers.iter().enumerate().rev() {
-            let c = dt_s.powi(k as i32);
+            let c = tau.powi(k as i32);
             for (o, x) in out.iter_mut().zip(p) {
                 *o += c * x;
             }
         }
+        for _ in 0..halvings {
+            square(out, 2 * self.n, self.stride, tau);
+            tau *= 2.0;
+        }
+    }
+
+    /// `z = Phi(dt_s) [z; cmd]` for a partial step (`z` padded to the stride, `buf` a
+    /// reused buffer): [`Discrete::advance_short`] when `|A dt| <= 1`, else the
+    /// transition of [`Discrete::partial`] applied as the nominal one is. Returns
+    /// `sum z_i * 0` over the new state: 0 when every entry is finite, NaN otherwise.
+    fn advance_partial(
+        &self,
+        dt_s: f64,
+        z: &mut [f64],
+        cmd: [f64; 3],
+        buf: &mut Vec<f64>,
+        scratch: &mut [f64],
+    ) -> f64 {
+        if self.norm_per_s * dt_s <= TAYLOR_MAX_NORM {
+            return self.advance_short(dt_s, z, cmd, buf);
+        }
+        self.partial(dt_s, buf);
+        apply_any(buf, z, 2 * self.n, cmd, scratch)
+    }
+
+    /// `z = Phi(dt_s) [z; cmd]` for a step with `|A dt| <= 1`: the Taylor series applied
+    /// to the state by Horner's rule, `x + tau A (x + tau A / 2 (x + ... (x + tau A / K
+    /// x)))` with `x = [z; cmd]`, one product with the sparse `A` per term (`r' = r'`,
+    /// `r''` from [`Discrete::accel_rows`], `v' = a`, `a' = j`, `j' = 0`), `O(K n^2)`
+    /// per step. `K` is the least degree whose first omitted term `|A dt|^(K+1)/(K+1)!`
+    /// is below `1e-18` (at most 20 at `|A dt| = 1`): the remainder, below
+    /// `e^1 1e-18`, is far below rounding.
+    fn advance_short(&self, dt_s: f64, z: &mut [f64], cmd: [f64; 3], buf: &mut Vec<f64>) -> f64 {
+        let n = self.n;
+        let n2 = 2 * n;
+        let dim = n2 + 3;
+        let x_norm = self.norm_per_s * dt_s;
+        let mut degree = 0;
+        let mut term = 1.0;
+        while term > TAYLOR_OMITTED && degree + 1 < TAYLOR_TERMS {
+            degree += 1;
+            term *= x_norm / degree as f64;
+        }
+        // Fixed sizes for the usual state sizes: the loops unroll, the state stays in
+        // registers (the same operations in the same order as the loop below).
+        let rows = &self.accel_rows;
+        match n {
+            1 => return horner::<1, 5>(rows, z, cmd, dt_s, degree),
+            2 => return horner::<2, 7>(rows, z, cmd, dt_s, degree),
+            3 => return horner::<3, 9>(rows, z, cmd, dt_s, degree),
+            4 => return horner::<4, 11>(rows, z, cmd, dt_s, degree),
+            _ => {}
+        }
+        buf.clear();
+        buf.extend_from_slice(&z[..n2]);
+        buf.extend_from_slice(&cmd);
+        buf.extend_from_within(..dim);
+        buf.resize(2 * dim + n, 0.0);
+        let (x, rest) = buf.split_at_mut(dim);
+        let (y, t) = rest.split_at_mut(dim);
+        for k in (1..=degree).rev() {
+            let h = dt_s / k as f64;
+            // y = x + h A y, every row from the old `y`: r'' into `t` first.
+            for ((ti, row), xi) in t
+                .iter_mut()
+                .zip(self.accel_rows.chunks_exact(n2 + 2))
+                .zip(&x[n..n2])
+            {
+                let mut acc = 0.0;
+                for (p, yj) in row.iter().zip(y.iter()) {
+                    acc += p * yj;
+                }
+                *ti = xi + h * acc;
+            }
+            for i in 0..n {
+                y[i] = x[i] + h * y[n + i];
+            }
+            y[n..n2].copy_from_slice(t);
+            y[n2] = x[n2] + h * y[n2 + 1];
+            y[n2 + 1] = x[n2 + 1] + h * y[n2 + 2];
+        }
+        z[..n2].copy_from_slice(&y[..n2]);
+        z[..n2].iter().fold(0.0, |s, v| s + v * 0.0)
     }
 
     /// `a_scaled^k / k!` (first `2n` rows, physical coordinates) for `k < TAYLOR_TERMS`.
@@ -196,6 +301,78 @@ impl Discrete {
             out.push(cols);
         }
         out
+    }
+}
+
+/// [`Discrete::advance_short`]'s Horner loop for `N` bodies (`D = 2N + 3` augmented
+/// states), with `accel_rows` its [`Discrete::accel_rows`]: the same operations in the
+/// same order, in fixed-size arrays.
+#[inline(always)]
+fn horner<const N: usize, const D: usize>(
+    accel_rows: &[f64],
+    z: &mut [f64],
+    cmd: [f64; 3],
+    dt_s: f64,
+    degree: usize,
+) -> f64 {
+    let n2 = 2 * N;
+    let mut x = [0.0f64; D];
+    x[..n2].copy_from_slice(&z[..n2]);
+    x[n2..].copy_from_slice(&cmd);
+    let mut y = x;
+    let rows: &[f64] = &accel_rows[..N * (n2 + 2)];
+    for k in (1..=degree).rev() {
+        let h = dt_s / k as f64;
+        let mut t = [0.0f64; N];
+        for (i, ti) in t.iter_mut().enumerate() {
+            let row = &rows[i * (n2 + 2)..(i + 1) * (n2 + 2)];
+            let mut acc = 0.0;
+            for (p, yj) in row.iter().zip(&y[..n2 + 2]) {
+                acc += p * yj;
+            }
+            *ti = x[N + i] + h * acc;
+        }
+        for i in 0..N {
+            y[i] = x[i] + h * y[N + i];
+        }
+        y[N..n2].copy_from_slice(&t);
+        y[n2] = x[n2] + h * y[n2 + 1];
+        y[n2 + 1] = x[n2 + 1] + h * y[n2 + 2];
+    }
+    z[..n2].copy_from_slice(&y[..n2]);
+    z[..n2].iter().fold(0.0, |s, v| s + v * 0.0)
+}
+
+/// `Phi(2 tau)` from `Phi(tau)`: the first `n2` rows of the transition over `tau`
+/// (physical coordinates, by column, `stride` rows per column: the state block `P`, then
+/// the command columns `Q` for `v, a, j`) become those over `2 tau`. The rows below are
+/// the command's own polynomial, `E(tau) = [[1, tau, tau^2/2], [0, 1, tau], [0, 0, 1]]`
+/// (constant jerk), so `Phi(tau)^2` has the rows `[P P, P Q + Q E]`.
+fn square(cols: &mut [f64], n2: usize, stride: usize, tau: f64) {
+    let old = cols.to_vec();
+    let col = |j: usize| &old[j * stride..j * stride + n2];
+    // `P [P | Q]`: column j of the product is P times column j of [P | Q].
+    for j in 0..n2 + 3 {
+        let acc = &mut cols[j * stride..j * stride + n2];
+        acc.fill(0.0);
+        for (k, &x) in col(j).iter().enumerate() {
+            for (a, p) in acc.iter_mut().zip(col(k)) {
+                *a += p * x;
+            }
+        }
+    }
+    // `+ Q E`: Q0 to v, Q0 tau + Q1 to a, Q0 tau^2/2 + Q1 tau + Q2 to j.
+    let e = [
+        [1.0, 0.0, 0.0],
+        [tau, 1.0, 0.0],
+        [tau * tau / 2.0, tau, 1.0],
+    ];
+    for (c, e) in e.iter().enumerate() {
+        for i in 0..n2 {
+            let qe = (old[n2 * stride + i] * e[0] + old[(n2 + 1) * stride + i] * e[1])
+                + old[(n2 + 2) * stride + i] * e[2];
+            cols[(n2 + c) * stride + i] += qe;
+        }
     }
 }
 
@@ -223,7 +400,7 @@ pub struct ModalAxis {
     pub stepper: Option<StepperState>,
     disc: std::sync::Arc<Discrete>,
     scratch: Vec<f64>,
-    /// The transition of the last partial step (reused buffer).
+    /// Reused buffer of the partial steps ([`Discrete::advance_partial`]).
     partial: Vec<f64>,
     /// `(x, toolhead, probe)` of [`axis_positions`] at the start (`z` zero): what an
     /// axis that is still idle at the same command reports, computed once.
@@ -316,6 +493,30 @@ fn apply<const M: usize>(cols: &[f64], z: &mut [f64], n2: usize, cmd: [f64; 3]) 
     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3])
 }
 
+/// [`apply`] for any stride (`rows` by column, `z.len()` rows per column; `scratch` of
+/// the same length).
+fn apply_any(rows: &[f64], z: &mut [f64], n2: usize, cmd: [f64; 3], scratch: &mut [f64]) -> f64 {
+    match z.len() {
+        4 => apply::<4>(rows, z, n2, cmd),
+        8 => apply::<8>(rows, z, n2, cmd),
+        12 => apply::<12>(rows, z, n2, cmd),
+        16 => apply::<16>(rows, z, n2, cmd),
+        stride => {
+            scratch.fill(0.0);
+            for (j, col) in rows.chunks_exact(stride).enumerate() {
+                let zj = if j < n2 { z[j] } else { cmd[j - n2] };
+                if j < n2 || zj != 0.0 {
+                    for (o, p) in scratch.iter_mut().zip(col) {
+                        *o += p * zj;
+                    }
+                }
+            }
+            z.copy_from_slice(scratch);
+            z.iter().fold(0.0, |s, x| s + x * 0.0)
+        }
+    }
+}
+
 /// The modal plant's mutable state.
 #[derive(Debug, Clone)]
 pub struct ModalState {
@@ -354,6 +555,34 @@ impl ModalPlant {
     /// The axes.
     pub fn axis_models(&self) -> &[AxisModel] {
         &self.axes
+    }
+
+    /// Axis `axis`'s transition over `dt_s` as stepping from `state` uses it (linearised
+    /// where the axis started): the first `2n` rows, physical coordinates, by column,
+    /// padded to a multiple of 4 rows. First as a partial step ([`Plant::step`] with a
+    /// step other than the nominal one) computes it, column by column (the step applied
+    /// to each unit vector of `[z; v, a, j]`), then as the
+    /// matrix exponential of the augmented system gives it (nalgebra's Pade `expm`, what
+    /// the nominal step uses); last the scale of each augmented coordinate (`2n + 3`:
+    /// scaled = scale x physical), the balanced coordinates in which the exponential is
+    /// taken. For tests that hold the one to the other.
+    #[doc(hidden)]
+    pub fn partial_transition(state: &ModalState, axis: usize, dt_s: f64) -> [Vec<f64>; 3] {
+        let disc = &state.axes[axis].disc;
+        let (n2, stride) = (2 * disc.n, disc.stride());
+        let (mut buf, mut scratch) = (Vec::new(), vec![0.0; stride]);
+        // Column j: the step applied to the j-th unit vector of `[z; v, a, j]`.
+        let mut fast = vec![0.0; stride * (n2 + 3)];
+        for (j, col) in fast.chunks_exact_mut(stride).enumerate() {
+            let mut cmd = [0.0; 3];
+            if j < n2 {
+                col[j] = 1.0;
+            } else {
+                cmd[j - n2] = 1.0;
+            }
+            disc.advance_partial(dt_s, col, cmd, &mut buf, &mut scratch);
+        }
+        [fast, disc.transition(dt_s), disc.scale.clone()]
     }
 
     /// Envelope of the free vibration (m) of body `body` of axis `axis` as if it were a
@@ -663,31 +892,11 @@ impl Plant for ModalPlant {
             st.idle = false;
             let disc = &st.disc;
             let n2 = 2 * disc.n;
-            let rows: &[f64] = if nominal {
-                disc.nominal()
-            } else {
-                disc.partial(dt_s, &mut st.partial);
-                &st.partial
-            };
             let cmd = [c.v, c.a, c.j];
-            let z_probe = match disc.stride() {
-                4 => apply::<4>(rows, &mut st.z, n2, cmd),
-                8 => apply::<8>(rows, &mut st.z, n2, cmd),
-                12 => apply::<12>(rows, &mut st.z, n2, cmd),
-                16 => apply::<16>(rows, &mut st.z, n2, cmd),
-                stride => {
-                    st.scratch.fill(0.0);
-                    for (j, col) in rows.chunks_exact(stride).enumerate() {
-                        let zj = if j < n2 { st.z[j] } else { cmd[j - n2] };
-                        if j < n2 || zj != 0.0 {
-                            for (o, p) in st.scratch.iter_mut().zip(col) {
-                                *o += p * zj;
-                            }
-                        }
-                    }
-                    st.z.copy_from_slice(&st.scratch);
-                    st.z.iter().fold(0.0, |s, x| s + x * 0.0)
-                }
+            let z_probe = if nominal {
+                apply_any(disc.nominal(), &mut st.z, n2, cmd, &mut st.scratch)
+            } else {
+                disc.advance_partial(dt_s, &mut st.z, cmd, &mut st.partial, &mut st.scratch)
             };
             if let (Some(sp), Some(ss)) = (&ax.stepper, st.stepper.as_mut()) {
                 // Linear driver: the load angle Nr (x rad_per_m - theta) is -Nr r_rotor.

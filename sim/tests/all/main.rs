@@ -9,6 +9,7 @@ mod common;
 mod lean_support;
 mod machine;
 mod modal_samples;
+mod modal_transition;
 #[path = "../../../planner/tests/all/module_graph.rs"]
 mod module_graph;
 #[cfg(feature = "mujoco")]
