@@ -383,3 +383,30 @@ fn the_gcode_kind_starts_a_layer_range_from_the_whole_jobs_state() {
         whole.print_time_s.to_bits()
     );
 }
+
+/// A machine with an undamped mode never settles: a `[gcode]` layer range cannot start
+/// from the state the layers before leave (no pre-roll is long enough), so the scenario
+/// is refused at `gcode.layers`; the whole file runs.
+#[test]
+fn the_gcode_kind_refuses_a_layer_range_on_an_undamped_machine() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let tower = root().join("gcode/prints/ringing_tower.gcode");
+    let text = |layers: &str| {
+        format!(
+            "name = \"undamped\"\n\
+             [machine.axis.x]\nmodes = [{{ frequency_hz = 40.0, damping_ratio = 0.0 }}]\n\
+             [machine.axis.y]\nmodes = [{{ frequency_hz = 40.0, damping_ratio = 0.05 }}]\n\
+             [gcode]\nfile = {:?}\nfirmware = \"klipper\"\n{layers}\
+             [limits]\nvmax_mm_s = 500.0\namax_mm_s2 = 3000.0\njmax_mm_s3 = 100000.0\n",
+            tower.to_str().expect("utf-8")
+        )
+    };
+    let ranged = write(dir.path(), "ranged.toml", &text("layers = \"1..1\"\n"));
+    let msg = settle::load_runs(&ranged).expect_err("refused").to_string();
+    assert!(
+        msg.contains("gcode.layers") && msg.contains("never decays"),
+        "{msg}"
+    );
+    let whole = write(dir.path(), "whole.toml", &text(""));
+    assert!(settle::load_runs(&whole).is_ok());
+}
