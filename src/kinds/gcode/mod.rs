@@ -12,16 +12,30 @@
 //! layers = "0..0"
 //! ```
 //!
-//! The run's motion is the job's shaped X and Y (and Z) over the layer range, one
-//! trajectory from the range's first move (`t = 0`) to its end; the common metrics are
-//! those of any run (residual after the end, settle time). The kind's probe measures the
-//! contour error against the G-code's own geometry ([`contour`]) and adds to runs.csv
-//! `print_time_s` (the whole file's, by the firmware's planner),
-//! `contour_worst_um`, `contour_p95_um` (printing samples, during the job) and
-//! `contour_worst_line`. Bad G-code is reported when the sweep is checked, with the file
-//! and line.
+//! The run's motion is the job's shaped X and Y (and Z), one trajectory. Without
+//! `layers` it runs from the job's first move (`t = 0`) to its end. With `layers` it
+//! starts from the whole job's state, as `settle gcode --layers` does: the job's chunks
+//! start a pre-roll ([`preroll`]) of at least `ln(1e6) / sigma` before the range's first
+//! move (`sigma` the slowest decay rate of the machine's linearised modes; no earlier
+//! than the file's first move), so the vibration the layers before leave is in the
+//! range's samples, and `t = 0` is the pre-roll's start, moved to the next instant of the
+//! print clock's sample grid (`k / sample_rate_hz`, the grid of `settle gcode`) so that
+//! both sample the same instants. The common metrics are those of any run over that
+//! trajectory: `move_time_s` is the pre-roll plus the range, the residual and the settle
+//! time are measured after the range's last move. The kind's probe measures the contour
+//! error against the G-code's own geometry ([`contour`]) and adds to runs.csv
+//! `print_time_s` (the whole file's, by the firmware's planner), `contour_worst_um`,
+//! `contour_p95_um` (printing samples of the range's moves, during the job; never the
+//! pre-roll's) and `contour_worst_line`. Bad G-code is reported when the sweep is
+//! checked, with the file and line.
+//!
+//! A physical machine on the modal backend is linearised where the run starts (the
+//! pre-roll's start with `layers`; `settle gcode --layers` linearises at the origin, where
+//! the whole job starts): on the modes form, which is linear, a range gives the numbers
+//! of the same layers in the whole job.
 
 pub mod contour;
+pub mod preroll;
 pub mod stats;
 
 use std::path::PathBuf;
@@ -32,7 +46,9 @@ use settle_gcode::job::{Firmware, Job, JobConfig, MoveInfo, PlannerConfig, Shape
 use settle_gcode::{GcodeError, MoveKind};
 use settle_planner::path::CornerStrategy;
 use settle_planner::path::junction::Junction;
+use settle_planner::shaper::stream::cut;
 use settle_planner::{PlanError, Profile, Segment, Trajectory};
+use settle_sim::{AxisModel, DriverMode};
 
 use crate::error::Error;
 use crate::input::source::Source;
@@ -190,15 +206,71 @@ fn shaper_setting(s: Option<&settle_planner::shaper::Shaper>) -> Option<ShaperSe
     })
 }
 
-/// The job of `run` opened, limited to its layers.
+/// The machine's axes with the linear driver (the modes form as it is): where the
+/// pre-roll's decay rate is read.
+fn linear_axes(run: &RunSpec) -> Result<Vec<AxisModel>, String> {
+    let axes = match &run.machine {
+        Some(m) => m.compile(DriverMode::Linear),
+        None => run
+            .modes
+            .iter()
+            .map(|a| AxisModel::from_modes(&a.axis, &run.modes_sim(&a.axis)?))
+            .collect(),
+    };
+    axes.map_err(|e| e.to_string())
+}
+
+/// The pre-roll of `run`'s layer range (s; 0 without one): [`preroll::preroll_s`] of the
+/// machine's slowest decay rate, plus two sample periods, so that moving the start to the
+/// sample grid leaves at least [`preroll::preroll_s`].
+fn preroll_of(run: &RunSpec, job: &GcodeJob) -> Result<f64, String> {
+    if job.layers.is_none() {
+        return Ok(0.0);
+    }
+    let sigma = preroll::slowest_decay_per_s(&linear_axes(run)?).map_err(|m| {
+        format!(
+            "{m}: a layer range cannot start from the state the layers before leave; simulate the whole file (no `layers`)"
+        )
+    })?;
+    Ok(preroll::preroll_s(sigma) + 2.0 / run.sample_rate_hz)
+}
+
+/// The job of `run` opened, limited to its layers with their pre-roll ([`preroll_of`]).
 fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<std::io::BufReader<std::fs::File>>, String> {
     let shaper = crate::kinds::shaper(run).map_err(|e| e.to_string())?;
     let cfg = job_config(run, job, shaper_setting(shaper.as_ref()))?;
     let j = Job::open(&job.file, cfg).map_err(|e| e.to_string())?;
     match job.layers {
-        Some((a, b)) => j.with_layers(a..=b).map_err(|e| e.to_string()),
+        Some((a, b)) => j
+            .with_layers(a..=b)
+            .and_then(|j| j.with_preroll_s(preroll_of(run, job).unwrap_or(0.0)))
+            .map_err(|e| e.to_string()),
         None => Ok(j),
     }
+}
+
+/// The chunks (print-clock start, trajectory) from `at_s` on: those ending before it
+/// dropped, the one containing it cut there ([`cut`]: the exact state at `at_s`).
+fn from_time(chunks: Vec<(f64, Trajectory)>, at_s: f64) -> Result<Vec<Trajectory>, PlanError> {
+    let mut out = Vec::with_capacity(chunks.len());
+    for (t0, tr) in chunks {
+        let d = tr.duration_s();
+        if out.is_empty() && at_s > t0 {
+            if t0 + d <= at_s {
+                continue;
+            }
+            let from = at_s - t0;
+            let axes = tr
+                .axes()
+                .iter()
+                .map(|p| cut(p, from, d))
+                .collect::<Result<Vec<_>, _>>()?;
+            out.push(Trajectory::new(axes)?);
+        } else {
+            out.push(tr);
+        }
+    }
+    Ok(out)
 }
 
 /// One profile per machine axis (X, Y, Z of the job by name), the chunks joined.
@@ -231,6 +303,8 @@ struct GcodeProbe {
     moves: Vec<Arc<MoveInfo>>,
     /// Print-clock time of the run's `t = 0` (s).
     t0_s: f64,
+    /// Only samples of moves in these layers count (the rest is the pre-roll).
+    layers: Option<(u32, u32)>,
     print_time_s: f64,
 }
 
@@ -254,7 +328,11 @@ impl Probe for GcodeProbe {
             let (Some(e), Some(owner)) = (active.error_mm(tp, p), active.owner(tp)) else {
                 continue;
             };
-            if owner.kind != MoveKind::Print {
+            if owner.kind != MoveKind::Print
+                || self
+                    .layers
+                    .is_some_and(|(a, b)| !(a..=b).contains(&owner.layer))
+            {
                 continue;
             }
             let e_um = e * 1e3;
@@ -332,12 +410,15 @@ impl Kind for GcodeRun {
         let Some(job) = run.state::<GcodeJob>() else {
             return Ok(());
         };
-        if run.machine.is_none() {
+        let names = run.axis_names();
+        let has = |a: &str| names.iter().any(|n| n == a);
+        if !(has("x") && has("y") && names.iter().all(|n| ["x", "y", "z"].contains(&n.as_str()))) {
             return Err((
                 "machine".into(),
-                "a G-code job needs a physical machine with axes x and y (e.g. `preset = \"printer_xy\"`)".into(),
+                "a G-code job needs a machine with axes x and y (and z), no others: a physical machine (e.g. `preset = \"printer_xy\"`) or modes on `[machine.axis.x]` and `[machine.axis.y]`".into(),
             ));
         }
+        preroll_of(run, job).map_err(|m| (run.blame("gcode.layers"), m))?;
         let mut j = open(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
         j.run_to_end()
             .map_err(|e| (run.blame("gcode.file"), e.to_string()))
@@ -351,23 +432,41 @@ impl Kind for GcodeRun {
             reason: "the G-code job failed to plan (checked when the sweep was validated)",
         };
         let mut j = open(run, job).map_err(failed)?;
-        let (mut chunks, mut moves, mut t0) = (Vec::new(), Vec::<Arc<MoveInfo>>::new(), None);
+        let (mut chunks, mut moves) = (Vec::new(), Vec::<Arc<MoveInfo>>::new());
         while let Some(c) = j.next_chunk().map_err(|e| failed(e.to_string()))? {
-            t0.get_or_insert(c.start_time_s);
             for m in &c.moves {
                 if moves.last().is_none_or(|l| m.index > l.index) {
                     moves.push(Arc::clone(m));
                 }
             }
-            chunks.push(c.trajectory);
+            chunks.push((c.start_time_s, c.trajectory));
         }
         j.run_to_end().map_err(|e| failed(e.to_string()))?;
+        let mut t0 = chunks.first().map_or(0.0, |c| c.0);
+        if let Some((a, _)) = job.layers {
+            // The pre-roll's start moved to the print clock's sample grid (module doc),
+            // when that leaves at least the pre-roll the modes need (it does unless the
+            // range starts within a pre-roll of the file's start, where the job starts at
+            // rest as in the whole run).
+            let dt = 1.0 / run.sample_rate_hz;
+            let on_grid = (t0 / dt).ceil() * dt;
+            let range_start = moves
+                .iter()
+                .find(|m| m.layer >= a && m.duration_s > 0.0)
+                .map(|m| m.start_time_s);
+            let needed = preroll_of(run, job).map_err(failed)? - 2.0 * dt;
+            if range_start.is_some_and(|r| r - on_grid >= needed) {
+                t0 = on_grid;
+            }
+        }
+        let chunks = from_time(chunks, t0)?;
         let trajectory = join(ctx.axes, &chunks)?;
         Ok(Planned {
             trajectory,
             probe: Some(Box::new(GcodeProbe {
                 moves,
-                t0_s: t0.unwrap_or(0.0),
+                t0_s: t0,
+                layers: job.layers,
                 print_time_s: j.print_time_s(),
             })),
         })

@@ -29,6 +29,7 @@ use settle_sim::{
 
 use crate::error::{Error, Location};
 use crate::input::machine_file::MachineForm;
+use crate::kinds::gcode::preroll::{preroll_s, slowest_decay_per_s};
 use crate::kinds::gcode::stats::{self, LayerMap, Spot};
 use crate::spec::backend::{Backend, NO_MUJOCO};
 use crate::workflows::{Exit, Report};
@@ -333,29 +334,6 @@ pub fn resolve_axes(
     }
 }
 
-/// The slowest decay rate (1/s) of the axes' free vibration: the least `-Re(p)` over the
-/// poles `p` of every axis linearised at rest at the origin (a mode's `zeta w`; a real
-/// pole's rate). Every disturbance of the linear model decays at least this fast, up to a
-/// constant of its eigenvectors.
-pub fn slowest_decay_per_s(linear_axes: &[AxisModel]) -> Result<f64, Error> {
-    let rest = Profile::empty(State::default());
-    let mut slowest = f64::INFINITY;
-    for a in linear_axes {
-        let lr =
-            LinearResponse::new(a, &rest).map_err(|e| Error::input("--machine", e.to_string()))?;
-        for p in lr.poles() {
-            slowest = slowest.min(-p.re);
-        }
-    }
-    if !(slowest.is_finite() && slowest > 0.0) {
-        return Err(Error::input(
-            "--machine",
-            "the machine has an undamped or unstable mode: its vibration never decays",
-        ));
-    }
-    Ok(slowest)
-}
-
 /// The longest period (s) of the axes' oscillatory modes (their damped periods).
 fn longest_period_s(linear_axes: &[AxisModel]) -> f64 {
     let rest = Profile::empty(State::default());
@@ -368,19 +346,8 @@ fn longest_period_s(linear_axes: &[AxisModel]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// How much smaller the vibration present when a layer range's pre-roll starts must
-/// become by the range's first move: 1e-6 (the envelope `exp(-sigma t)`, `sigma` the
-/// slowest decay rate).
-pub const PREROLL_DECAY: f64 = 1e-6;
-
 /// How much the ringing after the last move decays over the longest tail: 1e-3.
 pub const TAIL_DECAY: f64 = 1e-3;
-
-/// The pre-roll of a layer range (s): the time the slowest mode needs to decay by
-/// [`PREROLL_DECAY`], `ln(1 / PREROLL_DECAY) / sigma`.
-pub fn preroll_s(slowest_decay_per_s: f64) -> f64 {
-    (1.0 / PREROLL_DECAY).ln() / slowest_decay_per_s
-}
 
 /// The longest simulation after the last move (s): the time the slowest mode needs to
 /// decay by [`TAIL_DECAY`].
@@ -424,7 +391,7 @@ fn simulate(
     let (machine_name, axes, linear_axes) = resolve_axes(&opts.machine, opts.driver)?;
     // A machine with an undamped mode never settles: no tail, and a layer range cannot
     // start from the state the layers before leave.
-    let sigma = slowest_decay_per_s(&linear_axes);
+    let sigma = slowest_decay_per_s(&linear_axes).map_err(|m| Error::input("--machine", m));
     if opts.layers.is_some() && sigma.is_err() {
         return Err(Error::input(
             "--layers",

@@ -6,7 +6,7 @@
 //! ([`crate::kinds::gcode::stats`]).
 //!
 //! - With a layer range the job's chunks start a pre-roll before the range (see
-//!   [`super::preroll_s`]): the plant is stepped through it, but only samples of moves in
+//!   [`crate::kinds::gcode::preroll`]): the plant is stepped through it, but only samples of moves in
 //!   the range are counted.
 //! - When the job's motion ends the file, the machine is simulated on with the command
 //!   standing at the end point for [`StreamOptions::tail_s`] (or until the residual has
