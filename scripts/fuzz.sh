@@ -26,8 +26,8 @@ export RUSTFLAGS="${RUSTFLAGS:-} --cfg fuzzing -Cpasses=sancov-module \
   -Cllvm-args=-sanitizer-coverage-pc-table -Cllvm-args=-sanitizer-coverage-trace-compares"
 # Keep fuzz builds apart from the workspace's (different instrumentation flags).
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}-fuzz"
-# Profile `fuzz` (fuzz/Cargo.toml): optimisation level 1 with debug assertions and overflow
-# checks: a smoke run needs coverage and checks, and opt-level 3 costs most of the build.
+# Profile `fuzz` (fuzz/Cargo.toml): optimisation level 1, otherwise a release build: a smoke
+# run needs coverage, and opt-level 3 costs most of the build.
 echo "== fuzz build (${targets[*]})"
 bins=()
 for t in "${targets[@]}"; do bins+=(--bin "$t"); done
