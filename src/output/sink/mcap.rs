@@ -105,25 +105,26 @@ fn metadata(p: &Provenance, rec: &RunRecord) -> BTreeMap<String, String> {
     ])
 }
 
-/// Write one run to `w`; returns what each channel holds.
-pub fn write<W: Write + Seek>(
-    w: W,
-    p: &Provenance,
-    rec: &RunRecord,
-) -> Result<Vec<ChannelInfo>, mcap::McapError> {
-    let mut out = mcap::WriteOptions::new()
+/// A zstd-compressed MCAP writer on `w`, its library field naming this settle version.
+fn create<W: Write + Seek>(w: W, version: &str) -> Result<mcap::Writer<W>, mcap::McapError> {
+    mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))
         .compression_threads(0)
-        .library(format!("settle {}", p.settle_version))
-        .create(w)?;
-    out.write_metadata(&mcap::records::Metadata {
-        name: "settle".to_string(),
-        metadata: metadata(p, rec),
-    })?;
-    let series = rec.series;
-    let mut info = Vec::new();
+        .library(format!("settle {version}"))
+        .create(w)
+}
+
+/// One JSON-schema channel per signal group, `/<group>`; with what each will hold
+/// (`messages` messages).
+#[allow(clippy::type_complexity)]
+fn add_channels<W: Write + Seek>(
+    out: &mut mcap::Writer<W>,
+    groups: Vec<Group>,
+    messages: u64,
+) -> Result<(Vec<(u16, Group)>, Vec<ChannelInfo>), mcap::McapError> {
     let mut ids = Vec::new();
-    for g in groups(series) {
+    let mut info = Vec::new();
+    for g in groups {
         let schema = group_schema(&g).to_string();
         let name = format!("settle.{}", g.name);
         let schema_id = out.add_schema(&name, "jsonschema", schema.as_bytes())?;
@@ -134,9 +135,25 @@ pub fn write<W: Write + Seek>(
             topic,
             schema_name: name,
             schema,
-            messages: series.len() as u64,
+            messages,
         });
     }
+    Ok((ids, info))
+}
+
+/// Write one run to `w`; returns what each channel holds.
+pub fn write<W: Write + Seek>(
+    w: W,
+    p: &Provenance,
+    rec: &RunRecord,
+) -> Result<Vec<ChannelInfo>, mcap::McapError> {
+    let mut out = create(w, p.settle_version)?;
+    out.write_metadata(&mcap::records::Metadata {
+        name: "settle".to_string(),
+        metadata: metadata(p, rec),
+    })?;
+    let series = rec.series;
+    let (ids, mut info) = add_channels(&mut out, groups(series), series.len() as u64)?;
     let mut buf = Vec::with_capacity(256);
     for (i, &t) in series.t_s.iter().enumerate() {
         let time = ns(t);
@@ -221,31 +238,12 @@ impl<W: Write + Seek> Stream<W> {
         names: &[&str],
         units: &[&str],
     ) -> Result<Self, mcap::McapError> {
-        let mut out = mcap::WriteOptions::new()
-            .compression(Some(mcap::Compression::Zstd))
-            .compression_threads(0)
-            .library(format!("settle {version}"))
-            .create(w)?;
+        let mut out = create(w, version)?;
         out.write_metadata(&mcap::records::Metadata {
             name: "settle".to_string(),
             metadata,
         })?;
-        let mut ids = Vec::new();
-        let mut info = Vec::new();
-        for g in super::groups::group_names(names, units) {
-            let schema = group_schema(&g).to_string();
-            let name = format!("settle.{}", g.name);
-            let schema_id = out.add_schema(&name, "jsonschema", schema.as_bytes())?;
-            let topic = format!("/{}", g.name);
-            let id = out.add_channel(schema_id, &topic, "json", &BTreeMap::new())?;
-            ids.push((id, g));
-            info.push(ChannelInfo {
-                topic,
-                schema_name: name,
-                schema,
-                messages: 0,
-            });
-        }
+        let (ids, info) = add_channels(&mut out, super::groups::group_names(names, units), 0)?;
         Ok(Self {
             out,
             ids,
