@@ -314,8 +314,8 @@ fn a_layer_range_is_recorded_as_mcap() {
 /// difference is a free vibration of the modes from the whole run's deviation at that
 /// instant; over the pre-roll (at least `ln(1e6) / sigma`, `sigma` the slowest decay
 /// rate) it decays by 1e-6. One mode: a step of acceleration `a` gives `|e|` and
-/// `|e'| / wd` at most `a / w^2 * (1 + e^(-pi zeta / sqrt(1 - zeta^2)))` = 4000 / 251.3^2
-/// * 1.86 = 118 um at Klipper's 4000 mm/s^2 (the file's `M204 S4000`), 236 um for a
+/// `|e'| / wd` at most `a / w^2 * (1 + e^(-pi zeta / sqrt(1 - zeta^2)))` =
+/// `4000 / 251.3^2 * 1.86` = 118 um at Klipper's 4000 mm/s^2 (the file's `M204 S4000`), 236 um for a
 /// reversal: the amplitude is below 1.1 x sqrt(2) x 236 um = 370 um, and 1e-6 of it is
 /// 3.7e-4 um, so 1e-3 um is the stated tolerance (the modal plant's rounding, 1e-16 per
 /// step, is far below). `printer_xy` rings less than 250 um on this file: 1e-6 of it,
