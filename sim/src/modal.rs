@@ -14,8 +14,10 @@
 //! (sim/tests/all/modal_transition.rs).
 //!
 //! Position-dependent stiffness (a belt's spans) is **linearised at the start position**
-//! of each run: the model is exactly linear, which is what makes it the reference. What
-//! that costs against the real belt (stiffer towards the pulley) is measured by
+//! of each run, or at fixed axis positions given to the plant
+//! ([`ModalPlant::linearised_at`]: a G-code job is linearised where the print is, its
+//! layer ranges too): the model is exactly linear, which is what makes it the reference.
+//! What that costs against the real belt (stiffer towards the pulley) is measured by
 //! `settle validate` (rapier with the varying belt against rapier with it frozen).
 //!
 //! The modal plant simulates the linear driver spring only ([`DriverMode::Linear`]); the
@@ -381,6 +383,8 @@ fn square(cols: &mut [f64], n2: usize, stride: usize, tau: f64) {
 pub struct ModalPlant {
     axes: Vec<AxisModel>,
     nominal_dt_s: f64,
+    /// Where each axis is linearised (m), when not at its start ([`ModalPlant::linearised_at`]).
+    linearise_at_m: Option<Vec<f64>>,
 }
 
 /// One axis's mutable state.
@@ -549,7 +553,38 @@ impl ModalPlant {
                 });
             }
         }
-        Ok(Self { axes, nominal_dt_s })
+        Ok(Self {
+            axes,
+            nominal_dt_s,
+            linearise_at_m: None,
+        })
+    }
+
+    /// The same plant linearised at these axis positions (m, one per axis, in the order
+    /// of the axes) instead of each run's start: [`Plant::initial_state`] then starts
+    /// each axis at rest in the commanded state it is given (the deflection from the
+    /// command's static equilibrium zero) with the model linearised at the static
+    /// equilibrium of its axis position here. A machine whose stiffness does not depend
+    /// on position gives the same model at any point.
+    pub fn linearised_at(mut self, positions_m: Vec<f64>) -> Result<Self, SimError> {
+        if positions_m.len() != self.axes.len() {
+            return Err(SimError::AxisCount {
+                expected: self.axes.len(),
+                got: positions_m.len(),
+            });
+        }
+        if let Some(p) = positions_m.iter().find(|p| !p.is_finite()) {
+            return Err(SimError::InvalidModel {
+                what: format!("the linearisation point {p} m is not a finite position"),
+            });
+        }
+        self.linearise_at_m = Some(positions_m);
+        Ok(self)
+    }
+
+    /// Where the plant is linearised (m per axis), when not at each run's start.
+    pub fn linearisation_point(&self) -> Option<&[f64]> {
+        self.linearise_at_m.as_deref()
     }
 
     /// The axes.
@@ -840,8 +875,10 @@ impl Plant for ModalPlant {
             .axes
             .iter()
             .zip(start)
-            .map(|(a, s)| {
-                let disc = Discrete::new(a, s.p, self.nominal_dt_s)?;
+            .enumerate()
+            .map(|(i, (a, s))| {
+                let at = self.linearise_at_m.as_ref().map_or(s.p, |p| p[i]);
+                let disc = Discrete::new(a, at, self.nominal_dt_s)?;
                 let stride = disc.stride();
                 let stepper = a.stepper.as_ref().map(|st| {
                     let mut ss = st.at_rest(s.p).0;

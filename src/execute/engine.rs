@@ -13,7 +13,7 @@ use crate::spec::backend::Backend;
 use crate::spec::backend::NO_MUJOCO;
 
 /// Options every backend honours.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct SimOptions {
     /// Position-dependent belt stiffness: varying (the physics) or frozen at the start
     /// (the linear model; the modal backend always freezes it).
@@ -21,6 +21,11 @@ pub struct SimOptions {
     /// Largest integration step of time-stepping backends (s); `None`: their own choice
     /// (rapier: `STEP_FRACTION / w_max`).
     pub max_step_s: Option<f64>,
+    /// Where the modal backend linearises a position-dependent stiffness: one position
+    /// per axis (m, in the order of the axes); `None`: each axis's start. The run kind
+    /// chooses it ([`crate::kinds::Planned::linearise_at_m`]); the nonlinear backends
+    /// follow the stiffness along the travel and ignore it.
+    pub linearise_at_m: Option<Vec<f64>>,
 }
 
 /// Simulate `traj` (one profile per axis, in the order of `axes`) on `backend` and measure
@@ -52,7 +57,10 @@ pub fn run_trajectory(
     let meta: Vec<AxisMeta> = axes.iter().map(AxisMeta::of).collect();
     match backend {
         Backend::Modal => {
-            let plant = ModalPlant::new(axes, 1.0 / observe.sample_rate_hz)?;
+            let mut plant = ModalPlant::new(axes, 1.0 / observe.sample_rate_hz)?;
+            if let Some(at) = &options.linearise_at_m {
+                plant = plant.linearised_at(at.clone())?;
+            }
             simulate(&plant, &names, &meta, traj, observe, record)
         }
         Backend::Rapier => {

@@ -77,7 +77,10 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
         run: spec.id,
         source,
     })?;
-    let options = sim_options(spec);
+    let options = SimOptions {
+        linearise_at_m: planned.linearise_at_m.clone(),
+        ..sim_options(spec)
+    };
     let observe = observe_of(spec);
     let traj = &planned.trajectory;
     let samples = (traj.duration_s() + spec.window_s) * spec.sample_rate_hz;

@@ -121,6 +121,9 @@ pub struct Planned {
     /// What the kind measures beyond the common metrics: the runner then records the run's
     /// series for it.
     pub probe: Option<Box<dyn Probe>>,
+    /// Where the modal backend linearises the machine (m per machine axis); `None`: at
+    /// the trajectory's start (see [`crate::execute::SimOptions::linearise_at_m`]).
+    pub linearise_at_m: Option<Vec<f64>>,
 }
 
 /// A runs.csv column a kind plots against each swept parameter.

@@ -40,6 +40,7 @@ impl Kind for PointMove {
         Ok(Planned {
             trajectory: on_axis(ctx.axes, &run.axis, &profile)?,
             probe: None,
+            linearise_at_m: None,
         })
     }
 }

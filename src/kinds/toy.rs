@@ -130,6 +130,7 @@ impl Kind for Toy {
         Ok(Planned {
             trajectory: on_axis(ctx.axes, &run.axis, &shuttle)?,
             probe: Some(Box::new(MaxError { move_end_s })),
+            linearise_at_m: None,
         })
     }
 

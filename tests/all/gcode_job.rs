@@ -77,21 +77,48 @@ fn the_cube_layer_writes_layers_summary_and_a_ringing_map() {
 }
 
 /// The same corner as G-code through settle's planner (`[gcode]`) and as a `[corner]` run
-/// (same machine, planner, limits, sample clock): the same metrics. The windowed planner
-/// cuts its chunks at other instants than `plan_path` ends its segments, so the plant's
-/// steps split at different times; the modal plant is exact for any split, so the
-/// results differ by rounding only: 1e-9 relative is far above that (1e-16 per step,
-/// 1e4 steps).
+/// (same machine, planner, limits, sample clock): the same metrics, on the same linear
+/// model. printer_xy's belts depend on position: the G-code job is linearised at the
+/// centre of its printing moves (X 10, Y 10 mm: the corner's legs span 0..20 mm), the
+/// corner run at its start, so the corner run is simulated here at the G-code job's
+/// point. The windowed planner cuts its chunks at other instants than `plan_path` ends its
+/// segments, so the plant's steps split at different times; the modal plant is exact for
+/// any split, so the results differ by rounding only: 1e-9 relative is far above that
+/// (1e-16 per step, 1e4 steps).
 #[test]
 fn a_gcode_corner_gives_the_metrics_of_the_corner_kind() {
-    let run = |name: &str| {
+    let load = |name: &str| {
         let (_, mut runs) = settle::load_runs(&root().join("scenarios").join(name)).expect("loads");
         settle::execute::set_backend(Path::new(name), &mut runs, Backend::Modal).expect("modal");
         assert_eq!(runs.len(), 1);
-        settle::execute::execute(&runs[0], None).expect("runs")
+        runs.remove(0)
     };
-    let g = run("gcode_corner.toml");
-    let c = run("gcode_corner_reference.toml");
+    let (g_run, c_run) = (
+        load("gcode_corner.toml"),
+        load("gcode_corner_reference.toml"),
+    );
+    let g = settle::execute::execute(&g_run, None).expect("runs");
+    let axes = settle::execute::axes_of(&c_run).expect("axes");
+    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+    let point = settle::kinds::plan(&g_run, &names)
+        .expect("plans")
+        .linearise_at_m
+        .expect("printer_xy's belts depend on position");
+    assert_eq!(point, vec![10.0 * 1e-3, 10.0 * 1e-3]);
+    let planned = settle::kinds::plan(&c_run, &names).expect("plans");
+    assert!(planned.probe.is_none() && planned.linearise_at_m.is_none());
+    let c = settle::execute::run_trajectory(
+        axes,
+        Backend::Modal,
+        &settle::execute::SimOptions {
+            linearise_at_m: Some(point),
+            ..settle::execute::sim_options(&c_run)
+        },
+        &planned.trajectory,
+        &settle::execute::observe_of(&c_run),
+        None,
+    )
+    .expect("runs");
     let close = |a: f64, b: f64, what: &str| {
         assert!(
             (a - b).abs() <= 1e-9 * a.abs().max(b.abs()),

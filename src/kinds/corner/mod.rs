@@ -128,6 +128,7 @@ impl Kind for CornerPath {
         Ok(Planned {
             trajectory,
             probe: None,
+            linearise_at_m: None,
         })
     }
 

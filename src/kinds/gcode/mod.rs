@@ -29,12 +29,21 @@
 //! pre-roll's) and `contour_worst_line`. Bad G-code is reported when the sweep is
 //! checked, with the file and line.
 //!
-//! A physical machine on the modal backend is linearised where the run starts (the
-//! pre-roll's start with `layers`; `settle gcode --layers` linearises at the origin, where
-//! the whole job starts): on the modes form, which is linear, a range gives the numbers
-//! of the same layers in the whole job.
+//! A physical machine on the modal backend is linearised where the print is
+//! ([`linpoint`]: the centre of the file's printing moves), the point `settle gcode`
+//! uses, for the whole file and for any layer range of it: a range gives the numbers of
+//! the same layers in the whole job, and the kind the numbers of `settle gcode`.
+//!
+//! A range that ends before the file does: the contour columns count the range's samples
+//! up to its last command, as `settle gcode --layers` does (the whole job's samples after
+//! it belong to the next layer's moves). The common metrics (`residual_*`, settle times)
+//! are defined as for any run: the command then stands at the range's last point for the
+//! observation window, as if the job stopped dead there (a range can end moving, and the
+//! real job goes on); they measure that stop, not the print, and `settle gcode --layers`
+//! reports no such ringing for a range that ends before the file.
 
 pub mod contour;
+pub mod linpoint;
 pub mod preroll;
 pub mod stats;
 
@@ -43,7 +52,7 @@ use std::sync::Arc;
 
 use serde::Deserialize;
 use settle_gcode::job::{Firmware, Job, JobConfig, MoveInfo, PlannerConfig, ShaperSetting};
-use settle_gcode::{GcodeError, MoveKind};
+use settle_gcode::{GcodeError, MoveKind, Reader, ReaderOptions};
 use settle_planner::path::CornerStrategy;
 use settle_planner::path::junction::Junction;
 use settle_planner::shaper::stream::cut;
@@ -55,6 +64,7 @@ use crate::input::source::Source;
 use crate::kinds::{Kind, KindState, PathMove, PlanContext, Planned, Probe, Role, any_has};
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
+use crate::spec::backend::Backend;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::value::Value;
 use contour::ActiveMoves;
@@ -233,6 +243,21 @@ fn preroll_of(run: &RunSpec, job: &GcodeJob) -> Result<f64, String> {
         )
     })?;
     Ok(preroll::preroll_s(sigma) + 2.0 / run.sample_rate_hz)
+}
+
+/// Where the modal backend linearises `run`'s machine ([`linpoint`]), one position (m)
+/// per machine axis in `axes`' order: `None` on the other backends and on a machine whose
+/// stiffness does not depend on position (the modes form).
+fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option<Vec<f64>>, String> {
+    if run.backend != Backend::Modal || !linpoint::depends_on_position(&linear_axes(run)?) {
+        return Ok(None);
+    }
+    let dialect = JobConfig::defaults(job.firmware)
+        .map_err(|e| e.to_string())?
+        .dialect;
+    let reader = Reader::open(&job.file, ReaderOptions::new(dialect)).map_err(|e| e.to_string())?;
+    let point = linpoint::linearisation_point(reader).map_err(|e| e.to_string())?;
+    Ok(Some(point.on_axes(axes)))
 }
 
 /// The job of `run` opened, limited to its layers with their pre-roll ([`preroll_of`]).
@@ -461,6 +486,7 @@ impl Kind for GcodeRun {
         }
         let chunks = from_time(chunks, t0)?;
         let trajectory = join(ctx.axes, &chunks)?;
+        let linearise_at_m = linearise_at(run, job, ctx.axes).map_err(failed)?;
         Ok(Planned {
             trajectory,
             probe: Some(Box::new(GcodeProbe {
@@ -469,6 +495,7 @@ impl Kind for GcodeRun {
                 layers: job.layers,
                 print_time_s: j.print_time_s(),
             })),
+            linearise_at_m,
         })
     }
 

@@ -184,6 +184,7 @@ impl Kind for ScanStep {
         Ok(Planned {
             trajectory: Trajectory::new(profiles)?,
             probe: Some(Box::new(StepProbe { raster: r, y0_m })),
+            linearise_at_m: None,
         })
     }
 

@@ -8,6 +8,12 @@
 //! worst and 95th percentile over printing samples ([`crate::kinds::gcode::stats`]); the outputs are
 //! `layers.csv`, `summary.md` and the ringing maps of the worst layers ([`report`]).
 //! Everything is computed before anything is written: a bad file writes nothing.
+//!
+//! On the modal backend a machine whose stiffness depends on position (a belt's spans) is
+//! linearised at one point for the whole file, where the print is
+//! ([`crate::kinds::gcode::linpoint`]: the centre of the printing moves' bounding box),
+//! for the whole run and for any layer range alike; the `[gcode]` run kind uses the same
+//! point, so both give the same numbers.
 
 pub mod compare;
 pub mod record;
@@ -22,13 +28,11 @@ use settle_gcode::{GcodeError, Reader, ReaderOptions};
 use settle_planner::{Profile, State};
 use settle_sim::closed_form::LinearResponse;
 use settle_sim::machine::Machine;
-use settle_sim::{
-    AxisModel, DriverMode, ModalPlant, ModalState, Mode, Plant, RapierOptions, RapierPlant,
-    SimError,
-};
+use settle_sim::{AxisModel, DriverMode, ModalPlant, Mode, Plant, RapierOptions, RapierPlant};
 
 use crate::error::{Error, Location};
 use crate::input::machine_file::MachineForm;
+use crate::kinds::gcode::linpoint::{LinPoint, depends_on_position, linearisation_point};
 use crate::kinds::gcode::preroll::{preroll_s, slowest_decay_per_s};
 use crate::kinds::gcode::stats::{self, LayerMap, Spot};
 use crate::spec::backend::{Backend, NO_MUJOCO};
@@ -152,6 +156,9 @@ pub struct GcodeOutcome {
     pub versus: Option<Box<GcodeOutcome>>,
     /// The MCAP recording's channels, when one was written.
     pub recording: Option<Vec<crate::output::sink::mcap::ChannelInfo>>,
+    /// Where the modal backend linearised the machine (a machine whose stiffness depends
+    /// on position; [`crate::kinds::gcode::linpoint`]).
+    pub linearised_at: Option<LinPoint>,
 }
 
 impl GcodeOutcome {
@@ -179,6 +186,9 @@ impl GcodeOutcome {
             self.worst_um,
             self.p95_um
         ));
+        if let Some(p) = &self.linearised_at {
+            r.out(format!("modal backend linearised at {}", p.describe()));
+        }
         if let Some(s) = self.worst().first() {
             r.out(format!(
                 "worst at line {} (layer {}, X {:.2} Y {:.2} mm)",
@@ -428,14 +438,20 @@ fn simulate(
         tail_hold_s: longest_period_s(&linear_axes),
     };
     let err = gcode_error(&opts.file);
-    let reader = Reader::open(
-        &opts.file,
-        ReaderOptions {
-            skip_bad_lines: opts.skip_bad_lines,
-            ..ReaderOptions::new(opts.job.dialect)
-        },
-    )
-    .map_err(&err)?;
+    let reader_options = ReaderOptions {
+        skip_bad_lines: opts.skip_bad_lines,
+        ..ReaderOptions::new(opts.job.dialect)
+    };
+    // The modal backend's linearisation point, where a position-dependent stiffness
+    // makes it matter: one pass of the reader over the whole file.
+    let point = match opts.backend == Backend::Modal && depends_on_position(&axes) {
+        true => Some(
+            linearisation_point(Reader::open(&opts.file, reader_options.clone()).map_err(&err)?)
+                .map_err(&err)?,
+        ),
+        false => None,
+    };
+    let reader = Reader::open(&opts.file, reader_options).map_err(&err)?;
     let mut job = Job::new(reader, opts.job.clone())
         .map_err(&err)?
         .with_name(opts.file.display().to_string());
@@ -449,23 +465,16 @@ fn simulate(
     let dt = 1.0 / opts.sample_rate_hz;
     let (streamed, rec) = match opts.backend {
         Backend::Modal => {
-            let plant = ModalPlant::new(axes, dt).map_err(sim_err)?;
-            // A layer range starts at rest in the commanded state of its pre-roll, with
-            // the machine linearised where the whole job starts (at rest at the origin,
-            // as every planner starts), so that it computes the whole job's numbers.
-            let at_origin = |starts: &[State]| {
-                let mut st = plant.initial_state(&vec![State::default(); starts.len()])?;
-                for (a, s) in st.axes.iter_mut().zip(starts) {
-                    a.base = *s;
-                }
-                Ok(st)
-            };
-            let at_start = |starts: &[State]| plant.initial_state(starts);
-            let init: &dyn Fn(&[State]) -> Result<ModalState, SimError> = match opts.layers {
-                Some(_) => &at_origin,
-                None => &at_start,
-            };
-            simulate_job(&mut job, &plant, init, sopts, rec, &opts.file)?
+            // Linearised where the print is, the same point for the whole run and any
+            // layer range ([`crate::kinds::gcode::linpoint`]); a range starts at rest in
+            // the commanded state of its pre-roll.
+            let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+            let mut plant = ModalPlant::new(axes, dt).map_err(sim_err)?;
+            if let Some(p) = &point {
+                plant = plant.linearised_at(p.on_axes(&names)).map_err(sim_err)?;
+            }
+            let init = |starts: &[State]| plant.initial_state(starts);
+            simulate_job(&mut job, &plant, &init, sopts, rec, &opts.file)?
         }
         Backend::Rapier => {
             let plant = RapierPlant::new(
@@ -524,6 +533,7 @@ fn simulate(
         files: Vec::new(),
         versus: None,
         recording: None,
+        linearised_at: point,
     };
     Ok((outcome, rec))
 }
