@@ -38,6 +38,9 @@ fn embedded(figures: &[(String, String)]) -> Vec<Figure> {
         .collect()
 }
 
+/// The title of the table of every run in a sweep's report.
+pub const RUNS_TITLE: &str = "All runs (runs.csv)";
+
 /// A number cell with `text` shown (`value` non-finite for `not settled`).
 fn num(value: f64, text: String) -> Cell {
     Cell::Number { value, text }
@@ -237,16 +240,16 @@ fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
     }
 }
 
-/// The report of a sweep: `csv` is its runs.csv (row `i` = `runs[i]`, read into `table`),
-/// `figures` the figures' captions and SVG markup, `sections` the run kinds' summary
-/// sections (shown as text).
+/// The report of a sweep: `table` is its runs.csv (row `i` = `runs[i]`), `figures` the
+/// figures' captions and SVG files. The table of every run is left out (`runs` is `None`):
+/// the caller writes it from runs.csv as the page is written
+/// ([`crate::output::html::render_to`] with [`RUNS_TITLE`]).
 pub fn sweep_report(
     sc: &Scenario,
     file: ScenarioFile<'_>,
     runs: &[RunSpec],
     table: &RunsTable,
-    csv: &str,
-    figures: &[(String, String)],
+    figures: &[(String, std::path::PathBuf)],
 ) -> Report {
     let mut intro = vec![format!("{}. {} runs.", machines_line(runs), runs.len())];
     if !sc.description.trim().is_empty() {
@@ -287,8 +290,14 @@ pub fn sweep_report(
         intro,
         winners,
         tables,
-        figures: embedded(figures),
-        runs: Table::from_csv("All runs (runs.csv)", csv).ok(),
+        figures: figures
+            .iter()
+            .map(|(title, svg)| Figure {
+                title: title.clone(),
+                image: Image::SvgFile(svg.clone()),
+            })
+            .collect(),
+        runs: None,
         failed,
         provenance: provenance(
             file,

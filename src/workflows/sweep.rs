@@ -316,6 +316,8 @@ pub fn sweep(
     for r in &runs {
         csv.push_str(&rows[&r.id]);
     }
+    // The rows are in `csv` now.
+    drop(rows);
     match opts.shard {
         Some(s) => {
             write_atomic(&out.join("runs.csv"), csv.as_bytes())?;

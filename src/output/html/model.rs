@@ -148,6 +148,9 @@ pub enum Image {
     /// SVG markup (e.g. from the crate's plots), embedded inline as is: it must be trusted
     /// markup, not user text. A leading XML declaration or doctype is dropped.
     Svg(String),
+    /// An SVG file, read and embedded as [`Image::Svg`] when the page is written (so a
+    /// report holds no figure's markup until then).
+    SvgFile(std::path::PathBuf),
     /// PNG bytes, embedded as a base64 `data:` URI.
     Png(Vec<u8>),
 }
