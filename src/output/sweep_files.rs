@@ -67,11 +67,11 @@ pub fn write_sweep(
         .iter()
         .map(|f| (f.title.clone(), out.join(&f.svg)))
         .collect();
-    let report = sweep_report(sc, file, runs, &table, &svgs);
+    let (report, ranking_rows) = sweep_report(sc, file, runs, &table, &svgs);
     drop(table);
     let path = out.join(REPORT);
     write_atomic_with(&path, |w| {
-        crate::output::html::render_to(&report, Some((RUNS_TITLE, csv)), w, &path)
+        crate::output::html::render_to(&report, Some((RUNS_TITLE, csv)), &ranking_rows, w, &path)
     })
 }
 

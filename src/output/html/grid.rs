@@ -64,6 +64,45 @@ pub(crate) fn push_table(out: &mut impl Out, id: &str, t: &Table) {
     push_tail(out, lazy);
 }
 
+/// Write table `t` (its rows left out) as [`push_table`] writes it with rows `row(0)`,
+/// `row(1)`, ... up to the first `None`, one row at a time (two passes: the columns' types
+/// first), so no row is kept.
+pub(crate) fn push_made_table(
+    out: &mut impl Out,
+    id: &str,
+    t: &Table,
+    row: impl Fn(usize) -> Option<Vec<Cell>>,
+) {
+    let columns = t.header.len();
+    // numeric_column and plain, a row at a time.
+    let mut any = vec![false; columns];
+    let mut other = vec![false; columns];
+    let mut plain = true;
+    let mut rows = 0;
+    while let Some(r) = row(rows) {
+        for (j, cell) in r.iter().enumerate().take(columns) {
+            match cell {
+                Cell::Number { .. } => any[j] = true,
+                Cell::Text(s) if s.is_empty() => {}
+                _ => other[j] = true,
+            }
+        }
+        plain &= r
+            .iter()
+            .all(|c| !matches!(c, Cell::Link { .. }) && sort_key(c).is_none());
+        rows += 1;
+    }
+    let numeric: Vec<bool> = any.iter().zip(&other).map(|(a, o)| *a && !o).collect();
+    let lazy = rows > LAZY_ROWS && plain;
+    push_head(out, id, &t.title, &t.note, &t.header, &numeric, lazy);
+    for k in 0..rows {
+        if let Some(r) = row(k) {
+            push_row(out, &r, columns, &numeric, lazy);
+        }
+    }
+    push_tail(out, lazy);
+}
+
 /// Write CSV text as [`push_table`] writes `Table::from_csv(title, text)`, one record at a
 /// time (two passes over the text; no row kept), so a runs table of 100,000 runs costs no
 /// memory per run. Nothing is written, and `false` returned, when `from_csv` would fail.

@@ -64,7 +64,7 @@ pub use csv::CsvError;
 pub use grid::LAZY_ROWS;
 pub use model::{
     BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, Provenance, Reference, Report,
-    Stat, Table,
+    Rows, Stat, Table,
 };
 
 /// The page for `report`: a complete HTML document (UTF-8). A figure given as a file
@@ -75,17 +75,19 @@ pub fn render(report: &Report) -> String {
 
 /// Write the page for `report` to `w` as it is made (the page is never held whole);
 /// `runs_csv` (title, CSV text) is the table of every run when `report.runs` is `None`,
-/// written as `Table::from_csv(title, text)` would be, one record at a time. The bytes are
-/// [`render`]'s. Errors: a figure file that cannot be read, or a failed write (`path` is
-/// the file the error names).
+/// written as `Table::from_csv(title, text)` would be, one record at a time; a table of
+/// `report.tables` without rows gets those `rows` makes, as if it held them. The bytes are
+/// [`render`]'s of the report with those rows. Errors: a figure file that cannot be read,
+/// or a failed write (`path` is the file the error names).
 pub fn render_to(
     report: &Report,
     runs_csv: Option<(&str, &str)>,
+    rows: &dyn Rows,
     w: impl std::io::Write,
     path: &std::path::Path,
 ) -> Result<(), crate::error::Error> {
     let mut sink = Sink { w, error: None };
-    let done = page::page_to(&mut sink, report, runs_csv);
+    let done = page::page_to(&mut sink, report, runs_csv, rows);
     if let Some(e) = sink.error {
         return Err(crate::error::Error::write(path, e));
     }

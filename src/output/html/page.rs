@@ -3,8 +3,8 @@
 
 use super::Out;
 use super::escape::{base64, escaped, push_escaped};
-use super::grid::{push_csv_table, push_table};
-use super::model::{BandWinner, Cell, Figure, Image, Provenance, Reference, Report, Table};
+use super::grid::{push_csv_table, push_made_table, push_table};
+use super::model::{BandWinner, Cell, Figure, Image, Provenance, Reference, Report, Rows, Table};
 use crate::error::Error;
 
 const STYLE: &str = include_str!("style.css");
@@ -19,7 +19,7 @@ const CONTENT_POLICY: &str =
 pub(crate) fn page(r: &Report) -> String {
     let mut out = String::with_capacity(64 * 1024);
     // Only a figure given as a file can fail, and then it is left out.
-    let _ = page_to(&mut out, r, None);
+    let _ = page_to(&mut out, r, None, &());
     out
 }
 
@@ -30,6 +30,7 @@ pub(crate) fn page_to(
     out: &mut impl Out,
     r: &Report,
     runs_csv: Option<(&str, &str)>,
+    rows: &dyn Rows,
 ) -> Result<(), Error> {
     out.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
     let _ = writeln!(
@@ -51,7 +52,12 @@ pub(crate) fn page_to(
     out.push_str("</header>\n");
     push_winners(out, &r.winners);
     for (i, t) in r.tables.iter().enumerate() {
-        push_table(out, &format!("table-{}", i + 1), t);
+        let id = format!("table-{}", i + 1);
+        if t.rows.is_empty() && rows.row(i, 0).is_some() {
+            push_made_table(out, &id, t, |k| rows.row(i, k));
+        } else {
+            push_table(out, &id, t);
+        }
     }
     push_figures(out, &r.figures)?;
     if let Some(runs) = &r.runs {
