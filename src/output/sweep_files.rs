@@ -23,8 +23,9 @@ use crate::error::Error;
 use crate::input::runs_table::RunsTable;
 use crate::input::scenario::Scenario;
 use crate::output::atomic::{write_atomic, write_atomic_with};
+use crate::output::html::Sink;
 use crate::output::report::{RUNS_TITLE, ScenarioFile, sweep_report};
-use crate::output::summary::summary_md;
+use crate::output::summary::summary_to;
 use crate::spec::run_spec::RunSpec;
 
 /// Folder of the sweep figures inside the output folder.
@@ -57,10 +58,12 @@ pub fn write_sweep(
     if let Some(j) = crate::output::jobs::jobs(sc, runs, &table) {
         figures.extend(crate::output::plot::jobs::write(&plots, &sc.name, &j)?);
     }
-    write_atomic(
-        &out.join("summary.md"),
-        summary_md(sc, file.path, runs, &table, &figures).as_bytes(),
-    )?;
+    let summary = out.join("summary.md");
+    write_atomic_with(&summary, |w| {
+        let mut sink = Sink::new(w);
+        summary_to(&mut sink, sc, file.path, runs, &table, &figures);
+        sink.finish(&summary)
+    })?;
     // The figures are read from their files, and the table of every run from `csv`, as
     // the page is written: report.html is never held whole.
     let svgs: Vec<(String, PathBuf)> = figures

@@ -86,13 +86,10 @@ pub fn render_to(
     w: impl std::io::Write,
     path: &std::path::Path,
 ) -> Result<(), crate::error::Error> {
-    let mut sink = Sink { w, error: None };
+    let mut sink = Sink::new(w);
     let done = page::page_to(&mut sink, report, runs_csv, rows);
-    if let Some(e) = sink.error {
-        return Err(crate::error::Error::write(path, e));
-    }
-    done?;
-    std::io::Write::flush(&mut sink.w).map_err(|e| crate::error::Error::write(path, e))
+    sink.finish(path)?;
+    done
 }
 
 /// Where the page is written: text is appended to it.
@@ -114,9 +111,24 @@ impl Out for String {
 }
 
 /// A writer as an [`Out`]: the first write error is kept, and nothing more is written.
-struct Sink<W: std::io::Write> {
+pub(crate) struct Sink<W: std::io::Write> {
     w: W,
     error: Option<std::io::Error>,
+}
+
+impl<W: std::io::Write> Sink<W> {
+    /// Text written to `w`.
+    pub(crate) fn new(w: W) -> Self {
+        Self { w, error: None }
+    }
+
+    /// Flush the writer; the first write error, naming `path`.
+    pub(crate) fn finish(mut self, path: &std::path::Path) -> Result<(), crate::error::Error> {
+        if let Some(e) = self.error.take() {
+            return Err(crate::error::Error::write(path, e));
+        }
+        std::io::Write::flush(&mut self.w).map_err(|e| crate::error::Error::write(path, e))
+    }
 }
 
 impl<W: std::io::Write> std::fmt::Write for Sink<W> {
