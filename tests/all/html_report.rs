@@ -15,9 +15,7 @@ use crate::support::html::chromium::{
     Rect, browser, console_clean, region_spread, selftest, selftest_result, visit,
 };
 use crate::support::html::fixture::{column, generated_csv, quickstart_report};
-use settle::output::html::{
-    Cell, FailedRun, LAZY_ROWS, Report, Rows, Table, render, render_to,
-};
+use settle::output::html::{Cell, FailedRun, LAZY_ROWS, Report, Rows, Table, render, render_to};
 
 /// The shown texts of column `name` in the order a correct sort gives: by value, ascending
 /// or descending, non-finite values last either way, ties in row order.
@@ -431,7 +429,10 @@ fn a_page_written_as_it_is_made_is_the_rendered_page() {
     let big = Table::from_csv("big", &generated_csv(LAZY_ROWS + 1)).expect("generated CSV");
     for (csv, tables) in [
         (generated_csv(40), base.tables.clone()),
-        (generated_csv(LAZY_ROWS + 1), vec![base.tables[0].clone(), big]),
+        (
+            generated_csv(LAZY_ROWS + 1),
+            vec![base.tables[0].clone(), big],
+        ),
         ("run,reason\n0,\"open\n".to_string(), base.tables.clone()),
     ] {
         assert!(tables.iter().all(|t| !t.rows.is_empty()));
