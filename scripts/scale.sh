@@ -6,16 +6,20 @@
 #   scripts/scale.sh flat     sweeps of 1,000, 10,000 and 100,000 runs (scale_10k.toml with
 #                             more or fewer distances); fails if the CPU time (user + sys,
 #                             not wall: the machine may be shared) per run at 100,000 is
-#                             more than 20 % above that at 1,000 or at 10,000, or if the
-#                             peak RSS per run grows by more than 20 % from 10,000 to 100,000
+#                             more than 20 % above that at 1,000 or at 10,000, if the
+#                             peak RSS per run grows by more than 20 % from 10,000 to 100,000,
+#                             or if the peak RSS per run at 100,000 runs over the 1,000-run
+#                             sweep's (the fixed base) exceeds PER_RUN_LIMIT_B bytes
 #   scripts/scale.sh          all three
 # BACKEND (default modal) picks the sweep's backend; LIMIT_MB (default 200) the bound;
+# PER_RUN_LIMIT_B (default 4608, 4.5 KB) the bound per run of `flat`;
 # SETTLE=path/to/settle uses that binary instead of building the release one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what="${1:-all}"
 backend="${BACKEND:-modal}"
 limit_mb="${LIMIT_MB:-200}"
+per_run_limit_b="${PER_RUN_LIMIT_B:-4608}"
 
 memory() {
     cargo build --release --locked --bin settle
@@ -75,7 +79,7 @@ flat() {
     done | tee "$dir/table.txt"
     rm -rf "$dir/"*.toml "$dir/"time_*.txt
     local status=0
-    awk -v backend="$backend" '
+    awk -v backend="$backend" -v limit="$per_run_limit_b" '
         { n[NR] = $1; cpu[NR] = $2 / $1 * 1e3; kb[NR] = $3 / $1 }
         END {
             printf "| runs | CPU time (s) | per run (ms) | peak RSS (MB) | per run (KB) |\n"
@@ -89,6 +93,13 @@ flat() {
             }
             if (kb[3] > 1.2 * kb[2]) {
                 printf "scale.sh: peak RSS per run grows by more than 20 %% from %d to %d runs\n", n[2], n[3] > "/dev/stderr"
+                bad = 1
+            }
+            # Bytes per run over the smallest sweep (the fixed base: binary, plot buffers).
+            marginal = (kb[3] * n[3] - kb[1] * n[1]) * 1024 / (n[3] - n[1])
+            printf "peak RSS per run over the %d-run base at %d runs: %.0f B (limit %d B)\n", n[1], n[3], marginal, limit
+            if (marginal > limit) {
+                printf "scale.sh: peak RSS per run at %d runs is %.0f B, above %d B\n", n[3], marginal, limit > "/dev/stderr"
                 bad = 1
             }
             exit bad

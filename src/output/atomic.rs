@@ -24,6 +24,27 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), Error> {
     })
 }
 
+/// Write `path` atomically as `write` makes it (temporary file + rename), through a
+/// buffer: a large output (a report of 100,000 runs) is never held whole. Nothing is left
+/// behind when `write` fails.
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> Result<(), Error>,
+) -> Result<(), Error> {
+    let tmp = tmp_path(path);
+    let file = std::fs::File::create(&tmp).map_err(|e| Error::write(path, e))?;
+    let mut w = std::io::BufWriter::with_capacity(1 << 16, file);
+    let done = write(&mut w).and_then(|()| {
+        std::io::Write::flush(&mut w).map_err(|e| Error::write(path, e))?;
+        drop(w);
+        std::fs::rename(&tmp, path).map_err(|e| Error::write(path, e))
+    });
+    if done.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    done
+}
+
 /// Create `dir` and its parents.
 pub fn create_dir(dir: &Path) -> Result<(), Error> {
     std::fs::create_dir_all(dir).map_err(|e| Error::write(dir, e))

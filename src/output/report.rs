@@ -11,10 +11,12 @@ use crate::input::runs_table::RunsTable;
 use crate::input::scenario::Scenario;
 use crate::output::html::{
     BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, Provenance, Reference, Report,
-    Stat, Table,
+    Rows, Stat, Table,
 };
 use crate::output::jobs::{self, Jobs};
-use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, rank, run_command};
+use crate::output::ranking::{
+    Point, Ranked, Ranking, SHAPER_COLUMNS, gain_text, rank, run_command,
+};
 use crate::output::summary::{machines_line, ms};
 use crate::spec::run_spec::RunSpec;
 
@@ -37,6 +39,9 @@ fn embedded(figures: &[(String, String)]) -> Vec<Figure> {
         })
         .collect()
 }
+
+/// The title of the table of every run in a sweep's report.
+pub const RUNS_TITLE: &str = "All runs (runs.csv)";
 
 /// A number cell with `text` shown (`value` non-finite for `not settled`).
 fn num(value: f64, text: String) -> Cell {
@@ -101,7 +106,8 @@ fn winners(ranking: &Ranking) -> Vec<BandWinner> {
         .collect()
 }
 
-fn ranking_tables(ranking: &Ranking, runs: &[RunSpec], file: ScenarioFile<'_>) -> Vec<Table> {
+/// The ranking tables, one per band, without their rows ([`RankingRows`] makes them).
+fn ranking_tables(ranking: &Ranking) -> Vec<Table> {
     ranking
         .bands
         .iter()
@@ -123,53 +129,6 @@ fn ranking_tables(ranking: &Ranking, runs: &[RunSpec], file: ScenarioFile<'_>) -
             }
             header.push("run".into());
             header.push("command".into());
-            let mut rows = Vec::new();
-            for p in &b.points {
-                for r in &p.runs {
-                    let mut row: Vec<Cell> = p.workload.iter().map(Cell::text).collect();
-                    row.push(match r.rank {
-                        Some(n) => num(n as f64, n.to_string()),
-                        None => num(f64::INFINITY, "-".into()),
-                    });
-                    row.push(Cell::text(if r.current {
-                        format!("{} (current)", r.label)
-                    } else {
-                        r.label.clone()
-                    }));
-                    let t = |x: Option<f64>| num(x.map_or(f64::INFINITY, |x| x * 1e3), ms(x));
-                    match &r.failure {
-                        Some(f) => {
-                            row.push(num(r.move_s * 1e3, format!("{:.1}", r.move_s * 1e3)));
-                            row.push(Cell::text(f.clone()));
-                            row.push(num(f64::INFINITY, "failed".into()));
-                            row.push(num(f64::NAN, "-".into()));
-                        }
-                        None => {
-                            row.push(num(r.move_s * 1e3, format!("{:.1}", r.move_s * 1e3)));
-                            row.push(t(r.settle_s));
-                            row.push(t(r.total_s));
-                            row.push(num(
-                                r.residual_peak_um,
-                                format!("{:.2}", r.residual_peak_um),
-                            ));
-                        }
-                    }
-                    row.push(num(
-                        r.gain.map_or(f64::NAN, |g| g * 100.0),
-                        gain_text(r.gain),
-                    ));
-                    if let Some(sh) = &r.shaper {
-                        for (x, prec) in sh.iter().zip([3usize, 1, 0]) {
-                            row.push(x.map_or(num(f64::NAN, "-".into()), |x| {
-                                num(x, format!("{x:.prec$}"))
-                            }));
-                        }
-                    }
-                    row.push(num(r.id as f64, r.id.to_string()));
-                    row.push(Cell::text(run_command(file.path, &runs[r.row])));
-                    rows.push(row);
-                }
-            }
             Table {
                 title: format!("Ranking: move and settle to within {} um", b.band_um),
                 note: format!(
@@ -177,10 +136,82 @@ fn ranking_tables(ranking: &Ranking, runs: &[RunSpec], file: ScenarioFile<'_>) -
                     ranking.reference_name()
                 ),
                 header,
-                rows,
+                rows: Vec::new(),
             }
         })
         .collect()
+}
+
+/// The row of run `r` of workload point `p` in a ranking table.
+fn ranking_row(p: &Point, r: &Ranked, runs: &[RunSpec], file: ScenarioFile<'_>) -> Vec<Cell> {
+    let mut row: Vec<Cell> = p.workload.iter().map(Cell::text).collect();
+    row.push(match r.rank {
+        Some(n) => num(n as f64, n.to_string()),
+        None => num(f64::INFINITY, "-".into()),
+    });
+    row.push(Cell::text(if r.current {
+        format!("{} (current)", r.label)
+    } else {
+        r.label.clone()
+    }));
+    let t = |x: Option<f64>| num(x.map_or(f64::INFINITY, |x| x * 1e3), ms(x));
+    match &r.failure {
+        Some(f) => {
+            row.push(num(r.move_s * 1e3, format!("{:.1}", r.move_s * 1e3)));
+            row.push(Cell::text(f.clone()));
+            row.push(num(f64::INFINITY, "failed".into()));
+            row.push(num(f64::NAN, "-".into()));
+        }
+        None => {
+            row.push(num(r.move_s * 1e3, format!("{:.1}", r.move_s * 1e3)));
+            row.push(t(r.settle_s));
+            row.push(t(r.total_s));
+            row.push(num(
+                r.residual_peak_um,
+                format!("{:.2}", r.residual_peak_um),
+            ));
+        }
+    }
+    row.push(num(
+        r.gain.map_or(f64::NAN, |g| g * 100.0),
+        gain_text(r.gain),
+    ));
+    if let Some(sh) = &r.shaper {
+        for (x, prec) in sh.iter().zip([3usize, 1, 0]) {
+            row.push(x.map_or(num(f64::NAN, "-".into()), |x| num(x, format!("{x:.prec$}"))));
+        }
+    }
+    row.push(num(r.id as f64, r.id.to_string()));
+    row.push(Cell::text(run_command(file.path, &runs[r.row])));
+    row
+}
+
+/// The rows of a sweep report's ranking tables, made as the page is written
+/// ([`crate::output::html::render_to`]): a ranking of 100,000 runs is never held as cells.
+#[derive(Debug)]
+pub struct RankingRows<'a> {
+    /// The ranking, when the report has its tables.
+    ranking: Option<Ranking>,
+    /// The index of the first ranking table in the report's tables.
+    first: usize,
+    /// Per band, the first row of each workload point.
+    starts: Vec<Vec<usize>>,
+    /// The runs (row `i` of the runs table is `runs[i]`).
+    runs: &'a [RunSpec],
+    /// The scenario, as the commands name it.
+    file: ScenarioFile<'a>,
+}
+
+impl Rows for RankingRows<'_> {
+    fn row(&self, table: usize, k: usize) -> Option<Vec<Cell>> {
+        let b = table.checked_sub(self.first)?;
+        let band = self.ranking.as_ref()?.bands.get(b)?;
+        let starts = self.starts.get(b)?;
+        let p = starts.partition_point(|&s| s <= k).checked_sub(1)?;
+        let point = band.points.get(p)?;
+        let r = point.runs.get(k - starts[p])?;
+        Some(ranking_row(point, r, self.runs, self.file))
+    }
 }
 
 /// The G-code jobs' table ([`crate::output::jobs`]): the headline lines as its note.
@@ -237,17 +268,18 @@ fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
     }
 }
 
-/// The report of a sweep: `csv` is its runs.csv (row `i` = `runs[i]`, read into `table`),
-/// `figures` the figures' captions and SVG markup, `sections` the run kinds' summary
-/// sections (shown as text).
-pub fn sweep_report(
+/// The report of a sweep: `table` is its runs.csv (row `i` = `runs[i]`), `figures` the
+/// figures' captions and SVG files. What a report of many runs would hold is left to be
+/// made as the page is written ([`crate::output::html::render_to`]): the table of every
+/// run (`runs` is `None`; written from runs.csv under [`RUNS_TITLE`]) and the ranking
+/// tables' rows (the [`RankingRows`] returned).
+pub fn sweep_report<'a>(
     sc: &Scenario,
-    file: ScenarioFile<'_>,
-    runs: &[RunSpec],
+    file: ScenarioFile<'a>,
+    runs: &'a [RunSpec],
     table: &RunsTable,
-    csv: &str,
-    figures: &[(String, String)],
-) -> Report {
+    figures: &[(String, std::path::PathBuf)],
+) -> (Report, RankingRows<'a>) {
     let mut intro = vec![format!("{}. {} runs.", machines_line(runs), runs.len())];
     if !sc.description.trim().is_empty() {
         intro.insert(0, sc.description.trim().to_string());
@@ -260,14 +292,16 @@ pub fn sweep_report(
             kind_tables.extend(markdown_tables(&section));
         }
     }
-    let (winners, mut tables) = if replaced {
-        (Vec::new(), Vec::new())
+    let (winners, mut tables, ranking) = if replaced {
+        (Vec::new(), Vec::new(), None)
     } else {
         let ranking = rank(sc, runs, table);
-        (winners(&ranking), ranking_tables(&ranking, runs, file))
+        (winners(&ranking), ranking_tables(&ranking), Some(ranking))
     };
+    let mut first = 0;
     if let Some(j) = crate::output::jobs::jobs(sc, runs, table) {
         tables.insert(0, jobs_table(&j, runs, file));
+        first = 1;
     }
     tables.extend(kind_tables);
     let failed = (0..runs.len())
@@ -282,13 +316,41 @@ pub fn sweep_report(
         .first()
         .map(|r| r.backend.to_string())
         .unwrap_or_default();
-    Report {
+    let starts = ranking.as_ref().map_or(Vec::new(), |r| {
+        r.bands
+            .iter()
+            .map(|b| {
+                b.points
+                    .iter()
+                    .scan(0, |n, p| {
+                        let start = *n;
+                        *n += p.runs.len();
+                        Some(start)
+                    })
+                    .collect()
+            })
+            .collect()
+    });
+    let rows = RankingRows {
+        ranking,
+        first,
+        starts,
+        runs,
+        file,
+    };
+    let report = Report {
         title: sc.name.clone(),
         intro,
         winners,
         tables,
-        figures: embedded(figures),
-        runs: Table::from_csv("All runs (runs.csv)", csv).ok(),
+        figures: figures
+            .iter()
+            .map(|(title, svg)| Figure {
+                title: title.clone(),
+                image: Image::SvgFile(svg.clone()),
+            })
+            .collect(),
+        runs: None,
         failed,
         provenance: provenance(
             file,
@@ -304,7 +366,8 @@ pub fn sweep_report(
                 }
             ),
         ),
-    }
+    };
+    (report, rows)
 }
 
 /// A report from a Markdown summary (e.g. `settle tune`'s tune.md): its tables (each under

@@ -4,12 +4,11 @@
 //! metrics, so a summary rebuilt from a merged `runs.csv` is byte-identical to the one the
 //! unsharded sweep wrote.
 
-use std::fmt::Write as _;
-
 use std::path::Path;
 
 use crate::input::runs_table::RunsTable;
 use crate::input::scenario::Scenario;
+use crate::output::html::Out;
 use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, rank, run_command};
 use crate::spec::run_spec::RunSpec;
 
@@ -85,6 +84,20 @@ pub fn summary_md(
     figures: &[Figure],
 ) -> String {
     let mut out = String::new();
+    summary_to(&mut out, sc, scenario, runs, table, figures);
+    out
+}
+
+/// [`summary_md`], written to `out` as it is made (a summary of 100,000 runs is never
+/// held whole).
+pub(crate) fn summary_to(
+    out: &mut impl Out,
+    sc: &Scenario,
+    scenario: &Path,
+    runs: &[RunSpec],
+    table: &RunsTable,
+    figures: &[Figure],
+) {
     let _ = writeln!(out, "# {}\n", sc.name);
     if !sc.description.is_empty() {
         let _ = writeln!(out, "{}\n", sc.description.trim());
@@ -130,7 +143,7 @@ pub fn summary_md(
         }
     }
     if !replaced {
-        push_ranking(&mut out, &rank(sc, runs, table), runs, scenario);
+        push_ranking(out, &rank(sc, runs, table), runs, scenario);
     }
     for section in after.iter().filter(|s| !s.is_empty()) {
         out.push('\n');
@@ -144,7 +157,6 @@ pub fn summary_md(
             let _ = writeln!(out, "{} ([SVG]({}), [PNG]({}))\n", f.title, f.svg, f.png);
         }
     }
-    out
 }
 
 /// Whether the summary ranks candidates by move-and-settle time: no run kind's section
@@ -156,7 +168,7 @@ pub fn ranks_candidates(runs: &[RunSpec], table: &RunsTable) -> bool {
 }
 
 /// The winners and the ranking tables.
-fn push_ranking(out: &mut String, ranking: &Ranking, runs: &[RunSpec], scenario: &Path) {
+fn push_ranking(out: &mut impl Out, ranking: &Ranking, runs: &[RunSpec], scenario: &Path) {
     let reference = ranking.reference_name();
     let _ = writeln!(out, "## Winner per band\n");
     let compared = if ranking.setting_keys.is_empty() {

@@ -17,14 +17,15 @@
 //! `summary.md`, `report.html` and the plots are functions of `runs.csv` and the scenario
 //! alone, which is what makes a merged sweep byte-identical to an unsharded one.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::Error;
 use crate::input::runs_table::RunsTable;
 use crate::input::scenario::Scenario;
-use crate::output::atomic::write_atomic;
-use crate::output::report::{ScenarioFile, sweep_report};
-use crate::output::summary::summary_md;
+use crate::output::atomic::{write_atomic, write_atomic_with};
+use crate::output::html::Sink;
+use crate::output::report::{RUNS_TITLE, ScenarioFile, sweep_report};
+use crate::output::summary::summary_to;
 use crate::spec::run_spec::RunSpec;
 
 /// Folder of the sweep figures inside the output folder.
@@ -57,21 +58,24 @@ pub fn write_sweep(
     if let Some(j) = crate::output::jobs::jobs(sc, runs, &table) {
         figures.extend(crate::output::plot::jobs::write(&plots, &sc.name, &j)?);
     }
-    write_atomic(
-        &out.join("summary.md"),
-        summary_md(sc, file.path, runs, &table, &figures).as_bytes(),
-    )?;
-    let mut svgs = Vec::new();
-    for f in &figures {
-        let p = out.join(&f.svg);
-        let svg = std::fs::read_to_string(&p).map_err(|e| Error::read(&p, e))?;
-        svgs.push((f.title.clone(), svg));
-    }
-    let report = sweep_report(sc, file, runs, &table, csv, &svgs);
-    write_atomic(
-        &out.join(REPORT),
-        crate::output::html::render(&report).as_bytes(),
-    )
+    let summary = out.join("summary.md");
+    write_atomic_with(&summary, |w| {
+        let mut sink = Sink::new(w);
+        summary_to(&mut sink, sc, file.path, runs, &table, &figures);
+        sink.finish(&summary)
+    })?;
+    // The figures are read from their files, and the table of every run from `csv`, as
+    // the page is written: report.html is never held whole.
+    let svgs: Vec<(String, PathBuf)> = figures
+        .iter()
+        .map(|f| (f.title.clone(), out.join(&f.svg)))
+        .collect();
+    let (report, ranking_rows) = sweep_report(sc, file, runs, &table, &svgs);
+    drop(table);
+    let path = out.join(REPORT);
+    write_atomic_with(&path, |w| {
+        crate::output::html::render_to(&report, Some((RUNS_TITLE, csv)), &ranking_rows, w, &path)
+    })
 }
 
 /// The report's file name inside the output folder.

@@ -312,10 +312,15 @@ pub fn sweep(
         outcome.elapsed_s = started.elapsed().as_secs_f64();
         return Ok(outcome);
     }
-    let mut csv = header;
+    // Sized once: a String grown by doubling holds up to twice the text at the peak.
+    let mut csv =
+        String::with_capacity(header.len() + runs.iter().map(|r| rows[&r.id].len()).sum::<usize>());
+    csv.push_str(&header);
     for r in &runs {
         csv.push_str(&rows[&r.id]);
     }
+    // The rows are in `csv` now.
+    drop(rows);
     match opts.shard {
         Some(s) => {
             write_atomic(&out.join("runs.csv"), csv.as_bytes())?;

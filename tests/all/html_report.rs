@@ -15,7 +15,7 @@ use crate::support::html::chromium::{
     Rect, browser, console_clean, region_spread, selftest, selftest_result, visit,
 };
 use crate::support::html::fixture::{column, generated_csv, quickstart_report};
-use settle::output::html::{Cell, FailedRun, LAZY_ROWS, Report, Table, render};
+use settle::output::html::{Cell, FailedRun, LAZY_ROWS, Report, Rows, Table, render, render_to};
 
 /// The shown texts of column `name` in the order a correct sort gives: by value, ascending
 /// or descending, non-finite values last either way, ties in row order.
@@ -407,5 +407,66 @@ fn the_gcode_report_renders_sorts_and_logs_nothing_in_chromium() {
         let (spread, share) = region_spread(&img, rect);
         assert!(share > 0.3, "{name} is off screen: {rect:?}");
         assert!(spread > 20.0, "{name} looks blank: deviation {spread:.1}");
+    }
+}
+
+/// The rows of `tables`, made one at a time (as a sweep's ranking rows are).
+struct Held(Vec<Table>);
+
+impl Rows for Held {
+    fn row(&self, table: usize, k: usize) -> Option<Vec<Cell>> {
+        self.0.get(table)?.rows.get(k).cloned()
+    }
+}
+
+/// A page written as it is made (`render_to`: the table of every run from CSV text a record
+/// at a time, tables' rows made on demand) is byte for byte the page `render` makes from
+/// the report holding every row: small tables (DOM rows, sort keys) and tables above
+/// `LAZY_ROWS` (paged by the script), and a CSV that is not a table (left out by both).
+#[test]
+fn a_page_written_as_it_is_made_is_the_rendered_page() {
+    let base = quickstart_report();
+    let big = Table::from_csv("big", &generated_csv(LAZY_ROWS + 1)).expect("generated CSV");
+    for (csv, tables) in [
+        (generated_csv(40), base.tables.clone()),
+        (
+            generated_csv(LAZY_ROWS + 1),
+            vec![base.tables[0].clone(), big],
+        ),
+        ("run,reason\n0,\"open\n".to_string(), base.tables.clone()),
+    ] {
+        assert!(tables.iter().all(|t| !t.rows.is_empty()));
+        let held = Report {
+            tables: tables.clone(),
+            runs: Table::from_csv("All runs (runs.csv)", &csv).ok(),
+            ..base.clone()
+        };
+        let made = Report {
+            tables: tables
+                .iter()
+                .map(|t| Table {
+                    rows: Vec::new(),
+                    ..t.clone()
+                })
+                .collect(),
+            runs: None,
+            ..base.clone()
+        };
+        let mut bytes = Vec::new();
+        render_to(
+            &made,
+            Some(("All runs (runs.csv)", &csv)),
+            &Held(tables),
+            &mut bytes,
+            Path::new("report.html"),
+        )
+        .expect("written");
+        let want = render(&held);
+        assert!(
+            bytes == want.as_bytes(),
+            "the page written as it is made differs from the rendered one ({} vs {} bytes)",
+            bytes.len(),
+            want.len()
+        );
     }
 }

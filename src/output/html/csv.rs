@@ -49,49 +49,77 @@ impl std::error::Error for CsvError {}
 /// quoted (`"a,b"`, `""` for a quote inside); line ends are `\n` or `\r\n`; empty lines are
 /// skipped.
 fn records(text: &str) -> Result<Vec<(usize, Vec<String>)>, CsvError> {
-    let mut out = Vec::new();
-    let mut record: Vec<String> = Vec::new();
-    let mut cell = String::new();
-    let mut line = 1;
-    let mut start_line = 1;
-    let mut quoted = false;
-    let mut chars = text.chars().peekable();
-    while let Some(c) = chars.next() {
-        match (quoted, c) {
-            (true, '"') if chars.peek() == Some(&'"') => {
-                chars.next();
-                cell.push('"');
-            }
-            (true, '"') => quoted = false,
-            (true, c) => {
-                if c == '\n' {
-                    line += 1;
-                }
-                cell.push(c);
-            }
-            (false, '"') if cell.is_empty() => quoted = true,
-            (false, ',') => record.push(std::mem::take(&mut cell)),
-            (false, '\r') if chars.peek() == Some(&'\n') => {}
-            (false, '\n') => {
-                record.push(std::mem::take(&mut cell));
-                if !(record.len() == 1 && record[0].is_empty()) {
-                    out.push((start_line, std::mem::take(&mut record)));
-                }
-                record.clear();
-                line += 1;
-                start_line = line;
-            }
-            (false, c) => cell.push(c),
+    Records::new(text).collect()
+}
+
+/// The records of CSV text one at a time (see [`records`]): a quote left open is an error
+/// after the last record.
+pub(crate) struct Records<'a> {
+    chars: std::iter::Peekable<std::str::Chars<'a>>,
+    line: usize,
+    done: bool,
+}
+
+impl<'a> Records<'a> {
+    /// The records of `text`.
+    pub(crate) fn new(text: &'a str) -> Self {
+        Self {
+            chars: text.chars().peekable(),
+            line: 1,
+            done: false,
         }
     }
-    if quoted {
-        return Err(CsvError::UnclosedQuote { line: start_line });
+}
+
+impl Iterator for Records<'_> {
+    type Item = Result<(usize, Vec<String>), CsvError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done {
+            return None;
+        }
+        let mut record: Vec<String> = Vec::new();
+        let mut cell = String::new();
+        let mut start_line = self.line;
+        let mut quoted = false;
+        while let Some(c) = self.chars.next() {
+            match (quoted, c) {
+                (true, '"') if self.chars.peek() == Some(&'"') => {
+                    self.chars.next();
+                    cell.push('"');
+                }
+                (true, '"') => quoted = false,
+                (true, c) => {
+                    if c == '\n' {
+                        self.line += 1;
+                    }
+                    cell.push(c);
+                }
+                (false, '"') if cell.is_empty() => quoted = true,
+                (false, ',') => record.push(std::mem::take(&mut cell)),
+                (false, '\r') if self.chars.peek() == Some(&'\n') => {}
+                (false, '\n') => {
+                    record.push(std::mem::take(&mut cell));
+                    self.line += 1;
+                    if !(record.len() == 1 && record[0].is_empty()) {
+                        return Some(Ok((start_line, record)));
+                    }
+                    record.clear();
+                    start_line = self.line;
+                }
+                (false, c) => cell.push(c),
+            }
+        }
+        self.done = true;
+        if quoted {
+            return Some(Err(CsvError::UnclosedQuote { line: start_line }));
+        }
+        if !cell.is_empty() || !record.is_empty() {
+            record.push(cell);
+            return Some(Ok((start_line, record)));
+        }
+        None
     }
-    if !cell.is_empty() || !record.is_empty() {
-        record.push(cell);
-        out.push((start_line, record));
-    }
-    Ok(out)
 }
 
 impl Table {
@@ -126,18 +154,7 @@ impl Table {
                 any && all
             })
             .collect();
-        let rows = raw
-            .into_iter()
-            .map(|row| {
-                row.into_iter()
-                    .zip(&numeric)
-                    .map(|(text, &numeric)| match text.parse::<f64>() {
-                        Ok(value) if numeric => Cell::Number { value, text },
-                        _ => Cell::Text(text),
-                    })
-                    .collect()
-            })
-            .collect();
+        let rows = raw.into_iter().map(|row| typed(row, &numeric)).collect();
         Ok(Table {
             title: title.to_string(),
             note: String::new(),
@@ -145,6 +162,47 @@ impl Table {
             rows,
         })
     }
+}
+
+/// The cells of a record: a cell of a numeric column that parses is a number (its exact
+/// text kept), every other cell text.
+pub(crate) fn typed(row: Vec<String>, numeric: &[bool]) -> Vec<Cell> {
+    row.into_iter()
+        .zip(numeric)
+        .map(|(text, &numeric)| match text.parse::<f64>() {
+            Ok(value) if numeric => Cell::Number { value, text },
+            _ => Cell::Text(text),
+        })
+        .collect()
+}
+
+/// What [`Table::from_csv`] finds in CSV text, read one record at a time (nothing but the
+/// header kept): the header, which columns are numeric, and the number of rows; `None`
+/// when `from_csv` would fail.
+pub(crate) fn shape(text: &str) -> Option<(Vec<String>, Vec<bool>, usize)> {
+    let mut records = Records::new(text);
+    let header = match records.next()? {
+        Ok((_, header)) => header,
+        Err(_) => return None,
+    };
+    let mut any = vec![false; header.len()];
+    let mut all = vec![true; header.len()];
+    let mut rows = 0;
+    for r in records {
+        let (_, row) = r.ok()?;
+        if row.len() != header.len() {
+            return None;
+        }
+        for (c, cell) in row.iter().enumerate() {
+            if !cell.is_empty() {
+                any[c] = true;
+                all[c] &= cell.parse::<f64>().is_ok();
+            }
+        }
+        rows += 1;
+    }
+    let numeric = any.iter().zip(&all).map(|(a, b)| *a && *b).collect();
+    Some((header, numeric, rows))
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 /// Append `text` to `out` escaped for HTML text and quoted attribute values: `&`, `<`,
 /// `>`, `"` and `'` become character references, so no text can open a tag, close an
 /// element (`</pre>`, `</noscript>`) or end an attribute.
-pub(crate) fn push_escaped(out: &mut String, text: &str) {
+pub(crate) fn push_escaped(out: &mut impl super::Out, text: &str) {
     for c in text.chars() {
         match c {
             '&' => out.push_str("&amp;"),

@@ -7,6 +7,7 @@
 //! unparsed text that the script splits into rows itself and shows one page at a time, so a
 //! table of 100,000 runs costs no DOM nodes beyond the visible page.
 
+use super::Out;
 use super::escape::push_escaped;
 use super::model::{Cell, Table};
 
@@ -52,27 +53,109 @@ fn plain(t: &Table) -> bool {
         .all(|c| !matches!(c, Cell::Link { .. }) && sort_key(c).is_none())
 }
 
-/// Append the table, with id `id`, to `out`: its heading (`h2`), note, then the grid.
-pub(crate) fn push_table(out: &mut String, id: &str, t: &Table) {
+/// Write table `t` as a section with id `id`: heading, note, then the grid.
+pub(crate) fn push_table(out: &mut impl Out, id: &str, t: &Table) {
+    let numeric: Vec<bool> = (0..t.header.len()).map(|j| numeric_column(t, j)).collect();
+    let lazy = t.rows.len() > LAZY_ROWS && plain(t);
+    push_head(out, id, &t.title, &t.note, &t.header, &numeric, lazy);
+    for row in &t.rows {
+        push_row(out, row, t.header.len(), &numeric, lazy);
+    }
+    push_tail(out, lazy);
+}
+
+/// Write table `t` (its rows left out) as [`push_table`] writes it with rows `row(0)`,
+/// `row(1)`, ... up to the first `None`, one row at a time (two passes: the columns' types
+/// first), so no row is kept.
+pub(crate) fn push_made_table(
+    out: &mut impl Out,
+    id: &str,
+    t: &Table,
+    row: impl Fn(usize) -> Option<Vec<Cell>>,
+) {
+    let columns = t.header.len();
+    // numeric_column and plain, a row at a time.
+    let mut any = vec![false; columns];
+    let mut other = vec![false; columns];
+    let mut plain = true;
+    let mut rows = 0;
+    while let Some(r) = row(rows) {
+        for (j, cell) in r.iter().enumerate().take(columns) {
+            match cell {
+                Cell::Number { .. } => any[j] = true,
+                Cell::Text(s) if s.is_empty() => {}
+                _ => other[j] = true,
+            }
+        }
+        plain &= r
+            .iter()
+            .all(|c| !matches!(c, Cell::Link { .. }) && sort_key(c).is_none());
+        rows += 1;
+    }
+    let numeric: Vec<bool> = any.iter().zip(&other).map(|(a, o)| *a && !o).collect();
+    let lazy = rows > LAZY_ROWS && plain;
+    push_head(out, id, &t.title, &t.note, &t.header, &numeric, lazy);
+    for k in 0..rows {
+        if let Some(r) = row(k) {
+            push_row(out, &r, columns, &numeric, lazy);
+        }
+    }
+    push_tail(out, lazy);
+}
+
+/// Write CSV text as [`push_table`] writes `Table::from_csv(title, text)`, one record at a
+/// time (two passes over the text; no row kept), so a runs table of 100,000 runs costs no
+/// memory per run. Nothing is written, and `false` returned, when `from_csv` would fail.
+///
+/// A table from CSV is always plain: its cells are text, or numbers whose text is the
+/// value they were parsed from.
+pub(crate) fn push_csv_table(out: &mut impl Out, id: &str, title: &str, text: &str) -> bool {
+    let Some((header, numeric, rows)) = super::csv::shape(text) else {
+        return false;
+    };
+    let lazy = rows > LAZY_ROWS;
+    push_head(out, id, title, "", &header, &numeric, lazy);
+    for r in super::csv::Records::new(text).skip(1) {
+        let Ok((_, row)) = r else { break };
+        push_row(
+            out,
+            &super::csv::typed(row, &numeric),
+            header.len(),
+            &numeric,
+            lazy,
+        );
+    }
+    push_tail(out, lazy);
+    true
+}
+
+/// The section's heading, note and the table's head, up to `<tbody>`.
+fn push_head(
+    out: &mut impl Out,
+    id: &str,
+    title: &str,
+    note: &str,
+    header: &[String],
+    numeric: &[bool],
+    lazy: bool,
+) {
     out.push_str("<section class=\"table\" id=\"");
     push_escaped(out, id);
     out.push_str("\">\n<h2>");
-    push_escaped(out, &t.title);
+    push_escaped(out, title);
     out.push_str("</h2>\n");
-    if !t.note.is_empty() {
+    if !note.is_empty() {
         out.push_str("<p class=\"note\">");
-        push_escaped(out, &t.note);
+        push_escaped(out, note);
         out.push_str("</p>\n");
     }
-    let numeric: Vec<bool> = (0..t.header.len()).map(|j| numeric_column(t, j)).collect();
-    let lazy = t.rows.len() > LAZY_ROWS && plain(t);
     out.push_str(if lazy {
         "<div class=\"grid\" data-lazy>\n<noscript>"
     } else {
         "<div class=\"grid\">\n"
     });
     out.push_str("<div class=\"scroll\"><table class=\"data\">\n<thead><tr>");
-    for (name, &num) in t.header.iter().zip(&numeric) {
+    for (name, &num) in header.iter().zip(numeric) {
         out.push_str(if num {
             "<th data-type=\"num\">"
         } else {
@@ -82,15 +165,21 @@ pub(crate) fn push_table(out: &mut String, id: &str, t: &Table) {
         out.push_str("</th>");
     }
     out.push_str("</tr></thead>\n<tbody>\n");
-    for row in &t.rows {
-        out.push_str("<tr>");
-        for j in 0..row.len().max(t.header.len()) {
-            let empty = Cell::Text(String::new());
-            let cell = row.get(j).unwrap_or(&empty);
-            push_cell(out, cell, lazy, numeric.get(j).copied().unwrap_or(false));
-        }
-        out.push_str("</tr>\n");
+}
+
+/// One row (padded with empty cells to `columns`).
+fn push_row(out: &mut impl Out, row: &[Cell], columns: usize, numeric: &[bool], lazy: bool) {
+    out.push_str("<tr>");
+    for j in 0..row.len().max(columns) {
+        let empty = Cell::Text(String::new());
+        let cell = row.get(j).unwrap_or(&empty);
+        push_cell(out, cell, lazy, numeric.get(j).copied().unwrap_or(false));
     }
+    out.push_str("</tr>\n");
+}
+
+/// The end of the table and its section.
+fn push_tail(out: &mut impl Out, lazy: bool) {
     out.push_str("</tbody>\n</table></div>");
     if lazy {
         out.push_str("</noscript>");
@@ -100,7 +189,7 @@ pub(crate) fn push_table(out: &mut String, id: &str, t: &Table) {
 
 /// One cell; `</td>` is implied by the next cell or the row's `</tr>`. In a lazy table every
 /// cell is a bare `<td>` (the script adds the number class when it shows a row).
-fn push_cell(out: &mut String, cell: &Cell, lazy: bool, numeric: bool) {
+fn push_cell(out: &mut impl Out, cell: &Cell, lazy: bool, numeric: bool) {
     if lazy {
         out.push_str("<td>");
         push_escaped(out, cell.shown());

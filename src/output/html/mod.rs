@@ -64,10 +64,93 @@ pub use csv::CsvError;
 pub use grid::LAZY_ROWS;
 pub use model::{
     BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, Provenance, Reference, Report,
-    Stat, Table,
+    Rows, Stat, Table,
 };
 
-/// The page for `report`: a complete HTML document (UTF-8).
+/// The page for `report`: a complete HTML document (UTF-8). A figure given as a file
+/// ([`Image::SvgFile`]) that cannot be read is left out; [`render_to`] reports it.
 pub fn render(report: &Report) -> String {
     page::page(report)
+}
+
+/// Write the page for `report` to `w` as it is made (the page is never held whole);
+/// `runs_csv` (title, CSV text) is the table of every run when `report.runs` is `None`,
+/// written as `Table::from_csv(title, text)` would be, one record at a time; a table of
+/// `report.tables` without rows gets those `rows` makes, as if it held them. The bytes are
+/// [`render`]'s of the report with those rows. Errors: a figure file that cannot be read,
+/// or a failed write (`path` is the file the error names).
+pub fn render_to(
+    report: &Report,
+    runs_csv: Option<(&str, &str)>,
+    rows: &dyn Rows,
+    w: impl std::io::Write,
+    path: &std::path::Path,
+) -> Result<(), crate::error::Error> {
+    let mut sink = Sink::new(w);
+    let done = page::page_to(&mut sink, report, runs_csv, rows);
+    sink.finish(path)?;
+    done
+}
+
+/// Where the page is written: text is appended to it.
+pub(crate) trait Out: std::fmt::Write {
+    /// Append `s`.
+    fn push_str(&mut self, s: &str);
+    /// Append `c`.
+    fn push(&mut self, c: char);
+}
+
+impl Out for String {
+    fn push_str(&mut self, s: &str) {
+        String::push_str(self, s);
+    }
+
+    fn push(&mut self, c: char) {
+        String::push(self, c);
+    }
+}
+
+/// A writer as an [`Out`]: the first write error is kept, and nothing more is written.
+pub(crate) struct Sink<W: std::io::Write> {
+    w: W,
+    error: Option<std::io::Error>,
+}
+
+impl<W: std::io::Write> Sink<W> {
+    /// Text written to `w`.
+    pub(crate) fn new(w: W) -> Self {
+        Self { w, error: None }
+    }
+
+    /// Flush the writer; the first write error, naming `path`.
+    pub(crate) fn finish(mut self, path: &std::path::Path) -> Result<(), crate::error::Error> {
+        if let Some(e) = self.error.take() {
+            return Err(crate::error::Error::write(path, e));
+        }
+        std::io::Write::flush(&mut self.w).map_err(|e| crate::error::Error::write(path, e))
+    }
+}
+
+impl<W: std::io::Write> std::fmt::Write for Sink<W> {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        if self.error.is_none()
+            && let Err(e) = self.w.write_all(s.as_bytes())
+        {
+            self.error = Some(e);
+        }
+        if self.error.is_some() {
+            return Err(std::fmt::Error);
+        }
+        Ok(())
+    }
+}
+
+impl<W: std::io::Write> Out for Sink<W> {
+    fn push_str(&mut self, s: &str) {
+        let _ = std::fmt::Write::write_str(self, s);
+    }
+
+    fn push(&mut self, c: char) {
+        let _ = std::fmt::Write::write_char(self, c);
+    }
 }

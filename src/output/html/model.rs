@@ -88,6 +88,22 @@ pub struct Table {
     pub rows: Vec<Vec<Cell>>,
 }
 
+/// Rows made as the page is written, for the tables of a [`Report`] given without rows
+/// (a ranking of 100,000 runs is never held as cells): `row(t, k)` is row `k` of table
+/// `t` (its index in [`Report::tables`]), `None` past the last row or for a table it does
+/// not make.
+pub trait Rows {
+    /// Row `k` of table `table`.
+    fn row(&self, table: usize, k: usize) -> Option<Vec<Cell>>;
+}
+
+/// No rows made: every table has its own.
+impl Rows for () {
+    fn row(&self, _: usize, _: usize) -> Option<Vec<Cell>> {
+        None
+    }
+}
+
 /// One table cell.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Cell {
@@ -148,6 +164,9 @@ pub enum Image {
     /// SVG markup (e.g. from the crate's plots), embedded inline as is: it must be trusted
     /// markup, not user text. A leading XML declaration or doctype is dropped.
     Svg(String),
+    /// An SVG file, read and embedded as [`Image::Svg`] when the page is written (so a
+    /// report holds no figure's markup until then).
+    SvgFile(std::path::PathBuf),
     /// PNG bytes, embedded as a base64 `data:` URI.
     Png(Vec<u8>),
 }

@@ -1,11 +1,11 @@
 //! The page around the tables: head (inline style, a content policy that forbids any
 //! fetch), title and intro, winner cards, figures, failed runs, provenance, inline script.
 
-use std::fmt::Write as _;
-
+use super::Out;
 use super::escape::{base64, escaped, push_escaped};
-use super::grid::push_table;
-use super::model::{BandWinner, Cell, Figure, Image, Provenance, Reference, Report, Table};
+use super::grid::{push_csv_table, push_made_table, push_table};
+use super::model::{BandWinner, Cell, Figure, Image, Provenance, Reference, Report, Rows, Table};
+use crate::error::Error;
 
 const STYLE: &str = include_str!("style.css");
 const SCRIPT: &str = include_str!("script.js");
@@ -18,6 +18,20 @@ const CONTENT_POLICY: &str =
 /// The whole page.
 pub(crate) fn page(r: &Report) -> String {
     let mut out = String::with_capacity(64 * 1024);
+    // Only a figure given as a file can fail, and then it is left out.
+    let _ = page_to(&mut out, r, None, &());
+    out
+}
+
+/// The whole page, written to `out`; `runs_csv` (title, CSV text) is the table of every
+/// run when `r.runs` is `None`, written a record at a time. The error is a figure file
+/// that cannot be read.
+pub(crate) fn page_to(
+    out: &mut impl Out,
+    r: &Report,
+    runs_csv: Option<(&str, &str)>,
+    rows: &dyn Rows,
+) -> Result<(), Error> {
     out.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
     let _ = writeln!(
         out,
@@ -36,13 +50,20 @@ pub(crate) fn page(r: &Report) -> String {
         let _ = writeln!(out, "<p>{}</p>", escaped(line));
     }
     out.push_str("</header>\n");
-    push_winners(&mut out, &r.winners);
+    push_winners(out, &r.winners);
     for (i, t) in r.tables.iter().enumerate() {
-        push_table(&mut out, &format!("table-{}", i + 1), t);
+        let id = format!("table-{}", i + 1);
+        if t.rows.is_empty() && rows.row(i, 0).is_some() {
+            push_made_table(out, &id, t, |k| rows.row(i, k));
+        } else {
+            push_table(out, &id, t);
+        }
     }
-    push_figures(&mut out, &r.figures);
+    push_figures(out, &r.figures)?;
     if let Some(runs) = &r.runs {
-        push_table(&mut out, "runs", runs);
+        push_table(out, "runs", runs);
+    } else if let Some((title, text)) = runs_csv {
+        push_csv_table(out, "runs", title, text);
     }
     if !r.failed.is_empty() {
         let failed = Table {
@@ -61,11 +82,11 @@ pub(crate) fn page(r: &Report) -> String {
                 })
                 .collect(),
         };
-        push_table(&mut out, "failed", &failed);
+        push_table(out, "failed", &failed);
     }
-    push_provenance(&mut out, &r.provenance);
+    push_provenance(out, &r.provenance);
     let _ = write!(out, "<script>\n{SCRIPT}</script>\n</body>\n</html>\n");
-    out
+    Ok(())
 }
 
 /// The gain as shown large, and the sentence naming the reference.
@@ -89,7 +110,7 @@ fn gain_text(ratio: f64, reference: &Reference) -> (String, String) {
     (headline, format!("vs {who}: {label}"))
 }
 
-fn push_winners(out: &mut String, winners: &[BandWinner]) {
+fn push_winners(out: &mut impl Out, winners: &[BandWinner]) {
     if winners.is_empty() {
         return;
     }
@@ -148,15 +169,19 @@ fn inline_svg(svg: &str) -> &str {
     s
 }
 
-fn push_figures(out: &mut String, figures: &[Figure]) {
+fn push_figures(out: &mut impl Out, figures: &[Figure]) -> Result<(), Error> {
     if figures.is_empty() {
-        return;
+        return Ok(());
     }
     out.push_str("<section id=\"figures\">\n<h2>Figures</h2>\n");
     for (i, f) in figures.iter().enumerate() {
         let _ = write!(out, "<figure id=\"figure-{}\">\n<div class=\"img\">", i + 1);
         match &f.image {
             Image::Svg(svg) => out.push_str(inline_svg(svg)),
+            Image::SvgFile(path) => {
+                let svg = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+                out.push_str(inline_svg(&svg));
+            }
             Image::Png(bytes) => {
                 let _ = write!(
                     out,
@@ -173,9 +198,10 @@ fn push_figures(out: &mut String, figures: &[Figure]) {
         );
     }
     out.push_str("</section>\n");
+    Ok(())
 }
 
-fn push_provenance(out: &mut String, p: &Provenance) {
+fn push_provenance(out: &mut impl Out, p: &Provenance) {
     out.push_str("<section id=\"provenance\">\n<h2>Provenance</h2>\n<dl class=\"prov\">\n");
     for (label, value, code) in [
         ("settle version", &p.settle_version, false),
