@@ -16,8 +16,8 @@
 #   - profile `ci-rerun` (unoptimised: the rerun test writes one small recording): the
 #     `rerun` feature's build and its test;
 #   - scripts/fuzz.sh: in "$CARGO_TARGET_DIR-fuzz", settle's crates libFuzzer-instrumented
-#     at optimisation level 1, every other crate plain at level 0 (7.7 CPU-minutes cold
-#     instead of 12.1 with everything instrumented at level 1).
+#     at optimisation level 1, every other crate plain at level 0 (7.7 and 9.9 CPU-minutes
+#     cold instead of 12.1 and 13.5 with everything instrumented at level 1).
 # Headless Chromium's apt-get install runs in the background from the start and is waited
 # for before the test run (it waits on the network and the disk while the builds use the
 # CPU).
