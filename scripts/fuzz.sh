@@ -15,30 +15,26 @@ shift || true
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(scenario plan)
 
-# libFuzzer's coverage comes from LLVM's SanitizerCoverage (the flags libFuzzer's documentation
-# names: inline 8-bit counters, the PC table, compare tracing), applied by rustc to every crate
-# built for the target. Building for the host triple given explicitly keeps build scripts
-# and proc macros uninstrumented. No cargo-fuzz: it would be built from source first, and
-# the targets need nothing but these flags (libfuzzer-sys links libFuzzer itself).
-host=$(rustc -vV | sed -n 's/^host: //p')
-export RUSTFLAGS="${RUSTFLAGS:-} --cfg fuzzing -Cpasses=sancov-module \
-  -Cllvm-args=-sanitizer-coverage-level=4 -Cllvm-args=-sanitizer-coverage-inline-8bit-counters \
-  -Cllvm-args=-sanitizer-coverage-pc-table -Cllvm-args=-sanitizer-coverage-trace-compares"
+# libFuzzer's coverage comes from LLVM's SanitizerCoverage, added by scripts/fuzz-rustc.sh
+# (cargo's rustc wrapper here) to settle's own crates only: the code under test. The other
+# crates (serde, toml, nalgebra, ...) are built plainly, at optimisation level 0 (profile
+# `fuzz`), which halves the cold build. No cargo-fuzz: it would be built from source first,
+# and the targets need nothing but these flags (libfuzzer-sys links libFuzzer itself).
+export RUSTC_WRAPPER="$PWD/../scripts/fuzz-rustc.sh"
 # Keep fuzz builds apart from the workspace's (different instrumentation flags).
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}-fuzz"
-# Profile `fuzz` (fuzz/Cargo.toml): optimisation level 1, otherwise a release build: a smoke
-# run needs coverage, and opt-level 3 costs most of the build.
+# Profile `fuzz` (fuzz/Cargo.toml): settle's crates at optimisation level 1, the rest at 0.
 echo "== fuzz build (${targets[*]})"
 bins=()
 for t in "${targets[@]}"; do bins+=(--bin "$t"); done
-cargo build --profile fuzz --target "$host" "${bins[@]}"
+cargo build --profile fuzz "${bins[@]}"
 for t in "${targets[@]}"; do
   echo "== fuzz $t for ${secs}s"
   mkdir -p "corpus/$t"
   log="$(mktemp)"
   status=0
   mkdir -p "artifacts/$t"
-  "$CARGO_TARGET_DIR/$host/fuzz/$t" "corpus/$t" -artifact_prefix="artifacts/$t/" \
+  "$CARGO_TARGET_DIR/fuzz/$t" "corpus/$t" -artifact_prefix="artifacts/$t/" \
     -max_total_time="$secs" -max_len=4096 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
     >"$log" 2>&1 || status=$?
   # Show libFuzzer's summary, and everything on failure.
@@ -47,6 +43,6 @@ for t in "${targets[@]}"; do
     echo "fuzz target $t failed (exit $status): the input is in fuzz/artifacts/$t/" >&2
     exit 1
   fi
-  grep -E "^(Done|stat::number_of_executed_units)" "$log" || true
+  grep -E "^(Done|stat::number_of_executed_units|#[0-9]+[[:space:]]+DONE)" "$log" || true
   rm -f "$log"
 done
