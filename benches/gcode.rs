@@ -25,7 +25,7 @@ use settle_gcode::job::Firmware;
 mod synth;
 
 fn options(backend: Backend, layers: Option<(u32, u32)>) -> GcodeOptions {
-    let file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("gcode/prints/ringing_tower.gcode");
+    let file = PathBuf::from(manifest_dir()).join("gcode/prints/ringing_tower.gcode");
     let shaper = parse_shaper("mzv@48").expect("shaper");
     GcodeOptions {
         backend,
@@ -92,3 +92,15 @@ use cpu::thread_cpu_ns;
 
 criterion_group!(benches, bench);
 criterion_main!(benches);
+
+/// The package's directory: the `CARGO_MANIFEST_DIR` cargo sets when it runs this
+/// binary, else the one it was compiled with. The run-time value is the one that is right
+/// when a target directory is shared between clones at different paths: cargo reuses a
+/// test binary whose sources are unchanged, with the other clone's path compiled in.
+fn manifest_dir() -> &'static str {
+    static DIR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        std::env::var("CARGO_MANIFEST_DIR")
+            .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned())
+    })
+}

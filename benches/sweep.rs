@@ -7,7 +7,7 @@ use std::path::Path;
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn bench(c: &mut Criterion) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+    let path = Path::new(manifest_dir()).join("scenarios/quickstart.toml");
     let (_, mut runs) = settle::load_runs(&path).expect("quickstart");
     // The exact modal backend (what this bench has always measured); rapier, the sweep
     // default, is measured per backend in `benches/sim.rs`.
@@ -33,3 +33,15 @@ fn bench(c: &mut Criterion) {
 
 criterion_group!(benches, bench);
 criterion_main!(benches);
+
+/// The package's directory: the `CARGO_MANIFEST_DIR` cargo sets when it runs this
+/// binary, else the one it was compiled with. The run-time value is the one that is right
+/// when a target directory is shared between clones at different paths: cargo reuses a
+/// test binary whose sources are unchanged, with the other clone's path compiled in.
+fn manifest_dir() -> &'static str {
+    static DIR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        std::env::var("CARGO_MANIFEST_DIR")
+            .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned())
+    })
+}

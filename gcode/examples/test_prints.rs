@@ -169,7 +169,7 @@ fn arc_part() -> String {
 }
 
 fn main() -> std::io::Result<()> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("prints");
+    let dir = Path::new(manifest_dir()).join("prints");
     std::fs::create_dir_all(&dir)?;
     for (name, text) in [
         ("ringing_tower.gcode", ringing_tower()),
@@ -181,4 +181,16 @@ fn main() -> std::io::Result<()> {
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The package's directory: the `CARGO_MANIFEST_DIR` cargo sets when it runs this
+/// binary, else the one it was compiled with. The run-time value is the one that is right
+/// when a target directory is shared between clones at different paths: cargo reuses a
+/// test binary whose sources are unchanged, with the other clone's path compiled in.
+fn manifest_dir() -> &'static str {
+    static DIR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        std::env::var("CARGO_MANIFEST_DIR")
+            .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned())
+    })
 }

@@ -95,7 +95,7 @@ fn assert_input_error(args: &[&str], scenario_text: Option<&str>, expect: &str) 
 #[test]
 fn bad_input_exits_2_with_a_clear_error_and_no_output() {
     let good = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml"),
+        Path::new(crate::support::manifest_dir()).join("scenarios/quickstart.toml"),
     )
     .expect("quickstart");
     assert_input_error(

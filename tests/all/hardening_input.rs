@@ -212,7 +212,7 @@ fn os_errors_are_printed_once() {
 /// it) is the same baseline: `settle check` passes.
 #[test]
 fn check_matches_rows_by_run_and_reads_a_bom() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(crate::support::manifest_dir());
     let scenario = root.join("scenarios/ci_quickstart.toml");
     let committed = std::fs::read_to_string(root.join("results/baselines/ci_quickstart.modal.csv"))
         .expect("committed baseline");

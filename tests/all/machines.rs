@@ -34,7 +34,7 @@ jmax_mm_s3 = 1e5
 
 #[test]
 fn presets_parse_compile_and_ring_where_their_comments_say() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = Path::new(crate::support::manifest_dir());
     for (name, path, text) in settle::input::machine_file::PRESETS {
         // The embedded text is the checked-in file.
         let on_disk = std::fs::read_to_string(dir.join(path)).expect("preset file");

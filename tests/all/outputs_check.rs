@@ -43,17 +43,17 @@ fn check_with(
 }
 
 fn scenario() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(SCENARIO)
+    Path::new(crate::support::manifest_dir()).join(SCENARIO)
 }
 
 fn baseline() -> RunsTable {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(BASELINE);
+    let p = Path::new(crate::support::manifest_dir()).join(BASELINE);
     RunsTable::parse(&std::fs::read_to_string(p).expect("committed baseline")).expect("parses")
 }
 
 #[test]
 fn unchanged_runs_pass_on_every_backend_with_a_baseline() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baselines");
+    let dir = Path::new(crate::support::manifest_dir()).join("results/baselines");
     let mut checked = Vec::new();
     for e in std::fs::read_dir(&dir).expect("results/baselines") {
         let name = e.expect("entry").file_name().to_string_lossy().into_owned();
@@ -82,7 +82,7 @@ fn unchanged_runs_pass_on_every_backend_with_a_baseline() {
 
 #[test]
 fn a_baseline_of_another_backend_is_refused() {
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join(BASELINE);
+    let base = Path::new(crate::support::manifest_dir()).join(BASELINE);
     let e = check_with(&scenario(), &base, |o| {
         o.backend = Some(settle::spec::backend::Backend::Modal)
     })
@@ -144,7 +144,7 @@ fn a_worse_machine_fails_on_settling_metrics() {
     assert_ne!(worse, src);
     let p = dir.path().join("ci_quickstart.toml");
     std::fs::write(&p, worse).expect("write");
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join(BASELINE);
+    let base = Path::new(crate::support::manifest_dir()).join(BASELINE);
     let (r, t) = check_with(&p, &base, |_| {}).expect("checks");
     assert_eq!(r.exit, Exit::Failed, "{t}");
     // The damping column changed, and settle times got worse.

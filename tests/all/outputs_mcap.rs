@@ -12,7 +12,7 @@ use settle::input::runs_table::RunsTable;
 const SCENARIO: &str = "scenarios/ci_quickstart.toml";
 
 fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+    Path::new(crate::support::manifest_dir())
 }
 
 fn settle(args: &[&str]) -> std::process::Output {

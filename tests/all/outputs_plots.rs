@@ -80,7 +80,7 @@ fn run_plot_draws_every_channel_and_the_residual() {
         trace.to_str().expect("utf-8"),
     ]);
     let svg = std::fs::read_to_string(dir.path().join("run-4.svg")).expect("svg");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(crate::support::manifest_dir());
     let (_, runs) = settle::load_runs(&root.join("scenarios/quickstart.toml")).expect("scenario");
     let (series, _) = settle::output::sink::record_run(&runs[4]).expect("runs");
     for c in &series.channels {

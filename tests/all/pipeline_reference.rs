@@ -12,7 +12,7 @@ use settle_sim::Mode;
 use settle_sim::closed_form::residual_at;
 
 fn check(backend: Backend, rel_tol: f64, settle_tol_s: f64) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+    let path = Path::new(crate::support::manifest_dir()).join("scenarios/quickstart.toml");
     let (_, mut runs) = settle::load_runs(&path).expect("quickstart");
     settle::execute::set_backend(&path, &mut runs, backend).expect("backend");
     let mut worst = 0.0f64;

@@ -169,7 +169,7 @@ fn a_line_that_is_not_utf8_is_answered_and_the_stream_goes_on() {
     }
     // The corpus file: a good line, a line of one 0xff byte, a good line.
     let corpus = std::fs::read(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        std::path::Path::new(crate::support::manifest_dir())
             .join("fuzz/corpus/plan/hardening_bad_utf8.jsonl"),
     )
     .expect("corpus file");
@@ -240,7 +240,7 @@ fn each_answer_arrives_before_the_next_line_is_written() {
 fn an_axis_already_at_its_target_is_answered() {
     let mut input = String::new();
     let corpus = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        std::path::Path::new(crate::support::manifest_dir())
             .join("fuzz/corpus/plan/hardening_axis_at_target.jsonl"),
     )
     .expect("corpus file");

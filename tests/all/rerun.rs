@@ -48,7 +48,7 @@ fn rrd_holds_every_channel_and_sample() {
             e.1 |= chunk.timelines().keys().any(|t| t.as_str() == "sim_time");
         }
     }
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = std::path::Path::new(crate::support::manifest_dir());
     let (_, runs) =
         settle::load_runs(&root.join("scenarios/ci_quickstart.toml")).expect("scenario");
     let (series, _) = settle::output::sink::record_run(&runs[1]).expect("runs");

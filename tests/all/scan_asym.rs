@@ -26,7 +26,7 @@ fn axis(preset: &str) -> AxisModel {
     let text = format!(
         "name = \"t\"\n[machine]\npreset = \"{preset}\"\ndriver_model = \"linear\"\n[move]\ndistance_mm = 1.0\n[limits]\nvmax_mm_s = 200.0\namax_mm_s2 = 2000.0\njmax_mm_s3 = 200000.0\n"
     );
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/t.toml");
+    let path = Path::new(crate::support::manifest_dir()).join("scenarios/t.toml");
     let (sc, src) = settle::expand::parse(&text, &path).expect("parses");
     let runs = settle::expand::expand(&sc, &src).expect("expands");
     settle::execute::axes_of(&runs[0])

@@ -15,7 +15,7 @@ use settle_sim::closed_form::residual_at;
 
 #[test]
 fn reentry_error_and_settling_equal_the_closed_form_on_modal() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/ci_scan.toml");
+    let path = Path::new(crate::support::manifest_dir()).join("scenarios/ci_scan.toml");
     let (_, mut runs) = settle::load_runs(&path).expect("loads");
     settle::execute::set_backend(&path, &mut runs, Backend::Modal).expect("modal");
     let mode = Mode::new(40.0, 0.05, 1.0).expect("mode");

@@ -34,7 +34,7 @@ profile = ["trapezoid", "scurve"]
 
 #[test]
 fn every_scenario_file_parses_and_expands() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let dir = Path::new(crate::support::manifest_dir()).join("scenarios");
     let mut n = 0;
     for entry in std::fs::read_dir(&dir).expect("scenarios/") {
         let path = entry.expect("entry").path();

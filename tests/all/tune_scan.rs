@@ -252,7 +252,7 @@ fn scan_family_winner_beats_the_default_on_rapier_and_its_overhead_is_real() {
 
 #[test]
 fn the_default_margin_keeps_the_corner_winner_inside_the_band_on_rapier() {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/tune_corner.toml");
+    let file = Path::new(crate::support::manifest_dir()).join("scenarios/tune_corner.toml");
     let text = std::fs::read_to_string(&file).expect("reads");
     let dir = tempfile::tempdir().expect("tempdir");
     let sample_s = 1.0 / 5000.0;

@@ -66,16 +66,28 @@ pub fn ignored(text: &str, dialect: Dialect) -> Vec<String> {
         .collect()
 }
 
+/// The package's directory: the `CARGO_MANIFEST_DIR` cargo sets when it runs this
+/// binary, else the one it was compiled with. The run-time value is the one that is right
+/// when a target directory is shared between clones at different paths: cargo reuses a
+/// test binary whose sources are unchanged, with the other clone's path compiled in.
+pub fn manifest_dir() -> &'static str {
+    static DIR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        std::env::var("CARGO_MANIFEST_DIR")
+            .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned())
+    })
+}
+
 /// The repository's test prints.
 pub fn print_path(name: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+    std::path::Path::new(manifest_dir())
         .join("prints")
         .join(name)
 }
 
 /// A file or folder under `tests/data/`.
 pub fn data_path(name: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+    std::path::Path::new(manifest_dir())
         .join("tests/data")
         .join(name)
 }

@@ -32,3 +32,15 @@ mod shaper_stream;
 mod tmc_5160;
 mod tmc_ramp;
 mod tmc_registers;
+
+/// The package's directory: the `CARGO_MANIFEST_DIR` cargo sets when it runs this
+/// binary, else the one it was compiled with. The run-time value is the one that is right
+/// when a target directory is shared between clones at different paths: cargo reuses a
+/// test binary whose sources are unchanged, with the other clone's path compiled in.
+fn manifest_dir() -> &'static str {
+    static DIR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        std::env::var("CARGO_MANIFEST_DIR")
+            .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned())
+    })
+}

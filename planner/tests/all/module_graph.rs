@@ -269,7 +269,7 @@ fn cycles(g: &Graph) -> Vec<Vec<String>> {
 
 #[test]
 fn no_module_cycles() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let src = Path::new(crate::manifest_dir()).join("src");
     let g = graph(&read_sources(&src));
     let found = cycles(&g);
     let report: Vec<String> = found

@@ -38,7 +38,7 @@ fn kinds(names: &[&str]) -> Vec<ShaperKind> {
 
 /// A processed calibration file as calibrate_shaper.py's `parse_log` reads it.
 fn read(file: &str) -> CalibrationData {
-    let path = format!("{}/tests/data/{file}", env!("CARGO_MANIFEST_DIR"));
+    let path = format!("{}/tests/data/{file}", crate::manifest_dir());
     let text = std::fs::read_to_string(&path).expect("calibration file");
     let mut cols: [Vec<f64>; 5] = Default::default();
     for line in text.lines().skip(1) {

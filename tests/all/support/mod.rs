@@ -5,10 +5,22 @@ use std::process::Command;
 
 pub mod html;
 
+/// The package's directory: the `CARGO_MANIFEST_DIR` cargo sets when it runs this
+/// binary, else the one it was compiled with. The run-time value is the one that is right
+/// when a target directory is shared between clones at different paths: cargo reuses a
+/// test binary whose sources are unchanged, with the other clone's path compiled in.
+pub fn manifest_dir() -> &'static str {
+    static DIR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        std::env::var("CARGO_MANIFEST_DIR")
+            .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned())
+    })
+}
+
 /// The `settle` binary, run from the repository root.
 pub fn settle() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_settle"));
-    c.current_dir(env!("CARGO_MANIFEST_DIR"));
+    c.current_dir(manifest_dir());
     c
 }
 
@@ -25,7 +37,7 @@ pub fn run_ok(cmd: &mut Command) -> std::process::Output {
 
 /// The repository root.
 pub fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    PathBuf::from(manifest_dir())
 }
 
 /// Write `text` as `dir/name`; its path.

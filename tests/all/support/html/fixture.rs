@@ -9,7 +9,7 @@ use settle::output::html::{
 
 /// A file of the repository as text.
 fn repo_file(rel: &str) -> String {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+    let path = Path::new(crate::support::manifest_dir()).join(rel);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
