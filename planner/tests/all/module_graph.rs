@@ -269,7 +269,7 @@ fn cycles(g: &Graph) -> Vec<Vec<String>> {
 
 #[test]
 fn no_module_cycles() {
-    let src = Path::new(crate::manifest_dir()).join("src");
+    let src = Path::new(manifest_dir()).join("src");
     let g = graph(&read_sources(&src));
     let found = cycles(&g);
     let report: Vec<String> = found
@@ -334,4 +334,16 @@ fn the_check_finds_cycles_and_follows_reexports() {
     assert_eq!(g[&m("p::r")], BTreeSet::from([m("p::q")]));
     assert_eq!(g[&m("p")], BTreeSet::from([m("p::q"), m("p::r")]));
     assert!(g[&m("p::q")].is_empty());
+}
+
+/// The package's directory: the `CARGO_MANIFEST_DIR` cargo sets when it runs this
+/// binary, else the one it was compiled with. The run-time value is the one that is right
+/// when a target directory is shared between clones at different paths: cargo reuses a
+/// test binary whose sources are unchanged, with the other clone's path compiled in.
+fn manifest_dir() -> &'static str {
+    static DIR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        std::env::var("CARGO_MANIFEST_DIR")
+            .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned())
+    })
 }
