@@ -3,8 +3,14 @@
 # libFuzzer's coverage instrumentation (LLVM's SanitizerCoverage with the flags libFuzzer's
 # documentation names: inline 8-bit counters, the PC table, compare tracing) and
 # `--cfg fuzzing` for settle's own crates only (CARGO_PKG_NAME `settle` or `settle-*`),
-# not for their build scripts; every other crate is compiled as cargo asks.
+# not for their build scripts; every other crate is compiled as cargo asks. A wrapper the
+# user had set (scripts/fuzz.sh passes it as SETTLE_FUZZ_INNER_WRAPPER, e.g. sccache) runs
+# the compiler in both cases.
 set -euo pipefail
+inner="${SETTLE_FUZZ_INNER_WRAPPER:-}"
+if [[ -n $inner ]]; then
+  set -- "$inner" "$@"
+fi
 case "${CARGO_PKG_NAME:-}" in
   settle | settle-*)
     case " $* " in

@@ -20,6 +20,11 @@ targets=("$@")
 # crates (serde, toml, nalgebra, ...) are built plainly, at optimisation level 0 (profile
 # `fuzz`), which halves the cold build. No cargo-fuzz: it would be built from source first,
 # and the targets need nothing but these flags (libfuzzer-sys links libFuzzer itself).
+# A rustc wrapper of your own (RUSTC_WRAPPER, e.g. sccache) still runs: fuzz-rustc.sh
+# calls it with the flags added.
+if [[ "${RUSTC_WRAPPER:-}" != */fuzz-rustc.sh ]]; then
+  export SETTLE_FUZZ_INNER_WRAPPER="${RUSTC_WRAPPER:-}"
+fi
 export RUSTC_WRAPPER="$PWD/../scripts/fuzz-rustc.sh"
 # Keep fuzz builds apart from the workspace's (different instrumentation flags).
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}-fuzz"
