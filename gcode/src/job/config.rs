@@ -230,3 +230,183 @@ impl JobConfig {
         self.planner.firmware()
     }
 }
+
+/// A printer's kinematics as settle's firmware planners model them: Cartesian and CoreXY.
+fn planner_kinematics(name: &str, key: &'static str) -> Result<Kinematics, GcodeError> {
+    match name {
+        "cartesian" => Ok(Kinematics::Cartesian),
+        "corexy" => Ok(Kinematics::CoreXy),
+        other => Err(GcodeError::JobSetting {
+            key,
+            reason: format!(
+                "`{other}`: settle's firmware planners model cartesian and corexy kinematics"
+            ),
+        }),
+    }
+}
+
+/// An axis's shaper as a configuration file sets it, as a job setting (`None`: the
+/// firmware does not shape the axis).
+fn config_shaper(
+    s: &crate::config::ShaperSetting,
+    dialect: Dialect,
+    key: &'static str,
+) -> Result<Option<ShaperSetting>, GcodeError> {
+    let bad = |reason: String| GcodeError::JobSetting { key, reason };
+    let Some(name) = s.kind_name(dialect) else {
+        if s.is_enabled(dialect) {
+            return Err(bad(format!(
+                "the `{}` shaper is known only by its impulses; settle does not model it",
+                s.name
+            )));
+        }
+        return Ok(None);
+    };
+    let kind = ShaperKind::parse(&name).map_err(|e| bad(e.to_string()))?;
+    let setting = ShaperSetting {
+        kind,
+        frequency_hz: s.frequency_hz,
+        damping_ratio: s.damping_ratio,
+    };
+    setting.build().map_err(|e| bad(e.to_string()))?;
+    Ok(Some(setting))
+}
+
+impl JobConfig {
+    /// What a Klipper printer starts a file with, from its configuration
+    /// ([`crate::config::KlipperConfig`]): `[printer]`'s `max_velocity`, `max_accel`,
+    /// `minimum_cruise_ratio`, `square_corner_velocity`, `max_z_velocity`, `max_z_accel`
+    /// and `kinematics` (cartesian or corexy), and `[input_shaper]` per axis (Klipper
+    /// shapes an axis whose frequency is above 0). Everything else is
+    /// [`JobConfig::defaults`]' (Klipper's extruder defaults among them: the configuration
+    /// reader does not read `[extruder]`).
+    pub fn from_klipper(c: &crate::config::KlipperConfig) -> Result<Self, GcodeError> {
+        let mut cfg = Self::defaults(Firmware::Klipper)?;
+        let p = &c.printer;
+        let mut k = KlipperConfig::new(p.max_velocity_mm_s * 1e-3, p.max_accel_mm_s2 * 1e-3);
+        k.minimum_cruise_ratio = p.minimum_cruise_ratio;
+        k.square_corner_velocity_m_s = p.square_corner_velocity_mm_s * 1e-3;
+        k.max_z_velocity_m_s = p.max_z_velocity_mm_s * 1e-3;
+        k.max_z_accel_m_s2 = p.max_z_accel_mm_s2 * 1e-3;
+        k.kinematics = planner_kinematics(&p.kinematics, "printer.kinematics")?;
+        k.validate().map_err(|e| GcodeError::JobSetting {
+            key: "printer",
+            reason: e.to_string(),
+        })?;
+        cfg.planner = PlannerConfig::Klipper(k);
+        if let Some(s) = &c.input_shaper {
+            let keys = [
+                "input_shaper.shaper_type_x",
+                "input_shaper.shaper_type_y",
+                "input_shaper.shaper_type_z",
+            ];
+            for (i, ((_, axis), key)) in s.iter().zip(keys).enumerate() {
+                cfg.shapers[i] = config_shaper(axis, Dialect::Klipper, key)?;
+            }
+        }
+        Ok(cfg)
+    }
+
+    /// What a RepRapFirmware machine starts a file with, from its `config.g`
+    /// ([`crate::config::RrfConfig`]): `M203` speeds, `M201` accelerations and `M566`
+    /// jerks of X, Y and Z, `M204`'s printing and travel accelerations, the kinematics of
+    /// `M669` (cartesian or corexy) and the `M593` shaper on X and Y (RepRapFirmware has
+    /// one shaper for the motion). Everything else is [`JobConfig::defaults`]'.
+    pub fn from_rrf(c: &crate::config::RrfConfig) -> Result<Self, GcodeError> {
+        let mut cfg = Self::defaults(Firmware::Rrf)?;
+        let mut r = RrfConfig::new();
+        for (i, (_, a)) in c.axes.iter().enumerate() {
+            r.max_feedrate_m_s[i] = a.max_speed_mm_s * 1e-3;
+            r.max_accel_m_s2[i] = a.max_accel_mm_s2 * 1e-3;
+            r.instant_dv_m_s[i] = a.max_jerk_mm_s * 1e-3;
+        }
+        r.print_accel_m_s2 = c.print_accel_mm_s2 * 1e-3;
+        r.travel_accel_m_s2 = c.travel_accel_mm_s2 * 1e-3;
+        r.kinematics = planner_kinematics(&c.kinematics, "M669 K")?;
+        r.validate().map_err(|e| GcodeError::JobSetting {
+            key: "config.g limits",
+            reason: e.to_string(),
+        })?;
+        cfg.planner = PlannerConfig::Rrf(r);
+        let shaper = config_shaper(&c.input_shaper, Dialect::Rrf, "M593")?;
+        cfg.shapers[0] = shaper;
+        cfg.shapers[1] = shaper;
+        Ok(cfg)
+    }
+}
+
+#[cfg(test)]
+mod from_config_tests {
+    use super::*;
+    use crate::config::{KlipperConfig as KlipperFile, RrfConfig as RrfFile};
+
+    #[test]
+    fn a_klipper_configuration_sets_the_planner_and_the_shapers_per_axis() {
+        let text = "[printer]\nkinematics: corexy\nmax_velocity: 300\nmax_accel: 5000\n\
+                    minimum_cruise_ratio: 0.25\nsquare_corner_velocity: 8\n\
+                    max_z_velocity: 15\nmax_z_accel: 100\n\
+                    [input_shaper]\nshaper_type_x: mzv\nshaper_freq_x: 52.4\n\
+                    shaper_type_y: ei\nshaper_freq_y: 41.5\ndamping_ratio_y: 0.08\n";
+        let cfg = JobConfig::from_klipper(&KlipperFile::parse(text, "printer.cfg").expect("ok"))
+            .expect("ok");
+        let PlannerConfig::Klipper(k) = &cfg.planner else {
+            panic!("not Klipper's planner: {:?}", cfg.planner)
+        };
+        assert_eq!(k.max_velocity_m_s, 0.3);
+        assert_eq!(k.max_accel_m_s2, 5.0);
+        assert_eq!(k.minimum_cruise_ratio, 0.25);
+        assert_eq!(k.square_corner_velocity_m_s, 8e-3);
+        assert_eq!((k.max_z_velocity_m_s, k.max_z_accel_m_s2), (15e-3, 0.1));
+        assert_eq!(k.kinematics, Kinematics::CoreXy);
+        let [x, y, z] = cfg.shapers;
+        let x = x.expect("X shaped");
+        let y = y.expect("Y shaped");
+        assert_eq!(
+            (x.kind, x.frequency_hz, x.damping_ratio),
+            (ShaperKind::MZV, 52.4, 0.1)
+        );
+        assert_eq!(
+            (y.kind, y.frequency_hz, y.damping_ratio),
+            (ShaperKind::EI, 41.5, 0.08)
+        );
+        assert_eq!(z, None, "Klipper leaves Z unshaped without shaper_freq_z");
+        assert_eq!(cfg.dialect, Dialect::Klipper);
+    }
+
+    #[test]
+    fn a_klipper_configuration_without_input_shaper_or_with_other_kinematics() {
+        let plain = "[printer]\nkinematics: cartesian\nmax_velocity: 200\nmax_accel: 3000\n";
+        let cfg =
+            JobConfig::from_klipper(&KlipperFile::parse(plain, "p.cfg").expect("ok")).expect("ok");
+        assert_eq!(cfg.shapers, [None; 3]);
+        let delta = "[printer]\nkinematics: delta\nmax_velocity: 200\nmax_accel: 3000\n";
+        let err = JobConfig::from_klipper(&KlipperFile::parse(delta, "p.cfg").expect("ok"))
+            .expect_err("refused")
+            .to_string();
+        assert!(
+            err.contains("printer.kinematics") && err.contains("delta"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_reprapfirmware_configuration_sets_the_planner_and_one_shaper() {
+        // M203 and M566 take mm/min: 18000 mm/min = 300 mm/s, 600 mm/min = 10 mm/s.
+        let text = "M669 K1\nM203 X18000 Y12000 Z600\nM201 X5000 Y4000 Z200\n\
+                    M566 X600 Y480 Z30\nM204 P3000 T6000\nM593 P\"mzv\" F42.5 S0.1\n";
+        let cfg = JobConfig::from_rrf(&RrfFile::parse(text, "config.g").expect("ok")).expect("ok");
+        let PlannerConfig::Rrf(r) = &cfg.planner else {
+            panic!("not RepRapFirmware's planner: {:?}", cfg.planner)
+        };
+        assert_eq!(r.kinematics, Kinematics::CoreXy);
+        assert_eq!(&r.max_feedrate_m_s[..3], &[0.3, 0.2, 0.01]);
+        assert_eq!(&r.max_accel_m_s2[..3], &[5.0, 4.0, 0.2]);
+        assert_eq!(&r.instant_dv_m_s[..3], &[0.01, 0.008, 0.0005]);
+        assert_eq!((r.print_accel_m_s2, r.travel_accel_m_s2), (3.0, 6.0));
+        let x = cfg.shapers[0].expect("X shaped");
+        assert_eq!(cfg.shapers[1], Some(x), "one shaper for X and Y");
+        assert_eq!(cfg.shapers[2], None);
+        assert_eq!((x.frequency_hz, x.damping_ratio), (42.5, 0.1));
+        assert_eq!(x.kind, ShaperKind::parse("rrf:mzv").expect("ok"));
+    }
+}
