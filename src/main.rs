@@ -200,15 +200,23 @@ enum Command {
         /// The machine: a preset (printer_xy), a machine file, or a scenario file (its [machine]).
         #[arg(long)]
         machine: String,
-        /// The planner: klipper, marlin, rrf or settle.
-        #[arg(long, default_value = "klipper", value_parser = parse_firmware)]
-        firmware: settle_gcode::job::Firmware,
+        /// The planner: klipper, marlin, rrf or settle [default: klipper; with --config,
+        /// rrf for a file ending in .g].
+        #[arg(long, value_parser = parse_firmware)]
+        firmware: Option<settle_gcode::job::Firmware>,
+        /// The firmware's configuration (Klipper printer.cfg with its includes, or
+        /// RepRapFirmware config.g): the planner's limits and the input shapers start as
+        /// it sets them, instead of the firmware's defaults.
+        #[arg(long, value_name = "FILE")]
+        config: Option<PathBuf>,
         /// Only these layers, A..B (both included) or A; the rest is planned, not simulated.
         #[arg(long, value_name = "A..B", value_parser = workflows::gcode::parse_layers)]
         layers: Option<(u32, u32)>,
-        /// Input shaper on X and Y: KIND@FREQ_HZ[/DAMPING], e.g. mzv@48 [default: none].
-        #[arg(long, value_parser = workflows::gcode::parse_shaper)]
-        shaper: Option<settle_gcode::job::ShaperSetting>,
+        /// Input shaper: KIND@FREQ_HZ[/DAMPING] (or none) on X and Y, e.g. mzv@48, or per
+        /// axis x=SPEC,y=SPEC, e.g. x=mzv@52,y=ei@41/0.08; an axis not named keeps its own
+        /// [default: none, or --config's].
+        #[arg(long, value_parser = workflows::gcode::parse_shapers)]
+        shaper: Option<workflows::gcode::XyShapers>,
         /// Simulation backend: modal (exact, linear driver only), rapier, mujoco.
         #[arg(long, default_value = "modal", value_parser = parse_backend)]
         backend: Backend,
@@ -231,13 +239,12 @@ enum Command {
         /// the layers (commanded and toolhead XY, contour error, line), streaming.
         #[arg(long)]
         mcap: bool,
-        /// Also run FIRMWARE[:SHAPER] (e.g. settle:none, klipper:ei@48) and compare: the
-        /// worst layer under both (compare-layer-<n>.svg/png) and compare.md.
+        /// Also run FIRMWARE[:SHAPER] (e.g. settle:none, klipper:ei@48,
+        /// klipper:x=mzv@52,y=ei@41) and compare: the worst layer under both
+        /// (compare-layer-<n>.svg/png) and compare.md. The firmware of --config keeps its
+        /// settings; another starts from its defaults.
         #[arg(long, value_name = "FIRMWARE[:SHAPER]", value_parser = workflows::gcode::compare::parse_setting)]
-        versus: Option<(
-            settle_gcode::job::Firmware,
-            Option<settle_gcode::job::ShaperSetting>,
-        )>,
+        versus: Option<(settle_gcode::job::Firmware, workflows::gcode::XyShapers)>,
     },
     /// Run one point of a sweep in detail: print its metrics, write its full trace as CSV.
     #[command(
@@ -502,6 +509,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             file,
             machine,
             firmware,
+            config,
             layers,
             shaper,
             backend,
@@ -523,7 +531,17 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 sample_rate_hz,
                 maps,
                 versus,
-                ..workflows::gcode::GcodeOptions::new(file, &machine, firmware)?.with_shaper(shaper)
+                ..match config {
+                    Some(config) => workflows::gcode::GcodeOptions::with_config(
+                        file, &machine, firmware, config,
+                    )?,
+                    None => workflows::gcode::GcodeOptions::new(
+                        file,
+                        &machine,
+                        firmware.unwrap_or(settle_gcode::job::Firmware::Klipper),
+                    )?,
+                }
+                .with_shapers(shaper.unwrap_or_default())
             };
             workflows::gcode::gcode(&opts)?.report()
         }

@@ -132,7 +132,7 @@ impl Imported {
 }
 
 /// A configuration reader's error as the harness's, at its file, line and key.
-fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
+pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
     if let settle_gcode::GcodeError::Io { source, .. } = e {
         return Error::read(path, source);
     }

@@ -6,6 +6,7 @@ mod support;
 mod cli;
 mod corners;
 mod faults;
+mod gcode_config;
 mod gcode_job;
 mod gcode_range;
 mod hardening_input;

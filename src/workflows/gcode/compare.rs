@@ -6,38 +6,44 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use settle_gcode::job::{Firmware, JobConfig, ShaperSetting};
+use settle_gcode::job::{Firmware, JobConfig};
 
 use super::report::map_panel;
-use super::{GcodeOptions, GcodeOutcome, measure, parse_shaper};
+use super::{GcodeOptions, GcodeOutcome, XyShapers, measure, parse_shapers};
 use crate::error::Error;
 use crate::output::atomic::write_atomic;
 use crate::output::plot::ringing::RingingMap;
 
-/// A setting as written after `--versus`: `FIRMWARE` (its defaults, unshaped) or
-/// `FIRMWARE:SHAPER` (`klipper:mzv@48`, `settle:none`).
-pub fn parse_setting(s: &str) -> Result<(Firmware, Option<ShaperSetting>), String> {
-    let (fw, shaper) = match s.split_once(':') {
-        Some((fw, sh)) if sh.eq_ignore_ascii_case("none") => (fw, None),
-        Some((fw, sh)) => (fw, Some(parse_shaper(sh)?)),
-        None => (s, None),
+/// A setting as written after `--versus`: `FIRMWARE` (unshaped) or `FIRMWARE:SHAPERS`
+/// (`klipper:mzv@48`, `settle:none`, `klipper:x=mzv@52,y=ei@41`; [`XyShapers`]).
+pub fn parse_setting(s: &str) -> Result<(Firmware, XyShapers), String> {
+    let (fw, shapers) = match s.split_once(':') {
+        Some((fw, sh)) => (fw, parse_shapers(sh).map_err(|e| format!("`{s}`: {e}"))?),
+        None => (s, XyShapers::both(None)),
     };
     let firmware = fw.parse::<Firmware>().map_err(|e| format!("`{s}`: {e}"))?;
-    Ok((firmware, shaper))
+    Ok((firmware, shapers))
 }
 
-/// The options of `base` with another firmware (its defaults) and shaper.
+/// The options of `base` with another setting: the same firmware as a `--config` run
+/// keeps the configuration's settings (and, on an axis the shapers do not name, its
+/// shaper); another firmware starts from its defaults, unshaped.
 pub fn versus(
     base: &GcodeOptions,
     firmware: Firmware,
-    shaper: Option<ShaperSetting>,
+    shapers: XyShapers,
 ) -> Result<GcodeOptions, Error> {
-    let job = JobConfig::defaults(firmware).map_err(super::gcode_error(&base.file))?;
+    let job = match &base.config {
+        Some(c) if c.job.firmware() == firmware => c.job.clone(),
+        _ => JobConfig::defaults(firmware).map_err(super::gcode_error(&base.file))?,
+    };
+    let config = base.config.clone().filter(|c| c.job.firmware() == firmware);
     Ok(GcodeOptions {
         job,
+        config,
         ..base.clone()
     }
-    .with_shaper(shaper))
+    .with_shapers(shapers))
 }
 
 /// The comparison table (Markdown) of outcomes.
@@ -113,9 +119,26 @@ mod tests {
     fn settings_parse() {
         let (f, s) = parse_setting("klipper:mzv@48").expect("setting");
         assert_eq!(f, Firmware::Klipper);
-        assert_eq!(s.map(|s| s.frequency_hz), Some(48.0));
-        assert_eq!(parse_setting("settle:none"), Ok((Firmware::Settle, None)));
-        assert_eq!(parse_setting("rrf"), Ok((Firmware::Rrf, None)));
+        let freq = |s: Option<Option<settle_gcode::job::ShaperSetting>>| {
+            s.map(|s| s.map(|s| s.frequency_hz))
+        };
+        assert_eq!((freq(s.x), freq(s.y)), (Some(Some(48.0)), Some(Some(48.0))));
+        let none = XyShapers::both(None);
+        assert_eq!(parse_setting("settle:none"), Ok((Firmware::Settle, none)));
+        assert_eq!(parse_setting("rrf"), Ok((Firmware::Rrf, none)));
         assert!(parse_setting("cnc").is_err());
+        let (_, s) = parse_setting("klipper:x=mzv@52,y=ei@41/0.08").expect("per axis");
+        assert_eq!((freq(s.x), freq(s.y)), (Some(Some(52.0)), Some(Some(41.0))));
+        assert_eq!(s.y.flatten().map(|s| s.damping_ratio), Some(0.08));
+        let (_, s) = parse_setting("klipper:y=none").expect("one axis");
+        assert_eq!((s.x, s.y), (None, Some(None)));
+        for bad in [
+            "klipper:x=mzv@52,x=ei@41",
+            "klipper:z=mzv@40",
+            "klipper:x=mzv",
+            "klipper:x",
+        ] {
+            assert!(parse_setting(bad).is_err(), "{bad}");
+        }
     }
 }

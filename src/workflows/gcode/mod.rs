@@ -69,10 +69,89 @@ pub struct GcodeOptions {
     pub maps: usize,
     /// A layer whose ringing map is kept besides the worst ones (the comparison's).
     pub map_layer: Option<u32>,
-    /// A second setting to compare with (`--versus`): firmware and X/Y shaper.
-    pub versus: Option<(Firmware, Option<ShaperSetting>)>,
+    /// A second setting to compare with (`--versus`): firmware and X/Y shapers.
+    pub versus: Option<(Firmware, XyShapers)>,
     /// Write `recording.mcap` into the output folder ([`record`]).
     pub mcap: bool,
+    /// The firmware configuration the planner's settings come from (`--config`).
+    pub config: Option<ConfigSource>,
+}
+
+/// A firmware configuration read for `--config`.
+#[derive(Debug, Clone)]
+pub struct ConfigSource {
+    /// printer.cfg or config.g.
+    pub path: PathBuf,
+    /// The job configuration it gives (shapers before `--shaper`).
+    pub job: JobConfig,
+    /// What the reader noted (SAVE_CONFIG values overridden, blocks not read).
+    pub notes: Vec<String>,
+}
+
+/// `--shaper` as written: `KIND@FREQ_HZ[/DAMPING]` or `none` for X and Y, or per axis
+/// `x=SPEC,y=SPEC`. An axis not named keeps the shaper it has (the configuration's with
+/// `--config`, none without).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct XyShapers {
+    /// X: `None` not named, `Some(None)` unshaped.
+    pub x: Option<Option<ShaperSetting>>,
+    /// Y: `None` not named, `Some(None)` unshaped.
+    pub y: Option<Option<ShaperSetting>>,
+}
+
+impl XyShapers {
+    /// The same shaper (or none) on X and Y.
+    pub fn both(s: Option<ShaperSetting>) -> Self {
+        Self {
+            x: Some(s),
+            y: Some(s),
+        }
+    }
+
+    /// `--shaper`'s text for `shapers` (X and Y): one spec when they are equal, else
+    /// `x=...,y=...`.
+    pub fn text(shapers: &[Option<ShaperSetting>; 3]) -> String {
+        let one =
+            |s: &Option<ShaperSetting>| s.as_ref().map_or("none".to_string(), report::shaper_arg);
+        if shapers[0] == shapers[1] {
+            one(&shapers[0])
+        } else {
+            format!("x={},y={}", one(&shapers[0]), one(&shapers[1]))
+        }
+    }
+}
+
+/// Parses `--shaper` (and the shaper of `--versus`): see [`XyShapers`].
+pub fn parse_shapers(s: &str) -> Result<XyShapers, String> {
+    let one = |spec: &str| -> Result<Option<ShaperSetting>, String> {
+        if spec.eq_ignore_ascii_case("none") {
+            Ok(None)
+        } else {
+            parse_shaper(spec).map(Some)
+        }
+    };
+    if !s.contains('=') {
+        return Ok(XyShapers::both(one(s)?));
+    }
+    let mut out = XyShapers::default();
+    for part in s.split(',') {
+        let bad_axis = || {
+            format!(
+                "`{s}`: per-axis shapers are x=SPEC,y=SPEC (SPEC a shaper such as mzv@48, or none)"
+            )
+        };
+        let (axis, spec) = part.split_once('=').ok_or_else(bad_axis)?;
+        let slot = match axis.trim().to_ascii_lowercase().as_str() {
+            "x" => &mut out.x,
+            "y" => &mut out.y,
+            _ => return Err(bad_axis()),
+        };
+        if slot.is_some() {
+            return Err(format!("`{s}`: axis {} is named twice", axis.trim()));
+        }
+        *slot = Some(one(spec.trim())?);
+    }
+    Ok(out)
 }
 
 impl GcodeOptions {
@@ -94,13 +173,83 @@ impl GcodeOptions {
             map_layer: None,
             versus: None,
             mcap: false,
+            config: None,
         })
     }
 
+    /// `file` on `machine` with the planner settings and shapers of a firmware
+    /// configuration (Klipper's printer.cfg with its includes, or RepRapFirmware's
+    /// config.g): `firmware` names which (`None`: RepRapFirmware for a file ending in `.g`,
+    /// else Klipper).
+    pub fn with_config(
+        file: PathBuf,
+        machine: &str,
+        firmware: Option<Firmware>,
+        config: PathBuf,
+    ) -> Result<Self, Error> {
+        let is_g = config
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("g"));
+        let firmware = firmware.unwrap_or(if is_g {
+            Firmware::Rrf
+        } else {
+            Firmware::Klipper
+        });
+        let note = |n: &settle_gcode::config::ConfigNote| match &n.at {
+            Some(at) => format!("{at}: {}", n.text),
+            None => n.text.clone(),
+        };
+        let (job, notes) = match firmware {
+            Firmware::Klipper => {
+                let c = settle_gcode::config::KlipperConfig::read(&config)
+                    .map_err(|e| crate::workflows::import::config_error(&config, e))?;
+                let job = JobConfig::from_klipper(&c).map_err(gcode_error(&config))?;
+                (job, c.notes.iter().map(note).collect())
+            }
+            Firmware::Rrf => {
+                let c = settle_gcode::config::RrfConfig::read(&config)
+                    .map_err(|e| crate::workflows::import::config_error(&config, e))?;
+                let job = JobConfig::from_rrf(&c).map_err(gcode_error(&config))?;
+                (job, c.notes.iter().map(note).collect())
+            }
+            Firmware::Marlin | Firmware::Settle => {
+                return Err(Error::input_key(
+                    &config,
+                    "--config",
+                    format!(
+                        "--config reads a Klipper printer.cfg (--firmware klipper) or a RepRapFirmware config.g (--firmware rrf), not {firmware}'s settings{}",
+                        if firmware == Firmware::Marlin {
+                            " (Marlin's M201/M203/M204/M205/M593 lines in the G-code file set them)"
+                        } else {
+                            ""
+                        }
+                    ),
+                ));
+            }
+        };
+        let mut opts = Self::new(file, machine, firmware)?;
+        opts.job = job.clone();
+        opts.config = Some(ConfigSource {
+            path: config,
+            job,
+            notes,
+        });
+        Ok(opts)
+    }
+
     /// The same input shaper on X and Y.
-    pub fn with_shaper(mut self, shaper: Option<ShaperSetting>) -> Self {
-        self.job.shapers[0] = shaper;
-        self.job.shapers[1] = shaper;
+    pub fn with_shaper(self, shaper: Option<ShaperSetting>) -> Self {
+        self.with_shapers(XyShapers::both(shaper))
+    }
+
+    /// The shapers `--shaper` names; an axis it does not name keeps its own.
+    pub fn with_shapers(mut self, shapers: XyShapers) -> Self {
+        if let Some(x) = shapers.x {
+            self.job.shapers[0] = x;
+        }
+        if let Some(y) = shapers.y {
+            self.job.shapers[1] = y;
+        }
         self
     }
 }
@@ -159,6 +308,8 @@ pub struct GcodeOutcome {
     /// Where the modal backend linearised the machine (a machine whose stiffness depends
     /// on position; [`crate::kinds::gcode::linpoint`]).
     pub linearised_at: Option<LinPoint>,
+    /// The planner's settings read from `--config`, in words, and the reader's notes.
+    pub config: Option<(String, Vec<String>)>,
 }
 
 impl GcodeOutcome {
@@ -186,6 +337,12 @@ impl GcodeOutcome {
             self.worst_um,
             self.p95_um
         ));
+        if let Some((settings, notes)) = &self.config {
+            r.out(settings.clone());
+            for n in notes {
+                r.err(format!("note: {n}"));
+            }
+        }
         if let Some(p) = &self.linearised_at {
             r.out(format!("modal backend linearised at {}", p.describe()));
         }
@@ -534,8 +691,65 @@ fn simulate(
         versus: None,
         recording: None,
         linearised_at: point,
+        config: opts.config.as_ref().map(|c| {
+            (
+                format!(
+                    "settings from {}: {}",
+                    c.path.display(),
+                    config_settings(&opts.job)
+                ),
+                c.notes.clone(),
+            )
+        }),
     };
     Ok((outcome, rec))
+}
+
+/// The planner's limits and the shapers of `job` in words, in the firmware's terms
+/// (`klipper: max_velocity 300 mm/s, max_accel 5000 mm/s^2, ...; shaper X mzv@52.4 Hz,
+/// Y ei@41.5 Hz`).
+pub fn config_settings(job: &JobConfig) -> String {
+    use settle_gcode::job::PlannerConfig;
+    let limits = match &job.planner {
+        PlannerConfig::Klipper(k) => format!(
+            "max_velocity {} mm/s, max_accel {} mm/s^2, minimum_cruise_ratio {}, square_corner_velocity {} mm/s",
+            k.max_velocity_m_s * 1e3,
+            k.max_accel_m_s2 * 1e3,
+            k.minimum_cruise_ratio,
+            k.square_corner_velocity_m_s * 1e3
+        ),
+        PlannerConfig::Rrf(c) => format!(
+            "M203 X{} Y{} mm/s, M201 X{} Y{} mm/s^2, M204 P{} T{} mm/s^2, M566 X{} Y{} mm/s",
+            c.max_feedrate_m_s[0] * 1e3,
+            c.max_feedrate_m_s[1] * 1e3,
+            c.max_accel_m_s2[0] * 1e3,
+            c.max_accel_m_s2[1] * 1e3,
+            c.print_accel_m_s2 * 1e3,
+            c.travel_accel_m_s2 * 1e3,
+            c.instant_dv_m_s[0] * 1e3,
+            c.instant_dv_m_s[1] * 1e3
+        ),
+        PlannerConfig::Marlin(_) | PlannerConfig::Settle(_) => "the firmware's defaults".into(),
+    };
+    format!(
+        "{}: {limits}; {}",
+        job.firmware(),
+        shaper_words(&job.shapers)
+    )
+}
+
+/// The X and Y shapers in words: `shaper mzv@48 Hz on X and Y`, `no shaper`, or per axis.
+fn shaper_words(shapers: &[Option<ShaperSetting>; 3]) -> String {
+    let name = |s: &Option<ShaperSetting>| {
+        s.map_or("none".to_string(), |s| {
+            format!("{}@{} Hz", s.kind.name(), s.frequency_hz)
+        })
+    };
+    match (&shapers[0], &shapers[1]) {
+        (None, None) => "no shaper".into(),
+        (x, y) if x == y => format!("shaper {} on X and Y", name(x)),
+        (x, y) => format!("shaper X {}, Y {}", name(x), name(y)),
+    }
 }
 
 /// The planner and the X and Y shapers in words: `klipper + mzv@48 Hz`, `settle` when
@@ -574,7 +788,7 @@ pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
         }
     };
     let b_opts = match opts.versus {
-        Some((fw, shaper)) => Some(compare::versus(opts, fw, shaper)?),
+        Some((fw, shapers)) => Some(compare::versus(opts, fw, shapers)?),
         None => None,
     };
     let b = match &b_opts {

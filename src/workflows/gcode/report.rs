@@ -14,7 +14,7 @@ use settle_gcode::job::ShaperSetting;
 
 use std::io::BufRead as _;
 
-use super::{DEFAULT_SAMPLE_RATE_HZ, GcodeOptions, GcodeOutcome};
+use super::{DEFAULT_SAMPLE_RATE_HZ, GcodeOptions, GcodeOutcome, XyShapers};
 use crate::error::Error;
 use crate::kinds::gcode::stats::LayerMap;
 use crate::output::atomic::{create_dir, write_atomic};
@@ -284,11 +284,26 @@ fn digest_and_lines(file: &Path, wanted: &[u64]) -> Result<(String, BTreeMap<u64
 }
 
 /// A shaper as `--shaper` takes it: `mzv@48`, `ei@52/0.08`.
-fn shaper_arg(s: &ShaperSetting) -> String {
+pub(crate) fn shaper_arg(s: &ShaperSetting) -> String {
     if s.damping_ratio == 0.1 {
         format!("{}@{}", s.kind.name(), s.frequency_hz)
     } else {
         format!("{}@{}/{}", s.kind.name(), s.frequency_hz, s.damping_ratio)
+    }
+}
+
+/// Shapers as `--shaper` and `--versus` take them: one spec (or `none`) for both axes, or
+/// `x=SPEC,y=SPEC` with the axes named.
+fn shapers_arg(s: &XyShapers) -> String {
+    let one = |s: &Option<ShaperSetting>| s.as_ref().map_or("none".to_string(), shaper_arg);
+    match (&s.x, &s.y) {
+        (Some(x), Some(y)) if x == y => one(x),
+        (x, y) => x
+            .iter()
+            .map(|x| format!("x={}", one(x)))
+            .chain(y.iter().map(|y| format!("y={}", one(y))))
+            .collect::<Vec<_>>()
+            .join(","),
     }
 }
 
@@ -300,8 +315,18 @@ pub fn command_line(opts: &GcodeOptions, dir: &Path) -> String {
         opts.machine,
         opts.job.firmware()
     );
-    if let Some(s) = &opts.job.shapers[0] {
-        let _ = write!(c, " --shaper {}", shaper_arg(s));
+    let shapers = XyShapers::text(&opts.job.shapers);
+    match &opts.config {
+        Some(config) => {
+            let _ = write!(c, " --config {}", config.path.display());
+            if config.job.shapers[..2] != opts.job.shapers[..2] {
+                let _ = write!(c, " --shaper {shapers}");
+            }
+        }
+        None if shapers != "none" => {
+            let _ = write!(c, " --shaper {shapers}");
+        }
+        None => {}
     }
     if let Some((a, b)) = opts.layers {
         let _ = write!(c, " --layers {a}..{b}");
@@ -321,12 +346,8 @@ pub fn command_line(opts: &GcodeOptions, dir: &Path) -> String {
     if opts.maps != 1 {
         let _ = write!(c, " --maps {}", opts.maps);
     }
-    if let Some((fw, shaper)) = &opts.versus {
-        let _ = write!(
-            c,
-            " --versus {fw}:{}",
-            shaper.as_ref().map_or("none".into(), shaper_arg)
-        );
+    if let Some((fw, shapers)) = &opts.versus {
+        let _ = write!(c, " --versus {fw}:{}", shapers_arg(shapers));
     }
     let _ = write!(c, " --out {}", dir.display());
     c
