@@ -149,3 +149,32 @@ fn a_configuration_settle_cannot_follow_exits_2_and_writes_nothing() {
         assert!(!out_dir.exists(), "{config:?} wrote {out_dir:?}");
     }
 }
+
+/// summary.md and report.html say what `--config` set and where the modal backend
+/// linearised the machine: the cube layer is printed at X and Y 100 to 120 mm, so at X and
+/// Y 110 mm.
+#[test]
+fn the_outputs_name_the_configurations_settings_and_the_linearisation_point() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cfg = write(
+        dir.path(),
+        "printer.cfg",
+        "[printer]\nkinematics: cartesian\nmax_velocity: 250\nmax_accel: 4500\n\
+         [input_shaper]\nshaper_freq_x: 48\nshaper_freq_y: 39.3\n",
+    );
+    let out = dir.path().join("out");
+    let opts = GcodeOptions {
+        out: Some(out.clone()),
+        ..with_config(root().join("gcode/prints/cube_layer.gcode"), cfg)
+    };
+    settle::workflows::gcode::gcode(&opts).expect("runs");
+    let want_settings = "klipper: max_velocity 250 mm/s, max_accel 4500 mm/s^2, \
+                         minimum_cruise_ratio 0.5, square_corner_velocity 5 mm/s; \
+                         shaper X mzv@48 Hz, Y mzv@39.3 Hz";
+    let want_point = "X 110.00 Y 110.00";
+    for name in ["summary.md", "report.html"] {
+        let text = std::fs::read_to_string(out.join(name)).expect("written");
+        assert!(text.contains(want_settings), "{name}: {text}");
+        assert!(text.contains(want_point), "{name}: {text}");
+    }
+}

@@ -850,6 +850,9 @@ fn recording_metrics(o: &GcodeOutcome) -> serde_json::Map<String, serde_json::Va
     if let Some(t) = &o.streamed.tail {
         m.insert("end_residual_um".into(), record::num(t.residual_peak_um));
     }
+    if let Some(p) = &o.linearised_at {
+        m.insert("linearised_at_mm".into(), json!(p.xyz_mm));
+    }
     if let Some(w) = o.worst().first() {
         m.insert("contour_worst_line".into(), json!(w.line));
     }

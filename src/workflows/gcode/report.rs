@@ -108,6 +108,16 @@ pub fn summary_md(o: &GcodeOutcome, maps: &[String]) -> String {
 the moves active at that time, over printing moves; p95 is the 95th percentile of all \
 printing samples.\n"
     );
+    if let Some((settings, _)) = &o.config {
+        let _ = writeln!(s, "Planner {settings}.\n");
+    }
+    if let Some(p) = &o.linearised_at {
+        let _ = writeln!(
+            s,
+            "The modal backend linearised the machine at {}.\n",
+            p.describe()
+        );
+    }
     if o.streamed.preroll_s > 0.0 {
         let _ = writeln!(
             s,
@@ -514,7 +524,17 @@ pub fn html_report(
                     label: "driver model".into(),
                     value: opts.driver.to_string(),
                 },
-            ],
+            ]
+            .into_iter()
+            .chain(o.config.as_ref().map(|(settings, _)| Stat {
+                label: "planner settings".into(),
+                value: settings.clone(),
+            }))
+            .chain(o.linearised_at.as_ref().map(|p| Stat {
+                label: "linearised at (modal)".into(),
+                value: p.describe(),
+            }))
+            .collect(),
             inputs,
         },
     })
