@@ -713,21 +713,21 @@ pub fn config_settings(job: &JobConfig) -> String {
     let limits = match &job.planner {
         PlannerConfig::Klipper(k) => format!(
             "max_velocity {} mm/s, max_accel {} mm/s^2, minimum_cruise_ratio {}, square_corner_velocity {} mm/s",
-            k.max_velocity_m_s * 1e3,
-            k.max_accel_m_s2 * 1e3,
+            mm(k.max_velocity_m_s),
+            mm(k.max_accel_m_s2),
             k.minimum_cruise_ratio,
-            k.square_corner_velocity_m_s * 1e3
+            mm(k.square_corner_velocity_m_s)
         ),
         PlannerConfig::Rrf(c) => format!(
             "M203 X{} Y{} mm/s, M201 X{} Y{} mm/s^2, M204 P{} T{} mm/s^2, M566 X{} Y{} mm/s",
-            c.max_feedrate_m_s[0] * 1e3,
-            c.max_feedrate_m_s[1] * 1e3,
-            c.max_accel_m_s2[0] * 1e3,
-            c.max_accel_m_s2[1] * 1e3,
-            c.print_accel_m_s2 * 1e3,
-            c.travel_accel_m_s2 * 1e3,
-            c.instant_dv_m_s[0] * 1e3,
-            c.instant_dv_m_s[1] * 1e3
+            mm(c.max_feedrate_m_s[0]),
+            mm(c.max_feedrate_m_s[1]),
+            mm(c.max_accel_m_s2[0]),
+            mm(c.max_accel_m_s2[1]),
+            mm(c.print_accel_m_s2),
+            mm(c.travel_accel_m_s2),
+            mm(c.instant_dv_m_s[0]),
+            mm(c.instant_dv_m_s[1])
         ),
         PlannerConfig::Marlin(_) | PlannerConfig::Settle(_) => "the firmware's defaults".into(),
     };
@@ -736,6 +736,13 @@ pub fn config_settings(job: &JobConfig) -> String {
         job.firmware(),
         shaper_words(&job.shapers)
     )
+}
+
+/// A length, speed or acceleration in m (per s, s^2) as mm, rounded to 1e-6 mm: the
+/// configuration's own number, not its round trip through metres (`70`, not
+/// `70.00000000000001`).
+fn mm(si: f64) -> String {
+    format!("{}", (si * 1e9).round() / 1e6)
 }
 
 /// The X and Y shapers in words: `shaper mzv@48 Hz on X and Y`, `no shaper`, or per axis.
