@@ -40,7 +40,7 @@ use settle_planner::shaper::Shaper;
 use settle_planner::{PlanError, Profile, State, Trajectory};
 
 use crate::error::Error;
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
@@ -254,7 +254,7 @@ pub trait Kind: std::fmt::Debug + Sync {
 
     /// Its summary section, read from the runs table (row `i` = `runs[i]`) so that a
     /// merged sweep's summary is the same; `None` when it has nothing to show.
-    fn summary(&self, runs: &[RunSpec], table: &RunsTable) -> Option<String> {
+    fn summary(&self, runs: &[RunSpec], table: &RunsColumns) -> Option<String> {
         let _ = (runs, table);
         None
     }

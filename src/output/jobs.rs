@@ -14,7 +14,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::ranking::{is_current, is_setting, label_part, run_command};
 use crate::spec::run_spec::RunSpec;
@@ -129,7 +129,7 @@ pub fn pareto(pts: &[(f64, f64)]) -> Vec<usize> {
 
 /// The G-code candidates of `runs` (row `i` of `table` is `runs[i]`); `None` when the
 /// table has no G-code columns.
-pub fn jobs(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Option<Jobs> {
+pub fn jobs(sc: &Scenario, runs: &[RunSpec], table: &RunsColumns) -> Option<Jobs> {
     table.column("contour_worst_um")?;
     table.column("print_time_s")?;
     let keys: Vec<String> = runs
@@ -139,7 +139,7 @@ pub fn jobs(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Option<Jobs> 
     let file = (0..runs.len())
         .find_map(|i| table.cell(i, "gcode_file").filter(|f| !f.is_empty()))
         .map(|f| {
-            Path::new(f)
+            Path::new(&*f)
                 .file_name()
                 .map_or(f.to_string(), |n| n.to_string_lossy().into_owned())
         })

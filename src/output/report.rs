@@ -7,7 +7,7 @@
 //! No clock is read: the same runs give the same page, so a merged sweep's report is the
 //! unsharded one's.
 
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::html::{
     BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, Provenance, Reference, Report,
@@ -194,10 +194,10 @@ pub struct RankingRows<'a> {
     ranking: Option<Ranking>,
     /// The index of the first ranking table in the report's tables.
     first: usize,
-    /// Per band, the first row of each workload point.
-    starts: Vec<Vec<usize>>,
     /// The runs (row `i` of the runs table is `runs[i]`).
     runs: &'a [RunSpec],
+    /// The runs table the ranking was made from.
+    table: &'a RunsColumns,
     /// The scenario, as the commands name it.
     file: ScenarioFile<'a>,
 }
@@ -205,12 +205,16 @@ pub struct RankingRows<'a> {
 impl Rows for RankingRows<'_> {
     fn row(&self, table: usize, k: usize) -> Option<Vec<Cell>> {
         let b = table.checked_sub(self.first)?;
-        let band = self.ranking.as_ref()?.bands.get(b)?;
-        let starts = self.starts.get(b)?;
-        let p = starts.partition_point(|&s| s <= k).checked_sub(1)?;
-        let point = band.points.get(p)?;
-        let r = point.runs.get(k - starts[p])?;
-        Some(ranking_row(point, r, self.runs, self.file))
+        let ranking = self.ranking.as_ref()?;
+        let band = ranking.bands.get(b)?;
+        let p = band
+            .points
+            .partition_point(|s| s.start as usize <= k)
+            .checked_sub(1)?;
+        let at = k - band.points[p].start as usize;
+        let point = ranking.point_runs(b, p, at..at + 1, self.runs, self.table)?;
+        let r = point.runs.first()?;
+        Some(ranking_row(&point, r, self.runs, self.file))
     }
 }
 
@@ -277,7 +281,7 @@ pub fn sweep_report<'a>(
     sc: &Scenario,
     file: ScenarioFile<'a>,
     runs: &'a [RunSpec],
-    table: &RunsTable,
+    table: &'a RunsColumns,
     figures: &[(String, std::path::PathBuf)],
 ) -> (Report, RankingRows<'a>) {
     let mut intro = vec![format!("{}. {} runs.", machines_line(runs), runs.len())];
@@ -316,26 +320,11 @@ pub fn sweep_report<'a>(
         .first()
         .map(|r| r.backend.to_string())
         .unwrap_or_default();
-    let starts = ranking.as_ref().map_or(Vec::new(), |r| {
-        r.bands
-            .iter()
-            .map(|b| {
-                b.points
-                    .iter()
-                    .scan(0, |n, p| {
-                        let start = *n;
-                        *n += p.runs.len();
-                        Some(start)
-                    })
-                    .collect()
-            })
-            .collect()
-    });
     let rows = RankingRows {
         ranking,
         first,
-        starts,
         runs,
+        table,
         file,
     };
     let report = Report {

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::html::Out;
 use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, rank, run_command};
@@ -80,7 +80,7 @@ pub fn summary_md(
     sc: &Scenario,
     scenario: &Path,
     runs: &[RunSpec],
-    table: &RunsTable,
+    table: &RunsColumns,
     figures: &[Figure],
 ) -> String {
     let mut out = String::new();
@@ -95,7 +95,7 @@ pub(crate) fn summary_to(
     sc: &Scenario,
     scenario: &Path,
     runs: &[RunSpec],
-    table: &RunsTable,
+    table: &RunsColumns,
     figures: &[Figure],
 ) {
     let _ = writeln!(out, "# {}\n", sc.name);
@@ -143,7 +143,7 @@ pub(crate) fn summary_to(
         }
     }
     if !replaced {
-        push_ranking(out, &rank(sc, runs, table), runs, scenario);
+        push_ranking(out, &rank(sc, runs, table), runs, table, scenario);
     }
     for section in after.iter().filter(|s| !s.is_empty()) {
         out.push('\n');
@@ -161,14 +161,20 @@ pub(crate) fn summary_to(
 
 /// Whether the summary ranks candidates by move-and-settle time: no run kind's section
 /// replaces the ranking (a raster scan's does).
-pub fn ranks_candidates(runs: &[RunSpec], table: &RunsTable) -> bool {
+pub fn ranks_candidates(runs: &[RunSpec], table: &RunsColumns) -> bool {
     !crate::kinds::all()
         .iter()
         .any(|k| k.replaces_move_tables() && k.summary(runs, table).is_some())
 }
 
 /// The winners and the ranking tables.
-fn push_ranking(out: &mut impl Out, ranking: &Ranking, runs: &[RunSpec], scenario: &Path) {
+fn push_ranking(
+    out: &mut impl Out,
+    ranking: &Ranking,
+    runs: &[RunSpec],
+    table: &RunsColumns,
+    scenario: &Path,
+) {
     let reference = ranking.reference_name();
     let _ = writeln!(out, "## Winner per band\n");
     let compared = if ranking.setting_keys.is_empty() {
@@ -225,7 +231,7 @@ fn push_ranking(out: &mut impl Out, ranking: &Ranking, runs: &[RunSpec], scenari
         }
     }
     out.push('\n');
-    for b in &ranking.bands {
+    for (bi, b) in ranking.bands.iter().enumerate() {
         let _ = writeln!(
             out,
             "## Ranking: move and settle to within {} um (ms)\n",
@@ -249,7 +255,7 @@ fn push_ranking(out: &mut impl Out, ranking: &Ranking, runs: &[RunSpec], scenari
         header.push("command".into());
         let _ = writeln!(out, "| {} |", header.join(" | "));
         let _ = writeln!(out, "|{}", "---:|".repeat(header.len()));
-        for p in &b.points {
+        for p in (0..b.points.len()).filter_map(|p| ranking.point(bi, p, runs, table)) {
             for r in &p.runs {
                 let mut row = p.workload.clone();
                 let mark = |s: String| {

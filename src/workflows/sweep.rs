@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use crate::error::Error;
 use crate::execute::pool::{Progress, run_all_with};
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::measure::metrics::Metrics;
 use crate::output::atomic::{create_dir, write_atomic};
 use crate::output::report::ScenarioFile;
@@ -426,7 +426,7 @@ fn remove_stale_temps(dir: &Path) -> Result<(), Error> {
 
 /// The failed runs, from runs.csv's `status` and `reason` columns.
 fn failures(runs: &[RunSpec], csv: &str) -> Vec<FailedRun> {
-    let Ok(table) = RunsTable::parse(csv) else {
+    let Ok(table) = RunsColumns::parse(csv) else {
         return Vec::new();
     };
     (0..runs.len())

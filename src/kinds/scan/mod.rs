@@ -40,7 +40,7 @@ use settle_planner::shaper::Shaper;
 use settle_planner::{PlanError, Profile, State, Trajectory};
 
 use crate::error::Error;
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
 use crate::kinds::{Kind, KindState, PlanContext, Planned, PlotColumn, Role};
 use crate::measure::metrics::Metrics;
@@ -212,7 +212,7 @@ impl Kind for ScanStep {
             .collect()
     }
 
-    fn summary(&self, runs: &[RunSpec], table: &RunsTable) -> Option<String> {
+    fn summary(&self, runs: &[RunSpec], table: &RunsColumns) -> Option<String> {
         table
             .column("scan_reentry_error_um")
             .map(|_| summary::section(runs, table))

@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::spec::groups::SweptGroups;
 use crate::spec::run_spec::RunSpec;
 
@@ -10,7 +10,7 @@ use crate::spec::run_spec::RunSpec;
 /// step-axis error at re-entry for every kind side by side, settled or not, with the
 /// window and the step's settle time. Read from the runs table, like the rest of the
 /// summary, so a merged sweep's summary is the same.
-pub fn section(runs: &[RunSpec], table: &RunsTable) -> String {
+pub fn section(runs: &[RunSpec], table: &RunsColumns) -> String {
     let mut out = String::new();
     let SweptGroups {
         kinds,

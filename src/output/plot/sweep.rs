@@ -20,7 +20,7 @@ use plotters::style::RGBColor;
 
 use super::{Figure, LegendEntry, Line, Marker, PALETTE, Panel, fmt_num};
 use crate::error::Error;
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::kinds::{self, PlotColumn};
 use crate::spec::run_spec::RunSpec;
 use crate::spec::value::Value;
@@ -29,7 +29,7 @@ use crate::spec::value::Value;
 /// has them (a scan's step-axis panels: the common ones would measure the run-out), else the
 /// common ones (per band the settle and move-and-settle times, the residual peak and RMS)
 /// and the other kinds' (a corner's contour error); only columns the table has.
-fn columns(bands: &[f64], table: &RunsTable) -> Vec<PlotColumn> {
+fn columns(bands: &[f64], table: &RunsColumns) -> Vec<PlotColumn> {
     let present = |p: &PlotColumn| table.column(&p.column).is_some();
     for k in kinds::all().iter().filter(|k| k.replaces_move_tables()) {
         let own: Vec<PlotColumn> = k.figures(bands).into_iter().filter(present).collect();
@@ -107,7 +107,7 @@ pub fn numeric_params(runs: &[RunSpec]) -> Vec<String> {
 const MAX_LINES: usize = 16;
 
 /// The lines of one metric against `param`.
-fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &PlotColumn) -> Vec<Line> {
+fn lines(runs: &[RunSpec], table: &RunsColumns, param: &str, m: &PlotColumn) -> Vec<Line> {
     let mut kinds: Vec<ProfileKind> = Vec::new();
     let mut combos: Vec<String> = Vec::new();
     for r in runs {
@@ -229,7 +229,7 @@ fn other_label(r: &RunSpec, param: &str) -> String {
 }
 
 /// The figure of `param`.
-pub fn figure(scenario: &str, runs: &[RunSpec], table: &RunsTable, param: &str) -> Figure {
+pub fn figure(scenario: &str, runs: &[RunSpec], table: &RunsColumns, param: &str) -> Figure {
     let bands = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
     let xs: Vec<f64> = runs
         .iter()
@@ -316,10 +316,10 @@ pub fn write_all(
     dir: &Path,
     scenario: &str,
     runs: &[RunSpec],
-    table: &RunsTable,
+    table: &RunsColumns,
 ) -> Result<Vec<crate::output::summary::Figure>, Error> {
     let params = numeric_params(runs);
-    if params.is_empty() || table.rows.is_empty() {
+    if params.is_empty() || table.is_empty() {
         return Ok(Vec::new());
     }
     crate::output::atomic::create_dir(dir)?;
