@@ -44,6 +44,38 @@ pub fn run_all(
     })
 }
 
+/// Run `run_one(k)` for every `k` in `0..n`, in parallel on `jobs` threads (all cores when
+/// `None`), reporting to `progress`; results in order of `k`. Once an interruption is
+/// requested ([`crate::execute::interrupt`]), calls not yet started are not made and come
+/// back as [`Error::Interrupted`] (with `k` as the run).
+pub fn run_each<T, F>(
+    n: usize,
+    jobs: Option<usize>,
+    progress: Progress,
+    run_one: F,
+) -> Result<Vec<Result<T, Error>>, Error>
+where
+    T: Send,
+    F: Fn(usize) -> Result<T, Error> + Sync,
+{
+    let pool = thread_pool(jobs)?;
+    let done = AtomicUsize::new(0);
+    let results = pool.install(|| {
+        (0..n)
+            .into_par_iter()
+            .map(|k| {
+                if crate::execute::interrupt::requested() {
+                    return Err(Error::Interrupted { run: k });
+                }
+                let r = run_one(k);
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, n);
+                r
+            })
+            .collect()
+    });
+    Ok(results)
+}
+
 /// [`run_all`] with a custom way to run one spec (e.g. recording it, or appending its row
 /// to a journal). Once an interruption is requested ([`crate::execute::interrupt`]), runs
 /// not yet started are not started and come back as [`Error::Interrupted`]; runs in

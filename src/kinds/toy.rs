@@ -21,6 +21,7 @@ use crate::kinds::{
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 use crate::spec::value::Value;
 
 /// `[toy]` as written.
@@ -134,7 +135,7 @@ impl Kind for Toy {
         })
     }
 
-    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+    fn columns(&self, runs: &dyn RunList) -> Vec<String> {
         if !any_has::<Shuttle>(runs) {
             return Vec::new();
         }
@@ -152,7 +153,7 @@ impl Kind for Toy {
         out
     }
 
-    fn summary(&self, runs: &[RunSpec], table: &RunsColumns) -> Option<String> {
+    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
         table.column("toy_max_error_um")?;
         let mut out =
             String::from("## Toy shuttle\n\n| run | legs | max error (um) |\n|---:|---:|---:|\n");

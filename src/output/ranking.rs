@@ -27,6 +27,7 @@ use crate::input::scenario::Scenario;
 use crate::output::runs_csv::band_label;
 use crate::spec::backend::Backend;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 use crate::spec::value::Value;
 
 /// Whether swept key `key` is a setting (compared) rather than part of the workload
@@ -272,7 +273,7 @@ fn label(r: &RunSpec) -> String {
 /// The workload points of `runs` in first-seen order, each with its rows in run order, as
 /// `(points' first entries in rows, rows)`: a few bytes a run (a point is found through a
 /// hash of its values, checked against the point's first run).
-fn workload_points(runs: &[RunSpec]) -> (Vec<usize>, Vec<u32>) {
+fn workload_points(runs: &dyn RunList) -> (Vec<usize>, Vec<u32>) {
     use std::hash::{Hash, Hasher};
     let hash = |w: &[String]| {
         let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -285,12 +286,12 @@ fn workload_points(runs: &[RunSpec]) -> (Vec<usize>, Vec<u32>) {
     let mut by_hash: std::collections::HashMap<u64, u32> = std::collections::HashMap::new();
     let mut point_of: Vec<u32> = Vec::with_capacity(runs.len());
     for (i, r) in runs.iter().enumerate() {
-        let w = values(r, false);
+        let w = values(&r, false);
         let h = hash(&w);
         let mut found = None;
         let mut k = by_hash.get(&h).copied();
         while let Some(p) = k {
-            if values(&runs[first_row[p as usize] as usize], false) == w {
+            if values(&runs.at(first_row[p as usize] as usize), false) == w {
                 found = Some(p);
                 break;
             }
@@ -326,8 +327,8 @@ fn workload_points(runs: &[RunSpec]) -> (Vec<usize>, Vec<u32>) {
     (starts, rows)
 }
 
-/// Rank `runs` (row `i` of `table` is `runs[i]`).
-pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsColumns) -> Ranking {
+/// Rank `runs` (row `i` of `table` is `runs.at(i)`).
+pub fn rank(sc: &Scenario, runs: &dyn RunList, table: &RunsColumns) -> Ranking {
     let keys: Vec<String> = runs
         .first()
         .map(|r| r.swept.iter().map(|(p, _)| p.clone()).collect())
@@ -340,19 +341,19 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsColumns) -> Ranking {
     let mut candidate_of: std::collections::HashMap<String, u32> = std::collections::HashMap::new();
     let mut run_candidate: Vec<u32> = Vec::with_capacity(runs.len());
     let mut run_current: Vec<bool> = Vec::with_capacity(runs.len());
-    for r in runs {
-        let l = label(r);
+    for r in runs.iter() {
+        let l = label(&r);
         let c = match candidate_of.get(&l) {
             Some(&c) => c,
             None => {
                 let c = candidates.len() as u32;
                 candidate_of.insert(l.clone(), c);
-                candidates.push((l, values(r, true)));
+                candidates.push((l, values(&r, true)));
                 c
             }
         };
         run_candidate.push(c);
-        run_current.push(is_current(sc, r));
+        run_current.push(is_current(sc, &r));
     }
     drop(candidate_of);
     let shapers = setting_keys.iter().any(|k| k.starts_with("shaper."))
@@ -389,7 +390,7 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsColumns) -> Ranking {
                     slot,
                     !ran(table, i),
                     time_of(table, i, &total_col),
-                    runs[i].id,
+                    runs.at(i).id,
                 ));
             }
             // Settled runs by time (ties in run order), then unsettled, then failed.
@@ -508,13 +509,13 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsColumns) -> Ranking {
 
 impl Ranking {
     /// Workload point `p` of band `b` as the tables show it: its values, its reference and
-    /// its runs with their numbers (read from `table`, row `i` = `runs[i]`, the table the
+    /// its runs with their numbers (read from `table`, row `i` = `runs.at(i)`, the table the
     /// ranking was made from).
     pub fn point(
         &self,
         b: usize,
         p: usize,
-        runs: &[RunSpec],
+        runs: &dyn RunList,
         table: &RunsColumns,
     ) -> Option<Point> {
         let n = self.bands.get(b)?.points.get(p)?.len as usize;
@@ -527,7 +528,7 @@ impl Ranking {
         b: usize,
         p: usize,
         which: std::ops::Range<usize>,
-        runs: &[RunSpec],
+        runs: &dyn RunList,
         table: &RunsColumns,
     ) -> Option<Point> {
         let band = self.bands.get(b)?;
@@ -558,7 +559,7 @@ impl Ranking {
                 let total_s = time_of(table, i, &total_col);
                 Ranked {
                     row: i,
-                    id: runs[i].id,
+                    id: runs.at(i).id,
                     rank: (s.rank > 0).then_some(s.rank as usize),
                     settings: self.candidates[s.candidate as usize].1.clone(),
                     label: label(s),
@@ -584,7 +585,7 @@ impl Ranking {
             })
             .collect();
         Some(Point {
-            workload: values(&runs[mine.first()?.row as usize], false),
+            workload: values(&runs.at(mine.first()?.row as usize), false),
             reference,
             runs: ranked,
         })

@@ -18,7 +18,7 @@ use crate::output::ranking::{
     Point, Ranked, Ranking, SHAPER_COLUMNS, gain_text, rank, run_command,
 };
 use crate::output::summary::{machines_line, ms};
-use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 /// The scenario a sweep ran, as the report names it.
 #[derive(Debug, Clone, Copy)]
@@ -143,7 +143,7 @@ fn ranking_tables(ranking: &Ranking) -> Vec<Table> {
 }
 
 /// The row of run `r` of workload point `p` in a ranking table.
-fn ranking_row(p: &Point, r: &Ranked, runs: &[RunSpec], file: ScenarioFile<'_>) -> Vec<Cell> {
+fn ranking_row(p: &Point, r: &Ranked, runs: &dyn RunList, file: ScenarioFile<'_>) -> Vec<Cell> {
     let mut row: Vec<Cell> = p.workload.iter().map(Cell::text).collect();
     row.push(match r.rank {
         Some(n) => num(n as f64, n.to_string()),
@@ -182,7 +182,7 @@ fn ranking_row(p: &Point, r: &Ranked, runs: &[RunSpec], file: ScenarioFile<'_>) 
         }
     }
     row.push(num(r.id as f64, r.id.to_string()));
-    row.push(Cell::text(run_command(file.path, &runs[r.row])));
+    row.push(Cell::text(run_command(file.path, &runs.at(r.row))));
     row
 }
 
@@ -194,8 +194,8 @@ pub struct RankingRows<'a> {
     ranking: Option<Ranking>,
     /// The index of the first ranking table in the report's tables.
     first: usize,
-    /// The runs (row `i` of the runs table is `runs[i]`).
-    runs: &'a [RunSpec],
+    /// The runs (row `i` of the runs table is `runs.at(i)`).
+    runs: &'a dyn RunList,
     /// The runs table the ranking was made from.
     table: &'a RunsColumns,
     /// The scenario, as the commands name it.
@@ -219,7 +219,7 @@ impl Rows for RankingRows<'_> {
 }
 
 /// The G-code jobs' table ([`crate::output::jobs`]): the headline lines as its note.
-fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
+fn jobs_table(j: &Jobs, runs: &dyn RunList, file: ScenarioFile<'_>) -> Table {
     let opt = |x: Option<f64>, prec: usize| match x {
         Some(x) => num(x, format!("{x:.prec$}")),
         None => num(f64::NAN, "-".into()),
@@ -256,7 +256,7 @@ fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
             }
             row.push(Cell::text(if r.pareto { "yes" } else { "" }));
             row.push(num(r.id as f64, r.id.to_string()));
-            row.push(Cell::text(run_command(file.path, &runs[r.row])));
+            row.push(Cell::text(run_command(file.path, &runs.at(r.row))));
             row
         })
         .collect();
@@ -272,7 +272,7 @@ fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
     }
 }
 
-/// The report of a sweep: `table` is its runs.csv (row `i` = `runs[i]`), `figures` the
+/// The report of a sweep: `table` is its runs.csv (row `i` = `runs.at(i)`), `figures` the
 /// figures' captions and SVG files. What a report of many runs would hold is left to be
 /// made as the page is written ([`crate::output::html::render_to`]): the table of every
 /// run (`runs` is `None`; written from runs.csv under [`RUNS_TITLE`]) and the ranking
@@ -280,7 +280,7 @@ fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
 pub fn sweep_report<'a>(
     sc: &Scenario,
     file: ScenarioFile<'a>,
-    runs: &'a [RunSpec],
+    runs: &'a dyn RunList,
     table: &'a RunsColumns,
     figures: &[(String, std::path::PathBuf)],
 ) -> (Report, RankingRows<'a>) {
@@ -311,7 +311,7 @@ pub fn sweep_report<'a>(
     let failed = (0..runs.len())
         .filter(|&i| table.cell(i, "status").is_some_and(|s| s != "ok"))
         .map(|i| FailedRun {
-            run: format!("run {}", runs[i].id),
+            run: format!("run {}", runs.at(i).id),
             status: table.cell(i, "status").unwrap_or_default().to_string(),
             reason: table.cell(i, "reason").unwrap_or_default().to_string(),
         })

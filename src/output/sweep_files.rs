@@ -26,7 +26,7 @@ use crate::output::atomic::{write_atomic, write_atomic_with};
 use crate::output::html::Sink;
 use crate::output::report::{RUNS_TITLE, ScenarioFile, sweep_report};
 use crate::output::summary::summary_to;
-use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 /// Folder of the sweep figures inside the output folder.
 pub const PLOTS: &str = "plots";
@@ -41,7 +41,7 @@ pub fn write_sweep(
     out: &Path,
     sc: &Scenario,
     file: ScenarioFile<'_>,
-    runs: &[RunSpec],
+    runs: &dyn RunList,
     csv: &str,
 ) -> Result<(), Error> {
     let table =

@@ -24,6 +24,7 @@ use crate::kinds::{Kind, KindState, PathMove, PlanContext, Planned, PlotColumn, 
 use crate::measure::metrics::Metrics;
 use crate::measure::path_metrics::columns as col;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 pub use geometry::{Corner, CornerSpec, Strategy};
 
@@ -132,7 +133,7 @@ impl Kind for CornerPath {
         })
     }
 
-    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+    fn columns(&self, runs: &dyn RunList) -> Vec<String> {
         if !any_has::<Corner>(runs) {
             return Vec::new();
         }
@@ -162,7 +163,7 @@ impl Kind for CornerPath {
         out
     }
 
-    fn summary(&self, runs: &[RunSpec], table: &RunsColumns) -> Option<String> {
+    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
         if !any_has::<Corner>(runs) || table.column(col::MAX_CONTOUR).is_none() {
             return None;
         }
@@ -182,7 +183,7 @@ impl Kind for CornerPath {
 
 /// The summary's corner section: per run (angle, strategy, kind, shaper), the planned corner speed,
 /// the commanded corner rounding and the toolhead's contour error.
-fn summary_section(runs: &[RunSpec], table: &RunsColumns) -> String {
+fn summary_section(runs: &dyn RunList, table: &RunsColumns) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
