@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::Error;
-use crate::execute::pool::{Progress, run_each};
+use crate::execute::pool::{Progress, run_each_errors};
 use crate::input::runs_columns::RunsColumns;
 use crate::measure::metrics::Metrics;
 use crate::output::atomic::{create_dir, write_atomic};
@@ -231,6 +231,8 @@ pub fn sweep(
         }
         _ => (Journal::start(&out, &key, &header)?, Default::default()),
     };
+    // The finished runs' ids (their rows stay in the journal).
+    let done: std::collections::HashSet<usize> = done.into_keys().collect();
     if opts.resume {
         note(&format!(
             "resuming: {} of {} runs already finished",
@@ -240,13 +242,13 @@ pub fn sweep(
     }
     // What is left to run (positions among the runs).
     let todo: Vec<u32> = (0..runs.len())
-        .filter(|&i| runs.id(i).is_some_and(|id| !done.contains_key(&id)))
+        .filter(|&i| runs.id(i).is_some_and(|id| !done.contains(&id)))
         .map(|i| i as u32)
         .collect();
     // An output that cannot be written (a full disk) is not a result of a run: the sweep
     // stops, the journal keeps what finished, and `--resume` completes it.
     let write_failed = std::sync::atomic::AtomicBool::new(false);
-    let run_one = |k: usize| -> Result<String, Error> {
+    let run_one = |k: usize| -> Result<(), Error> {
         let spec = (&runs as &dyn RunList).at(todo[k] as usize);
         let spec: &RunSpec = &spec;
         if write_failed.load(std::sync::atomic::Ordering::SeqCst) {
@@ -270,19 +272,17 @@ pub fn sweep(
             write_failed.store(true, std::sync::atomic::Ordering::SeqCst);
             return Err(e);
         }
-        Ok(row)
+        Ok(())
     };
-    let results = run_each(todo.len(), opts.jobs, progress, run_one)?;
-    let mut rows = done;
+    let errors = run_each_errors(todo.len(), opts.jobs, progress, run_one)?;
+    let finished = done.len() + todo.len() - errors.len();
+    drop((todo, done));
     let mut interrupted = 0usize;
     let mut write_error = None;
-    for (&i, r) in todo.iter().zip(results) {
-        match r {
-            Ok(row) => {
-                rows.insert(runs.id(i as usize).unwrap_or_default(), row);
-            }
-            Err(Error::Interrupted { .. }) => interrupted += 1,
-            Err(e) => {
+    for (_, e) in errors {
+        match e {
+            Error::Interrupted { .. } => interrupted += 1,
+            e => {
                 write_error.get_or_insert(e);
             }
         }
@@ -302,20 +302,13 @@ pub fn sweep(
         options: opts.clone(),
     };
     if interrupted > 0 || crate::execute::interrupt::requested() {
-        outcome.interrupted = Some(rows.len());
+        outcome.interrupted = Some(finished);
         outcome.elapsed_s = started.elapsed().as_secs_f64();
         return Ok(outcome);
     }
-    // Sized once: a String grown by doubling holds up to twice the text at the peak.
+    // The rows in run order, read back from the journal.
+    let csv = journal.runs_csv(&header, runs.len(), &|id| runs.position(id))?;
     let ids = || (0..runs.len()).filter_map(|i| runs.id(i));
-    let mut csv =
-        String::with_capacity(header.len() + ids().map(|id| rows[&id].len()).sum::<usize>());
-    csv.push_str(&header);
-    for id in ids() {
-        csv.push_str(&rows[&id]);
-    }
-    // The rows are in `csv` now.
-    drop(rows);
     match opts.shard {
         Some(s) => {
             write_atomic(&out.join("runs.csv"), csv.as_bytes())?;
