@@ -54,6 +54,8 @@ fn is_number_text(cell: &str, buf: &mut String) -> Option<f64> {
 struct Builder {
     column: Column,
     lookup: HashMap<String, u32>,
+    /// The rows expected (cells are reserved for them once, not grown by doubling).
+    rows: usize,
 }
 
 impl Builder {
@@ -65,12 +67,18 @@ impl Builder {
                 let text = std::mem::take(text);
                 let mut first = String::new();
                 self.column = match (is_number_text(&text, &mut first), is_number_text(cell, buf)) {
-                    (Some(a), Some(_)) => Column::Numbers(vec![a; row]),
+                    (Some(a), Some(_)) => {
+                        let mut xs = Vec::with_capacity(self.rows.max(row + 1));
+                        xs.resize(row, a);
+                        Column::Numbers(xs)
+                    }
                     _ => {
                         self.lookup.insert(text.clone(), 0);
+                        let mut index = Vec::with_capacity(self.rows.max(row + 1));
+                        index.resize(row, 0);
                         Column::Texts {
                             values: vec![text],
-                            index: vec![0; row],
+                            index,
                         }
                     }
                 };
@@ -80,7 +88,7 @@ impl Builder {
                 Some(x) => xs.push(x),
                 None => {
                     let mut values: Vec<String> = Vec::new();
-                    let mut index = Vec::with_capacity(xs.len() + 1);
+                    let mut index = Vec::with_capacity(self.rows.max(xs.len() + 1));
                     self.lookup.clear();
                     for x in xs.iter() {
                         let t = x.to_string();
@@ -119,11 +127,13 @@ impl RunsColumns {
     /// Parse CSV text: the same table and the same errors as
     /// [`crate::input::runs_table::RunsTable::parse`].
     pub fn parse(text: &str) -> Result<Self, String> {
-        Self::read(text.as_bytes())
+        let lines = text.bytes().filter(|&b| b == b'\n').count();
+        Self::read(text.as_bytes(), lines.saturating_sub(1))
     }
 
-    /// Parse CSV from `reader`, a record at a time (see [`RunsColumns::parse`]).
-    pub fn read(reader: impl std::io::Read) -> Result<Self, String> {
+    /// Parse CSV from `reader`, a record at a time (see [`RunsColumns::parse`]); `rows`:
+    /// the rows expected (a hint: their cells are reserved at once).
+    pub fn read(reader: impl std::io::Read, rows: usize) -> Result<Self, String> {
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(false)
             .flexible(true)
@@ -141,6 +151,7 @@ impl RunsColumns {
             .map(|_| Builder {
                 column: Column::Same(String::new()),
                 lookup: HashMap::new(),
+                rows,
             })
             .collect();
         let mut buf = String::new();
