@@ -29,14 +29,13 @@ pub trait RunList: std::fmt::Debug + Sync {
     fn id(&self, i: usize) -> Option<usize> {
         self.get(i).map(|r| r.id)
     }
+    /// Whether there are none.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 }
 
 impl dyn RunList + '_ {
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// The run at `i` (in order), which must exist.
     ///
     /// # Panics
@@ -119,7 +118,7 @@ impl Runs {
 
     /// The position of the run with id `id`, if it is one of these.
     pub fn position(&self, id: usize) -> Option<usize> {
-        (id >= self.first && (id - self.first) % self.step == 0)
+        (id >= self.first && (id - self.first).is_multiple_of(self.step))
             .then(|| (id - self.first) / self.step)
             .filter(|&i| i < self.len)
     }
