@@ -12,14 +12,15 @@
 #                             sweep's (the fixed base) exceeds PER_RUN_LIMIT_B bytes
 #   scripts/scale.sh          all three
 # BACKEND (default modal) picks the sweep's backend; LIMIT_MB (default 200) the bound;
-# PER_RUN_LIMIT_B (default 4608, 4.5 KB) the bound per run of `flat`;
+# PER_RUN_LIMIT_B (default 600) the bound per run of `flat`: measured 469-495 B at 100,000
+# runs (a ci-profile binary on 2 cores), the bound leaves room for the allocator's noise;
 # SETTLE=path/to/settle uses that binary instead of building the release one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what="${1:-all}"
 backend="${BACKEND:-modal}"
 limit_mb="${LIMIT_MB:-200}"
-per_run_limit_b="${PER_RUN_LIMIT_B:-4608}"
+per_run_limit_b="${PER_RUN_LIMIT_B:-600}"
 
 memory() {
     cargo build --release --locked --bin settle

@@ -16,6 +16,7 @@ use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
 use crate::spec::backend::{Backend, NO_MUJOCO};
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 pub use engine::{SimOptions, run_trajectory};
 
@@ -130,20 +131,38 @@ pub fn set_backend(
     runs: &mut [RunSpec],
     backend: Backend,
 ) -> Result<(), Error> {
+    check_drivers(path, runs.iter().map(|r| r.driver), backend)?;
+    for r in runs {
+        r.backend = backend;
+    }
+    Ok(())
+}
+
+/// The error of [`set_backend`] when `backend` cannot run `runs`, without setting it.
+pub fn check_backend(
+    path: &std::path::Path,
+    runs: &dyn RunList,
+    backend: Backend,
+) -> Result<(), Error> {
+    check_drivers(path, runs.iter().map(|r| r.driver), backend)
+}
+
+/// The error of [`set_backend`] for runs with `drivers`.
+fn check_drivers(
+    path: &std::path::Path,
+    mut drivers: impl Iterator<Item = DriverMode>,
+    backend: Backend,
+) -> Result<(), Error> {
     let err = |message: String| Error::input_key(path, "--backend", message);
     if !backend.available() {
         return Err(err(NO_MUJOCO.to_string()));
     }
     if backend == Backend::Modal
-        && let Some(r) = runs.iter().find(|r| r.driver != DriverMode::Linear)
+        && let Some(d) = drivers.find(|d| *d != DriverMode::Linear)
     {
         return Err(err(format!(
-            "the modal backend is the exact solution of the linear model: it cannot run the `{}` driver model; set `driver_model = \"linear\"` in [machine] or use --backend rapier",
-            r.driver
+            "the modal backend is the exact solution of the linear model: it cannot run the `{d}` driver model; set `driver_model = \"linear\"` in [machine] or use --backend rapier"
         )));
-    }
-    for r in runs {
-        r.backend = backend;
     }
     Ok(())
 }

@@ -44,6 +44,38 @@ pub fn run_all(
     })
 }
 
+/// Run `run_one(k)` for every `k` in `0..n`, in parallel on `jobs` threads (all cores when
+/// `None`), reporting to `progress`: the errors with their `k`, in order of `k` (nothing is
+/// kept for a call that succeeds). Once an interruption is requested
+/// ([`crate::execute::interrupt`]), calls not yet started are not made and come back as
+/// [`Error::Interrupted`] (with `k` as the run).
+pub fn run_each_errors<F>(
+    n: usize,
+    jobs: Option<usize>,
+    progress: Progress,
+    run_one: F,
+) -> Result<Vec<(usize, Error)>, Error>
+where
+    F: Fn(usize) -> Result<(), Error> + Sync,
+{
+    let pool = thread_pool(jobs)?;
+    let done = AtomicUsize::new(0);
+    let errors = pool.install(|| {
+        (0..n)
+            .into_par_iter()
+            .filter_map(|k| {
+                if crate::execute::interrupt::requested() {
+                    return Some((k, Error::Interrupted { run: k }));
+                }
+                let r = run_one(k);
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, n);
+                r.err().map(|e| (k, e))
+            })
+            .collect()
+    });
+    Ok(errors)
+}
+
 /// [`run_all`] with a custom way to run one spec (e.g. recording it, or appending its row
 /// to a journal). Once an interruption is requested ([`crate::execute::interrupt`]), runs
 /// not yet started are not started and come back as [`Error::Interrupted`]; runs in

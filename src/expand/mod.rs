@@ -227,34 +227,56 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
 /// Expand a scenario into validated runs: the base run, then the cartesian product of the
 /// sweep axes in the order written (the last axis varies fastest).
 pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
-    let Sweep { base, axes, total } = sweep_of(sc, src)?;
-    let mut presets: Vec<(String, Machine, String)> = Vec::new();
-    let mut runs = Vec::with_capacity(total);
-    type ModesKey = (
-        Option<Machine>,
-        Vec<crate::input::modes::AxisModes>,
-        f64,
-        String,
-    );
-    let mut last_modes: Option<(ModesKey, Option<(f64, f64)>)> = None;
-    for id in 0..total {
-        let mut run = base.clone();
-        run.id = id;
+    let runs = sweep_runs(sc, src)?;
+    let runs: &dyn crate::spec::runs::RunList = &runs;
+    Ok(runs.iter().map(std::borrow::Cow::into_owned).collect())
+}
+
+/// The runs of a sweep, made on demand from their ids: [`Sweep`]'s base and axes, with the
+/// machines of a swept preset loaded once.
+#[derive(Debug, Clone)]
+struct SweepRuns {
+    base: RunSpec,
+    axes: Vec<Axis>,
+    total: usize,
+    /// Swept presets: (name as written, machine, machine name).
+    presets: Vec<(String, Machine, String)>,
+}
+
+/// What makes run `id` fail: the key to blame and the message.
+type Blame = (String, String);
+
+impl SweepRuns {
+    /// The axes' value indices of run `id` (the last axis varies fastest).
+    fn picks(&self, id: usize) -> Vec<usize> {
         let mut rest = id;
-        let mut picks = vec![0; axes.len()];
-        for (i, axis) in axes.iter().enumerate().rev() {
+        let mut picks = vec![0; self.axes.len()];
+        for (i, axis) in self.axes.iter().enumerate().rev() {
             picks[i] = rest % axis.values.len();
             rest /= axis.values.len();
         }
+        picks
+    }
+
+    /// The swept preset of run `id`, if presets are swept.
+    fn preset_of(&self, picks: &[usize]) -> Option<&str> {
+        self.axes.iter().zip(picks).find_map(|(axis, &k)| {
+            match (axis.param == "machine.preset", &axis.values[k]) {
+                (true, Value::Text(name)) => Some(name.as_str()),
+                _ => None,
+            }
+        })
+    }
+
+    /// Run `id`, with its presets loaded into `self.presets`.
+    fn build(&self, id: usize) -> Result<RunSpec, Blame> {
+        let mut run = self.base.clone();
+        run.id = id;
+        let picks = self.picks(id);
         // A swept preset replaces the machine first; other machine keys then edit it.
-        for (axis, &k) in axes.iter().zip(&picks) {
+        for (axis, &k) in self.axes.iter().zip(&picks) {
             if let (true, Value::Text(name)) = (axis.param == "machine.preset", &axis.values[k]) {
-                if !presets.iter().any(|(n, _, _)| n == name) {
-                    let (m, _, _) = crate::input::machine_file::load_preset(name, &src.path, src)?;
-                    let mname = m.name.clone();
-                    presets.push((name.clone(), m, mname));
-                }
-                if let Some((_, m, mname)) = presets.iter().find(|(n, _, _)| n == name) {
+                if let Some((_, m, mname)) = self.presets.iter().find(|(n, _, _)| n == name) {
                     run.machine = Some(m.clone());
                     run.machine_name = mname.clone();
                 }
@@ -263,20 +285,20 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
                     .as_ref()
                     .is_some_and(|m| m.axis(&run.axis).is_none())
                 {
-                    return Err(src.error_at(
-                        "sweep.machine.preset",
+                    return Err((
+                        "sweep.machine.preset".to_string(),
                         format!("machine `{name}` has no axis `{}` (move.axis)", run.axis),
                     ));
                 }
             }
         }
-        for (axis, &k) in axes.iter().zip(&picks) {
+        for (axis, &k) in self.axes.iter().zip(&picks) {
             let v = &axis.values[k];
             let key = format!("sweep.{}", axis.param);
-            let known = run.set(&axis.param, v).map_err(|m| src.error_at(&key, m))?;
+            let known = run.set(&axis.param, v).map_err(|m| (key.clone(), m))?;
             if !known {
-                return Err(src.error_at(
-                    &key,
+                return Err((
+                    key,
                     format!("`{}` cannot be swept; allowed: {}", axis.param, sweepable()),
                 ));
             }
@@ -286,6 +308,56 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
         if let Some(d) = kinds::motion(&run).path_length_mm(&run) {
             run.distance_mm = d;
         }
+        Ok(run)
+    }
+}
+
+impl crate::spec::runs::MakeRun for SweepRuns {
+    fn total(&self) -> usize {
+        self.total
+    }
+
+    fn make(&self, id: usize) -> RunSpec {
+        match self.build(id) {
+            Ok(run) => run,
+            // Every run was built and checked when the sweep was expanded.
+            Err((key, message)) => panic!("run {id} of a checked sweep: {key}: {message}"),
+        }
+    }
+
+    fn set_backend(&mut self, backend: Backend) {
+        self.base.backend = backend;
+    }
+}
+
+/// Expand a scenario into validated runs made on demand ([`expand`] as a
+/// [`crate::spec::runs::Runs`]: every run is made and checked here, none is kept).
+pub fn sweep_runs(sc: &Scenario, src: &Source) -> Result<crate::spec::runs::Runs, Error> {
+    let Sweep { base, axes, total } = sweep_of(sc, src)?;
+    let mut runs = SweepRuns {
+        base,
+        axes,
+        total,
+        presets: Vec::new(),
+    };
+    type ModesKey = (
+        Option<Machine>,
+        Vec<crate::input::modes::AxisModes>,
+        f64,
+        String,
+    );
+    let mut last_modes: Option<(ModesKey, Option<(f64, f64)>)> = None;
+    for id in 0..total {
+        let picks = runs.picks(id);
+        if let Some(name) = runs.preset_of(&picks)
+            && !runs.presets.iter().any(|(n, _, _)| n == name)
+        {
+            let name = name.to_string();
+            let (m, _, _) = crate::input::machine_file::load_preset(&name, &src.path, src)?;
+            let mname = m.name.clone();
+            runs.presets.push((name, m, mname));
+        }
+        let run = runs.build(id).map_err(|(key, m)| src.error_at(&key, m))?;
         validate::validate_run(&run, src)?;
         // The modes change only with the machine, its modes, the moved axis or where the
         // move starts: most sweeps linearise the machine once.
@@ -311,10 +383,9 @@ pub fn expand(sc: &Scenario, src: &Source) -> Result<Vec<RunSpec>, Error> {
             }
         };
         validate::validate_sampling(&run, range, src)?;
-        runs.push(run);
     }
     // The values as written, which the sweep may have overridden in every run (checked
     // after the runs, whose errors name the sweep axis to blame).
-    validate::validate_base(&base, src)?;
-    Ok(runs)
+    validate::validate_base(&runs.base, src)?;
+    Ok(crate::spec::runs::Runs::new(Box::new(runs)))
 }

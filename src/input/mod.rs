@@ -7,6 +7,7 @@ pub mod file;
 pub mod keys;
 pub mod machine_file;
 pub mod modes;
+pub mod runs_columns;
 pub mod runs_table;
 pub mod scenario;
 pub mod source;

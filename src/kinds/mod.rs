@@ -40,12 +40,13 @@ use settle_planner::shaper::Shaper;
 use settle_planner::{PlanError, Profile, State, Trajectory};
 
 use crate::error::Error;
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
 pub use crate::spec::run_spec::KindState;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 /// Declares each kind's module and lists its kind in [`KINDS`]: one line per kind.
 macro_rules! register {
@@ -238,7 +239,7 @@ pub trait Kind: std::fmt::Debug + Sync {
 
     /// Its extra runs.csv columns, named from the runs alone (never from results, so that
     /// the header is the same whatever the results: the sweep journal relies on it).
-    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+    fn columns(&self, runs: &dyn RunList) -> Vec<String> {
         let _ = runs;
         Vec::new()
     }
@@ -254,7 +255,7 @@ pub trait Kind: std::fmt::Debug + Sync {
 
     /// Its summary section, read from the runs table (row `i` = `runs[i]`) so that a
     /// merged sweep's summary is the same; `None` when it has nothing to show.
-    fn summary(&self, runs: &[RunSpec], table: &RunsTable) -> Option<String> {
+    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
         let _ = (runs, table);
         None
     }
@@ -333,6 +334,6 @@ pub fn plan(run: &RunSpec, axes: &[String]) -> Result<Planned, PlanError> {
 }
 
 /// Whether `runs` share a kind state of type `T` (any of them has one).
-pub fn any_has<T: KindState>(runs: &[RunSpec]) -> bool {
+pub fn any_has<T: KindState>(runs: &dyn RunList) -> bool {
     runs.iter().any(|r| r.state::<T>().is_some())
 }

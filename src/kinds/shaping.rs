@@ -19,6 +19,7 @@ use crate::input::source::Source;
 use crate::kinds::{Kind, KindState, Role, any_has};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 use crate::spec::value::Value;
 
 /// Klipper's default damping ratio of its shapers (`damping_ratio_x`), 0.1: a shaper
@@ -219,7 +220,7 @@ impl Kind for Shaping {
             .flatten())
     }
 
-    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+    fn columns(&self, runs: &dyn RunList) -> Vec<String> {
         if !any_has::<ShaperSetting>(runs) {
             return Vec::new();
         }

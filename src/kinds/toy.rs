@@ -13,7 +13,7 @@ use serde::Deserialize;
 use settle_planner::{PlanError, Profile, Segment};
 
 use crate::error::Error;
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
 use crate::kinds::{
     Kind, KindState, PlanContext, Planned, PlotColumn, Probe, Role, any_has, on_axis,
@@ -21,6 +21,7 @@ use crate::kinds::{
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 use crate::spec::value::Value;
 
 /// `[toy]` as written.
@@ -134,7 +135,7 @@ impl Kind for Toy {
         })
     }
 
-    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+    fn columns(&self, runs: &dyn RunList) -> Vec<String> {
         if !any_has::<Shuttle>(runs) {
             return Vec::new();
         }
@@ -152,7 +153,7 @@ impl Kind for Toy {
         out
     }
 
-    fn summary(&self, runs: &[RunSpec], table: &RunsTable) -> Option<String> {
+    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
         table.column("toy_max_error_um")?;
         let mut out =
             String::from("## Toy shuttle\n\n| run | legs | max error (um) |\n|---:|---:|---:|\n");
@@ -161,7 +162,7 @@ impl Kind for Toy {
                 out,
                 "| {} | {} | {} |",
                 r.id,
-                table.cell(i, "toy_legs").unwrap_or("-"),
+                table.cell(i, "toy_legs").unwrap_or("-".into()),
                 table
                     .num(i, "toy_max_error_um")
                     .map_or("-".into(), |x| format!("{x:.2}"))

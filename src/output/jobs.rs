@@ -14,10 +14,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::ranking::{is_current, is_setting, label_part, run_command};
-use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 /// One candidate (run) of a G-code sweep.
 #[derive(Debug, Clone, PartialEq)]
@@ -127,9 +127,9 @@ pub fn pareto(pts: &[(f64, f64)]) -> Vec<usize> {
         .collect()
 }
 
-/// The G-code candidates of `runs` (row `i` of `table` is `runs[i]`); `None` when the
+/// The G-code candidates of `runs` (row `i` of `table` is `runs.at(i)`); `None` when the
 /// table has no G-code columns.
-pub fn jobs(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Option<Jobs> {
+pub fn jobs(sc: &Scenario, runs: &dyn RunList, table: &RunsColumns) -> Option<Jobs> {
     table.column("contour_worst_um")?;
     table.column("print_time_s")?;
     let keys: Vec<String> = runs
@@ -139,7 +139,7 @@ pub fn jobs(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Option<Jobs> 
     let file = (0..runs.len())
         .find_map(|i| table.cell(i, "gcode_file").filter(|f| !f.is_empty()))
         .map(|f| {
-            Path::new(f)
+            Path::new(&*f)
                 .file_name()
                 .map_or(f.to_string(), |n| n.to_string_lossy().into_owned())
         })
@@ -170,7 +170,7 @@ pub fn jobs(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Option<Jobs> 
                 worst_um: num("contour_worst_um"),
                 p95_um: num("contour_p95_um"),
                 worst_line: num("contour_worst_line").map(|l| l as u64),
-                current: is_current(sc, r),
+                current: is_current(sc, &r),
                 pareto: false,
                 failure: (!ok).then(|| {
                     let status = table.cell(i, "status").unwrap_or_default();
@@ -296,7 +296,7 @@ pub fn header(j: &Jobs) -> Vec<String> {
 pub const NOTE: &str = "Print time: the firmware planner's clock for the whole file. Contour error: distance in XY from the simulated toolhead to the commanded path, over printing moves; worst line: the G-code line where the worst error happens. Ranked by worst error (ties: print time). Pareto: no other candidate is both faster and less wrong. Vs current: +5 % = 5 % longer or more error than current, -76 % = 76 % less.";
 
 /// The summary.md section.
-pub fn section(j: &Jobs, scenario: &Path, runs: &[RunSpec]) -> String {
+pub fn section(j: &Jobs, scenario: &Path, runs: &dyn RunList) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -343,7 +343,7 @@ pub fn section(j: &Jobs, scenario: &Path, runs: &[RunSpec]) -> String {
         }
         row.push(if r.pareto { "yes" } else { "" }.into());
         row.push(r.id.to_string());
-        row.push(format!("`{}`", run_command(scenario, &runs[r.row])));
+        row.push(format!("`{}`", run_command(scenario, &runs.at(r.row))));
         let _ = writeln!(out, "| {} |", row.join(" | "));
     }
     out

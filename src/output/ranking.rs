@@ -22,11 +22,12 @@ use std::path::Path;
 
 use settle_planner::shaper::{Shaper, ShaperKind};
 
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::runs_csv::band_label;
 use crate::spec::backend::Backend;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 use crate::spec::value::Value;
 
 /// Whether swept key `key` is a setting (compared) rather than part of the workload
@@ -54,7 +55,7 @@ pub fn label_part(key: &str, v: &Value) -> String {
     }
 }
 
-/// One run in a band's ranking.
+/// One run in a band's ranking, as the tables show it (made by [`Ranking::point`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Ranked {
     /// Row in the runs table (= index into the runs).
@@ -86,7 +87,8 @@ pub struct Ranked {
     pub shaper: Option<[Option<f64>; 3]>,
 }
 
-/// One workload point of a band: its runs, fastest first.
+/// One workload point of a band, fastest first, as the tables show it (made on demand by
+/// [`Ranking::point`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Point {
     /// The workload values, as shown (one per workload key).
@@ -95,6 +97,32 @@ pub struct Point {
     pub reference: Option<(String, Option<f64>)>,
     /// The runs, ranked ones first (fastest first), then the unsettled and failed ones.
     pub runs: Vec<Ranked>,
+}
+
+/// One run's place in a band's ranking, as kept (a few bytes a run: the numbers are read
+/// back from the runs table when a [`Ranked`] is made).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Slot {
+    /// Row in the runs table (= index into the runs).
+    pub row: u32,
+    /// 1 for the fastest of its point; 0 for a failed or unsettled run.
+    pub rank: u32,
+    /// The candidate: its index in [`Ranking::candidates`].
+    pub candidate: u32,
+    /// Whether this run is the scenario's `[current]` candidate.
+    pub current: bool,
+}
+
+/// One workload point of a band, as kept: its runs are `order[start..start + len]` of its
+/// band.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointSlots {
+    /// The first of its runs in [`Band::order`].
+    pub start: u32,
+    /// How many runs it has.
+    pub len: u32,
+    /// The reference of the gains: the position of its run among the point's runs.
+    pub reference: Option<u32>,
 }
 
 /// The overall winner of a band.
@@ -115,8 +143,10 @@ pub struct Winner {
 pub struct Band {
     /// The band (um).
     pub band_um: f64,
-    /// Per workload point.
-    pub points: Vec<Point>,
+    /// Per workload point (see [`Ranking::point`]).
+    pub points: Vec<PointSlots>,
+    /// The runs of every workload point, point after point, each point's fastest first.
+    pub order: Vec<Slot>,
     /// The overall winner; `None` when no candidate settles at every point.
     pub winner: Option<Winner>,
     /// Every candidate with its move-and-settle time summed over the workload points, in
@@ -154,6 +184,9 @@ pub struct Ranking {
     pub current_label: Option<String>,
     /// Whether shapers are swept (the shaper columns are shown).
     pub shapers: bool,
+    /// Every candidate's label and setting values as shown (one per setting key), in the
+    /// order of the runs.
+    pub candidates: Vec<(String, Vec<String>)>,
     /// Per band.
     pub bands: Vec<Band>,
 }
@@ -185,8 +218,8 @@ pub fn run_command(scenario: &Path, run: &RunSpec) -> String {
 
 /// Klipper's suggested max_accel (mm/s^2) for the shaper in columns `shaper_type`,
 /// `shaper_frequency_hz`, `shaper_damping_ratio` of `row`; `None` for no shaper.
-fn max_accel(table: &RunsTable, row: usize) -> Option<f64> {
-    let kind = ShaperKind::parse(table.cell(row, "shaper_type")?).ok()?;
+fn max_accel(table: &RunsColumns, row: usize) -> Option<f64> {
+    let kind = ShaperKind::parse(&table.cell(row, "shaper_type")?).ok()?;
     let sh = Shaper::new(
         kind,
         table.num(row, "shaper_frequency_hz")?,
@@ -201,183 +234,249 @@ fn max_accel(table: &RunsTable, row: usize) -> Option<f64> {
     ))
 }
 
-/// Rank `runs` (row `i` of `table` is `runs[i]`).
-pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Ranking {
+/// Whether row `i` of `table` ran (`status` ok, or no status column).
+fn ran(table: &RunsColumns, i: usize) -> bool {
+    table.cell(i, "status").is_none_or(|s| s == "ok")
+}
+
+/// A time column of row `i` (`None` when not finite or the run failed).
+fn time_of(table: &RunsColumns, i: usize, column: &str) -> Option<f64> {
+    table
+        .num(i, column)
+        .filter(|x| x.is_finite() && ran(table, i))
+}
+
+/// The values of a run's settings (`setting`) or workload, as shown in the tables.
+fn values(r: &RunSpec, setting: bool) -> Vec<String> {
+    r.swept
+        .iter()
+        .filter(|(p, _)| is_setting(p) == setting)
+        .map(|(_, v)| v.to_string())
+        .collect()
+}
+
+/// A run's candidate label: its settings joined by `, `, or its profile kind.
+fn label(r: &RunSpec) -> String {
+    let s: Vec<String> = r
+        .swept
+        .iter()
+        .filter(|(p, _)| is_setting(p))
+        .map(|(p, v)| label_part(p, v))
+        .collect();
+    if s.is_empty() {
+        r.profile.to_string()
+    } else {
+        s.join(", ")
+    }
+}
+
+/// The workload points of `runs` in first-seen order, each with its rows in run order, as
+/// `(points' first entries in rows, rows)`: a few bytes a run (a point is found through a
+/// hash of its values, checked against the point's first run).
+fn workload_points(runs: &dyn RunList) -> (Vec<usize>, Vec<u32>) {
+    use std::hash::{Hash, Hasher};
+    let hash = |w: &[String]| {
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        w.hash(&mut h);
+        h.finish()
+    };
+    // Per point: its first row and the next point with the same hash.
+    let mut first_row: Vec<u32> = Vec::new();
+    let mut next_same: Vec<u32> = Vec::new();
+    let mut by_hash: std::collections::HashMap<u64, u32> = std::collections::HashMap::new();
+    let mut point_of: Vec<u32> = Vec::with_capacity(runs.len());
+    for (i, r) in runs.iter().enumerate() {
+        let w = values(&r, false);
+        let h = hash(&w);
+        let mut found = None;
+        let mut k = by_hash.get(&h).copied();
+        while let Some(p) = k {
+            if values(&runs.at(first_row[p as usize] as usize), false) == w {
+                found = Some(p);
+                break;
+            }
+            k = Some(next_same[p as usize]).filter(|&n| n != u32::MAX);
+        }
+        let p = match found {
+            Some(p) => p,
+            None => {
+                let p = first_row.len() as u32;
+                next_same.push(by_hash.insert(h, p).unwrap_or(u32::MAX));
+                first_row.push(i as u32);
+                p
+            }
+        };
+        point_of.push(p);
+    }
+    drop((by_hash, next_same, first_row));
+    // Rows grouped by point (a counting sort keeps run order within a point).
+    let n_points = point_of.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
+    let mut starts = vec![0usize; n_points + 1];
+    for &p in &point_of {
+        starts[p as usize + 1] += 1;
+    }
+    for k in 0..n_points {
+        starts[k + 1] += starts[k];
+    }
+    let mut fill = starts.clone();
+    let mut rows = vec![0u32; runs.len()];
+    for (i, &p) in point_of.iter().enumerate() {
+        rows[fill[p as usize]] = i as u32;
+        fill[p as usize] += 1;
+    }
+    (starts, rows)
+}
+
+/// Rank `runs` (row `i` of `table` is `runs.at(i)`).
+pub fn rank(sc: &Scenario, runs: &dyn RunList, table: &RunsColumns) -> Ranking {
     let keys: Vec<String> = runs
         .first()
         .map(|r| r.swept.iter().map(|(p, _)| p.clone()).collect())
         .unwrap_or_default();
     let setting_keys: Vec<String> = keys.iter().filter(|k| is_setting(k)).cloned().collect();
     let workload_keys: Vec<String> = keys.iter().filter(|k| !is_setting(k)).cloned().collect();
-    // The values of a run's settings (`setting`) or workload, as shown in the tables.
-    let values = |r: &RunSpec, setting: bool| -> Vec<String> {
-        r.swept
-            .iter()
-            .filter(|(p, _)| is_setting(p) == setting)
-            .map(|(_, v)| v.to_string())
-            .collect()
-    };
-    let label = |r: &RunSpec| {
-        let s: Vec<String> = r
-            .swept
-            .iter()
-            .filter(|(p, _)| is_setting(p))
-            .map(|(p, v)| label_part(p, v))
-            .collect();
-        if s.is_empty() {
-            r.profile.to_string()
-        } else {
-            s.join(", ")
-        }
-    };
-    // Workload points, first-seen order (found through an index: a sweep of many points
-    // must not search them all for every run).
-    let mut groups: Vec<(Vec<String>, Vec<usize>)> = Vec::new();
-    let mut group_of: std::collections::HashMap<Vec<String>, usize> =
-        std::collections::HashMap::new();
-    for (i, r) in runs.iter().enumerate() {
-        let w = values(r, false);
-        match group_of.get(&w) {
-            Some(&g) => groups[g].1.push(i),
+    let (starts, point_rows) = workload_points(runs);
+    // The candidates, first-seen in run order, and each run's.
+    let mut candidates: Vec<(String, Vec<String>)> = Vec::new();
+    let mut candidate_of: std::collections::HashMap<String, u32> = std::collections::HashMap::new();
+    let mut run_candidate: Vec<u32> = Vec::with_capacity(runs.len());
+    let mut run_current: Vec<bool> = Vec::with_capacity(runs.len());
+    for r in runs.iter() {
+        let l = label(&r);
+        let c = match candidate_of.get(&l) {
+            Some(&c) => c,
             None => {
-                group_of.insert(w.clone(), groups.len());
-                groups.push((w, vec![i]));
+                let c = candidates.len() as u32;
+                candidate_of.insert(l.clone(), c);
+                candidates.push((l, values(&r, true)));
+                c
             }
-        }
+        };
+        run_candidate.push(c);
+        run_current.push(is_current(sc, &r));
     }
+    drop(candidate_of);
     let shapers = setting_keys.iter().any(|k| k.starts_with("shaper."))
         && table.column("smoothing_mm").is_some();
-    let current_label = runs.iter().find(|r| is_current(sc, r)).map(label);
+    let current_label = run_current
+        .iter()
+        .position(|&c| c)
+        .map(|i| candidates[run_candidate[i] as usize].0.clone());
     let bands_um = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
     let mut bands = Vec::new();
     for band in bands_um {
         let b = band_label(band);
-        let mut points = Vec::new();
-        let mut sums: Vec<(String, f64, usize)> = Vec::new();
-        // `sums` and `candidates` list the same labels in the same order; `sum_of` indexes both.
-        let mut candidates: Vec<Candidate> = Vec::new();
-        let mut sum_of: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
-        for (workload, idx) in &groups {
-            let mut ranked: Vec<Ranked> = idx
-                .iter()
-                .map(|&i| {
-                    let ok = table.cell(i, "status").is_none_or(|s| s == "ok");
-                    let time = |c: &str| table.num(i, c).filter(|x| x.is_finite() && ok);
-                    let failure = (!ok).then(|| {
-                        let status = table.cell(i, "status").unwrap_or_default();
-                        match table.cell(i, "reason").filter(|s| !s.is_empty()) {
-                            Some(reason) => format!("{status}: {reason}"),
-                            None => status.to_string(),
-                        }
-                    });
-                    Ranked {
-                        row: i,
-                        id: runs[i].id,
-                        rank: None,
-                        settings: values(&runs[i], true),
-                        label: label(&runs[i]),
-                        move_s: table.num(i, "move_time_s").unwrap_or(f64::NAN),
-                        settle_s: time(&format!("settle_time_s_{b}")),
-                        total_s: time(&format!("move_and_settle_s_{b}")),
-                        residual_peak_um: table.num(i, "residual_peak_um").unwrap_or(f64::NAN),
-                        gain: None,
-                        current: is_current(sc, &runs[i]),
-                        failure,
-                        shaper: shapers.then(|| {
-                            [
-                                table.num(i, "smoothing_mm"),
-                                table.num(i, "remaining_vibration_pct"),
-                                max_accel(table, i),
-                            ]
-                        }),
-                    }
-                })
-                .collect();
+        let total_col = format!("move_and_settle_s_{b}");
+        let mut points = Vec::with_capacity(starts.len().saturating_sub(1));
+        let mut order: Vec<Slot> = Vec::with_capacity(runs.len());
+        let mut sums: Vec<(u32, f64, usize)> = Vec::new();
+        // `sums` and `band_candidates` list the same candidates in the same order;
+        // `sum_of` (by candidate) indexes both.
+        let mut band_candidates: Vec<Candidate> = Vec::new();
+        let mut sum_of: Vec<Option<usize>> = vec![None; candidates.len()];
+        // (failed, total, id) of each run of a point, to sort it.
+        let mut ranked: Vec<(Slot, bool, Option<f64>, usize)> = Vec::new();
+        for w in starts.windows(2) {
+            ranked.clear();
+            for &i in &point_rows[w[0]..w[1]] {
+                let i = i as usize;
+                let slot = Slot {
+                    row: i as u32,
+                    rank: 0,
+                    candidate: run_candidate[i],
+                    current: run_current[i],
+                };
+                ranked.push((
+                    slot,
+                    !ran(table, i),
+                    time_of(table, i, &total_col),
+                    runs.at(i).id,
+                ));
+            }
             // Settled runs by time (ties in run order), then unsettled, then failed.
             ranked.sort_by(|a, b| {
-                let key = |r: &Ranked| (r.failure.is_some(), r.total_s.unwrap_or(f64::INFINITY));
+                let key =
+                    |r: &(Slot, bool, Option<f64>, usize)| (r.1, r.2.unwrap_or(f64::INFINITY));
                 let (fa, ta) = key(a);
                 let (fb, tb) = key(b);
-                fa.cmp(&fb).then(ta.total_cmp(&tb)).then(a.id.cmp(&b.id))
+                fa.cmp(&fb).then(ta.total_cmp(&tb)).then(a.3.cmp(&b.3))
             });
             for (n, r) in ranked.iter_mut().enumerate() {
-                r.rank = r.total_s.map(|_| n + 1);
-            }
-            let reference = match ranked.iter().find(|r| r.current) {
-                Some(c) => Some((c.label.clone(), c.total_s)),
-                None if current_label.is_some() => None,
-                None => ranked
-                    .iter()
-                    .rev()
-                    .find(|r| r.failure.is_none())
-                    .map(|r| (r.label.clone(), r.total_s)),
-            };
-            if let Some((_, rt)) = &reference {
-                for r in &mut ranked {
-                    r.gain = match (rt, r.total_s) {
-                        (Some(rt), Some(t)) => Some(rt / t - 1.0),
-                        (None, Some(_)) => Some(f64::INFINITY),
-                        _ => None,
-                    };
+                if r.2.is_some() {
+                    r.0.rank = n as u32 + 1;
                 }
             }
+            let reference = match ranked.iter().position(|r| r.0.current) {
+                Some(c) => Some(c as u32),
+                None if current_label.is_some() => None,
+                None => ranked.iter().rposition(|r| !r.1).map(|k| k as u32),
+            };
             for r in &ranked {
-                let t = r.total_s.unwrap_or(f64::INFINITY);
-                match sum_of.get(&r.label) {
-                    Some(&k) => {
+                let t = r.2.unwrap_or(f64::INFINITY);
+                let c = r.0.candidate as usize;
+                match sum_of[c] {
+                    Some(k) => {
                         sums[k].1 += t;
                         sums[k].2 += 1;
-                        let c = &mut candidates[k];
-                        c.total_s = c.total_s.zip(r.total_s).map(|(a, b)| a + b);
-                        c.runs.push(r.id);
-                        c.failed |= r.failure.is_some();
+                        let bc = &mut band_candidates[k];
+                        bc.total_s = bc.total_s.zip(r.2).map(|(a, b)| a + b);
+                        bc.runs.push(r.3);
+                        bc.failed |= r.1;
                     }
                     None => {
-                        sum_of.insert(r.label.clone(), sums.len());
-                        sums.push((r.label.clone(), t, 1));
-                        candidates.push(Candidate {
-                            label: r.label.clone(),
-                            total_s: r.total_s,
-                            runs: vec![r.id],
-                            current: r.current,
-                            failed: r.failure.is_some(),
+                        sum_of[c] = Some(sums.len());
+                        sums.push((r.0.candidate, t, 1));
+                        band_candidates.push(Candidate {
+                            label: candidates[c].0.clone(),
+                            total_s: r.2,
+                            runs: vec![r.3],
+                            current: r.0.current,
+                            failed: r.1,
                         });
                     }
                 }
             }
-            points.push(Point {
-                workload: workload.clone(),
+            points.push(PointSlots {
+                start: order.len() as u32,
+                len: ranked.len() as u32,
                 reference,
-                runs: ranked,
             });
+            order.extend(ranked.iter().map(|r| r.0));
         }
         let n_points = points.len();
-        let full: Vec<&(String, f64, usize)> = sums.iter().filter(|s| s.2 == n_points).collect();
+        let full: Vec<(&str, f64)> = sums
+            .iter()
+            .filter(|s| s.2 == n_points)
+            .map(|s| (candidates[s.0 as usize].0.as_str(), s.1))
+            .collect();
         let winner = full
             .iter()
             .filter(|s| s.1.is_finite())
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|w| {
                 let reference = match &current_label {
-                    Some(c) => full.iter().find(|s| s.0 == *c).map(|s| (s.0.clone(), s.1)),
+                    Some(c) => full
+                        .iter()
+                        .find(|s| s.0 == c.as_str())
+                        .map(|s| (s.0.to_string(), s.1)),
                     None => full
                         .iter()
                         .max_by(|a, b| a.1.total_cmp(&b.1))
-                        .map(|s| (s.0.clone(), s.1)),
+                        .map(|s| (s.0.to_string(), s.1)),
                 };
                 Winner {
-                    label: w.0.clone(),
+                    label: w.0.to_string(),
                     total_s: w.1,
                     points: n_points,
                     reference,
                 }
             });
-        for c in &mut candidates {
+        for c in &mut band_candidates {
             if c.runs.len() < n_points {
                 c.total_s = None;
             }
         }
-        candidates.sort_by(|a, b| {
+        band_candidates.sort_by(|a, b| {
             let key = |c: &Candidate| {
                 (
                     c.failed,
@@ -392,8 +491,9 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Ranking {
         bands.push(Band {
             band_um: band,
             points,
+            order,
             winner,
-            candidates,
+            candidates: band_candidates,
         });
     }
     Ranking {
@@ -402,11 +502,95 @@ pub fn rank(sc: &Scenario, runs: &[RunSpec], table: &RunsTable) -> Ranking {
         has_current: !sc.current.is_empty(),
         current_label,
         shapers,
+        candidates,
         bands,
     }
 }
 
 impl Ranking {
+    /// Workload point `p` of band `b` as the tables show it: its values, its reference and
+    /// its runs with their numbers (read from `table`, row `i` = `runs.at(i)`, the table the
+    /// ranking was made from).
+    pub fn point(
+        &self,
+        b: usize,
+        p: usize,
+        runs: &dyn RunList,
+        table: &RunsColumns,
+    ) -> Option<Point> {
+        let n = self.bands.get(b)?.points.get(p)?.len as usize;
+        self.point_runs(b, p, 0..n, runs, table)
+    }
+
+    /// [`Ranking::point`] with only its runs `which` (positions among the point's runs).
+    pub fn point_runs(
+        &self,
+        b: usize,
+        p: usize,
+        which: std::ops::Range<usize>,
+        runs: &dyn RunList,
+        table: &RunsColumns,
+    ) -> Option<Point> {
+        let band = self.bands.get(b)?;
+        let slots = band.points.get(p)?;
+        let start = slots.start as usize;
+        let mine = &band.order[start..start + slots.len as usize];
+        let shown = mine.get(which)?;
+        let label = |s: &Slot| self.candidates[s.candidate as usize].0.clone();
+        let b_label = band_label(band.band_um);
+        let total_col = format!("move_and_settle_s_{b_label}");
+        let settle_col = format!("settle_time_s_{b_label}");
+        let reference = slots.reference.map(|k| {
+            let s = &mine[k as usize];
+            (label(s), time_of(table, s.row as usize, &total_col))
+        });
+        let ranked = shown
+            .iter()
+            .map(|s| {
+                let i = s.row as usize;
+                let ok = ran(table, i);
+                let failure = (!ok).then(|| {
+                    let status = table.cell(i, "status").unwrap_or_default();
+                    match table.cell(i, "reason").filter(|s| !s.is_empty()) {
+                        Some(reason) => format!("{status}: {reason}"),
+                        None => status.to_string(),
+                    }
+                });
+                let total_s = time_of(table, i, &total_col);
+                Ranked {
+                    row: i,
+                    id: runs.at(i).id,
+                    rank: (s.rank > 0).then_some(s.rank as usize),
+                    settings: self.candidates[s.candidate as usize].1.clone(),
+                    label: label(s),
+                    move_s: table.num(i, "move_time_s").unwrap_or(f64::NAN),
+                    settle_s: time_of(table, i, &settle_col),
+                    total_s,
+                    residual_peak_um: table.num(i, "residual_peak_um").unwrap_or(f64::NAN),
+                    gain: reference.as_ref().and_then(|(_, rt)| match (rt, total_s) {
+                        (Some(rt), Some(t)) => Some(rt / t - 1.0),
+                        (None, Some(_)) => Some(f64::INFINITY),
+                        _ => None,
+                    }),
+                    current: s.current,
+                    failure,
+                    shaper: self.shapers.then(|| {
+                        [
+                            table.num(i, "smoothing_mm"),
+                            table.num(i, "remaining_vibration_pct"),
+                            max_accel(table, i),
+                        ]
+                    }),
+                }
+            })
+            .collect();
+        Some(Point {
+            workload: values(&runs.at(mine.first()?.row as usize), false),
+            reference,
+            runs: ranked,
+        })
+    }
+
     /// What the gains are against, for headers: `vs current` or `vs slowest (no current
     /// given)`.
     pub fn reference_name(&self) -> &'static str {

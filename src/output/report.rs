@@ -7,7 +7,7 @@
 //! No clock is read: the same runs give the same page, so a merged sweep's report is the
 //! unsharded one's.
 
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::html::{
     BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, Provenance, Reference, Report,
@@ -18,7 +18,7 @@ use crate::output::ranking::{
     Point, Ranked, Ranking, SHAPER_COLUMNS, gain_text, rank, run_command,
 };
 use crate::output::summary::{machines_line, ms};
-use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 /// The scenario a sweep ran, as the report names it.
 #[derive(Debug, Clone, Copy)]
@@ -143,7 +143,7 @@ fn ranking_tables(ranking: &Ranking) -> Vec<Table> {
 }
 
 /// The row of run `r` of workload point `p` in a ranking table.
-fn ranking_row(p: &Point, r: &Ranked, runs: &[RunSpec], file: ScenarioFile<'_>) -> Vec<Cell> {
+fn ranking_row(p: &Point, r: &Ranked, runs: &dyn RunList, file: ScenarioFile<'_>) -> Vec<Cell> {
     let mut row: Vec<Cell> = p.workload.iter().map(Cell::text).collect();
     row.push(match r.rank {
         Some(n) => num(n as f64, n.to_string()),
@@ -182,7 +182,7 @@ fn ranking_row(p: &Point, r: &Ranked, runs: &[RunSpec], file: ScenarioFile<'_>) 
         }
     }
     row.push(num(r.id as f64, r.id.to_string()));
-    row.push(Cell::text(run_command(file.path, &runs[r.row])));
+    row.push(Cell::text(run_command(file.path, &runs.at(r.row))));
     row
 }
 
@@ -194,10 +194,10 @@ pub struct RankingRows<'a> {
     ranking: Option<Ranking>,
     /// The index of the first ranking table in the report's tables.
     first: usize,
-    /// Per band, the first row of each workload point.
-    starts: Vec<Vec<usize>>,
-    /// The runs (row `i` of the runs table is `runs[i]`).
-    runs: &'a [RunSpec],
+    /// The runs (row `i` of the runs table is `runs.at(i)`).
+    runs: &'a dyn RunList,
+    /// The runs table the ranking was made from.
+    table: &'a RunsColumns,
     /// The scenario, as the commands name it.
     file: ScenarioFile<'a>,
 }
@@ -205,17 +205,21 @@ pub struct RankingRows<'a> {
 impl Rows for RankingRows<'_> {
     fn row(&self, table: usize, k: usize) -> Option<Vec<Cell>> {
         let b = table.checked_sub(self.first)?;
-        let band = self.ranking.as_ref()?.bands.get(b)?;
-        let starts = self.starts.get(b)?;
-        let p = starts.partition_point(|&s| s <= k).checked_sub(1)?;
-        let point = band.points.get(p)?;
-        let r = point.runs.get(k - starts[p])?;
-        Some(ranking_row(point, r, self.runs, self.file))
+        let ranking = self.ranking.as_ref()?;
+        let band = ranking.bands.get(b)?;
+        let p = band
+            .points
+            .partition_point(|s| s.start as usize <= k)
+            .checked_sub(1)?;
+        let at = k - band.points[p].start as usize;
+        let point = ranking.point_runs(b, p, at..at + 1, self.runs, self.table)?;
+        let r = point.runs.first()?;
+        Some(ranking_row(&point, r, self.runs, self.file))
     }
 }
 
 /// The G-code jobs' table ([`crate::output::jobs`]): the headline lines as its note.
-fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
+fn jobs_table(j: &Jobs, runs: &dyn RunList, file: ScenarioFile<'_>) -> Table {
     let opt = |x: Option<f64>, prec: usize| match x {
         Some(x) => num(x, format!("{x:.prec$}")),
         None => num(f64::NAN, "-".into()),
@@ -252,7 +256,7 @@ fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
             }
             row.push(Cell::text(if r.pareto { "yes" } else { "" }));
             row.push(num(r.id as f64, r.id.to_string()));
-            row.push(Cell::text(run_command(file.path, &runs[r.row])));
+            row.push(Cell::text(run_command(file.path, &runs.at(r.row))));
             row
         })
         .collect();
@@ -268,7 +272,7 @@ fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
     }
 }
 
-/// The report of a sweep: `table` is its runs.csv (row `i` = `runs[i]`), `figures` the
+/// The report of a sweep: `table` is its runs.csv (row `i` = `runs.at(i)`), `figures` the
 /// figures' captions and SVG files. What a report of many runs would hold is left to be
 /// made as the page is written ([`crate::output::html::render_to`]): the table of every
 /// run (`runs` is `None`; written from runs.csv under [`RUNS_TITLE`]) and the ranking
@@ -276,8 +280,8 @@ fn jobs_table(j: &Jobs, runs: &[RunSpec], file: ScenarioFile<'_>) -> Table {
 pub fn sweep_report<'a>(
     sc: &Scenario,
     file: ScenarioFile<'a>,
-    runs: &'a [RunSpec],
-    table: &RunsTable,
+    runs: &'a dyn RunList,
+    table: &'a RunsColumns,
     figures: &[(String, std::path::PathBuf)],
 ) -> (Report, RankingRows<'a>) {
     let mut intro = vec![format!("{}. {} runs.", machines_line(runs), runs.len())];
@@ -307,7 +311,7 @@ pub fn sweep_report<'a>(
     let failed = (0..runs.len())
         .filter(|&i| table.cell(i, "status").is_some_and(|s| s != "ok"))
         .map(|i| FailedRun {
-            run: format!("run {}", runs[i].id),
+            run: format!("run {}", runs.at(i).id),
             status: table.cell(i, "status").unwrap_or_default().to_string(),
             reason: table.cell(i, "reason").unwrap_or_default().to_string(),
         })
@@ -316,26 +320,11 @@ pub fn sweep_report<'a>(
         .first()
         .map(|r| r.backend.to_string())
         .unwrap_or_default();
-    let starts = ranking.as_ref().map_or(Vec::new(), |r| {
-        r.bands
-            .iter()
-            .map(|b| {
-                b.points
-                    .iter()
-                    .scan(0, |n, p| {
-                        let start = *n;
-                        *n += p.runs.len();
-                        Some(start)
-                    })
-                    .collect()
-            })
-            .collect()
-    });
     let rows = RankingRows {
         ranking,
         first,
-        starts,
         runs,
+        table,
         file,
     };
     let report = Report {

@@ -13,6 +13,7 @@ use crate::input::runs_table::record;
 use crate::kinds::Kind;
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 /// A band as it appears in column names (`10um`).
 pub fn band_label(b: f64) -> String {
@@ -35,7 +36,7 @@ pub struct RunsCsv {
 
 impl RunsCsv {
     /// The columns of the sweep `runs`.
-    pub fn new(runs: &[RunSpec]) -> Self {
+    pub fn new(runs: &dyn RunList) -> Self {
         let bands_um = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
         // The modes form's modes: axis x's as `mode<i>_*`, another axis's as
         // `<axis>_mode<i>_*`.
@@ -99,13 +100,11 @@ impl RunsCsv {
             axis_names = mode_axes.iter().map(|(a, _)| a.clone()).collect();
         }
         if runs.first().is_some_and(|r| r.machine.is_some()) {
-            for a in runs
-                .iter()
-                .filter_map(|r| r.machine.as_ref())
-                .flat_map(|m| &m.axes)
-            {
-                if !axis_names.contains(&a.name) {
-                    axis_names.push(a.name.clone());
+            for r in runs.iter() {
+                for a in r.machine.iter().flat_map(|m| &m.axes) {
+                    if !axis_names.contains(&a.name) {
+                        axis_names.push(a.name.clone());
+                    }
                 }
             }
         }
@@ -228,11 +227,11 @@ fn profile_name(k: ProfileKind) -> String {
 }
 
 /// The whole runs.csv of `runs` with their `metrics` (in the same order).
-pub fn runs_csv(runs: &[RunSpec], metrics: &[Metrics]) -> String {
+pub fn runs_csv(runs: &dyn RunList, metrics: &[Metrics]) -> String {
     let layout = RunsCsv::new(runs);
     let mut out = layout.header();
     for (r, m) in runs.iter().zip(metrics) {
-        out.push_str(&layout.row(r, m));
+        out.push_str(&layout.row(&r, m));
     }
     out
 }

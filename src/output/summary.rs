@@ -6,11 +6,11 @@
 
 use std::path::Path;
 
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::html::Out;
 use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, rank, run_command};
-use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 /// A time in ms with one decimal, `not settled` for none.
 pub fn ms(t: Option<f64>) -> String {
@@ -30,9 +30,9 @@ pub struct Figure {
 
 /// The machines of `runs`, named once each in first-seen order: `printer_xy (axis x, linear
 /// driver)`, or the modes of the modes form.
-pub fn machines_line(runs: &[RunSpec]) -> String {
+pub fn machines_line(runs: &dyn RunList) -> String {
     let mut names: Vec<String> = Vec::new();
-    for r in runs {
+    for r in runs.iter() {
         let n = if r.machine.is_some() {
             format!("{} (axis {}, {} driver)", r.machine_name, r.axis, r.driver)
         } else {
@@ -73,14 +73,14 @@ pub fn machines_line(runs: &[RunSpec]) -> String {
 /// command that runs it alone; the failed runs with their reasons; the run kinds'
 /// sections; the figures. `scenario` is the scenario file as the commands name it.
 ///
-/// It reads the metrics from `table` (the runs table, row `i` = `runs[i]`) rather than from
+/// It reads the metrics from `table` (the runs table, row `i` = `runs.at(i)`) rather than from
 /// the metrics structs, so a summary rebuilt from a merged `runs.csv` is byte-identical to
 /// the one the unsharded sweep wrote.
 pub fn summary_md(
     sc: &Scenario,
     scenario: &Path,
-    runs: &[RunSpec],
-    table: &RunsTable,
+    runs: &dyn RunList,
+    table: &RunsColumns,
     figures: &[Figure],
 ) -> String {
     let mut out = String::new();
@@ -94,8 +94,8 @@ pub(crate) fn summary_to(
     out: &mut impl Out,
     sc: &Scenario,
     scenario: &Path,
-    runs: &[RunSpec],
-    table: &RunsTable,
+    runs: &dyn RunList,
+    table: &RunsColumns,
     figures: &[Figure],
 ) {
     let _ = writeln!(out, "# {}\n", sc.name);
@@ -116,7 +116,7 @@ pub(crate) fn summary_to(
             let _ = writeln!(
                 out,
                 "- run {}: {}: {}",
-                runs[i].id,
+                runs.at(i).id,
                 table.cell(i, "status").unwrap_or_default(),
                 table.cell(i, "reason").unwrap_or_default()
             );
@@ -143,7 +143,7 @@ pub(crate) fn summary_to(
         }
     }
     if !replaced {
-        push_ranking(out, &rank(sc, runs, table), runs, scenario);
+        push_ranking(out, &rank(sc, runs, table), runs, table, scenario);
     }
     for section in after.iter().filter(|s| !s.is_empty()) {
         out.push('\n');
@@ -161,14 +161,20 @@ pub(crate) fn summary_to(
 
 /// Whether the summary ranks candidates by move-and-settle time: no run kind's section
 /// replaces the ranking (a raster scan's does).
-pub fn ranks_candidates(runs: &[RunSpec], table: &RunsTable) -> bool {
+pub fn ranks_candidates(runs: &dyn RunList, table: &RunsColumns) -> bool {
     !crate::kinds::all()
         .iter()
         .any(|k| k.replaces_move_tables() && k.summary(runs, table).is_some())
 }
 
 /// The winners and the ranking tables.
-fn push_ranking(out: &mut impl Out, ranking: &Ranking, runs: &[RunSpec], scenario: &Path) {
+fn push_ranking(
+    out: &mut impl Out,
+    ranking: &Ranking,
+    runs: &dyn RunList,
+    table: &RunsColumns,
+    scenario: &Path,
+) {
     let reference = ranking.reference_name();
     let _ = writeln!(out, "## Winner per band\n");
     let compared = if ranking.setting_keys.is_empty() {
@@ -225,7 +231,7 @@ fn push_ranking(out: &mut impl Out, ranking: &Ranking, runs: &[RunSpec], scenari
         }
     }
     out.push('\n');
-    for b in &ranking.bands {
+    for (bi, b) in ranking.bands.iter().enumerate() {
         let _ = writeln!(
             out,
             "## Ranking: move and settle to within {} um (ms)\n",
@@ -249,7 +255,7 @@ fn push_ranking(out: &mut impl Out, ranking: &Ranking, runs: &[RunSpec], scenari
         header.push("command".into());
         let _ = writeln!(out, "| {} |", header.join(" | "));
         let _ = writeln!(out, "|{}", "---:|".repeat(header.len()));
-        for p in &b.points {
+        for p in (0..b.points.len()).filter_map(|p| ranking.point(bi, p, runs, table)) {
             for r in &p.runs {
                 let mut row = p.workload.clone();
                 let mark = |s: String| {
@@ -292,7 +298,7 @@ fn push_ranking(out: &mut impl Out, ranking: &Ranking, runs: &[RunSpec], scenari
                     row.push(f(sh[2], 0));
                 }
                 row.push(r.id.to_string());
-                row.push(format!("`{}`", run_command(scenario, &runs[r.row])));
+                row.push(format!("`{}`", run_command(scenario, &runs.at(r.row))));
                 let _ = writeln!(out, "| {} |", row.join(" | "));
             }
         }

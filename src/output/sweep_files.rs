@@ -20,13 +20,13 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::Error;
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::atomic::{write_atomic, write_atomic_with};
 use crate::output::html::Sink;
 use crate::output::report::{RUNS_TITLE, ScenarioFile, sweep_report};
 use crate::output::summary::summary_to;
-use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 /// Folder of the sweep figures inside the output folder.
 pub const PLOTS: &str = "plots";
@@ -41,11 +41,11 @@ pub fn write_sweep(
     out: &Path,
     sc: &Scenario,
     file: ScenarioFile<'_>,
-    runs: &[RunSpec],
+    runs: &dyn RunList,
     csv: &str,
 ) -> Result<(), Error> {
     let table =
-        RunsTable::parse(csv).map_err(|message| Error::input(out.join("runs.csv"), message))?;
+        RunsColumns::parse(csv).map_err(|message| Error::input(out.join("runs.csv"), message))?;
     write_atomic(&out.join("runs.csv"), csv.as_bytes())?;
     let plots = out.join(PLOTS);
     let mut figures = crate::output::plot::sweep::write_all(&plots, &sc.name, runs, &table)?;
@@ -71,7 +71,6 @@ pub fn write_sweep(
         .map(|f| (f.title.clone(), out.join(&f.svg)))
         .collect();
     let (report, ranking_rows) = sweep_report(sc, file, runs, &table, &svgs);
-    drop(table);
     let path = out.join(REPORT);
     write_atomic_with(&path, |w| {
         crate::output::html::render_to(&report, Some((RUNS_TITLE, csv)), &ranking_rows, w, &path)

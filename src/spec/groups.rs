@@ -3,23 +3,23 @@
 
 use settle_planner::ProfileKind;
 
-use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 /// Runs grouped by their swept values other than `profile` (first-seen order): the rows of
 /// the summary's side-by-side tables.
 #[derive(Debug)]
-pub struct SweptGroups<'a> {
+pub struct SweptGroups {
     /// The profile kinds, in first-seen order (the tables' column groups).
     pub kinds: Vec<ProfileKind>,
     /// Per swept point: its values joined by ` | `, and the indices of its runs.
     pub groups: Vec<(String, Vec<usize>)>,
     /// The swept parameters other than `profile`, in sweep order.
-    pub params: Vec<&'a str>,
+    pub params: Vec<String>,
 }
 
-impl<'a> SweptGroups<'a> {
+impl SweptGroups {
     /// Group `runs`.
-    pub fn of(runs: &'a [RunSpec]) -> Self {
+    pub fn of(runs: &dyn RunList) -> Self {
         let mut kinds: Vec<ProfileKind> = Vec::new();
         let mut groups: Vec<(String, Vec<usize>)> = Vec::new();
         for (i, r) in runs.iter().enumerate() {
@@ -38,13 +38,13 @@ impl<'a> SweptGroups<'a> {
                 None => groups.push((key, vec![i])),
             }
         }
-        let params: Vec<&str> = runs
+        let params: Vec<String> = runs
             .first()
             .map(|r| {
                 r.swept
                     .iter()
                     .filter(|(p, _)| p != "profile")
-                    .map(|(p, _)| p.as_str())
+                    .map(|(p, _)| p.clone())
                     .collect()
             })
             .unwrap_or_default();

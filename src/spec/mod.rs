@@ -6,4 +6,5 @@ pub mod backend;
 pub mod groups;
 pub mod machine;
 pub mod run_spec;
+pub mod runs;
 pub mod value;

@@ -207,6 +207,72 @@ restore them to resume, or delete the journal to start over"
         })
     }
 
+    /// runs.csv's text from the journal: `header`, then the row of every run in order
+    /// (`position` gives a run id's place among the `n` runs of the sweep, `None` for
+    /// another). The rows are read back from the file, so a sweep keeps none while it runs.
+    pub fn runs_csv(
+        &self,
+        header: &str,
+        n: usize,
+        position: &dyn Fn(usize) -> Option<usize>,
+    ) -> Result<String, Error> {
+        use std::io::{BufRead as _, Read as _, Seek as _, SeekFrom};
+        let read_err = |e| Error::read(&self.path, e);
+        let mut r = std::io::BufReader::new(File::open(&self.path).map_err(read_err)?);
+        let mut line = String::new();
+        let mut at = 0u64;
+        let mut next = |r: &mut std::io::BufReader<File>, line: &mut String| {
+            line.clear();
+            let n = r.read_line(line).map_err(read_err)?;
+            let start = at;
+            at += n as u64;
+            Ok::<_, Error>((start, n))
+        };
+        next(&mut r, &mut line)?;
+        next(&mut r, &mut line)?;
+        if line != header {
+            return Err(journal_error(
+                &self.path,
+                "its runs.csv header differs from this sweep's".into(),
+            ));
+        }
+        // Per run: where its row starts in the file and its length (with the newline).
+        let mut rows: Vec<(u64, u32)> = vec![(0, 0); n];
+        loop {
+            let (start, len) = next(&mut r, &mut line)?;
+            if len == 0 {
+                break;
+            }
+            let Some((sum, row)) = line.split_once(' ') else {
+                continue;
+            };
+            let id = row.split(',').next().and_then(|c| c.parse::<usize>().ok());
+            if let Some(k) = id.and_then(position) {
+                rows[k] = (start + sum.len() as u64 + 1, row.len() as u32);
+            }
+        }
+        if let Some(k) = rows.iter().position(|&(_, len)| len == 0) {
+            return Err(journal_error(
+                &self.path,
+                format!("no row for the run at place {k} of the sweep"),
+            ));
+        }
+        let total = header.len() + rows.iter().map(|&(_, len)| len as usize).sum::<usize>();
+        let mut csv = String::with_capacity(total);
+        csv.push_str(header);
+        let mut f = r.into_inner();
+        let mut buf = Vec::new();
+        for (start, len) in rows {
+            buf.resize(len as usize, 0);
+            f.seek(SeekFrom::Start(start)).map_err(read_err)?;
+            f.read_exact(&mut buf).map_err(read_err)?;
+            let row = std::str::from_utf8(&buf)
+                .map_err(|e| read_err(std::io::Error::new(std::io::ErrorKind::InvalidData, e)))?;
+            csv.push_str(row);
+        }
+        Ok(csv)
+    }
+
     /// The sweep is complete and its outputs written: remove the journal.
     pub fn finish(self) -> Result<(), Error> {
         std::fs::remove_file(&self.path).map_err(|source| Error::Write {

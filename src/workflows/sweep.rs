@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::Error;
-use crate::execute::pool::{Progress, run_all_with};
-use crate::input::runs_table::RunsTable;
+use crate::execute::pool::{Progress, run_each_errors};
+use crate::input::runs_columns::RunsColumns;
 use crate::measure::metrics::Metrics;
 use crate::output::atomic::{create_dir, write_atomic};
 use crate::output::report::ScenarioFile;
@@ -18,6 +18,7 @@ use crate::output::sink::{Provenance, Recorder};
 use crate::output::sweep_files::{PLOTS, RECORDINGS, write_sweep};
 use crate::spec::backend::Backend;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 use crate::workflows::journal::{self, Journal};
 use crate::workflows::lock::FolderLock;
 use crate::workflows::shard::{self, Manifest, Shard};
@@ -137,9 +138,11 @@ pub fn sweep(
     let started = Instant::now();
     let path = &opts.scenario;
     let (sc, src) = crate::expand::load(path)?;
-    let mut all_runs = crate::expand::expand(&sc, &src)?;
+    // Made on demand from their ids: a sweep holds no run spec per run.
+    let mut all_runs = crate::expand::sweep_runs(&sc, &src)?;
     let inputs = crate::expand::machine::inputs_identity(&sc, &src)?;
-    crate::execute::set_backend(path, &mut all_runs, opts.backend)?;
+    crate::execute::check_backend(path, &all_runs, opts.backend)?;
+    all_runs.set_backend(opts.backend);
     let base = PathBuf::from("results").join(&sc.name);
     let out = opts.out.clone().unwrap_or_else(|| match opts.shard {
         Some(s) => base.join(s.folder()),
@@ -156,11 +159,9 @@ pub fn sweep(
         ));
     }
     let rec = recorder(opts.mcap, opts.rerun, out.join(RECORDINGS), path, &sc.name)?;
-    // The runs of this sweep, kept once (a clone of every run spec would double the memory
-    // a large sweep holds while it runs).
     let total_runs = all_runs.len();
     let runs = match opts.shard {
-        Some(s) => s.select(&all_runs),
+        Some(s) => all_runs.every(s.k - 1, s.n),
         None => all_runs,
     };
     create_dir(&out)?;
@@ -197,7 +198,6 @@ pub fn sweep(
         opts.backend.name(),
         &opts.shard.map_or(String::new(), |s| s.to_string()),
     );
-    let ids: Vec<usize> = runs.iter().map(|r| r.id).collect();
     // The leading cells of each run's row: its parameters, up to its status.
     let n_params = layout
         .columns()
@@ -205,12 +205,8 @@ pub fn sweep(
         .position(|c| c == "status")
         .unwrap_or(0);
     let params = |id: usize| {
-        let spec = match opts.shard {
-            Some(s) if !s.contains(id) => return None,
-            Some(s) => runs.get((id - (s.k - 1)) / s.n)?,
-            None => runs.get(id)?,
-        };
-        let cells = layout.cells(spec, &Metrics::failed(&spec.bands_um, String::new()));
+        let spec = runs.get(runs.position(id)?)?;
+        let cells = layout.cells(&spec, &Metrics::failed(&spec.bands_um, String::new()));
         let mut prefix = crate::input::runs_table::record(&cells[..n_params]);
         prefix.pop();
         prefix.push(',');
@@ -235,6 +231,8 @@ pub fn sweep(
         }
         _ => (Journal::start(&out, &key, &header)?, Default::default()),
     };
+    // The finished runs' ids (their rows stay in the journal).
+    let done: std::collections::HashSet<usize> = done.into_keys().collect();
     if opts.resume {
         note(&format!(
             "resuming: {} of {} runs already finished",
@@ -242,19 +240,17 @@ pub fn sweep(
             runs.len()
         ));
     }
-    // What is left to run: every run unless resuming (no copy then).
-    let todo: std::borrow::Cow<'_, [RunSpec]> = if done.is_empty() {
-        std::borrow::Cow::Borrowed(&runs)
-    } else {
-        runs.iter()
-            .filter(|r| !done.contains_key(&r.id))
-            .cloned()
-            .collect()
-    };
+    // What is left to run (positions among the runs).
+    let todo: Vec<u32> = (0..runs.len())
+        .filter(|&i| runs.id(i).is_some_and(|id| !done.contains(&id)))
+        .map(|i| i as u32)
+        .collect();
     // An output that cannot be written (a full disk) is not a result of a run: the sweep
     // stops, the journal keeps what finished, and `--resume` completes it.
     let write_failed = std::sync::atomic::AtomicBool::new(false);
-    let run_one = |spec: &RunSpec| -> Result<String, Error> {
+    let run_one = |k: usize| -> Result<(), Error> {
+        let spec = (&runs as &dyn RunList).at(todo[k] as usize);
+        let spec: &RunSpec = &spec;
         if write_failed.load(std::sync::atomic::Ordering::SeqCst) {
             return Err(Error::Interrupted { run: spec.id });
         }
@@ -276,19 +272,17 @@ pub fn sweep(
             write_failed.store(true, std::sync::atomic::Ordering::SeqCst);
             return Err(e);
         }
-        Ok(row)
+        Ok(())
     };
-    let results = run_all_with(&todo, opts.jobs, progress, run_one)?;
-    let mut rows = done;
+    let errors = run_each_errors(todo.len(), opts.jobs, progress, run_one)?;
+    let finished = done.len() + todo.len() - errors.len();
+    drop((todo, done));
     let mut interrupted = 0usize;
     let mut write_error = None;
-    for (spec, r) in todo.iter().zip(results) {
-        match r {
-            Ok(row) => {
-                rows.insert(spec.id, row);
-            }
-            Err(Error::Interrupted { .. }) => interrupted += 1,
-            Err(e) => {
+    for (_, e) in errors {
+        match e {
+            Error::Interrupted { .. } => interrupted += 1,
+            e => {
                 write_error.get_or_insert(e);
             }
         }
@@ -308,19 +302,13 @@ pub fn sweep(
         options: opts.clone(),
     };
     if interrupted > 0 || crate::execute::interrupt::requested() {
-        outcome.interrupted = Some(rows.len());
+        outcome.interrupted = Some(finished);
         outcome.elapsed_s = started.elapsed().as_secs_f64();
         return Ok(outcome);
     }
-    // Sized once: a String grown by doubling holds up to twice the text at the peak.
-    let mut csv =
-        String::with_capacity(header.len() + runs.iter().map(|r| rows[&r.id].len()).sum::<usize>());
-    csv.push_str(&header);
-    for r in &runs {
-        csv.push_str(&rows[&r.id]);
-    }
-    // The rows are in `csv` now.
-    drop(rows);
+    // The rows in run order, read back from the journal.
+    let csv = journal.runs_csv(&header, runs.len(), &|id| runs.position(id))?;
+    let ids = || (0..runs.len()).filter_map(|i| runs.id(i));
     match opts.shard {
         Some(s) => {
             write_atomic(&out.join("runs.csv"), csv.as_bytes())?;
@@ -334,16 +322,15 @@ pub fn sweep(
                     shard: s.k,
                     shards: s.n,
                     total_runs,
-                    runs: ids.clone(),
+                    runs: ids().collect(),
                     settings: [("backend".to_string(), opts.backend.name().to_string())]
                         .into_iter()
                         .collect(),
                     inputs: inputs.clone(),
                     runs_digest: shard::runs_digest(&csv),
                     recordings: match &rec {
-                        Some(r) => ids
-                            .iter()
-                            .flat_map(|&id| {
+                        Some(r) => ids()
+                            .flat_map(|id| {
                                 [(r.mcap, "mcap"), (r.rerun, "rrd")]
                                     .into_iter()
                                     .filter(|(on, _)| *on)
@@ -425,15 +412,15 @@ fn remove_stale_temps(dir: &Path) -> Result<(), Error> {
 }
 
 /// The failed runs, from runs.csv's `status` and `reason` columns.
-fn failures(runs: &[RunSpec], csv: &str) -> Vec<FailedRun> {
-    let Ok(table) = RunsTable::parse(csv) else {
+fn failures(runs: &dyn RunList, csv: &str) -> Vec<FailedRun> {
+    let Ok(table) = RunsColumns::parse(csv) else {
         return Vec::new();
     };
     (0..runs.len())
         .filter(|&i| table.cell(i, "status").is_some_and(|s| s != "ok"))
         .map(|i| FailedRun {
-            id: runs[i].id,
-            what: format!("{}, {} mm", runs[i].profile, runs[i].distance_mm),
+            id: runs.at(i).id,
+            what: format!("{}, {} mm", runs.at(i).profile, runs.at(i).distance_mm),
             status: table.cell(i, "status").unwrap_or_default().to_string(),
             reason: table.cell(i, "reason").unwrap_or_default().to_string(),
         })

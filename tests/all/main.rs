@@ -34,6 +34,7 @@ mod scan_views;
 mod scenarios;
 mod shaping_sweep;
 mod step_samples;
+mod sweep_runs;
 mod sweep_safety;
 mod tune;
 mod tune_firmware;

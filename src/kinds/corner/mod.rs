@@ -18,12 +18,13 @@ use settle_planner::path::{PathOptions, plan_path};
 use settle_planner::{PlanError, Trajectory};
 
 use crate::error::Error;
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
 use crate::kinds::{Kind, KindState, PathMove, PlanContext, Planned, PlotColumn, Role, any_has};
 use crate::measure::metrics::Metrics;
 use crate::measure::path_metrics::columns as col;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 pub use geometry::{Corner, CornerSpec, Strategy};
 
@@ -132,7 +133,7 @@ impl Kind for CornerPath {
         })
     }
 
-    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+    fn columns(&self, runs: &dyn RunList) -> Vec<String> {
         if !any_has::<Corner>(runs) {
             return Vec::new();
         }
@@ -162,7 +163,7 @@ impl Kind for CornerPath {
         out
     }
 
-    fn summary(&self, runs: &[RunSpec], table: &RunsTable) -> Option<String> {
+    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
         if !any_has::<Corner>(runs) || table.column(col::MAX_CONTOUR).is_none() {
             return None;
         }
@@ -182,7 +183,7 @@ impl Kind for CornerPath {
 
 /// The summary's corner section: per run (angle, strategy, kind, shaper), the planned corner speed,
 /// the commanded corner rounding and the toolhead's contour error.
-fn summary_section(runs: &[RunSpec], table: &RunsTable) -> String {
+fn summary_section(runs: &dyn RunList, table: &RunsColumns) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -199,8 +200,8 @@ the corner point.\n"
     let _ = writeln!(out, "|---:|---:|---|---|---|---:|---:|---:|---:|---:|");
     // The shaper of a run: its type and frequency, `none` without a [shaper] table.
     let shaper = |row: usize| match (
-        table.cell(row, "shaper_type"),
-        table.cell(row, "shaper_frequency_hz"),
+        table.cell(row, "shaper_type").as_deref(),
+        table.cell(row, "shaper_frequency_hz").as_deref(),
     ) {
         (Some("none"), _) | (None, _) => "none".to_string(),
         (Some(t), Some(f)) => format!("{t} {f} Hz"),

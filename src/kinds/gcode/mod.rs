@@ -66,6 +66,7 @@ use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
 use crate::spec::backend::Backend;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 use crate::spec::value::Value;
 use contour::ActiveMoves;
 use stats::Histogram;
@@ -499,7 +500,7 @@ impl Kind for GcodeRun {
         })
     }
 
-    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+    fn columns(&self, runs: &dyn RunList) -> Vec<String> {
         if !any_has::<GcodeJob>(runs) {
             return Vec::new();
         }

@@ -40,11 +40,12 @@ use settle_planner::shaper::Shaper;
 use settle_planner::{PlanError, Profile, State, Trajectory};
 
 use crate::error::Error;
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
 use crate::kinds::{Kind, KindState, PlanContext, Planned, PlotColumn, Role};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 pub use step_metrics::{StepProbe, step_metrics};
 pub use table::ScanSpec;
@@ -190,7 +191,7 @@ impl Kind for ScanStep {
 
     /// The columns, named from the first scan run's bands, so the header never depends on
     /// results; [`step_metrics()`] fills them.
-    fn columns(&self, runs: &[RunSpec]) -> Vec<String> {
+    fn columns(&self, runs: &dyn RunList) -> Vec<String> {
         runs.iter()
             .find(|r| r.state::<ScanSpec>().is_some())
             .map(|r| column_names(&r.bands_um))
@@ -212,7 +213,7 @@ impl Kind for ScanStep {
             .collect()
     }
 
-    fn summary(&self, runs: &[RunSpec], table: &RunsTable) -> Option<String> {
+    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
         table
             .column("scan_reentry_error_um")
             .map(|_| summary::section(runs, table))

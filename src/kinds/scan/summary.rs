@@ -2,15 +2,15 @@
 
 use std::fmt::Write as _;
 
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::spec::groups::SweptGroups;
-use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 
 /// The summary's scan section (for a table with the scan columns): per band, the
 /// step-axis error at re-entry for every kind side by side, settled or not, with the
 /// window and the step's settle time. Read from the runs table, like the rest of the
 /// summary, so a merged sweep's summary is the same.
-pub fn section(runs: &[RunSpec], table: &RunsTable) -> String {
+pub fn section(runs: &dyn RunList, table: &RunsColumns) -> String {
     let mut out = String::new();
     let SweptGroups {
         kinds,
@@ -42,7 +42,7 @@ exit). The move is the step-over (`move.distance_mm`).\n",
             let cell =
                 idx.iter()
                     .copied()
-                    .find(|&i| runs[i].profile == *k)
+                    .find(|&i| runs.at(i).profile == *k)
                     .map_or("-".to_string(), |i| {
                         if table.cell(i, "status").is_some_and(|s| s != "ok") {
                             return "lost steps".to_string();

@@ -169,6 +169,30 @@ fn inline_svg(svg: &str) -> &str {
     s
 }
 
+/// The SVG file at `path`, inline ([`inline_svg`]), copied a line at a time: a figure of
+/// many runs (a marker per run) is never held whole. Its head (whole lines, the whole
+/// file when it is under 64 KB) is trimmed as [`inline_svg`] trims a document.
+fn push_svg_file(out: &mut impl Out, path: &std::path::Path) -> Result<(), Error> {
+    use std::io::BufRead as _;
+    let file = std::fs::File::open(path).map_err(|e| Error::read(path, e))?;
+    let mut r = std::io::BufReader::new(file);
+    let mut head = String::new();
+    while head.len() < 1 << 16 {
+        if r.read_line(&mut head).map_err(|e| Error::read(path, e))? == 0 {
+            break;
+        }
+    }
+    out.push_str(inline_svg(&head));
+    let mut line = String::new();
+    loop {
+        line.clear();
+        if r.read_line(&mut line).map_err(|e| Error::read(path, e))? == 0 {
+            return Ok(());
+        }
+        out.push_str(&line);
+    }
+}
+
 fn push_figures(out: &mut impl Out, figures: &[Figure]) -> Result<(), Error> {
     if figures.is_empty() {
         return Ok(());
@@ -178,10 +202,7 @@ fn push_figures(out: &mut impl Out, figures: &[Figure]) -> Result<(), Error> {
         let _ = write!(out, "<figure id=\"figure-{}\">\n<div class=\"img\">", i + 1);
         match &f.image {
             Image::Svg(svg) => out.push_str(inline_svg(svg)),
-            Image::SvgFile(path) => {
-                let svg = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
-                out.push_str(inline_svg(&svg));
-            }
+            Image::SvgFile(path) => push_svg_file(out, path)?,
             Image::Png(bytes) => {
                 let _ = write!(
                     out,

@@ -459,9 +459,11 @@ mod tests {
             has_current: true,
             current_label: Some("c28".into()),
             shapers: false,
+            candidates: Vec::new(),
             bands: vec![Band {
                 band_um: 10.0,
                 points: Vec::new(),
+                order: Vec::new(),
                 winner: Some(Winner {
                     label: "c0".into(),
                     total_s: 0.1,

@@ -13,6 +13,7 @@ pub mod identify;
 pub mod jobs;
 pub mod ringing;
 pub mod scan_trace;
+pub mod svg_stream;
 pub mod sweep;
 pub mod trace;
 
@@ -179,7 +180,7 @@ fn legend_columns(f: &Figure) -> usize {
 /// Height of one row of a figure legend (px).
 const LEGEND_ROW_PX: u32 = 26;
 
-fn init_fonts() {
+pub(crate) fn init_fonts() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The embedded font is valid TrueType; if registration failed anyway, text would be
@@ -716,13 +717,19 @@ pub fn write(f: &Figure, dir: &Path, stem: &str) -> Result<(), Error> {
         source: std::io::Error::other(e),
     };
     let svg = dir.join(format!("{stem}.svg"));
-    let mut text = String::new();
-    draw_figure(
-        SVGBackend::with_string(&mut text, size).into_drawing_area(),
-        f,
-    )
-    .map_err(|e| fail(&svg, e))?;
-    crate::output::atomic::write_atomic(&svg, text.as_bytes())?;
+    // Written as it is drawn: a figure of many runs is never held as text.
+    crate::output::atomic::write_atomic_with(&svg, |w| {
+        let error = std::cell::RefCell::new(None);
+        let drawn = draw_figure(
+            svg_stream::SvgStream::new(w, size, &error).into_drawing_area(),
+            f,
+        );
+        match (drawn, error.into_inner()) {
+            (_, Some(e)) => Err(Error::write(&svg, e)),
+            (Err(e), None) => Err(fail(&svg, e)),
+            (Ok(()), None) => Ok(()),
+        }
+    })?;
     let png = dir.join(format!("{stem}.png"));
     // The bitmap encoder picks the format from the extension: keep `.png` last.
     let tmp = dir.join(format!(".{stem}.tmp{}.png", std::process::id()));

@@ -20,16 +20,17 @@ use plotters::style::RGBColor;
 
 use super::{Figure, LegendEntry, Line, Marker, PALETTE, Panel, fmt_num};
 use crate::error::Error;
-use crate::input::runs_table::RunsTable;
+use crate::input::runs_columns::RunsColumns;
 use crate::kinds::{self, PlotColumn};
 use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
 use crate::spec::value::Value;
 
 /// The panels of a sweep figure: a run kind's that replace the common ones when the table
 /// has them (a scan's step-axis panels: the common ones would measure the run-out), else the
 /// common ones (per band the settle and move-and-settle times, the residual peak and RMS)
 /// and the other kinds' (a corner's contour error); only columns the table has.
-fn columns(bands: &[f64], table: &RunsTable) -> Vec<PlotColumn> {
+fn columns(bands: &[f64], table: &RunsColumns) -> Vec<PlotColumn> {
     let present = |p: &PlotColumn| table.column(&p.column).is_some();
     for k in kinds::all().iter().filter(|k| k.replaces_move_tables()) {
         let own: Vec<PlotColumn> = k.figures(bands).into_iter().filter(present).collect();
@@ -91,7 +92,7 @@ fn number(v: &Value) -> Option<f64> {
 }
 
 /// The swept numeric parameters of a sweep, in axis order.
-pub fn numeric_params(runs: &[RunSpec]) -> Vec<String> {
+pub fn numeric_params(runs: &dyn RunList) -> Vec<String> {
     runs.first()
         .map(|r| {
             r.swept
@@ -107,14 +108,14 @@ pub fn numeric_params(runs: &[RunSpec]) -> Vec<String> {
 const MAX_LINES: usize = 16;
 
 /// The lines of one metric against `param`.
-fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &PlotColumn) -> Vec<Line> {
+fn lines(runs: &dyn RunList, table: &RunsColumns, param: &str, m: &PlotColumn) -> Vec<Line> {
     let mut kinds: Vec<ProfileKind> = Vec::new();
     let mut combos: Vec<String> = Vec::new();
-    for r in runs {
+    for r in runs.iter() {
         if !kinds.contains(&r.profile) {
             kinds.push(r.profile);
         }
-        let c = other_label(r, param);
+        let c = other_label(&r, param);
         if !combos.contains(&c) {
             combos.push(c);
         }
@@ -136,7 +137,7 @@ fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &PlotColumn) -> Ve
                     .iter()
                     .enumerate()
                     .filter(|(_, r)| r.profile == *k && other_label(r, param) == *c)
-                    .filter_map(|(i, r)| Some((x_of(r)?, value(i)?)))
+                    .filter_map(|(i, r)| Some((x_of(&r)?, value(i)?)))
                     .collect();
                 pts.sort_by(|a, b| a.0.total_cmp(&b.0));
                 let label = if c.is_empty() {
@@ -155,7 +156,7 @@ fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &PlotColumn) -> Ve
     for (ki, k) in kinds.iter().enumerate() {
         let color = PALETTE[ki % PALETTE.len()];
         // Median over the other parameters, min-max band.
-        let mut xs: Vec<f64> = runs.iter().filter_map(x_of).collect();
+        let mut xs: Vec<f64> = runs.iter().filter_map(|r| x_of(&r)).collect();
         xs.sort_by(f64::total_cmp);
         xs.dedup();
         let mut pts = Vec::new();
@@ -183,13 +184,13 @@ fn lines(runs: &[RunSpec], table: &RunsTable, param: &str, m: &PlotColumn) -> Ve
                 band.push((x, *lo, *hi));
             }
         }
-        let others: Vec<&str> = runs
+        let others: Vec<String> = runs
             .first()
             .map(|r| {
                 r.swept
                     .iter()
                     .filter(|(p, v)| p != param && !matches!(v, Value::Kind(_)))
-                    .map(|(p, _)| p.as_str())
+                    .map(|(p, _)| p.clone())
                     .collect()
             })
             .unwrap_or_default();
@@ -229,7 +230,7 @@ fn other_label(r: &RunSpec, param: &str) -> String {
 }
 
 /// The figure of `param`.
-pub fn figure(scenario: &str, runs: &[RunSpec], table: &RunsTable, param: &str) -> Figure {
+pub fn figure(scenario: &str, runs: &dyn RunList, table: &RunsColumns, param: &str) -> Figure {
     let bands = runs.first().map(|r| r.bands_um.clone()).unwrap_or_default();
     let xs: Vec<f64> = runs
         .iter()
@@ -315,11 +316,11 @@ pub fn figure(scenario: &str, runs: &[RunSpec], table: &RunsTable, param: &str) 
 pub fn write_all(
     dir: &Path,
     scenario: &str,
-    runs: &[RunSpec],
-    table: &RunsTable,
+    runs: &dyn RunList,
+    table: &RunsColumns,
 ) -> Result<Vec<crate::output::summary::Figure>, Error> {
     let params = numeric_params(runs);
-    if params.is_empty() || table.rows.is_empty() {
+    if params.is_empty() || table.is_empty() {
         return Ok(Vec::new());
     }
     crate::output::atomic::create_dir(dir)?;

@@ -69,8 +69,7 @@ pub fn record_run(spec: &RunSpec) -> Result<(Series, Metrics), Error> {
 
 /// The `runs.csv` row of one run, as a table.
 pub fn row_of(spec: &RunSpec, m: &Metrics) -> RunsTable {
-    let csv =
-        crate::output::runs_csv::runs_csv(std::slice::from_ref(spec), std::slice::from_ref(m));
+    let csv = crate::output::runs_csv::runs_csv(&vec![spec.clone()], std::slice::from_ref(m));
     // runs_csv writes one header and one row of plain cells: this cannot fail.
     RunsTable::parse(&csv).unwrap_or_default()
 }
