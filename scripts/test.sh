@@ -10,11 +10,18 @@
 # Builds, and what they share (the cargo profiles are in Cargo.toml):
 #   - clippy (default features), clippy with MuJoCo (only settle-sim and the crates that
 #     depend on it change with the feature; everything else is reused), `cargo doc`: type
-#     checking only, one set of dependency metadata for all three;
+#     checking only, one set of dependency metadata for all three, in profile `ci` like the
+#     test build: the build scripts and proc macros (syn, serde_derive, clap_derive, the C++
+#     build of the `ruckig` dev-dependency, zstd's C library, ...) are built once, for the
+#     four builds (in profile `dev` they would be built optimised, its `package."*"`
+#     override outranking `build-override`, and then again for the test build). What the
+#     profile changes for the lints: code under `#[cfg(debug_assertions)]` is not compiled,
+#     so not linted (the workspace has none; `debug_assert!` is still checked);
 #   - profile `ci` (optimised like release, without LTO or debug info): every test of the
 #     workspace, then the regression gate with the `settle` binary the tests built;
 #   - profile `ci-rerun` (unoptimised: the rerun test writes one small recording): the
-#     `rerun` feature's build and its test;
+#     `rerun` feature's build (rerun's `re_sdk`, not the `rerun` crate that wraps it) and its
+#     test;
 #   - scripts/fuzz.sh: in "$CARGO_TARGET_DIR-fuzz", settle's crates libFuzzer-instrumented
 #     at optimisation level 1, every other crate plain at level 0 (7.7 and 9.9 CPU-minutes
 #     cold instead of 12.1 and 13.5 with everything instrumented at level 1).
@@ -94,14 +101,14 @@ phase "cargo fmt --check"
 cargo fmt --all -- --check
 
 phase "cargo clippy (default features)"
-cargo clippy --workspace --all-targets --locked -- -D warnings
+cargo clippy --workspace --all-targets --profile ci --locked -- -D warnings
 if [[ ${#features[@]} -gt 0 ]]; then
   phase "cargo clippy (with MuJoCo: rechecks what the feature changes)"
-  cargo clippy --workspace --all-targets --locked "${features[@]}" -- -D warnings
+  cargo clippy --workspace --all-targets --profile ci --locked "${features[@]}" -- -D warnings
 fi
 
 phase "cargo doc --no-deps (warnings are errors)"
-RUSTDOCFLAGS="${RUSTDOCFLAGS:-} -D warnings" cargo doc --workspace --no-deps --locked "${features[@]}"
+RUSTDOCFLAGS="${RUSTDOCFLAGS:-} -D warnings" cargo doc --workspace --no-deps --profile ci --locked "${features[@]}"
 
 phase "the book: mdbook build docs and its internal links (scripts/check-docs.sh)"
 scripts/check-docs.sh

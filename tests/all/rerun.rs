@@ -14,8 +14,8 @@ fn settle(args: &[&str]) -> std::process::Output {
 fn rrd_holds_every_channel_and_sample() {
     use std::collections::BTreeMap;
 
-    use rerun::external::re_log_encoding::DecoderApp;
-    use rerun::log::{Chunk, LogMsg};
+    use re_sdk::external::re_log_encoding::DecoderApp;
+    use re_sdk::log::{Chunk, LogMsg};
 
     let dir = tempfile::tempdir().expect("tempdir");
     let trace = dir.path().join("run-1.csv");

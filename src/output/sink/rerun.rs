@@ -33,7 +33,8 @@ fn markdown_row(rec: &RunRecord) -> String {
 /// Write one run to the file `path` (a temporary file, then a rename).
 #[cfg(feature = "rerun")]
 pub fn write_file(path: &Path, p: &Provenance, rec: &RunRecord) -> Result<(), Error> {
-    use rerun::{RecordingStreamBuilder, Scalars, TextDocument, TimeColumn};
+    use re_sdk::{RecordingStreamBuilder, log::TimeColumn};
+    use re_sdk_types::archetypes::{Scalars, TextDocument};
 
     let err = |e: String| Error::Write {
         path: path.to_path_buf(),
