@@ -167,10 +167,6 @@ fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)
 
 /// Read the current settings of a firmware configuration.
 pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
-    let note = |n: &settle_gcode::config::ConfigNote| match &n.at {
-        Some(at) => format!("{at}: {}", n.text),
-        None => n.text.clone(),
-    };
     match firmware {
         Firmware::Klipper => {
             let c = KlipperConfig::read(path).map_err(|e| config_error(path, e))?;
@@ -189,7 +185,7 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                 vmax_mm_s: c.printer.max_velocity_mm_s,
                 amax_mm_s2: c.printer.max_accel_mm_s2,
                 axes,
-                notes: c.notes.iter().map(note).collect(),
+                notes: c.notes.iter().map(ToString::to_string).collect(),
             })
         }
         Firmware::Rrf => {
@@ -211,7 +207,7 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                     .min(c.axes.x.max_accel_mm_s2)
                     .min(c.axes.y.max_accel_mm_s2),
                 axes,
-                notes: c.notes.iter().map(note).collect(),
+                notes: c.notes.iter().map(ToString::to_string).collect(),
             })
         }
         other => Err(Error::input_key(

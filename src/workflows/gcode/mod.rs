@@ -195,22 +195,18 @@ impl GcodeOptions {
         } else {
             Firmware::Klipper
         });
-        let note = |n: &settle_gcode::config::ConfigNote| match &n.at {
-            Some(at) => format!("{at}: {}", n.text),
-            None => n.text.clone(),
-        };
         let (job, notes) = match firmware {
             Firmware::Klipper => {
                 let c = settle_gcode::config::KlipperConfig::read(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
                 let job = JobConfig::from_klipper(&c).map_err(gcode_error(&config))?;
-                (job, c.notes.iter().map(note).collect())
+                (job, c.notes.iter().map(ToString::to_string).collect())
             }
             Firmware::Rrf => {
                 let c = settle_gcode::config::RrfConfig::read(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
                 let job = JobConfig::from_rrf(&c).map_err(gcode_error(&config))?;
-                (job, c.notes.iter().map(note).collect())
+                (job, c.notes.iter().map(ToString::to_string).collect())
             }
             Firmware::Marlin | Firmware::Settle => {
                 return Err(Error::input_key(
