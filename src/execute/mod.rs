@@ -1,11 +1,13 @@
 //! Executing runs: the machine's axes compiled for the run, its motion planned by its run
-//! kind, the one [`sim_options`] every kind's run is simulated with, the simulation loop
-//! ([`simulate`]) on the chosen backend ([`engine`]), the worker pool with progress
+//! kind, the one [`sim_options`] every kind's run is simulated with, the simulation
+//! driver every command runs its plants on ([`driver`]), the plant of the chosen backend
+//! ([`plant`]), a run as the driver's sink ([`simulate`]), the worker pool with progress
 //! reported through a callback ([`pool`]) and interruption ([`interrupt`]).
 
 pub mod cursor;
-pub mod engine;
+pub mod driver;
 pub mod interrupt;
+pub mod plant;
 pub mod pool;
 pub mod simulate;
 
@@ -18,7 +20,8 @@ use crate::spec::backend::{Backend, NO_MUJOCO};
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
 
-pub use engine::{SimOptions, run_trajectory};
+pub use plant::SimOptions;
+pub use simulate::run_trajectory;
 
 /// How a run is observed.
 #[derive(Debug, Clone, PartialEq)]

@@ -28,9 +28,10 @@ use settle_gcode::{GcodeError, Reader, ReaderOptions};
 use settle_planner::{Profile, State};
 use settle_sim::closed_form::LinearResponse;
 use settle_sim::machine::Machine;
-use settle_sim::{AxisModel, DriverMode, ModalPlant, Mode, Plant, RapierOptions, RapierPlant};
+use settle_sim::{AxisModel, DriverMode, Mode};
 
 use crate::error::{Error, Location};
+use crate::execute::SimOptions;
 use crate::input::machine_file::MachineForm;
 use crate::kinds::gcode::linpoint::{LinPoint, depends_on_position, linearisation_point};
 use crate::kinds::gcode::preroll::{preroll_s, slowest_decay_per_s};
@@ -614,43 +615,23 @@ fn simulate(
             .and_then(|j| j.with_preroll_s(sigma.as_ref().map_or(0.0, |&s| preroll_s(s))))
             .map_err(&err)?;
     }
-    let sim_err = |source| Error::Sim { run: 0, source };
-    let dt = 1.0 / opts.sample_rate_hz;
-    let (streamed, rec) = match opts.backend {
-        Backend::Modal => {
-            // Linearised where the print is, the same point for the whole run and any
-            // layer range ([`crate::kinds::gcode::linpoint`]); a range starts at rest in
-            // the commanded state of its pre-roll.
-            let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
-            let mut plant = ModalPlant::new(axes, dt).map_err(sim_err)?;
-            if let Some(p) = &point {
-                plant = plant.linearised_at(p.on_axes(&names)).map_err(sim_err)?;
-            }
-            let init = |starts: &[State]| plant.initial_state(starts);
-            simulate_job(&mut job, &plant, &init, sopts, rec, &opts.file)?
-        }
-        Backend::Rapier => {
-            let plant = RapierPlant::new(
-                axes,
-                RapierOptions {
-                    max_step_s: None,
-                    belt: Default::default(),
-                },
-            )
-            .map_err(sim_err)?;
-            let init = |starts: &[State]| plant.initial_state(starts);
-            simulate_job(&mut job, &plant, &init, sopts, rec, &opts.file)?
-        }
-        #[cfg(feature = "mujoco")]
-        Backend::Mujoco => {
-            let plant =
-                settle_sim::mujoco::MujocoPlant::new(axes, Default::default()).map_err(sim_err)?;
-            let init = |starts: &[State]| plant.initial_state(starts);
-            simulate_job(&mut job, &plant, &init, sopts, rec, &opts.file)?
-        }
-        #[cfg(not(feature = "mujoco"))]
-        Backend::Mujoco => return Err(Error::input("--backend", NO_MUJOCO)),
+    // On the modal backend: linearised where the print is, the same point for the whole
+    // run and any layer range ([`crate::kinds::gcode::linpoint`]); a range starts at rest
+    // in the commanded state of its pre-roll.
+    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+    let options = SimOptions {
+        linearise_at_m: point.as_ref().map(|p| p.on_axes(&names)),
+        ..SimOptions::default()
     };
+    let (streamed, rec) = simulate_job(
+        &mut job,
+        opts.backend,
+        axes,
+        &options,
+        sopts,
+        rec,
+        &opts.file,
+    )?;
     job.run_to_end().map_err(&err)?;
     let summary = job.summary();
     let mut by_layer: BTreeMap<u32, stats::LayerStats> = streamed

@@ -1,13 +1,9 @@
-//! The backends: one trajectory simulated on the plant of a [`Backend`] with the
-//! [`SimOptions`] every backend honours.
+//! The backends: the one constructor from a backend and a machine's axes to a plant, with
+//! the [`SimOptions`] every backend honours. The plant types differ, so what runs on the
+//! plant is a [`Simulation`], generic over them.
 
-use settle_planner::Trajectory;
-use settle_sim::{AxisModel, BeltModel, ModalPlant, RapierOptions, RapierPlant, SimError};
+use settle_sim::{AxisModel, BeltModel, ModalPlant, Plant, RapierOptions, RapierPlant, SimError};
 
-use crate::execute::Observe;
-use crate::execute::simulate::{AxisMeta, channels, simulate};
-use crate::measure::metrics::Metrics;
-use crate::measure::series::Series;
 use crate::spec::backend::Backend;
 #[cfg(not(feature = "mujoco"))]
 use crate::spec::backend::NO_MUJOCO;
@@ -23,45 +19,39 @@ pub struct SimOptions {
     pub max_step_s: Option<f64>,
     /// Where the modal backend linearises a position-dependent stiffness: one position
     /// per axis (m, in the order of the axes); `None`: each axis's start. The run kind
-    /// chooses it ([`crate::kinds::Planned::linearise_at_m`]); the nonlinear backends
-    /// follow the stiffness along the travel and ignore it.
+    /// chooses it ([`crate::kinds::Planned::linearise_at_m`]), `settle gcode` takes the
+    /// print's centre; the nonlinear backends follow the stiffness along the travel and
+    /// ignore it.
     pub linearise_at_m: Option<Vec<f64>>,
 }
 
-/// Simulate `traj` (one profile per axis, in the order of `axes`) on `backend` and measure
-/// it against the trajectory's end point.
-pub fn run_trajectory(
-    axes: Vec<AxisModel>,
+/// What runs on a plant (usually a [`crate::execute::driver::Driver`] and its sink).
+pub trait Simulation {
+    /// What it gives.
+    type Output;
+
+    /// Run on `plant`.
+    fn run<P: Plant>(self, plant: &P) -> Self::Output;
+}
+
+/// Build the plant of `backend` for `axes`, sampled at `sample_rate_hz` (the modal
+/// backend's nominal step), and run `sim` on it. `start_m` is each axis's start position
+/// (m), where MuJoCo freezes a belt's stiffness for [`BeltModel::Frozen`].
+pub fn with_plant<S: Simulation>(
     backend: Backend,
+    axes: Vec<AxisModel>,
     options: &SimOptions,
-    traj: &Trajectory,
-    observe: &Observe,
-    record: Option<&mut Series>,
-) -> Result<Metrics, SimError> {
-    if traj.dof() != axes.len() {
-        return Err(SimError::AxisCount {
-            expected: axes.len(),
-            got: traj.dof(),
-        });
-    }
-    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
-    let record = record.map(|rec| {
-        let mut ch = channels(&axes);
-        if traj.path().is_some() {
-            // Distance from the toolhead to the commanded path.
-            ch.push(("contour_error".into(), "m".into()));
-        }
-        *rec = Series::with_channels(ch);
-        rec
-    });
-    let meta: Vec<AxisMeta> = axes.iter().map(AxisMeta::of).collect();
+    sample_rate_hz: f64,
+    start_m: &[f64],
+    sim: S,
+) -> Result<S::Output, SimError> {
     match backend {
         Backend::Modal => {
-            let mut plant = ModalPlant::new(axes, 1.0 / observe.sample_rate_hz)?;
+            let mut plant = ModalPlant::new(axes, 1.0 / sample_rate_hz)?;
             if let Some(at) = &options.linearise_at_m {
                 plant = plant.linearised_at(at.clone())?;
             }
-            simulate(&plant, &names, &meta, traj, observe, record)
+            Ok(sim.run(&plant))
         }
         Backend::Rapier => {
             let plant = RapierPlant::new(
@@ -71,12 +61,12 @@ pub fn run_trajectory(
                     belt: options.belt,
                 },
             )?;
-            simulate(&plant, &names, &meta, traj, observe, record)
+            Ok(sim.run(&plant))
         }
         #[cfg(feature = "mujoco")]
         Backend::Mujoco => {
             let axes = match options.belt {
-                BeltModel::Frozen => freeze_belts(axes, traj)?,
+                BeltModel::Frozen => freeze_belts(axes, start_m)?,
                 BeltModel::Varying => axes,
             };
             let config = match options.max_step_s {
@@ -89,25 +79,25 @@ pub fn run_trajectory(
                 None => settle_sim::mujoco::MujocoConfig::default(),
             };
             let plant = settle_sim::mujoco::MujocoPlant::new(axes, config)?;
-            simulate(&plant, &names, &meta, traj, observe, record)
+            Ok(sim.run(&plant))
         }
         #[cfg(not(feature = "mujoco"))]
-        Backend::Mujoco => Err(SimError::Unsupported {
-            backend: "mujoco",
-            reason: NO_MUJOCO.into(),
-        }),
+        Backend::Mujoco => {
+            let _ = start_m;
+            Err(SimError::Unsupported {
+                backend: "mujoco",
+                reason: NO_MUJOCO.into(),
+            })
+        }
     }
 }
 
 /// Every position-dependent stiffness fixed at its value at the start equilibrium (the
 /// frozen belt of the linear model) for backends that otherwise vary it.
 #[cfg(feature = "mujoco")]
-fn freeze_belts(
-    mut axes: Vec<settle_sim::AxisModel>,
-    traj: &Trajectory,
-) -> Result<Vec<settle_sim::AxisModel>, SimError> {
-    for (ax, prof) in axes.iter_mut().zip(traj.axes()) {
-        let q0 = settle_sim::rapier::start_equilibrium(ax, prof.start().p)?.0;
+fn freeze_belts(mut axes: Vec<AxisModel>, start_m: &[f64]) -> Result<Vec<AxisModel>, SimError> {
+    for (ax, &p) in axes.iter_mut().zip(start_m) {
+        let q0 = settle_sim::rapier::start_equilibrium(ax, p)?.0;
         for c in &mut ax.lumped.couplings {
             if let Some(i) = c.stiffness.depends_on() {
                 c.stiffness = settle_sim::lumped::Stiffness::Constant(c.stiffness.at(q0[i]));
