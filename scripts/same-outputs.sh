@@ -1,0 +1,157 @@
+#!/usr/bin/env bash
+# Byte-identical outputs of two settle binaries: the proof a refactor changed nothing.
+#
+#   scripts/same-outputs.sh OLD_BIN NEW_BIN
+#
+# Runs the same commands with both binaries, each in a folder of its own (so that the
+# relative paths the outputs print are the same), and compares the folders with `diff -r`:
+# every file written, and every command's stdout, stderr and exit code. The commands:
+#   - `settle sweep` of every scenario in scenarios/ on modal and on rapier (runs.csv,
+#     summary.md, report.html, plots), one with --mcap;
+#   - `settle run` of a few cases with --plot and --mcap (the trace sink);
+#   - `settle check` of every baseline in results/baselines/ (without --update);
+#   - `settle gcode` on every print in gcode/prints/: plain, with --layers (and --mcap),
+#     --versus and --config (Klipper's printer.cfg, RepRapFirmware's config.g), and a layer
+#     on rapier with the full driver model;
+#   - `settle identify` on the example recordings, `settle machine` on the presets and on
+#     what identify wrote, `settle import` of the example configurations, `settle tune` on
+#     the tune scenarios, on the imported printer and with `--criterion klipper`;
+#   - `settle validate --backend rapier`.
+# Sweeps and tunes run with --jobs 2. Exit 0 when everything is the same, 1 with the diff.
+#
+# The old binary's outputs are kept and reused while neither it nor the inputs (this
+# script, scenarios/, gcode/prints/, the example configurations and recordings, the
+# baselines) change: a second comparison runs only the new binary.
+#
+# Environment:
+#   SAME_OUTPUTS_DIR    where the outputs go (default target/same-outputs)
+#   SAME_OUTPUTS_ONLY   an extended regular expression: only the cases whose name matches
+#                       (the old side is then not cached)
+set -euo pipefail
+[[ $# -eq 2 ]] || { echo "usage: $0 OLD_BIN NEW_BIN" >&2; exit 2; }
+cd "$(dirname "$0")/.."
+root=$(pwd)
+abs() { [[ $1 = /* ]] && echo "$1" || echo "$root/$1"; }
+old=$(abs "$1")
+new=$(abs "$2")
+for b in "$old" "$new"; do
+  [[ -x $b ]] || { echo "no executable at $b" >&2; exit 2; }
+done
+dir=$(abs "${SAME_OUTPUTS_DIR:-target/same-outputs}")
+only=${SAME_OUTPUTS_ONLY:-}
+
+S=$root/scenarios
+P=$root/gcode/prints
+VORON=$root/gcode/tests/data/klipper/voron/printer.cfg
+MINI=$root/gcode/tests/data/rrf/mini5plus/sys/config.g
+
+# The cases: NAME then the arguments of one settle command; `@` in an argument is the
+# case's output folder (out/NAME, relative to the side's folder).
+cases() {
+  local s b p stem base
+  for s in "$S"/*.toml; do
+    for b in modal rapier; do
+      echo "sweep-$(basename "$s" .toml)-$b sweep $s --backend $b --jobs 2 --out @"
+    done
+  done
+  echo "sweep-mcap-ci_corners sweep $S/ci_corners.toml --backend modal --jobs 2 --mcap --out @"
+  echo "run-quickstart-modal run $S/quickstart.toml --case 3 --backend modal --plot --mcap --out @/run-3.csv"
+  echo "run-quickstart-rapier run $S/quickstart.toml --case 3 --backend rapier --plot --out @/run-3.csv"
+  echo "run-ci_corners run $S/ci_corners.toml --case 3 --backend rapier --plot --out @/run-3.csv"
+  echo "run-ci_scan run $S/ci_scan.toml --case 5 --backend modal --plot --out @/run-5.csv"
+  echo "run-shapers run $S/shapers.toml --case 4 --backend modal --plot --out @/run-4.csv"
+  echo "run-gcode_corner run $S/gcode_corner.toml --case 0 --backend modal --plot --out @/run-0.csv"
+  for base in "$root"/results/baselines/*.csv; do
+    stem=$(basename "$base" .csv)
+    echo "check-$stem check $S/${stem%.*}.toml --baseline $base --jobs 2"
+  done
+  echo "identify identify $root/examples/data/raw_data_x_example.csv $root/examples/data/raw_data_y_example.csv --freq-start 30 --freq-end 90 --hz-per-sec 10 --out @/machine.toml"
+  for p in "$P"/*.gcode; do
+    stem=$(basename "$p" .gcode)
+    echo "gcode-$stem gcode $p --machine printer_xy --firmware klipper --shaper mzv@48 --out @"
+    echo "gcode-$stem-layers gcode $p --machine printer_xy --shaper x=mzv@52,y=ei@41/0.08 --layers 0..1 --mcap --out @"
+    echo "gcode-$stem-versus gcode $p --machine printer_xy --firmware klipper --shaper mzv@48 --versus settle:none --maps 2 --out @"
+    echo "gcode-$stem-config gcode $p --machine printer_xy --config $VORON --versus klipper:none --out @"
+    echo "gcode-$stem-rrf gcode $p --machine printer_xy --config $MINI --out @"
+    echo "gcode-$stem-marlin gcode $p --machine $S/printer_xy.toml --firmware marlin --out @"
+    echo "gcode-$stem-rapier gcode $p --machine printer_xy --backend rapier --driver full --layers 1..1 --out @"
+  done
+  echo "gcode-corner-modes gcode $S/gcode_corner.gcode --machine out/identify/machine.toml --firmware settle --out @"
+  echo "machine-printer_xy machine printer_xy"
+  echo "machine-leadscrew_stage machine leadscrew_stage"
+  echo "machine-scenario machine $S/scan_machines.toml"
+  echo "machine-identified machine out/identify/machine.toml"
+  echo "import-voron import klipper $VORON --out @/printer.toml"
+  echo "import-voron-identified import klipper $VORON --machine out/identify/machine.toml --out @/printer.toml"
+  echo "import-mini import rrf $MINI --out @/printer.toml"
+  for s in "$S"/tune_*.toml; do
+    echo "tune-$(basename "$s" .toml) tune $s --jobs 2 --out @"
+  done
+  echo "tune-printer-checked tune $S/tune_printer.toml --check-on rapier --jobs 2 --out @"
+  echo "tune-imported tune out/import-voron-identified/printer.toml --jobs 2 --out @"
+  echo "tune-imported-rrf tune out/import-mini/printer.toml --firmware rrf --jobs 2 --out @"
+  echo "tune-klipper-criterion tune --criterion klipper $root/planner/tests/data/klipper_two_peaks.csv"
+  echo "validate-rapier validate --backend rapier --out @/validate.md"
+}
+
+# Run every case with binary $1, then move the results to folder $2. Both sides run in
+# the same folder ($dir/run), so that absolute paths written into outputs (the machine file
+# an imported scenario names) are the same.
+run_side() {
+  local bin=$1 dest=$2 side=$dir/run name args a out i=0 total start
+  total=$(cases | grep -cE "^(${only:-.*}) " || true)
+  rm -rf "$side" "$dest"
+  mkdir -p "$side/out" "$side/status"
+  while read -r name args; do
+    [[ -z $only || $name =~ ^($only)$ ]] || continue
+    i=$((i + 1))
+    out=out/$name
+    mkdir -p "$side/$out"
+    local argv=()
+    for a in $args; do
+      argv+=("${a//@/$out}")
+    done
+    start=$(date +%s)
+    set +e
+    (cd "$side" && "$bin" "${argv[@]}" </dev/null >"status/$name.stdout" 2>"status/$name.stderr")
+    echo $? >"$side/status/$name.exit"
+    set -e
+    echo "   [$i/$total] $name: exit $(cat "$side/status/$name.exit") ($(($(date +%s) - start)) s)"
+  done < <(cases)
+  mv "$side" "$dest"
+}
+
+# The wall-clock times the commands report on stderr ("16 runs in 0.05 s", "48 rows, 0
+# failed (2.0 s)") are no output: blanked in both sides before they are compared.
+blank_times() {
+  sed -i -E 's/([0-9]+ runs? in )[0-9.]+ s/\1<time> s/g; s/\([0-9.]+ s\)/(<time> s)/g' "$1"/status/*.stderr
+}
+
+# The identity of the inputs the old side's outputs depend on.
+key=$( (sha256sum <"$old"; cases; find scenarios gcode/prints gcode/tests/data examples/data \
+  planner/tests/data results/baselines -type f -print0 | sort -z | xargs -0 sha256sum) |
+  sha256sum | cut -c1-16)
+old_side=$dir/old-$key
+if [[ -n $only ]]; then
+  old_side=$dir/old-partial
+fi
+mkdir -p "$dir"
+if [[ -n $only || ! -f $old_side/done ]]; then
+  echo "== old: $old"
+  run_side "$old" "$old_side"
+  [[ -n $only ]] || touch "$old_side/done"
+else
+  echo "== old: $old (outputs kept in $old_side)"
+fi
+echo "== new: $new"
+run_side "$new" "$dir/new"
+blank_times "$old_side"
+blank_times "$dir/new"
+echo "== diff -r $old_side $dir/new"
+if diff -r -x done "$old_side" "$dir/new" >"$dir/diff.txt"; then
+  echo "same outputs: $(find "$dir/new/out" -type f | wc -l) files and $(find "$dir/new/status" -name '*.exit' | wc -l) commands' stdout, stderr and exit code"
+else
+  head -100 "$dir/diff.txt"
+  echo "DIFFERENT (the whole diff: $dir/diff.txt)" >&2
+  exit 1
+fi
