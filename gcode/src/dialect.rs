@@ -17,9 +17,8 @@
 //! | M92 M350 M906 M208 M669 M98 M501 | not commands (`printer.cfg` holds these settings) | counted as ignored | [`crate::Setting`]s and macro-call notes (`config.g`) |
 
 use std::fmt;
-use std::str::FromStr;
 
-use crate::GcodeError;
+use settle_planner::firmware::Firmware;
 
 /// The firmware whose G-code conventions the reader follows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -36,13 +35,29 @@ impl Dialect {
     /// All dialects, in a fixed order.
     pub const ALL: [Dialect; 3] = [Dialect::Klipper, Dialect::Marlin, Dialect::Rrf];
 
-    /// The name used on the command line and in files (`klipper`, `marlin`, `rrf`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Dialect::Klipper => "klipper",
-            Dialect::Marlin => "marlin",
-            Dialect::Rrf => "rrf",
+    /// The dialect a file for `firmware`'s planner is read in: its own, and Marlin's for
+    /// settle's planner (most slicers write Marlin-flavoured G-code) and for a firmware
+    /// that reads no G-code.
+    pub fn of(firmware: Firmware) -> Self {
+        match firmware {
+            Firmware::Klipper => Dialect::Klipper,
+            Firmware::Rrf => Dialect::Rrf,
+            Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => Dialect::Marlin,
         }
+    }
+
+    /// The firmware whose conventions these are.
+    pub fn firmware(self) -> Firmware {
+        match self {
+            Dialect::Klipper => Firmware::Klipper,
+            Dialect::Marlin => Firmware::Marlin,
+            Dialect::Rrf => Firmware::Rrf,
+        }
+    }
+
+    /// Its firmware's name (`klipper`, `marlin`, `rrf`).
+    pub fn name(self) -> &'static str {
+        self.firmware().name()
     }
 
     /// The feed rate in force before the file sets one, mm/s (see the module table).
@@ -57,20 +72,5 @@ impl Dialect {
 impl fmt::Display for Dialect {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
-    }
-}
-
-impl FromStr for Dialect {
-    type Err = GcodeError;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "klipper" => Ok(Dialect::Klipper),
-            "marlin" => Ok(Dialect::Marlin),
-            "rrf" | "reprapfirmware" | "duet" => Ok(Dialect::Rrf),
-            _ => Err(GcodeError::UnknownDialect {
-                name: s.to_string(),
-            }),
-        }
     }
 }

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use settle::spec::backend::Backend;
 use settle::workflows::gcode::{GcodeOptions, gcode, measure, parse_shaper};
-use settle_gcode::job::Firmware;
+use settle_planner::firmware::Firmware;
 
 use crate::support::{extra, root, settle, write};
 

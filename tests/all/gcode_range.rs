@@ -8,7 +8,7 @@ use std::process::Command;
 use serde_json::Value;
 use settle::kinds::gcode::preroll::{preroll_s, slowest_decay_per_s};
 use settle::workflows::gcode::{GcodeOptions, measure};
-use settle_gcode::job::Firmware;
+use settle_planner::firmware::Firmware;
 
 use crate::support::{extra, root, settle, write};
 

@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use settle::spec::backend::Backend;
 use settle::workflows::import::{ImportOptions, import};
-use settle::workflows::tune::firmware::Firmware;
 use settle::workflows::tune::{Options, tune_with};
+use settle_planner::firmware::Firmware;
 
 /// A small Klipper configuration: cartesian, its current shapers on X and Y.
 const PRINTER_CFG: &str = "[printer]

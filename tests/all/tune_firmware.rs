@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use settle::spec::backend::Backend;
 use settle::workflows::tune::{Options, tune_axis};
 use settle_planner::ProfileKind;
-use settle_planner::shaper::Firmware as ShaperFirmware;
+use settle_planner::firmware::Firmware;
 
 use crate::support::{root, write};
 
@@ -53,9 +53,9 @@ fn firmware_restricts_the_candidates() {
     let dir = tempfile::tempdir().expect("tempdir");
     let small = "frequency_scales = [1.0]\njerk_steps = 1\n";
     for (fw, shaper_fw) in [
-        ("klipper", Some(ShaperFirmware::Klipper)),
-        ("marlin", Some(ShaperFirmware::Marlin)),
-        ("rrf", Some(ShaperFirmware::Rrf)),
+        ("klipper", Some(Firmware::Klipper)),
+        ("marlin", Some(Firmware::Marlin)),
+        ("rrf", Some(Firmware::Rrf)),
         ("tmc4361a", None),
     ] {
         let o = run(

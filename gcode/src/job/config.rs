@@ -2,14 +2,11 @@
 //! how arcs are cut, as plain data (the harness fills it from a machine or preset, or from
 //! an imported printer.cfg / config.g).
 
-use std::fmt;
-use std::str::FromStr;
-
-use settle_planner::firmware::Kinematics;
 use settle_planner::firmware::klipper::KlipperConfig;
 use settle_planner::firmware::marlin::MarlinConfig;
 use settle_planner::firmware::profiles::ProfileOptions;
 use settle_planner::firmware::rrf::RrfConfig;
+use settle_planner::firmware::{Firmware, Kinematics};
 use settle_planner::path::junction::Junction;
 use settle_planner::path::{CornerStrategy, PathOptions};
 use settle_planner::shaper::stream::Alignment;
@@ -18,70 +15,15 @@ use settle_planner::{Limits, PlanError, ProfileKind};
 
 use crate::{ArcSegmentation, Dialect, GcodeError};
 
-/// Whose planner runs the job.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Firmware {
-    /// Klipper's toolhead planner.
-    Klipper,
-    /// Marlin's planner and stepper.
-    Marlin,
-    /// RepRapFirmware's planner.
-    Rrf,
-    /// settle's own jerk-limited look-ahead ([`settle_planner::path`]).
-    Settle,
-}
-
-impl Firmware {
-    /// Every firmware, in a fixed order.
-    pub const ALL: [Firmware; 4] = [
-        Firmware::Klipper,
-        Firmware::Marlin,
-        Firmware::Rrf,
-        Firmware::Settle,
-    ];
-
-    /// The name on the command line (`klipper`, `marlin`, `rrf`, `settle`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Firmware::Klipper => "klipper",
-            Firmware::Marlin => "marlin",
-            Firmware::Rrf => "rrf",
-            Firmware::Settle => "settle",
+/// A firmware by name, for a G-code job: one of [`Firmware::GCODE`] (klipper, marlin,
+/// rrf, settle; `reprapfirmware` and `duet` are rrf).
+pub fn parse_firmware(name: &str) -> Result<Firmware, GcodeError> {
+    Firmware::parse_among(name, &Firmware::GCODE, "a G-code planner").map_err(|reason| {
+        GcodeError::JobSetting {
+            key: "firmware",
+            reason,
         }
-    }
-
-    /// The G-code dialect a file for this firmware is read in (settle's planner reads
-    /// Marlin-flavoured G-code unless told otherwise: most slicers write it).
-    pub fn dialect(self) -> Dialect {
-        match self {
-            Firmware::Klipper => Dialect::Klipper,
-            Firmware::Marlin | Firmware::Settle => Dialect::Marlin,
-            Firmware::Rrf => Dialect::Rrf,
-        }
-    }
-}
-
-impl fmt::Display for Firmware {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Firmware {
-    type Err = GcodeError;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "klipper" => Ok(Firmware::Klipper),
-            "marlin" => Ok(Firmware::Marlin),
-            "rrf" | "reprapfirmware" | "duet" => Ok(Firmware::Rrf),
-            "settle" => Ok(Firmware::Settle),
-            _ => Err(GcodeError::JobSetting {
-                key: "firmware",
-                reason: format!("unknown firmware `{s}` (allowed: klipper, marlin, rrf, settle)"),
-            }),
-        }
-    }
+    })
 }
 
 /// An input shaper on one axis: which, and the mode it is tuned to.
@@ -212,8 +154,17 @@ impl JobConfig {
                     reason: e.to_string(),
                 })?)
             }
+            Firmware::Tmc4361a => {
+                return Err(GcodeError::JobSetting {
+                    key: "firmware",
+                    reason: format!(
+                        "{firmware} is a motion controller: it plans no G-code job; allowed: {}",
+                        Firmware::names(&Firmware::GCODE)
+                    ),
+                });
+            }
         };
-        let dialect = firmware.dialect();
+        let dialect = Dialect::of(firmware);
         Ok(Self {
             planner,
             dialect,

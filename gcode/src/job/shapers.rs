@@ -16,8 +16,9 @@
 
 use settle_planner::shaper::{MarlinShaper, RrfShaper, ShaperKind};
 
-use super::config::{Firmware, ShaperSetting};
+use super::config::ShaperSetting;
 use crate::limits::{AxisFlags, FtShaper, LimitChange};
+use settle_planner::firmware::Firmware;
 
 /// One axis's shaper state as its firmware keeps it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,7 +64,7 @@ impl ShaperState {
         let (default_kind, default_f, default_z) = match firmware {
             Firmware::Rrf => (None, 40.0, 0.1),
             Firmware::Klipper => (Some(ShaperKind::MZV), 0.0, 0.1),
-            Firmware::Marlin | Firmware::Settle => (None, 0.0, 0.1),
+            Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => (None, 0.0, 0.1),
         };
         let axes = initial.map(|s| match s {
             Some(s) => Axis {

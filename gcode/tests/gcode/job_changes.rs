@@ -3,7 +3,8 @@
 //! shapers' flush delays) and shapes what follows with the new shaper, the motion before
 //! keeping the old one.
 
-use settle_gcode::job::{Firmware, JobChunk, JobConfig, PlannerConfig, ShaperSetting};
+use settle_gcode::job::{JobChunk, JobConfig, PlannerConfig, ShaperSetting};
+use settle_planner::firmware::Firmware;
 use settle_planner::firmware::klipper::KlipperConfig;
 use settle_planner::firmware::marlin::{MarlinConfig, MarlinPlanner};
 use settle_planner::firmware::rrf::RrfConfig;

@@ -62,8 +62,10 @@ mod planned;
 pub mod profiles;
 pub mod rrf;
 mod timeline;
+mod which;
 
 pub use planned::{MAX_PHASES, PathState, Phase, PlannedMove, RampShape};
+pub use which::Firmware;
 
 use crate::PlanError;
 

@@ -9,16 +9,7 @@
 
 use std::fmt;
 
-/// The firmware whose definition a shaper follows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Firmware {
-    /// Klipper (klippy/extras/shaper_defs.py).
-    Klipper,
-    /// Marlin's FT_MOTION (Marlin/src/module/ft_motion/shaping.cpp, M493).
-    Marlin,
-    /// RepRapFirmware's M593 (src/Movement/AxisShaper.cpp).
-    Rrf,
-}
+use crate::firmware::Firmware;
 
 /// Marlin FT_MOTION's shaper families (`ftMotionShaper_t`; M493 `C1`..`C8`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -241,7 +232,7 @@ impl ShaperKind {
         }
     }
 
-    /// The firmware whose definition this is.
+    /// The firmware whose definition this is (Klipper, Marlin or RepRapFirmware).
     pub fn firmware(self) -> Firmware {
         match self {
             ShaperKind::Marlin { .. } => Firmware::Marlin,

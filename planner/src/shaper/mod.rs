@@ -31,8 +31,8 @@ pub mod stream;
 mod tests;
 
 pub use kind::{
-    Firmware, KLIPPER_DEFAULT_DAMPING_RATIO, KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL,
-    MarlinShaper, RRF_STEP_CLOCK_HZ, RrfShaper, ShaperKind,
+    KLIPPER_DEFAULT_DAMPING_RATIO, KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL, MarlinShaper,
+    RRF_STEP_CLOCK_HZ, RrfShaper, ShaperKind,
 };
 pub use response::{remaining_vibration, smoothing_mm};
 

@@ -3,7 +3,8 @@
 //! allowed.
 
 use settle_planner::PlanError;
-use settle_planner::shaper::{Firmware, MarlinShaper, RrfShaper, ShaperKind};
+use settle_planner::firmware::Firmware;
+use settle_planner::shaper::{MarlinShaper, RrfShaper, ShaperKind};
 
 #[test]
 fn display_round_trips_for_every_family_and_parameters() {

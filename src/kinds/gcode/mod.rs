@@ -51,8 +51,9 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use serde::Deserialize;
-use settle_gcode::job::{Firmware, Job, JobConfig, MoveInfo, PlannerConfig, ShaperSetting};
-use settle_gcode::{GcodeError, MoveKind, Reader, ReaderOptions};
+use settle_gcode::job::{Job, JobConfig, MoveInfo, PlannerConfig, ShaperSetting, parse_firmware};
+use settle_planner::firmware::Firmware;
+use settle_gcode::{MoveKind, Reader, ReaderOptions};
 use settle_planner::path::CornerStrategy;
 use settle_planner::path::junction::Junction;
 use settle_planner::shaper::stream::cut;
@@ -131,10 +132,13 @@ impl KindState for GcodeJob {
     fn set(&mut self, key: &str, value: &Value) -> Result<(), String> {
         match (key, value) {
             ("firmware", Value::Text(t)) => {
-                self.firmware = t.parse().map_err(|e: GcodeError| e.to_string())?;
+                self.firmware = parse_firmware(t).map_err(|e| e.to_string())?;
             }
             ("firmware", _) => {
-                return Err("`gcode.firmware` takes names: klipper, marlin, rrf, settle".into());
+                return Err(format!(
+                    "`gcode.firmware` takes names: {}",
+                    Firmware::names(&Firmware::GCODE)
+                ));
             }
             _ => {
                 return Err(format!(
@@ -400,10 +404,8 @@ impl Kind for GcodeRun {
         let Some(spec) = src.table::<GcodeSpec>("gcode")? else {
             return Ok(None);
         };
-        let firmware = spec
-            .firmware
-            .parse()
-            .map_err(|e: GcodeError| src.error_at("gcode.firmware", e.to_string()))?;
+        let firmware = parse_firmware(&spec.firmware)
+            .map_err(|e| src.error_at("gcode.firmware", e.to_string()))?;
         let layers = spec
             .layers
             .as_deref()

@@ -23,8 +23,9 @@ pub mod stream;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use settle_gcode::job::{Firmware, Job, JobConfig, ShaperSetting};
+use settle_gcode::job::{Job, JobConfig, ShaperSetting};
 use settle_gcode::{GcodeError, Reader, ReaderOptions};
+use settle_planner::firmware::Firmware;
 use settle_planner::{Profile, State};
 use settle_sim::closed_form::LinearResponse;
 use settle_sim::machine::Machine;
@@ -209,7 +210,7 @@ impl GcodeOptions {
                 let job = JobConfig::from_rrf(&c).map_err(gcode_error(&config))?;
                 (job, c.notes.iter().map(ToString::to_string).collect())
             }
-            Firmware::Marlin | Firmware::Settle => {
+            Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => {
                 return Err(Error::input_key(
                     &config,
                     "--config",

@@ -18,7 +18,7 @@ use std::fmt::Write as _;
 
 use settle_gcode::config::{KlipperExport, RrfExport, ShaperSetting as FirmwareShaper};
 use settle_planner::ProfileKind;
-use settle_planner::shaper::Firmware as ShaperFirmware;
+use settle_planner::firmware::Firmware;
 use settle_planner::tmc::ramp::SRampParams;
 use settle_planner::tmc::registers::{TmcUnits, export};
 
@@ -69,7 +69,7 @@ fn klipper_axis(axes: &[(String, Outcome)], letter: &str) -> Result<FirmwareShap
             return Ok(klipper_off());
         };
         return match w.candidate.shaper.and_then(|sh| sh.kind) {
-            Some(k) if k.firmware() == ShaperFirmware::Klipper => Ok(s),
+            Some(k) if k.firmware() == Firmware::Klipper => Ok(s),
             _ => Err(format!(
                 "the recommended shaper on {letter}, {}, is not one of Klipper's; tune with --firmware klipper",
                 s.name
@@ -172,7 +172,7 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
             frequency_hz: 40.0,
             damping_ratio: 0.1,
         },
-        (Some(s), Some(k)) if k.firmware() == ShaperFirmware::Rrf => s,
+        (Some(s), Some(k)) if k.firmware() == Firmware::Rrf => s,
         (Some(s), _) => {
             return format!(
                 "# no RepRapFirmware configuration: the recommended shaper on {axis}, {}, is not one of RepRapFirmware's; tune with --firmware rrf\n",

@@ -10,8 +10,9 @@ use crate::input::source::Source;
 use crate::kinds::corner::Corner;
 use crate::kinds::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
 use crate::spec::run_spec::RunSpec;
-use crate::workflows::tune::firmware::Firmware;
+use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::search::{BandSource, Candidate, Plan};
+use settle_planner::firmware::Firmware;
 
 /// Four-jerk BOW1..4 patterns searched (multiples of jmax; each <= 1).
 pub const BOW_PATTERNS: [[f64; 4]; 5] = [
@@ -65,8 +66,8 @@ pub fn plan(
         base.axis = a.to_string();
     }
     let firmware = match &spec.firmware {
-        None => Firmware::Any,
-        Some(f) => Firmware::parse(f).map_err(|m| src.error_at("tune.firmware", m))?,
+        None => Candidates::ANY,
+        Some(f) => Candidates::parse(f).map_err(|m| src.error_at("tune.firmware", m))?,
     };
     if let Some(cur) = spec.axis.as_ref().and_then(|m| m.get(&base.axis)) {
         let current = current_shaper(cur, base.state::<ShaperSetting>())
@@ -260,7 +261,7 @@ pub fn plan(
         })
         .collect();
     let mut modes = tuning_modes(&base);
-    if matches!(firmware, Firmware::Tmc4361a) {
+    if firmware.firmware() == Some(Firmware::Tmc4361a) {
         modes.clear();
     }
     if modes.is_empty() && shapers.iter().any(Option::is_some) {
