@@ -55,14 +55,7 @@ pub fn sim_options(spec: &RunSpec) -> SimOptions {
 /// The axes a run simulates: the machine compiled for the run's driver model, or one axis
 /// per axis of the modes form.
 pub fn axes_of(spec: &RunSpec) -> Result<Vec<AxisModel>, SimError> {
-    match &spec.machine {
-        Some(m) => m.compile(spec.driver),
-        None => spec
-            .modes
-            .iter()
-            .map(|a| AxisModel::from_modes(&a.axis, &spec.modes_sim(&a.axis)?))
-            .collect(),
-    }
+    spec.machine.axes(spec.driver)
 }
 
 /// Plan and simulate one run on its backend. When `record` is given, it is replaced by a

@@ -13,8 +13,8 @@ pub mod validate;
 
 use std::path::Path;
 
+use crate::input::machine_form::MachineForm;
 use settle_planner::ProfileKind;
-use settle_sim::machine::Machine;
 
 use crate::error::Error;
 use crate::input::scenario::{MoveSpec, Scenario};
@@ -151,15 +151,11 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
     let base_profile =
         ProfileKind::parse(&mv.profile).map_err(|e| src.error_at(profile_key, e.to_string()))?;
     let machine::Resolved {
-        machine,
-        modes,
+        form: machine,
         name: machine_name,
         driver,
     } = machine::resolve_machine(sc, src)?;
-    let axis_names: Vec<String> = match &machine {
-        Some(m) => m.axes.iter().map(|a| a.name.clone()).collect(),
-        None => modes.iter().map(|a| a.axis.clone()).collect(),
-    };
+    let axis_names = machine.axis_names();
     if !is_path && !axis_names.contains(&mv.axis) {
         return Err(src.error_at(
             "move.axis",
@@ -178,7 +174,6 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
         vmax_mm_s: sc.limits.vmax_mm_s,
         amax_mm_s2: sc.limits.amax_mm_s2,
         jmax_mm_s3: sc.limits.jmax_mm_s3,
-        modes,
         machine,
         machine_name,
         driver,
@@ -215,7 +210,7 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
                 format!("the sweep expands to more than {MAX_RUNS} runs"),
             )
         })?;
-    if axes.iter().any(|a| a.param == "machine.preset") && base.machine.is_none() {
+    if axes.iter().any(|a| a.param == "machine.preset") && base.machine.physical().is_none() {
         return Err(src.error_at(
             "sweep.machine.preset",
             "sweeping presets needs a physical machine: give `preset` in [machine], not `modes`",
@@ -240,7 +235,7 @@ struct SweepRuns {
     axes: Vec<Axis>,
     total: usize,
     /// Swept presets: (name as written, machine, machine name).
-    presets: Vec<(String, Machine, String)>,
+    presets: Vec<(String, MachineForm, String)>,
 }
 
 /// What makes run `id` fail: the key to blame and the message.
@@ -277,14 +272,10 @@ impl SweepRuns {
         for (axis, &k) in self.axes.iter().zip(&picks) {
             if let (true, Value::Text(name)) = (axis.param == "machine.preset", &axis.values[k]) {
                 if let Some((_, m, mname)) = self.presets.iter().find(|(n, _, _)| n == name) {
-                    run.machine = Some(m.clone());
+                    run.machine = m.clone();
                     run.machine_name = mname.clone();
                 }
-                if run
-                    .machine
-                    .as_ref()
-                    .is_some_and(|m| m.axis(&run.axis).is_none())
-                {
+                if run.machine.physical().is_some() && !run.machine.has_axis(&run.axis) {
                     return Err((
                         "sweep.machine.preset".to_string(),
                         format!("machine `{name}` has no axis `{}` (move.axis)", run.axis),
@@ -340,12 +331,7 @@ pub fn sweep_runs(sc: &Scenario, src: &Source) -> Result<crate::spec::runs::Runs
         total,
         presets: Vec::new(),
     };
-    type ModesKey = (
-        Option<Machine>,
-        Vec<crate::input::modes::AxisModes>,
-        f64,
-        String,
-    );
+    type ModesKey = (MachineForm, f64, String);
     let mut last_modes: Option<(ModesKey, Option<(f64, f64)>)> = None;
     for id in 0..total {
         let picks = runs.picks(id);
@@ -353,8 +339,8 @@ pub fn sweep_runs(sc: &Scenario, src: &Source) -> Result<crate::spec::runs::Runs
             && !runs.presets.iter().any(|(n, _, _)| n == name)
         {
             let name = name.to_string();
-            let (m, _, _) = crate::input::machine_file::load_preset(&name, &src.path, src)?;
-            let mname = m.name.clone();
+            let m = machine::swept_preset(&name, src)?.form;
+            let mname = m.physical().map(|m| m.name.clone()).unwrap_or_default();
             runs.presets.push((name, m, mname));
         }
         let run = runs.build(id).map_err(|(key, m)| src.error_at(&key, m))?;
@@ -362,22 +348,14 @@ pub fn sweep_runs(sc: &Scenario, src: &Source) -> Result<crate::spec::runs::Runs
         // The modes change only with the machine, its modes, the moved axis or where the
         // move starts: most sweeps linearise the machine once.
         let range = match &last_modes {
-            Some(((m, modes, start, axis), r))
-                if *m == run.machine
-                    && *modes == run.modes
-                    && *start == run.start_mm
-                    && *axis == run.axis =>
+            Some(((m, start, axis), r))
+                if *m == run.machine && *start == run.start_mm && *axis == run.axis =>
             {
                 *r
             }
             _ => {
                 let r = validate::mode_range_hz(&run);
-                let key = (
-                    run.machine.clone(),
-                    run.modes.clone(),
-                    run.start_mm,
-                    run.axis.clone(),
-                );
+                let key = (run.machine.clone(), run.start_mm, run.axis.clone());
                 last_modes = Some((key, r));
                 r
             }

@@ -68,11 +68,11 @@ fn validate_duration(run: &RunSpec, src: &Source) -> Result<(), Error> {
 /// rotations at 0 Hz left out). `None` when there are none or the machine cannot be
 /// linearised (its own checks report why).
 pub fn mode_range_hz(run: &RunSpec) -> Option<(f64, f64)> {
-    let freqs: Vec<f64> = match &run.machine {
+    let freqs: Vec<f64> = match run.machine.physical() {
         None => run
             .axis
             .split('+')
-            .flat_map(|a| run.modes_of(a).iter().map(|m| m.frequency_hz))
+            .flat_map(|a| run.machine.modes_of(a).iter().map(|m| m.frequency_hz))
             .collect(),
         Some(machine) => {
             let axes = machine.compile(settle_sim::DriverMode::Linear).ok()?;
@@ -104,7 +104,7 @@ pub fn validate_sampling(
     let Some((slowest_hz, fastest_hz)) = range else {
         return Ok(());
     };
-    let what = if run.machine.is_some() {
+    let what = if run.machine.physical().is_some() {
         "the machine's linearised modes"
     } else {
         "machine.modes"
@@ -263,7 +263,7 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
         ));
     }
     kind_check(false)?;
-    if let Some(machine) = &run.machine {
+    if let Some(machine) = run.machine.physical() {
         let machine_swept = || {
             run.swept
                 .iter()
@@ -294,7 +294,7 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
         }
     }
     // The modes as written were checked when the machine was read; swept values here.
-    for a in &run.modes {
+    for a in run.machine.modes() {
         for (i, m) in a.modes.iter().enumerate() {
             if let Err(e) = Mode::new(m.frequency_hz, m.damping_ratio, m.weight) {
                 let field = if !(m.frequency_hz.is_finite() && m.frequency_hz > 0.0) {

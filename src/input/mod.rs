@@ -6,6 +6,7 @@
 pub mod file;
 pub mod keys;
 pub mod machine_file;
+pub mod machine_form;
 pub mod modes;
 pub mod runs_columns;
 pub mod runs_table;

@@ -6,9 +6,10 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::Deserialize;
+use settle_sim::machine::{Driver, Motor};
 
 use crate::error::Error;
-use crate::input::machine_file::{AxisSpec, DriverSpec, MotorSpec};
+use crate::input::machine_file::AxisSpec;
 pub use crate::input::modes::ModeSpec;
 use crate::input::source::Source;
 use crate::input::tune_spec::TuneSpec;
@@ -80,9 +81,9 @@ pub struct MachineSpec {
     /// Name of an inline machine (default: the scenario's name).
     pub name: Option<String>,
     /// Inline machine: motor of every axis that does not name its own.
-    pub motor: Option<MotorSpec>,
+    pub motor: Option<Motor>,
     /// Inline machine: driver of every axis that does not name its own.
-    pub driver: Option<DriverSpec>,
+    pub driver: Option<Driver>,
     /// Inline machine: the axes, by name (physical axes, or `modes = [...]` each).
     #[serde(default)]
     pub axis: BTreeMap<String, AxisSpec>,

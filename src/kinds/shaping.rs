@@ -142,16 +142,15 @@ impl KindState for ShaperSetting {
 pub fn dominant_mode(spec: &RunSpec) -> Option<(f64, f64)> {
     // A corner path (`x+y`): its first axis, the one the path starts along.
     let name = spec.axis.split('+').next()?;
-    if spec.machine.is_none() {
+    let Some(machine) = spec.machine.physical() else {
         let mut best: Option<&ModeSpec> = None;
-        for m in spec.modes_of(name) {
+        for m in spec.machine.modes_of(name) {
             if best.is_none_or(|b| m.weight.abs() > b.weight.abs()) {
                 best = Some(m);
             }
         }
         return best.map(|m| (m.frequency_hz, m.damping_ratio));
-    }
-    let machine = spec.machine.as_ref()?;
+    };
     let axes = machine.compile(settle_sim::DriverMode::Linear).ok()?;
     let axis = axes.iter().find(|a| a.name == name)?;
     let limits = spec.limits_si().ok()?;

@@ -41,7 +41,8 @@ impl RunsCsv {
         // The modes form's modes: axis x's as `mode<i>_*`, another axis's as
         // `<axis>_mode<i>_*`.
         let mode_axes: Vec<(String, usize)> = runs.first().map_or(Vec::new(), |r| {
-            r.modes
+            r.machine
+                .modes()
                 .iter()
                 .map(|a| (a.axis.clone(), a.modes.len()))
                 .collect()
@@ -99,9 +100,9 @@ impl RunsCsv {
         if mode_axes.len() > 1 {
             axis_names = mode_axes.iter().map(|(a, _)| a.clone()).collect();
         }
-        if runs.first().is_some_and(|r| r.machine.is_some()) {
+        if runs.first().is_some_and(|r| r.machine.physical().is_some()) {
             for r in runs.iter() {
-                for a in r.machine.iter().flat_map(|m| &m.axes) {
+                for a in r.machine.physical().iter().flat_map(|m| &m.axes) {
                     if !axis_names.contains(&a.name) {
                         axis_names.push(a.name.clone());
                     }
@@ -157,7 +158,7 @@ impl RunsCsv {
             r.amax_mm_s2.to_string(),
             r.jmax_mm_s3.map_or(String::new(), |j| j.to_string()),
         ]);
-        for md in r.modes.iter().flat_map(|a| &a.modes) {
+        for md in r.machine.modes().iter().flat_map(|a| &a.modes) {
             c.extend([
                 md.frequency_hz.to_string(),
                 md.damping_ratio.to_string(),

@@ -33,13 +33,14 @@ pub struct Figure {
 pub fn machines_line(runs: &dyn RunList) -> String {
     let mut names: Vec<String> = Vec::new();
     for r in runs.iter() {
-        let n = if r.machine.is_some() {
+        let n = if r.machine.physical().is_some() {
             format!("{} (axis {}, {} driver)", r.machine_name, r.axis, r.driver)
         } else {
             // Each axis's modes, prefixed with the axis when the machine has several.
-            let several = r.modes.len() > 1;
+            let several = r.machine.modes().len() > 1;
             let modes: Vec<String> = r
-                .modes
+                .machine
+                .modes()
                 .iter()
                 .flat_map(|a| {
                     let prefix = if several {

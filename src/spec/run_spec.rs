@@ -4,10 +4,9 @@
 use std::any::Any;
 
 use settle_planner::{Limits, ProfileKind};
-use settle_sim::machine::Machine;
-use settle_sim::{DriverMode, Mode};
+use settle_sim::DriverMode;
 
-use crate::input::modes::{AxisModes, ModeSpec};
+use crate::input::machine_form::MachineForm;
 use crate::spec::backend::Backend;
 use crate::spec::value::Value;
 
@@ -77,11 +76,8 @@ pub struct RunSpec {
     pub amax_mm_s2: f64,
     /// Maximum jerk (mm/s^3), if given.
     pub jmax_mm_s3: Option<f64>,
-    /// The machine's modes per axis, ordered by axis name (modes form; empty for a
-    /// physical machine).
-    pub modes: Vec<AxisModes>,
-    /// The physical machine (preset, machine file or inline), if not given by modes.
-    pub machine: Option<Machine>,
+    /// The machine: physical (preset, machine file or inline) or its modes per axis.
+    pub machine: MachineForm,
     /// The machine's name (the preset's, or `modes`).
     pub machine_name: String,
     /// How the motors are driven (physical machines; `linear` for the modes form).
@@ -130,26 +126,9 @@ impl RunSpec {
         )
     }
 
-    /// The modes of `axis` (modes form; empty when it has none or the machine is
-    /// physical).
-    pub fn modes_of(&self, axis: &str) -> &[ModeSpec] {
-        crate::input::modes::modes_of(&self.modes, axis).unwrap_or_default()
-    }
-
     /// The names of the machine's axes (physical or modes form), in order.
     pub fn axis_names(&self) -> Vec<String> {
-        match &self.machine {
-            Some(m) => m.axes.iter().map(|a| a.name.clone()).collect(),
-            None => self.modes.iter().map(|a| a.axis.clone()).collect(),
-        }
-    }
-
-    /// The modes of `axis` as sim types.
-    pub fn modes_sim(&self, axis: &str) -> Result<Vec<Mode>, settle_sim::SimError> {
-        self.modes_of(axis)
-            .iter()
-            .map(|m| Mode::new(m.frequency_hz, m.damping_ratio, m.weight))
-            .collect()
+        self.machine.axis_names()
     }
 
     /// The run's state of type `T` (a run kind's), if it has one.
@@ -230,8 +209,13 @@ impl RunSpec {
                 if let Some((axis, i, field)) = mode_param(other) {
                     let x = num(value)?;
                     let names = self.axis_names().join(", ");
-                    let Some(a) = self.modes.iter_mut().find(|a| a.axis == axis) else {
-                        return Err(if self.machine.is_some() {
+                    let physical = self.machine.physical().is_some();
+                    let modes = match &mut self.machine {
+                        MachineForm::Modes(axes) => axes.as_mut_slice(),
+                        MachineForm::Physical(_) => &mut [],
+                    };
+                    let Some(a) = modes.iter_mut().find(|a| a.axis == axis) else {
+                        return Err(if physical {
                             format!(
                                 "`{other}` needs a machine given by its modes, not a physical one"
                             )
@@ -256,7 +240,7 @@ impl RunSpec {
                     .find_map(|p| other.strip_prefix("machine.").filter(|r| r.starts_with(p)))
                 {
                     let x = num(value)?;
-                    let Some(m) = self.machine.as_mut() else {
+                    let MachineForm::Physical(m) = &mut self.machine else {
                         return Err(format!(
                             "`{other}` needs a physical machine (preset or [machine.axis.*]), not modes"
                         ));

@@ -148,8 +148,8 @@ fn the_modes_shorthand_is_axis_x_and_sweeps_reach_every_axis() {
         + "[sweep]\n\"machine.axis.y.modes.0.frequency_hz\" = [20.0, 30.0]\n\"machine.modes.0.damping_ratio\" = [0.1]\n";
     let runs = expand(&text).expect("shorthand plus an axis table");
     assert_eq!(runs.len(), 2);
-    assert_eq!(runs[1].modes_of("y")[0].frequency_hz, 30.0);
-    assert_eq!(runs[1].modes_of("x")[0].damping_ratio, 0.1);
+    assert_eq!(runs[1].machine.modes_of("y")[0].frequency_hz, 30.0);
+    assert_eq!(runs[1].machine.modes_of("x")[0].damping_ratio, 0.1);
     let msg = err(&text.replace("[20.0, 30.0]", "[20.0, -1.0]"));
     assert!(
         msg.contains("key `sweep.machine.axis.y.modes.0.frequency_hz`"),

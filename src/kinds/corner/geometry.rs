@@ -286,7 +286,7 @@ impl Corner {
             ));
         }
         check_machine(self, &run.machine_name, &run.axis_names()).map_err(|m| (key("axes"), m))?;
-        let Some(machine) = &run.machine else {
+        let Some(machine) = run.machine.physical() else {
             return Ok(());
         };
         // Every point inside every axis's belt travel.

@@ -224,15 +224,9 @@ fn shaper_setting(s: Option<&settle_planner::shaper::Shaper>) -> Option<ShaperSe
 /// The machine's axes with the linear driver (the modes form as it is): where the
 /// pre-roll's decay rate is read.
 fn linear_axes(run: &RunSpec) -> Result<Vec<AxisModel>, String> {
-    let axes = match &run.machine {
-        Some(m) => m.compile(DriverMode::Linear),
-        None => run
-            .modes
-            .iter()
-            .map(|a| AxisModel::from_modes(&a.axis, &run.modes_sim(&a.axis)?))
-            .collect(),
-    };
-    axes.map_err(|e| e.to_string())
+    run.machine
+        .axes(DriverMode::Linear)
+        .map_err(|e| e.to_string())
 }
 
 /// The pre-roll of `run`'s layer range (s; 0 without one): [`preroll::preroll_s`] of the

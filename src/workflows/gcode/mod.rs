@@ -29,11 +29,12 @@ use settle_planner::firmware::Firmware;
 use settle_planner::{Profile, State};
 use settle_sim::closed_form::LinearResponse;
 use settle_sim::machine::Machine;
-use settle_sim::{AxisModel, DriverMode, Mode};
+use settle_sim::{AxisModel, DriverMode};
 
 use crate::error::{Error, Location};
 use crate::execute::SimOptions;
-use crate::input::machine_file::MachineForm;
+use crate::expand::machine::Named;
+use crate::input::machine_form::MachineForm;
 use crate::kinds::gcode::linpoint::{LinPoint, depends_on_position, linearisation_point};
 use crate::kinds::gcode::preroll::{preroll_s, slowest_decay_per_s};
 use crate::kinds::gcode::stats::{self, LayerMap, Spot};
@@ -416,46 +417,21 @@ pub fn gcode_error(file: &Path) -> impl Fn(GcodeError) -> Error + '_ {
     }
 }
 
-/// The machine `--machine` names: a built-in preset, a machine file, or a scenario file
-/// (its `[machine]`).
+/// The machine `--machine` names: a built-in preset, a machine file (either form), or a
+/// scenario file (its `[machine]`), resolved by [`crate::expand::machine::named`].
+fn named_machine(name: &str) -> Result<Named, Error> {
+    crate::expand::machine::named(name, Path::new(""), true, &|m| Error::input("--machine", m))
+}
+
+/// The physical machine `--machine` names.
 pub fn resolve_machine(name: &str) -> Result<Machine, Error> {
-    match resolve_form(name)? {
-        (_, MachineForm::Physical(m)) => Ok(m),
-        (_, MachineForm::Modes(_)) => Err(Error::input(
+    match named_machine(name)?.form {
+        MachineForm::Physical(m) => Ok(m),
+        MachineForm::Modes(_) => Err(Error::input(
             "--machine",
             format!("`{name}` gives the machine by its modes; a physical machine is needed here"),
         )),
     }
-}
-
-/// The machine `--machine` names, in either form, with its name.
-fn resolve_form(name: &str) -> Result<(String, MachineForm), Error> {
-    let here = Path::new("--machine");
-    let src = crate::input::source::Source::new("", here);
-    let path = Path::new(name);
-    let is_scenario = name.ends_with(".toml")
-        && std::fs::read_to_string(path)
-            .ok()
-            .and_then(|t| t.parse::<toml::Table>().ok())
-            .is_some_and(|t| t.contains_key("machine"));
-    if is_scenario {
-        let (sc, src) = crate::expand::load(path)?;
-        let r = crate::expand::machine::resolve_machine(&sc, &src)?;
-        let form = match r.machine {
-            Some(m) => MachineForm::Physical(m),
-            None => MachineForm::Modes(r.modes),
-        };
-        return Ok((r.name, form));
-    }
-    let base = std::env::current_dir().unwrap_or_default().join("here");
-    crate::input::machine_file::load_any(name, &base, &src)
-        .map(|(d, _)| (d.name, d.form))
-        .map_err(|e| match e {
-            Error::Input { message, .. } if !name.ends_with(".toml") => {
-                Error::input(here, message.replace("machine.preset", "--machine"))
-            }
-            other => other,
-        })
 }
 
 /// The machine's axes for `driver`, and the same axes with the linear driver (whose
@@ -465,38 +441,19 @@ pub fn resolve_axes(
     name: &str,
     driver: DriverMode,
 ) -> Result<(String, Vec<AxisModel>, Vec<AxisModel>), Error> {
-    let bad = |e: settle_sim::SimError| Error::input("--machine", e.to_string());
-    match resolve_form(name)? {
-        (n, MachineForm::Physical(m)) => {
-            let axes = m.compile(driver).map_err(bad)?;
-            let linear = m.compile(DriverMode::Linear).map_err(bad)?;
-            let _ = n;
-            Ok((m.name.clone(), axes, linear))
-        }
-        (n, MachineForm::Modes(axes)) => {
-            if driver != DriverMode::Linear {
-                return Err(Error::input(
-                    "--driver",
-                    format!(
-                        "`{name}` gives the machine by its modes: it has no driver model but the linear one"
-                    ),
-                ));
-            }
-            let axes = axes
-                .iter()
-                .map(|a| {
-                    let modes = a
-                        .modes
-                        .iter()
-                        .map(|m| Mode::new(m.frequency_hz, m.damping_ratio, m.weight))
-                        .collect::<Result<Vec<_>, _>>()?;
-                    AxisModel::from_modes(&a.axis, &modes)
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(bad)?;
-            Ok((n, axes.clone(), axes))
-        }
+    let n = named_machine(name)?;
+    if n.form.physical().is_none() && driver != DriverMode::Linear {
+        return Err(Error::input(
+            "--driver",
+            format!(
+                "`{name}` gives the machine by its modes: it has no driver model but the linear one"
+            ),
+        ));
     }
+    let bad = |e: settle_sim::SimError| Error::input("--machine", e.to_string());
+    let axes = n.form.axes(driver).map_err(bad)?;
+    let linear = n.form.axes(DriverMode::Linear).map_err(bad)?;
+    Ok((n.name, axes, linear))
 }
 
 /// The longest period (s) of the axes' oscillatory modes (their damped periods).

@@ -391,13 +391,13 @@ pub const MAX_BAND_PCT: f64 = 49.0;
 /// in settle-identify's `random_sweeps_from_env`). `None` without sigmas or for a
 /// physical machine.
 pub fn identified_band(base: &RunSpec) -> Option<(f64, f64, f64)> {
-    if base.machine.is_some() {
+    if base.machine.physical().is_some() {
         return None;
     }
     let tuned = tuning_modes(base);
     let mut best: Option<(f64, f64, f64)> = None;
     for name in base.axis.split('+') {
-        for m in base.modes_of(name) {
+        for m in base.machine.modes_of(name) {
             let Some(s) = m.frequency_sigma_hz else {
                 continue;
             };
@@ -446,12 +446,12 @@ fn current_shaper(
 /// corner path: the strongest of each of its axes), or the two strongest modes of the
 /// moving axis's linearised response.
 pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
-    if base.machine.is_none() {
+    let Some(machine) = base.machine.physical() else {
         let names: Vec<&str> = base.axis.split('+').collect();
         let per_axis = if names.len() > 1 { 1 } else { 2 };
         let mut out: Vec<(f64, f64)> = Vec::new();
         for name in names {
-            let mut m: Vec<_> = base.modes_of(name).to_vec();
+            let mut m: Vec<_> = base.machine.modes_of(name).to_vec();
             m.sort_by(|a, b| b.weight.abs().total_cmp(&a.weight.abs()));
             for m in m.iter().take(per_axis) {
                 let f = m.frequency_hz;
@@ -461,9 +461,6 @@ pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
             }
         }
         return out;
-    }
-    let Some(machine) = &base.machine else {
-        return Vec::new();
     };
     let Ok(axes) = machine.compile(settle_sim::DriverMode::Linear) else {
         return Vec::new();
