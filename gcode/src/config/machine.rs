@@ -3,8 +3,8 @@
 
 use std::fmt;
 
-use crate::dialect::Dialect;
 use crate::error::Location;
+use crate::read::dialect::Dialect;
 
 /// One value per axis X, Y, Z.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

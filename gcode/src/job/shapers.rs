@@ -17,7 +17,7 @@
 use settle_planner::shaper::{MarlinShaper, RrfShaper, ShaperKind};
 
 use super::config::ShaperSetting;
-use crate::limits::{AxisFlags, FtShaper, LimitChange};
+use crate::read::limits::{AxisFlags, FtShaper, LimitChange};
 use settle_planner::firmware::Firmware;
 
 /// One axis's shaper state as its firmware keeps it.

@@ -10,11 +10,11 @@
 
 use std::io::{self, Write};
 
-use crate::dialect::Dialect;
-use crate::event::{Event, EventKind, LayerSource, Note};
-use crate::geometry::{Move, Path};
-use crate::limits::{AxisFlags, AxisValues, LimitChange};
-use crate::setting::Setting;
+use crate::read::dialect::Dialect;
+use crate::read::event::{Event, EventKind, LayerSource, Note};
+use crate::read::geometry::{Move, Path};
+use crate::read::limits::{AxisFlags, AxisValues, LimitChange};
+use crate::read::setting::Setting;
 
 /// Writes events as G-code.
 #[derive(Debug)]

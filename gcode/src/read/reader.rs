@@ -7,18 +7,18 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::sync::Arc;
 
-use crate::cmd::{Cmd, CmdName};
-use crate::dialect::Dialect;
 use crate::error::{GcodeError, Location};
-use crate::event::{Event, EventKind, Note};
-use crate::geometry::{MoveKind, Point};
-use crate::layers::{LayerMode, Layers};
-use crate::lex::{LexError, LineKind, lex};
-use crate::limit_parse::{self, Outcome};
-use crate::lines::{LineStatus, Lines};
-use crate::motion::Motion;
-use crate::params::{KeyValues, Params};
-use crate::setting_parse;
+use crate::read::cmd::{Cmd, CmdName};
+use crate::read::dialect::Dialect;
+use crate::read::event::{Event, EventKind, Note};
+use crate::read::geometry::{MoveKind, Point};
+use crate::read::layers::{LayerMode, Layers};
+use crate::read::lex::{LexError, LineKind, lex};
+use crate::read::limit_parse::{self, Outcome};
+use crate::read::lines::{LineStatus, Lines};
+use crate::read::motion::Motion;
+use crate::read::params::{KeyValues, Params};
+use crate::read::setting_parse;
 
 /// How the reader reads.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,7 +91,7 @@ struct Interp {
     params: Params,
     kv: KeyValues,
     queue: VecDeque<Event>,
-    layer_buf: Vec<(u64, u32, crate::event::LayerChange)>,
+    layer_buf: Vec<(u64, u32, crate::read::event::LayerChange)>,
     ignored: BTreeMap<String, u64>,
     name_buf: String,
     skipped: Skipped,

@@ -5,11 +5,11 @@ use std::fmt;
 use std::io::BufRead;
 
 use crate::error::GcodeError;
-use crate::event::{Event, EventKind, Note};
-use crate::geometry::{Bounds, MoveKind, Path};
-use crate::limits::LimitChange;
-use crate::reader::Reader;
-use crate::setting::Setting;
+use crate::read::event::{Event, EventKind, Note};
+use crate::read::geometry::{Bounds, MoveKind, Path};
+use crate::read::limits::LimitChange;
+use crate::read::reader::Reader;
+use crate::read::setting::Setting;
 
 /// Distinct limit changes (and notes) kept; further distinct ones are only counted.
 const MAX_KEPT: usize = 256;

@@ -6,7 +6,7 @@
 //! splitting and in Marlin's `parser.h`). Klipper's `KEY=VALUE` values are read as Python's
 //! `float()` would (exponents allowed); NaN and infinities are refused everywhere.
 
-use crate::lex::skip_ws;
+use crate::read::lex::skip_ws;
 
 /// One letter parameter.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use crate::error::{GcodeError, Location};
-use crate::params::{KeyValues, ParamError, Params, Value};
+use crate::read::params::{KeyValues, ParamError, Params, Value};
 
 /// A range check for a parameter value, with the text that tells the user what is allowed.
 #[derive(Debug, Clone, Copy)]

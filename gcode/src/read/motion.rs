@@ -2,13 +2,13 @@
 //! plane) and the commands that move or rename the position: G0-G4, G17-G19, G28, G90,
 //! G91, G92, M82, M83.
 
-use crate::arc::{Arc, ArcProblem};
-use crate::cmd::{Check, Cmd, FINITE, NON_NEGATIVE, POSITIVE};
-use crate::dialect::Dialect;
 use crate::error::GcodeError;
-use crate::geometry::{Move, MoveKind, Path, Point};
-use crate::limits::AxisFlags;
-use crate::params::Params;
+use crate::read::arc::{Arc, ArcProblem};
+use crate::read::cmd::{Check, Cmd, FINITE, NON_NEGATIVE, POSITIVE};
+use crate::read::dialect::Dialect;
+use crate::read::geometry::{Move, MoveKind, Path, Point};
+use crate::read::limits::AxisFlags;
+use crate::read::params::Params;
 
 const AXES: [u8; 4] = [b'X', b'Y', b'Z', b'E'];
 

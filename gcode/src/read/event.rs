@@ -1,8 +1,8 @@
 //! What the reader yields: events in file order, each with its line and layer.
 
-use crate::geometry::Move;
-use crate::limits::{AxisFlags, LimitChange};
-use crate::setting::Setting;
+use crate::read::geometry::Move;
+use crate::read::limits::{AxisFlags, LimitChange};
+use crate::read::setting::Setting;
 
 /// One thing the file asks for.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,11 +1,12 @@
-//! No module cycles in a crate's `src/`: every `crate::`, `super::`, `self::` and
-//! child-module path is resolved to the module (the file) that defines what it names,
-//! through `pub use` re-exports, and the graph of those references must have no cycle.
-//! Comments and `#[cfg(test)] mod ... { }` blocks are left out (a unit test may use
-//! anything).
-//!
-//! One file for both crates: settle-sim's test binary includes it by path, and each checks
-//! the `src/` of the crate it is compiled for (`CARGO_MANIFEST_DIR`).
+//! No module cycles in any crate of the workspace: for every crate the root `Cargo.toml`
+//! names (its `[workspace] members` and the root package), every `crate::`, `super::`,
+//! `self::` and child-module path of its `src/` is resolved to the module (the file) that
+//! defines what it names, through `pub use` re-exports, and the graph of those references
+//! must have no cycle. A module using its own descendants is structure (it declares them and
+//! dispatches to them), not a dependency; every other reference counts, a child using its
+//! parent's items included. Comments and `#[cfg(test)] mod ... { }` blocks are left out (a
+//! unit test may use anything). The root package's binary (`src/main.rs`) is a crate of its
+//! own that uses the library by its name: its module is the library's root file's.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -17,7 +18,7 @@ type Module = Vec<String>;
 type Graph = BTreeMap<Module, BTreeSet<Module>>;
 
 /// Every `.rs` file under `src` by module path (`lib.rs`, `main.rs` and `mod.rs` name
-/// their folder's module).
+/// their folder's module; `src/main.rs` is left out beside a `src/lib.rs`).
 fn read_sources(src: &Path) -> BTreeMap<Module, String> {
     fn walk(dir: &Path, prefix: &[String], out: &mut BTreeMap<Module, String>) {
         let mut entries: Vec<_> = std::fs::read_dir(dir)
@@ -36,6 +37,9 @@ fn read_sources(src: &Path) -> BTreeMap<Module, String> {
                 module.push(name);
                 walk(&path, &module, out);
             } else if let Some(stem) = name.strip_suffix(".rs") {
+                if prefix.is_empty() && stem == "main" && dir.join("lib.rs").exists() {
+                    continue;
+                }
                 if !matches!(stem, "lib" | "main" | "mod") {
                     module.push(stem.to_string());
                 }
@@ -209,7 +213,8 @@ fn graph(sources: &BTreeMap<Module, String>) -> Graph {
         let out = g.entry(m.clone()).or_default();
         for p in paths {
             let target = resolve(p, &modules, &reexports, 0);
-            if &target != m && !target.is_empty() {
+            // Itself, or one of its descendants: structure, not a dependency.
+            if !target.starts_with(m) && !target.is_empty() {
                 out.insert(target);
             }
         }
@@ -267,14 +272,40 @@ fn cycles(g: &Graph) -> Vec<Vec<String>> {
     t.out
 }
 
+/// The `src/` folder of every crate of the workspace: the root package's and each
+/// member's, from the root `Cargo.toml`.
+fn crate_sources() -> Vec<std::path::PathBuf> {
+    let root = Path::new(manifest_dir());
+    let text = std::fs::read_to_string(root.join("Cargo.toml")).expect("read Cargo.toml");
+    let manifest: toml::Table = text.parse().expect("Cargo.toml parses");
+    let members = manifest["workspace"]["members"]
+        .as_array()
+        .expect("[workspace] members");
+    let mut out = vec![root.join("src")];
+    out.extend(
+        members
+            .iter()
+            .map(|m| root.join(m.as_str().expect("a member path")).join("src")),
+    );
+    out
+}
+
 #[test]
-fn no_module_cycles() {
-    let src = Path::new(manifest_dir()).join("src");
-    let g = graph(&read_sources(&src));
-    let found = cycles(&g);
-    let report: Vec<String> = found
-        .iter()
-        .map(|c| {
+fn no_module_cycles_in_any_crate() {
+    let crates = crate_sources();
+    // The root package and every member (planner, sim, gcode, identify, ...).
+    assert!(crates.len() >= 5, "{crates:?}");
+    let mut report = Vec::new();
+    for src in &crates {
+        let g = graph(&read_sources(src));
+        // Every crate's graph is read: every module is in it, and most refer to others.
+        assert!(
+            g.len() > 5 && g.values().filter(|t| !t.is_empty()).count() > 3,
+            "{}: {} modules",
+            src.display(),
+            g.len()
+        );
+        for c in cycles(&g) {
             let edges: Vec<String> = c
                 .iter()
                 .map(|m| {
@@ -287,17 +318,15 @@ fn no_module_cycles() {
                     format!("{m} -> {}", to.join(", "))
                 })
                 .collect();
-            format!("cycle {{{}}}: {}", c.join(", "), edges.join("; "))
-        })
-        .collect();
-    assert!(
-        found.is_empty(),
-        "{}:\n{}",
-        src.display(),
-        report.join("\n")
-    );
-    // The graph is not empty: every module is in it, and most refer to others.
-    assert!(g.len() > 5 && g.values().filter(|t| !t.is_empty()).count() > 3);
+            report.push(format!(
+                "{}: cycle {{{}}}: {}",
+                src.display(),
+                c.join(", "),
+                edges.join("; ")
+            ));
+        }
+    }
+    assert!(report.is_empty(), "{}", report.join("\n"));
 }
 
 #[test]
@@ -332,8 +361,34 @@ fn the_check_finds_cycles_and_follows_reexports() {
     ]));
     assert!(cycles(&g).is_empty(), "{g:?}");
     assert_eq!(g[&m("p::r")], BTreeSet::from([m("p::q")]));
-    assert_eq!(g[&m("p")], BTreeSet::from([m("p::q"), m("p::r")]));
+    assert!(
+        g[&m("p")].is_empty(),
+        "a module's use of its children is structure"
+    );
     assert!(g[&m("p::q")].is_empty());
+    // A child using its parent's own item while the parent dispatches to the child: no
+    // cycle; two children using each other: a cycle.
+    let g = graph(&src(&[
+        ("", "mod k;\n"),
+        (
+            "k",
+            "mod a;\nmod b;\npub trait Kind {}\npub fn all() { a::A; }\n",
+        ),
+        ("k::a", "pub struct A;\nimpl super::Kind for A {}\n"),
+        ("k::b", "use crate::k::a::A;\n"),
+    ]));
+    assert!(cycles(&g).is_empty(), "{g:?}");
+    assert_eq!(g[&m("k::a")], BTreeSet::from([m("k")]));
+    let g = graph(&src(&[
+        ("", "mod k;\n"),
+        ("k", "mod a;\nmod b;\n"),
+        ("k::a", "pub struct A;\nfn f() -> super::b::B { todo!() }\n"),
+        ("k::b", "pub struct B;\nuse crate::k::a::A;\n"),
+    ]));
+    assert_eq!(
+        cycles(&g),
+        vec![vec!["k::a".to_string(), "k::b".to_string()]]
+    );
 }
 
 /// The package's directory: the `CARGO_MANIFEST_DIR` cargo sets when it runs this

@@ -1,14 +1,14 @@
-//! Motion-limit commands read in the units of the chosen dialect (see [`crate::limits`]
+//! Motion-limit commands read in the units of the chosen dialect (see [`crate::read::limits`]
 //! for each command's source).
 
-use crate::cmd::{
+use crate::error::GcodeError;
+use crate::read::cmd::{
     BELOW_ONE, BOOL, Check, Cmd, FINITE, FRACTION, NON_NEGATIVE, POSITIVE, SMALL_INT,
 };
-use crate::dialect::Dialect;
-use crate::error::GcodeError;
-use crate::event::Note;
-use crate::limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
-use crate::params::{KeyValues, Params};
+use crate::read::dialect::Dialect;
+use crate::read::event::Note;
+use crate::read::limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
+use crate::read::params::{KeyValues, Params};
 
 /// What a command turned out to be.
 #[derive(Debug)]

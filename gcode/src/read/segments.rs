@@ -29,8 +29,8 @@
 use std::f32::consts::TAU as TAU32;
 use std::f64::consts::TAU;
 
-use crate::dialect::Dialect;
-use crate::geometry::{Move, Path, Point};
+use crate::read::dialect::Dialect;
+use crate::read::geometry::{Move, Path, Point};
 
 /// Klipper's `[gcode_arcs]` section.
 #[derive(Debug, Clone, Copy, PartialEq)]

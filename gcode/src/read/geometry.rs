@@ -1,6 +1,6 @@
 //! Moves: where they start and end, how fast they were asked to go, whether they print.
 
-use crate::arc::Arc;
+use crate::read::arc::Arc;
 
 /// A machine position, mm: X Y Z and the extruder's E.
 ///
@@ -125,7 +125,9 @@ impl Move {
         b.include(&self.start);
         b.include(&self.end);
         if let Path::Arc(a) = &self.path {
-            a.include_extremes(&mut b, self.start.z_mm);
+            for [x, y] in a.extremes_xy() {
+                b.include_xyz([x, y, self.start.z_mm]);
+            }
         }
         b
     }

@@ -1,13 +1,13 @@
 //! Machine-setting and macro commands of RepRapFirmware's configuration files, read into
-//! [`Setting`]s and notes (see [`crate::setting`] for each command's source).
+//! [`Setting`]s and notes (see [`crate::read::setting`] for each command's source).
 
-use crate::cmd::{Check, Cmd, NON_NEGATIVE, POSITIVE, SMALL_INT};
-use crate::dialect::Dialect;
 use crate::error::GcodeError;
-use crate::event::Note;
-use crate::limits::AxisValues;
-use crate::params::{Params, Value};
-use crate::setting::Setting;
+use crate::read::cmd::{Check, Cmd, NON_NEGATIVE, POSITIVE, SMALL_INT};
+use crate::read::dialect::Dialect;
+use crate::read::event::Note;
+use crate::read::limits::AxisValues;
+use crate::read::params::{Params, Value};
+use crate::read::setting::Setting;
 
 /// What a command turned out to be.
 #[derive(Debug)]
@@ -61,7 +61,7 @@ fn limits(cmd: &Cmd, p: &Params) -> Result<Setting, GcodeError> {
         (b'Y', &mut minimum_mm.y, &mut maximum_mm.y),
         (b'Z', &mut minimum_mm.z, &mut maximum_mm.z),
     ] {
-        let values = cmd.list(p, letter, crate::cmd::FINITE)?;
+        let values = cmd.list(p, letter, crate::read::cmd::FINITE)?;
         match values.as_slice() {
             [] => {}
             [v] if set_minimum => *min = Some(*v),

@@ -4,8 +4,8 @@
 //! write layer markers in its header comments (before the first move), and from the first
 //! marker on: a purge line in the start G-code must not count as a layer.
 
-use crate::event::{LayerChange, LayerSource};
-use crate::geometry::Move;
+use crate::read::event::{LayerChange, LayerSource};
+use crate::read::geometry::Move;
 
 /// Where layer changes come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -5,7 +5,7 @@
 //! applying them in order (what a later `M350` does to an earlier `M92`) is
 //! [`crate::config::RrfConfig`]'s business.
 
-use crate::limits::AxisValues;
+use crate::read::limits::AxisValues;
 
 /// A machine setting read from the file. Only the RepRapFirmware dialect produces these;
 /// the other dialects count the commands as ignored.

@@ -20,8 +20,6 @@
 
 use std::f64::consts::{FRAC_PI_2, TAU};
 
-use crate::geometry::Bounds;
-
 /// End points closer than this make a full circle, mm (Marlin's `NEAR`).
 pub const FULL_CIRCLE_TOLERANCE_MM: f64 = 1e-6;
 
@@ -183,21 +181,22 @@ impl Arc {
         )
     }
 
-    /// Adds the points where the arc reaches its extreme X or Y (the quadrant points it
-    /// passes) to `b`, at height `z_mm`.
-    pub(crate) fn include_extremes(&self, b: &mut Bounds, z_mm: f64) {
+    /// The points (X, Y, mm) where the arc reaches its extreme X or Y: the quadrant points
+    /// it passes, in the order +X, +Y, -X, -Y.
+    pub(crate) fn extremes_xy(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
         let (cx, cy, r) = (self.centre_x_mm, self.centre_y_mm, self.radius_mm);
         let quadrants = [(cx + r, cy), (cx, cy + r), (cx - r, cy), (cx, cy - r)];
-        for (k, &(x, y)) in quadrants.iter().enumerate() {
-            let theta = k as f64 * FRAC_PI_2;
-            let ahead = if self.clockwise() {
-                (self.start_angle_rad - theta).rem_euclid(TAU)
-            } else {
-                (theta - self.start_angle_rad).rem_euclid(TAU)
-            };
-            if ahead <= self.sweep_rad.abs() {
-                b.include_xyz([x, y, z_mm]);
-            }
-        }
+        quadrants
+            .into_iter()
+            .enumerate()
+            .filter_map(move |(k, (x, y))| {
+                let theta = k as f64 * FRAC_PI_2;
+                let ahead = if self.clockwise() {
+                    (self.start_angle_rad - theta).rem_euclid(TAU)
+                } else {
+                    (theta - self.start_angle_rad).rem_euclid(TAU)
+                };
+                (ahead <= self.sweep_rad.abs()).then_some([x, y])
+            })
     }
 }
