@@ -7,7 +7,8 @@
 # relative paths the outputs print are the same), and compares the folders with `diff -r`:
 # every file written, and every command's stdout, stderr and exit code. The commands:
 #   - `settle sweep` of every scenario in scenarios/ on modal and on rapier (runs.csv,
-#     summary.md, report.html, plots), one with --mcap;
+#     summary.md, report.html, plots), one with --mcap, and one that sweeps a physical
+#     machine's fields by their machine-file keys;
 #   - `settle run` of a few cases with --plot and --mcap (the trace sink);
 #   - `settle check` of every baseline in results/baselines/ (without --update);
 #   - `settle gcode` on every print in gcode/prints/: plain, with --layers (and --mcap),
@@ -55,6 +56,8 @@ cases() {
     done
   done
   echo "sweep-mcap-ci_corners sweep $S/ci_corners.toml --backend modal --jobs 2 --mcap --out @"
+  echo "sweep-machine-fields-modal sweep in/machine_fields.toml --backend modal --jobs 2 --out @"
+  echo "sweep-machine-fields-rapier sweep in/machine_fields.toml --backend rapier --jobs 2 --out @"
   echo "run-quickstart-modal run $S/quickstart.toml --case 3 --backend modal --plot --mcap --out @/run-3.csv"
   echo "run-quickstart-rapier run $S/quickstart.toml --case 3 --backend rapier --plot --out @/run-3.csv"
   echo "run-ci_corners run $S/ci_corners.toml --case 3 --backend rapier --plot --out @/run-3.csv"
@@ -101,7 +104,31 @@ run_side() {
   local bin=$1 dest=$2 side=$dir/run name args a out i=0 total start
   total=$(cases | grep -cE "^(${only:-.*}) " || true)
   rm -rf "$side" "$dest"
-  mkdir -p "$side/out" "$side/status"
+  mkdir -p "$side/out" "$side/status" "$side/in"
+  # A physical machine's fields swept by their machine-file keys (no shipped scenario does).
+  cat >"$side/in/machine_fields.toml" <<'TOML'
+name = "machine_fields"
+[machine]
+preset = "printer_xy"
+driver_model = "linear"
+[move]
+axis = "y"
+distance_mm = 10.0
+profile = "scurve"
+[limits]
+vmax_mm_s = 300.0
+amax_mm_s2 = 3000.0
+jmax_mm_s3 = 100000.0
+[observe]
+window_s = 0.3
+sample_rate_hz = 5000
+bands_um = [10.0]
+[sweep]
+"machine.axis.y.mount.stiffness_n_per_m" = [2.0e5, 4.0e5]
+"machine.axis.y.belt.pulley_teeth" = [16, 20]
+"machine.driver.microsteps" = [16, 32]
+"machine.motor.rotor_inertia_g_cm2" = [54.0]
+TOML
   while read -r name args; do
     [[ -z $only || $name =~ ^($only)$ ]] || continue
     i=$((i + 1))
