@@ -12,7 +12,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use settle_gcode::job::{Job, JobConfig, ShaperSetting};
 use settle_gcode::{Reader, ReaderOptions};
 use settle_planner::firmware::Firmware;
-use settle_planner::shaper::ShaperKind;
+use settle_planner::shaper::ShaperType;
 
 mod synth;
 
@@ -26,7 +26,7 @@ fn config(fw: Firmware) -> JobConfig {
     };
     for (i, f) in [48.0, 41.0].into_iter().enumerate() {
         c.shapers[i] = Some(ShaperSetting {
-            kind: ShaperKind::parse(name).expect("name"),
+            shaper_type: ShaperType::parse(name).expect("name"),
             frequency_hz: f,
             damping_ratio: 0.1,
         });

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use settle_gcode::job::{Job, JobConfig, ShaperSetting};
 use settle_planner::firmware::Firmware;
-use settle_planner::shaper::ShaperKind;
+use settle_planner::shaper::ShaperType;
 
 #[path = "../benches/synth/mod.rs"]
 mod synth;
@@ -48,7 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     for (i, f) in [48.0, 41.0].into_iter().enumerate() {
         cfg.shapers[i] = Some(ShaperSetting {
-            kind: ShaperKind::parse(name)?,
+            shaper_type: ShaperType::parse(name)?,
             frequency_hz: f,
             damping_ratio: 0.1,
         });

@@ -60,7 +60,7 @@ mod unit;
 pub mod velocity;
 
 pub use error::PlanError;
-pub use kind::{KindParams, ProfileKind};
+pub use kind::{ProfileKind, ProfileParams};
 pub use limits::Limits;
 pub use profile::{Profile, Sample, Segment, State};
 pub use trajectory::Trajectory;

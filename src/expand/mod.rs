@@ -184,7 +184,7 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
         bands_um: sc.observe.bands_um.clone(),
         max_step_s: sc.sim.max_step_s,
         swept: Vec::new(),
-        kind_params: settle_planner::KindParams::default(),
+        profile_params: settle_planner::ProfileParams::default(),
         kinds: states,
     };
     validate::validate_observe(&base, src)?;

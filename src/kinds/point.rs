@@ -31,7 +31,7 @@ impl Kind for PointMove {
             run.start_mm * 1e-3,
             run.distance_mm * 1e-3,
             &limits,
-            &run.kind_params,
+            &run.profile_params,
         )?;
         let profile = match &ctx.shaper {
             Some(s) => s.apply(&profile)?,

@@ -11,7 +11,7 @@
 
 use serde::Deserialize;
 use settle_planner::PlanError;
-use settle_planner::shaper::{Shaper, ShaperKind};
+use settle_planner::shaper::{Shaper, ShaperType};
 
 use crate::error::Error;
 use crate::input::scenario::ModeSpec;
@@ -48,11 +48,11 @@ fn default_damping() -> f64 {
     DEFAULT_DAMPING_RATIO
 }
 
-/// A run's shaper setting (resolved): `kind` is `None` for `type = "none"`.
+/// A run's shaper setting (resolved): `shaper_type` is `None` for `type = "none"`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShaperSetting {
     /// The family, or `None` (no shaping).
-    pub kind: Option<ShaperKind>,
+    pub shaper_type: Option<ShaperType>,
     /// Frequency (Hz).
     pub frequency_hz: f64,
     /// Damping ratio the shaper is designed for.
@@ -63,11 +63,11 @@ pub struct ShaperSetting {
 pub const ALLOWED_TYPES: &str = "none, zv, mzv, zvd, ei, 2hump_ei, 3hump_ei";
 
 /// Parse a shaper type name (`none` is no shaping).
-pub fn parse_type(name: &str) -> Result<Option<ShaperKind>, String> {
+pub fn parse_type(name: &str) -> Result<Option<ShaperType>, String> {
     if name.eq_ignore_ascii_case("none") {
         return Ok(None);
     }
-    ShaperKind::parse(name)
+    ShaperType::parse(name)
         .map(Some)
         .map_err(|_| format!("unknown shaper type `{name}`; allowed: {ALLOWED_TYPES}"))
 }
@@ -77,7 +77,7 @@ impl ShaperSetting {
     pub fn from_spec(spec: &ShaperSpec) -> Result<Self, (&'static str, String)> {
         let kind = parse_type(&spec.type_).map_err(|m| ("shaper.type", m))?;
         Ok(Self {
-            kind,
+            shaper_type: kind,
             frequency_hz: spec.frequency_hz,
             damping_ratio: spec.damping_ratio,
         })
@@ -85,7 +85,7 @@ impl ShaperSetting {
 
     /// The shaper, or `None` for no shaping. Errors for a bad frequency or damping ratio.
     pub fn shaper(&self) -> Result<Option<Shaper>, PlanError> {
-        self.kind
+        self.shaper_type
             .map(|k| Shaper::new(k, self.frequency_hz, self.damping_ratio))
             .transpose()
     }
@@ -118,7 +118,7 @@ impl KindState for ShaperSetting {
 
     fn set(&mut self, key: &str, value: &Value) -> Result<(), String> {
         match (key, value) {
-            ("type", Value::Text(t)) => self.kind = parse_type(t)?,
+            ("type", Value::Text(t)) => self.shaper_type = parse_type(t)?,
             ("frequency_hz", Value::Number(x)) => self.frequency_hz = *x,
             ("damping_ratio", Value::Number(x)) => self.damping_ratio = *x,
             ("type", _) => return Err(format!("`shaper.type` takes names: {ALLOWED_TYPES}")),
@@ -234,7 +234,7 @@ impl Kind for Shaping {
             return Vec::new();
         };
         let name = setting
-            .kind
+            .shaper_type
             .map_or_else(|| "none".to_string(), |k| k.name().to_string());
         let mut out = vec![
             name.to_string(),

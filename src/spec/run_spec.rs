@@ -98,7 +98,7 @@ pub struct RunSpec {
     pub swept: Vec<(String, Value)>,
     /// Parameters of the profile kinds that take any (PVT asymmetry, four-jerk BOW1..4
     /// scales); the planner's defaults unless `settle tune` searches them.
-    pub kind_params: settle_planner::KindParams,
+    pub profile_params: settle_planner::ProfileParams,
     /// The states of the run kinds whose tables the scenario has (at most one each).
     pub kinds: Vec<Box<dyn KindState>>,
 }

@@ -162,7 +162,7 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
 }
 
 fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)> {
-    s.kind_name(dialect)
+    s.type_name(dialect)
         .map(|n| (n, s.frequency_hz, s.damping_ratio))
 }
 

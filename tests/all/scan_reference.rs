@@ -9,7 +9,7 @@ use crate::support::extra;
 use std::path::Path;
 
 use settle::spec::backend::Backend;
-use settle_planner::KindParams;
+use settle_planner::ProfileParams;
 use settle_sim::Mode;
 use settle_sim::closed_form::residual_at;
 
@@ -31,7 +31,7 @@ fn reentry_error_and_settling_equal_the_closed_form_on_modal() {
                 0.0,
                 spec.distance_mm * 1e-3,
                 &spec.limits_si().expect("limits"),
-                &KindParams::default(),
+                &ProfileParams::default(),
             )
             .expect("step");
         // The deflection e (m) at time tau after the step's start, for tau >= its end.

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 use settle::kinds::scan::ScanSpec;
 use settle::spec::backend::Backend;
-use settle_planner::KindParams;
+use settle_planner::ProfileParams;
 use settle_planner::shaper::Shaper;
 use settle_sim::Mode;
 use settle_sim::closed_form::residual_at;
@@ -81,12 +81,12 @@ profile = ["trapezoid", "scurve"]
                 0.0,
                 spec.distance_mm * 1e-3,
                 &spec.limits_si().expect("limits"),
-                &KindParams::default(),
+                &ProfileParams::default(),
             )
             .expect("step");
         let kind = spec
             .state::<settle::kinds::shaping::ShaperSetting>()
-            .and_then(|s| s.kind);
+            .and_then(|s| s.shaper_type);
         let step = match kind {
             Some(k) => Shaper::new(k, F_HZ, 0.1)
                 .expect("shaper")

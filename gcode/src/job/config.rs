@@ -10,7 +10,7 @@ use settle_planner::firmware::{Firmware, Kinematics};
 use settle_planner::path::junction::Junction;
 use settle_planner::path::{CornerStrategy, PathOptions};
 use settle_planner::shaper::stream::Alignment;
-use settle_planner::shaper::{Shaper, ShaperKind};
+use settle_planner::shaper::{Shaper, ShaperType};
 use settle_planner::{Limits, PlanError, ProfileKind};
 
 use crate::{ArcSegmentation, Dialect, GcodeError};
@@ -30,7 +30,7 @@ pub fn parse_firmware(name: &str) -> Result<Firmware, GcodeError> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShaperSetting {
     /// The shaper (bare names are Klipper's, `marlin:` and `rrf:` the other firmwares').
-    pub kind: ShaperKind,
+    pub shaper_type: ShaperType,
     /// Frequency it is tuned to (Hz).
     pub frequency_hz: f64,
     /// Damping ratio it is tuned to.
@@ -40,7 +40,7 @@ pub struct ShaperSetting {
 impl ShaperSetting {
     /// The shaper's impulses (its firmware's checks apply).
     pub fn build(&self) -> Result<Shaper, PlanError> {
-        Shaper::new(self.kind, self.frequency_hz, self.damping_ratio)
+        Shaper::new(self.shaper_type, self.frequency_hz, self.damping_ratio)
     }
 }
 
@@ -204,7 +204,7 @@ fn config_shaper(
     key: &'static str,
 ) -> Result<Option<ShaperSetting>, GcodeError> {
     let bad = |reason: String| GcodeError::JobSetting { key, reason };
-    let Some(name) = s.kind_name(dialect) else {
+    let Some(name) = s.type_name(dialect) else {
         if s.is_enabled(dialect) {
             return Err(bad(format!(
                 "the `{}` shaper is known only by its impulses; settle does not model it",
@@ -213,9 +213,9 @@ fn config_shaper(
         }
         return Ok(None);
     };
-    let kind = ShaperKind::parse(&name).map_err(|e| bad(e.to_string()))?;
+    let kind = ShaperType::parse(&name).map_err(|e| bad(e.to_string()))?;
     let setting = ShaperSetting {
-        kind,
+        shaper_type: kind,
         frequency_hz: s.frequency_hz,
         damping_ratio: s.damping_ratio,
     };
@@ -313,12 +313,12 @@ mod from_config_tests {
         let x = x.expect("X shaped");
         let y = y.expect("Y shaped");
         assert_eq!(
-            (x.kind, x.frequency_hz, x.damping_ratio),
-            (ShaperKind::MZV, 52.4, 0.1)
+            (x.shaper_type, x.frequency_hz, x.damping_ratio),
+            (ShaperType::MZV, 52.4, 0.1)
         );
         assert_eq!(
-            (y.kind, y.frequency_hz, y.damping_ratio),
-            (ShaperKind::EI, 41.5, 0.08)
+            (y.shaper_type, y.frequency_hz, y.damping_ratio),
+            (ShaperType::EI, 41.5, 0.08)
         );
         assert_eq!(z, None, "Klipper leaves Z unshaped without shaper_freq_z");
         assert_eq!(cfg.dialect, Dialect::Klipper);
@@ -358,6 +358,6 @@ mod from_config_tests {
         assert_eq!(cfg.shapers[1], Some(x), "one shaper for X and Y");
         assert_eq!(cfg.shapers[2], None);
         assert_eq!((x.frequency_hz, x.damping_ratio), (42.5, 0.1));
-        assert_eq!(x.kind, ShaperKind::parse("rrf:mzv").expect("ok"));
+        assert_eq!(x.shaper_type, ShaperType::parse("rrf:mzv").expect("ok"));
     }
 }

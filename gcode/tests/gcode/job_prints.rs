@@ -5,7 +5,7 @@ use std::collections::BTreeSet;
 use settle_gcode::job::{Job, JobChunk, JobConfig, ShaperSetting};
 use settle_gcode::{Reader, ReaderOptions};
 use settle_planner::firmware::Firmware;
-use settle_planner::shaper::ShaperKind;
+use settle_planner::shaper::ShaperType;
 
 use crate::job_util::{MM, assert_contiguous, assert_rel, at};
 use crate::print_path;
@@ -17,18 +17,18 @@ fn shaped(fw: Firmware) -> JobConfig {
     let mut c = JobConfig::defaults(fw).expect("defaults");
     let kinds = match fw {
         Firmware::Marlin => [
-            ShaperKind::parse("marlin:zvd").expect("name"),
-            ShaperKind::parse("marlin:mzv").expect("name"),
+            ShaperType::parse("marlin:zvd").expect("name"),
+            ShaperType::parse("marlin:mzv").expect("name"),
         ],
         Firmware::Rrf => [
-            ShaperKind::parse("rrf:zvd").expect("name"),
-            ShaperKind::parse("rrf:ei2").expect("name"),
+            ShaperType::parse("rrf:zvd").expect("name"),
+            ShaperType::parse("rrf:ei2").expect("name"),
         ],
-        _ => [ShaperKind::MZV, ShaperKind::EI],
+        _ => [ShaperType::MZV, ShaperType::EI],
     };
     for (i, (kind, f)) in kinds.into_iter().zip([48.0, 41.0]).enumerate() {
         c.shapers[i] = Some(ShaperSetting {
-            kind,
+            shaper_type: kind,
             frequency_hz: f,
             damping_ratio: 0.1,
         });

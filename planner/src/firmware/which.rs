@@ -4,7 +4,7 @@
 //!
 //! - Klipper, Marlin and RepRapFirmware plan G-code jobs ([`crate::firmware::klipper`],
 //!   [`crate::firmware::marlin`], [`crate::firmware::rrf`]) and shape with their own shaper
-//!   definitions ([`crate::shaper::ShaperKind::firmware`]); `rrf` is also written
+//!   definitions ([`crate::shaper::ShaperType::firmware`]); `rrf` is also written
 //!   `reprapfirmware` or `duet` (RepRapFirmware runs on Duet boards).
 //! - `settle` is settle's own jerk-limited look-ahead ([`crate::path`]): it plans G-code
 //!   jobs too.

@@ -215,7 +215,7 @@ pub fn job_config(run: &RunSpec, job: &GcodeJob, shaper: Option<ShaperSetting>) 
 /// The shaper the run's `[shaper]` sets, as a job setting.
 fn shaper_setting(s: Option<&settle_planner::shaper::Shaper>) -> Option<ShaperSetting> {
     s.map(|s| ShaperSetting {
-        kind: s.kind(),
+        shaper_type: s.shaper_type(),
         frequency_hz: s.frequency_hz(),
         damping_ratio: s.damping_ratio(),
     })

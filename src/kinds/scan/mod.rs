@@ -80,7 +80,7 @@ pub fn plan_raster(
         fly_jmax: scan.fly_jmax_mm_s3.map(|j| j * 1e-3),
         step_kind: spec.profile,
         step_limits: spec.limits_si()?,
-        step_params: spec.kind_params,
+        step_params: spec.profile_params,
         placement,
         settle_margin_s: scan.settle_margin_s + t_shaper_s,
     })?;

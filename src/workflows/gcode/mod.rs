@@ -684,7 +684,7 @@ fn mm(si: f64) -> String {
 fn shaper_words(shapers: &[Option<ShaperSetting>; 3]) -> String {
     let name = |s: &Option<ShaperSetting>| {
         s.map_or("none".to_string(), |s| {
-            format!("{}@{} Hz", s.kind.name(), s.frequency_hz)
+            format!("{}@{} Hz", s.shaper_type.name(), s.frequency_hz)
         })
     };
     match (&shapers[0], &shapers[1]) {
@@ -697,8 +697,9 @@ fn shaper_words(shapers: &[Option<ShaperSetting>; 3]) -> String {
 /// The planner and the X and Y shapers in words: `klipper + mzv@48 Hz`, `settle` when
 /// unshaped, both shapers when they differ.
 pub fn setting_name(job: &JobConfig) -> String {
-    let name =
-        |s: &Option<ShaperSetting>| s.map(|s| format!("{}@{} Hz", s.kind.name(), s.frequency_hz));
+    let name = |s: &Option<ShaperSetting>| {
+        s.map(|s| format!("{}@{} Hz", s.shaper_type.name(), s.frequency_hz))
+    };
     match (name(&job.shapers[0]), name(&job.shapers[1])) {
         (None, None) => job.firmware().to_string(),
         (x, y) if x == y => format!("{} + {}", job.firmware(), x.unwrap_or_default()),
@@ -817,9 +818,9 @@ pub fn parse_shaper(s: &str) -> Result<ShaperSetting, String> {
         None => (rest, 0.1),
     };
     let frequency_hz = f.parse::<f64>().map_err(|_| bad())?;
-    let kind = settle_planner::shaper::ShaperKind::parse(kind).map_err(|e| e.to_string())?;
+    let kind = settle_planner::shaper::ShaperType::parse(kind).map_err(|e| e.to_string())?;
     let setting = ShaperSetting {
-        kind,
+        shaper_type: kind,
         frequency_hz,
         damping_ratio: z,
     };

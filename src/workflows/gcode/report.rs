@@ -296,9 +296,14 @@ fn digest_and_lines(file: &Path, wanted: &[u64]) -> Result<(String, BTreeMap<u64
 /// A shaper as `--shaper` takes it: `mzv@48`, `ei@52/0.08`.
 pub(crate) fn shaper_arg(s: &ShaperSetting) -> String {
     if s.damping_ratio == 0.1 {
-        format!("{}@{}", s.kind.name(), s.frequency_hz)
+        format!("{}@{}", s.shaper_type.name(), s.frequency_hz)
     } else {
-        format!("{}@{}/{}", s.kind.name(), s.frequency_hz, s.damping_ratio)
+        format!(
+            "{}@{}/{}",
+            s.shaper_type.name(),
+            s.frequency_hz,
+            s.damping_ratio
+        )
     }
 }
 

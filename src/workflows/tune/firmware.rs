@@ -4,14 +4,14 @@
 //! - Klipper, Marlin and RepRapFirmware plan trapezoids (constant-acceleration phases;
 //!   Klipper's `klippy/toolhead.py` `Move`, RepRapFirmware's `DDA`, Marlin's planner
 //!   without its optional Bezier jerk), each shaping with its own shaper set
-//!   (`ShaperKind::KLIPPER`, `ShaperKind::MARLIN`, `ShaperKind::RRF`).
+//!   (`ShaperType::KLIPPER`, `ShaperType::MARLIN`, `ShaperType::RRF`).
 //! - The TMC4361A's ramp generator runs S-shaped ramps (BOW1..4: `scurve` and `fourjerk`)
 //!   and has no input shaper.
 //! - `any`: every profile kind and Klipper's shapers (settle's default set).
 
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
-use settle_planner::shaper::ShaperKind;
+use settle_planner::shaper::ShaperType;
 
 /// The firmwares `settle tune` searches for (and exports to): Klipper, Marlin,
 /// RepRapFirmware and the TMC4361A.
@@ -75,11 +75,11 @@ impl Candidates {
     }
 
     /// The shapers it runs (none for the TMC4361A; Klipper's for any).
-    pub fn shapers(self) -> Vec<ShaperKind> {
+    pub fn shapers(self) -> Vec<ShaperType> {
         match self.0 {
-            None | Some(Firmware::Klipper | Firmware::Settle) => ShaperKind::KLIPPER.to_vec(),
-            Some(Firmware::Marlin) => ShaperKind::MARLIN.to_vec(),
-            Some(Firmware::Rrf) => ShaperKind::RRF.to_vec(),
+            None | Some(Firmware::Klipper | Firmware::Settle) => ShaperType::KLIPPER.to_vec(),
+            Some(Firmware::Marlin) => ShaperType::MARLIN.to_vec(),
+            Some(Firmware::Rrf) => ShaperType::RRF.to_vec(),
             Some(Firmware::Tmc4361a) => Vec::new(),
         }
     }
@@ -102,7 +102,7 @@ impl Candidates {
     }
 
     /// `Ok` when it runs `shaper` (`None`, no shaping, always), else why not.
-    pub fn check_shaper(self, shaper: Option<ShaperKind>) -> Result<(), String> {
+    pub fn check_shaper(self, shaper: Option<ShaperType>) -> Result<(), String> {
         let Some(k) = shaper else {
             return Ok(());
         };

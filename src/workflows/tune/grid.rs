@@ -1,8 +1,8 @@
 //! The search grid of `settle tune`: the `[tune]` table resolved against the scenario's
 //! base run into candidates (kinds, jerks, kind parameters, shapers) and the move family.
 
-use settle_planner::shaper::ShaperKind;
-use settle_planner::{KindParams, ProfileKind};
+use settle_planner::shaper::ShaperType;
+use settle_planner::{ProfileKind, ProfileParams};
 
 use crate::error::Error;
 use crate::input::scenario::Scenario;
@@ -23,7 +23,7 @@ pub const BOW_PATTERNS: [[f64; 4]; 5] = [
     [0.5, 1.0, 0.5, 1.0],
 ];
 
-/// PVT asymmetries searched (`KindParams::pvt_asym_ki`, in (1/3, 1); 0.5 is its default).
+/// PVT asymmetries searched (`ProfileParams::pvt_asym_ki`, in (1/3, 1); 0.5 is its default).
 pub const PVT_KI: [f64; 4] = [0.4, 0.5, 0.65, 0.8];
 
 /// Default frequency scales: the mode frequency +-20% (shapers are tuned to a measured
@@ -169,7 +169,7 @@ pub fn plan(
             })
             .collect::<Result<_, _>>()?,
     };
-    let shapers: Vec<Option<ShaperKind>> = match &spec.shapers {
+    let shapers: Vec<Option<ShaperType>> = match &spec.shapers {
         None => std::iter::once(None)
             .chain(firmware.shapers().into_iter().map(Some))
             .collect(),
@@ -281,7 +281,7 @@ pub fn plan(
                         // calibrate_shaper.py prints `%.1f`): the exported value is the
                         // simulated one.
                         let s = ShaperSetting {
-                            kind: Some(*k),
+                            shaper_type: Some(*k),
                             frequency_hz: (f * x * 10.0).round() / 10.0,
                             damping_ratio: DEFAULT_DAMPING_RATIO,
                         };
@@ -301,24 +301,24 @@ pub fn plan(
         } else {
             jerks.iter().copied().map(Some).collect()
         };
-        let params: Vec<KindParams> = match kind {
+        let params: Vec<ProfileParams> = match kind {
             // Corner paths plan their legs from the limits alone.
-            _ if base.state::<Corner>().is_some() => vec![KindParams::default()],
+            _ if base.state::<Corner>().is_some() => vec![ProfileParams::default()],
             ProfileKind::PvtAsym => PVT_KI
                 .iter()
-                .map(|&k| KindParams {
+                .map(|&k| ProfileParams {
                     pvt_asym_ki: k,
-                    ..KindParams::default()
+                    ..ProfileParams::default()
                 })
                 .collect(),
             ProfileKind::FourJerk => BOW_PATTERNS
                 .iter()
-                .map(|&b| KindParams {
+                .map(|&b| ProfileParams {
                     fourjerk_jerk_scale: b,
-                    ..KindParams::default()
+                    ..ProfileParams::default()
                 })
                 .collect(),
-            _ => vec![KindParams::default()],
+            _ => vec![ProfileParams::default()],
         };
         for j in &jerk_list {
             for p in &params {
@@ -422,13 +422,13 @@ fn current_shaper(
 ) -> Result<Option<ShaperSetting>, String> {
     let kind = match &cur.shaper {
         Some(name) => crate::kinds::shaping::parse_type(name)?,
-        None => scenario.and_then(|s| s.kind),
+        None => scenario.and_then(|s| s.shaper_type),
     };
     let Some(kind) = kind else {
         return Ok(None);
     };
     let s = ShaperSetting {
-        kind: Some(kind),
+        shaper_type: Some(kind),
         frequency_hz: cur
             .frequency_hz
             .or(scenario.map(|s| s.frequency_hz))

@@ -57,7 +57,7 @@ pub fn report(path: &Path) -> Result<Report, Error> {
     for s in &sel.per_shaper {
         r.out(format!(
             "Fitted shaper '{}' frequency = {:.1} Hz (vibrations = {:.1}%, smoothing ~= {:.3})",
-            s.kind.name(),
+            s.shaper_type.name(),
             s.frequency_hz,
             s.vibrations * 100.0,
             s.smoothing_mm
@@ -66,14 +66,14 @@ pub fn report(path: &Path) -> Result<Report, Error> {
         let _ = write!(
             line,
             "To avoid too much smoothing with '{}', suggested max_accel <= {:.0} mm/sec^2",
-            s.kind.name(),
+            s.shaper_type.name(),
             (s.max_accel_mm_s2 / 100.0).round_ties_even() * 100.0 // Python 3 round()
         );
         r.out(line);
     }
     r.out(format!(
         "Recommended shaper is {} @ {:.1} Hz",
-        sel.recommended.kind.name(),
+        sel.recommended.shaper_type.name(),
         sel.recommended.frequency_hz
     ));
     Ok(r)

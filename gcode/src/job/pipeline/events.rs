@@ -228,7 +228,7 @@ impl<R: BufRead> Job<R> {
                 command,
                 PlanError::UnknownKind {
                     name,
-                    allowed: settle_planner::shaper::ShaperKind::ALLOWED,
+                    allowed: settle_planner::shaper::ShaperType::ALLOWED,
                 },
             ),
             ShaperProblem::Unsupported(why) => GcodeError::Unsupported {

@@ -4,7 +4,7 @@
 //! shapers of Marlin's FT_MOTION and RepRapFirmware's M593 carry a `marlin:` or `rrf:`
 //! prefix, because the same name means different impulses there (Marlin's MZV decays by the
 //! ZV factor, RepRapFirmware's MZV puts its impulses in the opposite order, both EIs differ
-//! from Klipper's). See [`ShaperKind::parse`] for the syntax; `Display` writes the same
+//! from Klipper's). See [`ShaperType::parse`] for the syntax; `Display` writes the same
 //! syntax back, and a Klipper kind's text is what Klipper's `shaper_type` accepts.
 
 use std::fmt;
@@ -130,7 +130,7 @@ pub const RRF_STEP_CLOCK_HZ: u32 = 750_000;
 /// A shaper family with the parameters that change its impulses (frequency and damping
 /// ratio are given separately to [`crate::shaper::Shaper::new`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum ShaperKind {
+pub enum ShaperType {
     /// Klipper `zv`.
     Zv,
     /// Klipper `mzv(n, t)`: `n` impulses over `t` damped periods (classic MZV: 3, 0.75).
@@ -169,46 +169,46 @@ pub enum ShaperKind {
     },
 }
 
-impl ShaperKind {
+impl ShaperType {
     /// Klipper's classic MZV, `mzv` = `mzv(n=3,t=0.75)`.
-    pub const MZV: ShaperKind = ShaperKind::Mzv { n: 3, t: 0.75 };
+    pub const MZV: ShaperType = ShaperType::Mzv { n: 3, t: 0.75 };
     /// Klipper's `ei` with its default tolerance.
-    pub const EI: ShaperKind = ShaperKind::Ei {
+    pub const EI: ShaperType = ShaperType::Ei {
         v_tol: KLIPPER_V_TOL,
     };
     /// Klipper's six shapers with their default parameters, shortest first: what the bare
     /// names mean.
-    pub const KLIPPER: [ShaperKind; 6] = [
-        ShaperKind::Zv,
-        ShaperKind::MZV,
-        ShaperKind::Zvd,
-        ShaperKind::EI,
-        ShaperKind::TwoHumpEi,
-        ShaperKind::ThreeHumpEi,
+    pub const KLIPPER: [ShaperType; 6] = [
+        ShaperType::Zv,
+        ShaperType::MZV,
+        ShaperType::Zvd,
+        ShaperType::EI,
+        ShaperType::TwoHumpEi,
+        ShaperType::ThreeHumpEi,
     ];
-    /// Klipper's six (the same as [`ShaperKind::KLIPPER`]).
-    pub const ALL: [ShaperKind; 6] = Self::KLIPPER;
+    /// Klipper's six (the same as [`ShaperType::KLIPPER`]).
+    pub const ALL: [ShaperType; 6] = Self::KLIPPER;
     /// Marlin's eight with their defaults (`v_tol` 0.05, `FTM_FS` 1000 Hz).
-    pub const MARLIN: [ShaperKind; 8] = {
-        let mut out = [ShaperKind::Zv; 8];
+    pub const MARLIN: [ShaperType; 8] = {
+        let mut out = [ShaperType::Zv; 8];
         let mut i = 0;
         while i < 8 {
-            out[i] = ShaperKind::marlin(MarlinShaper::ALL[i]);
+            out[i] = ShaperType::marlin(MarlinShaper::ALL[i]);
             i += 1;
         }
         out
     };
     /// RepRapFirmware's six with the Duet 3 step clock.
-    pub const RRF: [ShaperKind; 6] = {
-        let mut out = [ShaperKind::Zv; 6];
+    pub const RRF: [ShaperType; 6] = {
+        let mut out = [ShaperType::Zv; 6];
         let mut i = 0;
         while i < 6 {
-            out[i] = ShaperKind::rrf(RrfShaper::ALL[i]);
+            out[i] = ShaperType::rrf(RrfShaper::ALL[i]);
             i += 1;
         }
         out
     };
-    /// The syntax [`ShaperKind::parse`] accepts.
+    /// The syntax [`ShaperType::parse`] accepts.
     pub const ALLOWED: &'static str = "zv, mzv, zvd, ei, 2hump_ei, 3hump_ei (Klipper; also \
         klipper:NAME, mzv(n=N,t=T) or mzv(n=N,tau=TAU) with integer N >= 3, ei(v_tol=V)); \
         marlin:zv, marlin:zvd, marlin:zvdd, marlin:zvddd, marlin:ei, marlin:2hei, \
@@ -217,7 +217,7 @@ impl ShaperKind {
 
     /// A Marlin shaper with Marlin's defaults.
     pub const fn marlin(shaper: MarlinShaper) -> Self {
-        ShaperKind::Marlin {
+        ShaperType::Marlin {
             shaper,
             v_tol: MARLIN_V_TOL,
             ftm_fs_hz: MARLIN_FTM_FS_HZ,
@@ -226,7 +226,7 @@ impl ShaperKind {
 
     /// A RepRapFirmware shaper on the Duet 3 step clock.
     pub const fn rrf(shaper: RrfShaper) -> Self {
-        ShaperKind::Rrf {
+        ShaperType::Rrf {
             shaper,
             step_clock_hz: RRF_STEP_CLOCK_HZ,
         }
@@ -235,8 +235,8 @@ impl ShaperKind {
     /// The firmware whose definition this is (Klipper, Marlin or RepRapFirmware).
     pub fn firmware(self) -> Firmware {
         match self {
-            ShaperKind::Marlin { .. } => Firmware::Marlin,
-            ShaperKind::Rrf { .. } => Firmware::Rrf,
+            ShaperType::Marlin { .. } => Firmware::Marlin,
+            ShaperType::Rrf { .. } => Firmware::Rrf,
             _ => Firmware::Klipper,
         }
     }
@@ -246,25 +246,25 @@ impl ShaperKind {
     /// `None` for other firmwares' shapers.
     pub fn klipper_min_freq_hz(self) -> Option<f64> {
         match self {
-            ShaperKind::Zv => Some(21.0),
-            ShaperKind::Mzv { .. } => Some(23.0),
-            ShaperKind::Zvd | ShaperKind::Ei { .. } => Some(29.0),
-            ShaperKind::TwoHumpEi => Some(39.0),
-            ShaperKind::ThreeHumpEi => Some(48.0),
-            ShaperKind::Marlin { .. } | ShaperKind::Rrf { .. } => None,
+            ShaperType::Zv => Some(21.0),
+            ShaperType::Mzv { .. } => Some(23.0),
+            ShaperType::Zvd | ShaperType::Ei { .. } => Some(29.0),
+            ShaperType::TwoHumpEi => Some(39.0),
+            ShaperType::ThreeHumpEi => Some(48.0),
+            ShaperType::Marlin { .. } | ShaperType::Rrf { .. } => None,
         }
     }
 
     /// The family name without parameters (`mzv`, `marlin:zvdd`, `rrf:ei2`).
     pub fn family(self) -> &'static str {
         match self {
-            ShaperKind::Zv => "zv",
-            ShaperKind::Mzv { .. } => "mzv",
-            ShaperKind::Zvd => "zvd",
-            ShaperKind::Ei { .. } => "ei",
-            ShaperKind::TwoHumpEi => "2hump_ei",
-            ShaperKind::ThreeHumpEi => "3hump_ei",
-            ShaperKind::Marlin { shaper, .. } => match shaper {
+            ShaperType::Zv => "zv",
+            ShaperType::Mzv { .. } => "mzv",
+            ShaperType::Zvd => "zvd",
+            ShaperType::Ei { .. } => "ei",
+            ShaperType::TwoHumpEi => "2hump_ei",
+            ShaperType::ThreeHumpEi => "3hump_ei",
+            ShaperType::Marlin { shaper, .. } => match shaper {
                 MarlinShaper::Zv => "marlin:zv",
                 MarlinShaper::Zvd => "marlin:zvd",
                 MarlinShaper::Zvdd => "marlin:zvdd",
@@ -274,7 +274,7 @@ impl ShaperKind {
                 MarlinShaper::ThreeHei => "marlin:3hei",
                 MarlinShaper::Mzv => "marlin:mzv",
             },
-            ShaperKind::Rrf { shaper, .. } => match shaper {
+            ShaperType::Rrf { shaper, .. } => match shaper {
                 RrfShaper::Zvd => "rrf:zvd",
                 RrfShaper::Zvdd => "rrf:zvdd",
                 RrfShaper::Zvddd => "rrf:zvddd",
@@ -292,21 +292,21 @@ impl ShaperKind {
     }
 }
 
-impl fmt::Display for ShaperKind {
+impl fmt::Display for ShaperType {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.family())?;
         // `{}` of an f64 is the shortest text that parses back to the same value, without
         // an exponent: Klipper's parameter pattern (`[\d.]+`) reads it.
         let mut params: Vec<String> = Vec::new();
         match *self {
-            ShaperKind::Mzv { n, t } if *self != ShaperKind::MZV => {
+            ShaperType::Mzv { n, t } if *self != ShaperType::MZV => {
                 params.push(format!("n={n}"));
                 params.push(format!("t={t}"));
             }
-            ShaperKind::Ei { v_tol } if v_tol != KLIPPER_V_TOL => {
+            ShaperType::Ei { v_tol } if v_tol != KLIPPER_V_TOL => {
                 params.push(format!("v_tol={v_tol}"));
             }
-            ShaperKind::Marlin {
+            ShaperType::Marlin {
                 shaper,
                 v_tol,
                 ftm_fs_hz,
@@ -318,7 +318,7 @@ impl fmt::Display for ShaperKind {
                     params.push(format!("ftm_fs={ftm_fs_hz}"));
                 }
             }
-            ShaperKind::Rrf { step_clock_hz, .. } if step_clock_hz != RRF_STEP_CLOCK_HZ => {
+            ShaperType::Rrf { step_clock_hz, .. } if step_clock_hz != RRF_STEP_CLOCK_HZ => {
                 params.push(format!("step_clock={step_clock_hz}"));
             }
             _ => {}
@@ -330,11 +330,11 @@ impl fmt::Display for ShaperKind {
     }
 }
 
-impl std::str::FromStr for ShaperKind {
+impl std::str::FromStr for ShaperType {
     type Err = crate::PlanError;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        ShaperKind::parse(s)
+        ShaperType::parse(s)
     }
 }
 
