@@ -18,8 +18,8 @@ pub struct SimOptions {
     /// (rapier: `STEP_FRACTION / w_max`).
     pub max_step_s: Option<f64>,
     /// Where the modal backend linearises a position-dependent stiffness: one position
-    /// per axis (m, in the order of the axes); `None`: each axis's start. The run kind
-    /// chooses it ([`crate::kinds::Planned::linearise_at_m`]), `settle gcode` takes the
+    /// per axis (m, in the order of the axes); `None`: each axis's start. The study
+    /// chooses it ([`crate::studies::Planned::linearise_at_m`]), `settle gcode` takes the
     /// print's centre; the nonlinear backends follow the stiffness along the travel and
     /// ignore it.
     pub linearise_at_m: Option<Vec<f64>>,

@@ -2,8 +2,8 @@
 //! file always gives the same runs in the same order (the only I/O is reading a machine
 //! file the scenario names by path).
 //!
-//! The base run comes from the scenario's core tables and the run kinds' tables (each
-//! registered kind parses its own, `crate::kinds`); the sweep axes ([`axes`]) then vary it,
+//! The base run comes from the scenario's core tables and the studies' tables (each
+//! registered study parses its own, `crate::studies`); the sweep axes ([`axes`]) then vary it,
 //! the last axis fastest, and every run is checked ([`validate`]).
 
 pub mod axes;
@@ -19,21 +19,21 @@ use settle_planner::ProfileKind;
 use crate::error::Error;
 use crate::input::scenario::{MoveSpec, Scenario};
 use crate::input::source::Source;
-use crate::kinds::{self, Kind, KindState, Role};
 use crate::spec::backend::Backend;
 use crate::spec::run_spec::{RunSpec, SWEEPABLE};
 use crate::spec::value::Value;
+use crate::studies::{self, Role, Study, StudyState};
 
 pub use axes::{Axis, MAX_RUNS};
 
-/// Read a scenario file (its core and every kind's table).
+/// Read a scenario file (its core and every study's table).
 pub fn load(path: &Path) -> Result<(Scenario, Source), Error> {
-    crate::input::scenario::load(path, &kinds::tables())
+    crate::input::scenario::load(path, &studies::tables())
 }
 
 /// Parse scenario text (see [`load`]); `path` is used in error messages.
 pub fn parse(text: &str, path: &Path) -> Result<(Scenario, Source), Error> {
-    crate::input::scenario::parse(text, path, &kinds::tables())
+    crate::input::scenario::parse(text, path, &studies::tables())
 }
 
 /// Load a scenario file and expand it into validated runs.
@@ -50,10 +50,10 @@ pub fn parse_runs(text: &str, path: &Path) -> Result<(Scenario, Vec<RunSpec>), E
     Ok((sc, runs))
 }
 
-/// Everything that can be swept, for messages: the keys of every run, then each kind's.
+/// Everything that can be swept, for messages: the keys of every run, then each study's.
 pub fn sweepable() -> String {
     let mut out = SWEEPABLE.to_string();
-    for k in kinds::all() {
+    for k in studies::all() {
         if let (Some(t), s) = (k.table(), k.sweepable())
             && !s.is_empty()
         {
@@ -63,19 +63,19 @@ pub fn sweepable() -> String {
     out
 }
 
-/// How a kind is given in a scenario, for messages: `[corner] (a corner path)`.
-fn given_as(k: &dyn Kind) -> String {
+/// How a study is given in a scenario, for messages: `[corner] (a corner path)`.
+fn given_as(k: &dyn Study) -> String {
     format!("[{}] (a {})", k.table().unwrap_or("move"), k.name())
 }
 
-/// The run kinds' states from their tables, and the move every run starts from: `[move]`
-/// (`None`), or a path kind's stand-in for it (with the key its profile kind is blamed on).
-type BaseMotion = (Vec<Box<dyn KindState>>, MoveSpec, Option<&'static str>);
+/// The studies' states from their tables, and the move every run starts from: `[move]`
+/// (`None`), or a path study's stand-in for it (with the key its profile kind is blamed on).
+type BaseMotion = (Vec<Box<dyn StudyState>>, MoveSpec, Option<&'static str>);
 
 fn base_motion(sc: &Scenario, src: &Source) -> Result<BaseMotion, Error> {
     let mut states = Vec::new();
-    let mut motion: Option<&dyn Kind> = None;
-    for k in kinds::all() {
+    let mut motion: Option<&dyn Study> = None;
+    for k in studies::all() {
         let Some(state) = k.parse(src)? else {
             continue;
         };
@@ -94,7 +94,7 @@ fn base_motion(sc: &Scenario, src: &Source) -> Result<BaseMotion, Error> {
         }
         states.push(state);
     }
-    let paths: Vec<String> = kinds::all()
+    let paths: Vec<String> = studies::all()
         .iter()
         .filter(|k| k.role() == Role::Path)
         .map(|k| given_as(*k))
@@ -185,7 +185,7 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
         max_step_s: sc.sim.max_step_s,
         swept: Vec::new(),
         profile_params: settle_planner::ProfileParams::default(),
-        kinds: states,
+        studies: states,
     };
     validate::validate_observe(&base, src)?;
     if sc.sweep.len() > validate::MAX_SWEEP_AXES {
@@ -295,8 +295,8 @@ impl SweepRuns {
             }
             run.swept.push((axis.param.clone(), v.clone()));
         }
-        // A path kind's move length is its path length.
-        if let Some(d) = kinds::motion(&run).path_length_mm(&run) {
+        // A path study's move length is its path length.
+        if let Some(d) = studies::motion(&run).path_length_mm(&run) {
             run.distance_mm = d;
         }
         Ok(run)

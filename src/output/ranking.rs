@@ -229,7 +229,7 @@ fn max_accel(table: &RunsColumns, row: usize) -> Option<f64> {
     Some(settle_planner::shaper_select::max_accel_mm_s2(
         sh.amplitudes(),
         sh.times_s(),
-        crate::kinds::shaping::SMOOTHING_SCV_MM_S,
+        crate::studies::shaping::SMOOTHING_SCV_MM_S,
         settle_planner::shaper_select::TARGET_SMOOTHING_MM,
     ))
 }

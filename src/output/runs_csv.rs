@@ -1,5 +1,5 @@
 //! `runs.csv`: one row per run, its parameters then its metrics, then the columns of its
-//! run kinds (in registration order, `crate::kinds::KINDS`). Written with the `csv` crate
+//! studies (in registration order, `crate::studies::STUDIES`). Written with the `csv` crate
 //! (`crate::input::runs_table::record`): numbers in Rust's shortest round-trip form, free
 //! text (a failed run's reason) quoted where it holds a comma or a quote.
 //!
@@ -10,10 +10,10 @@
 use settle_planner::ProfileKind;
 
 use crate::input::runs_table::record;
-use crate::kinds::Kind;
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
+use crate::studies::Study;
 
 /// A band as it appears in column names (`10um`).
 pub fn band_label(b: f64) -> String {
@@ -31,7 +31,7 @@ pub struct RunsCsv {
     header: Vec<String>,
     bands_um: Vec<f64>,
     axis_names: Vec<String>,
-    kinds: Vec<(&'static dyn Kind, usize)>,
+    studies: Vec<(&'static dyn Study, usize)>,
 }
 
 impl RunsCsv {
@@ -118,11 +118,11 @@ impl RunsCsv {
             header.push(format!("{a}_max_following_error_um"));
             header.push(format!("{a}_max_load_angle_deg"));
         }
-        let mut kinds = Vec::new();
-        for k in crate::kinds::all() {
+        let mut studies = Vec::new();
+        for k in crate::studies::all() {
             let cols = k.columns(runs);
             if !cols.is_empty() {
-                kinds.push((*k, cols.len()));
+                studies.push((*k, cols.len()));
                 header.extend(cols);
             }
         }
@@ -130,7 +130,7 @@ impl RunsCsv {
             header,
             bands_um,
             axis_names,
-            kinds,
+            studies,
         }
     }
 
@@ -209,7 +209,7 @@ impl RunsCsv {
             let empty = 5 + 2 * m.settle_time_s.len() + self.axis_names.len() * (4 + n_bands);
             c.extend(std::iter::repeat_n(String::new(), empty));
         }
-        for (k, n) in &self.kinds {
+        for (k, n) in &self.studies {
             let mut cells = k.cells(r, m);
             cells.resize(*n, String::new());
             c.extend(cells);

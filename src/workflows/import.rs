@@ -283,7 +283,7 @@ fn scenario_text(
         (
             "none".into(),
             frequency_hz,
-            crate::kinds::shaping::DEFAULT_DAMPING_RATIO,
+            crate::studies::shaping::DEFAULT_DAMPING_RATIO,
         )
     });
     let accels = around(cur.amax_mm_s2, &ACCEL_SCALES, 100.0);

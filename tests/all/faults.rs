@@ -278,7 +278,7 @@ fn a_mujoco_blow_up_is_a_fault_too() {
 
 /// A raster scan's step on one 480 Hz mode through rapier: with `[sim] max_step_s = 2 ms`
 /// at 1 kHz sampling (a 1 ms step, `w h = 3.0`, past symplectic Euler's limit of 2) the run blows up and is a fault; with
-/// rapier's own step it runs. Every run kind is simulated with the scenario's `[sim]`
+/// rapier's own step it runs. Every study is simulated with the scenario's `[sim]`
 /// settings (`settle::execute::sim_options`), the scan step included.
 #[test]
 fn a_scan_step_honours_the_sim_max_step() {

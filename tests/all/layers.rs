@@ -4,8 +4,8 @@
 //!
 //! Read from the source text: every `crate::<path>` (in `use` trees, `{...}` groups
 //! included, and in paths in code) and every `super::<path>` escape, comments left out.
-//! A path names the deepest module file it reaches (`crate::kinds::corner::Corner` ->
-//! `kinds::corner`). A module using its own descendants is structure (it declares them),
+//! A path names the deepest module file it reaches (`crate::studies::corner::Corner` ->
+//! `studies::corner`). A module using its own descendants is structure (it declares them),
 //! not an import; every other edge counts, a child using its parent's items included.
 
 use std::collections::BTreeSet;
@@ -17,7 +17,7 @@ const LAYERS: [&str; 9] = [
     "input",
     "spec",
     "measure",
-    "kinds",
+    "studies",
     "expand",
     "execute",
     "output",
@@ -252,14 +252,14 @@ fn every_module_imports_only_earlier_layers() {
 #[test]
 fn the_checker_sees_groups_escapes_and_later_layers() {
     let code_text = code(
-        "use crate::{input::source::Source, kinds::{self, Kind}};\n\
+        "use crate::{input::source::Source, studies::{self, Study}};\n\
          // use crate::workflows::sweep;\n\
          let x = \"crate::output\"; use super::super::spec::value::Value;\n",
     );
     let paths = paths_after(&code_text, "crate");
     assert_eq!(
         paths,
-        ["input::source::Source", "kinds::self", "kinds::Kind"],
+        ["input::source::Source", "studies::self", "studies::Study"],
         "comments and strings are not code"
     );
     assert_eq!(

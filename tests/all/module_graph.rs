@@ -372,9 +372,9 @@ fn the_check_finds_cycles_and_follows_reexports() {
         ("", "mod k;\n"),
         (
             "k",
-            "mod a;\nmod b;\npub trait Kind {}\npub fn all() { a::A; }\n",
+            "mod a;\nmod b;\npub trait Study {}\npub fn all() { a::A; }\n",
         ),
-        ("k::a", "pub struct A;\nimpl super::Kind for A {}\n"),
+        ("k::a", "pub struct A;\nimpl super::Study for A {}\n"),
         ("k::b", "use crate::k::a::A;\n"),
     ]));
     assert!(cycles(&g).is_empty(), "{g:?}");

@@ -119,7 +119,7 @@ fn shaped_trapezoid_leaves_the_closed_form_fraction_of_the_residual() {
         assert!((pct - 100.0 * rv).abs() < 1e-9, "{kind}: {pct}");
         assert_eq!(row[col("shaper_type")], kind.name());
         assert_eq!(
-            run.state::<settle::kinds::shaping::ShaperSetting>()
+            run.state::<settle::studies::shaping::ShaperSetting>()
                 .and_then(|s| s.shaper_type),
             Some(kind)
         );

@@ -68,7 +68,7 @@ fn check(r: &settle::spec::run_spec::RunSpec, &(id, kind, d, v, f): &Expected) {
     assert_eq!(
         r.swept,
         vec![
-            ("profile".to_string(), Value::Kind(kind)),
+            ("profile".to_string(), Value::Study(kind)),
             ("move.distance_mm".to_string(), Value::Number(d)),
             ("limits.vmax_mm_s".to_string(), Value::Number(v)),
             ("machine.modes.0.frequency_hz".to_string(), Value::Number(f)),

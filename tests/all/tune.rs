@@ -422,7 +422,7 @@ fn refinement_never_loses_to_the_grid_and_stays_within_the_limits() {
 
 #[test]
 fn neighbours_step_the_frequency_and_cap_the_jerk() {
-    use settle::kinds::shaping::ShaperSetting;
+    use settle::studies::shaping::ShaperSetting;
     use settle::workflows::tune::rank::neighbours;
     use settle::workflows::tune::search::Candidate;
     use settle_planner::shaper::ShaperType;

@@ -13,8 +13,8 @@
 use crate::support::extra;
 use std::path::{Path, PathBuf};
 
-use settle::kinds::scan::ScanSpec;
 use settle::spec::backend::Backend;
+use settle::studies::scan::ScanSpec;
 use settle_planner::ProfileParams;
 use settle_planner::shaper::Shaper;
 use settle_sim::Mode;
@@ -70,10 +70,10 @@ profile = ["trapezoid", "scurve"]
     let mode = Mode::new(F_HZ, ZETA, 1.0).expect("mode");
     let mut unshaped_um = std::collections::HashMap::new();
     for spec in &runs {
-        spec.state::<settle::kinds::scan::ScanSpec>()
+        spec.state::<settle::studies::scan::ScanSpec>()
             .expect("scan run");
         let m = settle::execute::execute(spec, None).expect("runs");
-        let r = settle::kinds::scan::raster(spec).expect("plans");
+        let r = settle::studies::scan::raster(spec).expect("plans");
         let tr = r.turnarounds[0];
         let plain = spec
             .profile
@@ -85,7 +85,7 @@ profile = ["trapezoid", "scurve"]
             )
             .expect("step");
         let kind = spec
-            .state::<settle::kinds::shaping::ShaperSetting>()
+            .state::<settle::studies::shaping::ShaperSetting>()
             .and_then(|s| s.shaper_type);
         let step = match kind {
             Some(k) => Shaper::new(k, F_HZ, 0.1)

@@ -3,16 +3,16 @@
 //!
 //! The job's shaped X, Y (and Z, when the machine has it) motion drives the machine's
 //! axes of the same names, in the G-code's coordinates (position 0 of a machine axis is
-//! G-code 0). Per sample the toolhead's contour error ([`crate::kinds::gcode::contour`]) is measured, per move
+//! G-code 0). Per sample the toolhead's contour error ([`crate::studies::gcode::contour`]) is measured, per move
 //! its largest value (the ringing after the corner at the move's start), per layer the
-//! worst and 95th percentile over printing samples ([`crate::kinds::gcode::stats`]); the outputs are
+//! worst and 95th percentile over printing samples ([`crate::studies::gcode::stats`]); the outputs are
 //! `layers.csv`, `summary.md` and the ringing maps of the worst layers ([`report`]).
 //! Everything is computed before anything is written: a bad file writes nothing.
 //!
 //! On the modal backend a machine whose stiffness depends on position (a belt's spans) is
 //! linearised at one point for the whole file, where the print is
-//! ([`crate::kinds::gcode::linpoint`]: the centre of the printing moves' bounding box),
-//! for the whole run and for any layer range alike; the `[gcode]` run kind uses the same
+//! ([`crate::studies::gcode::linpoint`]: the centre of the printing moves' bounding box),
+//! for the whole run and for any layer range alike; the `[gcode]` study uses the same
 //! point, so both give the same numbers.
 
 pub mod compare;
@@ -35,10 +35,10 @@ use crate::error::{Error, Location};
 use crate::execute::SimOptions;
 use crate::expand::machine::Named;
 use crate::input::machine_form::MachineForm;
-use crate::kinds::gcode::linpoint::{LinPoint, depends_on_position, linearisation_point};
-use crate::kinds::gcode::preroll::{preroll_s, slowest_decay_per_s};
-use crate::kinds::gcode::stats::{self, LayerMap, Spot};
 use crate::spec::backend::{Backend, NO_MUJOCO};
+use crate::studies::gcode::linpoint::{LinPoint, depends_on_position, linearisation_point};
+use crate::studies::gcode::preroll::{preroll_s, slowest_decay_per_s};
+use crate::studies::gcode::stats::{self, LayerMap, Spot};
 use crate::workflows::{Exit, Report};
 use stream::{StreamOptions, Streamed, simulate_job};
 
@@ -305,7 +305,7 @@ pub struct GcodeOutcome {
     /// The MCAP recording's channels, when one was written.
     pub recording: Option<Vec<crate::output::sink::mcap::ChannelInfo>>,
     /// Where the modal backend linearised the machine (a machine whose stiffness depends
-    /// on position; [`crate::kinds::gcode::linpoint`]).
+    /// on position; [`crate::studies::gcode::linpoint`]).
     pub linearised_at: Option<LinPoint>,
     /// The planner's settings read from `--config`, in words, and the reader's notes.
     pub config: Option<(String, Vec<String>)>,
@@ -574,7 +574,7 @@ fn simulate(
             .map_err(&err)?;
     }
     // On the modal backend: linearised where the print is, the same point for the whole
-    // run and any layer range ([`crate::kinds::gcode::linpoint`]); a range starts at rest
+    // run and any layer range ([`crate::studies::gcode::linpoint`]); a range starts at rest
     // in the commanded state of its pre-roll.
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
     let options = SimOptions {
@@ -802,7 +802,7 @@ fn recording_metrics(o: &GcodeOutcome) -> serde_json::Map<String, serde_json::Va
     m
 }
 
-pub use crate::kinds::gcode::parse_layers;
+pub use crate::studies::gcode::parse_layers;
 
 /// An input shaper as written on the command line: `KIND@FREQ_HZ` or
 /// `KIND@FREQ_HZ/DAMPING` (damping 0.1 when not given, Klipper's default), e.g. `mzv@48`.

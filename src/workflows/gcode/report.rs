@@ -16,12 +16,12 @@ use std::io::BufRead as _;
 
 use super::{DEFAULT_SAMPLE_RATE_HZ, GcodeOptions, GcodeOutcome, XyShapers};
 use crate::error::Error;
-use crate::kinds::gcode::stats::LayerMap;
 use crate::output::atomic::{create_dir, write_atomic};
 use crate::output::html::{Cell, Figure, Image, InputFile, Provenance, Report, Stat, Table};
 use crate::output::plot::ringing::{MapPanel, MapSpot, RingingMap};
 use crate::output::sha256::Sha256;
 use crate::spec::backend::Backend;
+use crate::studies::gcode::stats::LayerMap;
 
 /// layers.csv's columns.
 pub const LAYER_COLUMNS: [&str; 14] = [

@@ -2,11 +2,11 @@
 //! after the other with its state carried across them (chunks join continuously), on one
 //! sample clock (`k / sample_rate` s of print time), with plant steps split at every
 //! breakpoint of the command (the modal plant is then exact). Each sample's contour error
-//! ([`crate::kinds::gcode::contour`]) feeds the per-move, per-layer and whole-job account
-//! ([`crate::kinds::gcode::stats`]).
+//! ([`crate::studies::gcode::contour`]) feeds the per-move, per-layer and whole-job account
+//! ([`crate::studies::gcode::stats`]).
 //!
 //! - With a layer range the job's chunks start a pre-roll before the range (see
-//!   [`crate::kinds::gcode::preroll`]): the plant is stepped through it, but only samples of moves in
+//!   [`crate::studies::gcode::preroll`]): the plant is stepped through it, but only samples of moves in
 //!   the range are counted.
 //! - When the job's motion ends the file, the machine is simulated on with the command
 //!   standing at the end point for [`StreamOptions::tail_s`] (or until the residual has
@@ -28,9 +28,9 @@ use super::record::Recorder;
 use crate::error::Error;
 use crate::execute::driver::{Batched, Clock, Driver, Full, Sink, Stop};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
-use crate::kinds::gcode::contour::ActiveMoves;
-use crate::kinds::gcode::stats::{Histogram, LayerMap, LayerStats, MapPoint, Spot, TopSpots};
 use crate::spec::backend::Backend;
+use crate::studies::gcode::contour::ActiveMoves;
+use crate::studies::gcode::stats::{Histogram, LayerMap, LayerStats, MapPoint, Spot, TopSpots};
 
 /// How the job is sampled and what is kept.
 #[derive(Debug, Clone, PartialEq)]

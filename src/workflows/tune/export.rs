@@ -24,8 +24,8 @@ use settle_planner::tmc::registers::{TmcUnits, export};
 
 use super::Outcome;
 use super::search::Score;
-use crate::kinds::corner::Corner;
-use crate::kinds::shaping::DEFAULT_DAMPING_RATIO;
+use crate::studies::corner::Corner;
+use crate::studies::shaping::DEFAULT_DAMPING_RATIO;
 
 /// The TMC4361A clock assumed when `[tune] tmc_clock_hz` is not given (Hz). In the chip's
 /// default (frequency) mode the clock appears only in CLK_FREQ, so the ramp registers do

@@ -7,9 +7,9 @@ use settle_planner::{ProfileKind, ProfileParams};
 use crate::error::Error;
 use crate::input::scenario::Scenario;
 use crate::input::source::Source;
-use crate::kinds::corner::Corner;
-use crate::kinds::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
 use crate::spec::run_spec::RunSpec;
+use crate::studies::corner::Corner;
+use crate::studies::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
 use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::search::{BandSource, Candidate, Plan};
 use settle_planner::firmware::Firmware;
@@ -182,7 +182,7 @@ pub fn plan(
         Some(list) => list
             .iter()
             .map(|s| {
-                let k = crate::kinds::shaping::parse_type(s)
+                let k = crate::studies::shaping::parse_type(s)
                     .map_err(|m| src.error_at("tune.shapers", m))?;
                 firmware
                     .check_shaper(k)
@@ -421,7 +421,7 @@ fn current_shaper(
     scenario: Option<&ShaperSetting>,
 ) -> Result<Option<ShaperSetting>, String> {
     let kind = match &cur.shaper {
-        Some(name) => crate::kinds::shaping::parse_type(name)?,
+        Some(name) => crate::studies::shaping::parse_type(name)?,
         None => scenario.and_then(|s| s.shaper_type),
     };
     let Some(kind) = kind else {

@@ -4,7 +4,7 @@
 
 use crate::error::Error;
 use crate::execute::pool::{Progress, quiet, run_all};
-use crate::kinds::shaping::ShaperSetting;
+use crate::studies::shaping::ShaperSetting;
 use crate::workflows::tune::search::{Candidate, Plan, Score};
 
 /// Default rounds of refinement around the grid winner: 0 (grid only). Each round looks

@@ -7,9 +7,9 @@ use std::fmt::Write as _;
 use super::Outcome;
 use super::search::{BandSource, Plan, Score};
 use crate::input::runs_table::record;
-use crate::kinds::corner::Corner;
-use crate::kinds::scan::ScanSpec;
 use crate::output::plot::{Figure, Line, Marker, PALETTE, Panel};
+use crate::studies::corner::Corner;
+use crate::studies::scan::ScanSpec;
 use settle_planner::ProfileKind;
 use settle_planner::shaper::ShaperType;
 

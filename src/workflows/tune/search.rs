@@ -36,11 +36,11 @@ use settle_planner::{ProfileKind, ProfileParams};
 
 use crate::error::Error;
 use crate::input::tune_spec::TuneSpec;
-use crate::kinds::corner::Corner;
-use crate::kinds::scan::ScanSpec;
-use crate::kinds::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
+use crate::studies::corner::Corner;
+use crate::studies::scan::ScanSpec;
+use crate::studies::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting};
 use crate::workflows::tune::scan_figures::scan_figures;
 
 /// One point of the search grid.

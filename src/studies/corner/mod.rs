@@ -20,7 +20,7 @@ use settle_planner::{PlanError, Trajectory};
 use crate::error::Error;
 use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
-use crate::kinds::{Kind, KindState, PathMove, PlanContext, Planned, PlotColumn, Role, any_has};
+use crate::studies::{Study, StudyState, PathMove, PlanContext, Planned, PlotColumn, Role, any_has};
 use crate::measure::metrics::Metrics;
 use crate::measure::path_metrics::columns as col;
 use crate::spec::run_spec::RunSpec;
@@ -44,7 +44,7 @@ pub const PARAM_COLUMNS: [&str; 7] = [
     "blend_deviation_mm",
 ];
 
-/// The corner-path kind.
+/// The corner-path study.
 #[derive(Debug, Clone, Copy)]
 pub struct CornerPath;
 
@@ -60,7 +60,7 @@ pub fn trajectory(
     plan_path(&path, &opts)
 }
 
-impl Kind for CornerPath {
+impl Study for CornerPath {
     fn name(&self) -> &'static str {
         "corner path"
     }
@@ -77,14 +77,14 @@ impl Kind for CornerPath {
         SWEEPABLE
     }
 
-    fn parse(&self, src: &Source) -> Result<Option<Box<dyn KindState>>, Error> {
+    fn parse(&self, src: &Source) -> Result<Option<Box<dyn StudyState>>, Error> {
         let Some(spec) = src.table::<CornerSpec>("corner")? else {
             return Ok(None);
         };
         Ok(Some(Box::new(Corner::from_spec(&spec, src)?)))
     }
 
-    fn path_move(&self, state: &dyn KindState) -> Option<PathMove> {
+    fn path_move(&self, state: &dyn StudyState) -> Option<PathMove> {
         let c = (state as &dyn std::any::Any).downcast_ref::<Corner>()?;
         Some(PathMove {
             profile: c.profile.clone(),

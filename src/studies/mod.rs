@@ -1,39 +1,39 @@
-//! Run kinds: what one run of a sweep does with the machine. A point-to-point move, a
+//! Studies: what one run of a sweep does with the machine. A point-to-point move, a
 //! corner path, a raster scan's step, input shaping of the commanded motion: each is a
-//! [`Kind`], one module of this folder, and the expander (`crate::expand`), the runner
+//! [`Study`], one module of this folder, and the expander (`crate::expand`), the runner
 //! (`crate::execute`), runs.csv and the summary (`crate::output`) go through [`all`], the
-//! registered kinds, without naming one.
+//! registered studies, without naming one.
 //!
-//! A kind
-//! - claims a table of the scenario file ([`Kind::table`]: `[corner]`, `[scan]`,
-//!   `[shaper]`; the point move claims none: it is the kind of a run no other motion kind
+//! A study
+//! - claims a table of the scenario file ([`Study::table`]: `[corner]`, `[scan]`,
+//!   `[shaper]`; the point move claims none: it is the study of a run no other motion study
 //!   claims) and parses it into the per-run state every run of the sweep starts from
-//!   ([`Kind::parse`], a [`KindState`] that the sweep then sets through its keys,
+//!   ([`Study::parse`], a [`StudyState`] that the sweep then sets through its keys,
 //!   `corner.angle_deg`, ...),
-//! - checks each run ([`Kind::validate`]),
-//! - plans the run's motion ([`Kind::plan`], [`Role::Move`] and [`Role::Path`] kinds), or
-//!   transforms the motion another kind plans ([`Kind::shaper`], [`Role::Modifier`]),
+//! - checks each run ([`Study::validate`]),
+//! - plans the run's motion ([`Study::plan`], [`Role::Move`] and [`Role::Path`] studies), or
+//!   transforms the motion another study plans ([`Study::shaper`], [`Role::Modifier`]),
 //! - may measure more than the common metrics from the run's series ([`Planned::probe`]),
-//! - names its extra runs.csv columns and fills their cells ([`Kind::columns`],
-//!   [`Kind::cells`]), and adds its section to the summary and its panels to the figures
-//!   ([`Kind::summary`], [`Kind::figures`]).
+//! - names its extra runs.csv columns and fills their cells ([`Study::columns`],
+//!   [`Study::cells`]), and adds its section to the summary and its panels to the figures
+//!   ([`Study::summary`], [`Study::figures`]).
 //!
-//! # Adding a kind
+//! # Adding a study
 //!
 //! One file and one line:
-//! 1. `src/kinds/<name>.rs`: the table as a `#[derive(Deserialize)]
+//! 1. `src/studies/<name>.rs`: the table as a `#[derive(Deserialize)]
 //!    #[serde(deny_unknown_fields)]` struct; the per-run state (`Clone + PartialEq + Debug`)
-//!    implementing [`KindState`] (`table` returns the table's name, `set` takes its swept
-//!    keys); a unit struct implementing [`Kind`]: `table` and `role`, `parse` (read the
+//!    implementing [`StudyState`] (`table` returns the table's name, `set` takes its swept
+//!    keys); a unit struct implementing [`Study`]: `table` and `role`, `parse` (read the
 //!    table with [`Source::table`], so errors name the file, line and key), `plan` for a
-//!    motion kind, and whichever of `validate`, `columns`/`cells`, `summary`, `figures` it
+//!    motion study, and whichever of `validate`, `columns`/`cells`, `summary`, `figures` it
 //!    needs (each has a default that adds nothing).
-//! 2. `<name>::<Kind>,` in the `register!` list below (it declares the module and puts the
-//!    kind in [`KINDS`]), at the place its runs.csv columns and summary section belong
+//! 2. `<name>::<Study>,` in the `register!` list below (it declares the module and puts the
+//!    study in [`STUDIES`]), at the place its runs.csv columns and summary section belong
 //!    (registration order is their order).
 //!
-//! `src/kinds/toy.rs` (compiled for the unit tests only, registered by its line in the
-//! list) is such a kind; `src/workflows/toy_pipeline.rs` runs it through the whole
+//! `src/studies/toy.rs` (compiled for the unit tests only, registered by its line in the
+//! list) is such a study; `src/workflows/toy_pipeline.rs` runs it through the whole
 //! pipeline: parse, sweep, run, runs.csv, summary, figures.
 
 use settle_planner::shaper::Shaper;
@@ -44,18 +44,18 @@ use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
-pub use crate::spec::run_spec::KindState;
 use crate::spec::run_spec::RunSpec;
+pub use crate::spec::run_spec::StudyState;
 use crate::spec::runs::RunList;
 
-/// Declares each kind's module and lists its kind in [`KINDS`]: one line per kind.
+/// Declares each study's module and lists it in [`STUDIES`]: one line per kind.
 macro_rules! register {
-    ($($(#[$attr:meta])* $module:ident :: $kind:ident),* $(,)?) => {
+    ($($(#[$attr:meta])* $module:ident :: $study:ident),* $(,)?) => {
         $($(#[$attr])* pub mod $module;)*
 
-        /// Every run kind, in registration order: runs.csv's kind columns, the summary's
-        /// kind sections and the figures' kind panels follow it.
-        pub static KINDS: &[&dyn Kind] = &[$($(#[$attr])* &$module::$kind),*];
+        /// Every study, in registration order: runs.csv's study columns, the summary's
+        /// study sections and the figures' study panels follow it.
+        pub static STUDIES: &[&dyn Study] = &[$($(#[$attr])* &$module::$study),*];
     };
 }
 
@@ -69,12 +69,12 @@ register! {
     toy::Toy,
 }
 
-/// The registered kinds ([`KINDS`]).
-pub fn all() -> &'static [&'static dyn Kind] {
-    KINDS
+/// The registered studies ([`STUDIES`]).
+pub fn all() -> &'static [&'static dyn Study] {
+    STUDIES
 }
 
-/// What a kind does with the run's motion.
+/// What a study does with the run's motion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Role {
     /// Plans the motion from `[move]` (the point-to-point move, which claims no table; a
@@ -82,11 +82,11 @@ pub enum Role {
     Move,
     /// Plans a motion of its own instead of `[move]` (a corner path).
     Path,
-    /// Transforms the motion the run's motion kind plans (an input shaper).
+    /// Transforms the motion the run's motion study plans (an input shaper).
     Modifier,
 }
 
-/// What a path kind stands in for `[move]` with.
+/// What a path study stands in for `[move]` with.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PathMove {
     /// The profile kind named in its table (the speed law of the path).
@@ -94,16 +94,16 @@ pub struct PathMove {
     /// The key of that name (`corner.profile`), for errors.
     pub profile_key: &'static str,
     /// The machine axes it moves, joined by `+` (runs.csv's `axis`, e.g. `x+y`: no machine
-    /// axis has this name, so the point move's travel check leaves the path to its kind).
+    /// axis has this name, so the point move's travel check leaves the path to its study).
     pub axis: String,
 }
 
-/// What a motion kind plans with.
+/// What a motion study plans with.
 #[derive(Debug, Clone)]
 pub struct PlanContext<'a> {
     /// The machine's axes, in order: the trajectory has one profile per axis.
     pub axes: &'a [String],
-    /// The input shaper of the run's modifier kinds, if any: the motion kind applies it
+    /// The input shaper of the run's modifier studies, if any: the motion study applies it
     /// where it belongs (every axis of a path, the step of a raster).
     pub shaper: Option<Shaper>,
 }
@@ -119,7 +119,7 @@ pub trait Probe: std::fmt::Debug + Send {
 pub struct Planned {
     /// One profile per machine axis (with the path geometry, when it follows a path).
     pub trajectory: Trajectory,
-    /// What the kind measures beyond the common metrics: the runner then records the run's
+    /// What the study measures beyond the common metrics: the runner then records the run's
     /// series for it.
     pub probe: Option<Box<dyn Probe>>,
     /// Where the modal backend linearises the machine (m per machine axis); `None`: at
@@ -127,7 +127,7 @@ pub struct Planned {
     pub linearise_at_m: Option<Vec<f64>>,
 }
 
-/// A runs.csv column a kind plots against each swept parameter.
+/// A runs.csv column a study plots against each swept parameter.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlotColumn {
     /// The column.
@@ -181,8 +181,8 @@ pub fn on_axis(axes: &[String], axis: &str, profile: &Profile) -> Result<Traject
     )
 }
 
-/// A run kind (see the module documentation).
-pub trait Kind: std::fmt::Debug + Sync {
+/// A study (see the module documentation).
+pub trait Study: std::fmt::Debug + Sync {
     /// What it is, in messages (`corner path`).
     fn name(&self) -> &'static str;
 
@@ -199,24 +199,24 @@ pub trait Kind: std::fmt::Debug + Sync {
 
     /// Parse its table from the scenario: the state every run starts from, `None` when the
     /// scenario has no such table.
-    fn parse(&self, src: &Source) -> Result<Option<Box<dyn KindState>>, Error> {
+    fn parse(&self, src: &Source) -> Result<Option<Box<dyn StudyState>>, Error> {
         let _ = src;
         Ok(None)
     }
 
-    /// A path kind's stand-in for `[move]` (from its state in the scenario).
-    fn path_move(&self, state: &dyn KindState) -> Option<PathMove> {
+    /// A path study's stand-in for `[move]` (from its state in the scenario).
+    fn path_move(&self, state: &dyn StudyState) -> Option<PathMove> {
         let _ = state;
         None
     }
 
-    /// A path kind's move length (mm) for `run` (runs.csv's `distance_mm`).
+    /// A path study's move length (mm) for `run` (runs.csv's `distance_mm`).
     fn path_length_mm(&self, run: &RunSpec) -> Option<f64> {
         let _ = run;
         None
     }
 
-    /// Check a run that has this kind's state: `(key to blame, message)` for the first
+    /// Check a run that has this study's state: `(key to blame, message)` for the first
     /// problem.
     fn validate(&self, run: &RunSpec) -> Result<(), (String, String)> {
         let _ = run;
@@ -229,11 +229,11 @@ pub trait Kind: std::fmt::Debug + Sync {
         Ok(None)
     }
 
-    /// Plan the run's motion (motion kinds: [`Role::Move`], [`Role::Path`]).
+    /// Plan the run's motion (motion studies: [`Role::Move`], [`Role::Path`]).
     fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {
         let _ = (run, ctx);
         Err(PlanError::InvalidInput {
-            reason: "this run kind plans no motion",
+            reason: "this study plans no motion",
         })
     }
 
@@ -244,9 +244,9 @@ pub trait Kind: std::fmt::Debug + Sync {
         Vec::new()
     }
 
-    /// The cells of [`Kind::columns`] for `run` with metrics `m`, in column order; asked
+    /// The cells of [`Study::columns`] for `run` with metrics `m`, in column order; asked
     /// only when the sweep has the columns (missing cells are left empty, e.g. all of
-    /// them for a run without this kind's state). A failed run's metrics are not numbers:
+    /// them for a run without this study's state). A failed run's metrics are not numbers:
     /// leave their cells empty.
     fn cells(&self, run: &RunSpec, m: &Metrics) -> Vec<String> {
         let _ = (run, m);
@@ -267,40 +267,40 @@ pub trait Kind: std::fmt::Debug + Sync {
     }
 
     /// Whether its summary section and panels replace the common move-and-settle ones
-    /// (which would not measure what the kind is about: a raster's run-out, not its step).
+    /// (which would not measure what the study is about: a raster's run-out, not its step).
     fn replaces_move_tables(&self) -> bool {
         false
     }
 }
 
-/// The tables the kinds claim (left out of the scenario's strict parse).
+/// The tables the studies claim (left out of the scenario's strict parse).
 pub fn tables() -> Vec<&'static str> {
     all().iter().filter_map(|k| k.table()).collect()
 }
 
-/// The kind whose table is `table`.
-pub fn by_table(table: &str) -> Option<&'static dyn Kind> {
+/// The study whose table is `table`.
+pub fn by_table(table: &str) -> Option<&'static dyn Study> {
     all().iter().copied().find(|k| k.table() == Some(table))
 }
 
-/// Whether `run` has `kind`: its state (a kind with a table), or no other motion kind (the
+/// Whether `run` has `study`: its state (a study with a table), or no other motion study (the
 /// point move).
-pub fn has(run: &RunSpec, kind: &dyn Kind) -> bool {
-    match kind.table() {
+pub fn has(run: &RunSpec, study: &dyn Study) -> bool {
+    match study.table() {
         Some(t) => run.state_of(t).is_some(),
-        None => kind.role() != Role::Modifier && motion(run).table().is_none(),
+        None => study.role() != Role::Modifier && motion(run).table().is_none(),
     }
 }
 
-/// The kinds `run` has, in registration order.
-pub fn of(run: &RunSpec) -> impl Iterator<Item = &'static dyn Kind> + '_ {
+/// The studies `run` has, in registration order.
+pub fn of(run: &RunSpec) -> impl Iterator<Item = &'static dyn Study> + '_ {
     all().iter().copied().filter(move |k| has(run, *k))
 }
 
-/// The kind that plans `run`'s motion: the first motion kind whose state it has, else the
-/// point move (the motion kind without a table).
-pub fn motion(run: &RunSpec) -> &'static dyn Kind {
-    let is_motion = |k: &&dyn Kind| k.role() != Role::Modifier;
+/// The study that plans `run`'s motion: the first motion study whose state it has, else the
+/// point move (the motion study without a table).
+pub fn motion(run: &RunSpec) -> &'static dyn Study {
+    let is_motion = |k: &&dyn Study| k.role() != Role::Modifier;
     all()
         .iter()
         .copied()
@@ -316,7 +316,7 @@ pub fn motion(run: &RunSpec) -> &'static dyn Kind {
         .unwrap_or(&point::PointMove)
 }
 
-/// The input shaper `run`'s modifier kinds apply (the last one that has one).
+/// The input shaper `run`'s modifier studies apply (the last one that has one).
 pub fn shaper(run: &RunSpec) -> Result<Option<Shaper>, PlanError> {
     let mut shaper = None;
     for k in of(run).filter(|k| k.role() == Role::Modifier) {
@@ -327,13 +327,13 @@ pub fn shaper(run: &RunSpec) -> Result<Option<Shaper>, PlanError> {
     Ok(shaper)
 }
 
-/// Plan `run` on a machine with axes `axes`: its motion kind, with its modifiers' shaper.
+/// Plan `run` on a machine with axes `axes`: its motion study, with its modifiers' shaper.
 pub fn plan(run: &RunSpec, axes: &[String]) -> Result<Planned, PlanError> {
     let shaper = shaper(run)?;
     motion(run).plan(run, &PlanContext { axes, shaper })
 }
 
-/// Whether `runs` share a kind state of type `T` (any of them has one).
-pub fn any_has<T: KindState>(runs: &dyn RunList) -> bool {
+/// Whether `runs` share a study state of type `T` (any of them has one).
+pub fn any_has<T: StudyState>(runs: &dyn RunList) -> bool {
     runs.iter().any(|r| r.state::<T>().is_some())
 }

@@ -1,5 +1,5 @@
 //! The corner of a corner run: the `[corner]` table as written ([`CornerSpec`]), resolved
-//! per run ([`Corner`], the kind's state that the sweep sets through `corner.<key>`), its
+//! per run ([`Corner`], the study's state that the sweep sets through `corner.<key>`), its
 //! geometry in the machine's coordinates and its checks against the run's machine.
 //!
 //! The geometry: the first segment (`leg_in_mm`) runs along the first path axis (`axes[0]`,
@@ -15,7 +15,7 @@ use settle_planner::{PlanError, ProfileKind};
 
 use crate::error::Error;
 use crate::input::source::Source;
-use crate::spec::run_spec::{KindState, RunSpec};
+use crate::spec::run_spec::{StudyState, RunSpec};
 use crate::spec::value::Value;
 
 /// The `[corner]` table as written (mm, mm/s, degrees).
@@ -316,7 +316,7 @@ impl Corner {
     }
 }
 
-impl KindState for Corner {
+impl StudyState for Corner {
     fn table(&self) -> &'static str {
         "corner"
     }

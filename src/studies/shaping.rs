@@ -1,6 +1,6 @@
 //! Input shaping in sweeps, a modifier kind: the scenario's `[shaper]` table, its sweepable
 //! keys (`shaper.type`, `shaper.frequency_hz`, `shaper.damping_ratio`), the shaper it
-//! hands the run's motion kind (which applies it where it belongs: every axis of a path,
+//! hands the run's motion study (which applies it where it belongs: every axis of a path,
 //! the step of a raster) and its runs.csv columns.
 //!
 //! Design: the shaper is a table of its own, orthogonal to the profile kind, rather than
@@ -16,7 +16,7 @@ use settle_planner::shaper::{Shaper, ShaperType};
 use crate::error::Error;
 use crate::input::scenario::ModeSpec;
 use crate::input::source::Source;
-use crate::kinds::{Kind, KindState, Role, any_has};
+use crate::studies::{Study, StudyState, Role, any_has};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
@@ -111,7 +111,7 @@ impl ShaperSetting {
     }
 }
 
-impl KindState for ShaperSetting {
+impl StudyState for ShaperSetting {
     fn table(&self) -> &'static str {
         "shaper"
     }
@@ -179,7 +179,7 @@ pub const COLUMNS: [&str; 6] = [
 #[derive(Debug, Clone, Copy)]
 pub struct Shaping;
 
-impl Kind for Shaping {
+impl Study for Shaping {
     fn name(&self) -> &'static str {
         "input shaper"
     }
@@ -196,7 +196,7 @@ impl Kind for Shaping {
         "shaper.type, shaper.frequency_hz, shaper.damping_ratio"
     }
 
-    fn parse(&self, src: &Source) -> Result<Option<Box<dyn KindState>>, Error> {
+    fn parse(&self, src: &Source) -> Result<Option<Box<dyn StudyState>>, Error> {
         let Some(spec) = src.table::<ShaperSpec>("shaper")? else {
             return Ok(None);
         };

@@ -1,6 +1,6 @@
 //! Where the modal backend linearises a G-code job: one point for the whole file, the
 //! same for the whole run and for any layer range of it (`settle gcode` and the `[gcode]`
-//! run kind alike), found by one streaming pass of the reader over the whole file
+//! study alike), found by one streaming pass of the reader over the whole file
 //! (bounded memory: the running box only).
 //!
 //! The point is the centre of the XY(Z) bounding box of the file's **printing** moves

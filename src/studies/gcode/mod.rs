@@ -1,4 +1,4 @@
-//! G-code jobs in sweeps, a path kind: the scenario's `[gcode]` table names a G-code file
+//! G-code jobs in sweeps, a path study: the scenario's `[gcode]` table names a G-code file
 //! (relative to the scenario), the firmware whose planner runs it and the layers to
 //! simulate; the sweep varies `gcode.firmware`, the existing `shaper.*` keys (the shaper
 //! goes into the job, on X and Y, as the firmware shapes) and the `[limits]` keys (the
@@ -22,7 +22,7 @@
 //! print clock's sample grid (`k / sample_rate_hz`, the grid of `settle gcode`) so that
 //! both sample the same instants. The common metrics are those of any run over that
 //! trajectory: `move_time_s` is the pre-roll plus the range, the residual and the settle
-//! time are measured after the range's last move. The kind's probe measures the contour
+//! time are measured after the range's last move. The study's probe measures the contour
 //! error against the G-code's own geometry ([`contour`]) and adds to runs.csv
 //! `print_time_s` (the whole file's, by the firmware's planner), `contour_worst_um`,
 //! `contour_p95_um` (printing samples of the range's moves, during the job; never the
@@ -32,7 +32,7 @@
 //! A physical machine on the modal backend is linearised where the print is
 //! ([`linpoint`]: the centre of the file's printing moves), the point `settle gcode`
 //! uses, for the whole file and for any layer range of it: a range gives the numbers of
-//! the same layers in the whole job, and the kind the numbers of `settle gcode`.
+//! the same layers in the whole job, and the study the numbers of `settle gcode`.
 //!
 //! A range that ends before the file does: the contour columns count the range's samples
 //! up to its last command, as `settle gcode --layers` does (the whole job's samples after
@@ -62,7 +62,7 @@ use settle_sim::{AxisModel, DriverMode};
 
 use crate::error::Error;
 use crate::input::source::Source;
-use crate::kinds::{Kind, KindState, PathMove, PlanContext, Planned, Probe, Role, any_has};
+use crate::studies::{Study, StudyState, PathMove, PlanContext, Planned, Probe, Role, any_has};
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
 use crate::spec::backend::Backend;
@@ -124,7 +124,7 @@ pub struct GcodeJob {
     pub square_corner_velocity_mm_s: f64,
 }
 
-impl KindState for GcodeJob {
+impl StudyState for GcodeJob {
     fn table(&self) -> &'static str {
         "gcode"
     }
@@ -261,7 +261,7 @@ fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option
 
 /// The job of `run` opened, limited to its layers with their pre-roll ([`preroll_of`]).
 fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<std::io::BufReader<std::fs::File>>, String> {
-    let shaper = crate::kinds::shaper(run).map_err(|e| e.to_string())?;
+    let shaper = crate::studies::shaper(run).map_err(|e| e.to_string())?;
     let cfg = job_config(run, job, shaper_setting(shaper.as_ref()))?;
     let j = Job::open(&job.file, cfg).map_err(|e| e.to_string())?;
     match job.layers {
@@ -321,7 +321,7 @@ fn join(axes: &[String], chunks: &[Trajectory]) -> Result<Trajectory, PlanError>
     Trajectory::new(out)
 }
 
-/// The kind's probe: contour error of the recorded toolhead against the job's moves.
+/// The study's probe: contour error of the recorded toolhead against the job's moves.
 #[derive(Debug)]
 struct GcodeProbe {
     moves: Vec<Arc<MoveInfo>>,
@@ -373,11 +373,11 @@ impl Probe for GcodeProbe {
     }
 }
 
-/// The G-code job kind.
+/// The G-code job study.
 #[derive(Debug, Clone, Copy)]
 pub struct GcodeRun;
 
-impl Kind for GcodeRun {
+impl Study for GcodeRun {
     fn name(&self) -> &'static str {
         "G-code job"
     }
@@ -394,7 +394,7 @@ impl Kind for GcodeRun {
         "gcode.firmware"
     }
 
-    fn parse(&self, src: &Source) -> Result<Option<Box<dyn KindState>>, Error> {
+    fn parse(&self, src: &Source) -> Result<Option<Box<dyn StudyState>>, Error> {
         let Some(spec) = src.table::<GcodeSpec>("gcode")? else {
             return Ok(None);
         };
@@ -418,7 +418,7 @@ impl Kind for GcodeRun {
         })))
     }
 
-    fn path_move(&self, state: &dyn KindState) -> Option<PathMove> {
+    fn path_move(&self, state: &dyn StudyState) -> Option<PathMove> {
         let job = (state as &dyn std::any::Any).downcast_ref::<GcodeJob>()?;
         Some(PathMove {
             profile: job.profile.clone(),

@@ -1,11 +1,11 @@
-//! The scan kind's own figures, measured from the step axis's toolhead positions over the
-//! whole raster (see the module documentation of [`crate::kinds::scan`] for their
+//! The scan study's own figures, measured from the step axis's toolhead positions over the
+//! whole raster (see the module documentation of [`crate::studies::scan`] for their
 //! definitions).
 
 use settle_planner::raster::Raster;
 
 use crate::error::Error;
-use crate::kinds::Probe;
+use crate::studies::Probe;
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
 use crate::spec::run_spec::RunSpec;

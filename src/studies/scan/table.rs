@@ -1,10 +1,10 @@
 //! The `[scan]` table: the fly axis of a raster scan whose step is the scenario's move. It
-//! is also the kind's per-run state, set by the sweep through `scan.<key>`.
+//! is also the study's per-run state, set by the sweep through `scan.<key>`.
 
 use serde::Deserialize;
 use settle_planner::raster::StepPlacement;
 
-use crate::spec::run_spec::KindState;
+use crate::spec::run_spec::StudyState;
 use crate::spec::value::Value;
 
 /// The `[scan]` table of a scenario (mm, s).
@@ -120,7 +120,7 @@ impl ScanSpec {
     }
 }
 
-impl KindState for ScanSpec {
+impl StudyState for ScanSpec {
     fn table(&self) -> &'static str {
         "scan"
     }

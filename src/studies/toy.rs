@@ -1,5 +1,5 @@
-//! A toy run kind, compiled for the unit tests only: the recipe of [`crate::kinds`]
-//! followed to the letter (this file and one line in `KINDS`), which
+//! A toy study, compiled for the unit tests only: the recipe of [`crate::studies`]
+//! followed to the letter (this file and one line in `STUDIES`), which
 //! `crate::workflows::toy_pipeline` runs through the whole pipeline.
 //!
 //! `[toy] legs = N`: a shuttle, the point move done `N` times there and back (an odd `N`
@@ -15,8 +15,8 @@ use settle_planner::{PlanError, Profile, Segment};
 use crate::error::Error;
 use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
-use crate::kinds::{
-    Kind, KindState, PlanContext, Planned, PlotColumn, Probe, Role, any_has, on_axis,
+use crate::studies::{
+    Study, StudyState, PlanContext, Planned, PlotColumn, Probe, Role, any_has, on_axis,
 };
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
@@ -38,7 +38,7 @@ pub struct Shuttle {
     pub legs: u32,
 }
 
-impl KindState for Shuttle {
+impl StudyState for Shuttle {
     fn table(&self) -> &'static str {
         "toy"
     }
@@ -55,7 +55,7 @@ impl KindState for Shuttle {
     }
 }
 
-/// The toy kind.
+/// The toy study.
 #[derive(Debug, Clone, Copy)]
 pub struct Toy;
 
@@ -80,7 +80,7 @@ impl Probe for MaxError {
     }
 }
 
-impl Kind for Toy {
+impl Study for Toy {
     fn name(&self) -> &'static str {
         "toy shuttle"
     }
@@ -97,10 +97,10 @@ impl Kind for Toy {
         "toy.legs"
     }
 
-    fn parse(&self, src: &Source) -> Result<Option<Box<dyn KindState>>, Error> {
+    fn parse(&self, src: &Source) -> Result<Option<Box<dyn StudyState>>, Error> {
         Ok(src
             .table::<ToyTable>("toy")?
-            .map(|t| Box::new(Shuttle { legs: t.legs }) as Box<dyn KindState>))
+            .map(|t| Box::new(Shuttle { legs: t.legs }) as Box<dyn StudyState>))
     }
 
     fn validate(&self, run: &RunSpec) -> Result<(), (String, String)> {

@@ -1,6 +1,6 @@
 //! The pre-roll of a layer range: how long before the range's first move a simulation of
 //! the range starts, so that it starts from the motion the layers before leave (used by
-//! the `[gcode]` run kind and by `settle gcode --layers`).
+//! the `[gcode]` study and by `settle gcode --layers`).
 //!
 //! A range simulated from rest differs from the same layers in the whole job by a free
 //! vibration of the machine's modes (the model is linear, so the difference of the two

@@ -42,7 +42,7 @@ use settle_planner::{PlanError, Profile, State, Trajectory};
 use crate::error::Error;
 use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
-use crate::kinds::{Kind, KindState, PlanContext, Planned, PlotColumn, Role};
+use crate::studies::{Study, StudyState, PlanContext, Planned, PlotColumn, Role};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
@@ -106,7 +106,7 @@ pub fn raster(spec: &RunSpec) -> Result<Raster, PlanError> {
     let scan = spec.state::<ScanSpec>().ok_or(PlanError::InvalidInput {
         reason: "a scan run without its scan",
     })?;
-    plan_raster(spec, scan, crate::kinds::shaper(spec)?.as_ref())
+    plan_raster(spec, scan, crate::studies::shaper(spec)?.as_ref())
 }
 
 /// The raster-scan-step kind.
@@ -133,7 +133,7 @@ pub fn column_names(bands_um: &[f64]) -> Vec<String> {
     out
 }
 
-impl Kind for ScanStep {
+impl Study for ScanStep {
     fn name(&self) -> &'static str {
         "raster scan step"
     }
@@ -150,10 +150,10 @@ impl Kind for ScanStep {
         SWEEPABLE
     }
 
-    fn parse(&self, src: &Source) -> Result<Option<Box<dyn KindState>>, Error> {
+    fn parse(&self, src: &Source) -> Result<Option<Box<dyn StudyState>>, Error> {
         Ok(src
             .table::<ScanSpec>("scan")?
-            .map(|s| Box::new(s) as Box<dyn KindState>))
+            .map(|s| Box::new(s) as Box<dyn StudyState>))
     }
 
     fn validate(&self, run: &RunSpec) -> Result<(), (String, String)> {

@@ -1,18 +1,18 @@
 //! The point-to-point move of `[move]`: a rest-to-rest profile of the run's kind on one
-//! machine axis, every other axis holding at 0. It claims no table: it is the kind of every
-//! run that no other motion kind claims, and the common metrics (move and settle, residual
+//! machine axis, every other axis holding at 0. It claims no table: it is the study of every
+//! run that no other motion study claims, and the common metrics (move and settle, residual
 //! vibration) are its figures.
 
 use settle_planner::PlanError;
 
-use crate::kinds::{Kind, PlanContext, Planned, Role, on_axis};
+use crate::studies::{Study, PlanContext, Planned, Role, on_axis};
 use crate::spec::run_spec::RunSpec;
 
 /// The point-to-point move.
 #[derive(Debug, Clone, Copy)]
 pub struct PointMove;
 
-impl Kind for PointMove {
+impl Study for PointMove {
     fn name(&self) -> &'static str {
         "point-to-point move"
     }
