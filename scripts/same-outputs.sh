@@ -46,55 +46,60 @@ P=$root/gcode/prints
 VORON=$root/gcode/tests/data/klipper/voron/printer.cfg
 MINI=$root/gcode/tests/data/rrf/mini5plus/sys/config.g
 
-# The cases: NAME then the arguments of one settle command; `@` in an argument is the
+# The cases: NAME then the arguments of one settle command; `{out}` in an argument is the
 # case's output folder (out/NAME, relative to the side's folder).
 cases() {
   local s b p stem base
   for s in "$S"/*.toml; do
     for b in modal rapier; do
-      echo "sweep-$(basename "$s" .toml)-$b sweep $s --backend $b --jobs 2 --out @"
+      echo "sweep-$(basename "$s" .toml)-$b sweep $s --backend $b --jobs 2 --out {out}"
     done
   done
-  echo "sweep-mcap-ci_corners sweep $S/ci_corners.toml --backend modal --jobs 2 --mcap --out @"
-  echo "sweep-machine-fields-modal sweep in/machine_fields.toml --backend modal --jobs 2 --out @"
-  echo "sweep-machine-fields-rapier sweep in/machine_fields.toml --backend rapier --jobs 2 --out @"
-  echo "run-quickstart-modal run $S/quickstart.toml --case 3 --backend modal --plot --mcap --out @/run-3.csv"
-  echo "run-quickstart-rapier run $S/quickstart.toml --case 3 --backend rapier --plot --out @/run-3.csv"
-  echo "run-ci_corners run $S/ci_corners.toml --case 3 --backend rapier --plot --out @/run-3.csv"
-  echo "run-ci_scan run $S/ci_scan.toml --case 5 --backend modal --plot --out @/run-5.csv"
-  echo "run-shapers run $S/shapers.toml --case 4 --backend modal --plot --out @/run-4.csv"
-  echo "run-gcode_corner run $S/gcode_corner.toml --case 0 --backend modal --plot --out @/run-0.csv"
+  echo "sweep-mcap-ci_corners sweep $S/ci_corners.toml --backend modal --jobs 2 --mcap --out {out}"
+  echo "sweep-machine-fields-modal sweep in/machine_fields.toml --backend modal --jobs 2 --out {out}"
+  echo "sweep-machine-fields-rapier sweep in/machine_fields.toml --backend rapier --jobs 2 --out {out}"
+  echo "run-quickstart-modal run $S/quickstart.toml --case 3 --backend modal --plot --mcap --out {out}/run-3.csv"
+  echo "run-quickstart-rapier run $S/quickstart.toml --case 3 --backend rapier --plot --out {out}/run-3.csv"
+  echo "run-ci_corners run $S/ci_corners.toml --case 3 --backend rapier --plot --out {out}/run-3.csv"
+  echo "run-ci_scan run $S/ci_scan.toml --case 5 --backend modal --plot --out {out}/run-5.csv"
+  echo "run-shapers run $S/shapers.toml --case 4 --backend modal --plot --out {out}/run-4.csv"
+  echo "run-gcode_corner run $S/gcode_corner.toml --case 0 --backend modal --plot --out {out}/run-0.csv"
   for base in "$root"/results/baselines/*.csv; do
     stem=$(basename "$base" .csv)
     echo "check-$stem check $S/${stem%.*}.toml --baseline $base --jobs 2"
   done
-  echo "identify identify $root/examples/data/raw_data_x_example.csv $root/examples/data/raw_data_y_example.csv --freq-start 30 --freq-end 90 --hz-per-sec 10 --out @/machine.toml"
+  echo "identify identify $root/examples/data/raw_data_x_example.csv $root/examples/data/raw_data_y_example.csv --freq-start 30 --freq-end 90 --hz-per-sec 10 --out {out}/machine.toml"
   for p in "$P"/*.gcode; do
     stem=$(basename "$p" .gcode)
-    echo "gcode-$stem gcode $p --machine printer_xy --firmware klipper --shaper mzv@48 --out @"
-    echo "gcode-$stem-layers gcode $p --machine printer_xy --shaper x=mzv@52,y=ei@41/0.08 --layers 0..1 --mcap --out @"
-    echo "gcode-$stem-versus gcode $p --machine printer_xy --firmware klipper --shaper mzv@48 --versus settle:none --maps 2 --out @"
-    echo "gcode-$stem-config gcode $p --machine printer_xy --config $VORON --versus klipper:none --out @"
-    echo "gcode-$stem-rrf gcode $p --machine printer_xy --config $MINI --out @"
-    echo "gcode-$stem-marlin gcode $p --machine $S/printer_xy.toml --firmware marlin --out @"
-    echo "gcode-$stem-rapier gcode $p --machine printer_xy --backend rapier --driver full --layers 1..1 --out @"
+    # Klipper refuses the R form of G2/G3, which arc_part.gcode uses: RepRapFirmware there.
+    fw=klipper cfg=$VORON
+    if [[ $stem == arc_part ]]; then
+      fw=rrf cfg=$MINI
+    fi
+    echo "gcode-$stem gcode $p --machine printer_xy --firmware $fw --shaper mzv@48 --out {out}"
+    echo "gcode-$stem-layers gcode $p --machine printer_xy --firmware $fw --shaper x=mzv@52,y=ei@41/0.08 --layers 0..1 --mcap --out {out}"
+    echo "gcode-$stem-versus gcode $p --machine printer_xy --firmware $fw --shaper mzv@48 --versus settle:none --maps 2 --out {out}"
+    echo "gcode-$stem-config gcode $p --machine printer_xy --config $cfg --versus $fw:none --out {out}"
+    echo "gcode-$stem-rrf gcode $p --machine printer_xy --config $MINI --out {out}"
+    echo "gcode-$stem-marlin gcode $p --machine $S/printer_xy.toml --firmware marlin --out {out}"
+    echo "gcode-$stem-rapier gcode $p --machine printer_xy --firmware $fw --backend rapier --driver full --layers 1..1 --out {out}"
   done
-  echo "gcode-corner-modes gcode $S/gcode_corner.gcode --machine out/identify/machine.toml --firmware settle --out @"
+  echo "gcode-corner-modes gcode $S/gcode_corner.gcode --machine out/identify/machine.toml --firmware settle --out {out}"
   echo "machine-printer_xy machine printer_xy"
   echo "machine-leadscrew_stage machine leadscrew_stage"
   echo "machine-scenario machine $S/scan_machines.toml"
   echo "machine-identified machine out/identify/machine.toml"
-  echo "import-voron import klipper $VORON --out @/printer.toml"
-  echo "import-voron-identified import klipper $VORON --machine out/identify/machine.toml --out @/printer.toml"
-  echo "import-mini import rrf $MINI --out @/printer.toml"
+  echo "import-voron import klipper $VORON --out {out}/printer.toml"
+  echo "import-voron-identified import klipper $VORON --machine out/identify/machine.toml --out {out}/printer.toml"
+  echo "import-mini import rrf $MINI --out {out}/printer.toml"
   for s in "$S"/tune_*.toml; do
-    echo "tune-$(basename "$s" .toml) tune $s --jobs 2 --out @"
+    echo "tune-$(basename "$s" .toml) tune $s --jobs 2 --out {out}"
   done
-  echo "tune-printer-checked tune $S/tune_printer.toml --check-on rapier --jobs 2 --out @"
-  echo "tune-imported tune out/import-voron-identified/printer.toml --jobs 2 --out @"
-  echo "tune-imported-rrf tune out/import-mini/printer.toml --firmware rrf --jobs 2 --out @"
+  echo "tune-printer-checked tune $S/tune_printer.toml --check-on rapier --jobs 2 --out {out}"
+  echo "tune-imported tune out/import-voron-identified/printer.toml --jobs 2 --out {out}"
+  echo "tune-imported-rrf tune out/import-mini/printer.toml --firmware rrf --jobs 2 --out {out}"
   echo "tune-klipper-criterion tune --criterion klipper $root/planner/tests/data/klipper_two_peaks.csv"
-  echo "validate-rapier validate --backend rapier --out @/validate.md"
+  echo "validate-rapier validate --backend rapier --out {out}/validate.md"
 }
 
 # Run every case with binary $1, then move the results to folder $2. Both sides run in
@@ -136,7 +141,7 @@ TOML
     mkdir -p "$side/$out"
     local argv=()
     for a in $args; do
-      argv+=("${a//@/$out}")
+      argv+=("${a//\{out\}/$out}")
     done
     start=$(date +%s)
     set +e
