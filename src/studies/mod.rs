@@ -1,13 +1,14 @@
 //! Studies: what one run of a sweep does with the machine. A point-to-point move, a
-//! corner path, a raster scan's step, input shaping of the commanded motion: each is a
-//! [`Study`], one module of this folder, and the expander (`crate::expand`), the runner
+//! corner path, a raster scan's step, input shaping of the commanded motion, a G-code
+//! job: each is a [`Study`], one module of this folder, and the expander (`crate::expand`), the runner
 //! (`crate::execute`), runs.csv and the summary (`crate::output`) go through [`all`], the
 //! registered studies, without naming one.
 //!
 //! A study
 //! - claims a table of the scenario file ([`Study::table`]: `[corner]`, `[scan]`,
-//!   `[shaper]`; the point move claims none: it is the study of a run no other motion study
-//!   claims) and parses it into the per-run state every run of the sweep starts from
+//!   `[shaper]`, `[gcode]`; the point move claims none: it is the study of a run no other
+//!   motion study claims) and parses it into the per-run state every run of the sweep
+//!   starts from
 //!   ([`Study::parse`], a [`StudyState`] that the sweep then sets through its keys,
 //!   `corner.angle_deg`, ...),
 //! - checks each run ([`Study::validate`]),

@@ -10,8 +10,8 @@
 //! 2. **At the same duration** (an asymmetric move in a symmetric time frame): the
 //!    asymmetric step vs the pure jerk-limited symmetric step of equal time.
 //!
-//! The test asserts what the physics shows (the numbers are in the README, under "Raster
-//! scan steps in the harness", and in docs/reports/REPORT-scan.md).
+//! The test asserts what the physics shows (the numbers are in the book's raster scan
+//! page, `docs/guide/scans.md`).
 
 use std::path::Path;
 
