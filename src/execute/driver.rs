@@ -352,10 +352,28 @@ impl<'p, P: Plant> Driver<'p, P> {
         Ok(())
     }
 
-    /// Step `cmd` for `h_s` seconds (a partial step), without a sample.
-    pub fn step_held(&mut self, cmd: &[Sample], h_s: f64) -> Result<(), Stop> {
-        let t = self.t;
-        self.step(Some(cmd), h_s, t)
+    /// Hold `cmd` on the driver's own clock from where it stands: a step to the next
+    /// sample (part of a period), then every sample up to `last_k`.
+    pub fn hold_on(
+        &mut self,
+        cmd: &[Sample],
+        last_k: u64,
+        sink: &mut impl Sink,
+    ) -> Result<(), Stop> {
+        let k = self.k;
+        if k > last_k {
+            return Ok(());
+        }
+        let clock = Clock {
+            origin_s: 0.0,
+            dt_s: self.dt,
+        };
+        let (t, h) = (self.t, clock.time(k) - self.t);
+        if h > 0.0 {
+            self.step(Some(cmd), h, t)?;
+        }
+        self.full(k, clock.time(k), Some(cmd), sink)?;
+        self.hold(cmd, k + 1..=last_k, clock, sink)
     }
 
     /// Evaluate the plant now in full as sample `k` at `t_s` with command `cmd`.
@@ -486,6 +504,16 @@ impl<'p, P: Plant> Driver<'p, P> {
         }
         Ok(())
     }
+}
+
+/// The command standing still at `ends` (one state per axis): their positions, no motion.
+pub fn standing_at(ends: &[State]) -> Vec<Sample> {
+    ends.iter()
+        .map(|e| Sample {
+            p: e.p,
+            ..Sample::default()
+        })
+        .collect()
 }
 
 /// The buffers of [`Plant::step_samples`] calls (up to [`CHUNK`] samples, sample-major).

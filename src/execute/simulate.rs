@@ -8,7 +8,7 @@ use settle_planner::{Profile, Sample, State, Trajectory};
 use settle_sim::{AxisModel, DriverMode, Plant, SimError};
 
 use crate::execute::Observe;
-use crate::execute::driver::{Batched, Clock, Driver, Full, Sink, Stop};
+use crate::execute::driver::{Batched, Clock, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::measure::accumulator::Accumulator;
 use crate::measure::metrics::{Metrics, Status};
@@ -171,13 +171,7 @@ pub fn simulate<P: Plant>(
     };
     let mut driver = Driver::new(plant, names, &starts, observe.sample_rate_hz, 0.0, !lean)?;
     // The end of the move, then the observation window at the end point.
-    let hold: Vec<Sample> = ends
-        .iter()
-        .map(|e| Sample {
-            p: e.p,
-            ..Sample::default()
-        })
-        .collect();
+    let hold = standing_at(&ends);
     let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
     let window = Clock {
         origin_s: t_end,

@@ -21,12 +21,12 @@ use std::path::Path;
 
 use settle_gcode::MoveKind;
 use settle_gcode::job::Job;
-use settle_planner::{Profile, Sample, State, Trajectory};
+use settle_planner::{Profile, State, Trajectory};
 use settle_sim::{AxisModel, Observation, Plant, SimError};
 
 use super::record::Recorder;
 use crate::error::Error;
-use crate::execute::driver::{Batched, Clock, Driver, Full, Sink, Stop};
+use crate::execute::driver::{Batched, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
 use crate::studies::gcode::contour::ActiveMoves;
@@ -425,12 +425,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
     type Output = Result<(Streamed, Option<Recorder>), Error>;
 
     fn run<P: Plant>(self, plant: &P) -> Self::Output {
-        let JobSim {
-            job,
-            opts,
-            rec,
-            file,
-        } = self;
+        let (job, opts, rec, file) = (self.job, self.opts, self.rec, self.file);
         let n = opts.job_axes.len();
         let (rate, dt) = (opts.sample_rate_hz, 1.0 / opts.sample_rate_hz);
         let job_axes = opts.job_axes.clone();
@@ -488,13 +483,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
         {
             // The ringing after the last move: the command stands at the end point,
             // from the first sample after the end (a partial step) on.
-            let hold: Vec<Sample> = end
-                .iter()
-                .map(|e| Sample {
-                    p: e.p,
-                    ..Sample::default()
-                })
-                .collect();
+            let hold = standing_at(&end);
             let [ix, iy] = acc.opts.xy;
             acc.ringing = Some(Ringing {
                 tail: Tail::default(),
@@ -503,23 +492,8 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
             });
             let t_end = t;
             let last_k = ((t_end + tail_s) / dt).floor() as u64;
-            let k = d.next_sample();
-            if k <= last_k {
-                let h0 = k as f64 * dt - t_end;
-                let clock = Clock {
-                    origin_s: 0.0,
-                    dt_s: dt,
-                };
-                let rang = (if h0 > 0.0 {
-                    d.step_held(&hold, h0)
-                } else {
-                    Ok(())
-                })
-                .and_then(|()| d.sample_now(k, clock.time(k), &hold, &mut acc))
-                .and_then(|()| d.hold(&hold, k + 1..=last_k, clock, &mut acc));
-                if let Err(stop) = rang {
-                    stopped(stop, &mut acc)?;
-                }
+            if let Err(stop) = d.hold_on(&hold, last_k, &mut acc) {
+                stopped(stop, &mut acc)?;
             }
             let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
             tail.duration_s = d.time_s() - t_end;
