@@ -150,6 +150,8 @@ pub struct Driver<'p, P: Plant> {
     /// Every sample observed in full (a recording): no batches.
     record: bool,
     batch: Option<Buffers>,
+    /// The fewest samples a batch takes (fewer are stepped one by one).
+    min_batch: usize,
     obs: Vec<Observation>,
     cmd: Vec<Sample>,
     cmd_p: Vec<f64>,
@@ -166,6 +168,7 @@ impl<P: Plant> std::fmt::Debug for Driver<'_, P> {
             .field("time_s", &self.t)
             .field("record", &self.record)
             .field("batches", &self.batch.is_some())
+            .field("min_batch", &self.min_batch)
             .finish_non_exhaustive()
     }
 }
@@ -194,12 +197,21 @@ impl<'p, P: Plant> Driver<'p, P> {
             t: 0.0,
             record,
             batch: (!record).then(|| Buffers::new(axes)),
+            min_batch: 1,
             obs: vec![Observation::default(); axes],
             cmd: vec![Sample::default(); axes],
             cmd_p: vec![0.0; axes],
             toolhead: vec![0.0; axes],
             polls: 0,
         })
+    }
+
+    /// Batches of at least `n` samples only (default 1): a shorter run of whole samples is
+    /// stepped sample by sample through [`Plant::step`]. (A plant's batch may take longer
+    /// internal steps than one sample, MuJoCo's does: the choice can change the last bits.)
+    pub fn with_min_batch(mut self, n: usize) -> Self {
+        self.min_batch = n.max(1);
+        self
     }
 
     /// The next sample's index on the clock.
@@ -278,20 +290,20 @@ impl<'p, P: Plant> Driver<'p, P> {
                     }
                     m += 1;
                 }
-                if let Some(b) = self.batch.as_mut() {
+                if let Some(b) = self.batch.as_mut().filter(|_| m >= self.min_batch) {
                     for (i, c) in b.cmds.chunks_exact_mut(n).take(m).enumerate() {
                         cursor.at(local(k0 - 1 + i as u64), c);
                     }
-                }
-                let fail = |i: usize| clock.time(k0 - 1 + i as u64);
-                if let Some(done) = self.step_batch(m, k0, clock, &fail, sink)? {
-                    self.k = k0 + done as u64 - 1;
-                    tau = local(self.k);
-                    // The command at the last sample serves it.
-                    cursor.at(tau, &mut self.cmd);
-                    self.full(self.k, clock.time(self.k), None, sink)?;
-                    self.k += 1;
-                    continue;
+                    let fail = |i: usize| clock.time(k0 - 1 + i as u64);
+                    if let Some(done) = self.step_batch(m, k0, clock, &fail, sink)? {
+                        self.k = k0 + done as u64 - 1;
+                        tau = local(self.k);
+                        // The command at the last sample serves it.
+                        cursor.at(tau, &mut self.cmd);
+                        self.full(self.k, clock.time(self.k), None, sink)?;
+                        self.k += 1;
+                        continue;
+                    }
                 }
             }
             cursor.at(tau, &mut self.cmd);
@@ -330,8 +342,8 @@ impl<'p, P: Plant> Driver<'p, P> {
         let dt = self.dt;
         let mut k = first;
         while k <= last {
-            if self.batch.is_some() {
-                let m = (last - k + 1).min(CHUNK as u64) as usize;
+            let m = (last - k + 1).min(CHUNK as u64) as usize;
+            if self.batch.is_some() && m >= self.min_batch {
                 let fail = |i: usize| clock.time(k + i as u64) - dt;
                 if let Some(done) = self.step_batch(m, k, clock, &fail, sink)? {
                     self.full(

@@ -452,9 +452,11 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                 None => {
                     let starts: Vec<_> = sub.axes().iter().map(Profile::start).collect();
                     t_first = t0;
-                    driver.insert(
-                        Driver::new(plant, &names, &starts, rate, t0, false).map_err(sim_err)?,
-                    )
+                    // A lone whole sample goes through `Plant::step`, as `settle gcode` has
+                    // always stepped it (MuJoCo's batch would take it as one long step).
+                    let d =
+                        Driver::new(plant, &names, &starts, rate, t0, false).map_err(sim_err)?;
+                    driver.insert(d.with_min_batch(2))
                 }
             };
             if range_start.is_none()
