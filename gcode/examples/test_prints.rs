@@ -8,6 +8,12 @@
 //! - `arc_part.gcode`: a rounded plate with a round hole, arcs in the I/J and R forms,
 //!   a full circle and a helical ramp, layer markers `; layer n, Z = z`. R-form arcs are
 //!   refused by Klipper: read this one with the marlin or rrf dialect.
+//! - `laser_raster.gcode`: a GRBL laser engraving of a 20 x 12 mm grey image (a shaded
+//!   disc with a square window) as raster software writes it for GRBL's laser mode
+//!   (its first command, `$32=1`): `M4` dynamic power, bidirectional scan lines along X every 0.2 mm at
+//!   6000 mm/min with the power `S` (0-1000, five levels) on each run of pixels, 2 mm of
+//!   overscan at `S0` at both ends of a line, `G0` step-overs; read it with the grbl
+//!   dialect.
 //!
 //! Run: `cargo run -p settle-gcode --example test_prints` (from the repository root).
 
@@ -168,6 +174,70 @@ fn arc_part() -> String {
     g
 }
 
+/// The grey level (0 white .. 4 black) of the raster image at (x, y) mm: a disc of
+/// radius 5.5 mm shaded darker towards its centre, with a 3 mm square window.
+fn raster_level(x: f64, y: f64) -> u32 {
+    let r = (x - 10.0).hypot(y - 6.0);
+    if r > 5.5 || ((x - 10.0).abs() < 1.5 && (y - 6.0).abs() < 1.5) {
+        return 0;
+    }
+    (1.0 + 3.99 * (1.0 - r / 5.5)).floor() as u32
+}
+
+fn laser_raster() -> String {
+    let mut g = String::new();
+    header(
+        &mut g,
+        "GRBL laser raster, a 20 x 12 mm grey image in 60 bidirectional lines at 6000 mm/min",
+    );
+    put!(
+        g,
+        "; grbl dialect, laser mode on: M4 dynamic power, S 0-1000"
+    );
+    g.push_str("$32=1\nG00 G17 G40 G21 G54\nG90\nM4\nM8\n");
+    let (x0, x1, over, pitch, px): (f64, f64, f64, f64, f64) = (40.0, 60.0, 2.0, 0.2, 0.1);
+    let mut first = true;
+    for line in 0..60 {
+        let y = 40.0 + pitch * f64::from(line) + 0.5 * pitch;
+        let forward = line % 2 == 0;
+        let (from, dir) = if forward { (x0, 1.0) } else { (x1, -1.0) };
+        let start = from - dir * over;
+        if first {
+            put!(g, "G0 X{start:.3} Y{y:.3}");
+            put!(g, "G1 X{from:.3} S0 F6000");
+            first = false;
+        } else {
+            put!(g, "G0 X{start:.3} Y{y:.3}");
+            put!(g, "G1 X{from:.3} S0");
+        }
+        // Runs of equal level along the line, pixels of 0.1 mm.
+        let n = ((x1 - x0) / px).round() as u32;
+        let level = |k: u32| {
+            let xm = if forward {
+                px * (f64::from(k) + 0.5)
+            } else {
+                (x1 - x0) - px * (f64::from(k) + 0.5)
+            };
+            raster_level(xm, y - 40.0)
+        };
+        let mut k = 0;
+        while k < n {
+            let l = level(k);
+            let mut j = k + 1;
+            while j < n && level(j) == l {
+                j += 1;
+            }
+            let x = from + dir * px * f64::from(j);
+            put!(g, "G1 X{x:.3} S{}", l * 250);
+            k = j;
+        }
+        let end = if forward { x1 } else { x0 } + dir * over;
+        put!(g, "G1 X{end:.3} S0");
+    }
+    g.push_str("M9\nG1 S0\nM5\nG90\nG0 X0 Y0\nM2\n");
+    g
+}
+
 fn main() -> std::io::Result<()> {
     let dir = Path::new(manifest_dir()).join("prints");
     std::fs::create_dir_all(&dir)?;
@@ -175,6 +245,7 @@ fn main() -> std::io::Result<()> {
         ("ringing_tower.gcode", ringing_tower()),
         ("cube_layer.gcode", cube_layer()),
         ("arc_part.gcode", arc_part()),
+        ("laser_raster.gcode", laser_raster()),
     ] {
         let path = dir.join(name);
         std::fs::write(&path, text)?;

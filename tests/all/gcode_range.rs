@@ -445,7 +445,7 @@ fn the_linearisation_point_is_the_centre_of_the_printing_moves() {
          G91\nG1 Y20 E1\nG1 X-5 F3000\nG1 E-0.5\nG90\nG92 X0 Y0\n\
          G1 X10 Y-40 E1\nG0 X-125 Y-130\nG1 X0 Y0\n",
     );
-    assert_eq!(p.source, PointSource::Printing);
+    assert_eq!(p.source, PointSource::Working);
     assert_eq!(p.xyz_mm, [22.5, 10.0, 0.2]);
     assert_eq!(
         p.on_axes(&["y".into(), "x".into()]),

@@ -1,6 +1,7 @@
 //! Firmware configuration files in and out: Klipper's `printer.cfg` (with its includes and
-//! SAVE_CONFIG block) and RepRapFirmware's `config.g` (with the macros it runs) read into
-//! plain data ([`KlipperConfig`], [`RrfConfig`]) with the values the firmware would use,
+//! SAVE_CONFIG block), RepRapFirmware's `config.g` (with the macros it runs) and GRBL's
+//! `$$` settings read into plain data ([`KlipperConfig`], [`RrfConfig`],
+//! [`GrblSettings`]) with the values the firmware would use,
 //! and input shaper settings written back in each firmware's own syntax, ready to paste
 //! ([`KlipperExport`], [`RrfExport`]).
 //!
@@ -51,6 +52,7 @@ mod export_klipper;
 mod export_rrf;
 mod export_text;
 mod glob;
+mod grbl;
 mod ini;
 mod klipper;
 mod klipper_files;
@@ -62,6 +64,7 @@ mod rrf_script;
 
 pub use export_klipper::KlipperExport;
 pub use export_rrf::RrfExport;
+pub use grbl::GrblSettings;
 pub use klipper::{
     DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
     DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,

@@ -347,6 +347,8 @@ impl RrfConfig {
                     .map_or_else(|| format!("kinematics {code}"), |k| (*k).to_string());
                 return Ok(());
             }
+            // The RepRapFirmware reader produces none.
+            Setting::Grbl { .. } => return Ok(()),
         }
         self.set_state(state);
         Ok(())

@@ -69,7 +69,8 @@ mod pipeline;
 mod settle;
 mod shapers;
 mod slice;
+mod travel;
 
-pub use chunk::{JobChunk, JobSummary, LayerTime, MoveGeometry, MoveInfo};
+pub use chunk::{JobChunk, JobSummary, LayerTime, LimitOverride, MoveGeometry, MoveInfo};
 pub use config::{JobConfig, PlannerConfig, SettleConfig, ShaperSetting, parse_firmware};
 pub use pipeline::Job;

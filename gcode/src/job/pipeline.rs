@@ -10,16 +10,18 @@ use std::sync::Arc;
 use settle_planner::PlanError;
 use settle_planner::firmware::profiles::ProfileStream;
 
-use super::chunk::{JobChunk, JobSummary};
+use super::chunk::{JobChunk, JobSummary, LimitOverride};
 use super::config::{JobConfig, PlannerConfig, ShaperSetting};
 use super::driver::Driver;
 use super::input::{AxisShapers, Input};
 use super::moves::MoveTable;
 use super::settle::SettlePlanner;
 use super::shapers::ShaperState;
+use super::travel::Travel;
+use crate::config::GrblSettings;
 use crate::error::GcodeError;
 use crate::read::geometry::Point;
-use crate::read::reader::{Reader, ReaderOptions};
+use crate::read::reader::Reader;
 
 mod events;
 
@@ -63,13 +65,21 @@ pub struct Job<R> {
     limit_changes: u64,
     shaper_changes: u64,
     ignored: BTreeMap<String, u64>,
+    /// GRBL: the `$` settings in force.
+    grbl: Option<GrblSettings>,
+    /// The machine's travel and the firmware's rule for moves that leave it.
+    travel: Travel,
+    /// The planner's limits at the start (the configuration's), by name.
+    start_limits: Vec<(&'static str, f64)>,
+    /// Limits the file raised above them.
+    overrides: Vec<LimitOverride>,
 }
 
 impl Job<BufReader<File>> {
     /// Open `path` and plan it with `cfg` (read in `cfg.dialect`).
     pub fn open(path: impl AsRef<FsPath>, cfg: JobConfig) -> Result<Self, GcodeError> {
         let path = path.as_ref();
-        let reader = Reader::open(path, ReaderOptions::new(cfg.dialect))?;
+        let reader = Reader::open(path, cfg.reader_options())?;
         Ok(Job::new(reader, cfg)?.with_name(path.display().to_string()))
     }
 }
@@ -108,6 +118,19 @@ impl<R: BufRead> Job<R> {
         };
         let initial = build(&cfg.shapers).map_err(setting("shapers"))?;
         let cfg_feed = cfg.dialect.initial_feed_mm_s();
+        let grbl = match &cfg.planner {
+            PlannerConfig::Grbl(g) => Some(g.clone()),
+            _ => None,
+        };
+        let travel = Travel::new(
+            cfg.firmware(),
+            cfg.travel_mm,
+            grbl.as_ref().is_some_and(|g| g.soft_limits),
+        );
+        let start_limits = match &planner {
+            Planner::Firmware(d, _) => d.limits(),
+            Planner::Settle(_) => Vec::new(),
+        };
         Ok(Self {
             reader,
             source: Arc::from("<input>"),
@@ -128,6 +151,10 @@ impl<R: BufRead> Job<R> {
             limit_changes: 0,
             shaper_changes: 0,
             ignored: BTreeMap::new(),
+            grbl,
+            travel,
+            start_limits,
+            overrides: Vec::new(),
         })
     }
 
@@ -240,6 +267,8 @@ impl<R: BufRead> Job<R> {
             limit_changes: self.limit_changes,
             shaper_changes: self.shaper_changes,
             ignored: self.ignored.clone(),
+            features: self.reader.features().to_vec(),
+            overrides: self.overrides.clone(),
             complete: self.eof,
         }
     }

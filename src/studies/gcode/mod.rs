@@ -25,12 +25,12 @@
 //! time are measured after the range's last move. The study's probe measures the contour
 //! error against the G-code's own geometry ([`contour`]) and adds to runs.csv
 //! `print_time_s` (the whole file's, by the firmware's planner), `contour_worst_um`,
-//! `contour_p95_um` (printing samples of the range's moves, during the job; never the
+//! `contour_p95_um` (working samples of the range's moves, during the job; never the
 //! pre-roll's) and `contour_worst_line`. Bad G-code is reported when the sweep is
 //! checked, with the file and line.
 //!
 //! A physical machine on the modal backend is linearised where the print is
-//! ([`linpoint`]: the centre of the file's printing moves), the point `settle gcode`
+//! ([`linpoint`]: the centre of the file's working moves), the point `settle gcode`
 //! uses, for the whole file and for any layer range of it: a range gives the numbers of
 //! the same layers in the whole job, and the study the numbers of `settle gcode`.
 //!
@@ -43,9 +43,12 @@
 //! reports no such ringing for a range that ends before the file.
 
 pub mod contour;
+pub mod features;
+pub mod fly;
 pub mod linpoint;
 pub mod preroll;
 pub mod stats;
+pub mod work;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -53,7 +56,7 @@ use std::sync::Arc;
 use serde::Deserialize;
 use settle_gcode::job::{Job, JobConfig, MoveInfo, PlannerConfig, ShaperSetting, parse_firmware};
 use settle_planner::firmware::Firmware;
-use settle_gcode::{MoveKind, Reader, ReaderOptions};
+use settle_gcode::Reader;
 use settle_planner::path::CornerStrategy;
 use settle_planner::path::junction::Junction;
 use settle_planner::shaper::stream::cut;
@@ -195,6 +198,10 @@ pub fn job_config(run: &RunSpec, job: &GcodeJob, shaper: Option<ShaperSetting>) 
             c.print_accel_m_s2 = a;
             c.travel_accel_m_s2 = a;
         }
+        PlannerConfig::Grbl(g) => {
+            g.max_rate_mm_min = [run.vmax_mm_s * 60.0; 3];
+            g.accel_mm_s2 = [run.amax_mm_s2; 3];
+        }
         PlannerConfig::Settle(c) => {
             c.limits = run.limits_si().map_err(|e| e.to_string())?;
             c.kind = settle_planner::ProfileKind::parse(&job.profile).map_err(|e| e.to_string())?;
@@ -251,10 +258,10 @@ fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option
     if run.backend != Backend::Modal || !linpoint::depends_on_position(&linear_axes(run)?) {
         return Ok(None);
     }
-    let dialect = JobConfig::defaults(job.firmware)
+    let options = JobConfig::defaults(job.firmware)
         .map_err(|e| e.to_string())?
-        .dialect;
-    let reader = Reader::open(&job.file, ReaderOptions::new(dialect)).map_err(|e| e.to_string())?;
+        .reader_options();
+    let reader = Reader::open(&job.file, options).map_err(|e| e.to_string())?;
     let point = linpoint::linearisation_point(reader).map_err(|e| e.to_string())?;
     Ok(Some(point.on_axes(axes)))
 }
@@ -352,7 +359,7 @@ impl Probe for GcodeProbe {
             let (Some(e), Some(owner)) = (active.error_mm(tp, p), active.owner(tp)) else {
                 continue;
             };
-            if owner.kind != MoveKind::Print
+            if !owner.working
                 || self
                     .layers
                     .is_some_and(|(a, b)| !(a..=b).contains(&owner.layer))
@@ -443,7 +450,14 @@ impl Study for GcodeRun {
         preroll_of(run, job).map_err(|m| (run.blame("gcode.layers"), m))?;
         let mut j = open(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
         j.run_to_end()
-            .map_err(|e| (run.blame("gcode.file"), e.to_string()))
+            .map_err(|e| (run.blame("gcode.file"), e.to_string()))?;
+        match work::nothing_to_measure(&j.summary(), j.reader().lines_read()) {
+            Some(why) => Err((
+                run.blame("gcode.file"),
+                format!("{}: {why}", job.file.display()),
+            )),
+            None => Ok(()),
+        }
     }
 
     fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {

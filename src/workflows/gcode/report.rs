@@ -105,8 +105,8 @@ pub fn summary_md(o: &GcodeOutcome, maps: &[String]) -> String {
     let _ = writeln!(
         s,
         "Contour error: distance in XY from the simulated toolhead to the commanded path of \
-the moves active at that time, over printing moves; p95 is the 95th percentile of all \
-printing samples.\n"
+the moves active at that time, over working moves (extruding, or the laser or spindle on \
+in a feed move); p95 is the 95th percentile of all working samples.\n"
     );
     if let Some((settings, _)) = &o.config {
         let _ = writeln!(s, "Planner {settings}.\n");
@@ -193,6 +193,13 @@ more torque than it has",
             l.layer, l.duration_s, l.moves
         );
     }
+    s.push_str(&super::features::summary_sections(o));
+    if !o.overrides.is_empty() {
+        let _ = writeln!(s, "\n## Limits the file raises\n");
+        for v in &o.overrides {
+            let _ = writeln!(s, "- {}", super::override_words(v));
+        }
+    }
     if !o.ignored.is_empty() {
         let _ = writeln!(s, "\n## Commands not followed\n");
         for (what, n) in &o.ignored {
@@ -247,6 +254,18 @@ pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         files.push(dir.join(format!("{stem}.svg")));
         files.push(dir.join(format!("{stem}.png")));
         stems.push(stem);
+    }
+    if super::features::has_features(o) {
+        let path = dir.join("features.csv");
+        let bytes = super::features::features_csv(o)
+            .map_err(|e| Error::write(&path, std::io::Error::other(e)))?;
+        write_atomic(&path, &bytes)?;
+        files.push(path);
+    }
+    if let Some(fig) = super::features::z_figure(o) {
+        crate::output::plot::write(&fig, dir, "error-z")?;
+        files.push(dir.join("error-z.svg"));
+        files.push(dir.join("error-z.png"));
     }
     let md = dir.join("summary.md");
     write_atomic(&md, summary_md(o, &stems).as_bytes())?;
@@ -411,12 +430,18 @@ pub fn html_report(
             texts.get(&w.line).map_or("", String::as_str)
         ));
     }
+    if let Some(f) = super::features::fly_words(o) {
+        intro.push(f);
+    }
+    for v in &o.overrides {
+        intro.push(format!("Note: {}", super::override_words(v)));
+    }
     if let Some(f) = &o.streamed.fault {
         intro.push(format!("Simulation fault: {f}"));
     }
     let mut tables = vec![Table {
         title: "Worst spots".into(),
-        note: "The largest contour errors, at most one per move, with the G-code line of the move. Contour error: distance in XY from the simulated toolhead to the commanded path of the moves active at that time, over printing moves.".into(),
+        note: "The largest contour errors, at most one per move, with the G-code line of the move. Contour error: distance in XY from the simulated toolhead to the commanded path of the moves active at that time, over working moves (extruding, or the laser or spindle on in a feed move).".into(),
         header: ["error (um)", "line", "G-code", "layer", "X (mm)", "Y (mm)", "time (s)"]
             .map(String::from)
             .to_vec(),
@@ -465,6 +490,7 @@ pub fn html_report(
                 .collect(),
         });
     }
+    tables.extend(super::features::features_table(o));
     if !o.ignored.is_empty() {
         tables.push(Table {
             title: "Commands not followed".into(),
@@ -565,6 +591,9 @@ pub fn write_html(o: &GcodeOutcome, opts: &GcodeOptions, dir: &Path) -> Result<P
             ),
             None => match stem.strip_prefix("compare-layer-") {
                 Some(n) => format!("Layer {n} under both settings, on one colour scale"),
+                None if stem == "error-z" => {
+                    "Contour error against Z: per layer the worst and the 95th percentile".into()
+                }
                 None => stem.clone(),
             },
         };

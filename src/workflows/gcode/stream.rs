@@ -19,7 +19,6 @@ use std::io::BufRead;
 use std::ops::ControlFlow;
 use std::path::Path;
 
-use settle_gcode::MoveKind;
 use settle_gcode::job::Job;
 use settle_planner::{Profile, State, Trajectory};
 use settle_sim::{AxisModel, Observation, Plant, SimError};
@@ -30,6 +29,8 @@ use crate::execute::driver::{Batched, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
 use crate::studies::gcode::contour::ActiveMoves;
+use crate::studies::gcode::features::FeatureAccount;
+use crate::studies::gcode::fly::FlyAxis;
 use crate::studies::gcode::stats::{Histogram, LayerMap, LayerStats, MapPoint, Spot, TopSpots};
 
 /// How the job is sampled and what is kept.
@@ -102,6 +103,10 @@ pub struct Streamed {
     pub tail: Option<Tail>,
     /// Where a motor was first seen past its stability limit (see [`LostStep`]).
     pub first_lost_step: Option<LostStep>,
+    /// The error per slicer feature type.
+    pub features: FeatureAccount,
+    /// The along-line error of scan lines (raster jobs).
+    pub fly: FlyAxis,
 }
 
 /// Where a motor's load angle was first seen past 90 electrical degrees (the driver
@@ -133,8 +138,9 @@ struct Account {
     hist: Histogram,
     map: Vec<MapPoint>,
     layer_top: TopSpots,
-    /// The move the last sample belonged to: index, kind, layer, line, worst spot.
-    owner: Option<(u64, MoveKind, u32, u64, Option<Spot>)>,
+    /// The move the last sample belonged to: index, whether it works, layer, line, worst
+    /// spot.
+    owner: Option<(u64, bool, u32, u64, Option<Spot>)>,
     map_every: u64,
     /// The MCAP recording of the counted samples.
     rec: Option<Recorder>,
@@ -178,7 +184,7 @@ impl Account {
     }
 
     fn end_move(&mut self) {
-        if let Some((_, MoveKind::Print, _, _, Some(spot))) = self.owner.take()
+        if let Some((_, true, _, _, Some(spot))) = self.owner.take()
             && let Some(l) = self.layer.as_mut()
         {
             l.add_move(&spot);
@@ -239,7 +245,7 @@ impl Account {
             } else {
                 self.end_move();
             }
-            self.owner = Some((m.index, m.kind, m.layer, m.line, None));
+            self.owner = Some((m.index, m.working, m.layer, m.line, None));
         }
         let err_um = err_mm * 1e3;
         if let Some(r) = self.rec.as_mut() {
@@ -256,9 +262,21 @@ impl Account {
                 ],
             );
         }
-        let print = m.kind == MoveKind::Print;
+        let print = m.working;
         if print {
             self.hist.push(err_um);
+            let spot = || Spot {
+                error_um: err_um,
+                time_s: t,
+                x_mm: x,
+                y_mm: y,
+                line: m.line,
+                layer: m.layer,
+                move_index: m.index,
+            };
+            self.out.features.sample(m.feature, m.layer, err_um, spot);
+            let cmd = [cmd_m[ix] * 1e3, cmd_m[iy] * 1e3];
+            self.out.fly.sample(&m, t, cmd, [x, y]);
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
             {

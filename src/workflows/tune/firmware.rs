@@ -67,7 +67,7 @@ impl Candidates {
     pub fn kinds(self) -> Vec<ProfileKind> {
         match self.0 {
             None | Some(Firmware::Settle) => ProfileKind::ALL.to_vec(),
-            Some(Firmware::Klipper | Firmware::Marlin | Firmware::Rrf) => {
+            Some(Firmware::Klipper | Firmware::Marlin | Firmware::Rrf | Firmware::Grbl) => {
                 vec![ProfileKind::Trapezoid]
             }
             Some(Firmware::Tmc4361a) => vec![ProfileKind::SCurve, ProfileKind::FourJerk],
@@ -80,7 +80,8 @@ impl Candidates {
             None | Some(Firmware::Klipper | Firmware::Settle) => ShaperType::KLIPPER.to_vec(),
             Some(Firmware::Marlin) => ShaperType::MARLIN.to_vec(),
             Some(Firmware::Rrf) => ShaperType::RRF.to_vec(),
-            Some(Firmware::Tmc4361a) => Vec::new(),
+            // GRBL has no input shaper.
+            Some(Firmware::Tmc4361a | Firmware::Grbl) => Vec::new(),
         }
     }
 
