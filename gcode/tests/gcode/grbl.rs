@@ -172,3 +172,76 @@ fn a_job_plans_a_laser_file_with_the_settings_it_was_given() {
     let summary = job.summary();
     assert!(summary.layers.iter().all(|l| l.working_s > 0.0));
 }
+
+/// The words of a line as (letter, value), read by hand: `G1 X95.454Y106.321Z-0`.
+fn words(line: &str) -> Vec<(char, f64)> {
+    let code = line.split(';').next().unwrap_or("");
+    let mut out = Vec::new();
+    let mut chars = code.chars().peekable();
+    while let Some(c) = chars.next() {
+        if c.is_ascii_alphabetic() {
+            let mut num = String::new();
+            while let Some(&d) = chars.peek() {
+                if d.is_ascii_digit() || d == '.' || d == '-' {
+                    num.push(d);
+                    chars.next();
+                } else {
+                    break;
+                }
+            }
+            if let Ok(v) = num.parse() {
+                out.push((c.to_ascii_uppercase(), v));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_shipped_laser_and_cnc_jobs_work_where_their_text_says() {
+    // By hand from the text: the raster's G1 lines with S above 0 are the burn (laser
+    // mode from its `$32=1`); every G1 of the UGS contour cuts (M3 S1000 from the start,
+    // M5 at the end).
+    for (name, laser) in [("laser_raster.gcode", true), ("ugs_logo.gcode", false)] {
+        let text = std::fs::read_to_string(super::print_path(name)).expect("print");
+        let (mut pos, mut s, mut by_hand, mut cuts) = ([0.0f64; 3], 0.0, 0.0, 0);
+        for line in text.lines() {
+            let w = words(line);
+            let g1 = w.iter().any(|&(l, v)| l == 'G' && v == 1.0);
+            let mut to = pos;
+            for &(l, v) in &w {
+                match l {
+                    'X' => to[0] = v,
+                    'Y' => to[1] = v,
+                    'Z' => to[2] = v,
+                    'S' => s = v,
+                    _ => {}
+                }
+            }
+            let d =
+                ((to[0] - pos[0]).powi(2) + (to[1] - pos[1]).powi(2) + (to[2] - pos[2]).powi(2))
+                    .sqrt();
+            if g1 && d > 0.0 && (!laser || s > 0.0) {
+                by_hand += d;
+                cuts += 1;
+            }
+            pos = to;
+        }
+        let r = Reader::open(super::print_path(name), ReaderOptions::new(Dialect::Grbl))
+            .expect("opens");
+        let (mut settle, mut n) = (0.0, 0);
+        for e in r {
+            if let EventKind::Move(m) = e.expect("valid").kind
+                && m.is_working()
+            {
+                settle += m.length_mm();
+                n += 1;
+            }
+        }
+        assert_eq!(n, cuts, "{name}");
+        assert!(
+            (settle - by_hand).abs() < 1e-9 * by_hand,
+            "{name}: {settle} vs {by_hand}"
+        );
+    }
+}
