@@ -7,6 +7,7 @@ use settle_gcode::config::GrblSettings;
 use settle_gcode::job::JobConfig;
 use settle_planner::firmware::Firmware;
 
+use crate::support::one_mode::OneMode;
 use crate::support::write;
 
 const ONE_MODE: &str = "name = \"one mode\"\n\
@@ -39,21 +40,7 @@ fn a_scan_line_measures_the_closed_form_error_along_the_fly_axis() {
     let machine = write(dir.path(), "one_mode.toml", ONE_MODE);
     let file = write(dir.path(), "line.nc", "G90\nM3 S500\nG1 X30 F6000\n");
     let o = measure(&grbl(file, machine.to_str().expect("utf-8"))).expect("runs");
-    let w = std::f64::consts::TAU * 40.0;
-    let (s, wd) = (0.05 * w, w * (1.0f64 - 0.05 * 0.05).sqrt());
-    let free = |u: f64, v: f64, t: f64| {
-        let (a, b) = (u, (v + s * u) / wd);
-        let (c, sn, e) = ((wd * t).cos(), (wd * t).sin(), (-s * t).exp());
-        (
-            e * (a * c + b * sn),
-            e * ((-s * a + wd * b) * c + (-s * b - wd * a) * sn),
-        )
-    };
-    let phase = |e: f64, v: f64, acc: f64, t: f64| {
-        let p = -acc / (w * w);
-        let (u, v) = free(e - p, v, t);
-        (u + p, v)
-    };
+    let mode = OneMode::new(40.0, 0.05);
     let (vmax, amax, d) = (0.1, 3.0, 0.03);
     let ta = vmax / amax;
     let tc = (d - vmax * vmax / amax) / vmax;
@@ -69,9 +56,9 @@ fn a_scan_line_measures_the_closed_form_error_along_the_fly_axis() {
         let mut t0 = 0.0;
         for (acc, dur) in [(amax, ta), (0.0, tc), (-amax, ta), (0.0, f64::INFINITY)] {
             if t <= t0 + dur {
-                return phase(e, v, acc, t - t0).0;
+                return mode.phase(e, v, acc, t - t0).0;
             }
-            (e, v) = phase(e, v, acc, dur);
+            (e, v) = mode.phase(e, v, acc, dur);
             t0 += dur;
         }
         e

@@ -88,31 +88,19 @@ impl Driver {
             }
             Driver::Marlin(p) => {
                 let c = p.config();
-                vec![
-                    ("M204 P print acceleration (mm/s^2)", mm(c.print_accel_m_s2)),
-                    (
-                        "M204 T travel acceleration (mm/s^2)",
-                        mm(c.travel_accel_m_s2),
-                    ),
-                    ("M201 X (mm/s^2)", mm(c.max_accel_m_s2[0])),
-                    ("M201 Y (mm/s^2)", mm(c.max_accel_m_s2[1])),
-                    ("M203 X (mm/s)", mm(c.max_feedrate_m_s[0])),
-                    ("M203 Y (mm/s)", mm(c.max_feedrate_m_s[1])),
-                ]
+                m20x(
+                    [c.print_accel_m_s2, c.travel_accel_m_s2],
+                    &c.max_accel_m_s2,
+                    &c.max_feedrate_m_s,
+                )
             }
             Driver::Rrf(p) => {
                 let c = p.config();
-                vec![
-                    ("M204 P print acceleration (mm/s^2)", mm(c.print_accel_m_s2)),
-                    (
-                        "M204 T travel acceleration (mm/s^2)",
-                        mm(c.travel_accel_m_s2),
-                    ),
-                    ("M201 X (mm/s^2)", mm(c.max_accel_m_s2[0])),
-                    ("M201 Y (mm/s^2)", mm(c.max_accel_m_s2[1])),
-                    ("M203 X (mm/s)", mm(c.max_feedrate_m_s[0])),
-                    ("M203 Y (mm/s)", mm(c.max_feedrate_m_s[1])),
-                ]
+                m20x(
+                    [c.print_accel_m_s2, c.travel_accel_m_s2],
+                    &c.max_accel_m_s2,
+                    &c.max_feedrate_m_s,
+                )
             }
             Driver::Grbl(p) => {
                 let c = p.config();
@@ -277,6 +265,19 @@ impl Driver {
             Driver::Grbl(_) => Ok(OTHER),
         }
     }
+}
+
+/// Marlin's and RepRapFirmware's limits by name (mm units): `M204 P`/`T`, `M201` and
+/// `M203` of X and Y.
+fn m20x(accel: [f64; 2], max_accel: &[f64; 4], max_feed: &[f64; 4]) -> Vec<(&'static str, f64)> {
+    vec![
+        ("M204 P print acceleration (mm/s^2)", accel[0] / MM),
+        ("M204 T travel acceleration (mm/s^2)", accel[1] / MM),
+        ("M201 X (mm/s^2)", max_accel[0] / MM),
+        ("M201 Y (mm/s^2)", max_accel[1] / MM),
+        ("M203 X (mm/s)", max_feed[0] / MM),
+        ("M203 Y (mm/s)", max_feed[1] / MM),
+    ]
 }
 
 /// Set `to` from a value in mm units, if given.

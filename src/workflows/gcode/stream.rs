@@ -280,15 +280,7 @@ impl Account {
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
             {
-                o.4 = Some(Spot {
-                    error_um: err_um,
-                    time_s: t,
-                    x_mm: x,
-                    y_mm: y,
-                    line: m.line,
-                    layer: m.layer,
-                    move_index: m.index,
-                });
+                o.4 = Some(spot());
             }
         }
         if k.is_multiple_of(self.map_every) {

@@ -55,4 +55,5 @@ pub fn extra(m: &settle::Metrics, name: &str) -> f64 {
         .unwrap_or_else(|| panic!("no column {name}"))
         .1
 }
+pub mod one_mode;
 pub mod resonance;
