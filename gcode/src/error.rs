@@ -278,7 +278,7 @@ pub enum GcodeError {
         source: Box<settle_planner::PlanError>,
     },
     /// A move the firmware refuses because it leaves the machine's travel, in the
-    /// firmware's words (Klipper's "Move out of range: x y z [e]", GRBL's soft-limit
+    /// firmware's words (Klipper's `Move out of range: x y z [e]`, GRBL's soft-limit
     /// alarm): the print stops there.
     #[error("{at}: {command}: {message}")]
     OutOfTravel {

@@ -30,10 +30,9 @@ use settle_planner::firmware::grbl::GrblConfig;
 
 use super::klipper_files::read_text;
 use super::machine::ConfigNote;
-use crate::error::{GcodeError, Location};
+use crate::error::GcodeError;
 use crate::read::dialect::Dialect;
 use crate::read::event::EventKind;
-use crate::read::reader::{Reader, ReaderOptions};
 use crate::read::setting::Setting;
 
 /// GRBL's settings, with GRBL's `DEFAULTS_GENERIC` (grbl/defaults.h) for those a file
@@ -181,16 +180,9 @@ impl GrblSettings {
             })
             .collect::<Vec<_>>()
             .join("\n");
-        let reader = Reader::new(kept.as_bytes(), ReaderOptions::new(Dialect::Grbl))
-            .with_name(source.clone());
-        for event in reader {
-            let event = event?;
-            let at = Location {
-                source_name: source.clone(),
-                line: event.line,
-                column: None,
-            };
-            match event.kind {
+        for event in super::located_events(&kept, Dialect::Grbl, &source) {
+            let (at, kind) = event?;
+            match kind {
                 EventKind::Setting(Setting::Grbl { number, value }) => {
                     s.apply(number, value)
                         .map_err(|allowed| GcodeError::ConfigValue {

@@ -63,6 +63,35 @@ mod rrf;
 mod rrf_script;
 
 pub use export_klipper::KlipperExport;
+
+use std::sync::Arc;
+
+use crate::error::{GcodeError, Location};
+use crate::read::dialect::Dialect;
+use crate::read::event::EventKind;
+use crate::read::reader::{Reader, ReaderOptions};
+
+/// The events of a configuration file's `text` read in `dialect`, each with its line in
+/// `source` (what config.g's and GRBL's settings readers walk).
+pub(crate) fn located_events<'a>(
+    text: &'a str,
+    dialect: Dialect,
+    source: &Arc<str>,
+) -> impl Iterator<Item = Result<(Location, EventKind), GcodeError>> + 'a {
+    let source = source.clone();
+    Reader::new(text.as_bytes(), ReaderOptions::new(dialect))
+        .with_name(source.clone())
+        .map(move |e| {
+            e.map(|e| {
+                let at = Location {
+                    source_name: source.clone(),
+                    line: e.line,
+                    column: None,
+                };
+                (at, e.kind)
+            })
+        })
+}
 pub use export_rrf::RrfExport;
 pub use grbl::GrblSettings;
 pub use klipper::{

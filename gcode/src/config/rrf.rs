@@ -25,7 +25,6 @@ use crate::error::{GcodeError, Location};
 use crate::read::dialect::Dialect;
 use crate::read::event::{EventKind, Note};
 use crate::read::limits::{AxisValues, LimitChange};
-use crate::read::reader::{Reader, ReaderOptions};
 use crate::read::setting::Setting;
 
 /// The kinematics by `M669 K` code (`KinematicsType`,
@@ -183,16 +182,9 @@ impl RrfConfig {
         files.stack.push(absolute(path));
         let script = unconditional(text, &source);
         self.notes.extend(script.notes);
-        let reader = Reader::new(script.text.as_bytes(), ReaderOptions::new(Dialect::Rrf))
-            .with_name(source.clone());
-        for event in reader {
-            let event = event?;
-            let at = Location {
-                source_name: source.clone(),
-                line: event.line,
-                column: None,
-            };
-            match event.kind {
+        for event in super::located_events(&script.text, Dialect::Rrf, &source) {
+            let (at, kind) = event?;
+            match kind {
                 EventKind::Setting(s) => self.setting(&s, &at)?,
                 EventKind::Limits(l) => self.limits(&l, &at)?,
                 EventKind::Note(Note::MacroCall { path: name, .. }) => {
