@@ -44,6 +44,8 @@ pub struct MoveInfo {
     /// Whether it works the material ([`crate::Move::is_working`]): the moves whose error
     /// counts.
     pub working: bool,
+    /// The spindle or laser over it ([`crate::Tool::Off`] on a printer).
+    pub tool: crate::Tool,
     /// The slicer's feature type: an index into [`JobSummary::features`] (0: none named).
     pub feature: u16,
     /// When the planner starts it (s, print clock): the start of its first planned

@@ -4,10 +4,12 @@
 //! **along** the scan line, toolhead minus command on the fly axis, inside the scan
 //! region (the laser on). The contour error, across the line, does not see it.
 //!
-//! Every working straight move along X (or along Y) counts: its samples' along-axis error
-//! (toolhead minus the command the machine receives on that axis) goes to that axis's
-//! histogram. A job is a raster when more than half of its working length is such lines
-//! along one axis ([`FlyAxis::raster`]); that axis is its fly axis.
+//! Every laser move (working, [`settle_gcode::Tool::Laser`]) straight along X (or along Y)
+//! counts: its samples' along-axis error (toolhead minus the command the machine receives
+//! on that axis) goes to that axis's histogram. A laser job is a raster when more than
+//! half of its working length is such lines along one axis ([`FlyAxis::raster`]); that
+//! axis is its fly axis. Printers and mills draw contours, not rasters: their moves are
+//! not counted.
 
 use super::stats::{Histogram, Spot};
 use settle_gcode::job::{MoveGeometry, MoveInfo};
@@ -46,6 +48,9 @@ fn along(m: &MoveInfo) -> Option<(usize, f64)> {
 impl FlyAxis {
     /// A working sample of move `m` at `t`: commanded and toolhead X, Y (mm).
     pub fn sample(&mut self, m: &MoveInfo, t: f64, cmd_mm: [f64; 2], head_mm: [f64; 2]) {
+        if !matches!(m.tool, settle_gcode::Tool::Laser { .. }) {
+            return;
+        }
         let first = self.last_move != Some(m.index);
         self.last_move = Some(m.index);
         let line = along(m);

@@ -170,6 +170,7 @@ impl<R: BufRead> Job<R> {
             layer,
             kind: mv.kind,
             working: mv.is_working(),
+            tool: mv.tool,
             feature: mv.feature,
             start_time_s: 0.0,
             duration_s: 0.0,
