@@ -17,7 +17,7 @@ use crate::config::GrblSettings;
 use crate::{ArcSegmentation, Dialect, GcodeError, GrblArcs, ReaderOptions};
 
 /// A firmware by name, for a G-code job: one of [`Firmware::GCODE`] (klipper, marlin,
-/// rrf, settle; `reprapfirmware` and `duet` are rrf).
+/// rrf, grbl, settle; `reprapfirmware` and `duet` are rrf, `grblhal` is grbl).
 pub fn parse_firmware(name: &str) -> Result<Firmware, GcodeError> {
     Firmware::parse_among(name, &Firmware::GCODE, "a G-code planner").map_err(|reason| {
         GcodeError::JobSetting {
