@@ -14,6 +14,12 @@
 //!   6000 mm/min with the power `S` (0-1000, five levels) on each run of pixels, 2 mm of
 //!   overscan at `S0` at both ends of a line, `G0` step-overs; read it with the grbl
 //!   dialect.
+//! - `cnc_contour.gcode`: a GRBL milling job for a 60 x 40 mm plate with 5 mm corner
+//!   radii, a 12 mm round pocket and a 16 x 10 mm square-cornered pocket, cut with a 3 mm
+//!   end mill (`M3 S10000`): the pockets cleared in rings in two 1 mm passes, the outside
+//!   profile in three passes to 3.2 mm, climb milling (pockets `G3`, profile `G2`, arcs in
+//!   the I/J form and one corner in the R form), cutting feed 1000 mm/min, plunges at
+//!   300 mm/min, `G0` rapids at a safe height of 5 mm; read it with the grbl dialect.
 //!
 //! Run: `cargo run -p settle-gcode --example test_prints` (from the repository root).
 
@@ -238,6 +244,83 @@ fn laser_raster() -> String {
     g
 }
 
+/// The rectangle `(x_lo, y_lo, x_hi, y_hi)` traced counter-clockwise from its lower-left
+/// corner, which the tool is at.
+fn rectangle_ccw(out: &mut String, (x_lo, y_lo, x_hi, y_hi): (f64, f64, f64, f64)) {
+    for (x, y) in [(x_hi, y_lo), (x_hi, y_hi), (x_lo, y_hi), (x_lo, y_lo)] {
+        put!(out, "G1 X{x:.3} Y{y:.3}");
+    }
+}
+
+fn cnc_contour() -> String {
+    let mut g = String::new();
+    header(
+        &mut g,
+        "GRBL milling of a 60 x 40 mm plate with two pockets, a 3 mm end mill at 1000 mm/min",
+    );
+    put!(
+        g,
+        "; grbl dialect; stock top at Z 0, 3 mm thick; tool radius 1.5 mm; spindle M3"
+    );
+    g.push_str("G21 G90 G17 G94 G54\nM3 S10000\nG4 P2\nG0 Z5\n");
+    let (safe, plunge, feed) = (5.0, 300.0, 1000.0);
+    // The round pocket: 12 mm across about (35, 40), cleared in rings of the tool centre
+    // at 1.5, 3 and 4.5 mm (the last one leaves the wall at 6 mm), counter-clockwise.
+    put!(g, "; round pocket, 12 mm across at X35 Y40, 2 mm deep");
+    put!(g, "G0 X35.000 Y40.000\nG0 Z1.000");
+    for depth in [-1.0f64, -2.0] {
+        put!(g, "G1 Z{depth:.3} F{plunge:.0}");
+        for (k, r) in [1.5f64, 3.0, 4.5].into_iter().enumerate() {
+            let x = 35.0 + r;
+            if k == 0 {
+                put!(g, "G1 X{x:.3} F{feed:.0}");
+            } else {
+                put!(g, "G1 X{x:.3}");
+            }
+            put!(g, "G3 X{x:.3} Y40.000 I{:.3} J0", -r);
+        }
+        put!(g, "G1 X35.000 Y40.000");
+    }
+    put!(g, "G0 Z{safe:.3}");
+    // The square-cornered pocket from (54, 35) to (70, 45): a centre line, then rectangles
+    // of the tool centre inset 4, 2.75 and 1.5 mm (the wall), counter-clockwise.
+    put!(g, "; square-cornered pocket, X54..70 Y35..45, 2 mm deep");
+    for depth in [-1.0f64, -2.0] {
+        put!(g, "G0 X59.000 Y40.000\nG0 Z1.000");
+        put!(g, "G1 Z{depth:.3} F{plunge:.0}");
+        put!(g, "G1 X65.000 F{feed:.0}");
+        for inset in [4.0, 2.75, 1.5] {
+            let r = (54.0 + inset, 35.0 + inset, 70.0 - inset, 45.0 - inset);
+            put!(g, "G1 X{:.3} Y{:.3}", r.0, r.1);
+            rectangle_ccw(&mut g, r);
+        }
+        put!(g, "G0 Z{safe:.3}");
+    }
+    // The outside profile of the plate (20, 20)-(80, 60), corner radius 5: the tool centre
+    // 1.5 mm outside, corners of 6.5 mm about the plate's corner centres, clockwise from
+    // the left edge, a lead-in from X15 outside the part; the last corner in the R form.
+    put!(
+        g,
+        "; outside profile, plate X20..80 Y20..60, corner radius 5, through 3 mm"
+    );
+    put!(g, "G0 X15.000 Y25.000\nG0 Z1.000");
+    for depth in [-1.0f64, -2.0, -3.2] {
+        put!(g, "G1 Z{depth:.3} F{plunge:.0}");
+        put!(g, "G1 X18.500 F{feed:.0}");
+        put!(g, "G1 Y55.000");
+        put!(g, "G2 X25.000 Y61.500 I6.500 J0");
+        put!(g, "G1 X75.000");
+        put!(g, "G2 X81.500 Y55.000 I0 J-6.500");
+        put!(g, "G1 Y25.000");
+        put!(g, "G2 X75.000 Y18.500 I-6.500 J0");
+        put!(g, "G1 X25.000");
+        put!(g, "G2 X18.500 Y25.000 R6.500");
+        put!(g, "G1 X15.000");
+    }
+    g.push_str("G0 Z5.000\nM5\nG0 X0 Y0\nM30\n");
+    g
+}
+
 fn main() -> std::io::Result<()> {
     let dir = Path::new(manifest_dir()).join("prints");
     std::fs::create_dir_all(&dir)?;
@@ -246,6 +329,7 @@ fn main() -> std::io::Result<()> {
         ("cube_layer.gcode", cube_layer()),
         ("arc_part.gcode", arc_part()),
         ("laser_raster.gcode", laser_raster()),
+        ("cnc_contour.gcode", cnc_contour()),
     ] {
         let path = dir.join(name);
         std::fs::write(&path, text)?;

@@ -1,6 +1,8 @@
 //! The GRBL dialect against grbl/gcode.c's rules: several commands a line, modal motion,
 //! the spindle and laser state and when GRBL stops for them, units, offsets, `$` lines.
 
+use std::f64::consts::TAU;
+
 use settle_gcode::{Dialect, EventKind, Move, Reader, ReaderOptions, Setting, Tool};
 
 use super::{events, moves};
@@ -197,17 +199,50 @@ fn words(line: &str) -> Vec<(char, f64)> {
     out
 }
 
+/// The length of an XY arc (plus its Z) from `from` to `to` read by hand from its words:
+/// the sweep about the centre `from + (I, J)` in the arc's direction (a whole turn when it
+/// ends where it starts), or for the R form the chord's angle `2 asin(chord / 2R)`, the
+/// long way round for a negative R.
+fn arc_length_by_hand(w: &[(char, f64)], from: [f64; 3], to: [f64; 3], cw: bool) -> f64 {
+    let word = |c: char| w.iter().find(|&&(l, _)| l == c).map(|&(_, v)| v);
+    let (sweep, r) = if let Some(rr) = word('R') {
+        let chord = (to[0] - from[0]).hypot(to[1] - from[1]);
+        let short = 2.0 * (chord / (2.0 * rr.abs())).asin();
+        (if rr < 0.0 { TAU - short } else { short }, rr.abs())
+    } else {
+        let c = [
+            from[0] + word('I').unwrap_or(0.0),
+            from[1] + word('J').unwrap_or(0.0),
+        ];
+        let (a, b) = (
+            [from[0] - c[0], from[1] - c[1]],
+            [to[0] - c[0], to[1] - c[1]],
+        );
+        let ccw = (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]);
+        let sweep = match (cw, ccw) {
+            (_, s) if s == 0.0 => TAU,
+            (true, s) if s < 0.0 => -s,
+            (true, s) => TAU - s,
+            (false, s) if s > 0.0 => s,
+            (false, s) => TAU + s,
+        };
+        (sweep, a[0].hypot(a[1]))
+    };
+    (sweep * r).hypot(to[2] - from[2])
+}
+
 #[test]
 fn the_shipped_laser_and_cnc_jobs_work_where_their_text_says() {
     // By hand from the text: the raster's G1 lines with S above 0 are the burn (laser
-    // mode from its `$32=1`); every G1 of the UGS contour cuts (M3 S1000 from the start,
-    // M5 at the end).
-    for (name, laser) in [("laser_raster.gcode", true), ("ugs_logo.gcode", false)] {
+    // mode from its `$32=1`); every G1, G2 and G3 of the CNC contour cuts (M3 S10000
+    // from the start, M5 at the end), plunges included, the rapids (G0) do not.
+    for (name, laser) in [("laser_raster.gcode", true), ("cnc_contour.gcode", false)] {
         let text = std::fs::read_to_string(super::print_path(name)).expect("print");
         let (mut pos, mut s, mut by_hand, mut cuts) = ([0.0f64; 3], 0.0, 0.0, 0);
+        let mut arcs = 0;
         for line in text.lines() {
             let w = words(line);
-            let g1 = w.iter().any(|&(l, v)| l == 'G' && v == 1.0);
+            let g = |n: f64| w.iter().any(|&(l, v)| l == 'G' && v == n);
             let mut to = pos;
             for &(l, v) in &w {
                 match l {
@@ -218,15 +253,24 @@ fn the_shipped_laser_and_cnc_jobs_work_where_their_text_says() {
                     _ => {}
                 }
             }
-            let d =
+            let d = if g(2.0) || g(3.0) {
+                arcs += 1;
+                arc_length_by_hand(&w, pos, to, g(2.0))
+            } else if g(1.0) {
                 ((to[0] - pos[0]).powi(2) + (to[1] - pos[1]).powi(2) + (to[2] - pos[2]).powi(2))
-                    .sqrt();
-            if g1 && d > 0.0 && (!laser || s > 0.0) {
+                    .sqrt()
+            } else {
+                0.0
+            };
+            if d > 0.0 && (!laser || s > 0.0) {
                 by_hand += d;
                 cuts += 1;
             }
             pos = to;
         }
+        // The contour's arcs: 3 rings in each of 2 pocket passes, 4 corners in each of
+        // 3 profile passes.
+        assert_eq!(arcs, if laser { 0 } else { 18 }, "{name}");
         let r = Reader::open(super::print_path(name), ReaderOptions::new(Dialect::Grbl))
             .expect("opens");
         let (mut settle, mut n) = (0.0, 0);
