@@ -5,10 +5,15 @@
 //!   range on an axis the move moves, with `Move out of range: x y z [e]`
 //!   (klippy/toolhead.py `Move.move_error`, `%.3f`): the print stops. This job stops
 //!   with the same words (an input error: the file does not run on this configuration).
-//! - **RepRapFirmware 3.5** (`M208`): on a printer a move past the limits of a homed axis
-//!   is clamped to them (`Kinematics::LimitPosition`, src/GCodes/GCodes.cpp, error only
-//!   on lasers and CNC): listed as not followed (the clamped part is not what the file
-//!   draws; the planned motion here is the file's).
+//! - **RepRapFirmware 3.5 and 3.6** (`M208`, limits on by default, `M564 S1`): on a
+//!   printer (`MachineType::fff`) `GCodes::DoStraightMove` (src/GCodes/GCodes.cpp) clamps
+//!   each coordinate of a homed moving axis to its limits (`Kinematics::LimitPosition`
+//!   of a Cartesian machine) and takes the clamped point as the new position
+//!   (`ToolOffsetInverseTransform`); only a laser or CNC machine raises "target position
+//!   outside machine limits". Simulated so: every point of a move (start, arc segments,
+//!   end) clamped to the limits, the extrusion as written, and listed once per axis (the
+//!   part differs from the file). RepRapFirmware 3.7 raises the error on printers too for
+//!   absolute moves; that version is not the one settle's planner follows.
 //! - **GRBL** (`$130`-`$132`, soft limits `$20=1` with homing `$22=1`): machine
 //!   coordinates run over the travel from the homed end, and the work offsets are not in
 //!   the file, so what settle can check is the job's extent: an axis whose moves span more
@@ -65,6 +70,24 @@ impl Travel {
         }
     }
 
+    /// Whether the firmware runs a move past the travel clamped to it (RepRapFirmware).
+    pub(crate) fn clamps(&self) -> bool {
+        self.firmware == Firmware::Rrf && self.limits.iter().any(Option::is_some)
+    }
+
+    /// `p` as RepRapFirmware runs it: each of X, Y, Z inside its limits (a Cartesian
+    /// machine's `LimitPosition`); E untouched.
+    pub(crate) fn clamp(&self, p: &mut Point) {
+        for (c, lim) in [&mut p.x_mm, &mut p.y_mm, &mut p.z_mm]
+            .into_iter()
+            .zip(self.limits)
+        {
+            if let Some((lo, hi)) = lim {
+                *c = c.clamp(lo, hi);
+            }
+        }
+    }
+
     /// A straight move from `a` to `b` (mm, machine frame).
     pub(crate) fn check(&mut self, a: &Point, b: &Point) -> TravelCheck {
         let (pa, pb) = ([a.x_mm, a.y_mm, a.z_mm], [b.x_mm, b.y_mm, b.z_mm]);
@@ -85,7 +108,7 @@ impl Travel {
                     if pb[k] != pa[k] && (pb[k] < lo || pb[k] > hi) && !self.listed[k] {
                         self.listed[k] = true;
                         return TravelCheck::Listed(format!(
-                            "moves past the M208 {} limits ({lo} to {hi} mm): RepRapFirmware clamps them to the limits (the part differs from the file; simulated as written)",
+                            "moves past the M208 {} limits ({lo} to {hi} mm): RepRapFirmware clamps them to the limits (simulated clamped; the part differs from the file)",
                             AXES[k]
                         ));
                     }

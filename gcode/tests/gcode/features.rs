@@ -103,3 +103,32 @@ fn grbl_travel_is_checked_on_the_job_extent_and_notes_reach_the_summary() {
     );
     let _ = Firmware::Grbl;
 }
+
+#[test]
+fn reprapfirmware_clamps_a_printer_move_to_its_m208_limits() {
+    // RepRapFirmware 3.5/3.6 on a printer (GCodes::DoStraightMove, Kinematics::LimitPosition):
+    // a coordinate past M208 is clamped and the clamped point is the new position. So the
+    // file below runs exactly as the file with X200 written in place of X250 and without
+    // the travel to X260 (clamped onto where the toolhead already is), the extrusion as
+    // written.
+    let c =
+        settle_gcode::config::RrfConfig::parse("M208 X0:200 Y0:200\n", "config.g").expect("config");
+    let cfg = JobConfig::from_rrf(&c).expect("job config");
+    assert_eq!(cfg.travel_mm[0], Some((0.0, 200.0)));
+    let run = |text: &str| {
+        let reader = Reader::new(text.as_bytes(), cfg.reader_options());
+        let mut j = Job::new(reader, cfg.clone()).expect("job");
+        for chunk in j.by_ref() {
+            chunk.expect("runs");
+        }
+        (j.print_time_s(), j.summary())
+    };
+    let (t, s) = run("M83\nG1 X100 Y100 F6000\nG1 X250 E1\nG0 X260\nG1 X100 Y150 E2\n");
+    let (want, _) = run("M83\nG1 X100 Y100 F6000\nG1 X200 E1\nG1 X100 Y150 E2\n");
+    assert_eq!(t.to_bits(), want.to_bits(), "{t} vs {want}");
+    assert!(
+        s.ignored.keys().any(|k| k.contains("M208 X limits")),
+        "{:?}",
+        s.ignored
+    );
+}

@@ -151,15 +151,24 @@ impl<R: BufRead> Job<R> {
                 from = *p;
             }
         }
+        // What the firmware runs: the file's points, or RepRapFirmware's clamped ones.
+        let (mut start, mut end) = (mv.start, mv.end);
+        if check_travel && self.travel.clamps() {
+            self.travel.clamp(&mut start);
+            for p in &mut points {
+                self.travel.clamp(p);
+            }
+            end = points.last().copied().unwrap_or(start);
+        }
         let xyz = |p: &Point| [p.x_mm, p.y_mm, p.z_mm];
         let geometry = match &mv.path {
             Path::Line => MoveGeometry::Line {
-                from_mm: xyz(&mv.start),
-                to_mm: xyz(&mv.end),
+                from_mm: xyz(&start),
+                to_mm: xyz(&end),
             },
             Path::Arc(a) => MoveGeometry::Arc {
                 arc: *a,
-                points_mm: std::iter::once(xyz(&mv.start))
+                points_mm: std::iter::once(xyz(&start))
                     .chain(points.iter().map(xyz))
                     .collect(),
             },
@@ -174,13 +183,13 @@ impl<R: BufRead> Job<R> {
             feature: mv.feature,
             start_time_s: 0.0,
             duration_s: 0.0,
-            start_mm: mv.start,
-            end_mm: mv.end,
+            start_mm: start,
+            end_mm: end,
             feed_mm_s: mv.feed_mm_s,
             geometry,
         };
         self.moves += 1;
-        self.last_end = mv.end;
+        self.last_end = end;
         self.last_feed_mm_s = mv.feed_mm_s;
         let first = self.seq;
         let extruder_only = mv.kind == MoveKind::Extruder;
@@ -198,7 +207,7 @@ impl<R: BufRead> Job<R> {
         } else {
             speed
         };
-        let mut prev = mv.start;
+        let mut prev = start;
         let result = (|| -> Result<(), GcodeError> {
             if extruder_only {
                 let de = mv.extrusion_mm() * MM;
