@@ -65,6 +65,7 @@ mod config;
 mod driver;
 mod input;
 mod moves;
+mod not_followed;
 mod pipeline;
 mod settle;
 mod shapers;

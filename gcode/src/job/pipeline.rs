@@ -258,6 +258,13 @@ impl<R: BufRead> Job<R> {
     /// What the job has done so far.
     pub fn summary(&self) -> JobSummary {
         let t = self.print_time_s();
+        // What the planner was told to do but did not, and what the reader passed over.
+        let mut ignored = self.ignored.clone();
+        let firmware = self.cfg.firmware();
+        for (name, n) in self.reader.ignored_commands() {
+            let what = format!("{name}: {}", super::not_followed::reason(firmware, name));
+            *ignored.entry(what).or_insert(0) += n;
+        }
         JobSummary {
             firmware: Some(self.cfg.firmware()),
             print_time_s: t,
@@ -266,7 +273,7 @@ impl<R: BufRead> Job<R> {
             segments: self.seq,
             limit_changes: self.limit_changes,
             shaper_changes: self.shaper_changes,
-            ignored: self.ignored.clone(),
+            ignored,
             features: self.reader.features().to_vec(),
             overrides: self.overrides.clone(),
             complete: self.eof,

@@ -132,3 +132,29 @@ fn reprapfirmware_clamps_a_printer_move_to_its_m208_limits() {
         s.ignored
     );
 }
+
+#[test]
+fn every_command_the_planner_does_not_follow_is_listed_for_every_printer_firmware() {
+    // A start of print as slicers write it: none of these is motion the planner runs.
+    let text = "M104 S200\nM109 S200\nM106 S255\nG29\nT0\nM900 K0.05\nM84\nG1 X10 E1 F600\n";
+    for firmware in [Firmware::Klipper, Firmware::Rrf, Firmware::Marlin] {
+        let j = job(JobConfig::defaults(firmware).expect("defaults"), text).expect("runs");
+        let ignored = j.summary().ignored;
+        let names: Vec<&str> = ignored
+            .keys()
+            .map(|k| k.split(':').next().unwrap_or(""))
+            .collect();
+        assert_eq!(
+            names,
+            ["G29", "M104", "M106", "M109", "M84", "M900", "T0"],
+            "{firmware:?}: {ignored:?}"
+        );
+        assert!(ignored.values().all(|&n| n == 1), "{ignored:?}");
+        assert!(
+            ignored
+                .keys()
+                .any(|k| k.starts_with("M109: waits for a temperature")),
+            "{ignored:?}"
+        );
+    }
+}
