@@ -123,3 +123,51 @@ fn the_error_is_given_per_feature_type_with_the_outer_wall_first() {
     let second = csv.lines().nth(1).expect("a row");
     assert!(second.starts_with("External perimeter,true,"), "{csv}");
 }
+
+#[test]
+fn each_layer_gives_each_feature_types_worst_and_p95() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let machine = write(dir.path(), "one_mode.toml", ONE_MODE);
+    // Layer 1: outer wall only; layer 2: outer wall, then infill across it.
+    let square = "G1 X40 E1 F6000\nG1 Y40 E1\nG1 X10 E1\nG1 Y10 E1\n";
+    let file = write(
+        dir.path(),
+        "layers.gcode",
+        &format!(
+            "G90\nM83\nG1 X10 Y10 F6000\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2\n;TYPE:External perimeter\n\
+             {square};LAYER_CHANGE\n;Z:0.4\nG1 Z0.4\n{square};TYPE:Solid infill\nG1 X40 Y40 E2 F3000\n"
+        ),
+    );
+    let o = measure(
+        &GcodeOptions::new(file, machine.to_str().expect("utf-8"), Firmware::Klipper)
+            .expect("options"),
+    )
+    .expect("runs");
+    use settle::workflows::gcode::features::{layer_features_csv, layer_outer_wall};
+    let stats = |layer: u32| {
+        o.layers
+            .iter()
+            .find(|l| l.layer == layer)
+            .and_then(|l| l.stats.clone())
+            .expect("simulated layer")
+    };
+    // A layer of outer wall alone: its outer wall's numbers are the layer's, counted by
+    // the layer's own histogram.
+    let (l1, l2) = (stats(1), stats(2));
+    let (w1, p1) = layer_outer_wall(&o, 1).expect("outer wall in layer 1");
+    assert_eq!((w1, p1), (l1.worst_um(), l1.p95_um));
+    // With infill too, the larger of the two types' worst is the layer's.
+    let f = &o.streamed.features;
+    let (w2, p2) = layer_outer_wall(&o, 2).expect("outer wall in layer 2");
+    let infill = f.layer_worst[&(2, 2)];
+    assert_eq!(w2.max(infill), l2.worst_um());
+    assert!(p2 > 0.0 && p2 <= w2 * 1.001 && f.layer_p95[&(2, 2)] > 0.0);
+    let csv = String::from_utf8(layer_features_csv(&o).expect("csv")).expect("utf-8");
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows.len(), 4, "{csv}");
+    assert!(
+        rows[1].starts_with("1,0.2,External perimeter,true,")
+            && rows[3].starts_with("2,0.4,Solid infill,false,"),
+        "{csv}"
+    );
+}

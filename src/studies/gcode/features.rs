@@ -1,11 +1,12 @@
 //! The error per slicer feature type (`;TYPE:External perimeter`, Cura's
 //! `;TYPE:WALL-OUTER`, ...; [`settle_gcode::Reader::features`]): over each type's working
-//! samples, the worst (with its spot) and the 95th percentile, and per layer the worst of
-//! each type (for the error-against-Z figure). The outer wall is what a print is judged
+//! samples, the worst (with its spot) and the 95th percentile, and per layer the worst
+//! and the 95th percentile of each type (the error-against-Z figure, layer_features.csv,
+//! the outer wall's columns of the layers table). The outer wall is what a print is judged
 //! by ([`is_outer_wall`]).
 //!
-//! Memory: one histogram per type (at most [`settle_gcode::MAX_FEATURES`]) and one number
-//! per layer and type.
+//! Memory: two histograms per type (the whole job's and the current layer's; at most
+//! [`settle_gcode::MAX_FEATURES`] types) and two numbers per layer and type.
 
 use std::collections::BTreeMap;
 
@@ -34,6 +35,11 @@ pub struct FeatureAccount {
     pub stats: BTreeMap<u16, FeatureStats>,
     /// Per (layer, feature index), its worst error (um).
     pub layer_worst: BTreeMap<(u32, u16), f64>,
+    /// Per (layer, feature index), the 95th percentile of its errors (um); NaN when the
+    /// layer's samples came in two separate runs (its percentile is then not known).
+    pub layer_p95: BTreeMap<(u32, u16), f64>,
+    /// Per feature index, the current layer's errors (cleared at each layer's end).
+    current: BTreeMap<u16, Histogram>,
 }
 
 impl FeatureAccount {
@@ -47,6 +53,22 @@ impl FeatureAccount {
         }
         let w = self.layer_worst.entry((layer, feature)).or_insert(0.0);
         *w = w.max(err_um);
+        self.current.entry(feature).or_default().push(err_um);
+    }
+
+    /// The end of layer `layer`'s samples: each type's 95th percentile over them.
+    pub fn end_layer(&mut self, layer: u32) {
+        for (&f, h) in &mut self.current {
+            if h.total() == 0 {
+                continue;
+            }
+            let p95 = h.quantile_um(0.95);
+            self.layer_p95
+                .entry((layer, f))
+                .and_modify(|v| *v = f64::NAN)
+                .or_insert(p95);
+            h.clear();
+        }
     }
 
     /// Whether any sample came from a named feature type (index above 0).

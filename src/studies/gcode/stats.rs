@@ -61,6 +61,12 @@ impl Histogram {
         self.total += other.total;
     }
 
+    /// Forget every count (keeps the bins' memory).
+    pub fn clear(&mut self) {
+        self.counts.fill(0);
+        self.total = 0;
+    }
+
     /// Samples counted.
     pub fn total(&self) -> u64 {
         self.total

@@ -1,6 +1,7 @@
 //! The outputs of `settle gcode` about where on the part the error is: per slicer feature
 //! type (`features.csv`, a section of summary.md, a table of report.html; the outer wall
-//! first, then by worst error), the fly-axis error of a raster job, and the figure of the
+//! first, then by worst error), per layer and type (`layer_features.csv`, a table of
+//! report.html, the outer wall's columns of summary.md's layers), the fly-axis error of a raster job, and the figure of the
 //! error against Z (`error-z.svg/png`: per layer the worst and 95th-percentile error, and
 //! the outer wall's worst when the file names its features).
 
@@ -79,6 +80,67 @@ pub fn features_csv(o: &GcodeOutcome) -> Result<Vec<u8>, csv::Error> {
         w.write_record(&row)?;
     }
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
+}
+
+/// layer_features.csv's columns.
+pub const LAYER_FEATURE_COLUMNS: [&str; 6] = [
+    "layer",
+    "z_mm",
+    "feature",
+    "outer_wall",
+    "worst_um",
+    "p95_um",
+];
+
+/// The Z of layer `layer` (when the file gives one).
+fn layer_z(o: &GcodeOutcome, layer: u32) -> Option<f64> {
+    o.layers
+        .iter()
+        .find(|l| l.layer == layer)
+        .and_then(|l| l.z_mm)
+}
+
+/// layer_features.csv as bytes: per layer, each feature type's worst and p95 (an empty
+/// p95 when the layer's samples came in two separate runs).
+pub fn layer_features_csv(o: &GcodeOutcome) -> Result<Vec<u8>, csv::Error> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(LAYER_FEATURE_COLUMNS)?;
+    let f = &o.streamed.features;
+    for (&(layer, i), &worst) in &f.layer_worst {
+        let n = name(o, i);
+        let p95 = f.layer_p95.get(&(layer, i)).copied().unwrap_or(f64::NAN);
+        w.write_record([
+            layer.to_string(),
+            layer_z(o, layer)
+                .map(|z| format!("{z}"))
+                .unwrap_or_default(),
+            n.clone(),
+            is_outer_wall(&n).to_string(),
+            format!("{worst}"),
+            if p95.is_nan() {
+                String::new()
+            } else {
+                format!("{p95}")
+            },
+        ])?;
+    }
+    w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
+}
+
+/// Whether the file names an outer wall among its feature types.
+pub fn has_outer_wall(o: &GcodeOutcome) -> bool {
+    o.features.iter().skip(1).any(|n| is_outer_wall(n))
+}
+
+/// The outer wall's worst and p95 (um) in layer `layer` (the outer-wall type with the
+/// larger worst if the slicer names two); `None` when the layer has no outer wall.
+pub fn layer_outer_wall(o: &GcodeOutcome, layer: u32) -> Option<(f64, f64)> {
+    let f = &o.streamed.features;
+    f.layer_worst
+        .range((layer, 0)..=(layer, u16::MAX))
+        .filter(|((_, i), _)| is_outer_wall(&name(o, *i)))
+        .map(|(k, &w)| (w, f.layer_p95.get(k).copied().unwrap_or(f64::NAN)))
+        .max_by(|a, b| a.0.total_cmp(&b.0))
 }
 
 /// The summary.md sections: the feature types (when the file names them) and the
@@ -212,12 +274,7 @@ pub fn z_figure(o: &GcodeOutcome) -> Option<Figure> {
         .map(|(i, _)| i as u16)
         .collect();
     if !outer.is_empty() {
-        let z_of = |layer: u32| {
-            o.layers
-                .iter()
-                .find(|l| l.layer == layer)
-                .and_then(|l| l.z_mm)
-        };
+        let z_of = |layer: u32| layer_z(o, layer);
         let mut pts: Vec<(f64, f64)> = o
             .streamed
             .features

@@ -170,11 +170,21 @@ more torque than it has",
         );
     }
     let _ = writeln!(s, "\n## Layers\n");
+    let outer = super::features::has_outer_wall(o);
     let _ = writeln!(
         s,
-        "| layer | Z (mm) | time (s) | moves | worst (um) | p95 (um) | worst line |"
+        "| layer | Z (mm) | time (s) | moves | worst (um) | p95 (um) | worst line |{}",
+        if outer {
+            " outer wall worst (um) | outer wall p95 (um) |"
+        } else {
+            ""
+        }
     );
-    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        s,
+        "|---:|---:|---:|---:|---:|---:|---:|{}",
+        if outer { "---:|---:|" } else { "" }
+    );
     for l in &o.layers {
         let z = l.z_mm.map_or(String::new(), |z| format!("{z:.2}"));
         let (w, p, line) = match &l.stats {
@@ -187,9 +197,18 @@ more torque than it has",
             ),
             None => ("-".into(), "-".into(), "-".into()),
         };
+        let wall = if !outer {
+            String::new()
+        } else {
+            match super::features::layer_outer_wall(o, l.layer) {
+                Some((w, p)) if p.is_nan() => format!(" {w:.2} | - |"),
+                Some((w, p)) => format!(" {w:.2} | {p:.2} |"),
+                None => " - | - |".into(),
+            }
+        };
         let _ = writeln!(
             s,
-            "| {} | {z} | {:.2} | {} | {w} | {p} | {line} |",
+            "| {} | {z} | {:.2} | {} | {w} | {p} | {line} |{wall}",
             l.layer, l.duration_s, l.moves
         );
     }
@@ -256,11 +275,15 @@ pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         stems.push(stem);
     }
     if super::features::has_features(o) {
-        let path = dir.join("features.csv");
-        let bytes = super::features::features_csv(o)
-            .map_err(|e| Error::write(&path, std::io::Error::other(e)))?;
-        write_atomic(&path, &bytes)?;
-        files.push(path);
+        for (file, bytes) in [
+            ("features.csv", super::features::features_csv(o)),
+            ("layer_features.csv", super::features::layer_features_csv(o)),
+        ] {
+            let path = dir.join(file);
+            let bytes = bytes.map_err(|e| Error::write(&path, std::io::Error::other(e)))?;
+            write_atomic(&path, &bytes)?;
+            files.push(path);
+        }
     }
     if let Some(fig) = super::features::z_figure(o) {
         crate::output::plot::write(&fig, dir, "error-z")?;
@@ -491,6 +514,17 @@ pub fn html_report(
         });
     }
     tables.extend(super::features::features_table(o));
+    if super::features::has_features(o) {
+        let csv = super::features::layer_features_csv(o)
+            .map_err(|e| Error::write(dir.join("layer_features.csv"), std::io::Error::other(e)))?;
+        tables.extend(
+            Table::from_csv(
+                "Feature types per layer (layer_features.csv)",
+                &String::from_utf8_lossy(&csv),
+            )
+            .ok(),
+        );
+    }
     if !o.ignored.is_empty() {
         tables.push(Table {
             title: "Commands not followed".into(),

@@ -198,6 +198,7 @@ impl Account {
         let Some(mut l) = self.layer.take() else {
             return;
         };
+        self.out.features.end_layer(l.layer);
         l.p95_um = self.hist.quantile_um(0.95);
         self.out.all.merge(&self.hist);
         self.hist = Histogram::default();
