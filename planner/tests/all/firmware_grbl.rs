@@ -68,6 +68,82 @@ fn a_square_corner_passes_at_the_junction_deviation_speed() {
 }
 
 #[test]
+fn an_oblique_corner_takes_the_acceleration_along_the_change_of_direction() {
+    // GRBL's junction deviation (grbl/planner.c plan_buffer_line) with X at 100 and Y at
+    // 400 mm/s^2: 10 mm along X, then 45 degrees up to (20, 10), at F1200 (20 mm/s).
+    // junction_cos_theta = -(u_prev . u) = -1/sqrt 2; the junction unit vector is
+    // u - u_prev = (1/sqrt 2 - 1, 1/sqrt 2) normalised = (-0.382683, 0.923880), and
+    // limit_value_by_axis_maximum gives min(100 / 0.382683, 400 / 0.923880) = 261.313
+    // mm/s^2 (X binds); sin(theta/2) = sqrt((1 - cos theta) / 2) = 0.923880, so
+    // v^2 = 261.313 * 0.01 * 0.923880 / (1 - 0.923880) = 31.716 and v = 5.6317 mm/s. Neither
+    // pass binds: from rest over 10 mm at 100 mm/s^2 and to rest over 14.14 mm at 141.4
+    // mm/s^2 (the second block's acceleration along (1, 1)/sqrt 2) both allow more.
+    let c = GrblConfig {
+        accel_m_s2: [0.1, 0.4, 0.1],
+        ..cfg()
+    };
+    let u = [0.5f64.sqrt() - 1.0, 0.5f64.sqrt()];
+    let n = u[0].hypot(u[1]);
+    let a_j = (100.0 / (u[0] / n).abs()).min(400.0 / (u[1] / n).abs());
+    assert!((a_j - 261.313).abs() < 1e-3, "{a_j}");
+    let s = (0.5 * (1.0 + 0.5f64.sqrt())).sqrt();
+    let vj = (a_j * 0.01 * s / (1.0 - s)).sqrt();
+    assert!((vj - 5.6317).abs() < 1e-4, "{vj}");
+    let (moves, t) = plan(
+        c,
+        &[
+            xy([0.0, 0.0], [10.0, 0.0], 20.0),
+            xy([10.0, 0.0], [20.0, 10.0], 20.0),
+        ],
+    );
+    assert_rel("junction", moves[0].end_speed_m_s / MM, vj, 1e-9);
+    let a2 = 100.0 * 2f64.sqrt();
+    assert_rel(
+        "second block's acceleration",
+        moves[1].accel_m_s2 / MM,
+        a2,
+        1e-12,
+    );
+    let want =
+        block_time(10.0, 0.0, 20.0, vj, 100.0) + block_time(10.0 * 2f64.sqrt(), vj, 20.0, 0.0, a2);
+    assert_rel("print time", t, want, 1e-12);
+}
+
+#[test]
+fn a_corner_before_a_short_last_block_is_capped_by_the_stop_after_it() {
+    // The square corner of the first test (junction deviation allows 1.8478 mm/s), but the
+    // leg after it is 0.01 mm and the newest block ends at rest: the reverse pass caps the
+    // corner at sqrt(2 a d) = sqrt(2 * 100 * 0.01) = 1.4142 mm/s.
+    let (moves, _) = plan(
+        cfg(),
+        &[
+            xy([0.0, 0.0], [10.0, 0.0], 10.0),
+            xy([10.0, 0.0], [10.0, 0.01], 10.0),
+        ],
+    );
+    assert_rel(
+        "corner",
+        moves[0].end_speed_m_s / MM,
+        (2.0f64 * 100.0 * 0.01).sqrt(),
+        1e-9,
+    );
+}
+
+#[test]
+fn targets_are_rounded_to_whole_steps_as_grbl_does() {
+    // grbl/planner.c: target_steps = lround(target * steps_per_mm) and the block is the
+    // step delta over steps_per_mm. At 80 steps/mm, X 10.01 mm is 800.8 steps -> 801 ->
+    // 10.0125 mm; from rest to rest at 10 mm/s and 100 mm/s^2 that block takes
+    // 0.1 + (10.0125 - 1) / 10 + 0.1 = 1.10125 s.
+    let c = GrblConfig {
+        steps_per_m: [80e3; 3],
+        ..cfg()
+    };
+    let (_, t) = plan(c, &[xy([0.0, 0.0], [10.01, 0.0], 10.0)]);
+    assert_rel("rounded block", t, 1.10125, 1e-12);
+}
+
+#[test]
 fn a_diagonal_move_accelerates_and_rapids_at_the_limit_along_its_direction() {
     // A 45-degree move: each axis carries 1/sqrt 2 of it, so the box allows
     // 100 * sqrt 2 mm/s^2 and 100 * sqrt 2 mm/s along the path. A rapid (G0) runs at that
