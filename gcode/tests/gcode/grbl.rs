@@ -220,7 +220,7 @@ fn arc_length_by_hand(w: &[(char, f64)], from: [f64; 3], to: [f64; 3], cw: bool)
         );
         let ccw = (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]);
         let sweep = match (cw, ccw) {
-            (_, s) if s == 0.0 => TAU,
+            (_, 0.0) => TAU,
             (true, s) if s < 0.0 => -s,
             (true, s) => TAU - s,
             (false, s) if s > 0.0 => s,
