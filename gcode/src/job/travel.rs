@@ -12,7 +12,9 @@
 //!   (`ToolOffsetInverseTransform`); only a laser or CNC machine raises "target position
 //!   outside machine limits". Simulated so: every point of a move (start, arc segments,
 //!   end) clamped to the limits, the extrusion as written, and listed once per axis (the
-//!   part differs from the file). RepRapFirmware 3.7 raises the error on printers too for
+//!   part differs from the file). An arc (`G2`/`G3`) whose end is past the limits is
+//!   abandoned with "G2/G3: outside machine limits" on every machine type
+//!   (`GCodes::DoArcMove`): this job stops with those words. RepRapFirmware 3.7 raises the error on printers too for
 //!   absolute moves; that version is not the one settle's planner follows.
 //! - **GRBL** (`$130`-`$132`, soft limits `$20=1` with homing `$22=1`): machine
 //!   coordinates run over the travel from the homed end, and the work offsets are not in
@@ -86,6 +88,25 @@ impl Travel {
                 *c = c.clamp(lo, hi);
             }
         }
+    }
+
+    /// RepRapFirmware's check of an arc (`GCodes::DoArcMove`): an arc whose end is past the
+    /// M208 limits is abandoned with an error on every machine type (only the points on
+    /// the way are clamped on a printer). The message, or `None` when it ends inside.
+    pub(crate) fn arc_refused(&self, end: &Point) -> Option<String> {
+        if self.firmware != Firmware::Rrf {
+            return None;
+        }
+        let p = [end.x_mm, end.y_mm, end.z_mm];
+        (0..3).find_map(|k| {
+            let (lo, hi) = self.limits[k]?;
+            (p[k] < lo || p[k] > hi).then(|| {
+                format!(
+                    "RepRapFirmware abandons the arc: \"G2/G3: outside machine limits\" (its end {} {:.3} mm, M208 {lo} to {hi} mm)",
+                    AXES[k], p[k]
+                )
+            })
+        })
     }
 
     /// A straight move from `a` to `b` (mm, machine frame).

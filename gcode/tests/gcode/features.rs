@@ -131,6 +131,36 @@ fn reprapfirmware_clamps_a_printer_move_to_its_m208_limits() {
         "{:?}",
         s.ignored
     );
+    // An arc ending past the limits is abandoned with an error (GCodes::DoArcMove); one
+    // that only passes beyond them on the way is clamped point by point.
+    let reader = |t: &'static str| Reader::new(t.as_bytes(), cfg.reader_options());
+    let err = Job::new(
+        reader("G1 X190 Y100 F6000\nG2 X210 Y100 I10 J0\n"),
+        cfg.clone(),
+    )
+    .expect("job")
+    .run_to_end()
+    .expect_err("refused")
+    .to_string();
+    assert!(
+        err.contains(":2:") && err.contains("G2/G3: outside machine limits"),
+        "{err}"
+    );
+    let mut j = Job::new(
+        reader("G1 X190 Y100 F6000\nG2 X190 Y100 I6 J0\n"),
+        cfg.clone(),
+    )
+    .expect("job");
+    j.run_to_end()
+        .expect("a full circle out to X 202 runs clamped");
+    assert!(
+        j.summary()
+            .ignored
+            .keys()
+            .any(|k| k.starts_with("G2: moves past the M208 X limits")),
+        "{:?}",
+        j.summary().ignored
+    );
 }
 
 #[test]

@@ -134,6 +134,14 @@ impl<R: BufRead> Job<R> {
         let mut points = std::mem::take(&mut self.points);
         mv.segments_into(&self.cfg.arcs, &mut points);
         if check_travel {
+            if let (Path::Arc(_), Some(message)) = (&mv.path, self.travel.arc_refused(&mv.end)) {
+                self.points = points;
+                return Err(GcodeError::OutOfTravel {
+                    at: self.at(line),
+                    command: command.to_string(),
+                    message,
+                });
+            }
             let mut from = mv.start;
             for p in &points {
                 match self.travel.check(&from, p) {
