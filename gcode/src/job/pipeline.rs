@@ -61,6 +61,9 @@ pub struct Job<R> {
     points: Vec<Point>,
     /// Where the last move ended, and its feed (mm, mm/s).
     last_end: Point,
+    /// Where the firmware stands when it is not where the file put it (RepRapFirmware
+    /// after an arc cut short at its limits): the next move starts here.
+    resync: Option<Point>,
     last_feed_mm_s: f64,
     limit_changes: u64,
     shaper_changes: u64,
@@ -147,6 +150,7 @@ impl<R: BufRead> Job<R> {
             eof: false,
             points: Vec::new(),
             last_end: Point::default(),
+            resync: None,
             last_feed_mm_s: cfg_feed,
             limit_changes: 0,
             shaper_changes: 0,

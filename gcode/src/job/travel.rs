@@ -14,7 +14,10 @@
 //!   end) clamped to the limits, the extrusion as written, and listed once per axis (the
 //!   part differs from the file). An arc (`G2`/`G3`) whose end is past the limits is
 //!   abandoned with "G2/G3: outside machine limits" on every machine type
-//!   (`GCodes::DoArcMove`): this job stops with those words. RepRapFirmware 3.7 raises the error on printers too for
+//!   (`GCodes::DoArcMove`): this job stops with those words. An arc that ends inside but
+//!   passes beyond them on the way is cut short at its last segment inside
+//!   (`GCodes::ReadMove` aborts the segmented move; a printer carries on from there):
+//!   simulated so, and listed. RepRapFirmware 3.7 raises the error on printers too for
 //!   absolute moves; that version is not the one settle's planner follows.
 //! - **GRBL** (`$130`-`$132`, soft limits `$20=1` with homing `$22=1`): machine
 //!   coordinates run over the travel from the homed end, and the work offsets are not in
@@ -107,6 +110,14 @@ impl Travel {
                 )
             })
         })
+    }
+
+    /// Whether `p` is inside every limit.
+    pub(crate) fn inside(&self, p: &Point) -> bool {
+        [p.x_mm, p.y_mm, p.z_mm]
+            .into_iter()
+            .zip(self.limits)
+            .all(|(c, lim)| lim.is_none_or(|(lo, hi)| (lo..=hi).contains(&c)))
     }
 
     /// A straight move from `a` to `b` (mm, machine frame).

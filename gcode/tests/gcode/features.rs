@@ -146,18 +146,42 @@ fn reprapfirmware_clamps_a_printer_move_to_its_m208_limits() {
         err.contains(":2:") && err.contains("G2/G3: outside machine limits"),
         "{err}"
     );
+    // A full circle about (196, 100) of radius 6 reaches X 202: RepRapFirmware 3.5/3.6
+    // runs its segments up to the last one inside X 200 (GCodes::ReadMove aborts the
+    // segmented move) and the next move starts there. Clockwise from (190, 100) it rises
+    // over the top and meets X 200 at cos = 2/3, Y = 100 + 6 sqrt(5/9) = 104.47: the last
+    // segment inside ends before that, higher up the circle.
     let mut j = Job::new(
-        reader("G1 X190 Y100 F6000\nG2 X190 Y100 I6 J0\n"),
+        reader("G1 X190 Y100 F6000\nG2 X190 Y100 I6 J0\nG1 X100 Y100\n"),
         cfg.clone(),
     )
     .expect("job");
-    j.run_to_end()
-        .expect("a full circle out to X 202 runs clamped");
+    let mut moves = Vec::new();
+    for chunk in j.by_ref() {
+        for m in chunk.expect("runs").moves {
+            if moves
+                .last()
+                .is_none_or(|l: &std::sync::Arc<settle_gcode::job::MoveInfo>| l.index != m.index)
+            {
+                moves.push(m);
+            }
+        }
+    }
+    assert_eq!(moves.len(), 3);
+    let (arc, next) = (&moves[1], &moves[2]);
+    assert!(
+        arc.end_mm.x_mm <= 200.0
+            && arc.end_mm.x_mm > 199.0
+            && arc.end_mm.y_mm > 100.0 + 6.0 * (1.0f64 - 4.0 / 9.0).sqrt(),
+        "{:?}",
+        arc.end_mm
+    );
+    assert_eq!(next.start_mm, arc.end_mm);
     assert!(
         j.summary()
             .ignored
             .keys()
-            .any(|k| k.starts_with("G2: moves past the M208 X limits")),
+            .any(|k| k.starts_with("G2: an arc past the M208 limits on the way")),
         "{:?}",
         j.summary().ignored
     );

@@ -142,6 +142,15 @@ impl<R: BufRead> Job<R> {
                     message,
                 });
             }
+            if matches!(mv.path, Path::Arc(_))
+                && self.travel.clamps()
+                && let Some(i) = points.iter().position(|p| !self.travel.inside(p))
+            {
+                points.truncate(i);
+                self.ignore(format!(
+                    "{command}: an arc past the M208 limits on the way: RepRapFirmware stops it at its last segment inside (\"intermediate position outside machine limits\") and goes on from there"
+                ));
+            }
             let mut from = mv.start;
             for p in &points {
                 match self.travel.check(&from, p) {
@@ -159,14 +168,22 @@ impl<R: BufRead> Job<R> {
                 from = *p;
             }
         }
-        // What the firmware runs: the file's points, or RepRapFirmware's clamped ones.
-        let (mut start, mut end) = (mv.start, mv.end);
+        // What the firmware runs: the file's points, or RepRapFirmware's clamped ones, from
+        // where the firmware stands.
+        let (mut start, mut end) = (self.resync.take().unwrap_or(mv.start), mv.end);
         if check_travel && self.travel.clamps() {
             self.travel.clamp(&mut start);
             for p in &mut points {
                 self.travel.clamp(p);
             }
             end = points.last().copied().unwrap_or(start);
+            if end != mv.end {
+                self.resync = Some(end);
+            }
+            if points.is_empty() {
+                self.points = points;
+                return Ok(());
+            }
         }
         let xyz = |p: &Point| [p.x_mm, p.y_mm, p.z_mm];
         let geometry = match &mv.path {
