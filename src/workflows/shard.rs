@@ -138,6 +138,18 @@ fn input_error(file: &Path, message: String) -> Error {
 pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
     let path = dir.join(MANIFEST);
     if !path.exists() {
+        if let Some(journal) = crate::workflows::journal::existing(dir) {
+            return Err(input_error(
+                dir,
+                format!(
+                    "an unfinished shard: {} but no {MANIFEST} ({}): it was stopped (a time limit, a node lost) or is still running; \
+finish it with `settle sweep SCENARIO --shard K/N --out {} --resume`, then merge",
+                    crate::workflows::journal::FILE,
+                    journal_shard(&journal),
+                    dir.display()
+                ),
+            ));
+        }
         return Err(input_error(
             dir,
             format!(
@@ -180,6 +192,19 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
     }
     let table = RunsTable::parse(&csv).map_err(|e| input_error(&csv_path, e))?;
     Ok((m, table))
+}
+
+/// Which shard a journal belongs to, from its first line (`...; shard K/N; ...`, see
+/// [`crate::workflows::journal::key_line`]), in words.
+fn journal_shard(journal: &Path) -> String {
+    use std::io::{BufRead, Read};
+    let mut line = String::new();
+    let read = std::fs::File::open(journal)
+        .map(|f| std::io::BufReader::new(f.take(4096)).read_line(&mut line));
+    match (read, line.split("; ").find(|p| p.starts_with("shard "))) {
+        (Ok(_), Some(shard)) => format!("its journal is of {shard}"),
+        _ => "its journal names no shard".to_string(),
+    }
 }
 
 /// Write a shard's manifest into `dir`.
@@ -293,9 +318,12 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, Error> {
         return Err(input_error(
             &first_dir,
             format!(
-                "missing shard(s) {} of scenario `{}`: give every shard folder",
+                "missing shard(s) {} of scenario `{}`: give every shard folder (a shard whose task failed or never ran has none: \
+run it with `settle sweep {} --shard {}`)",
                 missing.join(", "),
-                first.scenario_name
+                first.scenario_name,
+                first.scenario_file,
+                missing[0]
             ),
         ));
     }

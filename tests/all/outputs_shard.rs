@@ -144,9 +144,25 @@ fn bad_merges_are_clear_errors() {
     let a3 = mk("a3", "scenarios/ci_quickstart.toml", "3/3");
     let q2 = mk("q2", "scenarios/quickstart.toml", "2/3");
     merge_err(&[&a1, &a3], "missing shard(s) 2/3");
+    merge_err(
+        &[&a1, &a3],
+        "run it with `settle sweep scenarios/ci_quickstart.toml --shard 2/3`",
+    );
+    merge_err(&[&a2], "missing shard(s) 1/3, 3/3");
     merge_err(&[&a1, &a2, &a2, &a3], "given twice");
     merge_err(&[&a1, &q2, &a3], "not from the same sweep");
     merge_err(&[&a1, dir.path()], "not a shard folder");
+    // A shard stopped before it finished (a time limit): a journal, no manifest.
+    let stopped = dir.path().join("stopped");
+    std::fs::create_dir(&stopped).expect("mkdir");
+    std::fs::write(
+        stopped.join("journal.csv"),
+        "settle-journal; key 0; ci_quickstart; backend rapier; shard 2/3; settle 0.1.0\n",
+    )
+    .expect("write");
+    merge_err(&[&a1, &stopped, &a3], "an unfinished shard");
+    merge_err(&[&a1, &stopped, &a3], "its journal is of shard 2/3");
+    merge_err(&[&a1, &stopped, &a3], "--resume");
     // A shard whose rows were tampered with.
     let csv = std::fs::read_to_string(a2.join("runs.csv")).expect("csv");
     let cut: String = csv.lines().take(2).map(|l| format!("{l}\n")).collect();
@@ -161,4 +177,80 @@ fn bad_merges_are_clear_errors() {
     let o = settle(&["sweep", "scenarios/ci_quickstart.toml", "--shard", "1/7"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("at most 6 shards"));
+}
+
+/// Shards whose runs lose steps merge like any other (failed runs are results): the merge
+/// lists them and exits 0, or 1 with `--fail-on-failed-runs`, and writes the unsharded
+/// sweep's files either way.
+#[test]
+fn shards_with_failed_runs_merge_and_list_them() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scenario = dir.path().join("stage.toml");
+    std::fs::write(
+        &scenario,
+        r#"name = "stage"
+[machine]
+preset = "leadscrew_stage"
+[move]
+distance_mm = 20.0
+[limits]
+vmax_mm_s = 300.0
+amax_mm_s2 = 2000.0
+jmax_mm_s3 = 200000.0
+[observe]
+window_s = 0.05
+[sweep]
+"limits.amax_mm_s2" = [2000, 20000]
+"move.distance_mm" = [5, 20]
+"#,
+    )
+    .expect("write");
+    let whole = dir.path().join("whole");
+    ok(&["sweep", s(&scenario), "--out", s(&whole)]);
+    let csv = std::fs::read_to_string(whole.join("runs.csv")).expect("csv");
+    assert!(
+        csv.contains(",lost_steps,"),
+        "the scenario loses steps: {csv}"
+    );
+    let shards: Vec<PathBuf> = (1..=2)
+        .map(|k| {
+            let d = dir.path().join(format!("shard{k}"));
+            ok(&[
+                "sweep",
+                s(&scenario),
+                "--shard",
+                &format!("{k}/2"),
+                "--out",
+                s(&d),
+            ]);
+            d
+        })
+        .collect();
+    let merged = dir.path().join("merged");
+    let o = settle(&["merge", s(&shards[0]), s(&shards[1]), "--out", s(&merged)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("runs failed") && err.contains("lost_steps: lost "),
+        "{err}"
+    );
+    for f in files(&whole) {
+        assert!(
+            std::fs::read(whole.join(&f)).expect("read")
+                == std::fs::read(merged.join(&f)).expect("read"),
+            "{} differs",
+            f.display()
+        );
+    }
+    let strict = dir.path().join("strict");
+    let o = settle(&[
+        "merge",
+        s(&shards[0]),
+        s(&shards[1]),
+        "--fail-on-failed-runs",
+        "--out",
+        s(&strict),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(strict.join("summary.md").exists(), "written all the same");
 }
