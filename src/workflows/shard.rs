@@ -139,13 +139,18 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
     let path = dir.join(MANIFEST);
     if !path.exists() {
         if let Some(journal) = crate::workflows::journal::existing(dir) {
+            let shard = journal_shard(&journal);
             return Err(input_error(
                 dir,
                 format!(
                     "an unfinished shard: {} but no {MANIFEST} ({}): it was stopped (a time limit, a node lost) or is still running; \
-finish it with `settle sweep SCENARIO --shard K/N --out {} --resume`, then merge",
+finish it with `settle sweep SCENARIO --shard {} --out {} --resume`, then merge",
                     crate::workflows::journal::FILE,
-                    journal_shard(&journal),
+                    shard.as_ref().map_or_else(
+                        || "its journal names no shard".to_string(),
+                        |s| format!("its journal is of shard {s}")
+                    ),
+                    shard.as_deref().unwrap_or("K/N"),
                     dir.display()
                 ),
             ));
@@ -194,17 +199,16 @@ finish it with `settle sweep SCENARIO --shard K/N --out {} --resume`, then merge
     Ok((m, table))
 }
 
-/// Which shard a journal belongs to, from its first line (`...; shard K/N; ...`, see
-/// [`crate::workflows::journal::key_line`]), in words.
-fn journal_shard(journal: &Path) -> String {
+/// Which shard (`K/N`) a journal belongs to, from its first line (`...; shard K/N; ...`,
+/// see [`crate::workflows::journal::key_line`]).
+fn journal_shard(journal: &Path) -> Option<String> {
     use std::io::{BufRead, Read};
     let mut line = String::new();
-    let read = std::fs::File::open(journal)
-        .map(|f| std::io::BufReader::new(f.take(4096)).read_line(&mut line));
-    match (read, line.split("; ").find(|p| p.starts_with("shard "))) {
-        (Ok(_), Some(shard)) => format!("its journal is of {shard}"),
-        _ => "its journal names no shard".to_string(),
-    }
+    std::fs::File::open(journal)
+        .and_then(|f| std::io::BufReader::new(f.take(4096)).read_line(&mut line))
+        .ok()?;
+    let shard = line.split("; ").find_map(|p| p.strip_prefix("shard "))?;
+    shard.parse::<Shard>().ok().map(|s| s.to_string())
 }
 
 /// Write a shard's manifest into `dir`.

@@ -162,7 +162,13 @@ fn bad_merges_are_clear_errors() {
     .expect("write");
     merge_err(&[&a1, &stopped, &a3], "an unfinished shard");
     merge_err(&[&a1, &stopped, &a3], "its journal is of shard 2/3");
-    merge_err(&[&a1, &stopped, &a3], "--resume");
+    merge_err(
+        &[&a1, &stopped, &a3],
+        &format!(
+            "settle sweep SCENARIO --shard 2/3 --out {} --resume",
+            stopped.display()
+        ),
+    );
     // A shard whose rows were tampered with.
     let csv = std::fs::read_to_string(a2.join("runs.csv")).expect("csv");
     let cut: String = csv.lines().take(2).map(|l| format!("{l}\n")).collect();
