@@ -212,6 +212,7 @@ pub fn sweep(
         prefix.push(',');
         Some(prefix)
     };
+    let resuming = opts.resume && journal::existing(&out).is_some();
     let (journal, done) = match journal::existing(&out) {
         Some(_) if opts.resume => {
             let (j, done, notes) = Journal::resume(&out, &key, &header, &params)?;
@@ -233,12 +234,14 @@ pub fn sweep(
     };
     // The finished runs' ids (their rows stay in the journal).
     let done: std::collections::HashSet<usize> = done.into_keys().collect();
-    if opts.resume {
+    if resuming {
         note(&format!(
             "resuming: {} of {} runs already finished",
             done.len(),
             runs.len()
         ));
+    } else if opts.resume {
+        note("--resume: no journal here, so a new sweep");
     }
     // What is left to run (positions among the runs).
     let todo: Vec<u32> = (0..runs.len())
@@ -517,8 +520,7 @@ pub fn list_failures(r: &mut Report, failed: &[FailedRun], runs: usize) {
         return;
     }
     r.err(format!(
-        "{} of {runs} runs failed (status and reason in runs.csv; results, not errors: \
---fail-on-failed-runs makes them exit 1):",
+        "{} of {runs} runs failed (status and reason in runs.csv):",
         failed.len(),
     ));
     const SHOWN: usize = 20;
