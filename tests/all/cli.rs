@@ -7,7 +7,7 @@ use settle::execute::pool::quiet;
 use settle::spec::backend::Backend;
 use settle::workflows::sweep::{SweepOptions, sweep};
 
-use crate::support::{root, settle};
+use crate::support::{root, run_case_1, settle};
 
 #[test]
 fn quickstart_sweep_writes_one_row_per_run() {
@@ -293,16 +293,7 @@ window_s = 0.1
         "{summary}"
     );
     // `settle run` agrees: the same status and reason, no metrics, the same exit code.
-    let run = |extra: &[&str]| {
-        settle()
-            .arg("run")
-            .arg(&scenario)
-            .args(["--case", "1", "--out"])
-            .arg(dir.path().join("run-1.csv"))
-            .args(extra)
-            .output()
-            .expect("runs")
-    };
+    let run = |extra: &[&str]| run_case_1(&scenario, &dir.path().join("run-1.csv"), extra);
     let out = run(&[]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(0), "{stdout}");

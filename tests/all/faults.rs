@@ -2,7 +2,7 @@
 //! `--fail-on-failed-runs`), and interrupted sweeps keep their finished runs and resume to
 //! the same output.
 
-use crate::support::{settle, write};
+use crate::support::{run_case_1, settle, write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -110,15 +110,13 @@ fn a_blow_up_is_a_failed_run_with_its_reason_and_the_sweep_goes_on() {
 fn settle_run_reports_a_fault_as_a_failed_run_not_as_numbers() {
     let dir = tempfile::tempdir().expect("tempdir");
     let scenario = write(dir.path(), "blowup.toml", BLOW_UP);
+    let trace = dir.path().join("run-1.csv");
     let run = |extra: &[&str]| {
-        settle()
-            .arg("run")
-            .arg(&scenario)
-            .args(["--case", "1", "--backend", "rapier", "--out"])
-            .arg(dir.path().join("run-1.csv"))
-            .args(extra)
-            .output()
-            .expect("runs")
+        run_case_1(
+            &scenario,
+            &trace,
+            &[&["--backend", "rapier"], extra].concat(),
+        )
     };
     let out = run(&[]);
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -135,8 +133,8 @@ fn settle_run_reports_a_fault_as_a_failed_run_not_as_numbers() {
             "{metric} printed for a fault: {stdout}"
         );
     }
-    let trace = std::fs::read_to_string(dir.path().join("run-1.csv")).expect("trace");
-    assert!(trace.lines().count() > 2, "the trace up to the fault");
+    let text = std::fs::read_to_string(&trace).expect("trace");
+    assert!(text.lines().count() > 2, "the trace up to the fault");
     assert_eq!(run(&["--fail-on-failed-runs"]).status.code(), Some(1));
 }
 

@@ -26,20 +26,7 @@ fn s(p: &Path) -> &str {
 
 /// Every file under `dir`, relative, sorted.
 fn files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).expect("read_dir") {
-            let p = e.expect("entry").path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.push(p.strip_prefix(dir).expect("prefix").to_path_buf());
-            }
-        }
-    }
-    out.sort();
-    out
+    crate::support::files_under(dir)
 }
 
 #[test]
@@ -191,32 +178,18 @@ fn bad_merges_are_clear_errors() {
 #[test]
 fn shards_with_failed_runs_merge_and_list_them() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let scenario = dir.path().join("stage.toml");
-    std::fs::write(
-        &scenario,
-        r#"name = "stage"
-[machine]
-preset = "leadscrew_stage"
-[move]
-distance_mm = 20.0
-[limits]
-vmax_mm_s = 300.0
-amax_mm_s2 = 2000.0
-jmax_mm_s3 = 200000.0
-[observe]
-window_s = 0.05
-[sweep]
-"limits.amax_mm_s2" = [2000, 20000]
-"move.distance_mm" = [5, 20]
-"#,
-    )
-    .expect("write");
+    // 16 runs of a lead-screw stage, 3 of which lose steps (runs 7, 11 and 15).
+    let scenario = crate::support::root().join("tests/shards/big_lost_steps.toml");
     let whole = dir.path().join("whole");
     ok(&["sweep", s(&scenario), "--out", s(&whole)]);
     let csv = std::fs::read_to_string(whole.join("runs.csv")).expect("csv");
-    assert!(
-        csv.contains(",lost_steps,"),
-        "the scenario loses steps: {csv}"
+    assert_eq!(
+        csv.lines()
+            .skip(1)
+            .filter(|l| l.contains(",lost_steps,"))
+            .count(),
+        3,
+        "the scenario loses steps in 3 runs: {csv}"
     );
     let shards: Vec<PathBuf> = (1..=2)
         .map(|k| {

@@ -111,23 +111,15 @@ fn run(argv: &[String], volume: &Path, env: &[(String, String)]) -> std::process
 
 /// Every file under `dir`, relative, sorted, leaving out the shard folders.
 fn files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).expect("read_dir") {
-            let p = e.expect("entry").path();
-            let shard = p
-                .file_name()
-                .is_some_and(|n| n.to_string_lossy().starts_with("shard-"));
-            if p.is_dir() && !shard {
-                stack.push(p);
-            } else if p.is_file() {
-                out.push(p.strip_prefix(dir).expect("prefix").to_path_buf());
-            }
-        }
-    }
-    out.sort();
-    out
+    let shard = |p: &PathBuf| {
+        p.components()
+            .next()
+            .is_some_and(|c| c.as_os_str().to_string_lossy().starts_with("shard-"))
+    };
+    crate::support::files_under(dir)
+        .into_iter()
+        .filter(|p| !shard(p))
+        .collect()
 }
 
 #[test]
