@@ -1,6 +1,15 @@
 //! The `settle` command: arguments, a call to a workflow of the library
-//! (`settle::workflows`), printing, and exit codes: 0 ok; 1 failed runs, a regression or an
-//! I/O failure; 2 bad input or usage; 130 an interrupted sweep.
+//! (`settle::workflows`), printing, and exit codes (docs/reference/cli.md):
+//!
+//! - 0: the command finished and wrote every output. Runs that failed physically (lost
+//!   steps, a simulation fault) are results, not failures of the command: recorded with
+//!   their reasons (runs.csv, summary.md, stderr) and still exit 0, so that a scheduler's
+//!   `afterok` dependency (Slurm) or a Job's success (Kubernetes) goes on to the merge;
+//!   `--fail-on-failed-runs` turns them into exit 1;
+//! - 1: the command failed: a regression found by `settle check`, a failed `settle
+//!   validate` check, an I/O failure (with `--fail-on-failed-runs`, also failed runs);
+//! - 2: bad input or usage, nothing run;
+//! - 130: an interrupted sweep (its finished runs kept for `--resume`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -11,6 +20,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use settle::Error;
 use settle::execute::interrupt;
 use settle::spec::backend::Backend;
+use settle::workflows::scheduler::ShardArg;
 use settle::workflows::{self, Exit, Report};
 
 fn parse_backend(s: &str) -> Result<Backend, String> {
@@ -65,14 +75,19 @@ enum Command {
         outputs: OutputFlags,
         /// Run only shard K of N (1-based: runs i with i % N == K-1) into
         /// DIR [default: results/<scenario name>/shard-K-of-N/]; combine with `settle merge`.
-        #[arg(long, value_name = "K/N")]
-        shard: Option<workflows::shard::Shard>,
+        /// `slurm`: K and N of this Slurm job array task (SLURM_ARRAY_TASK_ID, _MIN, _STEP,
+        /// _COUNT); `kubernetes`: of this Indexed Job pod (JOB_COMPLETION_INDEX + 1 of
+        /// SETTLE_SHARD_COUNT, which the Job spec sets to its completions).
+        #[arg(long, value_name = "K/N|slurm|kubernetes")]
+        shard: Option<ShardArg>,
         /// Continue an interrupted sweep: keep the runs in OUT/journal.csv, run the rest.
         #[arg(long)]
         resume: bool,
         /// Overwrite the results of an earlier sweep in OUT (refused without it).
         #[arg(long, conflicts_with = "resume")]
         force: bool,
+        #[command(flatten)]
+        failed_runs: FailedRunsFlag,
     },
     /// Check every backend against the closed form and against each other; print a table.
     #[command(
@@ -124,6 +139,8 @@ enum Command {
         /// Output folder [default: results/<scenario name>/].
         #[arg(long)]
         out: Option<PathBuf>,
+        #[command(flatten)]
+        failed_runs: FailedRunsFlag,
     },
     /// Plan motion problems: JSON lines on stdin, one profile (or error) per line on stdout.
     #[command(
@@ -245,6 +262,8 @@ enum Command {
         /// settings; another starts from its defaults.
         #[arg(long, value_name = "FIRMWARE[:SHAPER]", value_parser = workflows::gcode::compare::parse_setting)]
         versus: Option<(settle_gcode::job::Firmware, workflows::gcode::XyShapers)>,
+        #[command(flatten)]
+        failed_runs: FailedRunsFlag,
     },
     /// Run one point of a sweep in detail: print its metrics, write its full trace as CSV.
     #[command(
@@ -267,6 +286,8 @@ enum Command {
         /// Simulation backend: modal, rapier, mujoco.
         #[arg(long, default_value = "rapier", value_parser = parse_backend)]
         backend: Backend,
+        #[command(flatten)]
+        failed_runs: FailedRunsFlag,
     },
     /// Print a machine's modes per axis (frequency, damping ratio, weight).
     #[command(
@@ -337,6 +358,15 @@ fn parse_method(s: &str) -> Result<settle_identify::MethodChoice, String> {
     }
 }
 
+/// How runs that failed physically end the command.
+#[derive(clap::Args, Debug, Clone, Copy)]
+struct FailedRunsFlag {
+    /// Exit 1 when a run failed (lost steps, a simulation fault) [default: exit 0: a failed
+    /// run is a result, listed with its reason in the outputs and on stderr].
+    #[arg(long)]
+    fail_on_failed_runs: bool,
+}
+
 /// Recordings a sweep or a run can write.
 #[derive(clap::Args, Debug, Clone, Copy)]
 struct OutputFlags {
@@ -354,7 +384,7 @@ fn main() -> ExitCode {
             print!("{}", report.stdout);
             eprint!("{}", report.stderr);
             ExitCode::from(match report.exit {
-                Exit::Ok => 0,
+                Exit::Ok | Exit::RunsFailed => 0,
                 Exit::Failed => 1,
                 Exit::Interrupted => interrupt::EXIT_CODE,
             })
@@ -406,6 +436,13 @@ fn dispatch(command: Command) -> Result<Report, Error> {
     };
     let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
     let jobs = |j: Option<u16>| j.map(usize::from);
+    // Failed runs end these commands with exit 1 only when asked.
+    let failed_runs = |mut r: Report, flag: FailedRunsFlag| {
+        if flag.fail_on_failed_runs && r.exit == Exit::RunsFailed {
+            r.exit = Exit::Failed;
+        }
+        r
+    };
     let report = match command {
         Command::Sweep {
             scenario,
@@ -416,7 +453,18 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             shard,
             resume,
             force,
+            failed_runs: flag,
         } => {
+            let shard = match shard {
+                Some(arg) => {
+                    let r = arg.resolve(&|name| std::env::var(name).ok())?;
+                    if !r.source.is_empty() {
+                        note(&format!("--shard {}: {}", r.shard, r.source));
+                    }
+                    Some(r.shard)
+                }
+                None => None,
+            };
             install_interrupt()?;
             let opts = workflows::sweep::SweepOptions {
                 out,
@@ -428,7 +476,10 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 force,
                 ..workflows::sweep::SweepOptions::new(scenario, backend)
             };
-            workflows::sweep::sweep(&opts, &note, &progress)?.report()
+            failed_runs(
+                workflows::sweep::sweep(&opts, &note, &progress)?.report(),
+                flag,
+            )
         }
         Command::Validate { backend, out } => {
             workflows::validate::validate(backend, out.as_deref())?.report()
@@ -452,7 +503,11 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             };
             workflows::check::check(&opts, &progress)?.report()
         }
-        Command::Merge { dirs, out } => workflows::merge::merge(&dirs, out)?.report(),
+        Command::Merge {
+            dirs,
+            out,
+            failed_runs: flag,
+        } => failed_runs(workflows::merge::merge(&dirs, out)?.report(), flag),
         Command::Tune {
             scenario,
             out,
@@ -520,6 +575,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             maps,
             mcap,
             versus,
+            failed_runs: flag,
         } => {
             let opts = workflows::gcode::GcodeOptions {
                 mcap,
@@ -543,7 +599,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 }
                 .with_shapers(shaper.unwrap_or_default())
             };
-            workflows::gcode::gcode(&opts)?.report()
+            failed_runs(workflows::gcode::gcode(&opts)?.report(), flag)
         }
         Command::Run {
             scenario,
@@ -552,6 +608,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             outputs,
             plot,
             backend,
+            failed_runs: flag,
         } => {
             let opts = workflows::run::RunOptions {
                 out,
@@ -560,7 +617,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 plot,
                 ..workflows::run::RunOptions::new(scenario, case, backend)
             };
-            workflows::run::run(&opts)?.report()
+            failed_runs(workflows::run::run(&opts)?.report(), flag)
         }
         Command::Machine { file } => workflows::machine::machine_modes(&file)?.report(),
         Command::Identify {

@@ -33,6 +33,7 @@ mod scan_reference;
 mod scan_views;
 mod scenarios;
 mod shaping_sweep;
+mod shards_kubernetes;
 mod step_samples;
 mod sweep_runs;
 mod sweep_safety;
