@@ -29,17 +29,6 @@ pub struct ScenarioFile<'a> {
     pub text: &'a str,
 }
 
-/// The figures (caption, SVG markup) as the page embeds them.
-fn embedded(figures: &[(String, String)]) -> Vec<Figure> {
-    figures
-        .iter()
-        .map(|(title, svg)| Figure {
-            title: title.clone(),
-            image: Image::Svg(svg.clone()),
-        })
-        .collect()
-}
-
 /// The title of the table of every run in a sweep's report.
 pub const RUNS_TITLE: &str = "All runs (runs.csv)";
 
@@ -332,6 +321,7 @@ pub fn sweep_report<'a>(
         intro,
         winners,
         tables,
+        sections: Vec::new(),
         figures: figures
             .iter()
             .map(|(title, svg)| Figure {
@@ -357,29 +347,6 @@ pub fn sweep_report<'a>(
         ),
     };
     (report, rows)
-}
-
-/// A report from a Markdown summary (e.g. `settle tune`'s tune.md): its tables (each under
-/// its heading, the paragraph under it as its note), the candidates table `csv` as the
-/// sortable, filterable table of every run, the `figures` (caption, SVG markup) and the
-/// provenance.
-pub fn markdown_report(
-    title: &str,
-    markdown: &str,
-    csv: &str,
-    figures: &[(String, String)],
-    provenance: Provenance,
-) -> Report {
-    Report {
-        title: title.to_string(),
-        intro: Vec::new(),
-        winners: Vec::new(),
-        tables: markdown_tables(markdown),
-        figures: embedded(figures),
-        runs: Table::from_csv("Every candidate", csv).ok(),
-        failed: Vec::new(),
-        provenance,
-    }
 }
 
 /// The provenance of a run of settle on `file` with `backend`, `command` as typed.
