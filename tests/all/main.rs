@@ -39,6 +39,7 @@ mod sweep_runs;
 mod sweep_safety;
 mod tune;
 mod tune_firmware;
+mod tune_klipper;
 mod tune_scan;
 mod validate;
 mod workflows;

@@ -51,7 +51,8 @@ fn modal() -> Options {
 #[test]
 fn firmware_restricts_the_candidates() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let small = "frequency_scales = [1.0]\njerk_steps = 1\n";
+    // The TMC4361A's register ranges depend on the resolution: 80 microsteps per mm.
+    let small = "frequency_scales = [1.0]\njerk_steps = 1\nusteps_per_mm = 80.0\n";
     for (fw, shaper_fw) in [
         ("klipper", Some(ShaperFirmware::Klipper)),
         ("marlin", Some(ShaperFirmware::Marlin)),
@@ -114,7 +115,7 @@ fn smoothing_and_max_accel_are_klippers_and_bound_the_acceleration() {
     let dir = tempfile::tempdir().expect("tempdir");
     let o = run(
         dir.path(),
-        "firmware = \"klipper\"\nshapers = [\"mzv\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [5000.0, 7000.0]\n",
+        "firmware = \"klipper\"\nshapers = [\"mzv\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [5000.0, 7000.0]\nshaper_damping_ratio = 0.1\n",
         &modal(),
     );
     // Klipper's numbers for MZV at 47.19999999999992 Hz, damping 0.1, at 5000 mm/s^2 and
@@ -144,7 +145,7 @@ fn smoothing_and_max_accel_are_klippers_and_bound_the_acceleration() {
     // A looser limit lets it in.
     let o = run(
         dir.path(),
-        "firmware = \"klipper\"\nshapers = [\"mzv\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [7000.0]\nmax_smoothing_mm = 0.2\n",
+        "firmware = \"klipper\"\nshapers = [\"mzv\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [7000.0]\nmax_smoothing_mm = 0.2\nshaper_damping_ratio = 0.1\n",
         &modal(),
     );
     assert!(
@@ -324,13 +325,7 @@ fn identified_frequency_band_makes_tune_prefer_a_robust_shaper() {
             < shaped(&exact, winner.as_deref().expect("shaped")).move_and_settle_s
     );
     // The report says which band it used.
-    let md = settle::workflows::tune::report::markdown(
-        "t",
-        &wide.plan,
-        &wide.scores,
-        wide.winner,
-        &wide.front,
-    );
+    let md = settle::workflows::tune::report::axis_section("x", &wide, "pareto.svg");
     assert!(
         md.contains("Frequency band: +-10.000% (2 sigma of the identified 47.20 +- 2.360 Hz mode"),
         "{md}"

@@ -136,7 +136,7 @@ pub fn table(axes: &[(String, Outcome)]) -> Table {
                 num(s.move_time_s * 1e3, 1, None),
                 num(s.residual_peak_um, 2, None),
                 num(s.simulated_move_and_settle_s * 1e3, 1, Some("not settled")),
-                Cell::text(super::report::status(s)),
+                Cell::text(super::cells::status(s)),
             ]);
         }
     }

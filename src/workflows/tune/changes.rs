@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 use settle_gcode::config::Note;
 
 use super::Outcome;
-use super::report::ms;
+use super::cells::ms;
 use super::search::Score;
 
 /// One changed setting.
@@ -240,7 +240,7 @@ pub fn klipper(axes: &[(String, Outcome)], accel: Option<f64>) -> Vec<Change> {
                     &format!("shaper_freq_{letter}"),
                     &format!("damping_ratio_{letter}"),
                 ],
-                ("mzv", 0.0, super::export::KLIPPER_OFF_DAMPING),
+                ("mzv", 0.0, super::target::KLIPPER_OFF_DAMPING),
             ));
         }
     }

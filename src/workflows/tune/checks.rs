@@ -3,7 +3,8 @@
 
 use std::fmt::Write as _;
 
-use super::{Outcome, rank, report};
+use super::cells::{headings, ms, row, rows_header};
+use super::{Outcome, rank};
 
 /// The refinement paragraph of the report: the grid winner, how many candidates the
 /// refinement evaluated, and what it gained.
@@ -18,7 +19,7 @@ pub fn refine_text(o: &Outcome) -> String {
         return String::new();
     }
     let (g, w) = (&o.scores[o.grid_winner], &o.scores[o.winner]);
-    let [_, _, h_score] = report::headings(&o.plan);
+    let [_, _, h_score] = headings(&o.plan);
     let mut out = format!(
         "\n### Refinement around the grid winner\n\n{} grid candidates, then {} rounds around the grid winner ({extra} more candidates). ",
         o.plan.candidates.len(),
@@ -57,9 +58,9 @@ pub fn check_text(o: &Outcome) -> String {
     let band = plan.base.bands_um[plan.band_index];
     let mut out = String::new();
     let _ = writeln!(out, "\n### Checked on a second backend: {b}\n");
-    out.push_str(&report::rows_header(plan));
-    report::row(&mut out, "current", d);
-    report::row(&mut out, "recommended", w);
+    out.push_str(&rows_header(plan));
+    row(&mut out, "current", d);
+    row(&mut out, "recommended", w);
     let verdict = if w.move_and_settle_s < d.simulated_move_and_settle_s {
         format!(
             "the recommendation still beats the current settings on {b}: {:.1}% better",
@@ -73,8 +74,8 @@ pub fn check_text(o: &Outcome) -> String {
     let _ = writeln!(
         out,
         "Into the {band} um band the recommendation takes {} ms on {b} ({} ms on {}, {}).",
-        report::ms(w.at_band_s),
-        report::ms(searched.at_band_s),
+        ms(w.at_band_s),
+        ms(searched.at_band_s),
         plan.base.backend,
         if w.at_band_s <= searched.at_band_s + 1.0 / plan.base.sample_rate_hz {
             "confirmed within one sample"

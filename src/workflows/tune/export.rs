@@ -60,15 +60,12 @@ fn shaper_of(s: &Score) -> Option<FirmwareShaper> {
     })
 }
 
-/// The damping ratio written with Klipper's "no shaping" (Klipper's default).
-pub const KLIPPER_OFF_DAMPING: f64 = DEFAULT_DAMPING_RATIO;
-
 /// Klipper's "no shaping" on an axis: frequency 0 (`klippy/extras/input_shaper.py`).
 fn klipper_off() -> FirmwareShaper {
     FirmwareShaper {
         name: "mzv".into(),
         frequency_hz: 0.0,
-        damping_ratio: KLIPPER_OFF_DAMPING,
+        damping_ratio: target::KLIPPER_OFF_DAMPING,
     }
 }
 
@@ -228,7 +225,7 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
         let _ = writeln!(
             head,
             "; axis {a} alone would take {} (RepRapFirmware has one shaper for all axes: the lowest-frequency axis's is written)",
-            super::report::shaper_text(&o.scores[o.winner])
+            super::cells::shaper_text(&o.scores[o.winner])
         );
     }
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));

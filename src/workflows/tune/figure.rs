@@ -5,7 +5,7 @@
 use plotters::style::RGBColor;
 
 use super::Outcome;
-use super::report::headings;
+use super::cells::headings;
 use super::search::Score;
 use crate::output::plot::{Figure, Line, Marker, PALETTE, Panel};
 use settle_planner::shaper::ShaperKind;

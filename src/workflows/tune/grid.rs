@@ -339,14 +339,25 @@ pub fn plan(
             "found no vibration mode of the moving axis to tune shapers to",
         ));
     }
+    if let Some(z) = spec.shaper_damping_ratio
+        && !(z.is_finite() && (0.0..1.0).contains(&z))
+    {
+        return Err(src.error_at(
+            "tune.shaper_damping_ratio",
+            format!("must be 0 to under 1, got {z}"),
+        ));
+    }
+    let (fixed_damping, damping_source) = design_damping_source(&spec, &base);
     let mut shaper_settings: Vec<Option<ShaperSetting>> = Vec::new();
     for s in &shapers {
         match s {
             None => shaper_settings.push(None),
             Some(k) => {
                 for (f, zeta) in &modes {
-                    // Designed for the mode's own damping, as far as the firmware takes it.
-                    let (damping_ratio, moved) = target::design_damping(*k, *zeta);
+                    // Designed for the mode's own damping (or the fixed one), as far as
+                    // the firmware takes it.
+                    let (damping_ratio, moved) =
+                        target::design_damping(*k, fixed_damping.unwrap_or(*zeta));
                     if let Some(why) = moved {
                         let note = format!(
                             "{} is designed for damping {damping_ratio} on the {f:.1} Hz mode: {why}.",
@@ -435,7 +446,35 @@ pub fn plan(
         notes,
         modes_source,
         builtin_preset,
+        damping_source,
     })
+}
+
+/// The damping ratio the shapers are designed for when it is one for all (`None`: each
+/// mode's own), and the report's sentence saying which and why: `[tune]
+/// shaper_damping_ratio`, else the modes' own on a machine given by its modes, else
+/// Klipper's default 0.1 (a physical machine's modal damping is an estimate from its
+/// parts).
+pub fn design_damping_source(
+    spec: &crate::input::tune_spec::TuneSpec,
+    base: &RunSpec,
+) -> (Option<f64>, String) {
+    match (spec.shaper_damping_ratio, &base.machine) {
+        (Some(z), _) => (
+            Some(z),
+            format!("Shapers are designed for damping ratio {z} (`[tune] shaper_damping_ratio`)."),
+        ),
+        (None, Some(_)) => (
+            Some(DEFAULT_DAMPING_RATIO),
+            format!(
+                "Shapers are designed for Klipper's default damping ratio {DEFAULT_DAMPING_RATIO}: the damping of a physical machine's linearised modes is an estimate from its parts, not a measurement (`[tune] shaper_damping_ratio` sets another)."
+            ),
+        ),
+        (None, None) => (
+            None,
+            "Shapers are designed for the damping ratio of the mode they are tuned to (the machine's, not Klipper's default 0.1).".into(),
+        ),
+    }
 }
 
 /// Where the modes of `base`'s machine come from, in a few words: identified (the modes

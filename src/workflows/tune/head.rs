@@ -5,7 +5,8 @@
 use std::fmt::Write as _;
 
 use super::Outcome;
-use super::report::{gain_text, ms, shaper_text};
+use super::cells::{ms, shaper_text};
+use super::report::gain_text;
 use super::search::BandSource;
 
 /// The warning when the machine is a built-in preset while the scenario holds a printer's

@@ -87,12 +87,21 @@ pub fn weighted_modes(plan: &Plan) -> Vec<(f64, f64, f64)> {
 /// The calibration data Klipper's default resonance test would give on `modes` (see the
 /// module documentation), normalised as Klipper does before choosing.
 pub fn spectrum(modes: &[(f64, f64, f64)]) -> CalibrationData {
-    let welch = Welch::klipper(SAMPLE_RATE_HZ);
+    spectrum_of(modes, &SweepTest::klipper(), SAMPLE_RATE_HZ)
+}
+
+/// [`spectrum`] of the resonance test `test` recorded at `sample_rate_hz`.
+pub fn spectrum_of(
+    modes: &[(f64, f64, f64)],
+    test: &SweepTest,
+    sample_rate_hz: f64,
+) -> CalibrationData {
+    let welch = Welch::klipper(sample_rate_hz);
     let bin = welch.bin_hz();
     let bins: Vec<usize> = (0..)
-        .take_while(|k| *k as f64 * bin <= MAX_FREQ_HZ)
+        .take_while(|k| *k as f64 * bin <= MAX_FREQ_HZ.min(sample_rate_hz / 2.0))
         .collect();
-    let model = SweepModel::new(&welch, &bins, &SweepTest::klipper());
+    let model = SweepModel::new(&welch, &bins, test);
     let params: Vec<ModeParams> = modes
         .iter()
         .map(|&(f_hz, zeta, weight)| ModeParams { f_hz, zeta, weight })

@@ -4,8 +4,8 @@
 
 use std::fmt::Write as _;
 
+use super::cells::{ms, shaper_text, status};
 use super::klipper_choice::KlipperChoice;
-use super::report::{ms, shaper_text, status};
 use super::search::{Plan, Score};
 use settle_planner::shaper_select::Fit;
 

@@ -8,6 +8,7 @@
 //! choice on a resonance CSV ([`klipper_criterion`]).
 
 pub mod candidates;
+pub mod cells;
 pub mod changes;
 pub mod checks;
 pub mod export;
@@ -317,6 +318,8 @@ pub fn tune_with(
         let fig = figure::pareto_figure(&sc.name, axis, o);
         crate::output::plot::write(&fig, &out, &name)?;
         md.push_str(&report::axis_section(axis, o, &format!("{name}.svg")));
+        md.push_str(&checks::refine_text(o));
+        md.push_str(&checks::check_text(o));
         md.push('\n');
         figures.push(out.join(format!("{name}.svg")));
     }

@@ -7,37 +7,11 @@
 use std::fmt::Write as _;
 
 use super::Outcome;
+use super::cells::{headings, ms, row, rows_header};
 use super::search::{Plan, Score};
 use crate::kinds::corner::Corner;
 use crate::kinds::scan::ScanSpec;
 use settle_planner::ProfileKind;
-
-/// A candidate's shaper in words: `mzv @ 52.0 Hz (zeta 0.1)` or `none`.
-pub fn shaper_text(s: &Score) -> String {
-    match s.candidate.shaper.and_then(|sh| sh.kind.map(|k| (k, sh))) {
-        Some((k, sh)) => format!(
-            "{} @ {:.1} Hz (zeta {})",
-            k.name(),
-            sh.frequency_hz,
-            sh.damping_ratio
-        ),
-        None => "none".into(),
-    }
-}
-
-/// Column headings of the report's tables: (move time, residual, score), which for scan
-/// steps are the step, the error over the next line, and the overhead per line.
-pub fn headings(plan: &Plan) -> [&'static str; 3] {
-    if plan.base.state::<ScanSpec>().is_some() {
-        [
-            "step (ms)",
-            "line residual peak (um)",
-            "overhead per line (ms)",
-        ]
-    } else {
-        ["move (ms)", "residual peak (um)", "move+settle (ms)"]
-    }
-}
 
 /// The score in words (band, margin; scan steps: the overhead per line).
 pub fn score_text(plan: &Plan) -> String {
@@ -88,50 +62,6 @@ fn family(plan: &Plan) -> String {
         ),
         None => format!("Moves: {:?} mm", plan.distances_mm),
     }
-}
-
-/// Seconds as milliseconds with one decimal, or "not settled".
-pub(crate) fn ms(x: f64) -> String {
-    if x.is_finite() {
-        format!("{:.1}", x * 1e3)
-    } else {
-        "not settled".into()
-    }
-}
-
-/// A candidate's standing: `ok`, or why it is out.
-pub fn status(s: &Score) -> String {
-    match &s.infeasible {
-        None => "ok".into(),
-        Some(why) => format!("out: {}", why.short()),
-    }
-}
-
-/// The header of a `| | candidate | ... | status |` table of `plan`.
-pub(crate) fn rows_header(plan: &Plan) -> String {
-    let band = plan.base.bands_um[plan.band_index];
-    let scored = plan.bands_um[plan.score_band_index];
-    let [h_move, h_res, h_score] = headings(plan);
-    let h_score = h_score.replace(" (ms)", &format!(" into {scored} um (ms)"));
-    format!(
-        "| | candidate | accel (mm/s^2) | {h_move} | {h_res} | {h_score} | into {band} um (ms) | status |\n|---|---|---:|---:|---:|---:|---:|---|\n"
-    )
-}
-
-/// One row of a [`rows_header`] table: the simulated figures (an infeasible candidate's
-/// too) and its status.
-pub(crate) fn row(out: &mut String, tag: &str, s: &Score) {
-    let _ = writeln!(
-        out,
-        "| {tag} | {} | {} | {} | {:.2} | {} | {} | {} |",
-        s.candidate.label(),
-        s.accel_mm_s2,
-        ms(s.move_time_s),
-        s.residual_peak_um,
-        ms(s.simulated_move_and_settle_s),
-        ms(s.at_band_s),
-        status(s)
-    );
 }
 
 /// The gain of `w` over the current `d`, in words.
@@ -199,8 +129,8 @@ fn search_text(out: &mut String, o: &Outcome) {
     {
         let _ = writeln!(
             out,
-            "Shapers are designed for the damping ratio of the mode they are tuned to (the machine's, not Klipper's default 0.1); a shaped candidate smoothing more than {} mm at its acceleration (Klipper's figure at 5 mm/s) is out.\n",
-            plan.max_smoothing_mm
+            "{} A shaped candidate smoothing more than {} mm at its acceleration (Klipper's figure at 5 mm/s) is out.\n",
+            plan.damping_source, plan.max_smoothing_mm
         );
     }
     if plan.frequency_tolerance > 0.0 {
@@ -302,8 +232,6 @@ pub fn axis_section(axis: &str, o: &Outcome, figure: &str) -> String {
         );
     }
     let _ = writeln!(out, "\n![Pareto front, axis {axis}]({figure})");
-    out.push_str(&super::checks::refine_text(o));
-    out.push_str(&super::checks::check_text(o));
     out
 }
 

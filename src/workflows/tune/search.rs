@@ -287,6 +287,9 @@ pub struct Plan {
     pub modes_source: String,
     /// The built-in preset the machine is, if it is one (a model, not a measured machine).
     pub builtin_preset: Option<String>,
+    /// Which damping ratio the shapers are designed for, as a sentence for the report
+    /// ([`super::grid::design_damping_source`]).
+    pub damping_source: String,
 }
 
 impl Plan {

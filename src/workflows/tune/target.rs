@@ -20,6 +20,9 @@ use settle_planner::tmc::registers::TmcUnits;
 use super::firmware::Firmware;
 use super::search::Candidate;
 
+/// The damping ratio written with Klipper's "no shaping" (frequency 0): its default.
+pub const KLIPPER_OFF_DAMPING: f64 = settle_planner::shaper::KLIPPER_DEFAULT_DAMPING_RATIO;
+
 /// The damping ratios a shaper of `kind` may be designed for on its firmware, `(lowest,
 /// highest)`.
 pub fn damping_range(kind: ShaperKind) -> (f64, f64) {
