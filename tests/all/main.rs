@@ -41,5 +41,6 @@ mod tune;
 mod tune_firmware;
 mod tune_klipper;
 mod tune_scan;
+mod tune_trust;
 mod validate;
 mod workflows;

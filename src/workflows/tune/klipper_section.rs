@@ -107,20 +107,30 @@ fn difference(k: &KlipperChoice, winner: &Score) -> String {
         )
     };
     let zeta: Vec<String> = k.modes.iter().map(|(_, z, _)| format!("{z:.3}")).collect();
-    let on_machine = if dk > ds + 0.5 {
-        format!("its shaper lasts {dk:.1} ms against {ds:.1} ms, and every move pays that delay")
-    } else if k.score.residual_peak_um > winner.residual_peak_um {
-        format!(
+    let mut factors: Vec<String> = Vec::new();
+    if dk > ds + 0.5 {
+        factors.push(format!(
+            "its shaper lasts {dk:.1} ms against {ds:.1} ms, and every move pays that delay"
+        ));
+    }
+    if k.score.residual_peak_um > winner.residual_peak_um {
+        factors.push(format!(
             "on this machine's modes (damping {}; Klipper designs for 0.1 and judges over 0.075 to 0.15) it leaves {:.2} um of ringing after the move against {:.2} um",
             zeta.join(", "),
             k.score.residual_peak_um,
             winner.residual_peak_um
-        )
-    } else {
-        format!(
-            "it moves at {} mm/s^2 against {} mm/s^2",
+        ));
+    }
+    if k.score.accel_mm_s2 < winner.accel_mm_s2 {
+        factors.push(format!(
+            "its smoothing holds it to {} mm/s^2 against {} mm/s^2",
             k.score.accel_mm_s2, winner.accel_mm_s2
-        )
+        ));
+    }
+    let on_machine = if factors.is_empty() {
+        "in simulated time the two are this close".to_string()
+    } else {
+        factors.join("; ")
     };
     format!("{by_klipper}; but {on_machine}.")
 }

@@ -71,9 +71,12 @@ pub fn gain_text(plan: &Plan, d: &Score, w: &Score) -> String {
     if !now.is_finite() {
         return "no candidate is feasible".into();
     }
-    let faster = if base.is_finite() {
+    let per_line = if scan { " per line" } else { "" };
+    let faster = if !base.is_finite() {
+        "the current settings do not settle in the window".to_string()
+    } else if now <= base {
         format!(
-            "{:.1}% {} ({:.1} ms saved{})",
+            "{:.1}% {} ({:.1} ms saved{per_line})",
             100.0 * (1.0 - now / base),
             if scan {
                 "less overhead per line"
@@ -81,10 +84,18 @@ pub fn gain_text(plan: &Plan, d: &Score, w: &Score) -> String {
                 "faster"
             },
             (base - now) * 1e3,
-            if scan { " per line" } else { "" }
         )
     } else {
-        "the current settings do not settle in the window".into()
+        format!(
+            "{:.1}% {} than the current settings ({:.1} ms more{per_line})",
+            100.0 * (now / base - 1.0),
+            if scan {
+                "more overhead per line"
+            } else {
+                "slower"
+            },
+            (now - base) * 1e3,
+        )
     };
     match &d.infeasible {
         Some(why) if base.is_finite() => {
