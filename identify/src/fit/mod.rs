@@ -2,6 +2,7 @@
 //! ([`ringdown`]), with model selection and uncertainties shared here.
 
 pub mod lm;
+pub mod pencil;
 pub mod ringdown;
 pub mod sweep;
 pub mod sweep_model;
