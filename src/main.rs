@@ -141,8 +141,10 @@ enum Command {
     )]
     Tune {
         /// The scenario file (TOML) with [move], [limits] and an optional [tune] table; with
-        /// `--criterion klipper`, a Klipper resonance CSV.
-        scenario: PathBuf,
+        /// `--criterion klipper`, one or more Klipper resonance CSVs (processed or raw; the
+        /// files of one axis, named like calibration_data_x_*.csv, are combined).
+        #[arg(required = true, num_args = 1..)]
+        scenario: Vec<PathBuf>,
         /// Only candidates this firmware runs: klipper, marlin, rrf, tmc4361a, any
         /// [default: the scenario's `[tune] firmware`, else any].
         #[arg(long)]
@@ -169,6 +171,18 @@ enum Command {
         /// Worker threads [default: all cores].
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
         jobs: Option<u16>,
+        /// `--criterion klipper`: the shapers to try, comma-separated (calibrate_shaper.py's
+        /// --shapers) [default: zv,mzv,ei,2hump_ei,3hump_ei].
+        #[arg(long)]
+        shapers: Option<String>,
+        /// `--criterion klipper`: the square-corner velocity for smoothing (mm/s, 0.1 to
+        /// 1000; calibrate_shaper.py's --scv) [default: 5].
+        #[arg(long)]
+        scv: Option<f64>,
+        /// `--criterion klipper`: the most smoothing to allow (mm, 0.05 to 10;
+        /// calibrate_shaper.py's --max_smoothing).
+        #[arg(long, alias = "max_smoothing")]
+        max_smoothing: Option<f64>,
     },
     /// Read a firmware configuration (Klipper printer.cfg, RepRapFirmware config.g) into a
     /// scenario with your current settings as its baseline and a search around them.
@@ -462,10 +476,31 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             firmware,
             frequency_tolerance,
             criterion,
+            shapers,
+            scv,
+            max_smoothing,
         } => {
             if criterion == "klipper" {
-                workflows::tune::klipper_criterion::report(&scenario)?
+                workflows::tune::klipper_criterion::report(
+                    &workflows::tune::klipper_criterion::KlipperCriterion::from_args(
+                        scenario,
+                        out,
+                        shapers.as_deref(),
+                        scv,
+                        max_smoothing,
+                    )?,
+                )?
+            } else if scenario.len() != 1
+                || shapers.is_some()
+                || scv.is_some()
+                || max_smoothing.is_some()
+            {
+                return Err(Error::input(
+                    "SCENARIO",
+                    "settle tune takes one scenario file; several files and --shapers, --scv, --max-smoothing go with --criterion klipper",
+                ));
             } else {
+                let scenario = &scenario[0];
                 let opts = workflows::tune::Options {
                     check_on,
                     jobs: jobs(j),
@@ -473,7 +508,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     frequency_tolerance_pct: frequency_tolerance,
                     ..workflows::tune::Options::new(backend)
                 };
-                workflows::tune::tune_with(&scenario, out, &opts, &progress)?.report()
+                workflows::tune::tune_with(scenario, out, &opts, &progress)?.report()
             }
         }
         Command::Import {

@@ -30,7 +30,8 @@ pub use excitation::SweepTest;
 pub use identify::{MethodChoice, Options, identify_recording, identify_spectrum};
 pub use read::{FileData, Recording, RecordingFormat, read_file};
 pub use result::{
-    AxisIdentification, Diagnostics, Estimate, Figure, IdentifiedMode, Method, WeightBasis,
+    AxisIdentification, Diagnostics, Estimate, Figure, IdentifiedMode, Method, RejectedPeak,
+    WeightBasis,
 };
 
 /// Identify every axis recording in a file (a `.stdata` file may hold several

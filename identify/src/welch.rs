@@ -247,3 +247,21 @@ impl Welch {
             .collect()
     }
 }
+
+/// Klipper's frequency response of a raw recording (`calc_freq_response` in
+/// `klippy/extras/shaper_calibrate.py`): the sample rate `N / (t_last - t_first)`, Klipper's
+/// segment length and half-segment hop, and the PSD of each sensor axis. Returns the bin
+/// frequencies and the three PSDs ((mm/s^2)^2/Hz); `None` when an axis is missing or the
+/// recording is not longer than one segment (Klipper's `N <= M`).
+pub fn klipper_response(rec: &crate::read::Recording) -> Option<(Vec<f64>, [Vec<f64>; 3])> {
+    let welch = Welch::klipper(rec.sample_rate_hz);
+    if rec.len() <= welch.nfft() {
+        return None;
+    }
+    let mut psd = rec
+        .accel_mm_s2
+        .iter()
+        .map(|a| a.as_deref().and_then(|a| welch.psd(a)));
+    let (x, y, z) = (psd.next()??, psd.next()??, psd.next()??);
+    Some((welch.freqs_hz(), [x, y, z]))
+}

@@ -3,6 +3,7 @@
 
 pub mod lm;
 pub mod pencil;
+pub mod rejected;
 pub mod ringdown;
 pub mod sweep;
 pub mod sweep_model;

@@ -162,11 +162,13 @@ pub fn fit(
             } else {
                 (None, WeightBasis::NotIdentified)
             };
+            let (f, z) = (at(0), at(1));
             IdentifiedMode {
-                frequency_hz: at(0),
-                damping_ratio: at(1),
+                frequency_hz: f,
+                damping_ratio: z,
                 weight,
                 weight_basis,
+                peak_hz: f.value * (1.0 - z.value * z.value).max(0.0).sqrt(),
             }
         })
         .collect();
@@ -183,6 +185,8 @@ pub fn fit(
             points: n,
             candidates,
             span: (start as f64 * dt, end as f64 * dt),
+            rejected: Vec::new(),
+            converged: fit.converged,
         },
         window: (start, end),
         curve,

@@ -328,7 +328,8 @@ pub fn run(backends: &[Backend]) -> Result<Validation, String> {
             let (m, series) = simulate(&case, backend, &frozen, case.axes.clone())?;
             let e = post_move_error(&series, &axis.name, t_end, target);
             let ys: Vec<f64> = e.iter().step_by(decimate).take(400).copied().collect();
-            let fit = settle_identify::fit::pencil::fit(&ys, dt * decimate as f64, order).unwrap_or_default();
+            let fit = settle_identify::fit::pencil::fit(&ys, dt * decimate as f64, order)
+                .unwrap_or_default();
             // The measured mode nearest the analytic dominant one.
             let measured = fit.iter().min_by(|a, b| {
                 (a.frequency_hz - f_an)
