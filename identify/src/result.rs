@@ -117,9 +117,8 @@ pub struct Diagnostics {
     pub candidates: Vec<(usize, f64)>,
     /// Fitted band or window: `(start, end)` in Hz (sweep) or s (ring-down).
     pub span: (f64, f64),
-    /// Sweep fit: the peaks in the data that are not modes, each with the reason (the
-    /// further mode the model selection refused, the bumps the fitted model leaves);
-    /// empty for a ring-down fit.
+    /// Sweep fit: the peaks in the data that are not modes (where the data stand well over
+    /// the fitted model), each with the reason, lowest first; empty for a ring-down fit.
     pub rejected: Vec<RejectedPeak>,
     /// Whether the final least-squares fit converged (its last step changed the sum of
     /// squares by less than `1e-12` of it) rather than stopping at its iteration limit.

@@ -83,3 +83,65 @@ fn klipper_criterion_writes_input_shaper_lines_per_axis() {
         assert!(svg.is_file(), "{}", svg.display());
     }
 }
+
+/// A raw recording (`examples/data/raw_data_x_example.csv`): settle computes the PSD as
+/// Klipper does, and every line equals what calibrate_shaper.py printed for the same file
+/// (Klipper 84104bbbd762, numpy 2).
+#[test]
+fn klipper_criterion_on_a_raw_recording_equals_calibrate_shaper() {
+    let want = [
+        "Fitted shaper 'zv' frequency = 45.0 Hz (vibrations = 0.9%, smoothing ~= 0.081)",
+        "To avoid too much smoothing with 'zv', suggested max_accel <= 7900 mm/sec^2",
+        "Fitted shaper 'mzv' frequency = 46.6 Hz (vibrations = 0.0%, smoothing ~= 0.094)",
+        "To avoid too much smoothing with 'mzv', suggested max_accel <= 6400 mm/sec^2",
+        "Fitted shaper 'ei' frequency = 57.0 Hz (vibrations = 0.0%, smoothing ~= 0.101)",
+        "To avoid too much smoothing with 'ei', suggested max_accel <= 5900 mm/sec^2",
+        "Fitted shaper '2hump_ei' frequency = 73.4 Hz (vibrations = 0.0%, smoothing ~= 0.105)",
+        "To avoid too much smoothing with '2hump_ei', suggested max_accel <= 5700 mm/sec^2",
+        "Fitted shaper '3hump_ei' frequency = 92.0 Hz (vibrations = 0.0%, smoothing ~= 0.107)",
+        "To avoid too much smoothing with '3hump_ei', suggested max_accel <= 5600 mm/sec^2",
+        "Recommended shaper is mzv @ 46.6 Hz",
+    ];
+    let file = crate::support::root().join("examples/data/raw_data_x_example.csv");
+    let c = KlipperCriterion::from_args(vec![file], None, None, None, None).expect("options");
+    let r = report(&c).expect("chooses");
+    let got: Vec<&str> = r.stdout.lines().skip(1).collect();
+    assert_eq!(got, want);
+}
+
+/// The script's options: `--shapers` with a parameterised shaper, `--max-smoothing`
+/// (calibrate_shaper.py `--shapers "mzv(n=4,t=0.8),ei" --max_smoothing 0.08` on the same
+/// file printed these lines, Klipper 84104bbbd762), and values out of range refused
+/// naming the option.
+#[test]
+fn klipper_criterion_takes_the_scripts_options() {
+    let file = corpus_dir().join("voronpi_resonances_y_20221029_162350.csv");
+    let c = KlipperCriterion::from_args(
+        vec![file.clone()],
+        None,
+        Some("mzv(n=4,t=0.8),ei"),
+        None,
+        Some(0.08),
+    )
+    .expect("options");
+    let r = report(&c).expect("chooses");
+    let got: Vec<&str> = r.stdout.lines().skip(1).collect();
+    assert_eq!(got, MAX_SMOOTHING_LINES);
+    for (shapers, scv, smoothing, name) in [
+        (Some("mzv,foo"), None, None, "--shapers"),
+        (None, Some(0.0), None, "--scv"),
+        (None, None, Some(0.01), "--max-smoothing"),
+    ] {
+        let e = KlipperCriterion::from_args(vec![file.clone()], None, shapers, scv, smoothing)
+            .expect_err("refused");
+        assert!(e.to_string().contains(name), "{e}");
+    }
+}
+
+const MAX_SMOOTHING_LINES: [&str; 5] = [
+    "Fitted shaper 'mzv(n=4,t=0.8)' frequency = 50.6 Hz (vibrations = 2.3%, smoothing ~= 0.079)",
+    "To avoid too much smoothing with 'mzv(n=4,t=0.8)', suggested max_accel <= 7600 mm/sec^2",
+    "Fitted shaper 'ei' frequency = 64.2 Hz (vibrations = 3.2%, smoothing ~= 0.080)",
+    "To avoid too much smoothing with 'ei', suggested max_accel <= 7500 mm/sec^2",
+    "Recommended shaper is mzv(n=4,t=0.8) @ 50.6 Hz",
+];

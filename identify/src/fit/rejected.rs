@@ -1,6 +1,6 @@
 //! The peaks a person sees in a sweep fit's figure that are not modes, each with the
-//! reason: the further mode the model selection tried and refused, and the bumps the
-//! fitted model leaves in the data.
+//! reason: the bumps the fitted model leaves in the data, with the verdict of the model
+//! selection where it tried a further mode there.
 
 use super::BIC_MARGIN;
 use super::lm::LmFit;
@@ -45,7 +45,12 @@ pub fn refused_candidate(
     preferred: bool,
 ) -> RejectedPeak {
     let gain = bic_smaller - bic_larger;
-    let reason = if !preferred {
+    let reason = if !preferred && gain < 0.0 {
+        format!(
+            "a further mode here raises the Bayesian information criterion by {:.1}; a mode must lower it by {BIC_MARGIN}",
+            -gain
+        )
+    } else if !preferred {
         format!(
             "a further mode here lowers the Bayesian information criterion by {gain:.1}, less than the {BIC_MARGIN} a mode must gain"
         )
@@ -59,8 +64,9 @@ pub fn refused_candidate(
 }
 
 /// The bumps the fitted model leaves (see [`BUMP_RATIO`]), more than 3 bins from every
-/// mode's natural and peak frequency and from every peak already listed in `listed`;
-/// `limit` says whether the model selection stopped at the most modes allowed.
+/// mode's natural and peak frequency (`taken_hz`). A bump within 3 bins of a further mode
+/// the model selection tried and refused (`tried`) carries that verdict; the others say
+/// that no further mode passed, or (`limit`) that the fit holds the most modes allowed.
 pub fn bumps(
     data: &[f64],
     model: &[f64],
@@ -68,7 +74,7 @@ pub fn bumps(
     freq: &[f64],
     bin: f64,
     taken_hz: &[f64],
-    listed: &[RejectedPeak],
+    tried: &[RejectedPeak],
     limit: Option<usize>,
 ) -> Vec<RejectedPeak> {
     let n = data.len();
@@ -81,17 +87,20 @@ pub fn bumps(
             continue;
         }
         let near = |f: f64| (f - freq[j]).abs() <= 3.0 * bin;
-        if taken_hz.iter().any(|&f| near(f))
-            || listed.iter().chain(&out).any(|p| near(p.frequency_hz))
-        {
+        if taken_hz.iter().any(|&f| near(f)) || out.iter().any(|p| near(p.frequency_hz)) {
             continue;
         }
-        let reason = match limit {
-            Some(m) => format!(
+        let verdict = tried.iter().find(|p| near(p.frequency_hz));
+        let reason = match (verdict, limit) {
+            (Some(v), _) => format!(
+                "the data stand {:.1} times over the fitted model here; {}",
+                ratio[j], v.reason
+            ),
+            (None, Some(m)) => format!(
                 "the data stand {:.1} times over the fitted model here; the fit holds the most modes allowed ({m}, --max-modes)",
                 ratio[j]
             ),
-            None => format!(
+            (None, None) => format!(
                 "the data stand {:.1} times over the fitted model here; no further mode passed the model selection",
                 ratio[j]
             ),

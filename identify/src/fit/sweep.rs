@@ -323,9 +323,7 @@ pub fn fit(
         .flat_map(|m| [m.frequency_hz.value, m.peak_hz])
         .collect();
     let limit = (refused.is_empty() && modes.len() == max_modes).then_some(max_modes);
-    let bumps = rejected::bumps(&y, &curve, noise, &freq, bin, &taken, &refused, limit);
-    refused.extend(bumps);
-    refused.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+    let refused = rejected::bumps(&y, &curve, noise, &freq, bin, &taken, &refused, limit);
     let rms = (y
         .iter()
         .zip(&curve)
