@@ -316,6 +316,10 @@ enum Command {
         /// decay), sweep, ringdown.
         #[arg(long, default_value = "auto", value_parser = parse_method)]
         method: settle_identify::MethodChoice,
+        /// The column of a Klipper processed spectrum to fit: xyz (psd_xyz, the total
+        /// Klipper tunes against) or one sensor axis's (x, y, z).
+        #[arg(long, default_value = "xyz", value_parser = parse_column)]
+        column: settle_identify::SpectrumColumn,
         /// The resonance test's first frequency (Hz; Klipper's FREQ_START / min_freq)
         /// [default: Klipper's defaults for this and the five options below].
         #[arg(long)]
@@ -337,6 +341,17 @@ enum Command {
         #[arg(long)]
         sweeping_period: Option<f64>,
     },
+}
+
+fn parse_column(s: &str) -> Result<settle_identify::SpectrumColumn, String> {
+    use settle_identify::SpectrumColumn;
+    match s {
+        "xyz" => Ok(SpectrumColumn::Total),
+        "x" => Ok(SpectrumColumn::Axis(0)),
+        "y" => Ok(SpectrumColumn::Axis(1)),
+        "z" => Ok(SpectrumColumn::Axis(2)),
+        _ => Err(format!("unknown column `{s}`; allowed: xyz, x, y, z")),
+    }
 }
 
 fn parse_method(s: &str) -> Result<settle_identify::MethodChoice, String> {
@@ -605,6 +620,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             figures,
             max_modes,
             method,
+            column,
             freq_start,
             freq_end,
             hz_per_sec,
@@ -630,6 +646,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     },
                     max_modes,
                     method,
+                    column,
                 },
                 ..workflows::identify::IdentifyOptions::new(files)
             };

@@ -20,7 +20,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Err("usage: identify_file FILE | --write-sweep FILE".into());
     };
     let opts = Options {
-        test: SweepTest::klipper_legacy(),
+        test: SweepTest::klipper(),
         ..Options::default()
     };
     for id in identify_file(std::path::Path::new(path), &opts)? {

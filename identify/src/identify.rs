@@ -21,6 +21,17 @@ pub enum MethodChoice {
     RingDown,
 }
 
+/// Which column of a Klipper processed spectrum to fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SpectrumColumn {
+    /// `psd_xyz`, the total over the sensor axes (what Klipper tunes against; it does not
+    /// depend on how the sensor is mounted), or a multi-data-set file's first column.
+    #[default]
+    Total,
+    /// One sensor axis's column (`psd_x` = 0, `psd_y` = 1, `psd_z` = 2).
+    Axis(usize),
+}
+
 /// Options of an identification.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
@@ -30,6 +41,8 @@ pub struct Options {
     pub max_modes: usize,
     /// Which fit.
     pub method: MethodChoice,
+    /// Which column of a processed spectrum to fit (default the total).
+    pub column: SpectrumColumn,
 }
 
 impl Default for Options {
@@ -38,6 +51,7 @@ impl Default for Options {
             test: SweepTest::klipper(),
             max_modes: 3,
             method: MethodChoice::Auto,
+            column: SpectrumColumn::Total,
         }
     }
 }
@@ -341,7 +355,20 @@ pub fn identify_spectrum(
     let welch = Welch::new(bin_hz * 2048.0, 2048);
     let len = first_bin + psd.freq_hz.len();
     let mut stored = vec![0.0; len];
-    stored[first_bin..].copy_from_slice(psd.sum());
+    let column = match opts.column {
+        SpectrumColumn::Total => psd.sum(),
+        SpectrumColumn::Axis(k) => psd.axis(k).ok_or_else(|| {
+            IdentifyError::format(
+                &psd.source,
+                (psd.last_line + 1 - psd.freq_hz.len())
+                    .saturating_sub(1)
+                    .max(1),
+                "a spectrum without per-axis columns",
+                "the header `freq,psd_x,psd_y,psd_z,psd_xyz` to fit one sensor axis's column (or fit the total)",
+            )
+        })?,
+    };
+    stored[first_bin..].copy_from_slice(column);
     let factor: Vec<f64> = (0..len)
         .map(|k| {
             if k < first_bin {

@@ -27,7 +27,7 @@ pub mod welch;
 pub use direction::Direction;
 pub use error::IdentifyError;
 pub use excitation::SweepTest;
-pub use identify::{MethodChoice, Options, identify_recording, identify_spectrum};
+pub use identify::{MethodChoice, Options, SpectrumColumn, identify_recording, identify_spectrum};
 pub use read::{FileData, Recording, RecordingFormat, read_file};
 pub use result::{
     AxisIdentification, Diagnostics, Estimate, Figure, IdentifiedMode, Method, RejectedPeak,

@@ -10,7 +10,7 @@
 
 use std::path::PathBuf;
 
-use settle_identify::{IdentifyError, Options, SweepTest, identify_file};
+use settle_identify::{IdentifyError, Options, SpectrumColumn, SweepTest, identify_file};
 
 /// `(file, main resonance, refused)`: the largest peak of `psd_xyz / (f + 0.1)` between 5
 /// and 135 Hz (the manifest's table), and whether settle refuses the file (its best modal
@@ -101,4 +101,23 @@ fn corpus_modes_include_the_published_main_resonance() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The per-column fit, when asked: the sensor's x column of a file whose energy lies
+/// there gives the same main resonance.
+#[test]
+fn corpus_per_column_fit() {
+    let opts = Options {
+        test: SweepTest::klipper_legacy(),
+        column: SpectrumColumn::Axis(0),
+        ..Options::default()
+    };
+    let ids = identify_file(&corpus("voronpi_resonances_x_20221029_162131.csv"), &opts)
+        .expect("fits psd_x");
+    let peaks: Vec<f64> = ids[0].modes.iter().map(|m| m.peak_hz).collect();
+    assert!(
+        peaks.iter().any(|f| (f - 67.1).abs() <= 0.03 * 67.1),
+        "{peaks:?}"
+    );
+    assert_eq!(ids[0].dominant_sensor_axis, Some(0));
 }
