@@ -4,9 +4,11 @@ use crate::IdentifyError;
 use crate::direction::{self, Direction};
 use crate::excitation::SweepTest;
 use crate::fit::{ringdown, sweep};
+use crate::read::klipper_grid::bin_grid;
 use crate::read::klipper_psd::ProcessedPsd;
 use crate::read::{Recording, RecordingFormat};
-use crate::result::{AxisIdentification, Diagnostics, Figure, IdentifiedMode, Method};
+use crate::result::{AxisIdentification, Figure, Method};
+use crate::trust::{check_duration, check_trust, free_recording};
 use crate::welch::Welch;
 
 /// Which fit to use on a recording.
@@ -242,94 +244,6 @@ pub fn identify_recording(
 /// Nyquist frequency; the sensor's anti-alias filter rolls off above that).
 const NYQUIST_USE: f64 = 0.45;
 
-/// How much longer than the test a sweep recording may last (factor, plus seconds): Klipper
-/// and Shake&Tune start the sensor a moment before the test and stop it after.
-const DURATION_SLACK: (f64, f64) = (1.5, 10.0);
-
-/// A Klipper raw file that is not a resonance test's (`ACCELEROMETER_MEASURE` writes
-/// `adxl345-*.csv`; `TEST_RESONANCES` writes `raw_data_*.csv`) and lasts less than half
-/// the test: a free recording, such as the ring-down after a move.
-fn free_recording(rec: &Recording, duration_s: f64, test: &SweepTest) -> bool {
-    let name = std::path::Path::new(&rec.source)
-        .file_name()
-        .map(|n| n.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    rec.format == RecordingFormat::KlipperRaw
-        && !name.starts_with("raw_data")
-        && duration_s < 0.5 * test.duration_s()
-}
-
-/// A sweep recording must last about as long as the test it is said to hold: the test's
-/// parameters shape the model, so a recording of another test would be fitted against the
-/// wrong excitation. Klipper's raw files and Shake&Tune's do not record the parameters.
-fn check_duration(source: &str, duration_s: f64, test: &SweepTest) -> Result<(), IdentifyError> {
-    let d = test.duration_s();
-    if duration_s >= 0.9 * d && duration_s <= DURATION_SLACK.0 * d + DURATION_SLACK.1 {
-        return Ok(());
-    }
-    Err(IdentifyError::NeedsTestParameters {
-        file: source.to_string(),
-        reason: format!(
-            "the recording lasts {duration_s:.1} s, but a resonance test from {} to {} Hz at {} Hz/s lasts {d:.1} s; the file does not record the test's parameters, and the fit needs them (they shape the excitation it models): give --freq-start, --freq-end and --hz-per-sec as in the TEST_RESONANCES command (and --accel-per-hz, --sweeping-accel, --sweeping-period where [resonance_tester] sets them), or --method ringdown for a free decay",
-            test.freq_start_hz, test.freq_end_hz, test.hz_per_sec
-        ),
-    })
-}
-
-/// Refuse a fit that cannot be stood behind: a frequency that is not finite, at or above
-/// `nyquist_hz` or outside `band_hz` (the span the data cover), a damping ratio outside
-/// `(0, 1)`, an uncertainty that is not finite or not smaller than its value, a fit that
-/// did not converge.
-fn check_trust(
-    source: &str,
-    modes: &[IdentifiedMode],
-    diagnostics: &Diagnostics,
-    band_hz: (f64, f64),
-    nyquist_hz: f64,
-) -> Result<(), IdentifyError> {
-    let fail = |reason: String| {
-        Err(IdentifyError::Unreliable {
-            file: source.to_string(),
-            reason,
-        })
-    };
-    if !diagnostics.converged {
-        return fail(
-            "the least-squares fit stopped at its iteration limit without converging".into(),
-        );
-    }
-    for m in modes {
-        let (f, z) = (m.frequency_hz, m.damping_ratio);
-        let name = format!("the mode at {:.2} Hz", f.value);
-        if !(f.value.is_finite() && f.value > 0.0) {
-            return fail(format!("a mode frequency of {} Hz", f.value));
-        }
-        if f.value >= nyquist_hz {
-            return fail(format!(
-                "{name} lies at or above the Nyquist frequency {nyquist_hz:.1} Hz"
-            ));
-        }
-        if f.value < band_hz.0 || f.value > band_hz.1 {
-            return fail(format!(
-                "{name} lies outside the {:.1}-{:.1} Hz the data cover",
-                band_hz.0, band_hz.1
-            ));
-        }
-        if !(z.value.is_finite() && z.value > 0.0 && z.value < 1.0) {
-            return fail(format!("{name} has a damping ratio of {}", z.value));
-        }
-        for (what, e) in [("frequency", f), ("damping ratio", z)] {
-            if !(e.sigma.is_finite() && e.sigma < e.value) {
-                return fail(format!(
-                    "{name}: its {what} {} has an uncertainty of {} (not smaller than the value)",
-                    e.value, e.sigma
-                ));
-            }
-        }
-    }
-    Ok(())
-}
-
 /// Significant digits of the PSD values in Klipper's processed files (`%.3e`,
 /// `save_calibration_data` in `klippy/extras/shaper_calibrate.py`).
 const KLIPPER_DIGITS: i32 = 4;
@@ -475,66 +389,4 @@ fn project_samples(rec: &Recording, axes: &[usize], dir: &Direction) -> Vec<f64>
 /// One segment over (nearly) the whole of a short recording: an even length.
 fn short_nfft(n: usize) -> usize {
     (n & !1).max(2)
-}
-
-/// Half the rounding step of Klipper's `%.1f` frequencies (Hz), with room for the
-/// binary representation of the written decimals.
-const FREQ_ROUNDING_HZ: f64 = 0.05 + 1e-9;
-
-/// The bins of a processed spectrum: Klipper writes `k fs / nfft` rounded to 0.1 Hz (`%.1f`
-/// of bins of the *measured* sample rate, so consecutive steps alternate, e.g. 1.5 and 1.6
-/// Hz), and the rows are fitted as bins `k0 + j` of one width. Every row `j` bounds that
-/// width to `[(f_j - 0.05) / (k0 + j), (f_j + 0.05) / (k0 + j)]`; the width is the middle of
-/// the intersection of these intervals, and its standard deviation the intersection's
-/// width over `sqrt(12)` (uniform over it). A row that leaves the intersection empty is off
-/// the grid. `k0` comes from a first estimate by least squares. Returns the first row's bin
-/// index, the bin width (Hz) and its standard deviation.
-fn bin_grid(psd: &ProcessedPsd) -> Result<(usize, f64, f64), IdentifyError> {
-    let f = &psd.freq_hz;
-    let n = f.len() as f64;
-    let mean_j = (n - 1.0) / 2.0;
-    let mean_f = f.iter().sum::<f64>() / n;
-    let (mut sxy, mut sxx) = (0.0, 0.0);
-    for (j, &v) in f.iter().enumerate() {
-        sxy += (j as f64 - mean_j) * (v - mean_f);
-        sxx += (j as f64 - mean_j).powi(2);
-    }
-    let rough = sxy / sxx;
-    let header_line = psd.last_line + 1 - f.len();
-    if rough.is_nan() || rough < 0.5 {
-        return Err(IdentifyError::format(
-            &psd.source,
-            header_line.saturating_sub(1).max(1),
-            format!(
-                "a spectrum on a {rough:.2} Hz grid (several data sets interpolated onto one grid)"
-            ),
-            "a spectrum on Klipper's own bins (fs / nfft, about 0.8 to 2 Hz): one data set per file",
-        ));
-    }
-    let first = ((mean_f - rough * mean_j) / rough).round().max(0.0);
-    let (mut lo, mut hi) = (0.0f64, f64::INFINITY);
-    for (j, &v) in f.iter().enumerate() {
-        let k = first + j as f64;
-        let (a, b) = if k == 0.0 {
-            if v.abs() <= FREQ_ROUNDING_HZ {
-                continue;
-            }
-            (f64::INFINITY, f64::NEG_INFINITY)
-        } else {
-            ((v - FREQ_ROUNDING_HZ) / k, (v + FREQ_ROUNDING_HZ) / k)
-        };
-        let (nlo, nhi) = (lo.max(a), hi.min(b));
-        if nlo > nhi {
-            return Err(IdentifyError::format(
-                &psd.source,
-                header_line + j,
-                format!(
-                    "frequency {v} Hz, which no bin width fitting the rows before it ({lo:.5} to {hi:.5} Hz) rounds to (bin {k})"
-                ),
-                "evenly spaced bins k fs / nfft as Klipper writes them (rounded to 0.1 Hz)",
-            ));
-        }
-        (lo, hi) = (nlo, nhi);
-    }
-    Ok((first as usize, 0.5 * (lo + hi), (hi - lo) / 12f64.sqrt()))
 }

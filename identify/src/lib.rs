@@ -22,6 +22,7 @@ pub mod fit;
 mod identify;
 pub mod read;
 pub mod result;
+mod trust;
 pub mod welch;
 
 pub use direction::Direction;

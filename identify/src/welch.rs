@@ -232,6 +232,30 @@ impl Welch {
             .sum()
     }
 
+    /// `c = 1 + 2 sum_d rho_d` of the estimator's bins: `rho_d`, the correlation of two
+    /// bins `d` apart of one windowed segment's periodogram, is `(sum a(x) a(x + d))^2 /
+    /// (sum a(x)^2)^2` over the amplitude kernel `a` ([`Welch::amplitude_kernel_table`];
+    /// 0.47 for neighbouring bins of Klipper's Kaiser window), summed over 6 bins. `n` bins
+    /// carry about `n / c` independent ones (1.95 for Klipper's window), which the sweep
+    /// fit's model selection counts ([`crate::fit::sweep`]). This is the noise's own
+    /// correlation, not a fit's residuals': on a real spectrum those mostly measure what
+    /// the model leaves out (a mode not yet fitted, structure the modal model does not
+    /// hold), and would count a spectrum with more to explain as holding fewer independent
+    /// bins, against adding the mode that explains it.
+    pub fn bin_correlation(&self) -> f64 {
+        const PER_BIN: usize = 32;
+        const BINS: usize = 6;
+        let table = self.amplitude_kernel_table(2 * BINS, PER_BIN);
+        let a = |x: isize| table.get(x.unsigned_abs()).copied().unwrap_or(0.0);
+        let span = (BINS * PER_BIN) as isize;
+        let overlap = |d: isize| -> f64 { (-span..=span).map(|x| a(x) * a(x + d)).sum() };
+        let zero = overlap(0);
+        let sum: f64 = (1..=BINS as isize)
+            .map(|d| (overlap(d * PER_BIN as isize) / zero).powi(2))
+            .sum();
+        1.0 + 2.0 * sum
+    }
+
     /// The signed amplitude kernel `a(d) = W(d) / sqrt(nfft sum w^2)`, so that
     /// [`Welch::kernel_table`] is `a^2`: one segment's transform of white noise at two
     /// frequencies `d1` and `d2` bins from a point correlates as `a(d1) a(d2)`, which is

@@ -2,18 +2,15 @@
 //! reason: the bumps the fitted model leaves in the data, with the verdict of the model
 //! selection where it tried a further mode there.
 
-use super::BIC_MARGIN;
 use super::lm::LmFit;
 use super::sweep_residual::SweepResidual;
+use super::{BIC_MARGIN, FittedSpectrum, SIGNAL_OVER_FLOOR};
 use crate::result::RejectedPeak;
 
 /// A bump counts when the data stand this many times over the fitted model (local
 /// maximum over +-2 bins) in a bin whose signal stands [`SIGNAL_OVER_FLOOR`] times over
 /// the noise floor.
 pub const BUMP_RATIO: f64 = 1.5;
-
-/// See [`BUMP_RATIO`].
-const SIGNAL_OVER_FLOOR: f64 = 3.0;
 
 /// The mode of `larger` (one more than `smaller`) farthest from all of `smaller`'s: the
 /// one the model selection added.
@@ -68,15 +65,18 @@ pub fn refused_candidate(
 /// the model selection tried and refused (`tried`) carries that verdict; the others say
 /// that no further mode passed, or (`limit`) that the fit holds the most modes allowed.
 pub fn bumps(
-    data: &[f64],
-    model: &[f64],
-    noise: f64,
-    freq: &[f64],
-    bin: f64,
+    s: FittedSpectrum,
     taken_hz: &[f64],
     tried: &[RejectedPeak],
     limit: Option<usize>,
 ) -> Vec<RejectedPeak> {
+    let FittedSpectrum {
+        data,
+        model,
+        noise,
+        freq,
+        bin,
+    } = s;
     let n = data.len();
     let ratio: Vec<f64> = data.iter().zip(model).map(|(d, m)| d / m).collect();
     let mut out: Vec<RejectedPeak> = Vec::new();

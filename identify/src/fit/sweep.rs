@@ -52,9 +52,9 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::lm::{self, LmFit};
-use super::rejected;
 use super::sweep_model::SweepModel;
 use super::sweep_residual::SweepResidual;
+use super::{FittedSpectrum, main_peak, rejected};
 use super::{SIGNIFICANCE, bic, bic_prefers};
 use crate::IdentifyError;
 use crate::excitation::SweepTest;
@@ -192,7 +192,7 @@ pub fn fit(
             .filter_map(|t| lm::minimise(|t| residual.residuals(t), t, MAX_ITERATIONS))
             .min_by(|a, b| a.rss.total_cmp(&b.rss))
     };
-    let bin_correlation = window_correlation(welch);
+    let bin_correlation = welch.bin_correlation();
     let mut best: Option<(LmFit, f64)> = None;
     let mut candidates = Vec::new();
     let mut refused = Vec::new();
@@ -317,13 +317,20 @@ pub fn fit(
     modes.sort_by(|a, b| a.frequency_hz.value.total_cmp(&b.frequency_hz.value));
     let curve = residual.expected(&fit.theta);
     let (gain, noise) = residual.gain_and_noise(&fit.theta);
-    check_main_peak(source, &y, &curve, noise, &freq, bin)?;
+    let fitted = FittedSpectrum {
+        data: &y,
+        model: &curve,
+        noise,
+        freq: &freq,
+        bin,
+    };
+    main_peak::check(source, fitted)?;
     let taken: Vec<f64> = modes
         .iter()
         .flat_map(|m| [m.frequency_hz.value, m.peak_hz])
         .collect();
     let limit = (refused.is_empty() && modes.len() == max_modes).then_some(max_modes);
-    let refused = rejected::bumps(&y, &curve, noise, &freq, bin, &taken, &refused, limit);
+    let refused = rejected::bumps(fitted, &taken, &refused, limit);
     let rms = (y
         .iter()
         .zip(&curve)
@@ -509,73 +516,6 @@ fn covariance(
     };
     fit.sandwich(&(&shape * scale + &fixed))
 }
-
-/// `c = 1 + 2 sum_d rho_d` of the estimator's bins: `rho_d`, the correlation of two bins
-/// `d` apart of one windowed segment's periodogram, is `(sum a(x) a(x + d))^2 / (sum
-/// a(x)^2)^2` over the window's amplitude kernel `a` ([`Welch::amplitude_kernel_table`];
-/// 0.47 for neighbouring bins of Klipper's Kaiser window). `n` bins then carry about `n /
-/// c` independent ones (1.95 for Klipper's window), which the model selection counts.
-/// This is the noise's own correlation: the correlation of a fit's residuals is not used,
-/// since on a real spectrum it mostly measures what the model leaves out (a mode not yet
-/// fitted, structure the modal model does not hold) and would count a spectrum with more
-/// to explain as holding fewer independent bins, against adding the mode that explains
-/// it.
-fn window_correlation(welch: &Welch) -> f64 {
-    let per_bin = 32;
-    let half = super::sweep_model::KERNEL_HALF_WIDTH_BINS;
-    let table = welch.amplitude_kernel_table(2 * half, per_bin);
-    let a = |x: isize| table.get(x.unsigned_abs()).copied().unwrap_or(0.0);
-    let span = (half * per_bin) as isize;
-    let overlap = |d: isize| -> f64 { (-span..=span).map(|x| a(x) * a(x + d)).sum() };
-    let zero = overlap(0);
-    let sum: f64 = (1..=half as isize)
-        .map(|d| (overlap(d * per_bin as isize) / zero).powi(2))
-        .sum();
-    1.0 + 2.0 * sum
-}
-
-/// The fitted model must reproduce the spectrum's main peak as Klipper's graph shows it:
-/// the frequency where `P / (f + 0.1)` (Klipper's `normalize_to_frequencies`) is largest
-/// over the bins where the signal stands at least [`SIGNAL_OVER_FLOOR`] times above the
-/// noise floor, taken alike from the data and from the model, must agree within 3 % or
-/// one bin. A model that places its peak elsewhere (one broad mode across a sharp peak and
-/// its shoulders, a spectrum the modal model does not hold) is not an answer: the error
-/// says where the data peak and where the model does.
-fn check_main_peak(
-    source: &str,
-    data: &[f64],
-    model: &[f64],
-    noise: f64,
-    freq: &[f64],
-    bin: f64,
-) -> Result<(), IdentifyError> {
-    let floor = noise.max(0.0);
-    let peak_of = |p: &[f64]| -> Option<usize> {
-        (0..p.len())
-            .filter(|&j| data[j] > SIGNAL_OVER_FLOOR * floor)
-            .max_by(|&a, &b| (p[a] / (freq[a] + 0.1)).total_cmp(&(p[b] / (freq[b] + 0.1))))
-    };
-    let (Some(d), Some(m)) = (peak_of(data), peak_of(model)) else {
-        return Ok(());
-    };
-    let (fd, fm) = (freq[d], freq[m]);
-    // Both are bin frequencies: one bin apart passes despite rounding.
-    if (fd - fm).abs() <= (MAIN_PEAK_TOLERANCE * fd).max(bin) * (1.0 + 1e-9) {
-        return Ok(());
-    }
-    Err(IdentifyError::Unreliable {
-        file: source.to_string(),
-        reason: format!(
-            "the spectrum peaks at {fd:.1} Hz (Klipper's normalised PSD), the fitted modes at {fm:.1} Hz: the modal model does not explain this spectrum's main peak (more modes with --max-modes, or the test's parameters if they differ from the defaults?)"
-        ),
-    })
-}
-
-/// See [`check_main_peak`].
-const SIGNAL_OVER_FLOOR: f64 = 3.0;
-
-/// See [`check_main_peak`]: 3 %.
-const MAIN_PEAK_TOLERANCE: f64 = 0.03;
 
 /// The `q` quantile of `v` (nearest rank).
 fn percentile(v: &[f64], q: f64) -> f64 {

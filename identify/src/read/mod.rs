@@ -1,12 +1,14 @@
 //! Readers for the accelerometer files users already have. Each returns plain data.
 //!
 //! - [`klipper_raw`]: Klipper's raw accelerometer CSV (`#time,accel_x,accel_y,accel_z`);
-//! - [`klipper_psd`]: Klipper's processed spectra (`freq,psd_x,psd_y,psd_z,psd_xyz...`);
+//! - [`klipper_psd`]: Klipper's processed spectra (`freq,psd_x,psd_y,psd_z,psd_xyz...`),
+//!   and [`klipper_grid`], the frequency grid they are written on;
 //! - [`rrf`]: RepRapFirmware's M956 CSV (`Sample,X,Y,Z` ... `Rate <Hz>, overflows <n>`);
 //! - [`stdata`]: Shake&Tune's `.stdata` (zstd-compressed JSON lines).
 //!
 //! [`read_file`] picks the reader from the file's content.
 
+pub mod klipper_grid;
 pub mod klipper_psd;
 pub mod klipper_raw;
 pub mod rrf;
