@@ -70,20 +70,14 @@ pub fn bumps(
     tried: &[RejectedPeak],
     limit: Option<usize>,
 ) -> Vec<RejectedPeak> {
-    let FittedSpectrum {
-        data,
-        model,
-        noise,
-        freq,
-        bin,
-    } = s;
+    let (data, freq, bin) = (s.data, s.freq, s.bin);
     let n = data.len();
-    let ratio: Vec<f64> = data.iter().zip(model).map(|(d, m)| d / m).collect();
+    let ratio: Vec<f64> = data.iter().zip(s.model).map(|(d, m)| d / m).collect();
     let mut out: Vec<RejectedPeak> = Vec::new();
     for j in 0..n {
         let (lo, hi) = (j.saturating_sub(2), (j + 2).min(n - 1));
         let local = (lo..=hi).all(|i| ratio[i] <= ratio[j]);
-        if !local || ratio[j] < BUMP_RATIO || data[j] < SIGNAL_OVER_FLOOR * noise.max(0.0) {
+        if !local || ratio[j] < BUMP_RATIO || data[j] < SIGNAL_OVER_FLOOR * s.noise.max(0.0) {
             continue;
         }
         let near = |f: f64| (f - freq[j]).abs() <= 3.0 * bin;
