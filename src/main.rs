@@ -158,8 +158,10 @@ enum Command {
     )]
     Tune {
         /// The scenario file (TOML) with [move], [limits] and an optional [tune] table; with
-        /// `--criterion klipper`, a Klipper resonance CSV.
-        scenario: PathBuf,
+        /// `--criterion klipper`, one or more Klipper resonance CSVs (processed or raw; the
+        /// files of one axis, named like calibration_data_x_*.csv, are combined).
+        #[arg(required = true, num_args = 1..)]
+        scenario: Vec<PathBuf>,
         /// Only candidates this firmware runs: klipper, marlin, rrf, tmc4361a, any
         /// [default: the scenario's `[tune] firmware`, else any].
         #[arg(long)]
@@ -186,6 +188,18 @@ enum Command {
         /// Worker threads [default: all cores].
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
         jobs: Option<u16>,
+        /// `--criterion klipper`: the shapers to try, comma-separated (calibrate_shaper.py's
+        /// --shapers) [default: zv,mzv,ei,2hump_ei,3hump_ei].
+        #[arg(long)]
+        shapers: Option<String>,
+        /// `--criterion klipper`: the square-corner velocity for smoothing (mm/s, 0.1 to
+        /// 1000; calibrate_shaper.py's --scv) [default: 5].
+        #[arg(long)]
+        scv: Option<f64>,
+        /// `--criterion klipper`: the most smoothing to allow (mm, 0.05 to 10;
+        /// calibrate_shaper.py's --max_smoothing).
+        #[arg(long, alias = "max_smoothing")]
+        max_smoothing: Option<f64>,
     },
     /// Read a firmware configuration (Klipper printer.cfg, RepRapFirmware config.g) into a
     /// scenario with your current settings as its baseline and a search around them.
@@ -323,6 +337,10 @@ enum Command {
         /// decay), sweep, ringdown.
         #[arg(long, default_value = "auto", value_parser = parse_method)]
         method: settle_identify::MethodChoice,
+        /// The column of a Klipper processed spectrum to fit: xyz (psd_xyz, the total
+        /// Klipper tunes against) or one sensor axis's (x, y, z).
+        #[arg(long, default_value = "xyz", value_parser = parse_column)]
+        column: settle_identify::SpectrumColumn,
         /// The resonance test's first frequency (Hz; Klipper's FREQ_START / min_freq)
         /// [default: Klipper's defaults for this and the five options below].
         #[arg(long)]
@@ -344,6 +362,17 @@ enum Command {
         #[arg(long)]
         sweeping_period: Option<f64>,
     },
+}
+
+fn parse_column(s: &str) -> Result<settle_identify::SpectrumColumn, String> {
+    use settle_identify::SpectrumColumn;
+    match s {
+        "xyz" => Ok(SpectrumColumn::Total),
+        "x" => Ok(SpectrumColumn::Axis(0)),
+        "y" => Ok(SpectrumColumn::Axis(1)),
+        "z" => Ok(SpectrumColumn::Axis(2)),
+        _ => Err(format!("unknown column `{s}`; allowed: xyz, x, y, z")),
+    }
 }
 
 fn parse_method(s: &str) -> Result<settle_identify::MethodChoice, String> {
@@ -517,10 +546,31 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             firmware,
             frequency_tolerance,
             criterion,
+            shapers,
+            scv,
+            max_smoothing,
         } => {
             if criterion == "klipper" {
-                workflows::tune::klipper_criterion::report(&scenario)?
+                workflows::tune::klipper_criterion::report(
+                    &workflows::tune::klipper_criterion::KlipperCriterion::from_args(
+                        scenario,
+                        out,
+                        shapers.as_deref(),
+                        scv,
+                        max_smoothing,
+                    )?,
+                )?
+            } else if scenario.len() != 1
+                || shapers.is_some()
+                || scv.is_some()
+                || max_smoothing.is_some()
+            {
+                return Err(Error::input(
+                    "SCENARIO",
+                    "settle tune takes one scenario file; several files and --shapers, --scv, --max-smoothing go with --criterion klipper",
+                ));
             } else {
+                let scenario = &scenario[0];
                 let opts = workflows::tune::Options {
                     check_on,
                     jobs: jobs(j),
@@ -528,7 +578,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     frequency_tolerance_pct: frequency_tolerance,
                     ..workflows::tune::Options::new(backend)
                 };
-                workflows::tune::tune_with(&scenario, out, &opts, &progress)?.report()
+                workflows::tune::tune_with(scenario, out, &opts, &progress)?.report()
             }
         }
         Command::Import {
@@ -627,6 +677,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             figures,
             max_modes,
             method,
+            column,
             freq_start,
             freq_end,
             hz_per_sec,
@@ -652,6 +703,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     },
                     max_modes,
                     method,
+                    column,
                 },
                 ..workflows::identify::IdentifyOptions::new(files)
             };

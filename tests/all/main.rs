@@ -14,6 +14,7 @@ mod html_report;
 mod identify_cmd;
 mod import;
 mod import_roundtrip;
+mod klipper_corpus;
 mod layers;
 mod limits;
 mod machine_cmd;
