@@ -301,7 +301,13 @@ pub fn report(c: &KlipperCriterion) -> Result<Report, Error> {
                 a.axis.map_or("all".to_string(), |c| c.to_string())
             );
             crate::output::plot::write(
-                &crate::output::plot::klipper_shapers::figure(a, &c.select),
+                &crate::output::plot::klipper_shapers::figure(
+                    a.axis,
+                    &a.files,
+                    &a.data[0],
+                    &a.selection,
+                    &c.select,
+                ),
                 dir,
                 &stem,
             )?;
