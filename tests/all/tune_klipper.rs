@@ -2,9 +2,10 @@
 //! gives Klipper the choice it makes on a recording of that machine.
 
 use settle::workflows::tune::klipper_choice::spectrum_of;
-use settle_identify::welch::Welch;
-use settle_identify::{FileData, SweepTest, read_file};
-use settle_planner::shaper_select::{CalibrationData, SelectOptions, find_best_shaper};
+use settle::workflows::tune::klipper_criterion::load;
+use settle_gcode::config::KlipperConfig;
+use settle_identify::SweepTest;
+use settle_planner::shaper_select::{SelectOptions, find_best_shaper};
 
 use crate::support::root;
 
@@ -19,44 +20,34 @@ fn example_test() -> SweepTest {
     }
 }
 
-/// Klipper's calibration data of a raw recording: the sum of the three axes' Welch PSDs
-/// (`psd_xyz`, as shaper_calibrate.py computes it), normalised.
-fn recorded(file: &str) -> CalibrationData {
-    let FileData::Recordings(r) = read_file(&root().join(file)).expect("reads") else {
-        panic!("{file} is a recording");
-    };
-    let rec = &r[0];
-    let welch = Welch::klipper(rec.sample_rate_hz);
-    let mut sum = vec![0.0; welch.freqs_hz().len()];
-    for a in rec.accel_mm_s2.iter().flatten() {
-        for (s, p) in sum.iter_mut().zip(welch.psd(a).expect("long enough")) {
-            *s += p;
-        }
-    }
-    let mut d = CalibrationData {
-        freq_hz: welch.freqs_hz(),
-        psd_sum: sum,
-        ..CalibrationData::default()
-    };
-    d.normalize_to_frequencies();
-    d
-}
-
+/// Also: the example printer.cfg's SAVE_CONFIG block holds what Klipper chooses on the
+/// example recordings.
 #[test]
 fn klippers_choice_on_the_modes_is_its_choice_on_the_recording() {
+    let cfg = root().join("examples/klipper/printer.cfg");
+    let text = std::fs::read_to_string(&cfg).expect("example printer.cfg");
+    let saved = KlipperConfig::parse(&text, &cfg)
+        .expect("reads")
+        .input_shaper
+        .expect("[input_shaper]");
     // The modes the example recordings were made from (examples/resonance_data.rs).
-    for (file, modes) in [
+    for (file, modes, saved) in [
         (
             "examples/data/raw_data_x_example.csv",
             vec![(45.0, 0.05, 0.8), (75.0, 0.07, 0.2)],
+            &saved.x,
         ),
         (
             "examples/data/raw_data_y_example.csv",
             vec![(39.0, 0.05, 1.0)],
+            &saved.y,
         ),
     ] {
         let opts = SelectOptions::default();
-        let from_recording = find_best_shaper(&[recorded(file)], &opts).expect("chooses");
+        // The recording's data as `settle tune --criterion klipper` reads it (Klipper's
+        // PSD of the three axes, summed and normalised: calibrate_shaper.py's).
+        let recorded = load(&root().join(file)).expect("reads");
+        let from_recording = find_best_shaper(&recorded, &opts).expect("chooses");
         let model = spectrum_of(&modes, &example_test(), 800.0);
         let from_modes = find_best_shaper(&[model], &opts).expect("chooses");
         let (r, m) = (from_recording.recommended, from_modes.recommended);
@@ -73,5 +64,14 @@ fn klippers_choice_on_the_modes_is_its_choice_on_the_recording() {
         );
         assert_eq!(r.kind, m.kind, "{file}");
         assert!((r.frequency_hz - m.frequency_hz).abs() <= 0.41, "{file}");
+        // SHAPER_CALIBRATE saves the frequency to 0.1 Hz.
+        assert_eq!(
+            (saved.name.as_str(), saved.frequency_hz),
+            (
+                r.kind.name().as_str(),
+                (r.frequency_hz * 10.0).round() / 10.0
+            ),
+            "{file}"
+        );
     }
 }
