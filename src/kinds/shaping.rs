@@ -227,6 +227,13 @@ impl Kind for Shaping {
         COLUMNS.iter().map(|c| c.to_string()).collect()
     }
 
+    /// A shaper's frequency and damping ratio with no shaper.
+    fn unused(&self, run: &RunSpec, key: &str) -> Option<&'static str> {
+        let s = run.state::<ShaperSetting>()?;
+        (s.kind.is_none() && matches!(key, "shaper.frequency_hz" | "shaper.damping_ratio"))
+            .then_some("no shaper (`none`) has a frequency or damping ratio")
+    }
+
     /// `remaining_vibration_pct` is Klipper's figure for the [`dominant_mode`] (100 = no
     /// reduction; 100 for `none`), `smoothing_mm` Klipper's at the run's acceleration and
     /// [`SMOOTHING_SCV_MM_S`] (0 for `none`).

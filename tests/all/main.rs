@@ -36,6 +36,7 @@ mod scenarios;
 mod shaping_sweep;
 mod shards_kubernetes;
 mod step_samples;
+mod sweep_repeats;
 mod sweep_runs;
 mod sweep_safety;
 mod tune;
