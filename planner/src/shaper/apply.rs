@@ -3,6 +3,11 @@
 use super::Shaper;
 use crate::{PlanError, Profile, Sample, Segment, State};
 
+/// The largest start or end acceleration [`Shaper::apply`] takes as zero, as a fraction of
+/// the profile's peak acceleration: a million times f64's round-off (2.2e-16), a million
+/// times below any acceleration a move is planned with.
+pub const END_ACCEL_ROUND_OFF: f64 = 1e-9;
+
 impl Shaper {
     /// Shape a profile: `q(t) = sum_i w_i p(t - T_i)`. Outside its span the profile is
     /// extended by its start state before `t = 0` and its end state after its end, moving on
@@ -10,9 +15,18 @@ impl Shaper {
     /// does too, `duration_s()` longer). The start and end accelerations must be zero (a
     /// move, not a fragment). Since the weights are positive and sum to 1, the shaped
     /// velocity, acceleration and jerk stay within the original's bounds.
+    ///
+    /// "Zero" is zero to round-off: within [`END_ACCEL_ROUND_OFF`] of the profile's peak
+    /// acceleration (a PVT step's knots sum its segments' jerks to about 1e-16 m/s^2, not
+    /// to 0); such a remainder is taken as 0, as the extension outside the span has it.
     pub fn apply(&self, profile: &Profile) -> Result<Profile, PlanError> {
         let (start, end) = (profile.start(), profile.end());
-        if start.a != 0.0 || end.a != 0.0 {
+        let peak = profile
+            .iter()
+            .map(|(_, s, _)| s.a.abs())
+            .fold(start.a.abs().max(end.a.abs()), f64::max);
+        let round_off = END_ACCEL_ROUND_OFF * peak;
+        if start.a.abs() > round_off || end.a.abs() > round_off {
             return Err(PlanError::InvalidInput {
                 reason: "input shaping needs a profile that starts and ends with zero acceleration",
             });

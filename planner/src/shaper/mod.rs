@@ -34,6 +34,7 @@ pub use kind::{
     Firmware, KLIPPER_DEFAULT_DAMPING_RATIO, KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL,
     MarlinShaper, RRF_STEP_CLOCK_HZ, RrfShaper, ShaperKind,
 };
+pub use apply::END_ACCEL_ROUND_OFF;
 pub use response::{remaining_vibration, smoothing_mm};
 
 use crate::PlanError;
