@@ -85,6 +85,23 @@ fn frequency_why(axis: &str, o: &Outcome, f: f64) -> String {
 
 /// Why the damping ratio is `z`.
 fn damping_why(axis: &str, o: &Outcome, f: f64, z: f64) -> String {
+    let spec = &o.plan.spec;
+    match (
+        super::grid::design_damping_source(spec, &o.plan.base).0,
+        spec.shaper_damping_ratio,
+    ) {
+        (Some(d), Some(_)) if (d - z).abs() < 5e-4 => {
+            return "the damping ratio every shaper is designed for (`[tune] shaper_damping_ratio`)"
+                .into();
+        }
+        (Some(d), None) if (d - z).abs() < 5e-4 => {
+            return format!(
+                "Klipper's default: the damping of the modes of a physical machine ({}) is an estimate from its parts, not a measurement",
+                o.plan.modes_source
+            );
+        }
+        _ => {}
+    }
     let nearest = o
         .plan
         .modes

@@ -91,7 +91,18 @@ fn difference(k: &KlipperChoice, winner: &Score) -> String {
         duration_ms(&k.score).unwrap_or(0.0),
         duration_ms(winner).unwrap_or(0.0),
     );
-    let by_klipper = if pick.vibrations < sf.vibrations {
+    // Vibrations equal to the shown 0.01 %: neither leaves more by Klipper's measure.
+    let level = (pick.vibrations * 1e4).round() == (sf.vibrations * 1e4).round();
+    let by_klipper = if level {
+        format!(
+            "By Klipper's measure both leave the same vibration ({:.2}%), and Klipper's score prefers its own ({:.4} against {:.4}; smoothing {:.3} mm against {:.3} mm at 5000 mm/s^2)",
+            pick.vibrations * 100.0,
+            pick.score,
+            sf.score,
+            pick.smoothing_mm,
+            sf.smoothing_mm
+        )
+    } else if pick.vibrations < sf.vibrations {
         format!(
             "By Klipper's measure its choice leaves less vibration ({:.2}% against {:.2}%)",
             pick.vibrations * 100.0,
