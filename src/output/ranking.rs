@@ -220,10 +220,8 @@ fn max_accel(table: &RunsColumns, row: usize) -> Option<f64> {
         table.num(row, "shaper_damping_ratio")?,
     )
     .ok()?;
-    Some(settle_planner::shaper_select::max_accel_mm_s2(
-        sh.amplitudes(),
-        sh.times_s(),
-        crate::kinds::shaping::SMOOTHING_SCV_MM_S,
+    Some(crate::kinds::shaping::max_accel_mm_s2(
+        &sh,
         settle_planner::shaper_select::TARGET_SMOOTHING_MM,
     ))
 }

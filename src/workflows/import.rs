@@ -271,10 +271,8 @@ pub fn top_accel(firmware: Firmware, run: &crate::spec::run_spec::RunSpec) -> Op
             let (z, _) = crate::workflows::tune::target::design_damping(k, zeta);
             let sh = settle_planner::shaper::Shaper::new(k, (f * highest * 10.0).round() / 10.0, z)
                 .ok()?;
-            Some(settle_planner::shaper_select::max_accel_mm_s2(
-                sh.amplitudes(),
-                sh.times_s(),
-                crate::kinds::shaping::SMOOTHING_SCV_MM_S,
+            Some(crate::kinds::shaping::max_accel_mm_s2(
+                &sh,
                 settle_planner::shaper_select::TARGET_SMOOTHING_MM,
             ))
         })

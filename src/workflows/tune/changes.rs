@@ -66,14 +66,18 @@ fn gain_why(axis: &str, o: &Outcome) -> String {
     }
 }
 
-/// Why the shaper is tuned to `f`: the mode it is nearest to as a multiple.
-fn frequency_why(axis: &str, o: &Outcome, f: f64) -> String {
-    let nearest = o
-        .plan
+/// The `(frequency, damping)` of the tuned mode nearest to `f` Hz (by ratio).
+fn nearest_mode(o: &Outcome, f: f64) -> Option<(f64, f64)> {
+    o.plan
         .modes
         .iter()
-        .min_by(|a, b| (f / a.0 - 1.0).abs().total_cmp(&(f / b.0 - 1.0).abs()));
-    match nearest {
+        .copied()
+        .min_by(|a, b| (f / a.0 - 1.0).abs().total_cmp(&(f / b.0 - 1.0).abs()))
+}
+
+/// Why the shaper is tuned to `f`: the mode it is nearest to as a multiple.
+fn frequency_why(axis: &str, o: &Outcome, f: f64) -> String {
+    match nearest_mode(o, f) {
         Some((m, _)) => format!(
             "tuned to axis {axis}'s {m:.1} Hz mode ({}; {:.2} x its frequency)",
             o.plan.modes_source,
@@ -86,10 +90,7 @@ fn frequency_why(axis: &str, o: &Outcome, f: f64) -> String {
 /// Why the damping ratio is `z`.
 fn damping_why(axis: &str, o: &Outcome, f: f64, z: f64) -> String {
     let spec = &o.plan.spec;
-    match (
-        super::grid::design_damping_source(spec, &o.plan.base).0,
-        spec.shaper_damping_ratio,
-    ) {
+    match (o.plan.shaper_damping, spec.shaper_damping_ratio) {
         (Some(d), Some(_)) if (d - z).abs() < 5e-4 => {
             return "the damping ratio every shaper is designed for (`[tune] shaper_damping_ratio`)"
                 .into();
@@ -102,12 +103,7 @@ fn damping_why(axis: &str, o: &Outcome, f: f64, z: f64) -> String {
         }
         _ => {}
     }
-    let nearest = o
-        .plan
-        .modes
-        .iter()
-        .min_by(|a, b| (f / a.0 - 1.0).abs().total_cmp(&(f / b.0 - 1.0).abs()));
-    match nearest {
+    match nearest_mode(o, f) {
         Some((m, zeta)) if (zeta - z).abs() < 5e-4 => format!(
             "the damping ratio of axis {axis}'s {m:.1} Hz mode ({})",
             o.plan.modes_source

@@ -220,10 +220,10 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
         frequency_hz: f64::NAN,
         damping_ratio: f64::NAN,
     });
-    let mut head = String::new();
+    let mut others = String::new();
     for (a, o) in axes.iter().filter(|(a, _)| a != axis) {
         let _ = writeln!(
-            head,
+            others,
             "; axis {a} alone would take {} (RepRapFirmware has one shaper for all axes: the lowest-frequency axis's is written)",
             super::cells::shaper_text(&o.scores[o.winner])
         );
@@ -241,9 +241,10 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
             .iter()
             .map(changes::Change::note),
     );
+    // The other axes' own choices follow the lines (the file starts with its header).
     match e.to_config_with_notes(&notes) {
-        Ok(text) => format!("{head}{text}"),
-        Err(err) => format!("{head}; no RepRapFirmware configuration: {err}\n"),
+        Ok(text) => format!("{text}{others}"),
+        Err(err) => format!("; no RepRapFirmware configuration: {err}\n{others}"),
     }
 }
 

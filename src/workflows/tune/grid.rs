@@ -447,6 +447,7 @@ pub fn plan(
         modes_source,
         builtin_preset,
         damping_source,
+        shaper_damping: fixed_damping,
     })
 }
 

@@ -31,14 +31,13 @@
 //! residual, then grid order, so the result is deterministic.
 
 use settle_planner::shaper::Shaper;
-use settle_planner::shaper_select::max_accel_mm_s2;
 use settle_planner::{KindParams, ProfileKind};
 
 use crate::error::Error;
 use crate::input::tune_spec::TuneSpec;
 use crate::kinds::corner::Corner;
 use crate::kinds::scan::ScanSpec;
-use crate::kinds::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting};
+use crate::kinds::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting, max_accel_mm_s2};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::workflows::tune::scan_figures::scan_figures;
@@ -290,6 +289,10 @@ pub struct Plan {
     /// Which damping ratio the shapers are designed for, as a sentence for the report
     /// ([`super::grid::design_damping_source`]).
     pub damping_source: String,
+    /// The damping ratio every shaper is designed for, when it is one for all (`[tune]
+    /// shaper_damping_ratio`, or Klipper's default on a physical machine); `None`: each
+    /// the damping of the mode it is tuned to.
+    pub shaper_damping: Option<f64>,
 }
 
 impl Plan {
@@ -341,12 +344,7 @@ impl Plan {
             None => (0.0, f64::INFINITY),
             Some(s) => (
                 s.smoothing_mm(accel_mm_s2, SMOOTHING_SCV_MM_S),
-                max_accel_mm_s2(
-                    s.amplitudes(),
-                    s.times_s(),
-                    SMOOTHING_SCV_MM_S,
-                    self.max_smoothing_mm,
-                ),
+                max_accel_mm_s2(&s, self.max_smoothing_mm),
             ),
         }
     }
