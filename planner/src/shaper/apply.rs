@@ -1,12 +1,7 @@
 //! Shaping a profile: the weighted sum of shifted copies, again as a [`Profile`].
 
-use super::Shaper;
+use super::{END_ACCEL_ROUND_OFF, Shaper};
 use crate::{PlanError, Profile, Sample, Segment, State};
-
-/// The largest start or end acceleration [`Shaper::apply`] takes as zero, as a fraction of
-/// the profile's peak acceleration: a million times f64's round-off (2.2e-16), a million
-/// times below any acceleration a move is planned with.
-pub const END_ACCEL_ROUND_OFF: f64 = 1e-9;
 
 impl Shaper {
     /// Shape a profile: `q(t) = sum_i w_i p(t - T_i)`. Outside its span the profile is

@@ -34,10 +34,14 @@ pub use kind::{
     Firmware, KLIPPER_DEFAULT_DAMPING_RATIO, KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL,
     MarlinShaper, RRF_STEP_CLOCK_HZ, RrfShaper, ShaperKind,
 };
-pub use apply::END_ACCEL_ROUND_OFF;
 pub use response::{remaining_vibration, smoothing_mm};
 
 use crate::PlanError;
+
+/// The largest start or end acceleration [`Shaper::apply`] takes as zero, as a fraction of
+/// the profile's peak acceleration: a million times f64's round-off (2.2e-16), a million
+/// times below any acceleration a move is planned with.
+pub const END_ACCEL_ROUND_OFF: f64 = 1e-9;
 
 /// Klipper's vibration tolerance of the EI family: 5% (a 20x reduction).
 pub const VIBRATION_TOLERANCE: f64 = KLIPPER_V_TOL;

@@ -181,7 +181,10 @@ fn a_round_off_end_acceleration_is_zero_and_a_real_one_is_refused() {
     let s = Shaper::new(ShaperKind::Zv, 33.4, 0.1).expect("shaper");
     let q = s.apply(&p).expect("a move from rest to rest is shaped");
     let end = q.end();
-    assert!((end.p - 0.005).abs() < 1e-12 && end.v.abs() < 1e-12, "{end:?}");
+    assert!(
+        (end.p - 0.005).abs() < 1e-12 && end.v.abs() < 1e-12,
+        "{end:?}"
+    );
     assert!((q.duration_s() - (p.duration_s() + s.duration_s())).abs() < 1e-12);
     // Stopped half-way through its acceleration, the same profile is a fragment.
     let cut = crate::Profile::new(p.start(), p.segments()[..1].to_vec()).expect("profile");
