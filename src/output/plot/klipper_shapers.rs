@@ -5,10 +5,24 @@
 //! test damping ratios (the script's `vals`).
 
 use settle_planner::shaper::{KLIPPER_DEFAULT_DAMPING_RATIO, Shaper, remaining_vibration};
-use settle_planner::shaper_select::{Fit, MAX_FREQ_HZ, SelectOptions};
+use std::path::PathBuf;
+
+use settle_planner::shaper_select::{CalibrationData, Fit, MAX_FREQ_HZ, SelectOptions, Selection};
 
 use crate::output::plot::{Figure, Line, PALETTE, Panel, Rule};
-use crate::workflows::tune::klipper_criterion::AxisChoice;
+
+/// What the graph of one axis shows: the axis, its files, the first data set (the one
+/// calibrate_shaper.py draws) and Klipper's choice.
+pub struct AxisGraph<'a> {
+    /// The machine axis the file names name, `None` when they name none.
+    pub axis: Option<char>,
+    /// The files, in the order given.
+    pub files: &'a [PathBuf],
+    /// The data set drawn.
+    pub data: &'a CalibrationData,
+    /// The choice.
+    pub selection: &'a Selection,
+}
 
 /// The remaining vibration of `fit`'s shaper at `freq_hz`, worst over the test damping
 /// ratios; `None` when the shaper cannot be built.
@@ -34,9 +48,9 @@ fn response(fit: &Fit, opts: &SelectOptions, freq_hz: &[f64]) -> Option<Vec<f64>
 }
 
 /// The figure for one axis's choice.
-pub fn figure(a: &AxisChoice, opts: &SelectOptions) -> Figure {
+pub fn figure(a: &AxisGraph, opts: &SelectOptions) -> Figure {
     let max_freq = opts.max_freq_hz.unwrap_or(MAX_FREQ_HZ);
-    let data = &a.data[0];
+    let data = a.data;
     let keep: Vec<usize> = (0..data.freq_hz.len())
         .filter(|&i| data.freq_hz[i] <= max_freq)
         .collect();

@@ -301,7 +301,15 @@ pub fn report(c: &KlipperCriterion) -> Result<Report, Error> {
                 a.axis.map_or("all".to_string(), |c| c.to_string())
             );
             crate::output::plot::write(
-                &crate::output::plot::klipper_shapers::figure(a, &c.select),
+                &crate::output::plot::klipper_shapers::figure(
+                    &crate::output::plot::klipper_shapers::AxisGraph {
+                        axis: a.axis,
+                        files: &a.files,
+                        data: &a.data[0],
+                        selection: &a.selection,
+                    },
+                    &c.select,
+                ),
                 dir,
                 &stem,
             )?;
