@@ -11,6 +11,19 @@ use settle_planner::shaper_select::{CalibrationData, Fit, MAX_FREQ_HZ, SelectOpt
 
 use crate::output::plot::{Figure, Line, PALETTE, Panel, Rule};
 
+/// What the graph of one axis shows: the axis, its files, the first data set (the one
+/// calibrate_shaper.py draws) and Klipper's choice.
+pub struct AxisGraph<'a> {
+    /// The machine axis the file names name, `None` when they name none.
+    pub axis: Option<char>,
+    /// The files, in the order given.
+    pub files: &'a [PathBuf],
+    /// The data set drawn.
+    pub data: &'a CalibrationData,
+    /// The choice.
+    pub selection: &'a Selection,
+}
+
 /// The remaining vibration of `fit`'s shaper at `freq_hz`, worst over the test damping
 /// ratios; `None` when the shaper cannot be built.
 fn response(fit: &Fit, opts: &SelectOptions, freq_hz: &[f64]) -> Option<Vec<f64>> {
@@ -34,16 +47,10 @@ fn response(fit: &Fit, opts: &SelectOptions, freq_hz: &[f64]) -> Option<Vec<f64>
     )
 }
 
-/// The figure for one axis's choice: `selection`, made with `opts` on `data` (the first
-/// data set of `files`, which recorded machine axis `axis`, `None` when they name none).
-pub fn figure(
-    axis: Option<char>,
-    files: &[PathBuf],
-    data: &CalibrationData,
-    selection: &Selection,
-    opts: &SelectOptions,
-) -> Figure {
+/// The figure for one axis's choice.
+pub fn figure(a: &AxisGraph, opts: &SelectOptions) -> Figure {
     let max_freq = opts.max_freq_hz.unwrap_or(MAX_FREQ_HZ);
+    let data = a.data;
     let keep: Vec<usize> = (0..data.freq_hz.len())
         .filter(|&i| data.freq_hz[i] <= max_freq)
         .collect();
@@ -65,7 +72,7 @@ pub fn figure(
             psd_lines.push(l);
         }
     }
-    let rec = &selection.recommended;
+    let rec = &a.selection.recommended;
     if let Some(v) = response(rec, opts, &freq) {
         let after = keep
             .iter()
@@ -83,7 +90,7 @@ pub fn figure(
         ));
     }
     let mut shaper_lines = Vec::new();
-    for (k, s) in selection.per_shaper.iter().enumerate() {
+    for (k, s) in a.selection.per_shaper.iter().enumerate() {
         if let Some(v) = response(s, opts, &freq) {
             let label = format!(
                 "{} ({:.1} Hz, vibr={:.1}%, sm~={:.2}, accel<={:.0})",
@@ -102,8 +109,8 @@ pub fn figure(
             shaper_lines.push(l);
         }
     }
-    let files: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
-    let axis = axis.map_or("all".to_string(), |c| c.to_string());
+    let files: Vec<String> = a.files.iter().map(|f| f.display().to_string()).collect();
+    let axis = a.axis.map_or("all".to_string(), |c| c.to_string());
     Figure {
         title: format!(
             "Klipper's choice, axis {axis}: {} @ {:.1} Hz ({})",

@@ -302,10 +302,12 @@ pub fn report(c: &KlipperCriterion) -> Result<Report, Error> {
             );
             crate::output::plot::write(
                 &crate::output::plot::klipper_shapers::figure(
-                    a.axis,
-                    &a.files,
-                    &a.data[0],
-                    &a.selection,
+                    &crate::output::plot::klipper_shapers::AxisGraph {
+                        axis: a.axis,
+                        files: &a.files,
+                        data: &a.data[0],
+                        selection: &a.selection,
+                    },
                     &c.select,
                 ),
                 dir,
