@@ -178,9 +178,12 @@ pub struct Ranking {
     /// a run of the same workload point and candidate, differing only in settings that do
     /// not change it (a jerk limit with a trapezoid, a frequency with no shaper).
     pub repeats: Vec<(u32, u32)>,
-    /// Why those settings do not change them: `(key, reason)`, once each.
-    pub unused: Vec<(String, &'static str)>,
+    /// Why those settings do not change them, once each.
+    pub unused: Vec<Unused>,
 }
+
+/// A swept key that does not change some runs, and why: `(key, reason)`.
+pub type Unused = (String, &'static str);
 
 /// Whether `run` is the `[current]` candidate of `sc` (every key given matches, or does
 /// not change the run: [`crate::kinds::unused`]).
@@ -525,9 +528,9 @@ fn repeats(
     starts: &[usize],
     point_rows: &[u32],
     run_candidate: &[u32],
-) -> (Vec<(u32, u32)>, Vec<(String, &'static str)>) {
+) -> (Vec<(u32, u32)>, Vec<Unused>) {
     let mut repeats = Vec::new();
-    let mut unused: Vec<(String, &'static str)> = Vec::new();
+    let mut unused: Vec<Unused> = Vec::new();
     let mut first: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
     for w in starts.windows(2) {
         first.clear();
