@@ -103,7 +103,7 @@ fn num(value: f64, digits: usize, inf: Option<&str>) -> Cell {
     Cell::Number { value, text }
 }
 
-/// The candidates for report.html: the rows of [`csv`] with times in ms (0.1 ms),
+/// The candidates for report.html: the rows of [`csv()`] with times in ms (0.1 ms),
 /// residuals to 0.01 um, smoothing to 0.001 mm, accelerations to 1 mm/s^2.
 pub fn table(axes: &[(String, Outcome)]) -> Table {
     let header = [
