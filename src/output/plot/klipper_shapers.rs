@@ -13,7 +13,7 @@ use crate::output::plot::{Figure, Line, PALETTE, Panel, Rule};
 
 /// What the graph of one axis shows: the axis, its files, the first data set (the one
 /// calibrate_shaper.py draws) and Klipper's choice.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug)]
 pub struct AxisGraph<'a> {
     /// The machine axis the file names name, `None` when they name none.
     pub axis: Option<char>,
