@@ -94,6 +94,25 @@ pub enum IdentifyError {
         /// Why not.
         reason: String,
     },
+    /// The recording needs the resonance test's parameters, which were not given and which
+    /// the file does not record.
+    #[error("{file}: {reason}")]
+    NeedsTestParameters {
+        /// The file.
+        file: String,
+        /// Which parameters, and why.
+        reason: String,
+    },
+    /// A fit ran but its result cannot be stood behind: a frequency at or above Nyquist or
+    /// outside the band the data cover, a value that is not a number, an uncertainty larger
+    /// than the value, a fit that did not converge.
+    #[error("{file}: the fit cannot be trusted: {reason}")]
+    Unreliable {
+        /// The file.
+        file: String,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// An option passed by the caller is out of range.
     #[error("option `{name}` = {value} is invalid: allowed {allowed}")]
     InvalidOption {

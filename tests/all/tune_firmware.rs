@@ -372,8 +372,15 @@ fn klipper_criterion_prints_what_calibrate_shaper_printed() {
             "Recommended shaper is mzv @ 25.6 Hz",
         ),
     ] {
-        let r = settle::workflows::tune::klipper_criterion::report(&calibration(file))
-            .expect("chooses");
+        let c = settle::workflows::tune::klipper_criterion::KlipperCriterion::from_args(
+            vec![calibration(file)],
+            None,
+            None,
+            None,
+            None,
+        )
+        .expect("options");
+        let r = settle::workflows::tune::klipper_criterion::report(&c).expect("chooses");
         assert_eq!(r.stdout.lines().last(), Some(want), "{file}:\n{}", r.stdout);
     }
     // The per-shaper lines, from the same run's numbers for one_peak (zv: 46.0 Hz,

@@ -73,6 +73,10 @@ pub struct ProcessedPsd {
     pub per_axis: bool,
     /// Names of the shaper columns (`zv(49.6)`...).
     pub shapers: Vec<String>,
+    /// True when the header holds the `shapers:` column (Klipper since October 2025); the
+    /// rule by which Klipper's `scripts/calibrate_shaper.py` takes a file's PSD as already
+    /// normalised.
+    pub shapers_marker: bool,
     /// How the PSD was normalised.
     pub normalisation: Normalisation,
     /// The last line read (for messages).
@@ -215,6 +219,7 @@ pub fn parse(file: &str, text: &str) -> Result<ProcessedPsd, IdentifyError> {
         columns,
         per_axis,
         shapers,
+        shapers_marker: marker.is_some(),
         normalisation,
         last_line,
     })

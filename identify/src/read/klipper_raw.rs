@@ -7,7 +7,7 @@
 //! applied. Klipper's own parser (`scripts/calibrate_shaper.py`, `np.loadtxt(...,
 //! comments='#')`) skips every line starting with `#`; so does this one.
 
-use super::{MIN_SAMPLES, Recording, RecordingFormat, check_monotonic, parse_number, truncate};
+use super::{MIN_SAMPLES, Recording, RecordingFormat, check_times, parse_number, truncate};
 use crate::IdentifyError;
 
 /// The header line Klipper writes.
@@ -85,7 +85,7 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
             needed: MIN_SAMPLES,
         });
     }
-    check_monotonic(file, &time_s, |i| line_numbers[i])?;
+    check_times(file, &time_s, |i| line_numbers[i])?;
     let span = time_s[time_s.len() - 1] - time_s[0];
     let [x, y, z] = axes;
     Ok(Recording {
@@ -95,6 +95,7 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
         sample_rate_hz: time_s.len() as f64 / span,
         time_s,
         accel_mm_s2: [Some(x), Some(y), Some(z)],
+        named_axis: None,
         last_line,
     })
 }

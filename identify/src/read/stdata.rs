@@ -10,7 +10,7 @@ use std::io::Read;
 
 use serde::Deserialize;
 
-use super::{MIN_SAMPLES, Recording, RecordingFormat, check_monotonic};
+use super::{MIN_SAMPLES, Recording, RecordingFormat, check_times};
 use crate::IdentifyError;
 
 #[derive(Deserialize)]
@@ -58,7 +58,7 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
             });
         }
         let time_s: Vec<f64> = m.samples.iter().map(|s| s[0]).collect();
-        check_monotonic(file, &time_s, |_| n)?;
+        check_times(file, &time_s, |_| n)?;
         let axis = |k: usize| Some(m.samples.iter().map(|s| s[k]).collect::<Vec<f64>>());
         let span = time_s[time_s.len() - 1] - time_s[0];
         out.push(Recording {
@@ -68,6 +68,7 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
             sample_rate_hz: time_s.len() as f64 / span,
             accel_mm_s2: [axis(1), axis(2), axis(3)],
             time_s,
+            named_axis: None,
             last_line: n,
         });
     }

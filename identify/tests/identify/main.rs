@@ -2,6 +2,8 @@
 //! recordings of settle's own plant in every file format.
 
 mod common;
+mod corpus;
+mod damping_shaketune;
 mod readers;
 mod ringdown;
 mod statistics;
