@@ -54,6 +54,8 @@ VORON=$root/gcode/tests/data/klipper/voron/printer.cfg
 MINI=$root/gcode/tests/data/rrf/mini5plus/sys/config.g
 CORPUS=$root/identify/tests/corpus
 LOST=$root/tests/shards/big_lost_steps.toml
+FAULT=$root/tests/faults/blowup.toml
+FIELDS=$root/tests/sweeps/machine_fields.toml
 
 # The cases: NAME then the arguments of one settle command; `{out}` in an argument is the
 # case's output folder (out/NAME, relative to the side's folder).
@@ -65,8 +67,8 @@ cases() {
     done
   done
   echo "sweep-mcap-ci_corners sweep $S/ci_corners.toml --backend modal --jobs 2 --mcap --out {out}"
-  echo "sweep-machine-fields-modal sweep in/machine_fields.toml --backend modal --jobs 2 --out {out}"
-  echo "sweep-machine-fields-rapier sweep in/machine_fields.toml --backend rapier --jobs 2 --out {out}"
+  echo "sweep-machine-fields-modal sweep $FIELDS --backend modal --jobs 2 --out {out}"
+  echo "sweep-machine-fields-rapier sweep $FIELDS --backend rapier --jobs 2 --out {out}"
   echo "run-quickstart-modal run $S/quickstart.toml --case 3 --backend modal --plot --mcap --out {out}/run-3.csv"
   echo "run-quickstart-rapier run $S/quickstart.toml --case 3 --backend rapier --plot --out {out}/run-3.csv"
   echo "run-ci_corners run $S/ci_corners.toml --case 3 --backend rapier --plot --out {out}/run-3.csv"
@@ -134,8 +136,8 @@ cases() {
   echo "merge-flag merge out/shard-1 out/shard-2 out/shard-3 out/shard-4 --fail-on-failed-runs --out {out}"
   echo "run-failed run $LOST --case 7 --backend rapier --out {out}/run-7.csv"
   echo "run-failed-flag run $LOST --case 7 --backend rapier --fail-on-failed-runs --out {out}/run-7.csv"
-  echo "sweep-fault sweep in/blowup.toml --backend rapier --out {out}"
-  echo "run-fault run in/blowup.toml --case 1 --backend rapier --plot --out {out}/run-1.csv"
+  echo "sweep-fault sweep $FAULT --backend rapier --out {out}"
+  echo "run-fault run $FAULT --case 1 --backend rapier --plot --out {out}/run-1.csv"
   echo "gcode-lost-steps gcode in/arcs.gcode --machine printer_xy --mcap --out {out}"
   echo "gcode-lost-steps-flag gcode in/arcs.gcode --machine printer_xy --fail-on-failed-runs --out {out}"
 }
@@ -148,49 +150,6 @@ run_side() {
   total=$(cases | grep -cE "^(${only:-.*}) " || true)
   rm -rf "$side" "$dest"
   mkdir -p "$side/out" "$side/status" "$side/in"
-  # A physical machine's fields swept by their machine-file keys (no shipped scenario does).
-  cat >"$side/in/machine_fields.toml" <<'TOML'
-name = "machine_fields"
-[machine]
-preset = "printer_xy"
-driver_model = "linear"
-[move]
-axis = "y"
-distance_mm = 10.0
-profile = "scurve"
-[limits]
-vmax_mm_s = 300.0
-amax_mm_s2 = 3000.0
-jmax_mm_s3 = 100000.0
-[observe]
-window_s = 0.3
-sample_rate_hz = 5000
-bands_um = [10.0]
-[sweep]
-"machine.axis.y.mount.stiffness_n_per_m" = [2.0e5, 4.0e5]
-"machine.axis.y.belt.pulley_teeth" = [16, 20]
-"machine.driver.microsteps" = [16, 32]
-"machine.motor.rotor_inertia_g_cm2" = [54.0]
-TOML
-  # A mode at 480 Hz stepped at 2 ms on rapier blows up (a fault, a failed run).
-  cat >"$side/in/blowup.toml" <<'TOML'
-name = "blowup"
-[machine]
-modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]
-[move]
-distance_mm = 5.0
-profile = "trapezoid"
-[limits]
-vmax_mm_s = 300.0
-amax_mm_s2 = 3000.0
-[observe]
-window_s = 0.3
-sample_rate_hz = 1000
-[sim]
-max_step_s = 0.002
-[sweep]
-"machine.modes.0.frequency_hz" = [40.0, 480.0]
-TOML
   # Two 2 mm arcs at 6000 mm/s^2 after a travel: printer_xy loses steps (a failed run).
   printf 'G90\nM83\nM204 S6000\nG0 X100 Y100 F9000\nG2 X102 Y102 I2 J0 E0.1 F3000\nG3 X100 Y100 I-2 J0 E0.1\n' >"$side/in/arcs.gcode"
   while read -r name args; do
@@ -224,7 +183,7 @@ blank_times() {
 
 # The identity of the inputs the old side's outputs depend on.
 key=$( (sha256sum <"$old"; cases; find scenarios gcode/prints gcode/tests/data examples/data \
-  planner/tests/data results/baselines identify/tests/corpus tests/shards -type f -print0 | sort -z | xargs -0 sha256sum) |
+  planner/tests/data results/baselines identify/tests/corpus tests/shards tests/faults tests/sweeps -type f -print0 | sort -z | xargs -0 sha256sum) |
   sha256sum | cut -c1-16)
 old_side=$dir/old-$key
 if [[ -n $only ]]; then

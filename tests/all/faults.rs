@@ -12,23 +12,7 @@ use std::time::{Duration, Instant};
 /// least a scenario may ask for): symplectic Euler is stable for `w h < 2`, so the 40 Hz
 /// mode (`w h = 0.25`) runs and the 480 Hz one (`w h = 3.0`) grows by a factor of about 7
 /// per step until it is caught.
-const BLOW_UP: &str = r#"name = "blowup"
-[machine]
-modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]
-[move]
-distance_mm = 5.0
-profile = "trapezoid"
-[limits]
-vmax_mm_s = 300.0
-amax_mm_s2 = 3000.0
-[observe]
-window_s = 0.3
-sample_rate_hz = 1000
-[sim]
-max_step_s = 0.002
-[sweep]
-"machine.modes.0.frequency_hz" = [40.0, 480.0]
-"#;
+const BLOW_UP: &str = include_str!("../faults/blowup.toml");
 
 #[test]
 fn a_blow_up_is_a_failed_run_with_its_reason_and_the_sweep_goes_on() {
