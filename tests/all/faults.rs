@@ -139,7 +139,7 @@ fn sim_step_must_be_positive() {
         .expect("runs");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("bad.toml:14"), "{stderr}");
+    assert!(stderr.contains("bad.toml:16"), "{stderr}");
     assert!(stderr.contains("sim.max_step_s"), "{stderr}");
     assert!(stderr.contains("> 0"), "{stderr}");
 }

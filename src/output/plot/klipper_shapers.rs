@@ -4,11 +4,12 @@
 //! bottom: each shaper's remaining vibration at its chosen frequency, the worst over the
 //! test damping ratios (the script's `vals`).
 
+use std::path::PathBuf;
+
 use settle_planner::shaper::{KLIPPER_DEFAULT_DAMPING_RATIO, Shaper, remaining_vibration};
-use settle_planner::shaper_select::{Fit, MAX_FREQ_HZ, SelectOptions};
+use settle_planner::shaper_select::{CalibrationData, Fit, MAX_FREQ_HZ, SelectOptions, Selection};
 
 use crate::output::plot::{Figure, Line, PALETTE, Panel, Rule};
-use crate::workflows::tune::klipper_criterion::AxisChoice;
 
 /// The remaining vibration of `fit`'s shaper at `freq_hz`, worst over the test damping
 /// ratios; `None` when the shaper cannot be built.
@@ -33,10 +34,16 @@ fn response(fit: &Fit, opts: &SelectOptions, freq_hz: &[f64]) -> Option<Vec<f64>
     )
 }
 
-/// The figure for one axis's choice.
-pub fn figure(a: &AxisChoice, opts: &SelectOptions) -> Figure {
+/// The figure for the choice `selection` on one axis (`axis`: `x`, `y`, `z` or `all`),
+/// from the spectrum `data` of `files`.
+pub fn figure(
+    axis: &str,
+    files: &[PathBuf],
+    data: &CalibrationData,
+    selection: &Selection,
+    opts: &SelectOptions,
+) -> Figure {
     let max_freq = opts.max_freq_hz.unwrap_or(MAX_FREQ_HZ);
-    let data = &a.data[0];
     let keep: Vec<usize> = (0..data.freq_hz.len())
         .filter(|&i| data.freq_hz[i] <= max_freq)
         .collect();
@@ -58,7 +65,7 @@ pub fn figure(a: &AxisChoice, opts: &SelectOptions) -> Figure {
             psd_lines.push(l);
         }
     }
-    let rec = &a.selection.recommended;
+    let rec = &selection.recommended;
     if let Some(v) = response(rec, opts, &freq) {
         let after = keep
             .iter()
@@ -76,7 +83,7 @@ pub fn figure(a: &AxisChoice, opts: &SelectOptions) -> Figure {
         ));
     }
     let mut shaper_lines = Vec::new();
-    for (k, s) in a.selection.per_shaper.iter().enumerate() {
+    for (k, s) in selection.per_shaper.iter().enumerate() {
         if let Some(v) = response(s, opts, &freq) {
             let label = format!(
                 "{} ({:.1} Hz, vibr={:.1}%, sm~={:.2}, accel<={:.0})",
@@ -95,8 +102,7 @@ pub fn figure(a: &AxisChoice, opts: &SelectOptions) -> Figure {
             shaper_lines.push(l);
         }
     }
-    let files: Vec<String> = a.files.iter().map(|f| f.display().to_string()).collect();
-    let axis = a.axis.map_or("all".to_string(), |c| c.to_string());
+    let files: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
     Figure {
         title: format!(
             "Klipper's choice, axis {axis}: {} @ {:.1} Hz ({})",

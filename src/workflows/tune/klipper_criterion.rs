@@ -296,15 +296,16 @@ pub fn report(c: &KlipperCriterion) -> Result<Report, Error> {
         write_atomic(&cfg, input_shaper_cfg(&choices).as_bytes())?;
         r.err(format!("wrote {}", cfg.display()));
         for a in &choices {
-            let stem = format!(
-                "klipper-shapers-{}",
-                a.axis.map_or("all".to_string(), |c| c.to_string())
+            let axis = a.axis.map_or("all".to_string(), |c| c.to_string());
+            let stem = format!("klipper-shapers-{axis}");
+            let figure = crate::output::plot::klipper_shapers::figure(
+                &axis,
+                &a.files,
+                &a.data[0],
+                &a.selection,
+                &c.select,
             );
-            crate::output::plot::write(
-                &crate::output::plot::klipper_shapers::figure(a, &c.select),
-                dir,
-                &stem,
-            )?;
+            crate::output::plot::write(&figure, dir, &stem)?;
             r.err(format!(
                 "wrote {} (and .png)",
                 dir.join(format!("{stem}.svg")).display()
