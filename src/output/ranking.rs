@@ -20,7 +20,7 @@
 
 use std::path::Path;
 
-use settle_planner::shaper::{Shaper, ShaperKind};
+use settle_planner::shaper::{Shaper, ShaperType};
 
 use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
@@ -219,7 +219,7 @@ pub fn run_command(scenario: &Path, run: &RunSpec) -> String {
 /// Klipper's suggested max_accel (mm/s^2) for the shaper in columns `shaper_type`,
 /// `shaper_frequency_hz`, `shaper_damping_ratio` of `row`; `None` for no shaper.
 fn max_accel(table: &RunsColumns, row: usize) -> Option<f64> {
-    let kind = ShaperKind::parse(&table.cell(row, "shaper_type")?).ok()?;
+    let kind = ShaperType::parse(&table.cell(row, "shaper_type")?).ok()?;
     let sh = Shaper::new(
         kind,
         table.num(row, "shaper_frequency_hz")?,
@@ -229,7 +229,7 @@ fn max_accel(table: &RunsColumns, row: usize) -> Option<f64> {
     Some(settle_planner::shaper_select::max_accel_mm_s2(
         sh.amplitudes(),
         sh.times_s(),
-        crate::kinds::shaping::SMOOTHING_SCV_MM_S,
+        crate::studies::shaping::SMOOTHING_SCV_MM_S,
         settle_planner::shaper_select::TARGET_SMOOTHING_MM,
     ))
 }

@@ -1,5 +1,5 @@
 //! Runs grouped by their swept values other than `profile`: the rows of the summary's
-//! side-by-side tables (every kind's section uses the same grouping).
+//! side-by-side tables (every study's section uses the same grouping).
 
 use settle_planner::ProfileKind;
 

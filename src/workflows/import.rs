@@ -29,9 +29,10 @@ use settle_gcode::config::{KlipperConfig, RrfConfig, ShaperSetting as FirmwareSh
 
 use crate::error::{Error, Location};
 use crate::output::atomic::write_atomic;
-use crate::workflows::tune::firmware::Firmware;
+use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::grid::{identified_band, tuning_modes};
 use crate::workflows::{Exit, Report};
+use settle_planner::firmware::Firmware;
 
 /// Shaper frequencies of the search, as multiples of the current one.
 pub const FREQUENCY_SCALES: [f64; 5] = [0.9, 0.95, 1.0, 1.05, 1.1];
@@ -161,8 +162,21 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
 }
 
 fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)> {
-    s.kind_name(dialect)
+    s.type_name(dialect)
         .map(|n| (n, s.frequency_hz, s.damping_ratio))
+}
+
+/// The firmwares whose configurations `settle import` reads: Klipper (printer.cfg) and
+/// RepRapFirmware (config.g).
+pub const READ: [Firmware; 2] = [Firmware::Klipper, Firmware::Rrf];
+
+/// A firmware of [`READ`] by name ([`Firmware::parse`]'s names).
+pub fn parse_firmware(name: &str) -> Result<Firmware, String> {
+    Firmware::parse_among(
+        name,
+        &READ,
+        "a firmware whose configuration settle import reads",
+    )
 }
 
 /// Read the current settings of a firmware configuration.
@@ -269,13 +283,13 @@ fn scenario_text(
         (
             "none".into(),
             frequency_hz,
-            crate::kinds::shaping::DEFAULT_DAMPING_RATIO,
+            crate::studies::shaping::DEFAULT_DAMPING_RATIO,
         )
     });
     let accels = around(cur.amax_mm_s2, &ACCEL_SCALES, 100.0);
     let freqs = around(f_now, &FREQUENCY_SCALES, 0.1);
     let mut types = vec![q("none")];
-    types.extend(fw.shapers().iter().map(|k| q(&k.name())));
+    types.extend(Candidates::of(fw).shapers().iter().map(|k| q(&k.name())));
     if !types.contains(&q(&type_now)) {
         types.push(q(&type_now));
     }

@@ -184,8 +184,8 @@ fn unreadable_file_is_an_input_error() {
 }
 
 #[test]
-fn unknown_tables_and_keys_inside_a_kind_table_name_their_line() {
-    // An unknown table: the strict scenario parse names its line and lists the run kinds'
+fn unknown_tables_and_keys_inside_a_study_table_name_their_line() {
+    // An unknown table: the strict scenario parse names its line and lists the studies'
     // tables besides its own keys.
     let msg = parse_err(&GOOD.replace("[sweep]", "[scna]\nlines = 3\n[sweep]"));
     assert!(msg.starts_with("bad.toml:10:"), "{msg}");

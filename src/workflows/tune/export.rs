@@ -18,14 +18,14 @@ use std::fmt::Write as _;
 
 use settle_gcode::config::{KlipperExport, RrfExport, ShaperSetting as FirmwareShaper};
 use settle_planner::ProfileKind;
-use settle_planner::shaper::Firmware as ShaperFirmware;
+use settle_planner::firmware::Firmware;
 use settle_planner::tmc::ramp::SRampParams;
 use settle_planner::tmc::registers::{TmcUnits, export};
 
 use super::Outcome;
 use super::search::Score;
-use crate::kinds::corner::Corner;
-use crate::kinds::shaping::DEFAULT_DAMPING_RATIO;
+use crate::studies::corner::Corner;
+use crate::studies::shaping::DEFAULT_DAMPING_RATIO;
 
 /// The TMC4361A clock assumed when `[tune] tmc_clock_hz` is not given (Hz). In the chip's
 /// default (frequency) mode the clock appears only in CLK_FREQ, so the ramp registers do
@@ -43,7 +43,7 @@ fn winner_of<'a>(axes: &'a [(String, Outcome)], letter: &str) -> Option<&'a Outc
 /// The firmware shaper of a score: `None` when the candidate is unshaped.
 fn shaper_of(s: &Score) -> Option<FirmwareShaper> {
     let sh = s.candidate.shaper?;
-    let k = sh.kind?;
+    let k = sh.shaper_type?;
     Some(FirmwareShaper {
         name: k.name(),
         frequency_hz: sh.frequency_hz,
@@ -68,8 +68,8 @@ fn klipper_axis(axes: &[(String, Outcome)], letter: &str) -> Result<FirmwareShap
         let Some(s) = shaper_of(w) else {
             return Ok(klipper_off());
         };
-        return match w.candidate.shaper.and_then(|sh| sh.kind) {
-            Some(k) if k.firmware() == ShaperFirmware::Klipper => Ok(s),
+        return match w.candidate.shaper.and_then(|sh| sh.shaper_type) {
+            Some(k) if k.firmware() == Firmware::Klipper => Ok(s),
             _ => Err(format!(
                 "the recommended shaper on {letter}, {}, is not one of Klipper's; tune with --firmware klipper",
                 s.name
@@ -158,7 +158,7 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
         let f = |s: &Score| {
             s.candidate
                 .shaper
-                .filter(|sh| sh.kind.is_some())
+                .filter(|sh| sh.shaper_type.is_some())
                 .map_or(f64::INFINITY, |sh| sh.frequency_hz)
         };
         f(a.1).total_cmp(&f(b.1))
@@ -166,13 +166,13 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
     let Some((axis, w)) = shaped.first() else {
         return "# no RepRapFirmware configuration: nothing was tuned\n".into();
     };
-    let shaper = match (shaper_of(w), w.candidate.shaper.and_then(|s| s.kind)) {
+    let shaper = match (shaper_of(w), w.candidate.shaper.and_then(|s| s.shaper_type)) {
         (None, _) => FirmwareShaper {
             name: "none".into(),
             frequency_hz: 40.0,
             damping_ratio: 0.1,
         },
-        (Some(s), Some(k)) if k.firmware() == ShaperFirmware::Rrf => s,
+        (Some(s), Some(k)) if k.firmware() == Firmware::Rrf => s,
         (Some(s), _) => {
             return format!(
                 "# no RepRapFirmware configuration: the recommended shaper on {axis}, {}, is not one of RepRapFirmware's; tune with --firmware rrf\n",
@@ -222,7 +222,7 @@ fn tmc_axis(axis: &str, o: &Outcome) -> Result<String, String> {
     let w = &o.scores[o.winner];
     let c = &w.candidate;
     let b = &plan.base;
-    if c.shaper.is_some_and(|sh| sh.kind.is_some()) {
+    if c.shaper.is_some_and(|sh| sh.shaper_type.is_some()) {
         return Err(format!(
             "the recommendation {} is input-shaped; the TMC4361A's ramp generator cannot shape (tune with --firmware tmc4361a)",
             c.label()

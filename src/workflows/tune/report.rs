@@ -7,11 +7,11 @@ use std::fmt::Write as _;
 use super::Outcome;
 use super::search::{BandSource, Plan, Score};
 use crate::input::runs_table::record;
-use crate::kinds::corner::Corner;
-use crate::kinds::scan::ScanSpec;
 use crate::output::plot::{Figure, Line, Marker, PALETTE, Panel};
+use crate::studies::corner::Corner;
+use crate::studies::scan::ScanSpec;
 use settle_planner::ProfileKind;
-use settle_planner::shaper::ShaperKind;
+use settle_planner::shaper::ShaperType;
 
 /// The candidates table: one row per candidate of every tuned axis, with its
 /// acceleration, Klipper's smoothing and the largest acceleration within the smoothing
@@ -40,7 +40,7 @@ pub fn candidates_csv(axes: &[(String, Outcome)]) -> String {
             let b = c.params.fourjerk_jerk_scale;
             let (st, sf) = match c
                 .shaper
-                .and_then(|sh| sh.kind.map(|k| (k, sh.frequency_hz)))
+                .and_then(|sh| sh.shaper_type.map(|k| (k, sh.frequency_hz)))
             {
                 Some((k, f)) => (k.name().to_string(), f.to_string()),
                 None => ("none".to_string(), String::new()),
@@ -73,7 +73,11 @@ pub fn candidates_csv(axes: &[(String, Outcome)]) -> String {
 
 /// A candidate's shaper in words: `mzv @ 52.0 Hz (zeta 0.1)` or `none`.
 pub fn shaper_text(s: &Score) -> String {
-    match s.candidate.shaper.and_then(|sh| sh.kind.map(|k| (k, sh))) {
+    match s
+        .candidate
+        .shaper
+        .and_then(|sh| sh.shaper_type.map(|k| (k, sh)))
+    {
         Some((k, sh)) => format!(
             "{} @ {:.1} Hz (zeta {})",
             k.name(),
@@ -400,9 +404,9 @@ pub fn pareto_figure(
     let pt = |s: &Score| (s.move_time_s * 1e3, s.residual_peak_um.max(1e-3));
     let mut lines = Vec::new();
     // One group per shaper the search holds (any firmware's), in order of appearance.
-    let mut groups: Vec<(String, Option<ShaperKind>)> = vec![("unshaped".into(), None)];
+    let mut groups: Vec<(String, Option<ShaperType>)> = vec![("unshaped".into(), None)];
     for s in scores {
-        if let Some(k) = s.candidate.shaper.and_then(|sh| sh.kind)
+        if let Some(k) = s.candidate.shaper.and_then(|sh| sh.shaper_type)
             && !groups.iter().any(|(_, g)| *g == Some(k))
         {
             groups.push((k.name(), Some(k)));
@@ -412,7 +416,7 @@ pub fn pareto_figure(
         let points: Vec<(f64, f64)> = scores
             .iter()
             .filter(|s| s.move_time_s.is_finite())
-            .filter(|s| s.candidate.shaper.and_then(|sh| sh.kind) == *kind)
+            .filter(|s| s.candidate.shaper.and_then(|sh| sh.shaper_type) == *kind)
             .map(pt)
             .collect();
         if points.is_empty() {

@@ -32,15 +32,15 @@
 
 use settle_planner::shaper::Shaper;
 use settle_planner::shaper_select::max_accel_mm_s2;
-use settle_planner::{KindParams, ProfileKind};
+use settle_planner::{ProfileKind, ProfileParams};
 
 use crate::error::Error;
 use crate::input::tune_spec::TuneSpec;
-use crate::kinds::corner::Corner;
-use crate::kinds::scan::ScanSpec;
-use crate::kinds::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
+use crate::studies::corner::Corner;
+use crate::studies::scan::ScanSpec;
+use crate::studies::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting};
 use crate::workflows::tune::scan_figures::scan_figures;
 
 /// One point of the search grid.
@@ -51,7 +51,7 @@ pub struct Candidate {
     /// Jerk limit (mm/s^3), `None` for the trapezoid.
     pub jmax_mm_s3: Option<f64>,
     /// PVT asymmetry and four-jerk BOW scales.
-    pub params: KindParams,
+    pub params: ProfileParams,
     /// Input shaper (`None`: unshaped).
     pub shaper: Option<ShaperSetting>,
     /// Acceleration limit (mm/s^2), `None` for the scenario's.
@@ -76,10 +76,10 @@ impl Candidate {
         if let Some(a) = self.amax_mm_s2 {
             s.push_str(&format!(" a={a}"));
         }
-        if let Some(sh) = self.shaper.filter(|s| s.kind.is_some()) {
+        if let Some(sh) = self.shaper.filter(|s| s.shaper_type.is_some()) {
             s.push_str(&format!(
                 " +{}@{:.1}Hz",
-                sh.kind
+                sh.shaper_type
                     .map_or_else(|| "none".to_string(), |k| k.name().to_string()),
                 sh.frequency_hz
             ));
@@ -97,7 +97,7 @@ impl Candidate {
     pub fn apply(&self, run: &mut RunSpec) {
         run.profile = self.kind;
         run.jmax_mm_s3 = self.jmax_mm_s3.or(run.jmax_mm_s3);
-        run.kind_params = self.params;
+        run.profile_params = self.params;
         if let Some(a) = self.amax_mm_s2 {
             run.amax_mm_s2 = a;
         }
@@ -112,7 +112,7 @@ impl Candidate {
         Self {
             kind: run.profile,
             jmax_mm_s3: run.jmax_mm_s3,
-            params: run.kind_params,
+            params: run.profile_params,
             shaper: run.state::<ShaperSetting>().copied(),
             amax_mm_s2: None,
         }
@@ -207,7 +207,7 @@ impl Plan {
     /// tolerance `t` also its shaper at `(1 - t)` and `(1 + t)` times its frequency.
     pub fn variants(&self, c: &Candidate) -> Vec<Candidate> {
         let t = self.frequency_tolerance;
-        match c.shaper.filter(|s| s.kind.is_some()) {
+        match c.shaper.filter(|s| s.shaper_type.is_some()) {
             Some(sh) if t > 0.0 => [1.0, 1.0 - t, 1.0 + t]
                 .into_iter()
                 .map(|k| Candidate {
