@@ -33,8 +33,8 @@ fn script_output() -> Vec<(String, Vec<String>)> {
 #[test]
 fn klipper_criterion_equals_calibrate_shaper_on_the_corpus() {
     let expected = script_output();
-    // 20 processed spectra and 2 raw recordings (Shake&Tune's).
-    assert_eq!(expected.len(), 22);
+    // 20 processed spectra, 4 Klipper raw recordings and 2 Shake&Tune `.stdata`.
+    assert_eq!(expected.len(), 26);
     for (file, want) in expected {
         let c = KlipperCriterion::from_args(vec![corpus_dir().join(&file)], None, None, None, None)
             .expect("options");
