@@ -162,6 +162,18 @@ pub fn answer(file: &str) -> &'static Answer {
     &answers()[i]
 }
 
+/// Every corpus file that gives modes: its name, its first published main resonance
+/// (Hz) and settle's identification.
+pub fn identified() -> impl Iterator<Item = (&'static str, f64, &'static AxisIdentification)> {
+    CORPUS
+        .iter()
+        .zip(answers())
+        .filter_map(|((file, _, mains, ..), answer)| {
+            let id = answer.as_ref().ok()?.first()?;
+            Some((*file, mains[0], id))
+        })
+}
+
 /// One line per file for the table of `docs/guide/real-recordings.md` (shown with
 /// `--nocapture`): each mode's natural frequency, own peak and damping ratio, or the
 /// refusal.
