@@ -27,9 +27,8 @@ fn parse_backend(s: &str) -> Result<Backend, String> {
     Backend::parse(s).ok_or_else(|| format!("unknown backend `{s}`; allowed: {}", Backend::ALLOWED))
 }
 
-fn parse_firmware(s: &str) -> Result<settle_gcode::job::Firmware, String> {
-    s.parse()
-        .map_err(|e: settle_gcode::GcodeError| e.to_string())
+fn parse_firmware(s: &str) -> Result<settle_planner::firmware::Firmware, String> {
+    settle_gcode::job::parse_firmware(s).map_err(|e| e.to_string())
 }
 
 fn parse_driver(s: &str) -> Result<settle_sim::DriverMode, String> {
@@ -211,8 +210,7 @@ enum Command {
         after_help = "Example:\n  settle import klipper printer.cfg --machine machine.toml --out printer.toml\n  settle tune printer.toml\n  (klipper.cfg in results/printer_import-tune/ holds the recommendation)"
     )]
     Import {
-        /// The firmware: klipper or rrf.
-        #[arg(value_parser = ["klipper", "rrf"])]
+        /// The firmware: klipper or rrf (also written reprapfirmware or duet).
         firmware: String,
         /// printer.cfg (with its includes) or config.g.
         config: PathBuf,
@@ -238,7 +236,7 @@ enum Command {
         /// The planner: klipper, marlin, rrf or settle [default: klipper; with --config,
         /// rrf for a file ending in .g].
         #[arg(long, value_parser = parse_firmware)]
-        firmware: Option<settle_gcode::job::Firmware>,
+        firmware: Option<settle_planner::firmware::Firmware>,
         /// The firmware's configuration (Klipper printer.cfg with its includes, or
         /// RepRapFirmware config.g): the planner's limits and the input shapers start as
         /// it sets them, instead of the firmware's defaults.
@@ -279,7 +277,10 @@ enum Command {
         /// (compare-layer-<n>.svg/png) and compare.md. The firmware of --config keeps its
         /// settings; another starts from its defaults.
         #[arg(long, value_name = "FIRMWARE[:SHAPER]", value_parser = workflows::gcode::compare::parse_setting)]
-        versus: Option<(settle_gcode::job::Firmware, workflows::gcode::XyShapers)>,
+        versus: Option<(
+            settle_planner::firmware::Firmware,
+            workflows::gcode::XyShapers,
+        )>,
         #[command(flatten)]
         failed_runs: FailedRunsFlag,
     },
@@ -594,7 +595,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             out,
         } => {
             let opts = workflows::import::ImportOptions {
-                firmware: workflows::tune::firmware::Firmware::parse(&firmware)
+                firmware: workflows::import::parse_firmware(&firmware)
                     .map_err(|m| Error::input_key(&config, "firmware", m))?,
                 config,
                 machine,
@@ -650,7 +651,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     None => workflows::gcode::GcodeOptions::new(
                         file,
                         &machine,
-                        firmware.unwrap_or(settle_gcode::job::Firmware::Klipper),
+                        firmware.unwrap_or(settle_planner::firmware::Firmware::Klipper),
                     )?,
                 }
                 .with_shapers(shaper.unwrap_or_default())

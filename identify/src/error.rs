@@ -53,6 +53,18 @@ pub enum IdentifyError {
         /// The previous sample's time (s).
         previous_s: f64,
     },
+    /// An input the readers do not take: not a regular file, or more than they read
+    /// (every input is bounded before it is read, so that identifying it stays within the
+    /// memory `docs/performance.md` states).
+    #[error("{file}: {found}; the readers take {allowed}")]
+    NotAccepted {
+        /// The file.
+        file: String,
+        /// What it is or holds.
+        found: String,
+        /// What the readers take.
+        allowed: String,
+    },
     /// Too few samples (or frequency rows) to analyse.
     #[error("{file}:{line}: the data end after {found} {what}; at least {needed} are needed")]
     TooFewSamples {
@@ -126,6 +138,19 @@ pub enum IdentifyError {
 }
 
 impl IdentifyError {
+    /// A [`IdentifyError::NotAccepted`] error.
+    pub(crate) fn not_accepted(
+        file: &str,
+        found: impl Into<String>,
+        allowed: impl Into<String>,
+    ) -> Self {
+        IdentifyError::NotAccepted {
+            file: file.to_string(),
+            found: found.into(),
+            allowed: allowed.into(),
+        }
+    }
+
     /// A [`IdentifyError::Format`] error.
     pub(crate) fn format(
         file: &str,

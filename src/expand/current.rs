@@ -18,7 +18,7 @@ pub fn same(v: &toml::Value, swept: &Value) -> bool {
     match (v, swept) {
         (toml::Value::Float(x), Value::Number(y)) => x == y,
         (toml::Value::Integer(x), Value::Number(y)) => (*x as f64) == *y,
-        (toml::Value::String(s), Value::Kind(k)) => ProfileKind::parse(s).is_ok_and(|p| p == *k),
+        (toml::Value::String(s), Value::Study(k)) => ProfileKind::parse(s).is_ok_and(|p| p == *k),
         (toml::Value::String(s), Value::Text(t)) => s == t,
         _ => false,
     }

@@ -20,7 +20,7 @@
 
 use std::path::Path;
 
-use settle_planner::shaper::{Shaper, ShaperKind};
+use settle_planner::shaper::{Shaper, ShaperType};
 
 use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
@@ -186,11 +186,11 @@ pub struct Ranking {
 pub type Unused = (String, &'static str);
 
 /// Whether `run` is the `[current]` candidate of `sc` (every key given matches, or does
-/// not change the run: [`crate::kinds::unused`]).
+/// not change the run: [`crate::studies::unused`]).
 pub fn is_current(sc: &Scenario, run: &RunSpec) -> bool {
     !sc.current.is_empty()
         && sc.current.iter().all(|(k, v)| {
-            crate::kinds::unused(run, k).is_some()
+            crate::studies::unused(run, k).is_some()
                 || run
                     .swept
                     .iter()
@@ -216,14 +216,14 @@ pub fn run_command(scenario: &Path, run: &RunSpec) -> String {
 /// Klipper's suggested max_accel (mm/s^2) for the shaper in columns `shaper_type`,
 /// `shaper_frequency_hz`, `shaper_damping_ratio` of `row`; `None` for no shaper.
 fn max_accel(table: &RunsColumns, row: usize) -> Option<f64> {
-    let kind = ShaperKind::parse(&table.cell(row, "shaper_type")?).ok()?;
+    let kind = ShaperType::parse(&table.cell(row, "shaper_type")?).ok()?;
     let sh = Shaper::new(
         kind,
         table.num(row, "shaper_frequency_hz")?,
         table.num(row, "shaper_damping_ratio")?,
     )
     .ok()?;
-    Some(crate::kinds::shaping::max_accel_mm_s2(
+    Some(crate::studies::shaping::max_accel_mm_s2(
         &sh,
         settle_planner::shaper_select::TARGET_SMOOTHING_MM,
     ))
@@ -242,13 +242,13 @@ fn time_of(table: &RunsColumns, i: usize, column: &str) -> Option<f64> {
 }
 
 /// The values of a run's settings (`setting`) or workload, as shown in the tables: `-`
-/// for a setting that does not change the run ([`crate::kinds::unused`]).
+/// for a setting that does not change the run ([`crate::studies::unused`]).
 fn values(r: &RunSpec, setting: bool) -> Vec<String> {
     r.swept
         .iter()
         .filter(|(p, _)| is_setting(p) == setting)
         .map(|(p, v)| {
-            if setting && crate::kinds::unused(r, p).is_some() {
+            if setting && crate::studies::unused(r, p).is_some() {
                 "-".to_string()
             } else {
                 v.to_string()
@@ -263,7 +263,7 @@ fn label(r: &RunSpec) -> String {
     let s: Vec<String> = r
         .swept
         .iter()
-        .filter(|(p, _)| is_setting(p) && crate::kinds::unused(r, p).is_none())
+        .filter(|(p, _)| is_setting(p) && crate::studies::unused(r, p).is_none())
         .map(|(p, v)| label_part(p, v))
         .collect();
     if s.is_empty() {
@@ -543,7 +543,7 @@ fn repeats(
             repeats.push((row, earlier));
             let r = runs.at(row as usize);
             for (key, _) in &r.swept {
-                if let Some(why) = crate::kinds::unused(&r, key)
+                if let Some(why) = crate::studies::unused(&r, key)
                     && !unused.iter().any(|(k, w)| k == key && *w == why)
                 {
                     unused.push((key.clone(), why));

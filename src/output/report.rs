@@ -281,13 +281,13 @@ pub fn sweep_report<'a>(
         intro.insert(0, sc.description.trim().to_string());
     }
     let mut replaced = false;
-    let mut kind_tables = Vec::new();
-    for k in crate::kinds::all() {
+    let mut study_tables = Vec::new();
+    for k in crate::studies::all() {
         if let Some(section) =
             k.summary(runs, table, &|r| crate::output::ranking::is_current(sc, r))
         {
             replaced |= k.replaces_move_tables();
-            kind_tables.extend(markdown_tables(&section));
+            study_tables.extend(markdown_tables(&section));
         }
     }
     let (winners, mut tables, ranking) = if replaced {
@@ -305,7 +305,7 @@ pub fn sweep_report<'a>(
         tables.insert(0, jobs_table(&j, runs, file));
         first = 1;
     }
-    tables.extend(kind_tables);
+    tables.extend(study_tables);
     let failed = (0..runs.len())
         .filter(|&i| table.cell(i, "status").is_some_and(|s| s != "ok"))
         .map(|i| FailedRun {

@@ -1,6 +1,6 @@
 //! `summary.md`: the overall winner per band, one ranking table per band (every swept
 //! setting compared at each swept point of the workload, see [`crate::output::ranking`]),
-//! the run kinds' sections, the figures. Read from the runs table rather than from the
+//! the studies' sections, the figures. Read from the runs table rather than from the
 //! metrics, so a summary rebuilt from a merged `runs.csv` is byte-identical to the one the
 //! unsharded sweep wrote.
 
@@ -51,13 +51,14 @@ pub fn significant(x: f64) -> f64 {
 pub fn machines_line(runs: &dyn RunList) -> String {
     let mut names: Vec<String> = Vec::new();
     for r in runs.iter() {
-        let n = if r.machine.is_some() {
+        let n = if r.machine.physical().is_some() {
             format!("{} (axis {}, {} driver)", r.machine_name, r.axis, r.driver)
         } else {
             // Each axis's modes, prefixed with the axis when the machine has several.
-            let several = r.modes.len() > 1;
+            let several = r.machine.modes().len() > 1;
             let modes: Vec<String> = r
-                .modes
+                .machine
+                .modes()
                 .iter()
                 .flat_map(|a| {
                     let prefix = if several {
@@ -92,7 +93,7 @@ pub fn machines_line(runs: &dyn RunList) -> String {
 
 /// The summary: the overall winner per band, then per band every run ranked within its
 /// workload point (the swept values that are not settings), with its run number and the
-/// command that runs it alone; the failed runs with their reasons; the run kinds'
+/// command that runs it alone; the failed runs with their reasons; the studies'
 /// sections; the figures. `scenario` is the scenario file as the commands name it.
 ///
 /// It reads the metrics from `table` (the runs table, row `i` = `runs.at(i)`) rather than from
@@ -149,11 +150,11 @@ pub(crate) fn summary_to(
         out.push_str(&crate::output::jobs::section(&j, scenario, runs));
         out.push('\n');
     }
-    // The run kinds' sections: those that replace the move-and-settle tables (which would
-    // not measure what the kind is about) stand in their place, the others follow them.
+    // The studies' sections: those that replace the move-and-settle tables (which would
+    // not measure what the study is about) stand in their place, the others follow them.
     let mut replaced = false;
     let mut after: Vec<String> = Vec::new();
-    for k in crate::kinds::all() {
+    for k in crate::studies::all() {
         let Some(section) = k.summary(runs, table, &|r| is_current(sc, r)) else {
             continue;
         };
@@ -181,10 +182,10 @@ pub(crate) fn summary_to(
     }
 }
 
-/// Whether the summary ranks candidates by move-and-settle time: no run kind's section
+/// Whether the summary ranks candidates by move-and-settle time: no study's section
 /// replaces the ranking (a raster scan's does).
 pub fn ranks_candidates(runs: &dyn RunList, table: &RunsColumns) -> bool {
-    !crate::kinds::all()
+    !crate::studies::all()
         .iter()
         .any(|k| k.replaces_move_tables() && k.summary(runs, table, &|_| false).is_some())
 }

@@ -1,5 +1,5 @@
 //! Runs grouped by their swept values other than `profile`: the rows of the summary's
-//! side-by-side tables (every kind's section uses the same grouping); and which swept keys
+//! side-by-side tables (every study's section uses the same grouping); and which swept keys
 //! are settings, which the workload ([`is_setting`]).
 
 use settle_planner::ProfileKind;

@@ -29,9 +29,10 @@ use settle_gcode::config::{KlipperConfig, RrfConfig, ShaperSetting as FirmwareSh
 
 use crate::error::{Error, Location};
 use crate::output::atomic::write_atomic;
-use crate::workflows::tune::firmware::Firmware;
+use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::grid::{identified_band, tuning_modes};
 use crate::workflows::{Exit, Report};
+use settle_planner::firmware::Firmware;
 
 /// Shaper frequencies of the search, as multiples of the current one.
 pub const FREQUENCY_SCALES: [f64; 5] = [0.9, 0.95, 1.0, 1.05, 1.1];
@@ -164,8 +165,21 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
 }
 
 fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)> {
-    s.kind_name(dialect)
+    s.type_name(dialect)
         .map(|n| (n, s.frequency_hz, s.damping_ratio))
+}
+
+/// The firmwares whose configurations `settle import` reads: Klipper (printer.cfg) and
+/// RepRapFirmware (config.g).
+pub const READ: [Firmware; 2] = [Firmware::Klipper, Firmware::Rrf];
+
+/// A firmware of [`READ`] by name ([`Firmware::parse`]'s names).
+pub fn parse_firmware(name: &str) -> Result<Firmware, String> {
+    Firmware::parse_among(
+        name,
+        &READ,
+        "a firmware whose configuration settle import reads",
+    )
 }
 
 /// Read the current settings of a firmware configuration.
@@ -264,14 +278,14 @@ fn around(x: f64, scales: &[f64], step: f64) -> Vec<f64> {
 pub fn top_accel(firmware: Firmware, run: &crate::spec::run_spec::RunSpec) -> Option<f64> {
     let (f, zeta) = tuning_modes(run).first().copied()?;
     let highest = FREQUENCY_SCALES.iter().copied().fold(0.0, f64::max);
-    firmware
+    Candidates::of(firmware)
         .shapers()
         .into_iter()
         .filter_map(|k| {
             let (z, _) = crate::workflows::tune::target::design_damping(k, zeta);
             let sh = settle_planner::shaper::Shaper::new(k, (f * highest * 10.0).round() / 10.0, z)
                 .ok()?;
-            Some(crate::kinds::shaping::max_accel_mm_s2(
+            Some(crate::studies::shaping::max_accel_mm_s2(
                 &sh,
                 settle_planner::shaper_select::TARGET_SMOOTHING_MM,
             ))
@@ -319,14 +333,14 @@ fn scenario_text(
         (
             "none".into(),
             frequency_hz,
-            crate::kinds::shaping::DEFAULT_DAMPING_RATIO,
+            crate::studies::shaping::DEFAULT_DAMPING_RATIO,
         )
     });
     let accels = around(cur.amax_mm_s2, &ACCEL_SCALES, 100.0);
     let tune_accels = tune_accels(cur.amax_mm_s2, top);
     let freqs = around(f_now, &FREQUENCY_SCALES, 0.1);
     let mut types = vec![q("none")];
-    types.extend(fw.shapers().iter().map(|k| q(&k.name())));
+    types.extend(Candidates::of(fw).shapers().iter().map(|k| q(&k.name())));
     if !types.contains(&q(&type_now)) {
         types.push(q(&type_now));
     }

@@ -12,23 +12,7 @@ use std::time::{Duration, Instant};
 /// least a scenario may ask for): symplectic Euler is stable for `w h < 2`, so the 40 Hz
 /// mode (`w h = 0.25`) runs and the 480 Hz one (`w h = 3.0`) grows by a factor of about 7
 /// per step until it is caught.
-const BLOW_UP: &str = r#"name = "blowup"
-[machine]
-modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]
-[move]
-distance_mm = 5.0
-profile = "trapezoid"
-[limits]
-vmax_mm_s = 300.0
-amax_mm_s2 = 3000.0
-[observe]
-window_s = 0.3
-sample_rate_hz = 1000
-[sim]
-max_step_s = 0.002
-[sweep]
-"machine.modes.0.frequency_hz" = [40.0, 480.0]
-"#;
+const BLOW_UP: &str = include_str!("../faults/blowup.toml");
 
 #[test]
 fn a_blow_up_is_a_failed_run_with_its_reason_and_the_sweep_goes_on() {
@@ -155,7 +139,7 @@ fn sim_step_must_be_positive() {
         .expect("runs");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("bad.toml:14"), "{stderr}");
+    assert!(stderr.contains("bad.toml:16"), "{stderr}");
     assert!(stderr.contains("sim.max_step_s"), "{stderr}");
     assert!(stderr.contains("> 0"), "{stderr}");
 }
@@ -332,7 +316,7 @@ fn a_mujoco_blow_up_is_a_fault_too() {
 
 /// A raster scan's step on one 480 Hz mode through rapier: with `[sim] max_step_s = 2 ms`
 /// at 1 kHz sampling (a 1 ms step, `w h = 3.0`, past symplectic Euler's limit of 2) the run blows up and is a fault; with
-/// rapier's own step it runs. Every run kind is simulated with the scenario's `[sim]`
+/// rapier's own step it runs. Every study is simulated with the scenario's `[sim]`
 /// settings (`settle::execute::sim_options`), the scan step included.
 #[test]
 fn a_scan_step_honours_the_sim_max_step() {

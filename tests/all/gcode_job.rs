@@ -1,10 +1,10 @@
-//! `settle gcode` and the `[gcode]` run kind: a G-code job simulated on printer_xy.
+//! `settle gcode` and the `[gcode]` study: a G-code job simulated on printer_xy.
 
 use std::path::{Path, PathBuf};
 
 use settle::spec::backend::Backend;
 use settle::workflows::gcode::{GcodeOptions, gcode, measure, parse_shaper};
-use settle_gcode::job::Firmware;
+use settle_planner::firmware::Firmware;
 
 use crate::support::{extra, root, settle, write};
 
@@ -86,7 +86,7 @@ fn the_cube_layer_writes_layers_summary_and_a_ringing_map() {
 /// any split, so the results differ by rounding only: 1e-9 relative is far above that
 /// (1e-16 per step, 1e4 steps).
 #[test]
-fn a_gcode_corner_gives_the_metrics_of_the_corner_kind() {
+fn a_gcode_corner_gives_the_metrics_of_the_corner_study() {
     let load = |name: &str| {
         let (_, mut runs) = settle::load_runs(&root().join("scenarios").join(name)).expect("loads");
         settle::execute::set_backend(Path::new(name), &mut runs, Backend::Modal).expect("modal");
@@ -100,12 +100,12 @@ fn a_gcode_corner_gives_the_metrics_of_the_corner_kind() {
     let g = settle::execute::execute(&g_run, None).expect("runs");
     let axes = settle::execute::axes_of(&c_run).expect("axes");
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
-    let point = settle::kinds::plan(&g_run, &names)
+    let point = settle::studies::plan(&g_run, &names)
         .expect("plans")
         .linearise_at_m
         .expect("printer_xy's belts depend on position");
     assert_eq!(point, vec![10.0 * 1e-3, 10.0 * 1e-3]);
-    let planned = settle::kinds::plan(&c_run, &names).expect("plans");
+    let planned = settle::studies::plan(&c_run, &names).expect("plans");
     assert!(planned.probe.is_none() && planned.linearise_at_m.is_none());
     let c = settle::execute::run_trajectory(
         axes,

@@ -6,7 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
-use settle::input::machine_file::{MachineForm, parse_any};
+use settle::input::machine_file::parse_any;
+use settle::input::machine_form::MachineForm;
 use settle::spec::backend::Backend;
 use settle::workflows::identify::{IdentifyOptions, identify};
 
@@ -68,7 +69,7 @@ fn identified_modes_go_into_a_machine_file_that_a_sweep_takes() {
         "name = \"s\"\n[machine]\npreset = \"machine.toml\"\n[move]\ndistance_mm = 5.0\naxis = \"y\"\nprofile = \"trapezoid\"\n[limits]\nvmax_mm_s = 100.0\namax_mm_s2 = 2000.0\n[sweep]\n\"limits.amax_mm_s2\" = [1000.0, 2000.0]\n",
     );
     let (_, mut runs) = settle::load_runs(&scenario).expect("expands");
-    assert_eq!(runs[0].modes, got.modes);
+    assert_eq!(runs[0].machine.modes(), got.modes);
     settle::execute::set_backend(&scenario, &mut runs, Backend::Modal).expect("modal");
     for r in &runs {
         let m = settle::execute::execute(r, None).expect("runs");

@@ -1,7 +1,8 @@
 //! `settle tune --criterion klipper` on the corpus of real files
 //! (`identify/tests/corpus/MANIFEST.md`): every line equal to what Klipper's
 //! `scripts/calibrate_shaper.py` printed for the same file
-//! (`identify/tests/corpus/klipper_calibrate_shaper.txt`, Klipper 84104bbbd762), and
+//! (`identify/tests/corpus/klipper_calibrate_shaper.txt`, Klipper 84104bbbd762; for a
+//! Shake&Tune `.stdata` recording, on its samples written as a Klipper raw CSV), and
 //! `--out` writing the `[input_shaper]` lines of the recommendation per axis.
 
 use std::path::PathBuf;
@@ -32,7 +33,8 @@ fn script_output() -> Vec<(String, Vec<String>)> {
 #[test]
 fn klipper_criterion_equals_calibrate_shaper_on_the_corpus() {
     let expected = script_output();
-    assert_eq!(expected.len(), 16);
+    // 20 processed spectra, 4 Klipper raw recordings and 2 Shake&Tune `.stdata`.
+    assert_eq!(expected.len(), 26);
     for (file, want) in expected {
         let c = KlipperCriterion::from_args(vec![corpus_dir().join(&file)], None, None, None, None)
             .expect("options");

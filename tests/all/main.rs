@@ -20,6 +20,7 @@ mod limits;
 mod machine_cmd;
 mod machines;
 mod modes_axes;
+mod module_graph;
 mod outputs_check;
 mod outputs_mcap;
 mod outputs_plots;

@@ -184,8 +184,8 @@ fn unreadable_file_is_an_input_error() {
 }
 
 #[test]
-fn unknown_tables_and_keys_inside_a_kind_table_name_their_line() {
-    // An unknown table: the strict scenario parse names its line and lists the run kinds'
+fn unknown_tables_and_keys_inside_a_study_table_name_their_line() {
+    // An unknown table: the strict scenario parse names its line and lists the studies'
     // tables besides its own keys.
     let msg = parse_err(&GOOD.replace("[sweep]", "[scna]\nlines = 3\n[sweep]"));
     assert!(msg.starts_with("bad.toml:10:"), "{msg}");
@@ -208,7 +208,7 @@ fn unknown_tables_and_keys_inside_a_kind_table_name_their_line() {
 }
 
 /// The keys a table of a scenario accepts, as the parser lists them for an unknown one
-/// (`expected one of `a`, `b`...`), without the run kinds' tables it adds at the top level.
+/// (`expected one of `a`, `b`...`), without the studies' tables it adds at the top level.
 fn accepted_keys(table: &str) -> Vec<String> {
     let head = format!("[{table}]\n");
     let text = if table.is_empty() {
@@ -216,7 +216,7 @@ fn accepted_keys(table: &str) -> Vec<String> {
     } else if GOOD.contains(&head) {
         GOOD.replace(&head, &format!("{head}bogus_key = 1\n"))
     } else {
-        // The run kind tables are parsed before the motion is checked, so `[corner]` or
+        // The studies' tables are parsed before the motion is checked, so `[corner]` or
         // `[gcode]` beside `[move]` still reports its unknown key first.
         format!("{GOOD}\n{head}bogus_key = 1\n")
     };
@@ -225,7 +225,7 @@ fn accepted_keys(table: &str) -> Vec<String> {
         .split("expected ")
         .nth(1)
         .unwrap_or_else(|| panic!("[{table}]: {e}"));
-    let list = list.split(", or a run kind's table").next().unwrap_or(list);
+    let list = list.split(", or a study's table").next().unwrap_or(list);
     list.split('`')
         .skip(1)
         .step_by(2)
@@ -251,7 +251,7 @@ fn the_scenario_reference_documents_every_table_and_key() {
     };
     let top = accepted_keys("");
     assert!(top.contains(&"current".to_string()), "{top:?}");
-    let mut tables: Vec<String> = settle::kinds::tables()
+    let mut tables: Vec<String> = settle::studies::tables()
         .iter()
         .map(|t| t.to_string())
         .collect();

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use settle::spec::backend::Backend;
 use settle::workflows::tune::{Options, tune_axis};
 use settle_planner::ProfileKind;
-use settle_planner::shaper::Firmware as ShaperFirmware;
+use settle_planner::firmware::Firmware;
 
 use crate::support::{root, write};
 
@@ -54,9 +54,9 @@ fn firmware_restricts_the_candidates() {
     // The TMC4361A's register ranges depend on the resolution: 80 microsteps per mm.
     let small = "frequency_scales = [1.0]\njerk_steps = 1\nusteps_per_mm = 80.0\n";
     for (fw, shaper_fw) in [
-        ("klipper", Some(ShaperFirmware::Klipper)),
-        ("marlin", Some(ShaperFirmware::Marlin)),
-        ("rrf", Some(ShaperFirmware::Rrf)),
+        ("klipper", Some(Firmware::Klipper)),
+        ("marlin", Some(Firmware::Marlin)),
+        ("rrf", Some(Firmware::Rrf)),
         ("tmc4361a", None),
     ] {
         let o = run(
@@ -71,7 +71,7 @@ fn firmware_restricts_the_candidates() {
         assert!(!grid.is_empty());
         for s in grid {
             let c = &s.candidate;
-            let kind = c.shaper.and_then(|sh| sh.kind);
+            let kind = c.shaper.and_then(|sh| sh.shaper_type);
             match shaper_fw {
                 Some(f) => {
                     assert_eq!(c.kind, ProfileKind::Trapezoid, "{fw}: {}", c.label());
@@ -172,7 +172,7 @@ fn frequency_tolerance_scores_the_worst_detuned_case() {
     assert_eq!(nominal.scores.len(), robust.scores.len());
     for (n, r) in nominal.scores.iter().zip(&robust.scores) {
         assert_eq!(n.candidate, r.candidate);
-        if n.candidate.shaper.and_then(|s| s.kind).is_some() {
+        if n.candidate.shaper.and_then(|s| s.shaper_type).is_some() {
             // The worst of nominal, -10 % and +10 %: never better than nominal.
             assert!(r.move_and_settle_s >= n.move_and_settle_s, "{n:?} {r:?}");
         } else {
@@ -188,7 +188,7 @@ fn frequency_tolerance_scores_the_worst_detuned_case() {
             .find(|s| {
                 s.candidate
                     .shaper
-                    .and_then(|sh| sh.kind)
+                    .and_then(|sh| sh.shaper_type)
                     .map(|k| k.name())
                     .as_deref()
                     == Some(name)
@@ -252,7 +252,7 @@ fn shaped<'a>(
         .find(|s| {
             s.candidate
                 .shaper
-                .and_then(|sh| sh.kind)
+                .and_then(|sh| sh.shaper_type)
                 .map(|k| k.name())
                 .as_deref()
                 == Some(name)
@@ -276,7 +276,7 @@ fn identified_frequency_band_makes_tune_prefer_a_robust_shaper() {
         o.scores[o.winner]
             .candidate
             .shaper
-            .and_then(|s| s.kind)
+            .and_then(|s| s.shaper_type)
             .map(|k| k.name())
     };
     // Known exactly (no sigma): no band, and ZV, the shortest shaper, wins at 47.2 Hz.
@@ -475,7 +475,7 @@ fn shapers_are_designed_for_the_modes_damping_within_what_the_firmware_takes() {
         o.scores
             .iter()
             .filter_map(|s| s.candidate.shaper)
-            .find(|sh| sh.kind.is_some_and(|k| k.name() == name))
+            .find(|sh| sh.shaper_type.is_some_and(|k| k.name() == name))
             .expect("searched")
             .damping_ratio
     };

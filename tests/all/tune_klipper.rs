@@ -53,22 +53,22 @@ fn klippers_choice_on_the_modes_is_its_choice_on_the_recording() {
         let (r, m) = (from_recording.recommended, from_modes.recommended);
         eprintln!(
             "{file}: recording {} @ {:.2} Hz (v {:.4}, max_accel {:.0}); modes {} @ {:.2} Hz (v {:.4}, max_accel {:.0})",
-            r.kind.name(),
+            r.shaper_type.name(),
             r.frequency_hz,
             r.vibrations,
             r.max_accel_mm_s2,
-            m.kind.name(),
+            m.shaper_type.name(),
             m.frequency_hz,
             m.vibrations,
             m.max_accel_mm_s2
         );
-        assert_eq!(r.kind, m.kind, "{file}");
+        assert_eq!(r.shaper_type, m.shaper_type, "{file}");
         assert!((r.frequency_hz - m.frequency_hz).abs() <= 0.41, "{file}");
         // SHAPER_CALIBRATE saves the frequency to 0.1 Hz.
         assert_eq!(
             (saved.name.as_str(), saved.frequency_hz),
             (
-                r.kind.name().as_str(),
+                r.shaper_type.name().as_str(),
                 (r.frequency_hz * 10.0).round() / 10.0
             ),
             "{file}"

@@ -21,7 +21,7 @@ pub struct RrfExport {
     /// What produced the values (a scenario, a command line); written as a comment.
     pub produced_by: String,
     /// The shaper of all axes: `name` an `M593 P` type (`zvd`, `mzv`, `ei2`, ...; a
-    /// `rrf:` prefix, as in `ShaperKind` names, is dropped), frequency in Hz, damping
+    /// `rrf:` prefix, as in `ShaperType` names, is dropped), frequency in Hz, damping
     /// ratio.
     pub shaper: ShaperSetting,
     /// `M204 P`: acceleration of printing moves, mm/s^2 (written only when given).

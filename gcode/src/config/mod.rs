@@ -27,7 +27,7 @@
 //!             shaper_type_y: ei\nshaper_freq_y: 41.5\n";
 //! let c = KlipperConfig::parse(text, "printer.cfg")?;
 //! let shaper = c.input_shaper.expect("an [input_shaper] section");
-//! assert_eq!(shaper.x.kind_name(Dialect::Klipper).as_deref(), Some("mzv"));
+//! assert_eq!(shaper.x.type_name(Dialect::Klipper).as_deref(), Some("mzv"));
 //! assert_eq!((shaper.x.frequency_hz, shaper.x.damping_ratio), (52.4, 0.1)); // default zeta
 //! assert_eq!(c.printer.minimum_cruise_ratio, 0.5); // Klipper's default
 //!

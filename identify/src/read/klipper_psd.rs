@@ -16,7 +16,7 @@
 //! `exp(1 - (10 / (f + 0.1))^2)`. The reader tells these apart by the bins between 0 and
 //! 5 Hz: all exactly zero means the older rule.
 
-use super::{parse_number, truncate};
+use super::{MAX_SPECTRUM_ROWS, parse_number, truncate};
 use crate::IdentifyError;
 
 /// Fewest frequency rows accepted.
@@ -161,6 +161,13 @@ pub fn parse(file: &str, text: &str) -> Result<ProcessedPsd, IdentifyError> {
                 n,
                 format!("frequency {f} Hz after {} Hz", freq_hz[freq_hz.len() - 1]),
                 "frequencies increasing from row to row",
+            ));
+        }
+        if freq_hz.len() == MAX_SPECTRUM_ROWS {
+            return Err(IdentifyError::not_accepted(
+                file,
+                format!("more than {MAX_SPECTRUM_ROWS} frequency rows (line {n})"),
+                format!("at most {MAX_SPECTRUM_ROWS} rows a spectrum"),
             ));
         }
         freq_hz.push(f);

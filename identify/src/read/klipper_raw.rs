@@ -7,7 +7,10 @@
 //! applied. Klipper's own parser (`scripts/calibrate_shaper.py`, `np.loadtxt(...,
 //! comments='#')`) skips every line starting with `#`; so does this one.
 
-use super::{MIN_SAMPLES, Recording, RecordingFormat, check_times, parse_number, truncate};
+use super::{
+    MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_times, parse_number,
+    too_many_samples, truncate,
+};
 use crate::IdentifyError;
 
 /// The header line Klipper writes.
@@ -68,6 +71,9 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
                 format!("more than 4 fields (`{}`)", truncate(l)),
                 "4 comma-separated numbers: time (s), accel_x, accel_y, accel_z (mm/s^2)",
             ));
+        }
+        if time_s.len() == MAX_SAMPLES {
+            return Err(too_many_samples(file, n));
         }
         time_s.push(row[0]);
         for (a, v) in axes.iter_mut().zip(&row[1..]) {

@@ -14,9 +14,32 @@ pub mod klipper_raw;
 pub mod rrf;
 pub mod stdata;
 
+use std::io::Read as _;
 use std::path::Path;
 
 use crate::IdentifyError;
+
+/// The largest file the readers take, and the most text a `.stdata` file may decompress
+/// to (bytes): 64 MiB, three times a 130 s Klipper test at 3.2 kHz (20 MB). With
+/// [`MAX_SAMPLES`] it bounds what identifying a file holds in memory
+/// (`docs/performance.md`).
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
+/// The most samples one recording may hold: 1.5 million, 7.8 minutes at 3.2 kHz.
+pub const MAX_SAMPLES: usize = 1_500_000;
+
+/// The most rows a processed spectrum may hold (Klipper writes about 130, one per bin up
+/// to 200 Hz).
+pub const MAX_SPECTRUM_ROWS: usize = 100_000;
+
+/// The error for a recording with more than [`MAX_SAMPLES`] samples, found at `line`.
+pub(crate) fn too_many_samples(file: &str, line: usize) -> IdentifyError {
+    IdentifyError::not_accepted(
+        file,
+        format!("more than {MAX_SAMPLES} samples (line {line})"),
+        format!("at most {MAX_SAMPLES} samples a recording (7.8 minutes at 3.2 kHz)"),
+    )
+}
 
 /// Standard gravity (mm/s^2), as Klipper's `adxl345.py` (`FREEFALL_ACCEL`) and the g
 /// values of RepRapFirmware's files use it.
@@ -118,10 +141,7 @@ pub enum FileData {
 /// Shake&Tune, `#time,` -> Klipper raw, `freq,` -> Klipper processed, `Sample` -> M956.
 pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| IdentifyError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let bytes = read_bounded(path, &file)?;
     if bytes.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
         return stdata::parse(&file, &bytes).map(FileData::Recordings);
     }
@@ -152,6 +172,44 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
             "a header `#time,accel_x,accel_y,accel_z` (Klipper raw), `freq,psd_x,...` (Klipper processed), `Sample,X,Y,Z` (RepRapFirmware M956) or a zstd-compressed .stdata file",
         ))
     }
+}
+
+/// The bytes of the regular file at `path`, at most [`MAX_FILE_BYTES`] of them: a folder,
+/// a device (`/dev/zero` never ends) or a pipe is refused before it is opened, and the
+/// read stops past the limit even if the file grows meanwhile.
+fn read_bounded(path: &Path, file: &str) -> Result<Vec<u8>, IdentifyError> {
+    let io = |source| IdentifyError::Io {
+        file: file.to_string(),
+        source,
+    };
+    let allowed = || format!("at most {MAX_FILE_BYTES} bytes (64 MiB)");
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(IdentifyError::not_accepted(
+            file,
+            "not a regular file (a folder, a device or a pipe)",
+            "a regular file",
+        ));
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(IdentifyError::not_accepted(
+            file,
+            format!("{} bytes", meta.len()),
+            allowed(),
+        ));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(IdentifyError::not_accepted(
+            file,
+            format!("more than {MAX_FILE_BYTES} bytes"),
+            allowed(),
+        ));
+    }
+    Ok(bytes)
 }
 
 /// Parse one number of a CSV field, naming the file, line and column on failure.

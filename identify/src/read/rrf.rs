@@ -9,8 +9,8 @@
 //! data from accelerometer` or `Received bad data` instead.
 
 use super::{
-    MAX_RATE_HZ, MIN_RATE_HZ, MIN_SAMPLES, Recording, RecordingFormat, STANDARD_GRAVITY_MM_S2,
-    parse_number, truncate,
+    MAX_RATE_HZ, MAX_SAMPLES, MIN_RATE_HZ, MIN_SAMPLES, Recording, RecordingFormat,
+    STANDARD_GRAVITY_MM_S2, parse_number, too_many_samples, truncate,
 };
 use crate::IdentifyError;
 
@@ -89,6 +89,9 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
                 format!("`{}`", truncate(l)),
                 expected,
             ));
+        }
+        if columns[0].len() == MAX_SAMPLES {
+            return Err(too_many_samples(file, n));
         }
         for (k, col) in columns.iter_mut().enumerate() {
             let name = names[k + 1];

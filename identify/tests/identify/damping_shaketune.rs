@@ -16,10 +16,16 @@
 //! of Klipper's resonance test (the pulse-only test the corpus files were measured with,
 //! `accel_per_hz` 75, 5 to 133.3 Hz) seen through Klipper's estimator, whose window widens
 //! a narrow peak: there the rule returns 0.62 to 0.77 of the true damping ratio.
+//!
+//! And on the real recordings whose Shake&Tune graph the owner published
+//! (`identify/tests/corpus/MANIFEST.md`): the rule applied to the spectrum settle
+//! measured gives the graph's damping ratio, and applied to settle's fitted model (the
+//! spectrum settle's modes give under that file's own test, window and sample rate) it
+//! gives about the same, while settle's own damping ratio stands above it.
 
-use settle_identify::SweepTest;
 use settle_identify::fit::sweep_model::{ModeParams, SweepModel};
 use settle_identify::welch::Welch;
+use settle_identify::{AxisIdentification, IdentifiedMode, SweepTest};
 
 /// Shake&Tune's damping estimate from a normalised PSD (see the module notes).
 fn shaketune_zeta(freq: &[f64], psd: &[f64]) -> Option<f64> {
@@ -88,4 +94,114 @@ fn shaketune_reads_about_two_thirds_of_the_damping() {
             "{f_hz} Hz, zeta {zeta}: ratio {ratio}"
         );
     }
+}
+
+/// The corpus files with a published Shake&Tune graph: `(file, w0 (Hz), zeta)` as the
+/// graph's title prints them.
+const SHAKETUNE_GRAPHS: [(&str, f64, f64); 5] = [
+    (
+        "neptune4pro_inputshaper_20250707_143713_axis_X.stdata",
+        77.1,
+        0.093,
+    ),
+    (
+        "neptune4pro_inputshaper_20250804_210218_axis_Y.stdata",
+        81.6,
+        0.064,
+    ),
+    ("metis_resonances_20240206_200114_X.csv", 64.1, 0.062),
+    ("metis_resonances_20240206_200335_Y.csv", 55.0, 0.088),
+    ("vt627_resonances_20240226_202625_X.csv", 68.8, 0.039),
+];
+
+/// Shake&Tune's damping estimate on the spectrum settle measured and on settle's fitted
+/// model (`psd / (f + 0.1)` over the fitted band of the identification's figure).
+fn shaketune_on_figure(id: &AxisIdentification) -> (f64, f64) {
+    let fig = &id.figure;
+    let fitted: Vec<usize> = (0..fig.x.len())
+        .filter(|&i| fig.model[i].is_finite())
+        .collect();
+    let freq: Vec<f64> = fitted.iter().map(|&i| fig.x[i]).collect();
+    let normalised =
+        |v: &[f64]| -> Vec<f64> { fitted.iter().map(|&i| v[i] / (fig.x[i] + 0.1)).collect() };
+    let zeta = |v: &[f64]| shaketune_zeta(&freq, &normalised(v)).expect("two half-power points");
+    (zeta(&fig.measured), zeta(&fig.model))
+}
+
+/// The mode whose natural frequency or own peak lies nearest `main_hz`.
+fn main_mode(id: &AxisIdentification, main_hz: f64) -> &IdentifiedMode {
+    let d = |m: &IdentifiedMode| {
+        (m.frequency_hz.value - main_hz)
+            .abs()
+            .min((m.peak_hz - main_hz).abs())
+    };
+    id.modes
+        .iter()
+        .min_by(|a, b| d(a).total_cmp(&d(b)))
+        .expect("a mode")
+}
+
+/// The median of `v`.
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    0.5 * (v[(n - 1) / 2] + v[n / 2])
+}
+
+/// On each real recording with a published Shake&Tune graph: Shake&Tune's rule on the
+/// spectrum settle measured (`psd / (f + 0.1)` over the fitted band) reproduces the
+/// graph's damping ratio within 10 % (settle's spectrum is the motion direction's at a
+/// quarter-segment hop, Shake&Tune's the sum of the three axes at half a segment), and
+/// settle's damping ratio of the main mode is larger. Over the files, the rule applied to
+/// settle's fitted model gives the graph's damping ratio within 10 % at the median,
+/// where settle's own stands at least 30 % above it: the gap is the rule's reading of a
+/// power spectrum, not a difference in the modes. The other modes are shown too
+/// (`--nocapture`), for `docs/guide/real-recordings.md`.
+#[test]
+fn shaketune_rule_on_settles_model_gives_the_published_damping() {
+    let (mut settle_over, mut model_over) = (Vec::new(), Vec::new());
+    for (file, w0, published) in SHAKETUNE_GRAPHS {
+        let ids = crate::corpus::answer(file).as_ref().expect("modes");
+        let id = &ids[0];
+        let (on_measured, on_model) = shaketune_on_figure(id);
+        let main = main_mode(id, w0);
+        let settle = main.damping_ratio.value;
+        println!(
+            "{file}: Shake&Tune {w0} Hz, {published}; its rule on settle's spectrum {on_measured:.3}, on settle's model {on_model:.3}; settle {:.1} Hz, {settle:.3} ({:.2} x)",
+            main.frequency_hz.value,
+            settle / published
+        );
+        assert!(
+            (on_measured / published - 1.0).abs() <= 0.1,
+            "{file}: Shake&Tune's rule on settle's spectrum {on_measured}, graph {published}"
+        );
+        assert!(settle > published, "{file}: settle {settle}");
+        settle_over.push(settle / published);
+        model_over.push(on_model / published);
+    }
+    let (settle_over, model_over) = (median(settle_over), median(model_over));
+    println!("median: settle {settle_over:.2} x, the rule on settle's model {model_over:.2} x");
+    assert!((model_over - 1.0).abs() <= 0.1, "{model_over}");
+    assert!(settle_over >= 1.3, "{settle_over}");
+}
+
+/// On every corpus file that gives modes: Shake&Tune's rule on the spectrum settle
+/// measured against settle's damping ratio of the mode at the published main resonance,
+/// shown per file (`--nocapture`) with the median, for `docs/guide/real-recordings.md`.
+/// The rule reads 0.62 to 0.77 of the true damping ratio on Klipper's spectra (above), so
+/// settle's must stand above it on every file, by 1.3 to 1.6 at the median.
+#[test]
+fn shaketune_rule_on_the_whole_corpus() {
+    let mut ratios = Vec::new();
+    for (file, main_hz, id) in crate::corpus::identified() {
+        let (on_measured, _) = shaketune_on_figure(id);
+        let settle = main_mode(id, main_hz).damping_ratio.value;
+        let ratio = settle / on_measured;
+        println!("{file}: Shake&Tune's rule {on_measured:.3}, settle {settle:.3} ({ratio:.2} x)");
+        assert!(ratio > 1.0, "{file}: {ratio}");
+        ratios.push(ratio);
+    }
+    let m = median(ratios);
+    println!("median {m:.2} x");
+    assert!((1.3..=1.6).contains(&m), "{m}");
 }

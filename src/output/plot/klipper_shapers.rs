@@ -4,26 +4,12 @@
 //! bottom: each shaper's remaining vibration at its chosen frequency, the worst over the
 //! test damping ratios (the script's `vals`).
 
-use settle_planner::shaper::{KLIPPER_DEFAULT_DAMPING_RATIO, Shaper, remaining_vibration};
 use std::path::PathBuf;
 
+use settle_planner::shaper::{KLIPPER_DEFAULT_DAMPING_RATIO, Shaper, remaining_vibration};
 use settle_planner::shaper_select::{CalibrationData, Fit, MAX_FREQ_HZ, SelectOptions, Selection};
 
 use crate::output::plot::{Figure, Line, PALETTE, Panel, Rule};
-
-/// What the graph of one axis shows: the axis, its files, the first data set (the one
-/// calibrate_shaper.py draws) and Klipper's choice.
-#[derive(Debug)]
-pub struct AxisGraph<'a> {
-    /// The machine axis the file names name, `None` when they name none.
-    pub axis: Option<char>,
-    /// The files, in the order given.
-    pub files: &'a [PathBuf],
-    /// The data set drawn.
-    pub data: &'a CalibrationData,
-    /// The choice.
-    pub selection: &'a Selection,
-}
 
 /// The remaining vibration of `fit`'s shaper at `freq_hz`, worst over the test damping
 /// ratios; `None` when the shaper cannot be built.
@@ -33,7 +19,7 @@ fn response(fit: &Fit, opts: &SelectOptions, freq_hz: &[f64]) -> Option<Vec<f64>
     } else {
         opts.damping_ratio
     };
-    let shaper = Shaper::new(fit.kind, fit.frequency_hz, zeta).ok()?;
+    let shaper = Shaper::new(fit.shaper_type, fit.frequency_hz, zeta).ok()?;
     let (a, t) = (shaper.amplitudes(), shaper.times_s());
     Some(
         freq_hz
@@ -48,10 +34,16 @@ fn response(fit: &Fit, opts: &SelectOptions, freq_hz: &[f64]) -> Option<Vec<f64>
     )
 }
 
-/// The figure for one axis's choice.
-pub fn figure(a: &AxisGraph, opts: &SelectOptions) -> Figure {
+/// The figure for the choice `selection` on one axis (`axis`: `x`, `y`, `z` or `all`),
+/// from the spectrum `data` of `files`.
+pub fn figure(
+    axis: &str,
+    files: &[PathBuf],
+    data: &CalibrationData,
+    selection: &Selection,
+    opts: &SelectOptions,
+) -> Figure {
     let max_freq = opts.max_freq_hz.unwrap_or(MAX_FREQ_HZ);
-    let data = a.data;
     let keep: Vec<usize> = (0..data.freq_hz.len())
         .filter(|&i| data.freq_hz[i] <= max_freq)
         .collect();
@@ -73,7 +65,7 @@ pub fn figure(a: &AxisGraph, opts: &SelectOptions) -> Figure {
             psd_lines.push(l);
         }
     }
-    let rec = &a.selection.recommended;
+    let rec = &selection.recommended;
     if let Some(v) = response(rec, opts, &freq) {
         let after = keep
             .iter()
@@ -83,7 +75,7 @@ pub fn figure(a: &AxisGraph, opts: &SelectOptions) -> Figure {
         psd_lines.push(Line::new(
             Some(format!(
                 "after {} @ {:.1} Hz",
-                rec.kind.name(),
+                rec.shaper_type.name(),
                 rec.frequency_hz
             )),
             PALETTE[5],
@@ -91,11 +83,11 @@ pub fn figure(a: &AxisGraph, opts: &SelectOptions) -> Figure {
         ));
     }
     let mut shaper_lines = Vec::new();
-    for (k, s) in a.selection.per_shaper.iter().enumerate() {
+    for (k, s) in selection.per_shaper.iter().enumerate() {
         if let Some(v) = response(s, opts, &freq) {
             let label = format!(
                 "{} ({:.1} Hz, vibr={:.1}%, sm~={:.2}, accel<={:.0})",
-                s.kind.name(),
+                s.shaper_type.name(),
                 s.frequency_hz,
                 s.vibrations * 100.0,
                 s.smoothing_mm,
@@ -110,12 +102,11 @@ pub fn figure(a: &AxisGraph, opts: &SelectOptions) -> Figure {
             shaper_lines.push(l);
         }
     }
-    let files: Vec<String> = a.files.iter().map(|f| f.display().to_string()).collect();
-    let axis = a.axis.map_or("all".to_string(), |c| c.to_string());
+    let files: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
     Figure {
         title: format!(
             "Klipper's choice, axis {axis}: {} @ {:.1} Hz ({})",
-            rec.kind.name(),
+            rec.shaper_type.name(),
             rec.frequency_hz,
             files.join(", ")
         ),

@@ -34,11 +34,10 @@ const COLUMNS: [&str; 19] = [
 /// The shaper's type, frequency and damping ratio as text (`none` and empty cells when
 /// unshaped).
 fn shaper_cells(s: &Score) -> (String, Option<f64>, Option<f64>) {
-    match s
-        .candidate
-        .shaper
-        .and_then(|sh| sh.kind.map(|k| (k, sh.frequency_hz, sh.damping_ratio)))
-    {
+    match s.candidate.shaper.and_then(|sh| {
+        sh.shaper_type
+            .map(|k| (k, sh.frequency_hz, sh.damping_ratio))
+    }) {
         Some((k, f, z)) => (k.name().to_string(), Some(f), Some(z)),
         None => ("none".to_string(), None, None),
     }

@@ -5,11 +5,15 @@
 use std::fmt::Write as _;
 
 use super::search::{Plan, Score};
-use crate::kinds::scan::ScanSpec;
+use crate::studies::scan::ScanSpec;
 
 /// A candidate's shaper in words: `mzv @ 52.0 Hz (zeta 0.1)` or `none`.
 pub fn shaper_text(s: &Score) -> String {
-    match s.candidate.shaper.and_then(|sh| sh.kind.map(|k| (k, sh))) {
+    match s
+        .candidate
+        .shaper
+        .and_then(|sh| sh.shaper_type.map(|k| (k, sh)))
+    {
         Some((k, sh)) => format!(
             "{} @ {:.1} Hz (zeta {})",
             k.name(),

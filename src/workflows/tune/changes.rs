@@ -42,7 +42,7 @@ impl Change {
 /// A shaper as `(type, frequency, damping)` text; `None` unshaped.
 fn shaper_values(s: &Score) -> Option<(String, f64, f64)> {
     let sh = s.candidate.shaper?;
-    Some((sh.kind?.name(), sh.frequency_hz, sh.damping_ratio))
+    Some((sh.shaper_type?.name(), sh.frequency_hz, sh.damping_ratio))
 }
 
 /// Why the recommendation `w` replaces the current `d` on `axis`: the gain, or why the

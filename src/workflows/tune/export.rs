@@ -26,15 +26,15 @@ use std::fmt::Write as _;
 
 use settle_gcode::config::{KlipperExport, Note, RrfExport, ShaperSetting as FirmwareShaper};
 use settle_planner::ProfileKind;
+use settle_planner::firmware::Firmware;
 use settle_planner::tmc::ramp::SRampParams;
 use settle_planner::tmc::registers::{TmcUnits, export};
 
 use super::Outcome;
-use super::firmware::Firmware;
 use super::search::Score;
 use super::{changes, head, target};
-use crate::kinds::corner::Corner;
-use crate::kinds::shaping::DEFAULT_DAMPING_RATIO;
+use crate::studies::corner::Corner;
+use crate::studies::shaping::DEFAULT_DAMPING_RATIO;
 
 /// The TMC4361A clock assumed when `[tune] tmc_clock_hz` is not given (Hz). In the chip's
 /// default (frequency) mode the clock appears only in CLK_FREQ, so the ramp registers do
@@ -52,7 +52,7 @@ fn winner_of<'a>(axes: &'a [(String, Outcome)], letter: &str) -> Option<&'a Outc
 /// The firmware shaper of a score: `None` when the candidate is unshaped.
 fn shaper_of(s: &Score) -> Option<FirmwareShaper> {
     let sh = s.candidate.shaper?;
-    let k = sh.kind?;
+    let k = sh.shaper_type?;
     Some(FirmwareShaper {
         name: k.name(),
         frequency_hz: sh.frequency_hz,
@@ -179,7 +179,7 @@ fn rrf_axis(axes: &[(String, Outcome)]) -> Option<(&str, &Score)> {
         let f = |s: &Score| {
             s.candidate
                 .shaper
-                .filter(|sh| sh.kind.is_some())
+                .filter(|sh| sh.shaper_type.is_some())
                 .map_or(f64::INFINITY, |sh| sh.frequency_hz)
         };
         f(a.1).total_cmp(&f(b.1))
@@ -279,7 +279,7 @@ fn tmc_axis(axis: &str, o: &Outcome) -> Result<String, String> {
     let w = &o.scores[o.winner];
     let c = &w.candidate;
     let b = &plan.base;
-    if c.shaper.is_some_and(|sh| sh.kind.is_some()) {
+    if c.shaper.is_some_and(|sh| sh.shaper_type.is_some()) {
         return Err(format!(
             "the recommendation {} is input-shaped; the TMC4361A's ramp generator cannot shape (tune with --firmware tmc4361a)",
             c.label()

@@ -8,7 +8,7 @@ use super::Outcome;
 use super::cells::headings;
 use super::search::Score;
 use crate::output::plot::{Figure, Line, Marker, PALETTE, Panel};
-use settle_planner::shaper::ShaperKind;
+use settle_planner::shaper::ShaperType;
 
 /// Greys of the groups out of the running, in order of first appearance.
 const GREYS: [RGBColor; 5] = [
@@ -27,9 +27,9 @@ pub fn pareto_figure(name: &str, axis: &str, o: &Outcome) -> Figure {
     let drawable = |s: &&Score| s.move_time_s.is_finite() && s.residual_peak_um.is_finite();
     let mut lines = Vec::new();
     // One group per shaper the search holds (any firmware's), in order of appearance.
-    let mut groups: Vec<(String, Option<ShaperKind>)> = vec![("unshaped".into(), None)];
+    let mut groups: Vec<(String, Option<ShaperType>)> = vec![("unshaped".into(), None)];
     for s in scores {
-        if let Some(k) = s.candidate.shaper.and_then(|sh| sh.kind)
+        if let Some(k) = s.candidate.shaper.and_then(|sh| sh.shaper_type)
             && !groups.iter().any(|(_, g)| *g == Some(k))
         {
             groups.push((k.name(), Some(k)));
@@ -40,7 +40,7 @@ pub fn pareto_figure(name: &str, axis: &str, o: &Outcome) -> Figure {
             .iter()
             .filter(drawable)
             .filter(|s| s.is_feasible())
-            .filter(|s| s.candidate.shaper.and_then(|sh| sh.kind) == *kind)
+            .filter(|s| s.candidate.shaper.and_then(|sh| sh.shaper_type) == *kind)
             .map(pt)
             .collect();
         if points.is_empty() {

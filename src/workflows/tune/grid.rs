@@ -1,18 +1,19 @@
 //! The search grid of `settle tune`: the `[tune]` table resolved against the scenario's
 //! base run into candidates (kinds, jerks, kind parameters, shapers) and the move family.
 
-use settle_planner::shaper::ShaperKind;
-use settle_planner::{KindParams, ProfileKind};
+use settle_planner::shaper::ShaperType;
+use settle_planner::{ProfileKind, ProfileParams};
 
 use crate::error::Error;
 use crate::input::scenario::Scenario;
 use crate::input::source::Source;
-use crate::kinds::corner::Corner;
-use crate::kinds::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
 use crate::spec::run_spec::RunSpec;
-use crate::workflows::tune::firmware::Firmware;
+use crate::studies::corner::Corner;
+use crate::studies::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
+use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::search::{BandSource, Candidate, Plan};
 use crate::workflows::tune::target;
+use settle_planner::firmware::Firmware;
 
 /// Four-jerk BOW1..4 patterns searched (multiples of jmax; each <= 1).
 pub const BOW_PATTERNS: [[f64; 4]; 5] = [
@@ -23,7 +24,7 @@ pub const BOW_PATTERNS: [[f64; 4]; 5] = [
     [0.5, 1.0, 0.5, 1.0],
 ];
 
-/// PVT asymmetries searched (`KindParams::pvt_asym_ki`, in (1/3, 1); 0.5 is its default).
+/// PVT asymmetries searched (`ProfileParams::pvt_asym_ki`, in (1/3, 1); 0.5 is its default).
 pub const PVT_KI: [f64; 4] = [0.4, 0.5, 0.65, 0.8];
 
 /// Default frequency scales: the mode frequency +-20% (shapers are tuned to a measured
@@ -66,8 +67,8 @@ pub fn plan(
         base.axis = a.to_string();
     }
     let firmware = match &spec.firmware {
-        None => Firmware::Any,
-        Some(f) => Firmware::parse(f).map_err(|m| src.error_at("tune.firmware", m))?,
+        None => Candidates::ANY,
+        Some(f) => Candidates::parse(f).map_err(|m| src.error_at("tune.firmware", m))?,
     };
     if let Some(cur) = spec.axis.as_ref().and_then(|m| m.get(&base.axis)) {
         let current = current_shaper(cur, base.state::<ShaperSetting>())
@@ -179,7 +180,7 @@ pub fn plan(
             })
             .collect::<Result<_, _>>()?,
     };
-    let shapers: Vec<Option<ShaperKind>> = match &spec.shapers {
+    let shapers: Vec<Option<ShaperType>> = match &spec.shapers {
         None => std::iter::once(None)
             .chain(firmware.shapers().into_iter().map(Some))
             .collect(),
@@ -192,7 +193,7 @@ pub fn plan(
         Some(list) => list
             .iter()
             .map(|s| {
-                let k = crate::kinds::shaping::parse_type(s)
+                let k = crate::studies::shaping::parse_type(s)
                     .map_err(|m| src.error_at("tune.shapers", m))?;
                 firmware
                     .check_shaper(k)
@@ -242,8 +243,8 @@ pub fn plan(
         return Err(src.error_at("tune.refine_rounds", "must be 0 to 20"));
     }
     let mut notes: Vec<String> = Vec::new();
-    let tmc = match firmware {
-        Firmware::Tmc4361a => {
+    let tmc = match firmware.firmware() {
+        Some(Firmware::Tmc4361a) => {
             let usteps = spec
                 .axis
                 .as_ref()
@@ -372,7 +373,7 @@ pub fn plan(
                         // calibrate_shaper.py prints `%.1f`): the exported value is the
                         // simulated one.
                         let s = ShaperSetting {
-                            kind: Some(*k),
+                            shaper_type: Some(*k),
                             frequency_hz: (f * x * 10.0).round() / 10.0,
                             damping_ratio,
                         };
@@ -392,24 +393,24 @@ pub fn plan(
         } else {
             jerks.iter().copied().map(Some).collect()
         };
-        let params: Vec<KindParams> = match kind {
+        let params: Vec<ProfileParams> = match kind {
             // Corner paths plan their legs from the limits alone.
-            _ if base.state::<Corner>().is_some() => vec![KindParams::default()],
+            _ if base.state::<Corner>().is_some() => vec![ProfileParams::default()],
             ProfileKind::PvtAsym => PVT_KI
                 .iter()
-                .map(|&k| KindParams {
+                .map(|&k| ProfileParams {
                     pvt_asym_ki: k,
-                    ..KindParams::default()
+                    ..ProfileParams::default()
                 })
                 .collect(),
             ProfileKind::FourJerk => BOW_PATTERNS
                 .iter()
-                .map(|&b| KindParams {
+                .map(|&b| ProfileParams {
                     fourjerk_jerk_scale: b,
-                    ..KindParams::default()
+                    ..ProfileParams::default()
                 })
                 .collect(),
-            _ => vec![KindParams::default()],
+            _ => vec![ProfileParams::default()],
         };
         for j in &jerk_list {
             for p in &params {
@@ -460,7 +461,7 @@ pub fn design_damping_source(
     spec: &crate::input::tune_spec::TuneSpec,
     base: &RunSpec,
 ) -> (Option<f64>, String) {
-    match (spec.shaper_damping_ratio, &base.machine) {
+    match (spec.shaper_damping_ratio, base.machine.physical()) {
         (Some(z), _) => (
             Some(z),
             format!("Shapers are designed for damping ratio {z} (`[tune] shaper_damping_ratio`)."),
@@ -484,11 +485,12 @@ pub fn design_damping_source(
 pub fn modes_source(base: &RunSpec, preset: Option<&str>) -> String {
     let name = &base.machine_name;
     let identified = base.axis.split('+').any(|a| {
-        base.modes_of(a)
+        base.machine
+            .modes_of(a)
             .iter()
             .any(|m| m.frequency_sigma_hz.is_some())
     });
-    match (&base.machine, preset) {
+    match (base.machine.physical(), preset) {
         (Some(_), Some(p)) => format!("linearised from the built-in preset `{p}`"),
         (Some(_), None) => format!("linearised from the machine `{name}`"),
         (None, _) if identified => format!("identified, machine `{name}`"),
@@ -535,13 +537,13 @@ pub const MAX_BAND_PCT: f64 = 49.0;
 /// in settle-identify's `random_sweeps_from_env`). `None` without sigmas or for a
 /// physical machine.
 pub fn identified_band(base: &RunSpec) -> Option<(f64, f64, f64)> {
-    if base.machine.is_some() {
+    if base.machine.physical().is_some() {
         return None;
     }
     let tuned = tuning_modes(base);
     let mut best: Option<(f64, f64, f64)> = None;
     for name in base.axis.split('+') {
-        for m in base.modes_of(name) {
+        for m in base.machine.modes_of(name) {
             let Some(s) = m.frequency_sigma_hz else {
                 continue;
             };
@@ -565,14 +567,14 @@ fn current_shaper(
     scenario: Option<&ShaperSetting>,
 ) -> Result<Option<ShaperSetting>, String> {
     let kind = match &cur.shaper {
-        Some(name) => crate::kinds::shaping::parse_type(name)?,
-        None => scenario.and_then(|s| s.kind),
+        Some(name) => crate::studies::shaping::parse_type(name)?,
+        None => scenario.and_then(|s| s.shaper_type),
     };
     let Some(kind) = kind else {
         return Ok(None);
     };
     let s = ShaperSetting {
-        kind: Some(kind),
+        shaper_type: Some(kind),
         frequency_hz: cur
             .frequency_hz
             .or(scenario.map(|s| s.frequency_hz))
@@ -590,12 +592,12 @@ fn current_shaper(
 /// corner path: the strongest of each of its axes), or the two strongest modes of the
 /// moving axis's linearised response.
 pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
-    if base.machine.is_none() {
+    let Some(machine) = base.machine.physical() else {
         let names: Vec<&str> = base.axis.split('+').collect();
         let per_axis = if names.len() > 1 { 1 } else { 2 };
         let mut out: Vec<(f64, f64)> = Vec::new();
         for name in names {
-            let mut m: Vec<_> = base.modes_of(name).to_vec();
+            let mut m: Vec<_> = base.machine.modes_of(name).to_vec();
             m.sort_by(|a, b| b.weight.abs().total_cmp(&a.weight.abs()));
             for m in m.iter().take(per_axis) {
                 let f = m.frequency_hz;
@@ -605,9 +607,6 @@ pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
             }
         }
         return out;
-    }
-    let Some(machine) = &base.machine else {
-        return Vec::new();
     };
     let Ok(axes) = machine.compile(settle_sim::DriverMode::Linear) else {
         return Vec::new();

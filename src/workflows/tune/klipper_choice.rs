@@ -17,18 +17,18 @@ use settle_identify::SweepTest;
 use settle_identify::fit::sweep_model::{ModeParams, SweepModel};
 use settle_identify::welch::Welch;
 use settle_planner::ProfileKind;
-use settle_planner::shaper::{Firmware as ShaperFirmware, KLIPPER_DEFAULT_DAMPING_RATIO};
+use settle_planner::firmware::Firmware;
+use settle_planner::shaper::KLIPPER_DEFAULT_DAMPING_RATIO;
 use settle_planner::shaper_select::{
     CalibrationData, Fit, MAX_FREQ_HZ, SelectOptions, Selection, ShaperFreqs, find_best_shaper,
     fit_shaper,
 };
 
-use super::firmware::Firmware;
 use super::search::{Candidate, Plan, Score};
 use crate::error::Error;
 use crate::execute::pool::quiet;
-use crate::kinds::corner::Corner;
-use crate::kinds::shaping::ShaperSetting;
+use crate::studies::corner::Corner;
+use crate::studies::shaping::ShaperSetting;
 
 /// The accelerometer rate of the spectrum (samples per second): the ADXL345's rate in
 /// Klipper's `[adxl345]` default.
@@ -54,8 +54,9 @@ pub struct KlipperChoice {
 /// or a physical axis's linearised modes at the move's start.
 pub fn weighted_modes(plan: &Plan) -> Vec<(f64, f64, f64)> {
     let base = &plan.base;
-    let Some(machine) = &base.machine else {
+    let Some(machine) = base.machine.physical() else {
         return base
+            .machine
             .modes_of(&base.axis)
             .iter()
             .map(|m| (m.frequency_hz, m.damping_ratio, m.weight))
@@ -120,12 +121,12 @@ pub fn spectrum_of(
 /// Whether the report compares with Klipper: a Klipper (or unrestricted) search of a
 /// point-to-point or scan move on one axis with shapers.
 pub fn applies(plan: &Plan) -> bool {
-    matches!(plan.firmware, Firmware::Klipper | Firmware::Any)
+    matches!(plan.firmware.firmware(), Some(Firmware::Klipper) | None)
         && plan.base.state::<Corner>().is_none()
         && plan
             .candidates
             .iter()
-            .any(|c| c.shaper.is_some_and(|s| s.kind.is_some()))
+            .any(|c| c.shaper.is_some_and(|s| s.shaper_type.is_some()))
 }
 
 /// Klipper's choice on the plan's machine, scored by settle, with settle's `winner`
@@ -156,9 +157,9 @@ pub fn compare(
     let candidate = Candidate {
         kind: ProfileKind::Trapezoid,
         jmax_mm_s3: None,
-        params: settle_planner::KindParams::default(),
+        params: settle_planner::ProfileParams::default(),
         shaper: Some(ShaperSetting {
-            kind: Some(pick.kind),
+            shaper_type: Some(pick.shaper_type),
             frequency_hz: (pick.frequency_hz * 10.0).round() / 10.0,
             damping_ratio: KLIPPER_DEFAULT_DAMPING_RATIO,
         }),
@@ -168,8 +169,8 @@ pub fn compare(
     let settle_fit = winner
         .candidate
         .shaper
-        .and_then(|sh| sh.kind.map(|k| (k, sh)))
-        .filter(|(k, _)| k.firmware() == ShaperFirmware::Klipper)
+        .and_then(|sh| sh.shaper_type.map(|k| (k, sh)))
+        .filter(|(k, _)| k.firmware() == Firmware::Klipper)
         .and_then(|(k, sh)| {
             let one = SelectOptions {
                 shaper_freqs: ShaperFreqs::List(vec![sh.frequency_hz]),

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 use settle_identify::read::{FileData, klipper_psd};
 use settle_identify::welch::klipper_response;
-use settle_planner::shaper::ShaperKind;
+use settle_planner::shaper::ShaperType;
 use settle_planner::shaper_select::{CalibrationData, SelectOptions, Selection, find_best_shaper};
 
 use crate::error::Error;
@@ -55,7 +55,7 @@ impl KlipperCriterion {
             select.shapers = split_shapers(list)
                 .iter()
                 .map(|name| {
-                    ShaperKind::parse(name).map_err(|e| Error::input("--shapers", e.to_string()))
+                    ShaperType::parse(name).map_err(|e| Error::input("--shapers", e.to_string()))
                 })
                 .collect::<Result<_, _>>()?;
             if select.shapers.is_empty() {
@@ -236,20 +236,20 @@ fn script_lines(a: &AxisChoice, r: &mut Report) {
     for s in &a.selection.per_shaper {
         r.out(format!(
             "Fitted shaper '{}' frequency = {:.1} Hz (vibrations = {:.1}%, smoothing ~= {:.3})",
-            s.kind.name(),
+            s.shaper_type.name(),
             s.frequency_hz,
             s.vibrations * 100.0,
             s.smoothing_mm
         ));
         r.out(format!(
             "To avoid too much smoothing with '{}', suggested max_accel <= {:.0} mm/sec^2",
-            s.kind.name(),
+            s.shaper_type.name(),
             (s.max_accel_mm_s2 / 100.0).round_ties_even() * 100.0 // Python 3 round()
         ));
     }
     r.out(format!(
         "Recommended shaper is {} @ {:.1} Hz",
-        a.selection.recommended.kind.name(),
+        a.selection.recommended.shaper_type.name(),
         a.selection.recommended.frequency_hz
     ));
 }
@@ -266,7 +266,7 @@ pub fn input_shaper_cfg(choices: &[AxisChoice]) -> String {
         let r = &a.selection.recommended;
         s.push_str(&format!(
             "shaper_type{suffix}: {}\nshaper_freq{suffix}: {:.1}\n",
-            r.kind.name(),
+            r.shaper_type.name(),
             r.frequency_hz
         ));
     }
@@ -276,7 +276,7 @@ pub fn input_shaper_cfg(choices: &[AxisChoice]) -> String {
             "# {}: suggested max_accel <= {:.0} mm/s^2 with {}\n",
             a.axis.map_or("all".to_string(), |c| c.to_string()),
             (r.max_accel_mm_s2 / 100.0).round_ties_even() * 100.0,
-            r.kind.name()
+            r.shaper_type.name()
         ));
     }
     s
@@ -296,23 +296,16 @@ pub fn report(c: &KlipperCriterion) -> Result<Report, Error> {
         write_atomic(&cfg, input_shaper_cfg(&choices).as_bytes())?;
         r.err(format!("wrote {}", cfg.display()));
         for a in &choices {
-            let stem = format!(
-                "klipper-shapers-{}",
-                a.axis.map_or("all".to_string(), |c| c.to_string())
+            let axis = a.axis.map_or("all".to_string(), |c| c.to_string());
+            let stem = format!("klipper-shapers-{axis}");
+            let figure = crate::output::plot::klipper_shapers::figure(
+                &axis,
+                &a.files,
+                &a.data[0],
+                &a.selection,
+                &c.select,
             );
-            crate::output::plot::write(
-                &crate::output::plot::klipper_shapers::figure(
-                    &crate::output::plot::klipper_shapers::AxisGraph {
-                        axis: a.axis,
-                        files: &a.files,
-                        data: &a.data[0],
-                        selection: &a.selection,
-                    },
-                    &c.select,
-                ),
-                dir,
-                &stem,
-            )?;
+            crate::output::plot::write(&figure, dir, &stem)?;
             r.err(format!(
                 "wrote {} (and .png)",
                 dir.join(format!("{stem}.svg")).display()

@@ -41,7 +41,7 @@ pub fn section(plan: &Plan, winner: &Score, k: &KlipperChoice) -> String {
         out,
         "Klipper's `SHAPER_CALIBRATE`, on the spectrum its default resonance test would record on this machine ({}), recommends **{} @ {:.1} Hz** (suggested max_accel <= {:.0} mm/s^2). Run by settle as Klipper would save it (damping ratio 0.1), at {} mm/s^2 (the lower of the current acceleration and that suggestion):\n",
         modes.join(", "),
-        pick.kind.name(),
+        pick.shaper_type.name(),
         pick.frequency_hz,
         (k.suggested_max_accel_mm_s2 / 100.0).round_ties_even() * 100.0,
         k.score.accel_mm_s2
@@ -79,8 +79,8 @@ fn difference(k: &KlipperChoice, winner: &Score) -> String {
     let same = winner
         .candidate
         .shaper
-        .and_then(|s| s.kind.map(|kind| (kind, s.frequency_hz)))
-        .is_some_and(|(kind, f)| kind == pick.kind && (f - pick.frequency_hz).abs() < 1.0);
+        .and_then(|s| s.shaper_type.map(|kind| (kind, s.frequency_hz)))
+        .is_some_and(|(kind, f)| kind == pick.shaper_type && (f - pick.frequency_hz).abs() < 1.0);
     if same {
         return "Here they agree on the shaper.".into();
     }

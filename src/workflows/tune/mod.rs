@@ -113,7 +113,7 @@ fn load(path: &Path, opts: &Options) -> Result<(Scenario, Source), Error> {
     let (mut sc, src) = crate::expand::load(path)?;
     let mut t = sc.tune.take().unwrap_or_default();
     if let Some(f) = &opts.firmware {
-        firmware::Firmware::parse(f).map_err(|m| Error::input_key(path, "--firmware", m))?;
+        firmware::Candidates::parse(f).map_err(|m| Error::input_key(path, "--firmware", m))?;
         t.firmware = Some(f.clone());
     }
     if let Some(p) = opts.frequency_tolerance_pct {

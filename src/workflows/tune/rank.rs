@@ -4,7 +4,7 @@
 
 use crate::error::Error;
 use crate::execute::pool::{Progress, quiet, run_all};
-use crate::kinds::shaping::ShaperSetting;
+use crate::studies::shaping::ShaperSetting;
 use crate::workflows::tune::search::{Candidate, Plan, Score};
 
 /// Default rounds of refinement around the grid winner: 0 (grid only). Each round looks
@@ -87,7 +87,7 @@ pub fn evaluate(
 /// `jmax` (a trapezoid has no jerk; an unshaped candidate no frequency).
 pub fn neighbours(c: &Candidate, df: f64, jr: f64, jmax: f64) -> Vec<Candidate> {
     let mut out = Vec::new();
-    if let Some(sh) = c.shaper.filter(|s| s.kind.is_some()) {
+    if let Some(sh) = c.shaper.filter(|s| s.shaper_type.is_some()) {
         for k in [-2.0, -1.0, 1.0, 2.0] {
             let f = sh.frequency_hz * (1.0 + k * df);
             if f > 0.0 {

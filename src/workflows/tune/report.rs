@@ -9,8 +9,8 @@ use std::fmt::Write as _;
 use super::Outcome;
 use super::cells::{headings, ms, row, rows_header};
 use super::search::{Plan, Score};
-use crate::kinds::corner::Corner;
-use crate::kinds::scan::ScanSpec;
+use crate::studies::corner::Corner;
+use crate::studies::scan::ScanSpec;
 use settle_planner::ProfileKind;
 
 /// The score in words (band, margin; scan steps: the overhead per line).
@@ -136,7 +136,7 @@ fn search_text(out: &mut String, o: &Outcome) {
     if plan
         .candidates
         .iter()
-        .any(|c| c.shaper.is_some_and(|s| s.kind.is_some()))
+        .any(|c| c.shaper.is_some_and(|s| s.shaper_type.is_some()))
     {
         let _ = writeln!(
             out,

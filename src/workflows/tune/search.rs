@@ -31,15 +31,15 @@
 //! residual, then grid order, so the result is deterministic.
 
 use settle_planner::shaper::Shaper;
-use settle_planner::{KindParams, ProfileKind};
+use settle_planner::{ProfileKind, ProfileParams};
 
 use crate::error::Error;
 use crate::input::tune_spec::TuneSpec;
-use crate::kinds::corner::Corner;
-use crate::kinds::scan::ScanSpec;
-use crate::kinds::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting, max_accel_mm_s2};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
+use crate::studies::corner::Corner;
+use crate::studies::scan::ScanSpec;
+use crate::studies::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting, max_accel_mm_s2};
 use crate::workflows::tune::scan_figures::scan_figures;
 
 /// One point of the search grid.
@@ -50,7 +50,7 @@ pub struct Candidate {
     /// Jerk limit (mm/s^3), `None` for the trapezoid.
     pub jmax_mm_s3: Option<f64>,
     /// PVT asymmetry and four-jerk BOW scales.
-    pub params: KindParams,
+    pub params: ProfileParams,
     /// Input shaper (`None`: unshaped).
     pub shaper: Option<ShaperSetting>,
     /// Acceleration limit (mm/s^2), `None` for the scenario's.
@@ -75,10 +75,10 @@ impl Candidate {
         if let Some(a) = self.amax_mm_s2 {
             s.push_str(&format!(" a={a}"));
         }
-        if let Some(sh) = self.shaper.filter(|s| s.kind.is_some()) {
+        if let Some(sh) = self.shaper.filter(|s| s.shaper_type.is_some()) {
             s.push_str(&format!(
                 " +{}@{:.1}Hz",
-                sh.kind
+                sh.shaper_type
                     .map_or_else(|| "none".to_string(), |k| k.name().to_string()),
                 sh.frequency_hz
             ));
@@ -96,7 +96,7 @@ impl Candidate {
     pub fn apply(&self, run: &mut RunSpec) {
         run.profile = self.kind;
         run.jmax_mm_s3 = self.jmax_mm_s3.or(run.jmax_mm_s3);
-        run.kind_params = self.params;
+        run.profile_params = self.params;
         if let Some(a) = self.amax_mm_s2 {
             run.amax_mm_s2 = a;
         }
@@ -111,7 +111,7 @@ impl Candidate {
         Self {
             kind: run.profile,
             jmax_mm_s3: run.jmax_mm_s3,
-            params: run.kind_params,
+            params: run.profile_params,
             shaper: run.state::<ShaperSetting>().copied(),
             amax_mm_s2: None,
         }
@@ -278,7 +278,7 @@ pub struct Plan {
     /// Largest smoothing a shaped candidate may have (mm).
     pub max_smoothing_mm: f64,
     /// The target whose candidates are searched.
-    pub firmware: crate::workflows::tune::firmware::Firmware,
+    pub firmware: crate::workflows::tune::firmware::Candidates,
     /// How the target or the machine shaped the search, as sentences for the report
     /// (the jerks a register holds, a damping ratio a shaper does not take).
     pub notes: Vec<String>,
@@ -321,7 +321,7 @@ impl Plan {
     /// tolerance `t` also its shaper at `(1 - t)` and `(1 + t)` times its frequency.
     pub fn variants(&self, c: &Candidate) -> Vec<Candidate> {
         let t = self.frequency_tolerance;
-        match c.shaper.filter(|s| s.kind.is_some()) {
+        match c.shaper.filter(|s| s.shaper_type.is_some()) {
             Some(sh) if t > 0.0 => [1.0, 1.0 - t, 1.0 + t]
                 .into_iter()
                 .map(|k| Candidate {

@@ -14,10 +14,11 @@
 //! - whether a recommendation can be written ([`expressible`]).
 
 use settle_planner::ProfileKind;
-use settle_planner::shaper::{Firmware as ShaperFirmware, ShaperKind};
+use settle_planner::firmware::Firmware;
+use settle_planner::shaper::ShaperType;
 use settle_planner::tmc::registers::TmcUnits;
 
-use super::firmware::Firmware;
+use super::firmware::Candidates;
 use super::search::Candidate;
 
 /// The damping ratio written with Klipper's "no shaping" (frequency 0): its default.
@@ -25,9 +26,9 @@ pub const KLIPPER_OFF_DAMPING: f64 = settle_planner::shaper::KLIPPER_DEFAULT_DAM
 
 /// The damping ratios a shaper of `kind` may be designed for on its firmware, `(lowest,
 /// highest)`.
-pub fn damping_range(kind: ShaperKind) -> (f64, f64) {
+pub fn damping_range(kind: ShaperType) -> (f64, f64) {
     match kind.firmware() {
-        ShaperFirmware::Klipper => (
+        Firmware::Klipper => (
             0.0,
             match kind.family() {
                 "ei" => 0.4,
@@ -36,15 +37,16 @@ pub fn damping_range(kind: ShaperKind) -> (f64, f64) {
                 _ => 0.99,
             },
         ),
-        ShaperFirmware::Marlin => (0.01, 0.99),
-        ShaperFirmware::Rrf => (0.0, 0.99),
+        Firmware::Marlin => (0.01, 0.99),
+        // RepRapFirmware's, and any other (no firmware but these three has shapers).
+        _ => (0.0, 0.99),
     }
 }
 
 /// The damping ratio a shaper of `kind` is designed for on a mode of damping `zeta`: the
 /// mode's own, within [`damping_range`] (rounded to 3 decimals, as a configuration file
 /// holds it), and why it differs when it had to be moved into the range.
-pub fn design_damping(kind: ShaperKind, zeta: f64) -> (f64, Option<String>) {
+pub fn design_damping(kind: ShaperType, zeta: f64) -> (f64, Option<String>) {
     let (lo, hi) = damping_range(kind);
     let z = (zeta * 1000.0).round() / 1000.0;
     if z > hi {
@@ -70,8 +72,8 @@ pub fn design_damping(kind: ShaperKind, zeta: f64) -> (f64, Option<String>) {
 
 /// Whether the firmware has one acceleration for all axes (so a recommendation for
 /// several axes shares it). `any` exports Klipper and RepRapFirmware settings, which do.
-pub fn one_acceleration(fw: Firmware) -> bool {
-    !matches!(fw, Firmware::Tmc4361a)
+pub fn one_acceleration(fw: Candidates) -> bool {
+    fw.firmware() != Some(Firmware::Tmc4361a)
 }
 
 /// The largest value of an unsigned 24-bit register (BOW1..4, AMAX, DMAX).
@@ -110,14 +112,15 @@ pub fn tmc_ranges(usteps_per_mm: f64, f_clk_hz: u32) -> TmcRanges {
 /// shaper), else why not. The jerk and register ranges of the TMC4361A are checked by
 /// the export, and kept inside them by the search.
 pub fn expressible(fw: Firmware, c: &Candidate) -> Result<(), String> {
-    fw.check_kind(c.kind)?;
-    fw.check_shaper(c.shaper.and_then(|s| s.kind))?;
-    if let Some(sh) = c.shaper.filter(|s| s.kind.is_some())
+    let runs = Candidates::of(fw);
+    runs.check_kind(c.kind)?;
+    runs.check_shaper(c.shaper.and_then(|s| s.shaper_type))?;
+    if let Some(sh) = c.shaper.filter(|s| s.shaper_type.is_some())
         && let Err(e) = sh.shaper()
     {
         return Err(e.to_string());
     }
-    if matches!(fw, Firmware::Tmc4361a) && c.kind == ProfileKind::Trapezoid {
+    if fw == Firmware::Tmc4361a && c.kind == ProfileKind::Trapezoid {
         return Err("a trapezoid's bows are infinite".into());
     }
     Ok(())

@@ -78,7 +78,7 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
-/// The extra figure `name` of a run kind in `m`.
+/// The extra figure `name` of a study in `m`.
 pub fn extra(m: &settle::Metrics, name: &str) -> f64 {
     m.extra
         .iter()
