@@ -113,6 +113,10 @@ enum Command {
         /// Relative tolerance in percent (numbers closer than this to the baseline pass).
         #[arg(long, value_name = "PCT", default_value_t = workflows::check::DEFAULT_TOLERANCE_PCT)]
         tolerance: f64,
+        /// Absolute floor of lengths in um (`_um` columns; `_mm` ones in their unit): a
+        /// change smaller than this is no change, whatever its percentage.
+        #[arg(long, value_name = "UM", default_value_t = workflows::check::DEFAULT_FLOOR_UM)]
+        floor_um: f64,
         /// Rewrite the baseline with this run's values (on purpose: commit the diff).
         #[arg(long)]
         update: bool,
@@ -518,6 +522,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             scenario,
             baseline,
             tolerance,
+            floor_um,
             update,
             allow_improvements,
             backend,
@@ -525,6 +530,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
         } => {
             let opts = workflows::check::CheckOptions {
                 tolerance_pct: tolerance,
+                floor_um,
                 update,
                 allow_improvements,
                 backend,

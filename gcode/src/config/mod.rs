@@ -62,6 +62,7 @@ mod rrf_script;
 
 pub use export_klipper::KlipperExport;
 pub use export_rrf::RrfExport;
+pub use export_text::Note;
 pub use klipper::{
     DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
     DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,
