@@ -5,7 +5,7 @@
 
 use settle_planner::PlanError;
 
-use crate::studies::{Study, PlanContext, Planned, Role, on_axis};
+use crate::studies::{PlanContext, Planned, Role, Study, jerk_unused, on_axis};
 use crate::spec::run_spec::RunSpec;
 
 /// The point-to-point move.
@@ -42,5 +42,9 @@ impl Study for PointMove {
             probe: None,
             linearise_at_m: None,
         })
+    }
+
+    fn unused(&self, run: &RunSpec, key: &str) -> Option<&'static str> {
+        jerk_unused(run, key)
     }
 }

@@ -9,6 +9,7 @@ use crate::output::atomic::create_dir;
 use crate::output::report::ScenarioFile;
 use crate::output::sweep_files::{RECORDINGS, write_sweep};
 use crate::spec::backend::Backend;
+use crate::workflows::sweep::{FailedRun, failures, list_failures};
 use crate::workflows::{Exit, Report};
 
 /// What a merge did.
@@ -24,6 +25,8 @@ pub struct MergeOutcome {
     pub out: PathBuf,
     /// Recordings gathered.
     pub recordings: usize,
+    /// The failed runs the shards hold (results, as in an unsharded sweep).
+    pub failed: Vec<FailedRun>,
 }
 
 /// Merge `dirs` (any order) into `out` (default: `results/<name>/`).
@@ -70,6 +73,7 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> Result<MergeOutcome, Err
     }
     Ok(MergeOutcome {
         shards: dirs.len(),
+        failed: failures(&m.runs, &m.csv),
         name: m.scenario.name,
         runs: m.runs.len(),
         out,
@@ -78,9 +82,14 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> Result<MergeOutcome, Err
 }
 
 impl MergeOutcome {
-    /// What `settle merge` prints.
+    /// What `settle merge` prints: where, and the failed runs as `settle sweep` lists them
+    /// (results: exit 0 unless `--fail-on-failed-runs`).
     pub fn report(&self) -> Report {
-        let mut r = Report::new(Exit::Ok);
+        let mut r = Report::new(if self.failed.is_empty() {
+            Exit::Ok
+        } else {
+            Exit::RunsFailed
+        });
         r.err(format!(
             "merged {} shards of `{}` ({} runs) into {}{}",
             self.shards,
@@ -93,6 +102,7 @@ impl MergeOutcome {
                 String::new()
             }
         ));
+        list_failures(&mut r, &self.failed, self.runs);
         r
     }
 }

@@ -64,6 +64,17 @@ mod rrf_script;
 
 pub use export_klipper::KlipperExport;
 
+pub use export_rrf::RrfExport;
+pub use export_text::Note;
+pub use grbl::GrblSettings;
+pub use klipper::{
+    DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
+    DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,
+    KlipperStepper,
+};
+pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
+pub use rrf::{RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RrfAxis, RrfConfig};
+
 use std::sync::Arc;
 
 use crate::error::{GcodeError, Location};
@@ -92,12 +103,3 @@ pub(crate) fn located_events<'a>(
             })
         })
 }
-pub use export_rrf::RrfExport;
-pub use grbl::GrblSettings;
-pub use klipper::{
-    DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
-    DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,
-    KlipperStepper,
-};
-pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
-pub use rrf::{RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RrfAxis, RrfConfig};

@@ -10,7 +10,10 @@ use std::io::Read;
 
 use serde::Deserialize;
 
-use super::{MIN_SAMPLES, Recording, RecordingFormat, check_monotonic};
+use super::{
+    MAX_FILE_BYTES, MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_times,
+    too_many_samples,
+};
 use crate::IdentifyError;
 
 #[derive(Deserialize)]
@@ -23,7 +26,7 @@ struct Measurement {
 pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> {
     let mut text = String::new();
     zstd::stream::read::Decoder::new(bytes)
-        .and_then(|mut d| d.read_to_string(&mut text))
+        .and_then(|d| d.take(MAX_FILE_BYTES + 1).read_to_string(&mut text))
         .map_err(|e| {
             IdentifyError::format(
                 file,
@@ -32,6 +35,13 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
                 "a zstd-compressed stream of JSON lines (Shake&Tune .stdata)",
             )
         })?;
+    if text.len() as u64 > MAX_FILE_BYTES {
+        return Err(IdentifyError::not_accepted(
+            file,
+            format!("more than {MAX_FILE_BYTES} bytes of text once decompressed"),
+            format!("at most {MAX_FILE_BYTES} bytes (64 MiB) of text"),
+        ));
+    }
     let mut out = Vec::new();
     let mut last = 0;
     for (i, line) in text.lines().enumerate() {
@@ -39,6 +49,10 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
         last = n;
         if line.trim().is_empty() {
             continue;
+        }
+        // Each sample is one `[`: more than the limit is refused before it is held.
+        if line.bytes().filter(|&b| b == b'[').count() > MAX_SAMPLES + 1 {
+            return Err(too_many_samples(file, n));
         }
         let m: Measurement = serde_json::from_str(line).map_err(|e| {
             IdentifyError::format(
@@ -58,7 +72,7 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
             });
         }
         let time_s: Vec<f64> = m.samples.iter().map(|s| s[0]).collect();
-        check_monotonic(file, &time_s, |_| n)?;
+        check_times(file, &time_s, |_| n)?;
         let axis = |k: usize| Some(m.samples.iter().map(|s| s[k]).collect::<Vec<f64>>());
         let span = time_s[time_s.len() - 1] - time_s[0];
         out.push(Recording {
@@ -68,6 +82,7 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
             sample_rate_hz: time_s.len() as f64 / span,
             accel_mm_s2: [axis(1), axis(2), axis(3)],
             time_s,
+            named_axis: None,
             last_line: n,
         });
     }

@@ -38,6 +38,11 @@ pub use shaper_type::{
 
 use crate::PlanError;
 
+/// The largest start or end acceleration [`Shaper::apply`] takes as zero, as a fraction of
+/// the profile's peak acceleration: a million times f64's round-off (2.2e-16), a million
+/// times below any acceleration a move is planned with.
+pub const END_ACCEL_ROUND_OFF: f64 = 1e-9;
+
 /// Klipper's vibration tolerance of the EI family: 5% (a 20x reduction).
 pub const VIBRATION_TOLERANCE: f64 = KLIPPER_V_TOL;
 

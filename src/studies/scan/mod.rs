@@ -42,7 +42,7 @@ use settle_planner::{PlanError, Profile, State, Trajectory};
 use crate::error::Error;
 use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
-use crate::studies::{Study, StudyState, PlanContext, Planned, PlotColumn, Role};
+use crate::studies::{PlanContext, Planned, PlotColumn, Role, Study, StudyState, jerk_unused};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
@@ -213,10 +213,15 @@ impl Study for ScanStep {
             .collect()
     }
 
-    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
+    fn summary(
+        &self,
+        runs: &dyn RunList,
+        table: &RunsColumns,
+        current: &dyn Fn(&RunSpec) -> bool,
+    ) -> Option<String> {
         table
             .column("scan_reentry_error_um")
-            .map(|_| summary::section(runs, table))
+            .map(|_| summary::section(runs, table, current))
     }
 
     fn figures(&self, bands_um: &[f64]) -> Vec<PlotColumn> {
@@ -262,5 +267,9 @@ impl Study for ScanStep {
     /// The move-and-settle tables would measure the raster's run-out, not the step.
     fn replaces_move_tables(&self) -> bool {
         true
+    }
+
+    fn unused(&self, run: &RunSpec, key: &str) -> Option<&'static str> {
+        jerk_unused(run, key)
     }
 }

@@ -333,10 +333,11 @@ impl GcodeOutcome {
         &self.streamed.maps
     }
 
-    /// What the binary prints, and exit 1 when the simulation failed.
+    /// What the binary prints; [`Exit::RunsFailed`] when the simulation failed (lost steps,
+    /// a fault): a result, written and reported, not a failure of the command.
     pub fn report(&self) -> Report {
         let failed = self.streamed.fault.is_some() || self.streamed.lost_steps > 0;
-        let mut r = Report::new(if failed { Exit::Failed } else { Exit::Ok });
+        let mut r = Report::new(if failed { Exit::RunsFailed } else { Exit::Ok });
         r.out(format!(
             "{}: {} on {} ({}): print time {:.1} s, contour error worst {:.2} um, p95 {:.2} um",
             self.file.display(),
@@ -388,7 +389,7 @@ impl GcodeOutcome {
                 )
             });
             r.err(format!(
-                "result: the machine loses steps ({} full steps{at}): the motion asks more of a motor than its torque gives (its load angle passed 90 electrical degrees); what it prints after that is not this simulation's toolpath (exit 1: a failed run, not a tool error)",
+                "result: the machine loses steps ({} full steps{at}): the motion asks more of a motor than its torque gives (its load angle passed 90 electrical degrees); what it prints after that is not this simulation's toolpath (a failed run: a result, exit 0; --fail-on-failed-runs makes it exit 1)",
                 self.streamed.lost_steps
             ));
         }

@@ -554,6 +554,7 @@ pub fn html_report(
         intro,
         winners: Vec::new(),
         tables,
+        sections: Vec::new(),
         figures: figures
             .into_iter()
             .map(|(title, svg)| Figure {
