@@ -155,6 +155,10 @@ pub enum Error {
     /// error names the file and, where one is to blame, the line).
     #[error(transparent)]
     Identify(#[from] settle_identify::IdentifyError),
+    /// An input that is not a regular file, too large or not text, or an output the
+    /// output rule refuses (a link, a device, one of the command's inputs).
+    #[error(transparent)]
+    File(settle_files::FileError),
     /// The run was not started: the sweep was interrupted (Ctrl-C or SIGTERM).
     #[error("run {run}: not run, the sweep was interrupted")]
     Interrupted {
@@ -207,6 +211,34 @@ impl Error {
         matches!(
             self,
             Error::Input { .. } | Error::Read { .. } | Error::Identify(_)
-        )
+        ) || matches!(self, Error::File(e) if e.is_input_error())
+    }
+}
+
+impl Error {
+    /// This error as a failure to write an output (exit code 1), when it is the output
+    /// rule refusing a path found in the way while a command writes (a folder where a
+    /// recording goes): not the user's input at fault but the output folder's state.
+    pub fn as_write_failure(self) -> Self {
+        match self {
+            Error::File(settle_files::FileError::Refused { path, why }) => Error::Write {
+                path,
+                source: std::io::Error::other(why),
+            },
+            e => e,
+        }
+    }
+}
+
+impl From<settle_files::FileError> for Error {
+    /// A file that cannot be read or written is [`Error::Read`] or [`Error::Write`] as
+    /// everywhere in the harness; the rest is [`Error::File`].
+    fn from(e: settle_files::FileError) -> Self {
+        use settle_files::FileError;
+        match e {
+            FileError::Read { path, source } => Error::Read { path, source },
+            FileError::Write { path, source } => Error::Write { path, source },
+            other => Error::File(other),
+        }
     }
 }

@@ -124,6 +124,10 @@ enum Command {
         /// Output folder [default: results/<scenario name>/].
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Overwrite the results of an earlier sweep in the output folder (refused
+        /// without it).
+        #[arg(long)]
+        force: bool,
     },
     /// Plan motion problems: JSON lines on stdin, one profile (or error) per line on stdout.
     #[command(
@@ -169,6 +173,10 @@ enum Command {
         /// Worker threads [default: all cores].
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
         jobs: Option<u16>,
+        /// Overwrite the results of an earlier tuning in the output folder (refused
+        /// without it).
+        #[arg(long)]
+        force: bool,
     },
     /// Read a firmware configuration (Klipper printer.cfg, RepRapFirmware config.g) into a
     /// scenario with your current settings as its baseline and a search around them.
@@ -245,6 +253,10 @@ enum Command {
         /// settings; another starts from its defaults.
         #[arg(long, value_name = "FIRMWARE[:SHAPER]", value_parser = workflows::gcode::compare::parse_setting)]
         versus: Option<(settle_gcode::job::Firmware, workflows::gcode::XyShapers)>,
+        /// Overwrite the results of an earlier run in the output folder (refused without
+        /// it).
+        #[arg(long)]
+        force: bool,
     },
     /// Run one point of a sweep in detail: print its metrics, write its full trace as CSV.
     #[command(
@@ -322,6 +334,10 @@ enum Command {
         /// Its period (s; Klipper's sweeping_period).
         #[arg(long)]
         sweeping_period: Option<f64>,
+        /// Overwrite the figures of an earlier identification in the figures folder
+        /// (refused without it).
+        #[arg(long)]
+        force: bool,
     },
 }
 
@@ -452,7 +468,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             };
             workflows::check::check(&opts, &progress)?.report()
         }
-        Command::Merge { dirs, out } => workflows::merge::merge(&dirs, out)?.report(),
+        Command::Merge { dirs, out, force } => workflows::merge::merge(&dirs, out, force)?.report(),
         Command::Tune {
             scenario,
             out,
@@ -462,6 +478,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             firmware,
             frequency_tolerance,
             criterion,
+            force,
         } => {
             if criterion == "klipper" {
                 workflows::tune::klipper_criterion::report(&scenario)?
@@ -471,6 +488,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     jobs: jobs(j),
                     firmware,
                     frequency_tolerance_pct: frequency_tolerance,
+                    force,
                     ..workflows::tune::Options::new(backend)
                 };
                 workflows::tune::tune_with(&scenario, out, &opts, &progress)?.report()
@@ -520,6 +538,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             maps,
             mcap,
             versus,
+            force,
         } => {
             let opts = workflows::gcode::GcodeOptions {
                 mcap,
@@ -531,6 +550,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 sample_rate_hz,
                 maps,
                 versus,
+                force,
                 ..match config {
                     Some(config) => workflows::gcode::GcodeOptions::with_config(
                         file, &machine, firmware, config,
@@ -576,6 +596,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             accel_per_hz,
             sweeping_accel,
             sweeping_period,
+            force,
         } => {
             let opts = workflows::identify::IdentifyOptions {
                 axis,
@@ -596,6 +617,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     max_modes,
                     method,
                 },
+                force,
                 ..workflows::identify::IdentifyOptions::new(files)
             };
             workflows::identify::identify(&opts)?.report()

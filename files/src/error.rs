@@ -58,7 +58,7 @@ pub enum FileError {
     },
     /// Writing here would destroy something the rule protects: a link, a device, a folder,
     /// one of the command's inputs.
-    #[error("{}: {why}", path.display())]
+    #[error("cannot write {}: {why}", path.display())]
     Refused {
         /// The output path.
         path: PathBuf,

@@ -35,11 +35,11 @@ pub fn check_target(path: &Path) -> Result<(), FileError> {
     }
     let why = match link_target(path) {
         Some(to) => format!(
-            "is a link (to {}); settle writes regular files or new paths only, never through a link: remove the link or write elsewhere",
+            "it is a link (to {}); settle writes regular files or new paths only, never through a link: remove the link or write elsewhere",
             to.display()
         ),
         None => format!(
-            "is {}; settle writes regular files or new paths only: write elsewhere",
+            "it is {}; settle writes regular files or new paths only: write elsewhere",
             what_is(&meta)
         ),
     };
@@ -59,7 +59,7 @@ pub fn create_folder(dir: &Path) -> Result<(), FileError> {
         return Err(FileError::Refused {
             path: dir.to_path_buf(),
             why: format!(
-                "is {}, not a folder: name a folder (or a new path) for the output",
+                "it is {}, not a folder: name a folder (or a new path) for the output",
                 what_is(&meta)
             ),
         });
@@ -77,11 +77,11 @@ pub fn create_subfolder(dir: &Path) -> Result<(), FileError> {
             path: dir.to_path_buf(),
             why: match link_target(dir) {
                 Some(to) => format!(
-                    "is a link (to {}); settle writes only inside its output folder, never through a link out of it: remove the link",
+                    "it is a link (to {}); settle writes only inside its output folder, never through a link out of it: remove the link",
                     to.display()
                 ),
                 None => format!(
-                    "is {}, where settle makes a folder of its output: remove it or write elsewhere",
+                    "it is {}, where settle makes a folder of its output: remove it or write elsewhere",
                     what_is(&meta)
                 ),
             },
@@ -97,6 +97,15 @@ pub fn tmp_path(path: &Path) -> PathBuf {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     path.with_file_name(format!(".{name}.tmp{}", std::process::id()))
+}
+
+/// Make `tmp` ready for a writer that opens its file by name (an image encoder) to write
+/// what becomes `path`: [`check_target`] of `path`, and whatever was at `tmp` removed, not
+/// followed. Finish with [`commit`].
+pub fn prepare_tmp(path: &Path, tmp: &Path) -> Result<(), FileError> {
+    check_target(path)?;
+    let _ = std::fs::remove_file(tmp);
+    Ok(())
 }
 
 /// A new temporary file for `path` ([`tmp_path`]), after [`check_target`] of `path`:
@@ -195,13 +204,16 @@ impl Inputs {
             Some(input) => Err(FileError::Refused {
                 path: out.to_path_buf(),
                 why: format!(
-                    "is {} (the same {}), an input of this command; settle never writes onto its inputs: write elsewhere",
+                    "{}; settle never writes onto its inputs: write elsewhere",
                     if input == out {
-                        "an input".to_string()
+                        "it is one of this command's inputs".to_string()
                     } else {
-                        format!("{}", input.display())
+                        format!(
+                            "it is the same {} as the input {}",
+                            if out.is_dir() { "folder" } else { "file" },
+                            input.display()
+                        )
                     },
-                    if out.is_dir() { "folder" } else { "file" },
                 ),
             }),
         }
@@ -228,7 +240,7 @@ impl Inputs {
                 return Err(FileError::Refused {
                     path: dir.join(rel),
                     why: format!(
-                        "is the input {}, and this command writes this file of its output folder; settle never writes onto its inputs: write elsewhere",
+                        "it is the input {}, and this command writes this file of its output folder; settle never writes onto its inputs: write elsewhere",
                         input.display()
                     ),
                 });
@@ -324,7 +336,7 @@ mod tests {
         std::fs::write(&rec, "data").expect("write");
         let inputs = Inputs::of([&rec]);
         let e = inputs.refuse(&rec).expect_err("the input").to_string();
-        assert!(e.contains("an input of this command"), "{e}");
+        assert!(e.contains("it is one of this command's inputs"), "{e}");
         inputs
             .refuse(&dir.path().join("machine.toml"))
             .expect("another file");
@@ -350,7 +362,7 @@ mod tests {
                 .refuse(&link)
                 .expect_err("through a link")
                 .to_string();
-            assert!(e.contains("rec.csv (the same file)"), "{e}");
+            assert!(e.contains("is the same file as the input "), "{e}");
         }
     }
 }

@@ -7,6 +7,10 @@
 /// What can go wrong reading a recording or identifying modes from it.
 #[derive(Debug, thiserror::Error)]
 pub enum IdentifyError {
+    /// The file is not a regular file, is larger than a recording can be, or decompresses
+    /// to more (settle-files' reader).
+    #[error(transparent)]
+    File(#[from] settle_files::FileError),
     /// The file could not be read.
     #[error("{file}: cannot read: {source}")]
     Io {

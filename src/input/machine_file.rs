@@ -489,17 +489,18 @@ pub fn load_any(
     }
     let base = scenario_path.parent().unwrap_or(Path::new("."));
     let path = base.join(value);
-    let text = crate::input::file::read_text(&path).map_err(|e| {
-        let why = match e {
-            Error::Read { source, .. } => source.to_string(),
-            Error::Input { message, .. } => message,
-            other => other.to_string(),
-        };
-        src.error_at(
-            "machine.preset",
-            format!("cannot read machine file {}: {why}", path.display()),
-        )
-    })?;
+    let text =
+        crate::input::file::read_text(&path, crate::input::file::limit::SETTINGS).map_err(|e| {
+            let why = match e {
+                Error::Read { source, .. } => source.to_string(),
+                Error::Input { message, .. } => message,
+                other => other.to_string(),
+            };
+            src.error_at(
+                "machine.preset",
+                format!("cannot read machine file {}: {why}", path.display()),
+            )
+        })?;
     Ok((parse_any(&text, &path)?, path))
 }
 

@@ -13,8 +13,11 @@ use std::path::{Path, PathBuf};
 
 use settle_identify::{AxisIdentification, Options, WeightBasis};
 
+use settle_files::write::Inputs;
+
 use crate::error::Error;
 use crate::input::modes::{AxisModes, ModeSpec, machine_file_text};
+use crate::output::folder::Results;
 use crate::workflows::{Exit, Report};
 
 /// What `settle identify` does.
@@ -31,6 +34,9 @@ pub struct IdentifyOptions {
     pub figures: Option<PathBuf>,
     /// settle-identify's options (the resonance test's parameters, modes per axis, fit).
     pub identify: Options,
+    /// Overwrite the figures of an earlier identification in the figures folder (refused
+    /// without it).
+    pub force: bool,
 }
 
 impl IdentifyOptions {
@@ -42,6 +48,7 @@ impl IdentifyOptions {
             out: None,
             figures: None,
             identify: Options::default(),
+            force: false,
         }
     }
 }
@@ -128,6 +135,14 @@ pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
     if opts.files.is_empty() {
         return Err(Error::input("FILE", "give one or more accelerometer files"));
     }
+    // The outputs, checked before any work: never onto a recording, a link or a device.
+    let inputs = Inputs::of(&opts.files);
+    if let Some(out) = &opts.out {
+        inputs.refuse(out)?;
+        settle_files::write::check_target(out)?;
+    }
+    let dir = figures_dir(opts);
+    crate::output::folder::check(&dir, &FIGURES, opts.force, &inputs, writes_figure)?;
     let mut axes: Vec<IdentifiedAxis> = Vec::new();
     for file in &opts.files {
         for id in settle_identify::identify_file(file, &opts.identify)? {
@@ -156,15 +171,7 @@ pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
             modes: modes_of(&a.id),
         })
         .collect();
-    let dir = match (&opts.figures, &opts.out) {
-        (Some(d), _) => d.clone(),
-        (None, Some(out)) => out
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
-        (None, None) => PathBuf::from("results/identify"),
-    };
-    std::fs::create_dir_all(&dir).map_err(|e| Error::write(&dir, e))?;
+    crate::output::atomic::create_dir(&dir)?;
     let mut figures = Vec::new();
     for a in &axes {
         let stem = format!("identify-{}", a.axis);
@@ -197,6 +204,42 @@ pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
         machine_file,
         figures,
     })
+}
+
+/// The figures folder: `--figures`, else the machine file's folder, else
+/// `results/identify/`.
+fn figures_dir(opts: &IdentifyOptions) -> PathBuf {
+    match (&opts.figures, &opts.out) {
+        (Some(d), _) => d.clone(),
+        (None, Some(out)) => out
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+        (None, None) => PathBuf::from("results/identify"),
+    }
+}
+
+/// The figures of an earlier identification, which `--force` overwrites.
+const FIGURES: Results<'static> = Results {
+    what: "settle identify",
+    marks: &[
+        "identify-x.svg",
+        "identify-x.png",
+        "identify-y.svg",
+        "identify-y.png",
+        "identify-z.svg",
+        "identify-z.png",
+    ],
+};
+
+/// Whether identify writes `rel` in its figures folder.
+fn writes_figure(rel: &Path) -> bool {
+    crate::output::folder::written(
+        rel,
+        &[],
+        &[],
+        &[("identify-", ".svg"), ("identify-", ".png")],
+    )
 }
 
 /// `value ± sigma` with at least `digits` decimals, and as many more as show the

@@ -28,6 +28,7 @@ use settle_gcode::Dialect;
 use settle_gcode::config::{KlipperConfig, RrfConfig, ShaperSetting as FirmwareShaper};
 
 use crate::error::{Error, Location};
+use crate::input::machine_file::MachineForm;
 use crate::output::atomic::write_atomic;
 use crate::workflows::tune::firmware::Firmware;
 use crate::workflows::tune::grid::{identified_band, tuning_modes};
@@ -133,9 +134,11 @@ impl Imported {
 
 /// A configuration reader's error as the harness's, at its file, line and key.
 pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
-    if let settle_gcode::GcodeError::Io { source, .. } = e {
-        return Error::read(path, source);
-    }
+    let e = match e {
+        settle_gcode::GcodeError::Io { source, .. } => return Error::read(path, source),
+        settle_gcode::GcodeError::File(f) => return (*f).into(),
+        e => e,
+    };
     let text = e.to_string();
     match e.location() {
         Some(at) => {
@@ -167,9 +170,18 @@ fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)
 
 /// Read the current settings of a firmware configuration.
 pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
+    read_current_files(firmware, path).map(|(c, _)| c)
+}
+
+/// [`read_current`], with the files read (the configuration and what it includes).
+pub fn read_current_files(
+    firmware: Firmware,
+    path: &Path,
+) -> Result<(Current, Vec<PathBuf>), Error> {
     match firmware {
         Firmware::Klipper => {
             let c = KlipperConfig::read(path).map_err(|e| config_error(path, e))?;
+            let files = c.files.clone();
             let axes = [("x", &c.steppers.x), ("y", &c.steppers.y)]
                 .into_iter()
                 .map(|(name, st)| AxisNow {
@@ -180,16 +192,18 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                     usteps_per_mm: st.as_ref().map(|s| s.drive.microsteps_per_mm),
                 })
                 .collect();
-            Ok(Current {
+            let cur = Current {
                 firmware,
                 vmax_mm_s: c.printer.max_velocity_mm_s,
                 amax_mm_s2: c.printer.max_accel_mm_s2,
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
-            })
+            };
+            Ok((cur, files))
         }
         Firmware::Rrf => {
             let c = RrfConfig::read(path).map_err(|e| config_error(path, e))?;
+            let files = c.files.clone();
             let shaper = shaper_now(&c.input_shaper, Dialect::Rrf);
             let axes = [("x", &c.axes.x), ("y", &c.axes.y)]
                 .into_iter()
@@ -199,7 +213,7 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                     usteps_per_mm: Some(a.drive.microsteps_per_mm),
                 })
                 .collect();
-            Ok(Current {
+            let cur = Current {
                 firmware,
                 vmax_mm_s: c.axes.x.max_speed_mm_s.min(c.axes.y.max_speed_mm_s),
                 amax_mm_s2: c
@@ -208,7 +222,8 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                     .min(c.axes.y.max_accel_mm_s2),
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
-            })
+            };
+            Ok((cur, files))
         }
         other => Err(Error::input_key(
             path,
@@ -394,13 +409,37 @@ fn name_of(config: &Path) -> String {
 /// Import: read the configuration, find the axes the machine has and its modes, write
 /// the scenario.
 pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
-    let cur = read_current(opts.firmware, &opts.config)?;
+    let (cur, files) = read_current_files(opts.firmware, &opts.config)?;
     let name = name_of(&opts.config);
     let out = opts
         .out
         .clone()
         .unwrap_or_else(|| opts.config.with_file_name(format!("{name}.toml")));
+    // Never onto the configuration, a file it includes or the machine file.
+    let mut inputs = settle_files::write::Inputs::of(&files);
+    inputs.add(&opts.config);
+    if let Some(m) = &opts.machine {
+        inputs.add(m);
+    }
+    inputs.refuse(&out)?;
+    settle_files::write::check_target(&out)?;
     let mut notes = cur.notes.clone();
+    // The machine's axes, read here so that its errors name it (and only it).
+    let machine_axes = match &opts.machine {
+        Some(m) => {
+            let text = crate::input::file::read_text(m, crate::input::file::limit::SETTINGS)?;
+            let d = crate::input::machine_file::parse_any(&text, m)?;
+            Some(match d.form {
+                MachineForm::Physical(machine) => machine
+                    .axes
+                    .iter()
+                    .map(|a| a.name.clone())
+                    .collect::<Vec<_>>(),
+                MachineForm::Modes(axes) => axes.iter().map(|a| a.axis.clone()).collect(),
+            })
+        }
+        None => None,
+    };
     let machine = match &opts.machine {
         Some(m) => std::path::absolute(m)
             .map_err(|e| Error::read(m, e))?
@@ -420,11 +459,28 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
     let mut centre_hz = None;
     let mut band = false;
     for a in &cur.axes {
+        let has_axis = machine_axes.as_ref().is_none_or(|m| m.contains(&a.name));
+        if !has_axis {
+            notes.push(format!(
+                "the machine has no axis `{}`: it is not tuned",
+                a.name
+            ));
+            continue;
+        }
         let text = scenario_text(&name, &machine, &cur, &[a], 40.0, &source, false);
         let probe = out.with_file_name(format!("{name}.probe.toml"));
-        if let Ok((_, runs)) = crate::expand::parse_runs(&text, &probe)
-            && let Some(run) = runs.first()
-        {
+        // The machine has the axis: a scenario that does not load is the settings' fault
+        // (a limit the firmware accepts that settle cannot run), said as such.
+        let (_, runs) = crate::expand::parse_runs(&text, &probe).map_err(|e| {
+            Error::input(
+                &opts.config,
+                format!(
+                    "the settings read for axis {} do not make a scenario settle can run: {e}",
+                    a.name
+                ),
+            )
+        })?;
+        if let Some(run) = runs.first() {
             if centre_hz.is_none() {
                 centre_hz = tuning_modes(run)
                     .first()
@@ -432,11 +488,6 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
             }
             band |= identified_band(run).is_some();
             axes.push(a);
-        } else {
-            notes.push(format!(
-                "the machine has no axis `{}`: it is not tuned",
-                a.name
-            ));
         }
     }
     if axes.is_empty() {

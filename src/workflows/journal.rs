@@ -96,6 +96,7 @@ impl Journal {
             path: path.clone(),
             source,
         };
+        settle_files::write::check_target(&path)?;
         let mut file = File::create(&path).map_err(write_err)?;
         file.write_all(format!("{key_line}\n{header}").as_bytes())
             .map_err(write_err)?;
@@ -117,7 +118,7 @@ impl Journal {
         params: &dyn Fn(usize) -> Option<String>,
     ) -> Result<Resumed, Error> {
         let path = out.join(FILE);
-        let text = crate::input::file::read_text(&path)?;
+        let text = crate::input::file::read_text(&path, crate::input::file::limit::RESULTS)?;
         let (first, rest) = text.split_once('\n').unwrap_or((&text, ""));
         if !first.starts_with(MAGIC) {
             return Err(journal_error(

@@ -37,6 +37,7 @@ impl FolderLock {
     pub fn take(out: &Path) -> Result<Self, Error> {
         let path = out.join(FILE);
         let write_err = |source| Error::write(&path, source);
+        settle_files::write::check_target(&path)?;
         let mut file = OpenOptions::new()
             .read(true)
             .write(true)

@@ -95,7 +95,7 @@ pub fn machine_modes(arg: &str) -> Result<MachineModes, Error> {
         return of_form(name, Path::new(path), d.form);
     }
     let path = Path::new(arg);
-    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let text = crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)?;
     let is_scenario = text
         .parse::<toml::Table>()
         .is_ok_and(|t| t.contains_key("machine"));

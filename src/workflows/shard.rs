@@ -145,7 +145,7 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
             ),
         ));
     }
-    let text = crate::input::file::read_text(&path)?;
+    let text = crate::input::file::read_text(&path, crate::input::file::limit::RESULTS)?;
     let m: Manifest =
         toml::from_str(&text).map_err(|e| input_error(&path, e.message().trim().to_string()))?;
     if m.format != FORMAT {
@@ -158,7 +158,7 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
         ));
     }
     let csv_path = dir.join("runs.csv");
-    let csv = crate::input::file::read_text(&csv_path)?;
+    let csv = crate::input::file::read_text(&csv_path, crate::input::file::limit::RESULTS)?;
     if runs_digest(&csv) != m.runs_digest {
         return Err(input_error(
             &csv_path,

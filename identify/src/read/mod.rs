@@ -98,10 +98,7 @@ pub enum FileData {
 /// Shake&Tune, `#time,` -> Klipper raw, `freq,` -> Klipper processed, `Sample` -> M956.
 pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| IdentifyError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let bytes = settle_files::read::read_bytes(path, settle_files::limit::RECORDING)?;
     if bytes.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
         return stdata::parse(&file, &bytes).map(FileData::Recordings);
     }

@@ -6,8 +6,6 @@
 //! (time in s, acceleration in mm/s^2, axes map applied). Line numbers in errors count
 //! the lines of the decompressed text.
 
-use std::io::Read;
-
 use serde::Deserialize;
 
 use super::{MIN_SAMPLES, Recording, RecordingFormat, check_monotonic};
@@ -21,17 +19,27 @@ struct Measurement {
 
 /// Parse the bytes of a `.stdata` file into one recording per measurement.
 pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> {
-    let mut text = String::new();
-    zstd::stream::read::Decoder::new(bytes)
-        .and_then(|mut d| d.read_to_string(&mut text))
-        .map_err(|e| {
-            IdentifyError::format(
+    // Decompressed text is capped as a recording file is: a small file can inflate to GBs.
+    let limit = settle_files::limit::RECORDING;
+    let not_text = |e: &dyn std::fmt::Display| {
+        IdentifyError::format(
+            file,
+            1,
+            format!("data that do not decompress to text ({e})"),
+            "a zstd-compressed stream of JSON lines (Shake&Tune .stdata)",
+        )
+    };
+    let inflated = zstd::stream::read::Decoder::new(bytes)
+        .and_then(|d| settle_files::read::read_capped(d, limit.bytes))
+        .map_err(|e| not_text(&e))?
+        .ok_or_else(|| {
+            settle_files::FileError::too_large(
                 file,
-                1,
-                format!("data that do not decompress to text ({e})"),
-                "a zstd-compressed stream of JSON lines (Shake&Tune .stdata)",
+                format!("decompresses to more than {} bytes", limit.bytes),
+                limit,
             )
         })?;
+    let text = String::from_utf8(inflated).map_err(|e| not_text(&e))?;
     let mut out = Vec::new();
     let mut last = 0;
     for (i, line) in text.lines().enumerate() {

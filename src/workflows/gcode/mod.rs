@@ -75,6 +75,8 @@ pub struct GcodeOptions {
     pub mcap: bool,
     /// The firmware configuration the planner's settings come from (`--config`).
     pub config: Option<ConfigSource>,
+    /// Overwrite the results of an earlier run in the output folder (refused without it).
+    pub force: bool,
 }
 
 /// A firmware configuration read for `--config`.
@@ -86,6 +88,8 @@ pub struct ConfigSource {
     pub job: JobConfig,
     /// What the reader noted (SAVE_CONFIG values overridden, blocks not read).
     pub notes: Vec<String>,
+    /// The files read (the configuration and what it includes or runs).
+    pub files: Vec<PathBuf>,
 }
 
 /// `--shaper` as written: `KIND@FREQ_HZ[/DAMPING]` or `none` for X and Y, or per axis
@@ -174,6 +178,7 @@ impl GcodeOptions {
             versus: None,
             mcap: false,
             config: None,
+            force: false,
         })
     }
 
@@ -195,18 +200,20 @@ impl GcodeOptions {
         } else {
             Firmware::Klipper
         });
-        let (job, notes) = match firmware {
+        let (job, notes, files) = match firmware {
             Firmware::Klipper => {
                 let c = settle_gcode::config::KlipperConfig::read(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
                 let job = JobConfig::from_klipper(&c).map_err(gcode_error(&config))?;
-                (job, c.notes.iter().map(ToString::to_string).collect())
+                let notes = c.notes.iter().map(ToString::to_string).collect();
+                (job, notes, c.files)
             }
             Firmware::Rrf => {
                 let c = settle_gcode::config::RrfConfig::read(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
                 let job = JobConfig::from_rrf(&c).map_err(gcode_error(&config))?;
-                (job, c.notes.iter().map(ToString::to_string).collect())
+                let notes = c.notes.iter().map(ToString::to_string).collect();
+                (job, notes, c.files)
             }
             Firmware::Marlin | Firmware::Settle => {
                 return Err(Error::input_key(
@@ -229,6 +236,7 @@ impl GcodeOptions {
             path: config,
             job,
             notes,
+            files,
         });
         Ok(opts)
     }
@@ -387,13 +395,14 @@ impl GcodeOutcome {
 /// the setting.
 pub fn gcode_error(file: &Path) -> impl Fn(GcodeError) -> Error + '_ {
     move |e| {
-        if let GcodeError::Io {
-            source_name,
-            source,
-        } = e
-        {
-            return Error::read(PathBuf::from(&*source_name), source);
-        }
+        let e = match e {
+            GcodeError::Io {
+                source_name,
+                source,
+            } => return Error::read(PathBuf::from(&*source_name), source),
+            GcodeError::File(f) => return (*f).into(),
+            e => e,
+        };
         if let Some(at) = e.location() {
             let prefix = format!("{at}: ");
             let text = e.to_string();
@@ -432,7 +441,7 @@ fn resolve_form(name: &str) -> Result<(String, MachineForm), Error> {
     let src = crate::input::source::Source::new("", here);
     let path = Path::new(name);
     let is_scenario = name.ends_with(".toml")
-        && std::fs::read_to_string(path)
+        && crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)
             .ok()
             .and_then(|t| t.parse::<toml::Table>().ok())
             .is_some_and(|t| t.contains_key("machine"));
@@ -775,11 +784,6 @@ pub fn setting_name(job: &JobConfig) -> String {
 /// `settle gcode`: simulate, then write layers.csv, summary.md and the ringing maps into
 /// the output folder.
 pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
-    let rec = match opts.mcap {
-        true => Some(record::Recorder::start(recording_metadata(opts))?),
-        false => None,
-    };
-    let (mut outcome, rec) = simulate(opts, rec)?;
     let dir = match &opts.out {
         Some(d) => d.clone(),
         None => {
@@ -790,6 +794,29 @@ pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
             PathBuf::from("results").join(format!("{stem}-gcode"))
         }
     };
+    // The output folder, before any work: never an input, nor earlier results unasked.
+    crate::output::folder::check(&dir, &RESULTS, opts.force, &opts.inputs(), writes)?;
+    // The recording streams into a temporary file inside the folder, made for it (and
+    // removed again, with the folder it needed, when the run fails: a bad file writes
+    // nothing).
+    let made = opts.mcap && std::fs::symlink_metadata(&dir).is_err();
+    let simulated = (|| {
+        let rec = match opts.mcap {
+            true => {
+                crate::output::atomic::create_dir(&dir)?;
+                Some(record::Recorder::start(
+                    recording_metadata(opts),
+                    &dir.join(RECORDING),
+                )?)
+            }
+            false => None,
+        };
+        simulate(opts, rec)
+    })();
+    if simulated.is_err() && made {
+        let _ = std::fs::remove_dir(&dir);
+    }
+    let (mut outcome, rec) = simulated?;
     let b_opts = match opts.versus {
         Some((fw, shapers)) => Some(compare::versus(opts, fw, shapers)?),
         None => None,
@@ -800,7 +827,7 @@ pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
     };
     outcome.files = report::write(&outcome, &dir)?;
     if let Some(rec) = rec {
-        let path = dir.join("recording.mcap");
+        let path = dir.join(RECORDING);
         outcome.recording = Some(rec.finish(recording_metrics(&outcome), &path)?);
         outcome.files.push(path);
     }
@@ -812,6 +839,52 @@ pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
     let html = report::write_html(&outcome, opts, &dir)?;
     outcome.files.push(html);
     Ok(outcome)
+}
+
+/// `--mcap`'s recording in the output folder.
+const RECORDING: &str = "recording.mcap";
+
+/// An earlier run's results in the output folder, which `--force` overwrites.
+const RESULTS: crate::output::folder::Results<'static> = crate::output::folder::Results {
+    what: "settle gcode",
+    marks: &[
+        "layers.csv",
+        "summary.md",
+        report::REPORT,
+        compare::FILE,
+        RECORDING,
+    ],
+};
+
+/// Whether `settle gcode` writes `rel` in its output folder.
+fn writes(rel: &Path) -> bool {
+    crate::output::folder::written(
+        rel,
+        RESULTS.marks,
+        &[],
+        &[
+            ("ringing-layer-", ".svg"),
+            ("ringing-layer-", ".png"),
+            ("compare-layer-", ".svg"),
+            ("compare-layer-", ".png"),
+        ],
+    )
+}
+
+impl GcodeOptions {
+    /// The files the run reads: the G-code, the machine file or scenario (a path), the
+    /// configuration and what it includes.
+    pub fn inputs(&self) -> settle_files::write::Inputs {
+        let mut inputs = settle_files::write::Inputs::of([&self.file]);
+        inputs.add(Path::new(&self.machine));
+        if let Some(c) = &self.config {
+            inputs.add(&c.path);
+            for f in &c.files {
+                inputs.add(f);
+            }
+        }
+        inputs
+    }
 }
 
 /// The `settle` metadata record of `--mcap`'s recording.

@@ -17,7 +17,7 @@ use crate::workflows::{Exit, Report};
 
 /// Klipper's choice on the processed CSV at `path`.
 pub fn choose(path: &Path) -> Result<Selection, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let text = crate::input::file::read_text(path, crate::input::file::limit::RECORDING)?;
     let psd = klipper_psd::parse(&path.display().to_string(), &text)
         .map_err(|e| Error::input(path, e.to_string()))?;
     // calibrate_shaper.py normalises unless the header has the `shapers:` column.

@@ -56,6 +56,9 @@ pub struct Options {
     pub firmware: Option<String>,
     /// `--frequency-tolerance PCT`: over `[tune] frequency_tolerance_pct`.
     pub frequency_tolerance_pct: Option<f64>,
+    /// Overwrite the results of an earlier tuning in the output folder (refused without
+    /// it).
+    pub force: bool,
 }
 
 impl Options {
@@ -67,6 +70,7 @@ impl Options {
             jobs: None,
             firmware: None,
             frequency_tolerance_pct: None,
+            force: false,
         }
     }
 }
@@ -293,6 +297,24 @@ pub fn tune_to(
     tune_with(path, out, &opts, progress)
 }
 
+/// The files `settle tune` writes in its output folder.
+const FILES: [&str; 8] = [
+    "tune.md",
+    "candidates.csv",
+    "klipper.cfg",
+    "rrf.g",
+    "tmc4361a.txt",
+    "pareto.svg",
+    "pareto.png",
+    crate::output::sweep_files::REPORT,
+];
+
+/// An earlier tuning's results, which `--force` overwrites.
+const RESULTS: crate::output::folder::Results<'static> = crate::output::folder::Results {
+    what: "settle tune",
+    marks: &FILES,
+};
+
 /// Tune every axis of `[tune] axes` (default: the move's axis) of `path`, and write into
 /// `out` (default: `results/<name>-tune/`): `tune.md` (your current settings ->
 /// recommended per axis, then each axis's search), `candidates.csv` (every candidate of
@@ -304,13 +326,17 @@ pub fn tune_with(
     opts: &Options,
     progress: Progress,
 ) -> Result<Tuned, Error> {
-    let (sc, _) = load(path, opts)?;
+    let (sc, src) = load(path, opts)?;
+    let out = out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-tune", sc.name)));
+    // The output folder, before the search: never an input, nor earlier results unasked.
+    let inputs = crate::expand::machine::input_files(&sc, &src);
+    let writes = |rel: &Path| crate::output::folder::written(rel, &FILES, &[], &[]);
+    crate::output::folder::check(&out, &RESULTS, opts.force, &inputs, writes)?;
     let mut done: Vec<(String, Outcome)> = Vec::new();
     for axis in axes(&sc) {
         let o = tune_axis(path, axis.as_deref(), opts, progress)?;
         done.push((o.plan.base.axis.clone(), o));
     }
-    let out = out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-tune", sc.name)));
     create_dir(&out)?;
     let mut md = format!("# settle tune: {}\n\n", sc.name);
     md.push_str(&report::current_to_recommended(&done));
@@ -347,10 +373,10 @@ pub fn tune_with(
     let fig = report::pareto_figure(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
     crate::output::plot::write(&fig, &out, "pareto")?;
     // report.html: tune.md's tables, every candidate, the Pareto figure, the provenance.
-    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let text = crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)?;
     let file = crate::output::report::ScenarioFile { path, text: &text };
     let svg_path = out.join("pareto.svg");
-    let svg = std::fs::read_to_string(&svg_path).map_err(|e| Error::read(&svg_path, e))?;
+    let svg = crate::input::file::read_text(&svg_path, crate::input::file::limit::RESULTS)?;
     let html = crate::output::report::markdown_report(
         &format!("{} (tune)", sc.name),
         &md,
