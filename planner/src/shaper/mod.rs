@@ -38,6 +38,12 @@ pub use response::{remaining_vibration, smoothing_mm};
 
 use crate::PlanError;
 
+/// The lowest shaper frequency settle runs (Hz), whatever a firmware accepts: a shaper
+/// lasts about one period (0.5/f for ZV to 2/f for 3-hump EI), so below 1 Hz it lasts
+/// seconds per move (and at 1e-6 Hz days), shaping nothing a machine has. [`Shaper::new`]
+/// keeps each firmware's own range; the callers that take a user's setting check this.
+pub const MIN_FREQUENCY_HZ: f64 = 1.0;
+
 /// Klipper's vibration tolerance of the EI family: 5% (a 20x reduction).
 pub const VIBRATION_TOLERANCE: f64 = KLIPPER_V_TOL;
 

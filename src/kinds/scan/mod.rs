@@ -157,10 +157,31 @@ impl Kind for ScanStep {
     }
 
     fn validate(&self, run: &RunSpec) -> Result<(), (String, String)> {
-        match run.state::<ScanSpec>().map(ScanSpec::validate) {
-            Some(Err((key, message))) => Err((run.blame(&format!("scan.{key}")), message)),
-            _ => Ok(()),
+        let Some(scan) = run.state::<ScanSpec>() else {
+            return Ok(());
+        };
+        scan.validate()
+            .map_err(|(key, message)| (run.blame(&format!("scan.{key}")), message))?;
+        // The fly axis: an axis of the machine (simulated), or a gantry axis it does not
+        // have (an ideal one); never the stepping axis.
+        let axes = run.axis_names();
+        let fly = scan.fly_axis.as_str();
+        if run.axis.split('+').any(|a| a == fly) {
+            return Err((
+                run.blame("scan.fly_axis"),
+                format!("`{fly}` is the axis that steps (move.axis); the fly axis is the other one"),
+            ));
         }
+        if !axes.iter().any(|a| a == fly) && !["x", "y", "z"].contains(&fly) {
+            return Err((
+                run.blame("scan.fly_axis"),
+                format!(
+                    "`{fly}` is not an axis of the machine ({}) nor a gantry axis x, y or z",
+                    axes.join(", ")
+                ),
+            ));
+        }
+        Ok(())
     }
 
     fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {
