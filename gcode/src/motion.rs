@@ -95,12 +95,12 @@ impl Motion {
             let (limit, allowed) = if k == 3 {
                 (
                     self.max_extruder_mm,
-                    "an extruder position within ReaderOptions::max_extruder_mm of 0",
+                    "an extruder position within the reader's limit of 0: 1e9 mm unless set otherwise",
                 )
             } else {
                 (
                     self.max_coordinate_mm,
-                    "a position within ReaderOptions::max_coordinate_mm of 0",
+                    "a position within the reader's limit of 0: 1e5 mm (100 m) unless set otherwise",
                 )
             };
             if t[k].abs() > limit {

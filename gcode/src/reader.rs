@@ -227,12 +227,14 @@ impl<R: BufRead> Iterator for Reader<R> {
                 }
                 Ok(Some(LineStatus::Complete)) => {
                     let line_no = self.lines.line_no();
-                    let result = self.interp.line(
-                        &self.source_name,
-                        line_no,
-                        self.lines.bytes(),
-                        &mut self.scratch,
-                    );
+                    let mut bytes = self.lines.bytes();
+                    if line_no == 1 {
+                        // A byte-order mark (editors on Windows write one) is not G-code.
+                        bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
+                    }
+                    let result =
+                        self.interp
+                            .line(&self.source_name, line_no, bytes, &mut self.scratch);
                     if let Err(e) = result {
                         self.fail(e);
                     }

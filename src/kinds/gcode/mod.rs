@@ -46,6 +46,7 @@ pub mod contour;
 pub mod linpoint;
 pub mod preroll;
 pub mod stats;
+pub mod work;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -447,7 +448,14 @@ impl Kind for GcodeRun {
         preroll_of(run, job).map_err(|m| (run.blame("gcode.layers"), m))?;
         let mut j = open(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
         j.run_to_end()
-            .map_err(|e| (run.blame("gcode.file"), e.to_string()))
+            .map_err(|e| (run.blame("gcode.file"), e.to_string()))?;
+        match work::nothing_to_measure(&j.summary(), j.reader().lines_read()) {
+            Some(why) => Err((
+                run.blame("gcode.file"),
+                format!("{}: {why}", job.file.display()),
+            )),
+            None => Ok(()),
+        }
     }
 
     fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {

@@ -386,6 +386,25 @@ impl GcodeOutcome {
         if self.skipped_lines > 0 {
             r.err(format!("skipped {} bad lines", self.skipped_lines));
         }
+        if !self.ignored.is_empty() {
+            const SHOWN: usize = 8;
+            let mut names: Vec<String> = self
+                .ignored
+                .iter()
+                .take(SHOWN)
+                .map(|(what, n)| {
+                    let name = what.split(':').next().unwrap_or(what);
+                    format!("{name} ({n}x)")
+                })
+                .collect();
+            if self.ignored.len() > SHOWN {
+                names.push(format!("and {} more", self.ignored.len() - SHOWN));
+            }
+            r.err(format!(
+                "not followed: {} (why: summary.md, Commands not followed)",
+                names.join(", ")
+            ));
+        }
         r
     }
 }
@@ -458,7 +477,8 @@ fn resolve_form(name: &str) -> Result<(String, MachineForm), Error> {
     crate::input::machine_file::load_any(name, &base, &src)
         .map(|(d, _)| (d.name, d.form))
         .map_err(|e| match e {
-            Error::Input { message, .. } if !name.ends_with(".toml") => {
+            // About the name itself (an unknown preset), not inside the file it names.
+            Error::Input { at, message } if at.file == here && !name.ends_with(".toml") => {
                 Error::input(here, message.replace("machine.preset", "--machine"))
             }
             other => other,
@@ -516,6 +536,46 @@ fn longest_period_s(linear_axes: &[AxisModel]) -> f64 {
         .filter(|p| p.im > 0.0)
         .map(|p| std::f64::consts::TAU / p.im)
         .fold(0.0, f64::max)
+}
+
+/// The fastest natural frequency (Hz) of the axes' modes, 0 when they have none.
+fn fastest_mode_hz(linear_axes: &[AxisModel]) -> f64 {
+    let rest = Profile::empty(State::default());
+    linear_axes
+        .iter()
+        .filter_map(|a| LinearResponse::new(a, &rest).ok())
+        .flat_map(|lr| lr.poles().to_vec())
+        .map(|p| p.norm() / std::f64::consts::TAU)
+        .fold(0.0, f64::max)
+}
+
+/// The highest `--sample-rate-hz` (Hz): fifty samples per period of a 2 kHz mode, far
+/// above a printer's (a toolhead's highest modes are 100-300 Hz); a job's simulation time
+/// grows with the rate.
+pub const MAX_SAMPLE_RATE_HZ: f64 = 100_000.0;
+
+/// `--sample-rate-hz` checked before any work: at least two samples per period of the
+/// machine's fastest mode (`fastest_hz`; fewer alias it, and the contour error between
+/// samples far apart is not seen: a scenario's `observe.sample_rate_hz` is held to the
+/// same), at most [`MAX_SAMPLE_RATE_HZ`].
+fn check_sample_rate(rate_hz: f64, fastest_hz: f64) -> Result<(), Error> {
+    let min = 2.0 * fastest_hz;
+    if rate_hz.is_finite() && rate_hz >= min && rate_hz > 0.0 && rate_hz <= MAX_SAMPLE_RATE_HZ {
+        return Ok(());
+    }
+    Err(Error::input(
+        "--sample-rate-hz",
+        if !(rate_hz.is_finite() && rate_hz > 0.0) {
+            format!("{rate_hz}: give a finite number of Hz > 0")
+        } else if rate_hz > MAX_SAMPLE_RATE_HZ {
+            format!("{rate_hz} Hz is above the limit of {MAX_SAMPLE_RATE_HZ} Hz")
+        } else {
+            format!(
+                "{rate_hz} Hz gives fewer than two samples per period of the machine's fastest mode ({fastest_hz:.1} Hz): give at least {min:.1} Hz (the default {DEFAULT_SAMPLE_RATE_HZ} Hz, or twenty samples per period, {:.0} Hz, for contour errors to a few percent)",
+                20.0 * fastest_hz
+            )
+        },
+    ))
 }
 
 /// How much the ringing after the last move decays over the longest tail: 1e-3.
@@ -580,12 +640,7 @@ fn simulate(
     if !opts.backend.available() {
         return Err(Error::input("--backend", NO_MUJOCO));
     }
-    if !(opts.sample_rate_hz.is_finite() && opts.sample_rate_hz > 0.0) {
-        return Err(Error::input(
-            "--sample-rate-hz",
-            "the sample rate must be a positive number of Hz",
-        ));
-    }
+    check_sample_rate(opts.sample_rate_hz, fastest_mode_hz(&linear_axes))?;
     let names = axes.iter().map(|a| a.name.clone()).collect();
     let sopts = StreamOptions {
         sample_rate_hz: opts.sample_rate_hz,
@@ -661,7 +716,20 @@ fn simulate(
         Backend::Mujoco => return Err(Error::input("--backend", NO_MUJOCO)),
     };
     job.run_to_end().map_err(&err)?;
-    let summary = job.summary();
+    let mut summary = job.summary();
+    if let Some(why) =
+        crate::kinds::gcode::work::nothing_to_measure(&summary, job.reader().lines_read())
+    {
+        return Err(Error::input(&opts.file, why));
+    }
+    // Every command not followed, the reader's (not motion: temperatures, fans, macros,
+    // unknown words) with the planner's, so none vanishes unsaid.
+    for (name, n) in job.reader().ignored_commands() {
+        *summary
+            .ignored
+            .entry(format!("{name}: not a motion, limit or shaper command"))
+            .or_insert(0) += n;
+    }
     let mut by_layer: BTreeMap<u32, stats::LayerStats> = streamed
         .layers
         .iter()
