@@ -240,9 +240,9 @@ enum Command {
         /// Sample rate (Hz).
         #[arg(long, default_value_t = workflows::gcode::DEFAULT_SAMPLE_RATE_HZ)]
         sample_rate_hz: f64,
-        /// Ringing maps to draw: the layers with the largest contour error.
-        #[arg(long, default_value_t = 1)]
-        maps: usize,
+        /// Ringing maps to draw: the layers with the largest contour error (0 to 50).
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(0..=50))]
+        maps: u16,
         /// Also write recording.mcap into the output folder: every simulated sample of
         /// the layers (commanded and toolhead XY, contour error, line), streaming.
         #[arg(long)]
@@ -316,23 +316,23 @@ enum Command {
         method: settle_identify::MethodChoice,
         /// The resonance test's first frequency (Hz; Klipper's FREQ_START / min_freq)
         /// [default: Klipper's defaults for this and the five options below].
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         freq_start: Option<f64>,
         /// Its last frequency (Hz; Klipper's FREQ_END / max_freq).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         freq_end: Option<f64>,
         /// Its sweep rate (Hz/s; Klipper's HZ_PER_SEC).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         hz_per_sec: Option<f64>,
         /// Its acceleration per Hz (mm/s^2/Hz; Klipper's accel_per_hz).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         accel_per_hz: Option<f64>,
         /// The slow sweeping motion's acceleration (mm/s^2; Klipper's sweeping_accel; 0
         /// for the pulse-only test of Klipper before December 2024).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         sweeping_accel: Option<f64>,
         /// Its period (s; Klipper's sweeping_period).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         sweeping_period: Option<f64>,
         /// Overwrite the figures of an earlier identification in the figures folder
         /// (refused without it).
@@ -376,7 +376,7 @@ fn main() -> ExitCode {
             })
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", settle::error::shorten_numbers(&e.to_string()));
             ExitCode::from(if e.is_input_error() { 2 } else { 1 })
         }
     }
@@ -548,7 +548,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 out,
                 skip_bad_lines,
                 sample_rate_hz,
-                maps,
+                maps: usize::from(maps),
                 versus,
                 force,
                 ..match config {

@@ -159,7 +159,12 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
                 message: text.strip_prefix(&prefix).unwrap_or(&text).to_string(),
             }
         }
-        None => Error::input(path, text),
+        None => match e {
+            settle_gcode::GcodeError::JobSetting { key, reason } => {
+                Error::input_key(path, key, reason)
+            }
+            _ => Error::input(path, text),
+        },
     }
 }
 
@@ -181,6 +186,9 @@ pub fn read_current_files(
     match firmware {
         Firmware::Klipper => {
             let c = KlipperConfig::read(path).map_err(|e| config_error(path, e))?;
+            // The planner's settings as `settle gcode --config` takes them: a shaper
+            // Klipper would refuse is refused here too, naming its key.
+            settle_gcode::job::JobConfig::from_klipper(&c).map_err(|e| config_error(path, e))?;
             let files = c.files.clone();
             let axes = [("x", &c.steppers.x), ("y", &c.steppers.y)]
                 .into_iter()
@@ -203,6 +211,7 @@ pub fn read_current_files(
         }
         Firmware::Rrf => {
             let c = RrfConfig::read(path).map_err(|e| config_error(path, e))?;
+            settle_gcode::job::JobConfig::from_rrf(&c).map_err(|e| config_error(path, e))?;
             let files = c.files.clone();
             let shaper = shaper_now(&c.input_shaper, Dialect::Rrf);
             let axes = [("x", &c.axes.x), ("y", &c.axes.y)]
@@ -384,6 +393,47 @@ fn scenario_text(
     t
 }
 
+/// A scenario made of the settings read that settle cannot run (`e`, against the probe
+/// scenario), said against the configuration and the firmware's own key.
+fn settings_error(config: &Path, firmware: Firmware, axis: &str, e: Error) -> Error {
+    let Error::Input { at, message } = e else {
+        return e;
+    };
+    let key = at.key.unwrap_or_default();
+    let key = key.strip_prefix("sweep.").unwrap_or(&key);
+    let klipper = firmware == Firmware::Klipper;
+    let firmware_key = match key {
+        k if k.starts_with("limits.amax") => {
+            if klipper {
+                "printer.max_accel"
+            } else {
+                "M201 / M204 P"
+            }
+        }
+        k if k.starts_with("limits.vmax") => {
+            if klipper {
+                "printer.max_velocity"
+            } else {
+                "M203"
+            }
+        }
+        k if k.starts_with("shaper.") => {
+            if klipper {
+                "input_shaper"
+            } else {
+                "M593"
+            }
+        }
+        _ => "",
+    };
+    let message = format!("axis {axis}: settle cannot run these settings: {message}");
+    if firmware_key.is_empty() {
+        Error::input(config, message)
+    } else {
+        Error::input_key(config, firmware_key, message)
+    }
+}
+
 /// A scenario name from the configuration's file name.
 fn name_of(config: &Path) -> String {
     let stem = config
@@ -471,15 +521,8 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
         let probe = out.with_file_name(format!("{name}.probe.toml"));
         // The machine has the axis: a scenario that does not load is the settings' fault
         // (a limit the firmware accepts that settle cannot run), said as such.
-        let (_, runs) = crate::expand::parse_runs(&text, &probe).map_err(|e| {
-            Error::input(
-                &opts.config,
-                format!(
-                    "the settings read for axis {} do not make a scenario settle can run: {e}",
-                    a.name
-                ),
-            )
-        })?;
+        let (_, runs) = crate::expand::parse_runs(&text, &probe)
+            .map_err(|e| settings_error(&opts.config, cur.firmware, &a.name, e))?;
         if let Some(run) = runs.first() {
             if centre_hz.is_none() {
                 centre_hz = tuning_modes(run)

@@ -60,7 +60,8 @@ pub fn answer(line: &str) -> String {
     match solve(line) {
         Ok(v) => v.to_string(),
         // The problem's own text (a name, a key) is quoted in the message: never 10 MB of it.
-        Err(e) => json!({ "error": crate::error::echo_quoted(&e) }).to_string(),
+        Err(e) => json!({ "error": crate::error::shorten_numbers(&crate::error::echo_quoted(&e)) })
+            .to_string(),
     }
 }
 
@@ -85,6 +86,9 @@ fn solve(line: &str) -> Result<Value, String> {
         match (v.len(), required) {
             (0, false) => Ok(None),
             (len, _) if len == n => Ok(Some(v[i])),
+            (0, true) => Err(format!(
+                "`{name}` is missing: it is required, one value per axis (as `vmax`)"
+            )),
             (len, _) => Err(format!(
                 "`{name}` has {len} values, expected {n} (one per axis, as `vmax`)"
             )),
@@ -122,7 +126,9 @@ fn solve(line: &str) -> Result<Value, String> {
         };
         axes.push(Axis {
             start: State {
-                p: or0("p0", &pr.p0)?,
+                // Required for the position interface, as documented: a missing start
+                // is not 0.
+                p: get("p0", &pr.p0, position, i)?.unwrap_or(0.0),
                 v: or0("v0", &pr.v0)?,
                 a: or0("a0", &pr.a0)?,
             },

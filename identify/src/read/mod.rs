@@ -102,7 +102,7 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     if bytes.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
         return stdata::parse(&file, &bytes).map(FileData::Recordings);
     }
-    let text = String::from_utf8(bytes).map_err(|e| {
+    let mut text = String::from_utf8(bytes).map_err(|e| {
         IdentifyError::format(
             &file,
             1,
@@ -110,6 +110,10 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
             "a CSV text file or a zstd-compressed .stdata file",
         )
     })?;
+    // A byte-order mark (spreadsheet programs on Windows write one) is not the header.
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
     let first = text
         .lines()
         .map(str::trim)
@@ -122,10 +126,12 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     } else if first.starts_with("Sample") {
         rrf::parse(&file, &text).map(|r| FileData::Recordings(vec![r]))
     } else {
+        // The line is not repeated: a file that is not a recording (a wrong path,
+        // /etc/shadow) is not shown on the terminal.
         Err(IdentifyError::format(
             &file,
             1,
-            format!("`{}`", truncate(first)),
+            "a first line that is not a recording's header",
             "a header `#time,accel_x,accel_y,accel_z` (Klipper raw), `freq,psd_x,...` (Klipper processed), `Sample,X,Y,Z` (RepRapFirmware M956) or a zstd-compressed .stdata file",
         ))
     }
