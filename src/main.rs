@@ -97,7 +97,7 @@ enum Command {
         #[arg(long)]
         baseline: PathBuf,
         /// Relative tolerance in percent (numbers closer than this to the baseline pass).
-        #[arg(long, value_name = "PCT", default_value_t = workflows::check::DEFAULT_TOLERANCE_PCT)]
+        #[arg(long, value_name = "PCT", allow_hyphen_values = true, default_value_t = workflows::check::DEFAULT_TOLERANCE_PCT)]
         tolerance: f64,
         /// Rewrite the baseline with this run's values (on purpose: commit the diff).
         #[arg(long)]
@@ -155,7 +155,7 @@ enum Command {
         /// off its frequency either way [default: `[tune] frequency_tolerance_pct`, else 0];
         /// a machine whose modes carry `frequency_sigma_hz` is checked over the wider of
         /// this and their 2-sigma band.
-        #[arg(long, value_name = "PCT")]
+        #[arg(long, value_name = "PCT", allow_hyphen_values = true)]
         frequency_tolerance: Option<f64>,
         /// `settle` (simulate move-and-settle on the machine) or `klipper` (Klipper's
         /// calibrate_shaper.py choice on a processed resonance CSV).
@@ -238,7 +238,7 @@ enum Command {
         #[arg(long)]
         skip_bad_lines: bool,
         /// Sample rate (Hz).
-        #[arg(long, default_value_t = workflows::gcode::DEFAULT_SAMPLE_RATE_HZ)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = workflows::gcode::DEFAULT_SAMPLE_RATE_HZ)]
         sample_rate_hz: f64,
         /// Ringing maps to draw: the layers with the largest contour error (0 to 50).
         #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(0..=50))]
@@ -316,23 +316,23 @@ enum Command {
         method: settle_identify::MethodChoice,
         /// The resonance test's first frequency (Hz; Klipper's FREQ_START / min_freq)
         /// [default: Klipper's defaults for this and the five options below].
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         freq_start: Option<f64>,
         /// Its last frequency (Hz; Klipper's FREQ_END / max_freq).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         freq_end: Option<f64>,
         /// Its sweep rate (Hz/s; Klipper's HZ_PER_SEC).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         hz_per_sec: Option<f64>,
         /// Its acceleration per Hz (mm/s^2/Hz; Klipper's accel_per_hz).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         accel_per_hz: Option<f64>,
         /// The slow sweeping motion's acceleration (mm/s^2; Klipper's sweeping_accel; 0
         /// for the pulse-only test of Klipper before December 2024).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         sweeping_accel: Option<f64>,
         /// Its period (s; Klipper's sweeping_period).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         sweeping_period: Option<f64>,
         /// Overwrite the figures of an earlier identification in the figures folder
         /// (refused without it).
