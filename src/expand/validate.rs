@@ -7,6 +7,7 @@ use settle_sim::Mode;
 use crate::error::Error;
 use crate::input::source::Source;
 use crate::kinds::{self, Role};
+use crate::spec::MAX_POSITION_MM;
 use crate::spec::run_spec::{RunSpec, needs_jerk};
 
 /// The most samples one run may simulate, move and observation window together: at the
@@ -15,12 +16,6 @@ use crate::spec::run_spec::{RunSpec, needs_jerk};
 /// (a distance in metres written as millimetres, a speed limit of `1e-9`), not a run to wait
 /// for.
 pub const MAX_SAMPLES_PER_RUN: f64 = 1e8;
-
-/// The largest |position| a move may start or end at (mm): 100 m, as the G-code reader
-/// takes coordinates. Positions are simulated in metres as f64, whose resolution at 100 m
-/// (1.4e-14 m) is far below the 1e-10 m (1e-4 um) the metrics print; at 1e15 mm a 1 mm
-/// move is not resolved at all.
-pub const MAX_POSITION_MM: f64 = 1e5;
 
 /// The shortest integration step `sim.max_step_s` may force (s): 1 us, a hundred times
 /// finer than a 1 kHz mode needs (`w h` = 0.006). The steps of a run are bounded as its
@@ -263,9 +258,13 @@ fn validate_positions(
         if x.abs() > MAX_POSITION_MM {
             return Err(src.error_at(
                 &blame(key),
-                format!(
-                    "the move {} at {x} mm; positions are limited to +-{MAX_POSITION_MM:e} mm (100 m: no machine is larger, and far out the simulation's numbers cannot resolve a move)",
-                    if key == "move.start_mm" { "starts" } else { "ends" }
+                crate::spec::beyond_positions(
+                    if key == "move.start_mm" {
+                        "the move starts"
+                    } else {
+                        "the move ends"
+                    },
+                    x,
                 ),
             ));
         }

@@ -16,6 +16,7 @@ use settle_planner::{PlanError, ProfileKind};
 use crate::error::Error;
 use crate::input::source::Source;
 use crate::spec::run_spec::{KindState, RunSpec};
+use crate::spec::{MAX_POSITION_MM, beyond_positions};
 use crate::spec::value::Value;
 
 /// The `[corner]` table as written (mm, mm/s, degrees).
@@ -272,6 +273,17 @@ impl Corner {
         }
         if self.corner_mm.iter().any(|x| !x.is_finite()) {
             return Err((key("corner_mm"), "coordinates must be finite (mm)".into()));
+        }
+        // Every point within the positions f64 resolves (as a move's start and end).
+        let points = self.points_mm();
+        for k in [1, 0, 2] {
+            if let Some(x) = points[k].iter().find(|x| x.abs() > MAX_POSITION_MM) {
+                let what = ["start", "corner", "end"][k];
+                return Err((
+                    key(["leg_in_mm", "corner_mm", "leg_out_mm"][k]),
+                    beyond_positions(&format!("the path's {what} point is"), *x),
+                ));
+            }
         }
         if matches!(run.profile, ProfileKind::PvtSym | ProfileKind::PvtAsym) {
             let key = if run.swept.iter().any(|(p, _)| p == "profile") {

@@ -46,6 +46,7 @@ use crate::kinds::{Kind, KindState, PlanContext, Planned, PlotColumn, Role};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
+use crate::spec::{MAX_POSITION_MM, beyond_positions};
 
 pub use step_metrics::{StepProbe, step_metrics};
 pub use table::ScanSpec;
@@ -162,6 +163,24 @@ impl Kind for ScanStep {
         };
         scan.validate()
             .map_err(|(key, message)| (run.blame(&format!("scan.{key}")), message))?;
+        // The raster within the positions f64 resolves: the fly axis from 0 to the
+        // width, the step axis from the start over every line's step.
+        let last_mm = run.start_mm + (scan.lines - 1) as f64 * run.distance_mm;
+        if scan.width_mm > MAX_POSITION_MM {
+            return Err((
+                run.blame("scan.width_mm"),
+                beyond_positions("the fly axis's far end is", scan.width_mm),
+            ));
+        }
+        if last_mm.abs() > MAX_POSITION_MM {
+            return Err((
+                run.blame("scan.lines"),
+                beyond_positions(
+                    &format!("the last of {} lines of the step axis is", scan.lines),
+                    last_mm,
+                ),
+            ));
+        }
         // The fly axis: an axis of the machine (simulated), or a gantry axis it does not
         // have (an ideal one); never the stepping axis.
         let axes = run.axis_names();
