@@ -17,6 +17,13 @@ use crate::spec::run_spec::{RunSpec, needs_jerk};
 /// for.
 pub const MAX_SAMPLES_PER_RUN: f64 = 1e8;
 
+/// The most values (samples times channels, the time stamp included) a run whose trace is
+/// kept may hold: `settle run`, a recorded sweep (`--mcap`, `--rerun`) and the run kinds
+/// that measure the whole trace (scans, shaping) keep it in memory, about 21 bytes a value
+/// with the vectors' growth: 336 MB at the limit, 670,000 samples (67 s at 10 kHz) of the
+/// 24 channels of a two-axis printer. A longer trace is refused before it is simulated.
+pub const MAX_RECORDED_VALUES: f64 = 1.6e7;
+
 /// The shortest integration step `sim.max_step_s` may force (s): 1 us, a hundred times
 /// finer than a 1 kHz mode needs (`w h` = 0.006). The steps of a run are bounded as its
 /// samples are, by [`MAX_SAMPLES_PER_RUN`].

@@ -171,6 +171,21 @@ impl RunOutcome {
         for (p, v) in &spec.swept {
             let _ = writeln!(s, "  {p} = {v}");
         }
+        let written: Vec<String> = self
+            .written
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        // A failed run has no numbers to show: its reason, and exit 1.
+        if let Status::Fault { reason } = &m.status {
+            let _ = writeln!(s, "  FAILED: {reason}");
+            let _ = writeln!(s, "wrote {} ({} samples)", written.join(", "), self.samples);
+            return Report {
+                stdout: s,
+                stderr: String::new(),
+                exit: Exit::Failed,
+            };
+        }
         let _ = writeln!(s, "  move_time_s            {:.6}", m.move_time_s);
         let _ = writeln!(s, "  residual_peak_um       {:.4}", m.residual_peak_um);
         let _ = writeln!(s, "  residual_rms_um        {:.4}", m.residual_rms_um);
@@ -244,16 +259,11 @@ impl RunOutcome {
                 "  FAILED: lost {steps} full steps (axis {axis}): the numbers above are not a settling result"
             );
         }
-        let written: Vec<String> = self
-            .written
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect();
         let _ = writeln!(s, "wrote {} ({} samples)", written.join(", "), self.samples);
         Report {
             stdout: s,
             stderr: String::new(),
-            exit: Exit::Ok,
+            exit: if m.is_ok() { Exit::Ok } else { Exit::Failed },
         }
     }
 }
