@@ -47,12 +47,27 @@ pub fn write_png(png: &Path, draw: impl FnOnce(&Path) -> Result<(), String>) -> 
     let tmp = png.with_file_name(format!(".{stem}.tmp{}.png", std::process::id()));
     prepare_tmp(png, &tmp)?;
     let drawn = draw(&tmp)
-        .map_err(|e| Error::write(png, std::io::Error::other(e)))
+        .map_err(|e| {
+            Error::write(
+                png,
+                os_error_in(&e).unwrap_or_else(|| std::io::Error::other(e)),
+            )
+        })
         .and_then(|()| Ok(commit(&tmp, png)?));
     if drawn.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
     drawn
+}
+
+/// The operating system's error a drawing library's message quotes (the image encoder
+/// turns the file's I/O error into text, ending in `(os error N)` as the standard library
+/// writes it), so that a full disk says "No space left on device" rather than how the
+/// drawing backend wrapped it.
+fn os_error_in(message: &str) -> Option<std::io::Error> {
+    let (_, after) = message.rsplit_once("(os error ")?;
+    let code = after.split(')').next()?.parse().ok()?;
+    Some(std::io::Error::from_raw_os_error(code))
 }
 
 /// The operating system's error behind a writer's error (an MCAP or compression stream
@@ -104,5 +119,14 @@ mod tests {
         assert!(e.to_string().contains("No space left on device"), "{e}");
         let e = io_cause(&Stream(std::io::Error::other("plain")));
         assert_eq!(e.to_string(), "plain");
+    }
+
+    #[test]
+    fn a_full_disk_is_named_through_a_drawing_backends_text() {
+        // What plotters reports when the PNG encoder's write fails on a full disk.
+        let text = r#"Drawing backend error: ImageError(IoError(Custom { kind: Other, error: "No space left on device (os error 28)" }))"#;
+        let e = os_error_in(text).expect("an OS error");
+        assert_eq!(e.kind(), std::io::ErrorKind::StorageFull, "{e}");
+        assert!(os_error_in("backend error: no such font").is_none());
     }
 }
