@@ -24,6 +24,13 @@ impl Mount {
         Self(dir.to_path_buf())
     }
 
+    /// Fill it: a file as large as it can hold.
+    fn fill(&self) {
+        use std::io::Write as _;
+        let mut f = std::fs::File::create(self.0.join("filler")).expect("creates");
+        while f.write_all(&[0; 4096]).is_ok() {}
+    }
+
     /// Remove everything on it.
     fn empty(&self) {
         for e in std::fs::read_dir(&self.0).expect("reads").flatten() {
@@ -39,7 +46,7 @@ impl Drop for Mount {
     }
 }
 
-/// Every file under `dir` whose name marks a temporary file.
+/// Every file under `dir` whose name marks a temporary file, or a sweep's lock.
 fn leftovers(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
@@ -48,7 +55,9 @@ fn leftovers(dir: &Path) -> Vec<PathBuf> {
             let p = e.path();
             if p.is_dir() {
                 stack.push(p);
-            } else if e.file_name().to_string_lossy().contains(".tmp") {
+            } else if e.file_name().to_string_lossy().contains(".tmp")
+                || e.file_name() == "sweep.lock"
+            {
                 out.push(p);
             }
         }
@@ -56,8 +65,8 @@ fn leftovers(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
-/// The cases, each on an empty 96 KiB disk.
-fn cases() -> Vec<Case> {
+/// The cases, each on an empty 96 KiB disk (`true`: a full one).
+fn cases() -> Vec<(Case, bool)> {
     let full = |what: &str, args: &[&str], file: &str| {
         Case::new(
             what,
@@ -128,7 +137,18 @@ fn cases() -> Vec<Case> {
             ],
             "g/",
         ),
+        full(
+            "sweep into a disk with no room at all",
+            &["sweep", "sc.toml", "--backend", "modal", "--out", "full/z"],
+            "z/",
+        ),
     ]
+    .into_iter()
+    .map(|c| {
+        let fill = c.name.contains("no room");
+        (c, fill)
+    })
+    .collect()
 }
 
 #[test]
@@ -143,8 +163,11 @@ fn a_full_disk_is_named_and_leaves_nothing_behind() {
     );
     let mount = Mount::new(&sb.root().join("full"), "96k");
     let mut problems = Vec::new();
-    for case in cases() {
+    for (case, fill) in cases() {
         mount.empty();
+        if fill {
+            mount.fill();
+        }
         let (o, p) = check(&case, &sb);
         println!("{}", super::run::line(&case, &o));
         problems.extend(p);
