@@ -24,6 +24,7 @@
 //! `SETTLE_ADVERSARIAL_BIN` the cases run against another build (an older one fails them).
 
 mod answers;
+mod book;
 mod errors;
 mod full_disk;
 mod generated;
