@@ -5,10 +5,10 @@
 //! - Inputs ([`read`]): every file is opened through [`read::open`], which resolves links,
 //!   accepts regular files only (a FIFO would block, `/dev/zero` never ends, a folder is
 //!   not a file), refuses a file above its kind's [`Limit`] before reading it and stops at
-//!   the limit while reading (a file that grows). [`read::capped`] bounds what a
+//!   the limit while reading (a file that grows). [`read::read_capped`] bounds what a
 //!   decompressor may produce. [`lines::BoundedLines`] splits a stream into lines of
 //!   bounded length without holding an over-long line.
-//! - Outputs ([`write`]): a file is written only where nothing is or where a regular file
+//! - Outputs ([`mod@write`]): a file is written only where nothing is or where a regular file
 //!   is (never onto a link, a folder, a device or a FIFO), through a temporary file and a
 //!   rename; a folder settle makes inside its output folder is never a link out of it; and
 //!   [`write::Inputs`] refuses an output that is one of the command's inputs, compared by

@@ -289,7 +289,7 @@ impl Account {
 
 /// The most points a layer's ringing map keeps: far more than the figure's 560 x 640
 /// pixels show, and a bounded memory whatever the layer's length (a long layer's map is
-/// halved each time it reaches twice this, see [`halve_map`]).
+/// halved, the worse of each pair of points kept, each time it reaches twice this).
 pub const MAX_MAP_POINTS: usize = 50_000;
 
 /// Halve a ringing map: each pair of neighbours becomes the one with the larger error
