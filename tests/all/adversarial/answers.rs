@@ -109,95 +109,45 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         "mzvn.cfg",
         "[printer]\nkinematics: cartesian\nmax_velocity: 300\nmax_accel: 3000\n[stepper_x]\nrotation_distance: 40\nmicrosteps: 16\n[stepper_y]\nrotation_distance: 40\nmicrosteps: 16\n[input_shaper]\nshaper_type_x: mzv(n=1000000,t=0.8)\nshaper_freq_x: 50\n",
     );
-    let refused = |what: &str, args: &[&str], parts: &[&str]| {
-        Case::new(what, args, &[], Expect::refused(parts))
+    let refused = |what: &str, line: &str, parts: &[&str]| {
+        Case::line(what, line, &[], Expect::refused(parts))
     };
     vec![
         refused(
             "gcode on prose",
-            &[
-                "gcode",
-                "prose.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-            ],
+            "gcode prose.gcode --machine printer_xy --out o",
             &["prose.gcode", "no move"],
         )
         .never_says("This is a note"),
         refused(
             "[gcode] file = a file that is not G-code",
-            &[
-                "sweep",
-                "sc_secret.toml",
-                "--backend",
-                "modal",
-                "--out",
-                "o",
-            ],
+            "sweep sc_secret.toml --backend modal --out o",
             &["gcode.file", "no move"],
         )
         .never_says(SECRET),
         refused(
             "gcode --sample-rate-hz 1 (under Nyquist)",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--sample-rate-hz",
-                "1",
-                "--out",
-                "o",
-            ],
+            "gcode print.gcode --machine printer_xy --sample-rate-hz 1 --out o",
             &["--sample-rate-hz", "two samples per period"],
         ),
         refused(
             "gcode --sample-rate-hz 1e-9",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--sample-rate-hz",
-                "1e-9",
-                "--out",
-                "o",
-            ],
+            "gcode print.gcode --machine printer_xy --sample-rate-hz 1e-9 --out o",
             &["--sample-rate-hz"],
         ),
         refused(
             "a 1 mm move at 1e15 mm",
-            &[
-                "run",
-                "far.toml",
-                "--case",
-                "0",
-                "--backend",
-                "modal",
-                "--out",
-                "o/t.csv",
-            ],
+            "run far.toml --case 0 --backend modal --out o/t.csv",
             &["move.start_mm", "1e5 mm"],
         ),
         refused(
             "identify a resonance sweep without its test's options",
-            &["identify", "rec_x.csv", "--out", "o/m.toml"],
+            "identify rec_x.csv --out o/m.toml",
             &["rec_x.csv", "no clean decay", "--hz-per-sec"],
         ),
-        Case::new(
+        Case::line(
             "run of a trace too long to keep: failed, with its reason",
-            &[
-                "run",
-                "long_window.toml",
-                "--case",
-                "0",
-                "--backend",
-                "modal",
-                "--out",
-                "o_long/t.csv",
-            ],
+            "run long_window.toml --case 0 --backend modal --out o_long/t.csv",
             &["o_long"],
             Expect::failed(&[
                 "FAILED: its trace is kept in memory",
@@ -206,81 +156,49 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         ),
         refused(
             "a corner at 1e15 mm",
-            &[
-                "run",
-                "corner_far.toml",
-                "--case",
-                "0",
-                "--backend",
-                "modal",
-                "--out",
-                "o/t.csv",
-            ],
+            "run corner_far.toml --case 0 --backend modal --out o/t.csv",
             &["corner.corner_mm", "1e5 mm"],
         ),
         refused(
             "a scan 1e15 mm wide",
-            &[
-                "run",
-                "scan_wide.toml",
-                "--case",
-                "0",
-                "--backend",
-                "modal",
-                "--out",
-                "o/t.csv",
-            ],
+            "run scan_wide.toml --case 0 --backend modal --out o/t.csv",
             &["scan.width_mm", "1e5 mm"],
         ),
         refused(
             "a mode of 1e-7 Hz",
-            &[
-                "sweep",
-                "slow_mode.toml",
-                "--backend",
-                "modal",
-                "--out",
-                "o",
-            ],
+            "sweep slow_mode.toml --backend modal --out o",
             &["observe.window_s", "slowest mode"],
         ),
         refused(
             "import a shaper Klipper refuses",
-            &["import", "klipper", "mzvn.cfg", "--out", "o/x.toml"],
+            "import klipper mzvn.cfg --out o/x.toml",
             &["mzvn.cfg", "shaper_type_x", "at most 10"],
         ),
         refused(
             "corner_mm = [1, 2, 3]",
-            &["sweep", "corner3.toml", "--backend", "modal", "--out", "o"],
+            "sweep corner3.toml --backend modal --out o",
             &["corner.corner_mm", "give exactly 2"],
         ),
         refused(
             "scan.fly_axis = \"bogus\"",
-            &["sweep", "fly.toml", "--backend", "modal", "--out", "o"],
+            "sweep fly.toml --backend modal --out o",
             &["scan.fly_axis", "bogus"],
         ),
         refused(
             "[tune] tmc_clock_hz = 0",
-            &["tune", "tmc.toml", "--out", "o"],
+            "tune tmc.toml --out o",
             &["tune.tmc_clock_hz", "4 to 32 MHz"],
         ),
-        Case::new(
+        Case::line(
             "plan without p0",
-            &["plan"],
+            "plan",
             &[],
             Expect::answered(&["`p0` is missing"]),
         )
         .stdin("{\"pf\":[1],\"vmax\":[1],\"amax\":[2],\"jmax\":[10]}\n"),
-        Case::new(
+        Case::line(
             "gcode lists unknown words as not followed",
-            &[
-                "gcode",
-                "words.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o_words",
-            ],
+            "gcode words.gcode --machine printer_xy --out o_words",
             &["o_words"],
             Expect::answered(&["not followed: FOO (1x), G999 (1x), HELLO (1x)"]),
         ),

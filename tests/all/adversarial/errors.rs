@@ -116,152 +116,86 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         )
         .env("SETTLE_ADVERSARIAL_MARKER", SECRET)
         .never_says(SECRET),
-        Case::new(
+        Case::line(
             "identify on a file that is no recording",
-            &["identify", "secret.txt", "--axis", "x"],
+            "identify secret.txt --axis x",
             &[],
             Expect::refused(&["secret.txt:1", "not a recording's header"]),
         )
         .never_says(SECRET),
-        Case::new(
+        Case::line(
             "gcode --machine a file that is not TOML",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "./secret.txt",
-                "--out",
-                "o",
-            ],
+            "gcode print.gcode --machine ./secret.txt --out o",
             &[],
             Expect::refused(&["secret.txt:1:"]),
         ),
         freq("0"),
         freq("-5"),
         freq("nan"),
-        Case::new(
+        Case::line(
             "identify --freq-end past Klipper's 300 Hz",
-            &["identify", "rec_x.csv", "--freq-end", "400"],
+            "identify rec_x.csv --freq-end 400",
             &[],
             Expect::refused(&["--freq-end", "300 Hz"]),
         ),
-        Case::new(
+        Case::line(
             "import with a --machine file that is not there",
-            &[
-                "import",
-                "klipper",
-                "plain.cfg",
-                "--machine",
-                "missing.toml",
-                "--out",
-                "o/x.toml",
-            ],
+            "import klipper plain.cfg --machine missing.toml --out o/x.toml",
             &[],
             Expect::refused(&["cannot read missing.toml"]),
         )
         .never_says("neither an x nor a y axis"),
-        Case::new(
+        Case::line(
             "import of max_accel: 1e-300 names the firmware key",
-            &["import", "klipper", "accel.cfg", "--out", "o/x.toml"],
+            "import klipper accel.cfg --out o/x.toml",
             &[],
             Expect::refused(&["accel.cfg", "printer.max_accel"]),
         )
         .never_says("neither an x nor a y axis"),
-        Case::new(
+        Case::line(
             "identify of a band too narrow names no line 0",
-            &[
-                "identify",
-                "rec_x.csv",
-                "--freq-start",
-                "30",
-                "--freq-end",
-                "35",
-                "--out",
-                "o/m.toml",
-            ],
+            "identify rec_x.csv --freq-start 30 --freq-end 35 --out o/m.toml",
             &[],
             Expect::refused(&["rec_x.csv: the data end after", "frequency bins"]),
         )
         .never_says(":0:"),
-        Case::new(
+        Case::line(
             "a G-code coordinate of 1e8 mm, without internal names",
-            &[
-                "gcode",
-                "far.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-            ],
+            "gcode far.gcode --machine printer_xy --out o",
             &[],
             Expect::refused(&["far.gcode:3:4", "parameter X", "1e5 mm"]),
         )
         .never_says("::"),
-        Case::new(
+        Case::line(
             "a G-code file with a byte-order mark",
-            &[
-                "gcode",
-                "bom.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o_bom",
-            ],
+            "gcode bom.gcode --machine printer_xy --out o_bom",
             &["o_bom"],
             Expect::answered(&["bom.gcode: klipper on printer_xy"]),
         ),
-        Case::new(
+        Case::line(
             "a printer.cfg with a byte-order mark",
-            &["import", "klipper", "bom.cfg", "--out", "o_bom_cfg/x.toml"],
+            "import klipper bom.cfg --out o_bom_cfg/x.toml",
             &["o_bom_cfg"],
             Expect::answered(&["Wrote o_bom_cfg/x.toml"]),
         ),
-        Case::new(
+        Case::line(
             "a recording with a byte-order mark",
-            &[
-                "identify",
-                "bom_x.csv",
-                "--freq-start",
-                "30",
-                "--freq-end",
-                "90",
-                "--hz-per-sec",
-                "10",
-                "--out",
-                "o_bom_x/m.toml",
-            ],
+            "identify bom_x.csv --freq-start 30 --freq-end 90 --hz-per-sec 10 --out o_bom_x/m.toml",
             &["o_bom_x"],
             Expect::answered(&["wrote o_bom_x/m.toml"]),
         ),
-        Case::new(
+        Case::line(
             "a journal row of garbage is not a finished run",
-            &[
-                "sweep",
-                "sc.toml",
-                "--backend",
-                "modal",
-                "--resume",
-                "--out",
-                "j",
-            ],
+            "sweep sc.toml --backend modal --resume --out j",
             &["j"],
             Expect::answered(&[
                 "its `residual_peak_um` is not a number; run 0 runs again",
                 "resuming: 1 of 2",
             ]),
         ),
-        Case::new(
+        Case::line(
             "a 1e300 mm move names its key without 300 digits",
-            &[
-                "run",
-                "far300.toml",
-                "--case",
-                "0",
-                "--backend",
-                "modal",
-                "--out",
-                "o/t.csv",
-            ],
+            "run far300.toml --case 0 --backend modal --out o/t.csv",
             &[],
             Expect::refused(&["move.distance_mm"]),
         ),

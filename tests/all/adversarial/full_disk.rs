@@ -67,10 +67,10 @@ fn leftovers(dir: &Path) -> Vec<PathBuf> {
 
 /// The cases, each on an empty 96 KiB disk (`true`: a full one).
 fn cases() -> Vec<(Case, bool)> {
-    let full = |what: &str, args: &[&str], file: &str| {
-        Case::new(
+    let full = |what: &str, line: &str, file: &str| {
+        Case::line(
             what,
-            args,
+            line,
             &["full"],
             Expect::failed(&[
                 &format!("cannot write full/{file}"),
@@ -84,62 +84,27 @@ fn cases() -> Vec<(Case, bool)> {
     vec![
         full(
             "run: an MCAP recording (a compression stream)",
-            &[
-                "run",
-                "long.toml",
-                "--case",
-                "0",
-                "--backend",
-                "modal",
-                "--out",
-                "full/r.mcap",
-            ],
+            "run long.toml --case 0 --backend modal --out full/r.mcap",
             "r.mcap",
         ),
         full(
             "identify: its figures (the PNG encoder)",
-            &[
-                "identify",
-                "rec_x.csv",
-                "--freq-start",
-                "30",
-                "--freq-end",
-                "90",
-                "--hz-per-sec",
-                "10",
-                "--out",
-                "full/i/m.toml",
-            ],
+            "identify rec_x.csv --freq-start 30 --freq-end 90 --hz-per-sec 10 --out full/i/m.toml",
             "i/identify-x.png",
         ),
         full(
             "sweep --mcap: its recordings",
-            &[
-                "sweep",
-                "long.toml",
-                "--backend",
-                "modal",
-                "--mcap",
-                "--out",
-                "full/s",
-            ],
+            "sweep long.toml --backend modal --mcap --out full/s",
             "s/recordings/run-",
         ),
         full(
             "gcode: its maps and tables",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "full/g",
-            ],
+            "gcode print.gcode --machine printer_xy --out full/g",
             "g/",
         ),
         full(
             "sweep into a disk with no room at all",
-            &["sweep", "sc.toml", "--backend", "modal", "--out", "full/z"],
+            "sweep sc.toml --backend modal --out full/z",
             "z/",
         ),
     ]

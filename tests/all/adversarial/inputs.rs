@@ -4,6 +4,7 @@
 //! scenarios; an include pattern that fans out; a line of `settle plan` input far past
 //! its limit.
 
+use super::sandbox::GCODE;
 use super::{Case, Expect, Sandbox, check_all};
 
 /// Every case of the class.
@@ -36,21 +37,11 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
     sb.write("sc_fifo.toml", &preset("fifo.toml"));
     sb.write("sc_zero.toml", &preset("zero.toml"));
     sb.write("sc_big.toml", &preset("big.toml"));
-    let gcode = |what: &str, args: &[&str]| {
-        let mut a = vec![
-            "gcode",
-            "print.gcode",
-            "--machine",
-            "printer_xy",
-            "--out",
-            "o",
-        ];
-        a.extend_from_slice(args);
-        Case::new(what, &a, &[], Expect::refused(&["not a regular file"]))
+    let refused = |what: &str, line: &str, parts: &[&str]| {
+        Case::line(what, line, &[], Expect::refused(parts))
     };
-    let refused = |what: &str, args: &[&str], parts: &[&str]| {
-        Case::new(what, args, &[], Expect::refused(parts))
-    };
+    let gcode =
+        |what: &str, more: &str| refused(what, &format!("{GCODE} {more}"), &["not a regular file"]);
     let huge_line = format!(
         "{{\"p0\":[0],\"pf\":[{}1],\"vmax\":[1],\"amax\":[2],\"jmax\":[10]}}\n{{\"p0\":[0],\"pf\":[1],\"vmax\":[1],\"amax\":[2],\"jmax\":[10]}}\n",
         "0".repeat(16 << 20)
@@ -58,230 +49,120 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
     vec![
         refused(
             "identify a FIFO",
-            &["identify", "fifo.csv"],
+            "identify fifo.csv",
             &["FIFO (named pipe), not a regular file"],
         ),
         refused(
             "identify a link to /dev/zero",
-            &["identify", "zero.csv"],
+            "identify zero.csv",
             &["character device (a link to /dev/zero)"],
         ),
         refused(
             "identify a folder",
-            &["identify", "folder.d"],
+            "identify folder.d",
             &["a folder, not a regular file"],
         ),
         refused(
             "identify a recording past 128 MiB",
-            &["identify", "big_x.csv"],
+            "identify big_x.csv",
             &["134217729 bytes", "is 128 MiB (134217728 bytes)"],
         ),
         refused(
             "identify a 4 GiB .stdata bomb",
-            &["identify", "bomb.stdata", "--axis", "x"],
+            "identify bomb.stdata --axis x",
             &["decompresses to more than 134217728 bytes", "128 MiB"],
         ),
         refused(
             "gcode a FIFO",
-            &[
-                "gcode",
-                "fifo.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-            ],
+            "gcode fifo.gcode --machine printer_xy --out o",
             &["FIFO"],
         ),
         refused(
             "gcode a link to /dev/zero",
-            &[
-                "gcode",
-                "zero.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-            ],
+            "gcode zero.gcode --machine printer_xy --out o",
             &["character device"],
         ),
         refused(
             "gcode a file past 2 GiB",
-            &[
-                "gcode",
-                "big.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-            ],
+            "gcode big.gcode --machine printer_xy --out o",
             &["the limit for a G-code file is 2048 MiB"],
         ),
-        gcode("gcode --config a FIFO", &["--config", "fifo.cfg"]),
-        gcode(
-            "gcode --config a link to /dev/zero",
-            &["--config", "zero.cfg"],
-        ),
+        gcode("gcode --config a FIFO", "--config fifo.cfg"),
+        gcode("gcode --config a link to /dev/zero", "--config zero.cfg"),
         refused(
             "gcode --config past 16 MiB",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-                "--config",
-                "big.cfg",
-            ],
+            &format!("{GCODE} --config big.cfg"),
             &["16 MiB"],
         ),
         refused(
             "[include] a FIFO",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-                "--config",
-                "inc_fifo.cfg",
-            ],
+            &format!("{GCODE} --config inc_fifo.cfg"),
             &["inc_fifo.cfg:3: [include fifo.cfg]", "FIFO"],
         ),
         refused(
             "[include] /dev/zero",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-                "--config",
-                "inc_zero.cfg",
-            ],
+            &format!("{GCODE} --config inc_zero.cfg"),
             &["inc_zero.cfg:3: [include zero.cfg]", "character device"],
         ),
         refused(
             "[include] a folder",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-                "--config",
-                "inc_dir.cfg",
-            ],
+            &format!("{GCODE} --config inc_dir.cfg"),
             &["inc_dir.cfg:2: [include folder.d]", "a folder"],
         ),
         refused(
             "[include] past 16 MiB",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-                "--config",
-                "inc_big.cfg",
-            ],
+            &format!("{GCODE} --config inc_big.cfg"),
             &["inc_big.cfg:2", "16 MiB"],
         ),
         refused(
             "[include] fanning out to 1,640 reads",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o",
-                "--config",
-                "fan.cfg",
-            ],
+            &format!("{GCODE} --config fan.cfg"),
             &["at most 1000 files"],
         ),
         refused(
             "import a FIFO",
-            &["import", "klipper", "fifo.cfg", "--out", "o/x.toml"],
+            "import klipper fifo.cfg --out o/x.toml",
             &["FIFO"],
         ),
         refused(
             "machine preset a FIFO",
-            &["sweep", "sc_fifo.toml", "--backend", "modal", "--out", "o"],
+            "sweep sc_fifo.toml --backend modal --out o",
             &["machine.preset", "FIFO"],
         ),
         refused(
             "machine preset /dev/zero",
-            &["sweep", "sc_zero.toml", "--backend", "modal", "--out", "o"],
+            "sweep sc_zero.toml --backend modal --out o",
             &["machine.preset", "character device"],
         ),
         refused(
             "machine preset past 16 MiB",
-            &["sweep", "sc_big.toml", "--backend", "modal", "--out", "o"],
+            "sweep sc_big.toml --backend modal --out o",
             &["machine.preset", "16 MiB"],
         ),
         refused(
             "gcode --machine a FIFO",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "fifo.toml",
-                "--out",
-                "o",
-            ],
+            "gcode print.gcode --machine fifo.toml --out o",
             &["FIFO"],
         ),
         refused(
             "check --baseline a FIFO",
-            &[
-                "check",
-                "sc.toml",
-                "--baseline",
-                "fifo.csv",
-                "--backend",
-                "modal",
-            ],
+            "check sc.toml --baseline fifo.csv --backend modal",
             &["FIFO"],
         ),
         refused(
             "check --baseline /dev/zero",
-            &[
-                "check",
-                "sc.toml",
-                "--baseline",
-                "zero.csv",
-                "--backend",
-                "modal",
-            ],
+            "check sc.toml --baseline zero.csv --backend modal",
             &["character device"],
         ),
         refused(
             "check --baseline past 256 MiB",
-            &[
-                "check",
-                "sc.toml",
-                "--baseline",
-                "big_runs.csv",
-                "--backend",
-                "modal",
-            ],
+            "check sc.toml --baseline big_runs.csv --backend modal",
             &["256 MiB"],
         ),
-        refused(
-            "sweep a FIFO",
-            &["sweep", "fifo.toml", "--out", "o"],
-            &["FIFO"],
-        ),
+        refused("sweep a FIFO", "sweep fifo.toml --out o", &["FIFO"]),
         refused(
             "sweep a scenario past 16 MiB",
-            &["sweep", "big.toml", "--out", "o"],
+            "sweep big.toml --out o",
             &["16 MiB"],
         ),
         Case::new(

@@ -113,21 +113,15 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             &[],
             Expect::refused(&["--force", "identify-x.svg"]),
         ),
-        Case::new(
+        Case::line(
             "import --out names its printer.cfg",
-            &["import", "klipper", "printer.cfg", "--out", "printer.cfg"],
+            "import klipper printer.cfg --out printer.cfg",
             &[],
             Expect::refused(&["inputs"]),
         ),
-        Case::new(
+        Case::line(
             "import --out names an included file",
-            &[
-                "import",
-                "klipper",
-                "printer.cfg",
-                "--out",
-                "inc/limits.cfg",
-            ],
+            "import klipper printer.cfg --out inc/limits.cfg",
             &[],
             Expect::refused(&["inc/limits.cfg", "inputs"]),
         ),
@@ -149,115 +143,70 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             &[],
             Expect::refused(&["character device"]),
         ),
-        Case::new(
+        Case::line(
             "merge --out names a shard",
-            &["merge", "s1", "s2", "--out", "s1"],
+            "merge s1 s2 --out s1",
             &[],
             Expect::refused(&["s1", "inputs"]),
         ),
-        Case::new(
+        Case::line(
             "merge into earlier results",
-            &["merge", "s1", "s2", "--out", "o_merge"],
+            "merge s1 s2 --out o_merge",
             &[],
             Expect::refused(&["--force", "runs.csv"]),
         ),
-        Case::new(
+        Case::line(
             "check --update onto its scenario",
-            &[
-                "check",
-                "sc.toml",
-                "--baseline",
-                "sc.toml",
-                "--update",
-                "--backend",
-                "modal",
-            ],
+            "check sc.toml --baseline sc.toml --update --backend modal",
             &[],
             Expect::refused(&["inputs"]),
         ),
-        Case::new(
+        Case::line(
             "sweep --out a file",
-            &[
-                "sweep",
-                "sc.toml",
-                "--backend",
-                "modal",
-                "--out",
-                "rec_x.csv",
-            ],
+            "sweep sc.toml --backend modal --out rec_x.csv",
             &[],
             Expect::refused(&["not a folder"]),
         ),
-        Case::new(
+        Case::line(
             "sweep with plots/ a link out",
-            &["sweep", "sc.toml", "--backend", "modal", "--out", "o_plots"],
+            "sweep sc.toml --backend modal --out o_plots",
             &["o_plots"],
             Expect::refused(&["plots", "never through a link"]),
         ),
-        Case::new(
+        Case::line(
             "sweep --mcap with recordings/ a link out",
-            &[
-                "sweep",
-                "sc.toml",
-                "--backend",
-                "modal",
-                "--mcap",
-                "--out",
-                "o_rec",
-            ],
+            "sweep sc.toml --backend modal --mcap --out o_rec",
             &["o_rec"],
             Expect::refused(&["recordings", "never through a link"]),
         ),
-        Case::new(
+        Case::line(
             "gcode over a user's summary.md",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o_gcode",
-            ],
+            "gcode print.gcode --machine printer_xy --out o_gcode",
             &[],
             Expect::refused(&["--force", "summary.md"]),
         ),
-        Case::new(
+        Case::line(
             "gcode --force over a user's summary.md",
-            &[
-                "gcode",
-                "print.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o_gcode",
-                "--force",
-            ],
+            "gcode print.gcode --machine printer_xy --out o_gcode --force",
             &["o_gcode"],
             Expect::answered(&["wrote o_gcode/summary.md"]),
         ),
-        Case::new(
+        Case::line(
             "gcode --out a folder where its G-code is a file it writes",
-            &[
-                "gcode",
-                "o_self/layers.csv",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o_self",
-            ],
+            "gcode o_self/layers.csv --machine printer_xy --out o_self",
             &[],
             Expect::refused(&["is the input", "o_self/layers.csv"]),
         ),
-        Case::new(
+        Case::line(
             "tune into earlier results",
-            &["tune", "sc.toml", "--out", "o_tune"],
+            "tune sc.toml --out o_tune",
             &[],
             Expect::refused(&["--force", "tune.md"]),
         ),
         // What still works.
-        Case::new(
+        Case::line(
             "sweep into a new folder",
-            &["sweep", "sc.toml", "--backend", "modal", "--out", "o_ok"],
+            "sweep sc.toml --backend modal --out o_ok",
             &["o_ok"],
             Expect::answered(&["wrote o_ok/runs.csv"]),
         ),

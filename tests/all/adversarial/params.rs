@@ -81,8 +81,8 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         a.extend_from_slice(more);
         Case::new(what, &a, &[], Expect::refused(parts))
     };
-    let refused = |what: &str, args: &[&str], parts: &[&str]| {
-        Case::new(what, args, &[], Expect::refused(parts))
+    let refused = |what: &str, line: &str, parts: &[&str]| {
+        Case::line(what, line, &[], Expect::refused(parts))
     };
     vec![
         gcode(
@@ -92,16 +92,7 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         ),
         refused(
             "M593 F0.000001 in a Marlin file",
-            &[
-                "gcode",
-                "m593.gcode",
-                "--machine",
-                "printer_xy",
-                "--firmware",
-                "marlin",
-                "--out",
-                "o",
-            ],
+            "gcode m593.gcode --machine printer_xy --firmware marlin --out o",
             &["m593.gcode:1", "M593", "below 1 Hz"],
         ),
         gcode(
@@ -112,59 +103,43 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         gcode("--maps 1000000", &["--maps", "1000000"], &["--maps"]),
         refused(
             "sim.max_step_s = 1e-300",
-            &["sweep", "step.toml", "--backend", "rapier", "--out", "o"],
+            "sweep step.toml --backend rapier --out o",
             &["step.toml:", "sim.max_step_s", "1e-6"],
         ),
         refused(
             "scan.lines = 1e9",
-            &["sweep", "scan_1e9.toml", "--backend", "modal", "--out", "o"],
+            "sweep scan_1e9.toml --backend modal --out o",
             &["scan.lines", "100000"],
         ),
         refused(
             "scan.lines = 2^63 - 1",
-            &["sweep", "scan_max.toml", "--backend", "modal", "--out", "o"],
+            "sweep scan_max.toml --backend modal --out o",
             &["scan.lines", "100000"],
         ),
         refused(
             "100,000 modes",
-            &[
-                "run",
-                "modes.toml",
-                "--case",
-                "0",
-                "--backend",
-                "modal",
-                "--out",
-                "o/t.csv",
-            ],
+            "run modes.toml --case 0 --backend modal --out o/t.csv",
             &["machine.modes", "at most 100 per axis"],
         ),
         refused(
             "tune over 1,000 frequency scales",
-            &["tune", "tune_many.toml", "--out", "o"],
+            "tune tune_many.toml --out o",
             &["tune.frequency_scales", "at most 64"],
         ),
         refused(
             "identify --hz-per-sec 1e-9",
-            &["identify", "rec_x.csv", "--hz-per-sec", "1e-9"],
+            "identify rec_x.csv --hz-per-sec 1e-9",
             &["--hz-per-sec", "0.1 to 100"],
         ),
-        Case::new(
+        Case::line(
             "the ringing map of a 3,200-line layer (1 h 41 min)",
-            &[
-                "gcode",
-                "layer.gcode",
-                "--machine",
-                "printer_xy",
-                "--out",
-                "o_layer",
-            ],
+            "gcode layer.gcode --machine printer_xy --out o_layer",
             &["o_layer"],
             Expect::answered(&["wrote o_layer/ringing-layer-1.png"]),
         ),
         refused(
             "identify --sweeping-period 1e-9",
-            &["identify", "rec_x.csv", "--sweeping-period", "1e-9"],
+            "identify rec_x.csv --sweeping-period 1e-9",
             &["--sweeping-period"],
         ),
     ]

@@ -79,6 +79,13 @@ impl Case {
         }
     }
 
+    /// `settle LINE` (its words split at spaces), which may write `writes`, expected to
+    /// do `expect`.
+    pub fn line(name: &str, line: &str, writes: &[&str], expect: Expect) -> Self {
+        let args: Vec<&str> = line.split_whitespace().collect();
+        Self::new(name, &args, writes, expect)
+    }
+
     /// The same, with `text` on standard input.
     pub fn stdin(mut self, text: impl Into<Vec<u8>>) -> Self {
         self.stdin = text.into();

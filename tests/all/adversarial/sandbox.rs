@@ -36,6 +36,9 @@ profile = ["trapezoid", "scurve"]
 /// A Klipper configuration that includes `inc/limits.cfg`.
 const PRINTER_CFG: &str = "[printer]\nkinematics: cartesian\nmax_velocity: 300\n[include inc/limits.cfg]\n[stepper_x]\nrotation_distance: 40\nmicrosteps: 16\n[stepper_y]\nrotation_distance: 40\nmicrosteps: 16\n[input_shaper]\nshaper_type_x: mzv\nshaper_freq_x: 50\nshaper_type_y: ei\nshaper_freq_y: 40\n";
 
+/// `settle gcode` on the sandbox's print, on printer_xy, into `o` (more options follow).
+pub const GCODE: &str = "gcode print.gcode --machine printer_xy --out o";
+
 /// The marker of a file whose content must never be repeated.
 pub const SECRET: &str = "ZQXSECRET";
 
