@@ -128,19 +128,23 @@ fn a_full_disk_is_named_and_leaves_nothing_behind() {
     );
     let mount = Mount::new(&sb.root().join("full"), "96k");
     let mut problems = Vec::new();
-    for (case, fill) in cases() {
+    let cases = cases();
+    let mut seconds = 0.0;
+    for (case, fill) in &cases {
         mount.empty();
-        if fill {
+        if *fill {
             mount.fill();
         }
-        let (o, p) = check(&case, &sb);
-        println!("{}", super::run::line(&case, &o));
+        let (o, p) = check(case, &sb);
+        println!("{}", super::run::line(case, &o));
+        seconds += o.seconds;
         problems.extend(p);
         let left = leftovers(&sb.root().join("full"));
         if !left.is_empty() {
             problems.push(format!("{}: left {left:?}", case.name));
         }
     }
+    super::run::summary(cases.len(), seconds);
     mount.empty();
     drop(mount);
     assert!(problems.is_empty(), "{}", problems.join("\n"));

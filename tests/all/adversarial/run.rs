@@ -345,6 +345,14 @@ pub fn check(case: &Case, sandbox: &Sandbox) -> (Outcome, Vec<String>) {
     (o, problems)
 }
 
+/// The report's last line: how many cases, their time, and the largest peak memory so far.
+pub fn summary(cases: usize, seconds: f64) {
+    println!(
+        "{cases} cases in {seconds:.1} s; the largest peak memory of every process this test binary has waited for so far: {:.1} MiB",
+        children_peak_kib() as f64 / 1024.0
+    );
+}
+
 /// Run every case in `sandbox`, print the report (with `--nocapture`), and fail with
 /// every problem found.
 pub fn check_all(sandbox: &Sandbox, cases: &[Case]) {
@@ -362,10 +370,6 @@ pub fn check_all(sandbox: &Sandbox, cases: &[Case]) {
             let _ = std::fs::remove_dir_all(&path).or_else(|_| std::fs::remove_file(&path));
         }
     }
-    println!(
-        "{} cases in {seconds:.1} s; the largest peak memory of every process this test binary has waited for so far: {:.1} MiB",
-        cases.len(),
-        children_peak_kib() as f64 / 1024.0
-    );
+    summary(cases.len(), seconds);
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
