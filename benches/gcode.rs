@@ -19,7 +19,7 @@ use std::path::PathBuf;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use settle::spec::backend::Backend;
 use settle::workflows::gcode::{GcodeOptions, measure, parse_shaper};
-use settle_gcode::job::Firmware;
+use settle_planner::firmware::Firmware;
 
 #[path = "../gcode/benches/synth/mod.rs"]
 mod synth;

@@ -1,6 +1,15 @@
 //! The `settle` command: arguments, a call to a workflow of the library
-//! (`settle::workflows`), printing, and exit codes: 0 ok; 1 failed runs, a regression or an
-//! I/O failure; 2 bad input or usage; 130 an interrupted sweep.
+//! (`settle::workflows`), printing, and exit codes (docs/reference/cli.md):
+//!
+//! - 0: the command finished and wrote every output. Runs that failed physically (lost
+//!   steps, a simulation fault) are results, not failures of the command: recorded with
+//!   their reasons (runs.csv, summary.md, stderr) and still exit 0, so that a scheduler's
+//!   `afterok` dependency (Slurm) or a Job's success (Kubernetes) goes on to the merge;
+//!   `--fail-on-failed-runs` turns them into exit 1;
+//! - 1: the command failed: a regression found by `settle check`, a failed `settle
+//!   validate` check, an I/O failure (with `--fail-on-failed-runs`, also failed runs);
+//! - 2: bad input or usage, nothing run;
+//! - 130: an interrupted sweep (its finished runs kept for `--resume`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -11,15 +20,15 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use settle::Error;
 use settle::execute::interrupt;
 use settle::spec::backend::Backend;
+use settle::workflows::scheduler::ShardArg;
 use settle::workflows::{self, Exit, Report};
 
 fn parse_backend(s: &str) -> Result<Backend, String> {
     Backend::parse(s).ok_or_else(|| format!("unknown backend `{s}`; allowed: {}", Backend::ALLOWED))
 }
 
-fn parse_firmware(s: &str) -> Result<settle_gcode::job::Firmware, String> {
-    s.parse()
-        .map_err(|e: settle_gcode::GcodeError| e.to_string())
+fn parse_firmware(s: &str) -> Result<settle_planner::firmware::Firmware, String> {
+    settle_gcode::job::parse_firmware(s).map_err(|e| e.to_string())
 }
 
 fn parse_driver(s: &str) -> Result<settle_sim::DriverMode, String> {
@@ -65,14 +74,19 @@ enum Command {
         outputs: OutputFlags,
         /// Run only shard K of N (1-based: runs i with i % N == K-1) into
         /// DIR [default: results/<scenario name>/shard-K-of-N/]; combine with `settle merge`.
-        #[arg(long, value_name = "K/N")]
-        shard: Option<workflows::shard::Shard>,
+        /// `slurm`: K and N of this Slurm job array task (SLURM_ARRAY_TASK_ID, _MIN, _STEP,
+        /// _COUNT); `kubernetes`: of this Indexed Job pod (JOB_COMPLETION_INDEX + 1 of
+        /// SETTLE_SHARD_COUNT, which the Job spec sets to its completions).
+        #[arg(long, value_name = "K/N|slurm|kubernetes")]
+        shard: Option<ShardArg>,
         /// Continue an interrupted sweep: keep the runs in OUT/journal.csv, run the rest.
         #[arg(long)]
         resume: bool,
         /// Overwrite the results of an earlier sweep in OUT (refused without it).
         #[arg(long, conflicts_with = "resume")]
         force: bool,
+        #[command(flatten)]
+        failed_runs: FailedRunsFlag,
     },
     /// Check every backend against the closed form and against each other; print a table.
     #[command(
@@ -99,6 +113,10 @@ enum Command {
         /// Relative tolerance in percent (numbers closer than this to the baseline pass).
         #[arg(long, value_name = "PCT", allow_hyphen_values = true, default_value_t = workflows::check::DEFAULT_TOLERANCE_PCT)]
         tolerance: f64,
+        /// Absolute floor of lengths in um (`_um` columns; `_mm` ones in their unit): a
+        /// change smaller than this is no change, whatever its percentage.
+        #[arg(long, value_name = "UM", default_value_t = workflows::check::DEFAULT_FLOOR_UM)]
+        floor_um: f64,
         /// Rewrite the baseline with this run's values (on purpose: commit the diff).
         #[arg(long)]
         update: bool,
@@ -128,6 +146,8 @@ enum Command {
         /// without it).
         #[arg(long)]
         force: bool,
+        #[command(flatten)]
+        failed_runs: FailedRunsFlag,
     },
     /// Plan motion problems: JSON lines on stdin, one profile (or error) per line on stdout.
     #[command(
@@ -145,8 +165,10 @@ enum Command {
     )]
     Tune {
         /// The scenario file (TOML) with [move], [limits] and an optional [tune] table; with
-        /// `--criterion klipper`, a Klipper resonance CSV.
-        scenario: PathBuf,
+        /// `--criterion klipper`, one or more Klipper resonance CSVs (processed or raw; the
+        /// files of one axis, named like calibration_data_x_*.csv, are combined).
+        #[arg(required = true, num_args = 1..)]
+        scenario: Vec<PathBuf>,
         /// Only candidates this firmware runs: klipper, marlin, rrf, tmc4361a, any
         /// [default: the scenario's `[tune] firmware`, else any].
         #[arg(long)]
@@ -177,6 +199,18 @@ enum Command {
         /// without it).
         #[arg(long)]
         force: bool,
+        /// `--criterion klipper`: the shapers to try, comma-separated (calibrate_shaper.py's
+        /// --shapers) [default: zv,mzv,ei,2hump_ei,3hump_ei].
+        #[arg(long)]
+        shapers: Option<String>,
+        /// `--criterion klipper`: the square-corner velocity for smoothing (mm/s, 0.1 to
+        /// 1000; calibrate_shaper.py's --scv) [default: 5].
+        #[arg(long)]
+        scv: Option<f64>,
+        /// `--criterion klipper`: the most smoothing to allow (mm, 0.05 to 10;
+        /// calibrate_shaper.py's --max_smoothing).
+        #[arg(long, alias = "max_smoothing")]
+        max_smoothing: Option<f64>,
     },
     /// Read a firmware configuration (Klipper printer.cfg, RepRapFirmware config.g) into a
     /// scenario with your current settings as its baseline and a search around them.
@@ -184,8 +218,7 @@ enum Command {
         after_help = "Example:\n  settle import klipper printer.cfg --machine machine.toml --out printer.toml\n  settle tune printer.toml\n  (klipper.cfg in results/printer_import-tune/ holds the recommendation)"
     )]
     Import {
-        /// The firmware: klipper or rrf.
-        #[arg(value_parser = ["klipper", "rrf"])]
+        /// The firmware: klipper or rrf (also written reprapfirmware or duet).
         firmware: String,
         /// printer.cfg (with its includes) or config.g.
         config: PathBuf,
@@ -211,7 +244,7 @@ enum Command {
         /// The planner: klipper, marlin, rrf or settle [default: klipper; with --config,
         /// rrf for a file ending in .g].
         #[arg(long, value_parser = parse_firmware)]
-        firmware: Option<settle_gcode::job::Firmware>,
+        firmware: Option<settle_planner::firmware::Firmware>,
         /// The firmware's configuration (Klipper printer.cfg with its includes, or
         /// RepRapFirmware config.g): the planner's limits and the input shapers start as
         /// it sets them, instead of the firmware's defaults.
@@ -252,11 +285,16 @@ enum Command {
         /// (compare-layer-<n>.svg/png) and compare.md. The firmware of --config keeps its
         /// settings; another starts from its defaults.
         #[arg(long, value_name = "FIRMWARE[:SHAPER]", value_parser = workflows::gcode::compare::parse_setting)]
-        versus: Option<(settle_gcode::job::Firmware, workflows::gcode::XyShapers)>,
+        versus: Option<(
+            settle_planner::firmware::Firmware,
+            workflows::gcode::XyShapers,
+        )>,
         /// Overwrite the results of an earlier run in the output folder (refused without
         /// it).
         #[arg(long)]
         force: bool,
+        #[command(flatten)]
+        failed_runs: FailedRunsFlag,
     },
     /// Run one point of a sweep in detail: print its metrics, write its full trace as CSV.
     #[command(
@@ -279,6 +317,8 @@ enum Command {
         /// Simulation backend: modal, rapier, mujoco.
         #[arg(long, default_value = "rapier", value_parser = parse_backend)]
         backend: Backend,
+        #[command(flatten)]
+        failed_runs: FailedRunsFlag,
     },
     /// Print a machine's modes per axis (frequency, damping ratio, weight).
     #[command(
@@ -314,6 +354,10 @@ enum Command {
         /// decay), sweep, ringdown.
         #[arg(long, default_value = "auto", value_parser = parse_method)]
         method: settle_identify::MethodChoice,
+        /// The column of a Klipper processed spectrum to fit: xyz (psd_xyz, the total
+        /// Klipper tunes against) or one sensor axis's (x, y, z).
+        #[arg(long, default_value = "xyz", value_parser = parse_column)]
+        column: settle_identify::SpectrumColumn,
         /// The resonance test's first frequency (Hz; Klipper's FREQ_START / min_freq)
         /// [default: Klipper's defaults for this and the five options below].
         #[arg(long, allow_hyphen_values = true)]
@@ -341,6 +385,17 @@ enum Command {
     },
 }
 
+fn parse_column(s: &str) -> Result<settle_identify::SpectrumColumn, String> {
+    use settle_identify::SpectrumColumn;
+    match s {
+        "xyz" => Ok(SpectrumColumn::Total),
+        "x" => Ok(SpectrumColumn::Axis(0)),
+        "y" => Ok(SpectrumColumn::Axis(1)),
+        "z" => Ok(SpectrumColumn::Axis(2)),
+        _ => Err(format!("unknown column `{s}`; allowed: xyz, x, y, z")),
+    }
+}
+
 fn parse_method(s: &str) -> Result<settle_identify::MethodChoice, String> {
     use settle_identify::MethodChoice;
     match s {
@@ -351,6 +406,15 @@ fn parse_method(s: &str) -> Result<settle_identify::MethodChoice, String> {
             "unknown method `{s}`; allowed: auto, sweep, ringdown"
         )),
     }
+}
+
+/// How runs that failed physically end the command.
+#[derive(clap::Args, Debug, Clone, Copy)]
+struct FailedRunsFlag {
+    /// Exit 1 when a run failed (lost steps, a simulation fault) [default: exit 0: a failed
+    /// run is a result, listed with its reason in the outputs and on stderr].
+    #[arg(long)]
+    fail_on_failed_runs: bool,
 }
 
 /// Recordings a sweep or a run can write.
@@ -370,7 +434,7 @@ fn main() -> ExitCode {
             print!("{}", report.stdout);
             eprint!("{}", report.stderr);
             ExitCode::from(match report.exit {
-                Exit::Ok => 0,
+                Exit::Ok | Exit::RunsFailed => 0,
                 Exit::Failed => 1,
                 Exit::Interrupted => interrupt::EXIT_CODE,
             })
@@ -422,6 +486,13 @@ fn dispatch(command: Command) -> Result<Report, Error> {
     };
     let note = |line: &str| bar.suspend(|| eprintln!("{line}"));
     let jobs = |j: Option<u16>| j.map(usize::from);
+    // Failed runs end these commands with exit 1 only when asked.
+    let failed_runs = |mut r: Report, flag: FailedRunsFlag| {
+        if flag.fail_on_failed_runs && r.exit == Exit::RunsFailed {
+            r.exit = Exit::Failed;
+        }
+        r
+    };
     let report = match command {
         Command::Sweep {
             scenario,
@@ -432,7 +503,18 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             shard,
             resume,
             force,
+            failed_runs: flag,
         } => {
+            let shard = match shard {
+                Some(arg) => {
+                    let r = arg.resolve(&|name| std::env::var(name).ok())?;
+                    if !r.source.is_empty() {
+                        note(&format!("--shard {}: {}", r.shard, r.source));
+                    }
+                    Some(r.shard)
+                }
+                None => None,
+            };
             install_interrupt()?;
             let opts = workflows::sweep::SweepOptions {
                 out,
@@ -444,7 +526,10 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 force,
                 ..workflows::sweep::SweepOptions::new(scenario, backend)
             };
-            workflows::sweep::sweep(&opts, &note, &progress)?.report()
+            failed_runs(
+                workflows::sweep::sweep(&opts, &note, &progress)?.report(),
+                flag,
+            )
         }
         Command::Validate { backend, out } => {
             workflows::validate::validate(backend, out.as_deref())?.report()
@@ -453,6 +538,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             scenario,
             baseline,
             tolerance,
+            floor_um,
             update,
             allow_improvements,
             backend,
@@ -460,6 +546,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
         } => {
             let opts = workflows::check::CheckOptions {
                 tolerance_pct: tolerance,
+                floor_um,
                 update,
                 allow_improvements,
                 backend,
@@ -468,7 +555,12 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             };
             workflows::check::check(&opts, &progress)?.report()
         }
-        Command::Merge { dirs, out, force } => workflows::merge::merge(&dirs, out, force)?.report(),
+        Command::Merge {
+            dirs,
+            out,
+            force,
+            failed_runs: flag,
+        } => failed_runs(workflows::merge::merge(&dirs, out, force)?.report(), flag),
         Command::Tune {
             scenario,
             out,
@@ -479,10 +571,31 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             frequency_tolerance,
             criterion,
             force,
+            shapers,
+            scv,
+            max_smoothing,
         } => {
             if criterion == "klipper" {
-                workflows::tune::klipper_criterion::report(&scenario)?
+                workflows::tune::klipper_criterion::report(
+                    &workflows::tune::klipper_criterion::KlipperCriterion::from_args(
+                        scenario,
+                        out,
+                        shapers.as_deref(),
+                        scv,
+                        max_smoothing,
+                    )?,
+                )?
+            } else if scenario.len() != 1
+                || shapers.is_some()
+                || scv.is_some()
+                || max_smoothing.is_some()
+            {
+                return Err(Error::input(
+                    "SCENARIO",
+                    "settle tune takes one scenario file; several files and --shapers, --scv, --max-smoothing go with --criterion klipper",
+                ));
             } else {
+                let scenario = &scenario[0];
                 let opts = workflows::tune::Options {
                     check_on,
                     jobs: jobs(j),
@@ -491,7 +604,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     force,
                     ..workflows::tune::Options::new(backend)
                 };
-                workflows::tune::tune_with(&scenario, out, &opts, &progress)?.report()
+                workflows::tune::tune_with(scenario, out, &opts, &progress)?.report()
             }
         }
         Command::Import {
@@ -501,7 +614,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             out,
         } => {
             let opts = workflows::import::ImportOptions {
-                firmware: workflows::tune::firmware::Firmware::parse(&firmware)
+                firmware: workflows::import::parse_firmware(&firmware)
                     .map_err(|m| Error::input_key(&config, "firmware", m))?,
                 config,
                 machine,
@@ -539,6 +652,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             mcap,
             versus,
             force,
+            failed_runs: flag,
         } => {
             let opts = workflows::gcode::GcodeOptions {
                 mcap,
@@ -558,12 +672,12 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     None => workflows::gcode::GcodeOptions::new(
                         file,
                         &machine,
-                        firmware.unwrap_or(settle_gcode::job::Firmware::Klipper),
+                        firmware.unwrap_or(settle_planner::firmware::Firmware::Klipper),
                     )?,
                 }
                 .with_shapers(shaper.unwrap_or_default())
             };
-            workflows::gcode::gcode(&opts)?.report()
+            failed_runs(workflows::gcode::gcode(&opts)?.report(), flag)
         }
         Command::Run {
             scenario,
@@ -572,6 +686,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             outputs,
             plot,
             backend,
+            failed_runs: flag,
         } => {
             let opts = workflows::run::RunOptions {
                 out,
@@ -580,7 +695,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 plot,
                 ..workflows::run::RunOptions::new(scenario, case, backend)
             };
-            workflows::run::run(&opts)?.report()
+            failed_runs(workflows::run::run(&opts)?.report(), flag)
         }
         Command::Machine { file } => workflows::machine::machine_modes(&file)?.report(),
         Command::Identify {
@@ -590,6 +705,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             figures,
             max_modes,
             method,
+            column,
             freq_start,
             freq_end,
             hz_per_sec,
@@ -616,6 +732,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     },
                     max_modes,
                     method,
+                    column,
                 },
                 force,
                 ..workflows::identify::IdentifyOptions::new(files)

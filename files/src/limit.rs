@@ -44,10 +44,12 @@ pub const GCODE: Limit = Limit {
 };
 
 /// An accelerometer recording (CSV, or a Shake&Tune `.stdata` once decompressed): a
-/// two-minute resonance test at 3,200 Hz is about 15 MB of Klipper CSV.
+/// two-minute resonance test at 3,200 Hz is about 15-20 MB of Klipper CSV; 64 MiB is
+/// three times that, and bounds what identifying a file holds in memory
+/// (docs/performance.md).
 pub const RECORDING: Limit = Limit {
     what: "an accelerometer recording (CSV, or .stdata once decompressed)",
-    bytes: 128 * MIB,
+    bytes: 64 * MIB,
 };
 
 /// One line of `settle plan` input (a problem of a few axes is a few hundred bytes).

@@ -9,9 +9,10 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use settle_gcode::job::{Firmware, Job, JobConfig, ShaperSetting};
+use settle_gcode::job::{Job, JobConfig, ShaperSetting};
 use settle_gcode::{Reader, ReaderOptions};
-use settle_planner::shaper::ShaperKind;
+use settle_planner::firmware::Firmware;
+use settle_planner::shaper::ShaperType;
 
 mod synth;
 
@@ -19,13 +20,13 @@ mod synth;
 fn config(fw: Firmware) -> JobConfig {
     let mut c = JobConfig::defaults(fw).expect("defaults");
     let name = match fw {
-        Firmware::Klipper | Firmware::Settle => "mzv",
         Firmware::Marlin => "marlin:zvd",
         Firmware::Rrf => "rrf:zvd",
+        _ => "mzv",
     };
     for (i, f) in [48.0, 41.0].into_iter().enumerate() {
         c.shapers[i] = Some(ShaperSetting {
-            kind: ShaperKind::parse(name).expect("name"),
+            shaper_type: ShaperType::parse(name).expect("name"),
             frequency_hz: f,
             damping_ratio: 0.1,
         });
@@ -62,7 +63,7 @@ fn bench(c: &mut Criterion) {
     for (label, text) in [("prints", &prints), ("synth_1MB", &synth)] {
         let mut g = c.benchmark_group(format!("job_{label}"));
         g.sample_size(10);
-        for fw in Firmware::ALL {
+        for fw in Firmware::GCODE {
             let (moves, print_s, segments) = run(text, fw);
             eprintln!(
                 "job_{label}/{fw}: {moves} moves, {print_s:.3} s of print time, {segments} X segments"

@@ -10,8 +10,9 @@
 use std::io::{BufWriter, Write};
 use std::time::Instant;
 
-use settle_gcode::job::{Firmware, Job, JobConfig, ShaperSetting};
-use settle_planner::shaper::ShaperKind;
+use settle_gcode::job::{Job, JobConfig, ShaperSetting};
+use settle_planner::firmware::Firmware;
+use settle_planner::shaper::ShaperType;
 
 #[path = "../benches/synth/mod.rs"]
 mod synth;
@@ -25,7 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mb: u64 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(100);
     let fw: Firmware = args
         .next()
-        .map(|s| s.parse())
+        .map(|s| settle_gcode::job::parse_firmware(&s))
         .transpose()?
         .unwrap_or(Firmware::Klipper);
     let dir = tempfile::tempdir()?;
@@ -41,13 +42,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let mut cfg = JobConfig::defaults(fw)?;
     let name = match fw {
-        Firmware::Klipper | Firmware::Settle => "mzv",
         Firmware::Marlin => "marlin:zvd",
         Firmware::Rrf => "rrf:zvd",
+        _ => "mzv",
     };
     for (i, f) in [48.0, 41.0].into_iter().enumerate() {
         cfg.shapers[i] = Some(ShaperSetting {
-            kind: ShaperKind::parse(name)?,
+            shaper_type: ShaperType::parse(name)?,
             frequency_hz: f,
             damping_ratio: 0.1,
         });

@@ -208,12 +208,6 @@ pub enum GcodeError {
         /// Distance from start to end.
         chord_mm: f64,
     },
-    /// A firmware dialect name that is not `klipper`, `marlin` or `rrf`.
-    #[error("unknown firmware dialect `{name}` (allowed: klipper, marlin, rrf)")]
-    UnknownDialect {
-        /// The name given.
-        name: String,
-    },
     /// A line of a firmware configuration file that is not what the format allows there.
     #[error("{at}: {what}")]
     ConfigSyntax {
@@ -335,7 +329,6 @@ impl GcodeError {
         match self {
             GcodeError::Io { .. }
             | GcodeError::File(_)
-            | GcodeError::UnknownDialect { .. }
             | GcodeError::ConfigMissing { .. }
             | GcodeError::ExportValue { .. }
             | GcodeError::JobSetting { .. } => None,

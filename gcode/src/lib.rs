@@ -1,9 +1,12 @@
 //! settle-gcode: what firmware reads — G-code jobs and firmware configuration files.
 //!
-//! Two parts: the streaming G-code reader below, and [`config`], which reads Klipper's
-//! `printer.cfg` and RepRapFirmware's `config.g` into plain data with the values the
-//! firmware would use (includes, SAVE_CONFIG, macros, defaults) and writes input shaper
-//! settings back in each firmware's syntax.
+//! Three parts, a folder each:
+//! - `read/`: the streaming G-code reader (below);
+//! - [`config`]: Klipper's `printer.cfg` and RepRapFirmware's `config.g` read into plain
+//!   data with the values the firmware would use (includes, SAVE_CONFIG, macros, defaults),
+//!   and input shaper settings written back in each firmware's syntax;
+//! - [`job`]: a G-code file replayed through a firmware's planner (settle-planner's
+//!   `firmware` planners) into per-axis motion, streaming.
 //!
 //! [`Reader`] turns any `BufRead` (or a file, [`Reader::open`]) into [`Event`]s in file
 //! order, each with its 1-based line and its layer: moves ([`Move`]: start and end in a
@@ -50,39 +53,23 @@
 // `!(x >= 0.0)`-style comparisons reject NaN together with out-of-range values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-mod arc;
-mod canonical;
-mod cmd;
 pub mod config;
-mod dialect;
 mod error;
-mod event;
-mod geometry;
 pub mod job;
-mod layers;
-mod lex;
-mod limit_parse;
-mod limits;
-mod motion;
-mod params;
-mod reader;
-mod segments;
-mod setting;
-mod setting_parse;
-mod summary;
+mod read;
 
-pub use arc::{
+pub use error::{GcodeError, Location};
+pub use read::arc::{
     Arc, FULL_CIRCLE_TOLERANCE_MM, RADIUS_TOLERANCE_MAX_MM, RADIUS_TOLERANCE_MM,
     RADIUS_TOLERANCE_REL,
 };
-pub use canonical::CanonicalWriter;
-pub use dialect::Dialect;
-pub use error::{GcodeError, Location};
-pub use event::{Event, EventKind, LayerChange, LayerSource, Note};
-pub use geometry::{Bounds, Move, MoveKind, Path, Point};
-pub use layers::LayerMode;
-pub use limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
-pub use reader::{FileInput, Reader, ReaderOptions, Skipped};
-pub use segments::{ArcSegmentation, KlipperArcs, MarlinArcs, RrfArcs};
-pub use setting::Setting;
-pub use summary::{LimitSeen, Summary};
+pub use read::canonical::CanonicalWriter;
+pub use read::dialect::Dialect;
+pub use read::event::{Event, EventKind, LayerChange, LayerSource, Note};
+pub use read::geometry::{Bounds, Move, MoveKind, Path, Point};
+pub use read::layers::LayerMode;
+pub use read::limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
+pub use read::reader::{FileInput, Reader, ReaderOptions, Skipped};
+pub use read::segments::{ArcSegmentation, KlipperArcs, MarlinArcs, RrfArcs};
+pub use read::setting::Setting;
+pub use read::summary::{LimitSeen, Summary};

@@ -13,7 +13,7 @@ pub enum ProfileKind {
     SCurve,
     /// Time-optimal profile under four jerks (Trinamic BOW1..BOW4): raise and lower the
     /// acceleration at `j1`, `j2`, raise and lower the deceleration at `j3`, `j4`, with
-    /// DMAX for braking (see [`crate::fourjerk`]). Parameters: [`KindParams`]
+    /// DMAX for braking (see [`crate::fourjerk`]). Parameters: [`ProfileParams`]
     /// `fourjerk_jerk_scale` (multiples of `jmax`) and `fourjerk_dmax_scale` (multiple of
     /// `amax`); with the defaults it is the S-curve.
     FourJerk,
@@ -24,14 +24,14 @@ pub enum ProfileKind {
     PvtSym,
     /// Asymmetric PVT step: peak acceleration and jerk in the first half, time scaled to
     /// the fastest within vmax, amax, jmax (see [`crate::pvt::step::asymmetric`]).
-    /// Parameter: [`KindParams`] `pvt_asym_ki` (`Ki`, 1/3 < Ki < 1).
+    /// Parameter: [`ProfileParams`] `pvt_asym_ki` (`Ki`, 1/3 < Ki < 1).
     PvtAsym,
 }
 
 /// Parameters of the kinds that take any (ignored by the others). The defaults make every
 /// kind plannable from [`Limits`] alone.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct KindParams {
+pub struct ProfileParams {
     /// `pvt_asym`: `Ki` (twice the fraction of the step covered when the acceleration
     /// peaks, see [`crate::pvt::step::AsymShape`]), in (1/3, 1). Default 0.5: peak
     /// acceleration at one third of the move, 0.375 d/t1^2 against a final deceleration
@@ -44,7 +44,7 @@ pub struct KindParams {
     pub fourjerk_dmax_scale: f64,
 }
 
-impl Default for KindParams {
+impl Default for ProfileParams {
     fn default() -> Self {
         Self {
             pvt_asym_ki: 0.5,
@@ -89,7 +89,7 @@ impl ProfileKind {
     }
 
     /// Plan a rest-to-rest move of signed `distance` starting at `p0` with the default
-    /// [`KindParams`]. Trapezoids and S-curves use the any-state planner of
+    /// [`ProfileParams`]. Trapezoids and S-curves use the any-state planner of
     /// [`crate::position`] (the closed-form planners in [`crate::scurve`] and
     /// [`crate::trapezoid`] are kept as independent references for the tests).
     pub fn rest_to_rest(
@@ -98,7 +98,7 @@ impl ProfileKind {
         distance: f64,
         limits: &Limits,
     ) -> Result<Profile, PlanError> {
-        self.rest_to_rest_with(p0, distance, limits, &KindParams::default())
+        self.rest_to_rest_with(p0, distance, limits, &ProfileParams::default())
     }
 
     /// [`Self::rest_to_rest`] with explicit parameters. The kinds after `scurve` use
@@ -108,7 +108,7 @@ impl ProfileKind {
         p0: f64,
         distance: f64,
         limits: &Limits,
-        params: &KindParams,
+        params: &ProfileParams,
     ) -> Result<Profile, PlanError> {
         let shape = match self {
             ProfileKind::Trapezoid => Shape::Trapezoid,
@@ -149,7 +149,7 @@ impl ProfileKind {
         p0: f64,
         distance: f64,
         limits: &Limits,
-        params: &KindParams,
+        params: &ProfileParams,
     ) -> Result<Profile, PlanError> {
         let jmax = limits
             .jmax()

@@ -15,8 +15,13 @@
 //! - four independent jerks: [`fourjerk`] (any state) and [`tmc`] (the TMC4361A ramp and
 //!   its registers);
 //! - [`pvt`] (PVT segments, turnarounds, step moves), [`raster`] (raster scans),
-//!   [`path`] (polylines with corners, look-ahead), [`shaper`] (input shapers);
-//! - [`ProfileKind`]: every kind by name, one entry point.
+//!   [`path`] (polylines with corners, look-ahead);
+//! - [`shaper`] (input shapers as Klipper, Marlin and RepRapFirmware compute them),
+//!   [`shaper_select`] (Klipper's choice of a shaper from a resonance measurement);
+//! - [`firmware`]: the firmwares by name ([`firmware::Firmware`]) and the planners of
+//!   Klipper, Marlin and RepRapFirmware (a G-code job's moves as the printer runs them);
+//! - [`ProfileKind`]: every profile kind by name, one entry point; [`ProfileParams`] the
+//!   parameters of those that take any.
 //!
 //! No I/O, no clocks, no simulation types. Units are whatever the caller uses consistently
 //! (settle's harness uses metres and seconds).
@@ -60,7 +65,7 @@ mod unit;
 pub mod velocity;
 
 pub use error::PlanError;
-pub use kind::{KindParams, ProfileKind};
+pub use kind::{ProfileKind, ProfileParams};
 pub use limits::Limits;
 pub use profile::{Profile, Sample, Segment, State};
 pub use trajectory::Trajectory;

@@ -23,7 +23,7 @@
 //! axis limits the overhead, the overhead grows with `v_diff`; see
 //! [`slowdown_fly_overhead_s`] and its test in `planner/tests/all/raster.rs`.
 
-use crate::kind::{KindParams, ProfileKind};
+use crate::kind::{ProfileKind, ProfileParams};
 use crate::pvt::turnaround::TwoSegment;
 use crate::pvt::{Knot, Pvt};
 use crate::{Limits, PlanError, Profile, Segment, State, Trajectory};
@@ -57,7 +57,7 @@ pub struct RasterSpec {
     /// The step axis's limits.
     pub step_limits: Limits,
     /// Parameters of the step kind.
-    pub step_params: KindParams,
+    pub step_params: ProfileParams,
     /// Where the step sits in the window.
     pub placement: StepPlacement,
     /// Time the step must be finished before re-entry (s, >= 0).

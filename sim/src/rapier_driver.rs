@@ -8,7 +8,8 @@
 //! staircase (one edge per microstep) through a current loop of ~8 us, so within a 100 us
 //! step they jump at instants that have nothing to do with the step grid. Sampling them at
 //! `t_n` moves every edge by up to `h/2`, a timing jitter that changed the printer's
-//! residual vibration by 2-7 % at the default step (docs/reports/REPORT-mujoco.md).
+//! residual vibration by up to 7 % at the default step (the figures are in
+//! `sim/tests/all/rapier_full_step.rs`, which checks the default step as it is now).
 //!
 //! So the torque applied at `t_n` is the mean of `Km (-ia sin(Nr theta) + ib cos(Nr theta))`
 //! over the kick window, along the rotor's leapfrog path `theta_n + omega_{n-1/2} (t - t_n)`

@@ -1,11 +1,13 @@
-//! Executing runs: the machine's axes compiled for the run, its motion planned by its run
-//! kind, the one [`sim_options`] every kind's run is simulated with, the simulation loop
-//! ([`simulate`]) on the chosen backend ([`engine`]), the worker pool with progress
+//! Executing runs: the machine's axes compiled for the run, its motion planned by its
+//! study, the one [`sim_options`] every study's run is simulated with, the simulation
+//! driver every command runs its plants on ([`driver`]), the plant of the chosen backend
+//! ([`plant`]), a run as the driver's sink ([`simulate`]), the worker pool with progress
 //! reported through a callback ([`pool`]) and interruption ([`interrupt`]).
 
 pub mod cursor;
-pub mod engine;
+pub mod driver;
 pub mod interrupt;
+pub mod plant;
 pub mod pool;
 pub mod simulate;
 
@@ -18,7 +20,8 @@ use crate::spec::backend::{Backend, NO_MUJOCO};
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
 
-pub use engine::{SimOptions, run_trajectory};
+pub use plant::SimOptions;
+pub use simulate::run_trajectory;
 
 /// How a run is observed.
 #[derive(Debug, Clone, PartialEq)]
@@ -52,19 +55,12 @@ pub fn sim_options(spec: &RunSpec) -> SimOptions {
 /// The axes a run simulates: the machine compiled for the run's driver model, or one axis
 /// per axis of the modes form.
 pub fn axes_of(spec: &RunSpec) -> Result<Vec<AxisModel>, SimError> {
-    match &spec.machine {
-        Some(m) => m.compile(spec.driver),
-        None => spec
-            .modes
-            .iter()
-            .map(|a| AxisModel::from_modes(&a.axis, &spec.modes_sim(&a.axis)?))
-            .collect(),
-    }
+    spec.machine.axes(spec.driver)
 }
 
 /// Plan and simulate one run on its backend. When `record` is given, it is replaced by a
 /// series with the run's channels ([`simulate::channels`]) and every sample is appended to
-/// it. A run kind that measures more than the common metrics ([`crate::kinds::Probe`]) gets
+/// it. A study that measures more than the common metrics ([`crate::studies::Probe`]) gets
 /// the series recorded (into `record`, or a series of its own) and adds its figures to an
 /// ok run's metrics.
 pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, Error> {
@@ -74,7 +70,7 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
     };
     let axes = axes_of(spec).map_err(sim_err)?;
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
-    let planned = crate::kinds::plan(spec, &names).map_err(|source| Error::Plan {
+    let planned = crate::studies::plan(spec, &names).map_err(|source| Error::Plan {
         run: spec.id,
         source,
     })?;

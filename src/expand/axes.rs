@@ -1,5 +1,5 @@
 //! Sweep axes: `[sweep]` keys and their values, a list or a range table, read into
-//! [`Value`]s. Numbers stay numbers, strings become names (a run kind's state checks its
+//! [`Value`]s. Numbers stay numbers, strings become names (a study's state checks its
 //! names, e.g. `corner.strategy`, when the axis is read), `profile` takes profile kinds.
 
 use settle_planner::ProfileKind;
@@ -23,8 +23,8 @@ pub struct Axis {
     pub values: Vec<Value>,
 }
 
-/// Read the sweep axes of a scenario whose runs start from `base`. A key of a run kind
-/// (`corner.angle_deg`) is checked against the base's state of that kind: the kind must be
+/// Read the sweep axes of a scenario whose runs start from `base`. A key of a study
+/// (`corner.angle_deg`) is checked against the base's state of that study: the study must be
 /// in the scenario and take every value.
 pub fn axes(sc: &Scenario, src: &Source, base: &RunSpec) -> Result<Vec<Axis>, Error> {
     let mut out = Vec::new();
@@ -47,7 +47,7 @@ pub fn axes(sc: &Scenario, src: &Source, base: &RunSpec) -> Result<Vec<Axis>, Er
                         ))
                     })?;
                     ProfileKind::parse(name)
-                        .map(Value::Kind)
+                        .map(Value::Study)
                         .map_err(|e| err(e.to_string()))
                 })
                 .collect::<Result<Vec<_>, _>>()?
@@ -90,7 +90,7 @@ pub fn axes(sc: &Scenario, src: &Source, base: &RunSpec) -> Result<Vec<Axis>, Er
                     values.len()
                 ))
             })?;
-        check_kind_values(param, &values, base).map_err(err)?;
+        check_study_values(param, &values, base).map_err(err)?;
         out.push(Axis {
             param: param.clone(),
             values,
@@ -99,13 +99,13 @@ pub fn axes(sc: &Scenario, src: &Source, base: &RunSpec) -> Result<Vec<Axis>, Er
     Ok(out)
 }
 
-/// A run kind's key (`<table>.<key>` with a registered kind's table): the base must have
-/// the kind, and its state must take every value.
-fn check_kind_values(param: &str, values: &[Value], base: &RunSpec) -> Result<(), String> {
+/// A study's key (`<table>.<key>` with a registered study's table): the base must have
+/// the study, and its state must take every value.
+fn check_study_values(param: &str, values: &[Value], base: &RunSpec) -> Result<(), String> {
     let Some((table, key)) = param.split_once('.') else {
         return Ok(());
     };
-    if crate::kinds::by_table(table).is_none() {
+    if crate::studies::by_table(table).is_none() {
         return Ok(());
     }
     let Some(state) = base.state_of(table) else {

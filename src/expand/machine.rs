@@ -1,10 +1,14 @@
-//! The scenario's machine: its modes per axis, a preset or machine file, or inline axes.
+//! Machines resolved: a scenario's `[machine]` (its modes per axis, a preset or machine
+//! file, or inline axes; [`resolve_machine`]) and a machine named by `preset = "..."`,
+//! `--machine` or `settle machine FILE` ([`named`], the one resolver of such names).
+
+use std::path::{Path, PathBuf};
 
 use settle_sim::DriverMode;
-use settle_sim::machine::Machine;
 
 use crate::error::Error;
-use crate::input::machine_file::MachineForm;
+use crate::input::machine_file::{PRESETS, parse_any};
+use crate::input::machine_form::MachineForm;
 use crate::input::modes::AxisModes;
 use crate::input::scenario::Scenario;
 use crate::input::source::Source;
@@ -12,14 +16,115 @@ use crate::input::source::Source;
 /// The scenario's machine, resolved.
 #[derive(Debug, Clone)]
 pub struct Resolved {
-    /// The physical machine, or `None` for the modes form.
-    pub machine: Option<Machine>,
-    /// The modes per axis (modes form; empty for a physical machine).
-    pub modes: Vec<AxisModes>,
+    /// The machine.
+    pub form: MachineForm,
     /// Its name (the preset's or machine file's, the inline machine's, or `modes`).
     pub name: String,
     /// How the motors are driven (`linear` for the modes form).
     pub driver: DriverMode,
+}
+
+/// A machine named by `preset = "..."`, `--machine` or `settle machine FILE`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Named {
+    /// Its name (a machine file's `name`, a scenario's machine's name).
+    pub name: String,
+    /// A machine file's `description` (empty for a scenario).
+    pub description: String,
+    /// The machine.
+    pub form: MachineForm,
+    /// The file it came from (a preset's: its repository path).
+    pub source: PathBuf,
+}
+
+/// The machine `value` names: a built-in preset ([`PRESETS`]), a machine file of either
+/// form at a path relative to the folder `base`, or (when `scenarios`) a scenario file:
+/// its `[machine]`. A value that is neither a preset's name nor a path (with a `/` or
+/// ending in `.toml`), or a file that cannot be read, is the error `err` makes of the
+/// message. `preset = "..."` is resolved relative to its scenario's folder, without
+/// scenarios; `--machine` and `settle machine FILE` relative to the working folder (`""`).
+pub fn named(
+    value: &str,
+    base: &Path,
+    scenarios: bool,
+    err: &dyn Fn(String) -> Error,
+) -> Result<Named, Error> {
+    if let Some((_, path, text)) = PRESETS.iter().find(|(n, _, _)| *n == value) {
+        let source = PathBuf::from(path);
+        let d = parse_any(text, &source)?;
+        return Ok(Named {
+            name: d.name,
+            description: d.description,
+            form: d.form,
+            source,
+        });
+    }
+    let looks_like_path = value.contains('/') || value.ends_with(".toml");
+    if !looks_like_path {
+        let names: Vec<&str> = PRESETS.iter().map(|(n, _, _)| *n).collect();
+        return Err(err(format!(
+            "unknown preset `{value}`; built in: {}, or give a path to a machine file (ending in .toml){}",
+            names.join(", "),
+            if scenarios { " or a scenario" } else { "" }
+        )));
+    }
+    let source = base.join(value);
+    let text = crate::input::file::read_text(&source, crate::input::file::limit::SETTINGS)
+        .map_err(|e| {
+            let why = match e {
+                Error::Read { source, .. } => source.to_string(),
+                Error::Input { message, .. } => message,
+                other => other.to_string(),
+            };
+            err(format!(
+                "cannot read machine file {}: {why}",
+                source.display()
+            ))
+        })?;
+    if scenarios
+        && text
+            .parse::<toml::Table>()
+            .is_ok_and(|t| t.contains_key("machine"))
+    {
+        let (sc, src) = crate::expand::parse(&text, &source)?;
+        let r = resolve_machine(&sc, &src)?;
+        return Ok(Named {
+            name: r.name,
+            description: String::new(),
+            form: r.form,
+            source,
+        });
+    }
+    let d = parse_any(&text, &source)?;
+    Ok(Named {
+        name: d.name,
+        description: d.description,
+        form: d.form,
+        source,
+    })
+}
+
+/// The folder a scenario's relative paths start from.
+fn folder(src: &Source) -> &Path {
+    src.path.parent().unwrap_or(Path::new("."))
+}
+
+/// `preset = "<value>"` of the scenario `src` for a machine to sweep through
+/// `machine.preset`: a physical one (errors keyed at `machine.preset`).
+pub fn swept_preset(value: &str, src: &Source) -> Result<Named, Error> {
+    let n = named(value, folder(src), false, &|m| {
+        src.error_at("machine.preset", m)
+    })?;
+    match n.form {
+        MachineForm::Physical(_) => Ok(n),
+        MachineForm::Modes(_) => Err(src.error_at(
+            "machine.preset",
+            format!(
+                "{} gives the machine by its modes; only physical machines (motor, belts, masses) can be swept as presets",
+                n.source.display()
+            ),
+        )),
+    }
 }
 
 /// The scenario's machine.
@@ -64,8 +169,7 @@ pub fn resolve_machine(sc: &Scenario, src: &Source) -> Result<Resolved, Error> {
     };
     let modes_machine = |modes: Vec<AxisModes>, name: String| -> Result<Resolved, Error> {
         Ok(Resolved {
-            machine: None,
-            modes,
+            form: MachineForm::Modes(modes),
             name,
             driver: no_motor(driver)?,
         })
@@ -107,15 +211,16 @@ pub fn resolve_machine(sc: &Scenario, src: &Source) -> Result<Resolved, Error> {
         return modes_machine(modes, name);
     }
     if let Some(preset) = &m.preset {
-        let (d, _) = crate::input::machine_file::load_any(preset, &src.path, src)?;
-        return match d.form {
+        let n = named(preset, folder(src), false, &|m| {
+            src.error_at("machine.preset", m)
+        })?;
+        return match n.form {
             MachineForm::Physical(machine) => Ok(Resolved {
                 name: machine.name.clone(),
-                machine: Some(machine),
-                modes: Vec::new(),
+                form: MachineForm::Physical(machine),
                 driver: driver.unwrap_or(DriverMode::Full),
             }),
-            MachineForm::Modes(modes) => modes_machine(modes, d.name),
+            MachineForm::Modes(modes) => modes_machine(modes, n.name),
         };
     }
     let driver = driver.unwrap_or(DriverMode::Full);
@@ -130,8 +235,7 @@ pub fn resolve_machine(sc: &Scenario, src: &Source) -> Result<Resolved, Error> {
             "machine.",
         )?;
         return Ok(Resolved {
-            machine: Some(machine),
-            modes: Vec::new(),
+            form: MachineForm::Physical(machine),
             name,
             driver,
         });

@@ -2,8 +2,8 @@
 //! file always gives the same runs in the same order (the only I/O is reading a machine
 //! file the scenario names by path).
 //!
-//! The base run comes from the scenario's core tables and the run kinds' tables (each
-//! registered kind parses its own, `crate::kinds`); the sweep axes ([`axes`]) then vary it,
+//! The base run comes from the scenario's core tables and the studies' tables (each
+//! registered study parses its own, `crate::studies`); the sweep axes ([`axes`]) then vary it,
 //! the last axis fastest, and every run is checked ([`validate`]).
 
 pub mod axes;
@@ -13,27 +13,27 @@ pub mod validate;
 
 use std::path::Path;
 
+use crate::input::machine_form::MachineForm;
 use settle_planner::ProfileKind;
-use settle_sim::machine::Machine;
 
 use crate::error::Error;
 use crate::input::scenario::{MoveSpec, Scenario};
 use crate::input::source::Source;
-use crate::kinds::{self, Kind, KindState, Role};
 use crate::spec::backend::Backend;
 use crate::spec::run_spec::{RunSpec, SWEEPABLE};
 use crate::spec::value::Value;
+use crate::studies::{self, Role, Study, StudyState};
 
 pub use axes::{Axis, MAX_RUNS};
 
-/// Read a scenario file (its core and every kind's table).
+/// Read a scenario file (its core and every study's table).
 pub fn load(path: &Path) -> Result<(Scenario, Source), Error> {
-    crate::input::scenario::load(path, &kinds::tables())
+    crate::input::scenario::load(path, &studies::tables())
 }
 
 /// Parse scenario text (see [`load`]); `path` is used in error messages.
 pub fn parse(text: &str, path: &Path) -> Result<(Scenario, Source), Error> {
-    crate::input::scenario::parse(text, path, &kinds::tables())
+    crate::input::scenario::parse(text, path, &studies::tables())
 }
 
 /// Load a scenario file and expand it into validated runs.
@@ -50,10 +50,10 @@ pub fn parse_runs(text: &str, path: &Path) -> Result<(Scenario, Vec<RunSpec>), E
     Ok((sc, runs))
 }
 
-/// Everything that can be swept, for messages: the keys of every run, then each kind's.
+/// Everything that can be swept, for messages: the keys of every run, then each study's.
 pub fn sweepable() -> String {
     let mut out = SWEEPABLE.to_string();
-    for k in kinds::all() {
+    for k in studies::all() {
         if let (Some(t), s) = (k.table(), k.sweepable())
             && !s.is_empty()
         {
@@ -63,19 +63,19 @@ pub fn sweepable() -> String {
     out
 }
 
-/// How a kind is given in a scenario, for messages: `[corner] (a corner path)`.
-fn given_as(k: &dyn Kind) -> String {
+/// How a study is given in a scenario, for messages: `[corner] (a corner path)`.
+fn given_as(k: &dyn Study) -> String {
     format!("[{}] (a {})", k.table().unwrap_or("move"), k.name())
 }
 
-/// The run kinds' states from their tables, and the move every run starts from: `[move]`
-/// (`None`), or a path kind's stand-in for it (with the key its profile kind is blamed on).
-type BaseMotion = (Vec<Box<dyn KindState>>, MoveSpec, Option<&'static str>);
+/// The studies' states from their tables, and the move every run starts from: `[move]`
+/// (`None`), or a path study's stand-in for it (with the key its profile kind is blamed on).
+type BaseMotion = (Vec<Box<dyn StudyState>>, MoveSpec, Option<&'static str>);
 
 fn base_motion(sc: &Scenario, src: &Source) -> Result<BaseMotion, Error> {
     let mut states = Vec::new();
-    let mut motion: Option<&dyn Kind> = None;
-    for k in kinds::all() {
+    let mut motion: Option<&dyn Study> = None;
+    for k in studies::all() {
         let Some(state) = k.parse(src)? else {
             continue;
         };
@@ -94,7 +94,7 @@ fn base_motion(sc: &Scenario, src: &Source) -> Result<BaseMotion, Error> {
         }
         states.push(state);
     }
-    let paths: Vec<String> = kinds::all()
+    let paths: Vec<String> = studies::all()
         .iter()
         .filter(|k| k.role() == Role::Path)
         .map(|k| given_as(*k))
@@ -151,15 +151,11 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
     let base_profile =
         ProfileKind::parse(&mv.profile).map_err(|e| src.error_at(profile_key, e.to_string()))?;
     let machine::Resolved {
-        machine,
-        modes,
+        form: machine,
         name: machine_name,
         driver,
     } = machine::resolve_machine(sc, src)?;
-    let axis_names: Vec<String> = match &machine {
-        Some(m) => m.axes.iter().map(|a| a.name.clone()).collect(),
-        None => modes.iter().map(|a| a.axis.clone()).collect(),
-    };
+    let axis_names = machine.axis_names();
     if !is_path && !axis_names.contains(&mv.axis) {
         return Err(src.error_at(
             "move.axis",
@@ -178,7 +174,6 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
         vmax_mm_s: sc.limits.vmax_mm_s,
         amax_mm_s2: sc.limits.amax_mm_s2,
         jmax_mm_s3: sc.limits.jmax_mm_s3,
-        modes,
         machine,
         machine_name,
         driver,
@@ -189,8 +184,8 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
         bands_um: sc.observe.bands_um.clone(),
         max_step_s: sc.sim.max_step_s,
         swept: Vec::new(),
-        kind_params: settle_planner::KindParams::default(),
-        kinds: states,
+        profile_params: settle_planner::ProfileParams::default(),
+        studies: states,
     };
     validate::validate_observe(&base, src)?;
     if sc.sweep.len() > validate::MAX_SWEEP_AXES {
@@ -215,7 +210,7 @@ pub fn sweep_of(sc: &Scenario, src: &Source) -> Result<Sweep, Error> {
                 format!("the sweep expands to more than {MAX_RUNS} runs"),
             )
         })?;
-    if axes.iter().any(|a| a.param == "machine.preset") && base.machine.is_none() {
+    if axes.iter().any(|a| a.param == "machine.preset") && base.machine.physical().is_none() {
         return Err(src.error_at(
             "sweep.machine.preset",
             "sweeping presets needs a physical machine: give `preset` in [machine], not `modes`",
@@ -240,7 +235,7 @@ struct SweepRuns {
     axes: Vec<Axis>,
     total: usize,
     /// Swept presets: (name as written, machine, machine name).
-    presets: Vec<(String, Machine, String)>,
+    presets: Vec<(String, MachineForm, String)>,
 }
 
 /// What makes run `id` fail: the key to blame and the message.
@@ -277,14 +272,10 @@ impl SweepRuns {
         for (axis, &k) in self.axes.iter().zip(&picks) {
             if let (true, Value::Text(name)) = (axis.param == "machine.preset", &axis.values[k]) {
                 if let Some((_, m, mname)) = self.presets.iter().find(|(n, _, _)| n == name) {
-                    run.machine = Some(m.clone());
+                    run.machine = m.clone();
                     run.machine_name = mname.clone();
                 }
-                if run
-                    .machine
-                    .as_ref()
-                    .is_some_and(|m| m.axis(&run.axis).is_none())
-                {
+                if run.machine.physical().is_some() && !run.machine.has_axis(&run.axis) {
                     return Err((
                         "sweep.machine.preset".to_string(),
                         format!("machine `{name}` has no axis `{}` (move.axis)", run.axis),
@@ -304,8 +295,8 @@ impl SweepRuns {
             }
             run.swept.push((axis.param.clone(), v.clone()));
         }
-        // A path kind's move length is its path length.
-        if let Some(d) = kinds::motion(&run).path_length_mm(&run) {
+        // A path study's move length is its path length.
+        if let Some(d) = studies::motion(&run).path_length_mm(&run) {
             run.distance_mm = d;
         }
         Ok(run)
@@ -340,12 +331,7 @@ pub fn sweep_runs(sc: &Scenario, src: &Source) -> Result<crate::spec::runs::Runs
         total,
         presets: Vec::new(),
     };
-    type ModesKey = (
-        Option<Machine>,
-        Vec<crate::input::modes::AxisModes>,
-        f64,
-        String,
-    );
+    type ModesKey = (MachineForm, f64, String);
     let mut last_modes: Option<(ModesKey, Option<(f64, f64)>)> = None;
     for id in 0..total {
         let picks = runs.picks(id);
@@ -353,8 +339,8 @@ pub fn sweep_runs(sc: &Scenario, src: &Source) -> Result<crate::spec::runs::Runs
             && !runs.presets.iter().any(|(n, _, _)| n == name)
         {
             let name = name.to_string();
-            let (m, _, _) = crate::input::machine_file::load_preset(&name, &src.path, src)?;
-            let mname = m.name.clone();
+            let m = machine::swept_preset(&name, src)?.form;
+            let mname = m.physical().map(|m| m.name.clone()).unwrap_or_default();
             runs.presets.push((name, m, mname));
         }
         let run = runs.build(id).map_err(|(key, m)| src.error_at(&key, m))?;
@@ -362,22 +348,14 @@ pub fn sweep_runs(sc: &Scenario, src: &Source) -> Result<crate::spec::runs::Runs
         // The modes change only with the machine, its modes, the moved axis or where the
         // move starts: most sweeps linearise the machine once.
         let range = match &last_modes {
-            Some(((m, modes, start, axis), r))
-                if *m == run.machine
-                    && *modes == run.modes
-                    && *start == run.start_mm
-                    && *axis == run.axis =>
+            Some(((m, start, axis), r))
+                if *m == run.machine && *start == run.start_mm && *axis == run.axis =>
             {
                 *r
             }
             _ => {
                 let r = validate::mode_range_hz(&run);
-                let key = (
-                    run.machine.clone(),
-                    run.modes.clone(),
-                    run.start_mm,
-                    run.axis.clone(),
-                );
+                let key = (run.machine.clone(), run.start_mm, run.axis.clone());
                 last_modes = Some((key, r));
                 r
             }

@@ -1,4 +1,4 @@
-//! Checks of expanded runs: every value finite and in range, the run kinds' own checks,
+//! Checks of expanded runs: every value finite and in range, the studies' own checks,
 //! the machine and the move's travel. Errors name the key to blame: the sweep axis when
 //! the value was swept.
 
@@ -6,9 +6,9 @@ use settle_sim::Mode;
 
 use crate::error::Error;
 use crate::input::source::Source;
-use crate::kinds::{self, Role};
 use crate::spec::MAX_POSITION_MM;
 use crate::spec::run_spec::{RunSpec, needs_jerk};
+use crate::studies::{self, Role};
 
 /// The most samples one run may simulate, move and observation window together: at the
 /// default 10 kHz that is 10,000 s of simulated time, far beyond any settling question, and
@@ -93,11 +93,11 @@ fn validate_duration(run: &RunSpec, src: &Source) -> Result<(), Error> {
 /// rotations at 0 Hz left out). `None` when there are none or the machine cannot be
 /// linearised (its own checks report why).
 pub fn mode_range_hz(run: &RunSpec) -> Option<(f64, f64)> {
-    let freqs: Vec<f64> = match &run.machine {
+    let freqs: Vec<f64> = match run.machine.physical() {
         None => run
             .axis
             .split('+')
-            .flat_map(|a| run.modes_of(a).iter().map(|m| m.frequency_hz))
+            .flat_map(|a| run.machine.modes_of(a).iter().map(|m| m.frequency_hz))
             .collect(),
         Some(machine) => {
             let axes = machine.compile(settle_sim::DriverMode::Linear).ok()?;
@@ -112,7 +112,11 @@ pub fn mode_range_hz(run: &RunSpec) -> Option<(f64, f64)> {
     };
     // A physical machine's rigid rotations are 0 Hz; a mode given is a mode, however slow
     // (its window is checked against it).
-    let rigid = if run.machine.is_some() { 1e-6 } else { 0.0 };
+    let rigid = if run.machine.physical().is_some() {
+        1e-6
+    } else {
+        0.0
+    };
     let freqs = freqs.into_iter().filter(|f| f.is_finite() && *f > rigid);
     freqs.fold(None, |r, f| match r {
         None => Some((f, f)),
@@ -132,7 +136,7 @@ pub fn validate_sampling(
     let Some((slowest_hz, fastest_hz)) = range else {
         return Ok(());
     };
-    let what = if run.machine.is_some() {
+    let what = if run.machine.physical().is_some() {
         "the machine's linearised modes"
     } else {
         "machine.modes"
@@ -225,7 +229,7 @@ pub fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
 /// Check the base values of the move and the limits as written, whether or not a sweep
 /// overrides them: a value that is not a number, not finite, or (with the others) gives a
 /// move beyond [`MAX_SAMPLES_PER_RUN`] is a mistake in the file even when every run takes
-/// a swept value instead. A path kind's move is checked per run (its length is its path's).
+/// a swept value instead. A path study's move is checked per run (its length is its path's).
 pub fn validate_base(base: &RunSpec, src: &Source) -> Result<(), Error> {
     for (key, value) in [
         ("move.distance_mm", base.distance_mm),
@@ -280,10 +284,10 @@ fn validate_positions(
 }
 
 /// Check one run: its path kind first (a corner path checks its profile kind and machine
-/// before the limits), then the keys of every run, then its other kinds, then its machine.
+/// before the limits), then the keys of every run, then its other studies, then its machine.
 pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
     let kind_check = |paths: bool| {
-        for k in kinds::of(run).filter(|k| (k.role() == Role::Path) == paths) {
+        for k in studies::of(run).filter(|k| (k.role() == Role::Path) == paths) {
             k.validate(run).map_err(|(key, m)| src.error_at(&key, m))?;
         }
         Ok::<(), Error>(())
@@ -321,7 +325,7 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
         ));
     }
     kind_check(false)?;
-    if let Some(machine) = &run.machine {
+    if let Some(machine) = run.machine.physical() {
         let machine_swept = || {
             run.swept
                 .iter()
@@ -352,7 +356,7 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
         }
     }
     // The modes as written were checked when the machine was read; swept values here.
-    for a in &run.modes {
+    for a in run.machine.modes() {
         for (i, m) in a.modes.iter().enumerate() {
             if let Err(e) = Mode::new(m.frequency_hz, m.damping_ratio, m.weight) {
                 let field = if !(m.frequency_hz.is_finite() && m.frequency_hz > 0.0) {

@@ -23,8 +23,12 @@ use settle_sim::machine::{
     AxisMachine, Belt, Driver, Frame, Machine, Motor, Mount, Screw, Transmission,
 };
 
+// The tables of an axis's parts (`belt`, `screw`, `mount`, `frame`, `motor`, `driver`)
+// are settle-sim's types, which carry the machine-file keys (`settle_sim::machine`).
+
 use crate::error::Error;
-use crate::input::modes::{AxisModes, ModeSpec};
+use crate::input::machine_form::MachineForm;
+use crate::input::modes::ModeSpec;
 use crate::input::source::Source;
 
 /// The built-in presets: name, repository path, text.
@@ -51,9 +55,9 @@ pub struct MachineFile {
     #[serde(default)]
     pub description: String,
     /// Motor of every axis that does not name its own.
-    pub motor: Option<MotorSpec>,
+    pub motor: Option<Motor>,
     /// Driver of every axis that does not name its own.
-    pub driver: Option<DriverSpec>,
+    pub driver: Option<Driver>,
     /// The axes, by name.
     pub axis: BTreeMap<String, AxisSpec>,
 }
@@ -72,121 +76,17 @@ pub struct AxisSpec {
     /// Mass carried rigidly with the carriage (kg), e.g. the X beam on a Y axis. Default 0.
     pub beam_kg: Option<f64>,
     /// A belt drive.
-    pub belt: Option<BeltSpec>,
+    pub belt: Option<Belt>,
     /// A screw drive.
-    pub screw: Option<ScrewSpec>,
+    pub screw: Option<Screw>,
     /// Toolhead mount.
-    pub mount: Option<MountSpec>,
+    pub mount: Option<Mount>,
     /// Optional frame mode.
-    pub frame: Option<FrameSpec>,
+    pub frame: Option<Frame>,
     /// Motor (else the machine-wide one).
-    pub motor: Option<MotorSpec>,
+    pub motor: Option<Motor>,
     /// Driver (else the machine-wide one).
-    pub driver: Option<DriverSpec>,
-}
-
-/// `[axis.<name>.belt]`.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BeltSpec {
-    /// Axial stiffness E*A (N).
-    pub ea_n: f64,
-    /// Drive pulley to idler (mm).
-    pub span_mm: f64,
-    /// Drive pulley teeth.
-    pub pulley_teeth: u32,
-    /// Belt pitch (mm); GT2 = 2.
-    #[serde(default = "two")]
-    pub pitch_mm: f64,
-    /// Pulley-to-carriage belt length at axis position 0 (mm).
-    pub carriage_at_zero_mm: f64,
-    /// Damping ratio against the carried mass.
-    pub damping_ratio: f64,
-}
-
-fn two() -> f64 {
-    2.0
-}
-
-/// `[axis.<name>.screw]`.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ScrewSpec {
-    /// Lead (mm per revolution).
-    pub lead_mm: f64,
-    /// Axial stiffness (N/m).
-    pub stiffness_n_per_m: f64,
-    /// Damping ratio against the carried mass.
-    pub damping_ratio: f64,
-}
-
-/// `[axis.<name>.mount]`.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MountSpec {
-    /// Stiffness (N/m).
-    pub stiffness_n_per_m: f64,
-    /// Damping ratio against the toolhead mass.
-    pub damping_ratio: f64,
-}
-
-/// `[axis.<name>.frame]`.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FrameSpec {
-    /// Modal mass (kg).
-    pub mass_kg: f64,
-    /// Stiffness to ground (N/m).
-    pub stiffness_n_per_m: f64,
-    /// Damping ratio.
-    pub damping_ratio: f64,
-}
-
-/// `[motor]`.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MotorSpec {
-    /// Holding torque, both phases at rated current (N m).
-    pub holding_torque_n_m: f64,
-    /// Rated phase current (A).
-    pub rated_current_a: f64,
-    /// Phase resistance (ohm).
-    pub resistance_ohm: f64,
-    /// Phase inductance (mH).
-    pub inductance_mh: f64,
-    /// Rotor inertia (g cm^2).
-    pub rotor_inertia_g_cm2: f64,
-    /// Rotor teeth (50 for 1.8 degree motors).
-    #[serde(default = "fifty")]
-    pub rotor_teeth: u32,
-    /// Detent torque (N m).
-    #[serde(default)]
-    pub detent_torque_n_m: f64,
-    /// Damping ratio of the rotor on the driver's magnetic spring.
-    pub damping_ratio: f64,
-}
-
-fn fifty() -> u32 {
-    50
-}
-
-/// `[driver]`.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DriverSpec {
-    /// Microsteps per full step.
-    pub microsteps: u32,
-    /// Run current (A rms).
-    pub run_current_a_rms: f64,
-    /// Supply voltage (V).
-    pub supply_v: f64,
-    /// Current loop bandwidth (Hz). Default 20 kHz.
-    #[serde(default = "bandwidth")]
-    pub current_loop_bandwidth_hz: f64,
-}
-
-fn bandwidth() -> f64 {
-    20_000.0
+    pub driver: Option<Driver>,
 }
 
 /// The most axes a machine may have: a gantry has two or three, a machine with its
@@ -197,8 +97,8 @@ pub const MAX_AXES: usize = 8;
 /// in `src` (`""` in a machine file, `"machine."` inline in a scenario), for errors.
 pub fn to_machine(
     name: &str,
-    motor: Option<&MotorSpec>,
-    driver: Option<&DriverSpec>,
+    motor: Option<&Motor>,
+    driver: Option<&Driver>,
     axes: &BTreeMap<String, AxisSpec>,
     src: &Source,
     prefix: &str,
@@ -230,19 +130,8 @@ pub fn to_machine(
             .as_ref()
             .ok_or_else(|| missing("mount", "a table"))?;
         let transmission = match (&a.belt, &a.screw) {
-            (Some(b), None) => Transmission::Belt(Belt {
-                ea_n: b.ea_n,
-                span_mm: b.span_mm,
-                pulley_teeth: b.pulley_teeth,
-                pitch_mm: b.pitch_mm,
-                carriage_at_zero_mm: b.carriage_at_zero_mm,
-                damping_ratio: b.damping_ratio,
-            }),
-            (None, Some(s)) => Transmission::Screw(Screw {
-                lead_mm: s.lead_mm,
-                stiffness_n_per_m: s.stiffness_n_per_m,
-                damping_ratio: s.damping_ratio,
-            }),
+            (Some(b), None) => Transmission::Belt(b.clone()),
+            (None, Some(s)) => Transmission::Screw(s.clone()),
             _ => {
                 return Err(src.error_at(
                     &format!("{prefix}axis.{axis}"),
@@ -276,31 +165,10 @@ pub fn to_machine(
             toolhead_kg,
             beam_kg: a.beam_kg.unwrap_or(0.0),
             transmission,
-            mount: Mount {
-                stiffness_n_per_m: mount.stiffness_n_per_m,
-                damping_ratio: mount.damping_ratio,
-            },
-            frame: a.frame.as_ref().map(|f| Frame {
-                mass_kg: f.mass_kg,
-                stiffness_n_per_m: f.stiffness_n_per_m,
-                damping_ratio: f.damping_ratio,
-            }),
-            motor: Motor {
-                holding_torque_n_m: m.holding_torque_n_m,
-                rated_current_a: m.rated_current_a,
-                resistance_ohm: m.resistance_ohm,
-                inductance_mh: m.inductance_mh,
-                rotor_inertia_g_cm2: m.rotor_inertia_g_cm2,
-                rotor_teeth: m.rotor_teeth,
-                detent_torque_n_m: m.detent_torque_n_m,
-                damping_ratio: m.damping_ratio,
-            },
-            driver: Driver {
-                microsteps: d.microsteps,
-                run_current_a_rms: d.run_current_a_rms,
-                supply_v: d.supply_v,
-                current_loop_bandwidth_hz: d.current_loop_bandwidth_hz,
-            },
+            mount: mount.clone(),
+            frame: a.frame.clone(),
+            motor: m.clone(),
+            driver: d.clone(),
         };
         if let Err(e) = machine_axis.validate() {
             return Err(match e {
@@ -334,15 +202,6 @@ pub fn to_machine(
     Ok(machine)
 }
 
-/// A machine as a file or scenario describes it.
-#[derive(Debug, Clone, PartialEq)]
-pub enum MachineForm {
-    /// Its parts (motor, driver, transmission, masses), compiled by settle-sim.
-    Physical(Machine),
-    /// Its modes per axis, ordered by axis name.
-    Modes(Vec<AxisModes>),
-}
-
 /// A machine file, read: its name, description and machine.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Described {
@@ -358,8 +217,8 @@ pub struct Described {
 /// `modes`, or every axis by its parts ([`to_machine`]). Keys as in [`to_machine`].
 pub fn to_form(
     name: &str,
-    motor: Option<&MotorSpec>,
-    driver: Option<&DriverSpec>,
+    motor: Option<&Motor>,
+    driver: Option<&Driver>,
     axes: &BTreeMap<String, AxisSpec>,
     src: &Source,
     prefix: &str,
@@ -454,7 +313,8 @@ pub fn parse(text: &str, path: &Path) -> Result<(Machine, String), Error> {
 }
 
 /// The machine file `preset = "<value>"` of a scenario at `scenario_path` names, `None`
-/// for a built-in preset (or a value that is neither; [`load_preset`] says why).
+/// for a built-in preset (or a value that is neither; `crate::expand::machine::named`
+/// says why).
 pub fn preset_file(value: &str, scenario_path: &Path) -> Option<PathBuf> {
     if PRESETS.iter().any(|(n, _, _)| *n == value)
         || !(value.contains('/') || value.ends_with(".toml"))
@@ -462,64 +322,4 @@ pub fn preset_file(value: &str, scenario_path: &Path) -> Option<PathBuf> {
         return None;
     }
     Some(scenario_path.parent().unwrap_or(Path::new(".")).join(value))
-}
-
-/// Resolve `preset = "<value>"` of a scenario at `scenario_path`: a built-in preset name,
-/// or a path to a machine file (relative to the scenario's folder) of either form.
-/// Returns the machine and the file it came from.
-pub fn load_any(
-    value: &str,
-    scenario_path: &Path,
-    src: &Source,
-) -> Result<(Described, PathBuf), Error> {
-    if let Some((_, path, text)) = PRESETS.iter().find(|(n, _, _)| *n == value) {
-        let path = PathBuf::from(path);
-        return Ok((parse_any(text, &path)?, path));
-    }
-    let looks_like_path = value.contains('/') || value.ends_with(".toml");
-    if !looks_like_path {
-        let names: Vec<&str> = PRESETS.iter().map(|(n, _, _)| *n).collect();
-        return Err(src.error_at(
-            "machine.preset",
-            format!(
-                "unknown preset `{value}`; built in: {}, or give a path to a machine file (ending in .toml)",
-                names.join(", ")
-            ),
-        ));
-    }
-    let base = scenario_path.parent().unwrap_or(Path::new("."));
-    let path = base.join(value);
-    let text =
-        crate::input::file::read_text(&path, crate::input::file::limit::SETTINGS).map_err(|e| {
-            let why = match e {
-                Error::Read { source, .. } => source.to_string(),
-                Error::Input { message, .. } => message,
-                other => other.to_string(),
-            };
-            src.error_at(
-                "machine.preset",
-                format!("cannot read machine file {}: {why}", path.display()),
-            )
-        })?;
-    Ok((parse_any(&text, &path)?, path))
-}
-
-/// [`load_any`] for a physical machine: returns the machine, its description and the
-/// file it came from.
-pub fn load_preset(
-    value: &str,
-    scenario_path: &Path,
-    src: &Source,
-) -> Result<(Machine, String, PathBuf), Error> {
-    let (d, path) = load_any(value, scenario_path, src)?;
-    match d.form {
-        MachineForm::Physical(m) => Ok((m, d.description, path)),
-        MachineForm::Modes(_) => Err(src.error_at(
-            "machine.preset",
-            format!(
-                "{} gives the machine by its modes; only physical machines (motor, belts, masses) can be swept as presets",
-                path.display()
-            ),
-        )),
-    }
 }

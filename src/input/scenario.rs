@@ -1,14 +1,15 @@
 //! Scenario files: what a user writes. Parsed strictly (unknown keys are errors) and
-//! reported with file, line and key. The run kinds' tables (`[corner]`, `[scan]`,
-//! `[shaper]`, ...) are read by the kinds themselves (`crate::kinds`); this is the rest.
+//! reported with file, line and key. The studies' tables (`[corner]`, `[scan]`,
+//! `[shaper]`, ...) are read by the studies themselves (`crate::studies`); this is the rest.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::Deserialize;
+use settle_sim::machine::{Driver, Motor};
 
 use crate::error::Error;
-use crate::input::machine_file::{AxisSpec, DriverSpec, MotorSpec};
+use crate::input::machine_file::AxisSpec;
 pub use crate::input::modes::ModeSpec;
 use crate::input::source::Source;
 use crate::input::tune_spec::TuneSpec;
@@ -24,8 +25,8 @@ pub struct Scenario {
     pub description: String,
     /// The machine the moves run on.
     pub machine: MachineSpec,
-    /// The base move (sweeps override its fields): a point-to-point move, or the move a run
-    /// kind builds on (the step of a `[scan]`). A kind with a path of its own (`[corner]`)
+    /// The base move (sweeps override its fields): a point-to-point move, or the move a
+    /// study builds on (the step of a `[scan]`). A study with a path of its own (`[corner]`)
     /// replaces it.
     #[serde(rename = "move")]
     pub move_: Option<MoveSpec>,
@@ -80,9 +81,9 @@ pub struct MachineSpec {
     /// Name of an inline machine (default: the scenario's name).
     pub name: Option<String>,
     /// Inline machine: motor of every axis that does not name its own.
-    pub motor: Option<MotorSpec>,
+    pub motor: Option<Motor>,
     /// Inline machine: driver of every axis that does not name its own.
-    pub driver: Option<DriverSpec>,
+    pub driver: Option<Driver>,
     /// Inline machine: the axes, by name (physical axes, or `modes = [...]` each).
     #[serde(default)]
     pub axis: BTreeMap<String, AxisSpec>,
@@ -166,8 +167,8 @@ impl Default for ObserveSpec {
     }
 }
 
-/// Read and parse a scenario file; `claimed` are the top-level tables others read (the run
-/// kinds' tables: `crate::kinds::tables`), left out of the strict parse.
+/// Read and parse a scenario file; `claimed` are the top-level tables others read (the
+/// studies' tables: `crate::studies::tables`), left out of the strict parse.
 pub fn load(path: &Path, claimed: &[&str]) -> Result<(Scenario, Source), Error> {
     let source = Source::load(path)?;
     let scenario = parse_source(&source, claimed)?;
@@ -194,7 +195,7 @@ fn parse_source(source: &Source, claimed: &[&str]) -> Result<Scenario, Error> {
             let tables: Vec<String> = claimed.iter().map(|t| format!("`{t}`")).collect();
             Error::Input {
                 at,
-                message: format!("{message}, or a run kind's table: {}", tables.join(", ")),
+                message: format!("{message}, or a study's table: {}", tables.join(", ")),
             }
         }
         other => other,

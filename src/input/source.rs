@@ -3,7 +3,7 @@
 //! file is deserialized here, so every error names the file, line, column and key.
 //!
 //! A document can be read in parts: [`Source::document`] reads it without the tables that
-//! others claim (the run kinds' `[corner]`, `[scan]`, ...; see `crate::kinds`), strictly
+//! others claim (the studies' `[corner]`, `[scan]`, ...; see `crate::studies`), strictly
 //! (`deny_unknown_fields` still rejects every other unknown key or table, naming its line),
 //! and [`Source::table`] reads one claimed table. Both keep the spans of the whole text, so
 //! an error inside `[corner]` names its line in the file.

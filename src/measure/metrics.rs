@@ -119,7 +119,7 @@ pub struct Metrics {
     pub status: Status,
     /// Contour error and corner metrics when the trajectory follows a path.
     pub path: Option<crate::measure::path_metrics::PathMetrics>,
-    /// Extra named figures a run kind measures (e.g. a scan's step-axis error at re-entry), in
+    /// Extra named figures a study measures (e.g. a scan's step-axis error at re-entry), in
     /// order; `inf` where a time was not reached.
     pub extra: Vec<(String, f64)>,
 }

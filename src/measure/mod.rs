@@ -1,6 +1,6 @@
 //! Measuring runs: the metrics and their definitions ([`metrics`]), computed streaming
 //! ([`accumulator`]; contour error along a path: [`path_metrics`]), and the full
-//! [`series::Series`] a run records when asked. No knowledge of backends or run kinds.
+//! [`series::Series`] a run records when asked. No knowledge of backends or studies.
 
 pub mod accumulator;
 pub mod metrics;

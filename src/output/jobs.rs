@@ -1,4 +1,4 @@
-//! G-code jobs in a sweep (the `[gcode]` run kind): what each candidate (a combination of
+//! G-code jobs in a sweep (the `[gcode]` study): what each candidate (a combination of
 //! the swept firmware, shaper and limits) costs in print time and gives in contour error,
 //! for summary.md, report.html and the figure `plots/gcode_jobs.svg/png`.
 //!

@@ -1,5 +1,5 @@
 //! `runs.csv`: one row per run, its parameters then its metrics, then the columns of its
-//! run kinds (in registration order, `crate::kinds::KINDS`). Written with the `csv` crate
+//! studies (in registration order, `crate::studies::STUDIES`). Written with the `csv` crate
 //! (`crate::input::runs_table::record`): numbers in Rust's shortest round-trip form, free
 //! text (a failed run's reason) quoted where it holds a comma or a quote.
 //!
@@ -10,10 +10,10 @@
 use settle_planner::ProfileKind;
 
 use crate::input::runs_table::record;
-use crate::kinds::Kind;
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
+use crate::studies::Study;
 
 /// A band as it appears in column names (`10um`).
 pub fn band_label(b: f64) -> String {
@@ -31,7 +31,7 @@ pub struct RunsCsv {
     header: Vec<String>,
     bands_um: Vec<f64>,
     axis_names: Vec<String>,
-    kinds: Vec<(&'static dyn Kind, usize)>,
+    studies: Vec<(&'static dyn Study, usize)>,
 }
 
 impl RunsCsv {
@@ -41,7 +41,8 @@ impl RunsCsv {
         // The modes form's modes: axis x's as `mode<i>_*`, another axis's as
         // `<axis>_mode<i>_*`.
         let mode_axes: Vec<(String, usize)> = runs.first().map_or(Vec::new(), |r| {
-            r.modes
+            r.machine
+                .modes()
                 .iter()
                 .map(|a| (a.axis.clone(), a.modes.len()))
                 .collect()
@@ -99,9 +100,9 @@ impl RunsCsv {
         if mode_axes.len() > 1 {
             axis_names = mode_axes.iter().map(|(a, _)| a.clone()).collect();
         }
-        if runs.first().is_some_and(|r| r.machine.is_some()) {
+        if runs.first().is_some_and(|r| r.machine.physical().is_some()) {
             for r in runs.iter() {
-                for a in r.machine.iter().flat_map(|m| &m.axes) {
+                for a in r.machine.physical().iter().flat_map(|m| &m.axes) {
                     if !axis_names.contains(&a.name) {
                         axis_names.push(a.name.clone());
                     }
@@ -117,11 +118,11 @@ impl RunsCsv {
             header.push(format!("{a}_max_following_error_um"));
             header.push(format!("{a}_max_load_angle_deg"));
         }
-        let mut kinds = Vec::new();
-        for k in crate::kinds::all() {
+        let mut studies = Vec::new();
+        for k in crate::studies::all() {
             let cols = k.columns(runs);
             if !cols.is_empty() {
-                kinds.push((*k, cols.len()));
+                studies.push((*k, cols.len()));
                 header.extend(cols);
             }
         }
@@ -129,7 +130,7 @@ impl RunsCsv {
             header,
             bands_um,
             axis_names,
-            kinds,
+            studies,
         }
     }
 
@@ -157,7 +158,7 @@ impl RunsCsv {
             r.amax_mm_s2.to_string(),
             r.jmax_mm_s3.map_or(String::new(), |j| j.to_string()),
         ]);
-        for md in r.modes.iter().flat_map(|a| &a.modes) {
+        for md in r.machine.modes().iter().flat_map(|a| &a.modes) {
             c.extend([
                 md.frequency_hz.to_string(),
                 md.damping_ratio.to_string(),
@@ -208,7 +209,7 @@ impl RunsCsv {
             let empty = 5 + 2 * m.settle_time_s.len() + self.axis_names.len() * (4 + n_bands);
             c.extend(std::iter::repeat_n(String::new(), empty));
         }
-        for (k, n) in &self.kinds {
+        for (k, n) in &self.studies {
             let mut cells = k.cells(r, m);
             cells.resize(*n, String::new());
             c.extend(cells);

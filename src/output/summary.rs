@@ -1,6 +1,6 @@
 //! `summary.md`: the overall winner per band, one ranking table per band (every swept
 //! setting compared at each swept point of the workload, see [`crate::output::ranking`]),
-//! the run kinds' sections, the figures. Read from the runs table rather than from the
+//! the studies' sections, the figures. Read from the runs table rather than from the
 //! metrics, so a summary rebuilt from a merged `runs.csv` is byte-identical to the one the
 //! unsharded sweep wrote.
 
@@ -9,7 +9,7 @@ use std::path::Path;
 use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::html::Out;
-use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, rank, run_command};
+use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, is_current, rank, run_command};
 use crate::spec::runs::RunList;
 
 /// A time in ms with one decimal, `not settled` for none.
@@ -28,18 +28,37 @@ pub struct Figure {
     pub png: String,
 }
 
+/// `x` to four significant digits, as short as it then prints (an identified
+/// 45.00161069 Hz mode is `45`, its 0.0500311 damping ratio `0.05003`, a 75.0139 Hz mode
+/// `75.01`; a mode written as 40 Hz stays `40`).
+pub fn significant(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let e = 3 - x.abs().log10().floor() as i32;
+    // Divided by an exact power of ten, the result is the double nearest the decimal.
+    if e >= 0 {
+        let p = 10f64.powi(e);
+        (x * p).round() / p
+    } else {
+        let p = 10f64.powi(-e);
+        (x / p).round() * p
+    }
+}
+
 /// The machines of `runs`, named once each in first-seen order: `printer_xy (axis x, linear
 /// driver)`, or the modes of the modes form.
 pub fn machines_line(runs: &dyn RunList) -> String {
     let mut names: Vec<String> = Vec::new();
     for r in runs.iter() {
-        let n = if r.machine.is_some() {
+        let n = if r.machine.physical().is_some() {
             format!("{} (axis {}, {} driver)", r.machine_name, r.axis, r.driver)
         } else {
             // Each axis's modes, prefixed with the axis when the machine has several.
-            let several = r.modes.len() > 1;
+            let several = r.machine.modes().len() > 1;
             let modes: Vec<String> = r
-                .modes
+                .machine
+                .modes()
                 .iter()
                 .flat_map(|a| {
                     let prefix = if several {
@@ -48,7 +67,11 @@ pub fn machines_line(runs: &dyn RunList) -> String {
                         String::new()
                     };
                     a.modes.iter().map(move |m| {
-                        format!("{prefix}{} Hz, zeta {}", m.frequency_hz, m.damping_ratio)
+                        format!(
+                            "{prefix}{} Hz, zeta {}",
+                            significant(m.frequency_hz),
+                            significant(m.damping_ratio)
+                        )
                     })
                 })
                 .collect();
@@ -70,7 +93,7 @@ pub fn machines_line(runs: &dyn RunList) -> String {
 
 /// The summary: the overall winner per band, then per band every run ranked within its
 /// workload point (the swept values that are not settings), with its run number and the
-/// command that runs it alone; the failed runs with their reasons; the run kinds'
+/// command that runs it alone; the failed runs with their reasons; the studies'
 /// sections; the figures. `scenario` is the scenario file as the commands name it.
 ///
 /// It reads the metrics from `table` (the runs table, row `i` = `runs.at(i)`) rather than from
@@ -127,12 +150,12 @@ pub(crate) fn summary_to(
         out.push_str(&crate::output::jobs::section(&j, scenario, runs));
         out.push('\n');
     }
-    // The run kinds' sections: those that replace the move-and-settle tables (which would
-    // not measure what the kind is about) stand in their place, the others follow them.
+    // The studies' sections: those that replace the move-and-settle tables (which would
+    // not measure what the study is about) stand in their place, the others follow them.
     let mut replaced = false;
     let mut after: Vec<String> = Vec::new();
-    for k in crate::kinds::all() {
-        let Some(section) = k.summary(runs, table) else {
+    for k in crate::studies::all() {
+        let Some(section) = k.summary(runs, table, &|r| is_current(sc, r)) else {
             continue;
         };
         if k.replaces_move_tables() {
@@ -159,12 +182,12 @@ pub(crate) fn summary_to(
     }
 }
 
-/// Whether the summary ranks candidates by move-and-settle time: no run kind's section
+/// Whether the summary ranks candidates by move-and-settle time: no study's section
 /// replaces the ranking (a raster scan's does).
 pub fn ranks_candidates(runs: &dyn RunList, table: &RunsColumns) -> bool {
-    !crate::kinds::all()
+    !crate::studies::all()
         .iter()
-        .any(|k| k.replaces_move_tables() && k.summary(runs, table).is_some())
+        .any(|k| k.replaces_move_tables() && k.summary(runs, table, &|_| false).is_some())
 }
 
 /// The winners and the ranking tables.
@@ -194,6 +217,9 @@ fn push_ranking(
         out,
         "Compared: {compared}. Winner: the least move-and-settle time{over}. Gain {reference}: how much longer the reference takes (+38 % = the reference takes 38 % longer).\n"
     );
+    if let Some(note) = ranking.repeats_note(runs) {
+        let _ = writeln!(out, "{note}\n");
+    }
     for b in &ranking.bands {
         match &b.winner {
             Some(w) => {

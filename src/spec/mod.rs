@@ -1,6 +1,6 @@
 //! What one run is: [`run_spec::RunSpec`] (one point of a sweep, resolved) with the values
 //! it was swept to ([`value::Value`]), the backend it runs on ([`backend::Backend`]) and
-//! the states of its run kinds ([`run_spec::KindState`], filled in by `crate::kinds`).
+//! the states of its studies ([`run_spec::StudyState`], filled in by `crate::studies`).
 
 pub mod backend;
 pub mod groups;

@@ -1,23 +1,22 @@
-//! One point of a sweep, fully resolved: [`RunSpec`], and [`KindState`], the per-run state
-//! of a run kind (`crate::kinds`) that a `RunSpec` carries without knowing the kind.
+//! One point of a sweep, fully resolved: [`RunSpec`], and [`StudyState`], the per-run state
+//! of a study (`crate::studies`) that a `RunSpec` carries without knowing the study.
 
 use std::any::Any;
 
 use settle_planner::{Limits, ProfileKind};
-use settle_sim::machine::Machine;
-use settle_sim::{DriverMode, Mode};
+use settle_sim::DriverMode;
 
-use crate::input::modes::{AxisModes, ModeSpec};
+use crate::input::machine_form::MachineForm;
 use crate::spec::backend::Backend;
 use crate::spec::value::Value;
 
-/// The per-run state of a run kind: its scenario table, resolved (e.g. the corner of a
+/// The per-run state of a study: its scenario table, resolved (e.g. the corner of a
 /// corner run), set by the sweep through its keys (`corner.angle_deg`).
 ///
-/// Implement [`KindState::table`] and [`KindState::set`] on a type that is `Clone`,
-/// `PartialEq` and `Debug`; cloning and comparing come with it ([`StateBox`]). The kind
+/// Implement [`StudyState::table`] and [`StudyState::set`] on a type that is `Clone`,
+/// `PartialEq` and `Debug`; cloning and comparing come with it ([`StateBox`]). The study
 /// reads its state back with [`RunSpec::state`].
-pub trait KindState: StateBox + std::fmt::Debug + Send + Sync {
+pub trait StudyState: StateBox + std::fmt::Debug + Send + Sync {
     /// The scenario table the state comes from (`corner` for `[corner]`): swept keys
     /// `<table>.<key>` are set on it.
     fn table(&self) -> &'static str;
@@ -27,34 +26,34 @@ pub trait KindState: StateBox + std::fmt::Debug + Send + Sync {
     fn set(&mut self, key: &str, value: &Value) -> Result<(), String>;
 }
 
-/// Cloning and comparing a boxed [`KindState`] (implemented for every `Clone + PartialEq`
+/// Cloning and comparing a boxed [`StudyState`] (implemented for every `Clone + PartialEq`
 /// state).
 pub trait StateBox: Any {
     /// A boxed copy.
-    fn clone_box(&self) -> Box<dyn KindState>;
+    fn clone_box(&self) -> Box<dyn StudyState>;
     /// Whether `other` is the same type with the same value.
-    fn eq_box(&self, other: &dyn KindState) -> bool;
+    fn eq_box(&self, other: &dyn StudyState) -> bool;
 }
 
-impl<T: KindState + Clone + PartialEq> StateBox for T {
-    fn clone_box(&self) -> Box<dyn KindState> {
+impl<T: StudyState + Clone + PartialEq> StateBox for T {
+    fn clone_box(&self) -> Box<dyn StudyState> {
         Box::new(self.clone())
     }
 
-    fn eq_box(&self, other: &dyn KindState) -> bool {
+    fn eq_box(&self, other: &dyn StudyState) -> bool {
         (other as &dyn Any)
             .downcast_ref::<T>()
             .is_some_and(|o| o == self)
     }
 }
 
-impl Clone for Box<dyn KindState> {
+impl Clone for Box<dyn StudyState> {
     fn clone(&self) -> Self {
         self.clone_box()
     }
 }
 
-impl PartialEq for Box<dyn KindState> {
+impl PartialEq for Box<dyn StudyState> {
     fn eq(&self, other: &Self) -> bool {
         self.eq_box(&**other)
     }
@@ -69,7 +68,7 @@ pub struct RunSpec {
     pub profile: ProfileKind,
     /// Start position (mm).
     pub start_mm: f64,
-    /// Signed move length (mm); a path kind's path length.
+    /// Signed move length (mm); a path study's path length.
     pub distance_mm: f64,
     /// Maximum speed (mm/s).
     pub vmax_mm_s: f64,
@@ -77,16 +76,13 @@ pub struct RunSpec {
     pub amax_mm_s2: f64,
     /// Maximum jerk (mm/s^3), if given.
     pub jmax_mm_s3: Option<f64>,
-    /// The machine's modes per axis, ordered by axis name (modes form; empty for a
-    /// physical machine).
-    pub modes: Vec<AxisModes>,
-    /// The physical machine (preset, machine file or inline), if not given by modes.
-    pub machine: Option<Machine>,
+    /// The machine: physical (preset, machine file or inline) or its modes per axis.
+    pub machine: MachineForm,
     /// The machine's name (the preset's, or `modes`).
     pub machine_name: String,
     /// How the motors are driven (physical machines; `linear` for the modes form).
     pub driver: DriverMode,
-    /// The axis that moves (a path kind's axes joined by `+`, e.g. `x+y`).
+    /// The axis that moves (a path study's axes joined by `+`, e.g. `x+y`).
     pub axis: String,
     /// The backend that simulates the run (set from the command line).
     pub backend: Backend,
@@ -102,12 +98,12 @@ pub struct RunSpec {
     pub swept: Vec<(String, Value)>,
     /// Parameters of the profile kinds that take any (PVT asymmetry, four-jerk BOW1..4
     /// scales); the planner's defaults unless `settle tune` searches them.
-    pub kind_params: settle_planner::KindParams,
-    /// The states of the run kinds whose tables the scenario has (at most one each).
-    pub kinds: Vec<Box<dyn KindState>>,
+    pub profile_params: settle_planner::ProfileParams,
+    /// The states of the studies whose tables the scenario has (at most one each).
+    pub studies: Vec<Box<dyn StudyState>>,
 }
 
-/// The parameters every scenario can sweep, for messages (the run kinds add theirs).
+/// The parameters every scenario can sweep, for messages (the studies add theirs).
 pub const SWEEPABLE: &str = "profile, move.distance_mm, move.start_mm, limits.vmax_mm_s, \
 limits.amax_mm_s2, limits.jmax_mm_s3, machine.modes.N.frequency_hz, machine.modes.N.damping_ratio, \
 machine.modes.N.weight (N = 0-based mode index of axis x), machine.axis.<axis>.modes.N.<field> \
@@ -130,58 +126,44 @@ impl RunSpec {
         )
     }
 
-    /// The modes of `axis` (modes form; empty when it has none or the machine is
-    /// physical).
-    pub fn modes_of(&self, axis: &str) -> &[ModeSpec] {
-        crate::input::modes::modes_of(&self.modes, axis).unwrap_or_default()
-    }
-
     /// The names of the machine's axes (physical or modes form), in order.
     pub fn axis_names(&self) -> Vec<String> {
-        match &self.machine {
-            Some(m) => m.axes.iter().map(|a| a.name.clone()).collect(),
-            None => self.modes.iter().map(|a| a.axis.clone()).collect(),
-        }
+        self.machine.axis_names()
     }
 
-    /// The modes of `axis` as sim types.
-    pub fn modes_sim(&self, axis: &str) -> Result<Vec<Mode>, settle_sim::SimError> {
-        self.modes_of(axis)
-            .iter()
-            .map(|m| Mode::new(m.frequency_hz, m.damping_ratio, m.weight))
-            .collect()
-    }
-
-    /// The run's state of type `T` (a run kind's), if it has one.
-    pub fn state<T: KindState>(&self) -> Option<&T> {
-        self.kinds
+    /// The run's state of type `T` (a study's), if it has one.
+    pub fn state<T: StudyState>(&self) -> Option<&T> {
+        self.studies
             .iter()
             .find_map(|s| (&**s as &dyn Any).downcast_ref::<T>())
     }
 
     /// The run's state of type `T`, to change it.
-    pub fn state_mut<T: KindState>(&mut self) -> Option<&mut T> {
-        self.kinds
+    pub fn state_mut<T: StudyState>(&mut self) -> Option<&mut T> {
+        self.studies
             .iter_mut()
             .find_map(|s| (&mut **s as &mut dyn Any).downcast_mut::<T>())
     }
 
-    /// The state of the kind whose table is `table`.
-    pub fn state_of(&self, table: &str) -> Option<&dyn KindState> {
-        self.kinds.iter().find(|s| s.table() == table).map(|s| &**s)
+    /// The state of the study whose table is `table`.
+    pub fn state_of(&self, table: &str) -> Option<&dyn StudyState> {
+        self.studies
+            .iter()
+            .find(|s| s.table() == table)
+            .map(|s| &**s)
     }
 
     /// Give the run `state`, replacing its state of the same table.
-    pub fn put_state(&mut self, state: Box<dyn KindState>) {
-        match self.kinds.iter_mut().find(|s| s.table() == state.table()) {
+    pub fn put_state(&mut self, state: Box<dyn StudyState>) {
+        match self.studies.iter_mut().find(|s| s.table() == state.table()) {
             Some(s) => *s = state,
-            None => self.kinds.push(state),
+            None => self.studies.push(state),
         }
     }
 
-    /// Remove the state of the kind whose table is `table`.
+    /// Remove the state of the study whose table is `table`.
     pub fn remove_state(&mut self, table: &str) {
-        self.kinds.retain(|s| s.table() != table);
+        self.studies.retain(|s| s.table() != table);
     }
 
     /// The swept values as `key = value`, joined by `sep`.
@@ -204,19 +186,19 @@ impl RunSpec {
     }
 
     /// Set swept parameter `param` to `value`: a key of every run, or `<table>.<key>` of a
-    /// kind state the run has. `Ok(false)`: no such parameter (the caller names the
+    /// study state the run has. `Ok(false)`: no such parameter (the caller names the
     /// allowed ones).
     pub fn set(&mut self, param: &str, value: &Value) -> Result<bool, String> {
         let num = |v: &Value| v.number().ok_or_else(|| format!("`{param}` takes numbers"));
         if let Some((table, key)) = param.split_once('.')
-            && let Some(state) = self.kinds.iter_mut().find(|s| s.table() == table)
+            && let Some(state) = self.studies.iter_mut().find(|s| s.table() == table)
         {
             state.set(key, value)?;
             return Ok(true);
         }
         match param {
             "profile" => match value {
-                Value::Kind(k) => self.profile = *k,
+                Value::Study(k) => self.profile = *k,
                 _ => return Err("`profile` takes profile kind names".into()),
             },
             "move.distance_mm" => self.distance_mm = num(value)?,
@@ -230,8 +212,13 @@ impl RunSpec {
                 if let Some((axis, i, field)) = mode_param(other) {
                     let x = num(value)?;
                     let names = self.axis_names().join(", ");
-                    let Some(a) = self.modes.iter_mut().find(|a| a.axis == axis) else {
-                        return Err(if self.machine.is_some() {
+                    let physical = self.machine.physical().is_some();
+                    let modes = match &mut self.machine {
+                        MachineForm::Modes(axes) => axes.as_mut_slice(),
+                        MachineForm::Physical(_) => &mut [],
+                    };
+                    let Some(a) = modes.iter_mut().find(|a| a.axis == axis) else {
+                        return Err(if physical {
                             format!(
                                 "`{other}` needs a machine given by its modes, not a physical one"
                             )
@@ -256,7 +243,7 @@ impl RunSpec {
                     .find_map(|p| other.strip_prefix("machine.").filter(|r| r.starts_with(p)))
                 {
                     let x = num(value)?;
-                    let Some(m) = self.machine.as_mut() else {
+                    let MachineForm::Physical(m) = &mut self.machine else {
                         return Err(format!(
                             "`{other}` needs a physical machine (preset or [machine.axis.*]), not modes"
                         ));

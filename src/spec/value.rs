@@ -8,7 +8,7 @@ pub enum Value {
     /// A number (in the parameter's unit).
     Number(f64),
     /// A profile kind.
-    Kind(ProfileKind),
+    Study(ProfileKind),
     /// A name (a corner strategy, `machine.preset`).
     Text(String),
 }
@@ -18,7 +18,7 @@ impl Value {
     pub fn number(&self) -> Option<f64> {
         match self {
             Value::Number(x) => Some(*x),
-            Value::Kind(_) | Value::Text(_) => None,
+            Value::Study(_) | Value::Text(_) => None,
         }
     }
 }
@@ -27,7 +27,7 @@ impl std::fmt::Display for Value {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Value::Number(x) => write!(f, "{x}"),
-            Value::Kind(k) => write!(f, "{k}"),
+            Value::Study(k) => write!(f, "{k}"),
             Value::Text(t) => f.write_str(t),
         }
     }

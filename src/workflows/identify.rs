@@ -78,10 +78,10 @@ pub struct Identified {
     pub figures: Vec<PathBuf>,
 }
 
-/// The machine axis `file` (recording `source`) excited: `axis` if given, else a token
+/// The machine axis `file` (identified as `id`) excited: `axis` if given, else a token
 /// `x`, `y` or `z` of the file's name (split at `_`, `-`, `.` and spaces), else of the
-/// measurement's name.
-fn axis_of(file: &Path, source: &str, axis: Option<&str>) -> Result<String, Error> {
+/// measurement's name, else the one axis the file holds (an M956 capture of one axis).
+fn axis_of(file: &Path, id: &AxisIdentification, axis: Option<&str>) -> Result<String, Error> {
     if let Some(a) = axis {
         return Ok(a.to_string());
     }
@@ -94,11 +94,12 @@ fn axis_of(file: &Path, source: &str, axis: Option<&str>) -> Result<String, Erro
     let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned());
     stem.as_deref()
         .and_then(token)
-        .or_else(|| token(source))
+        .or_else(|| token(&id.source))
+        .or_else(|| id.named_axis.map(|k| ["x", "y", "z"][k.min(2)].to_string()))
         .ok_or_else(|| {
             Error::input(
                 file,
-                "cannot tell which machine axis this file excited (its name holds no `x`, `y` or `z` token as in Klipper's raw_data_x_*.csv): give --axis x|y|z",
+                "cannot tell which machine axis this file excited (its name holds no `x`, `y` or `z` token as in Klipper's raw_data_x_*.csv, and it holds more than one sensor axis): give --axis x|y|z",
             )
         })
 }
@@ -147,7 +148,7 @@ pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
     let mut axes: Vec<IdentifiedAxis> = Vec::new();
     for file in &opts.files {
         for id in settle_identify::identify_file(file, &opts.identify)? {
-            let axis = axis_of(file, &id.source, opts.axis.as_deref())?;
+            let axis = axis_of(file, &id, opts.axis.as_deref())?;
             if let Some(prev) = axes.iter().find(|a| a.axis == axis) {
                 return Err(Error::input(
                     file,
@@ -337,8 +338,8 @@ impl Identified {
         let mut out = String::new();
         let _ = writeln!(
             out,
-            "{:<4} {:<16} {:>4} {:>20} {:>20} {:>18}  method",
-            "axis", "sensor", "mode", "frequency_hz", "damping_ratio", "weight"
+            "{:<4} {:<16} {:>4} {:>20} {:>8} {:>20} {:>18}  method",
+            "axis", "sensor", "mode", "frequency_hz", "peak_hz", "damping_ratio", "weight"
         );
         for a in &self.axes {
             let sensor = match (&a.id.direction, a.id.dominant_sensor_axis) {
@@ -358,16 +359,28 @@ impl Identified {
                 };
                 let _ = writeln!(
                     out,
-                    "{:<4} {:<16} {:>4} {:>20} {:>20} {:>18}  {method}",
+                    "{:<4} {:<16} {:>4} {:>20} {:>8.2} {:>20} {:>18}  {method}",
                     a.axis,
                     sensor,
                     i,
                     pm(m.frequency_hz.value, m.frequency_hz.sigma, 2),
+                    m.peak_hz,
                     pm(m.damping_ratio.value, m.damping_ratio.sigma, 4),
                     weight,
                 );
             }
+            for p in &a.id.diagnostics.rejected {
+                let _ = writeln!(
+                    out,
+                    "{:<4} not a mode: {:.1} Hz: {}",
+                    a.axis, p.frequency_hz, p.reason
+                );
+            }
         }
+        let _ = writeln!(
+            out,
+            "frequency_hz is each mode's natural frequency (the machine file's); peak_hz is where the mode shows as a peak in a spectrum, as Klipper's and Shake&Tune's graphs show it."
+        );
         if self
             .axes
             .iter()

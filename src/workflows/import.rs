@@ -28,17 +28,21 @@ use settle_gcode::Dialect;
 use settle_gcode::config::{KlipperConfig, RrfConfig, ShaperSetting as FirmwareShaper};
 
 use crate::error::{Error, Location};
-use crate::input::machine_file::MachineForm;
+use crate::input::machine_form::MachineForm;
 use crate::output::atomic::write_atomic;
-use crate::workflows::tune::firmware::Firmware;
+use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::grid::{identified_band, tuning_modes};
 use crate::workflows::{Exit, Report};
+use settle_planner::firmware::Firmware;
 
 /// Shaper frequencies of the search, as multiples of the current one.
 pub const FREQUENCY_SCALES: [f64; 5] = [0.9, 0.95, 1.0, 1.05, 1.1];
-/// Accelerations of the search, as multiples of the current one (never above it: the
-/// current `max_accel` is what the user's motors are known to reach).
+/// Accelerations of the sweep around the current settings, as multiples of the current
+/// one.
 pub const ACCEL_SCALES: [f64; 3] = [0.5, 0.75, 1.0];
+/// Accelerations `settle tune` searches above the current one, as multiples of it, up to
+/// the highest the machine allows ([`top_accel`]).
+pub const ACCEL_SCALES_ABOVE: [f64; 5] = [1.25, 1.5, 2.0, 3.0, 4.0];
 /// Robustness of the imported search (percent): a winner must still work with the real
 /// mode this far off the identified one. Kept when the machine's modes carry their
 /// identified sigmas: those are the statistical uncertainty of one measurement (often
@@ -169,8 +173,21 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
 }
 
 fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)> {
-    s.kind_name(dialect)
+    s.type_name(dialect)
         .map(|n| (n, s.frequency_hz, s.damping_ratio))
+}
+
+/// The firmwares whose configurations `settle import` reads: Klipper (printer.cfg) and
+/// RepRapFirmware (config.g).
+pub const READ: [Firmware; 2] = [Firmware::Klipper, Firmware::Rrf];
+
+/// A firmware of [`READ`] by name ([`Firmware::parse`]'s names).
+pub fn parse_firmware(name: &str) -> Result<Firmware, String> {
+    Firmware::parse_among(
+        name,
+        &READ,
+        "a firmware whose configuration settle import reads",
+    )
 }
 
 /// Read the current settings of a firmware configuration.
@@ -277,7 +294,53 @@ fn around(x: f64, scales: &[f64], step: f64) -> Vec<f64> {
     v
 }
 
-/// The scenario's text; `frequency_hz` is the sweep's centre for an unshaped first axis.
+/// The highest acceleration the machine allows a shaper on the axis of `run` (mm/s^2):
+/// the largest at which one of the firmware's shapers, tuned to the axis's strongest mode
+/// (at the search's highest frequency scale, designed for the mode's damping), keeps
+/// Klipper's smoothing within its 0.12 mm; above it every shaper that cancels the mode
+/// smooths more. `None` without a mode or a shaper.
+pub fn top_accel(firmware: Firmware, run: &crate::spec::run_spec::RunSpec) -> Option<f64> {
+    let (f, zeta) = tuning_modes(run).first().copied()?;
+    let highest = FREQUENCY_SCALES.iter().copied().fold(0.0, f64::max);
+    Candidates::of(firmware)
+        .shapers()
+        .into_iter()
+        .filter_map(|k| {
+            let (z, _) = crate::workflows::tune::target::design_damping(k, zeta);
+            let sh = settle_planner::shaper::Shaper::new(k, (f * highest * 10.0).round() / 10.0, z)
+                .ok()?;
+            Some(crate::studies::shaping::max_accel_mm_s2(
+                &sh,
+                settle_planner::shaper_select::TARGET_SMOOTHING_MM,
+            ))
+        })
+        .filter(|a| a.is_finite())
+        .reduce(f64::max)
+}
+
+/// The accelerations `settle tune` searches: [`ACCEL_SCALES`] of the current one, then
+/// [`ACCEL_SCALES_ABOVE`] up to `top` and `top` itself (both rounded down to 100 mm/s^2).
+pub fn tune_accels(current: f64, top: Option<f64>) -> Vec<f64> {
+    let mut v = around(current, &ACCEL_SCALES, 100.0);
+    if let Some(top) = top.map(|t| (t / 100.0).floor() * 100.0)
+        && top > current
+    {
+        v.extend(
+            ACCEL_SCALES_ABOVE
+                .iter()
+                .map(|k| (current * k / 100.0).floor() * 100.0)
+                .filter(|a| *a < top),
+        );
+        v.push(top);
+    }
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
+}
+
+/// The scenario's text; `frequency_hz` is the sweep's centre for an unshaped first axis,
+/// `top` the highest acceleration the machine allows ([`top_accel`]).
+#[allow(clippy::too_many_arguments)]
 fn scenario_text(
     name: &str,
     machine: &str,
@@ -286,6 +349,7 @@ fn scenario_text(
     frequency_hz: f64,
     source: &str,
     identified_band: bool,
+    top: Option<f64>,
 ) -> String {
     let first = axes.first().copied().unwrap_or(&cur.axes[0]);
     let fw = cur.firmware;
@@ -293,13 +357,14 @@ fn scenario_text(
         (
             "none".into(),
             frequency_hz,
-            crate::kinds::shaping::DEFAULT_DAMPING_RATIO,
+            crate::studies::shaping::DEFAULT_DAMPING_RATIO,
         )
     });
     let accels = around(cur.amax_mm_s2, &ACCEL_SCALES, 100.0);
+    let tune_accels = tune_accels(cur.amax_mm_s2, top);
     let freqs = around(f_now, &FREQUENCY_SCALES, 0.1);
     let mut types = vec![q("none")];
-    types.extend(fw.shapers().iter().map(|k| q(&k.name())));
+    types.extend(Candidates::of(fw).shapers().iter().map(|k| q(&k.name())));
     if !types.contains(&q(&type_now)) {
         types.push(q(&type_now));
     }
@@ -359,11 +424,19 @@ fn scenario_text(
     let names: Vec<String> = axes.iter().map(|a| q(&a.name)).collect();
     let _ = writeln!(
         t,
-        "[tune]\nfirmware = {}\naxes = [{}]\ndistances_mm = [5.0, 20.0]\nband_um = 10.0\nfrequency_scales = {}\naccelerations_mm_s2 = {}\n{}",
+        "[tune]\nfirmware = {}\naxes = [{}]\ndistances_mm = [5.0, 20.0]\nband_um = 10.0\nfrequency_scales = {}\n{}accelerations_mm_s2 = {}\n{}",
         q(fw.name()),
         names.join(", "),
         list(&FREQUENCY_SCALES),
-        list(&accels),
+        match top {
+            Some(t) if t > cur.amax_mm_s2 => format!(
+                "# From half the current acceleration up to {:.0} mm/s^2, the highest at which one of\n# {}'s shapers, tuned to the machine's strongest mode, stays within 0.12 mm of smoothing.\n",
+                (t / 100.0).floor() * 100.0,
+                fw.name()
+            ),
+            _ => "# Around the current acceleration: no shaper of the firmware stays within 0.12 mm of\n# smoothing above it on this machine.\n".to_string(),
+        },
+        list(&tune_accels),
         if identified_band {
             format!(
                 "# The machine file's frequency_sigma_hz gives each axis a 2-sigma band; tune uses\n# the wider of that band and this tolerance (the drift one measurement does not see).\nfrequency_tolerance_pct = {FREQUENCY_TOLERANCE_PCT:?}"
@@ -508,6 +581,7 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
     let mut axes: Vec<&AxisNow> = Vec::new();
     let mut centre_hz = None;
     let mut band = false;
+    let mut top: Option<f64> = None;
     for a in &cur.axes {
         let has_axis = machine_axes.as_ref().is_none_or(|m| m.contains(&a.name));
         if !has_axis {
@@ -517,7 +591,7 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
             ));
             continue;
         }
-        let text = scenario_text(&name, &machine, &cur, &[a], 40.0, &source, false);
+        let text = scenario_text(&name, &machine, &cur, &[a], 40.0, &source, false, None);
         let probe = out.with_file_name(format!("{name}.probe.toml"));
         // The machine has the axis: a scenario that does not load is the settings' fault
         // (a limit the firmware accepts that settle cannot run), said as such.
@@ -530,6 +604,9 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
                     .map(|(f, _)| (f * 10.0).round() / 10.0);
             }
             band |= identified_band(run).is_some();
+            if let Some(t) = top_accel(cur.firmware, run) {
+                top = Some(top.map_or(t, |m: f64| m.max(t)));
+            }
             axes.push(a);
         }
     }
@@ -549,6 +626,7 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
         centre_hz.unwrap_or(40.0),
         &source,
         band,
+        top,
     );
     // What is written must load.
     crate::expand::parse_runs(&text, &out)?;

@@ -16,7 +16,7 @@ use settle_sim::DriverMode;
 use settle_sim::closed_form::LinearResponse;
 
 use crate::error::Error;
-use crate::input::machine_file::{self, MachineForm, PRESETS};
+use crate::input::machine_form::MachineForm;
 use crate::input::modes::AxisModes;
 use crate::workflows::{Exit, Report};
 
@@ -88,28 +88,11 @@ impl MachineModes {
     }
 }
 
-/// The modes of the machine `arg` names: a preset name, a machine file or a scenario.
+/// The modes of the machine `arg` names: a preset name, a machine file or a scenario
+/// ([`crate::expand::machine::named`]).
 pub fn machine_modes(arg: &str) -> Result<MachineModes, Error> {
-    if let Some((name, path, text)) = PRESETS.iter().find(|(n, _, _)| *n == arg) {
-        let d = machine_file::parse_any(text, Path::new(path))?;
-        return of_form(name, Path::new(path), d.form);
-    }
-    let path = Path::new(arg);
-    let text = crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)?;
-    let is_scenario = text
-        .parse::<toml::Table>()
-        .is_ok_and(|t| t.contains_key("machine"));
-    if is_scenario {
-        let (sc, src) = crate::expand::load(path)?;
-        let r = crate::expand::machine::resolve_machine(&sc, &src)?;
-        let form = match r.machine {
-            Some(m) => MachineForm::Physical(m),
-            None => MachineForm::Modes(r.modes),
-        };
-        return of_form(&r.name, path, form);
-    }
-    let d = machine_file::parse_any(&text, path)?;
-    of_form(&d.name, path, d.form)
+    let n = crate::expand::machine::named(arg, Path::new(""), true, &|m| Error::input(arg, m))?;
+    of_form(&n.name, &n.source, n.form)
 }
 
 fn of_form(name: &str, source: &Path, form: MachineForm) -> Result<MachineModes, Error> {

@@ -11,6 +11,7 @@ use crate::output::atomic::{create_dir, create_subdir};
 use crate::output::report::ScenarioFile;
 use crate::output::sweep_files::{RECORDINGS, write_sweep};
 use crate::spec::backend::Backend;
+use crate::workflows::sweep::{FailedRun, failures, list_failures};
 use crate::workflows::{Exit, Report};
 
 /// What a merge did.
@@ -26,6 +27,8 @@ pub struct MergeOutcome {
     pub out: PathBuf,
     /// Recordings gathered.
     pub recordings: usize,
+    /// The failed runs the shards hold (results, as in an unsharded sweep).
+    pub failed: Vec<FailedRun>,
 }
 
 /// The results of an earlier merge (or sweep), which `--force` overwrites.
@@ -113,6 +116,7 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>, force: bool) -> Result<Merg
     }
     Ok(MergeOutcome {
         shards: dirs.len(),
+        failed: failures(&m.runs, &m.csv),
         name: m.scenario.name,
         runs: m.runs.len(),
         out,
@@ -121,9 +125,14 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>, force: bool) -> Result<Merg
 }
 
 impl MergeOutcome {
-    /// What `settle merge` prints.
+    /// What `settle merge` prints: where, and the failed runs as `settle sweep` lists them
+    /// (results: exit 0 unless `--fail-on-failed-runs`).
     pub fn report(&self) -> Report {
-        let mut r = Report::new(Exit::Ok);
+        let mut r = Report::new(if self.failed.is_empty() {
+            Exit::Ok
+        } else {
+            Exit::RunsFailed
+        });
         r.err(format!(
             "merged {} shards of `{}` ({} runs) into {}{}",
             self.shards,
@@ -136,6 +145,7 @@ impl MergeOutcome {
                 String::new()
             }
         ));
+        list_failures(&mut r, &self.failed, self.runs);
         r
     }
 }

@@ -138,6 +138,23 @@ fn input_error(file: &Path, message: String) -> Error {
 pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
     let path = dir.join(MANIFEST);
     if !path.exists() {
+        if let Some(journal) = crate::workflows::journal::existing(dir) {
+            let shard = journal_shard(&journal);
+            return Err(input_error(
+                dir,
+                format!(
+                    "an unfinished shard: {} but no {MANIFEST} ({}): it was stopped (a time limit, a node lost) or is still running; \
+finish it with `settle sweep SCENARIO --shard {} --out {} --resume`, then merge",
+                    crate::workflows::journal::FILE,
+                    shard.as_ref().map_or_else(
+                        || "its journal names no shard".to_string(),
+                        |s| format!("its journal is of shard {s}")
+                    ),
+                    shard.as_deref().unwrap_or("K/N"),
+                    dir.display()
+                ),
+            ));
+        }
         return Err(input_error(
             dir,
             format!(
@@ -180,6 +197,18 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
     }
     let table = RunsTable::parse(&csv).map_err(|e| input_error(&csv_path, e))?;
     Ok((m, table))
+}
+
+/// Which shard (`K/N`) a journal belongs to, from its first line (`...; shard K/N; ...`,
+/// see [`crate::workflows::journal::key_line`]).
+fn journal_shard(journal: &Path) -> Option<String> {
+    use std::io::{BufRead, Read};
+    let mut line = String::new();
+    std::fs::File::open(journal)
+        .and_then(|f| std::io::BufReader::new(f.take(4096)).read_line(&mut line))
+        .ok()?;
+    let shard = line.split("; ").find_map(|p| p.strip_prefix("shard "))?;
+    shard.parse::<Shard>().ok().map(|s| s.to_string())
 }
 
 /// Write a shard's manifest into `dir`.
@@ -293,9 +322,12 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, Error> {
         return Err(input_error(
             &first_dir,
             format!(
-                "missing shard(s) {} of scenario `{}`: give every shard folder",
+                "missing shard(s) {} of scenario `{}`: give every shard folder (a shard whose task failed or never ran has none: \
+run it with `settle sweep {} --shard {}`)",
                 missing.join(", "),
-                first.scenario_name
+                first.scenario_name,
+                first.scenario_file,
+                missing[0]
             ),
         ));
     }

@@ -220,6 +220,7 @@ pub fn sweep(
         prefix.push(',');
         Some(prefix)
     };
+    let resuming = opts.resume && journal::existing(&out).is_some();
     let (journal, done) = match journal::existing(&out) {
         Some(_) if opts.resume => {
             let (j, done, notes) = Journal::resume(&out, &key, &header, &params)?;
@@ -241,12 +242,14 @@ pub fn sweep(
     };
     // The finished runs' ids (their rows stay in the journal).
     let done: std::collections::HashSet<usize> = done.into_keys().collect();
-    if opts.resume {
+    if resuming {
         note(&format!(
             "resuming: {} of {} runs already finished",
             done.len(),
             runs.len()
         ));
+    } else if opts.resume {
+        note("--resume: no journal here, so a new sweep");
     }
     // What is left to run (positions among the runs).
     let todo: Vec<u32> = (0..runs.len())
@@ -444,7 +447,7 @@ fn remove_stale_temps(dir: &Path) -> Result<(), Error> {
 }
 
 /// The failed runs, from runs.csv's `status` and `reason` columns.
-fn failures(runs: &dyn RunList, csv: &str) -> Vec<FailedRun> {
+pub fn failures(runs: &dyn RunList, csv: &str) -> Vec<FailedRun> {
     let Ok(table) = RunsColumns::parse(csv) else {
         return Vec::new();
     };
@@ -514,7 +517,7 @@ impl SweepOutcome {
         let mut r = Report::new(if self.failed.is_empty() {
             Exit::Ok
         } else {
-            Exit::Failed
+            Exit::RunsFailed
         });
         match self.shard {
             Some(s) => r.err(format!(
@@ -537,23 +540,29 @@ impl SweepOutcome {
                     .map_or(String::new(), |d| format!("; recordings in {}", d.display()))
             )),
         }
-        if !self.failed.is_empty() {
-            r.err(format!(
-                "{} of {} runs failed (status and reason in runs.csv):",
-                self.failed.len(),
-                self.runs
-            ));
-            const SHOWN: usize = 20;
-            for f in self.failed.iter().take(SHOWN) {
-                r.err(format!(
-                    "  run {} ({}): {}: {}",
-                    f.id, f.what, f.status, f.reason
-                ));
-            }
-            if self.failed.len() > SHOWN {
-                r.err(format!("  ... and {} more", self.failed.len() - SHOWN));
-            }
-        }
+        list_failures(&mut r, &self.failed, self.runs);
         r
+    }
+}
+
+/// The failed runs on stderr (at most 20, then a count), as `settle sweep` and `settle
+/// merge` print them.
+pub fn list_failures(r: &mut Report, failed: &[FailedRun], runs: usize) {
+    if failed.is_empty() {
+        return;
+    }
+    r.err(format!(
+        "{} of {runs} runs failed (status and reason in runs.csv):",
+        failed.len(),
+    ));
+    const SHOWN: usize = 20;
+    for f in failed.iter().take(SHOWN) {
+        r.err(format!(
+            "  run {} ({}): {}: {}",
+            f.id, f.what, f.status, f.reason
+        ));
+    }
+    if failed.len() > SHOWN {
+        r.err(format!("  ... and {} more", failed.len() - SHOWN));
     }
 }

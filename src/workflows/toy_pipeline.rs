@@ -1,15 +1,15 @@
-//! The toy run kind (`crate::kinds::toy`, registered for the unit tests by one line in
-//! `crate::kinds::KINDS`) through the whole pipeline: its table parsed with errors that
+//! The toy study (`crate::studies::toy`, registered for the unit tests by one line in
+//! `crate::studies::STUDIES`) through the whole pipeline: its table parsed with errors that
 //! name the line and key, its key swept, its runs planned, simulated and measured, its
 //! columns in runs.csv and its section in the summary, by the sweep workflow. None of the
-//! expander, the runner, runs.csv or the summary knows it: adding a kind is one file and
+//! expander, the runner, runs.csv or the summary knows it: adding a study is one file and
 //! one line.
 
 use std::path::Path;
 
 use crate::execute::pool::quiet;
-use crate::kinds::toy::Shuttle;
 use crate::spec::backend::Backend;
+use crate::studies::toy::Shuttle;
 use crate::workflows::sweep::{SweepOptions, sweep};
 
 const TOY: &str = r#"name = "toy"
@@ -31,7 +31,7 @@ legs = 1
 "#;
 
 #[test]
-fn a_toy_kind_goes_through_expand_run_csv_and_summary() {
+fn a_toy_study_goes_through_expand_run_csv_and_summary() {
     let (_, mut runs) = crate::expand::parse_runs(TOY, Path::new("toy.toml")).expect("expands");
     assert_eq!(runs.len(), 3);
     let legs: Vec<u32> = runs

@@ -8,9 +8,9 @@ use std::path::Path;
 
 use settle::Metrics;
 use settle::RunSpec;
-use settle::kinds::corner::{Corner, Strategy};
 use settle::measure::path_metrics::PathMetrics;
 use settle::spec::backend::Backend;
+use settle::studies::corner::{Corner, Strategy};
 use settle_planner::ProfileKind;
 
 const VMAX: f64 = 200.0; // mm/s

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use settle::workflows::gcode::{GcodeOptions, measure, parse_shapers};
-use settle_gcode::job::Firmware;
+use settle_planner::firmware::Firmware;
 
 use crate::support::{root, settle, write};
 

@@ -6,9 +6,9 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use serde_json::Value;
-use settle::kinds::gcode::preroll::{preroll_s, slowest_decay_per_s};
+use settle::studies::gcode::preroll::{preroll_s, slowest_decay_per_s};
 use settle::workflows::gcode::{GcodeOptions, measure};
-use settle_gcode::job::Firmware;
+use settle_planner::firmware::Firmware;
 
 use crate::support::{extra, root, settle, write};
 
@@ -299,7 +299,7 @@ fn a_layer_range_is_recorded_as_mcap() {
     let _: PathBuf = bad_out;
 }
 
-/// The `[gcode]` run kind with `layers = "2..2"` gives the contour error of layer 2 in
+/// The `[gcode]` study with `layers = "2..2"` gives the contour error of layer 2 in
 /// `settle gcode` of the whole file (its layers.csv row) on the same machine and firmware
 /// (Klipper's defaults, whose limits the scenario repeats), both sampled at 2 kHz, on
 /// the modal backend: on a one-mode machine in the modes form (40 Hz, zeta 0.05, on X
@@ -329,7 +329,7 @@ fn a_layer_range_is_recorded_as_mcap() {
 /// on the code that linearised `settle gcode` at the origin and the kind at its
 /// pre-roll's start: 190.5 um against 247.8 um.
 #[test]
-fn the_gcode_kind_starts_a_layer_range_from_the_whole_jobs_state() {
+fn the_gcode_study_starts_a_layer_range_from_the_whole_jobs_state() {
     let dir = tempfile::tempdir().expect("tempdir");
     let modes = "[machine.axis.x]\nmodes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]\n\
                  [machine.axis.y]\nmodes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]\n";
@@ -431,7 +431,7 @@ fn the_modal_backend_linearises_a_job_where_the_print_is() {
 /// with no feed move either, the origin.
 #[test]
 fn the_linearisation_point_is_the_centre_of_the_printing_moves() {
-    use settle::kinds::gcode::linpoint::{PointSource, linearisation_point};
+    use settle::studies::gcode::linpoint::{PointSource, linearisation_point};
     use settle_gcode::{Dialect, Reader, ReaderOptions};
     let point = |text: &str| {
         linearisation_point(Reader::new(
@@ -465,7 +465,7 @@ fn the_linearisation_point_is_the_centre_of_the_printing_moves() {
 /// from the state the layers before leave (no pre-roll is long enough), so the scenario
 /// is refused at `gcode.layers`; the whole file runs.
 #[test]
-fn the_gcode_kind_refuses_a_layer_range_on_an_undamped_machine() {
+fn the_gcode_study_refuses_a_layer_range_on_an_undamped_machine() {
     let dir = tempfile::tempdir().expect("tempdir");
     let tower = root().join("gcode/prints/ringing_tower.gcode");
     let text = |layers: &str| {

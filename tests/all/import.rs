@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use settle::error::Error;
 use settle::workflows::import::{ImportOptions, import};
-use settle::workflows::tune::firmware::Firmware;
+use settle_planner::firmware::Firmware;
 
 use crate::support::root;
 

@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use settle::spec::backend::Backend;
 use settle::workflows::import::{ImportOptions, import};
-use settle::workflows::tune::firmware::Firmware;
 use settle::workflows::tune::{Options, tune_with};
+use settle_planner::firmware::Firmware;
 
 /// A small Klipper configuration: cartesian, its current shapers on X and Y.
 const PRINTER_CFG: &str = "[printer]
@@ -76,7 +76,7 @@ fn recommended(t: &settle::workflows::tune::Tuned, axis: &str) -> Option<(String
         .expect("axis tuned")
         .1;
     let sh = o.scores[o.winner].candidate.shaper?;
-    sh.kind
+    sh.shaper_type
         .map(|k| (k.name(), sh.frequency_hz, sh.damping_ratio))
 }
 
@@ -99,7 +99,11 @@ fn klipper_import_tune_export_import_gives_the_recommendation() {
     for (axis, o) in &t.axes {
         let c = &o.scores[0];
         let cur = c.candidate.shaper.expect("current shaper");
-        assert_eq!(cur.kind.map(|k| k.name()).as_deref(), Some("zv"), "{axis}");
+        assert_eq!(
+            cur.shaper_type.map(|k| k.name()).as_deref(),
+            Some("zv"),
+            "{axis}"
+        );
         assert_eq!(cur.frequency_hz, if axis == "x" { 45.0 } else { 35.0 });
         assert_eq!(c.accel_mm_s2, 3000.0);
         let w = &o.scores[o.winner];

@@ -70,7 +70,7 @@ fn scenario_with_a_preset_expands_on_the_named_axis() {
         ("y", "printer_xy")
     );
     assert_eq!(r.driver, DriverMode::Full);
-    assert_eq!(r.machine.as_ref().map(|m| m.axes.len()), Some(2));
+    assert_eq!(r.machine.physical().map(|m| m.axes.len()), Some(2));
 }
 
 #[test]
@@ -80,13 +80,13 @@ fn machine_parameters_can_be_swept() {
     );
     let runs = expand(&text, Path::new("p.toml")).expect("expands");
     assert_eq!(runs.len(), 4);
-    let y = |r: &settle::RunSpec| r.machine.as_ref().expect("machine").axes[1].clone();
+    let y = |r: &settle::RunSpec| r.machine.physical().expect("machine").axes[1].clone();
     assert_eq!(y(&runs[0]).mount.stiffness_n_per_m, 1e5);
     assert_eq!(y(&runs[3]).mount.stiffness_n_per_m, 1e6);
     assert_eq!(y(&runs[1]).driver.microsteps, 64);
     // Every axis gets the machine-wide value.
     assert_eq!(
-        runs[1].machine.as_ref().expect("machine").axes[0]
+        runs[1].machine.physical().expect("machine").axes[0]
             .driver
             .microsteps,
         64

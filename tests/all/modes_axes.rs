@@ -119,7 +119,7 @@ fn a_corner_on_an_xy_modes_machine_rings_on_each_axis_at_its_own_modes() {
     let m = &run_modal(&mut runs)[0];
     assert!(m.is_ok(), "{:?}", m.status);
     let names = runs[0].axis_names();
-    let planned = settle::kinds::plan(&runs[0], &names).expect("plans");
+    let planned = settle::studies::plan(&runs[0], &names).expect("plans");
     let traj = &planned.trajectory;
     let t_end = traj.duration_s();
     for (name, mode, profile) in [
@@ -148,8 +148,8 @@ fn the_modes_shorthand_is_axis_x_and_sweeps_reach_every_axis() {
         + "[sweep]\n\"machine.axis.y.modes.0.frequency_hz\" = [20.0, 30.0]\n\"machine.modes.0.damping_ratio\" = [0.1]\n";
     let runs = expand(&text).expect("shorthand plus an axis table");
     assert_eq!(runs.len(), 2);
-    assert_eq!(runs[1].modes_of("y")[0].frequency_hz, 30.0);
-    assert_eq!(runs[1].modes_of("x")[0].damping_ratio, 0.1);
+    assert_eq!(runs[1].machine.modes_of("y")[0].frequency_hz, 30.0);
+    assert_eq!(runs[1].machine.modes_of("x")[0].damping_ratio, 0.1);
     let msg = err(&text.replace("[20.0, 30.0]", "[20.0, -1.0]"));
     assert!(
         msg.contains("key `sweep.machine.axis.y.modes.0.frequency_hz`"),

@@ -23,7 +23,7 @@ fn check(backend: Backend, rel_tol: f64, settle_tol_s: f64) {
             .profile
             .rest_to_rest(spec.start_mm * 1e-3, spec.distance_mm * 1e-3, &lim)
             .expect("plan");
-        let modes: Vec<Mode> = spec.modes_sim("x").expect("modes");
+        let modes: Vec<Mode> = spec.machine.sim_modes("x").expect("modes");
         let t_end = prof.duration_s();
         let target = prof.end().p;
         let mut acc = Accumulator::new(&[target], &[1.0], t_end, &spec.bands_um);

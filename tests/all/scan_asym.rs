@@ -10,13 +10,13 @@
 //! 2. **At the same duration** (an asymmetric move in a symmetric time frame): the
 //!    asymmetric step vs the pure jerk-limited symmetric step of equal time.
 //!
-//! The test asserts what the physics shows (the numbers are in the README, under "Raster
-//! scan steps in the harness", and in docs/reports/REPORT-scan.md).
+//! The test asserts what the physics shows (the numbers are in the book's raster scan
+//! page, `docs/guide/scans.md`).
 
 use std::path::Path;
 
 use settle_planner::pvt::step::AsymShape;
-use settle_planner::{KindParams, Limits, Profile, ProfileKind};
+use settle_planner::{Limits, Profile, ProfileKind, ProfileParams};
 use settle_sim::AxisModel;
 use settle_sim::closed_form::LinearResponse;
 
@@ -71,7 +71,7 @@ fn symmetric_of_duration(t_s: f64) -> Profile {
 #[test]
 fn asymmetric_steps_settle_faster_on_a_raster_step_where_the_closed_form_says_so() {
     let lim = Limits::new(0.2, 2.0, Some(200.0)).expect("limits");
-    let params = KindParams::default();
+    let params = ProfileParams::default();
     for (preset, band_um) in [("printer_xy", 10.0), ("leadscrew_stage", 2.0)] {
         let ax = axis(preset);
         let band = band_um * 1e-6;
@@ -134,7 +134,7 @@ fn asymmetric_steps_settle_faster_on_a_raster_step_where_the_closed_form_says_so
     }
     // The default shape is Ki = 1/2.
     assert_eq!(
-        KindParams::default().pvt_asym_ki,
+        ProfileParams::default().pvt_asym_ki,
         AsymShape::new(0.5).expect("shape").ki
     );
 }

@@ -9,7 +9,7 @@ use crate::support::extra;
 use std::path::Path;
 
 use settle::spec::backend::Backend;
-use settle_planner::KindParams;
+use settle_planner::ProfileParams;
 use settle_sim::Mode;
 use settle_sim::closed_form::residual_at;
 
@@ -20,10 +20,10 @@ fn reentry_error_and_settling_equal_the_closed_form_on_modal() {
     settle::execute::set_backend(&path, &mut runs, Backend::Modal).expect("modal");
     let mode = Mode::new(40.0, 0.05, 1.0).expect("mode");
     for spec in &runs {
-        spec.state::<settle::kinds::scan::ScanSpec>()
+        spec.state::<settle::studies::scan::ScanSpec>()
             .expect("scan run");
         let m = settle::execute::execute(spec, None).expect("runs");
-        let r = settle::kinds::scan::raster(spec).expect("plans");
+        let r = settle::studies::scan::raster(spec).expect("plans");
         let tr = r.turnarounds[0];
         let step = spec
             .profile
@@ -31,7 +31,7 @@ fn reentry_error_and_settling_equal_the_closed_form_on_modal() {
                 0.0,
                 spec.distance_mm * 1e-3,
                 &spec.limits_si().expect("limits"),
-                &KindParams::default(),
+                &ProfileParams::default(),
             )
             .expect("step");
         // The deflection e (m) at time tau after the step's start, for tau >= its end.

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use settle::spec::backend::Backend;
-use settle_planner::shaper::{Shaper, ShaperKind};
+use settle_planner::shaper::{Shaper, ShaperType};
 use settle_planner::{Limits, ProfileKind};
 use settle_sim::Mode;
 use settle_sim::closed_form::{residual_at, residual_envelope};
@@ -82,7 +82,7 @@ fn shaped_trapezoid_leaves_the_closed_form_fraction_of_the_residual() {
     let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
     let rv_col = col("remaining_vibration_pct");
 
-    for (i, kind) in ShaperKind::ALL.into_iter().enumerate() {
+    for (i, kind) in ShaperType::ALL.into_iter().enumerate() {
         let (run, m) = (&runs[i + 1], &metrics[i + 1]);
         let shaper = Shaper::new(kind, F_HZ, 0.1).expect("shaper");
         let rv = shaper.remaining_vibration(F_HZ, ZETA);
@@ -119,8 +119,8 @@ fn shaped_trapezoid_leaves_the_closed_form_fraction_of_the_residual() {
         assert!((pct - 100.0 * rv).abs() < 1e-9, "{kind}: {pct}");
         assert_eq!(row[col("shaper_type")], kind.name());
         assert_eq!(
-            run.state::<settle::kinds::shaping::ShaperSetting>()
-                .and_then(|s| s.kind),
+            run.state::<settle::studies::shaping::ShaperSetting>()
+                .and_then(|s| s.shaper_type),
             Some(kind)
         );
     }

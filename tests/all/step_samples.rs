@@ -213,7 +213,9 @@ bands_um = [10.0]
     let spec = &runs[0];
     let axes = settle::execute::axes_of(spec).expect("axes");
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
-    let traj = settle::kinds::plan(spec, &names).expect("plan").trajectory;
+    let traj = settle::studies::plan(spec, &names)
+        .expect("plan")
+        .trajectory;
     assert!(traj.path().is_some(), "a path run");
     Case {
         axes,

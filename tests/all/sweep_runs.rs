@@ -61,13 +61,14 @@ fn check(r: &settle::spec::run_spec::RunSpec, &(id, kind, d, v, f): &Expected) {
     assert_eq!(r.amax_mm_s2, 3000.0, "run {id}");
     assert_eq!(r.jmax_mm_s3, Some(100000.0), "run {id}");
     assert_eq!(r.bands_um, vec![10.0, 50.0], "run {id}");
-    assert_eq!(r.modes.len(), 1, "run {id}");
-    assert_eq!(r.modes[0].modes[0].frequency_hz, f, "run {id}");
-    assert_eq!(r.modes[0].modes[0].damping_ratio, 0.05, "run {id}");
+    let modes = r.machine.modes();
+    assert_eq!(modes.len(), 1, "run {id}");
+    assert_eq!(modes[0].modes[0].frequency_hz, f, "run {id}");
+    assert_eq!(modes[0].modes[0].damping_ratio, 0.05, "run {id}");
     assert_eq!(
         r.swept,
         vec![
-            ("profile".to_string(), Value::Kind(kind)),
+            ("profile".to_string(), Value::Study(kind)),
             ("move.distance_mm".to_string(), Value::Number(d)),
             ("limits.vmax_mm_s".to_string(), Value::Number(v)),
             ("machine.modes.0.frequency_hz".to_string(), Value::Number(f)),

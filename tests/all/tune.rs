@@ -132,7 +132,7 @@ fn tuned_on_modal_still_beats_the_default_on_rapier() {
     let k = settle::workflows::tune::export::klipper(&[("y".to_string(), with_x)], "a test");
     assert!(k.contains("shaper_type_x: mzv\nshaper_freq_x: 52\n"), "{k}");
     assert!(!k.contains("max_accel"), "acceleration unchanged: {k}");
-    match w.candidate.shaper.and_then(|s| s.kind) {
+    match w.candidate.shaper.and_then(|s| s.shaper_type) {
         Some(kind) => {
             assert!(
                 k.contains(&format!("shaper_type_y: {}", kind.name())),
@@ -159,7 +159,7 @@ fn tmc_export_of_an_scurve_reads_back_to_its_jerk() {
     )
     .expect("tunes");
     let w = &o.scores[o.winner];
-    assert!(w.candidate.shaper.is_none_or(|s| s.kind.is_none()));
+    assert!(w.candidate.shaper.is_none_or(|s| s.shaper_type.is_none()));
     let text = settle::workflows::tune::export::tmc4361a(&[("y".to_string(), o.clone())]);
     // `NAME 0xAA = value ; note`
     let reg = |name: &str| -> u32 {
@@ -346,7 +346,7 @@ fn tune_command_writes_report_table_plot_and_exports() {
     assert!(status.status.success(), "{status:?}");
     let stdout = String::from_utf8_lossy(&status.stdout);
     assert!(
-        stdout.contains("**winner**") && stdout.contains("Gain of the winner"),
+        stdout.contains("**recommended**") && stdout.contains("Gain of the recommendation"),
         "{stdout}"
     );
     let csv = std::fs::read_to_string(out.join("candidates.csv")).expect("csv");
@@ -401,7 +401,7 @@ fn refinement_never_loses_to_the_grid_and_stays_within_the_limits() {
     // Refinement moves the frequency by at most 2 x (2.5 + 1.25 + 0.625 + 0.3125)% in
     // total, and never raises the jerk above the scenario's limit.
     if let (Some(a), Some(b)) = (gc.shaper, wc.shaper) {
-        assert_eq!(a.kind, b.kind);
+        assert_eq!(a.shaper_type, b.shaper_type);
         let r = b.frequency_hz / a.frequency_hz;
         assert!((1.0 - 0.1..=1.0 + 0.1).contains(&r), "{r}");
     }
@@ -422,17 +422,17 @@ fn refinement_never_loses_to_the_grid_and_stays_within_the_limits() {
 
 #[test]
 fn neighbours_step_the_frequency_and_cap_the_jerk() {
-    use settle::kinds::shaping::ShaperSetting;
+    use settle::studies::shaping::ShaperSetting;
     use settle::workflows::tune::rank::neighbours;
     use settle::workflows::tune::search::Candidate;
-    use settle_planner::shaper::ShaperKind;
-    use settle_planner::{KindParams, ProfileKind};
+    use settle_planner::shaper::ShaperType;
+    use settle_planner::{ProfileKind, ProfileParams};
     let c = Candidate {
         kind: ProfileKind::SCurve,
         jmax_mm_s3: Some(1e5),
-        params: KindParams::default(),
+        params: ProfileParams::default(),
         shaper: Some(ShaperSetting {
-            kind: Some(ShaperKind::MZV),
+            shaper_type: Some(ShaperType::MZV),
             frequency_hz: 40.0,
             damping_ratio: 0.1,
         }),

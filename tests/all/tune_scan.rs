@@ -13,9 +13,9 @@
 use crate::support::extra;
 use std::path::{Path, PathBuf};
 
-use settle::kinds::scan::ScanSpec;
 use settle::spec::backend::Backend;
-use settle_planner::KindParams;
+use settle::studies::scan::ScanSpec;
+use settle_planner::ProfileParams;
 use settle_planner::shaper::Shaper;
 use settle_sim::Mode;
 use settle_sim::closed_form::residual_at;
@@ -70,10 +70,10 @@ profile = ["trapezoid", "scurve"]
     let mode = Mode::new(F_HZ, ZETA, 1.0).expect("mode");
     let mut unshaped_um = std::collections::HashMap::new();
     for spec in &runs {
-        spec.state::<settle::kinds::scan::ScanSpec>()
+        spec.state::<settle::studies::scan::ScanSpec>()
             .expect("scan run");
         let m = settle::execute::execute(spec, None).expect("runs");
-        let r = settle::kinds::scan::raster(spec).expect("plans");
+        let r = settle::studies::scan::raster(spec).expect("plans");
         let tr = r.turnarounds[0];
         let plain = spec
             .profile
@@ -81,12 +81,12 @@ profile = ["trapezoid", "scurve"]
                 0.0,
                 spec.distance_mm * 1e-3,
                 &spec.limits_si().expect("limits"),
-                &KindParams::default(),
+                &ProfileParams::default(),
             )
             .expect("step");
         let kind = spec
-            .state::<settle::kinds::shaping::ShaperSetting>()
-            .and_then(|s| s.kind);
+            .state::<settle::studies::shaping::ShaperSetting>()
+            .and_then(|s| s.shaper_type);
         let step = match kind {
             Some(k) => Shaper::new(k, F_HZ, 0.1)
                 .expect("shaper")
@@ -317,7 +317,7 @@ fn tune_command_on_a_scan_writes_the_report_and_exports() {
         "overhead per line (ms)",
         "robustness margin 0.8 x the 10 um band",
         "less overhead per line",
-        "**winner**",
+        "**recommended**",
     ] {
         assert!(md.contains(want), "missing `{want}` in\n{md}");
     }

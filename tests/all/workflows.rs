@@ -75,7 +75,7 @@ fn a_sweep_with_lost_steps_reports_the_failed_run() {
         (1, "lost_steps")
     );
     let r = o.report();
-    assert_eq!(r.exit, Exit::Failed);
+    assert_eq!(r.exit, Exit::RunsFailed);
     assert!(r.stderr.contains("1 of 2 runs failed"), "{}", r.stderr);
 }
 

@@ -15,6 +15,13 @@ pub const MAX_FILES: usize = 1000;
 /// The most bytes one configuration reads in all its files.
 pub const MAX_BYTES: u64 = 64 * 1024 * 1024;
 
+/// A configuration file's text (settle-files' reader: a regular file of at most
+/// [`settle_files::limit::FIRMWARE_CONFIG`], UTF-8, a byte-order mark dropped), or an
+/// error naming it (and the line of invalid UTF-8).
+fn read_text(path: &Path) -> Result<String, settle_files::FileError> {
+    settle_files::read::read_text(path, settle_files::limit::FIRMWARE_CONFIG)
+}
+
 /// The reads left to a configuration.
 #[derive(Debug)]
 pub(crate) struct Budget {
@@ -45,7 +52,7 @@ impl Budget {
 
     /// The main file's text.
     pub(crate) fn main(&mut self, path: &Path) -> Result<String, GcodeError> {
-        let text = super::klipper_files::read_text(path)?;
+        let text = read_text(path)?;
         self.count(text.len(), None, "")?;
         Ok(text)
     }
@@ -59,7 +66,7 @@ impl Budget {
         what: &str,
     ) -> Result<String, GcodeError> {
         self.reserve(1, at, what)?;
-        let text = super::klipper_files::read_text(path).map_err(|source| GcodeError::Include {
+        let text = read_text(path).map_err(|source| GcodeError::Include {
             at: at.clone(),
             what: what.to_string(),
             source: Box::new(source),

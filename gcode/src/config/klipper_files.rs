@@ -38,13 +38,6 @@ pub(crate) struct Loaded {
     pub(crate) notes: Vec<ConfigNote>,
 }
 
-/// A configuration file's text (settle-files' reader: a regular file of at most
-/// [`settle_files::limit::FIRMWARE_CONFIG`], UTF-8, a byte-order mark dropped), or an
-/// error naming it (and the line of invalid UTF-8).
-pub(crate) fn read_text(path: &Path) -> Result<String, settle_files::FileError> {
-    settle_files::read::read_text(path, settle_files::limit::FIRMWARE_CONFIG)
-}
-
 /// `path` made absolute and normalised lexically (Python's `os.path.abspath`).
 pub(crate) fn absolute(path: &Path) -> PathBuf {
     let joined = match std::env::current_dir() {

@@ -3,7 +3,7 @@
 //! optionally with parameters in parentheses, by name or by position but not both:
 //! `mzv(n=4,t=0.8)`, `mzv(n=4,tau=1.2)`, `mzv(4,0.8)`, `ei(v_tol=0.03)`. Values are
 //! decimals of digits and one dot (`[\d.]+`). The text is kept as written; turning it into
-//! impulses is the planner's business (`settle_planner::shaper::ShaperKind` reads the
+//! impulses is the planner's business (`settle_planner::shaper::ShaperType` reads the
 //! same syntax).
 
 /// The shaper families and the largest damping ratio Klipper accepts for each

@@ -3,8 +3,8 @@
 
 use std::fmt;
 
-use crate::dialect::Dialect;
 use crate::error::Location;
+use crate::read::dialect::Dialect;
 
 /// One value per axis X, Y, Z.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -81,11 +81,11 @@ impl ShaperSetting {
         }
     }
 
-    /// The name in the syntax of `settle_planner::shaper::ShaperKind`: Klipper's text as is,
+    /// The name in the syntax of `settle_planner::shaper::ShaperType`: Klipper's text as is,
     /// `rrf:<type>` for RepRapFirmware, `marlin:<name>` for Marlin. `None` when the
     /// firmware does not shape with it ([`ShaperSetting::is_enabled`]) or it is
     /// RepRapFirmware's `custom` shaper, known only by its impulses.
-    pub fn kind_name(&self, firmware: Dialect) -> Option<String> {
+    pub fn type_name(&self, firmware: Dialect) -> Option<String> {
         if !self.is_enabled(firmware) {
             return None;
         }

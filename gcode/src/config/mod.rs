@@ -27,7 +27,7 @@
 //!             shaper_type_y: ei\nshaper_freq_y: 41.5\n";
 //! let c = KlipperConfig::parse(text, "printer.cfg")?;
 //! let shaper = c.input_shaper.expect("an [input_shaper] section");
-//! assert_eq!(shaper.x.kind_name(Dialect::Klipper).as_deref(), Some("mzv"));
+//! assert_eq!(shaper.x.type_name(Dialect::Klipper).as_deref(), Some("mzv"));
 //! assert_eq!((shaper.x.frequency_hz, shaper.x.damping_ratio), (52.4, 0.1)); // default zeta
 //! assert_eq!(c.printer.minimum_cruise_ratio, 0.5); // Klipper's default
 //!
@@ -64,6 +64,7 @@ mod rrf_script;
 pub use budget::{MAX_BYTES as MAX_CONFIG_BYTES, MAX_FILES as MAX_CONFIG_FILES};
 pub use export_klipper::KlipperExport;
 pub use export_rrf::RrfExport;
+pub use export_text::Note;
 pub use klipper::{
     DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
     DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,

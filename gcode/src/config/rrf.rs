@@ -22,12 +22,12 @@ use super::budget::Budget;
 use super::klipper_files::absolute;
 use super::machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
 use super::rrf_script::unconditional;
-use crate::dialect::Dialect;
 use crate::error::{GcodeError, Location};
-use crate::event::{EventKind, Note};
-use crate::limits::{AxisValues, LimitChange};
-use crate::reader::{Reader, ReaderOptions};
-use crate::setting::Setting;
+use crate::read::dialect::Dialect;
+use crate::read::event::{EventKind, Note};
+use crate::read::limits::{AxisValues, LimitChange};
+use crate::read::reader::{Reader, ReaderOptions};
+use crate::read::setting::Setting;
 
 /// The kinematics by `M669 K` code (`KinematicsType`,
 /// `src/Movement/Kinematics/Kinematics.h`), named as Klipper names the same ones.

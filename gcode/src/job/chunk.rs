@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use settle_planner::Trajectory;
 
-use super::config::Firmware;
-use crate::geometry::{MoveKind, Point};
+use crate::read::geometry::{MoveKind, Point};
+use settle_planner::firmware::Firmware;
 
 /// The path a move commands, for measuring contour error against it (mm, machine frame).
 #[derive(Debug, Clone, PartialEq)]

@@ -2,93 +2,35 @@
 //! how arcs are cut, as plain data (the harness fills it from a machine or preset, or from
 //! an imported printer.cfg / config.g).
 
-use std::fmt;
-use std::str::FromStr;
-
-use settle_planner::firmware::Kinematics;
 use settle_planner::firmware::klipper::KlipperConfig;
 use settle_planner::firmware::marlin::MarlinConfig;
 use settle_planner::firmware::profiles::ProfileOptions;
 use settle_planner::firmware::rrf::RrfConfig;
+use settle_planner::firmware::{Firmware, Kinematics};
 use settle_planner::path::junction::Junction;
 use settle_planner::path::{CornerStrategy, PathOptions};
 use settle_planner::shaper::stream::Alignment;
-use settle_planner::shaper::{Shaper, ShaperKind};
+use settle_planner::shaper::{Shaper, ShaperType};
 use settle_planner::{Limits, PlanError, ProfileKind};
 
 use crate::{ArcSegmentation, Dialect, GcodeError};
 
-/// Whose planner runs the job.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Firmware {
-    /// Klipper's toolhead planner.
-    Klipper,
-    /// Marlin's planner and stepper.
-    Marlin,
-    /// RepRapFirmware's planner.
-    Rrf,
-    /// settle's own jerk-limited look-ahead ([`settle_planner::path`]).
-    Settle,
-}
-
-impl Firmware {
-    /// Every firmware, in a fixed order.
-    pub const ALL: [Firmware; 4] = [
-        Firmware::Klipper,
-        Firmware::Marlin,
-        Firmware::Rrf,
-        Firmware::Settle,
-    ];
-
-    /// The name on the command line (`klipper`, `marlin`, `rrf`, `settle`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Firmware::Klipper => "klipper",
-            Firmware::Marlin => "marlin",
-            Firmware::Rrf => "rrf",
-            Firmware::Settle => "settle",
+/// A firmware by name, for a G-code job: one of [`Firmware::GCODE`] (klipper, marlin,
+/// rrf, settle; `reprapfirmware` and `duet` are rrf).
+pub fn parse_firmware(name: &str) -> Result<Firmware, GcodeError> {
+    Firmware::parse_among(name, &Firmware::GCODE, "a G-code planner").map_err(|reason| {
+        GcodeError::JobSetting {
+            key: "firmware",
+            reason,
         }
-    }
-
-    /// The G-code dialect a file for this firmware is read in (settle's planner reads
-    /// Marlin-flavoured G-code unless told otherwise: most slicers write it).
-    pub fn dialect(self) -> Dialect {
-        match self {
-            Firmware::Klipper => Dialect::Klipper,
-            Firmware::Marlin | Firmware::Settle => Dialect::Marlin,
-            Firmware::Rrf => Dialect::Rrf,
-        }
-    }
-}
-
-impl fmt::Display for Firmware {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Firmware {
-    type Err = GcodeError;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.to_ascii_lowercase().as_str() {
-            "klipper" => Ok(Firmware::Klipper),
-            "marlin" => Ok(Firmware::Marlin),
-            "rrf" | "reprapfirmware" | "duet" => Ok(Firmware::Rrf),
-            "settle" => Ok(Firmware::Settle),
-            _ => Err(GcodeError::JobSetting {
-                key: "firmware",
-                reason: format!("unknown firmware `{s}` (allowed: klipper, marlin, rrf, settle)"),
-            }),
-        }
-    }
+    })
 }
 
 /// An input shaper on one axis: which, and the mode it is tuned to.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShaperSetting {
     /// The shaper (bare names are Klipper's, `marlin:` and `rrf:` the other firmwares').
-    pub kind: ShaperKind,
+    pub shaper_type: ShaperType,
     /// Frequency it is tuned to (Hz).
     pub frequency_hz: f64,
     /// Damping ratio it is tuned to.
@@ -102,14 +44,14 @@ impl ShaperSetting {
         let min = settle_planner::shaper::MIN_FREQUENCY_HZ;
         if self.frequency_hz < min {
             return Err(PlanError::InvalidShaper {
-                name: self.kind.to_string(),
+                name: self.shaper_type.to_string(),
                 reason: format!(
                     "frequency {} Hz is below {min} Hz, the lowest settle runs (a shaper lasts about one period)",
                     self.frequency_hz
                 ),
             });
         }
-        Shaper::new(self.kind, self.frequency_hz, self.damping_ratio)
+        Shaper::new(self.shaper_type, self.frequency_hz, self.damping_ratio)
     }
 }
 
@@ -223,8 +165,17 @@ impl JobConfig {
                     reason: e.to_string(),
                 })?)
             }
+            Firmware::Tmc4361a => {
+                return Err(GcodeError::JobSetting {
+                    key: "firmware",
+                    reason: format!(
+                        "{firmware} is a motion controller: it plans no G-code job; allowed: {}",
+                        Firmware::names(&Firmware::GCODE)
+                    ),
+                });
+            }
         };
-        let dialect = firmware.dialect();
+        let dialect = Dialect::of(firmware);
         Ok(Self {
             planner,
             dialect,
@@ -264,7 +215,7 @@ fn config_shaper(
     key: &'static str,
 ) -> Result<Option<ShaperSetting>, GcodeError> {
     let bad = |reason: String| GcodeError::JobSetting { key, reason };
-    let Some(name) = s.kind_name(dialect) else {
+    let Some(name) = s.type_name(dialect) else {
         if s.is_enabled(dialect) {
             return Err(bad(format!(
                 "the `{}` shaper is known only by its impulses; settle does not model it",
@@ -273,9 +224,9 @@ fn config_shaper(
         }
         return Ok(None);
     };
-    let kind = ShaperKind::parse(&name).map_err(|e| bad(e.to_string()))?;
+    let kind = ShaperType::parse(&name).map_err(|e| bad(e.to_string()))?;
     let setting = ShaperSetting {
-        kind,
+        shaper_type: kind,
         frequency_hz: s.frequency_hz,
         damping_ratio: s.damping_ratio,
     };
@@ -373,12 +324,12 @@ mod from_config_tests {
         let x = x.expect("X shaped");
         let y = y.expect("Y shaped");
         assert_eq!(
-            (x.kind, x.frequency_hz, x.damping_ratio),
-            (ShaperKind::MZV, 52.4, 0.1)
+            (x.shaper_type, x.frequency_hz, x.damping_ratio),
+            (ShaperType::MZV, 52.4, 0.1)
         );
         assert_eq!(
-            (y.kind, y.frequency_hz, y.damping_ratio),
-            (ShaperKind::EI, 41.5, 0.08)
+            (y.shaper_type, y.frequency_hz, y.damping_ratio),
+            (ShaperType::EI, 41.5, 0.08)
         );
         assert_eq!(z, None, "Klipper leaves Z unshaped without shaper_freq_z");
         assert_eq!(cfg.dialect, Dialect::Klipper);
@@ -418,6 +369,6 @@ mod from_config_tests {
         assert_eq!(cfg.shapers[1], Some(x), "one shaper for X and Y");
         assert_eq!(cfg.shapers[2], None);
         assert_eq!((x.frequency_hz, x.damping_ratio), (42.5, 0.1));
-        assert_eq!(x.kind, ShaperKind::parse("rrf:mzv").expect("ok"));
+        assert_eq!(x.shaper_type, ShaperType::parse("rrf:mzv").expect("ok"));
     }
 }

@@ -13,7 +13,7 @@ use settle_planner::firmware::rrf::RrfPlanner;
 use settle_planner::firmware::{FirmwarePlanner, PlannedMove};
 
 use super::config::PlannerConfig;
-use crate::limits::{AxisValues, LimitChange};
+use crate::read::limits::{AxisValues, LimitChange};
 
 /// Millimetres (and mm/s, mm/s^2) to metres.
 const MM: f64 = 1e-3;

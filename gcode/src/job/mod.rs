@@ -39,7 +39,8 @@
 //! first move after the range.
 //!
 //! ```
-//! use settle_gcode::job::{Firmware, Job, JobConfig};
+//! use settle_gcode::job::{Job, JobConfig};
+//! use settle_planner::firmware::Firmware;
 //! use settle_gcode::{Reader, ReaderOptions};
 //!
 //! let text = "G1 X50 F6000\nG1 Y50\n";
@@ -70,5 +71,5 @@ mod shapers;
 mod slice;
 
 pub use chunk::{JobChunk, JobSummary, LayerTime, MoveGeometry, MoveInfo};
-pub use config::{Firmware, JobConfig, PlannerConfig, SettleConfig, ShaperSetting};
+pub use config::{JobConfig, PlannerConfig, SettleConfig, ShaperSetting, parse_firmware};
 pub use pipeline::Job;

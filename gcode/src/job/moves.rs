@@ -12,7 +12,7 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 
 use super::chunk::{LayerTime, MoveInfo};
-use crate::geometry::MoveKind;
+use crate::read::geometry::MoveKind;
 
 /// A move whose segments are still coming.
 #[derive(Debug)]

@@ -17,8 +17,8 @@ use super::moves::MoveTable;
 use super::settle::SettlePlanner;
 use super::shapers::ShaperState;
 use crate::error::GcodeError;
-use crate::geometry::Point;
-use crate::reader::{Reader, ReaderOptions};
+use crate::read::geometry::Point;
+use crate::read::reader::{Reader, ReaderOptions};
 
 mod events;
 

@@ -14,25 +14,26 @@
 //!   damping `S` (default 0.1); a frequency or damping given while the type is `none`
 //!   selects `zvd`. `custom` shapers (`H`, `T`) are not supported.
 
-use settle_planner::shaper::{MarlinShaper, RrfShaper, ShaperKind};
+use settle_planner::shaper::{MarlinShaper, RrfShaper, ShaperType};
 
-use super::config::{Firmware, ShaperSetting};
-use crate::limits::{AxisFlags, FtShaper, LimitChange};
+use super::config::ShaperSetting;
+use crate::read::limits::{AxisFlags, FtShaper, LimitChange};
+use settle_planner::firmware::Firmware;
 
 /// One axis's shaper state as its firmware keeps it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Axis {
     /// The family (`None`: no shaper selected).
-    kind: Option<ShaperKind>,
+    shaper_type: Option<ShaperType>,
     frequency_hz: f64,
     damping_ratio: f64,
 }
 
 impl Axis {
     fn setting(&self) -> Option<ShaperSetting> {
-        let kind = self.kind?;
+        let kind = self.shaper_type?;
         (self.frequency_hz > 0.0).then_some(ShaperSetting {
-            kind,
+            shaper_type: kind,
             frequency_hz: self.frequency_hz,
             damping_ratio: self.damping_ratio,
         })
@@ -62,17 +63,17 @@ impl ShaperState {
     pub(crate) fn new(firmware: Firmware, initial: &[Option<ShaperSetting>; 3]) -> Self {
         let (default_kind, default_f, default_z) = match firmware {
             Firmware::Rrf => (None, 40.0, 0.1),
-            Firmware::Klipper => (Some(ShaperKind::MZV), 0.0, 0.1),
-            Firmware::Marlin | Firmware::Settle => (None, 0.0, 0.1),
+            Firmware::Klipper => (Some(ShaperType::MZV), 0.0, 0.1),
+            Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => (None, 0.0, 0.1),
         };
         let axes = initial.map(|s| match s {
             Some(s) => Axis {
-                kind: Some(s.kind),
+                shaper_type: Some(s.shaper_type),
                 frequency_hz: s.frequency_hz,
                 damping_ratio: s.damping_ratio,
             },
             None => Axis {
-                kind: default_kind,
+                shaper_type: default_kind,
                 frequency_hz: default_f,
                 damping_ratio: default_z,
             },
@@ -88,8 +89,8 @@ impl ShaperState {
     pub(crate) fn settings(&self) -> [Option<ShaperSetting>; 3] {
         std::array::from_fn(|i| {
             let a = &self.axes[i];
-            match a.kind {
-                Some(ShaperKind::Marlin { .. }) if self.ft_off => None,
+            match a.shaper_type {
+                Some(ShaperType::Marlin { .. }) if self.ft_off => None,
                 _ => a.setting(),
             }
         })
@@ -117,9 +118,9 @@ impl ShaperState {
                     let name = shaper_type.as_ref().or(shaper_type_xyz[i].as_ref());
                     let a = &mut self.axes[i];
                     if let Some(name) = name {
-                        let kind = ShaperKind::parse(name)
+                        let kind = ShaperType::parse(name)
                             .map_err(|_| ShaperProblem::UnknownName(name.clone()))?;
-                        a.kind = Some(kind);
+                        a.shaper_type = Some(kind);
                     }
                     if let Some(f) = frequency_hz_xyz[i] {
                         a.frequency_hz = f;
@@ -143,7 +144,7 @@ impl ShaperState {
                         a.damping_ratio = z;
                     }
                     if let Some(f) = frequency_hz {
-                        a.kind = Some(ShaperKind::Zv);
+                        a.shaper_type = Some(ShaperType::Zv);
                         a.frequency_hz = *f;
                     }
                 }
@@ -166,7 +167,7 @@ impl ShaperState {
                 }
                 for a in self.marlin_axes(axes) {
                     if let Some(s) = shaper {
-                        a.kind = marlin_kind(*s);
+                        a.shaper_type = marlin_kind(*s);
                     }
                     if let Some(f) = frequency_hz {
                         a.frequency_hz = *f;
@@ -174,8 +175,8 @@ impl ShaperState {
                     if let Some(z) = damping_ratio {
                         a.damping_ratio = *z;
                     }
-                    if let (Some(q), Some(ShaperKind::Marlin { v_tol, .. })) =
-                        (vibration_tolerance, a.kind.as_mut())
+                    if let (Some(q), Some(ShaperType::Marlin { v_tol, .. })) =
+                        (vibration_tolerance, a.shaper_type.as_mut())
                     {
                         *v_tol = *q;
                     }
@@ -215,7 +216,7 @@ impl ShaperState {
                             .into_iter()
                             .find(|f| f.name() == name)
                             .ok_or_else(|| ShaperProblem::UnknownName(name.to_string()))?;
-                        Some(Some(ShaperKind::rrf(family)))
+                        Some(Some(ShaperType::rrf(family)))
                     }
                 };
                 let seen =
@@ -228,9 +229,9 @@ impl ShaperState {
                         a.damping_ratio = *z;
                     }
                     match kind {
-                        Some(k) => a.kind = k,
-                        None if seen && a.kind.is_none() => {
-                            a.kind = Some(ShaperKind::rrf(RrfShaper::Zvd));
+                        Some(k) => a.shaper_type = k,
+                        None if seen && a.shaper_type.is_none() => {
+                            a.shaper_type = Some(ShaperType::rrf(RrfShaper::Zvd));
                         }
                         None => {}
                     }
@@ -253,7 +254,7 @@ impl ShaperState {
 }
 
 /// The shaper of `M493 C`.
-fn marlin_kind(s: FtShaper) -> Option<ShaperKind> {
+fn marlin_kind(s: FtShaper) -> Option<ShaperType> {
     let family = match s {
         FtShaper::None => return None,
         FtShaper::Zv => MarlinShaper::Zv,
@@ -265,5 +266,5 @@ fn marlin_kind(s: FtShaper) -> Option<ShaperKind> {
         FtShaper::Ei3 => MarlinShaper::ThreeHei,
         FtShaper::Mzv => MarlinShaper::Mzv,
     };
-    Some(ShaperKind::marlin(family))
+    Some(ShaperType::marlin(family))
 }

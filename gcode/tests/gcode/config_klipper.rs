@@ -57,8 +57,8 @@ fn voron_config_reads_as_klipper_does() {
     assert_eq!(s.x, shaper("mzv", 54.2, 0.08));
     assert_eq!(s.y, shaper("ei", 41.4, 0.1));
     assert_eq!(s.z, shaper("mzv", 0.0, 0.1));
-    assert_eq!(s.y.kind_name(Dialect::Klipper).as_deref(), Some("ei"));
-    assert_eq!(s.z.kind_name(Dialect::Klipper), None);
+    assert_eq!(s.y.type_name(Dialect::Klipper).as_deref(), Some("ei"));
+    assert_eq!(s.z.type_name(Dialect::Klipper), None);
     let x = c.steppers.x.as_ref().expect("stepper_x");
     assert_eq!(x.drive.microsteps_per_mm, 160.0);
     assert_eq!(x.drive.microsteps, 32);

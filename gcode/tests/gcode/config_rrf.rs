@@ -75,7 +75,7 @@ fn mini5plus_config_reads_as_the_firmware_applies_it() {
         }
     );
     assert_eq!(
-        c.input_shaper.kind_name(Dialect::Rrf).as_deref(),
+        c.input_shaper.type_name(Dialect::Rrf).as_deref(),
         Some("rrf:mzv")
     );
     let files: Vec<String> = c
@@ -164,7 +164,7 @@ fn defaults_are_the_firmwares() {
     );
     assert_eq!(c.input_shaper.name, "none");
     assert!(!c.input_shaper.is_enabled(Dialect::Rrf));
-    assert_eq!(c.input_shaper.kind_name(Dialect::Rrf), None);
+    assert_eq!(c.input_shaper.type_name(Dialect::Rrf), None);
     assert_eq!(parse("M669 K1\n").kinematics, "corexy");
     assert_eq!(parse("M665 L360 R180 H400\n").kinematics, "delta");
 }

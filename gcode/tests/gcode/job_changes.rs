@@ -3,12 +3,13 @@
 //! shapers' flush delays) and shapes what follows with the new shaper, the motion before
 //! keeping the old one.
 
-use settle_gcode::job::{Firmware, JobChunk, JobConfig, PlannerConfig, ShaperSetting};
+use settle_gcode::job::{JobChunk, JobConfig, PlannerConfig, ShaperSetting};
+use settle_planner::firmware::Firmware;
 use settle_planner::firmware::klipper::KlipperConfig;
 use settle_planner::firmware::marlin::{MarlinConfig, MarlinPlanner};
 use settle_planner::firmware::rrf::RrfConfig;
 use settle_planner::firmware::{FirmwarePlanner, LinearMove};
-use settle_planner::shaper::{Shaper, ShaperKind};
+use settle_planner::shaper::{Shaper, ShaperType};
 
 use crate::job_util::{assert_contiguous, assert_rel, at, job, leg, run};
 
@@ -199,7 +200,7 @@ fn check_switch(
 
 fn setting(name: &str, f: f64, z: f64) -> Option<ShaperSetting> {
     Some(ShaperSetting {
-        kind: ShaperKind::parse(name).expect("name"),
+        shaper_type: ShaperType::parse(name).expect("name"),
         frequency_hz: f,
         damping_ratio: z,
     })

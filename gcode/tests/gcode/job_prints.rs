@@ -2,9 +2,10 @@
 
 use std::collections::BTreeSet;
 
-use settle_gcode::job::{Firmware, Job, JobChunk, JobConfig, ShaperSetting};
+use settle_gcode::job::{Job, JobChunk, JobConfig, ShaperSetting};
 use settle_gcode::{Reader, ReaderOptions};
-use settle_planner::shaper::ShaperKind;
+use settle_planner::firmware::Firmware;
+use settle_planner::shaper::ShaperType;
 
 use crate::job_util::{MM, assert_contiguous, assert_rel, at};
 use crate::print_path;
@@ -15,19 +16,19 @@ const PRINTS: [&str; 3] = ["cube_layer.gcode", "ringing_tower.gcode", "arc_part.
 fn shaped(fw: Firmware) -> JobConfig {
     let mut c = JobConfig::defaults(fw).expect("defaults");
     let kinds = match fw {
-        Firmware::Klipper | Firmware::Settle => [ShaperKind::MZV, ShaperKind::EI],
         Firmware::Marlin => [
-            ShaperKind::parse("marlin:zvd").expect("name"),
-            ShaperKind::parse("marlin:mzv").expect("name"),
+            ShaperType::parse("marlin:zvd").expect("name"),
+            ShaperType::parse("marlin:mzv").expect("name"),
         ],
         Firmware::Rrf => [
-            ShaperKind::parse("rrf:zvd").expect("name"),
-            ShaperKind::parse("rrf:ei2").expect("name"),
+            ShaperType::parse("rrf:zvd").expect("name"),
+            ShaperType::parse("rrf:ei2").expect("name"),
         ],
+        _ => [ShaperType::MZV, ShaperType::EI],
     };
     for (i, (kind, f)) in kinds.into_iter().zip([48.0, 41.0]).enumerate() {
         c.shapers[i] = Some(ShaperSetting {
-            kind,
+            shaper_type: kind,
             frequency_hz: f,
             damping_ratio: 0.1,
         });
@@ -61,7 +62,7 @@ fn final_position(name: &str, cfg: &JobConfig) -> [f64; 3] {
 #[test]
 fn every_print_through_every_firmware() {
     for name in PRINTS {
-        for fw in Firmware::ALL {
+        for fw in Firmware::GCODE {
             let mut cfg = shaped(fw);
             if (name, fw) == ("arc_part.gcode", Firmware::Klipper) {
                 // Klipper refuses R-form arcs; the job stops at the line that has one.
@@ -114,7 +115,7 @@ fn a_layer_range_is_the_whole_job_cut_at_its_moves() {
     // Layers 2 and 3 of the ringing tower: chunks from the start of layer 2's first move
     // to the start of layer 4's, equal to the whole job's motion there (the shapers see
     // the same input: the look-back covers their duration).
-    for fw in Firmware::ALL {
+    for fw in Firmware::GCODE {
         let cfg = shaped(fw);
         let (whole, mut whole_job) = run_file("ringing_tower.gcode", cfg.clone(), None);
         whole_job.run_to_end().expect("end");
@@ -170,7 +171,7 @@ fn a_layer_range_is_the_whole_job_cut_at_its_moves() {
 /// of the file.
 #[test]
 fn a_pre_roll_starts_the_range_earlier_with_the_whole_jobs_motion() {
-    for fw in Firmware::ALL {
+    for fw in Firmware::GCODE {
         let cfg = shaped(fw);
         let (whole, _) = run_file("ringing_tower.gcode", cfg.clone(), None);
         let moves: Vec<_> = whole.iter().flat_map(|c| c.moves.iter().cloned()).collect();
@@ -233,7 +234,7 @@ fn homing_after_motion_travels_home_continuously() {
     // G28 after moves: homing is not simulated, the toolhead travels to 0 on the homed
     // axes, so the motion stays continuous and the move count includes that travel.
     let text = "G1 X20 Y10 F6000\nG28 X\nG1 Y30\n";
-    for fw in Firmware::ALL {
+    for fw in Firmware::GCODE {
         let (chunks, s) = crate::job_util::run(text, JobConfig::defaults(fw).expect("defaults"));
         assert_contiguous(&chunks);
         assert_eq!(s.moves, 3, "{fw}");

@@ -3,7 +3,8 @@
 //! bit for bit (unshaped axes pass through the shaping stage unchanged), the same
 //! duration.
 
-use settle_gcode::job::{Firmware, JobConfig, PlannerConfig};
+use settle_gcode::job::{JobConfig, PlannerConfig};
+use settle_planner::firmware::Firmware;
 use settle_planner::path::{Path, PathPoint, plan_path};
 use settle_planner::{Sample, Trajectory};
 

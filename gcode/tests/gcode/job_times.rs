@@ -2,8 +2,9 @@
 //! (planner/tests/firmware_*.rs) and Klipper's own toolhead.py, to 1e-9 relative: the
 //! same moves written as G-code plan the same.
 
-use settle_gcode::job::{Firmware, JobConfig, PlannerConfig};
+use settle_gcode::job::{JobConfig, PlannerConfig};
 use settle_gcode::{ArcSegmentation, Reader, ReaderOptions};
+use settle_planner::firmware::Firmware;
 use settle_planner::firmware::klipper::{KlipperConfig, KlipperPlanner};
 use settle_planner::firmware::marlin::{MarlinConfig, MarlinJerk, MarlinPlanner};
 use settle_planner::firmware::rrf::{RrfConfig, RrfPlanner};
@@ -232,6 +233,6 @@ fn arcs_plan_as_the_firmware_cuts_them() {
         };
         assert_eq!(s.print_time_s, direct(p.as_mut(), &moves), "{fw}");
         assert_eq!(s.segments as usize, moves.len(), "{fw}");
-        assert_eq!(cfg.dialect, fw.dialect());
+        assert_eq!(cfg.dialect, settle_gcode::Dialect::of(fw));
     }
 }

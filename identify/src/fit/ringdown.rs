@@ -5,7 +5,7 @@
 //! (`w_dk = w_k sqrt(1 - zeta_k^2)`; `c` absorbs what is left of gravity and offsets).
 //! The fit is unbiased because it is this exact model fitted to the samples by least
 //! squares (white sensor noise): no width or envelope is read. Start values come from the
-//! matrix pencil ([`settle_sim::pencil`]) on the decay, with the linear amplitudes solved
+//! matrix pencil ([`super::pencil`]) on the decay, with the linear amplitudes solved
 //! by least squares for each start; Levenberg-Marquardt then refines
 //! `(ln f_k, ln zeta_k, a_k, b_k, c)`. Model size by BIC as for the sweep fit.
 //!
@@ -100,7 +100,7 @@ pub fn fit(
     for m in 1..=max_modes.max(1) {
         // Extra poles take up the noise, so the m strongest oscillations are the modes.
         let order = 2 * m + 1 + PENCIL_EXTRA_POLES;
-        let Some(found) = settle_sim::pencil::fit(&decimated, dt * q as f64, order) else {
+        let Some(found) = super::pencil::fit(&decimated, dt * q as f64, order) else {
             break;
         };
         let mut nonlinear: Vec<(f64, f64)> = found
@@ -177,11 +177,13 @@ pub fn fit(
             } else {
                 (None, WeightBasis::NotIdentified)
             };
+            let (f, z) = (at(0), at(1));
             IdentifiedMode {
-                frequency_hz: at(0),
-                damping_ratio: at(1),
+                frequency_hz: f,
+                damping_ratio: z,
                 weight,
                 weight_basis,
+                peak_hz: f.value * (1.0 - z.value * z.value).max(0.0).sqrt(),
             }
         })
         .collect();
@@ -208,6 +210,8 @@ pub fn fit(
             points: n,
             candidates,
             span: (start as f64 * dt, end as f64 * dt),
+            rejected: Vec::new(),
+            converged: fit.converged,
         },
         window: (start, end),
         curve,

@@ -8,7 +8,7 @@
 
 use serde::Deserialize;
 
-use super::{MIN_SAMPLES, Recording, RecordingFormat, check_monotonic};
+use super::{MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_times, too_many_samples};
 use crate::IdentifyError;
 
 #[derive(Deserialize)]
@@ -35,7 +35,7 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
         .ok_or_else(|| {
             settle_files::FileError::too_large(
                 file,
-                format!("decompresses to more than {} bytes", limit.bytes),
+                format!("more than {} bytes of text once decompressed", limit.bytes),
                 limit,
             )
         })?;
@@ -47,6 +47,10 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
         last = n;
         if line.trim().is_empty() {
             continue;
+        }
+        // Each sample is one `[`: more than the limit is refused before it is held.
+        if line.bytes().filter(|&b| b == b'[').count() > MAX_SAMPLES + 1 {
+            return Err(too_many_samples(file, n));
         }
         let m: Measurement = serde_json::from_str(line).map_err(|e| {
             IdentifyError::format(
@@ -66,7 +70,7 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
             });
         }
         let time_s: Vec<f64> = m.samples.iter().map(|s| s[0]).collect();
-        check_monotonic(file, &time_s, |_| n)?;
+        check_times(file, &time_s, |_| n)?;
         let axis = |k: usize| Some(m.samples.iter().map(|s| s[k]).collect::<Vec<f64>>());
         let span = time_s[time_s.len() - 1] - time_s[0];
         out.push(Recording {
@@ -76,6 +80,7 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
             sample_rate_hz: time_s.len() as f64 / span,
             accel_mm_s2: [axis(1), axis(2), axis(3)],
             time_s,
+            named_axis: None,
             last_line: n,
         });
     }

@@ -13,6 +13,9 @@
 //! - [`rrf`]: RepRapFirmware src/Movement/DDA.cpp (`InitStandardMove`, `DoLookahead`,
 //!   `MatchSpeeds`, `RecalculateMove`) and DDARing.cpp (`CanAddMove`, `PrepareMoves`).
 //!
+//! [`Firmware`] names every firmware settle knows (and settle's own planner), with the one
+//! parser of their names that every command uses.
+//!
 //! Every planner is a bounded queue like the firmware's own: push [`LinearMove`]s in, pull
 //! final [`PlannedMove`]s out; memory does not grow with the length of the job.
 //! [`profiles::ProfileStream`] turns planned moves into per-axis [`crate::Profile`]
@@ -62,8 +65,10 @@ mod planned;
 pub mod profiles;
 pub mod rrf;
 mod timeline;
+mod which;
 
 pub use planned::{MAX_PHASES, PathState, Phase, PlannedMove, RampShape};
+pub use which::Firmware;
 
 use crate::PlanError;
 

@@ -18,8 +18,8 @@
 
 use std::f64::consts::PI;
 
-use super::kind::Impulses;
 use super::mzv_solve::least_squares_first_column;
+use super::shaper_type::Impulses;
 
 /// Klipper's largest damping ratio per shaper (`max_damping_ratio` in `INPUT_SHAPERS`):
 /// `damping_ratio` above it is refused by `[input_shaper]` and `SET_INPUT_SHAPER`.

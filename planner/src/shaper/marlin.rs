@@ -22,8 +22,8 @@
 
 use std::f64::consts::PI;
 
-use super::kind::Impulses;
-use super::kind::MarlinShaper;
+use super::shaper_type::Impulses;
+use super::shaper_type::MarlinShaper;
 
 pub(super) fn impulses(
     shaper: MarlinShaper,

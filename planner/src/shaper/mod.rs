@@ -7,7 +7,7 @@
 //! price of a longer, smoother move (duration `T_last`, [`Shaper::smoothing_mm`]).
 //!
 //! Users paste shaper settings between settle and their firmware, and the firmwares do not
-//! agree on what a name means, so a [`ShaperKind`] names the firmware too:
+//! agree on what a name means, so a [`ShaperType`] names the firmware too:
 //! - bare names are Klipper's current definitions (klippy/extras/shaper_defs.py): `zv`, `mzv(n,t)`, `zvd`, `ei(v_tol)`, `2hump_ei`,
 //!   `3hump_ei`;
 //! - `marlin:...` are Marlin FT_MOTION's (Marlin/src/module/ft_motion/shaping.cpp), with
@@ -19,22 +19,22 @@
 //! copy has constant jerk, so the sum does too; acceleration jumps (trapezoids) stay jumps.
 
 mod apply;
-mod kind;
 mod klipper;
 mod marlin;
 mod mzv_solve;
 mod name;
 mod response;
 mod rrf;
+mod shaper_type;
 pub mod stream;
 #[cfg(test)]
 mod tests;
 
-pub use kind::{
-    Firmware, KLIPPER_DEFAULT_DAMPING_RATIO, KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL,
-    MarlinShaper, RRF_STEP_CLOCK_HZ, RrfShaper, ShaperKind,
-};
 pub use response::{remaining_vibration, smoothing_mm};
+pub use shaper_type::{
+    KLIPPER_DEFAULT_DAMPING_RATIO, KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL, MarlinShaper,
+    RRF_STEP_CLOCK_HZ, RrfShaper, ShaperType,
+};
 
 use crate::PlanError;
 
@@ -43,6 +43,10 @@ use crate::PlanError;
 /// seconds per move (and at 1e-6 Hz days), shaping nothing a machine has. [`Shaper::new`]
 /// keeps each firmware's own range; the callers that take a user's setting check this.
 pub const MIN_FREQUENCY_HZ: f64 = 1.0;
+/// The largest start or end acceleration [`Shaper::apply`] takes as zero, as a fraction of
+/// the profile's peak acceleration: a million times f64's round-off (2.2e-16), a million
+/// times below any acceleration a move is planned with.
+pub const END_ACCEL_ROUND_OFF: f64 = 1e-9;
 
 /// Klipper's vibration tolerance of the EI family: 5% (a 20x reduction).
 pub const VIBRATION_TOLERANCE: f64 = KLIPPER_V_TOL;
@@ -51,14 +55,14 @@ pub const VIBRATION_TOLERANCE: f64 = KLIPPER_V_TOL;
 /// 1, Marlin's and RepRapFirmware's do) and times (s), the first 0.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Shaper {
-    kind: ShaperKind,
+    shaper_type: ShaperType,
     frequency_hz: f64,
     damping_ratio: f64,
     amplitudes: Vec<f64>,
     times_s: Vec<f64>,
 }
 
-fn invalid(kind: ShaperKind, reason: String) -> PlanError {
+fn invalid(kind: ShaperType, reason: String) -> PlanError {
     PlanError::InvalidShaper {
         name: kind.to_string(),
         reason,
@@ -74,7 +78,7 @@ impl Shaper {
     ///   `0.01..1` (M493 `I` allows 1.0, where the firmware divides by zero). Default 0.1.
     /// - RepRapFirmware: `frequency_hz` in `step_clock / 131070 ..= 1000` (M593 `F`; 5.72
     ///   Hz on Duet 3), `damping_ratio` in `0..=0.99` (M593 `S`). Default 0.05 (3.6 line).
-    pub fn new(kind: ShaperKind, frequency_hz: f64, damping_ratio: f64) -> Result<Self, PlanError> {
+    pub fn new(kind: ShaperType, frequency_hz: f64, damping_ratio: f64) -> Result<Self, PlanError> {
         if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
             return Err(PlanError::NonFinite {
                 name: "shaper frequency_hz (must be finite and > 0)",
@@ -91,7 +95,7 @@ impl Shaper {
             invalid(kind, format!("{what} must be in {lo}..={hi}, got {v}"))
         };
         let (amplitudes, times_s) = match kind {
-            ShaperKind::Marlin {
+            ShaperType::Marlin {
                 shaper,
                 v_tol,
                 ftm_fs_hz,
@@ -111,7 +115,7 @@ impl Shaper {
                 }
                 marlin::impulses(shaper, frequency_hz, damping_ratio, v_tol, ftm_fs_hz)
             }
-            ShaperKind::Rrf {
+            ShaperType::Rrf {
                 shaper,
                 step_clock_hz,
             } => {
@@ -130,17 +134,17 @@ impl Shaper {
                     return Err(out_of("damping_ratio", 0.0, max, damping_ratio));
                 }
                 match kind {
-                    ShaperKind::Zv => klipper::zv(frequency_hz, damping_ratio),
-                    ShaperKind::Zvd => klipper::zvd(frequency_hz, damping_ratio),
-                    ShaperKind::Mzv { n, t } => klipper::mzv(frequency_hz, damping_ratio, n, t)
+                    ShaperType::Zv => klipper::zv(frequency_hz, damping_ratio),
+                    ShaperType::Zvd => klipper::zvd(frequency_hz, damping_ratio),
+                    ShaperType::Mzv { n, t } => klipper::mzv(frequency_hz, damping_ratio, n, t)
                         .map_err(|reason| invalid(kind, reason))?,
-                    ShaperKind::Ei { v_tol } => {
+                    ShaperType::Ei { v_tol } => {
                         if !(v_tol.is_finite() && v_tol >= 0.0) {
                             return Err(out_of("v_tol", 0.0, f64::INFINITY, v_tol));
                         }
                         klipper::ei(frequency_hz, damping_ratio, v_tol)
                     }
-                    ShaperKind::TwoHumpEi => klipper::two_hump_ei(frequency_hz, damping_ratio),
+                    ShaperType::TwoHumpEi => klipper::two_hump_ei(frequency_hz, damping_ratio),
                     _ => klipper::three_hump_ei(frequency_hz, damping_ratio),
                 }
             }
@@ -154,7 +158,7 @@ impl Shaper {
             ));
         }
         Ok(Self {
-            kind,
+            shaper_type: kind,
             frequency_hz,
             damping_ratio,
             amplitudes,
@@ -163,8 +167,8 @@ impl Shaper {
     }
 
     /// The family and its parameters.
-    pub fn kind(&self) -> ShaperKind {
-        self.kind
+    pub fn shaper_type(&self) -> ShaperType {
+        self.shaper_type
     }
 
     /// The frequency it is tuned to (Hz).

@@ -15,9 +15,9 @@
 //!
 //! Names are case-insensitive and spaces around parts are ignored.
 
-use super::kind::{
+use super::shaper_type::{
     KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL, MarlinShaper, RRF_STEP_CLOCK_HZ, RrfShaper,
-    ShaperKind,
+    ShaperType,
 };
 use crate::PlanError;
 
@@ -37,7 +37,7 @@ fn invalid(name: &str, reason: String) -> PlanError {
 fn unknown(name: &str) -> PlanError {
     PlanError::UnknownKind {
         name: name.to_string(),
-        allowed: ShaperKind::ALLOWED,
+        allowed: ShaperType::ALLOWED,
     }
 }
 
@@ -155,7 +155,7 @@ fn assign<'a>(
     Ok(out)
 }
 
-impl ShaperKind {
+impl ShaperType {
     /// Parse a shaper name (syntax in this module's documentation). Unknown names give
     /// [`PlanError::UnknownKind`] listing the allowed names; bad parameters give
     /// [`PlanError::InvalidShaper`] saying what is allowed.
@@ -175,12 +175,12 @@ impl ShaperKind {
     }
 }
 
-fn klipper(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperKind, PlanError> {
+fn klipper(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperType, PlanError> {
     let kind = match family {
-        "zv" => ShaperKind::Zv,
-        "zvd" => ShaperKind::Zvd,
-        "2hump_ei" => ShaperKind::TwoHumpEi,
-        "3hump_ei" => ShaperKind::ThreeHumpEi,
+        "zv" => ShaperType::Zv,
+        "zvd" => ShaperType::Zvd,
+        "2hump_ei" => ShaperType::TwoHumpEi,
+        "3hump_ei" => ShaperType::ThreeHumpEi,
         "mzv" => {
             let v = assign(name, args, &["n", "t", "tau"])?;
             let n = v[0]
@@ -198,7 +198,7 @@ fn klipper(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperKind, Pla
                 _ => 0.75,
             };
             super::klipper::mzv_coeffs(n, t).map_err(|reason| invalid(name, reason))?;
-            return Ok(ShaperKind::Mzv { n, t });
+            return Ok(ShaperType::Mzv { n, t });
         }
         "ei" => {
             let v = assign(name, args, &["v_tol"])?;
@@ -206,7 +206,7 @@ fn klipper(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperKind, Pla
                 .map(|s| number(name, "v_tol", s))
                 .transpose()?
                 .unwrap_or(KLIPPER_V_TOL);
-            return Ok(ShaperKind::Ei { v_tol });
+            return Ok(ShaperType::Ei { v_tol });
         }
         _ => return Err(unknown(name)),
     };
@@ -214,7 +214,7 @@ fn klipper(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperKind, Pla
     Ok(kind)
 }
 
-fn marlin(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperKind, PlanError> {
+fn marlin(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperType, PlanError> {
     let shaper = MarlinShaper::ALL
         .into_iter()
         .find(|s| s.name() == family)
@@ -247,14 +247,14 @@ fn marlin(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperKind, Plan
     if ftm_fs_hz == 0 {
         return Err(invalid(name, "`ftm_fs` must be > 0 Hz".into()));
     }
-    Ok(ShaperKind::Marlin {
+    Ok(ShaperType::Marlin {
         shaper,
         v_tol,
         ftm_fs_hz,
     })
 }
 
-fn rrf(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperKind, PlanError> {
+fn rrf(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperType, PlanError> {
     let shaper = RrfShaper::ALL
         .into_iter()
         .find(|s| s.name() == family)
@@ -267,7 +267,7 @@ fn rrf(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperKind, PlanErr
     if step_clock_hz == 0 {
         return Err(invalid(name, "`step_clock` must be > 0 Hz".into()));
     }
-    Ok(ShaperKind::Rrf {
+    Ok(ShaperType::Rrf {
         shaper,
         step_clock_hz,
     })

@@ -18,8 +18,8 @@
 //! Single precision where the firmware uses `float`, so `P` and the delays round as on the
 //! board; `lrintf` rounds half to even.
 
-use super::kind::Impulses;
-use super::kind::RrfShaper;
+use super::shaper_type::Impulses;
+use super::shaper_type::RrfShaper;
 
 /// `lrintf` of a value the firmware computes in double precision and passes as float.
 fn lrintf(x: f64) -> i64 {

@@ -4,7 +4,7 @@ use super::data::CalibrationData;
 use super::fit::fit_shaper;
 use super::options::{Fit, SelectOptions, Selection};
 use crate::PlanError;
-use crate::shaper::ShaperKind;
+use crate::shaper::ShaperType;
 
 /// Klipper's shaper choice on `data` (one or more data sets, e.g. several test points):
 /// every shaper of `opts.shapers` fitted, and the one Klipper recommends.
@@ -46,10 +46,10 @@ pub fn find_best_shaper(
             reason: "Klipper's shaper choice needs at least one shaper to try",
         });
     };
-    if recommended.kind == ShaperKind::Zv
-        && let Some(other) = per_shaper
-            .iter()
-            .find(|s| s.kind != ShaperKind::Zv && s.vibrations * 1.1 < recommended.vibrations)
+    if recommended.shaper_type == ShaperType::Zv
+        && let Some(other) = per_shaper.iter().find(|s| {
+            s.shaper_type != ShaperType::Zv && s.vibrations * 1.1 < recommended.vibrations
+        })
     {
         recommended = *other;
     }

@@ -9,7 +9,7 @@ use super::options::{
 };
 use crate::PlanError;
 use crate::shaper::{
-    KLIPPER_DEFAULT_DAMPING_RATIO, Shaper, ShaperKind, remaining_vibration, smoothing_mm,
+    KLIPPER_DEFAULT_DAMPING_RATIO, Shaper, ShaperType, remaining_vibration, smoothing_mm,
 };
 
 /// Klipper's "the shaper reduces vibrations at most 20x": PSD below `max/20` is ignored.
@@ -61,7 +61,7 @@ fn remaining(a: &[f64], t: &[f64], zeta: f64, freq_hz: &[f64], psd: &[f64]) -> f
 }
 
 /// The frequencies tried for `kind`, in increasing order.
-fn test_freqs(kind: ShaperKind, freqs: &ShaperFreqs) -> Result<Vec<f64>, PlanError> {
+fn test_freqs(kind: ShaperType, freqs: &ShaperFreqs) -> Result<Vec<f64>, PlanError> {
     let bad = |reason: String| PlanError::InvalidShaper {
         name: kind.to_string(),
         reason,
@@ -93,7 +93,7 @@ fn test_freqs(kind: ShaperKind, freqs: &ShaperFreqs) -> Result<Vec<f64>, PlanErr
 /// Fit one shaper (`fit_shaper`): Klipper's pick for it and every frequency tried, from the
 /// highest down (the scan stops early under `max_smoothing_mm`).
 pub fn fit_shaper(
-    kind: ShaperKind,
+    kind: ShaperType,
     data: &[CalibrationData],
     opts: &SelectOptions,
 ) -> Result<(Fit, Vec<Fit>), PlanError> {
@@ -157,7 +157,7 @@ pub fn fit_shaper(
         }
         let score = smoothing * (vibrations.powf(1.5) + vibrations * 0.2 + 0.01);
         let fit = Fit {
-            kind,
+            shaper_type: kind,
             frequency_hz: f,
             vibrations,
             smoothing_mm: smoothing,

@@ -1,6 +1,6 @@
 //! What Klipper's shaper choice takes (its constants and options) and gives back.
 
-use crate::shaper::ShaperKind;
+use crate::shaper::ShaperType;
 
 /// Klipper's test damping ratios (`TEST_DAMPING_RATIOS`): the printer's damping is
 /// unknown, so each shaper is judged by its worst case over these.
@@ -45,7 +45,7 @@ pub struct SelectOptions {
     /// Shapers to try, in order (order matters for ties): `AUTOTUNE_SHAPERS` = `zv`, `mzv`,
     /// `ei`, `2hump_ei`, `3hump_ei`. Kinds of other firmwares need frequencies with a start
     /// (they have no Klipper minimum frequency).
-    pub shapers: Vec<ShaperKind>,
+    pub shapers: Vec<ShaperType>,
     /// Damping ratio the shapers are built with (`DEFAULT_DAMPING_RATIO`, 0.1; Klipper
     /// treats 0 as "unset").
     pub damping_ratio: f64,
@@ -69,11 +69,11 @@ impl Default for SelectOptions {
     fn default() -> Self {
         Self {
             shapers: vec![
-                ShaperKind::Zv,
-                ShaperKind::MZV,
-                ShaperKind::EI,
-                ShaperKind::TwoHumpEi,
-                ShaperKind::ThreeHumpEi,
+                ShaperType::Zv,
+                ShaperType::MZV,
+                ShaperType::EI,
+                ShaperType::TwoHumpEi,
+                ShaperType::ThreeHumpEi,
             ],
             damping_ratio: crate::shaper::KLIPPER_DEFAULT_DAMPING_RATIO,
             scv_mm_s: 5.0,
@@ -90,7 +90,7 @@ impl Default for SelectOptions {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Fit {
     /// The shaper.
-    pub kind: ShaperKind,
+    pub shaper_type: ShaperType,
     /// Its frequency (Hz).
     pub frequency_hz: f64,
     /// Remaining vibration, a fraction of the PSD above the threshold (worst case).

@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use settle_planner::fourjerk::FourJerkLimits;
 use settle_planner::pvt::{self, PvtLimits};
-use settle_planner::{KindParams, Limits, PlanError, ProfileKind};
+use settle_planner::{Limits, PlanError, ProfileKind, ProfileParams};
 
 fn cases() -> usize {
     std::env::var("SETTLE_PLANNER_CASES")
@@ -51,7 +51,7 @@ fn new_kinds_reach_the_target_within_the_limits() {
         .expect("limits");
         let d = lu(&mut rng, 1e-6, 1e1) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
         let p0 = rng.random_range(-1.0..1.0);
-        let params = KindParams {
+        let params = ProfileParams {
             pvt_asym_ki: rng.random_range(0.35..0.95),
             fourjerk_jerk_scale: [0; 4].map(|_| rng.random_range(0.2..1.0)),
             fourjerk_dmax_scale: rng.random_range(0.3..2.0),
@@ -155,9 +155,9 @@ fn defaults_and_errors() {
             Err(PlanError::MissingJerkLimit { kind: name })
         );
     }
-    let bad = KindParams {
+    let bad = ProfileParams {
         pvt_asym_ki: 0.2,
-        ..KindParams::default()
+        ..ProfileParams::default()
     };
     assert!(matches!(
         ProfileKind::PvtAsym.rest_to_rest_with(0.0, 1.0, &lim, &bad),

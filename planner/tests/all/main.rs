@@ -16,7 +16,6 @@ mod fourjerk_check;
 mod fourjerk_oracle;
 mod interfaces;
 mod kinds_scan;
-mod module_graph;
 mod multi_axis;
 mod official_ruckig;
 mod path_window;

@@ -5,7 +5,7 @@
 
 use settle_planner::pvt::{PvtLimits, check};
 use settle_planner::raster::{RasterSpec, StepPlacement, plan, slowdown_fly_overhead_s};
-use settle_planner::{KindParams, Limits, ProfileKind};
+use settle_planner::{Limits, ProfileKind, ProfileParams};
 
 fn spec(kind: ProfileKind, step: f64) -> RasterSpec {
     RasterSpec {
@@ -17,7 +17,7 @@ fn spec(kind: ProfileKind, step: f64) -> RasterSpec {
         fly_jmax: None,
         step_kind: kind,
         step_limits: Limits::new(0.05, 2.0, Some(200.0)).expect("limits"),
-        step_params: KindParams::default(),
+        step_params: ProfileParams::default(),
         placement: StepPlacement::AtExit,
         settle_margin_s: 0.0,
     }

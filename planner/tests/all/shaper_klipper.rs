@@ -8,7 +8,7 @@
 //! leaves room for a different platform `exp`/`sin`/`cos`).
 
 use settle_planner::PlanError;
-use settle_planner::shaper::{Shaper, ShaperKind};
+use settle_planner::shaper::{Shaper, ShaperType};
 
 /// (name as written, f_hz, zeta, A, T) from shaper_defs.py.
 type Expected = (&'static str, f64, f64, &'static [f64], &'static [f64]);
@@ -52,7 +52,7 @@ fn close(a: f64, b: f64) -> bool {
 #[test]
 fn every_klipper_shaper_equals_shaper_defs_py() {
     for &(name, f, z, a, t) in KLIPPER {
-        let kind = ShaperKind::parse(name).expect("parses");
+        let kind = ShaperType::parse(name).expect("parses");
         let s = Shaper::new(kind, f, z).expect("builds");
         assert_eq!(s.amplitudes().len(), a.len(), "{name}");
         for (got, want) in s.amplitudes().iter().zip(a) {
@@ -68,7 +68,7 @@ fn every_klipper_shaper_equals_shaper_defs_py() {
 fn mzv_worked_value() {
     // MZV at 50 Hz, zeta 0.1: normalised amplitudes .3651 / .4075 / .2274 at
     // 0 / 7.538 / 15.076 ms.
-    let s = Shaper::new(ShaperKind::MZV, 50.0, 0.1).expect("mzv");
+    let s = Shaper::new(ShaperType::MZV, 50.0, 0.1).expect("mzv");
     let w: Vec<f64> = s.weights().collect();
     for (got, want) in w.iter().zip([0.3651, 0.4075, 0.2274]) {
         assert!((got - want).abs() < 5e-5, "{w:?}");
@@ -104,19 +104,19 @@ fn klippers_refusals_are_settles() {
             "Negative-valued shaper with n=4, t=0.200000",
         ),
     ] {
-        match ShaperKind::parse(name) {
+        match ShaperType::parse(name) {
             Err(PlanError::InvalidShaper { reason, .. }) => assert_eq!(reason, msg, "{name}"),
             other => panic!("{name}: {other:?}"),
         }
     }
     // Klipper's step generation holds at most 10 impulses (kin_shaper.c).
-    assert!(ShaperKind::parse("mzv(n=11,t=2)").is_err());
+    assert!(ShaperType::parse("mzv(n=11,t=2)").is_err());
     // max_damping_ratio: ei 0.4, 2hump_ei 0.3, 3hump_ei 0.2, the others 0.99.
     for (kind, max) in [
-        (ShaperKind::Zv, 0.99),
-        (ShaperKind::EI, 0.4),
-        (ShaperKind::TwoHumpEi, 0.3),
-        (ShaperKind::ThreeHumpEi, 0.2),
+        (ShaperType::Zv, 0.99),
+        (ShaperType::EI, 0.4),
+        (ShaperType::TwoHumpEi, 0.3),
+        (ShaperType::ThreeHumpEi, 0.2),
     ] {
         assert!(Shaper::new(kind, 40.0, max).is_ok(), "{kind}");
         assert!(

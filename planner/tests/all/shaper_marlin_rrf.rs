@@ -9,7 +9,7 @@
 use std::f64::consts::{PI, SQRT_2};
 
 use settle_planner::PlanError;
-use settle_planner::shaper::{MarlinShaper, RrfShaper, Shaper, ShaperKind};
+use settle_planner::shaper::{MarlinShaper, RrfShaper, Shaper, ShaperType};
 
 fn normalised(a: &[f64]) -> Vec<f64> {
     let s: f64 = a.iter().sum();
@@ -82,7 +82,7 @@ fn marlin_shapers_follow_shaping_cpp() {
                 MarlinShaper::Mzv => (vec![1.0, SQRT_2 * k, k * k], 0.375),
             };
             let t: Vec<f64> = (0..a.len()).map(|i| i as f64 * n1(base) / fs).collect();
-            let kind = ShaperKind::Marlin {
+            let kind = ShaperType::Marlin {
                 shaper,
                 v_tol: v,
                 ftm_fs_hz: 1000,
@@ -97,13 +97,13 @@ fn marlin_shapers_follow_shaping_cpp() {
 fn marlin_rounds_times_to_its_trajectory_rate() {
     // 40 Hz, zeta 0.1: half a damped period is 12.563 ms; at FTM_FS = 1 kHz Marlin puts the
     // ZV's second impulse at 13 samples, and the MZV's at 9 and 18 (0.375 periods = 9.42).
-    let zv = Shaper::new(ShaperKind::marlin(MarlinShaper::Zv), 40.0, 0.1).expect("zv");
+    let zv = Shaper::new(ShaperType::marlin(MarlinShaper::Zv), 40.0, 0.1).expect("zv");
     assert_eq!(zv.times_s(), &[0.0, 0.013]);
-    let mzv = Shaper::new(ShaperKind::marlin(MarlinShaper::Mzv), 40.0, 0.1).expect("mzv");
+    let mzv = Shaper::new(ShaperType::marlin(MarlinShaper::Mzv), 40.0, 0.1).expect("mzv");
     assert_eq!(mzv.times_s(), &[0.0, 0.009, 0.018]);
     // Rounding costs cancellation: Klipper's ZV leaves nothing at its frequency, Marlin's
     // 13 ms ZV leaves 5%.
-    let klipper = Shaper::new(ShaperKind::Zv, 40.0, 0.1).expect("zv");
+    let klipper = Shaper::new(ShaperType::Zv, 40.0, 0.1).expect("zv");
     assert!(klipper.remaining_vibration(40.0, 0.1) < 1e-12);
     let left = zv.remaining_vibration(40.0, 0.1);
     assert!(left > 0.03 && left < 0.08, "{left}");
@@ -111,7 +111,7 @@ fn marlin_rounds_times_to_its_trajectory_rate() {
     // unlike Klipper's MZV it does not cancel its own mode even at FTM_FS = 1 MHz: it
     // leaves |1 + sqrt2 K e^{...} + K^2 e^{...}| / (1 + sqrt2 K + K^2) = 2.511% (this
     // closed form evaluated separately in double precision).
-    let fine = ShaperKind::Marlin {
+    let fine = ShaperType::Marlin {
         shaper: MarlinShaper::Mzv,
         v_tol: 0.05,
         ftm_fs_hz: 1_000_000,
@@ -120,13 +120,13 @@ fn marlin_rounds_times_to_its_trajectory_rate() {
     let left = m.remaining_vibration(40.0, 0.1);
     assert!((left - 0.025109565184347895).abs() < 1e-5, "{left}");
     assert!(
-        Shaper::new(ShaperKind::MZV, 40.0, 0.1)
+        Shaper::new(ShaperType::MZV, 40.0, 0.1)
             .expect("k")
             .remaining_vibration(40.0, 0.1)
             < 1e-12
     );
     // M493's ranges: A up to FTM_FS/2, I from 0.01.
-    let zvk = ShaperKind::marlin(MarlinShaper::Zv);
+    let zvk = ShaperType::marlin(MarlinShaper::Zv);
     assert!(Shaper::new(zvk, 500.0, 0.1).is_ok());
     assert!(matches!(
         Shaper::new(zvk, 501.0, 0.1),
@@ -205,7 +205,7 @@ fn rrf_shapers_follow_axis_shaper_cpp() {
                     .to_vec(),
                 ),
             };
-            let kind = ShaperKind::rrf(shaper);
+            let kind = ShaperType::rrf(shaper);
             let s = Shaper::new(kind, f, z).expect("rrf shaper");
             assert_train(&s, &a, &ticks(&d), &format!("{kind} {f} Hz zeta {z}"));
         }
@@ -217,13 +217,13 @@ fn rrf_hand_computed_zvd_and_mzv_order() {
     // 40 Hz, zeta 0.05 (RepRapFirmware 3.6's default damping): the damped period is
     // 750000 / (40 sqrt(1 - 0.0025)) = 18773.48 step clocks -> 18773; ZVD delays 0, 9386,
     // 18773 ticks of 1/750 kHz.
-    let s = Shaper::new(ShaperKind::rrf(RrfShaper::Zvd), 40.0, 0.05).expect("zvd");
+    let s = Shaper::new(ShaperType::rrf(RrfShaper::Zvd), 40.0, 0.05).expect("zvd");
     assert_eq!(s.times_s(), &[0.0, 9386.0 / 750_000.0, 18773.0 / 750_000.0]);
     // RepRapFirmware's MZV applies Klipper's amplitudes last-first: undamped it is
     // Klipper's MZV (up to tick rounding), damped it leaves several percent at the very
     // mode it is tuned to.
-    let rrf = Shaper::new(ShaperKind::rrf(RrfShaper::Mzv), 40.0, 0.1).expect("mzv");
-    let klipper = Shaper::new(ShaperKind::MZV, 40.0, 0.1).expect("mzv");
+    let rrf = Shaper::new(ShaperType::rrf(RrfShaper::Mzv), 40.0, 0.1).expect("mzv");
+    let klipper = Shaper::new(ShaperType::MZV, 40.0, 0.1).expect("mzv");
     let w: Vec<f64> = rrf.weights().collect();
     let wk: Vec<f64> = klipper.weights().collect();
     for i in 0..3 {
@@ -231,10 +231,10 @@ fn rrf_hand_computed_zvd_and_mzv_order() {
     }
     assert!(klipper.remaining_vibration(40.0, 0.1) < 1e-12);
     assert!(rrf.remaining_vibration(40.0, 0.1) > 0.1);
-    let undamped = Shaper::new(ShaperKind::rrf(RrfShaper::Mzv), 40.0, 0.0).expect("mzv");
+    let undamped = Shaper::new(ShaperType::rrf(RrfShaper::Mzv), 40.0, 0.0).expect("mzv");
     assert!(undamped.remaining_vibration(40.0, 0.0) < 1e-3);
     // M593 ranges: F 5.72..=1000 Hz on a 750 kHz step clock, S 0..=0.99.
-    let k = ShaperKind::rrf(RrfShaper::Zvd);
+    let k = ShaperType::rrf(RrfShaper::Zvd);
     assert!(Shaper::new(k, 5.7, 0.1).is_err() && Shaper::new(k, 5.73, 0.1).is_ok());
     assert!(Shaper::new(k, 1000.0, 0.1).is_ok() && Shaper::new(k, 1000.5, 0.1).is_err());
     assert!(Shaper::new(k, 40.0, 0.99).is_ok() && Shaper::new(k, 40.0, 0.995).is_err());

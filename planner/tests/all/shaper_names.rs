@@ -3,35 +3,36 @@
 //! allowed.
 
 use settle_planner::PlanError;
-use settle_planner::shaper::{Firmware, MarlinShaper, RrfShaper, ShaperKind};
+use settle_planner::firmware::Firmware;
+use settle_planner::shaper::{MarlinShaper, RrfShaper, ShaperType};
 
 #[test]
 fn display_round_trips_for_every_family_and_parameters() {
-    let mut kinds: Vec<ShaperKind> = ShaperKind::KLIPPER
+    let mut kinds: Vec<ShaperType> = ShaperType::KLIPPER
         .into_iter()
-        .chain(ShaperKind::MARLIN)
-        .chain(ShaperKind::RRF)
+        .chain(ShaperType::MARLIN)
+        .chain(ShaperType::RRF)
         .collect();
     kinds.extend([
-        ShaperKind::Mzv { n: 4, t: 0.8 },
-        ShaperKind::Mzv { n: 5, t: 1.1 },
-        ShaperKind::Mzv {
+        ShaperType::Mzv { n: 4, t: 0.8 },
+        ShaperType::Mzv { n: 5, t: 1.1 },
+        ShaperType::Mzv {
             n: 3,
             t: 0.6666666666,
         },
-        ShaperKind::Mzv { n: 4, t: 1.0 },
-        ShaperKind::Ei { v_tol: 0.03 },
-        ShaperKind::Marlin {
+        ShaperType::Mzv { n: 4, t: 1.0 },
+        ShaperType::Ei { v_tol: 0.03 },
+        ShaperType::Marlin {
             shaper: MarlinShaper::TwoHei,
             v_tol: 0.1,
             ftm_fs_hz: 2000,
         },
-        ShaperKind::Marlin {
+        ShaperType::Marlin {
             shaper: MarlinShaper::Zvdd,
             v_tol: 0.05,
             ftm_fs_hz: 500,
         },
-        ShaperKind::Rrf {
+        ShaperType::Rrf {
             shaper: RrfShaper::Ei3,
             step_clock_hz: 937_500,
         },
@@ -39,9 +40,9 @@ fn display_round_trips_for_every_family_and_parameters() {
     for k in kinds {
         let text = k.to_string();
         assert_eq!(k.name(), text);
-        assert_eq!(ShaperKind::parse(&text).expect(&text), k, "{text}");
-        assert_eq!(text.parse::<ShaperKind>().expect(&text), k);
-        assert_eq!(ShaperKind::parse(&text.to_uppercase()).expect(&text), k);
+        assert_eq!(ShaperType::parse(&text).expect(&text), k, "{text}");
+        assert_eq!(text.parse::<ShaperType>().expect(&text), k);
+        assert_eq!(ShaperType::parse(&text.to_uppercase()).expect(&text), k);
     }
 }
 
@@ -69,24 +70,24 @@ fn written_forms() {
         ("rrf:zvd(step_clock=937500)", "rrf:zvd(step_clock=937500)"),
     ];
     for (written, canonical) in cases {
-        let k = ShaperKind::parse(written).expect(written);
+        let k = ShaperType::parse(written).expect(written);
         assert_eq!(k.to_string(), *canonical, "{written}");
     }
     // mzv(n=4, tau=1.2): t = tau (n - 1) / (n + 2 tau - 2) = 3.6 / 4.4.
-    match ShaperKind::parse("mzv(n=4,tau=1.2)").expect("tau") {
-        ShaperKind::Mzv { n: 4, t } => assert!((t - 3.6 / 4.4).abs() < 1e-15),
+    match ShaperType::parse("mzv(n=4,tau=1.2)").expect("tau") {
+        ShaperType::Mzv { n: 4, t } => assert!((t - 3.6 / 4.4).abs() < 1e-15),
         other => panic!("{other:?}"),
     }
     assert_eq!(
-        ShaperKind::parse("zvd").expect("zvd").firmware(),
+        ShaperType::parse("zvd").expect("zvd").firmware(),
         Firmware::Klipper
     );
     assert_eq!(
-        ShaperKind::parse("marlin:zvd").expect("m").firmware(),
+        ShaperType::parse("marlin:zvd").expect("m").firmware(),
         Firmware::Marlin
     );
     assert_eq!(
-        ShaperKind::parse("rrf:zvd").expect("r").firmware(),
+        ShaperType::parse("rrf:zvd").expect("r").firmware(),
         Firmware::Rrf
     );
     assert_eq!(MarlinShaper::from_m493_code(6), Some(MarlinShaper::TwoHei));
@@ -97,10 +98,10 @@ fn written_forms() {
 #[test]
 fn bad_names_list_what_is_allowed() {
     for bad in ["zvdd", "rrf:zv", "marlin:2hump_ei", "prusa:zv", "", "mzv2"] {
-        match ShaperKind::parse(bad) {
+        match ShaperType::parse(bad) {
             Err(PlanError::UnknownKind { name, allowed }) => {
                 assert_eq!(name, bad);
-                assert_eq!(allowed, ShaperKind::ALLOWED);
+                assert_eq!(allowed, ShaperType::ALLOWED);
                 let text = PlanError::UnknownKind { name, allowed }.to_string();
                 for family in ["2hump_ei", "marlin:zvdd", "rrf:ei3", "mzv(n=N,t=T)"] {
                     assert!(text.contains(family), "{text}");
@@ -124,7 +125,7 @@ fn bad_names_list_what_is_allowed() {
         ("ei(v_tol=0.1,v_tol=0.2)", "too many"),
         ("mzv(n=4,n=5)", "twice"),
     ] {
-        match ShaperKind::parse(bad) {
+        match ShaperType::parse(bad) {
             Err(e @ PlanError::InvalidShaper { .. }) => {
                 assert!(e.to_string().contains(says), "{bad}: {e}")
             }

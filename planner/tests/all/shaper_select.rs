@@ -15,7 +15,7 @@
 //! numbers agree to 1e-12 relative (1e-15 absolute for vibrations that are exactly zero);
 //! the recommended shaper and frequency are the same.
 
-use settle_planner::shaper::ShaperKind;
+use settle_planner::shaper::ShaperType;
 use settle_planner::shaper_select::{
     CalibrationData, SelectOptions, ShaperFreqs, find_best_shaper,
 };
@@ -29,10 +29,10 @@ struct Case {
     fits: &'static [(&'static str, f64, f64, f64, f64, f64)],
 }
 
-fn kinds(names: &[&str]) -> Vec<ShaperKind> {
+fn kinds(names: &[&str]) -> Vec<ShaperType> {
     names
         .iter()
-        .map(|n| ShaperKind::parse(n).expect("shaper name"))
+        .map(|n| ShaperType::parse(n).expect("shaper name"))
         .collect()
 }
 
@@ -195,8 +195,8 @@ fn recommendations_equal_calibrate_shaper_py() {
         let sel = find_best_shaper(&[data], &(case.opts)()).expect(case.name);
         let (name, freq) = case.recommended;
         assert_eq!(
-            sel.recommended.kind,
-            ShaperKind::parse(name).expect("name"),
+            sel.recommended.shaper_type,
+            ShaperType::parse(name).expect("name"),
             "{}",
             case.name
         );
@@ -211,7 +211,11 @@ fn recommendations_equal_calibrate_shaper_py() {
         assert_eq!(sel.per_shaper.len(), case.fits.len(), "{}", case.name);
         for (got, want) in sel.per_shaper.iter().zip(case.fits) {
             let what = format!("{} {}", case.name, want.0);
-            assert_eq!(got.kind, ShaperKind::parse(want.0).expect("name"), "{what}");
+            assert_eq!(
+                got.shaper_type,
+                ShaperType::parse(want.0).expect("name"),
+                "{what}"
+            );
             assert!(
                 close(got.frequency_hz, want.1),
                 "{what}: freq {} vs {}",

@@ -10,7 +10,7 @@ use settle_planner::firmware::klipper::{KlipperConfig, KlipperPlanner};
 use settle_planner::firmware::profiles::{ProfileOptions, ProfileStream};
 use settle_planner::firmware::{FirmwarePlanner, LinearMove};
 use settle_planner::shaper::stream::{Alignment, AxesShaper, ShaperStream, cut};
-use settle_planner::shaper::{Shaper, ShaperKind};
+use settle_planner::shaper::{Shaper, ShaperType};
 use settle_planner::{Profile, Sample, Segment, State, Trajectory};
 
 /// The part of `p` between `t0` and `t1` (s) as a profile starting at `t0`.
@@ -145,10 +145,10 @@ fn assert_equal(
 
 fn shapers() -> Vec<Shaper> {
     vec![
-        Shaper::new(ShaperKind::MZV, 50.0, 0.1).expect("mzv"),
-        Shaper::new(ShaperKind::ThreeHumpEi, 61.7, 0.12).expect("3hump_ei"),
-        Shaper::new(ShaperKind::parse("marlin:zvdd").expect("name"), 43.0, 0.1).expect("zvdd"),
-        Shaper::new(ShaperKind::parse("rrf:ei2").expect("name"), 38.5, 0.07).expect("ei2"),
+        Shaper::new(ShaperType::MZV, 50.0, 0.1).expect("mzv"),
+        Shaper::new(ShaperType::ThreeHumpEi, 61.7, 0.12).expect("3hump_ei"),
+        Shaper::new(ShaperType::parse("marlin:zvdd").expect("name"), 43.0, 0.1).expect("zvdd"),
+        Shaper::new(ShaperType::parse("rrf:ei2").expect("name"), 38.5, 0.07).expect("ei2"),
     ]
 }
 
@@ -187,7 +187,7 @@ fn causal_chunks_equal_whole_profile_shaping() {
         let whole = shaper.apply(&p).expect("apply");
         for cuts in cut_lists(d) {
             let chunks = stream(&shaper, Alignment::Causal, &p, &cuts);
-            let what = format!("{} cut at {cuts:?}", shaper.kind());
+            let what = format!("{} cut at {cuts:?}", shaper.shaper_type());
             assert_eq!(chunks[0].0, 0.0, "{what}");
             let end = chunks
                 .last()
@@ -334,8 +334,8 @@ fn a_firmware_corner_bridge_is_shaped_like_the_whole_move() {
     let chunks: Vec<_> = std::iter::from_fn(|| ps.pop()).collect();
     assert!(chunks.len() >= 2);
     let shapers = [
-        Some(Shaper::new(ShaperKind::MZV, 48.0, 0.1).expect("x")),
-        Some(Shaper::new(ShaperKind::Zvd, 36.0, 0.1).expect("y")),
+        Some(Shaper::new(ShaperType::MZV, 48.0, 0.1).expect("x")),
+        Some(Shaper::new(ShaperType::Zvd, 36.0, 0.1).expect("y")),
         None,
         None,
     ];
@@ -408,7 +408,7 @@ fn a_firmware_corner_bridge_is_shaped_like_the_whole_move() {
 
 #[test]
 fn misuse_is_refused() {
-    let s = Shaper::new(ShaperKind::Zv, 40.0, 0.1).expect("zv");
+    let s = Shaper::new(ShaperType::Zv, 40.0, 0.1).expect("zv");
     let mut st = ShaperStream::new(Some(&s), Alignment::Causal);
     assert!(st.emit(0.0).is_err(), "emit before input");
     let p = test_profile();

@@ -11,8 +11,14 @@
 //! Damping is given as damping ratios, each against a documented reference (the element's
 //! stiffness and the mass it carries), because that is what people measure and compare:
 //! `c = 2 zeta sqrt(k m_ref)`.
+//!
+//! The field names are the keys of machine files (settle's `docs/reference/machine-file.md`):
+//! the parts read and write themselves through serde under those names, so they are
+//! known in one place, here.
 
 mod compile;
+
+use serde::{Deserialize, Serialize};
 
 use crate::SimError;
 
@@ -25,8 +31,9 @@ pub struct Machine {
     pub axes: Vec<AxisMachine>,
 }
 
-/// One axis of a gantry.
-#[derive(Debug, Clone, PartialEq)]
+/// One axis of a gantry. As a table it is a machine file's `[axis.<name>]` with its
+/// `motor` and `driver` in it (the transmission as its `belt` or `screw` table).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AxisMachine {
     /// Axis name (`x`, `y`, ...).
     pub name: String,
@@ -36,12 +43,15 @@ pub struct AxisMachine {
     pub toolhead_kg: f64,
     /// Mass rigidly carried with the carriage besides itself (kg): for a Y axis, the X beam
     /// with its rail, the X motor and the X carriage. 0 when there is none.
+    #[serde(default)]
     pub beam_kg: f64,
     /// Belt or screw.
+    #[serde(flatten)]
     pub transmission: Transmission,
     /// Toolhead-to-carriage mount.
     pub mount: Mount,
     /// The frame mode, if modelled.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub frame: Option<Frame>,
     /// The motor.
     pub motor: Motor,
@@ -50,7 +60,8 @@ pub struct AxisMachine {
 }
 
 /// How the motor moves the carriage.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Transmission {
     /// A toothed belt loop from the drive pulley around an idler.
     Belt(Belt),
@@ -62,7 +73,8 @@ pub enum Transmission {
 /// one strand. The carriage is held by the span to the pulley (length s) and, in parallel,
 /// by the path around the idler back to the pulley (length 2 L - s):
 /// `k = EA/s + EA/(2 L - s)`, stiffest near the motor.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Belt {
     /// Axial stiffness E*A (N).
     pub ea_n: f64,
@@ -70,7 +82,8 @@ pub struct Belt {
     pub span_mm: f64,
     /// Teeth on the drive pulley.
     pub pulley_teeth: u32,
-    /// Belt pitch (mm): 2 for GT2.
+    /// Belt pitch (mm): 2 for GT2 (the default).
+    #[serde(default = "gt2_pitch_mm")]
     pub pitch_mm: f64,
     /// Belt length from the drive pulley to the carriage clamp when the axis is at
     /// position 0 (mm). Positive axis moves lengthen it.
@@ -80,7 +93,8 @@ pub struct Belt {
 }
 
 /// A lead screw or ball screw.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Screw {
     /// Lead: travel per revolution (mm).
     pub lead_mm: f64,
@@ -91,7 +105,8 @@ pub struct Screw {
 }
 
 /// The toolhead's mount on the carriage.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Mount {
     /// Stiffness along the axis (N/m).
     pub stiffness_n_per_m: f64,
@@ -101,7 +116,8 @@ pub struct Mount {
 
 /// A frame mode: the part of the frame that carries the motor and idler, moving along
 /// the axis on its own stiffness to the ground.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Frame {
     /// Modal mass (kg).
     pub mass_kg: f64,
@@ -112,7 +128,8 @@ pub struct Frame {
 }
 
 /// A two-phase hybrid stepper motor (datasheet values).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Motor {
     /// Holding torque (N m) with both phases at the rated current (the usual datasheet
     /// convention), so the torque constant is `Km = T_hold / (sqrt 2 I_rated)`.
@@ -125,16 +142,19 @@ pub struct Motor {
     pub inductance_mh: f64,
     /// Rotor inertia (g cm^2).
     pub rotor_inertia_g_cm2: f64,
-    /// Rotor teeth (50 for 1.8 degree motors, 100 for 0.9 degree).
+    /// Rotor teeth (50 for 1.8 degree motors, the default; 100 for 0.9 degree).
+    #[serde(default = "rotor_teeth_1_8_deg")]
     pub rotor_teeth: u32,
-    /// Detent (cogging, unpowered) torque (N m).
+    /// Detent (cogging, unpowered) torque (N m). Default 0.
+    #[serde(default)]
     pub detent_torque_n_m: f64,
     /// Damping ratio of the rotor alone on the driver's magnetic spring (k_theta, J).
     pub damping_ratio: f64,
 }
 
 /// The stepper driver's settings.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Driver {
     /// Microsteps per full step.
     pub microsteps: u32,
@@ -143,8 +163,24 @@ pub struct Driver {
     /// Supply voltage (V).
     pub supply_v: f64,
     /// Closed-loop bandwidth of the current controller (Hz); chopper drivers regulate
-    /// within a few PWM periods, so tens of kHz.
+    /// within a few PWM periods, so tens of kHz (default 20 kHz).
+    #[serde(default = "current_loop_20_khz")]
     pub current_loop_bandwidth_hz: f64,
+}
+
+/// GT2's pitch (mm).
+fn gt2_pitch_mm() -> f64 {
+    2.0
+}
+
+/// A 1.8 degree motor's rotor teeth.
+fn rotor_teeth_1_8_deg() -> u32 {
+    50
+}
+
+/// A chopper driver's current-loop bandwidth (Hz).
+fn current_loop_20_khz() -> f64 {
+    20_000.0
 }
 
 impl Machine {

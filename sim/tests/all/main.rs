@@ -1,8 +1,6 @@
 //! settle-sim's integration tests, one test binary: each module below is one suite;
 //! `common`, `lean_support` and `mujoco_support` are shared fixtures. The MuJoCo suites
 //! need the `mujoco` cargo feature (`cargo test -p settle-sim --features mujoco`).
-//! `module_graph` is settle-planner's module-cycle check (one file, included by path),
-//! run here on settle-sim's sources.
 
 mod common;
 #[cfg(feature = "mujoco")]
@@ -10,8 +8,6 @@ mod lean_support;
 mod machine;
 mod modal_samples;
 mod modal_transition;
-#[path = "../../../planner/tests/all/module_graph.rs"]
-mod module_graph;
 #[cfg(feature = "mujoco")]
 mod mujoco_axis;
 #[cfg(feature = "mujoco")]

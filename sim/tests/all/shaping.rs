@@ -2,7 +2,7 @@
 //! move equals the unshaped move's envelope times the shaper's remaining vibration
 //! `V(f, zeta)` (Klipper's estimate), evaluated with the independent closed form.
 
-use settle_planner::shaper::{Shaper, ShaperKind};
+use settle_planner::shaper::{Shaper, ShaperType};
 use settle_planner::{Limits, ProfileKind};
 use settle_sim::Mode;
 use settle_sim::closed_form::residual_envelope;
@@ -16,7 +16,7 @@ fn shaped_residual_is_the_remaining_vibration_times_the_unshaped_one() {
             for (f_mode, z_mode) in [(40.0, 0.05), (55.0, 0.1), (38.0, 0.02)] {
                 let mode = Mode::new(f_mode, z_mode, 1.0).expect("mode");
                 let unshaped = residual_envelope(&p, &mode);
-                for sk in ShaperKind::ALL {
+                for sk in ShaperType::ALL {
                     // Tuned slightly off the mode, as in practice.
                     let s = Shaper::new(sk, 42.0, 0.1).expect("shaper");
                     let q = s.apply(&p).expect("shaped");

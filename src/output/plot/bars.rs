@@ -464,6 +464,8 @@ mod tests {
                 }),
                 candidates,
             }],
+            repeats: Vec::new(),
+            unused: Vec::new(),
         };
         let chart = ranking_chart("demo", &ranking).expect("a chart");
         let p = &chart.panels[0];

@@ -11,6 +11,7 @@
 pub mod bars;
 pub mod identify;
 pub mod jobs;
+pub mod klipper_shapers;
 pub mod ringing;
 pub mod scan_trace;
 pub mod svg_stream;

@@ -9,7 +9,7 @@ use plotters::prelude::*;
 
 use super::{DrawResult, FONT, err, init_fonts};
 use crate::error::Error;
-pub use crate::kinds::gcode::stats::MapPoint;
+pub use crate::studies::gcode::stats::MapPoint;
 
 /// A marked spot: where, how large, which G-code line.
 #[derive(Debug, Clone, PartialEq)]

@@ -11,8 +11,8 @@
 
 use super::trace::decimate;
 use super::{Line, PALETTE, Panel, Rule, fmt_num};
-use crate::kinds::scan::ScanSpec;
 use crate::output::sink::RunRecord;
+use crate::studies::scan::ScanSpec;
 
 /// The raster's exit and re-entry marks (the first turnaround's labelled).
 fn marks(r: &settle_planner::raster::Raster) -> Vec<Rule> {
@@ -45,7 +45,7 @@ pub fn scan_view(rec: &RunRecord, panels: &mut Vec<Panel>) {
     let Some(scan) = rec.spec.state::<ScanSpec>() else {
         return;
     };
-    let Ok(r) = crate::kinds::scan::raster(rec.spec) else {
+    let Ok(r) = crate::studies::scan::raster(rec.spec) else {
         return;
     };
     let rules = marks(&r);

@@ -21,18 +21,18 @@ use plotters::style::RGBColor;
 use super::{Figure, LegendEntry, Line, Marker, PALETTE, Panel, fmt_num};
 use crate::error::Error;
 use crate::input::runs_columns::RunsColumns;
-use crate::kinds::{self, PlotColumn};
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
 use crate::spec::value::Value;
+use crate::studies::{self, PlotColumn};
 
-/// The panels of a sweep figure: a run kind's that replace the common ones when the table
+/// The panels of a sweep figure: a study's that replace the common ones when the table
 /// has them (a scan's step-axis panels: the common ones would measure the run-out), else the
 /// common ones (per band the settle and move-and-settle times, the residual peak and RMS)
-/// and the other kinds' (a corner's contour error); only columns the table has.
+/// and the other studies' (a corner's contour error); only columns the table has.
 fn columns(bands: &[f64], table: &RunsColumns) -> Vec<PlotColumn> {
     let present = |p: &PlotColumn| table.column(&p.column).is_some();
-    for k in kinds::all().iter().filter(|k| k.replaces_move_tables()) {
+    for k in studies::all().iter().filter(|k| k.replaces_move_tables()) {
         let own: Vec<PlotColumn> = k.figures(bands).into_iter().filter(present).collect();
         if !own.is_empty() {
             return own;
@@ -73,7 +73,7 @@ fn columns(bands: &[f64], table: &RunsColumns) -> Vec<PlotColumn> {
         1.0,
         true,
     ));
-    for k in kinds::all().iter().filter(|k| !k.replaces_move_tables()) {
+    for k in studies::all().iter().filter(|k| !k.replaces_move_tables()) {
         out.extend(k.figures(bands));
     }
     out.into_iter().filter(present).collect()
@@ -189,7 +189,7 @@ fn lines(runs: &dyn RunList, table: &RunsColumns, param: &str, m: &PlotColumn) -
             .map(|r| {
                 r.swept
                     .iter()
-                    .filter(|(p, v)| p != param && !matches!(v, Value::Kind(_)))
+                    .filter(|(p, v)| p != param && !matches!(v, Value::Study(_)))
                     .map(|(p, _)| p.clone())
                     .collect()
             })
@@ -219,7 +219,7 @@ fn lines(runs: &dyn RunList, table: &RunsColumns, param: &str, m: &PlotColumn) -
 fn other_label(r: &RunSpec, param: &str) -> String {
     r.swept
         .iter()
-        .filter(|(p, v)| p != param && !matches!(v, Value::Kind(_)))
+        .filter(|(p, v)| p != param && !matches!(v, Value::Study(_)))
         .map(|(p, v)| {
             let short = p.rsplit('.').next().unwrap_or(p);
             // Names (a swept machine preset) label themselves.

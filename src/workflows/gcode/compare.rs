@@ -6,7 +6,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use settle_gcode::job::{Firmware, JobConfig};
+use settle_gcode::job::JobConfig;
+use settle_planner::firmware::Firmware;
 
 use super::report::map_panel;
 use super::{GcodeOptions, GcodeOutcome, XyShapers, measure, parse_shapers};
@@ -24,7 +25,7 @@ pub fn parse_setting(s: &str) -> Result<(Firmware, XyShapers), String> {
         Some((fw, sh)) => (fw, parse_shapers(sh).map_err(|e| format!("`{s}`: {e}"))?),
         None => (s, XyShapers::both(None)),
     };
-    let firmware = fw.parse::<Firmware>().map_err(|e| format!("`{s}`: {e}"))?;
+    let firmware = settle_gcode::job::parse_firmware(fw).map_err(|e| format!("`{s}`: {e}"))?;
     Ok((firmware, shapers))
 }
 

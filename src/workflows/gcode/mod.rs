@@ -3,16 +3,16 @@
 //!
 //! The job's shaped X, Y (and Z, when the machine has it) motion drives the machine's
 //! axes of the same names, in the G-code's coordinates (position 0 of a machine axis is
-//! G-code 0). Per sample the toolhead's contour error ([`crate::kinds::gcode::contour`]) is measured, per move
+//! G-code 0). Per sample the toolhead's contour error ([`crate::studies::gcode::contour`]) is measured, per move
 //! its largest value (the ringing after the corner at the move's start), per layer the
-//! worst and 95th percentile over printing samples ([`crate::kinds::gcode::stats`]); the outputs are
+//! worst and 95th percentile over printing samples ([`crate::studies::gcode::stats`]); the outputs are
 //! `layers.csv`, `summary.md` and the ringing maps of the worst layers ([`report`]).
 //! Everything is computed before anything is written: a bad file writes nothing.
 //!
 //! On the modal backend a machine whose stiffness depends on position (a belt's spans) is
 //! linearised at one point for the whole file, where the print is
-//! ([`crate::kinds::gcode::linpoint`]: the centre of the printing moves' bounding box),
-//! for the whole run and for any layer range alike; the `[gcode]` run kind uses the same
+//! ([`crate::studies::gcode::linpoint`]: the centre of the printing moves' bounding box),
+//! for the whole run and for any layer range alike; the `[gcode]` study uses the same
 //! point, so both give the same numbers.
 
 pub mod compare;
@@ -23,19 +23,22 @@ pub mod stream;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use settle_gcode::job::{Firmware, Job, JobConfig, ShaperSetting};
+use settle_gcode::job::{Job, JobConfig, ShaperSetting};
 use settle_gcode::{GcodeError, Reader, ReaderOptions};
+use settle_planner::firmware::Firmware;
 use settle_planner::{Profile, State};
 use settle_sim::closed_form::LinearResponse;
 use settle_sim::machine::Machine;
-use settle_sim::{AxisModel, DriverMode, ModalPlant, Mode, Plant, RapierOptions, RapierPlant};
+use settle_sim::{AxisModel, DriverMode};
 
 use crate::error::{Error, Location};
-use crate::input::machine_file::MachineForm;
-use crate::kinds::gcode::linpoint::{LinPoint, depends_on_position, linearisation_point};
-use crate::kinds::gcode::preroll::{preroll_s, slowest_decay_per_s};
-use crate::kinds::gcode::stats::{self, LayerMap, Spot};
+use crate::execute::SimOptions;
+use crate::expand::machine::Named;
+use crate::input::machine_form::MachineForm;
 use crate::spec::backend::{Backend, NO_MUJOCO};
+use crate::studies::gcode::linpoint::{LinPoint, depends_on_position, linearisation_point};
+use crate::studies::gcode::preroll::{preroll_s, slowest_decay_per_s};
+use crate::studies::gcode::stats::{self, LayerMap, Spot};
 use crate::workflows::{Exit, Report};
 use stream::{StreamOptions, Streamed, simulate_job};
 
@@ -215,7 +218,7 @@ impl GcodeOptions {
                 let notes = c.notes.iter().map(ToString::to_string).collect();
                 (job, notes, c.files)
             }
-            Firmware::Marlin | Firmware::Settle => {
+            Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => {
                 return Err(Error::input_key(
                     &config,
                     "--config",
@@ -310,7 +313,7 @@ pub struct GcodeOutcome {
     /// The MCAP recording's channels, when one was written.
     pub recording: Option<Vec<crate::output::sink::mcap::ChannelInfo>>,
     /// Where the modal backend linearised the machine (a machine whose stiffness depends
-    /// on position; [`crate::kinds::gcode::linpoint`]).
+    /// on position; [`crate::studies::gcode::linpoint`]).
     pub linearised_at: Option<LinPoint>,
     /// The planner's settings read from `--config`, in words, and the reader's notes.
     pub config: Option<(String, Vec<String>)>,
@@ -327,10 +330,11 @@ impl GcodeOutcome {
         &self.streamed.maps
     }
 
-    /// What the binary prints, and exit 1 when the simulation failed.
+    /// What the binary prints; [`Exit::RunsFailed`] when the simulation failed (lost steps,
+    /// a fault): a result, written and reported, not a failure of the command.
     pub fn report(&self) -> Report {
         let failed = self.streamed.fault.is_some() || self.streamed.lost_steps > 0;
-        let mut r = Report::new(if failed { Exit::Failed } else { Exit::Ok });
+        let mut r = Report::new(if failed { Exit::RunsFailed } else { Exit::Ok });
         r.out(format!(
             "{}: {} on {} ({}): print time {:.1} s, contour error worst {:.2} um, p95 {:.2} um",
             self.file.display(),
@@ -379,7 +383,7 @@ impl GcodeOutcome {
                 )
             });
             r.err(format!(
-                "result: the machine loses steps ({} full steps{at}): the motion asks more of a motor than its torque gives (its load angle passed 90 electrical degrees); what it prints after that is not this simulation's toolpath (exit 1: a failed run, not a tool error)",
+                "result: the machine loses steps ({} full steps{at}): the motion asks more of a motor than its torque gives (its load angle passed 90 electrical degrees); what it prints after that is not this simulation's toolpath (a failed run: a result, exit 0; --fail-on-failed-runs makes it exit 1)",
                 self.streamed.lost_steps
             ));
         }
@@ -442,47 +446,21 @@ pub fn gcode_error(file: &Path) -> impl Fn(GcodeError) -> Error + '_ {
     }
 }
 
-/// The machine `--machine` names: a built-in preset, a machine file, or a scenario file
-/// (its `[machine]`).
+/// The machine `--machine` names: a built-in preset, a machine file (either form), or a
+/// scenario file (its `[machine]`), resolved by [`crate::expand::machine::named`].
+fn named_machine(name: &str) -> Result<Named, Error> {
+    crate::expand::machine::named(name, Path::new(""), true, &|m| Error::input("--machine", m))
+}
+
+/// The physical machine `--machine` names.
 pub fn resolve_machine(name: &str) -> Result<Machine, Error> {
-    match resolve_form(name)? {
-        (_, MachineForm::Physical(m)) => Ok(m),
-        (_, MachineForm::Modes(_)) => Err(Error::input(
+    match named_machine(name)?.form {
+        MachineForm::Physical(m) => Ok(m),
+        MachineForm::Modes(_) => Err(Error::input(
             "--machine",
             format!("`{name}` gives the machine by its modes; a physical machine is needed here"),
         )),
     }
-}
-
-/// The machine `--machine` names, in either form, with its name.
-fn resolve_form(name: &str) -> Result<(String, MachineForm), Error> {
-    let here = Path::new("--machine");
-    let src = crate::input::source::Source::new("", here);
-    let path = Path::new(name);
-    let is_scenario = name.ends_with(".toml")
-        && crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)
-            .ok()
-            .and_then(|t| t.parse::<toml::Table>().ok())
-            .is_some_and(|t| t.contains_key("machine"));
-    if is_scenario {
-        let (sc, src) = crate::expand::load(path)?;
-        let r = crate::expand::machine::resolve_machine(&sc, &src)?;
-        let form = match r.machine {
-            Some(m) => MachineForm::Physical(m),
-            None => MachineForm::Modes(r.modes),
-        };
-        return Ok((r.name, form));
-    }
-    let base = std::env::current_dir().unwrap_or_default().join("here");
-    crate::input::machine_file::load_any(name, &base, &src)
-        .map(|(d, _)| (d.name, d.form))
-        .map_err(|e| match e {
-            // About the name itself (an unknown preset), not inside the file it names.
-            Error::Input { at, message } if at.file == here && !name.ends_with(".toml") => {
-                Error::input(here, message.replace("machine.preset", "--machine"))
-            }
-            other => other,
-        })
 }
 
 /// The machine's axes for `driver`, and the same axes with the linear driver (whose
@@ -492,38 +470,19 @@ pub fn resolve_axes(
     name: &str,
     driver: DriverMode,
 ) -> Result<(String, Vec<AxisModel>, Vec<AxisModel>), Error> {
-    let bad = |e: settle_sim::SimError| Error::input("--machine", e.to_string());
-    match resolve_form(name)? {
-        (n, MachineForm::Physical(m)) => {
-            let axes = m.compile(driver).map_err(bad)?;
-            let linear = m.compile(DriverMode::Linear).map_err(bad)?;
-            let _ = n;
-            Ok((m.name.clone(), axes, linear))
-        }
-        (n, MachineForm::Modes(axes)) => {
-            if driver != DriverMode::Linear {
-                return Err(Error::input(
-                    "--driver",
-                    format!(
-                        "`{name}` gives the machine by its modes: it has no driver model but the linear one"
-                    ),
-                ));
-            }
-            let axes = axes
-                .iter()
-                .map(|a| {
-                    let modes = a
-                        .modes
-                        .iter()
-                        .map(|m| Mode::new(m.frequency_hz, m.damping_ratio, m.weight))
-                        .collect::<Result<Vec<_>, _>>()?;
-                    AxisModel::from_modes(&a.axis, &modes)
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(bad)?;
-            Ok((n, axes.clone(), axes))
-        }
+    let n = named_machine(name)?;
+    if n.form.physical().is_none() && driver != DriverMode::Linear {
+        return Err(Error::input(
+            "--driver",
+            format!(
+                "`{name}` gives the machine by its modes: it has no driver model but the linear one"
+            ),
+        ));
     }
+    let bad = |e: settle_sim::SimError| Error::input("--machine", e.to_string());
+    let axes = n.form.axes(driver).map_err(bad)?;
+    let linear = n.form.axes(DriverMode::Linear).map_err(bad)?;
+    Ok((n.name, axes, linear))
 }
 
 /// The longest period (s) of the axes' oscillatory modes (their damped periods).
@@ -678,47 +637,27 @@ fn simulate(
             .and_then(|j| j.with_preroll_s(sigma.as_ref().map_or(0.0, |&s| preroll_s(s))))
             .map_err(&err)?;
     }
-    let sim_err = |source| Error::Sim { run: 0, source };
-    let dt = 1.0 / opts.sample_rate_hz;
-    let (streamed, rec) = match opts.backend {
-        Backend::Modal => {
-            // Linearised where the print is, the same point for the whole run and any
-            // layer range ([`crate::kinds::gcode::linpoint`]); a range starts at rest in
-            // the commanded state of its pre-roll.
-            let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
-            let mut plant = ModalPlant::new(axes, dt).map_err(sim_err)?;
-            if let Some(p) = &point {
-                plant = plant.linearised_at(p.on_axes(&names)).map_err(sim_err)?;
-            }
-            let init = |starts: &[State]| plant.initial_state(starts);
-            simulate_job(&mut job, &plant, &init, sopts, rec, &opts.file)?
-        }
-        Backend::Rapier => {
-            let plant = RapierPlant::new(
-                axes,
-                RapierOptions {
-                    max_step_s: None,
-                    belt: Default::default(),
-                },
-            )
-            .map_err(sim_err)?;
-            let init = |starts: &[State]| plant.initial_state(starts);
-            simulate_job(&mut job, &plant, &init, sopts, rec, &opts.file)?
-        }
-        #[cfg(feature = "mujoco")]
-        Backend::Mujoco => {
-            let plant =
-                settle_sim::mujoco::MujocoPlant::new(axes, Default::default()).map_err(sim_err)?;
-            let init = |starts: &[State]| plant.initial_state(starts);
-            simulate_job(&mut job, &plant, &init, sopts, rec, &opts.file)?
-        }
-        #[cfg(not(feature = "mujoco"))]
-        Backend::Mujoco => return Err(Error::input("--backend", NO_MUJOCO)),
+    // On the modal backend: linearised where the print is, the same point for the whole
+    // run and any layer range ([`crate::studies::gcode::linpoint`]); a range starts at rest
+    // in the commanded state of its pre-roll.
+    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+    let options = SimOptions {
+        linearise_at_m: point.as_ref().map(|p| p.on_axes(&names)),
+        ..SimOptions::default()
     };
+    let (streamed, rec) = simulate_job(
+        &mut job,
+        opts.backend,
+        axes,
+        &options,
+        sopts,
+        rec,
+        &opts.file,
+    )?;
     job.run_to_end().map_err(&err)?;
     let mut summary = job.summary();
     if let Some(why) =
-        crate::kinds::gcode::work::nothing_to_measure(&summary, job.reader().lines_read())
+        crate::studies::gcode::work::nothing_to_measure(&summary, job.reader().lines_read())
     {
         return Err(Error::input(&opts.file, why));
     }
@@ -822,7 +761,7 @@ fn mm(si: f64) -> String {
 fn shaper_words(shapers: &[Option<ShaperSetting>; 3]) -> String {
     let name = |s: &Option<ShaperSetting>| {
         s.map_or("none".to_string(), |s| {
-            format!("{}@{} Hz", s.kind.name(), s.frequency_hz)
+            format!("{}@{} Hz", s.shaper_type.name(), s.frequency_hz)
         })
     };
     match (&shapers[0], &shapers[1]) {
@@ -835,8 +774,9 @@ fn shaper_words(shapers: &[Option<ShaperSetting>; 3]) -> String {
 /// The planner and the X and Y shapers in words: `klipper + mzv@48 Hz`, `settle` when
 /// unshaped, both shapers when they differ.
 pub fn setting_name(job: &JobConfig) -> String {
-    let name =
-        |s: &Option<ShaperSetting>| s.map(|s| format!("{}@{} Hz", s.kind.name(), s.frequency_hz));
+    let name = |s: &Option<ShaperSetting>| {
+        s.map(|s| format!("{}@{} Hz", s.shaper_type.name(), s.frequency_hz))
+    };
     match (name(&job.shapers[0]), name(&job.shapers[1])) {
         (None, None) => job.firmware().to_string(),
         (x, y) if x == y => format!("{} + {}", job.firmware(), x.unwrap_or_default()),
@@ -1003,7 +943,7 @@ fn recording_metrics(o: &GcodeOutcome) -> serde_json::Map<String, serde_json::Va
     m
 }
 
-pub use crate::kinds::gcode::parse_layers;
+pub use crate::studies::gcode::parse_layers;
 
 /// An input shaper as written on the command line: `KIND@FREQ_HZ` or
 /// `KIND@FREQ_HZ/DAMPING` (damping 0.1 when not given, Klipper's default), e.g. `mzv@48`.
@@ -1019,9 +959,9 @@ pub fn parse_shaper(s: &str) -> Result<ShaperSetting, String> {
         None => (rest, 0.1),
     };
     let frequency_hz = f.parse::<f64>().map_err(|_| bad())?;
-    let kind = settle_planner::shaper::ShaperKind::parse(kind).map_err(|e| e.to_string())?;
+    let kind = settle_planner::shaper::ShaperType::parse(kind).map_err(|e| e.to_string())?;
     let setting = ShaperSetting {
-        kind,
+        shaper_type: kind,
         frequency_hz,
         damping_ratio: z,
     };

@@ -5,7 +5,7 @@
 //!
 //! Topics (the sink's signal groups): `/cmd` (`x_m`, `y_m`: the commanded XY position),
 //! `/toolhead` (`x_m`, `y_m`), `/contour` (`error_m`: the contour error, see
-//! [`crate::kinds::gcode::contour`]), `/move` (`line`, `layer`: the G-code line and layer
+//! [`crate::studies::gcode::contour`]), `/move` (`line`, `layer`: the G-code line and layer
 //! of the move the sample belongs to); `/metrics` at the end: file, setting, machine,
 //! backend, print time, worst and p95 contour error.
 //!

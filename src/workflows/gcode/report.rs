@@ -16,12 +16,12 @@ use std::io::BufRead as _;
 
 use super::{DEFAULT_SAMPLE_RATE_HZ, GcodeOptions, GcodeOutcome, XyShapers};
 use crate::error::Error;
-use crate::kinds::gcode::stats::LayerMap;
 use crate::output::atomic::{create_dir, write_atomic};
 use crate::output::html::{Cell, Figure, Image, InputFile, Provenance, Report, Stat, Table};
 use crate::output::plot::ringing::{MapPanel, MapSpot, RingingMap};
 use crate::output::sha256::Sha256;
 use crate::spec::backend::Backend;
+use crate::studies::gcode::stats::LayerMap;
 
 /// layers.csv's columns.
 pub const LAYER_COLUMNS: [&str; 14] = [
@@ -296,9 +296,14 @@ fn digest_and_lines(file: &Path, wanted: &[u64]) -> Result<(String, BTreeMap<u64
 /// A shaper as `--shaper` takes it: `mzv@48`, `ei@52/0.08`.
 pub(crate) fn shaper_arg(s: &ShaperSetting) -> String {
     if s.damping_ratio == 0.1 {
-        format!("{}@{}", s.kind.name(), s.frequency_hz)
+        format!("{}@{}", s.shaper_type.name(), s.frequency_hz)
     } else {
-        format!("{}@{}/{}", s.kind.name(), s.frequency_hz, s.damping_ratio)
+        format!(
+            "{}@{}/{}",
+            s.shaper_type.name(),
+            s.frequency_hz,
+            s.damping_ratio
+        )
     }
 }
 
@@ -489,6 +494,7 @@ pub fn html_report(
         intro,
         winners: Vec::new(),
         tables,
+        sections: Vec::new(),
         figures: figures
             .into_iter()
             .map(|(title, svg)| Figure {

@@ -2,11 +2,11 @@
 //! after the other with its state carried across them (chunks join continuously), on one
 //! sample clock (`k / sample_rate` s of print time), with plant steps split at every
 //! breakpoint of the command (the modal plant is then exact). Each sample's contour error
-//! ([`crate::kinds::gcode::contour`]) feeds the per-move, per-layer and whole-job account
-//! ([`crate::kinds::gcode::stats`]).
+//! ([`crate::studies::gcode::contour`]) feeds the per-move, per-layer and whole-job account
+//! ([`crate::studies::gcode::stats`]).
 //!
 //! - With a layer range the job's chunks start a pre-roll before the range (see
-//!   [`crate::kinds::gcode::preroll`]): the plant is stepped through it, but only samples of moves in
+//!   [`crate::studies::gcode::preroll`]): the plant is stepped through it, but only samples of moves in
 //!   the range are counted.
 //! - When the job's motion ends the file, the machine is simulated on with the command
 //!   standing at the end point for [`StreamOptions::tail_s`] (or until the residual has
@@ -16,19 +16,21 @@
 //!   [`LayerStats::end_residual_um`].
 
 use std::io::BufRead;
+use std::ops::ControlFlow;
 use std::path::Path;
 
 use settle_gcode::MoveKind;
 use settle_gcode::job::Job;
-use settle_planner::{Profile, Sample, State, Trajectory};
-use settle_sim::{Observation, Plant, SimError};
+use settle_planner::{Profile, State, Trajectory};
+use settle_sim::{AxisModel, Observation, Plant, SimError};
 
 use super::record::Recorder;
 use crate::error::Error;
-use crate::execute::cursor::Cursor;
-use crate::kinds::gcode::contour::ActiveMoves;
-use crate::kinds::gcode::stats::{Histogram, LayerMap, LayerStats, MapPoint, Spot, TopSpots};
-use crate::measure::metrics::BLOWUP_M;
+use crate::execute::driver::{Batched, Driver, Full, Sink, Stop, standing_at};
+use crate::execute::plant::{SimOptions, Simulation, with_plant};
+use crate::spec::backend::Backend;
+use crate::studies::gcode::contour::ActiveMoves;
+use crate::studies::gcode::stats::{Histogram, LayerMap, LayerStats, MapPoint, Spot, TopSpots};
 
 /// How the job is sampled and what is kept.
 #[derive(Debug, Clone, PartialEq)]
@@ -138,6 +140,8 @@ struct Account {
     map_stride: u64,
     /// The MCAP recording of the counted samples.
     rec: Option<Recorder>,
+    /// The ringing after the last move, while it is simulated.
+    ringing: Option<Ringing>,
 }
 
 impl Account {
@@ -157,6 +161,7 @@ impl Account {
             map_every,
             map_stride: map_every,
             rec,
+            ringing: None,
         }
     }
 
@@ -213,7 +218,7 @@ impl Account {
         self.out.layers.push(l);
     }
 
-    fn sample(&mut self, k: u64, t: f64, cmd_m: &[f64], toolhead_m: &[f64]) {
+    fn add_sample(&mut self, k: u64, t: f64, cmd_m: &[f64], toolhead_m: &[f64]) {
         self.out.samples += 1;
         self.active.retire(t);
         let [ix, iy] = self.opts.xy;
@@ -344,282 +349,200 @@ impl Band {
     }
 }
 
-/// Samples per [`Plant::step_samples`] call (as the harness's simulation loop).
-const BATCH: usize = 256;
+/// The ringing after the last move, being simulated: the end point and the band.
+#[derive(Debug)]
+struct Ringing {
+    tail: Tail,
+    band: Band,
+    /// X and Y of the end point (m).
+    end_xy: [f64; 2],
+}
 
-/// How [`simulate_job`] makes the plant's state at the first chunk's start state.
-pub type Init<'a, S> = &'a dyn Fn(&[State]) -> Result<S, SimError>;
+impl Ringing {
+    /// The toolhead at `toolhead_m` at `t`: whether the tail can end here.
+    fn stops(&mut self, xy: [usize; 2], t: f64, toolhead_m: &[f64]) -> bool {
+        let [ix, iy] = xy;
+        let r = (toolhead_m[ix] - self.end_xy[0]).hypot(toolhead_m[iy] - self.end_xy[1]) * 1e6;
+        self.tail.add(r);
+        self.band.stops(t, r)
+    }
+}
 
-/// Simulate `job`'s chunks on `plant` (see the module doc); `init` makes the plant's
-/// state at the first chunk's start state (usually [`Plant::initial_state`]).
-pub fn simulate_job<R: BufRead, P: Plant>(
+impl Sink for Account {
+    /// Observations until a motor is seen losing steps (where and when is reported).
+    fn observes(&self) -> bool {
+        self.out.first_lost_step.is_none()
+    }
+
+    fn sample(&mut self, s: &Full<'_>) -> ControlFlow<()> {
+        self.add_sample(s.k, s.t_s, s.commanded_m, s.toolhead_m);
+        if let Some(obs) = s.observed
+            && self.out.first_lost_step.is_none()
+        {
+            self.lost_step_check(s.t_s, obs);
+        }
+        let xy = self.opts.xy;
+        if let Some(r) = self.ringing.as_mut()
+            && r.stops(xy, s.t_s, s.toolhead_m)
+        {
+            return ControlFlow::Break(());
+        }
+        ControlFlow::Continue(())
+    }
+
+    fn samples(&mut self, b: &Batched<'_>) -> ControlFlow<usize> {
+        let xy = self.opts.xy;
+        for i in 0..b.count {
+            let (c, h) = b.positions(i);
+            let t = b.time(i);
+            self.add_sample(b.k0 + i as u64, t, c, h);
+            if let Some(r) = self.ringing.as_mut()
+                && r.stops(xy, t, h)
+            {
+                return ControlFlow::Break(i);
+            }
+        }
+        ControlFlow::Continue(())
+    }
+}
+
+/// Simulate `job`'s chunks on the plant of `backend` for `axes` (see the module doc). The
+/// belts vary along the travel on the backends that model it ([`SimOptions::belt`]).
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_job<R: BufRead>(
     job: &mut Job<R>,
-    plant: &P,
-    init: Init<'_, P::State>,
+    backend: Backend,
+    axes: Vec<AxisModel>,
+    options: &SimOptions,
     opts: StreamOptions,
     rec: Option<Recorder>,
     file: &Path,
 ) -> Result<(Streamed, Option<Recorder>), Error> {
-    let n = opts.job_axes.len();
-    let dt = 1.0 / opts.sample_rate_hz;
-    let job_axes = opts.job_axes.clone();
-    let (tail_s, tail_hold_s) = (opts.tail_s, opts.tail_hold_s);
-    // The end state of the last chunk, per axis.
-    let mut end = vec![State::default(); n];
-    let mut range_start: Option<f64> = None;
-    let mut faulted = false;
-    let mut acc = Account::new(opts, rec);
-    let mut state: Option<P::State> = None;
-    let mut cmd = vec![Sample::default(); n];
-    let mut cmd_p = vec![0.0; n];
-    let mut toolhead = vec![0.0; n];
-    let mut obs = vec![Observation::default(); n];
-    let (mut t, mut k, mut t_first) = (0.0_f64, 0_u64, 0.0_f64);
-    let sim_err = |source| Error::Sim { run: 0, source };
-    // Runs of whole samples go to the plant in one call while it implements it.
-    let mut batch = true;
-    let mut cmds = vec![Sample::default(); BATCH * n];
-    let (mut bcmd_p, mut btool) = (vec![0.0; BATCH * n], vec![0.0; BATCH * n]);
-    // The sample at `t` (state `st`), checked in full: `true` when the plant faulted (the
-    // fault is recorded and the simulation ends).
-    macro_rules! sample_at {
-        ($st:expr, $t:expr) => {{
-            let t = $t;
-            let ok = plant.positions($st, &mut cmd_p, &mut toolhead)
-                && cmd_p
-                    .iter()
-                    .zip(&toolhead)
-                    .all(|(c, h)| (h - c).abs() <= BLOWUP_M);
-            let mut fault = false;
-            if !ok {
-                plant.observe($st, &mut obs);
-                match crate::execute::simulate::fault_in(t, &acc.opts.names, &obs) {
-                    Some(reason) => {
-                        acc.out.fault = Some(reason);
-                        fault = true;
-                    }
-                    None => {
-                        for ((h, c), o) in toolhead.iter_mut().zip(cmd_p.iter_mut()).zip(&obs) {
-                            *h = o.toolhead_m;
-                            *c = o.commanded_m;
-                        }
-                    }
-                }
-            }
-            if !fault {
-                acc.sample(k, t, &cmd_p, &toolhead);
-                if acc.out.first_lost_step.is_none() {
-                    plant.observe($st, &mut obs);
-                    acc.lost_step_check(t, &obs);
-                }
-            }
-            fault
-        }};
+    let rate = opts.sample_rate_hz;
+    let sim = JobSim {
+        job,
+        opts,
+        rec,
+        file,
+    };
+    with_plant(backend, axes, options, rate, &[], sim).map_err(sim_err)?
+}
+
+fn sim_err(source: SimError) -> Error {
+    Error::Sim { run: 0, source }
+}
+
+/// A job on a plant, as a [`Simulation`].
+struct JobSim<'a, R> {
+    job: &'a mut Job<R>,
+    opts: StreamOptions,
+    rec: Option<Recorder>,
+    file: &'a Path,
+}
+
+/// Where the driver stopped, for a job: a fault is the job's outcome, anything else an
+/// error.
+fn stopped(stop: Stop, acc: &mut Account) -> Result<(), Error> {
+    match stop {
+        Stop::Sink => Ok(()),
+        Stop::Fault(reason) => {
+            acc.out.fault = Some(reason);
+            Ok(())
+        }
+        Stop::Backend { error, .. } => Err(sim_err(error)),
+        Stop::Interrupted => Err(Error::Interrupted { run: 0 }),
     }
-    'chunks: while let Some(chunk) = job.next_chunk().map_err(super::gcode_error(file))? {
-        acc.active.add(&chunk.moves);
-        let axes: Vec<Profile> = job_axes
-            .iter()
-            .map(|&i| chunk.trajectory.axes()[i].clone())
-            .collect();
-        let sub = Trajectory::new(axes).map_err(|source| Error::Plan { run: 0, source })?;
-        // The chunk is stepped in its own time (`tau`, s from its start), so that a step
-        // ends exactly on each breakpoint and the next step's command comes from the next
-        // piece (a print-clock time `t0 + bp` taken back to the chunk's time can fall a
-        // rounding error before the breakpoint: the previous piece's acceleration, held
-        // for a whole step, would be a large error of the command). Samples are on the
-        // print clock: sample `k` is at `k dt`, `k dt - t0` in the chunk.
-        let t0 = chunk.start_time_s;
-        let t1 = sub.duration_s();
-        let mut cursor = Cursor::new(&sub);
-        let mut tau = 0.0_f64;
-        let st = match state.as_mut() {
-            Some(s) => s,
-            None => {
-                let starts: Vec<_> = sub.axes().iter().map(Profile::start).collect();
-                t_first = t0;
-                k = (t0 / dt).ceil() as u64;
-                state.insert(init(&starts).map_err(sim_err)?)
-            }
-        };
-        if range_start.is_none()
-            && let Some((a, _)) = acc.opts.layers
-        {
-            range_start = chunk
-                .moves
+}
+
+impl<R: BufRead> Simulation for JobSim<'_, R> {
+    type Output = Result<(Streamed, Option<Recorder>), Error>;
+
+    fn run<P: Plant>(self, plant: &P) -> Self::Output {
+        let (job, opts, rec, file) = (self.job, self.opts, self.rec, self.file);
+        let n = opts.job_axes.len();
+        let (rate, dt) = (opts.sample_rate_hz, 1.0 / opts.sample_rate_hz);
+        let job_axes = opts.job_axes.clone();
+        let names = opts.names.clone();
+        let (tail_s, tail_hold_s) = (opts.tail_s, opts.tail_hold_s);
+        // The end state of the last chunk, per axis.
+        let mut end = vec![State::default(); n];
+        let mut range_start: Option<f64> = None;
+        let mut acc = Account::new(opts, rec);
+        let mut driver: Option<Driver<'_, P>> = None;
+        let mut t_first = 0.0_f64;
+        let mut faulted = false;
+        while let Some(chunk) = job.next_chunk().map_err(super::gcode_error(file))? {
+            acc.active.add(&chunk.moves);
+            let axes: Vec<Profile> = job_axes
                 .iter()
-                .find(|m| m.layer >= a && m.duration_s > 0.0)
-                .map(|m| m.start_time_s);
-        }
-        for (e, p) in end.iter_mut().zip(sub.axes()) {
-            *e = p.end();
-        }
-        let local = |k: u64| k as f64 * dt - t0;
-        let bps = sub.breakpoints();
-        let mut next_bp = 0;
-        while tau < t1 {
-            while next_bp < bps.len() && bps[next_bp] <= tau {
-                next_bp += 1;
-            }
-            let t_sample = local(k);
-            let bp = bps.get(next_bp).copied().unwrap_or(t1).min(t1);
-            let next = t_sample.min(bp);
-            let whole = next == t_sample && k > 0 && tau == local(k - 1);
-            if whole && batch {
-                // Whole samples k, k + 1, ... before the breakpoint: one call.
-                let mut m = 1;
-                while m < BATCH && local(k + m as u64) <= bp {
-                    m += 1;
+                .map(|&i| chunk.trajectory.axes()[i].clone())
+                .collect();
+            let sub = Trajectory::new(axes).map_err(|source| Error::Plan { run: 0, source })?;
+            // The chunk's time 0 is its start on the print clock.
+            let t0 = chunk.start_time_s;
+            let d = match driver.as_mut() {
+                Some(d) => d,
+                None => {
+                    let starts: Vec<_> = sub.axes().iter().map(Profile::start).collect();
+                    t_first = t0;
+                    // A lone whole sample goes through `Plant::step`, as `settle gcode` has
+                    // always stepped it (MuJoCo's batch would take it as one long step).
+                    let d =
+                        Driver::new(plant, &names, &starts, rate, t0, false).map_err(sim_err)?;
+                    driver.insert(d.with_min_batch(2))
                 }
-                if m > 1 {
-                    for i in 0..m {
-                        cursor.at(local(k - 1 + i as u64), &mut cmds[i * n..(i + 1) * n]);
-                    }
-                    let (cp, th) = (&mut bcmd_p[..m * n], &mut btool[..m * n]);
-                    match plant.step_samples(st, &cmds[..m * n], dt, BLOWUP_M, cp, th) {
-                        Ok(Some(done)) if (1..=m).contains(&done) => {
-                            for i in 0..done - 1 {
-                                let ki = k + i as u64;
-                                let r = i * n..(i + 1) * n;
-                                acc.sample(ki, ki as f64 * dt, &cp[r.clone()], &th[r]);
-                            }
-                            k += done as u64 - 1;
-                            tau = local(k);
-                            t = k as f64 * dt;
-                            // The last sample of the call is evaluated in full.
-                            if sample_at!(st, t) {
-                                faulted = true;
-                                break 'chunks;
-                            }
-                            k += 1;
-                            continue;
-                        }
-                        Ok(_) => batch = false,
-                        Err((_, source)) => return Err(sim_err(source)),
-                    }
-                }
-            }
-            cursor.at(tau, &mut cmd);
-            let h = if whole { dt } else { next - tau };
-            if h > 0.0 {
-                plant.step(st, &cmd, h).map_err(sim_err)?;
-            }
-            tau = next;
-            t = t0 + tau;
-            if next == t_sample {
-                t = k as f64 * dt;
-                if sample_at!(st, t) {
-                    faulted = true;
-                    break 'chunks;
-                }
-                k += 1;
-            }
-        }
-    }
-    // The print time simulated: to the last command (the tail is counted apart).
-    acc.out.simulated_s = t - t_first;
-    if let Some(st) = state.as_mut().filter(|_| !faulted && tail_s > 0.0)
-        && job.ended_at_end_of_file()
-    {
-        // The ringing after the last move: the command stands at the end point.
-        let hold: Vec<Sample> = end
-            .iter()
-            .map(|e| Sample {
-                p: e.p,
-                ..Sample::default()
-            })
-            .collect();
-        let [ix, iy] = acc.opts.xy;
-        let (t_end, mut tail) = (t, Tail::default());
-        let mut band = Band::new(tail_hold_s);
-        for c in cmds.chunks_exact_mut(n) {
-            c.copy_from_slice(&hold);
-        }
-        let residual_um = |th: &[f64]| (th[ix] - hold[ix].p).hypot(th[iy] - hold[iy].p) * 1e6;
-        let last_k = ((t_end + tail_s) / dt).floor() as u64;
-        // To the first sample after the end (a partial step), then whole samples.
-        let h0 = k as f64 * dt - t;
-        if k <= last_k {
-            if h0 > 0.0 {
-                plant.step(st, &hold, h0).map_err(sim_err)?;
-            }
-            t = k as f64 * dt;
-            let stop = sample_at!(st, t) || {
-                let r = residual_um(&toolhead);
-                tail.add(r);
-                band.stops(t, r)
             };
-            k += 1;
-            while !stop && k <= last_k {
-                let m = if batch {
-                    (last_k - k + 1).min(BATCH as u64) as usize
-                } else {
-                    1
-                };
-                if m > 1 {
-                    let (cp, th) = (&mut bcmd_p[..m * n], &mut btool[..m * n]);
-                    match plant.step_samples(st, &cmds[..m * n], dt, BLOWUP_M, cp, th) {
-                        Ok(Some(done)) if (1..=m).contains(&done) => {
-                            let mut stop = false;
-                            for i in 0..done - 1 {
-                                let ki = k + i as u64;
-                                let ti = ki as f64 * dt;
-                                let th_i = &th[i * n..(i + 1) * n];
-                                acc.sample(ki, ti, &cp[i * n..(i + 1) * n], th_i);
-                                let r = residual_um(th_i);
-                                tail.add(r);
-                                t = ti;
-                                if band.stops(ti, r) {
-                                    stop = true;
-                                    break;
-                                }
-                            }
-                            if stop {
-                                break;
-                            }
-                            // The last sample of the call is evaluated in full.
-                            k += done as u64 - 1;
-                            t = k as f64 * dt;
-                            let stop = sample_at!(st, t) || {
-                                let r = residual_um(&toolhead);
-                                tail.add(r);
-                                band.stops(t, r)
-                            };
-                            k += 1;
-                            if stop {
-                                break;
-                            }
-                            continue;
-                        }
-                        Ok(_) => batch = false,
-                        Err((_, source)) => return Err(sim_err(source)),
-                    }
-                }
-                plant.step(st, &hold, dt).map_err(sim_err)?;
-                t = k as f64 * dt;
-                let stop = sample_at!(st, t) || {
-                    let r = residual_um(&toolhead);
-                    tail.add(r);
-                    band.stops(t, r)
-                };
-                k += 1;
-                if stop {
-                    break;
-                }
+            if range_start.is_none()
+                && let Some((a, _)) = acc.opts.layers
+            {
+                range_start = chunk
+                    .moves
+                    .iter()
+                    .find(|m| m.layer >= a && m.duration_s > 0.0)
+                    .map(|m| m.start_time_s);
+            }
+            for (e, p) in end.iter_mut().zip(sub.axes()) {
+                *e = p.end();
+            }
+            if let Err(stop) = d.follow(&sub, t0, true, &mut acc) {
+                faulted = true;
+                stopped(stop, &mut acc)?;
+                break;
             }
         }
-        tail.duration_s = t - t_end;
-        if let Some(l) = acc.layer.as_mut() {
-            l.end_residual_um = Some(tail.residual_peak_um);
+        // The print time simulated: to the last command (the tail is counted apart).
+        let t = driver.as_ref().map_or(0.0, Driver::time_s);
+        acc.out.simulated_s = t - t_first;
+        if let Some(d) = driver.as_mut().filter(|_| !faulted && tail_s > 0.0)
+            && job.ended_at_end_of_file()
+        {
+            // The ringing after the last move: the command stands at the end point,
+            // from the first sample after the end (a partial step) on.
+            let hold = standing_at(&end);
+            let [ix, iy] = acc.opts.xy;
+            acc.ringing = Some(Ringing {
+                tail: Tail::default(),
+                band: Band::new(tail_hold_s),
+                end_xy: [hold[ix].p, hold[iy].p],
+            });
+            let t_end = t;
+            let last_k = ((t_end + tail_s) / dt).floor() as u64;
+            if let Err(stop) = d.hold_on(&hold, last_k, &mut acc) {
+                stopped(stop, &mut acc)?;
+            }
+            let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
+            tail.duration_s = d.time_s() - t_end;
+            if let Some(l) = acc.layer.as_mut() {
+                l.end_residual_um = Some(tail.residual_peak_um);
+            }
+            acc.out.tail = Some(tail);
         }
-        acc.out.tail = Some(tail);
+        acc.out.preroll_s = range_start.map_or(0.0, |r| (r - t_first).max(0.0));
+        acc.end_layer();
+        if let Some(d) = driver.as_mut() {
+            acc.out.lost_steps = d.observe().iter().map(|o| o.lost_steps).sum();
+        }
+        acc.out.worst = acc.top.spots().to_vec();
+        Ok((acc.out, acc.rec))
     }
-    acc.out.preroll_s = range_start.map_or(0.0, |r| (r - t_first).max(0.0));
-    acc.end_layer();
-    if let Some(st) = state.as_ref() {
-        plant.observe(st, &mut obs);
-        acc.out.lost_steps = obs.iter().map(|o| o.lost_steps).sum();
-    }
-    acc.out.worst = acc.top.spots().to_vec();
-    Ok((acc.out, acc.rec))
 }

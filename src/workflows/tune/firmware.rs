@@ -1,74 +1,86 @@
-//! `--firmware` / `[tune] firmware`: which candidates a firmware (or motion chip) can run.
+//! `--firmware` / `[tune] firmware`: which candidates a firmware (or motion chip) can run
+//! (the firmware is settle-planner's [`Firmware`]).
 //!
 //! - Klipper, Marlin and RepRapFirmware plan trapezoids (constant-acceleration phases;
 //!   Klipper's `klippy/toolhead.py` `Move`, RepRapFirmware's `DDA`, Marlin's planner
 //!   without its optional Bezier jerk), each shaping with its own shaper set
-//!   (`ShaperKind::KLIPPER`, `ShaperKind::MARLIN`, `ShaperKind::RRF`).
+//!   (`ShaperType::KLIPPER`, `ShaperType::MARLIN`, `ShaperType::RRF`).
 //! - The TMC4361A's ramp generator runs S-shaped ramps (BOW1..4: `scurve` and `fourjerk`)
 //!   and has no input shaper.
 //! - `any`: every profile kind and Klipper's shapers (settle's default set).
 
 use settle_planner::ProfileKind;
-use settle_planner::shaper::{Firmware as ShaperFirmware, ShaperKind};
+use settle_planner::firmware::Firmware;
+use settle_planner::shaper::ShaperType;
 
-/// A firmware whose candidates `settle tune` restricts itself to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Firmware {
-    /// Klipper.
-    Klipper,
-    /// Marlin with FT_MOTION.
-    Marlin,
-    /// RepRapFirmware.
-    Rrf,
-    /// The TMC4361A motion controller.
-    Tmc4361a,
-    /// No restriction.
-    Any,
-}
+/// The firmwares `settle tune` searches for (and exports to): Klipper, Marlin,
+/// RepRapFirmware and the TMC4361A.
+pub const TUNED: [Firmware; 4] = [
+    Firmware::Klipper,
+    Firmware::Marlin,
+    Firmware::Rrf,
+    Firmware::Tmc4361a,
+];
 
 /// Names `--firmware` takes.
 pub const ALLOWED: &str = "klipper, marlin, rrf, tmc4361a, any";
 
-impl Firmware {
-    /// Parse a name of [`ALLOWED`].
-    pub fn parse(name: &str) -> Result<Self, String> {
-        Ok(match name.to_ascii_lowercase().as_str() {
-            "klipper" => Firmware::Klipper,
-            "marlin" => Firmware::Marlin,
-            "rrf" | "reprapfirmware" => Firmware::Rrf,
-            "tmc4361a" => Firmware::Tmc4361a,
-            "any" => Firmware::Any,
-            _ => return Err(format!("unknown firmware `{name}`; allowed: {ALLOWED}")),
-        })
+/// The candidates `settle tune` restricts itself to: those a firmware of [`TUNED`] runs,
+/// or (`any`) every one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Candidates(Option<Firmware>);
+
+impl Candidates {
+    /// No restriction.
+    pub const ANY: Candidates = Candidates(None);
+
+    /// What `firmware` runs.
+    pub fn of(firmware: Firmware) -> Self {
+        Candidates(Some(firmware))
     }
 
-    /// Its name as [`Firmware::parse`] takes it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Firmware::Klipper => "klipper",
-            Firmware::Marlin => "marlin",
-            Firmware::Rrf => "rrf",
-            Firmware::Tmc4361a => "tmc4361a",
-            Firmware::Any => "any",
+    /// The firmware, `None` for any.
+    pub fn firmware(self) -> Option<Firmware> {
+        self.0
+    }
+
+    /// Parse a name of [`ALLOWED`] (or another name of a firmware, [`Firmware::parse`]).
+    pub fn parse(name: &str) -> Result<Self, String> {
+        if name.eq_ignore_ascii_case("any") {
+            return Ok(Self::ANY);
         }
+        match Firmware::parse(name) {
+            Some(f) if TUNED.contains(&f) => Ok(Self::of(f)),
+            Some(f) => Err(format!(
+                "{f} is not a firmware settle tune searches for; allowed: {ALLOWED}"
+            )),
+            None => Err(format!("unknown firmware `{name}`; allowed: {ALLOWED}")),
+        }
+    }
+
+    /// Its name as [`Candidates::parse`] takes it.
+    pub fn name(self) -> &'static str {
+        self.0.map_or("any", Firmware::name)
     }
 
     /// The profile kinds it plans.
     pub fn kinds(self) -> Vec<ProfileKind> {
-        match self {
-            Firmware::Klipper | Firmware::Marlin | Firmware::Rrf => vec![ProfileKind::Trapezoid],
-            Firmware::Tmc4361a => vec![ProfileKind::SCurve, ProfileKind::FourJerk],
-            Firmware::Any => ProfileKind::ALL.to_vec(),
+        match self.0 {
+            None | Some(Firmware::Settle) => ProfileKind::ALL.to_vec(),
+            Some(Firmware::Klipper | Firmware::Marlin | Firmware::Rrf) => {
+                vec![ProfileKind::Trapezoid]
+            }
+            Some(Firmware::Tmc4361a) => vec![ProfileKind::SCurve, ProfileKind::FourJerk],
         }
     }
 
-    /// The shapers it runs (none for the TMC4361A).
-    pub fn shapers(self) -> Vec<ShaperKind> {
-        match self {
-            Firmware::Klipper | Firmware::Any => ShaperKind::KLIPPER.to_vec(),
-            Firmware::Marlin => ShaperKind::MARLIN.to_vec(),
-            Firmware::Rrf => ShaperKind::RRF.to_vec(),
-            Firmware::Tmc4361a => Vec::new(),
+    /// The shapers it runs (none for the TMC4361A; Klipper's for any).
+    pub fn shapers(self) -> Vec<ShaperType> {
+        match self.0 {
+            None | Some(Firmware::Klipper | Firmware::Settle) => ShaperType::KLIPPER.to_vec(),
+            Some(Firmware::Marlin) => ShaperType::MARLIN.to_vec(),
+            Some(Firmware::Rrf) => ShaperType::RRF.to_vec(),
+            Some(Firmware::Tmc4361a) => Vec::new(),
         }
     }
 
@@ -90,25 +102,24 @@ impl Firmware {
     }
 
     /// `Ok` when it runs `shaper` (`None`, no shaping, always), else why not.
-    pub fn check_shaper(self, shaper: Option<ShaperKind>) -> Result<(), String> {
+    pub fn check_shaper(self, shaper: Option<ShaperType>) -> Result<(), String> {
         let Some(k) = shaper else {
             return Ok(());
         };
-        let ok = match self {
-            Firmware::Any => true,
-            Firmware::Klipper => k.firmware() == ShaperFirmware::Klipper,
-            Firmware::Marlin => k.firmware() == ShaperFirmware::Marlin,
-            Firmware::Rrf => k.firmware() == ShaperFirmware::Rrf,
-            Firmware::Tmc4361a => false,
+        let ok = match self.0 {
+            None => true,
+            Some(Firmware::Tmc4361a) => false,
+            Some(f) => k.firmware() == f,
         };
         if ok {
             Ok(())
-        } else if self == Firmware::Tmc4361a {
+        } else if self.0 == Some(Firmware::Tmc4361a) {
             Err("the TMC4361A has no input shaper: give shapers = [\"none\"]".into())
         } else {
             Err(format!(
-                "{} does not run the shaper `{}`; it runs: {}",
+                "{} does not run {}'s shaper `{}`; it runs: {}",
                 self.name(),
+                k.firmware().name(),
                 k.name(),
                 self.shapers()
                     .iter()

@@ -1,17 +1,19 @@
 //! The search grid of `settle tune`: the `[tune]` table resolved against the scenario's
 //! base run into candidates (kinds, jerks, kind parameters, shapers) and the move family.
 
-use settle_planner::shaper::ShaperKind;
-use settle_planner::{KindParams, ProfileKind};
+use settle_planner::shaper::ShaperType;
+use settle_planner::{ProfileKind, ProfileParams};
 
 use crate::error::Error;
 use crate::input::scenario::Scenario;
 use crate::input::source::Source;
-use crate::kinds::corner::Corner;
-use crate::kinds::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
 use crate::spec::run_spec::RunSpec;
-use crate::workflows::tune::firmware::Firmware;
+use crate::studies::corner::Corner;
+use crate::studies::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
+use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::search::{BandSource, Candidate, Plan};
+use crate::workflows::tune::target;
+use settle_planner::firmware::Firmware;
 
 /// Four-jerk BOW1..4 patterns searched (multiples of jmax; each <= 1).
 pub const BOW_PATTERNS: [[f64; 4]; 5] = [
@@ -22,7 +24,7 @@ pub const BOW_PATTERNS: [[f64; 4]; 5] = [
     [0.5, 1.0, 0.5, 1.0],
 ];
 
-/// PVT asymmetries searched (`KindParams::pvt_asym_ki`, in (1/3, 1); 0.5 is its default).
+/// PVT asymmetries searched (`ProfileParams::pvt_asym_ki`, in (1/3, 1); 0.5 is its default).
 pub const PVT_KI: [f64; 4] = [0.4, 0.5, 0.65, 0.8];
 
 /// Default frequency scales: the mode frequency +-20% (shapers are tuned to a measured
@@ -97,8 +99,8 @@ pub fn plan(
         base.axis = a.to_string();
     }
     let firmware = match &spec.firmware {
-        None => Firmware::Any,
-        Some(f) => Firmware::parse(f).map_err(|m| src.error_at("tune.firmware", m))?,
+        None => Candidates::ANY,
+        Some(f) => Candidates::parse(f).map_err(|m| src.error_at("tune.firmware", m))?,
     };
     if let Some(cur) = spec.axis.as_ref().and_then(|m| m.get(&base.axis)) {
         let current = current_shaper(cur, base.state::<ShaperSetting>())
@@ -109,6 +111,16 @@ pub fn plan(
         }
     }
 
+    let builtin_preset = sc
+        .machine
+        .preset
+        .as_ref()
+        .filter(|p| {
+            crate::input::machine_file::PRESETS
+                .iter()
+                .any(|(n, _, _)| n == p)
+        })
+        .cloned();
     let distances_mm = spec
         .distances_mm
         .clone()
@@ -200,7 +212,7 @@ pub fn plan(
             })
             .collect::<Result<_, _>>()?,
     };
-    let shapers: Vec<Option<ShaperKind>> = match &spec.shapers {
+    let shapers: Vec<Option<ShaperType>> = match &spec.shapers {
         None => std::iter::once(None)
             .chain(firmware.shapers().into_iter().map(Some))
             .collect(),
@@ -213,7 +225,7 @@ pub fn plan(
         Some(list) => list
             .iter()
             .map(|s| {
-                let k = crate::kinds::shaping::parse_type(s)
+                let k = crate::studies::shaping::parse_type(s)
                     .map_err(|m| src.error_at("tune.shapers", m))?;
                 firmware
                     .check_shaper(k)
@@ -270,8 +282,68 @@ pub fn plan(
             format!("{hz} Hz: the TMC4361A takes a clock of 4 to 32 MHz (4000000 to 32000000)"),
         ));
     }
+    let mut notes: Vec<String> = Vec::new();
+    let tmc = match firmware.firmware() {
+        Some(Firmware::Tmc4361a) => {
+            let usteps = spec
+                .axis
+                .as_ref()
+                .and_then(|m| m.get(&base.axis))
+                .and_then(|a| a.usteps_per_mm)
+                .or(spec.usteps_per_mm)
+                .ok_or_else(|| {
+                    src.error_at(
+                        "tune.usteps_per_mm",
+                        format!(
+                            "firmware tmc4361a searches only what the chip's registers hold, which depends on the axis's resolution: give [tune.axis.{}] usteps_per_mm or [tune] usteps_per_mm (microsteps per mm)",
+                            base.axis
+                        ),
+                    )
+                })?;
+            let clock = spec
+                .tmc_clock_hz
+                .unwrap_or(super::export::DEFAULT_TMC_CLOCK_HZ);
+            let r = target::tmc_ranges(usteps, clock);
+            for (key, a) in std::iter::once(("limits.amax_mm_s2", base.amax_mm_s2)).chain(
+                accels
+                    .iter()
+                    .flatten()
+                    .map(|a| ("tune.accelerations_mm_s2", *a)),
+            ) {
+                if a > r.accel_mm_s2 {
+                    return Err(src.error_at(
+                        key,
+                        format!(
+                            "{a} mm/s^2 is more than the TMC4361A's AMAX holds at {usteps} microsteps/mm ({:.0} mm/s^2)",
+                            r.accel_mm_s2
+                        ),
+                    ));
+                }
+            }
+            if base.vmax_mm_s > r.speed_mm_s {
+                return Err(src.error_at(
+                    "limits.vmax_mm_s",
+                    format!(
+                        "{} mm/s is more than the TMC4361A's VMAX holds at {usteps} microsteps/mm ({:.0} mm/s)",
+                        base.vmax_mm_s, r.speed_mm_s
+                    ),
+                ));
+            }
+            Some((usteps, r))
+        }
+        _ => None,
+    };
     let jmax = match base.jmax_mm_s3 {
-        Some(j) => j,
+        Some(j) => match tmc {
+            Some((usteps, r)) if j > r.jerk_mm_s3.1 => {
+                notes.push(format!(
+                    "Jerks searched up to {:.0} mm/s^3, not the scenario's {j}: the most the TMC4361A's BOW1..4 registers hold at {usteps} microsteps/mm.",
+                    r.jerk_mm_s3.1
+                ));
+                r.jerk_mm_s3.1
+            }
+            _ => j,
+        },
         // Only trapezoids: no jerk to search.
         None if kinds.iter().all(|k| *k == ProfileKind::Trapezoid) => 0.0,
         None => {
@@ -289,40 +361,61 @@ pub fn plan(
     if !(span.is_finite() && span >= 1.0) {
         return Err(src.error_at("tune.jerk_span", "must be a finite number >= 1"));
     }
-    let jerks: Vec<f64> = (0..steps)
+    let lowest_jerk = tmc.map_or(0.0, |(_, r)| r.jerk_mm_s3.0);
+    let mut jerks: Vec<f64> = (0..steps)
         .map(|i| {
             if steps == 1 {
                 jmax
             } else {
                 let f = i as f64 / (steps - 1) as f64;
-                jmax / span.powf(1.0 - f)
+                (jmax / span.powf(1.0 - f)).max(lowest_jerk)
             }
         })
         .collect();
-    let mut modes = tuning_modes(&base);
-    if matches!(firmware, Firmware::Tmc4361a) {
-        modes.clear();
-    }
+    jerks.dedup();
+    let modes = tuning_modes(&base);
     if modes.is_empty() && shapers.iter().any(Option::is_some) {
         return Err(src.error_at(
             "machine",
             "found no vibration mode of the moving axis to tune shapers to",
         ));
     }
+    if let Some(z) = spec.shaper_damping_ratio
+        && !(z.is_finite() && (0.0..1.0).contains(&z))
+    {
+        return Err(src.error_at(
+            "tune.shaper_damping_ratio",
+            format!("must be 0 to under 1, got {z}"),
+        ));
+    }
+    let (fixed_damping, damping_source) = design_damping_source(&spec, &base);
     let mut shaper_settings: Vec<Option<ShaperSetting>> = Vec::new();
     for s in &shapers {
         match s {
             None => shaper_settings.push(None),
             Some(k) => {
-                for (f, _) in &modes {
+                for (f, zeta) in &modes {
+                    // Designed for the mode's own damping (or the fixed one), as far as
+                    // the firmware takes it.
+                    let (damping_ratio, moved) =
+                        target::design_damping(*k, fixed_damping.unwrap_or(*zeta));
+                    if let Some(why) = moved {
+                        let note = format!(
+                            "{} is designed for damping {damping_ratio} on the {f:.1} Hz mode: {why}.",
+                            k.name()
+                        );
+                        if !notes.contains(&note) {
+                            notes.push(note);
+                        }
+                    }
                     for x in &scales {
                         // To 0.1 Hz, as firmware configurations write it (Klipper's
                         // calibrate_shaper.py prints `%.1f`): the exported value is the
                         // simulated one.
                         let s = ShaperSetting {
-                            kind: Some(*k),
+                            shaper_type: Some(*k),
                             frequency_hz: (f * x * 10.0).round() / 10.0,
-                            damping_ratio: DEFAULT_DAMPING_RATIO,
+                            damping_ratio,
                         };
                         if !shaper_settings.contains(&Some(s)) {
                             shaper_settings.push(Some(s));
@@ -366,24 +459,24 @@ pub fn plan(
         } else {
             jerks.iter().copied().map(Some).collect()
         };
-        let params: Vec<KindParams> = match kind {
+        let params: Vec<ProfileParams> = match kind {
             // Corner paths plan their legs from the limits alone.
-            _ if base.state::<Corner>().is_some() => vec![KindParams::default()],
+            _ if base.state::<Corner>().is_some() => vec![ProfileParams::default()],
             ProfileKind::PvtAsym => PVT_KI
                 .iter()
-                .map(|&k| KindParams {
+                .map(|&k| ProfileParams {
                     pvt_asym_ki: k,
-                    ..KindParams::default()
+                    ..ProfileParams::default()
                 })
                 .collect(),
             ProfileKind::FourJerk => BOW_PATTERNS
                 .iter()
-                .map(|&b| KindParams {
+                .map(|&b| ProfileParams {
                     fourjerk_jerk_scale: b,
-                    ..KindParams::default()
+                    ..ProfileParams::default()
                 })
                 .collect(),
-            _ => vec![KindParams::default()],
+            _ => vec![ProfileParams::default()],
         };
         for j in &jerk_list {
             for p in &params {
@@ -401,6 +494,7 @@ pub fn plan(
             }
         }
     }
+    let modes_source = modes_source(&base, builtin_preset.as_deref());
     Ok(Plan {
         base,
         distances_mm,
@@ -415,7 +509,60 @@ pub fn plan(
         frequency_tolerance: tolerance_pct / 100.0,
         band_source,
         max_smoothing_mm,
+        firmware,
+        notes,
+        modes_source,
+        builtin_preset,
+        damping_source,
+        shaper_damping: fixed_damping,
     })
+}
+
+/// The damping ratio the shapers are designed for when it is one for all (`None`: each
+/// mode's own), and the report's sentence saying which and why: `[tune]
+/// shaper_damping_ratio`, else the modes' own on a machine given by its modes, else
+/// Klipper's default 0.1 (a physical machine's modal damping is an estimate from its
+/// parts).
+pub fn design_damping_source(
+    spec: &crate::input::tune_spec::TuneSpec,
+    base: &RunSpec,
+) -> (Option<f64>, String) {
+    match (spec.shaper_damping_ratio, base.machine.physical()) {
+        (Some(z), _) => (
+            Some(z),
+            format!("Shapers are designed for damping ratio {z} (`[tune] shaper_damping_ratio`)."),
+        ),
+        (None, Some(_)) => (
+            Some(DEFAULT_DAMPING_RATIO),
+            format!(
+                "Shapers are designed for Klipper's default damping ratio {DEFAULT_DAMPING_RATIO}: the damping of a physical machine's linearised modes is an estimate from its parts, not a measurement (`[tune] shaper_damping_ratio` sets another)."
+            ),
+        ),
+        (None, None) => (
+            None,
+            "Shapers are designed for the damping ratio of the mode they are tuned to (the machine's, not Klipper's default 0.1).".into(),
+        ),
+    }
+}
+
+/// Where the modes of `base`'s machine come from, in a few words: identified (the modes
+/// carry their standard deviations, as `settle identify` writes them), given, or
+/// linearised from a physical machine (`preset`: the built-in preset it is).
+pub fn modes_source(base: &RunSpec, preset: Option<&str>) -> String {
+    let name = &base.machine_name;
+    let identified = base.axis.split('+').any(|a| {
+        base.machine
+            .modes_of(a)
+            .iter()
+            .any(|m| m.frequency_sigma_hz.is_some())
+    });
+    match (base.machine.physical(), preset) {
+        (Some(_), Some(p)) => format!("linearised from the built-in preset `{p}`"),
+        (Some(_), None) => format!("linearised from the machine `{name}`"),
+        (None, _) if identified => format!("identified, machine `{name}`"),
+        (None, Some(p)) => format!("given by the built-in preset `{p}`"),
+        (None, None) => format!("given, machine `{name}`"),
+    }
 }
 
 /// The band (percent) a search scores its shapers over and where it came from: the
@@ -456,13 +603,13 @@ pub const MAX_BAND_PCT: f64 = 49.0;
 /// in settle-identify's `random_sweeps_from_env`). `None` without sigmas or for a
 /// physical machine.
 pub fn identified_band(base: &RunSpec) -> Option<(f64, f64, f64)> {
-    if base.machine.is_some() {
+    if base.machine.physical().is_some() {
         return None;
     }
     let tuned = tuning_modes(base);
     let mut best: Option<(f64, f64, f64)> = None;
     for name in base.axis.split('+') {
-        for m in base.modes_of(name) {
+        for m in base.machine.modes_of(name) {
             let Some(s) = m.frequency_sigma_hz else {
                 continue;
             };
@@ -486,14 +633,14 @@ fn current_shaper(
     scenario: Option<&ShaperSetting>,
 ) -> Result<Option<ShaperSetting>, String> {
     let kind = match &cur.shaper {
-        Some(name) => crate::kinds::shaping::parse_type(name)?,
-        None => scenario.and_then(|s| s.kind),
+        Some(name) => crate::studies::shaping::parse_type(name)?,
+        None => scenario.and_then(|s| s.shaper_type),
     };
     let Some(kind) = kind else {
         return Ok(None);
     };
     let s = ShaperSetting {
-        kind: Some(kind),
+        shaper_type: Some(kind),
         frequency_hz: cur
             .frequency_hz
             .or(scenario.map(|s| s.frequency_hz))
@@ -511,12 +658,12 @@ fn current_shaper(
 /// corner path: the strongest of each of its axes), or the two strongest modes of the
 /// moving axis's linearised response.
 pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
-    if base.machine.is_none() {
+    let Some(machine) = base.machine.physical() else {
         let names: Vec<&str> = base.axis.split('+').collect();
         let per_axis = if names.len() > 1 { 1 } else { 2 };
         let mut out: Vec<(f64, f64)> = Vec::new();
         for name in names {
-            let mut m: Vec<_> = base.modes_of(name).to_vec();
+            let mut m: Vec<_> = base.machine.modes_of(name).to_vec();
             m.sort_by(|a, b| b.weight.abs().total_cmp(&a.weight.abs()));
             for m in m.iter().take(per_axis) {
                 let f = m.frequency_hz;
@@ -526,9 +673,6 @@ pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
             }
         }
         return out;
-    }
-    let Some(machine) = &base.machine else {
-        return Vec::new();
     };
     let Ok(axes) = machine.compile(settle_sim::DriverMode::Linear) else {
         return Vec::new();

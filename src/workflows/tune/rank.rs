@@ -4,7 +4,7 @@
 
 use crate::error::Error;
 use crate::execute::pool::{Progress, quiet, run_all};
-use crate::kinds::shaping::ShaperSetting;
+use crate::studies::shaping::ShaperSetting;
 use crate::workflows::tune::search::{Candidate, Plan, Score};
 
 /// Default rounds of refinement around the grid winner: 0 (grid only). Each round looks
@@ -16,8 +16,9 @@ use crate::workflows::tune::search::{Candidate, Plan, Score};
 /// the refined winner 4.9 ms later than modal predicted; the grid winner on time).
 pub const DEFAULT_REFINE_ROUNDS: usize = 0;
 
-/// Index of the best score: lowest move-and-settle, then lowest residual (candidates that
-/// are inside the band when their move ends tie on move-and-settle); the first among equals.
+/// Index of the best feasible score: lowest move-and-settle, then lowest residual
+/// (candidates that are inside the band when their move ends tie on move-and-settle); the
+/// first among equals.
 pub fn best(scores: &[Score]) -> Option<usize> {
     let mut best: Option<usize> = None;
     for (i, s) in scores.iter().enumerate() {
@@ -26,18 +27,26 @@ pub fn best(scores: &[Score]) -> Option<usize> {
                 || (s.move_and_settle_s == b.move_and_settle_s
                     && s.residual_peak_um < b.residual_peak_um)
         };
-        if s.move_and_settle_s.is_finite() && best.is_none_or(|b| better(&scores[b])) {
+        if s.is_feasible()
+            && s.move_and_settle_s.is_finite()
+            && best.is_none_or(|b| better(&scores[b]))
+        {
             best = Some(i);
         }
     }
     best
 }
 
-/// Indices of the Pareto front of (move time, residual peak): no other candidate is at
-/// least as good in both and better in one. Sorted by move time.
+/// Indices of the Pareto front of (move time, residual peak) among the feasible
+/// candidates: no other feasible candidate is at least as good in both and better in one.
+/// Sorted by move time.
 pub fn pareto(scores: &[Score]) -> Vec<usize> {
     let ok: Vec<usize> = (0..scores.len())
-        .filter(|&i| scores[i].move_time_s.is_finite() && scores[i].residual_peak_um.is_finite())
+        .filter(|&i| {
+            scores[i].is_feasible()
+                && scores[i].move_time_s.is_finite()
+                && scores[i].residual_peak_um.is_finite()
+        })
         .collect();
     let mut idx: Vec<usize> = ok
         .iter()
@@ -78,7 +87,7 @@ pub fn evaluate(
 /// `jmax` (a trapezoid has no jerk; an unshaped candidate no frequency).
 pub fn neighbours(c: &Candidate, df: f64, jr: f64, jmax: f64) -> Vec<Candidate> {
     let mut out = Vec::new();
-    if let Some(sh) = c.shaper.filter(|s| s.kind.is_some()) {
+    if let Some(sh) = c.shaper.filter(|s| s.shaper_type.is_some()) {
         for k in [-2.0, -1.0, 1.0, 2.0] {
             let f = sh.frequency_hz * (1.0 + k * df);
             if f > 0.0 {

@@ -1,8 +1,8 @@
 //! The scan-step figure of merit of `settle tune`: the overhead per line at which a
 //! raster's step is settled.
 
-use crate::kinds::scan::ScanSpec;
 use crate::measure::metrics::Metrics;
+use crate::studies::scan::ScanSpec;
 
 /// The scan-step figures of one scan run (from its [`Metrics::extra`] columns).
 #[derive(Debug, Clone, PartialEq)]

@@ -5,7 +5,7 @@
 //! Per case and backend (linear driver, belt stiffness frozen at the start: the model the
 //! closed form solves):
 //! - **frequency**: the dominant mode measured from the simulated free response after the
-//!   move (matrix pencil, [`settle_sim::pencil`]) against the analytic eigenvalue;
+//!   move (matrix pencil, [`settle_identify::fit::pencil`]) against the analytic eigenvalue;
 //! - **numerical damping**: the measured damping ratio of that mode against the analytic
 //!   one, as a share of the physical damping;
 //! - **residual**: the peak residual vibration against the closed form
@@ -328,7 +328,8 @@ pub fn run(backends: &[Backend]) -> Result<Validation, String> {
             let (m, series) = simulate(&case, backend, &frozen, case.axes.clone())?;
             let e = post_move_error(&series, &axis.name, t_end, target);
             let ys: Vec<f64> = e.iter().step_by(decimate).take(400).copied().collect();
-            let fit = settle_sim::pencil::fit(&ys, dt * decimate as f64, order).unwrap_or_default();
+            let fit = settle_identify::fit::pencil::fit(&ys, dt * decimate as f64, order)
+                .unwrap_or_default();
             // The measured mode nearest the analytic dominant one.
             let measured = fit.iter().min_by(|a, b| {
                 (a.frequency_hz - f_an)

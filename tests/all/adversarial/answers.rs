@@ -147,10 +147,10 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         ),
         Case::line(
             "run of a trace too long to keep: failed, with its reason",
-            "run long_window.toml --case 0 --backend modal --out o_long/t.csv",
+            "run long_window.toml --case 0 --backend modal --out o_long/t.csv --fail-on-failed-runs",
             &["o_long"],
             Expect::failed(&[
-                "FAILED: its trace is kept in memory",
+                "FAILED (fault): its trace is kept in memory",
                 "over the limit of 1.6e7",
             ]),
         ),

@@ -49,7 +49,7 @@ fn the_book_lists_every_limit_as_the_code_has_it() {
     has(thousands(settle::expand::axes::MAX_RUNS));
     has(format!(
         "2 to {}",
-        thousands(settle::kinds::scan::table::MAX_LINES)
+        thousands(settle::studies::scan::table::MAX_LINES)
     ));
     has(format!(
         "at most {}",

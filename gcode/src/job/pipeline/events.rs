@@ -10,13 +10,13 @@ use settle_planner::{PlanError, Trajectory};
 
 use super::{Job, MM, Planner, Range, build};
 use crate::error::{GcodeError, Location};
-use crate::event::{Event, EventKind, Note};
-use crate::geometry::{Move, MoveKind, Path, Point};
 use crate::job::chunk::{JobChunk, MoveGeometry, MoveInfo};
 use crate::job::driver::{Driver, LimitOutcome};
 use crate::job::input::AxisShapers;
 use crate::job::shapers::ShaperProblem;
-use crate::limits::{AxisFlags, LimitChange};
+use crate::read::event::{Event, EventKind, Note};
+use crate::read::geometry::{Move, MoveKind, Path, Point};
+use crate::read::limits::{AxisFlags, LimitChange};
 
 /// The planner's refusal of what line `line` asks for.
 fn plan_error(source: &Arc<str>, line: u64, command: &str, e: PlanError) -> GcodeError {
@@ -228,7 +228,7 @@ impl<R: BufRead> Job<R> {
                 command,
                 PlanError::UnknownKind {
                     name,
-                    allowed: settle_planner::shaper::ShaperKind::ALLOWED,
+                    allowed: settle_planner::shaper::ShaperType::ALLOWED,
                 },
             ),
             ShaperProblem::Unsupported(why) => GcodeError::Unsupported {

@@ -1,0 +1,165 @@
+//! Layer changes from slicer comments, or from Z when a file has none.
+//!
+//! In [`LayerMode::Auto`] the Z fallback stays off once the file names a slicer known to
+//! write layer markers in its header comments (before the first move), and from the first
+//! marker on: a purge line in the start G-code must not count as a layer.
+
+use crate::read::event::{LayerChange, LayerSource};
+use crate::read::geometry::Move;
+
+/// Where layer changes come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LayerMode {
+    /// Slicer markers; a planar printing move at a new Z when the file has none.
+    #[default]
+    Auto,
+    /// Slicer markers only.
+    Comments,
+    /// Planar printing moves at a new Z only.
+    ZChange,
+}
+
+/// Slicers whose files carry layer markers (as they name themselves in the header).
+const MARKING_SLICERS: [&str; 8] = [
+    "prusaslicer",
+    "superslicer",
+    "orcaslicer",
+    "bambustudio",
+    "cura_steamengine",
+    "simplify3d",
+    "ideamaker",
+    "slic3r",
+];
+
+/// Z differences smaller than this are the same layer, mm.
+const SAME_Z_MM: f64 = 1e-6;
+
+#[derive(Debug, Default)]
+pub(crate) struct Layers {
+    mode: LayerMode,
+    /// The current layer index.
+    pub(crate) index: u32,
+    /// A marker waiting for its Z comment: (line, change).
+    pending: Option<(u64, LayerChange)>,
+    z_fallback_off: bool,
+    moved: bool,
+    layer_z: Option<f64>,
+}
+
+impl Layers {
+    pub(crate) fn new(mode: LayerMode) -> Self {
+        Layers {
+            mode,
+            z_fallback_off: mode == LayerMode::Comments,
+            ..Layers::default()
+        }
+    }
+
+    /// Reads a comment-only line; layer changes to emit now go to `emit` as (line, layer
+    /// index, change).
+    pub(crate) fn comment(
+        &mut self,
+        line: u64,
+        text: &str,
+        emit: &mut Vec<(u64, u32, LayerChange)>,
+    ) {
+        let t = text.trim();
+        if !self.moved && self.mode == LayerMode::Auto {
+            let lower = t.to_ascii_lowercase();
+            if MARKING_SLICERS.iter().any(|s| lower.contains(s)) {
+                self.z_fallback_off = true;
+            }
+        }
+        if self.mode == LayerMode::ZChange {
+            return;
+        }
+        let marker = if let Some(n) = t.strip_prefix("LAYER:") {
+            n.parse::<i64>()
+                .ok()
+                .map(|n| change(LayerSource::Cura, Some(n), None))
+        } else if t == "LAYER_CHANGE" {
+            Some(change(LayerSource::LayerChange, None, None))
+        } else if t == "CHANGE_LAYER" {
+            Some(change(LayerSource::ChangeLayer, None, None))
+        } else if let Some(rest) = t.strip_prefix("layer ") {
+            simplify3d(rest)
+        } else {
+            None
+        };
+        if let Some(marker) = marker {
+            self.z_fallback_off = true;
+            emit.extend(self.flush());
+            self.pending = Some((line, marker));
+            if !matches!(
+                marker.source,
+                LayerSource::LayerChange | LayerSource::ChangeLayer
+            ) {
+                emit.extend(self.flush());
+            }
+            return;
+        }
+        if let Some((_, pending)) = &mut self.pending {
+            let z = match pending.source {
+                LayerSource::LayerChange => t.strip_prefix("Z:"),
+                LayerSource::ChangeLayer => t.strip_prefix("Z_HEIGHT:"),
+                _ => None,
+            };
+            if let Some(z) = z
+                .and_then(|z| z.trim().parse::<f64>().ok())
+                .filter(|z| z.is_finite())
+            {
+                pending.z_mm = Some(z);
+                emit.extend(self.flush());
+            }
+        }
+    }
+
+    /// Emits the pending marker, if any, as the start of a new layer.
+    pub(crate) fn flush(&mut self) -> Option<(u64, u32, LayerChange)> {
+        let (line, c) = self.pending.take()?;
+        self.index += 1;
+        Some((line, self.index, c))
+    }
+
+    /// Called for every move before it is emitted; returns a Z-fallback layer change.
+    pub(crate) fn before_move(&mut self, mv: &Move, printing: bool) -> Option<LayerChange> {
+        self.moved = true;
+        if self.z_fallback_off || !printing || mv.start.z_mm != mv.end.z_mm {
+            return None;
+        }
+        let z = mv.end.z_mm;
+        if self.layer_z.is_some_and(|lz| (z - lz).abs() <= SAME_Z_MM) {
+            return None;
+        }
+        self.layer_z = Some(z);
+        self.index += 1;
+        Some(change(LayerSource::ZChange, None, Some(z)))
+    }
+}
+
+fn change(source: LayerSource, slicer_number: Option<i64>, z_mm: Option<f64>) -> LayerChange {
+    LayerChange {
+        source,
+        slicer_number,
+        z_mm,
+    }
+}
+
+/// `; layer 12, Z = 2.400` (the text after `layer `).
+fn simplify3d(rest: &str) -> Option<LayerChange> {
+    let (n, z) = rest.split_once(',')?;
+    let n = n.trim().parse::<i64>().ok()?;
+    let z = z
+        .trim()
+        .strip_prefix('Z')?
+        .trim_start()
+        .strip_prefix('=')?
+        .trim()
+        .parse::<f64>()
+        .ok()?;
+    Some(change(
+        LayerSource::Simplify3d,
+        Some(n),
+        Some(z).filter(|z| z.is_finite()),
+    ))
+}

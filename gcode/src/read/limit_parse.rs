@@ -1,0 +1,353 @@
+//! Motion-limit commands read in the units of the chosen dialect (see [`crate::read::limits`]
+//! for each command's source).
+
+use crate::error::GcodeError;
+use crate::read::cmd::{
+    BELOW_ONE, BOOL, Check, Cmd, FINITE, FRACTION, NON_NEGATIVE, POSITIVE, SMALL_INT,
+};
+use crate::read::dialect::Dialect;
+use crate::read::event::Note;
+use crate::read::limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
+use crate::read::params::{KeyValues, Params};
+
+/// What a command turned out to be.
+#[derive(Debug)]
+pub(crate) enum Outcome {
+    /// A limit change to report.
+    Limits(LimitChange),
+    /// A note to report.
+    Note(Note),
+    /// A query or no-op (no parameters): nothing to report.
+    Nothing,
+    /// Not a motion-limit command in this dialect: count it as ignored.
+    Unknown,
+}
+
+const PER_MIN: f64 = 1.0 / 60.0;
+
+/// Per-axis values of X Y Z E scaled by `scale`; E may be a list (first value).
+fn axes(cmd: &Cmd, p: &Params, check: Check, scale: f64) -> Result<AxisValues, GcodeError> {
+    let get = |l| cmd.num(p, l, check).map(|v| v.map(|v| v * scale));
+    Ok(AxisValues {
+        x: get(b'X')?,
+        y: get(b'Y')?,
+        z: get(b'Z')?,
+        e: cmd.first_num(p, b'E', check)?.map(|v| v * scale),
+    })
+}
+
+fn flags(p: &Params) -> AxisFlags {
+    AxisFlags {
+        x: p.has(b'X'),
+        y: p.has(b'Y'),
+        z: p.has(b'Z'),
+        e: p.has(b'E'),
+    }
+}
+
+fn small(
+    cmd: &Cmd,
+    p: &Params,
+    letter: u8,
+    max: u32,
+    allowed: &'static str,
+) -> Result<Option<u32>, GcodeError> {
+    match cmd.num(p, letter, SMALL_INT)? {
+        Some(v) if v as u32 <= max => Ok(Some(v as u32)),
+        Some(v) => Err(cmd.out_of_range(
+            Some(p.at(letter)),
+            &char::from(letter).to_string(),
+            v,
+            allowed,
+        )),
+        None => Ok(None),
+    }
+}
+
+/// An `M` command with letter parameters. `args` of `cmd` must already be in `p`.
+pub(crate) fn m_code(
+    dialect: Dialect,
+    cmd: &Cmd,
+    number: u32,
+    p: &Params,
+) -> Result<Outcome, GcodeError> {
+    use Dialect::*;
+    let limits = |c| Ok(Outcome::Limits(c));
+    let known = matches!(
+        (dialect, number),
+        (Marlin | Rrf, 201 | 203 | 204 | 205 | 593) | (Marlin, 493 | 494) | (Rrf, 566)
+    );
+    if known && p.is_empty() {
+        return Ok(Outcome::Nothing); // a report of the current values
+    }
+    match (dialect, number) {
+        (Marlin, 201) => {
+            cmd.allow(
+                p,
+                b"XYZEFST",
+                "X Y Z E (mm/s^2), F (Hz), S (%), T (extruder)",
+            )?;
+            limits(LimitChange::MaxAccel {
+                per_axis_mm_s2: axes(cmd, p, POSITIVE, 1.0)?,
+                xy_frequency_limit_hz: cmd.num(p, b'F', NON_NEGATIVE)?,
+                xy_frequency_min_speed_pct: cmd.num(p, b'S', NON_NEGATIVE)?,
+            })
+        }
+        (Rrf, 201) => {
+            cmd.allow(p, b"XYZEUVWABCD", "X Y Z E ... (mm/s^2)")?;
+            limits(LimitChange::MaxAccel {
+                per_axis_mm_s2: axes(cmd, p, POSITIVE, 1.0)?,
+                xy_frequency_limit_hz: None,
+                xy_frequency_min_speed_pct: None,
+            })
+        }
+        (Marlin, 203) => {
+            cmd.allow(p, b"XYZET", "X Y Z E (mm/s), T (extruder)")?;
+            limits(LimitChange::MaxFeedrate {
+                per_axis_mm_s: axes(cmd, p, POSITIVE, 1.0)?,
+                min_speed_mm_s: None,
+            })
+        }
+        (Rrf, 203) => {
+            cmd.allow(
+                p,
+                b"XYZEISUVWABCD",
+                "X Y Z E ... I (mm/min, or mm/s with S1), S (0 or 1)",
+            )?;
+            let scale = if cmd.num(p, b'S', BOOL)? == Some(1.0) {
+                1.0
+            } else {
+                PER_MIN
+            };
+            limits(LimitChange::MaxFeedrate {
+                per_axis_mm_s: axes(cmd, p, POSITIVE, scale)?,
+                min_speed_mm_s: cmd.num(p, b'I', POSITIVE)?.map(|v| v * scale),
+            })
+        }
+        (Klipper, 204) => {
+            cmd.allow(p, b"SPTR", "S, or P and T (mm/s^2)")?;
+            let (s, pp, t) = (
+                cmd.num(p, b'S', POSITIVE)?,
+                cmd.num(p, b'P', POSITIVE)?,
+                cmd.num(p, b'T', POSITIVE)?,
+            );
+            let accel = match (s, pp, t) {
+                (Some(s), _, _) => s,
+                (None, Some(pp), Some(t)) => pp.min(t),
+                _ => {
+                    return Ok(Outcome::Note(Note::IgnoredByFirmware {
+                        command: format!("M204{}", cmd.args.trim_end()),
+                        reason: "Klipper's M204 needs S, or both P and T (klippy/toolhead.py cmd_M204)",
+                    }));
+                }
+            };
+            limits(velocity_limit(None, Some(accel)))
+        }
+        (Marlin | Rrf, 204) => {
+            cmd.allow(p, b"PRST", "P T S R (mm/s^2)")?;
+            let s = cmd.num(p, b'S', POSITIVE)?;
+            let retract = cmd.num(p, b'R', POSITIVE)?;
+            limits(LimitChange::Accel {
+                print_mm_s2: cmd.num(p, b'P', POSITIVE)?.or(s),
+                travel_mm_s2: cmd.num(p, b'T', POSITIVE)?.or(s),
+                retract_mm_s2: if dialect == Marlin { retract } else { None },
+            })
+        }
+        (Marlin, 205) => {
+            cmd.allow(p, b"BSTJXYZE", "B (us) S T (mm/s) J (mm) X Y Z E (mm/s)")?;
+            limits(LimitChange::MarlinAdvanced {
+                junction_deviation_mm: cmd.num(p, b'J', POSITIVE)?,
+                jerk_mm_s: axes(cmd, p, NON_NEGATIVE, 1.0)?,
+                min_feedrate_mm_s: cmd.num(p, b'S', NON_NEGATIVE)?,
+                min_travel_feedrate_mm_s: cmd.num(p, b'T', NON_NEGATIVE)?,
+                min_segment_time_s: cmd.num(p, b'B', NON_NEGATIVE)?.map(|us| us * 1e-6),
+            })
+        }
+        (Rrf, 205 | 566) => {
+            // Axes beyond X Y Z E (U V W A B C D) are accepted and not reported.
+            let (allowed, scale): (&[u8], f64) = if number == 205 {
+                (b"XYZEUVWABCD", 1.0)
+            } else {
+                (b"XYZEPUVWABCD", PER_MIN)
+            };
+            cmd.allow(
+                p,
+                allowed,
+                if number == 205 {
+                    "X Y Z E ... (mm/s)"
+                } else {
+                    "X Y Z E ... (mm/min), P (policy)"
+                },
+            )?;
+            limits(LimitChange::RrfJerk {
+                per_axis_mm_s: axes(cmd, p, NON_NEGATIVE, scale)?,
+                policy: small(cmd, p, b'P', 1, "0 or 1")?,
+                sets_maximum: number == 566,
+            })
+        }
+        (Marlin, 593) => {
+            cmd.allow(p, b"XYZDF", "X Y Z (flags), D (damping ratio), F (Hz)")?;
+            limits(LimitChange::MarlinInputShaping {
+                axes: flags(p),
+                frequency_hz: cmd.num(p, b'F', NON_NEGATIVE)?,
+                damping_ratio: cmd.num(p, b'D', FRACTION)?,
+            })
+        }
+        (Rrf, 593) => {
+            cmd.allow(
+                p,
+                b"PFSLHT",
+                "P\"type\" F (Hz) S (damping) L (limit) H (amplitudes) T (durations, s)",
+            )?;
+            let damping = Check {
+                ok: |v| (0.0..=0.99).contains(&v),
+                allowed: "0 to 0.99",
+            };
+            limits(LimitChange::RrfInputShaping {
+                shaper: cmd.string(p, b'P')?.map(|s| s.to_ascii_lowercase()),
+                frequency_hz: cmd.num(p, b'F', POSITIVE)?,
+                damping_ratio: cmd.num(p, b'S', damping)?,
+                reduction_limit: cmd.num(p, b'L', FRACTION)?,
+                amplitudes: cmd.list(p, b'H', FINITE)?,
+                durations_s: cmd.list(p, b'T', NON_NEGATIVE)?,
+            })
+        }
+        (Marlin, 493) => {
+            cmd.allow(
+                p,
+                b"SHCDAFIQXYZE",
+                "S H (0/1) C (0-8) D (0-2) A (Hz) F I Q, X Y Z E (flags)",
+            )?;
+            let shaper = small(cmd, p, b'C', 8, "0 to 8")?.and_then(FtShaper::from_code);
+            limits(LimitChange::FtMotion {
+                enabled: cmd.num(p, b'S', BOOL)?.map(|v| v == 1.0),
+                axis_sync: cmd.num(p, b'H', BOOL)?.map(|v| v == 1.0),
+                axes: flags(p),
+                shaper,
+                dynamic_mode: small(cmd, p, b'D', 2, "0 to 2")?,
+                frequency_hz: cmd.num(p, b'A', NON_NEGATIVE)?,
+                frequency_scaling: cmd.num(p, b'F', FINITE)?,
+                damping_ratio: cmd.num(p, b'I', FRACTION)?,
+                vibration_tolerance: cmd.num(p, b'Q', FRACTION)?,
+            })
+        }
+        (Marlin, 494) => {
+            cmd.allow(p, b"TOXYZE", "T (0-2) O (overshoot) X Y Z E (s)")?;
+            limits(LimitChange::FtSmoothing {
+                trajectory: small(cmd, p, b'T', 2, "0 to 2")?,
+                overshoot: cmd.num(p, b'O', POSITIVE)?,
+                smoothing_s: axes(cmd, p, NON_NEGATIVE, 1.0)?,
+            })
+        }
+        _ => Ok(Outcome::Unknown),
+    }
+}
+
+fn velocity_limit(velocity: Option<f64>, accel: Option<f64>) -> LimitChange {
+    LimitChange::VelocityLimit {
+        velocity_mm_s: velocity,
+        accel_mm_s2: accel,
+        accel_to_decel_mm_s2: None,
+        square_corner_velocity_mm_s: None,
+        minimum_cruise_ratio: None,
+    }
+}
+
+const VELOCITY_KEYS: [&str; 5] = [
+    "VELOCITY",
+    "ACCEL",
+    "ACCEL_TO_DECEL",
+    "SQUARE_CORNER_VELOCITY",
+    "MINIMUM_CRUISE_RATIO",
+];
+const SHAPER_KEYS: [&str; 10] = [
+    "SHAPER_TYPE",
+    "SHAPER_TYPE_X",
+    "SHAPER_TYPE_Y",
+    "SHAPER_TYPE_Z",
+    "SHAPER_FREQ_X",
+    "SHAPER_FREQ_Y",
+    "SHAPER_FREQ_Z",
+    "DAMPING_RATIO_X",
+    "DAMPING_RATIO_Y",
+    "DAMPING_RATIO_Z",
+];
+
+/// A named (`KEY=VALUE`) command; only Klipper has motion-limit ones.
+pub(crate) fn named(
+    dialect: Dialect,
+    cmd: &Cmd,
+    name: &str,
+    kv: &KeyValues,
+) -> Result<Outcome, GcodeError> {
+    if dialect != Dialect::Klipper {
+        return Ok(Outcome::Unknown);
+    }
+    let num = |key: &str, check: Check| -> Result<Option<f64>, GcodeError> {
+        kv.pairs()
+            .iter()
+            .find(|(k, _, _)| k == key)
+            .map(|(k, v, at)| cmd.kv_num(*at, k, v, check))
+            .transpose()
+    };
+    let text = |key: &str| {
+        kv.pairs()
+            .iter()
+            .find(|(k, _, _)| k == key)
+            .map(|(_, v, _)| v.to_ascii_lowercase())
+    };
+    if name.eq_ignore_ascii_case("SET_VELOCITY_LIMIT") {
+        cmd.kv_unknown(
+            kv,
+            &VELOCITY_KEYS,
+            "VELOCITY ACCEL ACCEL_TO_DECEL SQUARE_CORNER_VELOCITY MINIMUM_CRUISE_RATIO",
+        )?;
+        if kv.pairs().is_empty() {
+            return Ok(Outcome::Nothing);
+        }
+        return Ok(Outcome::Limits(LimitChange::VelocityLimit {
+            velocity_mm_s: num("VELOCITY", POSITIVE)?,
+            accel_mm_s2: num("ACCEL", POSITIVE)?,
+            accel_to_decel_mm_s2: num("ACCEL_TO_DECEL", POSITIVE)?,
+            square_corner_velocity_mm_s: num("SQUARE_CORNER_VELOCITY", NON_NEGATIVE)?,
+            minimum_cruise_ratio: num("MINIMUM_CRUISE_RATIO", BELOW_ONE)?,
+        }));
+    }
+    if name.eq_ignore_ascii_case("SET_INPUT_SHAPER") {
+        cmd.kv_unknown(
+            kv,
+            &SHAPER_KEYS,
+            "SHAPER_TYPE(_X/_Y/_Z) SHAPER_FREQ_X/_Y/_Z DAMPING_RATIO_X/_Y/_Z",
+        )?;
+        if kv.pairs().is_empty() {
+            return Ok(Outcome::Nothing);
+        }
+        let per_axis = [
+            text("SHAPER_TYPE_X"),
+            text("SHAPER_TYPE_Y"),
+            text("SHAPER_TYPE_Z"),
+        ];
+        let shaper_type = text("SHAPER_TYPE");
+        if shaper_type.is_some() && per_axis.iter().any(Option::is_some) {
+            return Err(GcodeError::Syntax {
+                at: cmd.at(None),
+                what: "SHAPER_TYPE cannot be combined with SHAPER_TYPE_X/_Y/_Z (Klipper docs/G-Codes.md)",
+            });
+        }
+        return Ok(Outcome::Limits(LimitChange::InputShaper {
+            shaper_type,
+            shaper_type_xyz: per_axis,
+            frequency_hz_xyz: [
+                num("SHAPER_FREQ_X", NON_NEGATIVE)?,
+                num("SHAPER_FREQ_Y", NON_NEGATIVE)?,
+                num("SHAPER_FREQ_Z", NON_NEGATIVE)?,
+            ],
+            damping_ratio_xyz: [
+                num("DAMPING_RATIO_X", FRACTION)?,
+                num("DAMPING_RATIO_Y", FRACTION)?,
+                num("DAMPING_RATIO_Z", FRACTION)?,
+            ],
+        }));
+    }
+    Ok(Outcome::Unknown)
+}

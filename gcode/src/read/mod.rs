@@ -1,0 +1,30 @@
+//! The streaming G-code reader (see the crate documentation), what is where:
+//! - text: `settle_files::lines` (one bounded line at a time), [`lex`] (words and comments), [`cmd`]
+//!   (a line's command and [`params`]);
+//! - the firmware's conventions: [`dialect`];
+//! - motion: [`motion`] (modal state: units, absolute or relative, feed), [`geometry`]
+//!   (moves, points, paths, [`geometry::Bounds`]), [`arc`] (`G2`/`G3` geometry),
+//!   [`segments`] (how each firmware cuts an arc into straight moves);
+//! - what a line means: [`event`] (what the reader yields), [`layers`] (layer changes),
+//!   [`limits`] and [`limit_parse`] (motion-limit commands), [`setting`] and
+//!   [`setting_parse`] (RepRapFirmware's configuration commands);
+//! - [`reader`]: the reader itself; [`summary`]: a file's statistics;
+//!   [`canonical`]: events written back as G-code.
+
+pub(crate) mod arc;
+pub(crate) mod canonical;
+pub(crate) mod cmd;
+pub(crate) mod dialect;
+pub(crate) mod event;
+pub(crate) mod geometry;
+pub(crate) mod layers;
+pub(crate) mod lex;
+pub(crate) mod limit_parse;
+pub(crate) mod limits;
+pub(crate) mod motion;
+pub(crate) mod params;
+pub(crate) mod reader;
+pub(crate) mod segments;
+pub(crate) mod setting;
+pub(crate) mod setting_parse;
+pub(crate) mod summary;

@@ -1,0 +1,492 @@
+//! The streaming reader: lines in, events out, in file order.
+
+use std::collections::{BTreeMap, VecDeque};
+use std::fmt::Write as _;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::sync::Arc;
+
+use crate::error::{GcodeError, Location};
+use crate::read::cmd::{Cmd, CmdName};
+use crate::read::dialect::Dialect;
+use crate::read::event::{Event, EventKind, Note};
+use crate::read::geometry::{MoveKind, Point};
+use crate::read::layers::{LayerMode, Layers};
+use crate::read::lex::{LexError, LineKind, lex};
+use crate::read::limit_parse::{self, Outcome};
+use crate::read::motion::Motion;
+use crate::read::params::{KeyValues, Params};
+use crate::read::setting_parse;
+use settle_files::lines::{BoundedLines as Lines, LineStatus};
+
+/// How the reader reads.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReaderOptions {
+    /// Whose conventions to follow.
+    pub dialect: Dialect,
+    /// Count and skip bad lines (see [`Reader::skipped`]) instead of ending with an error.
+    pub skip_bad_lines: bool,
+    /// Longest line read, bytes (64 KiB by default: slicers write lines under 1 KiB; a
+    /// longer one is binary data or a corrupt file, and is skipped unread).
+    pub max_line_bytes: usize,
+    /// Where layer changes come from.
+    pub layers: LayerMode,
+    /// Largest |X|, |Y|, |Z| accepted, mm (1e5: no printer or gantry spans 100 m; larger
+    /// values are typing errors or garbage).
+    pub max_coordinate_mm: f64,
+    /// Largest |E| accepted, mm (1e9: a kilometre of filament is ~1e6 mm).
+    pub max_extruder_mm: f64,
+    /// How many skipped-line errors to keep for reporting (the rest are only counted).
+    pub kept_errors: usize,
+}
+
+impl ReaderOptions {
+    /// The defaults for `dialect`.
+    pub fn new(dialect: Dialect) -> Self {
+        ReaderOptions {
+            dialect,
+            skip_bad_lines: false,
+            max_line_bytes: 64 * 1024,
+            layers: LayerMode::Auto,
+            max_coordinate_mm: 1e5,
+            max_extruder_mm: 1e9,
+            kept_errors: 20,
+        }
+    }
+}
+
+/// Lines skipped under [`ReaderOptions::skip_bad_lines`].
+#[derive(Debug, Default)]
+pub struct Skipped {
+    /// How many.
+    pub count: u64,
+    /// The first [`ReaderOptions::kept_errors`] of them.
+    pub first: Vec<GcodeError>,
+}
+
+/// Distinct ignored command names kept; more are counted under `(other)`.
+const MAX_IGNORED_NAMES: usize = 256;
+
+/// A streaming G-code reader: an iterator of events (or the error that ended it).
+///
+/// Memory is bounded by [`ReaderOptions::max_line_bytes`] plus the input's buffer; the
+/// file is never held whole. After an error the iterator ends, unless
+/// [`ReaderOptions::skip_bad_lines`] is set.
+#[derive(Debug)]
+pub struct Reader<R> {
+    lines: Lines<R>,
+    source_name: Arc<str>,
+    scratch: String,
+    interp: Interp,
+    error: Option<GcodeError>,
+    finished: bool,
+}
+
+#[derive(Debug)]
+struct Interp {
+    opts: ReaderOptions,
+    motion: Motion,
+    layers: Layers,
+    params: Params,
+    kv: KeyValues,
+    queue: VecDeque<Event>,
+    layer_buf: Vec<(u64, u32, crate::read::event::LayerChange)>,
+    ignored: BTreeMap<String, u64>,
+    name_buf: String,
+    skipped: Skipped,
+}
+
+/// A G-code file open for reading (settle-files' reader: a regular file of at most
+/// [`settle_files::limit::GCODE`]).
+pub type FileInput = BufReader<settle_files::read::Input>;
+
+impl Reader<FileInput> {
+    /// Opens a file (a regular file, links followed, of at most
+    /// [`settle_files::limit::GCODE`]).
+    pub fn open(path: impl AsRef<Path>, options: ReaderOptions) -> Result<Self, GcodeError> {
+        let path = path.as_ref();
+        let name: Arc<str> = Arc::from(path.display().to_string());
+        let file = settle_files::read::open(path, settle_files::limit::GCODE)?;
+        Ok(Reader::new(BufReader::with_capacity(64 * 1024, file), options).with_name(name))
+    }
+}
+
+impl<R: BufRead> Reader<R> {
+    /// A reader over any buffered input.
+    pub fn new(input: R, options: ReaderOptions) -> Self {
+        let interp = Interp {
+            motion: Motion::new(
+                options.dialect,
+                options.max_coordinate_mm,
+                options.max_extruder_mm,
+            ),
+            layers: Layers::new(options.layers),
+            params: Params::default(),
+            kv: KeyValues::default(),
+            queue: VecDeque::new(),
+            layer_buf: Vec::new(),
+            ignored: BTreeMap::new(),
+            name_buf: String::new(),
+            skipped: Skipped::default(),
+            opts: options,
+        };
+        Reader {
+            lines: Lines::new(input, interp.opts.max_line_bytes),
+            source_name: Arc::from("<input>"),
+            scratch: String::new(),
+            interp,
+            error: None,
+            finished: false,
+        }
+    }
+
+    /// Names the input in error messages.
+    pub fn with_name(mut self, name: impl Into<Arc<str>>) -> Self {
+        self.source_name = name.into();
+        self
+    }
+
+    /// The options in use.
+    pub fn options(&self) -> &ReaderOptions {
+        &self.interp.opts
+    }
+
+    /// Commands ignored so far (not motion, or not known in this dialect), by name
+    /// (`M104`, `T0`, `PRINT_START`), with how often.
+    pub fn ignored_commands(&self) -> &BTreeMap<String, u64> {
+        &self.interp.ignored
+    }
+
+    /// Lines skipped so far under [`ReaderOptions::skip_bad_lines`].
+    pub fn skipped(&self) -> &Skipped {
+        &self.interp.skipped
+    }
+
+    /// Lines read so far.
+    pub fn lines_read(&self) -> u64 {
+        self.lines.line_no()
+    }
+
+    /// Bytes read so far.
+    pub fn bytes_read(&self) -> u64 {
+        self.lines.bytes_read()
+    }
+
+    /// The machine position after the events yielded so far, mm.
+    pub fn position(&self) -> Point {
+        self.interp.motion.position()
+    }
+
+    fn fail(&mut self, e: GcodeError) {
+        if self.interp.opts.skip_bad_lines {
+            let s = &mut self.interp.skipped;
+            s.count += 1;
+            if s.first.len() < self.interp.opts.kept_errors {
+                s.first.push(e);
+            }
+        } else {
+            self.error = Some(e);
+        }
+    }
+}
+
+impl<R: BufRead> Iterator for Reader<R> {
+    type Item = Result<Event, GcodeError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            if let Some(e) = self.interp.queue.pop_front() {
+                return Some(Ok(e));
+            }
+            if let Some(e) = self.error.take() {
+                self.finished = true;
+                return Some(Err(e));
+            }
+            if self.finished {
+                return None;
+            }
+            match self.lines.next_line() {
+                Err(source) => {
+                    self.finished = true;
+                    return Some(Err(GcodeError::io(&self.source_name, source)));
+                }
+                Ok(None) => {
+                    self.finished = true;
+                    self.interp.flush_layer();
+                }
+                Ok(Some(LineStatus::TooLong)) => {
+                    let at = Location {
+                        source_name: self.source_name.clone(),
+                        line: self.lines.line_no(),
+                        column: None,
+                    };
+                    self.fail(GcodeError::LineTooLong {
+                        at,
+                        limit_bytes: self.interp.opts.max_line_bytes,
+                    });
+                }
+                Ok(Some(LineStatus::Complete)) => {
+                    let line_no = self.lines.line_no();
+                    let mut bytes = self.lines.bytes();
+                    if line_no == 1 {
+                        // A byte-order mark (editors on Windows write one) is not G-code.
+                        bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
+                    }
+                    let result =
+                        self.interp
+                            .line(&self.source_name, line_no, bytes, &mut self.scratch);
+                    if let Err(e) = result {
+                        self.fail(e);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// RepRapFirmware's configuration commands ([`setting_parse`]).
+fn is_rrf_setting(number: u32) -> bool {
+    matches!(number, 92 | 350 | 906 | 208 | 669 | 665 | 98 | 501)
+}
+
+impl Interp {
+    fn push(&mut self, line: u64, kind: EventKind) {
+        self.queue.push_back(Event {
+            line,
+            layer: self.layers.index,
+            kind,
+        });
+    }
+
+    fn flush_layer(&mut self) {
+        if let Some((line, layer, c)) = self.layers.flush() {
+            self.queue.push_back(Event {
+                line,
+                layer,
+                kind: EventKind::Layer(c),
+            });
+        }
+    }
+
+    fn ignore(&mut self, name: CmdName) {
+        self.name_buf.clear();
+        match name {
+            CmdName::Code {
+                letter,
+                number,
+                sub,
+            } => {
+                let _ = write!(self.name_buf, "{}{number}", char::from(letter));
+                if let Some(s) = sub {
+                    let _ = write!(self.name_buf, ".{s}");
+                }
+            }
+            CmdName::Named(n) => self.name_buf.push_str(&n.to_ascii_uppercase()),
+        }
+        if let Some(c) = self.ignored.get_mut(self.name_buf.as_str()) {
+            *c += 1;
+        } else if self.ignored.len() < MAX_IGNORED_NAMES {
+            self.ignored.insert(self.name_buf.clone(), 1);
+        } else {
+            *self.ignored.entry("(other)".to_string()).or_insert(0) += 1;
+        }
+    }
+
+    fn line(
+        &mut self,
+        source: &Arc<str>,
+        line_no: u64,
+        bytes: &[u8],
+        scratch: &mut String,
+    ) -> Result<(), GcodeError> {
+        let at = |column: Option<usize>| Location {
+            source_name: source.clone(),
+            line: line_no,
+            column,
+        };
+        let text = std::str::from_utf8(bytes).map_err(|e| GcodeError::InvalidUtf8 {
+            at: at(Some(e.valid_up_to() + 1)),
+        })?;
+        let kind = lex(text, scratch).map_err(|e| match e {
+            LexError::Control { at: c, byte } => GcodeError::ControlCharacter {
+                at: at(Some(c + 1)),
+                byte,
+            },
+            LexError::Syntax { at: c, what } => GcodeError::Syntax {
+                at: at(Some(c + 1)),
+                what,
+            },
+            LexError::Checksum {
+                at: c,
+                found,
+                computed,
+            } => GcodeError::Checksum {
+                at: at(Some(c + 1)),
+                found,
+                computed,
+            },
+        })?;
+        match kind {
+            LineKind::Blank | LineKind::Percent => Ok(()),
+            LineKind::Comment(t) => {
+                self.layers.comment(line_no, t, &mut self.layer_buf);
+                for (line, layer, c) in self.layer_buf.drain(..) {
+                    self.queue.push_back(Event {
+                        line,
+                        layer,
+                        kind: EventKind::Layer(c),
+                    });
+                }
+                Ok(())
+            }
+            LineKind::Code {
+                letter,
+                number,
+                sub,
+                args,
+                args_at,
+            } => {
+                self.flush_layer();
+                let cmd = Cmd {
+                    name: CmdName::Code {
+                        letter,
+                        number,
+                        sub,
+                    },
+                    source,
+                    line: line_no,
+                    args_at,
+                    args,
+                };
+                self.code(&cmd, letter, number, sub)
+            }
+            LineKind::Extended {
+                name,
+                args,
+                args_at,
+            } => {
+                self.flush_layer();
+                let cmd = Cmd {
+                    name: CmdName::Named(name),
+                    source,
+                    line: line_no,
+                    args_at,
+                    args,
+                };
+                self.named(&cmd, name)
+            }
+        }
+    }
+
+    fn code(
+        &mut self,
+        cmd: &Cmd,
+        letter: u8,
+        number: u32,
+        sub: Option<u32>,
+    ) -> Result<(), GcodeError> {
+        let known = sub.is_none()
+            && match letter {
+                b'G' => matches!(number, 0..=4 | 17..=21 | 28 | 90..=92),
+                b'M' => {
+                    matches!(
+                        number,
+                        82 | 83 | 400 | 201 | 203 | 204 | 205 | 566 | 593 | 493 | 494
+                    ) || (self.opts.dialect == Dialect::Rrf && is_rrf_setting(number))
+                }
+                _ => false,
+            };
+        if !known {
+            self.ignore(cmd.name);
+            return Ok(());
+        }
+        self.params
+            .parse(cmd.args)
+            .map_err(|e| cmd.param_error(e))?;
+        let p = &self.params;
+        let line = cmd.line;
+        match (letter, number) {
+            (b'G', 0 | 1) => {
+                if let Some(mv) = self.motion.line(cmd, p, number == 0)? {
+                    if let Some(c) = self.layers.before_move(&mv, mv.kind == MoveKind::Print) {
+                        self.push(line, EventKind::Layer(c));
+                    }
+                    self.push(line, EventKind::Move(mv));
+                }
+            }
+            (b'G', 2 | 3) => {
+                let mv = self.motion.arc(cmd, p, number == 2)?;
+                if let Some(c) = self.layers.before_move(&mv, mv.kind == MoveKind::Print) {
+                    self.push(line, EventKind::Layer(c));
+                }
+                self.push(line, EventKind::Move(mv));
+            }
+            (b'G', 4) => {
+                let (duration_s, s_ignored) = self.motion.dwell(cmd, p)?;
+                if s_ignored {
+                    let note = Note::IgnoredByFirmware {
+                        command: format!("G4{}", cmd.args.trim_end()),
+                        reason: "Klipper's G4 reads only P, in milliseconds (klippy/toolhead.py cmd_G4)",
+                    };
+                    self.push(line, EventKind::Note(note));
+                }
+                self.push(line, EventKind::Dwell { duration_s });
+            }
+            (b'G', 17..=19) => {
+                cmd.allow(p, b"", "none")?;
+                self.motion.set_plane_xy(number == 17);
+            }
+            (b'G', 20) => {
+                return Err(cmd.unsupported("inch units: settle reads millimetre G-code (G21); convert the file to millimetres"));
+            }
+            (b'G', 21) => cmd.allow(p, b"", "none")?,
+            (b'G', 28) => {
+                let axes = self.motion.home(p);
+                self.push(line, EventKind::Note(Note::Homed { axes }));
+            }
+            (b'G', 90 | 91) => {
+                cmd.allow(p, b"", "none")?;
+                self.motion.set_relative(number == 91);
+            }
+            (b'G', 92) => self.motion.set_position(cmd, p)?,
+            (b'M', 82 | 83) => {
+                cmd.allow(p, b"", "none")?;
+                self.motion.set_e_relative(number == 83);
+            }
+            (b'M', 400) => self.push(line, EventKind::Dwell { duration_s: 0.0 }),
+            (b'M', n) if is_rrf_setting(n) => {
+                match setting_parse::m_code(self.opts.dialect, cmd, number, p)? {
+                    setting_parse::Outcome::Setting(s) => self.push(line, EventKind::Setting(s)),
+                    setting_parse::Outcome::Note(n) => self.push(line, EventKind::Note(n)),
+                    setting_parse::Outcome::Nothing => {}
+                    setting_parse::Outcome::Unknown => self.ignore(cmd.name),
+                }
+            }
+            (b'M', _) => match limit_parse::m_code(self.opts.dialect, cmd, number, p)? {
+                Outcome::Limits(c) => self.push(line, EventKind::Limits(c)),
+                Outcome::Note(n) => self.push(line, EventKind::Note(n)),
+                Outcome::Nothing => {}
+                Outcome::Unknown => self.ignore(cmd.name),
+            },
+            _ => self.ignore(cmd.name),
+        }
+        Ok(())
+    }
+
+    fn named(&mut self, cmd: &Cmd, name: &str) -> Result<(), GcodeError> {
+        let limit_command = name.eq_ignore_ascii_case("SET_VELOCITY_LIMIT")
+            || name.eq_ignore_ascii_case("SET_INPUT_SHAPER");
+        if self.opts.dialect != Dialect::Klipper || !limit_command {
+            self.ignore(cmd.name);
+            return Ok(());
+        }
+        self.kv.parse(cmd.args).map_err(|e| cmd.param_error(e))?;
+        match limit_parse::named(self.opts.dialect, cmd, name, &self.kv)? {
+            Outcome::Limits(c) => self.push(cmd.line, EventKind::Limits(c)),
+            Outcome::Note(n) => self.push(cmd.line, EventKind::Note(n)),
+            Outcome::Nothing => {}
+            Outcome::Unknown => self.ignore(cmd.name),
+        }
+        Ok(())
+    }
+}

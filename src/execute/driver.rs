@@ -1,0 +1,576 @@
+//! The simulation driver: one plant stepped through a command on a sample clock, every
+//! sample handed to a [`Sink`]. Every command that simulates a machine runs it: a sweep's
+//! runs and `settle run`'s traces ([`crate::execute::simulate`]) and `settle gcode`'s jobs
+//! (`crate::workflows::gcode::stream`) are its sinks.
+//!
+//! - The clock: sample `k` is at `k / sample_rate` s. A command ([`Driver::follow`]) is a
+//!   trajectory whose time 0 is `t0` on the clock (a G-code job's chunks follow one
+//!   another on one clock, the plant's state carried across them); [`Driver::hold`] holds
+//!   a command on a clock of its own (the observation window after a move).
+//! - Steps are split at every breakpoint of every axis, so each axis's commanded jerk is
+//!   constant within each step (the modal plant is then exact). A whole sample interval
+//!   is stepped as exactly `1 / sample_rate` s.
+//! - Runs of whole samples go to the plant in one call ([`Plant::step_samples`]) while it
+//!   implements it and the sink does not record every sample in full; the last sample of
+//!   each call is evaluated in full.
+//! - A sample evaluated in full is checked: a non-finite value or an error past
+//!   [`BLOWUP_M`] stops the driver with [`Stop::Fault`] ([`fault_in`]); a backend that
+//!   fails stops it with [`Stop::Backend`]; an interruption (Ctrl-C, SIGTERM) requested
+//!   ([`crate::execute::interrupt`]) is seen within [`INTERRUPT_POLL`] samples evaluated
+//!   in full and stops it with [`Stop::Interrupted`].
+
+use std::ops::{ControlFlow, RangeInclusive};
+
+use settle_planner::{Sample, State, Trajectory};
+use settle_sim::{Observation, Plant, SimError};
+
+use crate::execute::cursor::Cursor;
+use crate::measure::metrics::BLOWUP_M;
+
+/// Samples between two looks at [`crate::execute::interrupt::requested`].
+pub const INTERRUPT_POLL: usize = 64;
+
+/// Samples per [`Plant::step_samples`] call: long enough to make the per-call cost
+/// negligible, short enough that the buffers stay in the first-level cache.
+pub const CHUNK: usize = 256;
+
+/// Why the driver stopped before the end of what it was asked to do.
+#[derive(Debug)]
+pub enum Stop {
+    /// The sink asked to stop.
+    Sink,
+    /// A sample's values are not physical: the reason, with the axis and the time.
+    Fault(String),
+    /// The backend failed on the step that starts at `t_s` (s, on the clock).
+    Backend {
+        /// When the step started.
+        t_s: f64,
+        /// What the backend said.
+        error: SimError,
+    },
+    /// An interruption was requested.
+    Interrupted,
+}
+
+/// Times on a sample clock: sample `k` is at `origin_s + k dt_s` (s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clock {
+    /// The time of sample 0 (s).
+    pub origin_s: f64,
+    /// The sample period (s).
+    pub dt_s: f64,
+}
+
+impl Clock {
+    /// The time of sample `k` (s). (`0 + x` is `x` bit for bit for every `x >= 0`: a clock
+    /// at origin 0 gives `k dt` exactly.)
+    #[inline]
+    pub fn time(&self, k: u64) -> f64 {
+        self.origin_s + k as f64 * self.dt_s
+    }
+}
+
+/// A sample evaluated in full.
+#[derive(Debug)]
+pub struct Full<'a> {
+    /// Its index on the clock.
+    pub k: u64,
+    /// Its time (s).
+    pub t_s: f64,
+    /// The command at that time, per axis.
+    pub cmd: &'a [Sample],
+    /// The commanded positions per axis (m).
+    pub commanded_m: &'a [f64],
+    /// The toolhead positions per axis (m).
+    pub toolhead_m: &'a [f64],
+    /// What the plant shows, when it was observed (always when recording, or when the
+    /// sink asked through [`Sink::observes`]).
+    pub observed: Option<&'a [Observation]>,
+}
+
+/// Samples of one [`Plant::step_samples`] call, positions only (the plant vouched for
+/// them), sample-major.
+#[derive(Debug)]
+pub struct Batched<'a> {
+    /// The first one's index on the clock.
+    pub k0: u64,
+    /// How many.
+    pub count: usize,
+    /// The clock.
+    pub clock: Clock,
+    /// Axes per sample.
+    pub axes: usize,
+    /// The commanded positions (m): sample `i`'s at `[i * axes ..]`.
+    pub commanded_m: &'a [f64],
+    /// The toolhead positions (m), the same layout.
+    pub toolhead_m: &'a [f64],
+}
+
+impl Batched<'_> {
+    /// The time of sample `i` of the batch (s).
+    #[inline]
+    pub fn time(&self, i: usize) -> f64 {
+        self.clock.time(self.k0 + i as u64)
+    }
+
+    /// The commanded and toolhead positions of sample `i`.
+    #[inline]
+    pub fn positions(&self, i: usize) -> (&[f64], &[f64]) {
+        let r = i * self.axes..(i + 1) * self.axes;
+        (&self.commanded_m[r.clone()], &self.toolhead_m[r])
+    }
+}
+
+/// What the driver hands its samples to.
+pub trait Sink {
+    /// Whether the next sample evaluated in full should come with the plant's
+    /// observations (e.g. to see where a motor first loses steps).
+    fn observes(&self) -> bool {
+        false
+    }
+
+    /// A sample evaluated in full; `Break` stops the driver ([`Stop::Sink`]).
+    fn sample(&mut self, s: &Full<'_>) -> ControlFlow<()>;
+
+    /// The samples of a batch, in order; `Break(i)` stops the driver at sample `i` (taken).
+    fn samples(&mut self, b: &Batched<'_>) -> ControlFlow<usize>;
+}
+
+/// A plant, its state and the sample clock (see the module doc).
+pub struct Driver<'p, P: Plant> {
+    plant: &'p P,
+    state: P::State,
+    names: &'p [String],
+    axes: usize,
+    dt: f64,
+    /// The next sample's index on the clock.
+    k: u64,
+    /// The time of the last thing done (s): a step's end, or a sample.
+    t: f64,
+    /// Every sample observed in full (a recording): no batches.
+    record: bool,
+    batch: Option<Buffers>,
+    /// The fewest samples a batch takes (fewer are stepped one by one).
+    min_batch: usize,
+    obs: Vec<Observation>,
+    cmd: Vec<Sample>,
+    cmd_p: Vec<f64>,
+    toolhead: Vec<f64>,
+    polls: usize,
+}
+
+impl<P: Plant> std::fmt::Debug for Driver<'_, P> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Driver")
+            .field("axes", &self.names)
+            .field("dt_s", &self.dt)
+            .field("next_sample", &self.k)
+            .field("time_s", &self.t)
+            .field("record", &self.record)
+            .field("batches", &self.batch.is_some())
+            .field("min_batch", &self.min_batch)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<'p, P: Plant> Driver<'p, P> {
+    /// `plant` at rest at `start` (one state per axis, named `names`), its clock at
+    /// `sample_rate_hz` with the next sample the first at or after `t0_s`; `record`: every
+    /// sample evaluated in full.
+    pub fn new(
+        plant: &'p P,
+        names: &'p [String],
+        start: &[State],
+        sample_rate_hz: f64,
+        t0_s: f64,
+        record: bool,
+    ) -> Result<Self, SimError> {
+        let axes = start.len();
+        let dt = 1.0 / sample_rate_hz;
+        Ok(Self {
+            state: plant.initial_state(start)?,
+            plant,
+            names,
+            axes,
+            dt,
+            k: (t0_s / dt).ceil() as u64,
+            t: 0.0,
+            record,
+            batch: (!record).then(|| Buffers::new(axes)),
+            min_batch: 1,
+            obs: vec![Observation::default(); axes],
+            cmd: vec![Sample::default(); axes],
+            cmd_p: vec![0.0; axes],
+            toolhead: vec![0.0; axes],
+            polls: 0,
+        })
+    }
+
+    /// Batches of at least `n` samples only (default 1): a shorter run of whole samples is
+    /// stepped sample by sample through [`Plant::step`]. (A plant's batch may take longer
+    /// internal steps than one sample, MuJoCo's does: the choice can change the last bits.)
+    pub fn with_min_batch(mut self, n: usize) -> Self {
+        self.min_batch = n.max(1);
+        self
+    }
+
+    /// The next sample's index on the clock.
+    pub fn next_sample(&self) -> u64 {
+        self.k
+    }
+
+    /// The time of the last thing done (s): the end of the last step, or the last sample
+    /// handed to the sink.
+    pub fn time_s(&self) -> f64 {
+        self.t
+    }
+
+    /// The sample period (s).
+    pub fn dt_s(&self) -> f64 {
+        self.dt
+    }
+
+    /// What the plant shows now.
+    pub fn observe(&mut self) -> &[Observation] {
+        self.plant.observe(&self.state, &mut self.obs);
+        &self.obs
+    }
+
+    /// What the plant showed when it was last observed (by [`Driver::observe`] or at a
+    /// sample evaluated in full).
+    pub fn observations(&self) -> &[Observation] {
+        &self.obs
+    }
+
+    /// Step `traj`, whose time 0 is `t0_s` on the clock, to its end, taking every sample
+    /// of the clock from the next one on up to its end: before it (`with_end` false) or
+    /// at it too.
+    pub fn follow(
+        &mut self,
+        traj: &Trajectory,
+        t0_s: f64,
+        with_end: bool,
+        sink: &mut impl Sink,
+    ) -> Result<(), Stop> {
+        let (n, dt) = (self.axes, self.dt);
+        let t1 = traj.duration_s();
+        // Sample `k` in the trajectory's own time. The trajectory is stepped in its own
+        // time so that a step ends exactly on each breakpoint and the next step's command
+        // comes from the next piece (a clock time `t0 + bp` taken back to the
+        // trajectory's time can fall a rounding error before the breakpoint: the previous
+        // piece's acceleration, held for a whole step, would be a large error of the
+        // command).
+        let local = |k: u64| k as f64 * dt - t0_s;
+        let takes = |tau: f64| with_end || tau < t1;
+        let clock = Clock {
+            origin_s: 0.0,
+            dt_s: dt,
+        };
+        let breakpoints = traj.breakpoints();
+        let mut next_bp = 0usize;
+        let mut cursor = Cursor::new(traj);
+        let mut tau = 0.0_f64;
+        while tau < t1 {
+            while next_bp < breakpoints.len() && breakpoints[next_bp] <= tau {
+                next_bp += 1;
+            }
+            let bp = breakpoints.get(next_bp).copied().unwrap_or(t1).min(t1);
+            let t_sample = local(self.k);
+            let next = t_sample.min(bp);
+            let whole = next == t_sample && self.k > 0 && tau == local(self.k - 1);
+            if whole && takes(t_sample) && self.batch.is_some() {
+                // Samples k, k + 1, ... up to the breakpoint (inclusive): every step lies
+                // in one piece of every axis's command.
+                let k0 = self.k;
+                let mut m = 1;
+                while m < CHUNK {
+                    let ts = local(k0 + m as u64);
+                    if ts > bp || !takes(ts) {
+                        break;
+                    }
+                    m += 1;
+                }
+                if let Some(b) = self.batch.as_mut().filter(|_| m >= self.min_batch) {
+                    for (i, c) in b.cmds.chunks_exact_mut(n).take(m).enumerate() {
+                        cursor.at(local(k0 - 1 + i as u64), c);
+                    }
+                    let fail = |i: usize| clock.time(k0 - 1 + i as u64);
+                    if let Some(done) = self.step_batch(m, k0, clock, &fail, sink)? {
+                        self.k = k0 + done as u64 - 1;
+                        tau = local(self.k);
+                        // The command at the last sample serves it.
+                        cursor.at(tau, &mut self.cmd);
+                        self.full(self.k, clock.time(self.k), None, sink)?;
+                        self.k += 1;
+                        continue;
+                    }
+                }
+            }
+            cursor.at(tau, &mut self.cmd);
+            let h = if whole { dt } else { next - tau };
+            if h > 0.0 {
+                self.step(None, h, t0_s + tau)?;
+            }
+            tau = next;
+            self.t = t0_s + tau;
+            if next == t_sample {
+                if takes(t_sample) {
+                    cursor.at(tau, &mut self.cmd);
+                    self.full(self.k, clock.time(self.k), None, sink)?;
+                }
+                self.k += 1;
+            }
+        }
+        Ok(())
+    }
+
+    /// Hold `cmd` (one sample per axis): steps of one sample period, sample `k` at
+    /// `clock.time(k)` for every `k` of `ks`. The driver's own clock is left alone.
+    pub fn hold(
+        &mut self,
+        cmd: &[Sample],
+        ks: RangeInclusive<u64>,
+        clock: Clock,
+        sink: &mut impl Sink,
+    ) -> Result<(), Stop> {
+        let (first, last) = (*ks.start(), *ks.end());
+        if let Some(b) = self.batch.as_mut() {
+            for c in b.cmds.chunks_exact_mut(self.axes) {
+                c.copy_from_slice(cmd);
+            }
+        }
+        let dt = self.dt;
+        let mut k = first;
+        while k <= last {
+            let m = (last - k + 1).min(CHUNK as u64) as usize;
+            if self.batch.is_some() && m >= self.min_batch {
+                let fail = |i: usize| clock.time(k + i as u64) - dt;
+                if let Some(done) = self.step_batch(m, k, clock, &fail, sink)? {
+                    self.full(
+                        k + done as u64 - 1,
+                        clock.time(k + done as u64 - 1),
+                        Some(cmd),
+                        sink,
+                    )?;
+                    k += done as u64;
+                    continue;
+                }
+            }
+            let t = clock.time(k);
+            self.step(Some(cmd), dt, t - dt)?;
+            self.full(k, t, Some(cmd), sink)?;
+            k += 1;
+        }
+        Ok(())
+    }
+
+    /// Hold `cmd` on the driver's own clock from where it stands: a step to the next
+    /// sample (part of a period), then every sample up to `last_k`.
+    pub fn hold_on(
+        &mut self,
+        cmd: &[Sample],
+        last_k: u64,
+        sink: &mut impl Sink,
+    ) -> Result<(), Stop> {
+        let k = self.k;
+        if k > last_k {
+            return Ok(());
+        }
+        let clock = Clock {
+            origin_s: 0.0,
+            dt_s: self.dt,
+        };
+        let (t, h) = (self.t, clock.time(k) - self.t);
+        if h > 0.0 {
+            self.step(Some(cmd), h, t)?;
+        }
+        self.full(k, clock.time(k), Some(cmd), sink)?;
+        self.hold(cmd, k + 1..=last_k, clock, sink)
+    }
+
+    /// Evaluate the plant now in full as sample `k` at `t_s` with command `cmd`.
+    pub fn sample_now(
+        &mut self,
+        k: u64,
+        t_s: f64,
+        cmd: &[Sample],
+        sink: &mut impl Sink,
+    ) -> Result<(), Stop> {
+        self.full(k, t_s, Some(cmd), sink)
+    }
+
+    /// One step of `h` s with `cmd` (else the driver's current command); a failure is
+    /// reported at `t_fail`.
+    fn step(&mut self, cmd: Option<&[Sample]>, h: f64, t_fail: f64) -> Result<(), Stop> {
+        let cmd = cmd.unwrap_or(&self.cmd);
+        self.plant
+            .step(&mut self.state, cmd, h)
+            .map_err(|error| Stop::Backend { t_s: t_fail, error })
+    }
+
+    /// `m` whole samples in one call from sample `k0` on, the commands at their step
+    /// starts in the buffers. The sink gets every sample but the last one done;
+    /// `Some(done)`: `done` samples stepped, the state at the last one, which the caller
+    /// evaluates in full. That also covers a plant that stopped at an unvouched last
+    /// sample of the call (it returns `done == m` then, which reads as "all vouched
+    /// for"), at one `positions` per call. `None`: the plant steps sample by sample
+    /// (nothing was done; batches are off from now on). A step `i` that fails is reported
+    /// at `fail(i)`.
+    fn step_batch(
+        &mut self,
+        m: usize,
+        k0: u64,
+        clock: Clock,
+        fail: &dyn Fn(usize) -> f64,
+        sink: &mut impl Sink,
+    ) -> Result<Option<usize>, Stop> {
+        let Some(b) = self.batch.as_mut() else {
+            return Ok(None);
+        };
+        let len = m * self.axes;
+        let result = self.plant.step_samples(
+            &mut self.state,
+            &b.cmds[..len],
+            self.dt,
+            BLOWUP_M,
+            &mut b.cmd_p[..len],
+            &mut b.toolhead[..len],
+        );
+        let (count, outcome) = match result {
+            Ok(Some(done)) if (1..=m).contains(&done) => (done - 1, Ok(Some(done))),
+            Ok(_) => {
+                self.batch = None;
+                return Ok(None);
+            }
+            Err((failed, error)) => (
+                failed.min(m),
+                Err(Stop::Backend {
+                    t_s: fail(failed),
+                    error,
+                }),
+            ),
+        };
+        let view = Batched {
+            k0,
+            count,
+            clock,
+            axes: self.axes,
+            commanded_m: &b.cmd_p,
+            toolhead_m: &b.toolhead,
+        };
+        if count > 0 {
+            if let ControlFlow::Break(i) = sink.samples(&view) {
+                self.t = view.time(i);
+                return Err(Stop::Sink);
+            }
+            self.t = view.time(count - 1);
+        }
+        outcome
+    }
+
+    /// Evaluate the state in full as sample `k` at `t` (command `cmd`, else the driver's
+    /// current one): checked, handed to the sink, and an interruption looked for.
+    fn full(
+        &mut self,
+        k: u64,
+        t: f64,
+        cmd: Option<&[Sample]>,
+        sink: &mut impl Sink,
+    ) -> Result<(), Stop> {
+        self.t = t;
+        let plant = self.plant;
+        let observed = self.record
+            || sink.observes()
+            || !(plant.positions(&self.state, &mut self.cmd_p, &mut self.toolhead)
+                && self
+                    .cmd_p
+                    .iter()
+                    .zip(&self.toolhead)
+                    .all(|(c, h)| (h - c).abs() <= BLOWUP_M));
+        if observed {
+            // Every value finite and no blow-up is what `fault_in` checks; otherwise it
+            // names the fault.
+            plant.observe(&self.state, &mut self.obs);
+            for ((c, h), o) in self.cmd_p.iter_mut().zip(&mut self.toolhead).zip(&self.obs) {
+                *c = o.commanded_m;
+                *h = o.toolhead_m;
+            }
+            if let Some(reason) = fault_in(t, self.names, &self.obs) {
+                return Err(Stop::Fault(reason));
+            }
+        }
+        let s = Full {
+            k,
+            t_s: t,
+            cmd: cmd.unwrap_or(&self.cmd),
+            commanded_m: &self.cmd_p,
+            toolhead_m: &self.toolhead,
+            observed: observed.then_some(&self.obs[..]),
+        };
+        if sink.sample(&s).is_break() {
+            return Err(Stop::Sink);
+        }
+        self.polls += 1;
+        if self.polls.is_multiple_of(INTERRUPT_POLL) && crate::execute::interrupt::requested() {
+            return Err(Stop::Interrupted);
+        }
+        Ok(())
+    }
+}
+
+/// The command standing still at `ends` (one state per axis): their positions, no motion.
+pub fn standing_at(ends: &[State]) -> Vec<Sample> {
+    ends.iter()
+        .map(|e| Sample {
+            p: e.p,
+            ..Sample::default()
+        })
+        .collect()
+}
+
+/// The buffers of [`Plant::step_samples`] calls (up to [`CHUNK`] samples, sample-major).
+#[derive(Debug)]
+struct Buffers {
+    cmds: Vec<Sample>,
+    cmd_p: Vec<f64>,
+    toolhead: Vec<f64>,
+}
+
+impl Buffers {
+    fn new(axes: usize) -> Self {
+        Self {
+            cmds: vec![Sample::default(); CHUNK * axes],
+            cmd_p: vec![0.0; CHUNK * axes],
+            toolhead: vec![0.0; CHUNK * axes],
+        }
+    }
+}
+
+/// A simulation fault in the observations at `t`: a non-finite value, or an error beyond
+/// [`BLOWUP_M`] (see there). `None` when everything is physical.
+pub fn fault_in(t: f64, names: &[String], obs: &[Observation]) -> Option<String> {
+    for (i, o) in obs.iter().enumerate() {
+        let axis = names.get(i).map_or("?", String::as_str);
+        let values = [
+            ("toolhead position", Some(o.toolhead_m)),
+            ("commanded position", Some(o.commanded_m)),
+            ("carriage position", o.carriage_m),
+            ("motor angle", o.motor_angle_rad),
+        ];
+        for (what, v) in values {
+            if let Some(v) = v
+                && !v.is_finite()
+            {
+                return Some(format!("{what} of axis {axis} became {v} at t = {t:.6} s"));
+            }
+        }
+        let err = o.toolhead_m - o.commanded_m;
+        if err.abs() > BLOWUP_M {
+            return Some(format!(
+                "blow-up: axis {axis}'s toolhead is {:.3e} m from its command at t = {t:.6} s (limit {} m)",
+                err, BLOWUP_M
+            ));
+        }
+    }
+    None
+}

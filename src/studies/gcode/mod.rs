@@ -1,0 +1,527 @@
+//! G-code jobs in sweeps, a path study: the scenario's `[gcode]` table names a G-code file
+//! (relative to the scenario), the firmware whose planner runs it and the layers to
+//! simulate; the sweep varies `gcode.firmware`, the existing `shaper.*` keys (the shaper
+//! goes into the job, on X and Y, as the firmware shapes) and the `[limits]` keys (the
+//! firmware's velocity and acceleration limits; settle's planner also takes the jerk and
+//! the profile kind).
+//!
+//! ```toml
+//! [gcode]
+//! file = "../gcode/prints/cube_layer.gcode"
+//! firmware = "klipper"
+//! layers = "0..0"
+//! ```
+//!
+//! The run's motion is the job's shaped X and Y (and Z), one trajectory. Without
+//! `layers` it runs from the job's first move (`t = 0`) to its end. With `layers` it
+//! starts from the whole job's state, as `settle gcode --layers` does: the job's chunks
+//! start a pre-roll ([`preroll`]) of at least `ln(1e6) / sigma` before the range's first
+//! move (`sigma` the slowest decay rate of the machine's linearised modes; no earlier
+//! than the file's first move), so the vibration the layers before leave is in the
+//! range's samples, and `t = 0` is the pre-roll's start, moved to the next instant of the
+//! print clock's sample grid (`k / sample_rate_hz`, the grid of `settle gcode`) so that
+//! both sample the same instants. The common metrics are those of any run over that
+//! trajectory: `move_time_s` is the pre-roll plus the range, the residual and the settle
+//! time are measured after the range's last move. The study's probe measures the contour
+//! error against the G-code's own geometry ([`contour`]) and adds to runs.csv
+//! `print_time_s` (the whole file's, by the firmware's planner), `contour_worst_um`,
+//! `contour_p95_um` (printing samples of the range's moves, during the job; never the
+//! pre-roll's) and `contour_worst_line`. Bad G-code is reported when the sweep is
+//! checked, with the file and line.
+//!
+//! A physical machine on the modal backend is linearised where the print is
+//! ([`linpoint`]: the centre of the file's printing moves), the point `settle gcode`
+//! uses, for the whole file and for any layer range of it: a range gives the numbers of
+//! the same layers in the whole job, and the study the numbers of `settle gcode`.
+//!
+//! A range that ends before the file does: the contour columns count the range's samples
+//! up to its last command, as `settle gcode --layers` does (the whole job's samples after
+//! it belong to the next layer's moves). The common metrics (`residual_*`, settle times)
+//! are defined as for any run: the command then stands at the range's last point for the
+//! observation window, as if the job stopped dead there (a range can end moving, and the
+//! real job goes on); they measure that stop, not the print, and `settle gcode --layers`
+//! reports no such ringing for a range that ends before the file.
+
+pub mod contour;
+pub mod linpoint;
+pub mod preroll;
+pub mod stats;
+pub mod work;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use serde::Deserialize;
+use settle_gcode::job::{Job, JobConfig, MoveInfo, PlannerConfig, ShaperSetting, parse_firmware};
+use settle_planner::firmware::Firmware;
+use settle_gcode::{MoveKind, Reader, ReaderOptions};
+use settle_planner::path::CornerStrategy;
+use settle_planner::path::junction::Junction;
+use settle_planner::shaper::stream::cut;
+use settle_planner::{PlanError, Profile, Segment, Trajectory};
+use settle_sim::{AxisModel, DriverMode};
+
+use crate::error::Error;
+use crate::input::source::Source;
+use crate::studies::{Study, StudyState, PathMove, PlanContext, Planned, Probe, Role, any_has};
+use crate::measure::metrics::Metrics;
+use crate::measure::series::Series;
+use crate::spec::backend::Backend;
+use crate::spec::run_spec::RunSpec;
+use crate::spec::runs::RunList;
+use crate::spec::value::Value;
+use contour::ActiveMoves;
+use stats::Histogram;
+
+/// runs.csv columns of a G-code run.
+pub const COLUMNS: [&str; 6] = [
+    "gcode_file",
+    "firmware",
+    "print_time_s",
+    "contour_worst_um",
+    "contour_p95_um",
+    "contour_worst_line",
+];
+
+/// The `[gcode]` table.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct GcodeSpec {
+    /// The G-code file, relative to the scenario.
+    pub file: String,
+    /// `klipper`, `marlin`, `rrf` or `settle`.
+    pub firmware: String,
+    /// Layers to simulate, `A..B` or `A` (default: all).
+    pub layers: Option<String>,
+    /// The speed law of settle's planner (`scurve`, `trapezoid`, ...; default `scurve`).
+    #[serde(default = "default_profile")]
+    pub profile: String,
+    /// settle's planner: Klipper's corner rule at this speed (mm/s; default 5, Klipper's
+    /// `square_corner_velocity`); 0 stops at every corner.
+    #[serde(default = "default_scv")]
+    pub square_corner_velocity_mm_s: f64,
+}
+
+fn default_profile() -> String {
+    "scurve".into()
+}
+
+fn default_scv() -> f64 {
+    5.0
+}
+
+/// A run's G-code job.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GcodeJob {
+    /// The file (resolved against the scenario's folder).
+    pub file: PathBuf,
+    /// The planner.
+    pub firmware: Firmware,
+    /// Layer range (inclusive).
+    pub layers: Option<(u32, u32)>,
+    /// Profile name (settle's planner), as written.
+    pub profile: String,
+    /// settle's planner: square-corner velocity (mm/s).
+    pub square_corner_velocity_mm_s: f64,
+}
+
+impl StudyState for GcodeJob {
+    fn table(&self) -> &'static str {
+        "gcode"
+    }
+
+    fn set(&mut self, key: &str, value: &Value) -> Result<(), String> {
+        match (key, value) {
+            ("firmware", Value::Text(t)) => {
+                self.firmware = parse_firmware(t).map_err(|e| e.to_string())?;
+            }
+            ("firmware", _) => {
+                return Err(format!(
+                    "`gcode.firmware` takes names: {}",
+                    Firmware::names(&Firmware::GCODE)
+                ));
+            }
+            _ => {
+                return Err(format!(
+                    "`gcode.{key}` cannot be swept; allowed: gcode.firmware"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The layer range syntax of `[gcode] layers` and `--layers`: `A..B` (both included) or
+/// `A`.
+pub fn parse_layers(s: &str) -> Result<(u32, u32), String> {
+    let num = |t: &str| {
+        t.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{s}`: layers are `A..B` or `A` with whole numbers >= 0"))
+    };
+    let (a, b) = match s.split_once("..") {
+        Some((a, b)) => (num(a)?, num(b.trim_start_matches('='))?),
+        None => (num(s)?, num(s)?),
+    };
+    if a > b {
+        return Err(format!("`{s}`: the first layer is after the last"));
+    }
+    Ok((a, b))
+}
+
+/// The job configuration of `run`: its firmware's defaults, the run's limits, and
+/// `shaper` on X and Y.
+pub fn job_config(run: &RunSpec, job: &GcodeJob, shaper: Option<ShaperSetting>) -> Result<JobConfig, String> {
+    let mut cfg = JobConfig::defaults(job.firmware).map_err(|e| e.to_string())?;
+    let (v, a) = (run.vmax_mm_s * 1e-3, run.amax_mm_s2 * 1e-3);
+    match &mut cfg.planner {
+        PlannerConfig::Klipper(c) => {
+            c.max_velocity_m_s = v;
+            c.max_accel_m_s2 = a;
+        }
+        PlannerConfig::Marlin(c) => {
+            for i in 0..3 {
+                c.max_feedrate_m_s[i] = v;
+                c.max_accel_m_s2[i] = a;
+            }
+            c.print_accel_m_s2 = a;
+            c.travel_accel_m_s2 = a;
+            c.retract_accel_m_s2 = c.retract_accel_m_s2.min(a);
+        }
+        PlannerConfig::Rrf(c) => {
+            for i in 0..3 {
+                c.max_feedrate_m_s[i] = v;
+                c.max_accel_m_s2[i] = a;
+            }
+            c.print_accel_m_s2 = a;
+            c.travel_accel_m_s2 = a;
+        }
+        PlannerConfig::Settle(c) => {
+            c.limits = run.limits_si().map_err(|e| e.to_string())?;
+            c.kind = settle_planner::ProfileKind::parse(&job.profile).map_err(|e| e.to_string())?;
+            c.corners = if job.square_corner_velocity_mm_s > 0.0 {
+                CornerStrategy::Junction(Junction::Klipper {
+                    square_corner_velocity: job.square_corner_velocity_mm_s * 1e-3,
+                })
+            } else {
+                CornerStrategy::ExactStop
+            };
+        }
+    }
+    cfg.shapers[0] = shaper;
+    cfg.shapers[1] = shaper;
+    Ok(cfg)
+}
+
+/// The shaper the run's `[shaper]` sets, as a job setting.
+fn shaper_setting(s: Option<&settle_planner::shaper::Shaper>) -> Option<ShaperSetting> {
+    s.map(|s| ShaperSetting {
+        shaper_type: s.shaper_type(),
+        frequency_hz: s.frequency_hz(),
+        damping_ratio: s.damping_ratio(),
+    })
+}
+
+/// The machine's axes with the linear driver (the modes form as it is): where the
+/// pre-roll's decay rate is read.
+fn linear_axes(run: &RunSpec) -> Result<Vec<AxisModel>, String> {
+    run.machine
+        .axes(DriverMode::Linear)
+        .map_err(|e| e.to_string())
+}
+
+/// The pre-roll of `run`'s layer range (s; 0 without one): [`preroll::preroll_s`] of the
+/// machine's slowest decay rate, plus two sample periods, so that moving the start to the
+/// sample grid leaves at least [`preroll::preroll_s`].
+fn preroll_of(run: &RunSpec, job: &GcodeJob) -> Result<f64, String> {
+    if job.layers.is_none() {
+        return Ok(0.0);
+    }
+    let sigma = preroll::slowest_decay_per_s(&linear_axes(run)?).map_err(|m| {
+        format!(
+            "{m}: a layer range cannot start from the state the layers before leave; simulate the whole file (no `layers`)"
+        )
+    })?;
+    Ok(preroll::preroll_s(sigma) + 2.0 / run.sample_rate_hz)
+}
+
+/// Where the modal backend linearises `run`'s machine ([`linpoint`]), one position (m)
+/// per machine axis in `axes`' order: `None` on the other backends and on a machine whose
+/// stiffness does not depend on position (the modes form).
+fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option<Vec<f64>>, String> {
+    if run.backend != Backend::Modal || !linpoint::depends_on_position(&linear_axes(run)?) {
+        return Ok(None);
+    }
+    let dialect = JobConfig::defaults(job.firmware)
+        .map_err(|e| e.to_string())?
+        .dialect;
+    let reader = Reader::open(&job.file, ReaderOptions::new(dialect)).map_err(|e| e.to_string())?;
+    let point = linpoint::linearisation_point(reader).map_err(|e| e.to_string())?;
+    Ok(Some(point.on_axes(axes)))
+}
+
+/// The job of `run` opened, limited to its layers with their pre-roll ([`preroll_of`]).
+fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<settle_gcode::FileInput>, String> {
+    let shaper = crate::studies::shaper(run).map_err(|e| e.to_string())?;
+    let cfg = job_config(run, job, shaper_setting(shaper.as_ref()))?;
+    let j = Job::open(&job.file, cfg).map_err(|e| e.to_string())?;
+    match job.layers {
+        Some((a, b)) => j
+            .with_layers(a..=b)
+            .and_then(|j| j.with_preroll_s(preroll_of(run, job).unwrap_or(0.0)))
+            .map_err(|e| e.to_string()),
+        None => Ok(j),
+    }
+}
+
+/// The chunks (print-clock start, trajectory) from `at_s` on: those ending before it
+/// dropped, the one containing it cut there ([`cut`]: the exact state at `at_s`).
+fn from_time(chunks: Vec<(f64, Trajectory)>, at_s: f64) -> Result<Vec<Trajectory>, PlanError> {
+    let mut out = Vec::with_capacity(chunks.len());
+    for (t0, tr) in chunks {
+        let d = tr.duration_s();
+        if out.is_empty() && at_s > t0 {
+            if t0 + d <= at_s {
+                continue;
+            }
+            let from = at_s - t0;
+            let axes = tr
+                .axes()
+                .iter()
+                .map(|p| cut(p, from, d))
+                .collect::<Result<Vec<_>, _>>()?;
+            out.push(Trajectory::new(axes)?);
+        } else {
+            out.push(tr);
+        }
+    }
+    Ok(out)
+}
+
+/// One profile per machine axis (X, Y, Z of the job by name), the chunks joined.
+fn join(axes: &[String], chunks: &[Trajectory]) -> Result<Trajectory, PlanError> {
+    let mut out = Vec::new();
+    for name in axes {
+        let i = match name.as_str() {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            _ => {
+                return Err(PlanError::InvalidInput {
+                    reason: "a G-code job drives machine axes named x, y and z only",
+                });
+            }
+        };
+        let start = chunks.first().map(|c| c.axes()[i].start()).unwrap_or_default();
+        let segs: Vec<Segment> = chunks
+            .iter()
+            .flat_map(|c| c.axes()[i].segments().iter().copied())
+            .collect();
+        out.push(Profile::new(start, segs)?);
+    }
+    Trajectory::new(out)
+}
+
+/// The study's probe: contour error of the recorded toolhead against the job's moves.
+#[derive(Debug)]
+struct GcodeProbe {
+    moves: Vec<Arc<MoveInfo>>,
+    /// Print-clock time of the run's `t = 0` (s).
+    t0_s: f64,
+    /// Only samples of moves in these layers count (the rest is the pre-roll).
+    layers: Option<(u32, u32)>,
+    print_time_s: f64,
+}
+
+impl Probe for GcodeProbe {
+    fn measure(&self, _run: &RunSpec, series: &Series, m: &mut Metrics) -> Result<(), Error> {
+        let (Some(x), Some(y)) = (series.channel("toolhead_x"), series.channel("toolhead_y"))
+        else {
+            return Ok(());
+        };
+        let mut active = ActiveMoves::default();
+        active.add(&self.moves);
+        let mut hist = Histogram::default();
+        let (mut worst, mut line) = (0.0_f64, f64::NAN);
+        let t_end = m.move_time_s;
+        for (k, &t) in series.t_s.iter().enumerate() {
+            if t > t_end {
+                break;
+            }
+            let tp = t + self.t0_s;
+            let p = [x.data[k] * 1e3, y.data[k] * 1e3];
+            let (Some(e), Some(owner)) = (active.error_mm(tp, p), active.owner(tp)) else {
+                continue;
+            };
+            if owner.kind != MoveKind::Print
+                || self
+                    .layers
+                    .is_some_and(|(a, b)| !(a..=b).contains(&owner.layer))
+            {
+                continue;
+            }
+            let e_um = e * 1e3;
+            hist.push(e_um);
+            if e_um > worst {
+                (worst, line) = (e_um, owner.line as f64);
+            }
+        }
+        m.extra.push(("print_time_s".into(), self.print_time_s));
+        m.extra.push(("contour_worst_um".into(), worst));
+        m.extra.push(("contour_p95_um".into(), hist.quantile_um(0.95)));
+        m.extra.push(("contour_worst_line".into(), line));
+        Ok(())
+    }
+}
+
+/// The G-code job study.
+#[derive(Debug, Clone, Copy)]
+pub struct GcodeRun;
+
+impl Study for GcodeRun {
+    fn name(&self) -> &'static str {
+        "G-code job"
+    }
+
+    fn table(&self) -> Option<&'static str> {
+        Some("gcode")
+    }
+
+    fn role(&self) -> Role {
+        Role::Path
+    }
+
+    fn sweepable(&self) -> &'static str {
+        "gcode.firmware"
+    }
+
+    fn parse(&self, src: &Source) -> Result<Option<Box<dyn StudyState>>, Error> {
+        let Some(spec) = src.table::<GcodeSpec>("gcode")? else {
+            return Ok(None);
+        };
+        let firmware = parse_firmware(&spec.firmware)
+            .map_err(|e| src.error_at("gcode.firmware", e.to_string()))?;
+        let layers = spec
+            .layers
+            .as_deref()
+            .map(parse_layers)
+            .transpose()
+            .map_err(|m| src.error_at("gcode.layers", m))?;
+        settle_planner::ProfileKind::parse(&spec.profile)
+            .map_err(|e| src.error_at("gcode.profile", e.to_string()))?;
+        let base = src.path.parent().unwrap_or(std::path::Path::new("."));
+        Ok(Some(Box::new(GcodeJob {
+            file: base.join(&spec.file),
+            firmware,
+            layers,
+            profile: spec.profile,
+            square_corner_velocity_mm_s: spec.square_corner_velocity_mm_s,
+        })))
+    }
+
+    fn path_move(&self, state: &dyn StudyState) -> Option<PathMove> {
+        let job = (state as &dyn std::any::Any).downcast_ref::<GcodeJob>()?;
+        Some(PathMove {
+            profile: job.profile.clone(),
+            profile_key: "gcode.profile",
+            axis: "x+y".into(),
+        })
+    }
+
+    /// Plans the whole file once: bad G-code is an error naming its file and line.
+    fn validate(&self, run: &RunSpec) -> Result<(), (String, String)> {
+        let Some(job) = run.state::<GcodeJob>() else {
+            return Ok(());
+        };
+        let names = run.axis_names();
+        let has = |a: &str| names.iter().any(|n| n == a);
+        if !(has("x") && has("y") && names.iter().all(|n| ["x", "y", "z"].contains(&n.as_str()))) {
+            return Err((
+                "machine".into(),
+                "a G-code job needs a machine with axes x and y (and z), no others: a physical machine (e.g. `preset = \"printer_xy\"`) or modes on `[machine.axis.x]` and `[machine.axis.y]`".into(),
+            ));
+        }
+        preroll_of(run, job).map_err(|m| (run.blame("gcode.layers"), m))?;
+        let mut j = open(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
+        j.run_to_end()
+            .map_err(|e| (run.blame("gcode.file"), e.to_string()))?;
+        match work::nothing_to_measure(&j.summary(), j.reader().lines_read()) {
+            Some(why) => Err((
+                run.blame("gcode.file"),
+                format!("{}: {why}", job.file.display()),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {
+        let job = run.state::<GcodeJob>().ok_or(PlanError::InvalidInput {
+            reason: "not a G-code run",
+        })?;
+        let failed = |_| PlanError::InvalidInput {
+            reason: "the G-code job failed to plan (checked when the sweep was validated)",
+        };
+        let mut j = open(run, job).map_err(failed)?;
+        let (mut chunks, mut moves) = (Vec::new(), Vec::<Arc<MoveInfo>>::new());
+        while let Some(c) = j.next_chunk().map_err(|e| failed(e.to_string()))? {
+            for m in &c.moves {
+                if moves.last().is_none_or(|l| m.index > l.index) {
+                    moves.push(Arc::clone(m));
+                }
+            }
+            chunks.push((c.start_time_s, c.trajectory));
+        }
+        j.run_to_end().map_err(|e| failed(e.to_string()))?;
+        let mut t0 = chunks.first().map_or(0.0, |c| c.0);
+        if let Some((a, _)) = job.layers {
+            // The pre-roll's start moved to the print clock's sample grid (module doc),
+            // when that leaves at least the pre-roll the modes need (it does unless the
+            // range starts within a pre-roll of the file's start, where the job starts at
+            // rest as in the whole run).
+            let dt = 1.0 / run.sample_rate_hz;
+            let on_grid = (t0 / dt).ceil() * dt;
+            let range_start = moves
+                .iter()
+                .find(|m| m.layer >= a && m.duration_s > 0.0)
+                .map(|m| m.start_time_s);
+            let needed = preroll_of(run, job).map_err(failed)? - 2.0 * dt;
+            if range_start.is_some_and(|r| r - on_grid >= needed) {
+                t0 = on_grid;
+            }
+        }
+        let chunks = from_time(chunks, t0)?;
+        let trajectory = join(ctx.axes, &chunks)?;
+        let linearise_at_m = linearise_at(run, job, ctx.axes).map_err(failed)?;
+        Ok(Planned {
+            trajectory,
+            probe: Some(Box::new(GcodeProbe {
+                moves,
+                t0_s: t0,
+                layers: job.layers,
+                print_time_s: j.print_time_s(),
+            })),
+            linearise_at_m,
+        })
+    }
+
+    fn columns(&self, runs: &dyn RunList) -> Vec<String> {
+        if !any_has::<GcodeJob>(runs) {
+            return Vec::new();
+        }
+        COLUMNS.iter().map(|c| c.to_string()).collect()
+    }
+
+    fn cells(&self, run: &RunSpec, m: &Metrics) -> Vec<String> {
+        let Some(job) = run.state::<GcodeJob>() else {
+            return Vec::new();
+        };
+        let mut out = vec![job.file.display().to_string(), job.firmware.to_string()];
+        if m.is_ok() {
+            for c in &COLUMNS[2..] {
+                let v = m.extra.iter().find(|(n, _)| n == c).map(|(_, v)| *v);
+                out.push(v.map(|v| v.to_string()).unwrap_or_default());
+            }
+        }
+        out
+    }
+}
