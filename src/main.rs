@@ -229,6 +229,9 @@ enum Command {
         /// The scenario to write [default: <config name>_import.toml beside the config].
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Overwrite a scenario already at the output path (refused without it).
+        #[arg(long)]
+        force: bool,
     },
     /// Replay a G-code file through a firmware's planner on a machine: print time, contour
     /// error per layer, the worst spots with their lines, the ringing map.
@@ -612,6 +615,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             config,
             machine,
             out,
+            force,
         } => {
             let opts = workflows::import::ImportOptions {
                 firmware: workflows::import::parse_firmware(&firmware)
@@ -619,6 +623,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 config,
                 machine,
                 out,
+                force,
             };
             workflows::import::import(&opts)?.report()
         }

@@ -63,6 +63,9 @@ pub struct ImportOptions {
     pub machine: Option<PathBuf>,
     /// The scenario to write (default: `<config name>_import.toml` beside the config).
     pub out: Option<PathBuf>,
+    /// Replace a scenario already at `out` (refused without it: an earlier import, or a
+    /// scenario edited since, would be lost).
+    pub force: bool,
 }
 
 /// One axis's current settings.
@@ -546,6 +549,15 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
     }
     inputs.refuse(&out)?;
     settle_files::write::check_target(&out)?;
+    if !opts.force && std::fs::symlink_metadata(&out).is_ok() {
+        return Err(Error::input(
+            "--force",
+            format!(
+                "{} already exists (an earlier import, or a scenario edited since): pass --force to overwrite it, --out FILE to write elsewhere",
+                out.display()
+            ),
+        ));
+    }
     let mut notes = cur.notes.clone();
     // The machine's axes, read here so that its errors name it (and only it).
     let machine_axes = match &opts.machine {
