@@ -580,13 +580,16 @@ fn dispatch(command: Command) -> Result<Report, Error> {
         } => {
             if criterion == "klipper" {
                 workflows::tune::klipper_criterion::report(
-                    &workflows::tune::klipper_criterion::KlipperCriterion::from_args(
-                        scenario,
-                        out,
-                        shapers.as_deref(),
-                        scv,
-                        max_smoothing,
-                    )?,
+                    &workflows::tune::klipper_criterion::KlipperCriterion {
+                        force,
+                        ..workflows::tune::klipper_criterion::KlipperCriterion::from_args(
+                            scenario,
+                            out,
+                            shapers.as_deref(),
+                            scv,
+                            max_smoothing,
+                        )?
+                    },
                 )?
             } else if scenario.len() != 1
                 || shapers.is_some()

@@ -49,6 +49,8 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         ("o_tune/tune.md", "my notes\n"),
         ("o_merge/runs.csv", "run\n0\n"),
         ("o_fig/identify-x.svg", "<svg/>\n"),
+        ("o_import.toml", "# my edits\n"),
+        ("o_kc/input_shaper.cfg", "[input_shaper]\n"),
         (
             "o_self/layers.csv",
             &std::fs::read_to_string(sb.root().join("print.gcode")).expect("print"),
@@ -131,6 +133,36 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             &[],
             Expect::refused(&["character device"]),
         ),
+        Case::line(
+            "import over an earlier scenario",
+            "import klipper printer.cfg --out o_import.toml",
+            &[],
+            Expect::refused(&["--force", "o_import.toml"]),
+        ),
+        Case::line(
+            "import --force over an earlier scenario",
+            "import klipper printer.cfg --out o_import.toml --force",
+            &["o_import.toml"],
+            Expect::answered(&["o_import.toml"]),
+        ),
+        Case::line(
+            "tune --criterion klipper into earlier results",
+            "tune --criterion klipper rec_x.csv --out o_kc",
+            &[],
+            Expect::refused(&["--force", "input_shaper.cfg"]),
+        ),
+        Case::line(
+            "tune --criterion klipper --out a file",
+            "tune --criterion klipper rec_x.csv --out print.gcode",
+            &[],
+            Expect::refused(&["not a folder"]),
+        ),
+        Case::line(
+            "tune --criterion klipper --out a device",
+            "tune --criterion klipper rec_x.csv --out null.dev",
+            &[],
+            Expect::refused(&["not a folder"]),
+        ),
         case(
             "run --out names its scenario",
             mcap_run("sc.toml"),
@@ -209,6 +241,12 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "sweep sc.toml --backend modal --out o_ok",
             &["o_ok"],
             Expect::answered(&["wrote o_ok/runs.csv"]),
+        ),
+        Case::line(
+            "tune --criterion klipper into a new folder",
+            "tune --criterion klipper rec_x.csv --out o_kc_new",
+            &["o_kc_new"],
+            Expect::answered(&["wrote o_kc_new/input_shaper.cfg"]),
         ),
         case(
             "identify into a new folder",
