@@ -19,7 +19,7 @@ struct Writer {
     file: &'static str,
 }
 
-const WRITERS: [Writer; 5] = [
+const WRITERS: [Writer; 6] = [
     Writer {
         args: &["identify", "rec_x.csv"],
         input: "rec_x.csv",
@@ -45,6 +45,11 @@ const WRITERS: [Writer; 5] = [
         input: "print.gcode",
         file: "",
     },
+    Writer {
+        args: &["tune", "--criterion", "klipper", "rec_x.csv"],
+        input: "rec_x.csv",
+        file: "",
+    },
 ];
 
 /// Outputs aimed at random places: refused unless the place is new.
@@ -58,6 +63,7 @@ pub fn output_cases(sb: &Sandbox, r: &mut ChaCha8Rng, n: usize) -> Vec<Case> {
     }
     sb.write("earlier/summary.md", "my notes\n");
     sb.write("earlier/runs.csv", "run\n0\n");
+    sb.write("earlier/input_shaper.cfg", "[input_shaper]\n");
     (0..n)
         .map(|i| {
             let w = &WRITERS[r.random_range(0..WRITERS.len())];
