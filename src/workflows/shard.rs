@@ -204,8 +204,10 @@ finish it with `settle sweep SCENARIO --shard {} --out {} --resume`, then merge"
 fn journal_shard(journal: &Path) -> Option<String> {
     use std::io::{BufRead, Read};
     let mut line = String::new();
-    std::fs::File::open(journal)
-        .and_then(|f| std::io::BufReader::new(f.take(4096)).read_line(&mut line))
+    // Through the one reader (a regular file; a FIFO put in its place does not block).
+    let f = crate::input::file::open(journal, crate::input::file::limit::RESULTS).ok()?;
+    std::io::BufReader::new(f.take(4096))
+        .read_line(&mut line)
         .ok()?;
     let shard = line.split("; ").find_map(|p| p.strip_prefix("shard "))?;
     shard.parse::<Shard>().ok().map(|s| s.to_string())
