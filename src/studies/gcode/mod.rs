@@ -46,6 +46,7 @@ pub mod contour;
 pub mod linpoint;
 pub mod preroll;
 pub mod stats;
+pub mod work;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -260,7 +261,7 @@ fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option
 }
 
 /// The job of `run` opened, limited to its layers with their pre-roll ([`preroll_of`]).
-fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<std::io::BufReader<std::fs::File>>, String> {
+fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<settle_gcode::FileInput>, String> {
     let shaper = crate::studies::shaper(run).map_err(|e| e.to_string())?;
     let cfg = job_config(run, job, shaper_setting(shaper.as_ref()))?;
     let j = Job::open(&job.file, cfg).map_err(|e| e.to_string())?;
@@ -443,7 +444,14 @@ impl Study for GcodeRun {
         preroll_of(run, job).map_err(|m| (run.blame("gcode.layers"), m))?;
         let mut j = open(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
         j.run_to_end()
-            .map_err(|e| (run.blame("gcode.file"), e.to_string()))
+            .map_err(|e| (run.blame("gcode.file"), e.to_string()))?;
+        match work::nothing_to_measure(&j.summary(), j.reader().lines_read()) {
+            Some(why) => Err((
+                run.blame("gcode.file"),
+                format!("{}: {why}", job.file.display()),
+            )),
+            None => Ok(()),
+        }
     }
 
     fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {
