@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite, used verbatim by CI (.ci/run): formatting, lints, API docs, every
-# test, the regression gate, every command of the README and the book
-# (scripts/check-commands.sh), a fuzz smoke run and the `rerun` feature. Installs what it
-# needs without root: crates from crates.io through cargo, libmujoco 3.17.0 from its PyPI
+# test, the adversarial suite (scripts/adversarial.sh), the regression gate, every command
+# of the README and the book (scripts/check-commands.sh), a fuzz smoke run and the `rerun`
+# feature. Installs what it needs without root: crates from crates.io through cargo, libmujoco 3.17.0 from its PyPI
 # wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), the official MCAP reader from PyPI into .deps/ (scripts/mcap-python,
 # for the MCAP tests); with root (or sudo), headless Chromium from Debian's `chromium`
 # package when missing (scripts/browser-test.sh, for the report.html tests), and Debian's
@@ -135,6 +135,9 @@ fi
 
 phase "cargo test: run"
 cargo test --workspace --profile ci --locked "${features[@]}"
+
+phase "the adversarial suite with its generated cases (scripts/adversarial.sh)"
+scripts/adversarial.sh "${features[@]}"
 
 # The gate runs the `settle` binary the test build made (a `cargo run` would build it
 # again: without the dev-dependencies, some of its dependencies' features differ).

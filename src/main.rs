@@ -111,7 +111,7 @@ enum Command {
         #[arg(long)]
         baseline: PathBuf,
         /// Relative tolerance in percent (numbers closer than this to the baseline pass).
-        #[arg(long, value_name = "PCT", default_value_t = workflows::check::DEFAULT_TOLERANCE_PCT)]
+        #[arg(long, value_name = "PCT", allow_hyphen_values = true, default_value_t = workflows::check::DEFAULT_TOLERANCE_PCT)]
         tolerance: f64,
         /// Absolute floor of lengths in um (`_um` columns; `_mm` ones in their unit): a
         /// change smaller than this is no change, whatever its percentage.
@@ -142,6 +142,10 @@ enum Command {
         /// Output folder [default: results/<scenario name>/].
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Overwrite the results of an earlier sweep in the output folder (refused
+        /// without it).
+        #[arg(long)]
+        force: bool,
         #[command(flatten)]
         failed_runs: FailedRunsFlag,
     },
@@ -173,7 +177,7 @@ enum Command {
         /// off its frequency either way [default: `[tune] frequency_tolerance_pct`, else 0];
         /// a machine whose modes carry `frequency_sigma_hz` is checked over the wider of
         /// this and their 2-sigma band.
-        #[arg(long, value_name = "PCT")]
+        #[arg(long, value_name = "PCT", allow_hyphen_values = true)]
         frequency_tolerance: Option<f64>,
         /// `settle` (simulate move-and-settle on the machine) or `klipper` (Klipper's
         /// calibrate_shaper.py choice on a processed resonance CSV).
@@ -191,6 +195,10 @@ enum Command {
         /// Worker threads [default: all cores].
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
         jobs: Option<u16>,
+        /// Overwrite the results of an earlier tuning in the output folder (refused
+        /// without it).
+        #[arg(long)]
+        force: bool,
         /// `--criterion klipper`: the shapers to try, comma-separated (calibrate_shaper.py's
         /// --shapers) [default: zv,mzv,ei,2hump_ei,3hump_ei].
         #[arg(long)]
@@ -221,6 +229,9 @@ enum Command {
         /// The scenario to write [default: <config name>_import.toml beside the config].
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Overwrite a scenario already at the output path (refused without it).
+        #[arg(long)]
+        force: bool,
     },
     /// Replay a G-code file through a firmware's planner on a machine: print time, contour
     /// error per layer, the worst spots with their lines, the ringing map.
@@ -264,11 +275,11 @@ enum Command {
         #[arg(long)]
         skip_bad_lines: bool,
         /// Sample rate (Hz).
-        #[arg(long, default_value_t = workflows::gcode::DEFAULT_SAMPLE_RATE_HZ)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = workflows::gcode::DEFAULT_SAMPLE_RATE_HZ)]
         sample_rate_hz: f64,
-        /// Ringing maps to draw: the layers with the largest contour error.
-        #[arg(long, default_value_t = 1)]
-        maps: usize,
+        /// Ringing maps to draw: the layers with the largest contour error (0 to 50).
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u16).range(0..=50))]
+        maps: u16,
         /// Also write recording.mcap into the output folder: every simulated sample of
         /// the layers (commanded and toolhead XY, contour error, line), streaming.
         #[arg(long)]
@@ -282,6 +293,10 @@ enum Command {
             settle_planner::firmware::Firmware,
             workflows::gcode::XyShapers,
         )>,
+        /// Overwrite the results of an earlier run in the output folder (refused without
+        /// it).
+        #[arg(long)]
+        force: bool,
         #[command(flatten)]
         failed_runs: FailedRunsFlag,
     },
@@ -349,24 +364,28 @@ enum Command {
         column: settle_identify::SpectrumColumn,
         /// The resonance test's first frequency (Hz; Klipper's FREQ_START / min_freq)
         /// [default: Klipper's defaults for this and the five options below].
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         freq_start: Option<f64>,
         /// Its last frequency (Hz; Klipper's FREQ_END / max_freq).
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         freq_end: Option<f64>,
         /// Its sweep rate (Hz/s; Klipper's HZ_PER_SEC).
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         hz_per_sec: Option<f64>,
         /// Its acceleration per Hz (mm/s^2/Hz; Klipper's accel_per_hz).
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         accel_per_hz: Option<f64>,
         /// The slow sweeping motion's acceleration (mm/s^2; Klipper's sweeping_accel; 0
         /// for the pulse-only test of Klipper before December 2024).
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         sweeping_accel: Option<f64>,
         /// Its period (s; Klipper's sweeping_period).
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         sweeping_period: Option<f64>,
+        /// Overwrite the figures of an earlier identification in the figures folder
+        /// (refused without it).
+        #[arg(long)]
+        force: bool,
     },
 }
 
@@ -425,7 +444,7 @@ fn main() -> ExitCode {
             })
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", settle::error::shorten_numbers(&e.to_string()));
             ExitCode::from(if e.is_input_error() { 2 } else { 1 })
         }
     }
@@ -543,8 +562,9 @@ fn dispatch(command: Command) -> Result<Report, Error> {
         Command::Merge {
             dirs,
             out,
+            force,
             failed_runs: flag,
-        } => failed_runs(workflows::merge::merge(&dirs, out)?.report(), flag),
+        } => failed_runs(workflows::merge::merge(&dirs, out, force)?.report(), flag),
         Command::Tune {
             scenario,
             out,
@@ -554,19 +574,23 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             firmware,
             frequency_tolerance,
             criterion,
+            force,
             shapers,
             scv,
             max_smoothing,
         } => {
             if criterion == "klipper" {
                 workflows::tune::klipper_criterion::report(
-                    &workflows::tune::klipper_criterion::KlipperCriterion::from_args(
-                        scenario,
-                        out,
-                        shapers.as_deref(),
-                        scv,
-                        max_smoothing,
-                    )?,
+                    &workflows::tune::klipper_criterion::KlipperCriterion {
+                        force,
+                        ..workflows::tune::klipper_criterion::KlipperCriterion::from_args(
+                            scenario,
+                            out,
+                            shapers.as_deref(),
+                            scv,
+                            max_smoothing,
+                        )?
+                    },
                 )?
             } else if scenario.len() != 1
                 || shapers.is_some()
@@ -584,6 +608,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     jobs: jobs(j),
                     firmware,
                     frequency_tolerance_pct: frequency_tolerance,
+                    force,
                     ..workflows::tune::Options::new(backend)
                 };
                 workflows::tune::tune_with(scenario, out, &opts, &progress)?.report()
@@ -594,6 +619,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             config,
             machine,
             out,
+            force,
         } => {
             let opts = workflows::import::ImportOptions {
                 firmware: workflows::import::parse_firmware(&firmware)
@@ -601,6 +627,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 config,
                 machine,
                 out,
+                force,
             };
             workflows::import::import(&opts)?.report()
         }
@@ -633,6 +660,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             maps,
             mcap,
             versus,
+            force,
             failed_runs: flag,
         } => {
             let opts = workflows::gcode::GcodeOptions {
@@ -643,8 +671,9 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 out,
                 skip_bad_lines,
                 sample_rate_hz,
-                maps,
+                maps: usize::from(maps),
                 versus,
+                force,
                 ..match config {
                     Some(config) => workflows::gcode::GcodeOptions::with_config(
                         file, &machine, firmware, config,
@@ -692,6 +721,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             accel_per_hz,
             sweeping_accel,
             sweeping_period,
+            force,
         } => {
             let opts = workflows::identify::IdentifyOptions {
                 axis,
@@ -713,6 +743,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     method,
                     column,
                 },
+                force,
                 ..workflows::identify::IdentifyOptions::new(files)
             };
             workflows::identify::identify(&opts)?.report()

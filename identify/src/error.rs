@@ -7,6 +7,10 @@
 /// What can go wrong reading a recording or identifying modes from it.
 #[derive(Debug, thiserror::Error)]
 pub enum IdentifyError {
+    /// The file is not a regular file, is larger than a recording can be, or decompresses
+    /// to more (settle-files' reader).
+    #[error(transparent)]
+    File(#[from] settle_files::FileError),
     /// The file could not be read.
     #[error("{file}: cannot read: {source}")]
     Io {
@@ -66,11 +70,11 @@ pub enum IdentifyError {
         allowed: String,
     },
     /// Too few samples (or frequency rows) to analyse.
-    #[error("{file}:{line}: the data end after {found} {what}; at least {needed} are needed")]
+    #[error("{file}{}: the data end after {found} {what}; at least {needed} are needed", at_line(*line))]
     TooFewSamples {
         /// The file.
         file: String,
-        /// 1-based number of the last line read.
+        /// 1-based number of the last line read (0: about the whole file, no line named).
         line: usize,
         /// What was counted (`samples`, `frequency rows`).
         what: &'static str,
@@ -135,6 +139,15 @@ pub enum IdentifyError {
         /// What is allowed.
         allowed: &'static str,
     },
+}
+
+/// `:LINE`, or nothing for line 0 (a count over the whole file, not a line of it).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
+    }
 }
 
 impl IdentifyError {

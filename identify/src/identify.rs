@@ -71,7 +71,7 @@ impl Options {
         if !(1..=4).contains(&self.max_modes) {
             return bad("max_modes", self.max_modes as f64, "1 to 4");
         }
-        if !(t.freq_start_hz >= 1.0 && t.freq_end_hz > t.freq_start_hz + 5.0) {
+        if !(t.freq_start_hz >= 1.0 && t.freq_end_hz >= t.freq_start_hz + 5.0) {
             return bad(
                 "test.freq_end_hz",
                 t.freq_end_hz,

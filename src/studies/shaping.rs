@@ -113,6 +113,16 @@ impl ShaperSetting {
                 ),
             ));
         }
+        let min = settle_planner::shaper::MIN_FREQUENCY_HZ;
+        if self.shaper_type.is_some() && self.frequency_hz < min {
+            return Err((
+                "shaper.frequency_hz",
+                format!(
+                    "{} Hz is below {min} Hz, the lowest shaper frequency settle runs (a shaper lasts about one period)",
+                    self.frequency_hz
+                ),
+            ));
+        }
         if !(0.0..1.0).contains(&self.damping_ratio) {
             return Err((
                 "shaper.damping_ratio",

@@ -28,6 +28,7 @@ use settle_gcode::Dialect;
 use settle_gcode::config::{KlipperConfig, RrfConfig, ShaperSetting as FirmwareShaper};
 
 use crate::error::{Error, Location};
+use crate::input::machine_form::MachineForm;
 use crate::output::atomic::write_atomic;
 use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::grid::{identified_band, tuning_modes};
@@ -62,6 +63,9 @@ pub struct ImportOptions {
     pub machine: Option<PathBuf>,
     /// The scenario to write (default: `<config name>_import.toml` beside the config).
     pub out: Option<PathBuf>,
+    /// Replace a scenario already at `out` (refused without it: an earlier import, or a
+    /// scenario edited since, would be lost).
+    pub force: bool,
 }
 
 /// One axis's current settings.
@@ -137,9 +141,11 @@ impl Imported {
 
 /// A configuration reader's error as the harness's, at its file, line and key.
 pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
-    if let settle_gcode::GcodeError::Io { source, .. } = e {
-        return Error::read(path, source);
-    }
+    let e = match e {
+        settle_gcode::GcodeError::Io { source, .. } => return Error::read(path, source),
+        settle_gcode::GcodeError::File(f) => return (*f).into(),
+        e => e,
+    };
     let text = e.to_string();
     match e.location() {
         Some(at) => {
@@ -160,7 +166,12 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
                 message: text.strip_prefix(&prefix).unwrap_or(&text).to_string(),
             }
         }
-        None => Error::input(path, text),
+        None => match e {
+            settle_gcode::GcodeError::JobSetting { key, reason } => {
+                Error::input_key(path, key, reason)
+            }
+            _ => Error::input(path, text),
+        },
     }
 }
 
@@ -193,9 +204,21 @@ pub fn parse_firmware(name: &str) -> Result<Firmware, String> {
 
 /// Read the current settings of a firmware configuration.
 pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
+    read_current_files(firmware, path).map(|(c, _)| c)
+}
+
+/// [`read_current`], with the files read (the configuration and what it includes).
+pub fn read_current_files(
+    firmware: Firmware,
+    path: &Path,
+) -> Result<(Current, Vec<PathBuf>), Error> {
     match firmware {
         Firmware::Klipper => {
             let c = KlipperConfig::read(path).map_err(|e| config_error(path, e))?;
+            // The planner's settings as `settle gcode --config` takes them: a shaper
+            // Klipper would refuse is refused here too, naming its key.
+            settle_gcode::job::JobConfig::from_klipper(&c).map_err(|e| config_error(path, e))?;
+            let files = c.files.clone();
             let axes = [("x", &c.steppers.x), ("y", &c.steppers.y)]
                 .into_iter()
                 .map(|(name, st)| AxisNow {
@@ -206,16 +229,19 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                     usteps_per_mm: st.as_ref().map(|s| s.drive.microsteps_per_mm),
                 })
                 .collect();
-            Ok(Current {
+            let cur = Current {
                 firmware,
                 vmax_mm_s: c.printer.max_velocity_mm_s,
                 amax_mm_s2: c.printer.max_accel_mm_s2,
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
-            })
+            };
+            Ok((cur, files))
         }
         Firmware::Rrf => {
             let c = RrfConfig::read(path).map_err(|e| config_error(path, e))?;
+            settle_gcode::job::JobConfig::from_rrf(&c).map_err(|e| config_error(path, e))?;
+            let files = c.files.clone();
             let shaper = shaper_now(&c.input_shaper, Dialect::Rrf);
             let axes = [("x", &c.axes.x), ("y", &c.axes.y)]
                 .into_iter()
@@ -225,7 +251,7 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                     usteps_per_mm: Some(a.drive.microsteps_per_mm),
                 })
                 .collect();
-            Ok(Current {
+            let cur = Current {
                 firmware,
                 vmax_mm_s: c.axes.x.max_speed_mm_s.min(c.axes.y.max_speed_mm_s),
                 amax_mm_s2: c
@@ -234,7 +260,8 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                     .min(c.axes.y.max_accel_mm_s2),
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
-            })
+            };
+            Ok((cur, files))
         }
         other => Err(Error::input_key(
             path,
@@ -451,6 +478,47 @@ fn scenario_text(
     t
 }
 
+/// A scenario made of the settings read that settle cannot run (`e`, against the probe
+/// scenario), said against the configuration and the firmware's own key.
+fn settings_error(config: &Path, firmware: Firmware, axis: &str, e: Error) -> Error {
+    let Error::Input { at, message } = e else {
+        return e;
+    };
+    let key = at.key.unwrap_or_default();
+    let key = key.strip_prefix("sweep.").unwrap_or(&key);
+    let klipper = firmware == Firmware::Klipper;
+    let firmware_key = match key {
+        k if k.starts_with("limits.amax") => {
+            if klipper {
+                "printer.max_accel"
+            } else {
+                "M201 / M204 P"
+            }
+        }
+        k if k.starts_with("limits.vmax") => {
+            if klipper {
+                "printer.max_velocity"
+            } else {
+                "M203"
+            }
+        }
+        k if k.starts_with("shaper.") => {
+            if klipper {
+                "input_shaper"
+            } else {
+                "M593"
+            }
+        }
+        _ => "",
+    };
+    let message = format!("axis {axis}: settle cannot run these settings: {message}");
+    if firmware_key.is_empty() {
+        Error::input(config, message)
+    } else {
+        Error::input_key(config, firmware_key, message)
+    }
+}
+
 /// A scenario name from the configuration's file name.
 fn name_of(config: &Path) -> String {
     let stem = config
@@ -476,13 +544,46 @@ fn name_of(config: &Path) -> String {
 /// Import: read the configuration, find the axes the machine has and its modes, write
 /// the scenario.
 pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
-    let cur = read_current(opts.firmware, &opts.config)?;
+    let (cur, files) = read_current_files(opts.firmware, &opts.config)?;
     let name = name_of(&opts.config);
     let out = opts
         .out
         .clone()
         .unwrap_or_else(|| opts.config.with_file_name(format!("{name}.toml")));
+    // Never onto the configuration, a file it includes or the machine file.
+    let mut inputs = settle_files::write::Inputs::of(&files);
+    inputs.add(&opts.config);
+    if let Some(m) = &opts.machine {
+        inputs.add(m);
+    }
+    inputs.refuse(&out)?;
+    settle_files::write::check_target(&out)?;
+    if !opts.force && std::fs::symlink_metadata(&out).is_ok() {
+        return Err(Error::input(
+            "--force",
+            format!(
+                "{} already exists (an earlier import, or a scenario edited since): pass --force to overwrite it, --out FILE to write elsewhere",
+                out.display()
+            ),
+        ));
+    }
     let mut notes = cur.notes.clone();
+    // The machine's axes, read here so that its errors name it (and only it).
+    let machine_axes = match &opts.machine {
+        Some(m) => {
+            let text = crate::input::file::read_text(m, crate::input::file::limit::SETTINGS)?;
+            let d = crate::input::machine_file::parse_any(&text, m)?;
+            Some(match d.form {
+                MachineForm::Physical(machine) => machine
+                    .axes
+                    .iter()
+                    .map(|a| a.name.clone())
+                    .collect::<Vec<_>>(),
+                MachineForm::Modes(axes) => axes.iter().map(|a| a.axis.clone()).collect(),
+            })
+        }
+        None => None,
+    };
     let machine = match &opts.machine {
         Some(m) => std::path::absolute(m)
             .map_err(|e| Error::read(m, e))?
@@ -503,11 +604,21 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
     let mut band = false;
     let mut top: Option<f64> = None;
     for a in &cur.axes {
+        let has_axis = machine_axes.as_ref().is_none_or(|m| m.contains(&a.name));
+        if !has_axis {
+            notes.push(format!(
+                "the machine has no axis `{}`: it is not tuned",
+                a.name
+            ));
+            continue;
+        }
         let text = scenario_text(&name, &machine, &cur, &[a], 40.0, &source, false, None);
         let probe = out.with_file_name(format!("{name}.probe.toml"));
-        if let Ok((_, runs)) = crate::expand::parse_runs(&text, &probe)
-            && let Some(run) = runs.first()
-        {
+        // The machine has the axis: a scenario that does not load is the settings' fault
+        // (a limit the firmware accepts that settle cannot run), said as such.
+        let (_, runs) = crate::expand::parse_runs(&text, &probe)
+            .map_err(|e| settings_error(&opts.config, cur.firmware, &a.name, e))?;
+        if let Some(run) = runs.first() {
             if centre_hz.is_none() {
                 centre_hz = tuning_modes(run)
                     .first()
@@ -518,11 +629,6 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
                 top = Some(top.map_or(t, |m: f64| m.max(t)));
             }
             axes.push(a);
-        } else {
-            notes.push(format!(
-                "the machine has no axis `{}`: it is not tuned",
-                a.name
-            ));
         }
     }
     if axes.is_empty() {

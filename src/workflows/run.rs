@@ -69,7 +69,8 @@ pub struct RunOutcome {
 pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
     let path = &opts.scenario;
     let case = opts.case;
-    let (sc, mut runs) = crate::expand::load_runs(path)?;
+    let (sc, src) = crate::expand::load(path)?;
+    let mut runs = crate::expand::expand(&sc, &src)?;
     crate::execute::set_backend(path, &mut runs, opts.backend)?;
     let Some(spec) = runs.get(case) else {
         return Err(Error::input(
@@ -89,6 +90,28 @@ pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .map_or_else(|| PathBuf::from("."), PathBuf::from);
+    // Never onto the scenario or a file it reads, a link or a device: checked for every
+    // file the run writes, before it runs.
+    let inputs = crate::expand::machine::input_files(&sc, &src);
+    let stem = out.file_stem().map_or_else(
+        || format!("run-{case}"),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    let mut outputs = vec![out.clone()];
+    if opts.mcap {
+        outputs.push(out.with_extension("mcap"));
+    }
+    if opts.rerun {
+        outputs.push(out.with_extension("rrd"));
+    }
+    if opts.plot {
+        outputs.push(dir.join(format!("{stem}.svg")));
+        outputs.push(dir.join(format!("{stem}.png")));
+    }
+    for o in &outputs {
+        inputs.refuse(o)?;
+        settle_files::write::check_target(o)?;
+    }
     if out.parent().is_some_and(|d| !d.as_os_str().is_empty()) {
         create_dir(&dir)?;
     }
@@ -138,10 +161,6 @@ pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
         }
     }
     if opts.plot {
-        let stem = out.file_stem().map_or_else(
-            || format!("run-{case}"),
-            |s| s.to_string_lossy().into_owned(),
-        );
         let title = format!("{} run {case}: {}", sc.name, spec.swept_text(", "));
         let mut fig = crate::output::plot::trace::figure(&title, &record);
         crate::output::plot::scan_trace::scan_view(&record, &mut fig.panels);

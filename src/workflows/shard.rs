@@ -162,7 +162,7 @@ finish it with `settle sweep SCENARIO --shard {} --out {} --resume`, then merge"
             ),
         ));
     }
-    let text = crate::input::file::read_text(&path)?;
+    let text = crate::input::file::read_text(&path, crate::input::file::limit::RESULTS)?;
     let m: Manifest =
         toml::from_str(&text).map_err(|e| input_error(&path, e.message().trim().to_string()))?;
     if m.format != FORMAT {
@@ -175,7 +175,7 @@ finish it with `settle sweep SCENARIO --shard {} --out {} --resume`, then merge"
         ));
     }
     let csv_path = dir.join("runs.csv");
-    let csv = crate::input::file::read_text(&csv_path)?;
+    let csv = crate::input::file::read_text(&csv_path, crate::input::file::limit::RESULTS)?;
     if runs_digest(&csv) != m.runs_digest {
         return Err(input_error(
             &csv_path,
@@ -204,8 +204,10 @@ finish it with `settle sweep SCENARIO --shard {} --out {} --resume`, then merge"
 fn journal_shard(journal: &Path) -> Option<String> {
     use std::io::{BufRead, Read};
     let mut line = String::new();
-    std::fs::File::open(journal)
-        .and_then(|f| std::io::BufReader::new(f.take(4096)).read_line(&mut line))
+    // Through the one reader (a regular file; a FIFO put in its place does not block).
+    let f = crate::input::file::open(journal, crate::input::file::limit::RESULTS).ok()?;
+    std::io::BufReader::new(f.take(4096))
+        .read_line(&mut line)
         .ok()?;
     let shard = line.split("; ").find_map(|p| p.strip_prefix("shard "))?;
     shard.parse::<Shard>().ok().map(|s| s.to_string())

@@ -11,7 +11,7 @@ use crate::error::Error;
 use crate::execute::pool::{Progress, run_each_errors};
 use crate::input::runs_columns::RunsColumns;
 use crate::measure::metrics::Metrics;
-use crate::output::atomic::{create_dir, write_atomic};
+use crate::output::atomic::{create_dir, create_subdir, write_atomic};
 use crate::output::report::ScenarioFile;
 use crate::output::runs_csv::RunsCsv;
 use crate::output::sink::{Provenance, Recorder};
@@ -164,6 +164,14 @@ pub fn sweep(
         Some(s) => all_runs.every(s.k - 1, s.n),
         None => all_runs,
     };
+    // Never onto the scenario or a file it reads, nor through a link out of the folder.
+    let read = crate::expand::machine::input_files(&sc, &src);
+    crate::output::folder::check(&out, &NO_RESULTS, true, &read, writes)?;
+    for sub in [PLOTS, RECORDINGS] {
+        if std::fs::symlink_metadata(out.join(sub)).is_ok() {
+            create_subdir(&out.join(sub))?;
+        }
+    }
     create_dir(&out)?;
     // The lock first: a folder another sweep is writing is refused as such.
     let _lock = FolderLock::take(&out)?;
@@ -175,7 +183,7 @@ pub fn sweep(
         remove_stale_temps(&dir)?;
     }
     if let Some(r) = &rec {
-        create_dir(&r.dir)?;
+        create_subdir(&r.dir)?;
     }
     note(&format!(
         "{}: {} runs on {}{} -> {}",
@@ -258,7 +266,7 @@ pub fn sweep(
             return Err(Error::Interrupted { run: spec.id });
         }
         let m = match match &rec {
-            Some(r) => r.run(spec),
+            Some(r) => r.run(spec).map_err(Error::as_write_failure),
             None => crate::execute::execute(spec, None),
         } {
             Ok(m) => m,
@@ -367,6 +375,30 @@ pub const KEPT: [&str; 4] = [
     crate::output::sweep_files::REPORT,
     journal::FILE,
 ];
+
+/// The results-folder check without earlier results to find (a sweep finds them itself,
+/// after taking the folder's lock: [`refuse_overwrite`]).
+const NO_RESULTS: crate::output::folder::Results<'static> = crate::output::folder::Results {
+    what: "a sweep",
+    marks: &[],
+};
+
+/// Whether a sweep (or a shard) writes `rel` in its output folder.
+pub fn writes(rel: &Path) -> bool {
+    crate::output::folder::written(
+        rel,
+        &[
+            "runs.csv",
+            "summary.md",
+            crate::output::sweep_files::REPORT,
+            journal::FILE,
+            crate::workflows::lock::FILE,
+            shard::MANIFEST,
+        ],
+        &[PLOTS, RECORDINGS],
+        &[],
+    )
+}
 
 /// An error when `out` holds the results of an earlier sweep ([`KEPT`]).
 fn refuse_overwrite(out: &Path) -> Result<(), Error> {

@@ -213,8 +213,10 @@ fn a_single_axis_m956_capture_names_its_axis() {
     assert_eq!(code, Some(0), "{out}{err}");
     let row = out.lines().nth(1).expect("a mode row");
     assert!(row.starts_with("y "), "{out}");
+    // The command above wrote its figures there: --force replaces them.
     let got = identify(&IdentifyOptions {
         figures: Some(dir.path().to_path_buf()),
+        force: true,
         ..IdentifyOptions::new(vec![file])
     })
     .expect("identifies");

@@ -3,6 +3,8 @@
 
 mod support;
 
+#[cfg(target_os = "linux")]
+mod adversarial;
 mod cli;
 mod corners;
 mod faults;

@@ -28,7 +28,7 @@ use std::sync::Arc;
 
 use settle_planner::firmware::grbl::GrblConfig;
 
-use super::klipper_files::read_text;
+use super::budget::Budget;
 use super::machine::ConfigNote;
 use crate::error::GcodeError;
 use crate::read::dialect::Dialect;
@@ -154,10 +154,11 @@ impl GrblSettings {
         }
     }
 
-    /// Reads the settings file at `path`.
+    /// Reads the settings file at `path` (settle-files' reader: a regular file of at most
+    /// [`settle_files::limit::FIRMWARE_CONFIG`]).
     pub fn read(path: impl AsRef<Path>) -> Result<Self, GcodeError> {
         let path = path.as_ref();
-        let text = read_text(path)?;
+        let text = Budget::new().main(path)?;
         Self::parse(&text, path)
     }
 

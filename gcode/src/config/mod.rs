@@ -48,6 +48,7 @@
 //! # Ok::<(), settle_gcode::GcodeError>(())
 //! ```
 
+mod budget;
 mod export_klipper;
 mod export_rrf;
 mod export_text;
@@ -62,6 +63,7 @@ mod machine;
 mod rrf;
 mod rrf_script;
 
+pub use budget::{MAX_BYTES as MAX_CONFIG_BYTES, MAX_FILES as MAX_CONFIG_FILES};
 pub use export_klipper::KlipperExport;
 
 pub use export_rrf::RrfExport;

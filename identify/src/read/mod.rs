@@ -14,16 +14,15 @@ pub mod klipper_raw;
 pub mod rrf;
 pub mod stdata;
 
-use std::io::Read as _;
 use std::path::Path;
 
 use crate::IdentifyError;
 
 /// The largest file the readers take, and the most text a `.stdata` file may decompress
-/// to (bytes): 64 MiB, three times a 130 s Klipper test at 3.2 kHz (20 MB). With
-/// [`MAX_SAMPLES`] it bounds what identifying a file holds in memory
-/// (`docs/performance.md`).
-pub const MAX_FILE_BYTES: u64 = 64 << 20;
+/// to (bytes): settle-files' limit for a recording, [`settle_files::limit::RECORDING`]
+/// (64 MiB, three times a 130 s Klipper test at 3.2 kHz: 20 MB). With [`MAX_SAMPLES`] it
+/// bounds what identifying a file holds in memory (`docs/performance.md`).
+pub const MAX_FILE_BYTES: u64 = settle_files::limit::RECORDING.bytes;
 
 /// The most samples one recording may hold: 1.5 million, 7.8 minutes at 3.2 kHz.
 pub const MAX_SAMPLES: usize = 1_500_000;
@@ -141,11 +140,11 @@ pub enum FileData {
 /// Shake&Tune, `#time,` -> Klipper raw, `freq,` -> Klipper processed, `Sample` -> M956.
 pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     let file = path.display().to_string();
-    let bytes = read_bounded(path, &file)?;
+    let bytes = settle_files::read::read_bytes(path, settle_files::limit::RECORDING)?;
     if bytes.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
         return stdata::parse(&file, &bytes).map(FileData::Recordings);
     }
-    let text = String::from_utf8(bytes).map_err(|e| {
+    let mut text = String::from_utf8(bytes).map_err(|e| {
         IdentifyError::format(
             &file,
             1,
@@ -153,6 +152,10 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
             "a CSV text file or a zstd-compressed .stdata file",
         )
     })?;
+    // A byte-order mark (spreadsheet programs on Windows write one) is not the header.
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
     let first = text
         .lines()
         .map(str::trim)
@@ -165,51 +168,15 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     } else if first.starts_with("Sample") {
         rrf::parse(&file, &text).map(|r| FileData::Recordings(vec![r]))
     } else {
+        // The line is not repeated: a file that is not a recording (a wrong path,
+        // /etc/shadow) is not shown on the terminal.
         Err(IdentifyError::format(
             &file,
             1,
-            format!("`{}`", truncate(first)),
+            "a first line that is not a recording's header",
             "a header `#time,accel_x,accel_y,accel_z` (Klipper raw), `freq,psd_x,...` (Klipper processed), `Sample,X,Y,Z` (RepRapFirmware M956) or a zstd-compressed .stdata file",
         ))
     }
-}
-
-/// The bytes of the regular file at `path`, at most [`MAX_FILE_BYTES`] of them: a folder,
-/// a device (`/dev/zero` never ends) or a pipe is refused before it is opened, and the
-/// read stops past the limit even if the file grows meanwhile.
-fn read_bounded(path: &Path, file: &str) -> Result<Vec<u8>, IdentifyError> {
-    let io = |source| IdentifyError::Io {
-        file: file.to_string(),
-        source,
-    };
-    let allowed = || format!("at most {MAX_FILE_BYTES} bytes (64 MiB)");
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(IdentifyError::not_accepted(
-            file,
-            "not a regular file (a folder, a device or a pipe)",
-            "a regular file",
-        ));
-    }
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(IdentifyError::not_accepted(
-            file,
-            format!("{} bytes", meta.len()),
-            allowed(),
-        ));
-    }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
-        .map_err(io)?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
-        return Err(IdentifyError::not_accepted(
-            file,
-            format!("more than {MAX_FILE_BYTES} bytes"),
-            allowed(),
-        ));
-    }
-    Ok(bytes)
 }
 
 /// Parse one number of a CSV field, naming the file, line and column on failure.

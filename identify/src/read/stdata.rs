@@ -6,14 +6,9 @@
 //! (time in s, acceleration in mm/s^2, axes map applied). Line numbers in errors count
 //! the lines of the decompressed text.
 
-use std::io::Read;
-
 use serde::Deserialize;
 
-use super::{
-    MAX_FILE_BYTES, MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_times,
-    too_many_samples,
-};
+use super::{MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_times, too_many_samples};
 use crate::IdentifyError;
 
 #[derive(Deserialize)]
@@ -24,24 +19,27 @@ struct Measurement {
 
 /// Parse the bytes of a `.stdata` file into one recording per measurement.
 pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> {
-    let mut text = String::new();
-    zstd::stream::read::Decoder::new(bytes)
-        .and_then(|d| d.take(MAX_FILE_BYTES + 1).read_to_string(&mut text))
-        .map_err(|e| {
-            IdentifyError::format(
+    // Decompressed text is capped as a recording file is: a small file can inflate to GBs.
+    let limit = settle_files::limit::RECORDING;
+    let not_text = |e: &dyn std::fmt::Display| {
+        IdentifyError::format(
+            file,
+            1,
+            format!("data that do not decompress to text ({e})"),
+            "a zstd-compressed stream of JSON lines (Shake&Tune .stdata)",
+        )
+    };
+    let inflated = zstd::stream::read::Decoder::new(bytes)
+        .and_then(|d| settle_files::read::read_capped(d, limit.bytes))
+        .map_err(|e| not_text(&e))?
+        .ok_or_else(|| {
+            settle_files::FileError::too_large(
                 file,
-                1,
-                format!("data that do not decompress to text ({e})"),
-                "a zstd-compressed stream of JSON lines (Shake&Tune .stdata)",
+                format!("more than {} bytes of text once decompressed", limit.bytes),
+                limit,
             )
         })?;
-    if text.len() as u64 > MAX_FILE_BYTES {
-        return Err(IdentifyError::not_accepted(
-            file,
-            format!("more than {MAX_FILE_BYTES} bytes of text once decompressed"),
-            format!("at most {MAX_FILE_BYTES} bytes (64 MiB) of text"),
-        ));
-    }
+    let text = String::from_utf8(inflated).map_err(|e| not_text(&e))?;
     let mut out = Vec::new();
     let mut last = 0;
     for (i, line) in text.lines().enumerate() {

@@ -180,11 +180,14 @@ fn inline_svg(svg: &str) -> &str {
 /// file when it is under 64 KB) is trimmed as [`inline_svg`] trims a document.
 fn push_svg_file(out: &mut impl Out, path: &std::path::Path) -> Result<(), Error> {
     use std::io::BufRead as _;
-    let file = std::fs::File::open(path).map_err(|e| Error::read(path, e))?;
+    let file = crate::input::file::open(path, crate::input::file::limit::RESULTS)?;
     let mut r = std::io::BufReader::new(file);
     let mut head = String::new();
     while head.len() < 1 << 16 {
-        if r.read_line(&mut head).map_err(|e| Error::read(path, e))? == 0 {
+        if r.read_line(&mut head)
+            .map_err(|e| crate::input::file::stream_error(path, e))?
+            == 0
+        {
             break;
         }
     }
@@ -192,7 +195,10 @@ fn push_svg_file(out: &mut impl Out, path: &std::path::Path) -> Result<(), Error
     let mut line = String::new();
     loop {
         line.clear();
-        if r.read_line(&mut line).map_err(|e| Error::read(path, e))? == 0 {
+        if r.read_line(&mut line)
+            .map_err(|e| crate::input::file::stream_error(path, e))?
+            == 0
+        {
             return Ok(());
         }
         out.push_str(&line);

@@ -267,7 +267,7 @@ fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option
 }
 
 /// The job of `run` opened, limited to its layers with their pre-roll ([`preroll_of`]).
-fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<std::io::BufReader<std::fs::File>>, String> {
+fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<settle_gcode::FileInput>, String> {
     let shaper = crate::studies::shaper(run).map_err(|e| e.to_string())?;
     let cfg = job_config(run, job, shaper_setting(shaper.as_ref()))?;
     let j = Job::open(&job.file, cfg).map_err(|e| e.to_string())?;

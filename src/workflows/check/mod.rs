@@ -100,8 +100,15 @@ pub fn check(opts: &CheckOptions, progress: Progress) -> Result<Checked, Error> 
             format!("must be a finite length >= 0 (um), got {}", opts.floor_um),
         ));
     }
-    let (sc, mut runs) = crate::expand::load_runs(path)?;
-    let old = match crate::input::file::read_text(baseline) {
+    let (sc, src) = crate::expand::load(path)?;
+    let mut runs = crate::expand::expand(&sc, &src)?;
+    if opts.update {
+        // --update rewrites the baseline, and only the baseline: never the scenario or a
+        // file it reads, a link or a device.
+        crate::expand::machine::input_files(&sc, &src).refuse(baseline)?;
+        settle_files::write::check_target(baseline)?;
+    }
+    let old = match crate::input::file::read_text(baseline, crate::input::file::limit::RESULTS) {
         Ok(text) => Some(text),
         Err(Error::Read { source, .. })
             if source.kind() == std::io::ErrorKind::NotFound && opts.update =>

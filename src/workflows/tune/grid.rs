@@ -42,6 +42,13 @@ pub const DEFAULT_MARGIN: f64 = 0.8;
 /// (`TARGET_SMOOTHING` of shaper_calibrate.py); the default `max_smoothing_mm`.
 pub const DEFAULT_MAX_SMOOTHING_MM: f64 = settle_planner::shaper_select::TARGET_SMOOTHING_MM;
 
+/// The most values a list of `[tune]` may hold: the search is their product.
+pub const MAX_LIST: usize = 64;
+
+/// The most candidates a search may have (each is simulated over the move family; the
+/// default search of a printer axis has a few hundred).
+pub const MAX_CANDIDATES: usize = 100_000;
+
 /// Resolve the scenario's search on `axis` (default: the move's axis), with `axis`'s
 /// current settings (`[tune.axis.<name>]`) as the baseline candidate. Errors name the
 /// `[tune]` key. A `[sweep]` is refused unless the scenario marks a `[current]` point (an
@@ -53,6 +60,31 @@ pub fn plan(
     axis: Option<&str>,
 ) -> Result<Plan, Error> {
     let spec = sc.tune.clone().unwrap_or_default();
+    for (key, len) in [
+        (
+            "tune.distances_mm",
+            spec.distances_mm.as_ref().map(Vec::len),
+        ),
+        ("tune.angles_deg", spec.angles_deg.as_ref().map(Vec::len)),
+        ("tune.kinds", spec.kinds.as_ref().map(Vec::len)),
+        ("tune.shapers", spec.shapers.as_ref().map(Vec::len)),
+        (
+            "tune.frequency_scales",
+            spec.frequency_scales.as_ref().map(Vec::len),
+        ),
+        ("tune.axes", spec.axes.as_ref().map(Vec::len)),
+        (
+            "tune.accelerations_mm_s2",
+            spec.accelerations_mm_s2.as_ref().map(Vec::len),
+        ),
+    ] {
+        if let Some(n) = len.filter(|n| *n > MAX_LIST) {
+            return Err(src.error_at(
+                key,
+                format!("{n} values; at most {MAX_LIST} (the search is their product)"),
+            ));
+        }
+    }
     if !sc.sweep.is_empty() && sc.current.is_empty() {
         return Err(src.error_at(
             "sweep",
@@ -242,6 +274,14 @@ pub fn plan(
     if spec.refine_rounds.is_some_and(|r| r > 20) {
         return Err(src.error_at("tune.refine_rounds", "must be 0 to 20"));
     }
+    if let Some(hz) = spec.tmc_clock_hz
+        && !(4_000_000..=32_000_000).contains(&hz)
+    {
+        return Err(src.error_at(
+            "tune.tmc_clock_hz",
+            format!("{hz} Hz: the TMC4361A takes a clock of 4 to 32 MHz (4000000 to 32000000)"),
+        ));
+    }
     let mut notes: Vec<String> = Vec::new();
     let tmc = match firmware.firmware() {
         Some(Firmware::Tmc4361a) => {
@@ -384,6 +424,32 @@ pub fn plan(
                 }
             }
         }
+    }
+    let per_shape = shaper_settings.len() * accels.len();
+    let count: usize = 1 + kinds
+        .iter()
+        .map(|&k| {
+            let jerks_n = if k == ProfileKind::Trapezoid {
+                1
+            } else {
+                jerks.len()
+            };
+            let params_n = match k {
+                _ if base.state::<Corner>().is_some() => 1,
+                ProfileKind::PvtAsym => PVT_KI.len(),
+                ProfileKind::FourJerk => BOW_PATTERNS.len(),
+                _ => 1,
+            };
+            jerks_n * params_n * per_shape
+        })
+        .sum::<usize>();
+    if count > MAX_CANDIDATES {
+        return Err(src.error_at(
+            "tune",
+            format!(
+                "{count} candidates (kinds x jerks x kind parameters x shapers x frequencies x accelerations); at most {MAX_CANDIDATES}: give fewer values"
+            ),
+        ));
     }
     let default = Candidate::of(&base);
     let mut candidates = vec![default];

@@ -36,7 +36,31 @@ pub struct KlipperCriterion {
     pub out: Option<PathBuf>,
     /// calibrate_shaper.py's options (`--shapers`, `--scv`, `--max_smoothing`, ...).
     pub select: SelectOptions,
+    /// Overwrite the results of an earlier run in `out` (refused without it).
+    pub force: bool,
 }
+
+/// The files `--criterion klipper` writes in its output folder: `input_shaper.cfg` and
+/// one figure per axis group ([`FIGURES`]).
+const FILES: [&str; 1] = ["input_shaper.cfg"];
+
+/// The figures, `klipper-shapers-<axis>.svg/png` (`<axis>`: x, y, z or all).
+const FIGURES: [(&str, &str); 2] = [("klipper-shapers-", ".svg"), ("klipper-shapers-", ".png")];
+
+/// What marks an earlier run's results in the output folder.
+const MARKS: [&str; 5] = [
+    "input_shaper.cfg",
+    "klipper-shapers-x.svg",
+    "klipper-shapers-y.svg",
+    "klipper-shapers-z.svg",
+    "klipper-shapers-all.svg",
+];
+
+/// An earlier run's results, which `--force` overwrites.
+const RESULTS: crate::output::folder::Results<'static> = crate::output::folder::Results {
+    what: "settle tune --criterion klipper",
+    marks: &MARKS,
+};
 
 impl KlipperCriterion {
     /// From the command line: the files, `--out`, and calibrate_shaper.py's `--shapers`
@@ -80,7 +104,12 @@ impl KlipperCriterion {
             }
             select.max_smoothing_mm = Some(v);
         }
-        Ok(Self { files, out, select })
+        Ok(Self {
+            files,
+            out,
+            select,
+            force: false,
+        })
     }
 }
 
@@ -285,6 +314,13 @@ pub fn input_shaper_cfg(choices: &[AxisChoice]) -> String {
 /// What `settle tune --criterion klipper FILE...` prints (calibrate_shaper.py's lines per
 /// axis) and writes (with `--out`).
 pub fn report(c: &KlipperCriterion) -> Result<Report, Error> {
+    // The output folder, before any work: never one of the files read, a file, a link out
+    // or a device where a file goes, nor earlier results unasked.
+    if let Some(dir) = &c.out {
+        let inputs = settle_files::write::Inputs::of(&c.files);
+        let writes = |rel: &Path| crate::output::folder::written(rel, &FILES, &[], &FIGURES);
+        crate::output::folder::check(dir, &RESULTS, c.force, &inputs, writes)?;
+    }
     let choices = choose(c)?;
     let mut r = Report::new(Exit::Ok);
     for a in &choices {

@@ -76,6 +76,9 @@ pub struct Options {
     pub firmware: Option<String>,
     /// `--frequency-tolerance PCT`: over `[tune] frequency_tolerance_pct`.
     pub frequency_tolerance_pct: Option<f64>,
+    /// Overwrite the results of an earlier tuning in the output folder (refused without
+    /// it).
+    pub force: bool,
 }
 
 impl Options {
@@ -87,6 +90,7 @@ impl Options {
             jobs: None,
             firmware: None,
             frequency_tolerance_pct: None,
+            force: false,
         }
     }
 }
@@ -271,6 +275,28 @@ pub fn tune_to(
     tune_with(path, out, &opts, progress)
 }
 
+/// The files `settle tune` writes in its output folder (with `pareto-<axis>.svg/png`
+/// for several axes: [`PATTERNS`]).
+const FILES: [&str; 8] = [
+    "tune.md",
+    "candidates.csv",
+    "klipper.cfg",
+    "rrf.g",
+    "tmc4361a.txt",
+    "pareto.svg",
+    "pareto.png",
+    crate::output::sweep_files::REPORT,
+];
+
+/// An earlier tuning's results, which `--force` overwrites.
+const RESULTS: crate::output::folder::Results<'static> = crate::output::folder::Results {
+    what: "settle tune",
+    marks: &FILES,
+};
+
+/// The per-axis Pareto figures of a tuning of several axes ([`figure_name`]).
+const PATTERNS: [(&str, &str); 2] = [("pareto-", ".svg"), ("pareto-", ".png")];
+
 /// Tune every axis of `[tune] axes` (default: the move's axis) of `path`, sharing one
 /// acceleration where the firmware has one, and write into `out` (default:
 /// `results/<name>-tune/`): `tune.md` (the machine, your current settings ->
@@ -284,7 +310,12 @@ pub fn tune_with(
     opts: &Options,
     progress: Progress,
 ) -> Result<Tuned, Error> {
-    let (sc, _) = load(path, opts)?;
+    let (sc, src) = load(path, opts)?;
+    let out = out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-tune", sc.name)));
+    // The output folder, before the search: never an input, nor earlier results unasked.
+    let inputs = crate::expand::machine::input_files(&sc, &src);
+    let writes = |rel: &Path| crate::output::folder::written(rel, &FILES, &[], &PATTERNS);
+    crate::output::folder::check(&out, &RESULTS, opts.force, &inputs, writes)?;
     let mut done: Vec<(String, Outcome)> = Vec::new();
     for axis in axes(&sc) {
         let o = search_axis(path, axis.as_deref(), opts, progress)?;
@@ -298,7 +329,6 @@ pub fn tune_with(
     for (_, o) in &mut done {
         finish(path, o, opts)?;
     }
-    let out = out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-tune", sc.name)));
     create_dir(&out)?;
     let produced_by = format!("settle tune {}", path.display());
     let klipper = export::klipper(&done, &produced_by);
@@ -333,7 +363,7 @@ pub fn tune_with(
     write("klipper.cfg", &klipper)?;
     write("rrf.g", &rrf)?;
     write("tmc4361a.txt", &tmc)?;
-    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let text = crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)?;
     let page = html::page(html::Page {
         name: &sc.name,
         markdown: &md,

@@ -462,6 +462,10 @@ pub fn validate(backend: Option<Backend>, out: Option<&Path>) -> Result<Validate
         Some(b) => vec![b],
         None => Backend::ALL.into_iter().filter(|b| b.available()).collect(),
     };
+    if let Some(path) = out {
+        // Checked before the work: a link or a device is not written.
+        settle_files::write::check_target(path)?;
+    }
     let started = std::time::Instant::now();
     let validation = run(&backends).map_err(|e| Error::input("--backend", e))?;
     let markdown = markdown(&validation);
