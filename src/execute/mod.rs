@@ -76,6 +76,7 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
     })?;
     let options = SimOptions {
         linearise_at_m: planned.linearise_at_m.clone(),
+        step_at_m: planned.step_at_m.clone(),
         ..sim_options(spec)
     };
     let observe = observe_of(spec);

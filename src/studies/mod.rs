@@ -126,6 +126,9 @@ pub struct Planned {
     /// Where the modal backend linearises the machine (m per machine axis); `None`: at
     /// the trajectory's start (see [`crate::execute::SimOptions::linearise_at_m`]).
     pub linearise_at_m: Option<Vec<f64>>,
+    /// Where rapier sizes its integration step (m per machine axis); `None`: at the
+    /// trajectory's start (see [`crate::execute::SimOptions::step_at_m`]).
+    pub step_at_m: Option<Vec<f64>>,
 }
 
 /// A runs.csv column a study plots against each swept parameter.

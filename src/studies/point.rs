@@ -41,6 +41,7 @@ impl Study for PointMove {
             trajectory: on_axis(ctx.axes, &run.axis, &profile)?,
             probe: None,
             linearise_at_m: None,
+            step_at_m: None,
         })
     }
 }

@@ -132,6 +132,7 @@ impl Study for Toy {
             trajectory: on_axis(ctx.axes, &run.axis, &shuttle)?,
             probe: Some(Box::new(MaxError { move_end_s })),
             linearise_at_m: None,
+            step_at_m: None,
         })
     }
 

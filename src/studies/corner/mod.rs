@@ -130,6 +130,7 @@ impl Study for CornerPath {
             trajectory,
             probe: None,
             linearise_at_m: None,
+            step_at_m: None,
         })
     }
 

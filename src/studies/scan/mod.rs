@@ -186,6 +186,7 @@ impl Study for ScanStep {
             trajectory: Trajectory::new(profiles)?,
             probe: Some(Box::new(StepProbe { raster: r, y0_m })),
             linearise_at_m: None,
+            step_at_m: None,
         })
     }
 

@@ -579,6 +579,9 @@ fn simulate(
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
     let options = SimOptions {
         linearise_at_m: point.as_ref().map(|p| p.on_axes(&names)),
+        // Every planner starts the job at the origin: rapier's step is sized there, for
+        // the whole file and any layer range alike.
+        step_at_m: Some(vec![0.0; names.len()]),
         ..SimOptions::default()
     };
     let (streamed, rec) = simulate_job(
