@@ -13,14 +13,17 @@
 //! ```
 //!
 //! The run's motion is the job's shaped X and Y (and Z), one trajectory. Without
-//! `layers` it runs from the job's first move (`t = 0`) to its end. With `layers` it
-//! starts from the whole job's state, as `settle gcode --layers` does: the job's chunks
-//! start a pre-roll ([`preroll`]) of at least `ln(1e6) / sigma` before the range's first
-//! move (`sigma` the slowest decay rate of the machine's linearised modes; no earlier
-//! than the file's first move), so the vibration the layers before leave is in the
-//! range's samples, and `t = 0` is the pre-roll's start, moved to the next instant of the
-//! print clock's sample grid (`k / sample_rate_hz`, the grid of `settle gcode`) so that
-//! both sample the same instants. The common metrics are those of any run over that
+//! `layers` it runs from the job's first move to its end. With `layers` it starts from
+//! the whole job's state, as `settle gcode --layers` does: the job's chunks start a
+//! pre-roll ([`preroll`]) of at least `ln(1e6) / sigma` before the range's first move
+//! (`sigma` the slowest decay rate of the machine's linearised modes; no earlier than the
+//! file's first move), so the vibration the layers before leave is in the range's
+//! samples. `t = 0` is on the print clock's sample grid (`k / sample_rate_hz`, the grid
+//! of `settle gcode`) so that both sample the same instants: the pre-roll's start moved
+//! to the next instant of the grid, or, where the run starts with the job (at rest; a
+//! shaped job starts before the first move, by half the shaper's duration), the instant
+//! of the grid before, standing still until the job starts. The common metrics are those
+//! of any run over that
 //! trajectory: `move_time_s` is the pre-roll plus the range, the residual and the settle
 //! time are measured after the range's last move. The study's probe measures the contour
 //! error against the G-code's own geometry ([`contour`]) and adds to runs.csv
@@ -297,8 +300,14 @@ fn from_time(chunks: Vec<(f64, Trajectory)>, at_s: f64) -> Result<Vec<Trajectory
     Ok(out)
 }
 
-/// One profile per machine axis (X, Y, Z of the job by name), the chunks joined.
-fn join(axes: &[String], chunks: &[Trajectory]) -> Result<Trajectory, PlanError> {
+/// Whether every axis of `tr` starts at rest (no velocity, no acceleration).
+fn at_rest(tr: &Trajectory) -> bool {
+    tr.axes().iter().all(|p| p.start().v == 0.0 && p.start().a == 0.0)
+}
+
+/// One profile per machine axis (X, Y, Z of the job by name), the chunks joined after
+/// `rest_s` standing at the first one's start.
+fn join(axes: &[String], chunks: &[Trajectory], rest_s: f64) -> Result<Trajectory, PlanError> {
     let mut out = Vec::new();
     for name in axes {
         let i = match name.as_str() {
@@ -312,9 +321,17 @@ fn join(axes: &[String], chunks: &[Trajectory]) -> Result<Trajectory, PlanError>
             }
         };
         let start = chunks.first().map(|c| c.axes()[i].start()).unwrap_or_default();
-        let segs: Vec<Segment> = chunks
-            .iter()
-            .flat_map(|c| c.axes()[i].segments().iter().copied())
+        let rest = (rest_s > 0.0).then_some(Segment::Jerk {
+            duration_s: rest_s,
+            jerk: 0.0,
+        });
+        let segs: Vec<Segment> = rest
+            .into_iter()
+            .chain(
+                chunks
+                    .iter()
+                    .flat_map(|c| c.axes()[i].segments().iter().copied()),
+            )
             .collect();
         out.push(Profile::new(start, segs)?);
     }
@@ -464,13 +481,13 @@ impl Study for GcodeRun {
             chunks.push((c.start_time_s, c.trajectory));
         }
         j.run_to_end().map_err(|e| failed(e.to_string()))?;
+        let dt = 1.0 / run.sample_rate_hz;
         let mut t0 = chunks.first().map_or(0.0, |c| c.0);
         if let Some((a, _)) = job.layers {
             // The pre-roll's start moved to the print clock's sample grid (module doc),
             // when that leaves at least the pre-roll the modes need (it does unless the
             // range starts within a pre-roll of the file's start, where the job starts at
             // rest as in the whole run).
-            let dt = 1.0 / run.sample_rate_hz;
             let on_grid = (t0 / dt).ceil() * dt;
             let range_start = moves
                 .iter()
@@ -482,7 +499,16 @@ impl Study for GcodeRun {
             }
         }
         let chunks = from_time(chunks, t0)?;
-        let trajectory = join(ctx.axes, &chunks)?;
+        // The job starts at rest; a shaped job starts before 0 (a centred shaper leads by
+        // half its duration), between two instants of the sample grid. The run then
+        // starts at rest at the grid instant before: the same samples as `settle gcode`.
+        let mut rest_s = 0.0;
+        if (t0 / dt).ceil() * dt != t0 && chunks.first().is_some_and(at_rest) {
+            let before = (t0 / dt).floor() * dt;
+            rest_s = t0 - before;
+            t0 = before;
+        }
+        let trajectory = join(ctx.axes, &chunks, rest_s)?;
         let linearise_at_m = linearise_at(run, job, ctx.axes).map_err(failed)?;
         Ok(Planned {
             trajectory,
@@ -493,6 +519,9 @@ impl Study for GcodeRun {
                 print_time_s: j.print_time_s(),
             })),
             linearise_at_m,
+            // Every planner starts the job at the origin: rapier's step is sized there,
+            // as `settle gcode` sizes it, for the whole file and any layer range.
+            step_at_m: Some(vec![0.0; ctx.axes.len()]),
         })
     }
 
