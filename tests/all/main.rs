@@ -9,6 +9,7 @@ mod faults;
 mod gcode_config;
 mod gcode_job;
 mod gcode_range;
+mod gcode_range_random;
 mod hardening_input;
 mod html_report;
 mod identify_cmd;
