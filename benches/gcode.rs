@@ -1,13 +1,16 @@
-//! `settle gcode` speed: a shipped print through Klipper's planner with MZV shaping on the
-//! printer_xy machine (linear driver), streaming, on the modal backend (the whole file)
-//! and on rapier (one layer).
+//! `settle gcode` speed: shipped prints through Klipper's planner with MZV shaping on X
+//! and Y on the printer_xy machine (linear driver), streaming: on the modal backend the
+//! ringing tower and a real sliced print, the 3DBenchy of `gcode/prints/benchy/`
+//! (PrusaSlicer, 60,070 moves, 3,816 s of print; its provenance is in
+//! `gcode/prints/benchy/PROVENANCE.md`), both whole; on rapier one layer of the tower.
 //!
 //! Throughput is in elements per second with one element = one simulated microsecond of
 //! print, so criterion's "Melem/s" reads as *simulated seconds per wall second*. Targets
-//! per core: modal >= 1,000, rapier >= 20. After criterion's measurement each case also
-//! runs timed by the thread's own CPU clock (`/proc/thread-self/schedstat`, Linux) and
-//! prints simulated seconds per CPU second (wall time overstates the cost on a shared
-//! machine).
+//! per core: modal >= 5,000 on the benchy, rapier >= 20. After criterion's measurement
+//! each case also runs timed by the thread's own CPU clock (`/proc/thread-self/schedstat`,
+//! Linux) and prints simulated seconds per CPU second (wall time overstates the cost on a
+//! shared machine). A name filter on the command line (`cargo bench --bench gcode --
+//! benchy`) runs the matching cases only.
 //!
 //! With `SETTLE_SYNTH_GCODE=PATH` (and optionally `SETTLE_SYNTH_MB`, default 100) the bench
 //! first writes settle-gcode's synthetic slicer-like file of that size to PATH, for
@@ -24,8 +27,8 @@ use settle_planner::firmware::Firmware;
 #[path = "../gcode/benches/synth/mod.rs"]
 mod synth;
 
-fn options(backend: Backend, layers: Option<(u32, u32)>) -> GcodeOptions {
-    let file = PathBuf::from(manifest_dir()).join("gcode/prints/ringing_tower.gcode");
+fn options(file: &str, backend: Backend, layers: Option<(u32, u32)>) -> GcodeOptions {
+    let file = PathBuf::from(manifest_dir()).join(file);
     let shaper = parse_shaper("mzv@48").expect("shaper");
     GcodeOptions {
         backend,
@@ -46,29 +49,32 @@ fn bench(c: &mut Criterion) {
         let n = synth::write_gcode(&mut w, mb * 1_000_000).expect("write");
         println!("wrote {path}: {:.1} MB", n as f64 / 1e6);
     }
+    const TOWER: &str = "gcode/prints/ringing_tower.gcode";
     let cases = [
-        ("modal_ringing_tower", options(Backend::Modal, None)),
+        ("modal_ringing_tower", options(TOWER, Backend::Modal, None)),
+        (
+            "modal_benchy",
+            options("gcode/prints/benchy/3DBenchy.gcode", Backend::Modal, None),
+        ),
         (
             "rapier_ringing_tower_layer_1",
-            options(Backend::Rapier, Some((1, 1))),
+            options(TOWER, Backend::Rapier, Some((1, 1))),
         ),
     ];
+    let filter: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    let wanted = |name: &str| filter.is_empty() || filter.iter().any(|f| name.contains(f.as_str()));
     let mut group = c.benchmark_group("gcode");
     group.sample_size(10);
-    for (name, opts) in &cases {
+    for (name, opts) in cases.iter().filter(|(n, _)| wanted(n)) {
         let sim_s = measure(opts).expect("job").streamed.simulated_s;
         group.throughput(Throughput::Elements((sim_s * 1e6).round() as u64));
         group.bench_function(*name, |b| b.iter(|| black_box(measure(opts).expect("job"))));
     }
     group.finish();
-    let filter: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with('-'))
-        .collect();
-    for (name, opts) in &cases {
-        if !filter.is_empty() && !filter.iter().any(|f| name.contains(f.as_str())) {
-            continue;
-        }
+    for (name, opts) in cases.iter().filter(|(n, _)| wanted(n)) {
         let (Some(a), mut sim, mut runs) = (thread_cpu_ns(), 0.0, 0) else {
             continue;
         };
