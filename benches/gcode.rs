@@ -2,7 +2,8 @@
 //! and Y on the printer_xy machine (linear driver), streaming: on the modal backend the
 //! ringing tower and a real sliced print, the 3DBenchy of `gcode/prints/benchy/`
 //! (PrusaSlicer, 60,070 moves, 3,816 s of print; its provenance is in
-//! `gcode/prints/benchy/PROVENANCE.md`), both whole; on rapier one layer of the tower.
+//! `gcode/prints/benchy/PROVENANCE.md`), both whole, and the benchy on a machine given by
+//! its modes as `settle identify` writes one; on rapier one layer of the tower.
 //!
 //! Throughput is in elements per second with one element = one simulated microsecond of
 //! print, so criterion's "Melem/s" reads as *simulated seconds per wall second*. Targets
@@ -27,13 +28,33 @@ use settle_planner::firmware::Firmware;
 #[path = "../gcode/benches/synth/mod.rs"]
 mod synth;
 
+/// A machine given by its modes, as `settle identify` writes one (from the example
+/// recordings in examples/data it finds 45 and 75 Hz on X, 39 Hz on Y, zeta 0.05-0.07),
+/// written into the system's temporary folder: its path.
+fn identified_machine() -> String {
+    let path = std::env::temp_dir().join("settle-bench-identified.toml");
+    std::fs::write(
+        &path,
+        "name = \"identified\"\n\
+         [axis.x]\nmodes = [{ frequency_hz = 45.0, damping_ratio = 0.05, weight = 0.8 },\
+         { frequency_hz = 75.0, damping_ratio = 0.07, weight = 0.2 }]\n\
+         [axis.y]\nmodes = [{ frequency_hz = 39.0, damping_ratio = 0.05 }]\n",
+    )
+    .expect("machine file");
+    path.display().to_string()
+}
+
 fn options(file: &str, backend: Backend, layers: Option<(u32, u32)>) -> GcodeOptions {
+    on(file, "printer_xy", backend, layers)
+}
+
+fn on(file: &str, machine: &str, backend: Backend, layers: Option<(u32, u32)>) -> GcodeOptions {
     let file = PathBuf::from(manifest_dir()).join(file);
     let shaper = parse_shaper("mzv@48").expect("shaper");
     GcodeOptions {
         backend,
         layers,
-        ..GcodeOptions::new(file, "printer_xy", Firmware::Klipper)
+        ..GcodeOptions::new(file, machine, Firmware::Klipper)
             .expect("options")
             .with_shaper(Some(shaper))
     }
@@ -50,11 +71,14 @@ fn bench(c: &mut Criterion) {
         println!("wrote {path}: {:.1} MB", n as f64 / 1e6);
     }
     const TOWER: &str = "gcode/prints/ringing_tower.gcode";
+    const BENCHY: &str = "gcode/prints/benchy/3DBenchy.gcode";
+    let identified = identified_machine();
     let cases = [
         ("modal_ringing_tower", options(TOWER, Backend::Modal, None)),
+        ("modal_benchy", options(BENCHY, Backend::Modal, None)),
         (
-            "modal_benchy",
-            options("gcode/prints/benchy/3DBenchy.gcode", Backend::Modal, None),
+            "modal_benchy_identified",
+            on(BENCHY, &identified, Backend::Modal, None),
         ),
         (
             "rapier_ringing_tower_layer_1",
