@@ -366,7 +366,7 @@ impl Probe for GcodeProbe {
             }
             let tp = t + self.t0_s;
             let p = [x.data[k] * 1e3, y.data[k] * 1e3];
-            let (Some(e), Some(owner)) = (active.error_mm(tp, p), active.owner(tp)) else {
+            let Some((e, owner)) = active.at(tp, p) else {
                 continue;
             };
             if owner.kind != MoveKind::Print

@@ -121,6 +121,15 @@ pub struct LostStep {
     pub layer: u32,
 }
 
+/// The move a sample belongs to, as the account keeps it.
+#[derive(Debug, Clone, Copy)]
+struct Owner {
+    index: u64,
+    kind: MoveKind,
+    layer: u32,
+    line: u64,
+}
+
 /// The running account (module doc).
 #[derive(Debug)]
 struct Account {
@@ -219,11 +228,14 @@ impl Account {
         self.active.retire(t);
         let [ix, iy] = self.opts.xy;
         let (x, y) = (toolhead_m[ix] * 1e3, toolhead_m[iy] * 1e3);
-        let Some(err_mm) = self.active.error_mm(t, [x, y]) else {
+        let Some((err_mm, m)) = self.active.at(t, [x, y]) else {
             return;
         };
-        let Some(m) = self.active.owner(t).cloned() else {
-            return;
+        let m = Owner {
+            index: m.index,
+            kind: m.kind,
+            layer: m.layer,
+            line: m.line,
         };
         if self
             .opts
