@@ -6,6 +6,7 @@
 
 pub mod cursor;
 pub mod driver;
+pub mod inner_breaks;
 pub mod interrupt;
 pub mod plant;
 pub mod pool;

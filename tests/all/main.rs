@@ -3,6 +3,7 @@
 
 mod support;
 
+mod across_breakpoints;
 mod cli;
 mod corners;
 mod faults;

@@ -466,9 +466,11 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                     t_first = t0;
                     // A lone whole sample goes through `Plant::step`, as `settle gcode` has
                     // always stepped it (MuJoCo's batch would take it as one long step).
+                    // Batches go across the command's breakpoints where the plant can
+                    // (the modal plant).
                     let d =
                         Driver::new(plant, &names, &starts, rate, t0, false).map_err(sim_err)?;
-                    driver.insert(d.with_min_batch(2))
+                    driver.insert(d.with_min_batch(2).across_breakpoints())
                 }
             };
             if range_start.is_none()
