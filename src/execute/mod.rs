@@ -20,6 +20,7 @@ use crate::measure::series::Series;
 use crate::spec::backend::{Backend, NO_MUJOCO};
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
+use crate::studies::Motion;
 
 pub use plant::SimOptions;
 pub use simulate::run_trajectory;
@@ -81,14 +82,14 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
         ..sim_options(spec)
     };
     let observe = observe_of(spec);
-    let traj = &planned.trajectory;
-    let samples = (traj.duration_s() + spec.window_s) * spec.sample_rate_hz;
+    let duration_s = planned.motion.duration_s();
+    let samples = (duration_s + spec.window_s) * spec.sample_rate_hz;
     if !(samples.is_finite() && samples <= crate::expand::validate::MAX_SAMPLES_PER_RUN) {
         return Ok(Metrics::failed(
             &spec.bands_um,
             format!(
                 "the planned move takes {:.3e} s: with the {} s window at {} Hz that is {samples:.3e} samples, over the limit of {:e} per run",
-                traj.duration_s(),
+                duration_s,
                 spec.window_s,
                 spec.sample_rate_hz,
                 crate::expand::validate::MAX_SAMPLES_PER_RUN
@@ -102,9 +103,20 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
             m
         }
     };
+    let traj = match planned.motion {
+        Motion::Whole(t) => t,
+        Motion::Stream(mut s) => {
+            let m = simulate::run_stream(axes, spec.backend, &options, &mut s, &observe, record)
+                .map_err(|source| Error::Plan {
+                    run: spec.id,
+                    source,
+                })?;
+            return interrupted(m.map_err(sim_err));
+        }
+    };
     let Some(probe) = planned.probe else {
         return interrupted(
-            run_trajectory(axes, spec.backend, &options, traj, &observe, record).map_err(sim_err),
+            run_trajectory(axes, spec.backend, &options, &traj, &observe, record).map_err(sim_err),
         );
     };
     let mut local = Series::default();
@@ -113,7 +125,8 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
         None => &mut local,
     };
     let mut m = interrupted(
-        run_trajectory(axes, spec.backend, &options, traj, &observe, Some(series)).map_err(sim_err),
+        run_trajectory(axes, spec.backend, &options, &traj, &observe, Some(series))
+            .map_err(sim_err),
     )?;
     if m.is_ok() {
         probe.measure(spec, series, &mut m)?;

@@ -5,7 +5,7 @@
 
 use settle_planner::PlanError;
 
-use crate::studies::{Study, PlanContext, Planned, Role, on_axis};
+use crate::studies::{Motion, Study, PlanContext, Planned, Role, on_axis};
 use crate::spec::run_spec::RunSpec;
 
 /// The point-to-point move.
@@ -38,7 +38,7 @@ impl Study for PointMove {
             None => profile,
         };
         Ok(Planned {
-            trajectory: on_axis(ctx.axes, &run.axis, &profile)?,
+            motion: Motion::Whole(on_axis(ctx.axes, &run.axis, &profile)?),
             probe: None,
             linearise_at_m: None,
             step_at_m: None,

@@ -114,7 +114,7 @@ fn a_gcode_corner_gives_the_metrics_of_the_corner_study() {
             linearise_at_m: Some(point),
             ..settle::execute::sim_options(&c_run)
         },
-        &planned.trajectory,
+        planned.motion.whole().expect("a corner is planned whole"),
         &settle::execute::observe_of(&c_run),
         None,
     )
