@@ -226,7 +226,7 @@ fn the_contour_error_does_not_depend_on_the_sample_rate() {
 /// second, near printer_xy's modes: the rotor's load angle passes 90 electrical degrees on
 /// the linear driver (and the full driver on rapier slips poles on the same file). The
 /// run exits 1 as a failed run with a message saying what happened and where, and writes
-/// its outputs.
+/// its outputs, summary.md and report.html saying so at their top.
 #[test]
 fn lost_steps_are_reported_as_a_result_with_where_they_happen() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -256,6 +256,19 @@ fn lost_steps_are_reported_as_a_result_with_where_they_happen() {
         "{l:?}"
     );
     assert!(stderr.contains(&format!("line {}", l.line)), "{stderr}");
+    // Both pages say so first, before any number.
     let md = std::fs::read_to_string(out_dir.join("summary.md")).expect("summary");
-    assert!(md.contains("**Lost steps**"), "{md}");
+    let lost = md
+        .find("**Lost steps**")
+        .expect("summary.md names the lost steps");
+    assert!(lost < md.find("| print time").expect("figures"), "{md}");
+    let html = std::fs::read_to_string(out_dir.join("report.html")).expect("report");
+    let lost = html
+        .find("<p>Lost steps: ")
+        .expect("report.html names the lost steps");
+    let first = html.find("<header>").expect("header") + "<header>\n<h1>".len();
+    assert!(
+        !html[first..lost].contains("<p>") && html[lost..].contains(&format!("line {}", l.line)),
+        "report.html opens with the lost steps"
+    );
 }
