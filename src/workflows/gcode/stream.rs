@@ -24,6 +24,7 @@ use settle_gcode::job::Job;
 use settle_planner::{Profile, State, Trajectory};
 use settle_sim::{AxisModel, Observation, Plant, SimError};
 
+use super::Progress;
 use super::record::Recorder;
 use crate::error::Error;
 use crate::execute::driver::{Batched, Driver, Full, Sink, Stop, standing_at};
@@ -387,7 +388,7 @@ impl Sink for Account {
 
 /// Simulate `job`'s chunks on the plant of `backend` for `axes` (see the module doc). The
 /// belts vary along the travel on the backends that model it ([`SimOptions::belt`]).
-#[allow(clippy::too_many_arguments)]
+/// `file`: the job's G-code file, and what to tell how far it has been read.
 pub fn simulate_job<R: BufRead>(
     job: &mut Job<R>,
     backend: Backend,
@@ -395,14 +396,17 @@ pub fn simulate_job<R: BufRead>(
     options: &SimOptions,
     opts: StreamOptions,
     rec: Option<Recorder>,
-    file: &Path,
+    file: (&Path, Option<Progress<'_>>),
 ) -> Result<(Streamed, Option<Recorder>), Error> {
     let rate = opts.sample_rate_hz;
+    let (file, progress) = file;
+    let size = std::fs::metadata(file).map_or(0, |m| m.len());
     let sim = JobSim {
         job,
         opts,
         rec,
         file,
+        progress: progress.map(|p| (p, size)),
     };
     with_plant(backend, axes, options, rate, &[], sim).map_err(sim_err)?
 }
@@ -417,6 +421,8 @@ struct JobSim<'a, R> {
     opts: StreamOptions,
     rec: Option<Recorder>,
     file: &'a Path,
+    /// Told the bytes read after each chunk, with the file's size.
+    progress: Option<(Progress<'a>, u64)>,
 }
 
 /// Where the driver stopped, for a job: a fault is the job's outcome, anything else an
@@ -438,6 +444,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
 
     fn run<P: Plant>(self, plant: &P) -> Self::Output {
         let (job, opts, rec, file) = (self.job, self.opts, self.rec, self.file);
+        let progress = self.progress;
         let n = opts.job_axes.len();
         let (rate, dt) = (opts.sample_rate_hz, 1.0 / opts.sample_rate_hz);
         let job_axes = opts.job_axes.clone();
@@ -489,6 +496,9 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                 faulted = true;
                 stopped(stop, &mut acc)?;
                 break;
+            }
+            if let Some((tell, size)) = progress {
+                tell(job.reader().bytes_read(), size);
             }
         }
         // The print time simulated: to the last command (the tail is counted apart).
