@@ -244,6 +244,8 @@ fn lost_steps_are_reported_as_a_result_with_where_they_happen() {
         .expect("runs");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
+    // stderr is a pipe here, not a terminal: no progress bar.
+    assert!(!stderr.contains("of G-code simulated"), "{stderr}");
     assert!(
         stderr.contains("result: the machine loses steps")
             && stderr.contains("load angle passed 90 electrical degrees"),
