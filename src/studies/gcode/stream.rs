@@ -5,9 +5,9 @@
 //!
 //! Where the run starts and how long it lasts (the module doc of [`super`]: the print
 //! clock's sample grid, the pre-roll, a shaped job's lead) is found by a first pass over
-//! the job ([`Outline`]), which keeps only the chunks before the run's start (a pre-roll's
+//! the job (`Outline`), which keeps only the chunks before the run's start (a pre-roll's
 //! worth at most) and the durations and end state after it; the run then plans the job
-//! again as it is simulated ([`JobChunks`]).
+//! again as it is simulated (`JobChunks`).
 
 use std::fs::File;
 use std::io::BufReader;
