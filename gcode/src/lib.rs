@@ -69,7 +69,7 @@ pub use read::event::{Event, EventKind, LayerChange, LayerSource, Note};
 pub use read::geometry::{Bounds, Move, MoveKind, Path, Point};
 pub use read::layers::LayerMode;
 pub use read::limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
-pub use read::reader::{Reader, ReaderOptions, Skipped};
+pub use read::reader::{FileInput, Reader, ReaderOptions, Skipped};
 pub use read::segments::{ArcSegmentation, KlipperArcs, MarlinArcs, RrfArcs};
 pub use read::setting::Setting;
 pub use read::summary::{LimitSeen, Summary};

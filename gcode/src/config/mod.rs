@@ -47,6 +47,7 @@
 //! # Ok::<(), settle_gcode::GcodeError>(())
 //! ```
 
+mod budget;
 mod export_klipper;
 mod export_rrf;
 mod export_text;
@@ -60,8 +61,10 @@ mod machine;
 mod rrf;
 mod rrf_script;
 
+pub use budget::{MAX_BYTES as MAX_CONFIG_BYTES, MAX_FILES as MAX_CONFIG_FILES};
 pub use export_klipper::KlipperExport;
 pub use export_rrf::RrfExport;
+pub use export_text::Note;
 pub use klipper::{
     DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
     DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,

@@ -18,7 +18,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::klipper_files::{absolute, read_text};
+use super::budget::Budget;
+use super::klipper_files::absolute;
 use super::machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
 use super::rrf_script::unconditional;
 use crate::error::{GcodeError, Location};
@@ -107,6 +108,7 @@ pub struct RrfConfig {
 struct Files {
     sys: PathBuf,
     stack: Vec<PathBuf>,
+    budget: Budget,
 }
 
 /// Per-axis state while reading, in the firmware's units where they differ.
@@ -160,18 +162,23 @@ impl RrfConfig {
     /// Reads `config.g` at `path` and the macros it runs.
     pub fn read(path: impl AsRef<Path>) -> Result<Self, GcodeError> {
         let path = path.as_ref();
-        let text = read_text(path)?;
-        Self::parse(&text, path)
+        let mut budget = Budget::new();
+        let text = budget.main(path)?;
+        Self::parse_with(&text, path, budget)
     }
 
     /// Reads `text` as the configuration file at `path` (which names it in errors and
     /// anchors the macros it runs; it need not exist).
     pub fn parse(text: &str, path: impl AsRef<Path>) -> Result<Self, GcodeError> {
+        Self::parse_with(text, path.as_ref(), Budget::new())
+    }
+
+    fn parse_with(text: &str, path: &Path, budget: Budget) -> Result<Self, GcodeError> {
         let mut c = Self::defaults();
-        let path = path.as_ref();
         let mut files = Files {
             sys: path.parent().unwrap_or(Path::new("")).to_path_buf(),
             stack: Vec::new(),
+            budget,
         };
         c.run(text, path, &mut files)?;
         Ok(c)
@@ -235,7 +242,7 @@ impl RrfConfig {
                 chain: chain.join(" -> "),
             });
         }
-        if !file.is_file() {
+        if std::fs::metadata(&file).is_err() {
             self.notes.push(ConfigNote::at(
                 at,
                 format!(
@@ -245,7 +252,8 @@ impl RrfConfig {
             ));
             return Ok(());
         }
-        let text = read_text(&file)?;
+        let what = format!("M98 P\"{name}\"");
+        let text = files.budget.read(&file, &at, &what)?;
         self.run(&text, &file, files)
     }
 

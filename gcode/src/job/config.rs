@@ -38,8 +38,19 @@ pub struct ShaperSetting {
 }
 
 impl ShaperSetting {
-    /// The shaper's impulses (its firmware's checks apply).
+    /// The shaper's impulses (its firmware's checks apply, and settle's lowest frequency,
+    /// [`settle_planner::shaper::MIN_FREQUENCY_HZ`]).
     pub fn build(&self) -> Result<Shaper, PlanError> {
+        let min = settle_planner::shaper::MIN_FREQUENCY_HZ;
+        if self.frequency_hz < min {
+            return Err(PlanError::InvalidShaper {
+                name: self.shaper_type.to_string(),
+                reason: format!(
+                    "frequency {} Hz is below {min} Hz, the lowest settle runs (a shaper lasts about one period)",
+                    self.frequency_hz
+                ),
+            });
+        }
         Shaper::new(self.shaper_type, self.frequency_hz, self.damping_ratio)
     }
 }

@@ -1,8 +1,7 @@
 //! The job: reader events in, shaped chunks out (see the module doc of [`crate::job`]).
 
 use std::collections::{BTreeMap, VecDeque};
-use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::BufRead;
 use std::ops::RangeInclusive;
 use std::path::Path as FsPath;
 use std::sync::Arc;
@@ -65,7 +64,7 @@ pub struct Job<R> {
     ignored: BTreeMap<String, u64>,
 }
 
-impl Job<BufReader<File>> {
+impl Job<crate::FileInput> {
     /// Open `path` and plan it with `cfg` (read in `cfg.dialect`).
     pub fn open(path: impl AsRef<FsPath>, cfg: JobConfig) -> Result<Self, GcodeError> {
         let path = path.as_ref();

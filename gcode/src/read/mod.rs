@@ -1,5 +1,5 @@
 //! The streaming G-code reader (see the crate documentation), what is where:
-//! - text: [`lines`] (one bounded line at a time), [`lex`] (words and comments), [`cmd`]
+//! - text: `settle_files::lines` (one bounded line at a time), [`lex`] (words and comments), [`cmd`]
 //!   (a line's command and [`params`]);
 //! - the firmware's conventions: [`dialect`];
 //! - motion: [`motion`] (modal state: units, absolute or relative, feed), [`geometry`]
@@ -21,7 +21,6 @@ pub(crate) mod layers;
 pub(crate) mod lex;
 pub(crate) mod limit_parse;
 pub(crate) mod limits;
-pub(crate) mod lines;
 pub(crate) mod motion;
 pub(crate) mod params;
 pub(crate) mod reader;

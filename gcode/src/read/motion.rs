@@ -95,12 +95,12 @@ impl Motion {
             let (limit, allowed) = if k == 3 {
                 (
                     self.max_extruder_mm,
-                    "an extruder position within ReaderOptions::max_extruder_mm of 0",
+                    "an extruder position within the reader's limit (+-1e9 mm by default)",
                 )
             } else {
                 (
                     self.max_coordinate_mm,
-                    "a position within ReaderOptions::max_coordinate_mm of 0",
+                    "a position within the reader's limit (+-1e5 mm by default: 100 m, larger than any machine)",
                 )
             };
             if t[k].abs() > limit {

@@ -2,7 +2,6 @@
 
 use std::collections::{BTreeMap, VecDeque};
 use std::fmt::Write as _;
-use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::sync::Arc;
@@ -15,10 +14,10 @@ use crate::read::geometry::{MoveKind, Point};
 use crate::read::layers::{LayerMode, Layers};
 use crate::read::lex::{LexError, LineKind, lex};
 use crate::read::limit_parse::{self, Outcome};
-use crate::read::lines::{LineStatus, Lines};
 use crate::read::motion::Motion;
 use crate::read::params::{KeyValues, Params};
 use crate::read::setting_parse;
+use settle_files::lines::{BoundedLines as Lines, LineStatus};
 
 /// How the reader reads.
 #[derive(Debug, Clone, PartialEq)]
@@ -97,15 +96,17 @@ struct Interp {
     skipped: Skipped,
 }
 
-impl Reader<BufReader<File>> {
-    /// Opens a file.
+/// A G-code file open for reading (settle-files' reader: a regular file of at most
+/// [`settle_files::limit::GCODE`]).
+pub type FileInput = BufReader<settle_files::read::Input>;
+
+impl Reader<FileInput> {
+    /// Opens a file (a regular file, links followed, of at most
+    /// [`settle_files::limit::GCODE`]).
     pub fn open(path: impl AsRef<Path>, options: ReaderOptions) -> Result<Self, GcodeError> {
         let path = path.as_ref();
         let name: Arc<str> = Arc::from(path.display().to_string());
-        let file = File::open(path).map_err(|source| GcodeError::Io {
-            source_name: name.clone(),
-            source,
-        })?;
+        let file = settle_files::read::open(path, settle_files::limit::GCODE)?;
         Ok(Reader::new(BufReader::with_capacity(64 * 1024, file), options).with_name(name))
     }
 }
@@ -207,10 +208,7 @@ impl<R: BufRead> Iterator for Reader<R> {
             match self.lines.next_line() {
                 Err(source) => {
                     self.finished = true;
-                    return Some(Err(GcodeError::Io {
-                        source_name: self.source_name.clone(),
-                        source,
-                    }));
+                    return Some(Err(GcodeError::io(&self.source_name, source)));
                 }
                 Ok(None) => {
                     self.finished = true;
@@ -229,12 +227,14 @@ impl<R: BufRead> Iterator for Reader<R> {
                 }
                 Ok(Some(LineStatus::Complete)) => {
                     let line_no = self.lines.line_no();
-                    let result = self.interp.line(
-                        &self.source_name,
-                        line_no,
-                        self.lines.bytes(),
-                        &mut self.scratch,
-                    );
+                    let mut bytes = self.lines.bytes();
+                    if line_no == 1 {
+                        // A byte-order mark (editors on Windows write one) is not G-code.
+                        bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
+                    }
+                    let result =
+                        self.interp
+                            .line(&self.source_name, line_no, bytes, &mut self.scratch);
                     if let Err(e) = result {
                         self.fail(e);
                     }

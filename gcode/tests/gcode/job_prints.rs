@@ -40,7 +40,7 @@ fn run_file(
     name: &str,
     cfg: JobConfig,
     layers: Option<(u32, u32)>,
-) -> (Vec<JobChunk>, Job<std::io::BufReader<std::fs::File>>) {
+) -> (Vec<JobChunk>, Job<settle_gcode::FileInput>) {
     let mut job = Job::open(print_path(name), cfg).expect("open");
     if let Some((a, b)) = layers {
         job = job.with_layers(a..=b).expect("layers");

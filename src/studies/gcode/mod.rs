@@ -50,6 +50,7 @@ pub mod linpoint;
 pub mod preroll;
 pub mod stats;
 pub mod stream;
+pub mod work;
 
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -263,7 +264,7 @@ fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option
 }
 
 /// The job of `run` opened, limited to its layers with their pre-roll ([`preroll_of`]).
-fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<std::io::BufReader<std::fs::File>>, String> {
+fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<settle_gcode::FileInput>, String> {
     let shaper = crate::studies::shaper(run).map_err(|e| e.to_string())?;
     let cfg = job_config(run, job, shaper_setting(shaper.as_ref()))?;
     let j = Job::open(&job.file, cfg).map_err(|e| e.to_string())?;
@@ -373,6 +374,13 @@ impl Study for GcodeRun {
         let mut j = open(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
         j.run_to_end()
             .map_err(|e| (run.blame("gcode.file"), e.to_string()))?;
+        if let Some(why) = work::nothing_to_measure(&j.summary(), j.reader().lines_read()) {
+            return Err((
+                run.blame("gcode.file"),
+                format!("{}: {why}", job.file.display()),
+            ));
+        }
+        // Only a job that passed every check is remembered as checked.
         if let Ok(mut v) = VALIDATED.lock() {
             v.insert(key);
         }

@@ -9,10 +9,7 @@
 //! worth at most) and the durations and end state after it; the run then plans the job
 //! again as it is simulated (`JobChunks`).
 
-use std::fs::File;
-use std::io::BufReader;
-
-use settle_gcode::MoveKind;
+use settle_gcode::{FileInput, MoveKind};
 use settle_gcode::job::{Job, JobChunk};
 use settle_planner::shaper::stream::cut;
 use settle_planner::{PlanError, Profile, Segment, State, Trajectory};
@@ -108,7 +105,7 @@ impl Outline {
     /// The outline of `job` on the machine axes `map` ([`job_axes`]), sampled every `dt`
     /// s; `range`: the first layer of a layer range and the least pre-roll it needs (s).
     pub(super) fn of(
-        mut job: Job<BufReader<File>>,
+        mut job: Job<FileInput>,
         map: &[usize],
         dt: f64,
         range: Option<(u32, f64)>,
@@ -189,7 +186,7 @@ impl Outline {
 
 /// The run's chunks and contour error (module doc).
 pub(super) struct JobChunks {
-    job: Job<BufReader<File>>,
+    job: Job<FileInput>,
     map: Vec<usize>,
     /// Print-clock time of the run's `t = 0` (s).
     origin_s: f64,
@@ -212,7 +209,7 @@ impl JobChunks {
     /// The chunks of `job` (opened again as the outline's was) from `outline`'s start;
     /// only samples of moves in `layers` count.
     pub(super) fn new(
-        job: Job<BufReader<File>>,
+        job: Job<FileInput>,
         map: Vec<usize>,
         outline: &Outline,
         layers: Option<(u32, u32)>,

@@ -78,6 +78,8 @@ pub struct GcodeOptions {
     pub mcap: bool,
     /// The firmware configuration the planner's settings come from (`--config`).
     pub config: Option<ConfigSource>,
+    /// Overwrite the results of an earlier run in the output folder (refused without it).
+    pub force: bool,
 }
 
 /// A firmware configuration read for `--config`.
@@ -89,6 +91,8 @@ pub struct ConfigSource {
     pub job: JobConfig,
     /// What the reader noted (SAVE_CONFIG values overridden, blocks not read).
     pub notes: Vec<String>,
+    /// The files read (the configuration and what it includes or runs).
+    pub files: Vec<PathBuf>,
 }
 
 /// `--shaper` as written: `KIND@FREQ_HZ[/DAMPING]` or `none` for X and Y, or per axis
@@ -177,6 +181,7 @@ impl GcodeOptions {
             versus: None,
             mcap: false,
             config: None,
+            force: false,
         })
     }
 
@@ -198,18 +203,20 @@ impl GcodeOptions {
         } else {
             Firmware::Klipper
         });
-        let (job, notes) = match firmware {
+        let (job, notes, files) = match firmware {
             Firmware::Klipper => {
                 let c = settle_gcode::config::KlipperConfig::read(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
                 let job = JobConfig::from_klipper(&c).map_err(gcode_error(&config))?;
-                (job, c.notes.iter().map(ToString::to_string).collect())
+                let notes = c.notes.iter().map(ToString::to_string).collect();
+                (job, notes, c.files)
             }
             Firmware::Rrf => {
                 let c = settle_gcode::config::RrfConfig::read(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
                 let job = JobConfig::from_rrf(&c).map_err(gcode_error(&config))?;
-                (job, c.notes.iter().map(ToString::to_string).collect())
+                let notes = c.notes.iter().map(ToString::to_string).collect();
+                (job, notes, c.files)
             }
             Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => {
                 return Err(Error::input_key(
@@ -232,6 +239,7 @@ impl GcodeOptions {
             path: config,
             job,
             notes,
+            files,
         });
         Ok(opts)
     }
@@ -322,10 +330,11 @@ impl GcodeOutcome {
         &self.streamed.maps
     }
 
-    /// What the binary prints, and exit 1 when the simulation failed.
+    /// What the binary prints; [`Exit::RunsFailed`] when the simulation failed (lost steps,
+    /// a fault): a result, written and reported, not a failure of the command.
     pub fn report(&self) -> Report {
         let failed = self.streamed.fault.is_some() || self.streamed.lost_steps > 0;
-        let mut r = Report::new(if failed { Exit::Failed } else { Exit::Ok });
+        let mut r = Report::new(if failed { Exit::RunsFailed } else { Exit::Ok });
         r.out(format!(
             "{}: {} on {} ({}): print time {:.1} s, contour error worst {:.2} um, p95 {:.2} um",
             self.file.display(),
@@ -374,12 +383,31 @@ impl GcodeOutcome {
                 )
             });
             r.err(format!(
-                "result: the machine loses steps ({} full steps{at}): the motion asks more of a motor than its torque gives (its load angle passed 90 electrical degrees); what it prints after that is not this simulation's toolpath (exit 1: a failed run, not a tool error)",
+                "result: the machine loses steps ({} full steps{at}): the motion asks more of a motor than its torque gives (its load angle passed 90 electrical degrees); what it prints after that is not this simulation's toolpath (a failed run: a result, exit 0; --fail-on-failed-runs makes it exit 1)",
                 self.streamed.lost_steps
             ));
         }
         if self.skipped_lines > 0 {
             r.err(format!("skipped {} bad lines", self.skipped_lines));
+        }
+        if !self.ignored.is_empty() {
+            const SHOWN: usize = 8;
+            let mut names: Vec<String> = self
+                .ignored
+                .iter()
+                .take(SHOWN)
+                .map(|(what, n)| {
+                    let name = what.split(':').next().unwrap_or(what);
+                    format!("{name} ({n}x)")
+                })
+                .collect();
+            if self.ignored.len() > SHOWN {
+                names.push(format!("and {} more", self.ignored.len() - SHOWN));
+            }
+            r.err(format!(
+                "not followed: {} (why: summary.md, Commands not followed)",
+                names.join(", ")
+            ));
         }
         r
     }
@@ -390,13 +418,14 @@ impl GcodeOutcome {
 /// the setting.
 pub fn gcode_error(file: &Path) -> impl Fn(GcodeError) -> Error + '_ {
     move |e| {
-        if let GcodeError::Io {
-            source_name,
-            source,
-        } = e
-        {
-            return Error::read(PathBuf::from(&*source_name), source);
-        }
+        let e = match e {
+            GcodeError::Io {
+                source_name,
+                source,
+            } => return Error::read(PathBuf::from(&*source_name), source),
+            GcodeError::File(f) => return (*f).into(),
+            e => e,
+        };
         if let Some(at) = e.location() {
             let prefix = format!("{at}: ");
             let text = e.to_string();
@@ -468,6 +497,46 @@ fn longest_period_s(linear_axes: &[AxisModel]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The fastest natural frequency (Hz) of the axes' modes, 0 when they have none.
+fn fastest_mode_hz(linear_axes: &[AxisModel]) -> f64 {
+    let rest = Profile::empty(State::default());
+    linear_axes
+        .iter()
+        .filter_map(|a| LinearResponse::new(a, &rest).ok())
+        .flat_map(|lr| lr.poles().to_vec())
+        .map(|p| p.norm() / std::f64::consts::TAU)
+        .fold(0.0, f64::max)
+}
+
+/// The highest `--sample-rate-hz` (Hz): fifty samples per period of a 2 kHz mode, far
+/// above a printer's (a toolhead's highest modes are 100-300 Hz); a job's simulation time
+/// grows with the rate.
+pub const MAX_SAMPLE_RATE_HZ: f64 = 100_000.0;
+
+/// `--sample-rate-hz` checked before any work: at least two samples per period of the
+/// machine's fastest mode (`fastest_hz`; fewer alias it, and the contour error between
+/// samples far apart is not seen: a scenario's `observe.sample_rate_hz` is held to the
+/// same), at most [`MAX_SAMPLE_RATE_HZ`].
+fn check_sample_rate(rate_hz: f64, fastest_hz: f64) -> Result<(), Error> {
+    let min = 2.0 * fastest_hz;
+    if rate_hz.is_finite() && rate_hz >= min && rate_hz > 0.0 && rate_hz <= MAX_SAMPLE_RATE_HZ {
+        return Ok(());
+    }
+    Err(Error::input(
+        "--sample-rate-hz",
+        if !(rate_hz.is_finite() && rate_hz > 0.0) {
+            format!("{rate_hz}: give a finite number of Hz > 0")
+        } else if rate_hz > MAX_SAMPLE_RATE_HZ {
+            format!("{rate_hz} Hz is above the limit of {MAX_SAMPLE_RATE_HZ} Hz")
+        } else {
+            format!(
+                "{rate_hz} Hz gives fewer than two samples per period of the machine's fastest mode ({fastest_hz:.1} Hz): give at least {min:.1} Hz (the default {DEFAULT_SAMPLE_RATE_HZ} Hz, or twenty samples per period, {:.0} Hz, for contour errors to a few percent)",
+                20.0 * fastest_hz
+            )
+        },
+    ))
+}
+
 /// How much the ringing after the last move decays over the longest tail: 1e-3.
 pub const TAIL_DECAY: f64 = 1e-3;
 
@@ -536,12 +605,7 @@ fn simulate(
     if !opts.backend.available() {
         return Err(Error::input("--backend", NO_MUJOCO));
     }
-    if !(opts.sample_rate_hz.is_finite() && opts.sample_rate_hz > 0.0) {
-        return Err(Error::input(
-            "--sample-rate-hz",
-            "the sample rate must be a positive number of Hz",
-        ));
-    }
+    check_sample_rate(opts.sample_rate_hz, fastest_mode_hz(&linear_axes))?;
     let names = axes.iter().map(|a| a.name.clone()).collect();
     let sopts = StreamOptions {
         sample_rate_hz: opts.sample_rate_hz,
@@ -600,7 +664,20 @@ fn simulate(
         (&opts.file, progress),
     )?;
     job.run_to_end().map_err(&err)?;
-    let summary = job.summary();
+    let mut summary = job.summary();
+    if let Some(why) =
+        crate::studies::gcode::work::nothing_to_measure(&summary, job.reader().lines_read())
+    {
+        return Err(Error::input(&opts.file, why));
+    }
+    // Every command not followed, the reader's (not motion: temperatures, fans, macros,
+    // unknown words) with the planner's, so none vanishes unsaid.
+    for (name, n) in job.reader().ignored_commands() {
+        *summary
+            .ignored
+            .entry(format!("{name}: not a motion, limit or shaper command"))
+            .or_insert(0) += n;
+    }
     let mut by_layer: BTreeMap<u32, stats::LayerStats> = streamed
         .layers
         .iter()
@@ -733,11 +810,6 @@ pub fn gcode_with_progress(
     opts: &GcodeOptions,
     progress: Option<Progress<'_>>,
 ) -> Result<GcodeOutcome, Error> {
-    let rec = match opts.mcap {
-        true => Some(record::Recorder::start(recording_metadata(opts))?),
-        false => None,
-    };
-    let (mut outcome, rec) = simulate(opts, rec, progress)?;
     let dir = match &opts.out {
         Some(d) => d.clone(),
         None => {
@@ -748,6 +820,29 @@ pub fn gcode_with_progress(
             PathBuf::from("results").join(format!("{stem}-gcode"))
         }
     };
+    // The output folder, before any work: never an input, nor earlier results unasked.
+    crate::output::folder::check(&dir, &RESULTS, opts.force, &opts.inputs(), writes)?;
+    // The recording streams into a temporary file inside the folder, made for it (and
+    // removed again, with the folder it needed, when the run fails: a bad file writes
+    // nothing).
+    let made = opts.mcap && std::fs::symlink_metadata(&dir).is_err();
+    let simulated = (|| {
+        let rec = match opts.mcap {
+            true => {
+                crate::output::atomic::create_dir(&dir)?;
+                Some(record::Recorder::start(
+                    recording_metadata(opts),
+                    &dir.join(RECORDING),
+                )?)
+            }
+            false => None,
+        };
+        simulate(opts, rec, progress)
+    })();
+    if simulated.is_err() && made {
+        let _ = std::fs::remove_dir(&dir);
+    }
+    let (mut outcome, rec) = simulated?;
     let b_opts = match opts.versus {
         Some((fw, shapers)) => Some(compare::versus(opts, fw, shapers)?),
         None => None,
@@ -758,7 +853,7 @@ pub fn gcode_with_progress(
     };
     outcome.files = report::write(&outcome, &dir)?;
     if let Some(rec) = rec {
-        let path = dir.join("recording.mcap");
+        let path = dir.join(RECORDING);
         outcome.recording = Some(rec.finish(recording_metrics(&outcome), &path)?);
         outcome.files.push(path);
     }
@@ -770,6 +865,52 @@ pub fn gcode_with_progress(
     let html = report::write_html(&outcome, opts, &dir)?;
     outcome.files.push(html);
     Ok(outcome)
+}
+
+/// `--mcap`'s recording in the output folder.
+const RECORDING: &str = "recording.mcap";
+
+/// An earlier run's results in the output folder, which `--force` overwrites.
+const RESULTS: crate::output::folder::Results<'static> = crate::output::folder::Results {
+    what: "settle gcode",
+    marks: &[
+        "layers.csv",
+        "summary.md",
+        report::REPORT,
+        compare::FILE,
+        RECORDING,
+    ],
+};
+
+/// Whether `settle gcode` writes `rel` in its output folder.
+fn writes(rel: &Path) -> bool {
+    crate::output::folder::written(
+        rel,
+        RESULTS.marks,
+        &[],
+        &[
+            ("ringing-layer-", ".svg"),
+            ("ringing-layer-", ".png"),
+            ("compare-layer-", ".svg"),
+            ("compare-layer-", ".png"),
+        ],
+    )
+}
+
+impl GcodeOptions {
+    /// The files the run reads: the G-code, the machine file or scenario (a path), the
+    /// configuration and what it includes.
+    pub fn inputs(&self) -> settle_files::write::Inputs {
+        let mut inputs = settle_files::write::Inputs::of([&self.file]);
+        inputs.add(Path::new(&self.machine));
+        if let Some(c) = &self.config {
+            inputs.add(&c.path);
+            for f in &c.files {
+                inputs.add(f);
+            }
+        }
+        inputs
+    }
 }
 
 /// The `settle` metadata record of `--mcap`'s recording.

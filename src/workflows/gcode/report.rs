@@ -267,7 +267,7 @@ const LINE_CHARS: usize = 160;
 
 /// One pass over `file`: its SHA-256 and the text of the lines `wanted` (1-based).
 fn digest_and_lines(file: &Path, wanted: &[u64]) -> Result<(String, BTreeMap<u64, String>), Error> {
-    let f = std::fs::File::open(file).map_err(|e| Error::read(file, e))?;
+    let f = crate::input::file::open(file, crate::input::file::limit::GCODE)?;
     let mut reader = std::io::BufReader::new(f);
     let mut sha = Sha256::default();
     let mut lines = BTreeMap::new();
@@ -277,7 +277,7 @@ fn digest_and_lines(file: &Path, wanted: &[u64]) -> Result<(String, BTreeMap<u64
         buf.clear();
         let read = reader
             .read_until(b'\n', &mut buf)
-            .map_err(|e| Error::read(file, e))?;
+            .map_err(|e| crate::input::file::stream_error(file, e))?;
         if read == 0 {
             break;
         }
@@ -492,7 +492,7 @@ pub fn html_report(
     if opts.machine.ends_with(".toml") && machine.is_file() {
         inputs.push(InputFile {
             name: opts.machine.clone(),
-            text: crate::input::file::read_text(machine)?,
+            text: crate::input::file::read_text(machine, crate::input::file::limit::SETTINGS)?,
         });
     }
     Ok(Report {
@@ -500,6 +500,7 @@ pub fn html_report(
         intro,
         winners: Vec::new(),
         tables,
+        sections: Vec::new(),
         figures: figures
             .into_iter()
             .map(|(title, svg)| Figure {
@@ -574,7 +575,7 @@ pub fn write_html(o: &GcodeOutcome, opts: &GcodeOptions, dir: &Path) -> Result<P
                 None => stem.clone(),
             },
         };
-        let svg = std::fs::read_to_string(f).map_err(|e| Error::read(f, e))?;
+        let svg = crate::input::file::read_text(f, crate::input::file::limit::RESULTS)?;
         figures.push((title, svg));
     }
     let report = html_report(o, opts, dir, figures)?;

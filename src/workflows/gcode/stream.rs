@@ -146,6 +146,8 @@ struct Account {
     /// The move the last sample belonged to: index, kind, layer, line, worst spot.
     owner: Option<(u64, MoveKind, u32, u64, Option<Spot>)>,
     map_every: u64,
+    /// The current layer's map stride: `map_every`, doubled each time its map is halved.
+    map_stride: u64,
     /// The MCAP recording of the counted samples.
     rec: Option<Recorder>,
     /// The ringing after the last move, while it is simulated.
@@ -167,6 +169,7 @@ impl Account {
             map: Vec::new(),
             owner: None,
             map_every,
+            map_stride: map_every,
             rec,
             ringing: None,
         }
@@ -205,6 +208,7 @@ impl Account {
         l.p95_um = self.hist.quantile_um(0.95);
         self.out.all.merge(&self.hist);
         self.hist = Histogram::default();
+        self.map_stride = self.map_every;
         let map = LayerMap {
             layer: l.layer,
             points: std::mem::take(&mut self.map),
@@ -286,15 +290,44 @@ impl Account {
                 });
             }
         }
-        if k.is_multiple_of(self.map_every) {
+        if k.is_multiple_of(self.map_stride) {
             self.map.push(MapPoint {
                 x_mm: x as f32,
                 y_mm: y as f32,
                 error_um: err_um as f32,
                 print,
             });
+            if self.map.len() >= 2 * MAX_MAP_POINTS {
+                halve_map(&mut self.map);
+                self.map_stride *= 2;
+            }
         }
     }
+}
+
+/// The most points a layer's ringing map keeps: far more than the figure's 560 x 640
+/// pixels show, and a bounded memory whatever the layer's length (a long layer's map is
+/// halved, the worse of each pair of points kept, each time it reaches twice this).
+pub const MAX_MAP_POINTS: usize = 50_000;
+
+/// Halve a ringing map: each pair of neighbours becomes the one with the larger error
+/// (peaks are kept: the map is read for its worst spots), printing only if both are (a
+/// break in the drawn path stays a break).
+fn halve_map(map: &mut Vec<MapPoint>) {
+    let halved: Vec<MapPoint> = map
+        .chunks(2)
+        .map(|pair| {
+            let worst = pair
+                .iter()
+                .copied()
+                .fold(pair[0], |a, b| if b.error_um > a.error_um { b } else { a });
+            MapPoint {
+                print: pair.iter().all(|p| p.print),
+                ..worst
+            }
+        })
+        .collect();
+    *map = halved;
 }
 
 impl Tail {

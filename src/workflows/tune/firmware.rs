@@ -117,8 +117,9 @@ impl Candidates {
             Err("the TMC4361A has no input shaper: give shapers = [\"none\"]".into())
         } else {
             Err(format!(
-                "{} does not run the shaper `{}`; it runs: {}",
+                "{} does not run {}'s shaper `{}`; it runs: {}",
                 self.name(),
+                k.firmware().name(),
                 k.name(),
                 self.shapers()
                     .iter()
