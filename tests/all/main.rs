@@ -3,6 +3,7 @@
 
 mod support;
 
+mod across_breakpoints;
 #[cfg(target_os = "linux")]
 mod adversarial;
 mod cli;
@@ -11,6 +12,8 @@ mod faults;
 mod gcode_config;
 mod gcode_job;
 mod gcode_range;
+mod gcode_range_random;
+mod gcode_stream;
 mod hardening_input;
 mod html_report;
 mod identify_cmd;
