@@ -462,6 +462,18 @@ fn progress_bar() -> ProgressBar {
     bar
 }
 
+/// `settle gcode`'s progress bar on stderr (drawn only when stderr is a terminal): how
+/// much of the G-code file the simulation has read.
+fn gcode_progress_bar() -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template(
+        "{spinner} [{elapsed_precise}] {bar:40} {bytes}/{total_bytes} of G-code simulated ({eta} left)",
+    ) {
+        bar.set_style(style);
+    }
+    bar
+}
+
 /// Ctrl-C and SIGTERM stop new runs from starting (the finished ones are in the sweep's
 /// journal); a second signal exits at once, which loses nothing either.
 fn install_interrupt() -> Result<(), Error> {
@@ -686,7 +698,14 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                 }
                 .with_shapers(shaper.unwrap_or_default())
             };
-            failed_runs(workflows::gcode::gcode(&opts)?.report(), flag)
+            let bar = gcode_progress_bar();
+            let tell = |read: u64, size: u64| {
+                bar.set_length(size);
+                bar.set_position(read);
+            };
+            let outcome = workflows::gcode::gcode_with_progress(&opts, Some(&tell));
+            bar.finish_and_clear();
+            failed_runs(outcome?.report(), flag)
         }
         Command::Run {
             scenario,

@@ -21,6 +21,7 @@ mod error;
 pub mod lumped;
 pub mod machine;
 mod modal;
+mod modal_jump;
 mod mode;
 #[cfg(feature = "mujoco")]
 pub mod mujoco;
@@ -35,5 +36,5 @@ pub use axis::{AxisModel, DriverMode};
 pub use error::SimError;
 pub use modal::{ModalAxis, ModalPlant, ModalState};
 pub use mode::Mode;
-pub use plant::{Observation, Plant, advance_sample, check_step};
+pub use plant::{InnerBreak, Observation, Plant, advance_sample, check_step};
 pub use rapier::{BeltModel, RapierOptions, RapierPlant, RapierState};

@@ -27,7 +27,8 @@ use nalgebra::DMatrix;
 use settle_planner::{Sample, State};
 
 use crate::axis::{AxisModel, DriverMode};
-use crate::plant::check_step;
+use crate::modal_jump::Jumps;
+use crate::plant::{InnerBreak, check_step};
 use crate::stepper::StepperState;
 use crate::{Observation, Plant, SimError};
 
@@ -59,6 +60,9 @@ struct Discrete {
     /// `r, r', v, a`; the jerk enters through `a` only), row by row: what a short partial
     /// step multiplies the state by ([`Discrete::advance_short`]).
     accel_rows: Vec<f64>,
+    /// The response to a jump of the command inside a step, built at the first one
+    /// ([`crate::modal_jump`]).
+    jumps: std::sync::OnceLock<Jumps>,
 }
 
 /// Largest `|A h|` (infinity norm, scaled coordinates) over which partial steps sum the
@@ -142,7 +146,14 @@ impl Discrete {
             norm_per_s,
             powers: std::sync::OnceLock::new(),
             accel_rows,
+            jumps: std::sync::OnceLock::new(),
         })
+    }
+
+    /// The response to a jump of the command inside a step ([`crate::modal_jump`]).
+    fn jumps(&self) -> &Jumps {
+        self.jumps
+            .get_or_init(|| Jumps::new(&self.a_scaled, &self.scale, self.n, self.norm_per_s))
     }
 
     /// The transition for the nominal step, computed at the first call (the field of the
@@ -632,6 +643,49 @@ impl ModalPlant {
 }
 
 impl ModalPlant {
+    /// Every axis through the samples of `io` ([`run_axis`]), axis `a` across the
+    /// breakpoints `breaks[a]` (none when `breaks` is empty). Returns whether every
+    /// sample is one [`Plant::step`] and [`Plant::positions`] would vouch for; when not,
+    /// the axes are back where they were.
+    fn run_axes(
+        &self,
+        state: &mut ModalState,
+        io: &Io<'_>,
+        breaks: &[&[InnerBreak]],
+        commanded_m: &mut [f64],
+        toolhead_m: &mut [f64],
+    ) -> bool {
+        let mut good = true;
+        let mut done = 0;
+        for (a, (ax, st)) in self.axes.iter().zip(&mut state.axes).enumerate() {
+            st.save();
+            done = a + 1;
+            let b = breaks.get(a).copied().unwrap_or(&[]);
+            // The state's size as a constant: the product unrolls and `z` stays in
+            // registers.
+            good = match 2 * st.disc.n {
+                2 => run_axis::<4, 2>(ax, st, io, a, b, commanded_m, toolhead_m),
+                4 => run_axis::<4, 4>(ax, st, io, a, b, commanded_m, toolhead_m),
+                6 => run_axis::<8, 6>(ax, st, io, a, b, commanded_m, toolhead_m),
+                8 => run_axis::<8, 8>(ax, st, io, a, b, commanded_m, toolhead_m),
+                10 => run_axis::<12, 10>(ax, st, io, a, b, commanded_m, toolhead_m),
+                12 => run_axis::<12, 12>(ax, st, io, a, b, commanded_m, toolhead_m),
+                14 => run_axis::<16, 14>(ax, st, io, a, b, commanded_m, toolhead_m),
+                16 => run_axis::<16, 16>(ax, st, io, a, b, commanded_m, toolhead_m),
+                _ => false,
+            };
+            if !good {
+                break;
+            }
+        }
+        if !good {
+            for st in &mut state.axes[..done] {
+                st.restore();
+            }
+        }
+        good
+    }
+
     /// [`Plant::step_samples`] as [`Plant::step`] and [`Plant::positions`] per sample.
     fn samples_one_by_one(
         &self,
@@ -688,6 +742,7 @@ fn run_axis<const M: usize, const N2: usize>(
     st: &mut ModalAxis,
     io: &Io<'_>,
     a: usize,
+    breaks: &[InnerBreak],
     commanded_m: &mut [f64],
     toolhead_m: &mut [f64],
 ) -> bool {
@@ -722,7 +777,8 @@ fn run_axis<const M: usize, const N2: usize>(
         first.a.to_bits(),
         first.j.to_bits(),
     );
-    let held = first.v == 0.0
+    let held = breaks.is_empty()
+        && first.v == 0.0
         && first.a == 0.0
         && first.j == 0.0
         && (1..n).all(|i| {
@@ -754,6 +810,8 @@ fn run_axis<const M: usize, const N2: usize>(
         .take(n)
         .map(|(cm, th)| (&mut cm[a], &mut th[a]));
     let mut last = first;
+    // The breakpoints of the last step (their share of the base after it).
+    let mut last_breaks: &[InnerBreak] = &[];
     if held {
         // The command holds (the observation window): the same base position every
         // sample, no command columns (all zero), and an idle axis stays where it is.
@@ -792,13 +850,26 @@ fn run_axis<const M: usize, const N2: usize>(
             }
         }
     } else {
-        for ((cm, th), c) in outs.zip(io.cmds.chunks_exact(axes)) {
+        let mut rest = breaks;
+        for (i, ((cm, th), c)) in outs.zip(io.cmds.chunks_exact(axes)).enumerate() {
             let c = &c[a];
             last = *c;
-            let x = base_p(c);
-            if !(idle && c.v == 0.0 && c.a == 0.0 && c.j == 0.0) {
+            let mut x = base_p(c);
+            // This step's breakpoints ([`crate::modal_jump`]).
+            let here = rest.iter().take_while(|b| b.step == i).count();
+            let (jumps, after) = rest.split_at(here);
+            rest = after;
+            last_breaks = jumps;
+            if !(idle && c.v == 0.0 && c.a == 0.0 && c.j == 0.0 && jumps.is_empty()) {
                 idle = false;
                 advance(&phi, &phi_cmd, &mut z, Some([c.v, c.a, c.j]));
+                for b in jumps {
+                    disc.jumps()
+                        .add_to(b.before_end_s, [b.dv, b.da, b.dj], &mut z);
+                    let s = b.before_end_s;
+                    x += s * (b.dv + s * (b.da / 2.0 + s * b.dj / 6.0));
+                    probe += b.dv * 0.0 + b.da * 0.0 + b.dj * 0.0;
+                }
                 if let (Some((nr, rotor)), Some(ss)) = (track, stepper.as_mut()) {
                     ss.track(nr * z[rotor]);
                 }
@@ -823,6 +894,12 @@ fn run_axis<const M: usize, const N2: usize>(
         v: c.v + h * (c.a + h * c.j / 2.0),
         a: c.a + h * c.j,
     };
+    for b in last_breaks {
+        let s = b.before_end_s;
+        st.base.p += s * (b.dv + s * (b.da / 2.0 + s * b.dj / 6.0));
+        st.base.v += b.dv + s * (b.da + s * b.dj / 2.0);
+        st.base.a += b.da + s * b.dj;
+    }
     st.idle = idle;
     st.stepper = stepper;
     st.z[..N2].copy_from_slice(&z);
@@ -1004,33 +1081,47 @@ impl Plant for ModalPlant {
             dt_s,
             blowup_m,
         };
-        let mut good = true;
-        let mut done = 0;
-        for (a, (ax, st)) in self.axes.iter().zip(&mut state.axes).enumerate() {
-            st.save();
-            done = a + 1;
-            // The state's size as a constant: the product unrolls and `z` stays in
-            // registers.
-            good = match 2 * st.disc.n {
-                2 => run_axis::<4, 2>(ax, st, &io, a, commanded_m, toolhead_m),
-                4 => run_axis::<4, 4>(ax, st, &io, a, commanded_m, toolhead_m),
-                6 => run_axis::<8, 6>(ax, st, &io, a, commanded_m, toolhead_m),
-                8 => run_axis::<8, 8>(ax, st, &io, a, commanded_m, toolhead_m),
-                10 => run_axis::<12, 10>(ax, st, &io, a, commanded_m, toolhead_m),
-                12 => run_axis::<12, 12>(ax, st, &io, a, commanded_m, toolhead_m),
-                14 => run_axis::<16, 14>(ax, st, &io, a, commanded_m, toolhead_m),
-                16 => run_axis::<16, 16>(ax, st, &io, a, commanded_m, toolhead_m),
-                _ => false,
-            };
-            if !good {
-                break;
-            }
-        }
-        if !good {
-            for st in &mut state.axes[..done] {
-                st.restore();
-            }
+        if !self.run_axes(state, &io, &[], commanded_m, toolhead_m) {
             return self.samples_one_by_one(state, cmds, dt_s, blowup_m, commanded_m, toolhead_m);
+        }
+        for _ in 0..n {
+            state.t_s += dt_s;
+        }
+        Ok(Some(n))
+    }
+
+    /// [`Plant::step_samples`] with whole steps across breakpoints
+    /// (module `modal_jump`): `Ok(None)` when the step is not the nominal one, when a
+    /// step is too long for the jump's series on some axis (`Jumps::covers`), or when a
+    /// sample is not one to vouch for (the state is then unchanged and the caller splits
+    /// the steps, which finds the sample).
+    fn step_samples_across(
+        &self,
+        state: &mut ModalState,
+        cmds: &[Sample],
+        breaks: &[&[InnerBreak]],
+        dt_s: f64,
+        blowup_m: f64,
+        commanded_m: &mut [f64],
+        toolhead_m: &mut [f64],
+    ) -> Result<Option<usize>, (usize, SimError)> {
+        let axes = self.axes.len();
+        let n = cmds.len() / axes;
+        if dt_s != self.nominal_dt_s
+            || n * axes != cmds.len()
+            || breaks.len() != axes
+            || state.axes.iter().any(|st| !st.disc.jumps().covers(dt_s))
+        {
+            return Ok(None);
+        }
+        let io = Io {
+            cmds,
+            axes,
+            dt_s,
+            blowup_m,
+        };
+        if !self.run_axes(state, &io, breaks, commanded_m, toolhead_m) {
+            return Ok(None);
         }
         for _ in 0..n {
             state.t_s += dt_s;

@@ -30,6 +30,24 @@ pub struct Observation {
     pub max_load_angle_rad: Option<f64>,
 }
 
+/// A breakpoint of one axis's command inside a step of
+/// [`Plant::step_samples_across`]: at `before_end_s` before the step's end the command's
+/// velocity, acceleration and jerk jump by `dv`, `da`, `dj` from the continuation of the
+/// piece before (a new piece of its profile starts; positions are continuous).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct InnerBreak {
+    /// The step (its index in the call).
+    pub step: usize,
+    /// How long before the step's end (s), in `(0, dt_s)`.
+    pub before_end_s: f64,
+    /// Jump of the velocity (m/s).
+    pub dv: f64,
+    /// Jump of the acceleration (m/s^2).
+    pub da: f64,
+    /// Jump of the jerk (m/s^3).
+    pub dj: f64,
+}
+
 /// A plant: a constant model (`self`) and a separate mutable state.
 pub trait Plant {
     /// The mutable state.
@@ -91,6 +109,28 @@ pub trait Plant {
         &self,
         _state: &mut Self::State,
         _cmds: &[Sample],
+        _dt_s: f64,
+        _blowup_m: f64,
+        _commanded_m: &mut [f64],
+        _toolhead_m: &mut [f64],
+    ) -> Result<Option<usize>, (usize, SimError)> {
+        Ok(None)
+    }
+
+    /// [`Plant::step_samples`] across breakpoints: a step may hold breakpoints of an
+    /// axis's command, `breaks[a]` those of axis `a` in step order ([`InnerBreak`]), the
+    /// command at the start of step `i` being `cmds[i * axes + a]` as there. A plant that
+    /// solves its model exactly whatever the command's jerk does (the modal plant: the
+    /// response to a jump is one more term of the exact solution) takes a whole step
+    /// where others split it at each breakpoint; its results then agree with the split
+    /// steps' to rounding, not bit for bit. `Ok(None)` (the default): not implemented,
+    /// the caller splits the steps.
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn step_samples_across(
+        &self,
+        _state: &mut Self::State,
+        _cmds: &[Sample],
+        _breaks: &[&[InnerBreak]],
         _dt_s: f64,
         _blowup_m: f64,
         _commanded_m: &mut [f64],

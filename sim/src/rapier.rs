@@ -60,6 +60,9 @@ pub struct RapierOptions {
 pub struct RapierPlant {
     axes: Vec<AxisModel>,
     options: RapierOptions,
+    /// Where the step is sized ([`RapierPlant::stepped_from`]), when not at each run's
+    /// start: one position per axis (m).
+    step_at_m: Option<Vec<f64>>,
 }
 
 /// One axis inside the rapier world.
@@ -77,6 +80,9 @@ struct AxisBodies {
     qd_mid: Vec<f64>,
     base: Sample,
     stepper: Option<StepperState>,
+    /// The equilibrium where the step is sized: the stiffness a belt's stiffening is
+    /// measured against ([`RapierPlant::stepped_from`]; the start's by default).
+    q_step: Vec<f64>,
     /// Full driver: the magnetic torque's impulse over the last step's second half
     /// (N m s) and that half's length (s; 0 before the first step): the first half of the
     /// next step's kick window (`crate::rapier_driver`).
@@ -212,7 +218,33 @@ impl RapierPlant {
         {
             return Err(SimError::InvalidStep { dt_s: h });
         }
-        Ok(Self { axes, options })
+        Ok(Self {
+            axes,
+            options,
+            step_at_m: None,
+        })
+    }
+
+    /// The same plant with its integration step sized at these axis positions (m, one
+    /// per axis, in the order of the axes) instead of each run's start: the largest step
+    /// ([`RapierPlant::max_step_s`]) from the model there, and the shrinking when a belt
+    /// stiffens measured against its stiffness there. Runs of one job that start at
+    /// different places (a G-code layer range and the whole file) then step alike where
+    /// their states agree.
+    pub fn stepped_from(mut self, positions_m: Vec<f64>) -> Result<Self, SimError> {
+        if positions_m.len() != self.axes.len() {
+            return Err(SimError::AxisCount {
+                expected: self.axes.len(),
+                got: positions_m.len(),
+            });
+        }
+        if let Some(p) = positions_m.iter().find(|p| !p.is_finite()) {
+            return Err(SimError::InvalidModel {
+                what: format!("the step's reference position {p} m is not finite"),
+            });
+        }
+        self.step_at_m = Some(positions_m);
+        Ok(self)
     }
 
     /// The axes.
@@ -270,7 +302,12 @@ impl Plant for RapierPlant {
                 got: start.len(),
             });
         }
-        let h_max = self.max_step_s(start)?;
+        // Where the step is sized: the start, or the positions given.
+        let step_at: Vec<State> = match &self.step_at_m {
+            Some(at) => at.iter().map(|&p| State { p, v: 0.0, a: 0.0 }).collect(),
+            None => start.to_vec(),
+        };
+        let h_max = self.max_step_s(&step_at)?;
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::ZERO;
         world.integration_parameters.dt = h_max;
@@ -296,7 +333,12 @@ impl Plant for RapierPlant {
                 Vec::new()
             };
             let n = ax.lumped.dof();
+            let q_step = match &self.step_at_m {
+                Some(at) => start_equilibrium(ax, at[k])?.0,
+                None => q0.clone(),
+            };
             axes.push(AxisBodies {
+                q_step,
                 handles,
                 dir,
                 q: q0.clone(),
@@ -348,7 +390,8 @@ impl Plant for RapierPlant {
         if dt_s == 0.0 {
             return Ok(());
         }
-        // A belt stiffer than at the start (the carriage nearer a pulley) raises the
+        // A belt stiffer than where the step was sized (the start unless
+        // [`RapierPlant::stepped_from`] says; the carriage nearer a pulley) raises the
         // fastest rate by at most the square root of the stiffness ratio (one spring
         // scaled by f >= 1 gives K <= f K0): shrink the step to keep STEP_FRACTION.
         let mut stiffer = 1.0f64;
@@ -357,7 +400,7 @@ impl Plant for RapierPlant {
                 for c in &ax.lumped.couplings {
                     if c.stiffness.depends_on().is_some() {
                         let now = Lumped::stiffness_of(c, &ab.q);
-                        let start = Lumped::stiffness_of(c, &ab.q_frozen);
+                        let start = Lumped::stiffness_of(c, &ab.q_step);
                         stiffer = stiffer.max(now / start);
                     }
                 }

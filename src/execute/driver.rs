@@ -22,9 +22,10 @@
 use std::ops::{ControlFlow, RangeInclusive};
 
 use settle_planner::{Sample, State, Trajectory};
-use settle_sim::{Observation, Plant, SimError};
+use settle_sim::{InnerBreak, Observation, Plant, SimError};
 
 use crate::execute::cursor::Cursor;
+use crate::execute::inner_breaks::AxisBreaks;
 use crate::measure::metrics::BLOWUP_M;
 
 /// Samples between two looks at [`crate::execute::interrupt::requested`].
@@ -152,6 +153,10 @@ pub struct Driver<'p, P: Plant> {
     batch: Option<Buffers>,
     /// The fewest samples a batch takes (fewer are stepped one by one).
     min_batch: usize,
+    /// Batches go across breakpoints where the plant can ([`Driver::across_breakpoints`]).
+    across: bool,
+    /// Per axis, the breakpoints inside the steps of the batch being made.
+    breaks: Vec<Vec<InnerBreak>>,
     obs: Vec<Observation>,
     cmd: Vec<Sample>,
     cmd_p: Vec<f64>,
@@ -198,6 +203,8 @@ impl<'p, P: Plant> Driver<'p, P> {
             record,
             batch: (!record).then(|| Buffers::new(axes)),
             min_batch: 1,
+            across: false,
+            breaks: vec![Vec::new(); axes],
             obs: vec![Observation::default(); axes],
             cmd: vec![Sample::default(); axes],
             cmd_p: vec![0.0; axes],
@@ -211,6 +218,16 @@ impl<'p, P: Plant> Driver<'p, P> {
     /// internal steps than one sample, MuJoCo's does: the choice can change the last bits.)
     pub fn with_min_batch(mut self, n: usize) -> Self {
         self.min_batch = n.max(1);
+        self
+    }
+
+    /// Batches of whole samples go on across the command's breakpoints where the plant
+    /// steps across them exactly ([`Plant::step_samples_across`]: the modal plant) instead
+    /// of ending at each breakpoint, whose step is then split there. The results agree
+    /// with the split steps' to rounding, not bit for bit (a G-code job's command has
+    /// breakpoints every millisecond or so; splitting there cost most of its time).
+    pub fn across_breakpoints(mut self) -> Self {
+        self.across = true;
         self
     }
 
@@ -269,6 +286,7 @@ impl<'p, P: Plant> Driver<'p, P> {
         let breakpoints = traj.breakpoints();
         let mut next_bp = 0usize;
         let mut cursor = Cursor::new(traj);
+        let mut inner = self.across.then(|| AxisBreaks::new(traj));
         let mut tau = 0.0_f64;
         while tau < t1 {
             while next_bp < breakpoints.len() && breakpoints[next_bp] <= tau {
@@ -277,11 +295,52 @@ impl<'p, P: Plant> Driver<'p, P> {
             let bp = breakpoints.get(next_bp).copied().unwrap_or(t1).min(t1);
             let t_sample = local(self.k);
             let next = t_sample.min(bp);
-            let whole = next == t_sample && self.k > 0 && tau == local(self.k - 1);
+            let at_sample = self.k > 0 && tau == local(self.k - 1);
+            let whole = next == t_sample && at_sample;
+            if let Some(walk) = inner
+                .as_mut()
+                .filter(|_| at_sample && t_sample <= t1 && takes(t_sample) && self.batch.is_some())
+            {
+                // Samples k, k + 1, ... up to the trajectory's end, across breakpoints.
+                let k0 = self.k;
+                let mut m = 1;
+                while m < CHUNK {
+                    let ts = local(k0 + m as u64);
+                    if ts > t1 || !takes(ts) {
+                        break;
+                    }
+                    m += 1;
+                }
+                if m >= self.min_batch
+                    && let Some(b) = self.batch.as_mut()
+                {
+                    for (i, c) in b.cmds.chunks_exact_mut(n).take(m).enumerate() {
+                        cursor.at(local(k0 - 1 + i as u64), c);
+                    }
+                    walk.fill(m, |i| local(k0 - 1 + i as u64), &mut self.breaks);
+                    let fail = |i: usize| clock.time(k0 - 1 + i as u64);
+                    match self.step_batch(m, k0, clock, &fail, true, sink)? {
+                        Some(done) => {
+                            if done < m {
+                                // The walk went past steps not taken.
+                                inner = None;
+                            }
+                            self.k = k0 + done as u64 - 1;
+                            tau = local(self.k);
+                            cursor.at(tau, &mut self.cmd);
+                            self.full(self.k, clock.time(self.k), None, sink)?;
+                            self.k += 1;
+                            continue;
+                        }
+                        // The plant splits these steps: so does the rest of the trajectory.
+                        None => inner = None,
+                    }
+                }
+            }
             if whole && takes(t_sample) && self.batch.is_some() {
+                let k0 = self.k;
                 // Samples k, k + 1, ... up to the breakpoint (inclusive): every step lies
                 // in one piece of every axis's command.
-                let k0 = self.k;
                 let mut m = 1;
                 while m < CHUNK {
                     let ts = local(k0 + m as u64);
@@ -295,7 +354,7 @@ impl<'p, P: Plant> Driver<'p, P> {
                         cursor.at(local(k0 - 1 + i as u64), c);
                     }
                     let fail = |i: usize| clock.time(k0 - 1 + i as u64);
-                    if let Some(done) = self.step_batch(m, k0, clock, &fail, sink)? {
+                    if let Some(done) = self.step_batch(m, k0, clock, &fail, false, sink)? {
                         self.k = k0 + done as u64 - 1;
                         tau = local(self.k);
                         // The command at the last sample serves it.
@@ -345,7 +404,7 @@ impl<'p, P: Plant> Driver<'p, P> {
             let m = (last - k + 1).min(CHUNK as u64) as usize;
             if self.batch.is_some() && m >= self.min_batch {
                 let fail = |i: usize| clock.time(k + i as u64) - dt;
-                if let Some(done) = self.step_batch(m, k, clock, &fail, sink)? {
+                if let Some(done) = self.step_batch(m, k, clock, &fail, false, sink)? {
                     self.full(
                         k + done as u64 - 1,
                         clock.time(k + done as u64 - 1),
@@ -415,29 +474,45 @@ impl<'p, P: Plant> Driver<'p, P> {
     /// sample of the call (it returns `done == m` then, which reads as "all vouched
     /// for"), at one `positions` per call. `None`: the plant steps sample by sample
     /// (nothing was done; batches are off from now on). A step `i` that fails is reported
-    /// at `fail(i)`.
+    /// at `fail(i)`. `across`: the steps hold the breakpoints in [`Driver::breaks`]
+    /// ([`Plant::step_samples_across`]); `None` then leaves batches on.
     fn step_batch(
         &mut self,
         m: usize,
         k0: u64,
         clock: Clock,
         fail: &dyn Fn(usize) -> f64,
+        across: bool,
         sink: &mut impl Sink,
     ) -> Result<Option<usize>, Stop> {
         let Some(b) = self.batch.as_mut() else {
             return Ok(None);
         };
         let len = m * self.axes;
-        let result = self.plant.step_samples(
-            &mut self.state,
-            &b.cmds[..len],
-            self.dt,
-            BLOWUP_M,
-            &mut b.cmd_p[..len],
-            &mut b.toolhead[..len],
-        );
+        let result = if across {
+            let breaks: Vec<&[InnerBreak]> = self.breaks.iter().map(Vec::as_slice).collect();
+            self.plant.step_samples_across(
+                &mut self.state,
+                &b.cmds[..len],
+                &breaks,
+                self.dt,
+                BLOWUP_M,
+                &mut b.cmd_p[..len],
+                &mut b.toolhead[..len],
+            )
+        } else {
+            self.plant.step_samples(
+                &mut self.state,
+                &b.cmds[..len],
+                self.dt,
+                BLOWUP_M,
+                &mut b.cmd_p[..len],
+                &mut b.toolhead[..len],
+            )
+        };
         let (count, outcome) = match result {
             Ok(Some(done)) if (1..=m).contains(&done) => (done - 1, Ok(Some(done))),
+            Ok(_) if across => return Ok(None),
             Ok(_) => {
                 self.batch = None;
                 return Ok(None);

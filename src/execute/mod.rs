@@ -6,6 +6,7 @@
 
 pub mod cursor;
 pub mod driver;
+pub mod inner_breaks;
 pub mod interrupt;
 pub mod plant;
 pub mod pool;
@@ -19,6 +20,7 @@ use crate::measure::series::Series;
 use crate::spec::backend::{Backend, NO_MUJOCO};
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
+use crate::studies::Motion;
 
 pub use plant::SimOptions;
 pub use simulate::run_trajectory;
@@ -76,17 +78,18 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
     })?;
     let options = SimOptions {
         linearise_at_m: planned.linearise_at_m.clone(),
+        step_at_m: planned.step_at_m.clone(),
         ..sim_options(spec)
     };
     let observe = observe_of(spec);
-    let traj = &planned.trajectory;
-    let samples = (traj.duration_s() + spec.window_s) * spec.sample_rate_hz;
+    let duration_s = planned.motion.duration_s();
+    let samples = (duration_s + spec.window_s) * spec.sample_rate_hz;
     if !(samples.is_finite() && samples <= crate::expand::validate::MAX_SAMPLES_PER_RUN) {
         return Ok(Metrics::failed(
             &spec.bands_um,
             format!(
                 "the planned move takes {:.3e} s: with the {} s window at {} Hz that is {samples:.3e} samples, over the limit of {:e} per run",
-                traj.duration_s(),
+                duration_s,
                 spec.window_s,
                 spec.sample_rate_hz,
                 crate::expand::validate::MAX_SAMPLES_PER_RUN
@@ -102,7 +105,7 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
             &spec.bands_um,
             format!(
                 "its trace is kept in memory: {samples:.3e} samples (the {:.3e} s move and the {} s window at {} Hz) of {per_sample} values each are {values:.3e} values, over the limit of {:e}: shorten the move or the window, or lower observe.sample_rate_hz",
-                traj.duration_s(),
+                duration_s,
                 spec.window_s,
                 spec.sample_rate_hz,
                 crate::expand::validate::MAX_RECORDED_VALUES
@@ -116,9 +119,20 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
             m
         }
     };
+    let traj = match planned.motion {
+        Motion::Whole(t) => t,
+        Motion::Stream(mut s) => {
+            let m = simulate::run_stream(axes, spec.backend, &options, &mut s, &observe, record)
+                .map_err(|source| Error::Plan {
+                    run: spec.id,
+                    source,
+                })?;
+            return interrupted(m.map_err(sim_err));
+        }
+    };
     let Some(probe) = planned.probe else {
         return interrupted(
-            run_trajectory(axes, spec.backend, &options, traj, &observe, record).map_err(sim_err),
+            run_trajectory(axes, spec.backend, &options, &traj, &observe, record).map_err(sim_err),
         );
     };
     let mut local = Series::default();
@@ -127,7 +141,8 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
         None => &mut local,
     };
     let mut m = interrupted(
-        run_trajectory(axes, spec.backend, &options, traj, &observe, Some(series)).map_err(sim_err),
+        run_trajectory(axes, spec.backend, &options, &traj, &observe, Some(series))
+            .map_err(sim_err),
     )?;
     if m.is_ok() {
         probe.measure(spec, series, &mut m)?;

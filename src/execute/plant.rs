@@ -23,6 +23,10 @@ pub struct SimOptions {
     /// print's centre; the nonlinear backends follow the stiffness along the travel and
     /// ignore it.
     pub linearise_at_m: Option<Vec<f64>>,
+    /// Where rapier sizes its integration step: one position per axis (m, in the order
+    /// of the axes); `None`: each run's start. A G-code job gives its start (the origin)
+    /// for the whole file and any layer range alike, so that both step alike.
+    pub step_at_m: Option<Vec<f64>>,
 }
 
 /// What runs on a plant (usually a [`crate::execute::driver::Driver`] and its sink).
@@ -54,13 +58,16 @@ pub fn with_plant<S: Simulation>(
             Ok(sim.run(&plant))
         }
         Backend::Rapier => {
-            let plant = RapierPlant::new(
+            let mut plant = RapierPlant::new(
                 axes,
                 RapierOptions {
                     max_step_s: options.max_step_s,
                     belt: options.belt,
                 },
             )?;
+            if let Some(at) = &options.step_at_m {
+                plant = plant.stepped_from(at.clone())?;
+            }
             Ok(sim.run(&plant))
         }
         #[cfg(feature = "mujoco")]

@@ -4,7 +4,7 @@
 
 use std::ops::ControlFlow;
 
-use settle_planner::{Profile, Sample, State, Trajectory};
+use settle_planner::{PlanError, Profile, Sample, State, Trajectory};
 use settle_sim::{AxisModel, DriverMode, Plant, SimError};
 
 use crate::execute::Observe;
@@ -15,6 +15,7 @@ use crate::measure::metrics::{Metrics, Status};
 use crate::measure::path_metrics::PathAccumulator;
 use crate::measure::series::Series;
 use crate::spec::backend::Backend;
+use crate::studies::{MotionStream, Streamed};
 
 /// The channels [`crate::execute::execute`] records for these axes: per axis `cmd_p_<axis>` (m),
 /// `cmd_v_<axis>` (m/s), `cmd_a_<axis>` (m/s^2), `cmd_j_<axis>` (m/s^3), `toolhead_<axis>`
@@ -116,6 +117,67 @@ pub fn run_trajectory(
     )?
 }
 
+/// Simulate a streamed motion ([`simulate_stream`]) on `backend`, as [`run_trajectory`]
+/// does a whole trajectory.
+pub fn run_stream(
+    axes: Vec<AxisModel>,
+    backend: Backend,
+    options: &SimOptions,
+    motion: &mut Streamed,
+    observe: &Observe,
+    record: Option<&mut Series>,
+) -> Result<Result<Metrics, SimError>, PlanError> {
+    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+    let record = record.map(|rec| {
+        *rec = Series::with_channels(channels(&axes));
+        rec
+    });
+    let meta: Vec<AxisMeta> = axes.iter().map(AxisMeta::of).collect();
+    let start_m: Vec<f64> = motion.start.iter().map(|s| s.p).collect();
+    let run = StreamRun {
+        names: &names,
+        meta: &meta,
+        motion,
+        observe,
+        record,
+    };
+    match with_plant(
+        backend,
+        axes,
+        options,
+        observe.sample_rate_hz,
+        &start_m,
+        run,
+    ) {
+        Ok(r) => r,
+        Err(e) => Ok(Err(e)),
+    }
+}
+
+/// A run of [`simulate_stream`], as a [`Simulation`].
+struct StreamRun<'a> {
+    names: &'a [String],
+    meta: &'a [AxisMeta],
+    motion: &'a mut Streamed,
+    observe: &'a Observe,
+    record: Option<&'a mut Series>,
+}
+
+impl Simulation for StreamRun<'_> {
+    type Output = Result<Result<Metrics, SimError>, PlanError>;
+
+    fn run<P: Plant>(self, plant: &P) -> Self::Output {
+        simulate_stream(
+            plant,
+            self.names,
+            self.meta,
+            self.motion,
+            self.observe,
+            self.record,
+        )
+    }
+}
+
 /// A run of [`simulate`], as a [`Simulation`].
 struct Run<'a> {
     names: &'a [String],
@@ -159,24 +221,12 @@ pub fn simulate<P: Plant>(
     let t_end = traj.duration_s();
     let starts: Vec<State> = traj.axes().iter().map(Profile::start).collect();
     let ends: Vec<State> = traj.axes().iter().map(Profile::end).collect();
-    let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
-    let direction: Vec<f64> = starts.iter().zip(&ends).map(|(s, e)| e.p - s.p).collect();
     let lean = record.is_none();
-    let mut sink = RunSink {
-        acc: Accumulator::new(&target, &direction, t_end, &observe.bands_um),
-        path: traj.path().map(|g| PathAccumulator::new(g, t_end)),
-        record,
-        meta,
-        row: Vec::new(),
-    };
+    let mut sink = RunSink::new(&starts, &ends, t_end, observe, meta, record, None);
+    sink.path = traj.path().map(|g| PathAccumulator::new(g, t_end));
     let mut driver = Driver::new(plant, names, &starts, observe.sample_rate_hz, 0.0, !lean)?;
     // The end of the move, then the observation window at the end point.
     let hold = standing_at(&ends);
-    let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
-    let window = Clock {
-        origin_s: t_end,
-        dt_s: driver.dt_s(),
-    };
     let ran = driver.follow(traj, 0.0, false, &mut sink).and_then(|()| {
         if t_end > 0.0 {
             driver.sample_now(0, t_end, &hold, &mut sink)
@@ -185,8 +235,91 @@ pub fn simulate<P: Plant>(
             traj.state_at(0.0, &mut at);
             driver.sample_now(0, 0.0, &at, &mut sink)
         }?;
-        driver.hold(&hold, 1..=n, window, &mut sink)
+        window(&mut driver, &mut sink, &hold, t_end, observe)
     });
+    Ok(finish(&mut driver, sink, names, ran, lean))
+}
+
+/// Drive `plant` through a motion streamed chunk by chunk (a G-code job,
+/// [`crate::studies::Motion::Stream`]), as [`simulate`] drives a whole trajectory: the
+/// chunks one after the other on one sample clock, the end point held for the observation
+/// window; every sample also goes to the stream's own measurement. The driver steps as
+/// `settle gcode` does (across breakpoints; a lone whole sample through `Plant::step`).
+/// A chunk that fails to plan is the error.
+pub fn simulate_stream<P: Plant>(
+    plant: &P,
+    names: &[String],
+    meta: &[AxisMeta],
+    motion: &mut Streamed,
+    observe: &Observe,
+    record: Option<&mut Series>,
+) -> Result<Result<Metrics, SimError>, PlanError> {
+    let t_end = motion.duration_s;
+    let (starts, ends) = (motion.start.clone(), motion.end.clone());
+    let lean = record.is_none();
+    let chunks = &mut motion.chunks;
+    let mut next = chunks.next_chunk()?;
+    let mut sink = RunSink::new(
+        &starts,
+        &ends,
+        t_end,
+        observe,
+        meta,
+        record,
+        Some(&mut **chunks),
+    );
+    let mut driver = match Driver::new(plant, names, &starts, observe.sample_rate_hz, 0.0, !lean) {
+        Ok(d) => d.with_min_batch(2).across_breakpoints(),
+        Err(e) => return Ok(Err(e)),
+    };
+    let mut t0 = 0.0;
+    let mut ran = Ok(());
+    while let Some(chunk) = next.take() {
+        next = sink.stream_next()?;
+        ran = driver.follow(&chunk, t0, next.is_some(), &mut sink);
+        t0 += chunk.duration_s();
+        if ran.is_err() {
+            break;
+        }
+    }
+    let hold = standing_at(&ends);
+    let ran = ran.and_then(|()| {
+        driver.sample_now(0, t_end, &hold, &mut sink)?;
+        window(&mut driver, &mut sink, &hold, t_end, observe)
+    });
+    let mut m = finish(&mut driver, sink, names, ran, lean);
+    if m.is_ok() {
+        motion.chunks.measure(&mut m);
+    }
+    Ok(Ok(m))
+}
+
+/// The observation window after the move end `t_end`: the command `hold` (standing at the
+/// end point), a sample every `1/sample_rate` s after it.
+fn window<P: Plant>(
+    driver: &mut Driver<'_, P>,
+    sink: &mut RunSink<'_, '_>,
+    hold: &[Sample],
+    t_end: f64,
+    observe: &Observe,
+) -> Result<(), Stop> {
+    let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
+    let window = Clock {
+        origin_s: t_end,
+        dt_s: driver.dt_s(),
+    };
+    driver.hold(hold, 1..=n, window, sink)
+}
+
+/// The run's metrics: a fault, a backend failure or an interruption makes it a failed
+/// run, lost steps another.
+fn finish<P: Plant>(
+    driver: &mut Driver<'_, P>,
+    sink: RunSink<'_, '_>,
+    names: &[String],
+    ran: Result<(), Stop>,
+    lean: bool,
+) -> Metrics {
     let status = match ran {
         Ok(()) => None,
         Err(Stop::Fault(reason)) => Some(reason),
@@ -203,9 +336,9 @@ pub fn simulate<P: Plant>(
     };
     let angles: Vec<Option<f64>> = obs.iter().map(|o| o.max_load_angle_rad).collect();
     if let Some(reason) = status {
-        return Ok(sink
+        return sink
             .acc
-            .finish_with(names, &angles, Status::Fault { reason }));
+            .finish_with(names, &angles, Status::Fault { reason });
     }
     let lost: u32 = obs.iter().map(|o| o.lost_steps).sum();
     let status = match obs.iter().position(|o| o.lost_steps > 0) {
@@ -217,24 +350,61 @@ pub fn simulate<P: Plant>(
     };
     let mut metrics = sink.acc.finish_with(names, &angles, status);
     metrics.path = sink.path.map(|p| p.finish());
-    Ok(metrics)
+    metrics
 }
 
 /// The fault reason of a run ended by an interruption.
 pub const INTERRUPTED: &str = "interrupted";
 
-/// A run's sink: the streaming metrics, and the recording when asked.
+/// A run's sink: the streaming metrics, the measurement of a streamed motion, and the
+/// recording when asked.
 struct RunSink<'a, 'g> {
     acc: Accumulator,
     path: Option<PathAccumulator<'g>>,
+    stream: Option<&'a mut dyn MotionStream>,
     record: Option<&'a mut Series>,
     meta: &'a [AxisMeta],
     row: Vec<f64>,
 }
 
+impl<'a> RunSink<'a, '_> {
+    /// Measuring a motion from `starts` to `ends` that ends at `t_end` (s).
+    fn new(
+        starts: &[State],
+        ends: &[State],
+        t_end: f64,
+        observe: &Observe,
+        meta: &'a [AxisMeta],
+        record: Option<&'a mut Series>,
+        stream: Option<&'a mut dyn MotionStream>,
+    ) -> Self {
+        let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
+        let direction: Vec<f64> = starts.iter().zip(ends).map(|(s, e)| e.p - s.p).collect();
+        Self {
+            acc: Accumulator::new(&target, &direction, t_end, &observe.bands_um),
+            path: None,
+            stream,
+            record,
+            meta,
+            row: Vec::new(),
+        }
+    }
+
+    /// The streamed motion's next chunk.
+    fn stream_next(&mut self) -> Result<Option<Trajectory>, PlanError> {
+        match self.stream.as_deref_mut() {
+            Some(s) => s.next_chunk(),
+            None => Ok(None),
+        }
+    }
+}
+
 impl Sink for RunSink<'_, '_> {
     fn sample(&mut self, s: &Full<'_>) -> ControlFlow<()> {
         self.acc.push(s.t_s, s.commanded_m, s.toolhead_m);
+        if let Some(st) = self.stream.as_deref_mut() {
+            st.sample(s.t_s, s.toolhead_m);
+        }
         let contour = self.path.as_mut().map(|p| p.push(s.t_s, s.toolhead_m));
         if let (Some(rec), Some(obs)) = (self.record.as_deref_mut(), s.observed) {
             let row = &mut self.row;
@@ -269,6 +439,11 @@ impl Sink for RunSink<'_, '_> {
         if let Some(p) = self.path.as_mut() {
             for i in 0..b.count {
                 p.push(b.time(i), b.positions(i).1);
+            }
+        }
+        if let Some(st) = self.stream.as_deref_mut() {
+            for i in 0..b.count {
+                st.sample(b.time(i), b.positions(i).1);
             }
         }
         ControlFlow::Continue(())

@@ -15,6 +15,7 @@
 //! - plans the run's motion ([`Study::plan`], [`Role::Move`] and [`Role::Path`] studies), or
 //!   transforms the motion another study plans ([`Study::shaper`], [`Role::Modifier`]),
 //! - may measure more than the common metrics from the run's series ([`Planned::probe`]),
+//!   or, for a motion too long to plan whole, along its chunks ([`Motion::Stream`]),
 //! - names its extra runs.csv columns and fills their cells ([`Study::columns`],
 //!   [`Study::cells`]), and adds its section to the summary and its panels to the figures
 //!   ([`Study::summary`], [`Study::figures`]).
@@ -115,17 +116,86 @@ pub trait Probe: std::fmt::Debug + Send {
     fn measure(&self, run: &RunSpec, series: &Series, m: &mut Metrics) -> Result<(), Error>;
 }
 
+/// A planned run's motion.
+#[derive(Debug)]
+pub enum Motion {
+    /// One profile per machine axis (with the path geometry, when it follows a path).
+    Whole(Trajectory),
+    /// A motion too long to hold planned whole (a G-code job): its chunks one after the
+    /// other, measured as they are simulated.
+    Stream(Streamed),
+}
+
+impl Motion {
+    /// The trajectory of a motion planned whole; `None` for a streamed one.
+    pub fn whole(&self) -> Option<&Trajectory> {
+        match self {
+            Motion::Whole(t) => Some(t),
+            Motion::Stream(_) => None,
+        }
+    }
+
+    /// The motion's duration (s).
+    pub fn duration_s(&self) -> f64 {
+        match self {
+            Motion::Whole(t) => t.duration_s(),
+            Motion::Stream(s) => s.duration_s,
+        }
+    }
+}
+
+/// A motion simulated chunk by chunk ([`Motion::Stream`]): where it starts and ends and
+/// how long it takes (what the common metrics measure against, as for a whole
+/// trajectory), and its chunks with what the study measures along them.
+pub struct Streamed {
+    /// The start, per machine axis.
+    pub start: Vec<State>,
+    /// The end, per machine axis.
+    pub end: Vec<State>,
+    /// The duration (s): the sum of the chunks' durations, in order.
+    pub duration_s: f64,
+    /// The chunks and the study's measurement.
+    pub chunks: Box<dyn MotionStream>,
+}
+
+impl std::fmt::Debug for Streamed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Streamed")
+            .field("start", &self.start)
+            .field("end", &self.end)
+            .field("duration_s", &self.duration_s)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The chunks of a [`Streamed`] motion and what the study measures along them.
+pub trait MotionStream: Send {
+    /// The next chunk, one profile per machine axis, starting where the one before ended
+    /// (its time 0 is the sum of the durations before); `None` after the last.
+    fn next_chunk(&mut self) -> Result<Option<Trajectory>, PlanError>;
+
+    /// A sample at `t_s` (the run's clock) with the toolhead at `toolhead_m` (per machine
+    /// axis): every sample, in order, the observation window's too.
+    fn sample(&mut self, t_s: f64, toolhead_m: &[f64]);
+
+    /// Add its figures to an ok run's metrics.
+    fn measure(&mut self, m: &mut Metrics);
+}
+
 /// A planned run.
 #[derive(Debug)]
 pub struct Planned {
-    /// One profile per machine axis (with the path geometry, when it follows a path).
-    pub trajectory: Trajectory,
-    /// What the study measures beyond the common metrics: the runner then records the run's
-    /// series for it.
+    /// The motion.
+    pub motion: Motion,
+    /// What the study measures beyond the common metrics from a whole motion's series:
+    /// the runner then records the run's series for it.
     pub probe: Option<Box<dyn Probe>>,
     /// Where the modal backend linearises the machine (m per machine axis); `None`: at
     /// the trajectory's start (see [`crate::execute::SimOptions::linearise_at_m`]).
     pub linearise_at_m: Option<Vec<f64>>,
+    /// Where rapier sizes its integration step (m per machine axis); `None`: at the
+    /// trajectory's start (see [`crate::execute::SimOptions::step_at_m`]).
+    pub step_at_m: Option<Vec<f64>>,
 }
 
 /// A runs.csv column a study plots against each swept parameter.

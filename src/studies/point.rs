@@ -5,7 +5,7 @@
 
 use settle_planner::PlanError;
 
-use crate::studies::{PlanContext, Planned, Role, Study, jerk_unused, on_axis};
+use crate::studies::{Motion, PlanContext, Planned, Role, Study, jerk_unused, on_axis};
 use crate::spec::run_spec::RunSpec;
 
 /// The point-to-point move.
@@ -38,9 +38,10 @@ impl Study for PointMove {
             None => profile,
         };
         Ok(Planned {
-            trajectory: on_axis(ctx.axes, &run.axis, &profile)?,
+            motion: Motion::Whole(on_axis(ctx.axes, &run.axis, &profile)?),
             probe: None,
             linearise_at_m: None,
+            step_at_m: None,
         })
     }
 

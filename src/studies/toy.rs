@@ -16,7 +16,7 @@ use crate::error::Error;
 use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
 use crate::studies::{
-    Study, StudyState, PlanContext, Planned, PlotColumn, Probe, Role, any_has, on_axis,
+    Motion, Study, StudyState, PlanContext, Planned, PlotColumn, Probe, Role, any_has, on_axis,
 };
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
@@ -129,9 +129,10 @@ impl Study for Toy {
         let shuttle = Profile::new(there.start(), segments)?;
         let move_end_s = shuttle.duration_s();
         Ok(Planned {
-            trajectory: on_axis(ctx.axes, &run.axis, &shuttle)?,
+            motion: Motion::Whole(on_axis(ctx.axes, &run.axis, &shuttle)?),
             probe: Some(Box::new(MaxError { move_end_s })),
             linearise_at_m: None,
+            step_at_m: None,
         })
     }
 

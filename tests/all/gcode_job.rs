@@ -114,7 +114,7 @@ fn a_gcode_corner_gives_the_metrics_of_the_corner_study() {
             linearise_at_m: Some(point),
             ..settle::execute::sim_options(&c_run)
         },
-        &planned.trajectory,
+        planned.motion.whole().expect("a corner is planned whole"),
         &settle::execute::observe_of(&c_run),
         None,
     )
@@ -226,7 +226,8 @@ fn the_contour_error_does_not_depend_on_the_sample_rate() {
 /// second, near printer_xy's modes: the rotor's load angle passes 90 electrical degrees on
 /// the linear driver (and the full driver on rapier slips poles on the same file). The
 /// run is a failed run, a result: a message says what happened and where, the outputs are
-/// written, the exit code is 0 (1 with `--fail-on-failed-runs`).
+/// written, summary.md and report.html saying so at their top, the exit code is 0 (1 with
+/// `--fail-on-failed-runs`).
 #[test]
 fn lost_steps_are_reported_as_a_result_with_where_they_happen() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -254,6 +255,8 @@ fn lost_steps_are_reported_as_a_result_with_where_they_happen() {
             .code(),
         Some(1)
     );
+    // stderr is a pipe here, not a terminal: no progress bar.
+    assert!(!stderr.contains("of G-code simulated"), "{stderr}");
     assert!(
         stderr.contains("result: the machine loses steps")
             && stderr.contains("load angle passed 90 electrical degrees"),
@@ -266,6 +269,19 @@ fn lost_steps_are_reported_as_a_result_with_where_they_happen() {
         "{l:?}"
     );
     assert!(stderr.contains(&format!("line {}", l.line)), "{stderr}");
+    // Both pages say so first, before any number.
     let md = std::fs::read_to_string(out_dir.join("summary.md")).expect("summary");
-    assert!(md.contains("**Lost steps**"), "{md}");
+    let lost = md
+        .find("**Lost steps**")
+        .expect("summary.md names the lost steps");
+    assert!(lost < md.find("| print time").expect("figures"), "{md}");
+    let html = std::fs::read_to_string(out_dir.join("report.html")).expect("report");
+    let lost = html
+        .find("<p>Lost steps: ")
+        .expect("report.html names the lost steps");
+    let first = html.find("<header>").expect("header") + "<header>\n<h1>".len();
+    assert!(
+        !html[first..lost].contains("<p>") && html[lost..].contains(&format!("line {}", l.line)),
+        "report.html opens with the lost steps"
+    );
 }

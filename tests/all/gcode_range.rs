@@ -11,7 +11,7 @@ use settle::workflows::gcode::{GcodeOptions, measure};
 use settle_planner::firmware::Firmware;
 
 use crate::support::one_mode::OneMode;
-use crate::support::{extra, root, settle, write};
+use crate::support::{extra, one_modal_run, root, settle, write};
 
 fn tower(firmware: Firmware) -> GcodeOptions {
     GcodeOptions::new(
@@ -340,11 +340,8 @@ fn the_gcode_study_starts_a_layer_range_from_the_whole_jobs_state() {
                 tower.to_str().expect("utf-8")
             ),
         );
-        let (_, mut runs) = settle::load_runs(&scenario).expect("loads");
-        settle::execute::set_backend(&scenario, &mut runs, settle::spec::backend::Backend::Modal)
-            .expect("modal");
-        assert_eq!(runs.len(), 1);
-        let m = settle::execute::execute(&runs[0], None).expect("runs");
+        let run = one_modal_run(&scenario);
+        let m = settle::execute::execute(&run, None).expect("runs");
         assert!(m.is_ok(), "{m:?}");
         let whole = measure(&GcodeOptions::new(tower, name, Firmware::Klipper).expect("options"))
             .expect("runs");

@@ -3,6 +3,7 @@
 
 mod support;
 
+mod across_breakpoints;
 #[cfg(target_os = "linux")]
 mod adversarial;
 mod cli;
@@ -12,6 +13,8 @@ mod gcode_config;
 mod gcode_grbl;
 mod gcode_job;
 mod gcode_range;
+mod gcode_range_random;
+mod gcode_stream;
 mod hardening_input;
 mod html_report;
 mod identify_cmd;

@@ -120,7 +120,7 @@ fn a_corner_on_an_xy_modes_machine_rings_on_each_axis_at_its_own_modes() {
     assert!(m.is_ok(), "{:?}", m.status);
     let names = runs[0].axis_names();
     let planned = settle::studies::plan(&runs[0], &names).expect("plans");
-    let traj = &planned.trajectory;
+    let traj = planned.motion.whole().expect("a corner is planned whole");
     let t_end = traj.duration_s();
     for (name, mode, profile) in [
         ("x", X_MODE, &traj.axes()[0]),

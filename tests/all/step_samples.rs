@@ -215,7 +215,10 @@ bands_um = [10.0]
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
     let traj = settle::studies::plan(spec, &names)
         .expect("plan")
-        .trajectory;
+        .motion
+        .whole()
+        .expect("a corner is planned whole")
+        .clone();
     assert!(traj.path().is_some(), "a path run");
     Case {
         axes,

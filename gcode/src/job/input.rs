@@ -221,6 +221,13 @@ impl Input {
         Ok(())
     }
 
+    /// Up to when the output has been emitted (s; minus infinity before it starts).
+    pub(crate) fn emitted_until_s(&self) -> f64 {
+        self.shaper
+            .as_ref()
+            .map_or(f64::NEG_INFINITY, AxesShaper::emitted_until_s)
+    }
+
     /// Whether everything the range asks for has been emitted.
     pub(crate) fn done(&self) -> bool {
         let Some(s) = &self.shaper else {

@@ -20,7 +20,7 @@ use settle_planner::{PlanError, Trajectory};
 use crate::error::Error;
 use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
-use crate::studies::{Study, StudyState, PathMove, PlanContext, Planned, PlotColumn, Role, any_has};
+use crate::studies::{Motion, Study, StudyState, PathMove, PlanContext, Planned, PlotColumn, Role, any_has};
 use crate::measure::metrics::Metrics;
 use crate::measure::path_metrics::columns as col;
 use crate::spec::run_spec::RunSpec;
@@ -127,9 +127,10 @@ impl Study for CornerPath {
             None => traj,
         };
         Ok(Planned {
-            trajectory,
+            motion: Motion::Whole(trajectory),
             probe: None,
             linearise_at_m: None,
+            step_at_m: None,
         })
     }
 

@@ -17,7 +17,7 @@ use std::sync::Arc;
 
 use settle_gcode::job::{MoveGeometry, MoveInfo};
 
-/// How far (s) a move's span is widened for [`ActiveMoves::error_mm`]: 20 ms is longer
+/// How far (s) a move's span is widened for [`ActiveMoves::at`]: 20 ms is longer
 /// than half the longest Klipper shaper at 20 Hz (2DHUMP_EI at 20 Hz lasts 75 ms: the
 /// shaped command leads by at most half of it, 37 ms, only on shapers tuned below 40 Hz)
 /// and than a quarter period of the printer modes (30-120 Hz): the lag of the toolhead.
@@ -25,6 +25,14 @@ pub const ACTIVE_WINDOW_S: f64 = 0.02;
 
 /// Distance (mm) from `p` to the segment `a`-`b` (XY).
 pub fn segment_distance_mm(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    segment_distance_sq(p, a, b).sqrt()
+}
+
+/// The square of [`segment_distance_mm`] (mm^2): comparisons need no square root (the
+/// root is monotone and correctly rounded, so the root of the least square is the least
+/// root, bit for bit).
+#[inline]
+fn segment_distance_sq(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let (px, py) = (p[0] - a[0], p[1] - a[1]);
     let l2 = dx * dx + dy * dy;
@@ -34,18 +42,24 @@ pub fn segment_distance_mm(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
         0.0
     };
     let (ex, ey) = (px - s * dx, py - s * dy);
-    (ex * ex + ey * ey).sqrt()
+    ex * ex + ey * ey
 }
 
 /// Distance (mm) from `p` to a move's commanded geometry (XY).
 pub fn geometry_distance_mm(g: &MoveGeometry, p: [f64; 2]) -> f64 {
+    geometry_distance_sq(g, p).sqrt()
+}
+
+/// The square of [`geometry_distance_mm`] (mm^2).
+#[inline]
+fn geometry_distance_sq(g: &MoveGeometry, p: [f64; 2]) -> f64 {
     match g {
         MoveGeometry::Line { from_mm, to_mm } => {
-            segment_distance_mm(p, [from_mm[0], from_mm[1]], [to_mm[0], to_mm[1]])
+            segment_distance_sq(p, [from_mm[0], from_mm[1]], [to_mm[0], to_mm[1]])
         }
         MoveGeometry::Arc { points_mm, .. } => points_mm
             .windows(2)
-            .map(|w| segment_distance_mm(p, [w[0][0], w[0][1]], [w[1][0], w[1][1]]))
+            .map(|w| segment_distance_sq(p, [w[0][0], w[0][1]], [w[1][0], w[1][1]]))
             .fold(f64::INFINITY, f64::min),
     }
 }
@@ -87,22 +101,31 @@ impl ActiveMoves {
         }
     }
 
-    /// The contour error (mm) of a toolhead at `p` (XY, mm) at `t_s`: the distance to the
-    /// nearest active move, or to the move the sample belongs to when none is active (a
-    /// pause), `None` before the first move.
-    pub fn error_mm(&self, t_s: f64, p: [f64; 2]) -> Option<f64> {
+    /// The contour error (mm) of a toolhead at `p` (XY, mm) at `t_s`, and the move the
+    /// sample belongs to ([`ActiveMoves::owner`]), in one pass over the moves: the
+    /// distance to the nearest active move, or to the move the sample belongs to when
+    /// none is active (a pause); `None` before the first move has started.
+    pub fn at(&self, t_s: f64, p: [f64; 2]) -> Option<(f64, &MoveInfo)> {
         let mut best: Option<f64> = None;
+        let mut owner: Option<&Arc<MoveInfo>> = None;
+        // Moves are in order of their start times: every move after the first that starts
+        // beyond the window starts after `t_s` too (neither active nor the owner).
         for m in &self.moves {
             if m.start_time_s - ACTIVE_WINDOW_S > t_s {
                 break;
             }
+            if m.duration_s > 0.0 && m.start_time_s <= t_s {
+                owner = Some(m);
+            }
             if m.end_time_s() + ACTIVE_WINDOW_S < t_s {
                 continue;
             }
-            let d = geometry_distance_mm(&m.geometry, p);
+            let d = geometry_distance_sq(&m.geometry, p);
             best = Some(best.map_or(d, |b: f64| b.min(d)));
         }
-        best.or_else(|| self.owner(t_s).map(|m| geometry_distance_mm(&m.geometry, p)))
+        let owner = owner?;
+        let err = best.map_or_else(|| geometry_distance_mm(&owner.geometry, p), f64::sqrt);
+        Some((err, owner))
     }
 }
 

@@ -13,14 +13,17 @@
 //! ```
 //!
 //! The run's motion is the job's shaped X and Y (and Z), one trajectory. Without
-//! `layers` it runs from the job's first move (`t = 0`) to its end. With `layers` it
-//! starts from the whole job's state, as `settle gcode --layers` does: the job's chunks
-//! start a pre-roll ([`preroll`]) of at least `ln(1e6) / sigma` before the range's first
-//! move (`sigma` the slowest decay rate of the machine's linearised modes; no earlier
-//! than the file's first move), so the vibration the layers before leave is in the
-//! range's samples, and `t = 0` is the pre-roll's start, moved to the next instant of the
-//! print clock's sample grid (`k / sample_rate_hz`, the grid of `settle gcode`) so that
-//! both sample the same instants. The common metrics are those of any run over that
+//! `layers` it runs from the job's first move to its end. With `layers` it starts from
+//! the whole job's state, as `settle gcode --layers` does: the job's chunks start a
+//! pre-roll ([`preroll`]) of at least `ln(1e6) / sigma` before the range's first move
+//! (`sigma` the slowest decay rate of the machine's linearised modes; no earlier than the
+//! file's first move), so the vibration the layers before leave is in the range's
+//! samples. `t = 0` is on the print clock's sample grid (`k / sample_rate_hz`, the grid
+//! of `settle gcode`) so that both sample the same instants: the pre-roll's start moved
+//! to the next instant of the grid, or, where the run starts with the job (at rest; a
+//! shaped job starts before the first move, by half the shaper's duration), the instant
+//! of the grid before, standing still until the job starts. The common metrics are those
+//! of any run over that
 //! trajectory: `move_time_s` is the pre-roll plus the range, the residual and the settle
 //! time are measured after the range's last move. The study's probe measures the contour
 //! error against the G-code's own geometry ([`contour`]) and adds to runs.csv
@@ -48,32 +51,32 @@ pub mod fly;
 pub mod linpoint;
 pub mod preroll;
 pub mod stats;
+pub mod stream;
 pub mod work;
 
+use std::collections::BTreeSet;
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::Mutex;
 
 use serde::Deserialize;
-use settle_gcode::job::{Job, JobConfig, MoveInfo, PlannerConfig, ShaperSetting, parse_firmware};
-use settle_planner::firmware::Firmware;
+use settle_gcode::job::{Job, JobConfig, PlannerConfig, ShaperSetting, parse_firmware};
 use settle_gcode::Reader;
+use settle_planner::PlanError;
+use settle_planner::firmware::Firmware;
 use settle_planner::path::CornerStrategy;
 use settle_planner::path::junction::Junction;
-use settle_planner::shaper::stream::cut;
-use settle_planner::{PlanError, Profile, Segment, Trajectory};
 use settle_sim::{AxisModel, DriverMode};
 
 use crate::error::Error;
 use crate::input::source::Source;
-use crate::studies::{Study, StudyState, PathMove, PlanContext, Planned, Probe, Role, any_has};
 use crate::measure::metrics::Metrics;
-use crate::measure::series::Series;
 use crate::spec::backend::Backend;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
 use crate::spec::value::Value;
-use contour::ActiveMoves;
-use stats::Histogram;
+use crate::studies::{
+    Motion, PathMove, PlanContext, Planned, Role, Streamed, Study, StudyState, any_has,
+};
 
 /// runs.csv columns of a G-code run.
 pub const COLUMNS: [&str; 6] = [
@@ -280,104 +283,25 @@ fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<settle_gcode::FileInput>, S
     }
 }
 
-/// The chunks (print-clock start, trajectory) from `at_s` on: those ending before it
-/// dropped, the one containing it cut there ([`cut`]: the exact state at `at_s`).
-fn from_time(chunks: Vec<(f64, Trajectory)>, at_s: f64) -> Result<Vec<Trajectory>, PlanError> {
-    let mut out = Vec::with_capacity(chunks.len());
-    for (t0, tr) in chunks {
-        let d = tr.duration_s();
-        if out.is_empty() && at_s > t0 {
-            if t0 + d <= at_s {
-                continue;
-            }
-            let from = at_s - t0;
-            let axes = tr
-                .axes()
-                .iter()
-                .map(|p| cut(p, from, d))
-                .collect::<Result<Vec<_>, _>>()?;
-            out.push(Trajectory::new(axes)?);
-        } else {
-            out.push(tr);
-        }
-    }
-    Ok(out)
-}
+/// The jobs [`Study::validate`] has planned whole without an error, by
+/// [`validation_key`].
+static VALIDATED: Mutex<BTreeSet<String>> = Mutex::new(BTreeSet::new());
 
-/// One profile per machine axis (X, Y, Z of the job by name), the chunks joined.
-fn join(axes: &[String], chunks: &[Trajectory]) -> Result<Trajectory, PlanError> {
-    let mut out = Vec::new();
-    for name in axes {
-        let i = match name.as_str() {
-            "x" => 0,
-            "y" => 1,
-            "z" => 2,
-            _ => {
-                return Err(PlanError::InvalidInput {
-                    reason: "a G-code job drives machine axes named x, y and z only",
-                });
-            }
-        };
-        let start = chunks.first().map(|c| c.axes()[i].start()).unwrap_or_default();
-        let segs: Vec<Segment> = chunks
-            .iter()
-            .flat_map(|c| c.axes()[i].segments().iter().copied())
-            .collect();
-        out.push(Profile::new(start, segs)?);
-    }
-    Trajectory::new(out)
-}
-
-/// The study's probe: contour error of the recorded toolhead against the job's moves.
-#[derive(Debug)]
-struct GcodeProbe {
-    moves: Vec<Arc<MoveInfo>>,
-    /// Print-clock time of the run's `t = 0` (s).
-    t0_s: f64,
-    /// Only samples of moves in these layers count (the rest is the pre-roll).
-    layers: Option<(u32, u32)>,
-    print_time_s: f64,
-}
-
-impl Probe for GcodeProbe {
-    fn measure(&self, _run: &RunSpec, series: &Series, m: &mut Metrics) -> Result<(), Error> {
-        let (Some(x), Some(y)) = (series.channel("toolhead_x"), series.channel("toolhead_y"))
-        else {
-            return Ok(());
-        };
-        let mut active = ActiveMoves::default();
-        active.add(&self.moves);
-        let mut hist = Histogram::default();
-        let (mut worst, mut line) = (0.0_f64, f64::NAN);
-        let t_end = m.move_time_s;
-        for (k, &t) in series.t_s.iter().enumerate() {
-            if t > t_end {
-                break;
-            }
-            let tp = t + self.t0_s;
-            let p = [x.data[k] * 1e3, y.data[k] * 1e3];
-            let (Some(e), Some(owner)) = (active.error_mm(tp, p), active.owner(tp)) else {
-                continue;
-            };
-            if !owner.working
-                || self
-                    .layers
-                    .is_some_and(|(a, b)| !(a..=b).contains(&owner.layer))
-            {
-                continue;
-            }
-            let e_um = e * 1e3;
-            hist.push(e_um);
-            if e_um > worst {
-                (worst, line) = (e_um, owner.line as f64);
-            }
-        }
-        m.extra.push(("print_time_s".into(), self.print_time_s));
-        m.extra.push(("contour_worst_um".into(), worst));
-        m.extra.push(("contour_p95_um".into(), hist.quantile_um(0.95)));
-        m.extra.push(("contour_worst_line".into(), line));
-        Ok(())
-    }
+/// What the validity of `run`'s job depends on: the file (its path, size and modification
+/// time), the planner's settings without the shapers, and the layer range with its
+/// pre-roll. (A shaper only shapes the planned moves.)
+fn validation_key(run: &RunSpec, job: &GcodeJob) -> Result<String, String> {
+    let meta = std::fs::metadata(&job.file).map_err(|e| format!("{}: {e}", job.file.display()))?;
+    let mut cfg = job_config(run, job, None)?;
+    cfg.shapers = [None; 3];
+    Ok(format!(
+        "{}|{}|{:?}|{cfg:?}|{:?}|{:?}",
+        job.file.display(),
+        meta.len(),
+        meta.modified().ok(),
+        job.layers,
+        preroll_of(run, job)?
+    ))
 }
 
 /// The G-code job study.
@@ -448,18 +372,29 @@ impl Study for GcodeRun {
             ));
         }
         preroll_of(run, job).map_err(|m| (run.blame("gcode.layers"), m))?;
+        // Runs that differ in their shaper only plan the same moves: planned once.
+        let key = validation_key(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
+        if VALIDATED.lock().is_ok_and(|v| v.contains(&key)) {
+            return Ok(());
+        }
         let mut j = open(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
         j.run_to_end()
             .map_err(|e| (run.blame("gcode.file"), e.to_string()))?;
-        match work::nothing_to_measure(&j.summary(), j.reader().lines_read()) {
-            Some(why) => Err((
+        if let Some(why) = work::nothing_to_measure(&j.summary(), j.reader().lines_read()) {
+            return Err((
                 run.blame("gcode.file"),
                 format!("{}: {why}", job.file.display()),
-            )),
-            None => Ok(()),
+            ));
         }
+        // Only a job that passed every check is remembered as checked.
+        if let Ok(mut v) = VALIDATED.lock() {
+            v.insert(key);
+        }
+        Ok(())
     }
 
+    /// The job streamed chunk by chunk ([`stream`]): an outline pass finds where the run
+    /// starts and ends, the run plans the job again as it is simulated.
     fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {
         let job = run.state::<GcodeJob>().ok_or(PlanError::InvalidInput {
             reason: "not a G-code run",
@@ -467,46 +402,28 @@ impl Study for GcodeRun {
         let failed = |_| PlanError::InvalidInput {
             reason: "the G-code job failed to plan (checked when the sweep was validated)",
         };
-        let mut j = open(run, job).map_err(failed)?;
-        let (mut chunks, mut moves) = (Vec::new(), Vec::<Arc<MoveInfo>>::new());
-        while let Some(c) = j.next_chunk().map_err(|e| failed(e.to_string()))? {
-            for m in &c.moves {
-                if moves.last().is_none_or(|l| m.index > l.index) {
-                    moves.push(Arc::clone(m));
-                }
-            }
-            chunks.push((c.start_time_s, c.trajectory));
-        }
-        j.run_to_end().map_err(|e| failed(e.to_string()))?;
-        let mut t0 = chunks.first().map_or(0.0, |c| c.0);
-        if let Some((a, _)) = job.layers {
-            // The pre-roll's start moved to the print clock's sample grid (module doc),
-            // when that leaves at least the pre-roll the modes need (it does unless the
-            // range starts within a pre-roll of the file's start, where the job starts at
-            // rest as in the whole run).
-            let dt = 1.0 / run.sample_rate_hz;
-            let on_grid = (t0 / dt).ceil() * dt;
-            let range_start = moves
-                .iter()
-                .find(|m| m.layer >= a && m.duration_s > 0.0)
-                .map(|m| m.start_time_s);
-            let needed = preroll_of(run, job).map_err(failed)? - 2.0 * dt;
-            if range_start.is_some_and(|r| r - on_grid >= needed) {
-                t0 = on_grid;
-            }
-        }
-        let chunks = from_time(chunks, t0)?;
-        let trajectory = join(ctx.axes, &chunks)?;
+        let map = stream::job_axes(ctx.axes)?;
+        let dt = 1.0 / run.sample_rate_hz;
+        let range = match job.layers {
+            Some((a, _)) => Some((a, preroll_of(run, job).map_err(failed)? - 2.0 * dt)),
+            None => None,
+        };
+        let outline = stream::Outline::of(open(run, job).map_err(failed)?, &map, dt, range)?;
+        let chunks =
+            stream::JobChunks::new(open(run, job).map_err(failed)?, map, &outline, job.layers)?;
         let linearise_at_m = linearise_at(run, job, ctx.axes).map_err(failed)?;
         Ok(Planned {
-            trajectory,
-            probe: Some(Box::new(GcodeProbe {
-                moves,
-                t0_s: t0,
-                layers: job.layers,
-                print_time_s: j.print_time_s(),
-            })),
+            motion: Motion::Stream(Streamed {
+                start: outline.start.clone(),
+                end: outline.end.clone(),
+                duration_s: outline.duration_s,
+                chunks: Box::new(chunks),
+            }),
+            probe: None,
             linearise_at_m,
+            // Every planner starts the job at the origin: rapier's step is sized there,
+            // as `settle gcode` sizes it, for the whole file and any layer range.
+            step_at_m: Some(vec![0.0; ctx.axes.len()]),
         })
     }
 

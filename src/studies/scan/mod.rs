@@ -42,7 +42,9 @@ use settle_planner::{PlanError, Profile, State, Trajectory};
 use crate::error::Error;
 use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
-use crate::studies::{PlanContext, Planned, PlotColumn, Role, Study, StudyState, jerk_unused};
+use crate::studies::{
+    Motion, PlanContext, Planned, PlotColumn, Role, Study, StudyState, jerk_unused,
+};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
@@ -223,9 +225,10 @@ impl Study for ScanStep {
             })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Planned {
-            trajectory: Trajectory::new(profiles)?,
+            motion: Motion::Whole(Trajectory::new(profiles)?),
             probe: Some(Box::new(StepProbe { raster: r, y0_m })),
             linearise_at_m: None,
+            step_at_m: None,
         })
     }
 

@@ -612,13 +612,19 @@ fn axis_map(axes: &[AxisModel]) -> Result<(Vec<usize>, [usize; 2]), String> {
 
 /// Simulate the job without writing anything.
 pub fn measure(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
-    simulate(opts, None).map(|(o, _)| o)
+    simulate(opts, None, None).map(|(o, _)| o)
 }
 
-/// Simulate the job, recording the counted samples into `rec` when given.
+/// How far a simulation has read its G-code file: called as it goes with the bytes read
+/// and the file's size.
+pub type Progress<'a> = &'a dyn Fn(u64, u64);
+
+/// Simulate the job, recording the counted samples into `rec` when given, telling
+/// `progress` how far it has read.
 fn simulate(
     opts: &GcodeOptions,
     rec: Option<record::Recorder>,
+    progress: Option<Progress<'_>>,
 ) -> Result<(GcodeOutcome, Option<record::Recorder>), Error> {
     let (machine_name, axes, linear_axes) = resolve_axes(&opts.machine, opts.driver)?;
     // A machine with an undamped mode never settles: no tail, and a layer range cannot
@@ -684,6 +690,9 @@ fn simulate(
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
     let options = SimOptions {
         linearise_at_m: point.as_ref().map(|p| p.on_axes(&names)),
+        // Every planner starts the job at the origin: rapier's step is sized there, for
+        // the whole file and any layer range alike.
+        step_at_m: Some(vec![0.0; names.len()]),
         ..SimOptions::default()
     };
     let (streamed, rec) = simulate_job(
@@ -693,7 +702,7 @@ fn simulate(
         &options,
         sopts,
         rec,
-        &opts.file,
+        (&opts.file, progress),
     )?;
     job.run_to_end().map_err(&err)?;
     let summary = job.summary();
@@ -836,6 +845,15 @@ pub fn setting_name(job: &JobConfig) -> String {
 /// `settle gcode`: simulate, then write layers.csv, summary.md and the ringing maps into
 /// the output folder.
 pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
+    gcode_with_progress(opts, None)
+}
+
+/// [`gcode`], telling `progress` how far each simulation (the job's, then `--versus`'s)
+/// has read the file.
+pub fn gcode_with_progress(
+    opts: &GcodeOptions,
+    progress: Option<Progress<'_>>,
+) -> Result<GcodeOutcome, Error> {
     let dir = match &opts.out {
         Some(d) => d.clone(),
         None => {
@@ -863,7 +881,7 @@ pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
             }
             false => None,
         };
-        simulate(opts, rec)
+        simulate(opts, rec, progress)
     })();
     if simulated.is_err() && made {
         let _ = std::fs::remove_dir(&dir);
@@ -874,7 +892,7 @@ pub fn gcode(opts: &GcodeOptions) -> Result<GcodeOutcome, Error> {
         None => None,
     };
     let b = match &b_opts {
-        Some(b_opts) => Some(measure(b_opts)?),
+        Some(b_opts) => Some(simulate(b_opts, None, progress)?.0),
         None => None,
     };
     outcome.files = report::write(&outcome, &dir)?;

@@ -77,10 +77,37 @@ pub fn layers_csv(o: &GcodeOutcome) -> Result<Vec<u8>, csv::Error> {
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
 }
 
+/// What makes the run a failed one, first on summary.md and report.html: a simulation
+/// fault, lost steps (with where the first was seen); as (what, why) pairs.
+fn failures(o: &GcodeOutcome) -> Vec<(&'static str, String)> {
+    let mut out = Vec::new();
+    if let Some(f) = &o.streamed.fault {
+        out.push(("Simulation fault", f.to_string()));
+    }
+    if o.streamed.lost_steps > 0 {
+        let mut why = format!(
+            "{} full steps: a motor's load angle passed 90 electrical degrees, more torque than it has",
+            o.streamed.lost_steps
+        );
+        if let Some(l) = &o.streamed.first_lost_step {
+            why += &format!(
+                " (first seen on axis {} at {:.3} s, line {}, layer {})",
+                l.axis, l.time_s, l.line, l.layer
+            );
+        }
+        why += "; the part would differ from this toolpath after that.";
+        out.push(("Lost steps", why));
+    }
+    out
+}
+
 /// summary.md.
 pub fn summary_md(o: &GcodeOutcome, maps: &[String]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# {}\n", o.file.display());
+    for (what, why) in failures(o) {
+        let _ = writeln!(s, "**{what}**: {why}\n");
+    }
     let _ = writeln!(
         s,
         "{} planner on `{}` ({} backend).\n",
@@ -132,28 +159,6 @@ not counted), so that it starts from the vibration the layers before leave.\n",
             "Ringing after the last move: {:.2} um at most from the end point, {:.3} um after \
 {:.2} s.\n",
             t.residual_peak_um, t.residual_last_um, t.duration_s
-        );
-    }
-    if let Some(f) = &o.streamed.fault {
-        let _ = writeln!(s, "**Simulation fault**: {f}\n");
-    }
-    if o.streamed.lost_steps > 0 {
-        let _ = write!(
-            s,
-            "**Lost steps**: {} full steps: a motor's load angle passed 90 electrical degrees, \
-more torque than it has",
-            o.streamed.lost_steps
-        );
-        if let Some(l) = &o.streamed.first_lost_step {
-            let _ = write!(
-                s,
-                " (first seen on axis {} at {:.3} s, line {}, layer {})",
-                l.axis, l.time_s, l.line, l.layer
-            );
-        }
-        let _ = writeln!(
-            s,
-            "; the part would differ from this toolpath after that.\n"
         );
     }
     let _ = writeln!(s, "## Worst spots\n");
@@ -428,7 +433,11 @@ pub fn html_report(
 ) -> Result<Report, Error> {
     let wanted: Vec<u64> = o.worst().iter().map(|w| w.line).collect();
     let (sha, texts) = digest_and_lines(&o.file, &wanted)?;
-    let mut intro = vec![format!(
+    let mut intro: Vec<String> = failures(o)
+        .into_iter()
+        .map(|(what, why)| format!("{what}: {why}"))
+        .collect();
+    intro.push(format!(
         "{} planner on {} ({} backend): print time {:.2} s{}, contour error worst {:.2} um, p95 {:.2} um; {:.1} s of print simulated.",
         o.setting,
         o.machine,
@@ -442,7 +451,7 @@ pub fn html_report(
         o.worst_um,
         o.p95_um,
         o.streamed.simulated_s
-    )];
+    ));
     if let Some(w) = o.worst().first() {
         intro.push(format!(
             "Worst at line {} (layer {}, X {:.2} Y {:.2} mm): {}",
@@ -458,9 +467,6 @@ pub fn html_report(
     }
     for v in &o.overrides {
         intro.push(format!("Note: {}", super::override_words(v)));
-    }
-    if let Some(f) = &o.streamed.fault {
-        intro.push(format!("Simulation fault: {f}"));
     }
     let mut tables = vec![Table {
         title: "Worst spots".into(),

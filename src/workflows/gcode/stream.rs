@@ -23,6 +23,7 @@ use settle_gcode::job::Job;
 use settle_planner::{Profile, State, Trajectory};
 use settle_sim::{AxisModel, Observation, Plant, SimError};
 
+use super::Progress;
 use super::record::Recorder;
 use crate::error::Error;
 use crate::execute::driver::{Batched, Driver, Full, Sink, Stop, standing_at};
@@ -124,6 +125,16 @@ pub struct LostStep {
     pub line: u64,
     /// Its layer.
     pub layer: u32,
+}
+
+/// The move a sample belongs to, as the account keeps it.
+#[derive(Debug, Clone, Copy)]
+struct Owner {
+    index: u64,
+    working: bool,
+    feature: u16,
+    layer: u32,
+    line: u64,
 }
 
 /// The running account (module doc).
@@ -230,10 +241,7 @@ impl Account {
         self.active.retire(t);
         let [ix, iy] = self.opts.xy;
         let (x, y) = (toolhead_m[ix] * 1e3, toolhead_m[iy] * 1e3);
-        let Some(err_mm) = self.active.error_mm(t, [x, y]) else {
-            return;
-        };
-        let Some(m) = self.active.owner(t).cloned() else {
+        let Some((err_mm, m)) = self.active.at(t, [x, y]) else {
             return;
         };
         if self
@@ -243,6 +251,17 @@ impl Account {
         {
             return;
         }
+        if m.working {
+            let cmd = [cmd_m[ix] * 1e3, cmd_m[iy] * 1e3];
+            self.out.fly.sample(m, t, cmd, [x, y]);
+        }
+        let m = Owner {
+            index: m.index,
+            working: m.working,
+            feature: m.feature,
+            layer: m.layer,
+            line: m.line,
+        };
         if self.owner.as_ref().is_none_or(|o| o.0 != m.index) {
             if self.layer.as_ref().is_none_or(|l| l.layer != m.layer) {
                 self.end_layer();
@@ -280,8 +299,6 @@ impl Account {
                 move_index: m.index,
             };
             self.out.features.sample(m.feature, m.layer, err_um, spot);
-            let cmd = [cmd_m[ix] * 1e3, cmd_m[iy] * 1e3];
-            self.out.fly.sample(&m, t, cmd, [x, y]);
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
             {
@@ -419,7 +436,7 @@ impl Sink for Account {
 
 /// Simulate `job`'s chunks on the plant of `backend` for `axes` (see the module doc). The
 /// belts vary along the travel on the backends that model it ([`SimOptions::belt`]).
-#[allow(clippy::too_many_arguments)]
+/// `file`: the job's G-code file, and what to tell how far it has been read.
 pub fn simulate_job<R: BufRead>(
     job: &mut Job<R>,
     backend: Backend,
@@ -427,14 +444,17 @@ pub fn simulate_job<R: BufRead>(
     options: &SimOptions,
     opts: StreamOptions,
     rec: Option<Recorder>,
-    file: &Path,
+    file: (&Path, Option<Progress<'_>>),
 ) -> Result<(Streamed, Option<Recorder>), Error> {
     let rate = opts.sample_rate_hz;
+    let (file, progress) = file;
+    let size = std::fs::metadata(file).map_or(0, |m| m.len());
     let sim = JobSim {
         job,
         opts,
         rec,
         file,
+        progress: progress.map(|p| (p, size)),
     };
     with_plant(backend, axes, options, rate, &[], sim).map_err(sim_err)?
 }
@@ -449,6 +469,8 @@ struct JobSim<'a, R> {
     opts: StreamOptions,
     rec: Option<Recorder>,
     file: &'a Path,
+    /// Told the bytes read after each chunk, with the file's size.
+    progress: Option<(Progress<'a>, u64)>,
 }
 
 /// Where the driver stopped, for a job: a fault is the job's outcome, anything else an
@@ -470,6 +492,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
 
     fn run<P: Plant>(self, plant: &P) -> Self::Output {
         let (job, opts, rec, file) = (self.job, self.opts, self.rec, self.file);
+        let progress = self.progress;
         let n = opts.job_axes.len();
         let (rate, dt) = (opts.sample_rate_hz, 1.0 / opts.sample_rate_hz);
         let job_axes = opts.job_axes.clone();
@@ -498,9 +521,11 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                     t_first = t0;
                     // A lone whole sample goes through `Plant::step`, as `settle gcode` has
                     // always stepped it (MuJoCo's batch would take it as one long step).
+                    // Batches go across the command's breakpoints where the plant can
+                    // (the modal plant).
                     let d =
                         Driver::new(plant, &names, &starts, rate, t0, false).map_err(sim_err)?;
-                    driver.insert(d.with_min_batch(2))
+                    driver.insert(d.with_min_batch(2).across_breakpoints())
                 }
             };
             if range_start.is_none()
@@ -519,6 +544,9 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                 faulted = true;
                 stopped(stop, &mut acc)?;
                 break;
+            }
+            if let Some((tell, size)) = progress {
+                tell(job.reader().bytes_read(), size);
             }
         }
         // The print time simulated: to the last command (the tail is counted apart).

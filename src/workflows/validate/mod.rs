@@ -294,6 +294,7 @@ pub fn run(backends: &[Backend]) -> Result<Validation, String> {
         belt: BeltModel::Frozen,
         max_step_s: None,
         linearise_at_m: None,
+        step_at_m: None,
     };
     let mut rows = Vec::new();
     let mut effects = Vec::new();

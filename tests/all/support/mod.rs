@@ -88,3 +88,12 @@ pub fn extra(m: &settle::Metrics, name: &str) -> f64 {
 }
 pub mod one_mode;
 pub mod resonance;
+
+/// The one run of `scenario`, on the modal backend.
+pub fn one_modal_run(scenario: &Path) -> settle::spec::run_spec::RunSpec {
+    let (_, mut runs) = settle::load_runs(scenario).expect("loads");
+    settle::execute::set_backend(scenario, &mut runs, settle::spec::backend::Backend::Modal)
+        .expect("modal");
+    assert_eq!(runs.len(), 1, "one run");
+    runs.remove(0)
+}

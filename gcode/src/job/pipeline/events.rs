@@ -506,8 +506,22 @@ impl<R: BufRead> Job<R> {
     /// Planned segment `seq` runs from `t0` to `t1`: move timing and the layer range.
     fn on_span(&mut self, seq: u64, t0: f64, t1: f64) -> Result<(), PlanError> {
         let layer = self.table.planned(seq, t0, t1);
-        if self.layers.is_some() && self.range != Range::In {
-            self.table.forget_before(t0 - self.input.lookback_s());
+        match (self.layers, self.range) {
+            // Before the range: the output will start no earlier than the look-back
+            // before the range's first move, which starts at `t0` or later.
+            (Some(_), Range::Before) => self.table.forget_before(t0 - self.input.lookback_s()),
+            // After it: the planner runs ahead of the output (a look-ahead flush gives
+            // many segments at once, their chunks come after), so until the range is
+            // output only the moves before what has been output can go: the range's
+            // last chunks still list theirs.
+            (Some(_), Range::After) => {
+                let mut before = t0 - self.input.lookback_s();
+                if !self.input.done() {
+                    before = before.min(self.input.emitted_until_s());
+                }
+                self.table.forget_before(before);
+            }
+            _ => {}
         }
         let (Some((a, b)), Some(layer)) = (self.layers, layer) else {
             return Ok(());
