@@ -13,7 +13,7 @@
 #   - `settle check` of every baseline in results/baselines/ (without --update);
 #   - `settle gcode` on every print in gcode/prints/: plain, with --layers (and --mcap),
 #     --versus and --config (Klipper's printer.cfg, RepRapFirmware's config.g), and a layer
-#     on rapier with the full driver model;
+#     on rapier with the full driver model; GRBL's jobs on grbl with their $$ settings;
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
 #     what identify wrote, `settle import` of the example configurations, `settle tune` on
 #     the tune scenarios, on the imported printer and with `--criterion klipper`;
@@ -82,6 +82,18 @@ cases() {
   echo "identify identify $root/examples/data/raw_data_x_example.csv $root/examples/data/raw_data_y_example.csv --freq-start 30 --freq-end 90 --hz-per-sec 10 --out {out}/machine.toml"
   for p in "$P"/*.gcode; do
     stem=$(basename "$p" .gcode)
+    # GRBL's jobs (a laser raster, a milled contour) run on GRBL with their $$ settings.
+    grbl=
+    case $stem in
+      laser_raster) grbl=$P/laser_grbl_settings.txt ;;
+      cnc_contour) grbl=$P/shapeoko3_grbl_settings.txt ;;
+    esac
+    if [[ -n $grbl ]]; then
+      echo "gcode-$stem gcode $p --machine printer_xy --firmware grbl --config $grbl --out {out}"
+      echo "gcode-$stem-layers gcode $p --machine printer_xy --firmware grbl --config $grbl --layers 0..1 --mcap --out {out}"
+      echo "gcode-$stem-rapier gcode $p --machine printer_xy --firmware grbl --config $grbl --backend rapier --driver full --layers 1..1 --out {out}"
+      continue
+    fi
     # Klipper refuses the R form of G2/G3, which arc_part.gcode uses: RepRapFirmware there.
     fw=klipper cfg=$VORON
     if [[ $stem == arc_part ]]; then

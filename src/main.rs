@@ -244,13 +244,14 @@ enum Command {
         /// The machine: a preset (printer_xy), a machine file, or a scenario file (its [machine]).
         #[arg(long)]
         machine: String,
-        /// The planner: klipper, marlin, rrf or settle [default: klipper; with --config,
-        /// rrf for a file ending in .g].
+        /// The planner: klipper, marlin, rrf, grbl (GRBL and grblHAL: lasers and CNC) or
+        /// settle [default: klipper; with --config, rrf for a file ending in .g].
         #[arg(long, value_parser = parse_firmware)]
         firmware: Option<settle_planner::firmware::Firmware>,
-        /// The firmware's configuration (Klipper printer.cfg with its includes, or
-        /// RepRapFirmware config.g): the planner's limits and the input shapers start as
-        /// it sets them, instead of the firmware's defaults.
+        /// The firmware's configuration (Klipper printer.cfg with its includes,
+        /// RepRapFirmware config.g, or GRBL's settings as `$$` prints them, with --firmware
+        /// grbl): the planner's limits and the input shapers start as it sets them,
+        /// instead of the firmware's defaults.
         #[arg(long, value_name = "FILE")]
         config: Option<PathBuf>,
         /// Only these layers, A..B (both included) or A; the rest is planned, not simulated.

@@ -291,6 +291,18 @@ pub enum GcodeError {
         /// What the planner says (boxed: it is large and rare).
         source: Box<settle_planner::PlanError>,
     },
+    /// A move the firmware refuses because it leaves the machine's travel, in the
+    /// firmware's words (Klipper's `Move out of range: x y z [e]`, GRBL's soft-limit
+    /// alarm): the print stops there.
+    #[error("{at}: {command}: {message}")]
+    OutOfTravel {
+        /// The move's line.
+        at: Location,
+        /// The command (`G1`).
+        command: String,
+        /// What the firmware says, and the travel.
+        message: String,
+    },
     /// A job setting (not from the file) that cannot be used.
     #[error("job setting `{key}`: {reason}")]
     JobSetting {
@@ -353,7 +365,8 @@ impl GcodeError {
             | GcodeError::IncludeNotFound { at, .. }
             | GcodeError::IncludeCycle { at, .. }
             | GcodeError::Include { at, .. }
-            | GcodeError::Plan { at, .. } => Some(at),
+            | GcodeError::Plan { at, .. }
+            | GcodeError::OutOfTravel { at, .. } => Some(at),
         }
     }
 

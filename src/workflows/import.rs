@@ -184,8 +184,17 @@ fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)
 /// RepRapFirmware (config.g).
 pub const READ: [Firmware; 2] = [Firmware::Klipper, Firmware::Rrf];
 
-/// A firmware of [`READ`] by name ([`Firmware::parse`]'s names).
+/// A firmware of [`READ`] by name ([`Firmware::parse`]'s names); GRBL is refused with its
+/// reason (its `$$` settings feed `settle gcode`, not a tune: GRBL has no input shaper).
 pub fn parse_firmware(name: &str) -> Result<Firmware, String> {
+    if Firmware::parse(name) == Some(Firmware::Grbl) {
+        return Err(format!(
+            "grbl is not a firmware whose configuration settle import reads: GRBL has no \
+             input shaper for settle tune to set (its $$ settings are read by settle gcode \
+             --firmware grbl --config); allowed: {}",
+            Firmware::names(&READ)
+        ));
+    }
     Firmware::parse_among(
         name,
         &READ,

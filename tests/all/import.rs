@@ -177,6 +177,28 @@ fn import_command_exit_codes() {
     assert_eq!(r.status.code(), Some(2), "{r:?}");
 }
 
+/// One list of firmware names: `settle gcode` plans grbl (and grblHAL), `settle import`
+/// refuses it with the reason (exit 2), and names what it reads.
+#[test]
+fn import_refuses_grbl_with_its_reason() {
+    let r = crate::support::settle()
+        .args(["import", "grblHAL"])
+        .arg(voron())
+        .output()
+        .expect("runs");
+    assert_eq!(r.status.code(), Some(2), "{r:?}");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("grbl is not a firmware whose configuration settle import reads: GRBL has no input shaper"),
+        "{err}"
+    );
+    assert!(err.contains("allowed: klipper, rrf"), "{err}");
+    assert_eq!(
+        settle::workflows::import::parse_firmware("duet"),
+        Ok(Firmware::Rrf)
+    );
+}
+
 /// A scenario already at `--out` (an earlier import, or one edited since) is kept: the
 /// import is refused without `--force`, names it and changes nothing; with `--force` it is
 /// replaced.

@@ -10,6 +10,7 @@ mod cli;
 mod corners;
 mod faults;
 mod gcode_config;
+mod gcode_grbl;
 mod gcode_job;
 mod gcode_range;
 mod gcode_range_random;

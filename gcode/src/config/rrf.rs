@@ -26,7 +26,6 @@ use crate::error::{GcodeError, Location};
 use crate::read::dialect::Dialect;
 use crate::read::event::{EventKind, Note};
 use crate::read::limits::{AxisValues, LimitChange};
-use crate::read::reader::{Reader, ReaderOptions};
 use crate::read::setting::Setting;
 
 /// The kinematics by `M669 K` code (`KinematicsType`,
@@ -190,16 +189,9 @@ impl RrfConfig {
         files.stack.push(absolute(path));
         let script = unconditional(text, &source);
         self.notes.extend(script.notes);
-        let reader = Reader::new(script.text.as_bytes(), ReaderOptions::new(Dialect::Rrf))
-            .with_name(source.clone());
-        for event in reader {
-            let event = event?;
-            let at = Location {
-                source_name: source.clone(),
-                line: event.line,
-                column: None,
-            };
-            match event.kind {
+        for event in super::located_events(&script.text, Dialect::Rrf, &source) {
+            let (at, kind) = event?;
+            match kind {
                 EventKind::Setting(s) => self.setting(&s, &at)?,
                 EventKind::Limits(l) => self.limits(&l, &at)?,
                 EventKind::Note(Note::MacroCall { path: name, .. }) => {
@@ -355,6 +347,8 @@ impl RrfConfig {
                     .map_or_else(|| format!("kinematics {code}"), |k| (*k).to_string());
                 return Ok(());
             }
+            // The RepRapFirmware reader produces none.
+            Setting::Grbl { .. } => return Ok(()),
         }
         self.set_state(state);
         Ok(())

@@ -1,6 +1,6 @@
 //! A `[gcode]` run's job as a streamed motion ([`crate::studies::Motion::Stream`]): its
 //! chunks simulated one after the other, as `settle gcode` simulates them, and the
-//! contour error measured along them (printing samples of the range's moves, during the
+//! contour error measured along them (working samples of the range's moves, during the
 //! job), so that no run holds the whole job planned or its samples recorded.
 //!
 //! Where the run starts and how long it lasts (the module doc of [`super`]: the print
@@ -9,7 +9,7 @@
 //! worth at most) and the durations and end state after it; the run then plans the job
 //! again as it is simulated (`JobChunks`).
 
-use settle_gcode::{FileInput, MoveKind};
+use settle_gcode::FileInput;
 use settle_gcode::job::{Job, JobChunk};
 use settle_planner::shaper::stream::cut;
 use settle_planner::{PlanError, Profile, Segment, State, Trajectory};
@@ -267,7 +267,7 @@ impl MotionStream for JobChunks {
         let Some((e, owner)) = self.active.at(tp, p) else {
             return;
         };
-        if owner.kind != MoveKind::Print
+        if !owner.working
             || self
                 .layers
                 .is_some_and(|(a, b)| !(a..=b).contains(&owner.layer))

@@ -5,17 +5,18 @@
 //! axes of the same names, in the G-code's coordinates (position 0 of a machine axis is
 //! G-code 0). Per sample the toolhead's contour error ([`crate::studies::gcode::contour`]) is measured, per move
 //! its largest value (the ringing after the corner at the move's start), per layer the
-//! worst and 95th percentile over printing samples ([`crate::studies::gcode::stats`]); the outputs are
+//! worst and 95th percentile over working samples ([`crate::studies::gcode::stats`]); the outputs are
 //! `layers.csv`, `summary.md` and the ringing maps of the worst layers ([`report`]).
 //! Everything is computed before anything is written: a bad file writes nothing.
 //!
 //! On the modal backend a machine whose stiffness depends on position (a belt's spans) is
 //! linearised at one point for the whole file, where the print is
-//! ([`crate::studies::gcode::linpoint`]: the centre of the printing moves' bounding box),
+//! ([`crate::studies::gcode::linpoint`]: the centre of the working moves' bounding box),
 //! for the whole run and for any layer range alike; the `[gcode]` study uses the same
 //! point, so both give the same numbers.
 
 pub mod compare;
+pub mod features;
 pub mod record;
 pub mod report;
 pub mod stream;
@@ -218,12 +219,19 @@ impl GcodeOptions {
                 let notes = c.notes.iter().map(ToString::to_string).collect();
                 (job, notes, c.files)
             }
+            Firmware::Grbl => {
+                let c = settle_gcode::config::GrblSettings::read(&config)
+                    .map_err(|e| crate::workflows::import::config_error(&config, e))?;
+                let job = JobConfig::from_grbl(&c).map_err(gcode_error(&config))?;
+                let notes = c.notes.iter().map(ToString::to_string).collect();
+                (job, notes, c.files)
+            }
             Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => {
                 return Err(Error::input_key(
                     &config,
                     "--config",
                     format!(
-                        "--config reads a Klipper printer.cfg (--firmware klipper) or a RepRapFirmware config.g (--firmware rrf), not {firmware}'s settings{}",
+                        "--config reads a Klipper printer.cfg (--firmware klipper), a RepRapFirmware config.g (--firmware rrf) or GRBL's $$ settings (--firmware grbl), not {firmware}'s settings{}",
                         if firmware == Firmware::Marlin {
                             " (Marlin's M201/M203/M204/M205/M593 lines in the G-code file set them)"
                         } else {
@@ -306,6 +314,10 @@ pub struct GcodeOutcome {
     pub skipped_lines: u64,
     /// Commands read but not followed, with why, and how often.
     pub ignored: BTreeMap<String, u64>,
+    /// The slicer feature types the file names ([`settle_gcode::Reader::features`]).
+    pub features: Vec<String>,
+    /// The file's limit commands that raise a limit above the configuration's.
+    pub overrides: Vec<settle_gcode::job::LimitOverride>,
     /// Files written.
     pub files: Vec<PathBuf>,
     /// The outcome of the `--versus` setting.
@@ -360,6 +372,9 @@ impl GcodeOutcome {
                 s.line, s.layer, s.x_mm, s.y_mm
             ));
         }
+        if let Some(f) = features::fly_words(self) {
+            r.out(f);
+        }
         if let Some(t) = &self.streamed.tail {
             r.out(format!(
                 "ringing after the last move: {:.2} um at most, {:.3} um after {:.2} s",
@@ -390,6 +405,9 @@ impl GcodeOutcome {
         if self.skipped_lines > 0 {
             r.err(format!("skipped {} bad lines", self.skipped_lines));
         }
+        for o in &self.overrides {
+            r.err(format!("note: {}", override_words(o)));
+        }
         if !self.ignored.is_empty() {
             const SHOWN: usize = 8;
             let mut names: Vec<String> = self
@@ -411,6 +429,29 @@ impl GcodeOutcome {
         }
         r
     }
+}
+
+/// A limit the file raises, in words: `line 12: M204 raises max_accel (mm/s^2) from the
+/// configuration's 7000 to 15000; the firmware follows the file`.
+pub fn override_words(o: &settle_gcode::job::LimitOverride) -> String {
+    // Klipper reads M204 S as its SET_VELOCITY_LIMIT ACCEL.
+    let command = match o.command.as_str() {
+        "SET_VELOCITY_LIMIT" => "M204 (or SET_VELOCITY_LIMIT)",
+        c => c,
+    };
+    format!(
+        "line {}: {} raises {} from the configuration's {} to {}; the firmware follows the file",
+        o.line,
+        command,
+        o.limit,
+        plot_num(o.configured),
+        plot_num(o.file)
+    )
+}
+
+/// A setting's value as written (`7000`, `0.5`), without float noise.
+fn plot_num(v: f64) -> String {
+    format!("{}", (v * 1e6).round() / 1e6)
 }
 
 /// A settle-gcode error as the harness reports it: a located one is bad input at its
@@ -622,7 +663,7 @@ fn simulate(
     let err = gcode_error(&opts.file);
     let reader_options = ReaderOptions {
         skip_bad_lines: opts.skip_bad_lines,
-        ..ReaderOptions::new(opts.job.dialect)
+        ..opts.job.reader_options()
     };
     // The modal backend's linearisation point, where a position-dependent stiffness
     // makes it matter: one pass of the reader over the whole file.
@@ -664,19 +705,11 @@ fn simulate(
         (&opts.file, progress),
     )?;
     job.run_to_end().map_err(&err)?;
-    let mut summary = job.summary();
+    let summary = job.summary();
     if let Some(why) =
         crate::studies::gcode::work::nothing_to_measure(&summary, job.reader().lines_read())
     {
         return Err(Error::input(&opts.file, why));
-    }
-    // Every command not followed, the reader's (not motion: temperatures, fans, macros,
-    // unknown words) with the planner's, so none vanishes unsaid.
-    for (name, n) in job.reader().ignored_commands() {
-        *summary
-            .ignored
-            .entry(format!("{name}: not a motion, limit or shaper command"))
-            .or_insert(0) += n;
     }
     let mut by_layer: BTreeMap<u32, stats::LayerStats> = streamed
         .layers
@@ -708,6 +741,8 @@ fn simulate(
         streamed,
         skipped_lines: job.reader().skipped().count,
         ignored: summary.ignored,
+        features: summary.features,
+        overrides: summary.overrides,
         files: Vec::new(),
         versus: None,
         recording: None,
@@ -749,6 +784,15 @@ pub fn config_settings(job: &JobConfig) -> String {
             mm(c.travel_accel_m_s2),
             mm(c.instant_dv_m_s[0]),
             mm(c.instant_dv_m_s[1])
+        ),
+        PlannerConfig::Grbl(g) => format!(
+            "$110 {} $111 {} mm/min, $120 {} $121 {} mm/s^2, $11 {} mm, $32={}",
+            g.max_rate_mm_min[0],
+            g.max_rate_mm_min[1],
+            g.accel_mm_s2[0],
+            g.accel_mm_s2[1],
+            g.junction_deviation_mm,
+            u8::from(g.laser_mode)
         ),
         PlannerConfig::Marlin(_) | PlannerConfig::Settle(_) => "the firmware's defaults".into(),
     };
@@ -876,6 +920,10 @@ const RESULTS: crate::output::folder::Results<'static> = crate::output::folder::
     marks: &[
         "layers.csv",
         "summary.md",
+        "features.csv",
+        "layer_features.csv",
+        "error-z.svg",
+        "error-z.png",
         report::REPORT,
         compare::FILE,
         RECORDING,

@@ -132,8 +132,8 @@ pub fn summary_md(o: &GcodeOutcome, maps: &[String]) -> String {
     let _ = writeln!(
         s,
         "Contour error: distance in XY from the simulated toolhead to the commanded path of \
-the moves active at that time, over printing moves; p95 is the 95th percentile of all \
-printing samples.\n"
+the moves active at that time, over working moves (extruding, or the laser or spindle on \
+in a feed move); p95 is the 95th percentile of all working samples.\n"
     );
     if let Some((settings, _)) = &o.config {
         let _ = writeln!(s, "Planner {settings}.\n");
@@ -175,11 +175,21 @@ not counted), so that it starts from the vibration the layers before leave.\n",
         );
     }
     let _ = writeln!(s, "\n## Layers\n");
+    let outer = super::features::has_outer_wall(o);
     let _ = writeln!(
         s,
-        "| layer | Z (mm) | time (s) | moves | worst (um) | p95 (um) | worst line |"
+        "| layer | Z (mm) | time (s) | moves | worst (um) | p95 (um) | worst line |{}",
+        if outer {
+            " outer wall worst (um) | outer wall p95 (um) |"
+        } else {
+            ""
+        }
     );
-    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        s,
+        "|---:|---:|---:|---:|---:|---:|---:|{}",
+        if outer { "---:|---:|" } else { "" }
+    );
     for l in &o.layers {
         let z = l.z_mm.map_or(String::new(), |z| format!("{z:.2}"));
         let (w, p, line) = match &l.stats {
@@ -192,11 +202,27 @@ not counted), so that it starts from the vibration the layers before leave.\n",
             ),
             None => ("-".into(), "-".into(), "-".into()),
         };
+        let wall = if !outer {
+            String::new()
+        } else {
+            match super::features::layer_outer_wall(o, l.layer) {
+                Some((w, p)) if p.is_nan() => format!(" {w:.2} | - |"),
+                Some((w, p)) => format!(" {w:.2} | {p:.2} |"),
+                None => " - | - |".into(),
+            }
+        };
         let _ = writeln!(
             s,
-            "| {} | {z} | {:.2} | {} | {w} | {p} | {line} |",
+            "| {} | {z} | {:.2} | {} | {w} | {p} | {line} |{wall}",
             l.layer, l.duration_s, l.moves
         );
+    }
+    s.push_str(&super::features::summary_sections(o));
+    if !o.overrides.is_empty() {
+        let _ = writeln!(s, "\n## Limits the file raises\n");
+        for v in &o.overrides {
+            let _ = writeln!(s, "- {}", super::override_words(v));
+        }
     }
     if !o.ignored.is_empty() {
         let _ = writeln!(s, "\n## Commands not followed\n");
@@ -252,6 +278,22 @@ pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         files.push(dir.join(format!("{stem}.svg")));
         files.push(dir.join(format!("{stem}.png")));
         stems.push(stem);
+    }
+    if super::features::has_features(o) {
+        for (file, bytes) in [
+            ("features.csv", super::features::features_csv(o)),
+            ("layer_features.csv", super::features::layer_features_csv(o)),
+        ] {
+            let path = dir.join(file);
+            let bytes = bytes.map_err(|e| Error::write(&path, std::io::Error::other(e)))?;
+            write_atomic(&path, &bytes)?;
+            files.push(path);
+        }
+    }
+    if let Some(fig) = super::features::z_figure(o) {
+        crate::output::plot::write(&fig, dir, "error-z")?;
+        files.push(dir.join("error-z.svg"));
+        files.push(dir.join("error-z.png"));
     }
     let md = dir.join("summary.md");
     write_atomic(&md, summary_md(o, &stems).as_bytes())?;
@@ -420,9 +462,15 @@ pub fn html_report(
             texts.get(&w.line).map_or("", String::as_str)
         ));
     }
+    if let Some(f) = super::features::fly_words(o) {
+        intro.push(f);
+    }
+    for v in &o.overrides {
+        intro.push(format!("Note: {}", super::override_words(v)));
+    }
     let mut tables = vec![Table {
         title: "Worst spots".into(),
-        note: "The largest contour errors, at most one per move, with the G-code line of the move. Contour error: distance in XY from the simulated toolhead to the commanded path of the moves active at that time, over printing moves.".into(),
+        note: "The largest contour errors, at most one per move, with the G-code line of the move. Contour error: distance in XY from the simulated toolhead to the commanded path of the moves active at that time, over working moves (extruding, or the laser or spindle on in a feed move).".into(),
         header: ["error (um)", "line", "G-code", "layer", "X (mm)", "Y (mm)", "time (s)"]
             .map(String::from)
             .to_vec(),
@@ -470,6 +518,18 @@ pub fn html_report(
                 })
                 .collect(),
         });
+    }
+    tables.extend(super::features::features_table(o));
+    if super::features::has_features(o) {
+        let csv = super::features::layer_features_csv(o)
+            .map_err(|e| Error::write(dir.join("layer_features.csv"), std::io::Error::other(e)))?;
+        tables.extend(
+            Table::from_csv(
+                "Feature types per layer (layer_features.csv)",
+                &String::from_utf8_lossy(&csv),
+            )
+            .ok(),
+        );
     }
     if !o.ignored.is_empty() {
         tables.push(Table {
@@ -572,6 +632,9 @@ pub fn write_html(o: &GcodeOutcome, opts: &GcodeOptions, dir: &Path) -> Result<P
             ),
             None => match stem.strip_prefix("compare-layer-") {
                 Some(n) => format!("Layer {n} under both settings, on one colour scale"),
+                None if stem == "error-z" => {
+                    "Contour error against Z: per layer the worst and the 95th percentile".into()
+                }
                 None => stem.clone(),
             },
         };

@@ -19,7 +19,6 @@ use std::io::BufRead;
 use std::ops::ControlFlow;
 use std::path::Path;
 
-use settle_gcode::MoveKind;
 use settle_gcode::job::Job;
 use settle_planner::{Profile, State, Trajectory};
 use settle_sim::{AxisModel, Observation, Plant, SimError};
@@ -31,6 +30,8 @@ use crate::execute::driver::{Batched, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
 use crate::studies::gcode::contour::ActiveMoves;
+use crate::studies::gcode::features::FeatureAccount;
+use crate::studies::gcode::fly::FlyAxis;
 use crate::studies::gcode::stats::{Histogram, LayerMap, LayerStats, MapPoint, Spot, TopSpots};
 
 /// How the job is sampled and what is kept.
@@ -103,6 +104,10 @@ pub struct Streamed {
     pub tail: Option<Tail>,
     /// Where a motor was first seen past its stability limit (see [`LostStep`]).
     pub first_lost_step: Option<LostStep>,
+    /// The error per slicer feature type.
+    pub features: FeatureAccount,
+    /// The along-line error of scan lines (raster jobs).
+    pub fly: FlyAxis,
 }
 
 /// Where a motor's load angle was first seen past 90 electrical degrees (the driver
@@ -126,7 +131,8 @@ pub struct LostStep {
 #[derive(Debug, Clone, Copy)]
 struct Owner {
     index: u64,
-    kind: MoveKind,
+    working: bool,
+    feature: u16,
     layer: u32,
     line: u64,
 }
@@ -143,8 +149,9 @@ struct Account {
     hist: Histogram,
     map: Vec<MapPoint>,
     layer_top: TopSpots,
-    /// The move the last sample belonged to: index, kind, layer, line, worst spot.
-    owner: Option<(u64, MoveKind, u32, u64, Option<Spot>)>,
+    /// The move the last sample belonged to: index, whether it works, layer, line, worst
+    /// spot.
+    owner: Option<(u64, bool, u32, u64, Option<Spot>)>,
     map_every: u64,
     /// The current layer's map stride: `map_every`, doubled each time its map is halved.
     map_stride: u64,
@@ -191,7 +198,7 @@ impl Account {
     }
 
     fn end_move(&mut self) {
-        if let Some((_, MoveKind::Print, _, _, Some(spot))) = self.owner.take()
+        if let Some((_, true, _, _, Some(spot))) = self.owner.take()
             && let Some(l) = self.layer.as_mut()
         {
             l.add_move(&spot);
@@ -205,6 +212,7 @@ impl Account {
         let Some(mut l) = self.layer.take() else {
             return;
         };
+        self.out.features.end_layer(l.layer);
         l.p95_um = self.hist.quantile_um(0.95);
         self.out.all.merge(&self.hist);
         self.hist = Histogram::default();
@@ -236,12 +244,6 @@ impl Account {
         let Some((err_mm, m)) = self.active.at(t, [x, y]) else {
             return;
         };
-        let m = Owner {
-            index: m.index,
-            kind: m.kind,
-            layer: m.layer,
-            line: m.line,
-        };
         if self
             .opts
             .layers
@@ -249,6 +251,17 @@ impl Account {
         {
             return;
         }
+        if m.working {
+            let cmd = [cmd_m[ix] * 1e3, cmd_m[iy] * 1e3];
+            self.out.fly.sample(m, t, cmd, [x, y]);
+        }
+        let m = Owner {
+            index: m.index,
+            working: m.working,
+            feature: m.feature,
+            layer: m.layer,
+            line: m.line,
+        };
         if self.owner.as_ref().is_none_or(|o| o.0 != m.index) {
             if self.layer.as_ref().is_none_or(|l| l.layer != m.layer) {
                 self.end_layer();
@@ -256,7 +269,7 @@ impl Account {
             } else {
                 self.end_move();
             }
-            self.owner = Some((m.index, m.kind, m.layer, m.line, None));
+            self.owner = Some((m.index, m.working, m.layer, m.line, None));
         }
         let err_um = err_mm * 1e3;
         if let Some(r) = self.rec.as_mut() {
@@ -273,21 +286,23 @@ impl Account {
                 ],
             );
         }
-        let print = m.kind == MoveKind::Print;
+        let print = m.working;
         if print {
             self.hist.push(err_um);
+            let spot = || Spot {
+                error_um: err_um,
+                time_s: t,
+                x_mm: x,
+                y_mm: y,
+                line: m.line,
+                layer: m.layer,
+                move_index: m.index,
+            };
+            self.out.features.sample(m.feature, m.layer, err_um, spot);
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
             {
-                o.4 = Some(Spot {
-                    error_um: err_um,
-                    time_s: t,
-                    x_mm: x,
-                    y_mm: y,
-                    line: m.line,
-                    layer: m.layer,
-                    move_index: m.index,
-                });
+                o.4 = Some(spot());
             }
         }
         if k.is_multiple_of(self.map_stride) {

@@ -75,6 +75,10 @@ fn the_book_lists_every_limit_as_the_code_has_it() {
         "at least {} Hz",
         settle_planner::shaper::MIN_FREQUENCY_HZ
     ));
+    has(format!(
+        "at most {} distinct names",
+        settle_gcode::MAX_FEATURES
+    ));
     assert!(
         missing.is_empty(),
         "docs/guide/failures.md lacks {missing:?}"

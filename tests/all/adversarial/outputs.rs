@@ -46,6 +46,8 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
     }
     for (file, text) in [
         ("o_gcode/summary.md", "my notes\n"),
+        ("o_gcode_f/features.csv", "feature\n"),
+        ("o_gcode_z/error-z.svg", "<svg/>\n"),
         ("o_tune/tune.md", "my notes\n"),
         ("o_merge/runs.csv", "run\n0\n"),
         ("o_fig/identify-x.svg", "<svg/>\n"),
@@ -222,6 +224,18 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "gcode print.gcode --machine printer_xy --out o_gcode --force",
             &["o_gcode"],
             Expect::answered(&["wrote o_gcode/summary.md"]),
+        ),
+        Case::line(
+            "gcode over an earlier features.csv alone",
+            "gcode print.gcode --machine printer_xy --out o_gcode_f",
+            &[],
+            Expect::refused(&["--force", "features.csv"]),
+        ),
+        Case::line(
+            "gcode over an earlier error-z figure alone",
+            "gcode print.gcode --machine printer_xy --out o_gcode_z",
+            &[],
+            Expect::refused(&["--force", "error-z.svg"]),
         ),
         Case::line(
             "gcode --out a folder where its G-code is a file it writes",

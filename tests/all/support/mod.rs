@@ -86,6 +86,7 @@ pub fn extra(m: &settle::Metrics, name: &str) -> f64 {
         .unwrap_or_else(|| panic!("no column {name}"))
         .1
 }
+pub mod one_mode;
 pub mod resonance;
 
 /// The one run of `scenario`, on the modal backend.
