@@ -382,8 +382,8 @@ enum Command {
         /// Its period (s; Klipper's sweeping_period).
         #[arg(long, allow_hyphen_values = true)]
         sweeping_period: Option<f64>,
-        /// Overwrite the figures of an earlier identification in the figures folder
-        /// (refused without it).
+        /// Overwrite the machine file at --out and the figures of an earlier
+        /// identification in the figures folder (refused without it).
         #[arg(long)]
         force: bool,
     },

@@ -34,8 +34,8 @@ pub struct IdentifyOptions {
     pub figures: Option<PathBuf>,
     /// settle-identify's options (the resonance test's parameters, modes per axis, fit).
     pub identify: Options,
-    /// Overwrite the figures of an earlier identification in the figures folder (refused
-    /// without it).
+    /// Overwrite the machine file at `out` and the figures of an earlier identification
+    /// in the figures folder (refused without it).
     pub force: bool,
 }
 
@@ -142,6 +142,15 @@ pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
     if let Some(out) = &opts.out {
         inputs.refuse(out)?;
         settle_files::write::check_target(out)?;
+        if !opts.force && std::fs::symlink_metadata(out).is_ok() {
+            return Err(Error::input(
+                "--force",
+                format!(
+                    "{} already exists (an earlier identification's machine file?): pass --force to overwrite it, --out FILE to write elsewhere",
+                    out.display()
+                ),
+            ));
+        }
     }
     let dir = figures_dir(opts);
     crate::output::folder::check(&dir, &FIGURES, opts.force, &inputs, writes_figure)?;

@@ -52,6 +52,7 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         ("o_merge/runs.csv", "run\n0\n"),
         ("o_fig/identify-x.svg", "<svg/>\n"),
         ("o_import.toml", "# my edits\n"),
+        ("o_mf/m.toml", "# my machine\n"),
         ("o_kc/input_shaper.cfg", "[input_shaper]\n"),
         (
             "o_self/layers.csv",
@@ -116,6 +117,18 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             identify(&["--out", "o_fig/m.toml"]),
             &[],
             Expect::refused(&["--force", "identify-x.svg"]),
+        ),
+        case(
+            "identify over an earlier machine file",
+            identify(&["--out", "o_mf/m.toml"]),
+            &[],
+            Expect::refused(&["--force", "o_mf/m.toml already exists"]),
+        ),
+        case(
+            "identify --force over an earlier machine file",
+            identify(&["--out", "o_mf/m.toml", "--force"]),
+            &["o_mf/m.toml", "o_mf/identify-x.svg", "o_mf/identify-x.png"],
+            Expect::answered(&["wrote o_mf/m.toml"]),
         ),
         Case::line(
             "import --out names its printer.cfg",
