@@ -9,6 +9,7 @@ use std::path::Path;
 use settle::Metrics;
 use settle::execute::Observe;
 use settle::execute::simulate::{AxisMeta, simulate};
+use settle::studies::Motion;
 use settle_planner::{Limits, Profile, ProfileKind, Sample, State, Trajectory};
 use settle_sim::{AxisModel, DriverMode, ModalPlant, Observation, Plant, SimError};
 
@@ -148,8 +149,10 @@ impl Case {
         };
         let names: Vec<String> = self.axes.iter().map(|a| a.name.clone()).collect();
         let meta: Vec<AxisMeta> = self.axes.iter().map(AxisMeta::of).collect();
-        let m =
-            simulate(&plant, &names, &meta, &self.traj, &self.observe, None).expect("simulates");
+        let mut motion = Motion::Whole(self.traj.clone());
+        let m = simulate(&plant, &names, &meta, &mut motion, &self.observe, None)
+            .expect("plans")
+            .expect("simulates");
         (m, plant.steps.get())
     }
 
@@ -159,7 +162,10 @@ impl Case {
             ModalPlant::new(self.axes.clone(), 1.0 / self.observe.sample_rate_hz).expect("modal");
         let names: Vec<String> = self.axes.iter().map(|a| a.name.clone()).collect();
         let meta: Vec<AxisMeta> = self.axes.iter().map(AxisMeta::of).collect();
-        simulate(&plant, &names, &meta, &self.traj, &self.observe, None).expect("simulates")
+        let mut motion = Motion::Whole(self.traj.clone());
+        simulate(&plant, &names, &meta, &mut motion, &self.observe, None)
+            .expect("plans")
+            .expect("simulates")
     }
 }
 
