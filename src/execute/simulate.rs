@@ -1,12 +1,12 @@
-//! One run of a sweep (or `settle run`) on the simulation driver: the trajectory, then
-//! the end point held for the observation window, feeding the streaming metrics and, when
-//! asked, a full [`Series`].
+//! One run of a sweep (or `settle run`) on the simulation driver: its motion (a trajectory
+//! planned whole, or streamed chunk by chunk), then the end point held for the observation
+//! window, feeding the streaming metrics and, when asked, a full [`Series`].
 
 use std::borrow::Cow;
 use std::ops::ControlFlow;
 
-use settle_planner::{PlanError, Profile, State};
-use settle_sim::{AxisModel, DriverMode, Plant, SimError};
+use settle_planner::{PlanError, Profile, Sample, State};
+use settle_sim::{AxisModel, DriverMode, Observation, Plant, SimError};
 
 use crate::execute::Observe;
 use crate::execute::driver::{Batched, Clock, Driver, Full, Sink, Stop, standing_at};
@@ -18,6 +18,44 @@ use crate::measure::series::Series;
 use crate::spec::backend::Backend;
 use crate::studies::{Motion, MotionStream};
 
+/// A per-axis channel of a recording: its name (the axis's is appended: `cmd_p_x`), its
+/// unit, and its value from the command and the observation of the axis.
+type Column = (&'static str, &'static str, fn(&Sample, &Observation) -> f64);
+
+/// The channels every axis records: the command, the toolhead and its error (toolhead -
+/// command).
+const COMMON: [Column; 6] = [
+    ("cmd_p", "m", |c, _| c.p),
+    ("cmd_v", "m_s", |c, _| c.v),
+    ("cmd_a", "m_s2", |c, _| c.a),
+    ("cmd_j", "m_s3", |c, _| c.j),
+    ("toolhead", "m", |_, o| o.toolhead_m),
+    ("error", "m", |_, o| o.toolhead_m - o.commanded_m),
+];
+
+/// The carriage's channel (m), where the model has a carriage.
+const CARRIAGE: Column = ("carriage", "m", |_, o| o.carriage_m.unwrap_or(f64::NAN));
+
+/// The motor's channels (rad; the load angle in electrical rad), where it has a stepper.
+const MOTOR: [Column; 2] = [
+    ("motor_angle", "rad", |_, o| {
+        o.motor_angle_rad.unwrap_or(f64::NAN)
+    }),
+    ("load_angle", "rad", |_, o| {
+        o.load_angle_rad.unwrap_or(f64::NAN)
+    }),
+];
+
+/// The phase currents (A), for the full driver model.
+const CURRENTS: [Column; 2] = [
+    ("current_a", "A", |_, o| {
+        o.currents_a.map_or(f64::NAN, |c| c[0])
+    }),
+    ("current_b", "A", |_, o| {
+        o.currents_a.map_or(f64::NAN, |c| c[1])
+    }),
+];
+
 /// The channels [`crate::execute::execute`] records for these axes: per axis `cmd_p_<axis>` (m),
 /// `cmd_v_<axis>` (m/s), `cmd_a_<axis>` (m/s^2), `cmd_j_<axis>` (m/s^3), `toolhead_<axis>`
 /// (m), `error_<axis>` (toolhead - command, m) and, where the model has them,
@@ -27,54 +65,39 @@ use crate::studies::{Motion, MotionStream};
 pub fn channels(axes: &[AxisModel]) -> Vec<(String, String)> {
     let mut ch = Vec::new();
     for a in axes {
-        let n = &a.name;
-        for (c, u) in [
-            ("cmd_p", "m"),
-            ("cmd_v", "m_s"),
-            ("cmd_a", "m_s2"),
-            ("cmd_j", "m_s3"),
-            ("toolhead", "m"),
-            ("error", "m"),
-        ] {
-            ch.push((format!("{c}_{n}"), u.to_string()));
-        }
-        if a.carriage.is_some() {
-            ch.push((format!("carriage_{n}"), "m".into()));
-        }
-        if a.stepper.is_some() {
-            ch.push((format!("motor_angle_{n}"), "rad".into()));
-            ch.push((format!("load_angle_{n}"), "rad".into()));
-        }
-        if a.mode == DriverMode::Full {
-            ch.push((format!("current_a_{n}"), "A".into()));
-            ch.push((format!("current_b_{n}"), "A".into()));
+        for (c, u, _) in AxisMeta::of(a).columns {
+            ch.push((format!("{c}_{}", a.name), u.to_string()));
         }
     }
     ch.push(("error".into(), "m".into()));
     ch
 }
 
-/// Which optional channels an axis records.
-#[derive(Debug, Clone, Copy)]
+/// The channels an axis records, in order ([`channels`]).
+#[derive(Debug, Clone)]
 pub struct AxisMeta {
-    carriage: bool,
-    motor: bool,
-    currents: bool,
+    columns: Vec<Column>,
 }
 
 impl AxisMeta {
     /// What `axis` has.
     pub fn of(axis: &AxisModel) -> Self {
-        Self {
-            carriage: axis.carriage.is_some(),
-            motor: axis.stepper.is_some(),
-            currents: axis.mode == DriverMode::Full,
+        let mut columns = COMMON.to_vec();
+        if axis.carriage.is_some() {
+            columns.push(CARRIAGE);
         }
+        if axis.stepper.is_some() {
+            columns.extend(MOTOR);
+        }
+        if axis.mode == DriverMode::Full {
+            columns.extend(CURRENTS);
+        }
+        Self { columns }
     }
 }
 
 /// Simulate `motion` (one profile per axis of `axes`, in their order; planned whole or
-/// streamed) on `backend` and measure it against its end point ([`simulate`]). When
+/// streamed) on `backend` and measure it against its end point ([`Run`]). When
 /// `record` is given, it is replaced by a series with the run's channels ([`channels`],
 /// and `contour_error` for a path) and every sample is appended to it. A chunk of a
 /// streamed motion that fails to plan is the outer error.
@@ -116,13 +139,42 @@ pub fn run_motion(
     with_plant(backend, axes, options, rate, &start_m, run).unwrap_or_else(|e| Ok(Err(e)))
 }
 
-/// A run of [`simulate`], as a [`Simulation`].
-struct Run<'a> {
-    names: &'a [String],
-    meta: &'a [AxisMeta],
-    motion: &'a mut Motion,
-    observe: &'a Observe,
-    record: Option<&'a mut Series>,
+/// Where `motion` starts and ends, per axis.
+fn bounds(motion: &Motion) -> (Vec<State>, Vec<State>) {
+    match motion {
+        Motion::Whole(t) => (
+            t.axes().iter().map(Profile::start).collect(),
+            t.axes().iter().map(Profile::end).collect(),
+        ),
+        Motion::Stream(s) => (s.start.clone(), s.end.clone()),
+    }
+}
+
+/// A run on a plant ([`Simulation::run`]): the [`Driver`] through `motion`, then the end
+/// point held for the observation window, measuring the run ([`Accumulator`], the contour
+/// error of a path, a streamed motion's own measurement) and recording every sample into
+/// `record` when given.
+///
+/// A whole trajectory is a stream of one chunk. A streamed motion (a G-code job,
+/// [`crate::studies::Motion::Stream`]) is driven chunk by chunk on one sample clock, as
+/// `settle gcode` steps it (across breakpoints; a lone whole sample through
+/// `Plant::step`); a chunk that fails to plan is the outer error. Samples are taken every
+/// `1/sample_rate` s during the move, exactly at the move end T (with the command standing
+/// at the end point), and every `1/sample_rate` s after T. A fault ends the run where it
+/// happened: what was measured so far is kept in the accumulator but reported as a failed
+/// run (no metric values).
+#[derive(Debug)]
+pub struct Run<'a> {
+    /// The axes' names.
+    pub names: &'a [String],
+    /// The channels each axis records.
+    pub meta: &'a [AxisMeta],
+    /// The motion, one profile per axis.
+    pub motion: &'a mut Motion,
+    /// How it is observed.
+    pub observe: &'a Observe,
+    /// The recording (its channels already set), when asked.
+    pub record: Option<&'a mut Series>,
 }
 
 impl Simulation for Run<'_> {
@@ -136,106 +188,72 @@ impl Simulation for Run<'_> {
             observe,
             record,
         } = self;
-        simulate(plant, names, meta, motion, observe, record)
-    }
-}
-
-/// Where `motion` starts and ends, per axis.
-fn bounds(motion: &Motion) -> (Vec<State>, Vec<State>) {
-    match motion {
-        Motion::Whole(t) => (
-            t.axes().iter().map(Profile::start).collect(),
-            t.axes().iter().map(Profile::end).collect(),
-        ),
-        Motion::Stream(s) => (s.start.clone(), s.end.clone()),
-    }
-}
-
-/// Drive `plant` through `motion`, then hold the end point for the observation window
-/// ([`Driver`]), measuring the run ([`Accumulator`], the contour error of a path, a
-/// streamed motion's own measurement) and recording every sample into `record` when given.
-///
-/// A whole trajectory is a stream of one chunk. A streamed motion (a G-code job,
-/// [`crate::studies::Motion::Stream`]) is driven chunk by chunk on one sample clock, as
-/// `settle gcode` steps it (across breakpoints; a lone whole sample through
-/// `Plant::step`); a chunk that fails to plan is the outer error. Samples are taken every
-/// `1/sample_rate` s during the move, exactly at the move end T (with the command standing
-/// at the end point), and every `1/sample_rate` s after T. A fault ends the run where it
-/// happened: what was measured so far is kept in the accumulator but reported as a failed
-/// run (no metric values).
-pub fn simulate<P: Plant>(
-    plant: &P,
-    names: &[String],
-    meta: &[AxisMeta],
-    motion: &mut Motion,
-    observe: &Observe,
-    record: Option<&mut Series>,
-) -> Result<Result<Metrics, SimError>, PlanError> {
-    let (starts, ends) = bounds(motion);
-    let t_end = motion.duration_s();
-    let hold = standing_at(&ends);
-    // The command at the move's end; a move of no duration: the trajectory at 0.
-    let mut at_end = hold.clone();
-    let (mut next, stream, path) = match motion {
-        Motion::Whole(t) => {
-            let t = &*t;
-            if t_end <= 0.0 {
-                t.state_at(0.0, &mut at_end);
+        let (starts, ends) = bounds(motion);
+        let t_end = motion.duration_s();
+        let hold = standing_at(&ends);
+        // The command at the move's end; a move of no duration: the trajectory at 0.
+        let mut at_end = hold.clone();
+        let (mut next, stream, path) = match motion {
+            Motion::Whole(t) => {
+                let t = &*t;
+                if t_end <= 0.0 {
+                    t.state_at(0.0, &mut at_end);
+                }
+                let path = t.path().map(|g| PathAccumulator::new(g, t_end));
+                (Some(Cow::Borrowed(t)), None, path)
             }
-            let path = t.path().map(|g| PathAccumulator::new(g, t_end));
-            (Some(Cow::Borrowed(t)), None, path)
+            Motion::Stream(s) => {
+                let first = s.chunks.next_chunk()?.map(Cow::Owned);
+                (first, Some(&mut *s.chunks as &mut dyn MotionStream), None)
+            }
+        };
+        let driver = Driver::new(
+            plant,
+            names,
+            &starts,
+            observe.sample_rate_hz,
+            0.0,
+            record.is_some(),
+        );
+        let mut driver = match driver {
+            Ok(d) if stream.is_some() => d.with_min_batch(2).across_breakpoints(),
+            Ok(d) => d,
+            Err(e) => return Ok(Err(e)),
+        };
+        let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
+        let direction: Vec<f64> = starts.iter().zip(&ends).map(|(s, e)| e.p - s.p).collect();
+        let mut sink = RunSink {
+            acc: Accumulator::new(&target, &direction, t_end, &observe.bands_um),
+            path,
+            stream,
+            record,
+            meta,
+            row: Vec::new(),
+        };
+        let mut t0 = 0.0;
+        let mut ran = Ok(());
+        while let Some(chunk) = next.take() {
+            if let Some(s) = sink.stream.as_deref_mut() {
+                next = s.next_chunk()?.map(Cow::Owned);
+            }
+            ran = driver.follow(&chunk, t0, next.is_some(), &mut sink);
+            t0 += chunk.duration_s();
+            if ran.is_err() {
+                break;
+            }
         }
-        Motion::Stream(s) => {
-            let first = s.chunks.next_chunk()?.map(Cow::Owned);
-            (first, Some(&mut *s.chunks as &mut dyn MotionStream), None)
-        }
-    };
-    let driver = Driver::new(
-        plant,
-        names,
-        &starts,
-        observe.sample_rate_hz,
-        0.0,
-        record.is_some(),
-    );
-    let mut driver = match driver {
-        Ok(d) if stream.is_some() => d.with_min_batch(2).across_breakpoints(),
-        Ok(d) => d,
-        Err(e) => return Ok(Err(e)),
-    };
-    let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
-    let direction: Vec<f64> = starts.iter().zip(&ends).map(|(s, e)| e.p - s.p).collect();
-    let mut sink = RunSink {
-        acc: Accumulator::new(&target, &direction, t_end, &observe.bands_um),
-        path,
-        stream,
-        record,
-        meta,
-        row: Vec::new(),
-    };
-    let mut t0 = 0.0;
-    let mut ran = Ok(());
-    while let Some(chunk) = next.take() {
-        if let Some(s) = sink.stream.as_deref_mut() {
-            next = s.next_chunk()?.map(Cow::Owned);
-        }
-        ran = driver.follow(&chunk, t0, next.is_some(), &mut sink);
-        t0 += chunk.duration_s();
-        if ran.is_err() {
-            break;
-        }
+        // The end of the move, then the observation window at the end point.
+        let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
+        let window = Clock {
+            origin_s: t_end,
+            dt_s: driver.dt_s(),
+        };
+        let ran = ran.and_then(|()| {
+            driver.sample(0, t_end, Some(&at_end), &mut sink)?;
+            driver.hold(&hold, 1..=n, window, &mut sink)
+        });
+        Ok(Ok(finish(&mut driver, sink, names, ran)))
     }
-    // The end of the move, then the observation window at the end point.
-    let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
-    let window = Clock {
-        origin_s: t_end,
-        dt_s: driver.dt_s(),
-    };
-    let ran = ran.and_then(|()| {
-        driver.sample(0, t_end, Some(&at_end), &mut sink)?;
-        driver.hold(&hold, 1..=n, window, &mut sink)
-    });
-    Ok(Ok(finish(&mut driver, sink, names, ran)))
 }
 
 /// The run's metrics: a fault, a backend failure or an interruption makes it a failed
@@ -311,18 +329,7 @@ impl Sink for RunSink<'_, '_> {
             for ((o, c), m) in obs.iter().zip(s.cmd).zip(self.meta) {
                 let f = o.toolhead_m - o.commanded_m;
                 f2 += f * f;
-                row.extend([c.p, c.v, c.a, c.j, o.toolhead_m, f]);
-                if m.carriage {
-                    row.push(o.carriage_m.unwrap_or(f64::NAN));
-                }
-                if m.motor {
-                    row.push(o.motor_angle_rad.unwrap_or(f64::NAN));
-                    row.push(o.load_angle_rad.unwrap_or(f64::NAN));
-                }
-                if m.currents {
-                    let [ia, ib] = o.currents_a.unwrap_or([f64::NAN; 2]);
-                    row.extend([ia, ib]);
-                }
+                row.extend(m.columns.iter().map(|(_, _, value)| value(c, o)));
             }
             row.push(f2.sqrt());
             row.extend(contour);
