@@ -17,8 +17,9 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use settle::execute::{Observe, SimOptions, run_trajectory};
+use settle::execute::{Observe, SimOptions, run_motion};
 use settle::spec::backend::Backend;
+use settle::studies::Motion;
 use settle_planner::{Limits, Profile, ProfileKind, State, Trajectory};
 use settle_sim::DriverMode;
 
@@ -48,6 +49,7 @@ fn bench(c: &mut Criterion) {
         bands_um: vec![10.0, 50.0],
     };
     let simulated_us = ((traj.duration_s() + observe.window_s) * 1e6).round() as u64;
+    let mut motion = Motion::Whole(traj);
     let mut group = c.benchmark_group("printer_xy_10mm_scurve_y");
     group.throughput(Throughput::Elements(simulated_us));
     for &(name, backend, driver) in CASES {
@@ -55,14 +57,15 @@ fn bench(c: &mut Criterion) {
         group.bench_function(name, |b| {
             b.iter(|| {
                 black_box(
-                    run_trajectory(
+                    run_motion(
                         axes.clone(),
                         backend,
                         &SimOptions::default(),
-                        black_box(&traj),
+                        black_box(&mut motion),
                         &observe,
                         None,
                     )
+                    .expect("plans")
                     .expect("runs"),
                 )
             })
@@ -83,14 +86,15 @@ fn bench(c: &mut Criterion) {
         let mut runs = 0u32;
         while wall.elapsed().as_secs_f64() < 3.0 {
             black_box(
-                run_trajectory(
+                run_motion(
                     axes.clone(),
                     backend,
                     &SimOptions::default(),
-                    &traj,
+                    &mut motion,
                     &observe,
                     None,
                 )
+                .expect("plans")
                 .expect("runs"),
             );
             runs += 1;

@@ -231,11 +231,6 @@ impl<'p, P: Plant> Driver<'p, P> {
         self
     }
 
-    /// The next sample's index on the clock.
-    pub fn next_sample(&self) -> u64 {
-        self.k
-    }
-
     /// The time of the last thing done (s): the end of the last step, or the last sample
     /// handed to the sink.
     pub fn time_s(&self) -> f64 {
@@ -297,16 +292,17 @@ impl<'p, P: Plant> Driver<'p, P> {
             let next = t_sample.min(bp);
             let at_sample = self.k > 0 && tau == local(self.k - 1);
             let whole = next == t_sample && at_sample;
-            if let Some(walk) = inner
-                .as_mut()
-                .filter(|_| at_sample && t_sample <= t1 && takes(t_sample) && self.batch.is_some())
-            {
-                // Samples k, k + 1, ... up to the trajectory's end, across breakpoints.
-                let k0 = self.k;
+            // Samples k, k + 1, ... in one call: up to the breakpoint (inclusive), so that
+            // every step lies in one piece of every axis's command, or, across
+            // breakpoints, up to the trajectory's end.
+            let across = inner.is_some();
+            let batch = if across { t_sample <= t1 } else { whole };
+            if batch && at_sample && takes(t_sample) && self.batch.is_some() {
+                let (k0, end) = (self.k, if across { t1 } else { bp });
                 let mut m = 1;
                 while m < CHUNK {
                     let ts = local(k0 + m as u64);
-                    if ts > t1 || !takes(ts) {
+                    if ts > end || !takes(ts) {
                         break;
                     }
                     m += 1;
@@ -317,9 +313,11 @@ impl<'p, P: Plant> Driver<'p, P> {
                     for (i, c) in b.cmds.chunks_exact_mut(n).take(m).enumerate() {
                         cursor.at(local(k0 - 1 + i as u64), c);
                     }
-                    walk.fill(m, |i| local(k0 - 1 + i as u64), &mut self.breaks);
+                    if let Some(walk) = inner.as_mut() {
+                        walk.fill(m, |i| local(k0 - 1 + i as u64), &mut self.breaks);
+                    }
                     let fail = |i: usize| clock.time(k0 - 1 + i as u64);
-                    match self.step_batch(m, k0, clock, &fail, true, sink)? {
+                    match self.step_batch(m, k0, clock, &fail, across, sink)? {
                         Some(done) => {
                             if done < m {
                                 // The walk went past steps not taken.
@@ -327,41 +325,19 @@ impl<'p, P: Plant> Driver<'p, P> {
                             }
                             self.k = k0 + done as u64 - 1;
                             tau = local(self.k);
+                            // The command at the last sample serves it.
                             cursor.at(tau, &mut self.cmd);
-                            self.full(self.k, clock.time(self.k), None, sink)?;
+                            self.sample(self.k, clock.time(self.k), None, sink)?;
                             self.k += 1;
                             continue;
                         }
-                        // The plant splits these steps: so does the rest of the trajectory.
-                        None => inner = None,
-                    }
-                }
-            }
-            if whole && takes(t_sample) && self.batch.is_some() {
-                let k0 = self.k;
-                // Samples k, k + 1, ... up to the breakpoint (inclusive): every step lies
-                // in one piece of every axis's command.
-                let mut m = 1;
-                while m < CHUNK {
-                    let ts = local(k0 + m as u64);
-                    if ts > bp || !takes(ts) {
-                        break;
-                    }
-                    m += 1;
-                }
-                if let Some(b) = self.batch.as_mut().filter(|_| m >= self.min_batch) {
-                    for (i, c) in b.cmds.chunks_exact_mut(n).take(m).enumerate() {
-                        cursor.at(local(k0 - 1 + i as u64), c);
-                    }
-                    let fail = |i: usize| clock.time(k0 - 1 + i as u64);
-                    if let Some(done) = self.step_batch(m, k0, clock, &fail, false, sink)? {
-                        self.k = k0 + done as u64 - 1;
-                        tau = local(self.k);
-                        // The command at the last sample serves it.
-                        cursor.at(tau, &mut self.cmd);
-                        self.full(self.k, clock.time(self.k), None, sink)?;
-                        self.k += 1;
-                        continue;
+                        // The plant splits these steps: so does the rest of the
+                        // trajectory, from this sample on.
+                        None if across => {
+                            inner = None;
+                            continue;
+                        }
+                        None => {}
                     }
                 }
             }
@@ -375,7 +351,7 @@ impl<'p, P: Plant> Driver<'p, P> {
             if next == t_sample {
                 if takes(t_sample) {
                     cursor.at(tau, &mut self.cmd);
-                    self.full(self.k, clock.time(self.k), None, sink)?;
+                    self.sample(self.k, clock.time(self.k), None, sink)?;
                 }
                 self.k += 1;
             }
@@ -405,7 +381,7 @@ impl<'p, P: Plant> Driver<'p, P> {
             if self.batch.is_some() && m >= self.min_batch {
                 let fail = |i: usize| clock.time(k + i as u64) - dt;
                 if let Some(done) = self.step_batch(m, k, clock, &fail, false, sink)? {
-                    self.full(
+                    self.sample(
                         k + done as u64 - 1,
                         clock.time(k + done as u64 - 1),
                         Some(cmd),
@@ -417,7 +393,7 @@ impl<'p, P: Plant> Driver<'p, P> {
             }
             let t = clock.time(k);
             self.step(Some(cmd), dt, t - dt)?;
-            self.full(k, t, Some(cmd), sink)?;
+            self.sample(k, t, Some(cmd), sink)?;
             k += 1;
         }
         Ok(())
@@ -443,19 +419,8 @@ impl<'p, P: Plant> Driver<'p, P> {
         if h > 0.0 {
             self.step(Some(cmd), h, t)?;
         }
-        self.full(k, clock.time(k), Some(cmd), sink)?;
+        self.sample(k, clock.time(k), Some(cmd), sink)?;
         self.hold(cmd, k + 1..=last_k, clock, sink)
-    }
-
-    /// Evaluate the plant now in full as sample `k` at `t_s` with command `cmd`.
-    pub fn sample_now(
-        &mut self,
-        k: u64,
-        t_s: f64,
-        cmd: &[Sample],
-        sink: &mut impl Sink,
-    ) -> Result<(), Stop> {
-        self.full(k, t_s, Some(cmd), sink)
     }
 
     /// One step of `h` s with `cmd` (else the driver's current command); a failure is
@@ -543,9 +508,9 @@ impl<'p, P: Plant> Driver<'p, P> {
         outcome
     }
 
-    /// Evaluate the state in full as sample `k` at `t` (command `cmd`, else the driver's
-    /// current one): checked, handed to the sink, and an interruption looked for.
-    fn full(
+    /// Evaluate the plant now in full as sample `k` at `t` (command `cmd`, else the
+    /// driver's current one): checked, handed to the sink, and an interruption looked for.
+    pub fn sample(
         &mut self,
         k: u64,
         t: f64,

@@ -20,10 +20,9 @@ use crate::measure::series::Series;
 use crate::spec::backend::{Backend, NO_MUJOCO};
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
-use crate::studies::Motion;
 
 pub use plant::SimOptions;
-pub use simulate::run_trajectory;
+pub use simulate::run_motion;
 
 /// How a run is observed.
 #[derive(Debug, Clone, PartialEq)]
@@ -112,39 +111,32 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
             ),
         ));
     }
-    let interrupted = |m: Result<Metrics, Error>| {
-        if interrupt::requested() {
-            Err(Error::Interrupted { run: spec.id })
-        } else {
-            m
-        }
-    };
-    let traj = match planned.motion {
-        Motion::Whole(t) => t,
-        Motion::Stream(mut s) => {
-            let m = simulate::run_stream(axes, spec.backend, &options, &mut s, &observe, record)
-                .map_err(|source| Error::Plan {
-                    run: spec.id,
-                    source,
-                })?;
-            return interrupted(m.map_err(sim_err));
-        }
-    };
-    let Some(probe) = planned.probe else {
-        return interrupted(
-            run_trajectory(axes, spec.backend, &options, &traj, &observe, record).map_err(sim_err),
-        );
-    };
+    // A study that measures more than the common metrics gets the series recorded.
     let mut local = Series::default();
-    let series = match record {
-        Some(s) => s,
-        None => &mut local,
+    let mut series = match record {
+        Some(s) => Some(s),
+        None => planned.probe.is_some().then_some(&mut local),
     };
-    let mut m = interrupted(
-        run_trajectory(axes, spec.backend, &options, &traj, &observe, Some(series))
-            .map_err(sim_err),
-    )?;
-    if m.is_ok() {
+    let mut motion = planned.motion;
+    let m = run_motion(
+        axes,
+        spec.backend,
+        &options,
+        &mut motion,
+        &observe,
+        series.as_deref_mut(),
+    )
+    .map_err(|source| Error::Plan {
+        run: spec.id,
+        source,
+    })?;
+    if interrupt::requested() {
+        return Err(Error::Interrupted { run: spec.id });
+    }
+    let mut m = m.map_err(sim_err)?;
+    if let (Some(probe), Some(series)) = (planned.probe, series)
+        && m.is_ok()
+    {
         probe.measure(spec, series, &mut m)?;
     }
     Ok(m)

@@ -1,11 +1,12 @@
-//! One run of a sweep (or `settle run`) on the simulation driver: the trajectory, then
-//! the end point held for the observation window, feeding the streaming metrics and, when
-//! asked, a full [`Series`].
+//! One run of a sweep (or `settle run`) on the simulation driver: its motion (a trajectory
+//! planned whole, or streamed chunk by chunk), then the end point held for the observation
+//! window, feeding the streaming metrics and, when asked, a full [`Series`].
 
+use std::borrow::Cow;
 use std::ops::ControlFlow;
 
-use settle_planner::{PlanError, Profile, Sample, State, Trajectory};
-use settle_sim::{AxisModel, DriverMode, Plant, SimError};
+use settle_planner::{PlanError, Profile, Sample, State};
+use settle_sim::{AxisModel, DriverMode, Observation, Plant, SimError};
 
 use crate::execute::Observe;
 use crate::execute::driver::{Batched, Clock, Driver, Full, Sink, Stop, standing_at};
@@ -15,7 +16,45 @@ use crate::measure::metrics::{Metrics, Status};
 use crate::measure::path_metrics::PathAccumulator;
 use crate::measure::series::Series;
 use crate::spec::backend::Backend;
-use crate::studies::{MotionStream, Streamed};
+use crate::studies::{Motion, MotionStream};
+
+/// A per-axis channel of a recording: its name (the axis's is appended: `cmd_p_x`), its
+/// unit, and its value from the command and the observation of the axis.
+type Column = (&'static str, &'static str, fn(&Sample, &Observation) -> f64);
+
+/// The channels every axis records: the command, the toolhead and its error (toolhead -
+/// command).
+const COMMON: [Column; 6] = [
+    ("cmd_p", "m", |c, _| c.p),
+    ("cmd_v", "m_s", |c, _| c.v),
+    ("cmd_a", "m_s2", |c, _| c.a),
+    ("cmd_j", "m_s3", |c, _| c.j),
+    ("toolhead", "m", |_, o| o.toolhead_m),
+    ("error", "m", |_, o| o.toolhead_m - o.commanded_m),
+];
+
+/// The carriage's channel (m), where the model has a carriage.
+const CARRIAGE: Column = ("carriage", "m", |_, o| o.carriage_m.unwrap_or(f64::NAN));
+
+/// The motor's channels (rad; the load angle in electrical rad), where it has a stepper.
+const MOTOR: [Column; 2] = [
+    ("motor_angle", "rad", |_, o| {
+        o.motor_angle_rad.unwrap_or(f64::NAN)
+    }),
+    ("load_angle", "rad", |_, o| {
+        o.load_angle_rad.unwrap_or(f64::NAN)
+    }),
+];
+
+/// The phase currents (A), for the full driver model.
+const CURRENTS: [Column; 2] = [
+    ("current_a", "A", |_, o| {
+        o.currents_a.map_or(f64::NAN, |c| c[0])
+    }),
+    ("current_b", "A", |_, o| {
+        o.currents_a.map_or(f64::NAN, |c| c[1])
+    }),
+];
 
 /// The channels [`crate::execute::execute`] records for these axes: per axis `cmd_p_<axis>` (m),
 /// `cmd_v_<axis>` (m/s), `cmd_a_<axis>` (m/s^2), `cmd_j_<axis>` (m/s^3), `toolhead_<axis>`
@@ -26,72 +65,61 @@ use crate::studies::{MotionStream, Streamed};
 pub fn channels(axes: &[AxisModel]) -> Vec<(String, String)> {
     let mut ch = Vec::new();
     for a in axes {
-        let n = &a.name;
-        for (c, u) in [
-            ("cmd_p", "m"),
-            ("cmd_v", "m_s"),
-            ("cmd_a", "m_s2"),
-            ("cmd_j", "m_s3"),
-            ("toolhead", "m"),
-            ("error", "m"),
-        ] {
-            ch.push((format!("{c}_{n}"), u.to_string()));
-        }
-        if a.carriage.is_some() {
-            ch.push((format!("carriage_{n}"), "m".into()));
-        }
-        if a.stepper.is_some() {
-            ch.push((format!("motor_angle_{n}"), "rad".into()));
-            ch.push((format!("load_angle_{n}"), "rad".into()));
-        }
-        if a.mode == DriverMode::Full {
-            ch.push((format!("current_a_{n}"), "A".into()));
-            ch.push((format!("current_b_{n}"), "A".into()));
+        for (c, u, _) in AxisMeta::of(a).columns {
+            ch.push((format!("{c}_{}", a.name), u.to_string()));
         }
     }
     ch.push(("error".into(), "m".into()));
     ch
 }
 
-/// Which optional channels an axis records.
-#[derive(Debug, Clone, Copy)]
+/// The channels an axis records, in order ([`channels`]).
+#[derive(Debug, Clone)]
 pub struct AxisMeta {
-    carriage: bool,
-    motor: bool,
-    currents: bool,
+    columns: Vec<Column>,
 }
 
 impl AxisMeta {
     /// What `axis` has.
     pub fn of(axis: &AxisModel) -> Self {
-        Self {
-            carriage: axis.carriage.is_some(),
-            motor: axis.stepper.is_some(),
-            currents: axis.mode == DriverMode::Full,
+        let mut columns = COMMON.to_vec();
+        if axis.carriage.is_some() {
+            columns.push(CARRIAGE);
         }
+        if axis.stepper.is_some() {
+            columns.extend(MOTOR);
+        }
+        if axis.mode == DriverMode::Full {
+            columns.extend(CURRENTS);
+        }
+        Self { columns }
     }
 }
 
-/// Simulate `traj` (one profile per axis, in the order of `axes`) on `backend` and measure
-/// it against the trajectory's end point ([`simulate`]).
-pub fn run_trajectory(
+/// Simulate `motion` (one profile per axis of `axes`, in their order; planned whole or
+/// streamed) on `backend` and measure it against its end point ([`Run`]). When
+/// `record` is given, it is replaced by a series with the run's channels ([`channels`],
+/// and `contour_error` for a path) and every sample is appended to it. A chunk of a
+/// streamed motion that fails to plan is the outer error.
+pub fn run_motion(
     axes: Vec<AxisModel>,
     backend: Backend,
     options: &SimOptions,
-    traj: &Trajectory,
+    motion: &mut Motion,
     observe: &Observe,
     record: Option<&mut Series>,
-) -> Result<Metrics, SimError> {
-    if traj.dof() != axes.len() {
-        return Err(SimError::AxisCount {
+) -> Result<Result<Metrics, SimError>, PlanError> {
+    let (starts, _) = bounds(motion);
+    if starts.len() != axes.len() {
+        return Ok(Err(SimError::AxisCount {
             expected: axes.len(),
-            got: traj.dof(),
-        });
+            got: starts.len(),
+        }));
     }
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
     let record = record.map(|rec| {
         let mut ch = channels(&axes);
-        if traj.path().is_some() {
+        if motion.whole().is_some_and(|t| t.path().is_some()) {
             // Distance from the toolhead to the commanded path.
             ch.push(("contour_error".into(), "m".into()));
         }
@@ -99,226 +127,142 @@ pub fn run_trajectory(
         rec
     });
     let meta: Vec<AxisMeta> = axes.iter().map(AxisMeta::of).collect();
-    let start_m: Vec<f64> = traj.axes().iter().map(|p| p.start().p).collect();
+    let start_m: Vec<f64> = starts.iter().map(|s| s.p).collect();
     let run = Run {
-        names: &names,
-        meta: &meta,
-        traj,
-        observe,
-        record,
-    };
-    with_plant(
-        backend,
-        axes,
-        options,
-        observe.sample_rate_hz,
-        &start_m,
-        run,
-    )?
-}
-
-/// Simulate a streamed motion ([`simulate_stream`]) on `backend`, as [`run_trajectory`]
-/// does a whole trajectory.
-pub fn run_stream(
-    axes: Vec<AxisModel>,
-    backend: Backend,
-    options: &SimOptions,
-    motion: &mut Streamed,
-    observe: &Observe,
-    record: Option<&mut Series>,
-) -> Result<Result<Metrics, SimError>, PlanError> {
-    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
-    let record = record.map(|rec| {
-        *rec = Series::with_channels(channels(&axes));
-        rec
-    });
-    let meta: Vec<AxisMeta> = axes.iter().map(AxisMeta::of).collect();
-    let start_m: Vec<f64> = motion.start.iter().map(|s| s.p).collect();
-    let run = StreamRun {
         names: &names,
         meta: &meta,
         motion,
         observe,
         record,
     };
-    match with_plant(
-        backend,
-        axes,
-        options,
-        observe.sample_rate_hz,
-        &start_m,
-        run,
-    ) {
-        Ok(r) => r,
-        Err(e) => Ok(Err(e)),
+    let rate = observe.sample_rate_hz;
+    with_plant(backend, axes, options, rate, &start_m, run).unwrap_or_else(|e| Ok(Err(e)))
+}
+
+/// Where `motion` starts and ends, per axis.
+fn bounds(motion: &Motion) -> (Vec<State>, Vec<State>) {
+    match motion {
+        Motion::Whole(t) => (
+            t.axes().iter().map(Profile::start).collect(),
+            t.axes().iter().map(Profile::end).collect(),
+        ),
+        Motion::Stream(s) => (s.start.clone(), s.end.clone()),
     }
 }
 
-/// A run of [`simulate_stream`], as a [`Simulation`].
-struct StreamRun<'a> {
-    names: &'a [String],
-    meta: &'a [AxisMeta],
-    motion: &'a mut Streamed,
-    observe: &'a Observe,
-    record: Option<&'a mut Series>,
-}
-
-impl Simulation for StreamRun<'_> {
-    type Output = Result<Result<Metrics, SimError>, PlanError>;
-
-    fn run<P: Plant>(self, plant: &P) -> Self::Output {
-        simulate_stream(
-            plant,
-            self.names,
-            self.meta,
-            self.motion,
-            self.observe,
-            self.record,
-        )
-    }
-}
-
-/// A run of [`simulate`], as a [`Simulation`].
-struct Run<'a> {
-    names: &'a [String],
-    meta: &'a [AxisMeta],
-    traj: &'a Trajectory,
-    observe: &'a Observe,
-    record: Option<&'a mut Series>,
+/// A run on a plant ([`Simulation::run`]): the [`Driver`] through `motion`, then the end
+/// point held for the observation window, measuring the run ([`Accumulator`], the contour
+/// error of a path, a streamed motion's own measurement) and recording every sample into
+/// `record` when given.
+///
+/// A whole trajectory is a stream of one chunk. A streamed motion (a G-code job,
+/// [`crate::studies::Motion::Stream`]) is driven chunk by chunk on one sample clock, as
+/// `settle gcode` steps it (across breakpoints; a lone whole sample through
+/// `Plant::step`); a chunk that fails to plan is the outer error. Samples are taken every
+/// `1/sample_rate` s during the move, exactly at the move end T (with the command standing
+/// at the end point), and every `1/sample_rate` s after T. A fault ends the run where it
+/// happened: what was measured so far is kept in the accumulator but reported as a failed
+/// run (no metric values).
+#[derive(Debug)]
+pub struct Run<'a> {
+    /// The axes' names.
+    pub names: &'a [String],
+    /// The channels each axis records.
+    pub meta: &'a [AxisMeta],
+    /// The motion, one profile per axis.
+    pub motion: &'a mut Motion,
+    /// How it is observed.
+    pub observe: &'a Observe,
+    /// The recording (its channels already set), when asked.
+    pub record: Option<&'a mut Series>,
 }
 
 impl Simulation for Run<'_> {
-    type Output = Result<Metrics, SimError>;
+    type Output = Result<Result<Metrics, SimError>, PlanError>;
 
     fn run<P: Plant>(self, plant: &P) -> Self::Output {
-        simulate(
+        let Run {
+            names,
+            meta,
+            motion,
+            observe,
+            record,
+        } = self;
+        let (starts, ends) = bounds(motion);
+        let t_end = motion.duration_s();
+        let hold = standing_at(&ends);
+        // The command at the move's end; a move of no duration: the trajectory at 0.
+        let mut at_end = hold.clone();
+        let (mut next, stream, path) = match motion {
+            Motion::Whole(t) => {
+                let t = &*t;
+                if t_end <= 0.0 {
+                    t.state_at(0.0, &mut at_end);
+                }
+                let path = t.path().map(|g| PathAccumulator::new(g, t_end));
+                (Some(Cow::Borrowed(t)), None, path)
+            }
+            Motion::Stream(s) => {
+                let first = s.chunks.next_chunk()?.map(Cow::Owned);
+                (first, Some(&mut *s.chunks as &mut dyn MotionStream), None)
+            }
+        };
+        let driver = Driver::new(
             plant,
-            self.names,
-            self.meta,
-            self.traj,
-            self.observe,
-            self.record,
-        )
-    }
-}
-
-/// Drive `plant` through `traj`, then hold the end point for the observation window
-/// ([`Driver`]), measuring the run ([`Accumulator`], and the contour error of a path) and
-/// recording every sample into `record` when given.
-///
-/// Samples are taken every `1/sample_rate` s during the move, exactly at the move end T
-/// (with the command standing at the end point), and every `1/sample_rate` s after T. A
-/// fault ends the run where it happened: what was measured so far is kept in the
-/// accumulator but reported as a failed run (no metric values).
-pub fn simulate<P: Plant>(
-    plant: &P,
-    names: &[String],
-    meta: &[AxisMeta],
-    traj: &Trajectory,
-    observe: &Observe,
-    record: Option<&mut Series>,
-) -> Result<Metrics, SimError> {
-    let t_end = traj.duration_s();
-    let starts: Vec<State> = traj.axes().iter().map(Profile::start).collect();
-    let ends: Vec<State> = traj.axes().iter().map(Profile::end).collect();
-    let lean = record.is_none();
-    let mut sink = RunSink::new(&starts, &ends, t_end, observe, meta, record, None);
-    sink.path = traj.path().map(|g| PathAccumulator::new(g, t_end));
-    let mut driver = Driver::new(plant, names, &starts, observe.sample_rate_hz, 0.0, !lean)?;
-    // The end of the move, then the observation window at the end point.
-    let hold = standing_at(&ends);
-    let ran = driver.follow(traj, 0.0, false, &mut sink).and_then(|()| {
-        if t_end > 0.0 {
-            driver.sample_now(0, t_end, &hold, &mut sink)
-        } else {
-            let mut at = vec![Sample::default(); starts.len()];
-            traj.state_at(0.0, &mut at);
-            driver.sample_now(0, 0.0, &at, &mut sink)
-        }?;
-        window(&mut driver, &mut sink, &hold, t_end, observe)
-    });
-    Ok(finish(&mut driver, sink, names, ran, lean))
-}
-
-/// Drive `plant` through a motion streamed chunk by chunk (a G-code job,
-/// [`crate::studies::Motion::Stream`]), as [`simulate`] drives a whole trajectory: the
-/// chunks one after the other on one sample clock, the end point held for the observation
-/// window; every sample also goes to the stream's own measurement. The driver steps as
-/// `settle gcode` does (across breakpoints; a lone whole sample through `Plant::step`).
-/// A chunk that fails to plan is the error.
-pub fn simulate_stream<P: Plant>(
-    plant: &P,
-    names: &[String],
-    meta: &[AxisMeta],
-    motion: &mut Streamed,
-    observe: &Observe,
-    record: Option<&mut Series>,
-) -> Result<Result<Metrics, SimError>, PlanError> {
-    let t_end = motion.duration_s;
-    let (starts, ends) = (motion.start.clone(), motion.end.clone());
-    let lean = record.is_none();
-    let chunks = &mut motion.chunks;
-    let mut next = chunks.next_chunk()?;
-    let mut sink = RunSink::new(
-        &starts,
-        &ends,
-        t_end,
-        observe,
-        meta,
-        record,
-        Some(&mut **chunks),
-    );
-    let mut driver = match Driver::new(plant, names, &starts, observe.sample_rate_hz, 0.0, !lean) {
-        Ok(d) => d.with_min_batch(2).across_breakpoints(),
-        Err(e) => return Ok(Err(e)),
-    };
-    let mut t0 = 0.0;
-    let mut ran = Ok(());
-    while let Some(chunk) = next.take() {
-        next = sink.stream_next()?;
-        ran = driver.follow(&chunk, t0, next.is_some(), &mut sink);
-        t0 += chunk.duration_s();
-        if ran.is_err() {
-            break;
+            names,
+            &starts,
+            observe.sample_rate_hz,
+            0.0,
+            record.is_some(),
+        );
+        let mut driver = match driver {
+            Ok(d) if stream.is_some() => d.with_min_batch(2).across_breakpoints(),
+            Ok(d) => d,
+            Err(e) => return Ok(Err(e)),
+        };
+        let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
+        let direction: Vec<f64> = starts.iter().zip(&ends).map(|(s, e)| e.p - s.p).collect();
+        let mut sink = RunSink {
+            acc: Accumulator::new(&target, &direction, t_end, &observe.bands_um),
+            path,
+            stream,
+            record,
+            meta,
+            row: Vec::new(),
+        };
+        let mut t0 = 0.0;
+        let mut ran = Ok(());
+        while let Some(chunk) = next.take() {
+            if let Some(s) = sink.stream.as_deref_mut() {
+                next = s.next_chunk()?.map(Cow::Owned);
+            }
+            ran = driver.follow(&chunk, t0, next.is_some(), &mut sink);
+            t0 += chunk.duration_s();
+            if ran.is_err() {
+                break;
+            }
         }
+        // The end of the move, then the observation window at the end point.
+        let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
+        let window = Clock {
+            origin_s: t_end,
+            dt_s: driver.dt_s(),
+        };
+        let ran = ran.and_then(|()| {
+            driver.sample(0, t_end, Some(&at_end), &mut sink)?;
+            driver.hold(&hold, 1..=n, window, &mut sink)
+        });
+        Ok(Ok(finish(&mut driver, sink, names, ran)))
     }
-    let hold = standing_at(&ends);
-    let ran = ran.and_then(|()| {
-        driver.sample_now(0, t_end, &hold, &mut sink)?;
-        window(&mut driver, &mut sink, &hold, t_end, observe)
-    });
-    let mut m = finish(&mut driver, sink, names, ran, lean);
-    if m.is_ok() {
-        motion.chunks.measure(&mut m);
-    }
-    Ok(Ok(m))
-}
-
-/// The observation window after the move end `t_end`: the command `hold` (standing at the
-/// end point), a sample every `1/sample_rate` s after it.
-fn window<P: Plant>(
-    driver: &mut Driver<'_, P>,
-    sink: &mut RunSink<'_, '_>,
-    hold: &[Sample],
-    t_end: f64,
-    observe: &Observe,
-) -> Result<(), Stop> {
-    let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
-    let window = Clock {
-        origin_s: t_end,
-        dt_s: driver.dt_s(),
-    };
-    driver.hold(hold, 1..=n, window, sink)
 }
 
 /// The run's metrics: a fault, a backend failure or an interruption makes it a failed
-/// run, lost steps another.
+/// run, lost steps another; a streamed motion adds its figures to an ok run's.
 fn finish<P: Plant>(
     driver: &mut Driver<'_, P>,
     sink: RunSink<'_, '_>,
     names: &[String],
     ran: Result<(), Stop>,
-    lean: bool,
 ) -> Metrics {
     let status = match ran {
         Ok(()) => None,
@@ -329,7 +273,8 @@ fn finish<P: Plant>(
         Err(Stop::Interrupted) => Some(INTERRUPTED.to_string()),
         Err(Stop::Sink) => None,
     };
-    let obs = if lean {
+    // A recording observed every sample, the last one too.
+    let obs = if sink.record.is_none() {
         driver.observe()
     } else {
         driver.observations()
@@ -350,6 +295,9 @@ fn finish<P: Plant>(
     };
     let mut metrics = sink.acc.finish_with(names, &angles, status);
     metrics.path = sink.path.map(|p| p.finish());
+    if let Some(s) = sink.stream.filter(|_| metrics.is_ok()) {
+        s.measure(&mut metrics);
+    }
     metrics
 }
 
@@ -367,38 +315,6 @@ struct RunSink<'a, 'g> {
     row: Vec<f64>,
 }
 
-impl<'a> RunSink<'a, '_> {
-    /// Measuring a motion from `starts` to `ends` that ends at `t_end` (s).
-    fn new(
-        starts: &[State],
-        ends: &[State],
-        t_end: f64,
-        observe: &Observe,
-        meta: &'a [AxisMeta],
-        record: Option<&'a mut Series>,
-        stream: Option<&'a mut dyn MotionStream>,
-    ) -> Self {
-        let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
-        let direction: Vec<f64> = starts.iter().zip(ends).map(|(s, e)| e.p - s.p).collect();
-        Self {
-            acc: Accumulator::new(&target, &direction, t_end, &observe.bands_um),
-            path: None,
-            stream,
-            record,
-            meta,
-            row: Vec::new(),
-        }
-    }
-
-    /// The streamed motion's next chunk.
-    fn stream_next(&mut self) -> Result<Option<Trajectory>, PlanError> {
-        match self.stream.as_deref_mut() {
-            Some(s) => s.next_chunk(),
-            None => Ok(None),
-        }
-    }
-}
-
 impl Sink for RunSink<'_, '_> {
     fn sample(&mut self, s: &Full<'_>) -> ControlFlow<()> {
         self.acc.push(s.t_s, s.commanded_m, s.toolhead_m);
@@ -413,18 +329,7 @@ impl Sink for RunSink<'_, '_> {
             for ((o, c), m) in obs.iter().zip(s.cmd).zip(self.meta) {
                 let f = o.toolhead_m - o.commanded_m;
                 f2 += f * f;
-                row.extend([c.p, c.v, c.a, c.j, o.toolhead_m, f]);
-                if m.carriage {
-                    row.push(o.carriage_m.unwrap_or(f64::NAN));
-                }
-                if m.motor {
-                    row.push(o.motor_angle_rad.unwrap_or(f64::NAN));
-                    row.push(o.load_angle_rad.unwrap_or(f64::NAN));
-                }
-                if m.currents {
-                    let [ia, ib] = o.currents_a.unwrap_or([f64::NAN; 2]);
-                    row.extend([ia, ib]);
-                }
+                row.extend(m.columns.iter().map(|(_, _, value)| value(c, o)));
             }
             row.push(f2.sqrt());
             row.extend(contour);

@@ -105,19 +105,24 @@ fn a_gcode_corner_gives_the_metrics_of_the_corner_study() {
         .linearise_at_m
         .expect("printer_xy's belts depend on position");
     assert_eq!(point, vec![10.0 * 1e-3, 10.0 * 1e-3]);
-    let planned = settle::studies::plan(&c_run, &names).expect("plans");
+    let mut planned = settle::studies::plan(&c_run, &names).expect("plans");
     assert!(planned.probe.is_none() && planned.linearise_at_m.is_none());
-    let c = settle::execute::run_trajectory(
+    assert!(
+        planned.motion.whole().is_some(),
+        "a corner is planned whole"
+    );
+    let c = settle::execute::run_motion(
         axes,
         Backend::Modal,
         &settle::execute::SimOptions {
             linearise_at_m: Some(point),
             ..settle::execute::sim_options(&c_run)
         },
-        planned.motion.whole().expect("a corner is planned whole"),
+        &mut planned.motion,
         &settle::execute::observe_of(&c_run),
         None,
     )
+    .expect("plans")
     .expect("runs");
     let close = |a: f64, b: f64, what: &str| {
         assert!(

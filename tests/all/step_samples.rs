@@ -8,7 +8,9 @@ use std::path::Path;
 
 use settle::Metrics;
 use settle::execute::Observe;
-use settle::execute::simulate::{AxisMeta, simulate};
+use settle::execute::plant::Simulation;
+use settle::execute::simulate::{AxisMeta, Run};
+use settle::studies::Motion;
 use settle_planner::{Limits, Profile, ProfileKind, Sample, State, Trajectory};
 use settle_sim::{AxisModel, DriverMode, ModalPlant, Observation, Plant, SimError};
 
@@ -146,10 +148,7 @@ impl Case {
             at,
             steps: std::cell::Cell::new(0),
         };
-        let names: Vec<String> = self.axes.iter().map(|a| a.name.clone()).collect();
-        let meta: Vec<AxisMeta> = self.axes.iter().map(AxisMeta::of).collect();
-        let m =
-            simulate(&plant, &names, &meta, &self.traj, &self.observe, None).expect("simulates");
+        let m = self.simulate(&plant);
         (m, plant.steps.get())
     }
 
@@ -157,9 +156,21 @@ impl Case {
     fn modal(&self) -> Metrics {
         let plant =
             ModalPlant::new(self.axes.clone(), 1.0 / self.observe.sample_rate_hz).expect("modal");
+        self.simulate(&plant)
+    }
+
+    /// The run on `plant`.
+    fn simulate(&self, plant: &impl Plant) -> Metrics {
         let names: Vec<String> = self.axes.iter().map(|a| a.name.clone()).collect();
         let meta: Vec<AxisMeta> = self.axes.iter().map(AxisMeta::of).collect();
-        simulate(&plant, &names, &meta, &self.traj, &self.observe, None).expect("simulates")
+        let run = Run {
+            names: &names,
+            meta: &meta,
+            motion: &mut Motion::Whole(self.traj.clone()),
+            observe: &self.observe,
+            record: None,
+        };
+        run.run(plant).expect("plans").expect("simulates")
     }
 }
 

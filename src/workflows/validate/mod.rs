@@ -28,11 +28,12 @@ use settle_sim::machine::Machine;
 use settle_sim::{AxisModel, BeltModel, DriverMode, Mode};
 
 use crate::error::Error;
-use crate::execute::{Observe, SimOptions, run_trajectory};
+use crate::execute::{Observe, SimOptions, run_motion};
 use crate::measure::metrics::Metrics;
 use crate::measure::series::Series;
 use crate::output::atomic::write_atomic;
 use crate::spec::backend::{Backend, NO_MUJOCO};
+use crate::studies::Motion;
 
 pub use markdown::markdown;
 
@@ -268,14 +269,15 @@ fn simulate(
     axes: Vec<AxisModel>,
 ) -> Result<(Metrics, Series), String> {
     let mut series = Series::default();
-    let m = run_trajectory(
+    let m = run_motion(
         axes,
         backend,
         options,
-        &trajectory(case),
+        &mut Motion::Whole(trajectory(case)),
         &observe(),
         Some(&mut series),
     )
+    .map_err(|e| e.to_string())?
     .map_err(|e| e.to_string())?;
     Ok((m, series))
 }
