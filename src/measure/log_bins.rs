@@ -4,8 +4,8 @@
 //!
 //! The formula is a non-decreasing function of `x` (a division by a positive constant,
 //! the logarithm and `ceil` each are), so each bin `i >= 1` starts at a threshold `T_i`, the
-//! least `x` whose bin is `i` or more, found at construction by stepping from
-//! `min ratio^(i - 1)` one representable value at a time until the formula changes. A value's
+//! least `x` whose bin is `i` or more, found at construction by bisection around
+//! `min ratio^(i - 1)`. A value's
 //! bin is then the number of thresholds at or below it. The thresholds are looked up
 //! from a first guess: the bin of the lowest value sharing the value's exponent and top
 //! [`MANTISSA_BITS`] mantissa bits (an interval narrower than one bin when the ratio is
@@ -50,16 +50,32 @@ impl LogBins {
         let raw = |x: f64| ((x / min).ln() / ratio.ln()).ceil();
         let mut thresholds = vec![min; bins];
         for (i, t) in thresholds.iter_mut().enumerate().skip(1) {
-            // The bin is `i` or more once `ln(x / min) / ln(ratio)` passes `i - 1`.
+            // The bin is `i` or more once `ln(x / min) / ln(ratio)` passes `i - 1`: near
+            // `min e^((i - 1) ln(ratio))`, within a few units in the last place. Bisect
+            // the bit patterns (ordered as the positive values are) between a value below
+            // and one at or above, widened until they are.
             let want = i as f64;
-            let mut x = (min * ratio.powi(i as i32 - 1)).max(min.next_up());
-            while x > min && raw(x) >= want {
-                x = x.next_down();
+            let guess = (min * ((i - 1) as f64 * ratio.ln()).exp()).max(min.next_up());
+            let (mut lo, mut hi, mut width) = (guess.to_bits(), guess.to_bits(), 16u64);
+            while lo > min.to_bits() && raw(f64::from_bits(lo)) >= want {
+                lo = lo.saturating_sub(width).max(min.to_bits());
+                width *= 2;
             }
-            while raw(x) < want {
-                x = x.next_up();
+            width = 16;
+            while raw(f64::from_bits(hi)) < want {
+                hi += width;
+                width *= 2;
             }
-            *t = x;
+            // raw(lo) < want (or lo is `min`, bin 0), raw(hi) >= want.
+            while hi - lo > 1 {
+                let mid = lo + (hi - lo) / 2;
+                if raw(f64::from_bits(mid)) >= want {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            *t = f64::from_bits(hi);
         }
         let key = |x: f64| x.to_bits() >> SHIFT;
         let key0 = key(min);
