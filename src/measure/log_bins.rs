@@ -3,15 +3,14 @@
 //! same index for every `f64` as the formula gives.
 //!
 //! The formula is a non-decreasing function of `x` (a division by a positive constant,
-//! the logarithm and `ceil` each are), so each bin `i >= 1` starts at a threshold `T_i`, the
-//! least `x` whose bin is `i` or more, found at construction by bisection around
-//! `min ratio^(i - 1)`. A value's
-//! bin is then the number of thresholds at or below it. The thresholds are looked up
-//! from a first guess: the bin of the lowest value sharing the value's exponent and top
-//! [`MANTISSA_BITS`] mantissa bits (an interval narrower than one bin when the ratio is
-//! above `1 + 2^-10`, so at most one threshold falls inside it), then one comparison or
-//! two. The test module checks the lookup against the formula at and around every
-//! threshold and at random values.
+//! the logarithm and `ceil` each are), so each bin `i >= 1` starts at a threshold `T_i`,
+//! the least `x` whose bin is `i` or more, found at construction by bisection around
+//! `min ratio^(i - 1)`; a value's bin is the number of thresholds at or below it. The
+//! values sharing an exponent and the top [`MANTISSA_BITS`] mantissa bits (a key) span
+//! less than a bin when the ratio is above `1 + 2^-10`, so at most one threshold falls
+//! among them: a value's bin is that of its key's lowest value, plus one from that
+//! threshold on. Two independent loads, no logarithm. The test module checks the lookup
+//! against the formula at and around every threshold and at random values.
 
 /// Mantissa bits of the first guess's key (with the exponent).
 const MANTISSA_BITS: u32 = 10;
@@ -33,11 +32,52 @@ pub fn exact_bin(min: f64, ratio: f64, bins: usize, x: f64) -> usize {
 #[derive(Debug, Clone)]
 pub struct LogBins {
     min: f64,
-    /// `thresholds[i]` is `T_i` for `1 <= i < bins` (entry 0 is `min`, never compared).
-    thresholds: Vec<f64>,
+    /// The last bin's threshold: every value from here on is in the last bin.
+    top: f64,
+    /// The last bin (`bins - 1`).
+    last: usize,
     /// The bin of the lowest value of each key, from the key of `min` on.
     start: Vec<u16>,
+    /// The threshold of the bin after `start` of the same key (infinite after the last):
+    /// a value of that key is in the next bin from there on (the one after starts in a
+    /// later key).
+    next: Vec<f64>,
     key0: u64,
+}
+
+/// `T_i` for `1 <= i < bins` at index `i` (entry 0 is `min`).
+fn thresholds(min: f64, ratio: f64, bins: usize) -> Vec<f64> {
+    let raw = |x: f64| ((x / min).ln() / ratio.ln()).ceil();
+    let mut thresholds = vec![min; bins];
+    for (i, t) in thresholds.iter_mut().enumerate().skip(1) {
+        // The bin is `i` or more once `ln(x / min) / ln(ratio)` passes `i - 1`: near
+        // `min e^((i - 1) ln(ratio))`, within a few units in the last place. Bisect
+        // the bit patterns (ordered as the positive values are) between a value below
+        // and one at or above, widened until they are.
+        let want = i as f64;
+        let guess = (min * ((i - 1) as f64 * ratio.ln()).exp()).max(min.next_up());
+        let (mut lo, mut hi, mut width) = (guess.to_bits(), guess.to_bits(), 16u64);
+        while lo > min.to_bits() && raw(f64::from_bits(lo)) >= want {
+            lo = lo.saturating_sub(width).max(min.to_bits());
+            width *= 2;
+        }
+        width = 16;
+        while raw(f64::from_bits(hi)) < want {
+            hi += width;
+            width *= 2;
+        }
+        // raw(lo) < want (or lo is `min`, bin 0), raw(hi) >= want.
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if raw(f64::from_bits(mid)) >= want {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        *t = f64::from_bits(hi);
+    }
+    thresholds
 }
 
 impl LogBins {
@@ -45,54 +85,35 @@ impl LogBins {
     /// 65,536).
     pub fn new(min: f64, ratio: f64, bins: usize) -> Self {
         assert!(min > 0.0 && min.is_finite(), "min {min}");
-        assert!(ratio > 1.0 + 1.0 / 1024.0 && ratio.is_finite(), "ratio {ratio}");
+        assert!(
+            ratio > 1.0 + 1.0 / 1024.0 && ratio.is_finite(),
+            "ratio {ratio}"
+        );
         assert!((2..=1 << 16).contains(&bins), "bins {bins}");
-        let raw = |x: f64| ((x / min).ln() / ratio.ln()).ceil();
-        let mut thresholds = vec![min; bins];
-        for (i, t) in thresholds.iter_mut().enumerate().skip(1) {
-            // The bin is `i` or more once `ln(x / min) / ln(ratio)` passes `i - 1`: near
-            // `min e^((i - 1) ln(ratio))`, within a few units in the last place. Bisect
-            // the bit patterns (ordered as the positive values are) between a value below
-            // and one at or above, widened until they are.
-            let want = i as f64;
-            let guess = (min * ((i - 1) as f64 * ratio.ln()).exp()).max(min.next_up());
-            let (mut lo, mut hi, mut width) = (guess.to_bits(), guess.to_bits(), 16u64);
-            while lo > min.to_bits() && raw(f64::from_bits(lo)) >= want {
-                lo = lo.saturating_sub(width).max(min.to_bits());
-                width *= 2;
-            }
-            width = 16;
-            while raw(f64::from_bits(hi)) < want {
-                hi += width;
-                width *= 2;
-            }
-            // raw(lo) < want (or lo is `min`, bin 0), raw(hi) >= want.
-            while hi - lo > 1 {
-                let mid = lo + (hi - lo) / 2;
-                if raw(f64::from_bits(mid)) >= want {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            *t = f64::from_bits(hi);
-        }
+        let t = thresholds(min, ratio, bins);
         let key = |x: f64| x.to_bits() >> SHIFT;
         let key0 = key(min);
-        let last = key(thresholds[bins - 1]);
-        let mut start = Vec::with_capacity((last - key0 + 1) as usize);
+        let last = key(t[bins - 1]);
+        let keys = (last - key0 + 1) as usize;
+        let (mut start, mut next) = (Vec::with_capacity(keys), Vec::with_capacity(keys));
         let mut i = 0usize;
         for k in key0..=last {
             let lo = f64::from_bits(k << SHIFT).max(min.next_up());
-            while i + 1 < bins && thresholds[i + 1] <= lo {
+            while i + 1 < bins && t[i + 1] <= lo {
                 i += 1;
             }
+            // At most one threshold inside a key: a key is narrower than a bin.
+            let hi = f64::from_bits((k + 1) << SHIFT);
+            assert!(i + 2 >= bins || t[i + 2] >= hi, "two thresholds in a key");
             start.push(u16::try_from(i).expect("at most 65,536 bins"));
+            next.push(t.get(i + 1).copied().unwrap_or(f64::INFINITY));
         }
         Self {
             min,
-            thresholds,
+            top: t[bins - 1],
+            last: bins - 1,
             start,
+            next,
             key0,
         }
     }
@@ -100,21 +121,15 @@ impl LogBins {
     /// The bin of `x`: [`exact_bin`] of the parameters given to [`LogBins::new`].
     #[inline]
     pub fn bin(&self, x: f64) -> usize {
-        let t = &self.thresholds;
-        let last = t.len() - 1;
         // NaN and everything at or below `min` are in bin 0.
         if !(x > self.min) {
             return 0;
         }
-        if x >= t[last] {
-            return last;
+        if x >= self.top {
+            return self.last;
         }
-        let mut i = usize::from(self.start[((x.to_bits() >> SHIFT) - self.key0) as usize]);
-        // `x < t[last]`: the loop stops at `last` at the latest.
-        while x >= t[i + 1] {
-            i += 1;
-        }
-        i
+        let k = ((x.to_bits() >> SHIFT) - self.key0) as usize;
+        usize::from(self.start[k]) + usize::from(x >= self.next[k])
     }
 }
 
@@ -132,7 +147,7 @@ mod tests {
         let (min, ratio, bins) = (1e-3, 1.001, 18_432);
         let b = LogBins::new(min, ratio, bins);
         let check = |x: f64| assert_eq!(b.bin(x), exact_bin(min, ratio, bins, x), "x = {x:e}");
-        for &t in &b.thresholds {
+        for &t in &thresholds(min, ratio, bins) {
             let mut x = t;
             for _ in 0..40 {
                 x = x.next_down();
