@@ -122,7 +122,7 @@ impl LogBins {
     #[inline]
     pub fn bin(&self, x: f64) -> usize {
         // NaN and everything at or below `min` are in bin 0.
-        if !(x > self.min) {
+        if x.is_nan() || x <= self.min {
             return 0;
         }
         if x >= self.top {
