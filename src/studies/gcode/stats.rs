@@ -2,6 +2,8 @@
 //! 95th percentile from a bounded histogram), the worst spots (one per move) and the
 //! toolpath points of the ringing maps.
 
+use crate::measure::log_bins::LogBins;
+
 /// A point of a ringing map: the toolhead (mm) and its contour error (um); `print` false
 /// breaks the drawn path (travel, pauses).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,12 +46,27 @@ impl Default for Histogram {
 impl Histogram {
     /// Count one error (um).
     pub fn push(&mut self, err_um: f64) {
-        let i = if err_um <= HIST_MIN_UM {
-            0
-        } else {
-            ((err_um / HIST_MIN_UM).ln() / HIST_RATIO.ln()).ceil() as usize
-        };
-        self.counts[i.min(HIST_BINS - 1)] += 1;
+        // `ceil(ln(err / HIST_MIN_UM) / ln(HIST_RATIO))`, clamped to the bins, without
+        // the logarithm (crate::measure::log_bins). A sample's error is counted in a few
+        // histograms one after the other (the layer's, its feature's): the last value's
+        // bin is kept (the initial key, a NaN, is in bin 0 as every NaN is).
+        static BINS: std::sync::OnceLock<LogBins> = std::sync::OnceLock::new();
+        thread_local! {
+            static LAST: std::cell::Cell<(u64, usize)> = const { std::cell::Cell::new((u64::MAX, 0)) };
+        }
+        let key = err_um.to_bits();
+        let i = LAST.with(|last| {
+            let (k, i) = last.get();
+            if k == key {
+                return i;
+            }
+            let i = BINS
+                .get_or_init(|| LogBins::new(HIST_MIN_UM, HIST_RATIO, HIST_BINS))
+                .bin(err_um);
+            last.set((key, i));
+            i
+        });
+        self.counts[i] += 1;
         self.total += 1;
     }
 
