@@ -5,11 +5,11 @@
 use std::borrow::Cow;
 use std::ops::ControlFlow;
 
-use settle_planner::{PlanError, Profile, Sample, State};
+use settle_planner::{PlanError, Profile, Sample, State, Trajectory};
 use settle_sim::{AxisModel, DriverMode, Observation, Plant, SimError};
 
 use crate::execute::Observe;
-use crate::execute::driver::{Batched, Clock, Driver, Full, Sink, Stop, standing_at};
+use crate::execute::driver::{Batched, Chunk, Clock, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::measure::accumulator::Accumulator;
 use crate::measure::metrics::{Metrics, Status};
@@ -193,20 +193,16 @@ impl Simulation for Run<'_> {
         let hold = standing_at(&ends);
         // The command at the move's end; a move of no duration: the trajectory at 0.
         let mut at_end = hold.clone();
-        let (mut next, stream, path) = match motion {
-            Motion::Whole(t) => {
-                let t = &*t;
-                if t_end <= 0.0 {
-                    t.state_at(0.0, &mut at_end);
-                }
-                let path = t.path().map(|g| PathAccumulator::new(g, t_end));
-                (Some(Cow::Borrowed(t)), None, path)
-            }
-            Motion::Stream(s) => {
-                let first = s.chunks.next_chunk()?.map(Cow::Owned);
-                (first, Some(&mut *s.chunks as &mut dyn MotionStream), None)
-            }
+        let (whole, mut stream) = match motion {
+            Motion::Whole(t) => (Some(&*t), None),
+            Motion::Stream(s) => (None, Some(&mut *s.chunks as &mut dyn MotionStream)),
         };
+        if let Some(t) = whole.filter(|_| t_end <= 0.0) {
+            t.state_at(0.0, &mut at_end);
+        }
+        let path = whole.and_then(|t| t.path().map(|g| PathAccumulator::new(g, t_end)));
+        let mut chunks = Chunks { whole, t0: 0.0 };
+        let first = chunks.next(stream.as_deref_mut())?;
         let driver = Driver::new(
             plant,
             names,
@@ -216,7 +212,7 @@ impl Simulation for Run<'_> {
             record.is_some(),
         );
         let mut driver = match driver {
-            Ok(d) if stream.is_some() => d.with_min_batch(2).across_breakpoints(),
+            Ok(d) if stream.is_some() => d.streamed(),
             Ok(d) => d,
             Err(e) => return Ok(Err(e)),
         };
@@ -230,18 +226,8 @@ impl Simulation for Run<'_> {
             meta,
             row: Vec::new(),
         };
-        let mut t0 = 0.0;
-        let mut ran = Ok(());
-        while let Some(chunk) = next.take() {
-            if let Some(s) = sink.stream.as_deref_mut() {
-                next = s.next_chunk()?.map(Cow::Owned);
-            }
-            ran = driver.follow(&chunk, t0, next.is_some(), &mut sink);
-            t0 += chunk.duration_s();
-            if ran.is_err() {
-                break;
-            }
-        }
+        let next = |s: &mut RunSink| chunks.next(s.stream.as_deref_mut());
+        let ran = driver.follow_chunks(first, next, false, &mut sink)?;
         // The end of the move, then the observation window at the end point.
         let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
         let window = Clock {
@@ -253,6 +239,31 @@ impl Simulation for Run<'_> {
             driver.hold(&hold, 1..=n, window, &mut sink)
         });
         Ok(Ok(finish(&mut driver, sink, names, ran)))
+    }
+}
+
+/// A run's chunks on its clock from 0: a whole trajectory's one, or a streamed motion's,
+/// each from where the one before ended.
+struct Chunks<'t> {
+    whole: Option<&'t Trajectory>,
+    t0: f64,
+}
+
+impl<'t> Chunks<'t> {
+    fn next(
+        &mut self,
+        stream: Option<&mut (dyn MotionStream + '_)>,
+    ) -> Result<Option<Chunk<'t>>, PlanError> {
+        let chunk = match (self.whole.take(), stream) {
+            (Some(t), _) => Some(Cow::Borrowed(t)),
+            (None, Some(s)) => s.next_chunk()?.map(Cow::Owned),
+            (None, None) => None,
+        };
+        Ok(chunk.map(|c| {
+            let t0 = self.t0;
+            self.t0 += c.duration_s();
+            (t0, c)
+        }))
     }
 }
 
