@@ -5,7 +5,7 @@
 use std::borrow::Cow;
 use std::ops::ControlFlow;
 
-use settle_planner::{PlanError, Profile, Sample, State, Trajectory};
+use settle_planner::{PlanError, Profile, Sample, State};
 use settle_sim::{AxisModel, DriverMode, Observation, Plant, SimError};
 
 use crate::execute::Observe;
@@ -193,7 +193,7 @@ impl Simulation for Run<'_> {
         let hold = standing_at(&ends);
         // The command at the move's end; a move of no duration: the trajectory at 0.
         let mut at_end = hold.clone();
-        let (whole, mut stream) = match motion {
+        let (whole, stream) = match motion {
             Motion::Whole(t) => (Some(&*t), None),
             Motion::Stream(s) => (None, Some(&mut *s.chunks as &mut dyn MotionStream)),
         };
@@ -201,21 +201,6 @@ impl Simulation for Run<'_> {
             t.state_at(0.0, &mut at_end);
         }
         let path = whole.and_then(|t| t.path().map(|g| PathAccumulator::new(g, t_end)));
-        let mut chunks = Chunks { whole, t0: 0.0 };
-        let first = chunks.next(stream.as_deref_mut())?;
-        let driver = Driver::new(
-            plant,
-            names,
-            &starts,
-            observe.sample_rate_hz,
-            0.0,
-            record.is_some(),
-        );
-        let mut driver = match driver {
-            Ok(d) if stream.is_some() => d.streamed(),
-            Ok(d) => d,
-            Err(e) => return Ok(Err(e)),
-        };
         let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
         let direction: Vec<f64> = starts.iter().zip(&ends).map(|(s, e)| e.p - s.p).collect();
         let mut sink = RunSink {
@@ -226,8 +211,25 @@ impl Simulation for Run<'_> {
             meta,
             row: Vec::new(),
         };
-        let next = |s: &mut RunSink| chunks.next(s.stream.as_deref_mut());
-        let ran = driver.follow_chunks(first, next, false, &mut sink)?;
+        // A whole trajectory is a stream of one chunk.
+        let first = match whole {
+            Some(t) => Some((0.0, Cow::Borrowed(t))),
+            None => sink.next_chunk()?,
+        };
+        let driver = Driver::new(
+            plant,
+            names,
+            &starts,
+            observe.sample_rate_hz,
+            0.0,
+            sink.record.is_some(),
+        );
+        let mut driver = match driver {
+            Ok(d) if sink.stream.is_some() => d.streamed(),
+            Ok(d) => d,
+            Err(e) => return Ok(Err(e)),
+        };
+        let ran = driver.follow_chunks(first, RunSink::next_chunk, false, &mut sink)?;
         // The end of the move, then the observation window at the end point.
         let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
         let window = Clock {
@@ -239,31 +241,6 @@ impl Simulation for Run<'_> {
             driver.hold(&hold, 1..=n, window, &mut sink)
         });
         Ok(Ok(finish(&mut driver, sink, names, ran)))
-    }
-}
-
-/// A run's chunks on its clock from 0: a whole trajectory's one, or a streamed motion's,
-/// each from where the one before ended.
-struct Chunks<'t> {
-    whole: Option<&'t Trajectory>,
-    t0: f64,
-}
-
-impl<'t> Chunks<'t> {
-    fn next(
-        &mut self,
-        stream: Option<&mut (dyn MotionStream + '_)>,
-    ) -> Result<Option<Chunk<'t>>, PlanError> {
-        let chunk = match (self.whole.take(), stream) {
-            (Some(t), _) => Some(Cow::Borrowed(t)),
-            (None, Some(s)) => s.next_chunk()?.map(Cow::Owned),
-            (None, None) => None,
-        };
-        Ok(chunk.map(|c| {
-            let t0 = self.t0;
-            self.t0 += c.duration_s();
-            (t0, c)
-        }))
     }
 }
 
@@ -324,6 +301,16 @@ struct RunSink<'a, 'g> {
     record: Option<&'a mut Series>,
     meta: &'a [AxisMeta],
     row: Vec<f64>,
+}
+
+impl<'g> RunSink<'_, 'g> {
+    /// A streamed motion's next chunk.
+    fn next_chunk(&mut self) -> Result<Option<Chunk<'g>>, PlanError> {
+        let Some(s) = self.stream.as_deref_mut() else {
+            return Ok(None);
+        };
+        Ok(s.next_chunk()?.map(|(t0, c)| (t0, Cow::Owned(c))))
+    }
 }
 
 impl Sink for RunSink<'_, '_> {

@@ -450,15 +450,14 @@ pub fn simulate_job<R: BufRead>(
     let rate = opts.sample_rate_hz;
     let (file, progress) = file;
     let size = std::fs::metadata(file).map_or(0, |m| m.len());
-    let chunks = JobChunks {
-        job,
-        file,
-        progress: progress.map(|p| (p, size)),
-        end: Vec::new(),
-        range_start: None,
-    };
     let sim = JobSim {
-        chunks,
+        chunks: JobChunks {
+            job,
+            file,
+            progress: progress.map(|p| (p, size)),
+            end: Vec::new(),
+            range_start: None,
+        },
         acc: Account::new(opts, rec),
     };
     with_plant(backend, axes, options, rate, &[], sim).map_err(sim_err)?
@@ -490,11 +489,11 @@ struct JobChunks<'a, R> {
 impl<R: BufRead> JobChunks<'_, R> {
     /// The next chunk, its time 0 its start on the print clock.
     fn next(&mut self, acc: &mut Account) -> Result<Option<Chunk<'static>>, Error> {
-        let next = self
+        let Some(chunk) = self
             .job
             .next_chunk()
-            .map_err(super::gcode_error(self.file))?;
-        let Some(chunk) = next else {
+            .map_err(super::gcode_error(self.file))?
+        else {
             return Ok(None);
         };
         acc.active.add(&chunk.moves);
@@ -513,26 +512,20 @@ impl<R: BufRead> JobChunks<'_, R> {
         self.end = sub.axes().iter().map(Profile::end).collect();
         Ok(Some((chunk.start_time_s, Cow::Owned(sub))))
     }
-
-    /// Tell how far the file has been read.
-    fn tell(&self) {
-        if let Some((tell, size)) = self.progress {
-            tell(self.job.reader().bytes_read(), size);
-        }
-    }
 }
 
-/// Where the driver stopped, for a job: a fault is the job's outcome, anything else an
-/// error.
-fn stopped(stop: Stop, acc: &mut Account) -> Result<(), Error> {
-    match stop {
-        Stop::Sink => Ok(()),
-        Stop::Fault(reason) => {
+/// Whether the driver stopped early, for a job: a fault is the job's outcome, a backend's
+/// failure or an interruption an error.
+fn stopped(ran: Result<(), Stop>, acc: &mut Account) -> Result<bool, Error> {
+    match ran {
+        Ok(()) => Ok(false),
+        Err(Stop::Sink) => Ok(true),
+        Err(Stop::Fault(reason)) => {
             acc.out.fault = Some(reason);
-            Ok(())
+            Ok(true)
         }
-        Stop::Backend { error, .. } => Err(sim_err(error)),
-        Stop::Interrupted => Err(Error::Interrupted { run: 0 }),
+        Err(Stop::Backend { error, .. }) => Err(sim_err(error)),
+        Err(Stop::Interrupted) => Err(Error::Interrupted { run: 0 }),
     }
 }
 
@@ -553,14 +546,15 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
             let mut d = d.streamed();
             // The file is told how far it has been read after each chunk is simulated.
             let next = |acc: &mut Account| {
-                chunks.tell();
+                if let Some((tell, size)) = chunks.progress {
+                    tell(chunks.job.reader().bytes_read(), size);
+                }
                 chunks.next(acc)
             };
-            let ran = d.follow_chunks(Some(first), next, true, &mut acc)?;
-            let faulted = ran.is_err();
-            if let Err(stop) = ran {
-                stopped(stop, &mut acc)?;
-            }
+            let faulted = stopped(
+                d.follow_chunks(Some(first), next, true, &mut acc)?,
+                &mut acc,
+            )?;
             // The print time simulated: to the last command (the tail is counted apart).
             let t_end = d.time_s();
             acc.out.simulated_s = t_end - t_first;
@@ -576,9 +570,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                     end_xy: [hold[ix].p, hold[iy].p],
                 });
                 let last_k = ((t_end + tail_s) / d.dt_s()).floor() as u64;
-                if let Err(stop) = d.hold_on(&hold, last_k, &mut acc) {
-                    stopped(stop, &mut acc)?;
-                }
+                stopped(d.hold_on(&hold, last_k, &mut acc), &mut acc)?;
                 let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
                 tail.duration_s = d.time_s() - t_end;
                 if let Some(l) = acc.layer.as_mut() {
