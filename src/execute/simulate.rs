@@ -216,15 +216,8 @@ impl Simulation for Run<'_> {
             Some(t) => Some((0.0, Cow::Borrowed(t))),
             None => sink.next_chunk()?,
         };
-        let driver = Driver::new(
-            plant,
-            names,
-            &starts,
-            observe.sample_rate_hz,
-            0.0,
-            sink.record.is_some(),
-        );
-        let mut driver = match driver {
+        let (rate, full) = (observe.sample_rate_hz, sink.record.is_some());
+        let mut driver = match Driver::new(plant, names, &starts, rate, 0.0, full) {
             Ok(d) if sink.stream.is_some() => d.streamed(),
             Ok(d) => d,
             Err(e) => return Ok(Err(e)),
