@@ -4,9 +4,10 @@
 //! (`crate::workflows::gcode::stream`) are its sinks.
 //!
 //! - The clock: sample `k` is at `k / sample_rate` s. A command ([`Driver::follow`]) is a
-//!   trajectory whose time 0 is `t0` on the clock (a G-code job's chunks follow one
-//!   another on one clock, the plant's state carried across them); [`Driver::hold`] holds
-//!   a command on a clock of its own (the observation window after a move).
+//!   trajectory whose time 0 is `t0` on the clock; a motion's chunks follow one another
+//!   on one clock, the plant's state carried across them ([`Driver::follow_chunks`], the
+//!   one loop of a run and of a G-code job); [`Driver::hold`] holds a command on a clock
+//!   of its own (the observation window after a move).
 //! - Steps are split at every breakpoint of every axis, so each axis's commanded jerk is
 //!   constant within each step (the modal plant is then exact). A whole sample interval
 //!   is stepped as exactly `1 / sample_rate` s.
@@ -19,6 +20,7 @@
 //!   ([`crate::execute::interrupt`]) is seen within [`INTERRUPT_POLL`] samples evaluated
 //!   in full and stops it with [`Stop::Interrupted`].
 
+use std::borrow::Cow;
 use std::ops::{ControlFlow, RangeInclusive};
 
 use settle_planner::{Sample, State, Trajectory};
@@ -213,12 +215,14 @@ impl<'p, P: Plant> Driver<'p, P> {
         })
     }
 
-    /// Batches of at least `n` samples only (default 1): a shorter run of whole samples is
-    /// stepped sample by sample through [`Plant::step`]. (A plant's batch may take longer
-    /// internal steps than one sample, MuJoCo's does: the choice can change the last bits.)
-    pub fn with_min_batch(mut self, n: usize) -> Self {
-        self.min_batch = n.max(1);
-        self
+    /// The driver of a streamed motion (a G-code job's, in `settle gcode` or a sweep):
+    /// batches across breakpoints ([`Driver::across_breakpoints`]) of two samples at least,
+    /// a lone whole sample stepped through [`Plant::step`] as `settle gcode` has always
+    /// stepped it (a plant's batch may take longer internal steps than one sample, MuJoCo's
+    /// does: the choice can change the last bits).
+    pub fn streamed(mut self) -> Self {
+        self.min_batch = 2;
+        self.across_breakpoints()
     }
 
     /// Batches of whole samples go on across the command's breakpoints where the plant
@@ -357,6 +361,29 @@ impl<'p, P: Plant> Driver<'p, P> {
             }
         }
         Ok(())
+    }
+
+    /// Follow a motion's chunks one after the other ([`Driver::follow`]): `first`, then
+    /// each one `next` gives (handed the sink, which may be what reads them) until `None`.
+    /// Every chunk's end is sampled but the last one's, unless `last_end`: a run samples
+    /// its move's end apart (so it reads a chunk ahead, to know the last), a G-code job
+    /// does not. A chunk that fails to come is the outer error.
+    pub fn follow_chunks<'t, S: Sink, E>(
+        &mut self,
+        first: Option<Chunk<'t>>,
+        mut next: impl FnMut(&mut S) -> Result<Option<Chunk<'t>>, E>,
+        last_end: bool,
+        sink: &mut S,
+    ) -> Result<Result<(), Stop>, E> {
+        let mut chunk = first;
+        while let Some((t0, traj)) = chunk {
+            let ahead = if last_end { None } else { next(sink)? };
+            if let Err(stop) = self.follow(&traj, t0, last_end || ahead.is_some(), sink) {
+                return Ok(Err(stop));
+            }
+            chunk = if last_end { next(sink)? } else { ahead };
+        }
+        Ok(Ok(()))
     }
 
     /// Hold `cmd` (one sample per axis): steps of one sample period, sample `k` at
@@ -557,6 +584,9 @@ impl<'p, P: Plant> Driver<'p, P> {
         Ok(())
     }
 }
+
+/// A chunk of a motion: its time 0 on the driver's clock (s) and its command.
+pub type Chunk<'t> = (f64, Cow<'t, Trajectory>);
 
 /// The command standing still at `ends` (one state per axis): their positions, no motion.
 pub fn standing_at(ends: &[State]) -> Vec<Sample> {

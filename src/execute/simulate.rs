@@ -9,7 +9,7 @@ use settle_planner::{PlanError, Profile, Sample, State};
 use settle_sim::{AxisModel, DriverMode, Observation, Plant, SimError};
 
 use crate::execute::Observe;
-use crate::execute::driver::{Batched, Clock, Driver, Full, Sink, Stop, standing_at};
+use crate::execute::driver::{Batched, Chunk, Clock, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::measure::accumulator::Accumulator;
 use crate::measure::metrics::{Metrics, Status};
@@ -193,33 +193,14 @@ impl Simulation for Run<'_> {
         let hold = standing_at(&ends);
         // The command at the move's end; a move of no duration: the trajectory at 0.
         let mut at_end = hold.clone();
-        let (mut next, stream, path) = match motion {
-            Motion::Whole(t) => {
-                let t = &*t;
-                if t_end <= 0.0 {
-                    t.state_at(0.0, &mut at_end);
-                }
-                let path = t.path().map(|g| PathAccumulator::new(g, t_end));
-                (Some(Cow::Borrowed(t)), None, path)
-            }
-            Motion::Stream(s) => {
-                let first = s.chunks.next_chunk()?.map(Cow::Owned);
-                (first, Some(&mut *s.chunks as &mut dyn MotionStream), None)
-            }
+        let (whole, stream) = match motion {
+            Motion::Whole(t) => (Some(&*t), None),
+            Motion::Stream(s) => (None, Some(&mut *s.chunks as &mut dyn MotionStream)),
         };
-        let driver = Driver::new(
-            plant,
-            names,
-            &starts,
-            observe.sample_rate_hz,
-            0.0,
-            record.is_some(),
-        );
-        let mut driver = match driver {
-            Ok(d) if stream.is_some() => d.with_min_batch(2).across_breakpoints(),
-            Ok(d) => d,
-            Err(e) => return Ok(Err(e)),
-        };
+        if let Some(t) = whole.filter(|_| t_end <= 0.0) {
+            t.state_at(0.0, &mut at_end);
+        }
+        let path = whole.and_then(|t| t.path().map(|g| PathAccumulator::new(g, t_end)));
         let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
         let direction: Vec<f64> = starts.iter().zip(&ends).map(|(s, e)| e.p - s.p).collect();
         let mut sink = RunSink {
@@ -230,18 +211,18 @@ impl Simulation for Run<'_> {
             meta,
             row: Vec::new(),
         };
-        let mut t0 = 0.0;
-        let mut ran = Ok(());
-        while let Some(chunk) = next.take() {
-            if let Some(s) = sink.stream.as_deref_mut() {
-                next = s.next_chunk()?.map(Cow::Owned);
-            }
-            ran = driver.follow(&chunk, t0, next.is_some(), &mut sink);
-            t0 += chunk.duration_s();
-            if ran.is_err() {
-                break;
-            }
-        }
+        // A whole trajectory is a stream of one chunk.
+        let first = match whole {
+            Some(t) => Some((0.0, Cow::Borrowed(t))),
+            None => sink.next_chunk()?,
+        };
+        let (rate, full) = (observe.sample_rate_hz, sink.record.is_some());
+        let mut driver = match Driver::new(plant, names, &starts, rate, 0.0, full) {
+            Ok(d) if sink.stream.is_some() => d.streamed(),
+            Ok(d) => d,
+            Err(e) => return Ok(Err(e)),
+        };
+        let ran = driver.follow_chunks(first, RunSink::next_chunk, false, &mut sink)?;
         // The end of the move, then the observation window at the end point.
         let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
         let window = Clock {
@@ -313,6 +294,16 @@ struct RunSink<'a, 'g> {
     record: Option<&'a mut Series>,
     meta: &'a [AxisMeta],
     row: Vec<f64>,
+}
+
+impl<'g> RunSink<'_, 'g> {
+    /// A streamed motion's next chunk.
+    fn next_chunk(&mut self) -> Result<Option<Chunk<'g>>, PlanError> {
+        let Some(s) = self.stream.as_deref_mut() else {
+            return Ok(None);
+        };
+        Ok(s.next_chunk()?.map(|(t0, c)| (t0, Cow::Owned(c))))
+    }
 }
 
 impl Sink for RunSink<'_, '_> {

@@ -170,9 +170,10 @@ impl std::fmt::Debug for Streamed {
 
 /// The chunks of a [`Streamed`] motion and what the study measures along them.
 pub trait MotionStream: Send {
-    /// The next chunk, one profile per machine axis, starting where the one before ended
-    /// (its time 0 is the sum of the durations before); `None` after the last.
-    fn next_chunk(&mut self) -> Result<Option<Trajectory>, PlanError>;
+    /// The next chunk, one profile per machine axis, and its time 0 on the run's clock
+    /// (s): it starts where the one before ended, its time 0 the sum of the durations
+    /// before, in order; `None` after the last.
+    fn next_chunk(&mut self) -> Result<Option<(f64, Trajectory)>, PlanError>;
 
     /// A sample at `t_s` (the run's clock) with the toolhead at `toolhead_m` (per machine
     /// axis): every sample, in order, the observation window's too.

@@ -194,6 +194,8 @@ pub(super) struct JobChunks {
     cut_s: f64,
     /// The standing start, until taken.
     rest: Option<Trajectory>,
+    /// The next chunk's time 0 on the run's clock (s).
+    t0_s: f64,
     duration_s: f64,
     /// Machine indices of X and Y.
     xy: [usize; 2],
@@ -230,6 +232,7 @@ impl JobChunks {
             origin_s: outline.origin_s,
             cut_s: outline.cut_s,
             rest,
+            t0_s: 0.0,
             duration_s: outline.duration_s,
             xy: [ix, iy],
             layers,
@@ -242,18 +245,21 @@ impl JobChunks {
 }
 
 impl MotionStream for JobChunks {
-    fn next_chunk(&mut self) -> Result<Option<Trajectory>, PlanError> {
-        if let Some(r) = self.rest.take() {
-            return Ok(Some(r));
-        }
-        while let Some(c) = self.job.next_chunk().map_err(failed)? {
-            let tr = on_machine(&c, &self.map)?;
-            if let Some(tr) = from(c.start_time_s, tr, self.cut_s)? {
+    fn next_chunk(&mut self) -> Result<Option<(f64, Trajectory)>, PlanError> {
+        let mut next = self.rest.take();
+        while next.is_none()
+            && let Some(c) = self.job.next_chunk().map_err(failed)?
+        {
+            next = from(c.start_time_s, on_machine(&c, &self.map)?, self.cut_s)?;
+            if next.is_some() {
                 self.active.add(&c.moves);
-                return Ok(Some(tr));
             }
         }
-        Ok(None)
+        Ok(next.map(|tr| {
+            let t0 = self.t0_s;
+            self.t0_s += tr.duration_s();
+            (t0, tr)
+        }))
     }
 
     fn sample(&mut self, t_s: f64, toolhead_m: &[f64]) {

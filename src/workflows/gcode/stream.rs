@@ -15,6 +15,7 @@
 //!   and the largest distance from the end point is the last layer's
 //!   [`LayerStats::end_residual_um`].
 
+use std::borrow::Cow;
 use std::io::BufRead;
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -26,7 +27,7 @@ use settle_sim::{AxisModel, Observation, Plant, SimError};
 use super::Progress;
 use super::record::Recorder;
 use crate::error::Error;
-use crate::execute::driver::{Batched, Driver, Full, Sink, Stop, standing_at};
+use crate::execute::driver::{Batched, Chunk, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
 use crate::studies::gcode::contour::ActiveMoves;
@@ -450,11 +451,14 @@ pub fn simulate_job<R: BufRead>(
     let (file, progress) = file;
     let size = std::fs::metadata(file).map_or(0, |m| m.len());
     let sim = JobSim {
-        job,
-        opts,
-        rec,
-        file,
-        progress: progress.map(|p| (p, size)),
+        chunks: JobChunks {
+            job,
+            file,
+            progress: progress.map(|p| (p, size)),
+            end: Vec::new(),
+            range_start: None,
+        },
+        acc: Account::new(opts, rec),
     };
     with_plant(backend, axes, options, rate, &[], sim).map_err(sim_err)?
 }
@@ -463,27 +467,65 @@ fn sim_err(source: SimError) -> Error {
     Error::Sim { run: 0, source }
 }
 
-/// A job on a plant, as a [`Simulation`].
+/// A job on a plant, as a [`Simulation`]: its chunks and the account of their samples.
 struct JobSim<'a, R> {
+    chunks: JobChunks<'a, R>,
+    acc: Account,
+}
+
+/// A job's chunks on the machine's axes and the print clock, each one's moves handed to the
+/// account before it is sampled; where the layer range starts and the last chunk ends.
+struct JobChunks<'a, R> {
     job: &'a mut Job<R>,
-    opts: StreamOptions,
-    rec: Option<Recorder>,
     file: &'a Path,
     /// Told the bytes read after each chunk, with the file's size.
     progress: Option<(Progress<'a>, u64)>,
+    /// The end state of the last chunk, per axis.
+    end: Vec<State>,
+    /// Print-clock time of the layer range's first move.
+    range_start: Option<f64>,
 }
 
-/// Where the driver stopped, for a job: a fault is the job's outcome, anything else an
-/// error.
-fn stopped(stop: Stop, acc: &mut Account) -> Result<(), Error> {
-    match stop {
-        Stop::Sink => Ok(()),
-        Stop::Fault(reason) => {
-            acc.out.fault = Some(reason);
-            Ok(())
+impl<R: BufRead> JobChunks<'_, R> {
+    /// The next chunk, its time 0 its start on the print clock.
+    fn next(&mut self, acc: &mut Account) -> Result<Option<Chunk<'static>>, Error> {
+        let Some(chunk) = self
+            .job
+            .next_chunk()
+            .map_err(super::gcode_error(self.file))?
+        else {
+            return Ok(None);
+        };
+        acc.active.add(&chunk.moves);
+        let axes = acc.opts.job_axes.iter();
+        let axes = axes.map(|&i| chunk.trajectory.axes()[i].clone()).collect();
+        let sub = Trajectory::new(axes).map_err(|source| Error::Plan { run: 0, source })?;
+        if self.range_start.is_none()
+            && let Some((a, _)) = acc.opts.layers
+        {
+            self.range_start = chunk
+                .moves
+                .iter()
+                .find(|m| m.layer >= a && m.duration_s > 0.0)
+                .map(|m| m.start_time_s);
         }
-        Stop::Backend { error, .. } => Err(sim_err(error)),
-        Stop::Interrupted => Err(Error::Interrupted { run: 0 }),
+        self.end = sub.axes().iter().map(Profile::end).collect();
+        Ok(Some((chunk.start_time_s, Cow::Owned(sub))))
+    }
+}
+
+/// Whether the driver stopped early, for a job: a fault is the job's outcome, a backend's
+/// failure or an interruption an error.
+fn stopped(ran: Result<(), Stop>, acc: &mut Account) -> Result<bool, Error> {
+    match ran {
+        Ok(()) => Ok(false),
+        Err(Stop::Sink) => Ok(true),
+        Err(Stop::Fault(reason)) => {
+            acc.out.fault = Some(reason);
+            Ok(true)
+        }
+        Err(Stop::Backend { error, .. }) => Err(sim_err(error)),
+        Err(Stop::Interrupted) => Err(Error::Interrupted { run: 0 }),
     }
 }
 
@@ -491,96 +533,56 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
     type Output = Result<(Streamed, Option<Recorder>), Error>;
 
     fn run<P: Plant>(self, plant: &P) -> Self::Output {
-        let (job, opts, rec, file) = (self.job, self.opts, self.rec, self.file);
-        let progress = self.progress;
-        let n = opts.job_axes.len();
-        let (rate, dt) = (opts.sample_rate_hz, 1.0 / opts.sample_rate_hz);
-        let job_axes = opts.job_axes.clone();
-        let names = opts.names.clone();
-        let (tail_s, tail_hold_s) = (opts.tail_s, opts.tail_hold_s);
-        // The end state of the last chunk, per axis.
-        let mut end = vec![State::default(); n];
-        let mut range_start: Option<f64> = None;
-        let mut acc = Account::new(opts, rec);
-        let mut driver: Option<Driver<'_, P>> = None;
-        let mut t_first = 0.0_f64;
-        let mut faulted = false;
-        while let Some(chunk) = job.next_chunk().map_err(super::gcode_error(file))? {
-            acc.active.add(&chunk.moves);
-            let axes: Vec<Profile> = job_axes
-                .iter()
-                .map(|&i| chunk.trajectory.axes()[i].clone())
-                .collect();
-            let sub = Trajectory::new(axes).map_err(|source| Error::Plan { run: 0, source })?;
-            // The chunk's time 0 is its start on the print clock.
-            let t0 = chunk.start_time_s;
-            let d = match driver.as_mut() {
-                Some(d) => d,
-                None => {
-                    let starts: Vec<_> = sub.axes().iter().map(Profile::start).collect();
-                    t_first = t0;
-                    // A lone whole sample goes through `Plant::step`, as `settle gcode` has
-                    // always stepped it (MuJoCo's batch would take it as one long step).
-                    // Batches go across the command's breakpoints where the plant can
-                    // (the modal plant).
-                    let d =
-                        Driver::new(plant, &names, &starts, rate, t0, false).map_err(sim_err)?;
-                    driver.insert(d.with_min_batch(2).across_breakpoints())
+        let JobSim {
+            mut chunks,
+            mut acc,
+        } = self;
+        let names = acc.opts.names.clone();
+        if let Some(first) = chunks.next(&mut acc)? {
+            let t_first = first.0;
+            let starts: Vec<State> = first.1.axes().iter().map(Profile::start).collect();
+            let rate = acc.opts.sample_rate_hz;
+            let d = Driver::new(plant, &names, &starts, rate, t_first, false).map_err(sim_err)?;
+            let mut d = d.streamed();
+            // The file is told how far it has been read after each chunk is simulated.
+            let next = |acc: &mut Account| {
+                if let Some((tell, size)) = chunks.progress {
+                    tell(chunks.job.reader().bytes_read(), size);
                 }
+                chunks.next(acc)
             };
-            if range_start.is_none()
-                && let Some((a, _)) = acc.opts.layers
-            {
-                range_start = chunk
-                    .moves
-                    .iter()
-                    .find(|m| m.layer >= a && m.duration_s > 0.0)
-                    .map(|m| m.start_time_s);
+            let faulted = stopped(
+                d.follow_chunks(Some(first), next, true, &mut acc)?,
+                &mut acc,
+            )?;
+            // The print time simulated: to the last command (the tail is counted apart).
+            let t_end = d.time_s();
+            acc.out.simulated_s = t_end - t_first;
+            let tail_s = acc.opts.tail_s;
+            if !faulted && tail_s > 0.0 && chunks.job.ended_at_end_of_file() {
+                // The ringing after the last move: the command stands at the end point,
+                // from the first sample after the end (a partial step) on.
+                let hold = standing_at(&chunks.end);
+                let [ix, iy] = acc.opts.xy;
+                acc.ringing = Some(Ringing {
+                    tail: Tail::default(),
+                    band: Band::new(acc.opts.tail_hold_s),
+                    end_xy: [hold[ix].p, hold[iy].p],
+                });
+                let last_k = ((t_end + tail_s) / d.dt_s()).floor() as u64;
+                stopped(d.hold_on(&hold, last_k, &mut acc), &mut acc)?;
+                let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
+                tail.duration_s = d.time_s() - t_end;
+                if let Some(l) = acc.layer.as_mut() {
+                    l.end_residual_um = Some(tail.residual_peak_um);
+                }
+                acc.out.tail = Some(tail);
             }
-            for (e, p) in end.iter_mut().zip(sub.axes()) {
-                *e = p.end();
-            }
-            if let Err(stop) = d.follow(&sub, t0, true, &mut acc) {
-                faulted = true;
-                stopped(stop, &mut acc)?;
-                break;
-            }
-            if let Some((tell, size)) = progress {
-                tell(job.reader().bytes_read(), size);
-            }
-        }
-        // The print time simulated: to the last command (the tail is counted apart).
-        let t = driver.as_ref().map_or(0.0, Driver::time_s);
-        acc.out.simulated_s = t - t_first;
-        if let Some(d) = driver.as_mut().filter(|_| !faulted && tail_s > 0.0)
-            && job.ended_at_end_of_file()
-        {
-            // The ringing after the last move: the command stands at the end point,
-            // from the first sample after the end (a partial step) on.
-            let hold = standing_at(&end);
-            let [ix, iy] = acc.opts.xy;
-            acc.ringing = Some(Ringing {
-                tail: Tail::default(),
-                band: Band::new(tail_hold_s),
-                end_xy: [hold[ix].p, hold[iy].p],
-            });
-            let t_end = t;
-            let last_k = ((t_end + tail_s) / dt).floor() as u64;
-            if let Err(stop) = d.hold_on(&hold, last_k, &mut acc) {
-                stopped(stop, &mut acc)?;
-            }
-            let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
-            tail.duration_s = d.time_s() - t_end;
-            if let Some(l) = acc.layer.as_mut() {
-                l.end_residual_um = Some(tail.residual_peak_um);
-            }
-            acc.out.tail = Some(tail);
-        }
-        acc.out.preroll_s = range_start.map_or(0.0, |r| (r - t_first).max(0.0));
-        acc.end_layer();
-        if let Some(d) = driver.as_mut() {
+            let preroll_s = chunks.range_start.map(|r| (r - t_first).max(0.0));
+            acc.out.preroll_s = preroll_s.unwrap_or(0.0);
             acc.out.lost_steps = d.observe().iter().map(|o| o.lost_steps).sum();
         }
+        acc.end_layer();
         acc.out.worst = acc.top.spots().to_vec();
         Ok((acc.out, acc.rec))
     }
