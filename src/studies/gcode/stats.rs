@@ -100,6 +100,31 @@ pub struct Spot {
     pub layer: u32,
     /// The move's index in the file.
     pub move_index: u64,
+    /// The error's two parts here.
+    pub split: Split,
+}
+
+/// A contour error told apart (um): the shaper's *smoothing*, the distance in XY from
+/// the commanded (shaped) position to the G-code path of the moves active at that time
+/// (zero without a shaper: the planned command runs on the path), and the machine's
+/// *vibration*, the distance in XY from the toolhead to the commanded position (zero on
+/// a rigid machine). The contour error is at most their sum (the triangle inequality).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Split {
+    /// Commanded position to the G-code path (um).
+    pub smoothing_um: f64,
+    /// Toolhead to the commanded position (um).
+    pub vibration_um: f64,
+}
+
+impl Split {
+    /// Each part's larger value of `self` and `other`.
+    pub fn max(self, other: Split) -> Split {
+        Split {
+            smoothing_um: self.smoothing_um.max(other.smoothing_um),
+            vibration_um: self.vibration_um.max(other.vibration_um),
+        }
+    }
 }
 
 /// The largest `n` spots, at most one per move, largest first.
@@ -159,6 +184,9 @@ pub struct LayerStats {
     /// the toolhead to the end point after the last command (the ringing after the final
     /// stop).
     pub end_residual_um: Option<f64>,
+    /// The largest smoothing and the largest vibration of its printing samples (each
+    /// part's own largest, not the parts of the largest error).
+    pub split_worst: Split,
 }
 
 impl LayerStats {
@@ -171,6 +199,7 @@ impl LayerStats {
             print_moves: 0,
             mean_move_worst_um: 0.0,
             end_residual_um: None,
+            split_worst: Split::default(),
         }
     }
 
@@ -237,6 +266,7 @@ mod tests {
                 line: i as u64,
                 layer: 0,
                 move_index: i as u64,
+                split: Split::default(),
             });
         }
         let e: Vec<f64> = t.spots().iter().map(|s| s.error_um).collect();

@@ -24,7 +24,7 @@ use crate::spec::backend::Backend;
 use crate::studies::gcode::stats::LayerMap;
 
 /// layers.csv's columns.
-pub const LAYER_COLUMNS: [&str; 14] = [
+pub const LAYER_COLUMNS: [&str; 16] = [
     "layer",
     "z_mm",
     "start_s",
@@ -39,6 +39,8 @@ pub const LAYER_COLUMNS: [&str; 14] = [
     "worst_x_mm",
     "worst_y_mm",
     "end_residual_um",
+    "smoothing_worst_um",
+    "vibration_worst_um",
 ];
 
 /// layers.csv as bytes.
@@ -66,10 +68,12 @@ pub fn layers_csv(o: &GcodeOutcome) -> Result<Vec<u8>, csv::Error> {
                     None => row.extend([String::new(), String::new(), String::new()]),
                 }
                 row.push(s.end_residual_um.map(num).unwrap_or_default());
+                row.push(num(s.split_worst.smoothing_um));
+                row.push(num(s.split_worst.vibration_um));
             }
             None => {
                 row.push("false".into());
-                row.extend(std::iter::repeat_n(String::new(), 8));
+                row.extend(std::iter::repeat_n(String::new(), 10));
             }
         }
         w.write_record(&row)?;
@@ -117,23 +121,28 @@ pub fn summary_md(o: &GcodeOutcome, maps: &[String]) -> String {
     );
     let _ = writeln!(
         s,
-        "| print time | worst contour error | p95 contour error | simulated |"
+        "| print time | worst contour error | p95 contour error | worst smoothing | worst vibration | simulated |"
     );
-    let _ = writeln!(s, "|---:|---:|---:|---:|");
+    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|");
     let _ = writeln!(
         s,
-        "| {:.1} s ({:.1} min) | {:.2} um | {:.2} um | {:.1} s of print |\n",
+        "| {:.1} s ({:.1} min) | {:.2} um | {:.2} um | {:.2} um | {:.2} um | {:.1} s of print |\n",
         o.print_time_s,
         o.print_time_s / 60.0,
         o.worst_um,
         o.p95_um,
+        o.streamed.split_worst.smoothing_um,
+        o.streamed.split_worst.vibration_um,
         o.streamed.simulated_s
     );
     let _ = writeln!(
         s,
         "Contour error: distance in XY from the simulated toolhead to the commanded path of \
 the moves active at that time, over printing moves; p95 is the 95th percentile of all \
-printing samples.\n"
+printing samples. It has two parts: smoothing, the distance from the commanded (shaped) \
+position to that path, what the shaper trades for speed (zero without one), and vibration, \
+the distance from the toolhead to the commanded position, what the machine adds (zero on a \
+rigid one); each column is that part's own largest.\n"
     );
     if let Some((settings, _)) = &o.config {
         let _ = writeln!(s, "Planner {settings}.\n");
@@ -164,37 +173,46 @@ not counted), so that it starts from the vibration the layers before leave.\n",
     let _ = writeln!(s, "## Worst spots\n");
     let _ = writeln!(
         s,
-        "| error (um) | line | layer | X (mm) | Y (mm) | time (s) |"
+        "| error (um) | smoothing (um) | vibration (um) | line | layer | X (mm) | Y (mm) | time (s) |"
     );
-    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|");
     for w in o.worst() {
         let _ = writeln!(
             s,
-            "| {:.2} | {} | {} | {:.2} | {:.2} | {:.3} |",
-            w.error_um, w.line, w.layer, w.x_mm, w.y_mm, w.time_s
+            "| {:.2} | {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {:.3} |",
+            w.error_um,
+            w.split.smoothing_um,
+            w.split.vibration_um,
+            w.line,
+            w.layer,
+            w.x_mm,
+            w.y_mm,
+            w.time_s
         );
     }
     let _ = writeln!(s, "\n## Layers\n");
     let _ = writeln!(
         s,
-        "| layer | Z (mm) | time (s) | moves | worst (um) | p95 (um) | worst line |"
+        "| layer | Z (mm) | time (s) | moves | worst (um) | p95 (um) | worst line | smoothing (um) | vibration (um) |"
     );
-    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for l in &o.layers {
         let z = l.z_mm.map_or(String::new(), |z| format!("{z:.2}"));
-        let (w, p, line) = match &l.stats {
+        let (w, p, line, sm, vib) = match &l.stats {
             Some(st) => (
                 format!("{:.2}", st.worst_um()),
                 format!("{:.2}", st.p95_um),
                 st.worst
                     .as_ref()
                     .map_or(String::new(), |w| w.line.to_string()),
+                format!("{:.2}", st.split_worst.smoothing_um),
+                format!("{:.2}", st.split_worst.vibration_um),
             ),
-            None => ("-".into(), "-".into(), "-".into()),
+            None => ("-".into(), "-".into(), "-".into(), "-".into(), "-".into()),
         };
         let _ = writeln!(
             s,
-            "| {} | {z} | {:.2} | {} | {w} | {p} | {line} |",
+            "| {} | {z} | {:.2} | {} | {w} | {p} | {line} | {sm} | {vib} |",
             l.layer, l.duration_s, l.moves
         );
     }
@@ -409,6 +427,10 @@ pub fn html_report(
         o.worst_um,
         o.p95_um,
         o.streamed.simulated_s
+    ));
+    intro.push(format!(
+        "Of the contour error, smoothing (the shaped command against the G-code path, what the shaper trades for speed) reaches {:.2} um and vibration (the toolhead against the shaped command, what the machine adds) {:.2} um.",
+        o.streamed.split_worst.smoothing_um, o.streamed.split_worst.vibration_um
     ));
     if let Some(w) = o.worst().first() {
         intro.push(format!(

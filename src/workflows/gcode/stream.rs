@@ -31,7 +31,9 @@ use crate::execute::driver::{Batched, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
 use crate::studies::gcode::contour::ActiveMoves;
-use crate::studies::gcode::stats::{Histogram, LayerMap, LayerStats, MapPoint, Spot, TopSpots};
+use crate::studies::gcode::stats::{
+    Histogram, LayerMap, LayerStats, MapPoint, Split, Spot, TopSpots,
+};
 
 /// How the job is sampled and what is kept.
 #[derive(Debug, Clone, PartialEq)]
@@ -82,6 +84,8 @@ pub struct Streamed {
     pub layers: Vec<LayerStats>,
     /// Every printing sample's contour error.
     pub all: Histogram,
+    /// The largest smoothing and the largest vibration of the printing samples.
+    pub split_worst: Split,
     /// The worst spots of the job (one per move).
     pub worst: Vec<Spot>,
     /// The ringing maps of the worst layers, largest error first.
@@ -271,6 +275,15 @@ impl Account {
         }
         let print = m.kind == MoveKind::Print;
         if print {
+            let (cx, cy) = (cmd_m[ix] * 1e3, cmd_m[iy] * 1e3);
+            let split = Split {
+                smoothing_um: self.active.at(t, [cx, cy]).map_or(0.0, |(e, _)| e * 1e3),
+                vibration_um: (x - cx).hypot(y - cy) * 1e3,
+            };
+            self.out.split_worst = self.out.split_worst.max(split);
+            if let Some(l) = self.layer.as_mut() {
+                l.split_worst = l.split_worst.max(split);
+            }
             self.hist.push(err_um);
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
@@ -283,6 +296,7 @@ impl Account {
                     line: m.line,
                     layer: m.layer,
                     move_index: m.index,
+                    split,
                 });
             }
         }
