@@ -32,7 +32,7 @@ pub fn segment_distance_mm(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 /// root is monotone and correctly rounded, so the root of the least square is the least
 /// root, bit for bit).
 #[inline]
-fn segment_distance_sq(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+pub(crate) fn segment_distance_sq(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let (px, py) = (p[0] - a[0], p[1] - a[1]);
     let l2 = dx * dx + dy * dy;

@@ -45,6 +45,7 @@
 //! real job goes on); they measure that stop, not the print, and `settle gcode --layers`
 //! reports no such ringing for a range that ends before the file.
 
+pub mod command_path;
 pub mod contour;
 pub mod linpoint;
 pub mod preroll;

@@ -104,16 +104,27 @@ pub struct Spot {
     pub split: Split,
 }
 
-/// A contour error told apart (um): the shaper's *smoothing*, the distance in XY from
-/// the commanded (shaped) position to the G-code path of the moves active at that time
-/// (zero without a shaper: the planned command runs on the path), and the machine's
-/// *vibration*, the distance in XY from the toolhead to the commanded position (zero on
-/// a rigid machine). The contour error is at most their sum (the triangle inequality).
+/// A contour error told apart (um), each part a contour error of its own:
+///
+/// - *smoothing*: the commanded (shaped) position's distance in XY to the G-code path of
+///   the moves active at that time, as the toolhead's contour error is measured. What the
+///   shaper trades for speed. Without a shaper it is the planner model's corner bridge
+///   only: a profile cannot jump in speed, so each corner's speed jump `dv` is spread over
+///   a 100 us window (`settle_planner::firmware::profiles`), off the path by at most
+///   `|dv| w / 8 + |da| w^2 / 8` per axis (0.07 um for a 5 mm/s square corner at
+///   4,000 mm/s^2).
+/// - *vibration*: the toolhead's distance in XY to the command's own recent path
+///   ([`crate::studies::gcode::command_path`]): what the machine adds. The lag along the
+///   path is not vibration; a rigid machine has none.
+///
+/// Neither is the contour error's share: the toolhead's distance to the G-code path is at
+/// most the sum of its distance to the command's path and that path's distance to the
+/// G-code path.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Split {
     /// Commanded position to the G-code path (um).
     pub smoothing_um: f64,
-    /// Toolhead to the commanded position (um).
+    /// Toolhead to the command's path (um).
     pub vibration_um: f64,
 }
 

@@ -30,6 +30,7 @@ use crate::error::Error;
 use crate::execute::driver::{Batched, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
+use crate::studies::gcode::command_path::CommandPath;
 use crate::studies::gcode::contour::ActiveMoves;
 use crate::studies::gcode::stats::{
     Histogram, LayerMap, LayerStats, MapPoint, Split, Spot, TopSpots,
@@ -140,6 +141,8 @@ struct Owner {
 struct Account {
     opts: StreamOptions,
     active: ActiveMoves,
+    /// The command's recent path, the toolhead's vibration is measured against.
+    command: CommandPath,
     out: Streamed,
     top: TopSpots,
     layer: Option<LayerStats>,
@@ -159,12 +162,14 @@ struct Account {
 impl Account {
     fn new(opts: StreamOptions, rec: Option<Recorder>) -> Self {
         // About 1 kHz of map points.
-        let map_every = (opts.sample_rate_hz / 1000.0).round().max(1.0) as u64;
+        let sample_rate_hz = opts.sample_rate_hz;
+        let map_every = (sample_rate_hz / 1000.0).round().max(1.0) as u64;
         Self {
             top: TopSpots::new(opts.top_spots),
             layer_top: TopSpots::new(5),
             opts,
             active: ActiveMoves::default(),
+            command: CommandPath::new(sample_rate_hz),
             out: Streamed::default(),
             layer: None,
             hist: Histogram::default(),
@@ -233,6 +238,9 @@ impl Account {
         self.active.retire(t);
         let [ix, iy] = self.opts.xy;
         let (x, y) = (toolhead_m[ix] * 1e3, toolhead_m[iy] * 1e3);
+        let (cx, cy) = (cmd_m[ix] * 1e3, cmd_m[iy] * 1e3);
+        // Every sample's command is on the path, counted or not (the pre-roll's too).
+        self.command.push([cx, cy]);
         let Some((err_mm, m)) = self.active.at(t, [x, y]) else {
             return;
         };
@@ -275,10 +283,9 @@ impl Account {
         }
         let print = m.kind == MoveKind::Print;
         if print {
-            let (cx, cy) = (cmd_m[ix] * 1e3, cmd_m[iy] * 1e3);
             let split = Split {
                 smoothing_um: self.active.at(t, [cx, cy]).map_or(0.0, |(e, _)| e * 1e3),
-                vibration_um: (x - cx).hypot(y - cy) * 1e3,
+                vibration_um: self.command.distance_mm([x, y]).unwrap_or(0.0) * 1e3,
             };
             self.out.split_worst = self.out.split_worst.max(split);
             if let Some(l) = self.layer.as_mut() {
