@@ -5,6 +5,10 @@
 //! ([`crate::studies::gcode::contour`]) feeds the per-move, per-layer and whole-job account
 //! ([`crate::studies::gcode::stats`]).
 //!
+//! - Each sample is measured [`CommandPath::delay`] samples late (20 ms), when the
+//!   command's path is known that far after it too: its vibration is measured against the
+//!   command's path around it ([`crate::studies::gcode::command_path`]). The samples still
+//!   waiting are measured when the job's simulation ends.
 //! - With a layer range the job's chunks start a pre-roll before the range (see
 //!   [`crate::studies::gcode::preroll`]): the plant is stepped through it, but only samples of moves in
 //!   the range are counted.
@@ -15,6 +19,7 @@
 //!   and the largest distance from the end point is the last layer's
 //!   [`LayerStats::end_residual_um`].
 
+use std::collections::VecDeque;
 use std::io::BufRead;
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -136,13 +141,30 @@ struct Owner {
     line: u64,
 }
 
+/// A sample waiting to be measured: its clock index and time, and the commanded and
+/// toolhead XY (m).
+#[derive(Debug, Clone, Copy)]
+struct Waiting {
+    k: u64,
+    t: f64,
+    cmd: [f64; 2],
+    toolhead: [f64; 2],
+}
+
 /// The running account (module doc).
 #[derive(Debug)]
 struct Account {
     opts: StreamOptions,
     active: ActiveMoves,
-    /// The command's recent path, the toolhead's vibration is measured against.
+    /// The command's path around the sample being measured.
     command: CommandPath,
+    /// The chunk being followed: its start (s, print clock), X and Y profiles and the
+    /// index of each one's next breakpoint to put on the command's path.
+    chunk: Option<(f64, [Profile; 2], [usize; 2])>,
+    /// The samples not measured yet, oldest first.
+    waiting: VecDeque<Waiting>,
+    /// How many samples wait.
+    delay: usize,
     out: Streamed,
     top: TopSpots,
     layer: Option<LayerStats>,
@@ -169,7 +191,10 @@ impl Account {
             layer_top: TopSpots::new(5),
             opts,
             active: ActiveMoves::default(),
-            command: CommandPath::new(sample_rate_hz),
+            command: CommandPath::default(),
+            chunk: None,
+            waiting: VecDeque::new(),
+            delay: CommandPath::delay(sample_rate_hz),
             out: Streamed::default(),
             layer: None,
             hist: Histogram::default(),
@@ -233,14 +258,78 @@ impl Account {
         self.out.layers.push(l);
     }
 
+    /// A sample: its command joins the path, and the sample `delay` before it is measured.
     fn add_sample(&mut self, k: u64, t: f64, cmd_m: &[f64], toolhead_m: &[f64]) {
+        let [ix, iy] = self.opts.xy;
+        let w = Waiting {
+            k,
+            t,
+            cmd: [cmd_m[ix], cmd_m[iy]],
+            toolhead: [toolhead_m[ix], toolhead_m[iy]],
+        };
+        // Every sample's command is on the path, counted or not (the pre-roll's too),
+        // with the breakpoints before it.
+        self.breakpoints_before(t);
+        self.command.push(t, [w.cmd[0] * 1e3, w.cmd[1] * 1e3]);
+        self.waiting.push_back(w);
+        if self.waiting.len() > self.delay
+            && let Some(w) = self.waiting.pop_front()
+        {
+            self.measure(w);
+        }
+    }
+
+    /// Follow the chunk of `tr` from `t0_s` (print clock): its breakpoints go on the
+    /// command's path.
+    fn follow(&mut self, t0_s: f64, tr: &Trajectory) {
+        let [ix, iy] = self.opts.xy;
+        let xy = [tr.axes()[ix].clone(), tr.axes()[iy].clone()];
+        self.chunk = Some((t0_s, xy, [0, 0]));
+    }
+
+    /// Put the chunk's breakpoints before `t_s` on the command's path, in time order.
+    fn breakpoints_before(&mut self, t_s: f64) {
+        let Some((t0, xy, next)) = self.chunk.as_mut() else {
+            return;
+        };
+        let at = |next: &[usize; 2], i: usize| {
+            let p: &Profile = &xy[i];
+            (next[i] < p.segments().len()).then(|| *t0 + p.segment_start(next[i]).0)
+        };
+        loop {
+            let tb = match (at(next, 0), at(next, 1)) {
+                (Some(a), Some(b)) => a.min(b),
+                (Some(a), None) | (None, Some(a)) => a,
+                (None, None) => return,
+            };
+            if tb >= t_s {
+                return;
+            }
+            for i in 0..2 {
+                if at(next, i) == Some(tb) {
+                    next[i] += 1;
+                }
+            }
+            let tau = tb - *t0;
+            let c = [xy[0].state_at(tau).p * 1e3, xy[1].state_at(tau).p * 1e3];
+            self.command.push(tb, c);
+        }
+    }
+
+    /// Measure the samples still waiting (the path after them is all there will be).
+    fn flush(&mut self) {
+        while let Some(w) = self.waiting.pop_front() {
+            self.measure(w);
+        }
+    }
+
+    /// Measure a sample (module doc).
+    fn measure(&mut self, w: Waiting) {
+        let Waiting { k, t, .. } = w;
         self.out.samples += 1;
         self.active.retire(t);
-        let [ix, iy] = self.opts.xy;
-        let (x, y) = (toolhead_m[ix] * 1e3, toolhead_m[iy] * 1e3);
-        let (cx, cy) = (cmd_m[ix] * 1e3, cmd_m[iy] * 1e3);
-        // Every sample's command is on the path, counted or not (the pre-roll's too).
-        self.command.push([cx, cy]);
+        let (x, y) = (w.toolhead[0] * 1e3, w.toolhead[1] * 1e3);
+        let (cx, cy) = (w.cmd[0] * 1e3, w.cmd[1] * 1e3);
         let Some((err_mm, m)) = self.active.at(t, [x, y]) else {
             return;
         };
@@ -271,10 +360,10 @@ impl Account {
             r.sample(
                 t,
                 &[
-                    cmd_m[ix],
-                    cmd_m[iy],
-                    toolhead_m[ix],
-                    toolhead_m[iy],
+                    w.cmd[0],
+                    w.cmd[1],
+                    w.toolhead[0],
+                    w.toolhead[1],
                     err_mm * 1e-3,
                     m.line as f64,
                     f64::from(m.layer),
@@ -285,7 +374,7 @@ impl Account {
         if print {
             let split = Split {
                 smoothing_um: self.active.at(t, [cx, cy]).map_or(0.0, |(e, _)| e * 1e3),
-                vibration_um: self.command.distance_mm([x, y]).unwrap_or(0.0) * 1e3,
+                vibration_um: self.command.distance_mm(t, [x, y]).unwrap_or(0.0) * 1e3,
             };
             self.out.split_worst = self.out.split_worst.max(split);
             if let Some(l) = self.layer.as_mut() {
@@ -513,6 +602,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
             for (e, p) in end.iter_mut().zip(sub.axes()) {
                 *e = p.end();
             }
+            acc.follow(t0, &sub);
             if let Err(stop) = d.follow(&sub, t0, true, &mut acc) {
                 faulted = true;
                 stopped(stop, &mut acc)?;
@@ -544,12 +634,14 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
             }
             let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
             tail.duration_s = d.time_s() - t_end;
+            acc.flush();
             if let Some(l) = acc.layer.as_mut() {
                 l.end_residual_um = Some(tail.residual_peak_um);
             }
             acc.out.tail = Some(tail);
         }
         acc.out.preroll_s = range_start.map_or(0.0, |r| (r - t_first).max(0.0));
+        acc.flush();
         acc.end_layer();
         if let Some(d) = driver.as_mut() {
             acc.out.lost_steps = d.observe().iter().map(|o| o.lost_steps).sum();
