@@ -18,9 +18,10 @@
 //! in a sample: 1 um at 5 mm/s and 2 kHz).
 //!
 //! The distance is to the nearest of all the window's segments, measured only for the
-//! samples that count (printing moves): tracking the nearest segment from one sample to
-//! the next is cheaper but stops at local minima when the toolhead rings far from a fast
-//! command (a few um more than the nearest, on the ringing tower).
+//! samples that count (printing moves), each segment first against its bounding box
+//! (tracking the nearest segment from one sample to the next is cheaper still but stops
+//! at local minima when the toolhead rings far from a fast command: a few um more than
+//! the nearest on the ringing tower).
 
 use std::collections::VecDeque;
 
@@ -47,19 +48,25 @@ impl CommandPath {
 
     /// The toolhead's vibration at `t_s`: its distance (mm) from `p` (XY, mm) to the path
     /// from [`ACTIVE_WINDOW_S`] before `t_s` (older points are forgotten) to the last
-    /// point (module doc); `None` before the first command.
-    pub fn distance_mm(&mut self, t_s: f64, p: [f64; 2]) -> Option<f64> {
-        while self.points.len() > 1
-            && self.points[1].0 < t_s - ACTIVE_WINDOW_S
-        {
+    /// point (module doc), `c` being the commanded point at `t_s` (on the path); `None`
+    /// before the first command.
+    pub fn distance_mm(&mut self, t_s: f64, p: [f64; 2], c: [f64; 2]) -> Option<f64> {
+        while self.points.len() > 1 && self.points[1].0 < t_s - ACTIVE_WINDOW_S {
             self.points.pop_front();
         }
         let first = self.points.front()?.1;
         let (a, b) = self.points.as_slices();
-        let mut best = segment_distance_sq(p, first, first);
+        // The commanded point bounds the distance; a segment whose bounding box is no
+        // nearer cannot be nearer (most of the window's segments, skipped cheaply).
+        let mut best = segment_distance_sq(p, c, c).min(segment_distance_sq(p, first, first));
         let mut prev = first;
         for &(_, q) in a.iter().chain(b).skip(1) {
-            best = best.min(segment_distance_sq(p, prev, q));
+            let dx = (prev[0].min(q[0]) - p[0]).max(p[0] - prev[0].max(q[0]));
+            let dy = (prev[1].min(q[1]) - p[1]).max(p[1] - prev[1].max(q[1]));
+            let (dx, dy) = (dx.max(0.0), dy.max(0.0));
+            if dx * dx + dy * dy < best {
+                best = best.min(segment_distance_sq(p, prev, q));
+            }
             prev = q;
         }
         Some(best.sqrt())
@@ -82,10 +89,10 @@ mod tests {
         for k in 1..=5 {
             c.push((10 + k) as f64 * 1e-3, [10.0, k as f64]);
         }
-        assert_eq!(c.distance_mm(0.0, [4.5, 0.0]), Some(0.0));
-        assert_eq!(c.distance_mm(0.0, [7.0, 3.0]), Some(3.0));
-        assert_eq!(c.distance_mm(0.0, [10.0, 2.5]), Some(0.0));
-        assert_eq!(c.distance_mm(0.0, [10.0, 9.0]), Some(4.0));
+        assert_eq!(c.distance_mm(0.0, [4.5, 0.0], [10.0, 5.0]), Some(0.0));
+        assert_eq!(c.distance_mm(0.0, [7.0, 3.0], [10.0, 5.0]), Some(3.0));
+        assert_eq!(c.distance_mm(0.0, [10.0, 2.5], [10.0, 5.0]), Some(0.0));
+        assert_eq!(c.distance_mm(0.0, [10.0, 9.0], [10.0, 5.0]), Some(4.0));
     }
 
     /// Points more than 20 ms before the measured time are forgotten (but for the one
@@ -97,6 +104,6 @@ mod tests {
             c.push(k as f64 * 0.01, [k as f64, 0.0]);
         }
         // At 0.065 s the window starts at 0.045 s: the segment from 4 (0.04 s) to 5 on.
-        assert_eq!(c.distance_mm(0.065, [0.0, 0.0]), Some(4.0));
+        assert_eq!(c.distance_mm(0.065, [0.0, 0.0], [9.0, 0.0]), Some(4.0));
     }
 }

@@ -374,7 +374,7 @@ impl Account {
         if print {
             let split = Split {
                 smoothing_um: self.active.at(t, [cx, cy]).map_or(0.0, |(e, _)| e * 1e3),
-                vibration_um: self.command.distance_mm(t, [x, y]).unwrap_or(0.0) * 1e3,
+                vibration_um: self.command.distance_mm(t, [x, y], [cx, cy]).unwrap_or(0.0) * 1e3,
             };
             self.out.split_worst = self.out.split_worst.max(split);
             if let Some(l) = self.layer.as_mut() {
