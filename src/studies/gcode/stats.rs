@@ -2,8 +2,9 @@
 //! 95th percentile from a bounded histogram), the worst spots (one per move) and the
 //! toolpath points of the ringing maps.
 
-/// A point of a ringing map: the toolhead (mm) and its contour error (um); `print` false
-/// breaks the drawn path (travel, pauses).
+/// A point of a ringing map: the toolhead (mm), its contour error and the error's two
+/// parts ([`Split`], um; 0 off printing moves); `print` false breaks the drawn path
+/// (travel, pauses).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MapPoint {
     /// X (mm).
@@ -12,6 +13,10 @@ pub struct MapPoint {
     pub y_mm: f32,
     /// Contour error (um).
     pub error_um: f32,
+    /// Smoothing (um).
+    pub smoothing_um: f32,
+    /// Vibration (um).
+    pub vibration_um: f32,
     /// Whether the toolhead is printing here.
     pub print: bool,
 }

@@ -1,6 +1,7 @@
 //! The outputs of `settle gcode`: `layers.csv` (one row per layer), `summary.md` (print
 //! time, worst and 95th-percentile contour error, the worst spots with their G-code
-//! lines, the layers), `ringing-layer-<n>.svg/.png` (the maps of the worst layers) and,
+//! lines, the layers), `ringing-layer-<n>.svg/.png` (the maps of the worst layers),
+//! `split-layer-<n>.svg/.png` (each of those layers' smoothing and vibration) and,
 //! written last, `report.html` ([`write_html`]): the same in one self-contained page with
 //! the figures embedded, the layers in a sortable, filterable table, the worst spots with
 //! the text of their G-code lines, and the provenance (the file's SHA-256, the machine,
@@ -250,6 +251,33 @@ pub fn map_panel(m: &LayerMap, setting: &str) -> MapPanel {
     }
 }
 
+/// The figure of one layer's smoothing or vibration (`vibration`), as [`map_panel`]'s:
+/// each point coloured by that part, the worst spots (of the contour error) labelled
+/// with it.
+fn part_panel(m: &LayerMap, setting: &str, vibration: bool) -> MapPanel {
+    let mut p = map_panel(m, setting);
+    p.title = format!(
+        "layer {}, {}, {setting}",
+        m.layer,
+        if vibration { "vibration" } else { "smoothing" }
+    );
+    for q in &mut p.points {
+        q.error_um = if vibration {
+            q.vibration_um
+        } else {
+            q.smoothing_um
+        };
+    }
+    for (spot, s) in p.spots.iter_mut().zip(&m.spots) {
+        spot.error_um = if vibration {
+            s.split.vibration_um
+        } else {
+            s.split.smoothing_um
+        };
+    }
+    p
+}
+
 /// Write the outputs into `dir`; returns the files written.
 pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     create_dir(dir)?;
@@ -265,6 +293,19 @@ pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         RingingMap {
             title: format!("Contour error, {}", o.file.display()),
             panels: vec![map_panel(m, &setting)],
+        }
+        .write(dir, &stem)?;
+        files.push(dir.join(format!("{stem}.svg")));
+        files.push(dir.join(format!("{stem}.png")));
+        stems.push(stem);
+        // The same layer's two parts, side by side on one colour scale.
+        let stem = format!("split-layer-{}", m.layer);
+        RingingMap {
+            title: format!("Smoothing and vibration, {}", o.file.display()),
+            panels: vec![
+                part_panel(m, &setting, false),
+                part_panel(m, &setting, true),
+            ],
         }
         .write(dir, &stem)?;
         files.push(dir.join(format!("{stem}.svg")));
@@ -593,7 +634,13 @@ pub fn write_html(o: &GcodeOutcome, opts: &GcodeOptions, dir: &Path) -> Result<P
             ),
             None => match stem.strip_prefix("compare-layer-") {
                 Some(n) => format!("Layer {n} under both settings, on one colour scale"),
-                None => stem.clone(),
+                None => match stem.strip_prefix("split-layer-") {
+                    Some(n) => format!(
+                        "Layer {n}: the shaper's smoothing (command against the G-code path) and the machine's vibration (toolhead against the command's path), on one colour scale ({})",
+                        o.setting
+                    ),
+                    None => stem.clone(),
+                },
             },
         };
         let svg = std::fs::read_to_string(f).map_err(|e| Error::read(f, e))?;

@@ -371,8 +371,9 @@ impl Account {
             );
         }
         let print = m.kind == MoveKind::Print;
+        let mut split = Split::default();
         if print {
-            let split = Split {
+            split = Split {
                 smoothing_um: self.active.at(t, [cx, cy]).map_or(0.0, |(e, _)| e * 1e3),
                 vibration_um: self.command.distance_mm(t, [x, y], [cx, cy]).unwrap_or(0.0) * 1e3,
             };
@@ -401,6 +402,8 @@ impl Account {
                 x_mm: x as f32,
                 y_mm: y as f32,
                 error_um: err_um as f32,
+                smoothing_um: split.smoothing_um as f32,
+                vibration_um: split.vibration_um as f32,
                 print,
             });
         }
