@@ -380,7 +380,7 @@ fn the_gcode_report_renders_sorts_and_logs_nothing_in_chromium() {
     );
     // Three figures: the ringing map, its smoothing and vibration, and the comparison.
     assert_eq!(html.matches("<figure id=").count(), 3);
-    assert!(html.contains("the shaper's smoothing (command against the G-code path)"));
+    assert!(html.contains("smoothing (command against the G-code path)"));
 
     let Some(chrome) = browser() else { return };
     let (_keep, page) = write_page("gcode", &html);
