@@ -74,6 +74,7 @@ else
   bench "$planner_pkg" fourjerk -- "${mt[@]}" --sample-size 10
   bench "$planner_pkg" path -- "${mt[@]}" --sample-size 10
   bench settle sweep -- "${mt[@]}"
+  bench settle-identify identify -- "${mt[@]}"
   bench settle sim "${features[@]}" -- "${mt[@]}"
   if [[ ${#features[@]} -gt 0 ]]; then
     bench settle mujoco "${features[@]}" -- "${mt[@]}"
@@ -143,6 +144,10 @@ ABOUT = {
     "sweep": "One quickstart run on the modal backend (plan, exact simulation of a 10 mm "
     "S-curve and the 0.5 s window at 10 kHz, streaming metrics) and the 16-run quickstart "
     "sweep on one thread.",
+    "identify": "A 130 s Klipper raw resonance test at 3.2 kHz (419,200 samples, three axes, "
+    "19.8 MB of CSV, two modes): parsing the text, and identifying (Klipper's PSD at a "
+    "quarter-segment hop, the motion's direction, the sweep fit with model selection and "
+    "uncertainties), on one thread. Target: parse and identify under 1 s.",
     "sim": "The simulation loop per backend at its validated default step: the printer_xy "
     "preset, both axes simulated, a 10 mm S-curve on Y and the 0.5 s window at 10 kHz "
     "(0.649 s simulated per run), metrics streaming. *x real time* is simulated seconds per "

@@ -13,11 +13,18 @@
 #   - `settle check` of every baseline in results/baselines/ (without --update);
 #   - `settle gcode` on every print in gcode/prints/: plain, with --layers (and --mcap),
 #     --versus and --config (Klipper's printer.cfg, RepRapFirmware's config.g), and a layer
-#     on rapier with the full driver model;
+#     on rapier with the full driver model; GRBL's jobs on grbl with their $$ settings;
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
 #     what identify wrote, `settle import` of the example configurations, `settle tune` on
 #     the tune scenarios, on the imported printer and with `--criterion klipper`;
-#   - `settle validate --backend rapier`.
+#   - `settle validate --backend rapier`;
+#   - `settle identify` on every spectrum of identify/tests/corpus/ (and its refusals),
+#     `settle tune --criterion klipper` on them (per axis, with the script's options) and
+#     on a raw recording;
+#   - failed runs (lost steps, a fault) in a sweep, a run and a G-code job, with and
+#     without --fail-on-failed-runs; a sharded sweep (K/N, a Slurm array task and a
+#     Kubernetes completion index from the environment) and its merges, whole and with a
+#     shard missing.
 # Sweeps and tunes run with --jobs 2. Exit 0 when everything is the same, 1 with the diff.
 #
 # The old binary's outputs are kept and reused while neither it nor the inputs (this
@@ -45,6 +52,10 @@ S=$root/scenarios
 P=$root/gcode/prints
 VORON=$root/gcode/tests/data/klipper/voron/printer.cfg
 MINI=$root/gcode/tests/data/rrf/mini5plus/sys/config.g
+CORPUS=$root/identify/tests/corpus
+LOST=$root/tests/shards/big_lost_steps.toml
+FAULT=$root/tests/faults/blowup.toml
+FIELDS=$root/tests/sweeps/machine_fields.toml
 
 # The cases: NAME then the arguments of one settle command; `{out}` in an argument is the
 # case's output folder (out/NAME, relative to the side's folder).
@@ -56,8 +67,8 @@ cases() {
     done
   done
   echo "sweep-mcap-ci_corners sweep $S/ci_corners.toml --backend modal --jobs 2 --mcap --out {out}"
-  echo "sweep-machine-fields-modal sweep in/machine_fields.toml --backend modal --jobs 2 --out {out}"
-  echo "sweep-machine-fields-rapier sweep in/machine_fields.toml --backend rapier --jobs 2 --out {out}"
+  echo "sweep-machine-fields-modal sweep $FIELDS --backend modal --jobs 2 --out {out}"
+  echo "sweep-machine-fields-rapier sweep $FIELDS --backend rapier --jobs 2 --out {out}"
   echo "run-quickstart-modal run $S/quickstart.toml --case 3 --backend modal --plot --mcap --out {out}/run-3.csv"
   echo "run-quickstart-rapier run $S/quickstart.toml --case 3 --backend rapier --plot --out {out}/run-3.csv"
   echo "run-ci_corners run $S/ci_corners.toml --case 3 --backend rapier --plot --out {out}/run-3.csv"
@@ -71,6 +82,18 @@ cases() {
   echo "identify identify $root/examples/data/raw_data_x_example.csv $root/examples/data/raw_data_y_example.csv --freq-start 30 --freq-end 90 --hz-per-sec 10 --out {out}/machine.toml"
   for p in "$P"/*.gcode; do
     stem=$(basename "$p" .gcode)
+    # GRBL's jobs (a laser raster, a milled contour) run on GRBL with their $$ settings.
+    grbl=
+    case $stem in
+      laser_raster) grbl=$P/laser_grbl_settings.txt ;;
+      cnc_contour) grbl=$P/shapeoko3_grbl_settings.txt ;;
+    esac
+    if [[ -n $grbl ]]; then
+      echo "gcode-$stem gcode $p --machine printer_xy --firmware grbl --config $grbl --out {out}"
+      echo "gcode-$stem-layers gcode $p --machine printer_xy --firmware grbl --config $grbl --layers 0..1 --mcap --out {out}"
+      echo "gcode-$stem-rapier gcode $p --machine printer_xy --firmware grbl --config $grbl --backend rapier --driver full --layers 1..1 --out {out}"
+      continue
+    fi
     # Klipper refuses the R form of G2/G3, which arc_part.gcode uses: RepRapFirmware there.
     fw=klipper cfg=$VORON
     if [[ $stem == arc_part ]]; then
@@ -100,6 +123,35 @@ cases() {
   echo "tune-imported-rrf tune out/import-mini/printer.toml --firmware rrf --jobs 2 --out {out}"
   echo "tune-klipper-criterion tune --criterion klipper $root/planner/tests/data/klipper_two_peaks.csv"
   echo "validate-rapier validate --backend rapier --out {out}/validate.md"
+  # Real recordings: every corpus spectrum, one sensor column, a raw recording without its
+  # test's parameters (refused), Klipper's criterion per axis and with the script's options.
+  for f in "$CORPUS"/*.csv; do
+    echo "identify-corpus-$(basename "$f" .csv) identify $f --figures {out} --out {out}/machine.toml"
+  done
+  echo "identify-corpus-column identify $CORPUS/voronpi_resonances_y_20221029_162350.csv --column y --figures {out}"
+  echo "identify-corpus-column-refused identify $CORPUS/zippy_resonances_y_20220317_143943.csv --column x --figures {out}"
+  echo "identify-raw-no-parameters identify $root/examples/data/raw_data_x_example.csv --figures {out}"
+  echo "tune-klipper-corpus tune --criterion klipper $(echo "$CORPUS"/voronpi_resonances_[xy]_2022*.csv) --out {out}"
+  echo "tune-klipper-options tune --criterion klipper $CORPUS/voronpi_resonances_y_20221029_162350.csv --shapers mzv(n=4,t=0.8),ei --max-smoothing 0.08 --scv 10"
+  echo "tune-klipper-raw tune --criterion klipper $root/examples/data/raw_data_x_example.csv --out {out}"
+  # Failed runs are results; shards by K/N, by a Slurm array task and by a Kubernetes
+  # completion index (NAME=value before the arguments: the command's environment); merges
+  # of every shard and of a set with one missing.
+  echo "sweep-failed sweep $LOST --jobs 2 --out {out}"
+  echo "sweep-failed-flag sweep $LOST --jobs 2 --fail-on-failed-runs --out {out}"
+  echo "shard-1 sweep $LOST --shard 1/4 --out {out}"
+  echo "shard-2 sweep $LOST --shard 2/4 --out {out}"
+  echo "shard-3 JOB_COMPLETION_INDEX=2 SETTLE_SHARD_COUNT=4 sweep $LOST --shard kubernetes --out {out}"
+  echo "shard-4 SLURM_JOB_ID=104 SLURM_ARRAY_JOB_ID=100 SLURM_ARRAY_TASK_ID=4 SLURM_ARRAY_TASK_MIN=1 SLURM_ARRAY_TASK_MAX=4 SLURM_ARRAY_TASK_COUNT=4 sweep $LOST --shard slurm --fail-on-failed-runs --out {out}"
+  echo "merge-missing merge out/shard-1 out/shard-2 out/shard-3 --out {out}"
+  echo "merge merge out/shard-4 out/shard-2 out/shard-1 out/shard-3 --out {out}"
+  echo "merge-flag merge out/shard-1 out/shard-2 out/shard-3 out/shard-4 --fail-on-failed-runs --out {out}"
+  echo "run-failed run $LOST --case 7 --backend rapier --out {out}/run-7.csv"
+  echo "run-failed-flag run $LOST --case 7 --backend rapier --fail-on-failed-runs --out {out}/run-7.csv"
+  echo "sweep-fault sweep $FAULT --backend rapier --out {out}"
+  echo "run-fault run $FAULT --case 1 --backend rapier --plot --out {out}/run-1.csv"
+  echo "gcode-lost-steps gcode in/arcs.gcode --machine printer_xy --mcap --out {out}"
+  echo "gcode-lost-steps-flag gcode in/arcs.gcode --machine printer_xy --fail-on-failed-runs --out {out}"
 }
 
 # Run every case with binary $1, then move the results to folder $2. Both sides run in
@@ -110,42 +162,24 @@ run_side() {
   total=$(cases | grep -cE "^(${only:-.*}) " || true)
   rm -rf "$side" "$dest"
   mkdir -p "$side/out" "$side/status" "$side/in"
-  # A physical machine's fields swept by their machine-file keys (no shipped scenario does).
-  cat >"$side/in/machine_fields.toml" <<'TOML'
-name = "machine_fields"
-[machine]
-preset = "printer_xy"
-driver_model = "linear"
-[move]
-axis = "y"
-distance_mm = 10.0
-profile = "scurve"
-[limits]
-vmax_mm_s = 300.0
-amax_mm_s2 = 3000.0
-jmax_mm_s3 = 100000.0
-[observe]
-window_s = 0.3
-sample_rate_hz = 5000
-bands_um = [10.0]
-[sweep]
-"machine.axis.y.mount.stiffness_n_per_m" = [2.0e5, 4.0e5]
-"machine.axis.y.belt.pulley_teeth" = [16, 20]
-"machine.driver.microsteps" = [16, 32]
-"machine.motor.rotor_inertia_g_cm2" = [54.0]
-TOML
+  # Two 2 mm arcs at 6000 mm/s^2 after a travel: printer_xy loses steps (a failed run).
+  printf 'G90\nM83\nM204 S6000\nG0 X100 Y100 F9000\nG2 X102 Y102 I2 J0 E0.1 F3000\nG3 X100 Y100 I-2 J0 E0.1\n' >"$side/in/arcs.gcode"
   while read -r name args; do
     [[ -z $only || $name =~ ^($only)$ ]] || continue
     i=$((i + 1))
     out=out/$name
     mkdir -p "$side/$out"
-    local argv=()
+    local argv=() envs=()
     for a in $args; do
-      argv+=("${a//\{out\}/$out}")
+      if [[ ${#argv[@]} -eq 0 && $a =~ ^[A-Z_][A-Z0-9_]*= ]]; then
+        envs+=("$a")
+      else
+        argv+=("${a//\{out\}/$out}")
+      fi
     done
     start=$(date +%s)
     set +e
-    (cd "$side" && "$bin" "${argv[@]}" </dev/null >"status/$name.stdout" 2>"status/$name.stderr")
+    (cd "$side" && env "${envs[@]}" "$bin" "${argv[@]}" </dev/null >"status/$name.stdout" 2>"status/$name.stderr")
     echo $? >"$side/status/$name.exit"
     set -e
     echo "   [$i/$total] $name: exit $(cat "$side/status/$name.exit") ($(($(date +%s) - start)) s)"
@@ -161,7 +195,7 @@ blank_times() {
 
 # The identity of the inputs the old side's outputs depend on.
 key=$( (sha256sum <"$old"; cases; find scenarios gcode/prints gcode/tests/data examples/data \
-  planner/tests/data results/baselines -type f -print0 | sort -z | xargs -0 sha256sum) |
+  planner/tests/data results/baselines identify/tests/corpus tests/shards tests/faults tests/sweeps -type f -print0 | sort -z | xargs -0 sha256sum) |
   sha256sum | cut -c1-16)
 old_side=$dir/old-$key
 if [[ -n $only ]]; then

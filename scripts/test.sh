@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The whole test suite, used verbatim by CI (.ci/run): formatting, lints, API docs, every
-# test, the regression gate, every command of the README and the book
-# (scripts/check-commands.sh), a fuzz smoke run and the `rerun` feature. Installs what it
-# needs without root: crates from crates.io through cargo, libmujoco 3.17.0 from its PyPI
+# test, the adversarial suite (scripts/adversarial.sh), the regression gate, every command
+# of the README and the book (scripts/check-commands.sh), a fuzz smoke run and the `rerun`
+# feature. Installs what it needs without root: crates from crates.io through cargo, libmujoco 3.17.0 from its PyPI
 # wheel into .deps/mujoco/ (scripts/setup-mujoco.sh), the official MCAP reader from PyPI into .deps/ (scripts/mcap-python,
 # for the MCAP tests); with root (or sudo), headless Chromium from Debian's `chromium`
-# package when missing (scripts/browser-test.sh, for the report.html tests).
+# package when missing (scripts/browser-test.sh, for the report.html tests), and Debian's
+# Slurm 22.05 and munge when missing (scripts/slurm-recipes.sh: a single-node Slurm,
+# started and stopped by that phase, runs the cluster recipes of docs/guide/shards.md).
 #
 # Builds, and what they share (the cargo profiles are in Cargo.toml):
 #   - clippy (default features), clippy with MuJoCo (only settle-sim and the crates that
@@ -44,6 +46,8 @@
 #   SETTLE_SKIP_RERUN=1   skip building and testing the `rerun` feature
 #   SETTLE_SKIP_BROWSER=1 skip the report's browser checks (otherwise Debian's chromium is
 #                         installed with apt-get when /usr/bin/chromium is missing)
+#   SETTLE_SKIP_SLURM=1   skip the Slurm recipes (skipped by themselves, with the reason,
+#                         on a machine that cannot run the daemons)
 #   SETTLE_MCAP_PY_VERSION  the MCAP reader's version (scripts/mcap-python)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -132,6 +136,9 @@ fi
 phase "cargo test: run"
 cargo test --workspace --profile ci --locked "${features[@]}"
 
+phase "the adversarial suite with its generated cases (scripts/adversarial.sh)"
+scripts/adversarial.sh "${features[@]}"
+
 # The gate runs the `settle` binary the test build made (a `cargo run` would build it
 # again: without the dev-dependencies, some of its dependencies' features differ).
 settle_bin="${CARGO_TARGET_DIR:-target}/ci/settle"
@@ -155,6 +162,14 @@ done
 
 phase "every command in the README and the book, in fresh clones (scripts/check-commands.sh)"
 SETTLE_BIN="$settle_bin" scripts/check-commands.sh
+
+# --- Slurm: the cluster recipes of docs/guide/shards.md ----------------------------------
+# A single-node Slurm that scripts/slurm-recipes.sh starts and stops (also on failure):
+# the page's job script and submissions run as written, merged outputs against unsharded
+# sweeps byte for byte, a shard holding failed runs still merges. About 35 s warm.
+phase "Slurm: the recipes of docs/guide/shards.md on a single-node Slurm (scripts/slurm-recipes.sh)"
+SETTLE_BIN="$settle_bin" scripts/slurm-recipes.sh
+# --- end of the Slurm phase ---------------------------------------------------------------
 
 phase "fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
 scripts/fuzz.sh "${SETTLE_FUZZ_SECONDS:-15}"

@@ -68,6 +68,45 @@ pub fn echo(value: &str) -> String {
     }
 }
 
+/// The most digits a number in a message is printed with whole: a longer run of digits
+/// (`1e300` printed by `{}` is 301 of them) is printed in scientific notation instead.
+pub const NUMBER_DIGITS: usize = 24;
+
+/// `text` with every number of more than [`NUMBER_DIGITS`] digits written in scientific
+/// notation (`1e300`, `1.5e-300`): messages repeat the numbers they refuse, and Rust's
+/// `{}` writes every digit of a huge or tiny one.
+pub fn shorten_numbers(text: &str) -> String {
+    let bytes = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let start = i;
+        while i < bytes.len() && (bytes[i].is_ascii_digit() || bytes[i] == b'.') {
+            i += 1;
+        }
+        // A number does not end in a dot: that one ends the sentence.
+        if i > start + 1 && bytes[i - 1] == b'.' {
+            i -= 1;
+        }
+        if i == start {
+            // Not a number: copy the character whole.
+            let c = text[i..].chars().next().unwrap_or(' ');
+            out.push(c);
+            i += c.len_utf8();
+            continue;
+        }
+        let run = &text[start..i];
+        let digits = run.bytes().filter(u8::is_ascii_digit).count();
+        match run.parse::<f64>() {
+            Ok(v) if digits > NUMBER_DIGITS && run.matches('.').count() <= 1 => {
+                out.push_str(&format!("{v:e}"));
+            }
+            _ => out.push_str(run),
+        }
+    }
+    out
+}
+
 /// The longest `` `quoted` `` part of a message [`echo_quoted`] leaves whole: far above a
 /// command or a path settle suggests, far below input that is not worth printing back.
 pub const QUOTED_CHARS: usize = 1000;
@@ -155,6 +194,10 @@ pub enum Error {
     /// error names the file and, where one is to blame, the line).
     #[error(transparent)]
     Identify(#[from] settle_identify::IdentifyError),
+    /// An input that is not a regular file, too large or not text, or an output the
+    /// output rule refuses (a link, a device, one of the command's inputs).
+    #[error(transparent)]
+    File(settle_files::FileError),
     /// The run was not started: the sweep was interrupted (Ctrl-C or SIGTERM).
     #[error("run {run}: not run, the sweep was interrupted")]
     Interrupted {
@@ -207,6 +250,53 @@ impl Error {
         matches!(
             self,
             Error::Input { .. } | Error::Read { .. } | Error::Identify(_)
-        )
+        ) || matches!(self, Error::File(e) if e.is_input_error())
+    }
+}
+
+impl Error {
+    /// This error as a failure to write an output (exit code 1), when it is the output
+    /// rule refusing a path found in the way while a command writes (a folder where a
+    /// recording goes): not the user's input at fault but the output folder's state.
+    pub fn as_write_failure(self) -> Self {
+        match self {
+            Error::File(settle_files::FileError::Refused { path, why }) => Error::Write {
+                path,
+                source: std::io::Error::other(why),
+            },
+            e => e,
+        }
+    }
+}
+
+impl From<settle_files::FileError> for Error {
+    /// A file that cannot be read or written is [`Error::Read`] or [`Error::Write`] as
+    /// everywhere in the harness; the rest is [`Error::File`].
+    fn from(e: settle_files::FileError) -> Self {
+        use settle_files::FileError;
+        match e {
+            FileError::Read { path, source } => Error::Read { path, source },
+            FileError::Write { path, source } => Error::Write { path, source },
+            other => Error::File(other),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_numbers_are_shortened_and_others_kept() {
+        let huge = format!("{}", 1e300);
+        assert_eq!(huge.len(), 301);
+        assert_eq!(
+            shorten_numbers(&format!("got {huge} Hz, at most 1000000 Hz")),
+            "got 1e300 Hz, at most 1000000 Hz"
+        );
+        let tiny = format!("{}", -1.5e-300);
+        assert_eq!(shorten_numbers(&format!("x = {tiny}.")), "x = -1.5e-300.");
+        let kept = "line 12: 0.1 2.5e-7 v1.2.3 12345678901234567890 µm";
+        assert_eq!(shorten_numbers(kept), kept);
     }
 }

@@ -63,7 +63,7 @@ fn bench(c: &mut Criterion) {
     for (label, text) in [("prints", &prints), ("synth_1MB", &synth)] {
         let mut g = c.benchmark_group(format!("job_{label}"));
         g.sample_size(10);
-        for fw in Firmware::GCODE {
+        for fw in Firmware::PRINTERS {
             let (moves, print_s, segments) = run(text, fw);
             eprintln!(
                 "job_{label}/{fw}: {moves} moves, {print_s:.3} s of print time, {segments} X segments"

@@ -39,6 +39,20 @@ pub enum GcodeError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// A file that is not a regular file, larger than its limit, or not text (settle-files'
+    /// reader).
+    #[error(transparent)]
+    File(Box<settle_files::FileError>),
+    /// A file an `[include]` (or RepRapFirmware `M98 P`) names cannot be read.
+    #[error("{at}: {what}: {source}")]
+    Include {
+        /// The include line.
+        at: Location,
+        /// The include as written (`[include macros/*.cfg]`).
+        what: String,
+        /// Why the file cannot be read (boxed: it is large and rare).
+        source: Box<settle_files::FileError>,
+    },
     /// A line is longer than the reader's limit; it was not read into memory.
     #[error("{at}: line longer than {limit_bytes} bytes (binary data or a corrupt file?)")]
     LineTooLong {
@@ -277,6 +291,18 @@ pub enum GcodeError {
         /// What the planner says (boxed: it is large and rare).
         source: Box<settle_planner::PlanError>,
     },
+    /// A move the firmware refuses because it leaves the machine's travel, in the
+    /// firmware's words (Klipper's `Move out of range: x y z [e]`, GRBL's soft-limit
+    /// alarm): the print stops there.
+    #[error("{at}: {command}: {message}")]
+    OutOfTravel {
+        /// The move's line.
+        at: Location,
+        /// The command (`G1`).
+        command: String,
+        /// What the firmware says, and the travel.
+        message: String,
+    },
     /// A job setting (not from the file) that cannot be used.
     #[error("job setting `{key}`: {reason}")]
     JobSetting {
@@ -287,11 +313,34 @@ pub enum GcodeError {
     },
 }
 
+impl From<settle_files::FileError> for GcodeError {
+    fn from(e: settle_files::FileError) -> Self {
+        GcodeError::File(Box::new(e))
+    }
+}
+
 impl GcodeError {
+    /// A failed read of the stream named `source_name`: the reader's own error when the
+    /// file grew past its limit, else the operating system's.
+    pub(crate) fn io(source_name: &Arc<str>, source: std::io::Error) -> Self {
+        if source
+            .get_ref()
+            .is_some_and(|e| e.is::<settle_files::FileError>())
+        {
+            return settle_files::read::unwrap_io(std::path::Path::new(&**source_name), source)
+                .into();
+        }
+        GcodeError::Io {
+            source_name: source_name.clone(),
+            source,
+        }
+    }
+
     /// The location of a line error (`None` for I/O errors).
     pub fn location(&self) -> Option<&Location> {
         match self {
             GcodeError::Io { .. }
+            | GcodeError::File(_)
             | GcodeError::ConfigMissing { .. }
             | GcodeError::ExportValue { .. }
             | GcodeError::JobSetting { .. } => None,
@@ -315,7 +364,9 @@ impl GcodeError {
             | GcodeError::ConfigValue { at, .. }
             | GcodeError::IncludeNotFound { at, .. }
             | GcodeError::IncludeCycle { at, .. }
-            | GcodeError::Plan { at, .. } => Some(at),
+            | GcodeError::Include { at, .. }
+            | GcodeError::Plan { at, .. }
+            | GcodeError::OutOfTravel { at, .. } => Some(at),
         }
     }
 

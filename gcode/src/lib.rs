@@ -66,10 +66,10 @@ pub use read::arc::{
 pub use read::canonical::CanonicalWriter;
 pub use read::dialect::Dialect;
 pub use read::event::{Event, EventKind, LayerChange, LayerSource, Note};
-pub use read::geometry::{Bounds, Move, MoveKind, Path, Point};
+pub use read::geometry::{Bounds, Move, MoveKind, Path, Point, Tool};
 pub use read::layers::LayerMode;
 pub use read::limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
-pub use read::reader::{Reader, ReaderOptions, Skipped};
-pub use read::segments::{ArcSegmentation, KlipperArcs, MarlinArcs, RrfArcs};
+pub use read::reader::{FileInput, MAX_FEATURES, Reader, ReaderOptions, Skipped};
+pub use read::segments::{ArcSegmentation, GrblArcs, KlipperArcs, MarlinArcs, RrfArcs};
 pub use read::setting::Setting;
 pub use read::summary::{LimitSeen, Summary};

@@ -7,6 +7,10 @@
 /// What can go wrong reading a recording or identifying modes from it.
 #[derive(Debug, thiserror::Error)]
 pub enum IdentifyError {
+    /// The file is not a regular file, is larger than a recording can be, or decompresses
+    /// to more (settle-files' reader).
+    #[error(transparent)]
+    File(#[from] settle_files::FileError),
     /// The file could not be read.
     #[error("{file}: cannot read: {source}")]
     Io {
@@ -53,12 +57,24 @@ pub enum IdentifyError {
         /// The previous sample's time (s).
         previous_s: f64,
     },
+    /// An input the readers do not take: not a regular file, or more than they read
+    /// (every input is bounded before it is read, so that identifying it stays within the
+    /// memory `docs/performance.md` states).
+    #[error("{file}: {found}; the readers take {allowed}")]
+    NotAccepted {
+        /// The file.
+        file: String,
+        /// What it is or holds.
+        found: String,
+        /// What the readers take.
+        allowed: String,
+    },
     /// Too few samples (or frequency rows) to analyse.
-    #[error("{file}:{line}: the data end after {found} {what}; at least {needed} are needed")]
+    #[error("{file}{}: the data end after {found} {what}; at least {needed} are needed", at_line(*line))]
     TooFewSamples {
         /// The file.
         file: String,
-        /// 1-based number of the last line read.
+        /// 1-based number of the last line read (0: about the whole file, no line named).
         line: usize,
         /// What was counted (`samples`, `frequency rows`).
         what: &'static str,
@@ -94,6 +110,25 @@ pub enum IdentifyError {
         /// Why not.
         reason: String,
     },
+    /// The recording needs the resonance test's parameters, which were not given and which
+    /// the file does not record.
+    #[error("{file}: {reason}")]
+    NeedsTestParameters {
+        /// The file.
+        file: String,
+        /// Which parameters, and why.
+        reason: String,
+    },
+    /// A fit ran but its result cannot be stood behind: a frequency at or above Nyquist or
+    /// outside the band the data cover, a value that is not a number, an uncertainty larger
+    /// than the value, a fit that did not converge.
+    #[error("{file}: the fit cannot be trusted: {reason}")]
+    Unreliable {
+        /// The file.
+        file: String,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// An option passed by the caller is out of range.
     #[error("option `{name}` = {value} is invalid: allowed {allowed}")]
     InvalidOption {
@@ -106,7 +141,29 @@ pub enum IdentifyError {
     },
 }
 
+/// `:LINE`, or nothing for line 0 (a count over the whole file, not a line of it).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
+    }
+}
+
 impl IdentifyError {
+    /// A [`IdentifyError::NotAccepted`] error.
+    pub(crate) fn not_accepted(
+        file: &str,
+        found: impl Into<String>,
+        allowed: impl Into<String>,
+    ) -> Self {
+        IdentifyError::NotAccepted {
+            file: file.to_string(),
+            found: found.into(),
+            allowed: allowed.into(),
+        }
+    }
+
     /// A [`IdentifyError::Format`] error.
     pub(crate) fn format(
         file: &str,

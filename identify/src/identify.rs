@@ -4,9 +4,11 @@ use crate::IdentifyError;
 use crate::direction::{self, Direction};
 use crate::excitation::SweepTest;
 use crate::fit::{ringdown, sweep};
+use crate::read::klipper_grid::bin_grid;
 use crate::read::klipper_psd::ProcessedPsd;
 use crate::read::{Recording, RecordingFormat};
 use crate::result::{AxisIdentification, Figure, Method};
+use crate::trust::{check_duration, check_trust, free_recording};
 use crate::welch::Welch;
 
 /// Which fit to use on a recording.
@@ -21,6 +23,17 @@ pub enum MethodChoice {
     RingDown,
 }
 
+/// Which column of a Klipper processed spectrum to fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SpectrumColumn {
+    /// `psd_xyz`, the total over the sensor axes (what Klipper tunes against; it does not
+    /// depend on how the sensor is mounted), or a multi-data-set file's first column.
+    #[default]
+    Total,
+    /// One sensor axis's column (`psd_x` = 0, `psd_y` = 1, `psd_z` = 2).
+    Axis(usize),
+}
+
 /// Options of an identification.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
@@ -30,6 +43,8 @@ pub struct Options {
     pub max_modes: usize,
     /// Which fit.
     pub method: MethodChoice,
+    /// Which column of a processed spectrum to fit (default the total).
+    pub column: SpectrumColumn,
 }
 
 impl Default for Options {
@@ -38,6 +53,7 @@ impl Default for Options {
             test: SweepTest::klipper(),
             max_modes: 3,
             method: MethodChoice::Auto,
+            column: SpectrumColumn::Total,
         }
     }
 }
@@ -55,7 +71,7 @@ impl Options {
         if !(1..=4).contains(&self.max_modes) {
             return bad("max_modes", self.max_modes as f64, "1 to 4");
         }
-        if !(t.freq_start_hz >= 1.0 && t.freq_end_hz > t.freq_start_hz + 5.0) {
+        if !(t.freq_start_hz >= 1.0 && t.freq_end_hz >= t.freq_start_hz + 5.0) {
             return bad(
                 "test.freq_end_hz",
                 t.freq_end_hz,
@@ -105,11 +121,24 @@ pub fn identify_recording(
     let use_sweep = match opts.method {
         MethodChoice::Sweep => true,
         MethodChoice::RingDown => false,
+        MethodChoice::Auto if rec.format == RecordingFormat::RrfM956 => false,
+        MethodChoice::Auto if free_recording(rec, duration, &opts.test) => false,
         MethodChoice::Auto => {
-            rec.format != RecordingFormat::RrfM956 && duration >= 0.5 * opts.test.duration_s()
+            check_duration(&source, duration, &opts.test)?;
+            true
         }
     };
     let fs = rec.mean_rate_hz();
+    if use_sweep && opts.test.freq_start_hz >= NYQUIST_USE * fs {
+        return Err(IdentifyError::NeedsTestParameters {
+            file: source,
+            reason: format!(
+                "a sample rate of {fs:.1} Hz sees up to {:.1} Hz, below the test's first frequency {} Hz: record at a higher rate or give the test's band (--freq-start, --freq-end)",
+                NYQUIST_USE * fs,
+                opts.test.freq_start_hz
+            ),
+        });
+    }
     let welch = if use_sweep {
         // Klipper's window and segment length at a quarter-segment hop (see
         // `Welch::with_hop`): the sweep model is the time integral that hop samples.
@@ -132,10 +161,10 @@ pub fn identify_recording(
     let (lo_hz, hi_hz) = if use_sweep {
         (
             opts.test.freq_start_hz,
-            opts.test.freq_end_hz.min(0.45 * fs),
+            opts.test.freq_end_hz.min(NYQUIST_USE * fs),
         )
     } else {
-        (5.0, 0.45 * fs)
+        (5.0, NYQUIST_USE * fs)
     };
     let lo = (lo_hz / bin).ceil() as usize;
     let hi = ((hi_hz / bin).floor() as usize + 1)
@@ -154,6 +183,13 @@ pub fn identify_recording(
             opts.max_modes,
             None,
         )?;
+        check_trust(
+            &source,
+            &fit.modes,
+            &fit.diagnostics,
+            fit.diagnostics.span,
+            fs / 2.0,
+        )?;
         let shown = ((1.5 * opts.test.freq_end_hz).min(fs / 2.0) / bin) as usize + 1;
         let figure = spectrum_figure(
             &welch.freqs_hz()[..shown.min(psd.len())],
@@ -166,6 +202,7 @@ pub fn identify_recording(
             source,
             direction: Some(dir),
             dominant_sensor_axis: Some(dir.nearest_axis),
+            named_axis: rec.named_axis,
             modes: fit.modes,
             method: Method::SweepFit,
             diagnostics: fit.diagnostics,
@@ -174,6 +211,13 @@ pub fn identify_recording(
     }
     let s = project_samples(rec, &axes, &dir);
     let fit = ringdown::fit(&source, &s, fs, opts.max_modes)?;
+    check_trust(
+        &source,
+        &fit.modes,
+        &fit.diagnostics,
+        (lo_hz, hi_hz),
+        fs / 2.0,
+    )?;
     let mut model = vec![f64::NAN; s.len()];
     model[fit.window.0..fit.window.1].copy_from_slice(&fit.curve);
     let x = rec.time_s.iter().map(|t| t - rec.time_s[0]).collect();
@@ -181,11 +225,13 @@ pub fn identify_recording(
         source,
         direction: Some(dir),
         dominant_sensor_axis: Some(dir.nearest_axis),
+        named_axis: rec.named_axis,
         figure: Figure {
             x,
             measured: s,
             model,
             mode_freqs_hz: fit.modes.iter().map(|m| m.frequency_hz.value).collect(),
+            components: Vec::new(),
             labels: ("time (s)", "acceleration along the motion (mm/s^2)"),
         },
         modes: fit.modes,
@@ -193,6 +239,10 @@ pub fn identify_recording(
         diagnostics: fit.diagnostics,
     })
 }
+
+/// The highest frequency analysed, as a fraction of the sample rate: 0.45 (90 % of the
+/// Nyquist frequency; the sensor's anti-alias filter rolls off above that).
+const NYQUIST_USE: f64 = 0.45;
 
 /// Significant digits of the PSD values in Klipper's processed files (`%.3e`,
 /// `save_calibration_data` in `klippy/extras/shaper_calibrate.py`).
@@ -219,7 +269,20 @@ pub fn identify_spectrum(
     let welch = Welch::new(bin_hz * 2048.0, 2048);
     let len = first_bin + psd.freq_hz.len();
     let mut stored = vec![0.0; len];
-    stored[first_bin..].copy_from_slice(psd.sum());
+    let column = match opts.column {
+        SpectrumColumn::Total => psd.sum(),
+        SpectrumColumn::Axis(k) => psd.axis(k).ok_or_else(|| {
+            IdentifyError::format(
+                &psd.source,
+                (psd.last_line + 1 - psd.freq_hz.len())
+                    .saturating_sub(1)
+                    .max(1),
+                "a spectrum without per-axis columns",
+                "the header `freq,psd_x,psd_y,psd_z,psd_xyz` to fit one sensor axis's column (or fit the total)",
+            )
+        })?,
+    };
+    stored[first_bin..].copy_from_slice(column);
     let factor: Vec<f64> = (0..len)
         .map(|k| {
             if k < first_bin {
@@ -259,10 +322,18 @@ pub fn identify_spectrum(
         first_bin,
         &factor[first_bin..],
     );
+    check_trust(
+        &psd.source,
+        &fit.modes,
+        &fit.diagnostics,
+        fit.diagnostics.span,
+        f64::INFINITY,
+    )?;
     Ok(AxisIdentification {
         source: psd.source.clone(),
         direction: None,
         dominant_sensor_axis: dominant,
+        named_axis: None,
         modes: fit.modes,
         method: Method::SweepFit,
         diagnostics: fit.diagnostics,
@@ -280,17 +351,23 @@ fn spectrum_figure(
     factor: &[f64],
 ) -> Figure {
     let n = x.len().min(measured.len());
-    let mut model = vec![f64::NAN; n];
-    for (&k, &m) in fit.bins.iter().zip(&fit.model) {
-        if let Some(i) = k.checked_sub(offset).filter(|&i| i < n) {
-            model[i] = m * factor[i];
+    let on_bins = |values: &[f64]| {
+        let mut out = vec![f64::NAN; n];
+        for (&k, &m) in fit.bins.iter().zip(values) {
+            if let Some(i) = k.checked_sub(offset).filter(|&i| i < n) {
+                out[i] = m * factor[i];
+            }
         }
-    }
+        out
+    };
+    let model = on_bins(&fit.model);
+    let components = fit.components.iter().map(|c| on_bins(c)).collect();
     Figure {
         x: x[..n].to_vec(),
         measured: measured[..n].to_vec(),
         model,
         mode_freqs_hz: fit.modes.iter().map(|m| m.frequency_hz.value).collect(),
+        components,
         labels: ("frequency (Hz)", "power spectral density ((mm/s^2)^2/Hz)"),
     }
 }
@@ -312,46 +389,4 @@ fn project_samples(rec: &Recording, axes: &[usize], dir: &Direction) -> Vec<f64>
 /// One segment over (nearly) the whole of a short recording: an even length.
 fn short_nfft(n: usize) -> usize {
     (n & !1).max(2)
-}
-
-/// The bins of a processed spectrum: Klipper writes `k fs / nfft` rounded to 0.1 Hz, so
-/// the rows are fitted with `f0 + j bin` and `f0` must be a whole number of bins. Returns
-/// the first row's bin index, the bin width (Hz) and its standard deviation from the
-/// rounding (uniform over 0.1 Hz, a variance of `0.01 / 12` per row, through the
-/// regression's slope: `sqrt(0.01 / 12 / sum (j - mean j)^2)`).
-fn bin_grid(psd: &ProcessedPsd) -> Result<(usize, f64, f64), IdentifyError> {
-    let f = &psd.freq_hz;
-    let n = f.len() as f64;
-    let mean_j = (n - 1.0) / 2.0;
-    let mean_f = f.iter().sum::<f64>() / n;
-    let (mut sxy, mut sxx) = (0.0, 0.0);
-    for (j, &v) in f.iter().enumerate() {
-        sxy += (j as f64 - mean_j) * (v - mean_f);
-        sxx += (j as f64 - mean_j).powi(2);
-    }
-    let bin = sxy / sxx;
-    let f0 = mean_f - bin * mean_j;
-    let first = (f0 / bin).round().max(0.0);
-    let header_line = psd.last_line + 1 - f.len();
-    if bin.is_nan() || bin < 0.5 {
-        return Err(IdentifyError::format(
-            &psd.source,
-            header_line.saturating_sub(1).max(1),
-            format!(
-                "a spectrum on a {bin:.2} Hz grid (several data sets interpolated onto one grid)"
-            ),
-            "a spectrum on Klipper's own bins (fs / nfft, about 0.8 to 2 Hz): one data set per file",
-        ));
-    }
-    for (j, &v) in f.iter().enumerate() {
-        if (v - (first + j as f64) * bin).abs() > 0.06 {
-            return Err(IdentifyError::format(
-                &psd.source,
-                header_line + j,
-                format!("frequency {v} Hz off the grid of {bin:.4} Hz bins"),
-                "evenly spaced bins k fs / nfft as Klipper writes them (rounded to 0.1 Hz)",
-            ));
-        }
-    }
-    Ok((first as usize, bin, (0.01 / 12.0 / sxx).sqrt()))
 }

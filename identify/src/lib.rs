@@ -22,15 +22,17 @@ pub mod fit;
 mod identify;
 pub mod read;
 pub mod result;
+mod trust;
 pub mod welch;
 
 pub use direction::Direction;
 pub use error::IdentifyError;
 pub use excitation::SweepTest;
-pub use identify::{MethodChoice, Options, identify_recording, identify_spectrum};
+pub use identify::{MethodChoice, Options, SpectrumColumn, identify_recording, identify_spectrum};
 pub use read::{FileData, Recording, RecordingFormat, read_file};
 pub use result::{
-    AxisIdentification, Diagnostics, Estimate, Figure, IdentifiedMode, Method, WeightBasis,
+    AxisIdentification, Diagnostics, Estimate, Figure, IdentifiedMode, Method, RejectedPeak,
+    WeightBasis,
 };
 
 /// Identify every axis recording in a file (a `.stdata` file may hold several

@@ -232,6 +232,30 @@ impl Welch {
             .sum()
     }
 
+    /// `c = 1 + 2 sum_d rho_d` of the estimator's bins: `rho_d`, the correlation of two
+    /// bins `d` apart of one windowed segment's periodogram, is `(sum a(x) a(x + d))^2 /
+    /// (sum a(x)^2)^2` over the amplitude kernel `a` ([`Welch::amplitude_kernel_table`];
+    /// 0.47 for neighbouring bins of Klipper's Kaiser window), summed over 6 bins. `n` bins
+    /// carry about `n / c` independent ones (1.95 for Klipper's window), which the sweep
+    /// fit's model selection counts ([`crate::fit::sweep`]). This is the noise's own
+    /// correlation, not a fit's residuals': on a real spectrum those mostly measure what
+    /// the model leaves out (a mode not yet fitted, structure the modal model does not
+    /// hold), and would count a spectrum with more to explain as holding fewer independent
+    /// bins, against adding the mode that explains it.
+    pub fn bin_correlation(&self) -> f64 {
+        const PER_BIN: usize = 32;
+        const BINS: usize = 6;
+        let table = self.amplitude_kernel_table(2 * BINS, PER_BIN);
+        let a = |x: isize| table.get(x.unsigned_abs()).copied().unwrap_or(0.0);
+        let span = (BINS * PER_BIN) as isize;
+        let overlap = |d: isize| -> f64 { (-span..=span).map(|x| a(x) * a(x + d)).sum() };
+        let zero = overlap(0);
+        let sum: f64 = (1..=BINS as isize)
+            .map(|d| (overlap(d * PER_BIN as isize) / zero).powi(2))
+            .sum();
+        1.0 + 2.0 * sum
+    }
+
     /// The signed amplitude kernel `a(d) = W(d) / sqrt(nfft sum w^2)`, so that
     /// [`Welch::kernel_table`] is `a^2`: one segment's transform of white noise at two
     /// frequencies `d1` and `d2` bins from a point correlates as `a(d1) a(d2)`, which is
@@ -246,4 +270,22 @@ impl Welch {
             .map(|i| self.window_transform(i as f64 / per_bin as f64) / norm)
             .collect()
     }
+}
+
+/// Klipper's frequency response of a raw recording (`calc_freq_response` in
+/// `klippy/extras/shaper_calibrate.py`): the sample rate `N / (t_last - t_first)`, Klipper's
+/// segment length and half-segment hop, and the PSD of each sensor axis. Returns the bin
+/// frequencies and the three PSDs ((mm/s^2)^2/Hz); `None` when an axis is missing or the
+/// recording is not longer than one segment (Klipper's `N <= M`).
+pub fn klipper_response(rec: &crate::read::Recording) -> Option<(Vec<f64>, [Vec<f64>; 3])> {
+    let welch = Welch::klipper(rec.sample_rate_hz);
+    if rec.len() <= welch.nfft() {
+        return None;
+    }
+    let mut psd = rec
+        .accel_mm_s2
+        .iter()
+        .map(|a| a.as_deref().and_then(|a| welch.psd(a)));
+    let (x, y, z) = (psd.next()??, psd.next()??, psd.next()??);
+    Some((welch.freqs_hz(), [x, y, z]))
 }

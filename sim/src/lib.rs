@@ -12,8 +12,8 @@
 //!
 //! Backends never import each other: what they share (the explicit step bound, the start
 //! equilibrium) is in [`numerics`]. [`closed_form`] gives the residual vibration
-//! analytically, so the plants can be checked against an independent formula; [`pencil`]
-//! measures modes from a free response (the matrix pencil method).
+//! analytically, so the plants can be checked against an independent formula (the
+//! measured modes of a free response come from settle-identify's matrix pencil).
 
 mod axis;
 pub mod closed_form;
@@ -27,7 +27,6 @@ mod mode;
 pub mod mujoco;
 pub mod mujoco_status;
 pub mod numerics;
-pub mod pencil;
 mod plant;
 pub mod rapier;
 mod rapier_driver;

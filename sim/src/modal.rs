@@ -1091,8 +1091,8 @@ impl Plant for ModalPlant {
     }
 
     /// [`Plant::step_samples`] with whole steps across breakpoints
-    /// ([`crate::modal_jump`]): `Ok(None)` when the step is not the nominal one, when a
-    /// step is too long for the jump's series on some axis ([`Jumps::covers`]), or when a
+    /// (module `modal_jump`): `Ok(None)` when the step is not the nominal one, when a
+    /// step is too long for the jump's series on some axis (`Jumps::covers`), or when a
     /// sample is not one to vouch for (the state is then unchanged and the caller splits
     /// the steps, which finds the sample).
     fn step_samples_across(

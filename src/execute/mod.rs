@@ -96,6 +96,22 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
             ),
         ));
     }
+    // A trace kept in memory (recorded, or measured whole by the run's kind) is bounded.
+    let kept = record.is_some() || planned.probe.is_some();
+    let per_sample = simulate::channels(&axes).len() + 1;
+    let values = samples * per_sample as f64;
+    if kept && values > crate::expand::validate::MAX_RECORDED_VALUES {
+        return Ok(Metrics::failed(
+            &spec.bands_um,
+            format!(
+                "its trace is kept in memory: {samples:.3e} samples (the {:.3e} s move and the {} s window at {} Hz) of {per_sample} values each are {values:.3e} values, over the limit of {:e}: shorten the move or the window, or lower observe.sample_rate_hz",
+                duration_s,
+                spec.window_s,
+                spec.sample_rate_hz,
+                crate::expand::validate::MAX_RECORDED_VALUES
+            ),
+        ));
+    }
     let interrupted = |m: Result<Metrics, Error>| {
         if interrupt::requested() {
             Err(Error::Interrupted { run: spec.id })

@@ -1,6 +1,7 @@
 //! `[current]`: the user's current settings, one value per swept key. Checked here, where
-//! the sweep's axes are known: every key must be a swept key and every value one of that
-//! key's swept values, so that exactly one candidate per swept point is "current".
+//! the sweep's axes are known: every key must be a swept setting (not the workload, such
+//! as the move length: the settings are compared at every point of it) and every value one
+//! of that key's swept values, so that exactly one candidate per swept point is "current".
 
 use settle_planner::ProfileKind;
 
@@ -8,6 +9,7 @@ use crate::error::Error;
 use crate::expand::axes::Axis;
 use crate::input::scenario::Scenario;
 use crate::input::source::Source;
+use crate::spec::groups::is_setting;
 use crate::spec::value::Value;
 
 /// Whether the TOML value `v` (from `[current]`) is the swept value `swept`. Numbers
@@ -41,6 +43,24 @@ pub fn check(sc: &Scenario, src: &Source, axes: &[Axis]) -> Result<(), Error> {
                 ),
             ));
         };
+        if !is_setting(key) {
+            let settings: Vec<String> = axes
+                .iter()
+                .filter(|a| is_setting(&a.param))
+                .map(|a| format!("`{}`", a.param))
+                .collect();
+            return Err(src.error_at(
+                &at,
+                format!(
+                    "`{key}` is part of the workload the settings are compared on (every value of it is a point of the ranking, each with its own gain against the current settings), not a setting; [current] takes the swept settings: {}",
+                    if settings.is_empty() {
+                        "none (the scenario sweeps only the workload)".to_string()
+                    } else {
+                        settings.join(", ")
+                    }
+                ),
+            ));
+        }
         if !axis.values.iter().any(|s| same(v, s)) {
             let values: Vec<String> = axis.values.iter().map(|s| format!("{s}")).collect();
             return Err(src.error_at(

@@ -69,17 +69,18 @@ pub fn named(
         )));
     }
     let source = base.join(value);
-    let text = crate::input::file::read_text(&source).map_err(|e| {
-        let why = match e {
-            Error::Read { source, .. } => source.to_string(),
-            Error::Input { message, .. } => message,
-            other => other.to_string(),
-        };
-        err(format!(
-            "cannot read machine file {}: {why}",
-            source.display()
-        ))
-    })?;
+    let text = crate::input::file::read_text(&source, crate::input::file::limit::SETTINGS)
+        .map_err(|e| {
+            let why = match e {
+                Error::Read { source, .. } => source.to_string(),
+                Error::Input { message, .. } => message,
+                other => other.to_string(),
+            };
+            err(format!(
+                "cannot read machine file {}: {why}",
+                source.display()
+            ))
+        })?;
     if scenarios
         && text
             .parse::<toml::Table>()
@@ -245,22 +246,46 @@ pub fn resolve_machine(sc: &Scenario, src: &Source) -> Result<Resolved, Error> {
     ))
 }
 
+/// The machine files a scenario names (`preset` in `[machine]`, or swept as
+/// `machine.preset`), in the order named.
+fn machine_files(sc: &Scenario, src: &Source) -> Vec<std::path::PathBuf> {
+    let mut values: Vec<&str> = sc.machine.preset.iter().map(String::as_str).collect();
+    if let Some(list) = sc.sweep.get("machine.preset").and_then(|v| v.as_array()) {
+        values.extend(list.iter().filter_map(|v| v.as_str()));
+    }
+    values
+        .into_iter()
+        .filter_map(|v| crate::input::machine_file::preset_file(v, &src.path))
+        .collect()
+}
+
+/// Every file a scenario reads: itself, its machine files and its G-code file (`[gcode]
+/// file`), for the output rule (no output is one of them).
+pub fn input_files(sc: &Scenario, src: &Source) -> settle_files::write::Inputs {
+    let mut inputs = settle_files::write::Inputs::of(machine_files(sc, src));
+    inputs.add(&src.path);
+    if let Ok(Some(t)) = src.table::<toml::Table>("gcode")
+        && let Some(file) = t.get("file").and_then(|v| v.as_str())
+    {
+        inputs.add(
+            &src.path
+                .parent()
+                .unwrap_or(std::path::Path::new("."))
+                .join(file),
+        );
+    }
+    inputs
+}
+
 /// The identity of the files a scenario reads besides itself (its machine files, given by
 /// `preset` in `[machine]` or swept as `machine.preset`), by content: one `path=digest` per
 /// file, in the order named, empty when it reads none. A sweep's journal and a shard's
 /// manifest carry it, so that a machine file edited between an interruption and
 /// `--resume`, or between two shards, is noticed.
 pub fn inputs_identity(sc: &Scenario, src: &Source) -> Result<String, Error> {
-    let mut values: Vec<&str> = sc.machine.preset.iter().map(String::as_str).collect();
-    if let Some(list) = sc.sweep.get("machine.preset").and_then(|v| v.as_array()) {
-        values.extend(list.iter().filter_map(|v| v.as_str()));
-    }
     let mut out = Vec::new();
-    for v in values {
-        let Some(path) = crate::input::machine_file::preset_file(v, &src.path) else {
-            continue;
-        };
-        let bytes = crate::input::file::read_bytes(&path)?;
+    for path in machine_files(sc, src) {
+        let bytes = crate::input::file::read_bytes(&path, crate::input::file::limit::SETTINGS)?;
         let entry = format!(
             "{}={:016x}",
             path.display(),

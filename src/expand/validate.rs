@@ -6,6 +6,7 @@ use settle_sim::Mode;
 
 use crate::error::Error;
 use crate::input::source::Source;
+use crate::spec::MAX_POSITION_MM;
 use crate::spec::run_spec::{RunSpec, needs_jerk};
 use crate::studies::{self, Role};
 
@@ -15,6 +16,18 @@ use crate::studies::{self, Role};
 /// (a distance in metres written as millimetres, a speed limit of `1e-9`), not a run to wait
 /// for.
 pub const MAX_SAMPLES_PER_RUN: f64 = 1e8;
+
+/// The most values (samples times channels, the time stamp included) a run whose trace is
+/// kept may hold: `settle run`, a recorded sweep (`--mcap`, `--rerun`) and the run kinds
+/// that measure the whole trace (scans, shaping) keep it in memory, about 21 bytes a value
+/// with the vectors' growth: 336 MB at the limit, 670,000 samples (67 s at 10 kHz) of the
+/// 24 channels of a two-axis printer. A longer trace is refused before it is simulated.
+pub const MAX_RECORDED_VALUES: f64 = 1.6e7;
+
+/// The shortest integration step `sim.max_step_s` may force (s): 1 us, a hundred times
+/// finer than a 1 kHz mode needs (`w h` = 0.006). The steps of a run are bounded as its
+/// samples are, by [`MAX_SAMPLES_PER_RUN`].
+pub const MIN_STEP_S: f64 = 1e-6;
 
 /// The most settling bands a scenario may give: each is a column of runs.csv and a panel
 /// of every figure, and a handful (a tolerance and a few looser or tighter ones) answers
@@ -40,6 +53,18 @@ pub fn min_move_time_s(distance_mm: f64, vmax_mm_s: f64, amax_mm_s2: f64) -> f64
 /// observation window) stays within [`MAX_SAMPLES_PER_RUN`] samples, before any work.
 fn validate_duration(run: &RunSpec, src: &Source) -> Result<(), Error> {
     let move_s = min_move_time_s(run.distance_mm, run.vmax_mm_s, run.amax_mm_s2);
+    if let Some(h) = run.max_step_s {
+        let steps = (move_s + run.window_s) / h;
+        if !(steps.is_finite() && steps <= MAX_SAMPLES_PER_RUN) {
+            return Err(src.error_at(
+                &run.blame("sim.max_step_s"),
+                format!(
+                    "{h} s steps over at least {:.3e} s (the move and the window) are {steps:.3e} steps, over the limit of {MAX_SAMPLES_PER_RUN:e} per run: raise max_step_s",
+                    move_s + run.window_s
+                ),
+            ));
+        }
+    }
     let samples = (move_s + run.window_s) * run.sample_rate_hz;
     if samples.is_finite() && samples <= MAX_SAMPLES_PER_RUN {
         return Ok(());
@@ -85,7 +110,14 @@ pub fn mode_range_hz(run: &RunSpec) -> Option<(f64, f64)> {
             out
         }
     };
-    let freqs = freqs.into_iter().filter(|f| f.is_finite() && *f > 1e-6);
+    // A physical machine's rigid rotations are 0 Hz; a mode given is a mode, however slow
+    // (its window is checked against it).
+    let rigid = if run.machine.physical().is_some() {
+        1e-6
+    } else {
+        0.0
+    };
+    let freqs = freqs.into_iter().filter(|f| f.is_finite() && *f > rigid);
     freqs.fold(None, |r, f| match r {
         None => Some((f, f)),
         Some((lo, hi)) => Some((f64::min(lo, f), f64::max(hi, f))),
@@ -158,11 +190,11 @@ pub fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
         ));
     }
     if let Some(h) = run.max_step_s
-        && !(h.is_finite() && h > 0.0)
+        && !(h.is_finite() && h >= MIN_STEP_S)
     {
         return Err(src.error_at(
             "sim.max_step_s",
-            format!("must be a finite number > 0 (s), got {h}"),
+            format!("must be a finite number > 0 and at least {MIN_STEP_S:e} (s), got {h}"),
         ));
     }
     if run.bands_um.is_empty() || run.bands_um.iter().any(|b| !(b.is_finite() && *b > 0.0)) {
@@ -207,6 +239,7 @@ pub fn validate_base(base: &RunSpec, src: &Source) -> Result<(), Error> {
             return Err(src.error_at(key, format!("must be finite, got {value}")));
         }
     }
+
     for (key, value, unit) in [
         ("limits.vmax_mm_s", Some(base.vmax_mm_s), "mm/s"),
         ("limits.amax_mm_s2", Some(base.amax_mm_s2), "mm/s^2"),
@@ -219,7 +252,35 @@ pub fn validate_base(base: &RunSpec, src: &Source) -> Result<(), Error> {
             ));
         }
     }
-    validate_duration(base, src)
+    validate_duration(base, src)?;
+    validate_positions(base, src, |k| k.to_string())
+}
+
+/// Check that the move starts and ends within [`MAX_POSITION_MM`] (`blame` names the key).
+fn validate_positions(
+    run: &RunSpec,
+    src: &Source,
+    blame: impl Fn(&str) -> String,
+) -> Result<(), Error> {
+    for (key, x) in [
+        ("move.start_mm", run.start_mm),
+        ("move.distance_mm", run.start_mm + run.distance_mm),
+    ] {
+        if x.abs() > MAX_POSITION_MM {
+            return Err(src.error_at(
+                &blame(key),
+                crate::spec::beyond_positions(
+                    if key == "move.start_mm" {
+                        "the move starts"
+                    } else {
+                        "the move ends"
+                    },
+                    x,
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Check one run: its path kind first (a corner path checks its profile kind and machine
@@ -240,6 +301,7 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
             return Err(src.error_at(&run.blame(name), format!("must be finite, got {value}")));
         }
     }
+
     let limits = [
         ("limits.vmax_mm_s", Some(run.vmax_mm_s), "mm/s"),
         ("limits.amax_mm_s2", Some(run.amax_mm_s2), "mm/s^2"),
@@ -315,5 +377,6 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
             }
         }
     }
-    validate_duration(run, src)
+    validate_duration(run, src)?;
+    validate_positions(run, src, |k| run.blame(k))
 }

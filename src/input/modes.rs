@@ -84,8 +84,14 @@ pub fn machine_file_text(name: &str, description: &str, axes: &[AxisModes]) -> S
     out
 }
 
+/// The most modes one axis may have: identification finds up to 4 per axis, a careful
+/// model a dozen; the simulation's cost grows with the cube of the count (1,000 modes take
+/// 19 s per run, 100,000 would need 80 GB).
+pub const MAX_MODES_PER_AXIS: usize = 100;
+
 /// The axes `axes` (name, the key their modes are written at, the modes) checked: at
-/// least one mode each, every mode valid (settle-sim's `Mode::new`); errors name the key.
+/// least one mode each and at most [`MAX_MODES_PER_AXIS`], every mode valid (settle-sim's
+/// `Mode::new`); errors name the key.
 pub fn to_axis_modes<'a>(
     axes: impl IntoIterator<Item = (String, String, &'a [ModeSpec])>,
     src: &Source,
@@ -96,6 +102,15 @@ pub fn to_axis_modes<'a>(
             return Err(src.error_at(
                 &key,
                 "give one or more modes: `modes = [{ frequency_hz, damping_ratio, weight }]`",
+            ));
+        }
+        if modes.len() > MAX_MODES_PER_AXIS {
+            return Err(src.error_at(
+                &key,
+                format!(
+                    "{} modes; at most {MAX_MODES_PER_AXIS} per axis (a machine's axis has a handful that matter; each adds to every step of the simulation)",
+                    modes.len()
+                ),
             ));
         }
         for (i, m) in modes.iter().enumerate() {

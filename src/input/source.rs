@@ -38,7 +38,7 @@ impl Source {
 
     /// Read the file at `path`.
     pub fn load(path: &Path) -> Result<Self, Error> {
-        let text = crate::input::file::read_text(path)?;
+        let text = crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)?;
         Ok(Self::new(&text, path))
     }
 

@@ -62,6 +62,12 @@ pub struct TuneSpec {
     /// frequency and detuned by this many percent either way (the real mode a few percent
     /// off the identified one) [default 0: the nominal frequency alone].
     pub frequency_tolerance_pct: Option<f64>,
+    /// The damping ratio every shaper is designed for, 0 to under 1 (within what each
+    /// shaper's firmware takes) [default: on a machine given by its modes (a machine file
+    /// from `settle identify`, or modes written by hand) the damping ratio of the mode the
+    /// shaper is tuned to; on a physical machine, whose modal damping is an estimate from
+    /// its parts, Klipper's default 0.1].
+    pub shaper_damping_ratio: Option<f64>,
     /// The user's current settings per axis (`[tune.axis.x]`): the baseline candidate of
     /// that axis and the machine's resolution for the register export.
     pub axis: Option<BTreeMap<String, AxisCurrent>>,

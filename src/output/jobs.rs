@@ -293,7 +293,7 @@ pub fn header(j: &Jobs) -> Vec<String> {
 }
 
 /// What the table's columns mean.
-pub const NOTE: &str = "Print time: the firmware planner's clock for the whole file. Contour error: distance in XY from the simulated toolhead to the commanded path, over printing moves; worst line: the G-code line where the worst error happens. Ranked by worst error (ties: print time). Pareto: no other candidate is both faster and less wrong. Vs current: +5 % = 5 % longer or more error than current, -76 % = 76 % less.";
+pub const NOTE: &str = "Print time: the firmware planner's clock for the whole file. Contour error: distance in XY from the simulated toolhead to the commanded path, over working moves; worst line: the G-code line where the worst error happens. Ranked by worst error (ties: print time). Pareto: no other candidate is both faster and less wrong. Vs current: +5 % = 5 % longer or more error than current, -76 % = 76 % less.";
 
 /// The summary.md section.
 pub fn section(j: &Jobs, scenario: &Path, runs: &dyn RunList) -> String {

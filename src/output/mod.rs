@@ -5,6 +5,7 @@
 //! ([`atomic`]); and the files of a sweep's output folder together ([`sweep_files`]).
 
 pub mod atomic;
+pub mod folder;
 pub mod html;
 pub mod jobs;
 pub mod plot;

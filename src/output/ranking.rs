@@ -26,25 +26,10 @@ use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::runs_csv::band_label;
 use crate::spec::backend::Backend;
+pub use crate::spec::groups::is_setting;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
 use crate::spec::value::Value;
-
-/// Whether swept key `key` is a setting (compared) rather than part of the workload
-/// (grouped by): see the module documentation.
-pub fn is_setting(key: &str) -> bool {
-    const WORKLOAD: [&str; 8] = [
-        "move.distance_mm",
-        "move.start_mm",
-        "corner.angle_deg",
-        "corner.leg_in_mm",
-        "corner.leg_out_mm",
-        "scan.v_scan_mm_s",
-        "scan.width_mm",
-        "scan.settle_margin_s",
-    ];
-    !WORKLOAD.contains(&key)
-}
 
 /// A value as a candidate's label shows it: names as they are, numbers as `key=value` with
 /// the key's last part (`frequency_hz=52`).
@@ -189,15 +174,27 @@ pub struct Ranking {
     pub candidates: Vec<(String, Vec<String>)>,
     /// Per band.
     pub bands: Vec<Band>,
+    /// The runs left out of the ranking as repeats: `(row, row of the run it repeats)`,
+    /// a run of the same workload point and candidate, differing only in settings that do
+    /// not change it (a jerk limit with a trapezoid, a frequency with no shaper).
+    pub repeats: Vec<(u32, u32)>,
+    /// Why those settings do not change them, once each.
+    pub unused: Vec<Unused>,
 }
 
-/// Whether `run` is the `[current]` candidate of `sc` (every key given matches).
+/// A swept key that does not change some runs, and why: `(key, reason)`.
+pub type Unused = (String, &'static str);
+
+/// Whether `run` is the `[current]` candidate of `sc` (every key given matches, or does
+/// not change the run: [`crate::studies::unused`]).
 pub fn is_current(sc: &Scenario, run: &RunSpec) -> bool {
     !sc.current.is_empty()
         && sc.current.iter().all(|(k, v)| {
-            run.swept
-                .iter()
-                .any(|(p, s)| p == k && crate::expand::current::same(v, s))
+            crate::studies::unused(run, k).is_some()
+                || run
+                    .swept
+                    .iter()
+                    .any(|(p, s)| p == k && crate::expand::current::same(v, s))
         })
 }
 
@@ -226,10 +223,8 @@ fn max_accel(table: &RunsColumns, row: usize) -> Option<f64> {
         table.num(row, "shaper_damping_ratio")?,
     )
     .ok()?;
-    Some(settle_planner::shaper_select::max_accel_mm_s2(
-        sh.amplitudes(),
-        sh.times_s(),
-        crate::studies::shaping::SMOOTHING_SCV_MM_S,
+    Some(crate::studies::shaping::max_accel_mm_s2(
+        &sh,
         settle_planner::shaper_select::TARGET_SMOOTHING_MM,
     ))
 }
@@ -246,21 +241,29 @@ fn time_of(table: &RunsColumns, i: usize, column: &str) -> Option<f64> {
         .filter(|x| x.is_finite() && ran(table, i))
 }
 
-/// The values of a run's settings (`setting`) or workload, as shown in the tables.
+/// The values of a run's settings (`setting`) or workload, as shown in the tables: `-`
+/// for a setting that does not change the run ([`crate::studies::unused`]).
 fn values(r: &RunSpec, setting: bool) -> Vec<String> {
     r.swept
         .iter()
         .filter(|(p, _)| is_setting(p) == setting)
-        .map(|(_, v)| v.to_string())
+        .map(|(p, v)| {
+            if setting && crate::studies::unused(r, p).is_some() {
+                "-".to_string()
+            } else {
+                v.to_string()
+            }
+        })
         .collect()
 }
 
-/// A run's candidate label: its settings joined by `, `, or its profile kind.
+/// A run's candidate label: the settings that change it joined by `, `, or its profile
+/// kind.
 fn label(r: &RunSpec) -> String {
     let s: Vec<String> = r
         .swept
         .iter()
-        .filter(|(p, _)| is_setting(p))
+        .filter(|(p, _)| is_setting(p) && crate::studies::unused(r, p).is_none())
         .map(|(p, v)| label_part(p, v))
         .collect();
     if s.is_empty() {
@@ -356,6 +359,11 @@ pub fn rank(sc: &Scenario, runs: &dyn RunList, table: &RunsColumns) -> Ranking {
         run_current.push(is_current(sc, &r));
     }
     drop(candidate_of);
+    let (repeats, unused) = repeats(runs, &starts, &point_rows, &run_candidate);
+    let mut repeat = vec![false; runs.len()];
+    for &(row, _) in &repeats {
+        repeat[row as usize] = true;
+    }
     let shapers = setting_keys.iter().any(|k| k.starts_with("shaper."))
         && table.column("smoothing_mm").is_some();
     let current_label = run_current
@@ -378,7 +386,10 @@ pub fn rank(sc: &Scenario, runs: &dyn RunList, table: &RunsColumns) -> Ranking {
         let mut ranked: Vec<(Slot, bool, Option<f64>, usize)> = Vec::new();
         for w in starts.windows(2) {
             ranked.clear();
-            for &i in &point_rows[w[0]..w[1]] {
+            for &i in point_rows[w[0]..w[1]]
+                .iter()
+                .filter(|&&i| !repeat[i as usize])
+            {
                 let i = i as usize;
                 let slot = Slot {
                     row: i as u32,
@@ -504,10 +515,80 @@ pub fn rank(sc: &Scenario, runs: &dyn RunList, table: &RunsColumns) -> Ranking {
         shapers,
         candidates,
         bands,
+        repeats,
+        unused,
     }
 }
 
+/// The runs that repeat an earlier run of their workload point's candidate (see
+/// [`Ranking::repeats`]), with the `(key, reason)` of the settings that do not change
+/// them, once each.
+fn repeats(
+    runs: &dyn RunList,
+    starts: &[usize],
+    point_rows: &[u32],
+    run_candidate: &[u32],
+) -> (Vec<(u32, u32)>, Vec<Unused>) {
+    let mut repeats = Vec::new();
+    let mut unused: Vec<Unused> = Vec::new();
+    let mut first: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    for w in starts.windows(2) {
+        first.clear();
+        for &row in &point_rows[w[0]..w[1]] {
+            let c = run_candidate[row as usize];
+            let Some(&earlier) = first.get(&c) else {
+                first.insert(c, row);
+                continue;
+            };
+            repeats.push((row, earlier));
+            let r = runs.at(row as usize);
+            for (key, _) in &r.swept {
+                if let Some(why) = crate::studies::unused(&r, key)
+                    && !unused.iter().any(|(k, w)| k == key && *w == why)
+                {
+                    unused.push((key.clone(), why));
+                }
+            }
+        }
+    }
+    (repeats, unused)
+}
+
 impl Ranking {
+    /// The sentence on the runs ranked once ([`Ranking::repeats`]); `None` without any.
+    pub fn repeats_note(&self, runs: &dyn RunList) -> Option<String> {
+        const SHOWN: usize = 5;
+        if self.repeats.is_empty() {
+            return None;
+        }
+        let why: Vec<String> = self
+            .unused
+            .iter()
+            .map(|(k, w)| format!("`{k}`: {w}"))
+            .collect();
+        let mut pairs: Vec<String> = self
+            .repeats
+            .iter()
+            .take(SHOWN)
+            .map(|&(r, e)| {
+                format!(
+                    "run {} repeats run {}",
+                    runs.at(r as usize).id,
+                    runs.at(e as usize).id
+                )
+            })
+            .collect();
+        if self.repeats.len() > SHOWN {
+            pairs.push(format!("{} more", self.repeats.len() - SHOWN));
+        }
+        Some(format!(
+            "Ranked once: {} run(s) repeat another run of their point in every setting that changes them ({}). Those settings show as `-`; runs.csv keeps every run ({}).",
+            self.repeats.len(),
+            why.join("; "),
+            pairs.join(", ")
+        ))
+    }
+
     /// Workload point `p` of band `b` as the tables show it: its values, its reference and
     /// its runs with their numbers (read from `table`, row `i` = `runs.at(i)`, the table the
     /// ranking was made from).

@@ -29,17 +29,6 @@ pub struct ScenarioFile<'a> {
     pub text: &'a str,
 }
 
-/// The figures (caption, SVG markup) as the page embeds them.
-fn embedded(figures: &[(String, String)]) -> Vec<Figure> {
-    figures
-        .iter()
-        .map(|(title, svg)| Figure {
-            title: title.clone(),
-            image: Image::Svg(svg.clone()),
-        })
-        .collect()
-}
-
 /// The title of the table of every run in a sweep's report.
 pub const RUNS_TITLE: &str = "All runs (runs.csv)";
 
@@ -107,7 +96,10 @@ fn winners(ranking: &Ranking) -> Vec<BandWinner> {
 }
 
 /// The ranking tables, one per band, without their rows ([`RankingRows`] makes them).
-fn ranking_tables(ranking: &Ranking) -> Vec<Table> {
+fn ranking_tables(ranking: &Ranking, runs: &dyn RunList) -> Vec<Table> {
+    let repeats = ranking
+        .repeats_note(runs)
+        .map_or(String::new(), |n| format!(" {}", n.replace('`', "")));
     ranking
         .bands
         .iter()
@@ -132,7 +124,7 @@ fn ranking_tables(ranking: &Ranking) -> Vec<Table> {
             Table {
                 title: format!("Ranking: move and settle to within {} um", b.band_um),
                 note: format!(
-                    "Per swept point of the workload, fastest first. Gain {}: how much longer the reference takes.",
+                    "Per swept point of the workload, fastest first. Gain {}: how much longer the reference takes.{repeats}",
                     ranking.reference_name()
                 ),
                 header,
@@ -291,7 +283,9 @@ pub fn sweep_report<'a>(
     let mut replaced = false;
     let mut study_tables = Vec::new();
     for k in crate::studies::all() {
-        if let Some(section) = k.summary(runs, table) {
+        if let Some(section) =
+            k.summary(runs, table, &|r| crate::output::ranking::is_current(sc, r))
+        {
             replaced |= k.replaces_move_tables();
             study_tables.extend(markdown_tables(&section));
         }
@@ -300,7 +294,11 @@ pub fn sweep_report<'a>(
         (Vec::new(), Vec::new(), None)
     } else {
         let ranking = rank(sc, runs, table);
-        (winners(&ranking), ranking_tables(&ranking), Some(ranking))
+        (
+            winners(&ranking),
+            ranking_tables(&ranking, runs),
+            Some(ranking),
+        )
     };
     let mut first = 0;
     if let Some(j) = crate::output::jobs::jobs(sc, runs, table) {
@@ -332,6 +330,7 @@ pub fn sweep_report<'a>(
         intro,
         winners,
         tables,
+        sections: Vec::new(),
         figures: figures
             .iter()
             .map(|(title, svg)| Figure {
@@ -359,29 +358,6 @@ pub fn sweep_report<'a>(
     (report, rows)
 }
 
-/// A report from a Markdown summary (e.g. `settle tune`'s tune.md): its tables (each under
-/// its heading, the paragraph under it as its note), the candidates table `csv` as the
-/// sortable, filterable table of every run, the `figures` (caption, SVG markup) and the
-/// provenance.
-pub fn markdown_report(
-    title: &str,
-    markdown: &str,
-    csv: &str,
-    figures: &[(String, String)],
-    provenance: Provenance,
-) -> Report {
-    Report {
-        title: title.to_string(),
-        intro: Vec::new(),
-        winners: Vec::new(),
-        tables: markdown_tables(markdown),
-        figures: embedded(figures),
-        runs: Table::from_csv("Every candidate", csv).ok(),
-        failed: Vec::new(),
-        provenance,
-    }
-}
-
 /// The provenance of a run of settle on `file` with `backend`, `command` as typed.
 pub fn provenance(file: ScenarioFile<'_>, backend: &str, command: String) -> Provenance {
     Provenance {
@@ -397,8 +373,9 @@ pub fn provenance(file: ScenarioFile<'_>, backend: &str, command: String) -> Pro
     }
 }
 
-/// The tables of a summary section (Markdown): each `## heading`, the paragraph under it
-/// as the note, and its `| ... |` rows (bold marks dropped; numbers sort as numbers).
+/// The tables of a summary section (Markdown): each `## heading` (or `###`), the
+/// paragraph under it as the note, and its `| ... |` rows (bold marks dropped; numbers sort
+/// as numbers).
 fn markdown_tables(section: &str) -> Vec<Table> {
     let mut out: Vec<Table> = Vec::new();
     let mut title = String::new();
@@ -416,7 +393,10 @@ fn markdown_tables(section: &str) -> Vec<Table> {
         if !is_row && let Some(t) = current.take() {
             out.push(t);
         }
-        if let Some(h) = line.strip_prefix("## ") {
+        if let Some(h) = line
+            .strip_prefix("## ")
+            .or_else(|| line.strip_prefix("### "))
+        {
             title = h.trim().to_string();
             note.clear();
         } else if is_row {

@@ -9,7 +9,7 @@ use std::path::Path;
 use crate::input::runs_columns::RunsColumns;
 use crate::input::scenario::Scenario;
 use crate::output::html::Out;
-use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, rank, run_command};
+use crate::output::ranking::{Ranking, SHAPER_COLUMNS, gain_text, is_current, rank, run_command};
 use crate::spec::runs::RunList;
 
 /// A time in ms with one decimal, `not settled` for none.
@@ -26,6 +26,24 @@ pub struct Figure {
     pub svg: String,
     /// Path of the PNG, relative to the summary's folder.
     pub png: String,
+}
+
+/// `x` to four significant digits, as short as it then prints (an identified
+/// 45.00161069 Hz mode is `45`, its 0.0500311 damping ratio `0.05003`, a 75.0139 Hz mode
+/// `75.01`; a mode written as 40 Hz stays `40`).
+pub fn significant(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let e = 3 - x.abs().log10().floor() as i32;
+    // Divided by an exact power of ten, the result is the double nearest the decimal.
+    if e >= 0 {
+        let p = 10f64.powi(e);
+        (x * p).round() / p
+    } else {
+        let p = 10f64.powi(-e);
+        (x / p).round() * p
+    }
 }
 
 /// The machines of `runs`, named once each in first-seen order: `printer_xy (axis x, linear
@@ -49,7 +67,11 @@ pub fn machines_line(runs: &dyn RunList) -> String {
                         String::new()
                     };
                     a.modes.iter().map(move |m| {
-                        format!("{prefix}{} Hz, zeta {}", m.frequency_hz, m.damping_ratio)
+                        format!(
+                            "{prefix}{} Hz, zeta {}",
+                            significant(m.frequency_hz),
+                            significant(m.damping_ratio)
+                        )
                     })
                 })
                 .collect();
@@ -133,7 +155,7 @@ pub(crate) fn summary_to(
     let mut replaced = false;
     let mut after: Vec<String> = Vec::new();
     for k in crate::studies::all() {
-        let Some(section) = k.summary(runs, table) else {
+        let Some(section) = k.summary(runs, table, &|r| is_current(sc, r)) else {
             continue;
         };
         if k.replaces_move_tables() {
@@ -165,7 +187,7 @@ pub(crate) fn summary_to(
 pub fn ranks_candidates(runs: &dyn RunList, table: &RunsColumns) -> bool {
     !crate::studies::all()
         .iter()
-        .any(|k| k.replaces_move_tables() && k.summary(runs, table).is_some())
+        .any(|k| k.replaces_move_tables() && k.summary(runs, table, &|_| false).is_some())
 }
 
 /// The winners and the ranking tables.
@@ -195,6 +217,9 @@ fn push_ranking(
         out,
         "Compared: {compared}. Winner: the least move-and-settle time{over}. Gain {reference}: how much longer the reference takes (+38 % = the reference takes 38 % longer).\n"
     );
+    if let Some(note) = ranking.repeats_note(runs) {
+        let _ = writeln!(out, "{note}\n");
+    }
     for b in &ranking.bands {
         match &b.winner {
             Some(w) => {

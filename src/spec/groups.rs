@@ -1,9 +1,27 @@
 //! Runs grouped by their swept values other than `profile`: the rows of the summary's
-//! side-by-side tables (every study's section uses the same grouping).
+//! side-by-side tables (every study's section uses the same grouping); and which swept keys
+//! are settings, which the workload ([`is_setting`]).
 
 use settle_planner::ProfileKind;
 
 use crate::spec::runs::RunList;
+
+/// Whether swept key `key` is a setting (what a user chooses between: compared) rather
+/// than part of the workload (the job the settings are compared on: the move length, the
+/// corner angle and legs, the scan's speed and width; grouped by).
+pub fn is_setting(key: &str) -> bool {
+    const WORKLOAD: [&str; 8] = [
+        "move.distance_mm",
+        "move.start_mm",
+        "corner.angle_deg",
+        "corner.leg_in_mm",
+        "corner.leg_out_mm",
+        "scan.v_scan_mm_s",
+        "scan.width_mm",
+        "scan.settle_margin_s",
+    ];
+    !WORKLOAD.contains(&key)
+}
 
 /// Runs grouped by their swept values other than `profile` (first-seen order): the rows of
 /// the summary's side-by-side tables.

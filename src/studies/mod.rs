@@ -325,9 +325,15 @@ pub trait Study: std::fmt::Debug + Sync {
     }
 
     /// Its summary section, read from the runs table (row `i` = `runs[i]`) so that a
-    /// merged sweep's summary is the same; `None` when it has nothing to show.
-    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
-        let _ = (runs, table);
+    /// merged sweep's summary is the same; `None` when it has nothing to show. `current`
+    /// tells the scenario's `[current]` runs (the user's settings today) from the others.
+    fn summary(
+        &self,
+        runs: &dyn RunList,
+        table: &RunsColumns,
+        current: &dyn Fn(&RunSpec) -> bool,
+    ) -> Option<String> {
+        let _ = (runs, table, current);
         None
     }
 
@@ -342,6 +348,27 @@ pub trait Study: std::fmt::Debug + Sync {
     fn replaces_move_tables(&self) -> bool {
         false
     }
+
+    /// Why swept key `key` does not change a run that does this study (`a trapezoid has no
+    /// jerk limit`), or `None` when it does: runs that differ only in such values are the
+    /// same run, ranked once ([`unused`]).
+    fn unused(&self, run: &RunSpec, key: &str) -> Option<&'static str> {
+        let _ = (run, key);
+        None
+    }
+}
+
+/// Why swept key `key` does not change `run` (see [`Study::unused`]), asking the studies
+/// it does; `None` when it does.
+pub fn unused(run: &RunSpec, key: &str) -> Option<&'static str> {
+    of(run).find_map(|k| k.unused(run, key))
+}
+
+/// Why the jerk limit does not change a move of `run`'s profile kind: a trapezoid steps
+/// its acceleration (the point move's and a scan step's rule).
+pub fn jerk_unused(run: &RunSpec, key: &str) -> Option<&'static str> {
+    (key == "limits.jmax_mm_s3" && !crate::spec::run_spec::needs_jerk(run.profile))
+        .then_some("a trapezoid has no jerk limit")
 }
 
 /// The tables the studies claim (left out of the scenario's strict parse).

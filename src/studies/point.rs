@@ -5,7 +5,7 @@
 
 use settle_planner::PlanError;
 
-use crate::studies::{Motion, Study, PlanContext, Planned, Role, on_axis};
+use crate::studies::{Motion, PlanContext, Planned, Role, Study, jerk_unused, on_axis};
 use crate::spec::run_spec::RunSpec;
 
 /// The point-to-point move.
@@ -43,5 +43,9 @@ impl Study for PointMove {
             linearise_at_m: None,
             step_at_m: None,
         })
+    }
+
+    fn unused(&self, run: &RunSpec, key: &str) -> Option<&'static str> {
+        jerk_unused(run, key)
     }
 }

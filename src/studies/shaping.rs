@@ -30,6 +30,18 @@ pub const DEFAULT_DAMPING_RATIO: f64 = 0.1;
 /// `square_corner_velocity`); runs.csv uses the same, at the run's own acceleration.
 pub const SMOOTHING_SCV_MM_S: f64 = 5.0;
 
+/// The largest acceleration (mm/s^2) at which `shaper` smooths at most `max_smoothing_mm`
+/// at [`SMOOTHING_SCV_MM_S`]: Klipper's suggested `max_accel` (with its 0.12 mm target,
+/// settle-planner's `TARGET_SMOOTHING_MM`).
+pub fn max_accel_mm_s2(shaper: &Shaper, max_smoothing_mm: f64) -> f64 {
+    settle_planner::shaper_select::max_accel_mm_s2(
+        shaper.amplitudes(),
+        shaper.times_s(),
+        SMOOTHING_SCV_MM_S,
+        max_smoothing_mm,
+    )
+}
+
 /// The `[shaper]` table of a scenario.
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -97,6 +109,16 @@ impl ShaperSetting {
                 "shaper.frequency_hz",
                 format!(
                     "must be a finite number > 0 (Hz), got {}",
+                    self.frequency_hz
+                ),
+            ));
+        }
+        let min = settle_planner::shaper::MIN_FREQUENCY_HZ;
+        if self.shaper_type.is_some() && self.frequency_hz < min {
+            return Err((
+                "shaper.frequency_hz",
+                format!(
+                    "{} Hz is below {min} Hz, the lowest shaper frequency settle runs (a shaper lasts about one period)",
                     self.frequency_hz
                 ),
             ));
@@ -224,6 +246,13 @@ impl Study for Shaping {
             return Vec::new();
         }
         COLUMNS.iter().map(|c| c.to_string()).collect()
+    }
+
+    /// A shaper's frequency and damping ratio with no shaper.
+    fn unused(&self, run: &RunSpec, key: &str) -> Option<&'static str> {
+        let s = run.state::<ShaperSetting>()?;
+        (s.shaper_type.is_none() && matches!(key, "shaper.frequency_hz" | "shaper.damping_ratio"))
+            .then_some("no shaper (`none`) has a frequency or damping ratio")
     }
 
     /// `remaining_vibration_pct` is Klipper's figure for the [`dominant_mode`] (100 = no

@@ -154,7 +154,12 @@ impl Study for Toy {
         out
     }
 
-    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
+    fn summary(
+        &self,
+        runs: &dyn RunList,
+        table: &RunsColumns,
+        _current: &dyn Fn(&RunSpec) -> bool,
+    ) -> Option<String> {
         table.column("toy_max_error_um")?;
         let mut out =
             String::from("## Toy shuttle\n\n| run | legs | max error (um) |\n|---:|---:|---:|\n");

@@ -13,8 +13,11 @@ use std::path::{Path, PathBuf};
 
 use settle_identify::{AxisIdentification, Options, WeightBasis};
 
+use settle_files::write::Inputs;
+
 use crate::error::Error;
 use crate::input::modes::{AxisModes, ModeSpec, machine_file_text};
+use crate::output::folder::Results;
 use crate::workflows::{Exit, Report};
 
 /// What `settle identify` does.
@@ -31,6 +34,9 @@ pub struct IdentifyOptions {
     pub figures: Option<PathBuf>,
     /// settle-identify's options (the resonance test's parameters, modes per axis, fit).
     pub identify: Options,
+    /// Overwrite the figures of an earlier identification in the figures folder (refused
+    /// without it).
+    pub force: bool,
 }
 
 impl IdentifyOptions {
@@ -42,6 +48,7 @@ impl IdentifyOptions {
             out: None,
             figures: None,
             identify: Options::default(),
+            force: false,
         }
     }
 }
@@ -71,10 +78,10 @@ pub struct Identified {
     pub figures: Vec<PathBuf>,
 }
 
-/// The machine axis `file` (recording `source`) excited: `axis` if given, else a token
+/// The machine axis `file` (identified as `id`) excited: `axis` if given, else a token
 /// `x`, `y` or `z` of the file's name (split at `_`, `-`, `.` and spaces), else of the
-/// measurement's name.
-fn axis_of(file: &Path, source: &str, axis: Option<&str>) -> Result<String, Error> {
+/// measurement's name, else the one axis the file holds (an M956 capture of one axis).
+fn axis_of(file: &Path, id: &AxisIdentification, axis: Option<&str>) -> Result<String, Error> {
     if let Some(a) = axis {
         return Ok(a.to_string());
     }
@@ -87,11 +94,12 @@ fn axis_of(file: &Path, source: &str, axis: Option<&str>) -> Result<String, Erro
     let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned());
     stem.as_deref()
         .and_then(token)
-        .or_else(|| token(source))
+        .or_else(|| token(&id.source))
+        .or_else(|| id.named_axis.map(|k| ["x", "y", "z"][k.min(2)].to_string()))
         .ok_or_else(|| {
             Error::input(
                 file,
-                "cannot tell which machine axis this file excited (its name holds no `x`, `y` or `z` token as in Klipper's raw_data_x_*.csv): give --axis x|y|z",
+                "cannot tell which machine axis this file excited (its name holds no `x`, `y` or `z` token as in Klipper's raw_data_x_*.csv, and it holds more than one sensor axis): give --axis x|y|z",
             )
         })
 }
@@ -128,10 +136,19 @@ pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
     if opts.files.is_empty() {
         return Err(Error::input("FILE", "give one or more accelerometer files"));
     }
+    check_options(&opts.identify)?;
+    // The outputs, checked before any work: never onto a recording, a link or a device.
+    let inputs = Inputs::of(&opts.files);
+    if let Some(out) = &opts.out {
+        inputs.refuse(out)?;
+        settle_files::write::check_target(out)?;
+    }
+    let dir = figures_dir(opts);
+    crate::output::folder::check(&dir, &FIGURES, opts.force, &inputs, writes_figure)?;
     let mut axes: Vec<IdentifiedAxis> = Vec::new();
     for file in &opts.files {
         for id in settle_identify::identify_file(file, &opts.identify)? {
-            let axis = axis_of(file, &id.source, opts.axis.as_deref())?;
+            let axis = axis_of(file, &id, opts.axis.as_deref())?;
             if let Some(prev) = axes.iter().find(|a| a.axis == axis) {
                 return Err(Error::input(
                     file,
@@ -156,15 +173,7 @@ pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
             modes: modes_of(&a.id),
         })
         .collect();
-    let dir = match (&opts.figures, &opts.out) {
-        (Some(d), _) => d.clone(),
-        (None, Some(out)) => out
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
-        (None, None) => PathBuf::from("results/identify"),
-    };
-    std::fs::create_dir_all(&dir).map_err(|e| Error::write(&dir, e))?;
+    crate::output::atomic::create_dir(&dir)?;
     let mut figures = Vec::new();
     for a in &axes {
         let stem = format!("identify-{}", a.axis);
@@ -199,6 +208,118 @@ pub fn identify(opts: &IdentifyOptions) -> Result<Identified, Error> {
     })
 }
 
+/// The ranges of the resonance test's options, as `TEST_RESONANCES` takes them in
+/// Klipper's `resonance_tester.py` (FREQ_START >= 1 Hz, FREQ_END at most 300 Hz) with
+/// settle's own bounds where Klipper has none: a band of at least 5 Hz to fit in, a sweep
+/// rate of 0.1 to 100 Hz/s (Klipper's `hz_per_sec` takes 0.1 to 2; slower sweeps make
+/// tests of hours whose excitation settle would hold in memory), a sweeping period of 0
+/// (off) or 0.1 to 100 s.
+pub const FREQ_MIN_HZ: f64 = 1.0;
+/// See [`FREQ_MIN_HZ`].
+pub const FREQ_MAX_HZ: f64 = 300.0;
+/// See [`FREQ_MIN_HZ`].
+pub const HZ_PER_SEC: (f64, f64) = (0.1, 100.0);
+/// See [`FREQ_MIN_HZ`].
+pub const SWEEPING_PERIOD_S: (f64, f64) = (0.1, 100.0);
+
+/// Check the options against their documented ranges before any file is read; errors
+/// name the command-line option.
+fn check_options(o: &settle_identify::Options) -> Result<(), Error> {
+    let t = &o.test;
+    let bad = |key: &str, msg: String| Err(Error::input(key, msg));
+    if !(1..=4).contains(&o.max_modes) {
+        return bad("--max-modes", format!("{}: allowed 1 to 4", o.max_modes));
+    }
+    if !(t.freq_start_hz.is_finite() && (FREQ_MIN_HZ..FREQ_MAX_HZ).contains(&t.freq_start_hz)) {
+        return bad(
+            "--freq-start",
+            format!(
+                "{} Hz: allowed {FREQ_MIN_HZ} to under {FREQ_MAX_HZ} Hz (Klipper's FREQ_START is at least 1 Hz)",
+                t.freq_start_hz
+            ),
+        );
+    }
+    if !(t.freq_end_hz.is_finite()
+        && t.freq_end_hz >= t.freq_start_hz + 5.0
+        && t.freq_end_hz <= FREQ_MAX_HZ)
+    {
+        return bad(
+            "--freq-end",
+            format!(
+                "{} Hz: allowed from 5 Hz above --freq-start ({} Hz) to {FREQ_MAX_HZ} Hz (Klipper's FREQ_END is at most 300 Hz)",
+                t.freq_end_hz, t.freq_start_hz
+            ),
+        );
+    }
+    let (lo, hi) = HZ_PER_SEC;
+    if !(t.hz_per_sec.is_finite() && (lo..=hi).contains(&t.hz_per_sec)) {
+        return bad(
+            "--hz-per-sec",
+            format!("{} Hz/s: allowed {lo} to {hi} Hz/s", t.hz_per_sec),
+        );
+    }
+    if !(t.accel_per_hz.is_finite() && t.accel_per_hz > 0.0) {
+        return bad(
+            "--accel-per-hz",
+            format!("{} mm/s^2/Hz: allowed a finite number > 0", t.accel_per_hz),
+        );
+    }
+    if !(t.sweeping_accel_mm_s2.is_finite() && t.sweeping_accel_mm_s2 >= 0.0) {
+        return bad(
+            "--sweeping-accel",
+            format!(
+                "{} mm/s^2: allowed a finite number >= 0 (0: no sweeping motion)",
+                t.sweeping_accel_mm_s2
+            ),
+        );
+    }
+    let (lo, hi) = SWEEPING_PERIOD_S;
+    let p = t.sweeping_period_s;
+    if !(p == 0.0 || (p.is_finite() && (lo..=hi).contains(&p))) {
+        return bad(
+            "--sweeping-period",
+            format!("{p} s: allowed 0 (no sweeping motion) or {lo} to {hi} s"),
+        );
+    }
+    Ok(())
+}
+
+/// The figures folder: `--figures`, else the machine file's folder, else
+/// `results/identify/`.
+fn figures_dir(opts: &IdentifyOptions) -> PathBuf {
+    match (&opts.figures, &opts.out) {
+        (Some(d), _) => d.clone(),
+        (None, Some(out)) => out
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+        (None, None) => PathBuf::from("results/identify"),
+    }
+}
+
+/// The figures of an earlier identification, which `--force` overwrites.
+const FIGURES: Results<'static> = Results {
+    what: "settle identify",
+    marks: &[
+        "identify-x.svg",
+        "identify-x.png",
+        "identify-y.svg",
+        "identify-y.png",
+        "identify-z.svg",
+        "identify-z.png",
+    ],
+};
+
+/// Whether identify writes `rel` in its figures folder.
+fn writes_figure(rel: &Path) -> bool {
+    crate::output::folder::written(
+        rel,
+        &[],
+        &[],
+        &[("identify-", ".svg"), ("identify-", ".png")],
+    )
+}
+
 /// `value ± sigma` with at least `digits` decimals, and as many more as show the
 /// sigma's first two significant digits.
 fn pm(value: f64, sigma: f64, digits: usize) -> String {
@@ -217,8 +338,8 @@ impl Identified {
         let mut out = String::new();
         let _ = writeln!(
             out,
-            "{:<4} {:<16} {:>4} {:>20} {:>20} {:>18}  method",
-            "axis", "sensor", "mode", "frequency_hz", "damping_ratio", "weight"
+            "{:<4} {:<16} {:>4} {:>20} {:>8} {:>20} {:>18}  method",
+            "axis", "sensor", "mode", "frequency_hz", "peak_hz", "damping_ratio", "weight"
         );
         for a in &self.axes {
             let sensor = match (&a.id.direction, a.id.dominant_sensor_axis) {
@@ -238,16 +359,28 @@ impl Identified {
                 };
                 let _ = writeln!(
                     out,
-                    "{:<4} {:<16} {:>4} {:>20} {:>20} {:>18}  {method}",
+                    "{:<4} {:<16} {:>4} {:>20} {:>8.2} {:>20} {:>18}  {method}",
                     a.axis,
                     sensor,
                     i,
                     pm(m.frequency_hz.value, m.frequency_hz.sigma, 2),
+                    m.peak_hz,
                     pm(m.damping_ratio.value, m.damping_ratio.sigma, 4),
                     weight,
                 );
             }
+            for p in &a.id.diagnostics.rejected {
+                let _ = writeln!(
+                    out,
+                    "{:<4} not a mode: {:.1} Hz: {}",
+                    a.axis, p.frequency_hz, p.reason
+                );
+            }
         }
+        let _ = writeln!(
+            out,
+            "frequency_hz is each mode's natural frequency (the machine file's); peak_hz is where the mode shows as a peak in a spectrum, as Klipper's and Shake&Tune's graphs show it."
+        );
         if self
             .axes
             .iter()

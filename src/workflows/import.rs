@@ -28,6 +28,7 @@ use settle_gcode::Dialect;
 use settle_gcode::config::{KlipperConfig, RrfConfig, ShaperSetting as FirmwareShaper};
 
 use crate::error::{Error, Location};
+use crate::input::machine_form::MachineForm;
 use crate::output::atomic::write_atomic;
 use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::grid::{identified_band, tuning_modes};
@@ -36,9 +37,12 @@ use settle_planner::firmware::Firmware;
 
 /// Shaper frequencies of the search, as multiples of the current one.
 pub const FREQUENCY_SCALES: [f64; 5] = [0.9, 0.95, 1.0, 1.05, 1.1];
-/// Accelerations of the search, as multiples of the current one (never above it: the
-/// current `max_accel` is what the user's motors are known to reach).
+/// Accelerations of the sweep around the current settings, as multiples of the current
+/// one.
 pub const ACCEL_SCALES: [f64; 3] = [0.5, 0.75, 1.0];
+/// Accelerations `settle tune` searches above the current one, as multiples of it, up to
+/// the highest the machine allows ([`top_accel`]).
+pub const ACCEL_SCALES_ABOVE: [f64; 5] = [1.25, 1.5, 2.0, 3.0, 4.0];
 /// Robustness of the imported search (percent): a winner must still work with the real
 /// mode this far off the identified one. Kept when the machine's modes carry their
 /// identified sigmas: those are the statistical uncertainty of one measurement (often
@@ -59,6 +63,9 @@ pub struct ImportOptions {
     pub machine: Option<PathBuf>,
     /// The scenario to write (default: `<config name>_import.toml` beside the config).
     pub out: Option<PathBuf>,
+    /// Replace a scenario already at `out` (refused without it: an earlier import, or a
+    /// scenario edited since, would be lost).
+    pub force: bool,
 }
 
 /// One axis's current settings.
@@ -134,9 +141,11 @@ impl Imported {
 
 /// A configuration reader's error as the harness's, at its file, line and key.
 pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
-    if let settle_gcode::GcodeError::Io { source, .. } = e {
-        return Error::read(path, source);
-    }
+    let e = match e {
+        settle_gcode::GcodeError::Io { source, .. } => return Error::read(path, source),
+        settle_gcode::GcodeError::File(f) => return (*f).into(),
+        e => e,
+    };
     let text = e.to_string();
     match e.location() {
         Some(at) => {
@@ -157,7 +166,12 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
                 message: text.strip_prefix(&prefix).unwrap_or(&text).to_string(),
             }
         }
-        None => Error::input(path, text),
+        None => match e {
+            settle_gcode::GcodeError::JobSetting { key, reason } => {
+                Error::input_key(path, key, reason)
+            }
+            _ => Error::input(path, text),
+        },
     }
 }
 
@@ -170,8 +184,17 @@ fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)
 /// RepRapFirmware (config.g).
 pub const READ: [Firmware; 2] = [Firmware::Klipper, Firmware::Rrf];
 
-/// A firmware of [`READ`] by name ([`Firmware::parse`]'s names).
+/// A firmware of [`READ`] by name ([`Firmware::parse`]'s names); GRBL is refused with its
+/// reason (its `$$` settings feed `settle gcode`, not a tune: GRBL has no input shaper).
 pub fn parse_firmware(name: &str) -> Result<Firmware, String> {
+    if Firmware::parse(name) == Some(Firmware::Grbl) {
+        return Err(format!(
+            "grbl is not a firmware whose configuration settle import reads: GRBL has no \
+             input shaper for settle tune to set (its $$ settings are read by settle gcode \
+             --firmware grbl --config); allowed: {}",
+            Firmware::names(&READ)
+        ));
+    }
     Firmware::parse_among(
         name,
         &READ,
@@ -181,9 +204,21 @@ pub fn parse_firmware(name: &str) -> Result<Firmware, String> {
 
 /// Read the current settings of a firmware configuration.
 pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
+    read_current_files(firmware, path).map(|(c, _)| c)
+}
+
+/// [`read_current`], with the files read (the configuration and what it includes).
+pub fn read_current_files(
+    firmware: Firmware,
+    path: &Path,
+) -> Result<(Current, Vec<PathBuf>), Error> {
     match firmware {
         Firmware::Klipper => {
             let c = KlipperConfig::read(path).map_err(|e| config_error(path, e))?;
+            // The planner's settings as `settle gcode --config` takes them: a shaper
+            // Klipper would refuse is refused here too, naming its key.
+            settle_gcode::job::JobConfig::from_klipper(&c).map_err(|e| config_error(path, e))?;
+            let files = c.files.clone();
             let axes = [("x", &c.steppers.x), ("y", &c.steppers.y)]
                 .into_iter()
                 .map(|(name, st)| AxisNow {
@@ -194,16 +229,19 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                     usteps_per_mm: st.as_ref().map(|s| s.drive.microsteps_per_mm),
                 })
                 .collect();
-            Ok(Current {
+            let cur = Current {
                 firmware,
                 vmax_mm_s: c.printer.max_velocity_mm_s,
                 amax_mm_s2: c.printer.max_accel_mm_s2,
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
-            })
+            };
+            Ok((cur, files))
         }
         Firmware::Rrf => {
             let c = RrfConfig::read(path).map_err(|e| config_error(path, e))?;
+            settle_gcode::job::JobConfig::from_rrf(&c).map_err(|e| config_error(path, e))?;
+            let files = c.files.clone();
             let shaper = shaper_now(&c.input_shaper, Dialect::Rrf);
             let axes = [("x", &c.axes.x), ("y", &c.axes.y)]
                 .into_iter()
@@ -213,7 +251,7 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                     usteps_per_mm: Some(a.drive.microsteps_per_mm),
                 })
                 .collect();
-            Ok(Current {
+            let cur = Current {
                 firmware,
                 vmax_mm_s: c.axes.x.max_speed_mm_s.min(c.axes.y.max_speed_mm_s),
                 amax_mm_s2: c
@@ -222,7 +260,8 @@ pub fn read_current(firmware: Firmware, path: &Path) -> Result<Current, Error> {
                     .min(c.axes.y.max_accel_mm_s2),
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
-            })
+            };
+            Ok((cur, files))
         }
         other => Err(Error::input_key(
             path,
@@ -267,7 +306,53 @@ fn around(x: f64, scales: &[f64], step: f64) -> Vec<f64> {
     v
 }
 
-/// The scenario's text; `frequency_hz` is the sweep's centre for an unshaped first axis.
+/// The highest acceleration the machine allows a shaper on the axis of `run` (mm/s^2):
+/// the largest at which one of the firmware's shapers, tuned to the axis's strongest mode
+/// (at the search's highest frequency scale, designed for the mode's damping), keeps
+/// Klipper's smoothing within its 0.12 mm; above it every shaper that cancels the mode
+/// smooths more. `None` without a mode or a shaper.
+pub fn top_accel(firmware: Firmware, run: &crate::spec::run_spec::RunSpec) -> Option<f64> {
+    let (f, zeta) = tuning_modes(run).first().copied()?;
+    let highest = FREQUENCY_SCALES.iter().copied().fold(0.0, f64::max);
+    Candidates::of(firmware)
+        .shapers()
+        .into_iter()
+        .filter_map(|k| {
+            let (z, _) = crate::workflows::tune::target::design_damping(k, zeta);
+            let sh = settle_planner::shaper::Shaper::new(k, (f * highest * 10.0).round() / 10.0, z)
+                .ok()?;
+            Some(crate::studies::shaping::max_accel_mm_s2(
+                &sh,
+                settle_planner::shaper_select::TARGET_SMOOTHING_MM,
+            ))
+        })
+        .filter(|a| a.is_finite())
+        .reduce(f64::max)
+}
+
+/// The accelerations `settle tune` searches: [`ACCEL_SCALES`] of the current one, then
+/// [`ACCEL_SCALES_ABOVE`] up to `top` and `top` itself (both rounded down to 100 mm/s^2).
+pub fn tune_accels(current: f64, top: Option<f64>) -> Vec<f64> {
+    let mut v = around(current, &ACCEL_SCALES, 100.0);
+    if let Some(top) = top.map(|t| (t / 100.0).floor() * 100.0)
+        && top > current
+    {
+        v.extend(
+            ACCEL_SCALES_ABOVE
+                .iter()
+                .map(|k| (current * k / 100.0).floor() * 100.0)
+                .filter(|a| *a < top),
+        );
+        v.push(top);
+    }
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
+}
+
+/// The scenario's text; `frequency_hz` is the sweep's centre for an unshaped first axis,
+/// `top` the highest acceleration the machine allows ([`top_accel`]).
+#[allow(clippy::too_many_arguments)]
 fn scenario_text(
     name: &str,
     machine: &str,
@@ -276,6 +361,7 @@ fn scenario_text(
     frequency_hz: f64,
     source: &str,
     identified_band: bool,
+    top: Option<f64>,
 ) -> String {
     let first = axes.first().copied().unwrap_or(&cur.axes[0]);
     let fw = cur.firmware;
@@ -287,6 +373,7 @@ fn scenario_text(
         )
     });
     let accels = around(cur.amax_mm_s2, &ACCEL_SCALES, 100.0);
+    let tune_accels = tune_accels(cur.amax_mm_s2, top);
     let freqs = around(f_now, &FREQUENCY_SCALES, 0.1);
     let mut types = vec![q("none")];
     types.extend(Candidates::of(fw).shapers().iter().map(|k| q(&k.name())));
@@ -349,11 +436,19 @@ fn scenario_text(
     let names: Vec<String> = axes.iter().map(|a| q(&a.name)).collect();
     let _ = writeln!(
         t,
-        "[tune]\nfirmware = {}\naxes = [{}]\ndistances_mm = [5.0, 20.0]\nband_um = 10.0\nfrequency_scales = {}\naccelerations_mm_s2 = {}\n{}",
+        "[tune]\nfirmware = {}\naxes = [{}]\ndistances_mm = [5.0, 20.0]\nband_um = 10.0\nfrequency_scales = {}\n{}accelerations_mm_s2 = {}\n{}",
         q(fw.name()),
         names.join(", "),
         list(&FREQUENCY_SCALES),
-        list(&accels),
+        match top {
+            Some(t) if t > cur.amax_mm_s2 => format!(
+                "# From half the current acceleration up to {:.0} mm/s^2, the highest at which one of\n# {}'s shapers, tuned to the machine's strongest mode, stays within 0.12 mm of smoothing.\n",
+                (t / 100.0).floor() * 100.0,
+                fw.name()
+            ),
+            _ => "# Around the current acceleration: no shaper of the firmware stays within 0.12 mm of\n# smoothing above it on this machine.\n".to_string(),
+        },
+        list(&tune_accels),
         if identified_band {
             format!(
                 "# The machine file's frequency_sigma_hz gives each axis a 2-sigma band; tune uses\n# the wider of that band and this tolerance (the drift one measurement does not see).\nfrequency_tolerance_pct = {FREQUENCY_TOLERANCE_PCT:?}"
@@ -383,6 +478,47 @@ fn scenario_text(
     t
 }
 
+/// A scenario made of the settings read that settle cannot run (`e`, against the probe
+/// scenario), said against the configuration and the firmware's own key.
+fn settings_error(config: &Path, firmware: Firmware, axis: &str, e: Error) -> Error {
+    let Error::Input { at, message } = e else {
+        return e;
+    };
+    let key = at.key.unwrap_or_default();
+    let key = key.strip_prefix("sweep.").unwrap_or(&key);
+    let klipper = firmware == Firmware::Klipper;
+    let firmware_key = match key {
+        k if k.starts_with("limits.amax") => {
+            if klipper {
+                "printer.max_accel"
+            } else {
+                "M201 / M204 P"
+            }
+        }
+        k if k.starts_with("limits.vmax") => {
+            if klipper {
+                "printer.max_velocity"
+            } else {
+                "M203"
+            }
+        }
+        k if k.starts_with("shaper.") => {
+            if klipper {
+                "input_shaper"
+            } else {
+                "M593"
+            }
+        }
+        _ => "",
+    };
+    let message = format!("axis {axis}: settle cannot run these settings: {message}");
+    if firmware_key.is_empty() {
+        Error::input(config, message)
+    } else {
+        Error::input_key(config, firmware_key, message)
+    }
+}
+
 /// A scenario name from the configuration's file name.
 fn name_of(config: &Path) -> String {
     let stem = config
@@ -408,13 +544,46 @@ fn name_of(config: &Path) -> String {
 /// Import: read the configuration, find the axes the machine has and its modes, write
 /// the scenario.
 pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
-    let cur = read_current(opts.firmware, &opts.config)?;
+    let (cur, files) = read_current_files(opts.firmware, &opts.config)?;
     let name = name_of(&opts.config);
     let out = opts
         .out
         .clone()
         .unwrap_or_else(|| opts.config.with_file_name(format!("{name}.toml")));
+    // Never onto the configuration, a file it includes or the machine file.
+    let mut inputs = settle_files::write::Inputs::of(&files);
+    inputs.add(&opts.config);
+    if let Some(m) = &opts.machine {
+        inputs.add(m);
+    }
+    inputs.refuse(&out)?;
+    settle_files::write::check_target(&out)?;
+    if !opts.force && std::fs::symlink_metadata(&out).is_ok() {
+        return Err(Error::input(
+            "--force",
+            format!(
+                "{} already exists (an earlier import, or a scenario edited since): pass --force to overwrite it, --out FILE to write elsewhere",
+                out.display()
+            ),
+        ));
+    }
     let mut notes = cur.notes.clone();
+    // The machine's axes, read here so that its errors name it (and only it).
+    let machine_axes = match &opts.machine {
+        Some(m) => {
+            let text = crate::input::file::read_text(m, crate::input::file::limit::SETTINGS)?;
+            let d = crate::input::machine_file::parse_any(&text, m)?;
+            Some(match d.form {
+                MachineForm::Physical(machine) => machine
+                    .axes
+                    .iter()
+                    .map(|a| a.name.clone())
+                    .collect::<Vec<_>>(),
+                MachineForm::Modes(axes) => axes.iter().map(|a| a.axis.clone()).collect(),
+            })
+        }
+        None => None,
+    };
     let machine = match &opts.machine {
         Some(m) => std::path::absolute(m)
             .map_err(|e| Error::read(m, e))?
@@ -433,24 +602,33 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
     let mut axes: Vec<&AxisNow> = Vec::new();
     let mut centre_hz = None;
     let mut band = false;
+    let mut top: Option<f64> = None;
     for a in &cur.axes {
-        let text = scenario_text(&name, &machine, &cur, &[a], 40.0, &source, false);
+        let has_axis = machine_axes.as_ref().is_none_or(|m| m.contains(&a.name));
+        if !has_axis {
+            notes.push(format!(
+                "the machine has no axis `{}`: it is not tuned",
+                a.name
+            ));
+            continue;
+        }
+        let text = scenario_text(&name, &machine, &cur, &[a], 40.0, &source, false, None);
         let probe = out.with_file_name(format!("{name}.probe.toml"));
-        if let Ok((_, runs)) = crate::expand::parse_runs(&text, &probe)
-            && let Some(run) = runs.first()
-        {
+        // The machine has the axis: a scenario that does not load is the settings' fault
+        // (a limit the firmware accepts that settle cannot run), said as such.
+        let (_, runs) = crate::expand::parse_runs(&text, &probe)
+            .map_err(|e| settings_error(&opts.config, cur.firmware, &a.name, e))?;
+        if let Some(run) = runs.first() {
             if centre_hz.is_none() {
                 centre_hz = tuning_modes(run)
                     .first()
                     .map(|(f, _)| (f * 10.0).round() / 10.0);
             }
             band |= identified_band(run).is_some();
+            if let Some(t) = top_accel(cur.firmware, run) {
+                top = Some(top.map_or(t, |m: f64| m.max(t)));
+            }
             axes.push(a);
-        } else {
-            notes.push(format!(
-                "the machine has no axis `{}`: it is not tuned",
-                a.name
-            ));
         }
     }
     if axes.is_empty() {
@@ -469,6 +647,7 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
         centre_hz.unwrap_or(40.0),
         &source,
         band,
+        top,
     );
     // What is written must load.
     crate::expand::parse_runs(&text, &out)?;

@@ -96,6 +96,7 @@ impl Journal {
             path: path.clone(),
             source,
         };
+        settle_files::write::check_target(&path)?;
         let mut file = File::create(&path).map_err(write_err)?;
         file.write_all(format!("{key_line}\n{header}").as_bytes())
             .map_err(write_err)?;
@@ -117,7 +118,7 @@ impl Journal {
         params: &dyn Fn(usize) -> Option<String>,
     ) -> Result<Resumed, Error> {
         let path = out.join(FILE);
-        let text = crate::input::file::read_text(&path)?;
+        let text = crate::input::file::read_text(&path, crate::input::file::limit::RESULTS)?;
         let (first, rest) = text.split_once('\n').unwrap_or((&text, ""));
         if !first.starts_with(MAGIC) {
             return Err(journal_error(
@@ -146,7 +147,10 @@ restore them to resume, or delete the journal to start over"
         let mut notes = Vec::new();
         for (i, line) in rows.split_inclusive('\n').enumerate() {
             let number = i + 3;
-            match check_line(line, params) {
+            match check_line(line, params).and_then(|(id, row)| {
+                check_cells(header, &row).map_err(|why| (Some(id), why))?;
+                Ok((id, row))
+            }) {
                 Ok((id, row)) => match done.get(&id) {
                     Some(prev) if *prev != row => {
                         done.remove(&id);
@@ -323,6 +327,40 @@ fn check_line(
         return Err((Some(id), format!("run {id} has a NaN")));
     }
     Ok((id, row.to_string()))
+}
+
+/// A row's cells against the header: as many as it has columns, a `status` a run ends
+/// with, and the metrics every run has numbers (or empty, for a failed run): a row with a
+/// valid checksum and garbage cells is not a finished run.
+fn check_cells(header: &str, row: &str) -> Result<(), String> {
+    let table = crate::input::runs_table::RunsTable::parse(&format!("{header}{row}"))
+        .map_err(|e| format!("not a row of this sweep's runs.csv ({e})"))?;
+    let Some(cells) = table.rows.first().filter(|_| table.rows.len() == 1) else {
+        return Err("not one row of this sweep's runs.csv".into());
+    };
+    if let Some(s) = table.column("status")
+        && !matches!(cells[s].as_str(), "ok" | "lost_steps" | "fault")
+    {
+        return Err("its status is not one a run ends with (ok, lost_steps, fault)".into());
+    }
+    const METRICS: [&str; 7] = [
+        "move_time_s",
+        "residual_peak_um",
+        "residual_rms_um",
+        "settle_time_s_",
+        "move_and_settle_s_",
+        "overshoot_um",
+        "max_following_error_um",
+    ];
+    for (name, cell) in table.header.iter().zip(cells) {
+        let metric = METRICS
+            .iter()
+            .any(|m| name == m || (m.ends_with('_') && name.starts_with(m)));
+        if metric && !cell.is_empty() && crate::input::runs_table::number(cell).is_none() {
+            return Err(format!("its `{name}` is not a number"));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

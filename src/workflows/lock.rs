@@ -37,6 +37,7 @@ impl FolderLock {
     pub fn take(out: &Path) -> Result<Self, Error> {
         let path = out.join(FILE);
         let write_err = |source| Error::write(&path, source);
+        settle_files::write::check_target(&path)?;
         let mut file = OpenOptions::new()
             .read(true)
             .write(true)
@@ -70,9 +71,15 @@ impl FolderLock {
             host(),
             command.join(" ")
         );
-        file.set_len(0).map_err(write_err)?;
-        file.rewind().map_err(write_err)?;
-        file.write_all(text.as_bytes()).map_err(write_err)?;
+        let written = file
+            .set_len(0)
+            .and_then(|()| file.rewind())
+            .and_then(|()| file.write_all(text.as_bytes()));
+        if let Err(e) = written {
+            // Held by this process and naming no one (a full disk): not left behind.
+            let _ = std::fs::remove_file(&path);
+            return Err(write_err(e));
+        }
         Ok(Self { path, file })
     }
 }

@@ -1,5 +1,6 @@
 //! The commands as library functions with typed results: [`sweep`] (with its [`journal`],
-//! `--resume` and [`shard`]s), [`run`] (one case in detail), [`check`] (the regression
+//! `--resume` and [`shard`]s, K and N given or read from a [`scheduler`]'s environment),
+//! [`run`] (one case in detail), [`check`] (the regression
 //! gate), [`merge`] (sharded sweeps), [`validate`] (backends against the closed form),
 //! [`tune`] (the profile search), [`import`] (firmware configurations in), [`plan`] (JSON
 //! lines), [`machine`] (a machine's modes per axis) and [`identify`] (modes from
@@ -16,6 +17,7 @@ pub mod machine;
 pub mod merge;
 pub mod plan;
 pub mod run;
+pub mod scheduler;
 pub mod shard;
 pub mod sweep;
 #[cfg(test)]
@@ -28,7 +30,11 @@ pub mod validate;
 pub enum Exit {
     /// Everything ran and passed (exit code 0).
     Ok,
-    /// Runs failed, or a check found a regression (exit code 1).
+    /// The command finished and wrote every output, and some runs failed physically (lost
+    /// steps, a simulation fault): results, recorded with their reasons, not a failure of
+    /// the command (exit code 0, or 1 with `--fail-on-failed-runs`).
+    RunsFailed,
+    /// A check found a regression or a validation failed (exit code 1).
     Failed,
     /// A sweep was interrupted; its finished runs are kept for `--resume` (exit code 130,
     /// [`crate::execute::interrupt::EXIT_CODE`]).

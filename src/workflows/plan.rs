@@ -60,7 +60,8 @@ pub fn answer(line: &str) -> String {
     match solve(line) {
         Ok(v) => v.to_string(),
         // The problem's own text (a name, a key) is quoted in the message: never 10 MB of it.
-        Err(e) => json!({ "error": crate::error::echo_quoted(&e) }).to_string(),
+        Err(e) => json!({ "error": crate::error::shorten_numbers(&crate::error::echo_quoted(&e)) })
+            .to_string(),
     }
 }
 
@@ -85,6 +86,9 @@ fn solve(line: &str) -> Result<Value, String> {
         match (v.len(), required) {
             (0, false) => Ok(None),
             (len, _) if len == n => Ok(Some(v[i])),
+            (0, true) => Err(format!(
+                "`{name}` is missing: it is required, one value per axis (as `vmax`)"
+            )),
             (len, _) => Err(format!(
                 "`{name}` has {len} values, expected {n} (one per axis, as `vmax`)"
             )),
@@ -122,7 +126,9 @@ fn solve(line: &str) -> Result<Value, String> {
         };
         axes.push(Axis {
             start: State {
-                p: or0("p0", &pr.p0)?,
+                // Required for the position interface, as documented: a missing start
+                // is not 0.
+                p: get("p0", &pr.p0, position, i)?.unwrap_or(0.0),
                 v: or0("v0", &pr.v0)?,
                 a: or0("a0", &pr.a0)?,
             },
@@ -180,8 +186,9 @@ pub const BATCH: usize = 8192;
 /// Answer the JSON lines of `input` on `output`, in order, in parallel batches on `jobs`
 /// threads (all cores when `None`).
 ///
-/// Lines are split on `\n` (a `\r` before it is dropped); a line that is not UTF-8 is
-/// answered with an error and the stream goes on. A batch holds up to [`BATCH`] lines
+/// Lines are split on `\n` (a `\r` before it is dropped); a line that is not UTF-8, or
+/// longer than [`settle_files::limit::PLAN_LINE`] (skipped unread), is answered with an
+/// error and the stream goes on. A batch holds up to [`BATCH`] lines
 /// (`max_batch` lower, e.g. 1 for a terminal), but never waits for input: it ends as soon
 /// as the lines read so far are all that `input` has delivered (no complete line left in
 /// the read buffer), then its answers are written and flushed. So a client that writes one
@@ -193,38 +200,55 @@ pub fn plan_stream(
     max_batch: usize,
 ) -> Result<(), crate::error::Error> {
     use rayon::prelude::*;
-    use std::io::BufRead;
+    use settle_files::lines::{BoundedLines, LineStatus};
     let pool = crate::execute::pool::thread_pool(jobs)?;
     let read_err = |e| crate::error::Error::read("stdin", e);
     let write_err = |e| crate::error::Error::write("stdout", e);
-    let mut input = std::io::BufReader::with_capacity(1 << 16, input);
+    let limit = settle_files::limit::PLAN_LINE;
+    let mut input = BoundedLines::new(
+        std::io::BufReader::with_capacity(1 << 16, input),
+        usize::try_from(limit.bytes).unwrap_or(usize::MAX),
+    );
     let max_batch = max_batch.clamp(1, BATCH);
-    let mut number = 0u64;
-    let mut batch: Vec<(u64, Vec<u8>)> = Vec::new();
+    // A line longer than the limit is answered with an error, unread (`None`).
+    let mut batch: Vec<(u64, Option<Vec<u8>>)> = Vec::new();
     loop {
         batch.clear();
         let mut eof = false;
         while batch.len() < max_batch {
             // Reading on would wait for input: answer what is here first.
-            if !batch.is_empty() && !input.buffer().contains(&b'\n') {
+            if !batch.is_empty() && !input.get_ref().buffer().contains(&b'\n') {
                 break;
             }
-            let mut line = Vec::new();
-            if input.read_until(b'\n', &mut line).map_err(read_err)? == 0 {
+            let Some(status) = input.next_line().map_err(read_err)? else {
                 eof = true;
                 break;
-            }
-            if line.last() == Some(&b'\n') {
-                line.pop();
-                if line.last() == Some(&b'\r') {
-                    line.pop();
-                }
-            }
-            number += 1;
-            batch.push((number, line));
+            };
+            let line = match status {
+                LineStatus::Complete => Some(input.bytes().to_vec()),
+                LineStatus::TooLong => None,
+            };
+            batch.push((input.line_no(), line));
         }
-        let answers: Vec<String> =
-            pool.install(|| batch.par_iter().map(|(n, l)| answer_bytes(*n, l)).collect());
+        let too_long = |n: u64| {
+            json!({
+                "error": format!(
+                    "line {n}: longer than {}, the limit for {}",
+                    limit.human(),
+                    limit.what
+                )
+            })
+            .to_string()
+        };
+        let answers: Vec<String> = pool.install(|| {
+            batch
+                .par_iter()
+                .map(|(n, l)| match l {
+                    Some(l) => answer_bytes(*n, l),
+                    None => too_long(*n),
+                })
+                .collect()
+        });
         for a in answers {
             writeln!(output, "{a}").map_err(write_err)?;
         }

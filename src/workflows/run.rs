@@ -1,11 +1,17 @@
 //! `settle run SCENARIO --case ID`: one point of a sweep in detail: its full trace as CSV,
 //! optionally its recordings and a figure of its time series, and its metrics.
+//!
+//! A run that fails (lost steps, a simulation fault, a planner or backend error) is a
+//! result as in `settle sweep`: its status and reason are printed instead of its metrics
+//! (runs.csv leaves them empty too), its trace up to where it stopped is written, and the
+//! report ends with [`Exit::RunsFailed`].
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use crate::error::Error;
-use crate::measure::metrics::{Metrics, Status};
+use crate::measure::metrics::Metrics;
+use crate::measure::series::Series;
 use crate::output::atomic::{create_dir, write_atomic};
 use crate::output::sink::{RunRecord, record_run, row_of};
 use crate::spec::backend::Backend;
@@ -63,7 +69,8 @@ pub struct RunOutcome {
 pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
     let path = &opts.scenario;
     let case = opts.case;
-    let (sc, mut runs) = crate::expand::load_runs(path)?;
+    let (sc, src) = crate::expand::load(path)?;
+    let mut runs = crate::expand::expand(&sc, &src)?;
     crate::execute::set_backend(path, &mut runs, opts.backend)?;
     let Some(spec) = runs.get(case) else {
         return Err(Error::input(
@@ -83,24 +90,64 @@ pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .map_or_else(|| PathBuf::from("."), PathBuf::from);
+    // Never onto the scenario or a file it reads, a link or a device: checked for every
+    // file the run writes, before it runs.
+    let inputs = crate::expand::machine::input_files(&sc, &src);
+    let stem = out.file_stem().map_or_else(
+        || format!("run-{case}"),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    let mut outputs = vec![out.clone()];
+    if opts.mcap {
+        outputs.push(out.with_extension("mcap"));
+    }
+    if opts.rerun {
+        outputs.push(out.with_extension("rrd"));
+    }
+    if opts.plot {
+        outputs.push(dir.join(format!("{stem}.svg")));
+        outputs.push(dir.join(format!("{stem}.png")));
+    }
+    for o in &outputs {
+        inputs.refuse(o)?;
+        settle_files::write::check_target(o)?;
+    }
     if out.parent().is_some_and(|d| !d.as_os_str().is_empty()) {
         create_dir(&dir)?;
     }
     let rec =
         crate::workflows::sweep::recorder(opts.mcap, opts.rerun, dir.clone(), path, &sc.name)?;
-    let (series, m) = record_run(spec)?;
+    let (series, m) = match record_run(spec) {
+        Ok(done) => done,
+        // As in a sweep: not a result of the run.
+        Err(e @ (Error::Interrupted { .. } | Error::Write { .. })) => return Err(e),
+        // As in a sweep: the run failed before it measured anything; a result.
+        Err(e) => (
+            Series::default(),
+            Metrics::failed(&spec.bands_um, e.to_string()),
+        ),
+    };
+    let mut written = Vec::new();
+    if series.is_empty() {
+        return Ok(RunOutcome {
+            spec: spec.clone(),
+            metrics: m,
+            written,
+            samples: 0,
+        });
+    }
     let mut csv = Vec::new();
     series
         .write_csv(&mut csv)
         .map_err(|e| Error::write(&out, e))?;
     write_atomic(&out, &csv)?;
+    written.push(out.clone());
     let record = RunRecord {
         spec,
         series: &series,
         metrics: &m,
         row: row_of(spec, &m),
     };
-    let mut written = vec![out.clone()];
     if let Some(r) = &rec {
         if r.mcap {
             let p = out.with_extension("mcap");
@@ -114,10 +161,6 @@ pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
         }
     }
     if opts.plot {
-        let stem = out.file_stem().map_or_else(
-            || format!("run-{case}"),
-            |s| s.to_string_lossy().into_owned(),
-        );
         let title = format!("{} run {case}: {}", sc.name, spec.swept_text(", "));
         let mut fig = crate::output::plot::trace::figure(&title, &record);
         crate::output::plot::scan_trace::scan_view(&record, &mut fig.panels);
@@ -152,6 +195,9 @@ impl RunOutcome {
         for (p, v) in &spec.swept {
             let _ = writeln!(s, "  {p} = {v}");
         }
+        if !m.is_ok() {
+            return self.failed_report(s);
+        }
         let _ = writeln!(s, "  move_time_s            {:.6}", m.move_time_s);
         let _ = writeln!(s, "  residual_peak_um       {:.4}", m.residual_peak_um);
         let _ = writeln!(s, "  residual_rms_um        {:.4}", m.residual_rms_um);
@@ -179,15 +225,7 @@ impl RunOutcome {
                 );
             }
         }
-        for a in &m.axes {
-            if let Some(deg) = a.max_load_angle_deg {
-                let _ = writeln!(
-                    s,
-                    "  axis {}: max load angle {deg:.1} electrical degrees",
-                    a.name
-                );
-            }
-        }
+        self.load_angles(&mut s);
         if let Some((_, e)) = m.extra.iter().find(|(n, _)| n == "scan_reentry_error_um") {
             let _ = writeln!(
                 s,
@@ -219,22 +257,58 @@ impl RunOutcome {
         for (name, v) in &m.extra {
             let _ = writeln!(s, "  {name:<22} {v}");
         }
-        if let Status::LostSteps { axis, steps } = &m.status {
-            let _ = writeln!(
-                s,
-                "  FAILED: lost {steps} full steps (axis {axis}): the numbers above are not a settling result"
-            );
+        self.written_line(&mut s);
+        Report {
+            stdout: s,
+            stderr: String::new(),
+            exit: Exit::Ok,
         }
+    }
+
+    /// A failed run: its status and reason instead of metrics (none of them is a settling
+    /// result), the load angles that show how far a motor slipped, the trace up to the
+    /// failure.
+    fn failed_report(&self, mut s: String) -> Report {
+        let status = &self.metrics.status;
+        let _ = writeln!(
+            s,
+            "  FAILED ({}): {}: no settling result (runs.csv leaves its metrics empty too)",
+            status.name(),
+            status.reason()
+        );
+        self.load_angles(&mut s);
+        if self.written.is_empty() {
+            let _ = writeln!(s, "no trace: the run failed before its first sample");
+        } else {
+            self.written_line(&mut s);
+        }
+        Report {
+            stdout: s,
+            stderr: String::new(),
+            exit: Exit::RunsFailed,
+        }
+    }
+
+    /// The largest load angle per axis with a stepper.
+    fn load_angles(&self, s: &mut String) {
+        for a in &self.metrics.axes {
+            if let Some(deg) = a.max_load_angle_deg {
+                let _ = writeln!(
+                    s,
+                    "  axis {}: max load angle {deg:.1} electrical degrees",
+                    a.name
+                );
+            }
+        }
+    }
+
+    /// `wrote FILES (N samples)`.
+    fn written_line(&self, s: &mut String) {
         let written: Vec<String> = self
             .written
             .iter()
             .map(|p| p.display().to_string())
             .collect();
         let _ = writeln!(s, "wrote {} ({} samples)", written.join(", "), self.samples);
-        Report {
-            stdout: s,
-            stderr: String::new(),
-            exit: Exit::Ok,
-        }
     }
 }

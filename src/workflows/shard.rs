@@ -138,6 +138,23 @@ fn input_error(file: &Path, message: String) -> Error {
 pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
     let path = dir.join(MANIFEST);
     if !path.exists() {
+        if let Some(journal) = crate::workflows::journal::existing(dir) {
+            let shard = journal_shard(&journal);
+            return Err(input_error(
+                dir,
+                format!(
+                    "an unfinished shard: {} but no {MANIFEST} ({}): it was stopped (a time limit, a node lost) or is still running; \
+finish it with `settle sweep SCENARIO --shard {} --out {} --resume`, then merge",
+                    crate::workflows::journal::FILE,
+                    shard.as_ref().map_or_else(
+                        || "its journal names no shard".to_string(),
+                        |s| format!("its journal is of shard {s}")
+                    ),
+                    shard.as_deref().unwrap_or("K/N"),
+                    dir.display()
+                ),
+            ));
+        }
         return Err(input_error(
             dir,
             format!(
@@ -145,7 +162,7 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
             ),
         ));
     }
-    let text = crate::input::file::read_text(&path)?;
+    let text = crate::input::file::read_text(&path, crate::input::file::limit::RESULTS)?;
     let m: Manifest =
         toml::from_str(&text).map_err(|e| input_error(&path, e.message().trim().to_string()))?;
     if m.format != FORMAT {
@@ -158,7 +175,7 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
         ));
     }
     let csv_path = dir.join("runs.csv");
-    let csv = crate::input::file::read_text(&csv_path)?;
+    let csv = crate::input::file::read_text(&csv_path, crate::input::file::limit::RESULTS)?;
     if runs_digest(&csv) != m.runs_digest {
         return Err(input_error(
             &csv_path,
@@ -180,6 +197,20 @@ pub fn read(dir: &Path) -> Result<(Manifest, RunsTable), Error> {
     }
     let table = RunsTable::parse(&csv).map_err(|e| input_error(&csv_path, e))?;
     Ok((m, table))
+}
+
+/// Which shard (`K/N`) a journal belongs to, from its first line (`...; shard K/N; ...`,
+/// see [`crate::workflows::journal::key_line`]).
+fn journal_shard(journal: &Path) -> Option<String> {
+    use std::io::{BufRead, Read};
+    let mut line = String::new();
+    // Through the one reader (a regular file; a FIFO put in its place does not block).
+    let f = crate::input::file::open(journal, crate::input::file::limit::RESULTS).ok()?;
+    std::io::BufReader::new(f.take(4096))
+        .read_line(&mut line)
+        .ok()?;
+    let shard = line.split("; ").find_map(|p| p.strip_prefix("shard "))?;
+    shard.parse::<Shard>().ok().map(|s| s.to_string())
 }
 
 /// Write a shard's manifest into `dir`.
@@ -293,9 +324,12 @@ pub fn merge(dirs: &[PathBuf]) -> Result<Merged, Error> {
         return Err(input_error(
             &first_dir,
             format!(
-                "missing shard(s) {} of scenario `{}`: give every shard folder",
+                "missing shard(s) {} of scenario `{}`: give every shard folder (a shard whose task failed or never ran has none: \
+run it with `settle sweep {} --shard {}`)",
                 missing.join(", "),
-                first.scenario_name
+                first.scenario_name,
+                first.scenario_file,
+                missing[0]
             ),
         ));
     }

@@ -11,7 +11,7 @@ use crate::error::Error;
 use crate::execute::pool::{Progress, run_each_errors};
 use crate::input::runs_columns::RunsColumns;
 use crate::measure::metrics::Metrics;
-use crate::output::atomic::{create_dir, write_atomic};
+use crate::output::atomic::{create_dir, create_subdir, write_atomic};
 use crate::output::report::ScenarioFile;
 use crate::output::runs_csv::RunsCsv;
 use crate::output::sink::{Provenance, Recorder};
@@ -164,6 +164,14 @@ pub fn sweep(
         Some(s) => all_runs.every(s.k - 1, s.n),
         None => all_runs,
     };
+    // Never onto the scenario or a file it reads, nor through a link out of the folder.
+    let read = crate::expand::machine::input_files(&sc, &src);
+    crate::output::folder::check(&out, &NO_RESULTS, true, &read, writes)?;
+    for sub in [PLOTS, RECORDINGS] {
+        if std::fs::symlink_metadata(out.join(sub)).is_ok() {
+            create_subdir(&out.join(sub))?;
+        }
+    }
     create_dir(&out)?;
     // The lock first: a folder another sweep is writing is refused as such.
     let _lock = FolderLock::take(&out)?;
@@ -175,7 +183,7 @@ pub fn sweep(
         remove_stale_temps(&dir)?;
     }
     if let Some(r) = &rec {
-        create_dir(&r.dir)?;
+        create_subdir(&r.dir)?;
     }
     note(&format!(
         "{}: {} runs on {}{} -> {}",
@@ -212,6 +220,7 @@ pub fn sweep(
         prefix.push(',');
         Some(prefix)
     };
+    let resuming = opts.resume && journal::existing(&out).is_some();
     let (journal, done) = match journal::existing(&out) {
         Some(_) if opts.resume => {
             let (j, done, notes) = Journal::resume(&out, &key, &header, &params)?;
@@ -233,12 +242,14 @@ pub fn sweep(
     };
     // The finished runs' ids (their rows stay in the journal).
     let done: std::collections::HashSet<usize> = done.into_keys().collect();
-    if opts.resume {
+    if resuming {
         note(&format!(
             "resuming: {} of {} runs already finished",
             done.len(),
             runs.len()
         ));
+    } else if opts.resume {
+        note("--resume: no journal here, so a new sweep");
     }
     // What is left to run (positions among the runs).
     let todo: Vec<u32> = (0..runs.len())
@@ -255,7 +266,7 @@ pub fn sweep(
             return Err(Error::Interrupted { run: spec.id });
         }
         let m = match match &rec {
-            Some(r) => r.run(spec),
+            Some(r) => r.run(spec).map_err(Error::as_write_failure),
             None => crate::execute::execute(spec, None),
         } {
             Ok(m) => m,
@@ -365,6 +376,30 @@ pub const KEPT: [&str; 4] = [
     journal::FILE,
 ];
 
+/// The results-folder check without earlier results to find (a sweep finds them itself,
+/// after taking the folder's lock: [`refuse_overwrite`]).
+const NO_RESULTS: crate::output::folder::Results<'static> = crate::output::folder::Results {
+    what: "a sweep",
+    marks: &[],
+};
+
+/// Whether a sweep (or a shard) writes `rel` in its output folder.
+pub fn writes(rel: &Path) -> bool {
+    crate::output::folder::written(
+        rel,
+        &[
+            "runs.csv",
+            "summary.md",
+            crate::output::sweep_files::REPORT,
+            journal::FILE,
+            crate::workflows::lock::FILE,
+            shard::MANIFEST,
+        ],
+        &[PLOTS, RECORDINGS],
+        &[],
+    )
+}
+
 /// An error when `out` holds the results of an earlier sweep ([`KEPT`]).
 fn refuse_overwrite(out: &Path) -> Result<(), Error> {
     let found: Vec<&str> = KEPT
@@ -412,7 +447,7 @@ fn remove_stale_temps(dir: &Path) -> Result<(), Error> {
 }
 
 /// The failed runs, from runs.csv's `status` and `reason` columns.
-fn failures(runs: &dyn RunList, csv: &str) -> Vec<FailedRun> {
+pub fn failures(runs: &dyn RunList, csv: &str) -> Vec<FailedRun> {
     let Ok(table) = RunsColumns::parse(csv) else {
         return Vec::new();
     };
@@ -482,7 +517,7 @@ impl SweepOutcome {
         let mut r = Report::new(if self.failed.is_empty() {
             Exit::Ok
         } else {
-            Exit::Failed
+            Exit::RunsFailed
         });
         match self.shard {
             Some(s) => r.err(format!(
@@ -505,23 +540,29 @@ impl SweepOutcome {
                     .map_or(String::new(), |d| format!("; recordings in {}", d.display()))
             )),
         }
-        if !self.failed.is_empty() {
-            r.err(format!(
-                "{} of {} runs failed (status and reason in runs.csv):",
-                self.failed.len(),
-                self.runs
-            ));
-            const SHOWN: usize = 20;
-            for f in self.failed.iter().take(SHOWN) {
-                r.err(format!(
-                    "  run {} ({}): {}: {}",
-                    f.id, f.what, f.status, f.reason
-                ));
-            }
-            if self.failed.len() > SHOWN {
-                r.err(format!("  ... and {} more", self.failed.len() - SHOWN));
-            }
-        }
+        list_failures(&mut r, &self.failed, self.runs);
         r
+    }
+}
+
+/// The failed runs on stderr (at most 20, then a count), as `settle sweep` and `settle
+/// merge` print them.
+pub fn list_failures(r: &mut Report, failed: &[FailedRun], runs: usize) {
+    if failed.is_empty() {
+        return;
+    }
+    r.err(format!(
+        "{} of {runs} runs failed (status and reason in runs.csv):",
+        failed.len(),
+    ));
+    const SHOWN: usize = 20;
+    for f in failed.iter().take(SHOWN) {
+        r.err(format!(
+            "  run {} ({}): {}: {}",
+            f.id, f.what, f.status, f.reason
+        ));
+    }
+    if failed.len() > SHOWN {
+        r.err(format!("  ... and {} more", failed.len() - SHOWN));
     }
 }

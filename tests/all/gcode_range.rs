@@ -10,7 +10,8 @@ use settle::studies::gcode::preroll::{preroll_s, slowest_decay_per_s};
 use settle::workflows::gcode::{GcodeOptions, measure};
 use settle_planner::firmware::Firmware;
 
-use crate::support::{extra, root, settle, write};
+use crate::support::one_mode::OneMode;
+use crate::support::{extra, one_modal_run, root, settle, write};
 
 fn tower(firmware: Firmware) -> GcodeOptions {
     GcodeOptions::new(
@@ -113,29 +114,12 @@ fn the_ringing_after_the_last_move_is_the_closed_form_free_vibration() {
     )
     .expect("runs");
     let (f, zeta) = (40.0, 0.05);
-    let w = std::f64::consts::TAU * f;
-    let (s, wd) = (zeta * w, w * (1.0 - zeta * zeta).sqrt());
-    // Free vibration of (u, u') over t.
-    let free = |u: f64, v: f64, t: f64| {
-        let (a, b) = (u, (v + s * u) / wd);
-        let (c, sn, e) = ((wd * t).cos(), (wd * t).sin(), (-s * t).exp());
-        (
-            e * (a * c + b * sn),
-            e * ((-s * a + wd * b) * c + (-s * b - wd * a) * sn),
-        )
-    };
-    // A phase of command acceleration `acc` (m/s^2) for `t` s from (e, e').
-    let phase = |e: f64, v: f64, acc: f64, t: f64| {
-        let p = -acc / (w * w);
-        let (u, v) = free(e - p, v, t);
-        (u + p, v)
-    };
+    let mode = OneMode::new(f, zeta);
+    let (s, free) = (mode.sigma(), |u, v, t| mode.free(u, v, t));
     let (vmax, amax, d) = (0.1, 3.0, 0.03);
     let ta = vmax / amax;
     let tc = (d - vmax * vmax / amax) / vmax;
-    let (e, v) = phase(0.0, 0.0, amax, ta);
-    let (e, v) = phase(e, v, 0.0, tc);
-    let (e_end, v_end) = phase(e, v, -amax, ta);
+    let (e_end, v_end) = mode.after(&[(amax, ta), (0.0, tc), (-amax, ta)]);
     let t_end = 2.0 * ta + tc;
     assert!(
         (o.print_time_s - t_end).abs() <= 1e-12,
@@ -356,11 +340,8 @@ fn the_gcode_study_starts_a_layer_range_from_the_whole_jobs_state() {
                 tower.to_str().expect("utf-8")
             ),
         );
-        let (_, mut runs) = settle::load_runs(&scenario).expect("loads");
-        settle::execute::set_backend(&scenario, &mut runs, settle::spec::backend::Backend::Modal)
-            .expect("modal");
-        assert_eq!(runs.len(), 1);
-        let m = settle::execute::execute(&runs[0], None).expect("runs");
+        let run = one_modal_run(&scenario);
+        let m = settle::execute::execute(&run, None).expect("runs");
         assert!(m.is_ok(), "{m:?}");
         let whole = measure(&GcodeOptions::new(tower, name, Firmware::Klipper).expect("options"))
             .expect("runs");
@@ -445,7 +426,7 @@ fn the_linearisation_point_is_the_centre_of_the_printing_moves() {
          G91\nG1 Y20 E1\nG1 X-5 F3000\nG1 E-0.5\nG90\nG92 X0 Y0\n\
          G1 X10 Y-40 E1\nG0 X-125 Y-130\nG1 X0 Y0\n",
     );
-    assert_eq!(p.source, PointSource::Printing);
+    assert_eq!(p.source, PointSource::Working);
     assert_eq!(p.xyz_mm, [22.5, 10.0, 0.2]);
     assert_eq!(
         p.on_axes(&["y".into(), "x".into()]),

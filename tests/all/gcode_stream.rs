@@ -6,7 +6,7 @@ use settle::studies::Motion;
 use settle::workflows::gcode::{GcodeOptions, measure, parse_shapers};
 use settle_planner::firmware::Firmware;
 
-use crate::support::{extra, root, write};
+use crate::support::{extra, one_modal_run, root, write};
 
 /// The whole ringing tower (`gcode/prints/ringing_tower.gcode`, Klipper's defaults, MZV
 /// at 48 Hz on X and Y) as a `[gcode]` run gives `settle gcode`'s numbers on `printer_xy`
@@ -33,17 +33,14 @@ fn the_gcode_study_streams_the_whole_job_with_settle_gcodes_numbers() {
             tower.to_str().expect("utf-8")
         ),
     );
-    let (_, mut runs) = settle::load_runs(&scenario).expect("loads");
-    settle::execute::set_backend(&scenario, &mut runs, settle::spec::backend::Backend::Modal)
-        .expect("modal");
-    assert_eq!(runs.len(), 1);
-    let names = runs[0].axis_names();
-    let planned = settle::studies::plan(&runs[0], &names).expect("plans");
+    let run = one_modal_run(&scenario);
+    let names = run.axis_names();
+    let planned = settle::studies::plan(&run, &names).expect("plans");
     assert!(
         matches!(planned.motion, Motion::Stream(_)) && planned.probe.is_none(),
         "a G-code run is streamed, not held planned and recorded"
     );
-    let m = settle::execute::execute(&runs[0], None).expect("runs");
+    let m = settle::execute::execute(&run, None).expect("runs");
     assert!(m.is_ok(), "{m:?}");
     let opts = GcodeOptions::new(tower, "printer_xy", Firmware::Klipper)
         .expect("options")

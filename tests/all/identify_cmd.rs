@@ -126,3 +126,101 @@ fn bad_files_and_options_exit_2_naming_the_file_and_line() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("allowed: x, y, z"), "{err}");
 }
+
+/// What a new user runs first, and what the firmwares write that cannot be trusted: each
+/// is exit 2 with the reason, never a number.
+#[test]
+fn missing_test_parameters_and_unusable_files_exit_2_with_the_reason() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // A resonance test of 30-70 Hz at 10 Hz/s (4 s) identified without its parameters:
+    // Klipper's default test lasts 130 s, and the file does not say which test it holds.
+    let short = write(
+        dir.path(),
+        "raw_data_x_short.csv",
+        &resonance::recording(&[TRUTH], &short_test(), 0, 800.0, 0.1, 3),
+    );
+    let (code, out, err) = run(&["identify", path_str(&short)]);
+    assert_eq!(code, Some(2), "{out}{err}");
+    for want in [
+        "raw_data_x_short.csv",
+        "--freq-start",
+        "--hz-per-sec",
+        "lasts",
+    ] {
+        assert!(err.contains(want), "missing `{want}` in {err}");
+    }
+    // Time stamps in milliseconds: a sample rate of 1 Hz, refused at the last line.
+    let mut ms = String::from("#time,accel_x,accel_y,accel_z\n");
+    for i in 0..200 {
+        ms.push_str(&format!("{}.000000,1.0,2.0,9806.65\n", 1000 + i));
+    }
+    let ms = write(dir.path(), "raw_data_x_ms.csv", &ms);
+    let (code, _, err) = run(&["identify", path_str(&ms)]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("raw_data_x_ms.csv:201") && err.contains("seconds"),
+        "{err}"
+    );
+    // A gap in the time column, refused at the sample after it.
+    let mut gap = String::from("#time,accel_x,accel_y,accel_z\n");
+    for i in 0..200 {
+        let t = i as f64 / 1000.0 + if i >= 100 { 5.0 } else { 0.0 };
+        gap.push_str(&format!("{t:.6},1.0,2.0,9806.65\n"));
+    }
+    let gap = write(dir.path(), "raw_data_x_gap.csv", &gap);
+    let (code, _, err) = run(&["identify", path_str(&gap)]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("raw_data_x_gap.csv:102") && err.contains("gap"),
+        "{err}"
+    );
+    // RepRapFirmware's rate line out of any accelerometer's range.
+    let mut rrf = String::from("Sample,Y\n");
+    for i in 0..200 {
+        rrf.push_str(&format!("{i},0.01\n"));
+    }
+    let huge = write(dir.path(), "m956.csv", &(rrf + "Rate 1e300, overflows 0\n"));
+    let (code, _, err) = run(&["identify", path_str(&huge)]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("m956.csv:202") && err.contains("Rate"),
+        "{err}"
+    );
+}
+
+/// An M956 capture of one axis (`Sample,Y`, RepRapFirmware names files by date) is that
+/// machine axis without `--axis`: a free decay of 80 Hz, zeta 0.03 at 1,400 Hz.
+#[test]
+fn a_single_axis_m956_capture_names_its_axis() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (fs, f, zeta) = (1400.0, 80.0, 0.03);
+    let w = std::f64::consts::TAU * f;
+    let wd = w * (1.0f64 - zeta * zeta).sqrt();
+    let mut text = String::from("Sample,Y\n");
+    for i in 0..1000 {
+        let t = i as f64 / fs;
+        let g = 0.5 * (-zeta * w * t).exp() * (wd * t).cos();
+        text.push_str(&format!("{i},{g:.4}\n"));
+    }
+    text.push_str("Rate 1400, overflows 0\n");
+    let file = write(dir.path(), "20240714_111434.csv", &text);
+    let (code, out, err) = run(&[
+        "identify",
+        path_str(&file),
+        "--figures",
+        path_str(dir.path()),
+    ]);
+    assert_eq!(code, Some(0), "{out}{err}");
+    let row = out.lines().nth(1).expect("a mode row");
+    assert!(row.starts_with("y "), "{out}");
+    // The command above wrote its figures there: --force replaces them.
+    let got = identify(&IdentifyOptions {
+        figures: Some(dir.path().to_path_buf()),
+        force: true,
+        ..IdentifyOptions::new(vec![file])
+    })
+    .expect("identifies");
+    let m = &got.axes[0].id.modes[0];
+    assert!((m.frequency_hz.value - f).abs() < 0.002 * f, "{m:?}");
+    assert!((m.damping_ratio.value - zeta).abs() < 0.05 * zeta, "{m:?}");
+}

@@ -26,6 +26,7 @@ fn opts(firmware: Firmware, config: PathBuf, out: &Path) -> ImportOptions {
         config,
         machine: None,
         out: Some(out.to_path_buf()),
+        force: false,
     }
 }
 
@@ -174,4 +175,56 @@ fn import_command_exit_codes() {
         .output()
         .expect("runs");
     assert_eq!(r.status.code(), Some(2), "{r:?}");
+}
+
+/// One list of firmware names: `settle gcode` plans grbl (and grblHAL), `settle import`
+/// refuses it with the reason (exit 2), and names what it reads.
+#[test]
+fn import_refuses_grbl_with_its_reason() {
+    let r = crate::support::settle()
+        .args(["import", "grblHAL"])
+        .arg(voron())
+        .output()
+        .expect("runs");
+    assert_eq!(r.status.code(), Some(2), "{r:?}");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("grbl is not a firmware whose configuration settle import reads: GRBL has no input shaper"),
+        "{err}"
+    );
+    assert!(err.contains("allowed: klipper, rrf"), "{err}");
+    assert_eq!(
+        settle::workflows::import::parse_firmware("duet"),
+        Ok(Firmware::Rrf)
+    );
+}
+
+/// A scenario already at `--out` (an earlier import, or one edited since) is kept: the
+/// import is refused without `--force`, names it and changes nothing; with `--force` it is
+/// replaced.
+#[test]
+fn import_keeps_an_existing_scenario_without_force() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("v.toml");
+    std::fs::write(&out, "# my edits\n").expect("writes");
+    let import_cmd = |force: bool| {
+        let mut c = crate::support::settle();
+        c.args(["import", "klipper"])
+            .arg(voron())
+            .arg("--out")
+            .arg(&out);
+        if force {
+            c.arg("--force");
+        }
+        c.output().expect("runs")
+    };
+    let r = import_cmd(false);
+    assert_eq!(r.status.code(), Some(2), "{r:?}");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("--force") && err.contains("v.toml"), "{err}");
+    assert_eq!(std::fs::read_to_string(&out).expect("kept"), "# my edits\n");
+    let r = import_cmd(true);
+    assert!(r.status.success(), "{r:?}");
+    let (sc, _) = settle::load_runs(&out).expect("loads");
+    assert_eq!(sc.name, "printer_import");
 }

@@ -55,6 +55,7 @@ fn import_to(firmware: Firmware, config: &Path, out: &Path) -> settle::workflows
         config: config.to_path_buf(),
         machine: None,
         out: Some(out.to_path_buf()),
+        force: false,
     })
     .expect("imports")
 }

@@ -4,10 +4,13 @@
 mod support;
 
 mod across_breakpoints;
+#[cfg(target_os = "linux")]
+mod adversarial;
 mod cli;
 mod corners;
 mod faults;
 mod gcode_config;
+mod gcode_grbl;
 mod gcode_job;
 mod gcode_range;
 mod gcode_range_random;
@@ -18,6 +21,7 @@ mod html_report;
 mod identify_cmd;
 mod import;
 mod import_roundtrip;
+mod klipper_corpus;
 mod layers;
 mod limits;
 mod machine_cmd;
@@ -38,11 +42,15 @@ mod scan_reference;
 mod scan_views;
 mod scenarios;
 mod shaping_sweep;
+mod shards_kubernetes;
 mod step_samples;
+mod sweep_repeats;
 mod sweep_runs;
 mod sweep_safety;
 mod tune;
 mod tune_firmware;
+mod tune_klipper;
 mod tune_scan;
+mod tune_trust;
 mod validate;
 mod workflows;

@@ -298,9 +298,12 @@ fn no_module_cycles_in_any_crate() {
     let mut report = Vec::new();
     for src in &crates {
         let g = graph(&read_sources(src));
-        // Every crate's graph is read: every module is in it, and most refer to others.
+        // Every crate's graph is read: every module is in it, and many refer to others (at
+        // least four, or a third of the modules of a crate of fewer than twelve: the
+        // file-system crate's seven modules are three that use the others and four leaves).
+        let referring = g.values().filter(|t| !t.is_empty()).count();
         assert!(
-            g.len() > 5 && g.values().filter(|t| !t.is_empty()).count() > 3,
+            g.len() > 5 && referring * 3 >= g.len().min(12),
             "{}: {} modules",
             src.display(),
             g.len()

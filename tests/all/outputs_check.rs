@@ -203,3 +203,82 @@ fn a_baseline_of_another_shape_is_a_failure_with_the_reason() {
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
 }
+
+/// A move a ZV shaper at the mode's own frequency and damping cancels exactly: on the
+/// modal backend its residual is 0 um and its overshoot 2.5 nm.
+const CANCELLED: &str = r#"name = "zv_exact"
+[machine]
+modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]
+[move]
+distance_mm = 10.0
+profile = "trapezoid"
+[limits]
+vmax_mm_s = 200.0
+amax_mm_s2 = 3000.0
+[shaper]
+type = "zv"
+frequency_hz = 40.0
+damping_ratio = 0.05
+[observe]
+window_s = 0.2
+"#;
+
+#[test]
+fn changes_under_a_nanometre_are_no_regression_whatever_their_percentage() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let sc = crate::support::write(dir.path(), "zv.toml", CANCELLED);
+    let base = dir.path().join("base.csv");
+    let (sc_s, base_s) = (sc.to_str().expect("UTF-8"), base.to_str().expect("UTF-8"));
+    let o = settle(&[
+        "check",
+        sc_s,
+        "--baseline",
+        base_s,
+        "--backend",
+        "modal",
+        "--update",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let mut b = RunsTable::parse(&std::fs::read_to_string(&base).expect("baseline")).expect("csv");
+    let at = |b: &RunsTable, c: &str| b.column(c).expect(c);
+    let (peak, rms) = (at(&b, "residual_peak_um"), at(&b, "residual_rms_um"));
+    assert_eq!(
+        (b.rows[0][peak].as_str(), b.rows[0][rms].as_str()),
+        ("0", "0")
+    );
+    // Round-off residuals of another build, e.g. 7e-6 and 4.8e-6 um: a "change" of
+    // -100 % that is a few picometres.
+    b.rows[0][peak] = "7e-6".into();
+    b.rows[0][rms] = "4.8e-6".into();
+    std::fs::write(&base, b.to_csv()).expect("write");
+    let check = |extra: &[&str]| {
+        let mut args = vec!["check", sc_s, "--baseline", base_s];
+        args.extend_from_slice(extra);
+        settle(&args)
+    };
+    let o = check(&[]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(
+        text(&o).contains("within 0.1% (or 0.001 um)"),
+        "{}",
+        text(&o)
+    );
+    // The floor is the user's to set: at 0 every picometre counts.
+    let o = check(&["--floor-um", "0"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("residual_peak_um"), "{}", text(&o));
+    // A change of a few nanometres is beyond the floor: the 2.5 nm overshoot halved fails.
+    let over = at(&b, "overshoot_um");
+    let now: f64 = b.rows[0][over].parse().expect("number");
+    assert!((0.002..0.003).contains(&now), "{now}");
+    b.rows[0][over] = (now * 2.0).to_string();
+    std::fs::write(&base, b.to_csv()).expect("write");
+    let o = check(&[]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("overshoot_um"), "{}", text(&o));
+    assert!(!text(&o).contains("residual_peak_um"), "{}", text(&o));
+    // A floor that is not a length is bad input.
+    let o = check(&["--floor-um=-1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("--floor-um"), "{}", text(&o));
+}

@@ -89,11 +89,29 @@ fn a_shaper_sweep_of_one_profile_ranks_the_shapers_against_current() {
                 && runs.num(i, "shaper_frequency_hz") == Some(36.0)
         })
         .expect("the current run");
-    let mut order: Vec<usize> = (0..n).collect();
+    // No shaper has no frequency: `none` at 40 Hz (run 1) is `none` at 36 Hz (run 0),
+    // ranked once.
+    assert_eq!(
+        (
+            runs.cell(1, "shaper_type"),
+            runs.num(1, "shaper_frequency_hz")
+        ),
+        (Some("none"), Some(40.0))
+    );
+    for c in ["move_and_settle_s_10um", "residual_peak_um"] {
+        assert_eq!(runs.num(0, c), runs.num(1, c), "{c}: the same move");
+    }
+    let mut order: Vec<usize> = (0..n).filter(|&i| i != 1).collect();
     order.sort_by(|&a, &b| total(a).total_cmp(&total(b)).then(a.cmp(&b)));
+    assert!(
+        summary.contains(
+            "Ranked once: 1 run(s) repeat another run of their point in every setting that changes them (`shaper.frequency_hz`: no shaper (`none`) has a frequency or damping ratio)"
+        ) && summary.contains("(run 1 repeats run 0)."),
+        "{summary}"
+    );
 
     let t = md_table(&summary, "## Ranking: move and settle to within 10 um");
-    assert_eq!(t.len(), n + 1, "one row per run");
+    assert_eq!(t.len(), n, "one row per run but the repeat");
     assert_eq!(
         t[0][1], "shaper.type",
         "the shapers are compared: {:?}",
@@ -114,6 +132,11 @@ fn a_shaper_sweep_of_one_profile_ranks_the_shapers_against_current() {
             cell(&t, row, "shaper.type"),
             runs.cell(i, "shaper_type").expect("type")
         );
+        let frequency = match runs.cell(i, "shaper_type") {
+            Some("none") => "-".to_string(),
+            _ => runs.cell(i, "shaper_frequency_hz").expect("f").to_string(),
+        };
+        assert_eq!(cell(&t, row, "shaper.frequency_hz"), frequency, "run {id}");
         let shown_total = format!("{:.1}", total(i) * 1e3);
         assert_eq!(
             cell(&t, row, "total").trim_matches('*'),
@@ -289,17 +312,21 @@ fn the_sweep_report_renders_and_sorts_in_chromium() {
     );
     let Some(chrome) = browser() else { return };
     let runs = RunsTable::parse(&read(dir.path(), "runs.csv")).expect("runs.csv");
-    // The first ranking table (10 um; tables are numbered from 1), sorted by its run column.
+    // The first ranking table (10 um; tables are numbered from 1), sorted by its run
+    // column: every run but run 1 (no shaper at 40 Hz, the same move as at 36 Hz: ranked
+    // once).
     let (res, _) = selftest(&chrome, &page, "&grid=table-1&col=run");
     let mut ids: Vec<usize> = (0..runs.rows.len())
         .map(|i| runs.run_id(i).expect("id"))
+        .filter(|&id| id != 1)
         .collect();
     ids.sort_unstable();
     let asc: Vec<String> = ids.iter().map(usize::to_string).collect();
     let desc: Vec<String> = ids.iter().rev().map(usize::to_string).collect();
     assert_eq!(res["asc"], serde_json::json!(asc), "{res}");
     assert_eq!(res["desc"], serde_json::json!(desc), "{res}");
-    assert_eq!(res["rows"], runs.rows.len());
+    assert_eq!(res["rows"], runs.rows.len() - 1);
+    assert!(html.contains("run 1 repeats run 0"), "the table says why");
     // Every run, sorted by move-and-settle (numbers as numbers).
     let (all, _) = selftest(&chrome, &page, "&col=move_and_settle_s_10um");
     let j = runs.column("move_and_settle_s_10um").expect("column");
@@ -616,4 +643,79 @@ fn a_scan_summary_names_every_swept_machine() {
             / 2;
         assert_eq!(rows, expected, "{m}: one row per step-over: {t:?}");
     }
+}
+
+/// A raster scan's summary (whose own table stands in for the move-and-settle ranking)
+/// marks the `[current]` step and compares it, at each step-over, with the best step of
+/// that step-over: the one that stays inside the most bands over the next line, then
+/// the least error at re-entry (recomputed here from runs.csv).
+#[test]
+fn a_scan_summary_compares_the_current_step_with_the_best() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let text = std::fs::read_to_string(crate::support::root().join("scenarios/ci_scan.toml"))
+        .expect("scenario")
+        + "\n[current]\nprofile = \"trapezoid\"\n";
+    let sc = write(dir.path(), "scan.toml", &text);
+    let out = dir.path().join("out");
+    run_ok(
+        settle()
+            .arg("sweep")
+            .arg(&sc)
+            .args(["--backend", "modal", "--out"])
+            .arg(&out),
+    );
+    let runs = RunsTable::parse(&read(&out, "runs.csv")).expect("runs.csv");
+    let summary = read(&out, "summary.md");
+    let t = md_table(&summary, "## Scan steps");
+    for r in &t[1..] {
+        assert!(r[1].ends_with("(current)"), "the trapezoid column: {r:?}");
+        assert!(
+            !r[2].contains("current") && !r[3].contains("current"),
+            "{r:?}"
+        );
+    }
+    let c = md_table(&summary, "### Against your current settings");
+    assert_eq!(c.len(), 3, "one row per step-over: {c:?}");
+    let n = runs.rows.len();
+    for (row, d) in c[1..].iter().zip(["0.05", "0.5"]) {
+        let at = |i: usize| runs.num(i, "distance_mm") == d.parse().ok();
+        let key = |i: usize| {
+            let missed = [1, 10]
+                .iter()
+                .filter(|b| runs.num(i, &format!("scan_settled_{b}um")) != Some(1.0))
+                .count();
+            (missed, runs.num(i, "scan_reentry_error_um").expect("error"))
+        };
+        let current = (0..n)
+            .find(|&i| at(i) && runs.cell(i, "profile") == Some("trapezoid"))
+            .expect("current");
+        let best = (0..n)
+            .filter(|&i| at(i))
+            .min_by(|&a, &b| {
+                let (ka, kb) = (key(a), key(b));
+                ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+            })
+            .expect("best");
+        let id = |i: usize| runs.run_id(i).expect("id");
+        assert_eq!(row[0], format!("move.distance_mm = {d}"));
+        assert_eq!(row[1], format!("profile = trapezoid (run {})", id(current)));
+        assert_eq!(row[2], format!("{:.2}", key(current).1));
+        assert_eq!(
+            row[3],
+            format!(
+                "profile = {} (run {})",
+                runs.cell(best, "profile").expect("profile"),
+                id(best)
+            )
+        );
+        assert_eq!(row[4], format!("{:.2}", key(best).1));
+        assert_ne!(best, current, "the trapezoid step is not the best here");
+    }
+    // report.html has the comparison as a table of its own.
+    let html = read(&out, "report.html");
+    assert!(html.contains("Against your current settings"));
+    assert!(
+        !html.contains("###"),
+        "no Markdown heading left in the page"
+    );
 }

@@ -26,20 +26,7 @@ fn s(p: &Path) -> &str {
 
 /// Every file under `dir`, relative, sorted.
 fn files(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).expect("read_dir") {
-            let p = e.expect("entry").path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.push(p.strip_prefix(dir).expect("prefix").to_path_buf());
-            }
-        }
-    }
-    out.sort();
-    out
+    crate::support::files_under(dir)
 }
 
 #[test]
@@ -144,9 +131,31 @@ fn bad_merges_are_clear_errors() {
     let a3 = mk("a3", "scenarios/ci_quickstart.toml", "3/3");
     let q2 = mk("q2", "scenarios/quickstart.toml", "2/3");
     merge_err(&[&a1, &a3], "missing shard(s) 2/3");
+    merge_err(
+        &[&a1, &a3],
+        "run it with `settle sweep scenarios/ci_quickstart.toml --shard 2/3`",
+    );
+    merge_err(&[&a2], "missing shard(s) 1/3, 3/3");
     merge_err(&[&a1, &a2, &a2, &a3], "given twice");
     merge_err(&[&a1, &q2, &a3], "not from the same sweep");
     merge_err(&[&a1, dir.path()], "not a shard folder");
+    // A shard stopped before it finished (a time limit): a journal, no manifest.
+    let stopped = dir.path().join("stopped");
+    std::fs::create_dir(&stopped).expect("mkdir");
+    std::fs::write(
+        stopped.join("journal.csv"),
+        "settle-journal; key 0; ci_quickstart; backend rapier; shard 2/3; settle 0.1.0\n",
+    )
+    .expect("write");
+    merge_err(&[&a1, &stopped, &a3], "an unfinished shard");
+    merge_err(&[&a1, &stopped, &a3], "its journal is of shard 2/3");
+    merge_err(
+        &[&a1, &stopped, &a3],
+        &format!(
+            "settle sweep SCENARIO --shard 2/3 --out {} --resume",
+            stopped.display()
+        ),
+    );
     // A shard whose rows were tampered with.
     let csv = std::fs::read_to_string(a2.join("runs.csv")).expect("csv");
     let cut: String = csv.lines().take(2).map(|l| format!("{l}\n")).collect();
@@ -161,4 +170,66 @@ fn bad_merges_are_clear_errors() {
     let o = settle(&["sweep", "scenarios/ci_quickstart.toml", "--shard", "1/7"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("at most 6 shards"));
+}
+
+/// Shards whose runs lose steps merge like any other (failed runs are results): the merge
+/// lists them and exits 0, or 1 with `--fail-on-failed-runs`, and writes the unsharded
+/// sweep's files either way.
+#[test]
+fn shards_with_failed_runs_merge_and_list_them() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // 16 runs of a lead-screw stage, 3 of which lose steps (runs 7, 11 and 15).
+    let scenario = crate::support::root().join("tests/shards/big_lost_steps.toml");
+    let whole = dir.path().join("whole");
+    ok(&["sweep", s(&scenario), "--out", s(&whole)]);
+    let csv = std::fs::read_to_string(whole.join("runs.csv")).expect("csv");
+    assert_eq!(
+        csv.lines()
+            .skip(1)
+            .filter(|l| l.contains(",lost_steps,"))
+            .count(),
+        3,
+        "the scenario loses steps in 3 runs: {csv}"
+    );
+    let shards: Vec<PathBuf> = (1..=2)
+        .map(|k| {
+            let d = dir.path().join(format!("shard{k}"));
+            ok(&[
+                "sweep",
+                s(&scenario),
+                "--shard",
+                &format!("{k}/2"),
+                "--out",
+                s(&d),
+            ]);
+            d
+        })
+        .collect();
+    let merged = dir.path().join("merged");
+    let o = settle(&["merge", s(&shards[0]), s(&shards[1]), "--out", s(&merged)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("runs failed") && err.contains("lost_steps: lost "),
+        "{err}"
+    );
+    for f in files(&whole) {
+        assert!(
+            std::fs::read(whole.join(&f)).expect("read")
+                == std::fs::read(merged.join(&f)).expect("read"),
+            "{} differs",
+            f.display()
+        );
+    }
+    let strict = dir.path().join("strict");
+    let o = settle(&[
+        "merge",
+        s(&shards[0]),
+        s(&shards[1]),
+        "--fail-on-failed-runs",
+        "--out",
+        s(&strict),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(strict.join("summary.md").exists(), "written all the same");
 }

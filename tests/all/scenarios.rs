@@ -206,3 +206,74 @@ fn unknown_tables_and_keys_inside_a_study_table_name_their_line() {
     assert!(msg.starts_with("bad.toml:11:"), "{msg}");
     assert!(msg.contains("key `scan.v_scan_mm_s`"), "{msg}");
 }
+
+/// The keys a table of a scenario accepts, as the parser lists them for an unknown one
+/// (`expected one of `a`, `b`...`), without the studies' tables it adds at the top level.
+fn accepted_keys(table: &str) -> Vec<String> {
+    let head = format!("[{table}]\n");
+    let text = if table.is_empty() {
+        format!("bogus_key = 1\n{GOOD}")
+    } else if GOOD.contains(&head) {
+        GOOD.replace(&head, &format!("{head}bogus_key = 1\n"))
+    } else {
+        // The studies' tables are parsed before the motion is checked, so `[corner]` or
+        // `[gcode]` beside `[move]` still reports its unknown key first.
+        format!("{GOOD}\n{head}bogus_key = 1\n")
+    };
+    let e = parse_err(&text);
+    let list = e
+        .split("expected ")
+        .nth(1)
+        .unwrap_or_else(|| panic!("[{table}]: {e}"));
+    let list = list.split(", or a study's table").next().unwrap_or(list);
+    list.split('`')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_string)
+        .collect()
+}
+
+/// docs/reference/scenario.md documents every table a scenario takes (a `## `[table]``
+/// section, or a row of its top level) and every key of each, as the parser accepts them.
+#[test]
+fn the_scenario_reference_documents_every_table_and_key() {
+    let doc = std::fs::read_to_string(
+        Path::new(crate::support::manifest_dir()).join("docs/reference/scenario.md"),
+    )
+    .expect("docs/reference/scenario.md");
+    let section = |heading: &str| -> &str {
+        let start = doc
+            .find(&format!("\n## {heading}\n"))
+            .unwrap_or_else(|| panic!("no section `## {heading}` in scenario.md"));
+        let rest = &doc[start + 1..];
+        let end = rest[3..].find("\n## ").map_or(rest.len(), |e| e + 3);
+        &rest[..end]
+    };
+    let top = accepted_keys("");
+    assert!(top.contains(&"current".to_string()), "{top:?}");
+    let mut tables: Vec<String> = settle::studies::tables()
+        .iter()
+        .map(|t| t.to_string())
+        .collect();
+    for key in &top {
+        if section("Top level").contains(&format!("| `{key}` |")) {
+            continue;
+        }
+        tables.push(key.clone());
+    }
+    for t in &tables {
+        let s = section(&format!("`[{t}]`"));
+        if matches!(t.as_str(), "sweep" | "current") {
+            continue; // free-form: one key per swept parameter
+        }
+        for key in accepted_keys(t) {
+            assert!(
+                s.contains(&format!("`{key}")) || s.contains(&format!(".{key}.")),
+                "[{t}] `{key}` is not documented in scenario.md"
+            );
+        }
+    }
+    // One motion, and it is not only [move] or [corner].
+    assert!(!doc.contains("exactly one of `[move]` and `[corner]`"));
+    assert!(doc.contains("exactly one of `[move]`, `[corner]` and `[gcode]`"));
+}

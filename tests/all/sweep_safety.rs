@@ -84,7 +84,7 @@ fn sweep(scenario: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
 }
 
 /// A journal line as the sweep writes it: the row's checksum, a space, the row.
-fn journal_line(row: &str) -> String {
+pub fn journal_line(row: &str) -> String {
     format!(
         "{:016x} {row}",
         settle::input::file::digest(&[row.as_bytes()])
@@ -92,7 +92,7 @@ fn journal_line(row: &str) -> String {
 }
 
 /// The journal a sweep of `scenario` on modal would write, holding `rows` (with newlines).
-fn journal_of(scenario: &Path, header: &str, rows: &[String]) -> String {
+pub fn journal_of(scenario: &Path, header: &str, rows: &[String]) -> String {
     let (sc, src) = settle::expand::load(scenario).expect("loads");
     let inputs = settle::expand::machine::inputs_identity(&sc, &src).expect("inputs");
     let key = settle::workflows::journal::key_line(src.text(), &inputs, &sc.name, "modal", "");

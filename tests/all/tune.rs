@@ -346,7 +346,7 @@ fn tune_command_writes_report_table_plot_and_exports() {
     assert!(status.status.success(), "{status:?}");
     let stdout = String::from_utf8_lossy(&status.stdout);
     assert!(
-        stdout.contains("**winner**") && stdout.contains("Gain of the winner"),
+        stdout.contains("**recommended**") && stdout.contains("Gain of the recommendation"),
         "{stdout}"
     );
     let csv = std::fs::read_to_string(out.join("candidates.csv")).expect("csv");

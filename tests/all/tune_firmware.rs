@@ -51,7 +51,8 @@ fn modal() -> Options {
 #[test]
 fn firmware_restricts_the_candidates() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let small = "frequency_scales = [1.0]\njerk_steps = 1\n";
+    // The TMC4361A's register ranges depend on the resolution: 80 microsteps per mm.
+    let small = "frequency_scales = [1.0]\njerk_steps = 1\nusteps_per_mm = 80.0\n";
     for (fw, shaper_fw) in [
         ("klipper", Some(Firmware::Klipper)),
         ("marlin", Some(Firmware::Marlin)),
@@ -114,7 +115,7 @@ fn smoothing_and_max_accel_are_klippers_and_bound_the_acceleration() {
     let dir = tempfile::tempdir().expect("tempdir");
     let o = run(
         dir.path(),
-        "firmware = \"klipper\"\nshapers = [\"mzv\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [5000.0, 7000.0]\n",
+        "firmware = \"klipper\"\nshapers = [\"mzv\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [5000.0, 7000.0]\nshaper_damping_ratio = 0.1\n",
         &modal(),
     );
     // Klipper's numbers for MZV at 47.19999999999992 Hz, damping 0.1, at 5000 mm/s^2 and
@@ -144,7 +145,7 @@ fn smoothing_and_max_accel_are_klippers_and_bound_the_acceleration() {
     // A looser limit lets it in.
     let o = run(
         dir.path(),
-        "firmware = \"klipper\"\nshapers = [\"mzv\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [7000.0]\nmax_smoothing_mm = 0.2\n",
+        "firmware = \"klipper\"\nshapers = [\"mzv\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [7000.0]\nmax_smoothing_mm = 0.2\nshaper_damping_ratio = 0.1\n",
         &modal(),
     );
     assert!(
@@ -324,13 +325,7 @@ fn identified_frequency_band_makes_tune_prefer_a_robust_shaper() {
             < shaped(&exact, winner.as_deref().expect("shaped")).move_and_settle_s
     );
     // The report says which band it used.
-    let md = settle::workflows::tune::report::markdown(
-        "t",
-        &wide.plan,
-        &wide.scores,
-        wide.winner,
-        &wide.front,
-    );
+    let md = settle::workflows::tune::report::axis_section("x", &wide, "pareto.svg");
     assert!(
         md.contains("Frequency band: +-10.000% (2 sigma of the identified 47.20 +- 2.360 Hz mode"),
         "{md}"
@@ -372,8 +367,15 @@ fn klipper_criterion_prints_what_calibrate_shaper_printed() {
             "Recommended shaper is mzv @ 25.6 Hz",
         ),
     ] {
-        let r = settle::workflows::tune::klipper_criterion::report(&calibration(file))
-            .expect("chooses");
+        let c = settle::workflows::tune::klipper_criterion::KlipperCriterion::from_args(
+            vec![calibration(file)],
+            None,
+            None,
+            None,
+            None,
+        )
+        .expect("options");
+        let r = settle::workflows::tune::klipper_criterion::report(&c).expect("chooses");
         assert_eq!(r.stdout.lines().last(), Some(want), "{file}:\n{}", r.stdout);
     }
     // The per-shaper lines, from the same run's numbers for one_peak (zv: 46.0 Hz,
@@ -392,4 +394,169 @@ fn klipper_criterion_prints_what_calibrate_shaper_printed() {
     ] {
         assert!(out.contains(want), "missing `{want}` in\n{out}");
     }
+}
+
+#[test]
+fn out_of_the_running_candidates_say_why_and_never_win_or_reach_the_front() {
+    use settle::workflows::tune::search::Infeasible;
+    let dir = tempfile::tempdir().expect("tempdir");
+    // The current EI at 47.2 Hz smooths ~0.08 mm at 3000 mm/s^2: over a 0.05 mm limit.
+    let o = run(
+        dir.path(),
+        "firmware = \"klipper\"\nshapers = [\"none\", \"zv\", \"ei\"]\nfrequency_scales = [1.0]\naccelerations_mm_s2 = [3000.0, 9000.0]\nmax_smoothing_mm = 0.05\n[tune.axis.x]\nshaper = \"ei\"\nfrequency_hz = 47.2\n",
+        &modal(),
+    );
+    let cur = &o.scores[0];
+    match &cur.infeasible {
+        Some(Infeasible::Smoothing {
+            smoothing_mm,
+            limit_mm,
+            accel_mm_s2,
+        }) => {
+            assert_eq!(*smoothing_mm, cur.smoothing_mm);
+            assert_eq!((*limit_mm, *accel_mm_s2), (0.05, 3000.0));
+        }
+        other => panic!("{other:?}"),
+    }
+    // Its simulated time is kept (and shown), its ranking key is out of reach.
+    assert!(cur.simulated_move_and_settle_s.is_finite() && cur.move_and_settle_s.is_infinite());
+    for s in &o.scores {
+        let over = s.smoothing_mm > 0.05;
+        assert_eq!(
+            over,
+            matches!(s.infeasible, Some(Infeasible::Smoothing { .. })),
+            "{s:?}"
+        );
+    }
+    assert!(o.scores[o.winner].is_feasible());
+    // The front is the Pareto front of the feasible candidates, found here by brute force.
+    let ok: Vec<usize> = (0..o.scores.len())
+        .filter(|&i| o.scores[i].is_feasible())
+        .collect();
+    let dominated = |i: usize| {
+        let a = &o.scores[i];
+        ok.iter().any(|&j| {
+            let b = &o.scores[j];
+            b.move_time_s <= a.move_time_s
+                && b.residual_peak_um <= a.residual_peak_um
+                && (b.move_time_s < a.move_time_s || b.residual_peak_um < a.residual_peak_um)
+        })
+    };
+    let mut front: Vec<usize> = ok.iter().copied().filter(|&i| !dominated(i)).collect();
+    front.sort_by(|&a, &b| o.scores[a].move_time_s.total_cmp(&o.scores[b].move_time_s));
+    assert!(o.front.iter().all(|&i| o.scores[i].is_feasible()));
+    assert_eq!(o.front.len(), front.len());
+    // The report's row of the current settings gives its simulated time and why it is out.
+    let md = settle::workflows::tune::report::axis_section("x", &o, "pareto.svg");
+    let row = md
+        .lines()
+        .find(|l| l.starts_with("| current |"))
+        .expect("current row");
+    assert!(
+        row.contains(&format!("{:.1}", cur.simulated_move_and_settle_s * 1e3))
+            && row.ends_with(&format!(
+                "| out: smooths {:.3} mm > 0.05 mm |",
+                cur.smoothing_mm
+            )),
+        "{row}"
+    );
+}
+
+#[test]
+fn shapers_are_designed_for_the_modes_damping_within_what_the_firmware_takes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let text = scenario(
+        "firmware = \"klipper\"\nshapers = [\"mzv\", \"3hump_ei\"]\nfrequency_scales = [1.0]\n",
+    )
+    .replace("damping_ratio = 0.05", "damping_ratio = 0.25");
+    let p = write(dir.path(), "fw_test.toml", &text);
+    let o = tune_axis(&p, None, &modal(), &settle::execute::pool::quiet).expect("tunes");
+    let damping = |name: &str| {
+        o.scores
+            .iter()
+            .filter_map(|s| s.candidate.shaper)
+            .find(|sh| sh.shaper_type.is_some_and(|k| k.name() == name))
+            .expect("searched")
+            .damping_ratio
+    };
+    // MZV takes the mode's 0.25; Klipper's 3hump_ei at most 0.2 (shaper_defs.py).
+    assert_eq!(damping("mzv"), 0.25);
+    assert_eq!(damping("3hump_ei"), 0.2);
+    let md = settle::workflows::tune::report::axis_section("x", &o, "pareto.svg");
+    assert!(
+        md.contains("designed for the damping ratio of the mode"),
+        "{md}"
+    );
+    assert!(
+        md.contains("3hump_ei takes a damping ratio of at most 0.2"),
+        "{md}"
+    );
+    // A fixed damping ratio is taken as given (Klipper's default here).
+    let o = run(
+        dir.path(),
+        "shapers = [\"zv\"]\nfrequency_scales = [1.0]\nshaper_damping_ratio = 0.1\n",
+        &modal(),
+    );
+    assert!(
+        o.scores[1..]
+            .iter()
+            .all(|s| s.candidate.shaper.is_none_or(|sh| sh.damping_ratio == 0.1))
+    );
+}
+
+#[test]
+fn the_search_holds_only_what_the_target_can_take() {
+    use settle::workflows::tune::export;
+    let dir = tempfile::tempdir().expect("tempdir");
+    // The TMC4361A at 160 microsteps/mm: BOW1..4 hold at most (2^24 - 1) / 160 mm/s^3 in
+    // the frequency mode, far below the scenario's 1e8.
+    let text = scenario(
+        "firmware = \"tmc4361a\"\nusteps_per_mm = 160.0\njerk_steps = 3\nkinds = [\"scurve\"]\n",
+    )
+    .replace("jmax_mm_s3 = 100000.0", "jmax_mm_s3 = 1e8");
+    let p = write(dir.path(), "fw_test.toml", &text);
+    let o = tune_axis(&p, None, &modal(), &settle::execute::pool::quiet).expect("tunes");
+    let cap = 16_777_215.0 / 160.0;
+    for s in &o.scores[1..] {
+        assert!(s.candidate.jmax_mm_s3.is_some_and(|j| j <= cap), "{s:?}");
+    }
+    let tmc = export::tmc4361a(&[("x".to_string(), o.clone())]);
+    assert!(!tmc.contains("not written"), "{tmc}");
+    let md = settle::workflows::tune::report::axis_section("x", &o, "pareto.svg");
+    assert!(
+        md.contains("47.2 Hz (zeta 0.050)"),
+        "the modes are reported: {md}"
+    );
+    assert!(md.contains("Jerks searched up to 104858 mm/s^3"), "{md}");
+    // Without the resolution the chip's ranges are unknown: an error naming the key.
+    let p = write(
+        dir.path(),
+        "fw_test.toml",
+        &scenario("firmware = \"tmc4361a\"\n"),
+    );
+    let e = tune_axis(&p, None, &modal(), &settle::execute::pool::quiet).expect_err("refused");
+    assert!(e.to_string().contains("tune.usteps_per_mm"), "{e}");
+    // RepRapFirmware plans trapezoids: an S-curve recommendation is not written as an
+    // M593 line; an unshaped trapezoid is `M593 P"none"` alone.
+    let s = run(
+        dir.path(),
+        "kinds = [\"scurve\"]\nshapers = [\"none\"]\njerk_steps = 1\n",
+        &modal(),
+    );
+    let rrf = export::rrf(&[("x".to_string(), s)], "a test");
+    assert!(
+        rrf.starts_with("; no RepRapFirmware configuration: the recommendation on x, scurve")
+            && !rrf.contains("M593"),
+        "{rrf}"
+    );
+    let t = run(
+        dir.path(),
+        "kinds = [\"trapezoid\"]\nshapers = [\"none\"]\n",
+        &modal(),
+    );
+    let rrf = export::rrf(&[("x".to_string(), t)], "a test");
+    assert!(
+        rrf.contains("\nM593 P\"none\"\n") && !rrf.contains(" F"),
+        "{rrf}"
+    );
 }

@@ -317,7 +317,7 @@ fn tune_command_on_a_scan_writes_the_report_and_exports() {
         "overhead per line (ms)",
         "robustness margin 0.8 x the 10 um band",
         "less overhead per line",
-        "**winner**",
+        "**recommended**",
     ] {
         assert!(md.contains(want), "missing `{want}` in\n{md}");
     }

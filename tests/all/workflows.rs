@@ -75,7 +75,7 @@ fn a_sweep_with_lost_steps_reports_the_failed_run() {
         (1, "lost_steps")
     );
     let r = o.report();
-    assert_eq!(r.exit, Exit::Failed);
+    assert_eq!(r.exit, Exit::RunsFailed);
     assert!(r.stderr.contains("1 of 2 runs failed"), "{}", r.stderr);
 }
 
@@ -179,14 +179,14 @@ fn merged_shards_equal_the_unsharded_sweep() {
         dirs.push(d);
     }
     let merged = dir.path().join("merged");
-    let m = merge::merge(&dirs, Some(merged.clone())).expect("merges");
+    let m = merge::merge(&dirs, Some(merged.clone()), false).expect("merges");
     assert_eq!((m.shards, m.runs, m.recordings), (2, 6, 0));
     for f in ["runs.csv", "summary.md"] {
         let a = std::fs::read(full.join(f)).expect("full");
         let b = std::fs::read(merged.join(f)).expect("merged");
         assert!(a == b, "{f} differs");
     }
-    let e = merge::merge(&dirs[..1], None).expect_err("a shard missing");
+    let e = merge::merge(&dirs[..1], None, false).expect_err("a shard missing");
     assert!(
         e.is_input_error() && e.to_string().contains("missing shard(s) 1/2"),
         "{e}"

@@ -12,7 +12,7 @@
 //!
 //! [`KlipperConfig`]: super::KlipperConfig
 
-use super::export_text::{comment_text, refuse};
+use super::export_text::{Note, annotate, comment_text, refuse};
 use super::klipper_shaper;
 use super::machine::ShaperSetting;
 use crate::error::GcodeError;
@@ -66,6 +66,17 @@ fn axis(out: &mut String, letter: char, s: &ShaperSetting) -> Result<(), GcodeEr
 }
 
 impl KlipperExport {
+    /// The snippet with each note as a `#` comment above the option it names
+    /// ([`Note::key`], e.g. `shaper_freq_x`, `max_accel`), or an error naming the first
+    /// value Klipper would refuse.
+    pub fn to_config_with_notes(&self, notes: &[Note]) -> Result<String, GcodeError> {
+        let text = self.to_config()?;
+        Ok(annotate(&text, notes, "#", |line, key| {
+            line.strip_prefix(key)
+                .is_some_and(|rest| rest.starts_with(':'))
+        }))
+    }
+
     /// The snippet, or an error naming the first value Klipper would refuse.
     pub fn to_config(&self) -> Result<String, GcodeError> {
         let by = comment_text(&self.produced_by);

@@ -7,7 +7,7 @@
 //!
 //! [`RrfConfig`]: super::RrfConfig
 
-use super::export_text::{comment_text, refuse};
+use super::export_text::{Note, annotate, comment_text, refuse};
 use super::machine::ShaperSetting;
 use super::rrf::{MAX_SHAPER_FREQUENCY_HZ, MIN_SHAPER_FREQUENCY_HZ};
 use crate::error::GcodeError;
@@ -31,31 +31,37 @@ pub struct RrfExport {
 }
 
 impl RrfExport {
-    /// The lines, or an error naming the first value the firmware would refuse.
+    /// The lines with each note as a `;` comment above the command it names
+    /// ([`Note::key`], e.g. `M593 F`, `M204 P`), or an error naming the first value the
+    /// firmware would refuse.
+    pub fn to_config_with_notes(&self, notes: &[Note]) -> Result<String, GcodeError> {
+        let text = self.to_config()?;
+        Ok(annotate(&text, notes, ";", |line, key| {
+            let command = key.split_whitespace().next().unwrap_or(key);
+            line.split_whitespace().next() == Some(command)
+        }))
+    }
+
+    /// The lines, or an error naming the first value the firmware would refuse. Shaping
+    /// off is `M593 P"none"` alone (its frequency and damping mean nothing then).
     pub fn to_config(&self) -> Result<String, GcodeError> {
         let s = &self.shaper;
         let name = s.name.strip_prefix("rrf:").unwrap_or(&s.name);
         if !TYPES.contains(&name) {
             return Err(refuse("M593 P", &s.name, TYPES.join(", ")));
         }
-        if !(MIN_SHAPER_FREQUENCY_HZ..=MAX_SHAPER_FREQUENCY_HZ).contains(&s.frequency_hz) {
-            return Err(refuse(
-                "M593 F",
-                s.frequency_hz,
-                format!("{MIN_SHAPER_FREQUENCY_HZ:.3} to {MAX_SHAPER_FREQUENCY_HZ} Hz"),
-            ));
-        }
-        if !(0.0..=0.99).contains(&s.damping_ratio) {
-            return Err(refuse("M593 S", s.damping_ratio, "0 to 0.99"));
-        }
         let by = comment_text(&self.produced_by);
-        let mut out = format!(
+        let head = format!(
             "; Written by settle: {by}\n\
              ; RepRapFirmware has one input shaper for all axes: put these lines at the end of\n\
-             ; config.g (after any M501) in place of its other M593 line.\n\
-             M593 P\"{name}\" F{} S{}\n",
-            s.frequency_hz, s.damping_ratio
+             ; config.g (after any M501) in place of its other M593 line.\n"
         );
+        let m593 = if name == "none" {
+            "M593 P\"none\"\n".to_string()
+        } else {
+            self.shaper_line(name)?
+        };
+        let mut out = format!("{head}{m593}");
         let mut m204 = String::new();
         for (word, key, v) in [
             ("P", "M204 P", self.print_accel_mm_s2),
@@ -72,5 +78,24 @@ impl RrfExport {
             out.push_str(&format!("M204{m204}\n"));
         }
         Ok(out)
+    }
+
+    /// The `M593` line of a shaper that is on.
+    fn shaper_line(&self, name: &str) -> Result<String, GcodeError> {
+        let s = &self.shaper;
+        if !(MIN_SHAPER_FREQUENCY_HZ..=MAX_SHAPER_FREQUENCY_HZ).contains(&s.frequency_hz) {
+            return Err(refuse(
+                "M593 F",
+                s.frequency_hz,
+                format!("{MIN_SHAPER_FREQUENCY_HZ:.3} to {MAX_SHAPER_FREQUENCY_HZ} Hz"),
+            ));
+        }
+        if !(0.0..=0.99).contains(&s.damping_ratio) {
+            return Err(refuse("M593 S", s.damping_ratio, "0 to 0.99"));
+        }
+        Ok(format!(
+            "M593 P\"{name}\" F{} S{}\n",
+            s.frequency_hz, s.damping_ratio
+        ))
     }
 }

@@ -1,5 +1,6 @@
-//! What both exporters share: refusing a value the firmware would not accept, and
-//! making a comment line of free text.
+//! What both exporters share: refusing a value the firmware would not accept, making a
+//! comment line of free text, and comments written above the values they explain
+//! ([`Note`]).
 
 use crate::error::GcodeError;
 
@@ -17,4 +18,46 @@ pub(crate) fn comment_text(text: &str) -> String {
     text.chars()
         .map(|c| if c.is_control() { ' ' } else { c })
         .collect()
+}
+
+/// A comment written into an export above the line of the value it explains: `key` is
+/// the setting (Klipper's option name, e.g. `shaper_freq_x` or `max_accel`; a
+/// RepRapFirmware command and parameter, e.g. `M593 F`), or empty for the header.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Note {
+    /// The setting the comment explains (empty: the file as a whole).
+    pub key: String,
+    /// The comment's text (line breaks become spaces).
+    pub text: String,
+}
+
+/// `text` with each note as a `marker`-comment line above the first line that `is_line_of`
+/// says writes its key, and the header notes after the leading comment lines. Notes whose
+/// key no line writes are left out.
+pub(crate) fn annotate(
+    text: &str,
+    notes: &[Note],
+    marker: &str,
+    is_line_of: impl Fn(&str, &str) -> bool,
+) -> String {
+    let mut out = String::with_capacity(text.len() + 80 * notes.len());
+    let mut header_done = false;
+    let mut used = vec![false; notes.len()];
+    for line in text.lines() {
+        if !header_done && !line.starts_with(marker) {
+            header_done = true;
+            for n in notes.iter().filter(|n| n.key.is_empty()) {
+                out.push_str(&format!("{marker} {}\n", comment_text(&n.text)));
+            }
+        }
+        for (i, n) in notes.iter().enumerate() {
+            if !n.key.is_empty() && !used[i] && is_line_of(line, &n.key) {
+                used[i] = true;
+                out.push_str(&format!("{marker} {}\n", comment_text(&n.text)));
+            }
+        }
+        out.push_str(line);
+        out.push('\n');
+    }
+    out
 }

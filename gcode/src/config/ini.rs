@@ -168,7 +168,9 @@ pub(crate) fn parse_chunk<'a>(
         let Some(s) = section else {
             return Err(GcodeError::ConfigSyntax {
                 at: at(no),
-                what: format!("`{value}` before any [section] (a file starts with a section)"),
+                // Not echoed: a file that does not start as a configuration (a wrong
+                // include, `/etc/shadow`) is not repeated on the terminal.
+                what: "text before any [section]: a Klipper configuration file starts with a `[section]` header (is this a printer.cfg?)".to_string(),
             });
         };
         let Some(sep) = value.find([':', '=']) else {

@@ -20,6 +20,7 @@
 use std::path::{Component, Path, PathBuf};
 use std::sync::Arc;
 
+use super::budget::Budget;
 use super::glob::{glob, has_magic};
 use super::ini::{Store, parse_chunk, section_header};
 use super::machine::ConfigNote;
@@ -35,26 +36,6 @@ pub(crate) struct Loaded {
     pub(crate) store: Store,
     pub(crate) files: Vec<PathBuf>,
     pub(crate) notes: Vec<ConfigNote>,
-}
-
-/// A file's text, or an error naming it (and the line of invalid UTF-8).
-pub(crate) fn read_text(path: &Path) -> Result<String, GcodeError> {
-    let name: Arc<str> = Arc::from(path.display().to_string());
-    let bytes = std::fs::read(path).map_err(|source| GcodeError::Io {
-        source_name: name.clone(),
-        source,
-    })?;
-    String::from_utf8(bytes).map_err(|e| {
-        let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
-        let line_start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
-        GcodeError::InvalidUtf8 {
-            at: Location {
-                source_name: name,
-                line: 1 + good.iter().filter(|&&b| b == b'\n').count() as u64,
-                column: Some(good.len() - line_start + 1),
-            },
-        }
-    })
 }
 
 /// `path` made absolute and normalised lexically (Python's `os.path.abspath`).
@@ -78,6 +59,7 @@ pub(crate) fn absolute(path: &Path) -> PathBuf {
 
 struct Ctx {
     store: Store,
+    budget: Budget,
     files: Vec<PathBuf>,
     /// Files being read (absolute), outermost first.
     stack: Vec<PathBuf>,
@@ -86,15 +68,17 @@ struct Ctx {
 /// Reads `main` (its text given, or read from disk) with its includes and SAVE_CONFIG
 /// block.
 pub(crate) fn load(main: &Path, text: Option<&str>) -> Result<Loaded, GcodeError> {
+    let mut budget = Budget::new();
     let data = match text {
         Some(t) => t.replace("\r\n", "\n"),
-        None => read_text(main)?.replace("\r\n", "\n"),
+        None => budget.main(main)?.replace("\r\n", "\n"),
     };
     let source: Arc<str> = Arc::from(main.display().to_string());
     let mut notes = Vec::new();
     let (regular, autosave) = split_autosave(&data, &source, &mut notes);
     let mut ctx = Ctx {
         store: Store::default(),
+        budget,
         files: vec![main.to_path_buf()],
         stack: vec![absolute(main)],
     };
@@ -243,7 +227,7 @@ fn parse_file(ctx: &mut Ctx, path: &Path, data: &str, source: &Arc<str>) -> Resu
                     line: no,
                     column: None,
                 };
-                include(ctx, path, spec.trim(), at)?;
+                include(ctx, path, spec.trim(), &at)?;
             }
             None => buf.push((no, cut)),
         }
@@ -251,15 +235,17 @@ fn parse_file(ctx: &mut Ctx, path: &Path, data: &str, source: &Arc<str>) -> Resu
     parse_chunk(&mut ctx.store, source, buf)
 }
 
-fn include(ctx: &mut Ctx, from: &Path, spec: &str, at: Location) -> Result<(), GcodeError> {
+fn include(ctx: &mut Ctx, from: &Path, spec: &str, at: &Location) -> Result<(), GcodeError> {
     let pattern = from.parent().unwrap_or(Path::new("")).join(spec);
+    let what = format!("[include {spec}]");
     let mut names = glob(&pattern);
     if names.is_empty() && !has_magic(&pattern.to_string_lossy()) {
         return Err(GcodeError::IncludeNotFound {
-            at,
+            at: at.clone(),
             path: pattern.display().to_string(),
         });
     }
+    ctx.budget.reserve(names.len(), at, &what)?;
     names.sort_by(|a, b| a.to_string_lossy().cmp(&b.to_string_lossy()));
     for name in names {
         let abs = absolute(&name);
@@ -268,12 +254,12 @@ fn include(ctx: &mut Ctx, from: &Path, spec: &str, at: Location) -> Result<(), G
                 ctx.stack.iter().map(|p| p.display().to_string()).collect();
             chain.push(abs.display().to_string());
             return Err(GcodeError::IncludeCycle {
-                at,
+                at: at.clone(),
                 path: name.display().to_string(),
                 chain: chain.join(" -> "),
             });
         }
-        let text = read_text(&name)?.replace("\r\n", "\n");
+        let text = ctx.budget.read(&name, at, &what)?.replace("\r\n", "\n");
         let source: Arc<str> = Arc::from(name.display().to_string());
         ctx.files.push(name.clone());
         ctx.stack.push(abs);

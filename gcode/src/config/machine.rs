@@ -77,6 +77,8 @@ impl ShaperSetting {
     pub fn is_enabled(&self, firmware: Dialect) -> bool {
         match firmware {
             Dialect::Rrf => self.name != "none",
+            // GRBL has no input shaper.
+            Dialect::Grbl => false,
             _ => self.frequency_hz > 0.0,
         }
     }
@@ -94,6 +96,7 @@ impl ShaperSetting {
             Dialect::Rrf if self.name == "custom" => None,
             Dialect::Rrf => Some(format!("rrf:{}", self.name)),
             Dialect::Marlin => Some(format!("marlin:{}", self.name)),
+            Dialect::Grbl => None,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! Firmware configuration files in and out: Klipper's `printer.cfg` (with its includes and
-//! SAVE_CONFIG block) and RepRapFirmware's `config.g` (with the macros it runs) read into
-//! plain data ([`KlipperConfig`], [`RrfConfig`]) with the values the firmware would use,
+//! SAVE_CONFIG block), RepRapFirmware's `config.g` (with the macros it runs) and GRBL's
+//! `$$` settings read into plain data ([`KlipperConfig`], [`RrfConfig`],
+//! [`GrblSettings`]) with the values the firmware would use,
 //! and input shaper settings written back in each firmware's own syntax, ready to paste
 //! ([`KlipperExport`], [`RrfExport`]).
 //!
@@ -47,10 +48,12 @@
 //! # Ok::<(), settle_gcode::GcodeError>(())
 //! ```
 
+mod budget;
 mod export_klipper;
 mod export_rrf;
 mod export_text;
 mod glob;
+mod grbl;
 mod ini;
 mod klipper;
 mod klipper_files;
@@ -60,8 +63,12 @@ mod machine;
 mod rrf;
 mod rrf_script;
 
+pub use budget::{MAX_BYTES as MAX_CONFIG_BYTES, MAX_FILES as MAX_CONFIG_FILES};
 pub use export_klipper::KlipperExport;
+
 pub use export_rrf::RrfExport;
+pub use export_text::Note;
+pub use grbl::GrblSettings;
 pub use klipper::{
     DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
     DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,
@@ -69,3 +76,32 @@ pub use klipper::{
 };
 pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
 pub use rrf::{RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RrfAxis, RrfConfig};
+
+use std::sync::Arc;
+
+use crate::error::{GcodeError, Location};
+use crate::read::dialect::Dialect;
+use crate::read::event::EventKind;
+use crate::read::reader::{Reader, ReaderOptions};
+
+/// The events of a configuration file's `text` read in `dialect`, each with its line in
+/// `source` (what config.g's and GRBL's settings readers walk).
+pub(crate) fn located_events<'a>(
+    text: &'a str,
+    dialect: Dialect,
+    source: &Arc<str>,
+) -> impl Iterator<Item = Result<(Location, EventKind), GcodeError>> + 'a {
+    let source = source.clone();
+    Reader::new(text.as_bytes(), ReaderOptions::new(dialect))
+        .with_name(source.clone())
+        .map(move |e| {
+            e.map(|e| {
+                let at = Location {
+                    source_name: source.clone(),
+                    line: e.line,
+                    column: None,
+                };
+                (at, e.kind)
+            })
+        })
+}

@@ -18,14 +18,14 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::klipper_files::{absolute, read_text};
+use super::budget::Budget;
+use super::klipper_files::absolute;
 use super::machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
 use super::rrf_script::unconditional;
 use crate::error::{GcodeError, Location};
 use crate::read::dialect::Dialect;
 use crate::read::event::{EventKind, Note};
 use crate::read::limits::{AxisValues, LimitChange};
-use crate::read::reader::{Reader, ReaderOptions};
 use crate::read::setting::Setting;
 
 /// The kinematics by `M669 K` code (`KinematicsType`,
@@ -107,6 +107,7 @@ pub struct RrfConfig {
 struct Files {
     sys: PathBuf,
     stack: Vec<PathBuf>,
+    budget: Budget,
 }
 
 /// Per-axis state while reading, in the firmware's units where they differ.
@@ -160,18 +161,23 @@ impl RrfConfig {
     /// Reads `config.g` at `path` and the macros it runs.
     pub fn read(path: impl AsRef<Path>) -> Result<Self, GcodeError> {
         let path = path.as_ref();
-        let text = read_text(path)?;
-        Self::parse(&text, path)
+        let mut budget = Budget::new();
+        let text = budget.main(path)?;
+        Self::parse_with(&text, path, budget)
     }
 
     /// Reads `text` as the configuration file at `path` (which names it in errors and
     /// anchors the macros it runs; it need not exist).
     pub fn parse(text: &str, path: impl AsRef<Path>) -> Result<Self, GcodeError> {
+        Self::parse_with(text, path.as_ref(), Budget::new())
+    }
+
+    fn parse_with(text: &str, path: &Path, budget: Budget) -> Result<Self, GcodeError> {
         let mut c = Self::defaults();
-        let path = path.as_ref();
         let mut files = Files {
             sys: path.parent().unwrap_or(Path::new("")).to_path_buf(),
             stack: Vec::new(),
+            budget,
         };
         c.run(text, path, &mut files)?;
         Ok(c)
@@ -183,16 +189,9 @@ impl RrfConfig {
         files.stack.push(absolute(path));
         let script = unconditional(text, &source);
         self.notes.extend(script.notes);
-        let reader = Reader::new(script.text.as_bytes(), ReaderOptions::new(Dialect::Rrf))
-            .with_name(source.clone());
-        for event in reader {
-            let event = event?;
-            let at = Location {
-                source_name: source.clone(),
-                line: event.line,
-                column: None,
-            };
-            match event.kind {
+        for event in super::located_events(&script.text, Dialect::Rrf, &source) {
+            let (at, kind) = event?;
+            match kind {
                 EventKind::Setting(s) => self.setting(&s, &at)?,
                 EventKind::Limits(l) => self.limits(&l, &at)?,
                 EventKind::Note(Note::MacroCall { path: name, .. }) => {
@@ -235,7 +234,7 @@ impl RrfConfig {
                 chain: chain.join(" -> "),
             });
         }
-        if !file.is_file() {
+        if std::fs::metadata(&file).is_err() {
             self.notes.push(ConfigNote::at(
                 at,
                 format!(
@@ -245,7 +244,8 @@ impl RrfConfig {
             ));
             return Ok(());
         }
-        let text = read_text(&file)?;
+        let what = format!("M98 P\"{name}\"");
+        let text = files.budget.read(&file, &at, &what)?;
         self.run(&text, &file, files)
     }
 
@@ -347,6 +347,8 @@ impl RrfConfig {
                     .map_or_else(|| format!("kinematics {code}"), |k| (*k).to_string());
                 return Ok(());
             }
+            // The RepRapFirmware reader produces none.
+            Setting::Grbl { .. } => return Ok(()),
         }
         self.set_state(state);
         Ok(())

@@ -41,6 +41,13 @@ pub struct MoveInfo {
     pub layer: u32,
     /// Print, travel or extruder-only.
     pub kind: MoveKind,
+    /// Whether it works the material ([`crate::Move::is_working`]): the moves whose error
+    /// counts.
+    pub working: bool,
+    /// The spindle or laser over it ([`crate::Tool::Off`] on a printer).
+    pub tool: crate::Tool,
+    /// The slicer's feature type: an index into [`JobSummary::features`] (0: none named).
+    pub feature: u16,
     /// When the planner starts it (s, print clock): the start of its first planned
     /// segment (settle's planner: the middle of the corner transition at its start).
     pub start_time_s: f64,
@@ -96,8 +103,24 @@ pub struct LayerTime {
     pub duration_s: f64,
     /// Moves in it.
     pub moves: u64,
-    /// Time spent in its printing (extruding) moves (s).
-    pub printing_s: f64,
+    /// Time spent in its working moves (s): extruding on a printer, the laser or spindle
+    /// on in a feed move on a laser or mill ([`crate::Move::is_working`]).
+    pub working_s: f64,
+}
+
+/// A limit the file raises above the configuration it started with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LimitOverride {
+    /// The line of the command.
+    pub line: u64,
+    /// The command (`M204`, `SET_VELOCITY_LIMIT`, `$120`).
+    pub command: String,
+    /// The limit, by the firmware's name and unit (`max_accel (mm/s^2)`).
+    pub limit: &'static str,
+    /// The configuration's value.
+    pub configured: f64,
+    /// The file's.
+    pub file: f64,
 }
 
 /// What a job did, for reports.
@@ -120,6 +143,12 @@ pub struct JobSummary {
     pub shaper_changes: u64,
     /// Commands read but not followed, with why, and how often.
     pub ignored: BTreeMap<String, u64>,
+    /// The slicer feature types the file names, as [`crate::Reader::features`].
+    pub features: Vec<String>,
+    /// The file's limit commands that raise a limit above the configuration's (a
+    /// slicer's `M204 S15000` against `max_accel: 7000`): the first of each limit, in
+    /// file order.
+    pub overrides: Vec<LimitOverride>,
     /// Whether every line of the file has been planned.
     pub complete: bool,
 }

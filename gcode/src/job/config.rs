@@ -13,10 +13,11 @@ use settle_planner::shaper::stream::Alignment;
 use settle_planner::shaper::{Shaper, ShaperType};
 use settle_planner::{Limits, PlanError, ProfileKind};
 
-use crate::{ArcSegmentation, Dialect, GcodeError};
+use crate::config::GrblSettings;
+use crate::{ArcSegmentation, Dialect, GcodeError, GrblArcs, ReaderOptions};
 
 /// A firmware by name, for a G-code job: one of [`Firmware::GCODE`] (klipper, marlin,
-/// rrf, settle; `reprapfirmware` and `duet` are rrf).
+/// rrf, grbl, settle; `reprapfirmware` and `duet` are rrf, `grblhal` is grbl).
 pub fn parse_firmware(name: &str) -> Result<Firmware, GcodeError> {
     Firmware::parse_among(name, &Firmware::GCODE, "a G-code planner").map_err(|reason| {
         GcodeError::JobSetting {
@@ -38,8 +39,19 @@ pub struct ShaperSetting {
 }
 
 impl ShaperSetting {
-    /// The shaper's impulses (its firmware's checks apply).
+    /// The shaper's impulses (its firmware's checks apply, and settle's lowest frequency,
+    /// [`settle_planner::shaper::MIN_FREQUENCY_HZ`]).
     pub fn build(&self) -> Result<Shaper, PlanError> {
+        let min = settle_planner::shaper::MIN_FREQUENCY_HZ;
+        if self.frequency_hz < min {
+            return Err(PlanError::InvalidShaper {
+                name: self.shaper_type.to_string(),
+                reason: format!(
+                    "frequency {} Hz is below {min} Hz, the lowest settle runs (a shaper lasts about one period)",
+                    self.frequency_hz
+                ),
+            });
+        }
         Shaper::new(self.shaper_type, self.frequency_hz, self.damping_ratio)
     }
 }
@@ -88,6 +100,8 @@ pub enum PlannerConfig {
     Marlin(MarlinConfig),
     /// RepRapFirmware's config.g settings.
     Rrf(RrfConfig),
+    /// GRBL's `$` settings (the planner's, the arc tolerance, the laser mode).
+    Grbl(GrblSettings),
     /// settle's planner.
     Settle(SettleConfig),
 }
@@ -99,6 +113,7 @@ impl PlannerConfig {
             PlannerConfig::Klipper(_) => Firmware::Klipper,
             PlannerConfig::Marlin(_) => Firmware::Marlin,
             PlannerConfig::Rrf(_) => Firmware::Rrf,
+            PlannerConfig::Grbl(_) => Firmware::Grbl,
             PlannerConfig::Settle(_) => Firmware::Settle,
         }
     }
@@ -121,6 +136,10 @@ pub struct JobConfig {
     pub arcs: ArcSegmentation,
     /// How planned moves become profiles.
     pub profiles: ProfileOptions,
+    /// The travel of X, Y, Z (mm, machine frame): Klipper's `position_min` and
+    /// `position_max`, RepRapFirmware's `M208`, GRBL's `$130`-`$132` (from 0); `None`
+    /// where the configuration does not say (see [`crate::job`]'s travel rules).
+    pub travel_mm: [Option<(f64, f64)>; 3],
     /// Klipper: the least step-generation flush delay (s) besides the shapers', the
     /// larger of `SDS_CHECK_TIME` (1 ms, klippy/extras/motion_queuing.py) and half the
     /// extruder's `pressure_advance_smooth_time` when pressure advance is on (0.020 s for
@@ -136,6 +155,7 @@ impl JobConfig {
     ///   ([`KlipperConfig::new`]);
     /// - Marlin: [`MarlinConfig::new`] (its example configuration);
     /// - RepRapFirmware: [`RrfConfig::new`] (Configuration.h);
+    /// - GRBL: [`GrblSettings::new`] (grbl/defaults.h `DEFAULTS_GENERIC`);
     /// - settle: [`SettleConfig::new`].
     pub fn defaults(firmware: Firmware) -> Result<Self, GcodeError> {
         let planner = match firmware {
@@ -148,6 +168,7 @@ impl JobConfig {
             }
             Firmware::Marlin => PlannerConfig::Marlin(MarlinConfig::new()),
             Firmware::Rrf => PlannerConfig::Rrf(RrfConfig::new()),
+            Firmware::Grbl => PlannerConfig::Grbl(GrblSettings::new()),
             Firmware::Settle => {
                 PlannerConfig::Settle(SettleConfig::new().map_err(|e| GcodeError::JobSetting {
                     key: "settle limits",
@@ -172,6 +193,7 @@ impl JobConfig {
             alignment: Alignment::Centred,
             arcs: ArcSegmentation::default_for(dialect),
             profiles: ProfileOptions::default(),
+            travel_mm: [None; 3],
             klipper_flush_delay_s: 0.001,
         })
     }
@@ -179,6 +201,33 @@ impl JobConfig {
     /// Which firmware.
     pub fn firmware(&self) -> Firmware {
         self.planner.firmware()
+    }
+
+    /// How the file is read: in [`JobConfig::dialect`], with GRBL's laser mode (`$32`)
+    /// from its settings.
+    pub fn reader_options(&self) -> ReaderOptions {
+        let mut o = ReaderOptions::new(self.dialect);
+        if let PlannerConfig::Grbl(g) = &self.planner {
+            o.laser_mode = g.laser_mode;
+        }
+        o
+    }
+
+    /// What a GRBL machine starts a file with, from its `$$` settings
+    /// ([`GrblSettings`]): the planner's (`$11`, `$100`-`$122`, `$398`), the arc
+    /// tolerance (`$12`) and the laser mode (`$32`).
+    pub fn from_grbl(s: &GrblSettings) -> Result<Self, GcodeError> {
+        let mut cfg = Self::defaults(Firmware::Grbl)?;
+        s.planner().validate().map_err(|e| GcodeError::JobSetting {
+            key: "GRBL settings",
+            reason: e.to_string(),
+        })?;
+        cfg.arcs = ArcSegmentation::Grbl(GrblArcs {
+            tolerance_mm: s.arc_tolerance_mm,
+        });
+        cfg.planner = PlannerConfig::Grbl(s.clone());
+        cfg.travel_mm = s.max_travel_mm.map(|t| Some((0.0, t)));
+        Ok(cfg)
     }
 }
 
@@ -245,6 +294,11 @@ impl JobConfig {
             reason: e.to_string(),
         })?;
         cfg.planner = PlannerConfig::Klipper(k);
+        for (t, (_, s)) in cfg.travel_mm.iter_mut().zip(c.steppers.iter()) {
+            *t = s
+                .as_ref()
+                .and_then(|s| Some((s.drive.position_min_mm, s.drive.position_max_mm?)));
+        }
         if let Some(s) = &c.input_shaper {
             let keys = [
                 "input_shaper.shaper_type_x",
@@ -279,6 +333,12 @@ impl JobConfig {
             reason: e.to_string(),
         })?;
         cfg.planner = PlannerConfig::Rrf(r);
+        for (t, (_, a)) in cfg.travel_mm.iter_mut().zip(c.axes.iter()) {
+            *t = a
+                .drive
+                .position_max_mm
+                .map(|hi| (a.drive.position_min_mm, hi));
+        }
         let shaper = config_shaper(&c.input_shaper, Dialect::Rrf, "M593")?;
         cfg.shapers[0] = shaper;
         cfg.shapers[1] = shaper;

@@ -7,6 +7,7 @@
 //! does not simulate, is counted as ignored with the reason.
 
 use settle_planner::PlanError;
+use settle_planner::firmware::grbl::GrblPlanner;
 use settle_planner::firmware::klipper::KlipperPlanner;
 use settle_planner::firmware::marlin::{MarlinJerk, MarlinPlanner};
 use settle_planner::firmware::rrf::RrfPlanner;
@@ -33,6 +34,7 @@ pub(crate) enum Driver {
     Klipper(Box<KlipperPlanner>),
     Marlin(Box<MarlinPlanner>),
     Rrf(Box<RrfPlanner>),
+    Grbl(Box<GrblPlanner>),
 }
 
 impl Driver {
@@ -42,6 +44,7 @@ impl Driver {
             PlannerConfig::Klipper(c) => Driver::Klipper(Box::new(KlipperPlanner::new(*c)?)),
             PlannerConfig::Marlin(c) => Driver::Marlin(Box::new(MarlinPlanner::new(*c)?)),
             PlannerConfig::Rrf(c) => Driver::Rrf(Box::new(RrfPlanner::new(*c)?)),
+            PlannerConfig::Grbl(s) => Driver::Grbl(Box::new(GrblPlanner::new(s.planner())?)),
             PlannerConfig::Settle(_) => return Ok(None),
         }))
     }
@@ -52,6 +55,7 @@ impl Driver {
             Driver::Klipper(p) => p.as_mut(),
             Driver::Marlin(p) => p.as_mut(),
             Driver::Rrf(p) => p.as_mut(),
+            Driver::Grbl(p) => p.as_mut(),
         }
     }
 
@@ -61,6 +65,52 @@ impl Driver {
             Driver::Klipper(p) => p.print_time_s(),
             Driver::Marlin(p) => p.print_time_s(),
             Driver::Rrf(p) => p.print_time_s(),
+            Driver::Grbl(p) => p.print_time_s(),
+        }
+    }
+
+    /// The limits a file's commands change, by the firmware's name for them, in mm
+    /// units (mm/s, mm/s^2): what [`crate::job::JobSummary::overrides`] compares with the
+    /// configuration's.
+    pub(crate) fn limits(&self) -> Vec<(&'static str, f64)> {
+        let mm = |v: f64| v / MM;
+        match self {
+            Driver::Klipper(p) => {
+                let c = p.config();
+                vec![
+                    ("max_velocity (mm/s)", mm(c.max_velocity_m_s)),
+                    ("max_accel (mm/s^2)", mm(c.max_accel_m_s2)),
+                    (
+                        "square_corner_velocity (mm/s)",
+                        mm(c.square_corner_velocity_m_s),
+                    ),
+                ]
+            }
+            Driver::Marlin(p) => {
+                let c = p.config();
+                m20x(
+                    [c.print_accel_m_s2, c.travel_accel_m_s2],
+                    &c.max_accel_m_s2,
+                    &c.max_feedrate_m_s,
+                )
+            }
+            Driver::Rrf(p) => {
+                let c = p.config();
+                m20x(
+                    [c.print_accel_m_s2, c.travel_accel_m_s2],
+                    &c.max_accel_m_s2,
+                    &c.max_feedrate_m_s,
+                )
+            }
+            Driver::Grbl(p) => {
+                let c = p.config();
+                vec![
+                    ("$110 (mm/min)", c.max_rate_m_s[0] * 60e3),
+                    ("$111 (mm/min)", c.max_rate_m_s[1] * 60e3),
+                    ("$120 (mm/s^2)", mm(c.accel_m_s2[0])),
+                    ("$121 (mm/s^2)", mm(c.accel_m_s2[1])),
+                ]
+            }
         }
     }
 
@@ -211,8 +261,23 @@ impl Driver {
                 p.set_config(c)?;
                 Ok(LimitOutcome::Applied)
             }
+            // GRBL's settings are `$` lines ([`crate::Setting::Grbl`]), not M-codes.
+            Driver::Grbl(_) => Ok(OTHER),
         }
     }
+}
+
+/// Marlin's and RepRapFirmware's limits by name (mm units): `M204 P`/`T`, `M201` and
+/// `M203` of X and Y.
+fn m20x(accel: [f64; 2], max_accel: &[f64; 4], max_feed: &[f64; 4]) -> Vec<(&'static str, f64)> {
+    vec![
+        ("M204 P print acceleration (mm/s^2)", accel[0] / MM),
+        ("M204 T travel acceleration (mm/s^2)", accel[1] / MM),
+        ("M201 X (mm/s^2)", max_accel[0] / MM),
+        ("M201 Y (mm/s^2)", max_accel[1] / MM),
+        ("M203 X (mm/s)", max_feed[0] / MM),
+        ("M203 Y (mm/s)", max_feed[1] / MM),
+    ]
 }
 
 /// Set `to` from a value in mm units, if given.

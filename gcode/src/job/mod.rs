@@ -65,11 +65,13 @@ mod config;
 mod driver;
 mod input;
 mod moves;
+mod not_followed;
 mod pipeline;
 mod settle;
 mod shapers;
 mod slice;
+mod travel;
 
-pub use chunk::{JobChunk, JobSummary, LayerTime, MoveGeometry, MoveInfo};
+pub use chunk::{JobChunk, JobSummary, LayerTime, LimitOverride, MoveGeometry, MoveInfo};
 pub use config::{JobConfig, PlannerConfig, SettleConfig, ShaperSetting, parse_firmware};
 pub use pipeline::Job;

@@ -12,7 +12,6 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 
 use super::chunk::{LayerTime, MoveInfo};
-use crate::read::geometry::MoveKind;
 
 /// A move whose segments are still coming.
 #[derive(Debug)]
@@ -167,13 +166,13 @@ impl Account {
                 start_time_s: start,
                 duration_s: 0.0,
                 moves: 0,
-                printing_s: 0.0,
+                working_s: 0.0,
             });
         }
         if let Some(c) = self.current.as_mut() {
             c.moves += 1;
-            if m.kind == MoveKind::Print {
-                c.printing_s += m.duration_s;
+            if m.working {
+                c.working_s += m.duration_s;
             }
         }
     }

@@ -1,8 +1,7 @@
 //! The job: reader events in, shaped chunks out (see the module doc of [`crate::job`]).
 
 use std::collections::{BTreeMap, VecDeque};
-use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::BufRead;
 use std::ops::RangeInclusive;
 use std::path::Path as FsPath;
 use std::sync::Arc;
@@ -10,16 +9,18 @@ use std::sync::Arc;
 use settle_planner::PlanError;
 use settle_planner::firmware::profiles::ProfileStream;
 
-use super::chunk::{JobChunk, JobSummary};
+use super::chunk::{JobChunk, JobSummary, LimitOverride};
 use super::config::{JobConfig, PlannerConfig, ShaperSetting};
 use super::driver::Driver;
 use super::input::{AxisShapers, Input};
 use super::moves::MoveTable;
 use super::settle::SettlePlanner;
 use super::shapers::ShaperState;
+use super::travel::Travel;
+use crate::config::GrblSettings;
 use crate::error::GcodeError;
 use crate::read::geometry::Point;
-use crate::read::reader::{Reader, ReaderOptions};
+use crate::read::reader::Reader;
 
 mod events;
 
@@ -59,17 +60,28 @@ pub struct Job<R> {
     points: Vec<Point>,
     /// Where the last move ended, and its feed (mm, mm/s).
     last_end: Point,
+    /// Where the firmware stands when it is not where the file put it (RepRapFirmware
+    /// after an arc cut short at its limits): the next move starts here.
+    resync: Option<Point>,
     last_feed_mm_s: f64,
     limit_changes: u64,
     shaper_changes: u64,
     ignored: BTreeMap<String, u64>,
+    /// GRBL: the `$` settings in force.
+    grbl: Option<GrblSettings>,
+    /// The machine's travel and the firmware's rule for moves that leave it.
+    travel: Travel,
+    /// The planner's limits at the start (the configuration's), by name.
+    start_limits: Vec<(&'static str, f64)>,
+    /// Limits the file raised above them.
+    overrides: Vec<LimitOverride>,
 }
 
-impl Job<BufReader<File>> {
+impl Job<crate::FileInput> {
     /// Open `path` and plan it with `cfg` (read in `cfg.dialect`).
     pub fn open(path: impl AsRef<FsPath>, cfg: JobConfig) -> Result<Self, GcodeError> {
         let path = path.as_ref();
-        let reader = Reader::open(path, ReaderOptions::new(cfg.dialect))?;
+        let reader = Reader::open(path, cfg.reader_options())?;
         Ok(Job::new(reader, cfg)?.with_name(path.display().to_string()))
     }
 }
@@ -108,6 +120,19 @@ impl<R: BufRead> Job<R> {
         };
         let initial = build(&cfg.shapers).map_err(setting("shapers"))?;
         let cfg_feed = cfg.dialect.initial_feed_mm_s();
+        let grbl = match &cfg.planner {
+            PlannerConfig::Grbl(g) => Some(g.clone()),
+            _ => None,
+        };
+        let travel = Travel::new(
+            cfg.firmware(),
+            cfg.travel_mm,
+            grbl.as_ref().is_some_and(|g| g.soft_limits),
+        );
+        let start_limits = match &planner {
+            Planner::Firmware(d, _) => d.limits(),
+            Planner::Settle(_) => Vec::new(),
+        };
         Ok(Self {
             reader,
             source: Arc::from("<input>"),
@@ -124,10 +149,15 @@ impl<R: BufRead> Job<R> {
             eof: false,
             points: Vec::new(),
             last_end: Point::default(),
+            resync: None,
             last_feed_mm_s: cfg_feed,
             limit_changes: 0,
             shaper_changes: 0,
             ignored: BTreeMap::new(),
+            grbl,
+            travel,
+            start_limits,
+            overrides: Vec::new(),
         })
     }
 
@@ -231,6 +261,13 @@ impl<R: BufRead> Job<R> {
     /// What the job has done so far.
     pub fn summary(&self) -> JobSummary {
         let t = self.print_time_s();
+        // What the planner was told to do but did not, and what the reader passed over.
+        let mut ignored = self.ignored.clone();
+        let firmware = self.cfg.firmware();
+        for (name, n) in self.reader.ignored_commands() {
+            let what = format!("{name}: {}", super::not_followed::reason(firmware, name));
+            *ignored.entry(what).or_insert(0) += n;
+        }
         JobSummary {
             firmware: Some(self.cfg.firmware()),
             print_time_s: t,
@@ -239,7 +276,9 @@ impl<R: BufRead> Job<R> {
             segments: self.seq,
             limit_changes: self.limit_changes,
             shaper_changes: self.shaper_changes,
-            ignored: self.ignored.clone(),
+            ignored,
+            features: self.reader.features().to_vec(),
+            overrides: self.overrides.clone(),
             complete: self.eof,
         }
     }

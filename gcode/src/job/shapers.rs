@@ -64,7 +64,9 @@ impl ShaperState {
         let (default_kind, default_f, default_z) = match firmware {
             Firmware::Rrf => (None, 40.0, 0.1),
             Firmware::Klipper => (Some(ShaperType::MZV), 0.0, 0.1),
-            Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => (None, 0.0, 0.1),
+            Firmware::Marlin | Firmware::Grbl | Firmware::Settle | Firmware::Tmc4361a => {
+                (None, 0.0, 0.1)
+            }
         };
         let axes = initial.map(|s| match s {
             Some(s) => Axis {

@@ -47,8 +47,16 @@ fn per_min(v_mm_s: f64) -> f64 {
 }
 
 impl<W: Write> CanonicalWriter<W> {
-    /// A writer for `dialect`; writes the header (units, absolute modes) at once.
+    /// A writer for `dialect`; writes the header (units, absolute modes) at once. The
+    /// printer dialects only: GRBL's events (spindle synchronisations, modal state)
+    /// cannot be written back one for one (an `Unsupported` error).
     pub fn new(mut out: W, dialect: Dialect) -> io::Result<Self> {
+        if dialect == Dialect::Grbl {
+            return Err(io::Error::new(
+                io::ErrorKind::Unsupported,
+                "canonical G-code is written in the printer dialects (klipper, marlin, rrf)",
+            ));
+        }
         writeln!(
             out,
             "; canonical G-code written by settle-gcode ({dialect})"
@@ -82,7 +90,9 @@ impl<W: Write> CanonicalWriter<W> {
                             inverse(*duration_s, duration_s * 1000.0, |d| d / 1000.0)
                         )
                     }
-                    Dialect::Marlin | Dialect::Rrf => writeln!(self.out, "G4 S{duration_s}"),
+                    Dialect::Marlin | Dialect::Rrf | Dialect::Grbl => {
+                        writeln!(self.out, "G4 S{duration_s}")
+                    }
                 }
             }
             EventKind::Layer(c) => match (c.source, c.slicer_number, c.z_mm) {
@@ -126,6 +136,7 @@ impl<W: Write> CanonicalWriter<W> {
     fn write_setting(&mut self, c: &Setting) -> io::Result<()> {
         let o = &mut self.out;
         match c {
+            Setting::Grbl { number, value } => write!(o, "${number}={value}")?,
             Setting::StepsPerMm {
                 per_axis,
                 at_microstepping,

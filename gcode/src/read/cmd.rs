@@ -55,6 +55,8 @@ pub(crate) enum CmdName<'a> {
         sub: Option<u32>,
     },
     Named(&'a str),
+    /// A GRBL block (several commands on a line): its text.
+    Block(&'a str),
 }
 
 /// A command in its place.
@@ -84,6 +86,11 @@ impl Cmd<'_> {
                 sub: Some(s),
             } => format!("{}{number}.{s}", char::from(letter)),
             CmdName::Named(n) => n.to_ascii_uppercase(),
+            CmdName::Block(text) => {
+                let t = text.trim();
+                let cut = t.char_indices().nth(40).map_or(t.len(), |(i, _)| i);
+                t[..cut].to_ascii_uppercase()
+            }
         }
     }
 
@@ -115,7 +122,7 @@ impl Cmd<'_> {
                         .next()
                         .unwrap_or("")
                         .to_ascii_uppercase(),
-                    CmdName::Code { .. } => param.to_string(),
+                    CmdName::Code { .. } | CmdName::Block(_) => param.to_string(),
                 };
                 GcodeError::DuplicateParameter {
                     at: self.at(Some(at)),

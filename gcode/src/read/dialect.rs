@@ -1,8 +1,8 @@
 //! The firmware dialects: which commands exist and in which units.
 //!
-//! Where the three firmwares differ in how they read a command, the reader follows the
-//! dialect the caller chose. The differences that matter for motion, each checked at the
-//! firmware's source:
+//! Where the firmwares differ in how they read a command, the reader follows the dialect
+//! the caller chose. The differences that matter for motion among the three printer
+//! firmwares, each checked at the firmware's source:
 //!
 //! | | Klipper | Marlin | RepRapFirmware |
 //! |---|---|---|---|
@@ -15,6 +15,13 @@
 //! | M203 | not a command | mm/s | mm/min (mm/s with `S1`) |
 //! | jerk | `SQUARE_CORNER_VELOCITY` | M205 X/Y/Z/E mm/s, J junction deviation | M566 mm/min (limit), M205 mm/s (printing moves) |
 //! | M92 M350 M906 M208 M669 M98 M501 | not commands (`printer.cfg` holds these settings) | counted as ignored | [`crate::Setting`]s and macro-call notes (`config.g`) |
+//! | M220 / M221 | speed and extrusion factors (`klippy/extras/gcode_move.py`) | the same (`M220.cpp`, `M221.cpp`; whole percent) | the same (`GCodes2.cpp`) |
+//!
+//! GRBL and grblHAL (the CNC and laser firmware) read another language, RS274/NGC as
+//! grbl/gcode.c `gc_execute_line` parses it; see [`crate::read::grbl`]: several commands
+//! on a line, modal motion (`X10 Y5` continues the last `G0`-`G3`), `F` in mm/min (or
+//! in/min after `G20`), `G0` at the machine's rapid rate, `G4 P` in seconds, no extruder,
+//! the spindle or laser as `M3`/`M4`/`M5` and `S`, `$`-settings (`$110=5000`).
 
 use std::fmt;
 
@@ -29,11 +36,21 @@ pub enum Dialect {
     Marlin,
     /// RepRapFirmware 3.5.
     Rrf,
+    /// GRBL 1.1 (gnea/grbl) and grblHAL: CNC mills and lasers.
+    Grbl,
 }
 
 impl Dialect {
     /// All dialects, in a fixed order.
-    pub const ALL: [Dialect; 3] = [Dialect::Klipper, Dialect::Marlin, Dialect::Rrf];
+    pub const ALL: [Dialect; 4] = [
+        Dialect::Klipper,
+        Dialect::Marlin,
+        Dialect::Rrf,
+        Dialect::Grbl,
+    ];
+
+    /// The printer firmwares' dialects (an extruder `E`, slicer comments).
+    pub const PRINTERS: [Dialect; 3] = [Dialect::Klipper, Dialect::Marlin, Dialect::Rrf];
 
     /// The dialect a file for `firmware`'s planner is read in: its own, and Marlin's for
     /// settle's planner (most slicers write Marlin-flavoured G-code) and for a firmware
@@ -42,6 +59,7 @@ impl Dialect {
         match firmware {
             Firmware::Klipper => Dialect::Klipper,
             Firmware::Rrf => Dialect::Rrf,
+            Firmware::Grbl => Dialect::Grbl,
             Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => Dialect::Marlin,
         }
     }
@@ -52,19 +70,23 @@ impl Dialect {
             Dialect::Klipper => Firmware::Klipper,
             Dialect::Marlin => Firmware::Marlin,
             Dialect::Rrf => Firmware::Rrf,
+            Dialect::Grbl => Firmware::Grbl,
         }
     }
 
-    /// Its firmware's name (`klipper`, `marlin`, `rrf`).
+    /// Its firmware's name (`klipper`, `marlin`, `rrf`, `grbl`).
     pub fn name(self) -> &'static str {
         self.firmware().name()
     }
 
-    /// The feed rate in force before the file sets one, mm/s (see the module table).
+    /// The feed rate in force before the file sets one, mm/s (see the module table; GRBL
+    /// has none: its feed is undefined until an `F`, and a `G1` before one is refused,
+    /// error:22 in grbl/gcode.c).
     pub fn initial_feed_mm_s(self) -> f64 {
         match self {
             Dialect::Klipper | Dialect::Marlin => 25.0,
             Dialect::Rrf => 50.0,
+            Dialect::Grbl => 0.0,
         }
     }
 }

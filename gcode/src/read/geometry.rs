@@ -52,6 +52,41 @@ pub enum MoveKind {
     Extruder,
 }
 
+/// What a spindle or laser does over a move (GRBL's `M3`/`M4`/`M5` and `S`); a printer's
+/// tool is its extruder, which [`MoveKind`] describes.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Tool {
+    /// Nothing turns or fires: printers, `M5`, or a laser during a `G0` (GRBL's laser mode
+    /// turns the laser off for rapids, grbl/gcode.c `GC_PARSER_LASER_DISABLE`).
+    #[default]
+    Off,
+    /// A laser in GRBL's laser mode (`$32=1`) at power `S`: `M3` constant power, `M4`
+    /// (`dynamic`) power scaled by the current speed over the programmed rate
+    /// (grbl/stepper.c `is_pwm_rate_adjusted`).
+    Laser {
+        /// The `S` value in force (the firmware's scale, `$30` at full power).
+        s: f64,
+        /// `M4`: dynamic power.
+        dynamic: bool,
+    },
+    /// A spindle turning at `S` (`M3` clockwise, `M4` counter-clockwise), laser mode off.
+    Spindle {
+        /// The `S` value in force (rpm).
+        s: f64,
+    },
+}
+
+impl Tool {
+    /// Whether the tool works the material during a feed move: a laser or spindle on at
+    /// `S > 0`.
+    pub fn is_on(&self) -> bool {
+        match *self {
+            Tool::Off => false,
+            Tool::Laser { s, .. } | Tool::Spindle { s } => s > 0.0,
+        }
+    }
+}
+
 /// The geometry of a move between its start and end points.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Path {
@@ -79,9 +114,24 @@ pub struct Move {
     pub rapid: bool,
     /// Line or arc.
     pub path: Path,
+    /// The spindle or laser over the move ([`Tool::Off`] on a printer).
+    pub tool: Tool,
+    /// The slicer's feature type of the move (`;TYPE:` comments): an index into
+    /// [`crate::Reader::features`], 0 when the file names none.
+    pub feature: u16,
 }
 
 impl Move {
+    /// Whether the move works the material, the one notion of a "working" move every
+    /// metric counts: a printing (extruding) move on a printer, a feed move (`G1`, `G2`,
+    /// `G3`, not a rapid) with the laser or spindle on at `S > 0` on a laser or a mill.
+    pub fn is_working(&self) -> bool {
+        match self.tool {
+            Tool::Off => self.kind == MoveKind::Print,
+            tool => tool.is_on() && !self.rapid,
+        }
+    }
+
     /// Length of the XYZ path, mm: the straight distance for a line, the exact helical
     /// length `sqrt((r |sweep|)^2 + dz^2)` for an arc.
     pub fn length_mm(&self) -> f64 {

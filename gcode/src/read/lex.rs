@@ -50,9 +50,29 @@ pub(crate) enum LexError {
     Checksum { at: usize, found: u32, computed: u8 },
 }
 
-/// Lexes `line`. `scratch` receives the code text when parenthesised comments must be
-/// cut out of it (the common case borrows from `line`).
-pub(crate) fn lex<'a>(line: &'a str, scratch: &'a mut String) -> Result<LineKind<'a>, LexError> {
+/// A line's code: the text after the line number, its comments cut out.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Code<'a> {
+    /// The code text (comments blanked byte for byte, so offsets match the line); starts
+    /// at `at`, which is past any line number and white space.
+    pub(crate) text: &'a str,
+    /// 0-based byte offset of the first code character in `text` (= in the line).
+    pub(crate) at: usize,
+    /// The `;` comment, or the first `( )` comment.
+    pub(crate) comment: Option<&'a str>,
+}
+
+impl Code<'_> {
+    /// Whether the line holds nothing but comments and white space.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.at == self.text.len()
+    }
+}
+
+/// Cuts `line` into its code and comment (checksum verified, line number skipped).
+/// `scratch` receives the code text when parenthesised comments must be cut out of it (the
+/// common case borrows from `line`).
+pub(crate) fn code<'a>(line: &'a str, scratch: &'a mut String) -> Result<Code<'a>, LexError> {
     let bytes = line.as_bytes();
     // One pass: control characters anywhere, and (outside quotes) the `;` comment, any
     // `(` comment and any `*` that may start a checksum.
@@ -110,8 +130,19 @@ pub(crate) fn lex<'a>(line: &'a str, scratch: &'a mut String) -> Result<LineKind
         }
         i = skip_ws(cb, i);
     }
-    if i == cb.len() {
-        return Ok(match comment.or(paren_comment) {
+    Ok(Code {
+        text: code,
+        at: i,
+        comment: comment.or(paren_comment),
+    })
+}
+
+/// Lexes `line` (see [`code`] for `scratch`).
+pub(crate) fn lex<'a>(line: &'a str, scratch: &'a mut String) -> Result<LineKind<'a>, LexError> {
+    let c = code(line, scratch)?;
+    let (code, cb, i) = (c.text, c.text.as_bytes(), c.at);
+    if c.is_empty() {
+        return Ok(match c.comment {
             Some(c) => LineKind::Comment(c),
             None => LineKind::Blank,
         });

@@ -1,7 +1,7 @@
 //! The streaming G-code reader (see the crate documentation), what is where:
-//! - text: [`lines`] (one bounded line at a time), [`lex`] (words and comments), [`cmd`]
+//! - text: `settle_files::lines` (one bounded line at a time), [`lex`] (words and comments), [`cmd`]
 //!   (a line's command and [`params`]);
-//! - the firmware's conventions: [`dialect`];
+//! - the firmware's conventions: [`dialect`]; GRBL's language: [`grbl`];
 //! - motion: [`motion`] (modal state: units, absolute or relative, feed), [`geometry`]
 //!   (moves, points, paths, [`geometry::Bounds`]), [`arc`] (`G2`/`G3` geometry),
 //!   [`segments`] (how each firmware cuts an arc into straight moves);
@@ -17,11 +17,11 @@ pub(crate) mod cmd;
 pub(crate) mod dialect;
 pub(crate) mod event;
 pub(crate) mod geometry;
+pub(crate) mod grbl;
 pub(crate) mod layers;
 pub(crate) mod lex;
 pub(crate) mod limit_parse;
 pub(crate) mod limits;
-pub(crate) mod lines;
 pub(crate) mod motion;
 pub(crate) mod params;
 pub(crate) mod reader;

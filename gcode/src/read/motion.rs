@@ -1,12 +1,12 @@
-//! The modal motion state (position, G92 offsets, absolute/relative modes, feed rate, arc
-//! plane) and the commands that move or rename the position: G0-G4, G17-G19, G28, G90,
-//! G91, G92, M82, M83.
+//! The modal motion state (position, G92 offsets, absolute/relative modes, units, feed
+//! rate and its `M220` factor, the `M221` extrusion factor, arc plane) and the commands
+//! that move or rename the position: G0-G4, G17-G21, G28, G90, G91, G92, M82, M83.
 
 use crate::error::GcodeError;
 use crate::read::arc::{Arc, ArcProblem};
 use crate::read::cmd::{Check, Cmd, FINITE, NON_NEGATIVE, POSITIVE};
 use crate::read::dialect::Dialect;
-use crate::read::geometry::{Move, MoveKind, Path, Point};
+use crate::read::geometry::{Move, MoveKind, Path, Point, Tool};
 use crate::read::limits::AxisFlags;
 use crate::read::params::Params;
 
@@ -29,6 +29,14 @@ pub(crate) struct Motion {
     plane_xy: bool,
     max_coordinate_mm: f64,
     max_extruder_mm: f64,
+    /// Millimetres per unit of X, Y, Z, I, J, R and F: 1 (G21) or 25.4 (G20).
+    unit_mm: f64,
+    /// `M220`: the feed of every move is multiplied by this.
+    speed_factor: f64,
+    /// `M221`: extrusion is multiplied by this.
+    extrude_factor: f64,
+    /// GRBL's `G53`: this block's coordinates are machine coordinates.
+    machine_coordinates: bool,
 }
 
 impl Motion {
@@ -43,7 +51,67 @@ impl Motion {
             plane_xy: true,
             max_coordinate_mm,
             max_extruder_mm,
+            unit_mm: 1.0,
+            speed_factor: 1.0,
+            extrude_factor: 1.0,
+            machine_coordinates: false,
         }
+    }
+
+    /// G20 (true: inches) / G21.
+    pub(crate) fn set_inches(&mut self, inches: bool) {
+        self.unit_mm = if inches { 25.4 } else { 1.0 };
+    }
+
+    /// Millimetres per unit of the coordinates and feeds written (25.4 after G20).
+    pub(crate) fn unit_mm(&self) -> f64 {
+        self.unit_mm
+    }
+
+    /// `M220 S`: the feed factor (1 = 100 %).
+    pub(crate) fn set_speed_factor(&mut self, factor: f64) {
+        self.speed_factor = factor;
+    }
+
+    /// `M221 S`: the extrusion factor (1 = 100 %) for the extrusion from here on (as
+    /// Klipper's `cmd_M221` keeps the file's E position continuous).
+    pub(crate) fn set_extrude_factor(&mut self, factor: f64) {
+        let file_e = (self.pos[3] - self.offset[3]) / self.extrude_factor;
+        self.offset[3] = self.pos[3] - file_e * factor;
+        self.extrude_factor = factor;
+    }
+
+    /// The modal feed (mm/min as written, before `M220`); 0 when none was set (GRBL).
+    pub(crate) fn feed_mm_min(&self) -> f64 {
+        self.feed_mm_min
+    }
+
+    /// Sets the modal feed (mm/min as written).
+    pub(crate) fn set_feed_mm_min(&mut self, feed: f64) {
+        self.feed_mm_min = feed;
+    }
+
+    /// Sets machine minus file coordinates of X, Y, Z (GRBL's work offsets).
+    pub(crate) fn set_offsets(&mut self, offsets: [f64; 3]) {
+        self.offset[..3].copy_from_slice(&offsets);
+    }
+
+    /// GRBL's `G53` for the next move (cleared by it).
+    pub(crate) fn set_machine_coordinates(&mut self, on: bool) {
+        self.machine_coordinates = on;
+    }
+
+    /// Whether G91 is in force.
+    pub(crate) fn is_relative(&self) -> bool {
+        self.axes_relative
+    }
+
+    /// A straight move to a point given in machine coordinates (GRBL's `G28`/`G30`
+    /// travel), `None` when it goes nowhere.
+    pub(crate) fn line_to_machine(&mut self, xyz: [f64; 3], rapid: bool) -> Option<Move> {
+        let mut t = self.pos;
+        t[..3].copy_from_slice(&xyz);
+        (t != self.pos).then(|| self.finish(t, rapid, Path::Line))
     }
 
     /// The machine position, mm.
@@ -76,18 +144,23 @@ impl Motion {
     /// Reads F and X Y Z E: the target machine position and the feed, mm/min (committed
     /// by the caller once the whole line is good).
     fn target(&self, cmd: &Cmd, p: &Params) -> Result<([f64; 4], f64), GcodeError> {
-        let feed = cmd.num(p, b'F', POSITIVE)?.unwrap_or(self.feed_mm_min);
+        let feed = match cmd.num(p, b'F', POSITIVE)? {
+            Some(f) => f * self.unit_mm,
+            None => self.feed_mm_min,
+        };
         let mut t = self.pos;
         for (k, &letter) in AXES.iter().enumerate() {
             let Some(v) = cmd.num(p, letter, FINITE)? else {
                 continue;
             };
-            let relative = if k == 3 {
-                self.e_is_relative()
+            let (relative, v) = if k == 3 {
+                (self.e_is_relative(), v * self.extrude_factor)
             } else {
-                self.axes_relative
+                (self.axes_relative, v * self.unit_mm)
             };
-            t[k] = if relative {
+            t[k] = if self.machine_coordinates && k < 3 {
+                v
+            } else if relative {
                 self.pos[k] + v
             } else {
                 v + self.offset[k]
@@ -95,12 +168,12 @@ impl Motion {
             let (limit, allowed) = if k == 3 {
                 (
                     self.max_extruder_mm,
-                    "an extruder position within ReaderOptions::max_extruder_mm of 0",
+                    "an extruder position within the reader's limit (+-1e9 mm by default)",
                 )
             } else {
                 (
                     self.max_coordinate_mm,
-                    "a position within ReaderOptions::max_coordinate_mm of 0",
+                    "a position within the reader's limit (+-1e5 mm by default: 100 m, larger than any machine)",
                 )
             };
             if t[k].abs() > limit {
@@ -119,13 +192,16 @@ impl Motion {
         let start = self.position();
         self.pos = target;
         let end = self.position();
+        self.machine_coordinates = false;
         let mut mv = Move {
             start,
             end,
-            feed_mm_s: self.feed_mm_min / 60.0,
+            feed_mm_s: self.feed_mm_min * self.speed_factor / 60.0,
             kind: MoveKind::Travel,
             rapid,
             path,
+            tool: Tool::Off,
+            feature: 0,
         };
         let moves_xyz = match path {
             Path::Line => {
@@ -152,6 +228,7 @@ impl Motion {
         let (target, feed) = self.target(cmd, p)?;
         self.feed_mm_min = feed;
         if target == self.pos {
+            self.machine_coordinates = false;
             return Ok(None);
         }
         Ok(Some(self.finish(target, rapid, Path::Line)))
@@ -186,9 +263,10 @@ impl Motion {
             ok: |v| v.abs() <= 1e5,
             allowed: "within 1e5 mm",
         };
-        let i = cmd.num(p, b'I', offset_check)?;
-        let j = cmd.num(p, b'J', offset_check)?;
-        let r = cmd.num(p, b'R', offset_check)?;
+        let unit = |v: Option<f64>| v.map(|v| v * self.unit_mm);
+        let i = unit(cmd.num(p, b'I', offset_check)?);
+        let j = unit(cmd.num(p, b'J', offset_check)?);
+        let r = unit(cmd.num(p, b'R', offset_check)?);
         if r.is_some() && (i.is_some() || j.is_some()) {
             return Err(GcodeError::ArcMixedForms {
                 at: cmd.at(None),
@@ -225,6 +303,11 @@ impl Motion {
         }
         for (k, &letter) in AXES.iter().enumerate() {
             if let Some(v) = cmd.num(p, letter, FINITE)? {
+                let v = if k == 3 {
+                    v * self.extrude_factor
+                } else {
+                    v * self.unit_mm
+                };
                 self.offset[k] = self.pos[k] - v;
             }
         }
@@ -250,13 +333,18 @@ impl Motion {
                 e: false,
             }
         };
+        self.home_axes(axes);
+        axes
+    }
+
+    /// Homing of `axes` (GRBL's `$H`): they go to 0 and lose their offsets.
+    pub(crate) fn home_axes(&mut self, axes: AxisFlags) {
         for (k, homed) in [axes.x, axes.y, axes.z].into_iter().enumerate() {
             if homed {
                 self.pos[k] = 0.0;
                 self.offset[k] = 0.0;
             }
         }
-        axes
     }
 
     /// G4: the dwell time, s, and whether Klipper ignored an `S`.
@@ -267,6 +355,8 @@ impl Motion {
         Ok(match self.dialect {
             Dialect::Klipper => (ms.unwrap_or(0.0) / 1000.0, s.is_some()),
             Dialect::Marlin | Dialect::Rrf => (s.unwrap_or(ms.unwrap_or(0.0) / 1000.0), false),
+            // GRBL's P is in seconds (grbl/gcode.c `mc_dwell(gc_block.values.p)`).
+            Dialect::Grbl => (ms.unwrap_or(0.0), false),
         })
     }
 }

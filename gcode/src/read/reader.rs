@@ -2,23 +2,25 @@
 
 use std::collections::{BTreeMap, VecDeque};
 use std::fmt::Write as _;
-use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::sync::Arc;
 
 use crate::error::{GcodeError, Location};
-use crate::read::cmd::{Cmd, CmdName};
+use crate::read::cmd::{Check, Cmd, CmdName};
 use crate::read::dialect::Dialect;
 use crate::read::event::{Event, EventKind, Note};
-use crate::read::geometry::{MoveKind, Point};
+use crate::read::geometry::{Move, Point};
+use crate::read::grbl::GrblState;
+use crate::read::grbl::dollar::{self, Dollar};
+use crate::read::grbl::words;
 use crate::read::layers::{LayerMode, Layers};
-use crate::read::lex::{LexError, LineKind, lex};
+use crate::read::lex::{self, LexError, LineKind, lex};
 use crate::read::limit_parse::{self, Outcome};
-use crate::read::lines::{LineStatus, Lines};
 use crate::read::motion::Motion;
 use crate::read::params::{KeyValues, Params};
 use crate::read::setting_parse;
+use settle_files::lines::{BoundedLines as Lines, LineStatus};
 
 /// How the reader reads.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,6 +41,9 @@ pub struct ReaderOptions {
     pub max_extruder_mm: f64,
     /// How many skipped-line errors to keep for reporting (the rest are only counted).
     pub kept_errors: usize,
+    /// GRBL: the laser mode (`$32=1`) at the start of the file (off by default, as GRBL
+    /// ships; the file's own `$32` lines change it).
+    pub laser_mode: bool,
 }
 
 impl ReaderOptions {
@@ -52,6 +57,7 @@ impl ReaderOptions {
             max_coordinate_mm: 1e5,
             max_extruder_mm: 1e9,
             kept_errors: 20,
+            laser_mode: false,
         }
     }
 }
@@ -67,6 +73,10 @@ pub struct Skipped {
 
 /// Distinct ignored command names kept; more are counted under `(other)`.
 const MAX_IGNORED_NAMES: usize = 256;
+
+/// Distinct slicer feature types kept (a slicer writes some 15); more share the last,
+/// `(other)`.
+pub const MAX_FEATURES: usize = 64;
 
 /// A streaming G-code reader: an iterator of events (or the error that ended it).
 ///
@@ -95,17 +105,29 @@ struct Interp {
     ignored: BTreeMap<String, u64>,
     name_buf: String,
     skipped: Skipped,
+    /// GRBL's modal state (the GRBL dialect only).
+    grbl: GrblState,
+    /// GRBL: the line with its commands blanked, for the value words.
+    words_buf: String,
+    /// GRBL: events of the block being run.
+    block_out: Vec<EventKind>,
+    /// Feature types named so far; index 0 is "none".
+    features: Vec<String>,
+    /// The feature type in force (index into `features`).
+    feature: u16,
 }
 
-impl Reader<BufReader<File>> {
-    /// Opens a file.
+/// A G-code file open for reading (settle-files' reader: a regular file of at most
+/// [`settle_files::limit::GCODE`]).
+pub type FileInput = BufReader<settle_files::read::Input>;
+
+impl Reader<FileInput> {
+    /// Opens a file (a regular file, links followed, of at most
+    /// [`settle_files::limit::GCODE`]).
     pub fn open(path: impl AsRef<Path>, options: ReaderOptions) -> Result<Self, GcodeError> {
         let path = path.as_ref();
         let name: Arc<str> = Arc::from(path.display().to_string());
-        let file = File::open(path).map_err(|source| GcodeError::Io {
-            source_name: name.clone(),
-            source,
-        })?;
+        let file = settle_files::read::open(path, settle_files::limit::GCODE)?;
         Ok(Reader::new(BufReader::with_capacity(64 * 1024, file), options).with_name(name))
     }
 }
@@ -127,6 +149,11 @@ impl<R: BufRead> Reader<R> {
             ignored: BTreeMap::new(),
             name_buf: String::new(),
             skipped: Skipped::default(),
+            grbl: GrblState::new(options.laser_mode),
+            words_buf: String::new(),
+            block_out: Vec::new(),
+            features: vec![String::new()],
+            feature: 0,
             opts: options,
         };
         Reader {
@@ -154,6 +181,12 @@ impl<R: BufRead> Reader<R> {
     /// (`M104`, `T0`, `PRINT_START`), with how often.
     pub fn ignored_commands(&self) -> &BTreeMap<String, u64> {
         &self.interp.ignored
+    }
+
+    /// The slicer feature types named so far (`;TYPE:` comments): [`crate::Move::feature`]
+    /// indexes it; index 0 is the empty name (no feature named).
+    pub fn features(&self) -> &[String] {
+        &self.interp.features
     }
 
     /// Lines skipped so far under [`ReaderOptions::skip_bad_lines`].
@@ -207,10 +240,7 @@ impl<R: BufRead> Iterator for Reader<R> {
             match self.lines.next_line() {
                 Err(source) => {
                     self.finished = true;
-                    return Some(Err(GcodeError::Io {
-                        source_name: self.source_name.clone(),
-                        source,
-                    }));
+                    return Some(Err(GcodeError::io(&self.source_name, source)));
                 }
                 Ok(None) => {
                     self.finished = true;
@@ -229,12 +259,14 @@ impl<R: BufRead> Iterator for Reader<R> {
                 }
                 Ok(Some(LineStatus::Complete)) => {
                     let line_no = self.lines.line_no();
-                    let result = self.interp.line(
-                        &self.source_name,
-                        line_no,
-                        self.lines.bytes(),
-                        &mut self.scratch,
-                    );
+                    let mut bytes = self.lines.bytes();
+                    if line_no == 1 {
+                        // A byte-order mark (editors on Windows write one) is not G-code.
+                        bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
+                    }
+                    let result =
+                        self.interp
+                            .line(&self.source_name, line_no, bytes, &mut self.scratch);
                     if let Err(e) = result {
                         self.fail(e);
                     }
@@ -256,6 +288,43 @@ impl Interp {
             layer: self.layers.index,
             kind,
         });
+    }
+
+    /// A move, after the layer change it may start (Z fallback: a working move at a new
+    /// Z), tagged with the feature type in force.
+    fn push_move(&mut self, line: u64, mut mv: Move) {
+        mv.feature = self.feature;
+        if let Some(c) = self.layers.before_move(&mv, mv.is_working()) {
+            self.push(line, EventKind::Layer(c));
+        }
+        self.push(line, EventKind::Move(mv));
+    }
+
+    /// A comment line: a layer marker, or a slicer feature type.
+    fn comment(&mut self, line_no: u64, t: &str) {
+        self.layers.comment(line_no, t, &mut self.layer_buf);
+        for (line, layer, c) in self.layer_buf.drain(..) {
+            self.queue.push_back(Event {
+                line,
+                layer,
+                kind: EventKind::Layer(c),
+            });
+        }
+        if let Some(name) = feature_name(t) {
+            self.feature = match self.features.iter().position(|f| f == name) {
+                Some(i) => i as u16,
+                None if self.features.len() < MAX_FEATURES - 1 => {
+                    self.features.push(name.to_string());
+                    (self.features.len() - 1) as u16
+                }
+                None => {
+                    if self.features.len() < MAX_FEATURES {
+                        self.features.push("(other)".to_string());
+                    }
+                    (MAX_FEATURES - 1) as u16
+                }
+            };
+        }
     }
 
     fn flush_layer(&mut self) {
@@ -281,7 +350,9 @@ impl Interp {
                     let _ = write!(self.name_buf, ".{s}");
                 }
             }
-            CmdName::Named(n) => self.name_buf.push_str(&n.to_ascii_uppercase()),
+            CmdName::Named(n) | CmdName::Block(n) => {
+                self.name_buf.push_str(&n.to_ascii_uppercase());
+            }
         }
         if let Some(c) = self.ignored.get_mut(self.name_buf.as_str()) {
             *c += 1;
@@ -307,7 +378,7 @@ impl Interp {
         let text = std::str::from_utf8(bytes).map_err(|e| GcodeError::InvalidUtf8 {
             at: at(Some(e.valid_up_to() + 1)),
         })?;
-        let kind = lex(text, scratch).map_err(|e| match e {
+        let lex_error = |e: LexError| match e {
             LexError::Control { at: c, byte } => GcodeError::ControlCharacter {
                 at: at(Some(c + 1)),
                 byte,
@@ -325,18 +396,16 @@ impl Interp {
                 found,
                 computed,
             },
-        })?;
+        };
+        if self.opts.dialect == Dialect::Grbl {
+            let code = lex::code(text, scratch).map_err(lex_error)?;
+            return self.grbl_line(source, line_no, code, &at);
+        }
+        let kind = lex(text, scratch).map_err(lex_error)?;
         match kind {
             LineKind::Blank | LineKind::Percent => Ok(()),
             LineKind::Comment(t) => {
-                self.layers.comment(line_no, t, &mut self.layer_buf);
-                for (line, layer, c) in self.layer_buf.drain(..) {
-                    self.queue.push_back(Event {
-                        line,
-                        layer,
-                        kind: EventKind::Layer(c),
-                    });
-                }
+                self.comment(line_no, t);
                 Ok(())
             }
             LineKind::Code {
@@ -391,7 +460,7 @@ impl Interp {
                 b'M' => {
                     matches!(
                         number,
-                        82 | 83 | 400 | 201 | 203 | 204 | 205 | 566 | 593 | 493 | 494
+                        82 | 83 | 400 | 201 | 203 | 204 | 205 | 566 | 593 | 493 | 494 | 220 | 221
                     ) || (self.opts.dialect == Dialect::Rrf && is_rrf_setting(number))
                 }
                 _ => false,
@@ -408,18 +477,12 @@ impl Interp {
         match (letter, number) {
             (b'G', 0 | 1) => {
                 if let Some(mv) = self.motion.line(cmd, p, number == 0)? {
-                    if let Some(c) = self.layers.before_move(&mv, mv.kind == MoveKind::Print) {
-                        self.push(line, EventKind::Layer(c));
-                    }
-                    self.push(line, EventKind::Move(mv));
+                    self.push_move(line, mv);
                 }
             }
             (b'G', 2 | 3) => {
                 let mv = self.motion.arc(cmd, p, number == 2)?;
-                if let Some(c) = self.layers.before_move(&mv, mv.kind == MoveKind::Print) {
-                    self.push(line, EventKind::Layer(c));
-                }
-                self.push(line, EventKind::Move(mv));
+                self.push_move(line, mv);
             }
             (b'G', 4) => {
                 let (duration_s, s_ignored) = self.motion.dwell(cmd, p)?;
@@ -436,10 +499,22 @@ impl Interp {
                 cmd.allow(p, b"", "none")?;
                 self.motion.set_plane_xy(number == 17);
             }
-            (b'G', 20) => {
-                return Err(cmd.unsupported("inch units: settle reads millimetre G-code (G21); convert the file to millimetres"));
+            (b'G', 20 | 21) => {
+                cmd.allow(p, b"", "none")?;
+                match self.opts.dialect {
+                    Dialect::Klipper if number == 20 => {
+                        return Err(cmd.unsupported(
+                            "Klipper refuses inch units (klippy/extras/gcode_move.py cmd_G20: \"Machine does not support G20\"); convert the file to millimetres",
+                        ));
+                    }
+                    Dialect::Marlin if number == 20 => {
+                        return Err(cmd.unsupported(
+                            "Marlin reads G20 only when built with INCH_MODE_SUPPORT (off in its example configuration); convert the file to millimetres",
+                        ));
+                    }
+                    _ => self.motion.set_inches(number == 20),
+                }
             }
-            (b'G', 21) => cmd.allow(p, b"", "none")?,
             (b'G', 28) => {
                 let axes = self.motion.home(p);
                 self.push(line, EventKind::Note(Note::Homed { axes }));
@@ -454,6 +529,7 @@ impl Interp {
                 self.motion.set_e_relative(number == 83);
             }
             (b'M', 400) => self.push(line, EventKind::Dwell { duration_s: 0.0 }),
+            (b'M', 220 | 221) => factor(&mut self.motion, self.opts.dialect, cmd, number, p)?,
             (b'M', n) if is_rrf_setting(n) => {
                 match setting_parse::m_code(self.opts.dialect, cmd, number, p)? {
                     setting_parse::Outcome::Setting(s) => self.push(line, EventKind::Setting(s)),
@@ -473,6 +549,61 @@ impl Interp {
         Ok(())
     }
 
+    /// A line of GRBL G-code: a `$` command, or a block ([`crate::read::grbl`]).
+    fn grbl_line(
+        &mut self,
+        source: &Arc<str>,
+        line_no: u64,
+        code: lex::Code<'_>,
+        at: &dyn Fn(Option<usize>) -> Location,
+    ) -> Result<(), GcodeError> {
+        if code.is_empty() {
+            if let Some(t) = code.comment {
+                self.comment(line_no, t);
+            }
+            return Ok(());
+        }
+        self.flush_layer();
+        let text = &code.text[code.at..];
+        self.block_out.clear();
+        let mut out = std::mem::take(&mut self.block_out);
+        let result = if text.starts_with('$') {
+            match dollar::line(&mut self.grbl, &mut self.motion, text, at, &mut out) {
+                Ok(Dollar::Events) => Ok(()),
+                Ok(Dollar::Ignored(name)) => {
+                    *self.ignored.entry(name.to_string()).or_insert(0) += 1;
+                    Ok(())
+                }
+                Err(e) => Err(e),
+            }
+        } else {
+            let cmd = Cmd {
+                name: CmdName::Block(text),
+                source,
+                line: line_no,
+                args_at: code.at,
+                args: text,
+            };
+            let mut rest = std::mem::take(&mut self.words_buf);
+            let r = words::read(&cmd, text, &mut rest).and_then(|w| {
+                self.params.parse(&rest).map_err(|e| cmd.param_error(e))?;
+                let cmd = Cmd { args: &rest, ..cmd };
+                self.grbl
+                    .block(&mut self.motion, &cmd, &w, &self.params, &mut out)
+            });
+            self.words_buf = rest;
+            r
+        };
+        for kind in out.drain(..) {
+            match kind {
+                EventKind::Move(mv) => self.push_move(line_no, mv),
+                other => self.push(line_no, other),
+            }
+        }
+        self.block_out = out;
+        result
+    }
+
     fn named(&mut self, cmd: &Cmd, name: &str) -> Result<(), GcodeError> {
         let limit_command = name.eq_ignore_ascii_case("SET_VELOCITY_LIMIT")
             || name.eq_ignore_ascii_case("SET_INPUT_SHAPER");
@@ -489,4 +620,51 @@ impl Interp {
         }
         Ok(())
     }
+}
+
+/// The feature type a comment names: PrusaSlicer, SuperSlicer, OrcaSlicer and Cura write
+/// `;TYPE:External perimeter` / `;TYPE:WALL-OUTER`; OrcaSlicer and BambuStudio for Bambu
+/// printers `; FEATURE: Outer wall` (OrcaSlicer `GCodeProcessor::Reserved_Tags`).
+fn feature_name(comment: &str) -> Option<&str> {
+    let t = comment.trim();
+    let name = t
+        .strip_prefix("TYPE:")
+        .or_else(|| t.strip_prefix("FEATURE:"))?
+        .trim();
+    (!name.is_empty() && name.len() <= 64).then_some(name)
+}
+
+/// `M220 S` (feed factor) and `M221 S` (extrusion factor), percent: Klipper
+/// `cmd_M220`/`cmd_M221` (klippy/extras/gcode_move.py; without `S` they reset to
+/// 100 %), Marlin `M220.cpp`/`M221.cpp` (whole percent; without `S` they report),
+/// RepRapFirmware (`GCodes2.cpp`; without `S` they report).
+fn factor(
+    motion: &mut Motion,
+    dialect: Dialect,
+    cmd: &Cmd,
+    number: u32,
+    p: &Params,
+) -> Result<(), GcodeError> {
+    let allowed: &[u8] = match dialect {
+        Dialect::Marlin => b"SBRT",
+        Dialect::Rrf => b"SD",
+        _ => b"S",
+    };
+    cmd.allow(p, allowed, "S (percent)")?;
+    let check = Check {
+        ok: |v| v > 0.0 && v <= 1e4,
+        allowed: "a percentage above 0, up to 10000",
+    };
+    let percent = match (cmd.num(p, b'S', check)?, dialect) {
+        (Some(s), Dialect::Marlin) => s.trunc().max(1.0),
+        (Some(s), _) => s,
+        (None, Dialect::Klipper) => 100.0,
+        (None, _) => return Ok(()),
+    };
+    if number == 220 {
+        motion.set_speed_factor(percent / 100.0);
+    } else {
+        motion.set_extrude_factor(percent / 100.0);
+    }
+    Ok(())
 }

@@ -21,6 +21,7 @@
 //!   `max(1, trunc(r sweep / length + 0.8))`, angles by incremental rotation with a full
 //!   sine/cosine every 9th segment, Z and E each step `(end - current) / segments left`.
 //!   Single precision like the firmware.
+//! - **GRBL** ([`crate::read::grbl::arcs`]): segments from the arc tolerance `$12`.
 //!
 //! The returned points exclude the start and end at the move's end point (every firmware
 //! sends its last segment to the target as written; Klipper's last E is its running sum
@@ -31,6 +32,7 @@ use std::f64::consts::TAU;
 
 use crate::read::dialect::Dialect;
 use crate::read::geometry::{Move, Path, Point};
+pub use crate::read::grbl::arcs::GrblArcs;
 
 /// Klipper's `[gcode_arcs]` section.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,6 +110,8 @@ pub enum ArcSegmentation {
     Marlin(MarlinArcs),
     /// RepRapFirmware.
     Rrf(RrfArcs),
+    /// GRBL.
+    Grbl(GrblArcs),
 }
 
 impl ArcSegmentation {
@@ -117,6 +121,7 @@ impl ArcSegmentation {
             Dialect::Klipper => ArcSegmentation::Klipper(KlipperArcs::default()),
             Dialect::Marlin => ArcSegmentation::Marlin(MarlinArcs::default()),
             Dialect::Rrf => ArcSegmentation::Rrf(RrfArcs::default()),
+            Dialect::Grbl => ArcSegmentation::Grbl(GrblArcs::default()),
         }
     }
 }
@@ -138,6 +143,7 @@ impl Move {
             (Path::Arc(_), ArcSegmentation::Klipper(p)) => klipper(self, p, out),
             (Path::Arc(_), ArcSegmentation::Marlin(p)) => marlin(self, p, out),
             (Path::Arc(_), ArcSegmentation::Rrf(p)) => rrf(self, p, out),
+            (Path::Arc(_), ArcSegmentation::Grbl(p)) => crate::read::grbl::arcs::grbl(self, p, out),
         }
     }
 }

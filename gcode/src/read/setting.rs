@@ -7,8 +7,9 @@
 
 use crate::read::limits::AxisValues;
 
-/// A machine setting read from the file. Only the RepRapFirmware dialect produces these;
-/// the other dialects count the commands as ignored.
+/// A machine setting read from the file. The RepRapFirmware dialect produces the
+/// configuration commands, the GRBL dialect its `$N=V` lines; the other dialects count
+/// the commands as ignored.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Setting {
     /// `M92`: steps per mm per axis. With `S` the values are for that microstepping, and the
@@ -56,6 +57,14 @@ pub enum Setting {
         /// The `KinematicsType` code.
         code: u32,
     },
+    /// GRBL's `$N=V` (grbl/settings.c `settings_store_global_setting`; what each number
+    /// means: [`crate::config::GrblSettings`]).
+    Grbl {
+        /// The setting's number (`110` for `$110`).
+        number: u16,
+        /// Its value, in GRBL's units (mm/min, mm/s^2, mm).
+        value: f64,
+    },
 }
 
 impl Setting {
@@ -67,6 +76,7 @@ impl Setting {
             Setting::MotorCurrent { .. } => "M906",
             Setting::AxisLimits { .. } => "M208",
             Setting::Kinematics { .. } => "M669",
+            Setting::Grbl { .. } => "$",
         }
     }
 }

@@ -208,3 +208,49 @@ fn rrf_export_refuses_what_the_firmware_refuses() {
     }
     assert!(base.to_config().is_ok());
 }
+
+#[test]
+fn shaping_off_is_m593_none_alone_and_notes_sit_above_their_values() {
+    use settle_gcode::config::Note;
+    let off = RrfExport {
+        produced_by: "a test".into(),
+        shaper: shaper("none", f64::NAN, f64::NAN),
+        print_accel_mm_s2: Some(2500.0),
+        travel_accel_mm_s2: None,
+    };
+    let note = |key: &str, text: &str| Note {
+        key: key.into(),
+        text: text.into(),
+    };
+    let text = off
+        .to_config_with_notes(&[note("M204 P", "was 3000"), note("", "head\nline")])
+        .expect("valid");
+    assert!(
+        text.ends_with("; head line\nM593 P\"none\"\n; was 3000\nM204 P2500\n"),
+        "{text}"
+    );
+    let c = RrfConfig::parse(&text, "sys/config.g").expect("valid");
+    assert_eq!(c.input_shaper.name, "none");
+    assert_eq!(c.print_accel_mm_s2, 2500.0);
+    let k = klipper_export()
+        .to_config_with_notes(&[note("shaper_freq_y", "41.4 -> 38.1"), note("nowhere", "x")])
+        .expect("valid");
+    assert!(
+        k.contains("shaper_type_y: ei\n# 41.4 -> 38.1\nshaper_freq_y: 38.099999999999994\n"),
+        "{k}"
+    );
+    assert!(
+        !k.contains("# x\n"),
+        "a note whose key is not written is left out: {k}"
+    );
+    let printer = "[printer]\nkinematics: cartesian\nmax_velocity: 300\nmax_accel: 1\n";
+    let read = |t: &str| {
+        KlipperConfig::parse(&format!("{printer}{t}"), "p.cfg")
+            .expect("valid")
+            .input_shaper
+    };
+    assert_eq!(
+        read(&k),
+        read(&klipper_export().to_config().expect("valid"))
+    );
+}

@@ -396,19 +396,39 @@ fn unreadable_files_are_errors() {
         ("d1/x", ""),
     ]);
     std::fs::write(dir.path().join("bad.cfg"), b"[mcu]\nserial: /dev/tty\xff\n").expect("write");
+    // The include line is named, then the included file's line and column.
     match read_err(dir.path(), "printer.cfg") {
-        GcodeError::InvalidUtf8 { at } => {
-            assert!(at.source_name.ends_with("bad.cfg"));
-            assert_eq!((at.line, at.column), (2, Some(17)));
+        GcodeError::Include { at, what, source } => {
+            assert!(at.source_name.ends_with("printer.cfg"));
+            assert_eq!(what, "[include bad.cfg]");
+            match *source {
+                settle_files::FileError::NotText {
+                    path, line, column, ..
+                } => {
+                    assert!(path.ends_with("bad.cfg"));
+                    assert_eq!((line, column), (2, 17));
+                }
+                e => panic!("{e:?}"),
+            }
+        }
+        e => panic!("{e:?}"),
+    }
+    // A folder matched by an include: named with the include's line.
+    match read_err(dir.path(), "dir.cfg") {
+        GcodeError::Include { at, source, .. } => {
+            assert!(at.source_name.ends_with("dir.cfg"));
+            assert!(matches!(
+                *source,
+                settle_files::FileError::NotRegular {
+                    what: "a folder",
+                    ..
+                }
+            ));
         }
         e => panic!("{e:?}"),
     }
     assert!(matches!(
-        read_err(dir.path(), "dir.cfg"),
-        GcodeError::Io { .. }
-    ));
-    assert!(matches!(
         read_err(dir.path(), "missing.cfg"),
-        GcodeError::Io { .. }
+        GcodeError::File(f) if matches!(*f, settle_files::FileError::Read { .. })
     ));
 }

@@ -40,7 +40,7 @@ fn run_file(
     name: &str,
     cfg: JobConfig,
     layers: Option<(u32, u32)>,
-) -> (Vec<JobChunk>, Job<std::io::BufReader<std::fs::File>>) {
+) -> (Vec<JobChunk>, Job<settle_gcode::FileInput>) {
     let mut job = Job::open(print_path(name), cfg).expect("open");
     if let Some((a, b)) = layers {
         job = job.with_layers(a..=b).expect("layers");
@@ -62,7 +62,7 @@ fn final_position(name: &str, cfg: &JobConfig) -> [f64; 3] {
 #[test]
 fn every_print_through_every_firmware() {
     for name in PRINTS {
-        for fw in Firmware::GCODE {
+        for fw in Firmware::PRINTERS {
             let mut cfg = shaped(fw);
             if (name, fw) == ("arc_part.gcode", Firmware::Klipper) {
                 // Klipper refuses R-form arcs; the job stops at the line that has one.
@@ -115,7 +115,7 @@ fn a_layer_range_is_the_whole_job_cut_at_its_moves() {
     // Layers 2 and 3 of the ringing tower: chunks from the start of layer 2's first move
     // to the start of layer 4's, equal to the whole job's motion there (the shapers see
     // the same input: the look-back covers their duration).
-    for fw in Firmware::GCODE {
+    for fw in Firmware::PRINTERS {
         let cfg = shaped(fw);
         let (whole, mut whole_job) = run_file("ringing_tower.gcode", cfg.clone(), None);
         whole_job.run_to_end().expect("end");
@@ -171,7 +171,7 @@ fn a_layer_range_is_the_whole_job_cut_at_its_moves() {
 /// of the file.
 #[test]
 fn a_pre_roll_starts_the_range_earlier_with_the_whole_jobs_motion() {
-    for fw in Firmware::GCODE {
+    for fw in Firmware::PRINTERS {
         let cfg = shaped(fw);
         let (whole, _) = run_file("ringing_tower.gcode", cfg.clone(), None);
         let moves: Vec<_> = whole.iter().flat_map(|c| c.moves.iter().cloned()).collect();
@@ -234,7 +234,7 @@ fn homing_after_motion_travels_home_continuously() {
     // G28 after moves: homing is not simulated, the toolhead travels to 0 on the homed
     // axes, so the motion stays continuous and the move count includes that travel.
     let text = "G1 X20 Y10 F6000\nG28 X\nG1 Y30\n";
-    for fw in Firmware::GCODE {
+    for fw in Firmware::PRINTERS {
         let (chunks, s) = crate::job_util::run(text, JobConfig::defaults(fw).expect("defaults"));
         assert_contiguous(&chunks);
         assert_eq!(s.moves, 3, "{fw}");

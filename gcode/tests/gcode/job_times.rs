@@ -229,7 +229,9 @@ fn arcs_plan_as_the_firmware_cuts_them() {
             PlannerConfig::Klipper(c) => Box::new(KlipperPlanner::new(*c).expect("c")),
             PlannerConfig::Marlin(c) => Box::new(MarlinPlanner::new(*c).expect("c")),
             PlannerConfig::Rrf(c) => Box::new(RrfPlanner::new(*c).expect("c")),
-            PlannerConfig::Settle(_) => unreachable!("firmwares only"),
+            PlannerConfig::Grbl(_) | PlannerConfig::Settle(_) => {
+                unreachable!("printer firmwares only")
+            }
         };
         assert_eq!(s.print_time_s, direct(p.as_mut(), &moves), "{fw}");
         assert_eq!(s.segments as usize, moves.len(), "{fw}");

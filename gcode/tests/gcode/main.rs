@@ -6,6 +6,8 @@ mod config_klipper;
 mod config_rrf;
 mod dialects;
 mod errors;
+mod features;
+mod grbl;
 mod job_changes;
 mod job_prints;
 mod job_settle;

@@ -7,6 +7,12 @@
 
 use nalgebra::{DMatrix, DVector};
 
+/// The search has converged when a step lowers the sum of squares by less than this
+/// fraction of it: the parameters then move by far less than their standard deviations
+/// (a change `d` of the sum of squares moves a parameter by about `sqrt(d / RSS)` of its
+/// standard deviation per residual degree of freedom).
+pub const CONVERGED_RELATIVE: f64 = 1e-10;
+
 /// Result of a fit.
 #[derive(Debug, Clone)]
 pub struct LmFit {
@@ -24,6 +30,10 @@ pub struct LmFit {
     pub jacobian: DMatrix<f64>,
     /// Iterations taken.
     pub iterations: usize,
+    /// True when the last step changed the sum of squares by less than
+    /// [`CONVERGED_RELATIVE`] of it (or no step lowered it), false when the iteration limit
+    /// stopped the search.
+    pub converged: bool,
 }
 
 impl LmFit {
@@ -103,6 +113,7 @@ where
     let mut rss = sum_sq(&r);
     let mut lambda = 1e-3;
     let mut iterations = 0;
+    let mut converged = false;
     let p = theta.len();
     while iterations < max_iterations {
         iterations += 1;
@@ -124,7 +135,7 @@ where
             match f(&trial) {
                 Some(rt) if sum_sq(&rt) < rss => {
                     let new_rss = sum_sq(&rt);
-                    let small = rss - new_rss <= 1e-12 * rss.max(f64::MIN_POSITIVE);
+                    let small = rss - new_rss <= CONVERGED_RELATIVE * rss.max(f64::MIN_POSITIVE);
                     theta = trial;
                     r = rt;
                     rss = new_rss;
@@ -136,6 +147,7 @@ where
             }
         }
         if !improved {
+            converged = true;
             break;
         }
     }
@@ -148,5 +160,6 @@ where
         inv_normal,
         jacobian: j,
         iterations,
+        converged,
     })
 }

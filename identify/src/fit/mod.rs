@@ -2,10 +2,34 @@
 //! ([`ringdown`]), with model selection and uncertainties shared here.
 
 pub mod lm;
+pub mod main_peak;
+pub mod pencil;
+pub mod rejected;
 pub mod ringdown;
 pub mod sweep;
 pub mod sweep_model;
 pub mod sweep_residual;
+
+/// The checks after a sweep fit read only the bins where the measured PSD stands at least
+/// this many times above the fitted noise floor.
+pub const SIGNAL_OVER_FLOOR: f64 = 3.0;
+
+/// A fitted spectrum, per fitted bin: the data and the model (the recording's PSD, before
+/// any stored normalisation), the fitted noise floor, the bins' frequencies and the bin
+/// width (Hz). What the checks after a sweep fit read ([`main_peak`], [`rejected`]).
+#[derive(Debug, Clone, Copy)]
+pub struct FittedSpectrum<'a> {
+    /// Measured PSD per bin.
+    pub data: &'a [f64],
+    /// Fitted PSD per bin.
+    pub model: &'a [f64],
+    /// Fitted noise floor.
+    pub noise: f64,
+    /// Frequency per bin (Hz).
+    pub freq: &'a [f64],
+    /// Bin width (Hz).
+    pub bin: f64,
+}
 
 /// A larger model must lower the Bayesian information criterion by at least this much
 /// (Kass & Raftery's "very strong" evidence: a BIC difference above 10).

@@ -5,7 +5,7 @@
 //! (`w_dk = w_k sqrt(1 - zeta_k^2)`; `c` absorbs what is left of gravity and offsets).
 //! The fit is unbiased because it is this exact model fitted to the samples by least
 //! squares (white sensor noise): no width or envelope is read. Start values come from the
-//! matrix pencil ([`settle_sim::pencil`]) on the decay, with the linear amplitudes solved
+//! matrix pencil ([`super::pencil`]) on the decay, with the linear amplitudes solved
 //! by least squares for each start; Levenberg-Marquardt then refines
 //! `(ln f_k, ln zeta_k, a_k, b_k, c)`. Model size by BIC as for the sweep fit.
 //!
@@ -31,6 +31,12 @@ const PENCIL_SAMPLES: usize = 600;
 
 /// Poles beyond `2 m + 1` given to the matrix pencil.
 const PENCIL_EXTRA_POLES: usize = 6;
+
+/// The least share of the window's variance the fitted decay must explain: a free decay
+/// over sensor noise leaves a few per cent unexplained; a record that holds no decay (a
+/// resonance sweep read without its test's options, whose forced oscillation goes on
+/// after the "decay" the fit finds) leaves most of it.
+pub const MIN_EXPLAINED: f64 = 0.5;
 
 /// Samples fitted at most.
 const MAX_FIT_SAMPLES: usize = 20_000;
@@ -84,14 +90,17 @@ pub fn fit(
     let q = (y.len() / PENCIL_SAMPLES)
         .max(1)
         .min(((sample_rate_hz / (8.0 * f_dom)).floor() as usize).max(1));
-    let decimated: Vec<f64> = y.iter().step_by(q).copied().collect();
+    // The start of the decay, where it stands out of the noise most: the pencil's SVD
+    // costs the cube of its length (the whole of a 5,200-sample record at 800 Hz, where
+    // the oscillation allows no decimation, took 20 s).
+    let decimated: Vec<f64> = y.iter().step_by(q).take(PENCIL_SAMPLES).copied().collect();
     let nyquist = 0.45 * sample_rate_hz / q as f64;
     let mut best: Option<(LmFit, f64)> = None;
     let mut candidates = Vec::new();
     for m in 1..=max_modes.max(1) {
         // Extra poles take up the noise, so the m strongest oscillations are the modes.
         let order = 2 * m + 1 + PENCIL_EXTRA_POLES;
-        let Some(found) = settle_sim::pencil::fit(&decimated, dt * q as f64, order) else {
+        let Some(found) = super::pencil::fit(&decimated, dt * q as f64, order) else {
             break;
         };
         let mut nonlinear: Vec<(f64, f64)> = found
@@ -138,9 +147,15 @@ pub fn fit(
         )));
     };
     let c = correlation_inflation(&fit.residuals);
-    let sig = fit
+    // Without finite uncertainties the fit has not converged to a decay: no answer.
+    let Some(sig) = fit
         .sigmas(c)
-        .unwrap_or_else(|| vec![f64::NAN; fit.theta.len()]);
+        .filter(|s| s.iter().chain(&fit.theta).all(|v| v.is_finite()))
+    else {
+        return Err(fail(format!(
+            "the fit of a free decay after sample {start} did not converge (its uncertainties are not finite): the recording holds no clean decay; a resonance test's recording needs the test's --freq-start, --freq-end and --hz-per-sec"
+        )));
+    };
     let m = fit.theta.len() / 4;
     let mut modes: Vec<IdentifiedMode> = (0..m)
         .map(|k| {
@@ -162,17 +177,29 @@ pub fn fit(
             } else {
                 (None, WeightBasis::NotIdentified)
             };
+            let (f, z) = (at(0), at(1));
             IdentifiedMode {
-                frequency_hz: at(0),
-                damping_ratio: at(1),
+                frequency_hz: f,
+                damping_ratio: z,
                 weight,
                 weight_basis,
+                peak_hz: f.value * (1.0 - z.value * z.value).max(0.0).sqrt(),
             }
         })
         .collect();
     modes.sort_by(|a, b| a.frequency_hz.value.total_cmp(&b.frequency_hz.value));
-    let curve: Vec<f64> = y.iter().zip(&fit.residuals).map(|(v, r)| v - r).collect();
     let n = y.len();
+    let mean = y.iter().sum::<f64>() / n as f64;
+    let total: f64 = y.iter().map(|v| (v - mean).powi(2)).sum();
+    let explained = 1.0 - fit.rss / total;
+    if explained.is_nan() || explained < MIN_EXPLAINED {
+        return Err(fail(format!(
+            "the damped oscillations fitted after sample {start} explain {:.0} % of the signal there (at least {:.0} % for a free decay): the recording holds no clean decay; a resonance test's recording needs the test's --freq-start, --freq-end and --hz-per-sec",
+            100.0 * explained.max(0.0),
+            100.0 * MIN_EXPLAINED
+        )));
+    }
+    let curve: Vec<f64> = y.iter().zip(&fit.residuals).map(|(v, r)| v - r).collect();
     let rms = (fit.rss / n as f64).sqrt();
     Ok(RingDownFit {
         modes,
@@ -183,6 +210,8 @@ pub fn fit(
             points: n,
             candidates,
             span: (start as f64 * dt, end as f64 * dt),
+            rejected: Vec::new(),
+            converged: fit.converged,
         },
         window: (start, end),
         curve,

@@ -38,12 +38,17 @@
 //!
 //! Procedure. The bins are first weighted by the measured PSD itself (the weights' limit
 //! where the sweep dominates the noise); the first mode starts at the largest response
-//! (PSD over the excitation) with three damping guesses. Each further mode starts both
-//! from the previous fit plus a mode at the largest excess of the data over it and from
-//! the largest peaks of the response (each with its own width and height), and the best
-//! start wins: broad overlapping modes mislead a one-mode fit, whose solution is then no
-//! starting point for two. A mode is kept while the Bayesian information criterion (with
-//! the residuals' correlation counted: `n_eff = n / c`) drops by at least
+//! (PSD over the excitation) with three damping guesses. Each further mode starts from
+//! the previous fit plus a mode at the largest excess of the data over it, from the
+//! previous fit plus a mode at each of the highest local maxima of the response it does
+//! not yet hold, and from the largest peaks of the response (each with its own width and
+//! height), and the best start wins: broad overlapping modes mislead a one-mode fit,
+//! whose solution is then no starting point for two, and a broad mode fitted across a
+//! peak and its shoulder stands over the shoulder, leaving no excess there
+//! (`identify/tests/corpus/metis_resonances_20240206_200335_Y.csv`, peaks at 43 and 55
+//! Hz: one mode at 57.4 Hz, zeta 0.20, without these starts; 43.9 and 53.8 Hz with
+//! them). A mode is kept while the Bayesian information criterion (with the residuals'
+//! correlation counted: `n_eff = n / c`) drops by at least
 //! [`super::BIC_MARGIN`] and every mode stays significant (weight and damping at least
 //! [`super::SIGNIFICANCE`] standard deviations from 0, frequencies a bin apart). The
 //! chosen model is refitted with the weights of its own expected PSD and noise floor; the
@@ -54,10 +59,11 @@ use nalgebra::{DMatrix, DVector};
 use super::lm::{self, LmFit};
 use super::sweep_model::SweepModel;
 use super::sweep_residual::SweepResidual;
-use super::{SIGNIFICANCE, bic, bic_prefers, correlation_inflation};
+use super::{FittedSpectrum, main_peak, rejected};
+use super::{SIGNIFICANCE, bic, bic_prefers};
 use crate::IdentifyError;
 use crate::excitation::SweepTest;
-use crate::result::{Diagnostics, Estimate, IdentifiedMode, WeightBasis};
+use crate::result::{Diagnostics, Estimate, IdentifiedMode, WeightBasis, response_peak_hz};
 use crate::welch::Welch;
 
 /// Largest PSD in the band over the noise floor (its 5th percentile) must reach this.
@@ -74,6 +80,10 @@ const EDGE_BINS: f64 = 3.0;
 /// below this fraction of its height between it and every higher one.
 const PEAK_DIP: f64 = 0.7;
 
+/// Places of the largest excess of the data over the smaller model that a further mode
+/// starts from.
+const EXCESS_STARTS: usize = 3;
+
 /// Iterations per Levenberg-Marquardt run.
 const MAX_ITERATIONS: usize = 200;
 
@@ -89,6 +99,9 @@ pub struct SweepFit {
     /// The model per fitted bin, in the units of the recording's PSD (before any stored
     /// normalisation).
     pub model: Vec<f64>,
+    /// Each mode's share, in the order of [`SweepFit::modes`]: the model with that mode
+    /// alone (the same gain and noise floor), per fitted bin.
+    pub components: Vec<Vec<f64>>,
     /// Fitted gain `G` and noise floor `N` ((mm/s^2)^2/Hz).
     pub gain_and_noise: (f64, f64),
 }
@@ -150,6 +163,7 @@ pub fn fit(
     }
     let response: Vec<f64> = y.iter().zip(&exc).map(|(a, e)| a / e).collect();
     let peaks = response_peaks(&response, &freq);
+    let maxima = response_maxima(&response);
     let median = percentile(&response, 0.5);
     let top = peaks.first().map_or(0.0, |p| response[p.index]);
     if top.is_nan() || top < MIN_PROMINENCE * median {
@@ -184,8 +198,10 @@ pub fn fit(
             .filter_map(|t| lm::minimise(|t| residual.residuals(t), t, MAX_ITERATIONS))
             .min_by(|a, b| a.rss.total_cmp(&b.rss))
     };
+    let bin_correlation = welch.bin_correlation();
     let mut best: Option<(LmFit, f64)> = None;
     let mut candidates = Vec::new();
+    let mut refused = Vec::new();
     for m in 1..=max_modes.max(1) {
         let mut starts = Vec::new();
         match &best {
@@ -198,9 +214,20 @@ pub fn fit(
                 }
             }
             Some((prev, _)) => {
-                if let Some(j) = largest_excess(prev, &freq, bin) {
+                let excesses = largest_excesses(prev, &freq, bin, EXCESS_STARTS);
+                let shoulders = unfitted_maxima(&maxima, prev, &freq, bin, EXCESS_STARTS);
+                for (rank, j) in excesses.into_iter().chain(shoulders).enumerate() {
                     let mut t = prev.theta.clone();
                     t.extend([freq[j].ln(), 0.05f64.ln(), 0.2f64.ln()]);
+                    if rank == 0 {
+                        // A broad mode fitted across two peaks is no start for two sharp
+                        // ones: the same start with the fitted modes' damping halved.
+                        let mut sharp = t.clone();
+                        for k in 0..m - 1 {
+                            sharp[2 + 3 * k + 1] -= std::f64::consts::LN_2;
+                        }
+                        starts.push(sharp);
+                    }
                     starts.push(t);
                 }
                 if peaks.len() >= m {
@@ -215,12 +242,25 @@ pub fn fit(
         let Some(fit) = run(&residual, &starts) else {
             break;
         };
-        let c = correlation_inflation(&fit.residuals);
+        let c = bin_correlation;
         let score = bic(fit.rss, n, fit.theta.len(), c);
         candidates.push((m, score));
         let accept = match &best {
             None => true,
-            Some((prev, _)) => bic_prefers(&fit, prev, n, c) && significant(&fit, c, bin),
+            Some((prev, prev_score)) => {
+                let preferred = bic_prefers(&fit, prev, n, c);
+                let accept = preferred && significant(&fit, c, bin);
+                if !accept {
+                    refused.push(rejected::refused_candidate(
+                        &fit,
+                        prev,
+                        score,
+                        *prev_score,
+                        preferred,
+                    ));
+                }
+                accept
+            }
         };
         if !accept {
             break;
@@ -234,7 +274,7 @@ pub fn fit(
     let (_, noise) = residual.gain_and_noise(&searched.theta);
     residual.set_weights(&residual.expected(&searched.theta), noise);
     let fit = run(&residual, std::slice::from_ref(&searched.theta)).unwrap_or(searched);
-    let c = correlation_inflation(&fit.residuals);
+    let c = bin_correlation;
     // A file's rounding: uniform over one unit of the last digit kept, a variance of
     // `unit^2 / 12`, independent from bin to bin, relative to the value for `ln P`.
     let rounding: Vec<f64> = match digits {
@@ -260,17 +300,42 @@ pub fn fit(
                     sigma: value * sig[2 + 3 * k + i],
                 }
             };
+            let (f, z, w) = (at(0), at(1), at(2));
             IdentifiedMode {
-                frequency_hz: at(0),
-                damping_ratio: at(1),
-                weight: Some(at(2)),
+                frequency_hz: f,
+                damping_ratio: z,
+                weight: Some(w),
                 weight_basis: WeightBasis::Fitted,
+                peak_hz: response_peak_hz(f.value, z.value, w.value),
             }
         })
         .collect();
+    let mut components: Vec<(f64, Vec<f64>)> = (0..modes.len())
+        .map(|k| {
+            let mut theta = fit.theta[..2].to_vec();
+            theta.extend_from_slice(&fit.theta[2 + 3 * k..5 + 3 * k]);
+            (modes[k].frequency_hz.value, residual.expected(&theta))
+        })
+        .collect();
+    components.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let components = components.into_iter().map(|c| c.1).collect();
     modes.sort_by(|a, b| a.frequency_hz.value.total_cmp(&b.frequency_hz.value));
     let curve = residual.expected(&fit.theta);
     let (gain, noise) = residual.gain_and_noise(&fit.theta);
+    let fitted = FittedSpectrum {
+        data: &y,
+        model: &curve,
+        noise,
+        freq: &freq,
+        bin,
+    };
+    main_peak::check(source, fitted)?;
+    let taken: Vec<f64> = modes
+        .iter()
+        .flat_map(|m| [m.frequency_hz.value, m.peak_hz])
+        .collect();
+    let limit = (refused.is_empty() && modes.len() == max_modes).then_some(max_modes);
+    let refused = rejected::bumps(fitted, &taken, &refused, limit);
     let rms = (y
         .iter()
         .zip(&curve)
@@ -287,9 +352,12 @@ pub fn fit(
             points: n,
             candidates,
             span: (freq[0], freq[n - 1]),
+            rejected: refused,
+            converged: fit.converged,
         },
         bins,
         model: curve,
+        components,
         gain_and_noise: (gain, noise),
     })
 }
@@ -309,16 +377,8 @@ struct Peak {
 fn response_peaks(response: &[f64], freq: &[f64]) -> Vec<Peak> {
     let n = response.len();
     let base = percentile(response, 0.5);
-    let mut maxima: Vec<usize> = (0..n)
-        .filter(|&j| {
-            let lo = j.saturating_sub(2);
-            let hi = (j + 2).min(n - 1);
-            (lo..=hi).all(|i| response[i] <= response[j]) && response[j] > base
-        })
-        .collect();
-    maxima.sort_by(|&a, &b| response[b].total_cmp(&response[a]));
     let mut peaks: Vec<Peak> = Vec::new();
-    for j in maxima {
+    for j in response_maxima(response) {
         let separate = peaks.iter().all(|p| {
             let (lo, hi) = (p.index.min(j), p.index.max(j));
             let dip = response[lo..=hi]
@@ -339,17 +399,66 @@ fn response_peaks(response: &[f64], freq: &[f64]) -> Vec<Peak> {
     peaks
 }
 
-/// The bin with the largest excess of the data over `fit` (summed over 3 bins), more than
-/// 3 bins from every fitted mode.
-fn largest_excess(fit: &LmFit, freq: &[f64], bin: f64) -> Option<usize> {
+/// The response's local maxima (over +-2 bins) above its median, highest first: the
+/// peaks [`response_peaks`] keeps and the shoulders it merges into a higher neighbour.
+fn response_maxima(response: &[f64]) -> Vec<usize> {
+    let n = response.len();
+    let base = percentile(response, 0.5);
+    let mut maxima: Vec<usize> = (0..n)
+        .filter(|&j| {
+            let lo = j.saturating_sub(2);
+            let hi = (j + 2).min(n - 1);
+            (lo..=hi).all(|i| response[i] <= response[j]) && response[j] > base
+        })
+        .collect();
+    maxima.sort_by(|&a, &b| response[b].total_cmp(&response[a]));
+    maxima
+}
+
+/// The `count` bins with the largest excess of the data over `fit` (summed over 3 bins),
+/// largest first, each more than 3 bins from every fitted mode and from each other.
+fn largest_excesses(fit: &LmFit, freq: &[f64], bin: f64, count: usize) -> Vec<usize> {
     let r = &fit.residuals;
-    let taken: Vec<f64> = SweepResidual::modes(&fit.theta)
+    let mut taken: Vec<f64> = SweepResidual::modes(&fit.theta)
         .iter()
         .map(|m| m.f_hz)
         .collect();
-    (1..r.len().saturating_sub(1))
-        .filter(|&j| taken.iter().all(|&f| (f - freq[j]).abs() > 3.0 * bin))
-        .max_by(|&a, &b| (r[a - 1] + r[a] + r[a + 1]).total_cmp(&(r[b - 1] + r[b] + r[b + 1])))
+    let excess = |j: usize| r[j - 1] + r[j] + r[j + 1];
+    let mut order: Vec<usize> = (1..r.len().saturating_sub(1)).collect();
+    order.sort_by(|&a, &b| excess(b).total_cmp(&excess(a)));
+    let mut out = Vec::new();
+    for j in order {
+        if out.len() == count || excess(j) <= 0.0 {
+            break;
+        }
+        if taken.iter().all(|&f| (f - freq[j]).abs() > 3.0 * bin) {
+            out.push(j);
+            taken.push(freq[j]);
+        }
+    }
+    out
+}
+
+/// The first `count` of `maxima` more than 3 bins from every mode of `fit`: a peak of
+/// the data the fit does not yet hold, though the model may already stand over it (a
+/// broad mode fitted across a peak and its shoulder leaves no excess there).
+fn unfitted_maxima(
+    maxima: &[usize],
+    fit: &LmFit,
+    freq: &[f64],
+    bin: f64,
+    count: usize,
+) -> Vec<usize> {
+    let fitted: Vec<f64> = SweepResidual::modes(&fit.theta)
+        .iter()
+        .map(|m| m.f_hz)
+        .collect();
+    maxima
+        .iter()
+        .copied()
+        .filter(|&j| fitted.iter().all(|&f| (f - freq[j]).abs() > 3.0 * bin))
+        .take(count)
+        .collect()
 }
 
 /// Every mode of `fit` clearly present: weight and damping at least [`SIGNIFICANCE`]

@@ -16,7 +16,7 @@
 //! `exp(1 - (10 / (f + 0.1))^2)`. The reader tells these apart by the bins between 0 and
 //! 5 Hz: all exactly zero means the older rule.
 
-use super::{parse_number, truncate};
+use super::{MAX_SPECTRUM_ROWS, parse_number, truncate};
 use crate::IdentifyError;
 
 /// Fewest frequency rows accepted.
@@ -73,6 +73,10 @@ pub struct ProcessedPsd {
     pub per_axis: bool,
     /// Names of the shaper columns (`zv(49.6)`...).
     pub shapers: Vec<String>,
+    /// True when the header holds the `shapers:` column (Klipper since October 2025); the
+    /// rule by which Klipper's `scripts/calibrate_shaper.py` takes a file's PSD as already
+    /// normalised.
+    pub shapers_marker: bool,
     /// How the PSD was normalised.
     pub normalisation: Normalisation,
     /// The last line read (for messages).
@@ -159,6 +163,13 @@ pub fn parse(file: &str, text: &str) -> Result<ProcessedPsd, IdentifyError> {
                 "frequencies increasing from row to row",
             ));
         }
+        if freq_hz.len() == MAX_SPECTRUM_ROWS {
+            return Err(IdentifyError::not_accepted(
+                file,
+                format!("more than {MAX_SPECTRUM_ROWS} frequency rows (line {n})"),
+                format!("at most {MAX_SPECTRUM_ROWS} rows a spectrum"),
+            ));
+        }
         freq_hz.push(f);
         for (k, (name, col)) in columns.iter_mut().enumerate() {
             let v = parse_number(file, n, name, fields[k + 1])?;
@@ -215,6 +226,7 @@ pub fn parse(file: &str, text: &str) -> Result<ProcessedPsd, IdentifyError> {
         columns,
         per_axis,
         shapers,
+        shapers_marker: marker.is_some(),
         normalisation,
         last_line,
     })

@@ -7,7 +7,10 @@
 //! applied. Klipper's own parser (`scripts/calibrate_shaper.py`, `np.loadtxt(...,
 //! comments='#')`) skips every line starting with `#`; so does this one.
 
-use super::{MIN_SAMPLES, Recording, RecordingFormat, check_monotonic, parse_number, truncate};
+use super::{
+    MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_times, parse_number,
+    too_many_samples, truncate,
+};
 use crate::IdentifyError;
 
 /// The header line Klipper writes.
@@ -69,6 +72,9 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
                 "4 comma-separated numbers: time (s), accel_x, accel_y, accel_z (mm/s^2)",
             ));
         }
+        if time_s.len() == MAX_SAMPLES {
+            return Err(too_many_samples(file, n));
+        }
         time_s.push(row[0]);
         for (a, v) in axes.iter_mut().zip(&row[1..]) {
             a.push(*v);
@@ -85,7 +91,7 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
             needed: MIN_SAMPLES,
         });
     }
-    check_monotonic(file, &time_s, |i| line_numbers[i])?;
+    check_times(file, &time_s, |i| line_numbers[i])?;
     let span = time_s[time_s.len() - 1] - time_s[0];
     let [x, y, z] = axes;
     Ok(Recording {
@@ -95,6 +101,7 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
         sample_rate_hz: time_s.len() as f64 / span,
         time_s,
         accel_mm_s2: [Some(x), Some(y), Some(z)],
+        named_axis: None,
         last_line,
     })
 }

@@ -1,12 +1,14 @@
 //! Readers for the accelerometer files users already have. Each returns plain data.
 //!
 //! - [`klipper_raw`]: Klipper's raw accelerometer CSV (`#time,accel_x,accel_y,accel_z`);
-//! - [`klipper_psd`]: Klipper's processed spectra (`freq,psd_x,psd_y,psd_z,psd_xyz...`);
+//! - [`klipper_psd`]: Klipper's processed spectra (`freq,psd_x,psd_y,psd_z,psd_xyz...`),
+//!   and [`klipper_grid`], the frequency grid they are written on;
 //! - [`rrf`]: RepRapFirmware's M956 CSV (`Sample,X,Y,Z` ... `Rate <Hz>, overflows <n>`);
 //! - [`stdata`]: Shake&Tune's `.stdata` (zstd-compressed JSON lines).
 //!
 //! [`read_file`] picks the reader from the file's content.
 
+pub mod klipper_grid;
 pub mod klipper_psd;
 pub mod klipper_raw;
 pub mod rrf;
@@ -16,12 +18,48 @@ use std::path::Path;
 
 use crate::IdentifyError;
 
+/// The largest file the readers take, and the most text a `.stdata` file may decompress
+/// to (bytes): settle-files' limit for a recording, [`settle_files::limit::RECORDING`]
+/// (64 MiB, three times a 130 s Klipper test at 3.2 kHz: 20 MB). With [`MAX_SAMPLES`] it
+/// bounds what identifying a file holds in memory (`docs/performance.md`).
+pub const MAX_FILE_BYTES: u64 = settle_files::limit::RECORDING.bytes;
+
+/// The most samples one recording may hold: 1.5 million, 7.8 minutes at 3.2 kHz.
+pub const MAX_SAMPLES: usize = 1_500_000;
+
+/// The most rows a processed spectrum may hold (Klipper writes about 130, one per bin up
+/// to 200 Hz).
+pub const MAX_SPECTRUM_ROWS: usize = 100_000;
+
+/// The error for a recording with more than [`MAX_SAMPLES`] samples, found at `line`.
+pub(crate) fn too_many_samples(file: &str, line: usize) -> IdentifyError {
+    IdentifyError::not_accepted(
+        file,
+        format!("more than {MAX_SAMPLES} samples (line {line})"),
+        format!("at most {MAX_SAMPLES} samples a recording (7.8 minutes at 3.2 kHz)"),
+    )
+}
+
 /// Standard gravity (mm/s^2), as Klipper's `adxl345.py` (`FREEFALL_ACCEL`) and the g
 /// values of RepRapFirmware's files use it.
 pub const STANDARD_GRAVITY_MM_S2: f64 = 9_806.65;
 
 /// Fewest samples a reader accepts: below this no spectrum or decay can be measured.
 pub const MIN_SAMPLES: usize = 64;
+
+/// Slowest sample rate a reader accepts (Hz): accelerometers for resonance tests sample at
+/// 400 to 6,400 Hz; a rate below this means the time column is not in seconds
+/// (milliseconds give 1,000 times too low a rate) or the file is not a recording.
+pub const MIN_RATE_HZ: f64 = 20.0;
+
+/// Fastest sample rate a reader accepts (Hz): fifteen times the fastest ADXL345 rate.
+pub const MAX_RATE_HZ: f64 = 100_000.0;
+
+/// Longest interval between two samples, in median intervals: Klipper's and Shake&Tune's
+/// samples arrive evenly (their time stamps jitter by a few percent); a longer pause is a
+/// gap in the recording (two recordings joined, samples lost), which a spectrum or a
+/// decay fit cannot bridge.
+pub const MAX_GAP_INTERVALS: f64 = 20.0;
 
 /// Which file format a recording came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,6 +89,10 @@ pub struct Recording {
     /// Sample rate (Hz). Klipper files: `N / (t_last - t_first)`, exactly as Klipper's
     /// `shaper_calibrate.py` computes it; M956 files: the `Rate` line.
     pub sample_rate_hz: f64,
+    /// The one sensor axis the file holds, when it names a single one (an M956 capture of
+    /// one axis, `Sample,Y`): RepRapFirmware users record the axis they test, so it is the
+    /// machine axis unless told otherwise (0 = x).
+    pub named_axis: Option<usize>,
     /// The last line number of the file that holds a sample (for messages).
     pub last_line: usize,
 }
@@ -98,14 +140,11 @@ pub enum FileData {
 /// Shake&Tune, `#time,` -> Klipper raw, `freq,` -> Klipper processed, `Sample` -> M956.
 pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| IdentifyError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let bytes = settle_files::read::read_bytes(path, settle_files::limit::RECORDING)?;
     if bytes.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
         return stdata::parse(&file, &bytes).map(FileData::Recordings);
     }
-    let text = String::from_utf8(bytes).map_err(|e| {
+    let mut text = String::from_utf8(bytes).map_err(|e| {
         IdentifyError::format(
             &file,
             1,
@@ -113,6 +152,10 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
             "a CSV text file or a zstd-compressed .stdata file",
         )
     })?;
+    // A byte-order mark (spreadsheet programs on Windows write one) is not the header.
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
     let first = text
         .lines()
         .map(str::trim)
@@ -125,10 +168,12 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     } else if first.starts_with("Sample") {
         rrf::parse(&file, &text).map(|r| FileData::Recordings(vec![r]))
     } else {
+        // The line is not repeated: a file that is not a recording (a wrong path,
+        // /etc/shadow) is not shown on the terminal.
         Err(IdentifyError::format(
             &file,
             1,
-            format!("`{}`", truncate(first)),
+            "a first line that is not a recording's header",
             "a header `#time,accel_x,accel_y,accel_z` (Klipper raw), `freq,psd_x,...` (Klipper processed), `Sample,X,Y,Z` (RepRapFirmware M956) or a zstd-compressed .stdata file",
         ))
     }
@@ -160,8 +205,10 @@ pub(crate) fn parse_number(
     Ok(v)
 }
 
-/// Check that time stamps increase strictly; `lines[i]` is sample `i`'s line number.
-pub(crate) fn check_monotonic(
+/// Check the time stamps (at least two): strictly increasing, a sample rate between
+/// [`MIN_RATE_HZ`] and [`MAX_RATE_HZ`], no interval longer than [`MAX_GAP_INTERVALS`]
+/// median intervals. `line_of(i)` is sample `i`'s line number.
+pub(crate) fn check_times(
     file: &str,
     time_s: &[f64],
     line_of: impl Fn(usize) -> usize,
@@ -175,6 +222,43 @@ pub(crate) fn check_monotonic(
                 previous_s: w[0],
             });
         }
+    }
+    let n = time_s.len();
+    let rate = (n - 1) as f64 / (time_s[n - 1] - time_s[0]);
+    if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) {
+        return Err(IdentifyError::format(
+            file,
+            line_of(n - 1),
+            format!(
+                "time stamps {:.6} to {:.6} for {n} samples, a sample rate of {rate:.4} Hz",
+                time_s[0],
+                time_s[n - 1]
+            ),
+            format!(
+                "times in seconds (Klipper writes `%.6f` s) at {MIN_RATE_HZ} to {MAX_RATE_HZ} samples per second"
+            ),
+        ));
+    }
+    let mut dt: Vec<f64> = time_s.windows(2).map(|w| w[1] - w[0]).collect();
+    let mid = dt.len() / 2;
+    let median = *dt.select_nth_unstable_by(mid, f64::total_cmp).1;
+    if let Some(i) = time_s
+        .windows(2)
+        .position(|w| w[1] - w[0] > MAX_GAP_INTERVALS * median)
+    {
+        return Err(IdentifyError::format(
+            file,
+            line_of(i + 1),
+            format!(
+                "a gap of {:.6} s after {:.6} s, {:.0} times the median interval of {median:.6} s",
+                time_s[i + 1] - time_s[i],
+                time_s[i],
+                (time_s[i + 1] - time_s[i]) / median
+            ),
+            format!(
+                "one continuous recording (no interval longer than {MAX_GAP_INTERVALS} median intervals): split the file at the gap"
+            ),
+        ));
     }
     Ok(())
 }

@@ -9,7 +9,8 @@
 //! data from accelerometer` or `Received bad data` instead.
 
 use super::{
-    MIN_SAMPLES, Recording, RecordingFormat, STANDARD_GRAVITY_MM_S2, parse_number, truncate,
+    MAX_RATE_HZ, MAX_SAMPLES, MIN_RATE_HZ, MIN_SAMPLES, Recording, RecordingFormat,
+    STANDARD_GRAVITY_MM_S2, parse_number, too_many_samples, truncate,
 };
 use crate::IdentifyError;
 
@@ -89,6 +90,9 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
                 expected,
             ));
         }
+        if columns[0].len() == MAX_SAMPLES {
+            return Err(too_many_samples(file, n));
+        }
         for (k, col) in columns.iter_mut().enumerate() {
             let name = names[k + 1];
             let Some(v) = fields.next() else {
@@ -135,6 +139,7 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
             needed: MIN_SAMPLES,
         });
     }
+    let named_axis = (axis_of_column.len() == 1).then(|| axis_of_column[0]);
     let mut accel: [Option<Vec<f64>>; 3] = [None, None, None];
     for (axis, col) in axis_of_column.into_iter().zip(columns) {
         accel[axis] = Some(col);
@@ -146,20 +151,40 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
         time_s: (0..count).map(|i| i as f64 / rate_hz).collect(),
         accel_mm_s2: accel,
         sample_rate_hz: rate_hz,
+        named_axis,
         last_line,
     })
 }
 
-/// `rest` is what follows `Rate`: ` <Hz>, overflows <n>`.
+/// `rest` is what follows `Rate`: ` <Hz>, overflows <n>`. The rate must lie between
+/// [`MIN_RATE_HZ`] and [`MAX_RATE_HZ`]; a capture with overflows lost samples (the
+/// sensor's FIFO overflowed), so its samples are not evenly spaced at the rate and are
+/// refused.
 fn parse_rate_line(file: &str, line: usize, rest: &str) -> Result<f64, IdentifyError> {
-    let expected = "`Rate <Hz>, overflows <n>` with a rate > 0";
-    let bad = || IdentifyError::format(file, line, format!("`Rate{}`", truncate(rest)), expected);
+    let expected =
+        format!("`Rate <Hz>, overflows <n>` with a rate of {MIN_RATE_HZ} to {MAX_RATE_HZ} Hz");
+    let bad = || {
+        IdentifyError::format(
+            file,
+            line,
+            format!("`Rate{}`", truncate(rest)),
+            expected.clone(),
+        )
+    };
     let (rate, overflows) = rest.split_once(',').ok_or_else(bad)?;
     let rate: f64 = rate.trim().parse().map_err(|_| bad())?;
     let overflows = overflows.trim().strip_prefix("overflows").ok_or_else(bad)?;
-    overflows.trim().parse::<u64>().map_err(|_| bad())?;
-    if !(rate.is_finite() && rate > 0.0) {
+    let overflows = overflows.trim().parse::<u64>().map_err(|_| bad())?;
+    if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) {
         return Err(bad());
+    }
+    if overflows > 0 {
+        return Err(IdentifyError::format(
+            file,
+            line,
+            format!("`Rate{}`: the capture lost samples", truncate(rest)),
+            "`overflows 0`: samples evenly spaced at the rate (capture again, fewer samples or a lower rate)",
+        ));
     }
     Ok(rate)
 }

@@ -6,11 +6,9 @@
 //! (time in s, acceleration in mm/s^2, axes map applied). Line numbers in errors count
 //! the lines of the decompressed text.
 
-use std::io::Read;
-
 use serde::Deserialize;
 
-use super::{MIN_SAMPLES, Recording, RecordingFormat, check_monotonic};
+use super::{MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_times, too_many_samples};
 use crate::IdentifyError;
 
 #[derive(Deserialize)]
@@ -21,17 +19,27 @@ struct Measurement {
 
 /// Parse the bytes of a `.stdata` file into one recording per measurement.
 pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> {
-    let mut text = String::new();
-    zstd::stream::read::Decoder::new(bytes)
-        .and_then(|mut d| d.read_to_string(&mut text))
-        .map_err(|e| {
-            IdentifyError::format(
+    // Decompressed text is capped as a recording file is: a small file can inflate to GBs.
+    let limit = settle_files::limit::RECORDING;
+    let not_text = |e: &dyn std::fmt::Display| {
+        IdentifyError::format(
+            file,
+            1,
+            format!("data that do not decompress to text ({e})"),
+            "a zstd-compressed stream of JSON lines (Shake&Tune .stdata)",
+        )
+    };
+    let inflated = zstd::stream::read::Decoder::new(bytes)
+        .and_then(|d| settle_files::read::read_capped(d, limit.bytes))
+        .map_err(|e| not_text(&e))?
+        .ok_or_else(|| {
+            settle_files::FileError::too_large(
                 file,
-                1,
-                format!("data that do not decompress to text ({e})"),
-                "a zstd-compressed stream of JSON lines (Shake&Tune .stdata)",
+                format!("more than {} bytes of text once decompressed", limit.bytes),
+                limit,
             )
         })?;
+    let text = String::from_utf8(inflated).map_err(|e| not_text(&e))?;
     let mut out = Vec::new();
     let mut last = 0;
     for (i, line) in text.lines().enumerate() {
@@ -39,6 +47,10 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
         last = n;
         if line.trim().is_empty() {
             continue;
+        }
+        // Each sample is one `[`: more than the limit is refused before it is held.
+        if line.bytes().filter(|&b| b == b'[').count() > MAX_SAMPLES + 1 {
+            return Err(too_many_samples(file, n));
         }
         let m: Measurement = serde_json::from_str(line).map_err(|e| {
             IdentifyError::format(
@@ -58,7 +70,7 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
             });
         }
         let time_s: Vec<f64> = m.samples.iter().map(|s| s[0]).collect();
-        check_monotonic(file, &time_s, |_| n)?;
+        check_times(file, &time_s, |_| n)?;
         let axis = |k: usize| Some(m.samples.iter().map(|s| s[k]).collect::<Vec<f64>>());
         let span = time_s[time_s.len() - 1] - time_s[0];
         out.push(Recording {
@@ -68,6 +80,7 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
             sample_rate_hz: time_s.len() as f64 / span,
             accel_mm_s2: [axis(1), axis(2), axis(3)],
             time_s,
+            named_axis: None,
             last_line: n,
         });
     }

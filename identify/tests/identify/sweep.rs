@@ -211,8 +211,9 @@ fn noise_alone_has_no_peak() {
     );
 }
 
-/// Random one- and two-mode sweeps (zeta 0.02-0.2, 25-128 Hz of the 5-135 Hz sweep); how
-/// many from `IDENTIFY_SWEEP_CASES` (default 0: the fixed cases above run in CI). Every
+/// Random one- and two-mode sweeps (zeta 0.02-0.2, 25-128 Hz of the 5-135 Hz sweep);
+/// ignored by default (a study over many cases: the fixed cases above
+/// run in CI), run with `--ignored`; how many from `IDENTIFY_SWEEP_CASES` (default 32). Every
 /// case runs; each failed check is printed, then the mean and spread over all modes of the
 /// relative errors and of `(estimate - truth) / sigma`, and per parameter how many 2-sigma
 /// intervals cover the truth. The test fails if a case misses the acceptance tolerances
@@ -223,12 +224,13 @@ fn noise_alone_has_no_peak() {
 /// misses the truth, so a two-mode case with six checks fails one of them about a quarter
 /// of the time.
 #[test]
+#[ignore = "a study over 32 random sweeps (about 20 s): run with --ignored, IDENTIFY_SWEEP_CASES=32"]
 fn random_sweeps_from_env() {
     use rand::{Rng, SeedableRng};
     let cases: usize = std::env::var("IDENTIFY_SWEEP_CASES")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(0);
+        .unwrap_or(32);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2026);
     let mut failed = Vec::new();
     let mut inaccurate = Vec::new();

@@ -232,8 +232,12 @@ pub fn stdata(name: &str, axes: &[Vec<f64>; 3], t0: f64, fs: f64) -> Vec<u8> {
 /// with 0.5 s of rest either side, two modes (42 Hz zeta 0.04 weight 0.75, 95 Hz zeta
 /// 0.08 weight 0.25), sensor rotated: about 419,000 samples.
 pub fn default_sweep_axes() -> [Vec<f64>; 3] {
+    sweep_axes_at(3200.0)
+}
+
+/// The bench's recording sampled at `fs` (Hz) instead.
+pub fn sweep_axes_at(fs: f64) -> [Vec<f64>; 3] {
     let test = settle_identify::SweepTest::klipper();
-    let fs = 3200.0;
     let n = ((test.duration_s() + 1.0) * fs) as usize;
     let accel = toolhead_accel(
         &[(42.0, 0.04, 0.75), (95.0, 0.08, 0.25)],

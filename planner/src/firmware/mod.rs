@@ -1,4 +1,5 @@
-//! Motion planning as printer firmwares do it: Klipper, Marlin and RepRapFirmware.
+//! Motion planning as firmwares do it: Klipper, Marlin and RepRapFirmware for printers,
+//! GRBL for CNC mills and lasers.
 //!
 //! Each firmware turns a stream of straight moves into trapezoids (Marlin optionally into
 //! S-curves) with its own corner rule, look-ahead and queue. The planners here follow the
@@ -12,6 +13,9 @@
 //!   stepper.cpp (how the stepper runs a block, `S_CURVE_ACCELERATION`).
 //! - [`rrf`]: RepRapFirmware src/Movement/DDA.cpp (`InitStandardMove`, `DoLookahead`,
 //!   `MatchSpeeds`, `RecalculateMove`) and DDARing.cpp (`CanAddMove`, `PrepareMoves`).
+//! - [`grbl`]: GRBL 1.1 grbl/planner.c (`plan_buffer_line`, `planner_recalculate`) and
+//!   grbl/stepper.c (the block's trapezoid in `st_prep_buffer`); grblHAL plans the same
+//!   way.
 //!
 //! [`Firmware`] names every firmware settle knows (and settle's own planner), with the one
 //! parser of their names that every command uses.
@@ -59,6 +63,7 @@
 //! # Ok::<(), settle_planner::PlanError>(())
 //! ```
 
+pub mod grbl;
 pub mod klipper;
 pub mod marlin;
 mod planned;
@@ -84,6 +89,10 @@ pub struct LinearMove {
     /// Requested speed (m/s): the feed rate along the XYZ path, or of the extruder for an
     /// extruder-only move.
     pub speed_m_s: f64,
+    /// A rapid (`G0`) that a CNC firmware runs at its machine's own rate, whatever
+    /// `speed_m_s` says (GRBL's `PL_COND_FLAG_RAPID_MOTION`); the printer firmwares plan
+    /// `G0` like `G1` and ignore it.
+    pub rapid: bool,
 }
 
 impl LinearMove {
@@ -94,7 +103,14 @@ impl LinearMove {
             end_m,
             extrude_m,
             speed_m_s,
+            rapid: false,
         }
+    }
+
+    /// The same move as a rapid ([`LinearMove::rapid`]).
+    pub fn as_rapid(mut self) -> Self {
+        self.rapid = true;
+        self
     }
 
     /// X, Y, Z and E displacement (m).

@@ -6,6 +6,8 @@
 //!   [`crate::firmware::marlin`], [`crate::firmware::rrf`]) and shape with their own shaper
 //!   definitions ([`crate::shaper::ShaperType::firmware`]); `rrf` is also written
 //!   `reprapfirmware` or `duet` (RepRapFirmware runs on Duet boards).
+//! - GRBL (gnea/grbl 1.1, and grblHAL, which plans the same way) runs CNC mills and
+//!   lasers: its planner is [`crate::firmware::grbl`].
 //! - `settle` is settle's own jerk-limited look-ahead ([`crate::path`]): it plans G-code
 //!   jobs too.
 //! - The TMC4361A is a motion controller: it runs S-shaped ramps (BOW1..4), no G-code.
@@ -23,6 +25,8 @@ pub enum Firmware {
     Marlin,
     /// RepRapFirmware.
     Rrf,
+    /// GRBL and grblHAL.
+    Grbl,
     /// settle's own planner.
     Settle,
     /// The TMC4361A motion controller.
@@ -31,16 +35,27 @@ pub enum Firmware {
 
 impl Firmware {
     /// Every firmware, in a fixed order.
-    pub const ALL: [Firmware; 5] = [
+    pub const ALL: [Firmware; 6] = [
         Firmware::Klipper,
         Firmware::Marlin,
         Firmware::Rrf,
+        Firmware::Grbl,
         Firmware::Settle,
         Firmware::Tmc4361a,
     ];
 
     /// Those that plan G-code jobs.
-    pub const GCODE: [Firmware; 4] = [
+    pub const GCODE: [Firmware; 5] = [
+        Firmware::Klipper,
+        Firmware::Marlin,
+        Firmware::Rrf,
+        Firmware::Grbl,
+        Firmware::Settle,
+    ];
+
+    /// Those that plan a printer's G-code (an extruder `E`, slicer files): all of
+    /// [`Firmware::GCODE`] but GRBL.
+    pub const PRINTERS: [Firmware; 4] = [
         Firmware::Klipper,
         Firmware::Marlin,
         Firmware::Rrf,
@@ -54,17 +69,19 @@ impl Firmware {
             Firmware::Klipper => "klipper",
             Firmware::Marlin => "marlin",
             Firmware::Rrf => "rrf",
+            Firmware::Grbl => "grbl",
             Firmware::Settle => "settle",
             Firmware::Tmc4361a => "tmc4361a",
         }
     }
 
     /// A firmware by name (any case): its [`Firmware::name`], or `reprapfirmware` or
-    /// `duet` for RepRapFirmware.
+    /// `duet` for RepRapFirmware, `grblhal` for GRBL.
     pub fn parse(name: &str) -> Option<Self> {
         let lower = name.to_ascii_lowercase();
         match lower.as_str() {
             "reprapfirmware" | "duet" => Some(Firmware::Rrf),
+            "grblhal" => Some(Firmware::Grbl),
             n => Self::ALL.into_iter().find(|f| f.name() == n),
         }
     }
@@ -113,7 +130,8 @@ mod tests {
         }
         assert_eq!(Firmware::parse("duet"), Some(Firmware::Rrf));
         assert_eq!(Firmware::parse("RepRapFirmware"), Some(Firmware::Rrf));
-        assert_eq!(Firmware::parse("grbl"), None);
+        assert_eq!(Firmware::parse("grblHAL"), Some(Firmware::Grbl));
+        assert_eq!(Firmware::parse("linuxcnc"), None);
         let only = [Firmware::Klipper, Firmware::Rrf];
         assert_eq!(
             Firmware::parse_among("duet", &only, "read"),

@@ -1,6 +1,6 @@
 //! Shaping a profile: the weighted sum of shifted copies, again as a [`Profile`].
 
-use super::Shaper;
+use super::{END_ACCEL_ROUND_OFF, Shaper};
 use crate::{PlanError, Profile, Sample, Segment, State};
 
 impl Shaper {
@@ -10,9 +10,18 @@ impl Shaper {
     /// does too, `duration_s()` longer). The start and end accelerations must be zero (a
     /// move, not a fragment). Since the weights are positive and sum to 1, the shaped
     /// velocity, acceleration and jerk stay within the original's bounds.
+    ///
+    /// "Zero" is zero to round-off: within [`END_ACCEL_ROUND_OFF`] of the profile's peak
+    /// acceleration (a PVT step's knots sum its segments' jerks to about 1e-16 m/s^2, not
+    /// to 0); such a remainder is taken as 0, as the extension outside the span has it.
     pub fn apply(&self, profile: &Profile) -> Result<Profile, PlanError> {
         let (start, end) = (profile.start(), profile.end());
-        if start.a != 0.0 || end.a != 0.0 {
+        let peak = profile
+            .iter()
+            .map(|(_, s, _)| s.a.abs())
+            .fold(start.a.abs().max(end.a.abs()), f64::max);
+        let round_off = END_ACCEL_ROUND_OFF * peak;
+        if start.a.abs() > round_off || end.a.abs() > round_off {
             return Err(PlanError::InvalidInput {
                 reason: "input shaping needs a profile that starts and ends with zero acceleration",
             });

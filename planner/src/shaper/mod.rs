@@ -38,6 +38,16 @@ pub use shaper_type::{
 
 use crate::PlanError;
 
+/// The lowest shaper frequency settle runs (Hz), whatever a firmware accepts: a shaper
+/// lasts about one period (0.5/f for ZV to 2/f for 3-hump EI), so below 1 Hz it lasts
+/// seconds per move (and at 1e-6 Hz days), shaping nothing a machine has. [`Shaper::new`]
+/// keeps each firmware's own range; the callers that take a user's setting check this.
+pub const MIN_FREQUENCY_HZ: f64 = 1.0;
+/// The largest start or end acceleration [`Shaper::apply`] takes as zero, as a fraction of
+/// the profile's peak acceleration: a million times f64's round-off (2.2e-16), a million
+/// times below any acceleration a move is planned with.
+pub const END_ACCEL_ROUND_OFF: f64 = 1e-9;
+
 /// Klipper's vibration tolerance of the EI family: 5% (a 20x reduction).
 pub const VIBRATION_TOLERANCE: f64 = KLIPPER_V_TOL;
 

@@ -167,6 +167,31 @@ fn shaped_profile_is_the_weighted_sum_of_shifted_copies() {
     }
 }
 
+/// A PVT step ends at zero acceleration up to round-off (its knots sum the segments'
+/// jerks): 1.1e-16 m/s^2 for this symmetric one. Shaping takes it as a move that ends at
+/// rest; a fragment that ends accelerating is still refused.
+#[test]
+fn a_round_off_end_acceleration_is_zero_and_a_real_one_is_refused() {
+    let lim = Limits::new(0.3, 3.0, Some(17.78)).expect("limits");
+    let p = ProfileKind::PvtSym
+        .rest_to_rest(0.0, 0.005, &lim)
+        .expect("plan");
+    let a_end = p.end().a;
+    assert!(a_end != 0.0 && a_end.abs() < 1e-15, "{a_end:e}");
+    let s = Shaper::new(ShaperType::Zv, 33.4, 0.1).expect("shaper");
+    let q = s.apply(&p).expect("a move from rest to rest is shaped");
+    let end = q.end();
+    assert!(
+        (end.p - 0.005).abs() < 1e-12 && end.v.abs() < 1e-12,
+        "{end:?}"
+    );
+    assert!((q.duration_s() - (p.duration_s() + s.duration_s())).abs() < 1e-12);
+    // Stopped half-way through its acceleration, the same profile is a fragment.
+    let cut = crate::Profile::new(p.start(), p.segments()[..1].to_vec()).expect("profile");
+    assert!(cut.end().a.abs() > 1e-3, "{:?}", cut.end());
+    assert!(matches!(s.apply(&cut), Err(PlanError::InvalidInput { .. })));
+}
+
 #[test]
 fn bad_input_is_rejected() {
     assert!(Shaper::new(ShaperType::EI, 0.0, 0.1).is_err());

@@ -7,6 +7,7 @@ mod braked;
 mod common;
 mod corner_blend;
 mod firmware_common;
+mod firmware_grbl;
 mod firmware_klipper;
 mod firmware_marlin;
 mod firmware_profiles;

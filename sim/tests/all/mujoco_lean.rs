@@ -59,9 +59,9 @@ fn trace_error(a: &[(f64, Vec<Observation>)], b: &[(f64, Vec<Observation>)], i: 
 }
 
 /// The dominant post-move ringing (frequency by matrix pencil).
-fn ringing(e: &[f64]) -> settle_sim::pencil::MeasuredMode {
+fn ringing(e: &[f64]) -> settle_identify::fit::pencil::MeasuredMode {
     let y: Vec<f64> = e.iter().take(1200).step_by(2).copied().collect();
-    let fit = settle_sim::pencil::fit(&y, 2.0 * DT, 8).expect("pencil fit");
+    let fit = settle_identify::fit::pencil::fit(&y, 2.0 * DT, 8).expect("pencil fit");
     *fit.iter()
         .find(|m| m.frequency_hz > 5.0)
         .expect("an oscillatory mode")

@@ -33,9 +33,9 @@ fn post_move(trace: &[(f64, Vec<Observation>)], t_end: f64, target: f64) -> Vec<
 fn compare(label: &str, a: &[f64], b: &[f64]) {
     let fit = |e: &[f64]| {
         let y: Vec<f64> = e.iter().take(1200).step_by(2).copied().collect();
-        settle_sim::pencil::fit(&y, 2.0 * DT, 8).expect("pencil fit")
+        settle_identify::fit::pencil::fit(&y, 2.0 * DT, 8).expect("pencil fit")
     };
-    let osc = |m: &[settle_sim::pencil::MeasuredMode]| {
+    let osc = |m: &[settle_identify::fit::pencil::MeasuredMode]| {
         *m.iter()
             .find(|m| m.frequency_hz > 5.0)
             .expect("an oscillatory mode")

@@ -102,7 +102,8 @@ fn free_decay_frequency_and_damping_on_rapier() {
             .take(600)
             .map(|x| x.1)
             .collect();
-        let fit = settle_sim::pencil::fit(&e, 2.0 * DT, 2 * axis.lumped.dof()).expect("pencil fit");
+        let fit = settle_identify::fit::pencil::fit(&e, 2.0 * DT, 2 * axis.lumped.dof())
+            .expect("pencil fit");
         let (f, z, _) = cf.modes()[0];
         let got = fit
             .iter()
@@ -212,7 +213,7 @@ fn varying_belt_rings_at_the_end_position_frequency() {
         .take(600)
         .map(|x| x.1)
         .collect();
-    let fit = settle_sim::pencil::fit(&e, 2.0 * DT, 6).expect("fit");
+    let fit = settle_identify::fit::pencil::fit(&e, 2.0 * DT, 6).expect("fit");
     let at = |x: f64| {
         let q = axis.lumped.equilibrium(x, None).expect("equilibrium");
         axis.lumped.natural_frequencies_hz(&q)[0]

@@ -55,9 +55,14 @@ fn plain(t: &Table) -> bool {
 
 /// Write table `t` as a section with id `id`: heading, note, then the grid.
 pub(crate) fn push_table(out: &mut impl Out, id: &str, t: &Table) {
+    push_table_at(out, id, t, "h2");
+}
+
+/// [`push_table`] with the heading element `h` (`h3` for a table inside a section).
+pub(crate) fn push_table_at(out: &mut impl Out, id: &str, t: &Table, h: &str) {
     let numeric: Vec<bool> = (0..t.header.len()).map(|j| numeric_column(t, j)).collect();
     let lazy = t.rows.len() > LAZY_ROWS && plain(t);
-    push_head(out, id, &t.title, &t.note, &t.header, &numeric, lazy);
+    push_head(out, id, &t.title, &t.note, &t.header, &numeric, lazy, h);
     for row in &t.rows {
         push_row(out, row, t.header.len(), &numeric, lazy);
     }
@@ -94,7 +99,7 @@ pub(crate) fn push_made_table(
     }
     let numeric: Vec<bool> = any.iter().zip(&other).map(|(a, o)| *a && !o).collect();
     let lazy = rows > LAZY_ROWS && plain;
-    push_head(out, id, &t.title, &t.note, &t.header, &numeric, lazy);
+    push_head(out, id, &t.title, &t.note, &t.header, &numeric, lazy, "h2");
     for k in 0..rows {
         if let Some(r) = row(k) {
             push_row(out, &r, columns, &numeric, lazy);
@@ -114,7 +119,7 @@ pub(crate) fn push_csv_table(out: &mut impl Out, id: &str, title: &str, text: &s
         return false;
     };
     let lazy = rows > LAZY_ROWS;
-    push_head(out, id, title, "", &header, &numeric, lazy);
+    push_head(out, id, title, "", &header, &numeric, lazy, "h2");
     for r in super::csv::Records::new(text).skip(1) {
         let Ok((_, row)) = r else { break };
         push_row(
@@ -130,6 +135,7 @@ pub(crate) fn push_csv_table(out: &mut impl Out, id: &str, title: &str, text: &s
 }
 
 /// The section's heading, note and the table's head, up to `<tbody>`.
+#[allow(clippy::too_many_arguments)]
 fn push_head(
     out: &mut impl Out,
     id: &str,
@@ -138,12 +144,13 @@ fn push_head(
     header: &[String],
     numeric: &[bool],
     lazy: bool,
+    h: &str,
 ) {
     out.push_str("<section class=\"table\" id=\"");
     push_escaped(out, id);
-    out.push_str("\">\n<h2>");
+    let _ = write!(out, "\">\n<{h}>");
     push_escaped(out, title);
-    out.push_str("</h2>\n");
+    let _ = writeln!(out, "</{h}>");
     if !note.is_empty() {
         out.push_str("<p class=\"note\">");
         push_escaped(out, note);

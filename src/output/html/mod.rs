@@ -49,6 +49,8 @@
 //!   column's filter; `matched` is the count of rows that pass, `shown` the rows on the page.
 //!
 //! The result also holds `rows` (the table's row count), `columns` (its header), `lazy`,
+//! `sections` (per section of [`Report::sections`]: its `id`, `title`, and the count of its
+//! `tables`, `figures` and drawn `svgs` (an inline SVG with a non-empty box)),
 //! `errors` (script errors caught on the page), `images` (the natural width of every
 //! `<img>`, 0 when it did not decode), `rects` (page-space boxes in CSS pixels, `x`, `y`,
 //! `w`, `h`: `table`, the table's visible box, and `figure`, the first figure's image) and
@@ -64,7 +66,7 @@ pub use csv::CsvError;
 pub use grid::LAZY_ROWS;
 pub use model::{
     BandWinner, Cell, FailedRun, Figure, Gain, Image, InputFile, Provenance, Reference, Report,
-    Rows, Stat, Table,
+    Rows, Section, Stat, Table,
 };
 
 /// The page for `report`: a complete HTML document (UTF-8). A figure given as a file

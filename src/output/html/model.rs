@@ -13,6 +13,9 @@ pub struct Report {
     pub winners: Vec<BandWinner>,
     /// Named tables (e.g. move-and-settle per swept point), in order.
     pub tables: Vec<Table>,
+    /// Sections after the tables, each with its own tables, figures and texts (e.g. one
+    /// per tuned axis).
+    pub sections: Vec<Section>,
     /// Figures, in order.
     pub figures: Vec<Figure>,
     /// Every run (e.g. `runs.csv` read by [`Table::from_csv`]): sortable and filterable.
@@ -21,6 +24,24 @@ pub struct Report {
     pub failed: Vec<FailedRun>,
     /// Where the numbers come from.
     pub provenance: Provenance,
+}
+
+/// A part of the page under its own heading: a paragraph or two, its tables, its figures
+/// and preformatted texts (e.g. an exported configuration file).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Section {
+    /// The element id (letters, digits, `-`), e.g. `axis-x`.
+    pub id: String,
+    /// The heading.
+    pub title: String,
+    /// Paragraphs under the heading.
+    pub intro: Vec<String>,
+    /// Its tables, in order.
+    pub tables: Vec<Table>,
+    /// Its figures, in order.
+    pub figures: Vec<Figure>,
+    /// Preformatted texts: a name and the text, shown as is.
+    pub texts: Vec<InputFile>,
 }
 
 /// The fastest candidate for one settling band.

@@ -3,8 +3,10 @@
 
 use super::Out;
 use super::escape::{base64, escaped, push_escaped};
-use super::grid::{push_csv_table, push_made_table, push_table};
-use super::model::{BandWinner, Cell, Figure, Image, Provenance, Reference, Report, Rows, Table};
+use super::grid::{push_csv_table, push_made_table, push_table, push_table_at};
+use super::model::{
+    BandWinner, Cell, Figure, Image, Provenance, Reference, Report, Rows, Section, Table,
+};
 use crate::error::Error;
 
 const STYLE: &str = include_str!("style.css");
@@ -58,6 +60,10 @@ pub(crate) fn page_to(
         } else {
             push_table(out, &id, t);
         }
+    }
+    let mut next = r.tables.len();
+    for s in &r.sections {
+        push_section(out, s, &mut next)?;
     }
     push_figures(out, &r.figures)?;
     if let Some(runs) = &r.runs {
@@ -174,11 +180,14 @@ fn inline_svg(svg: &str) -> &str {
 /// file when it is under 64 KB) is trimmed as [`inline_svg`] trims a document.
 fn push_svg_file(out: &mut impl Out, path: &std::path::Path) -> Result<(), Error> {
     use std::io::BufRead as _;
-    let file = std::fs::File::open(path).map_err(|e| Error::read(path, e))?;
+    let file = crate::input::file::open(path, crate::input::file::limit::RESULTS)?;
     let mut r = std::io::BufReader::new(file);
     let mut head = String::new();
     while head.len() < 1 << 16 {
-        if r.read_line(&mut head).map_err(|e| Error::read(path, e))? == 0 {
+        if r.read_line(&mut head)
+            .map_err(|e| crate::input::file::stream_error(path, e))?
+            == 0
+        {
             break;
         }
     }
@@ -186,11 +195,68 @@ fn push_svg_file(out: &mut impl Out, path: &std::path::Path) -> Result<(), Error
     let mut line = String::new();
     loop {
         line.clear();
-        if r.read_line(&mut line).map_err(|e| Error::read(path, e))? == 0 {
+        if r.read_line(&mut line)
+            .map_err(|e| crate::input::file::stream_error(path, e))?
+            == 0
+        {
             return Ok(());
         }
         out.push_str(&line);
     }
+}
+
+/// A [`Section`]: heading, paragraphs, its tables (numbered on from `next`, as
+/// `table-N`), figures and texts.
+fn push_section(out: &mut impl Out, s: &Section, next: &mut usize) -> Result<(), Error> {
+    out.push_str("<section class=\"part\" id=\"");
+    push_escaped(out, &s.id);
+    out.push_str("\">\n<h2>");
+    push_escaped(out, &s.title);
+    out.push_str("</h2>\n");
+    for line in &s.intro {
+        let _ = writeln!(out, "<p>{}</p>", escaped(line));
+    }
+    for t in &s.tables {
+        *next += 1;
+        push_table_at(out, &format!("table-{next}"), t, "h3");
+    }
+    for (i, f) in s.figures.iter().enumerate() {
+        push_figure(out, &format!("{}-figure-{}", s.id, i + 1), f)?;
+    }
+    for t in &s.texts {
+        out.push_str("<div class=\"file\">\n<h3>");
+        push_escaped(out, &t.name);
+        out.push_str("</h3>\n<pre>\n");
+        push_escaped(out, &t.text);
+        out.push_str("</pre>\n</div>\n");
+    }
+    out.push_str("</section>\n");
+    Ok(())
+}
+
+/// One figure, with element id `id`.
+fn push_figure(out: &mut impl Out, id: &str, f: &Figure) -> Result<(), Error> {
+    out.push_str("<figure id=\"");
+    push_escaped(out, id);
+    out.push_str("\">\n<div class=\"img\">");
+    match &f.image {
+        Image::Svg(svg) => out.push_str(inline_svg(svg)),
+        Image::SvgFile(path) => push_svg_file(out, path)?,
+        Image::Png(bytes) => {
+            let _ = write!(
+                out,
+                "<img alt=\"{}\" src=\"data:image/png;base64,{}\">",
+                escaped(&f.title),
+                base64(bytes)
+            );
+        }
+    }
+    let _ = writeln!(
+        out,
+        "</div>\n<figcaption>{}</figcaption>\n</figure>",
+        escaped(&f.title)
+    );
+    Ok(())
 }
 
 fn push_figures(out: &mut impl Out, figures: &[Figure]) -> Result<(), Error> {
@@ -199,24 +265,7 @@ fn push_figures(out: &mut impl Out, figures: &[Figure]) -> Result<(), Error> {
     }
     out.push_str("<section id=\"figures\">\n<h2>Figures</h2>\n");
     for (i, f) in figures.iter().enumerate() {
-        let _ = write!(out, "<figure id=\"figure-{}\">\n<div class=\"img\">", i + 1);
-        match &f.image {
-            Image::Svg(svg) => out.push_str(inline_svg(svg)),
-            Image::SvgFile(path) => push_svg_file(out, path)?,
-            Image::Png(bytes) => {
-                let _ = write!(
-                    out,
-                    "<img alt=\"{}\" src=\"data:image/png;base64,{}\">",
-                    escaped(&f.title),
-                    base64(bytes)
-                );
-            }
-        }
-        let _ = writeln!(
-            out,
-            "</div>\n<figcaption>{}</figcaption>\n</figure>",
-            escaped(&f.title)
-        );
+        push_figure(out, &format!("figure-{}", i + 1), f)?;
     }
     out.push_str("</section>\n");
     Ok(())

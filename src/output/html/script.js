@@ -295,6 +295,14 @@
     var id = p.grid || 'runs', g = grids.filter(function (x) { return x.id === id; })[0];
     var res = { grids: grids.length, init_ms: initMs, errors: errors };
     res.images = Array.prototype.map.call(document.images, function (i) { return i.naturalWidth; });
+    res.sections = Array.prototype.map.call(document.querySelectorAll('section.part'), function (s) {
+      var drawn = Array.prototype.filter.call(s.querySelectorAll('figure .img > svg'), function (v) {
+        var b = v.getBoundingClientRect();
+        return b.width > 0 && b.height > 0;
+      });
+      return { id: s.id, title: s.querySelector('h2').textContent, tables: s.querySelectorAll('div.grid').length,
+        figures: s.querySelectorAll('figure').length, svgs: drawn.length };
+    });
     if (g) {
       res.rows = g.rows.length;
       res.columns = g.names;

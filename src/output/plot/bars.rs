@@ -181,7 +181,7 @@ pub fn write(
     let Some(chart) = ranking_chart(name, ranking) else {
         return Ok(None);
     };
-    crate::output::atomic::create_dir(dir)?;
+    crate::output::atomic::create_subdir(dir)?;
     chart.write(dir, STEM)?;
     let folder = dir
         .file_name()
@@ -233,17 +233,9 @@ impl BarChart {
         self.draw(SVGBackend::with_string(&mut text, size).into_drawing_area())
             .map_err(|e| fail(&svg, e))?;
         crate::output::atomic::write_atomic(&svg, text.as_bytes())?;
-        let png = dir.join(format!("{stem}.png"));
-        // The bitmap encoder picks the format from the extension: keep `.png` last.
-        let tmp = dir.join(format!(".{stem}.tmp{}.png", std::process::id()));
-        let drawn = self
-            .draw(BitMapBackend::new(&tmp, size).into_drawing_area())
-            .map_err(|e| fail(&png, e))
-            .and_then(|()| std::fs::rename(&tmp, &png).map_err(|e| fail(&png, e.to_string())));
-        if drawn.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        drawn
+        crate::output::atomic::write_png(&dir.join(format!("{stem}.png")), |tmp| {
+            self.draw(BitMapBackend::new(tmp, size).into_drawing_area())
+        })
     }
 
     /// Width of the label column (px): the longest label, within bounds.
@@ -472,6 +464,8 @@ mod tests {
                 }),
                 candidates,
             }],
+            repeats: Vec::new(),
+            unused: Vec::new(),
         };
         let chart = ranking_chart("demo", &ranking).expect("a chart");
         let p = &chart.panels[0];

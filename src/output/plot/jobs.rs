@@ -144,7 +144,7 @@ pub fn write(
     let Some(f) = figure(name, jobs) else {
         return Ok(None);
     };
-    crate::output::atomic::create_dir(dir)?;
+    crate::output::atomic::create_subdir(dir)?;
     super::write(&f, dir, STEM)?;
     let folder = dir
         .file_name()

@@ -11,6 +11,7 @@
 pub mod bars;
 pub mod identify;
 pub mod jobs;
+pub mod klipper_shapers;
 pub mod ringing;
 pub mod scan_trace;
 pub mod svg_stream;
@@ -730,14 +731,7 @@ pub fn write(f: &Figure, dir: &Path, stem: &str) -> Result<(), Error> {
             (Ok(()), None) => Ok(()),
         }
     })?;
-    let png = dir.join(format!("{stem}.png"));
-    // The bitmap encoder picks the format from the extension: keep `.png` last.
-    let tmp = dir.join(format!(".{stem}.tmp{}.png", std::process::id()));
-    let drawn = draw_figure(BitMapBackend::new(&tmp, size).into_drawing_area(), f)
-        .map_err(|e| fail(&png, e))
-        .and_then(|()| std::fs::rename(&tmp, &png).map_err(|e| fail(&png, e.to_string())));
-    if drawn.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    drawn
+    crate::output::atomic::write_png(&dir.join(format!("{stem}.png")), |tmp| {
+        draw_figure(BitMapBackend::new(tmp, size).into_drawing_area(), f)
+    })
 }

@@ -108,16 +108,9 @@ impl RingingMap {
         self.draw(SVGBackend::with_string(&mut text, size).into_drawing_area())
             .map_err(|e| fail(&svg, e))?;
         crate::output::atomic::write_atomic(&svg, text.as_bytes())?;
-        let png = dir.join(format!("{stem}.png"));
-        let tmp = dir.join(format!(".{stem}.tmp{}.png", std::process::id()));
-        let drawn = self
-            .draw(BitMapBackend::new(&tmp, size).into_drawing_area())
-            .map_err(|e| fail(&png, e))
-            .and_then(|()| std::fs::rename(&tmp, &png).map_err(|e| fail(&png, e.to_string())));
-        if drawn.is_err() {
-            let _ = std::fs::remove_file(&tmp);
-        }
-        drawn
+        crate::output::atomic::write_png(&dir.join(format!("{stem}.png")), |tmp| {
+            self.draw(BitMapBackend::new(tmp, size).into_drawing_area())
+        })
     }
 
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> DrawResult {

@@ -323,7 +323,7 @@ pub fn write_all(
     if params.is_empty() || table.is_empty() {
         return Ok(Vec::new());
     }
-    crate::output::atomic::create_dir(dir)?;
+    crate::output::atomic::create_subdir(dir)?;
     let folder = dir
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())

@@ -339,13 +339,12 @@ pub fn write_file(path: &Path, p: &Provenance, rec: &RunRecord) -> Result<Vec<Ch
         path: path.to_path_buf(),
         source,
     };
-    let tmp = crate::output::atomic::tmp_path(path);
-    let file = std::fs::File::create(&tmp).map_err(err)?;
+    let (tmp, file) = crate::output::atomic::create_tmp(path)?;
     let mut w = BufWriter::new(file);
     let result = write(&mut w, p, rec)
-        .map_err(|e| err(std::io::Error::other(e)))
+        .map_err(|e| err(crate::output::atomic::io_cause(&e)))
         .and_then(|info| w.flush().map_err(err).map(|()| info))
-        .and_then(|info| std::fs::rename(&tmp, path).map_err(err).map(|()| info));
+        .and_then(|info| Ok(crate::output::atomic::commit(&tmp, path).map(|()| info)?));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }

@@ -33,10 +33,8 @@ pub struct Provenance {
 impl Provenance {
     /// Read the scenario file's text for the record.
     pub fn load(path: &Path, scenario_name: &str) -> Result<Self, Error> {
-        let scenario_text = std::fs::read_to_string(path).map_err(|source| Error::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let scenario_text =
+            crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)?;
         Ok(Self {
             settle_version: env!("CARGO_PKG_VERSION"),
             scenario_name: scenario_name.to_string(),

@@ -41,6 +41,7 @@ pub fn write_file(path: &Path, p: &Provenance, rec: &RunRecord) -> Result<(), Er
         source: std::io::Error::other(e),
     };
     let tmp = crate::output::atomic::tmp_path(path);
+    crate::output::atomic::prepare_tmp(path, &tmp)?;
     let result = (|| -> Result<(), String> {
         let stream = RecordingStreamBuilder::new("settle")
             .save(&tmp)
@@ -84,7 +85,7 @@ pub fn write_file(path: &Path, p: &Provenance, rec: &RunRecord) -> Result<(), Er
             .map_err(|e| e.to_string())?;
         stream.flush_blocking().map_err(|e| e.to_string())?;
         drop(stream);
-        std::fs::rename(&tmp, path).map_err(|e| e.to_string())
+        crate::output::atomic::commit(&tmp, path).map_err(|e| e.to_string())
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);

@@ -16,6 +16,7 @@ use settle_planner::{PlanError, ProfileKind};
 use crate::error::Error;
 use crate::input::source::Source;
 use crate::spec::run_spec::{StudyState, RunSpec};
+use crate::spec::{MAX_POSITION_MM, beyond_positions};
 use crate::spec::value::Value;
 
 /// The `[corner]` table as written (mm, mm/s, degrees).
@@ -31,11 +32,11 @@ pub struct CornerSpec {
     pub leg_out_mm: f64,
     /// The corner point, one coordinate per path axis (mm). Default the origin: the middle
     /// of the travel on the presets.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exactly")]
     pub corner_mm: [f64; 2],
     /// The machine axes of the path's two directions (default `["x", "y"]`): the first
     /// segment runs along `axes[0]`.
-    #[serde(default = "default_axes")]
+    #[serde(default = "default_axes", deserialize_with = "exactly")]
     pub axes: [String; 2],
     /// Profile kind of the straight runs (`trapezoid`, `scurve`, `fourjerk`); sweep
     /// `profile` to compare kinds.
@@ -56,6 +57,19 @@ pub struct CornerSpec {
     /// printer's line width of 0.4 mm divided by 4.
     #[serde(default = "default_blend_deviation")]
     pub blend_deviation_mm: f64,
+}
+
+/// Exactly `N` values: serde reads the first `N` of a longer array into `[T; N]` and would
+/// drop the rest (`corner_mm = [1, 2, 3]`).
+fn exactly<'de, D, T, const N: usize>(d: D) -> Result<[T; N], D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let v = Vec::<T>::deserialize(d)?;
+    let n = v.len();
+    v.try_into()
+        .map_err(|_| serde::de::Error::custom(format!("{n} values; give exactly {N}, one per path axis")))
 }
 
 fn default_axes() -> [String; 2] {
@@ -259,6 +273,17 @@ impl Corner {
         }
         if self.corner_mm.iter().any(|x| !x.is_finite()) {
             return Err((key("corner_mm"), "coordinates must be finite (mm)".into()));
+        }
+        // Every point within the positions f64 resolves (as a move's start and end).
+        let points = self.points_mm();
+        for k in [1, 0, 2] {
+            if let Some(x) = points[k].iter().find(|x| x.abs() > MAX_POSITION_MM) {
+                let what = ["start", "corner", "end"][k];
+                return Err((
+                    key(["leg_in_mm", "corner_mm", "leg_out_mm"][k]),
+                    beyond_positions(&format!("the path's {what} point is"), *x),
+                ));
+            }
         }
         if matches!(run.profile, ProfileKind::PvtSym | ProfileKind::PvtAsym) {
             let key = if run.swept.iter().any(|(p, _)| p == "profile") {

@@ -164,11 +164,43 @@ impl Study for CornerPath {
         out
     }
 
-    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
+    fn summary(
+        &self,
+        runs: &dyn RunList,
+        table: &RunsColumns,
+        _current: &dyn Fn(&RunSpec) -> bool,
+    ) -> Option<String> {
         if !any_has::<Corner>(runs) || table.column(col::MAX_CONTOUR).is_none() {
             return None;
         }
         Some(summary_section(runs, table))
+    }
+
+    /// A strategy's parameter under another strategy; the jerk limit of a trapezoid path
+    /// that does not blend (only the blend is jerk-limited then).
+    fn unused(&self, run: &RunSpec, key: &str) -> Option<&'static str> {
+        let c = run.state::<Corner>()?;
+        let (used, why) = match key {
+            "corner.junction_deviation_mm" => (
+                c.strategy == Strategy::JunctionDeviation,
+                "only the junction_deviation strategy uses it",
+            ),
+            "corner.square_corner_velocity_mm_s" => (
+                c.strategy == Strategy::SquareCornerVelocity,
+                "only the square_corner_velocity strategy uses it",
+            ),
+            "corner.blend_deviation_mm" => (
+                c.strategy == Strategy::Blend,
+                "only the blend strategy uses it",
+            ),
+            "limits.jmax_mm_s3" => (
+                run.profile != settle_planner::ProfileKind::Trapezoid
+                    || c.strategy == Strategy::Blend,
+                "a trapezoid path has no jerk limit unless it blends its corners",
+            ),
+            _ => return None,
+        };
+        (!used).then_some(why)
     }
 
     fn figures(&self, _bands_um: &[f64]) -> Vec<PlotColumn> {

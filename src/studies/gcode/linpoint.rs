@@ -3,9 +3,10 @@
 //! study alike), found by one streaming pass of the reader over the whole file
 //! (bounded memory: the running box only).
 //!
-//! The point is the centre of the XY(Z) bounding box of the file's **printing** moves
-//! (the reader's [`MoveKind::Print`]: XYZ travel with positive extrusion; arcs with the
-//! quadrant points they pass, [`settle_gcode::Move::bounds`]), in the G-code's
+//! The point is the centre of the XY(Z) bounding box of the file's **working** moves
+//! ([`settle_gcode::Move::is_working`]: extruding on a printer, the laser or spindle on in
+//! a feed move on a laser or a mill; arcs with the quadrant points they pass,
+//! [`settle_gcode::Move::bounds`]), in the G-code's
 //! coordinates after G90/G91, G92 and homing as the reader resolves them. A physical
 //! machine's stiffness depends on where the carriage is (a belt's spans); the print is
 //! where the ringing is measured, and its box centre is at most half the part's size from
@@ -15,9 +16,9 @@
 //! printed. Travel moves do not count: they go to and from the part (and the first one
 //! starts at the origin).
 //!
-//! A file with no printing move (a laser or CNC path has no extrusion) takes the box of
-//! its feed moves (G1, G2, G3: the cutting moves; G0 rapids go to and from the work), and
-//! a file without those the origin; the outputs say which
+//! A file with no working move (a path without extrusion and without a laser or spindle
+//! command) takes the box of its feed moves (G1, G2, G3; G0 rapids go to and from the
+//! work), and a file without those the origin; the outputs say which
 //! ([`PointSource`]).
 
 use std::io::BufRead;
@@ -27,9 +28,9 @@ use settle_gcode::{Bounds, EventKind, GcodeError, MoveKind, Reader};
 /// What the point is the centre of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PointSource {
-    /// The box of the printing (extruding) moves.
-    Printing,
-    /// No printing move: the box of the feed moves (G1, G2, G3).
+    /// The box of the working moves (extruding, or the laser or spindle on).
+    Working,
+    /// No working move: the box of the feed moves (G1, G2, G3).
     Feed,
     /// No feed move either: the origin, where the job starts.
     Origin,
@@ -39,11 +40,11 @@ impl PointSource {
     /// In words, for the outputs.
     pub fn describe(self) -> &'static str {
         match self {
-            PointSource::Printing => "the centre of the printing moves' bounding box",
+            PointSource::Working => "the centre of the working moves' bounding box",
             PointSource::Feed => {
-                "the centre of the feed moves' bounding box (the file has no printing move)"
+                "the centre of the feed moves' bounding box (the file has no working move)"
             }
-            PointSource::Origin => "the origin (the file has no printing or feed move)",
+            PointSource::Origin => "the origin (the file has no working or feed move)",
         }
     }
 }
@@ -89,7 +90,7 @@ pub fn linearisation_point<R: BufRead>(reader: Reader<R>) -> Result<LinPoint, Gc
     for ev in reader {
         if let EventKind::Move(mv) = &ev?.kind {
             let b = mv.bounds();
-            if mv.kind == MoveKind::Print {
+            if mv.is_working() {
                 print.union(&b);
             } else if !mv.rapid && mv.kind == MoveKind::Travel {
                 feed.union(&b);
@@ -100,7 +101,7 @@ pub fn linearisation_point<R: BufRead>(reader: Reader<R>) -> Result<LinPoint, Gc
     Ok(if !print.is_empty() {
         LinPoint {
             xyz_mm: centre(&print),
-            source: PointSource::Printing,
+            source: PointSource::Working,
         }
     } else if !feed.is_empty() {
         LinPoint {

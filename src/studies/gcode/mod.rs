@@ -28,12 +28,12 @@
 //! time are measured after the range's last move. The study's probe measures the contour
 //! error against the G-code's own geometry ([`contour`]) and adds to runs.csv
 //! `print_time_s` (the whole file's, by the firmware's planner), `contour_worst_um`,
-//! `contour_p95_um` (printing samples of the range's moves, during the job; never the
+//! `contour_p95_um` (working samples of the range's moves, during the job; never the
 //! pre-roll's) and `contour_worst_line`. Bad G-code is reported when the sweep is
 //! checked, with the file and line.
 //!
 //! A physical machine on the modal backend is linearised where the print is
-//! ([`linpoint`]: the centre of the file's printing moves), the point `settle gcode`
+//! ([`linpoint`]: the centre of the file's working moves), the point `settle gcode`
 //! uses, for the whole file and for any layer range of it: a range gives the numbers of
 //! the same layers in the whole job, and the study the numbers of `settle gcode`.
 //!
@@ -47,10 +47,13 @@
 
 pub mod command_path;
 pub mod contour;
+pub mod features;
+pub mod fly;
 pub mod linpoint;
 pub mod preroll;
 pub mod stats;
 pub mod stream;
+pub mod work;
 
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -58,7 +61,7 @@ use std::sync::Mutex;
 
 use serde::Deserialize;
 use settle_gcode::job::{Job, JobConfig, PlannerConfig, ShaperSetting, parse_firmware};
-use settle_gcode::{Reader, ReaderOptions};
+use settle_gcode::Reader;
 use settle_planner::PlanError;
 use settle_planner::firmware::Firmware;
 use settle_planner::path::CornerStrategy;
@@ -199,6 +202,10 @@ pub fn job_config(run: &RunSpec, job: &GcodeJob, shaper: Option<ShaperSetting>) 
             c.print_accel_m_s2 = a;
             c.travel_accel_m_s2 = a;
         }
+        PlannerConfig::Grbl(g) => {
+            g.max_rate_mm_min = [run.vmax_mm_s * 60.0; 3];
+            g.accel_mm_s2 = [run.amax_mm_s2; 3];
+        }
         PlannerConfig::Settle(c) => {
             c.limits = run.limits_si().map_err(|e| e.to_string())?;
             c.kind = settle_planner::ProfileKind::parse(&job.profile).map_err(|e| e.to_string())?;
@@ -255,16 +262,16 @@ fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option
     if run.backend != Backend::Modal || !linpoint::depends_on_position(&linear_axes(run)?) {
         return Ok(None);
     }
-    let dialect = JobConfig::defaults(job.firmware)
+    let options = JobConfig::defaults(job.firmware)
         .map_err(|e| e.to_string())?
-        .dialect;
-    let reader = Reader::open(&job.file, ReaderOptions::new(dialect)).map_err(|e| e.to_string())?;
+        .reader_options();
+    let reader = Reader::open(&job.file, options).map_err(|e| e.to_string())?;
     let point = linpoint::linearisation_point(reader).map_err(|e| e.to_string())?;
     Ok(Some(point.on_axes(axes)))
 }
 
 /// The job of `run` opened, limited to its layers with their pre-roll ([`preroll_of`]).
-fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<std::io::BufReader<std::fs::File>>, String> {
+fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<settle_gcode::FileInput>, String> {
     let shaper = crate::studies::shaper(run).map_err(|e| e.to_string())?;
     let cfg = job_config(run, job, shaper_setting(shaper.as_ref()))?;
     let j = Job::open(&job.file, cfg).map_err(|e| e.to_string())?;
@@ -374,6 +381,13 @@ impl Study for GcodeRun {
         let mut j = open(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
         j.run_to_end()
             .map_err(|e| (run.blame("gcode.file"), e.to_string()))?;
+        if let Some(why) = work::nothing_to_measure(&j.summary(), j.reader().lines_read()) {
+            return Err((
+                run.blame("gcode.file"),
+                format!("{}: {why}", job.file.display()),
+            ));
+        }
+        // Only a job that passed every check is remembered as checked.
         if let Ok(mut v) = VALIDATED.lock() {
             v.insert(key);
         }

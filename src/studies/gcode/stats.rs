@@ -66,6 +66,12 @@ impl Histogram {
         self.total += other.total;
     }
 
+    /// Forget every count (keeps the bins' memory).
+    pub fn clear(&mut self) {
+        self.counts.fill(0);
+        self.total = 0;
+    }
+
     /// Samples counted.
     pub fn total(&self) -> u64 {
         self.total
@@ -180,7 +186,7 @@ impl TopSpots {
     }
 }
 
-/// One layer's contour-error account (printing samples only).
+/// One layer's contour-error account (working samples only: [`settle_gcode::Move::is_working`]).
 #[derive(Debug, Clone)]
 pub struct LayerStats {
     /// Layer index.
@@ -193,7 +199,7 @@ pub struct LayerStats {
     pub p95_um: f64,
     /// Printing moves in it that were simulated.
     pub print_moves: u64,
-    /// Mean over its printing moves of each move's largest error (um): the typical
+    /// Mean over its working moves of each move's largest error (um): the typical
     /// ringing after a corner.
     pub mean_move_worst_um: f64,
     /// The last layer of a job that ends the file: the largest distance in XY (um) from
@@ -219,7 +225,7 @@ impl LayerStats {
         }
     }
 
-    /// Its largest error (um), 0 without printing samples.
+    /// Its largest error (um), 0 without working samples.
     pub fn worst_um(&self) -> f64 {
         self.worst.as_ref().map_or(0.0, |s| s.error_um)
     }

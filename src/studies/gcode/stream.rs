@@ -1,18 +1,15 @@
 //! A `[gcode]` run's job as a streamed motion ([`crate::studies::Motion::Stream`]): its
 //! chunks simulated one after the other, as `settle gcode` simulates them, and the
-//! contour error measured along them (printing samples of the range's moves, during the
+//! contour error measured along them (working samples of the range's moves, during the
 //! job), so that no run holds the whole job planned or its samples recorded.
 //!
 //! Where the run starts and how long it lasts (the module doc of [`super`]: the print
 //! clock's sample grid, the pre-roll, a shaped job's lead) is found by a first pass over
-//! the job ([`Outline`]), which keeps only the chunks before the run's start (a pre-roll's
+//! the job (`Outline`), which keeps only the chunks before the run's start (a pre-roll's
 //! worth at most) and the durations and end state after it; the run then plans the job
-//! again as it is simulated ([`JobChunks`]).
+//! again as it is simulated (`JobChunks`).
 
-use std::fs::File;
-use std::io::BufReader;
-
-use settle_gcode::MoveKind;
+use settle_gcode::FileInput;
 use settle_gcode::job::{Job, JobChunk};
 use settle_planner::shaper::stream::cut;
 use settle_planner::{PlanError, Profile, Segment, State, Trajectory};
@@ -108,7 +105,7 @@ impl Outline {
     /// The outline of `job` on the machine axes `map` ([`job_axes`]), sampled every `dt`
     /// s; `range`: the first layer of a layer range and the least pre-roll it needs (s).
     pub(super) fn of(
-        mut job: Job<BufReader<File>>,
+        mut job: Job<FileInput>,
         map: &[usize],
         dt: f64,
         range: Option<(u32, f64)>,
@@ -189,7 +186,7 @@ impl Outline {
 
 /// The run's chunks and contour error (module doc).
 pub(super) struct JobChunks {
-    job: Job<BufReader<File>>,
+    job: Job<FileInput>,
     map: Vec<usize>,
     /// Print-clock time of the run's `t = 0` (s).
     origin_s: f64,
@@ -212,7 +209,7 @@ impl JobChunks {
     /// The chunks of `job` (opened again as the outline's was) from `outline`'s start;
     /// only samples of moves in `layers` count.
     pub(super) fn new(
-        job: Job<BufReader<File>>,
+        job: Job<FileInput>,
         map: Vec<usize>,
         outline: &Outline,
         layers: Option<(u32, u32)>,
@@ -270,7 +267,7 @@ impl MotionStream for JobChunks {
         let Some((e, owner)) = self.active.at(tp, p) else {
             return;
         };
-        if owner.kind != MoveKind::Print
+        if !owner.working
             || self
                 .layers
                 .is_some_and(|(a, b)| !(a..=b).contains(&owner.layer))

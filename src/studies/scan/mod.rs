@@ -42,10 +42,13 @@ use settle_planner::{PlanError, Profile, State, Trajectory};
 use crate::error::Error;
 use crate::input::runs_columns::RunsColumns;
 use crate::input::source::Source;
-use crate::studies::{Motion, Study, StudyState, PlanContext, Planned, PlotColumn, Role};
+use crate::studies::{
+    Motion, PlanContext, Planned, PlotColumn, Role, Study, StudyState, jerk_unused,
+};
 use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::spec::runs::RunList;
+use crate::spec::{MAX_POSITION_MM, beyond_positions};
 
 pub use step_metrics::{StepProbe, step_metrics};
 pub use table::ScanSpec;
@@ -157,10 +160,49 @@ impl Study for ScanStep {
     }
 
     fn validate(&self, run: &RunSpec) -> Result<(), (String, String)> {
-        match run.state::<ScanSpec>().map(ScanSpec::validate) {
-            Some(Err((key, message))) => Err((run.blame(&format!("scan.{key}")), message)),
-            _ => Ok(()),
+        let Some(scan) = run.state::<ScanSpec>() else {
+            return Ok(());
+        };
+        scan.validate()
+            .map_err(|(key, message)| (run.blame(&format!("scan.{key}")), message))?;
+        // The raster within the positions f64 resolves: the fly axis from 0 to the
+        // width, the step axis from the start over every line's step.
+        let last_mm = run.start_mm + (scan.lines - 1) as f64 * run.distance_mm;
+        if scan.width_mm > MAX_POSITION_MM {
+            return Err((
+                run.blame("scan.width_mm"),
+                beyond_positions("the fly axis's far end is", scan.width_mm),
+            ));
         }
+        if last_mm.abs() > MAX_POSITION_MM {
+            return Err((
+                run.blame("scan.lines"),
+                beyond_positions(
+                    &format!("the last of {} lines of the step axis is", scan.lines),
+                    last_mm,
+                ),
+            ));
+        }
+        // The fly axis: an axis of the machine (simulated), or a gantry axis it does not
+        // have (an ideal one); never the stepping axis.
+        let axes = run.axis_names();
+        let fly = scan.fly_axis.as_str();
+        if run.axis.split('+').any(|a| a == fly) {
+            return Err((
+                run.blame("scan.fly_axis"),
+                format!("`{fly}` is the axis that steps (move.axis); the fly axis is the other one"),
+            ));
+        }
+        if !axes.iter().any(|a| a == fly) && !["x", "y", "z"].contains(&fly) {
+            return Err((
+                run.blame("scan.fly_axis"),
+                format!(
+                    "`{fly}` is not an axis of the machine ({}) nor a gantry axis x, y or z",
+                    axes.join(", ")
+                ),
+            ));
+        }
+        Ok(())
     }
 
     fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {
@@ -214,10 +256,15 @@ impl Study for ScanStep {
             .collect()
     }
 
-    fn summary(&self, runs: &dyn RunList, table: &RunsColumns) -> Option<String> {
+    fn summary(
+        &self,
+        runs: &dyn RunList,
+        table: &RunsColumns,
+        current: &dyn Fn(&RunSpec) -> bool,
+    ) -> Option<String> {
         table
             .column("scan_reentry_error_um")
-            .map(|_| summary::section(runs, table))
+            .map(|_| summary::section(runs, table, current))
     }
 
     fn figures(&self, bands_um: &[f64]) -> Vec<PlotColumn> {
@@ -263,5 +310,9 @@ impl Study for ScanStep {
     /// The move-and-settle tables would measure the raster's run-out, not the step.
     fn replaces_move_tables(&self) -> bool {
         true
+    }
+
+    fn unused(&self, run: &RunSpec, key: &str) -> Option<&'static str> {
+        jerk_unused(run, key)
     }
 }

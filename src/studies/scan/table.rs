@@ -37,6 +37,10 @@ pub struct ScanSpec {
     pub fly_axis: String,
 }
 
+/// The most lines a scan may have: each line is a turnaround and a step of the planned
+/// raster, held in memory; a wafer or a print bed is scanned in thousands.
+pub const MAX_LINES: usize = 100_000;
+
 fn default_width() -> f64 {
     20.0
 }
@@ -94,13 +98,26 @@ impl ScanSpec {
                 ),
             ));
         }
-        if self.lines < 2 {
+        if !(2..=MAX_LINES).contains(&self.lines) {
             return Err((
                 "lines",
                 format!(
-                    "a scan needs at least 2 lines (one step), got {}",
+                    "a scan needs 2 to {MAX_LINES} lines (one step per turnaround), got {}",
                     self.lines
                 ),
+            ));
+        }
+        let name_ok = !self.fly_axis.is_empty()
+            && self.fly_axis.len() <= 32
+            && self
+                .fly_axis
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !name_ok {
+            return Err((
+                "fly_axis",
+                "an axis name: letters, digits and `_`, as the machine's axes are named (x, y, z)"
+                    .into(),
             ));
         }
         self.placement()?;

@@ -3,8 +3,12 @@
 //! A baseline is a `runs.csv` (`results/baselines/<scenario>.csv`). Every cell of every run
 //! is compared, parameters and metrics alike, matched by the `run` column:
 //!
-//! - numbers differ when `|now - baseline| > max(tolerance * |baseline|, floor)`, the floor
-//!   being float noise for the column's unit (`_s`: 1e-9 s, `_um`: 1e-6 um, else 1e-12);
+//! - numbers differ when `|now - baseline| > max(tolerance * |baseline|, floor)`: a
+//!   relative tolerance, and an absolute floor under which no change means anything. For
+//!   lengths the floor is [`DEFAULT_FLOOR_UM`] (1 nm; `_um` columns, and `_mm` ones in
+//!   their unit), so that a residual of 7e-6 um becoming 4.8e-6 um (a shaper cancelling a
+//!   mode down to float round-off, a "-31 %" change) is not a regression; for other
+//!   columns it is float noise in their unit (`_s`: 1e-9 s, else 1e-12);
 //! - `inf` (not settled) equals only `inf`; finite -> `inf` and back are changes with an
 //!   infinite delta;
 //! - text cells (profile kind, a run status) differ when the text differs.
@@ -28,6 +32,12 @@ use crate::input::runs_table::{RunsTable, number};
 /// Default relative tolerance (percent): far above float noise between machines (1e-12),
 /// far below any change a user would notice (the profile kinds differ by 10-300%).
 pub const DEFAULT_TOLERANCE_PCT: f64 = 0.1;
+
+/// Default absolute floor of length columns (um): 1 nm, a thousandth of the smallest
+/// settling band the checked-in scenarios use (1 um), far above float round-off of a
+/// residual (a cancelled mode leaves about 1e-6 um), far below anything that moves a
+/// settling time.
+pub const DEFAULT_FLOOR_UM: f64 = 1e-3;
 
 /// Which direction is an improvement for a column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -58,12 +68,16 @@ pub fn direction(column: &str) -> Direction {
     }
 }
 
-/// Float-noise floor for a column, in its unit.
-fn floor(column: &str) -> f64 {
-    if column.ends_with("_s") || column.contains("_s_") {
+/// The absolute floor for a column, in its unit: `floor_um` for lengths (`_um`, `_mm`),
+/// float noise for the others.
+fn floor(column: &str, floor_um: f64) -> f64 {
+    let unit = |u: &str| column.ends_with(u) || column.contains(&format!("{u}_"));
+    if unit("_um") {
+        floor_um
+    } else if unit("_mm") {
+        floor_um * 1e-3
+    } else if unit("_s") {
         1e-9
-    } else if column.ends_with("_um") || column.contains("_um_") {
-        1e-6
     } else {
         1e-12
     }
@@ -141,8 +155,15 @@ fn verdict(column: &str, increased: bool) -> Verdict {
     }
 }
 
-/// Compare one cell; `None` when equal within the tolerance.
-fn compare_cell(column: &str, base: &str, now: &str, tol: f64) -> Option<(Option<f64>, Verdict)> {
+/// Compare one cell; `None` when equal within the relative tolerance `tol` or the
+/// column's absolute floor.
+fn compare_cell(
+    column: &str,
+    base: &str,
+    now: &str,
+    tol: f64,
+    floor_um: f64,
+) -> Option<(Option<f64>, Verdict)> {
     if base == now {
         return None;
     }
@@ -152,7 +173,7 @@ fn compare_cell(column: &str, base: &str, now: &str, tol: f64) -> Option<(Option
                 return None;
             }
             if b.is_finite() && n.is_finite() {
-                if (n - b).abs() <= (tol * b.abs()).max(floor(column)) {
+                if (n - b).abs() <= (tol * b.abs()).max(floor(column, floor_um)) {
                     return None;
                 }
                 let pct = if b == 0.0 {
@@ -178,7 +199,8 @@ fn compare_cell(column: &str, base: &str, now: &str, tol: f64) -> Option<(Option
     }
 }
 
-/// Compare `now` with `baseline` at relative tolerance `tolerance_pct` (percent).
+/// Compare `now` with `baseline` at relative tolerance `tolerance_pct` (percent) and the
+/// absolute floor `floor_um` of length columns (um).
 ///
 /// Errors (not regressions, but a baseline that does not describe this scenario): columns
 /// added or missing, runs added or missing, no `run` column.
@@ -186,6 +208,7 @@ pub fn compare(
     baseline: &RunsTable,
     now: &RunsTable,
     tolerance_pct: f64,
+    floor_um: f64,
 ) -> Result<Comparison, String> {
     if baseline.header != now.header {
         let missing: Vec<&str> = baseline
@@ -250,7 +273,9 @@ if intended, rewrite the baseline with --update",
             if c == run_col {
                 continue;
             }
-            if let Some((delta_pct, verdict)) = compare_cell(column, &b_row[c], &n_row[c], tol) {
+            if let Some((delta_pct, verdict)) =
+                compare_cell(column, &b_row[c], &n_row[c], tol, floor_um)
+            {
                 changes.push(Change {
                     run: n_row[run_col].clone(),
                     column: column.clone(),
@@ -369,6 +394,7 @@ mod tests {
             &RunsTable::parse(BASE).expect("base"),
             &RunsTable::parse(now).expect("now"),
             tol,
+            DEFAULT_FLOOR_UM,
         )
     }
 
@@ -469,6 +495,7 @@ mod tests {
             &RunsTable::parse(twice).expect("table"),
             &RunsTable::parse(BASE).expect("table"),
             0.1,
+            DEFAULT_FLOOR_UM,
         )
         .expect_err("run 0 twice");
         assert!(e.contains("run 0 twice"), "{e}");
@@ -480,10 +507,34 @@ mod tests {
     #[test]
     fn zero_baseline_uses_the_noise_floor() {
         // A settle time of exactly 0 s that becomes 1e-12 s is float noise, 1e-6 s is not.
-        assert_eq!(compare_cell("settle_time_s_10um", "0", "1e-12", 1e-3), None);
+        let cell = |c, b, n| compare_cell(c, b, n, 1e-3, DEFAULT_FLOOR_UM);
+        assert_eq!(cell("settle_time_s_10um", "0", "1e-12"), None);
         assert_eq!(
-            compare_cell("settle_time_s_10um", "0", "0.000001", 1e-3),
+            cell("settle_time_s_10um", "0", "0.000001"),
             Some((Some(f64::INFINITY), Verdict::Worse))
         );
+    }
+
+    /// A residual at float round-off that moves by a third is no change (it is far under
+    /// the 1 nm floor); a change of a nanometre and more is, and so is a relative change
+    /// beyond the tolerance above the floor. Millimetre columns take the same floor in
+    /// their unit.
+    #[test]
+    fn lengths_under_the_absolute_floor_are_no_change() {
+        let cell = |c, b, n, floor| compare_cell(c, b, n, 1e-3, floor);
+        assert_eq!(cell("residual_peak_um", "7e-6", "4.8e-6", 1e-3), None);
+        assert_eq!(cell("y_residual_rms_um", "0", "0.0009", 1e-3), None);
+        assert_eq!(
+            cell("residual_peak_um", "0.0001", "0.0021", 1e-3),
+            Some((Some(2000.0), Verdict::Worse))
+        );
+        assert_eq!(
+            cell("residual_peak_um", "10", "10.5", 1e-3),
+            Some((Some(5.0), Verdict::Worse))
+        );
+        assert_eq!(cell("smoothing_mm", "0.1", "0.1000009", 1e-3), None);
+        assert!(cell("smoothing_mm", "0.1", "0.1002", 1e-3).is_some());
+        // The floor is the caller's: at 1e-7 um the round-off change shows.
+        assert!(cell("residual_peak_um", "7e-6", "4.8e-6", 1e-7).is_some());
     }
 }

@@ -14,7 +14,7 @@ use crate::output::runs_csv::runs_csv;
 use crate::spec::backend::Backend;
 use crate::workflows::{Exit, Report};
 
-pub use compare::{Comparison, DEFAULT_TOLERANCE_PCT, Verdict};
+pub use compare::{Comparison, DEFAULT_FLOOR_UM, DEFAULT_TOLERANCE_PCT, Verdict};
 
 /// What to check against what.
 #[derive(Debug, Clone, PartialEq)]
@@ -25,6 +25,8 @@ pub struct CheckOptions {
     pub baseline: PathBuf,
     /// Relative tolerance (percent).
     pub tolerance_pct: f64,
+    /// Absolute floor of length columns (um): changes smaller than it are no change.
+    pub floor_um: f64,
     /// Rewrite the baseline with this run's values.
     pub update: bool,
     /// Pass when every change is an improvement of a settling metric.
@@ -42,6 +44,7 @@ impl CheckOptions {
             scenario: scenario.into(),
             baseline: baseline.into(),
             tolerance_pct: DEFAULT_TOLERANCE_PCT,
+            floor_um: DEFAULT_FLOOR_UM,
             update: false,
             allow_improvements: false,
             backend: None,
@@ -91,8 +94,21 @@ pub fn check(opts: &CheckOptions, progress: Progress) -> Result<Checked, Error> 
             format!("must be a finite percentage >= 0, got {tol}"),
         ));
     }
-    let (sc, mut runs) = crate::expand::load_runs(path)?;
-    let old = match crate::input::file::read_text(baseline) {
+    if !(opts.floor_um.is_finite() && opts.floor_um >= 0.0) {
+        return Err(Error::input(
+            "--floor-um",
+            format!("must be a finite length >= 0 (um), got {}", opts.floor_um),
+        ));
+    }
+    let (sc, src) = crate::expand::load(path)?;
+    let mut runs = crate::expand::expand(&sc, &src)?;
+    if opts.update {
+        // --update rewrites the baseline, and only the baseline: never the scenario or a
+        // file it reads, a link or a device.
+        crate::expand::machine::input_files(&sc, &src).refuse(baseline)?;
+        settle_files::write::check_target(baseline)?;
+    }
+    let old = match crate::input::file::read_text(baseline, crate::input::file::limit::RESULTS) {
         Ok(text) => Some(text),
         Err(Error::Read { source, .. })
             if source.kind() == std::io::ErrorKind::NotFound && opts.update =>
@@ -150,7 +166,9 @@ pub fn check(opts: &CheckOptions, progress: Progress) -> Result<Checked, Error> 
     let metrics = results.into_iter().collect::<Result<Vec<_>, _>>()?;
     let csv = runs_csv(&runs, &metrics);
     let now = RunsTable::parse(&csv).map_err(|e| Error::input("runs.csv", e))?;
-    let comparison = old_table.as_ref().map(|b| compare::compare(b, &now, tol));
+    let comparison = old_table
+        .as_ref()
+        .map(|b| compare::compare(b, &now, tol, opts.floor_um));
     let outcome = if opts.update {
         if let Some(dir) = baseline.parent().filter(|d| !d.as_os_str().is_empty()) {
             create_dir(dir)?;
@@ -188,7 +206,8 @@ impl Checked {
     /// What `settle check` prints: the table of changes and the verdict.
     pub fn report(&self) -> Report {
         let (name, opts) = (&self.name, &self.opts);
-        let (baseline, tol) = (opts.baseline.display(), opts.tolerance_pct);
+        let baseline = opts.baseline.display();
+        let tol = format!("{}% (or {} um)", opts.tolerance_pct, opts.floor_um);
         let mut r = Report::new(if self.passed() {
             Exit::Ok
         } else {
@@ -197,12 +216,12 @@ impl Checked {
         match &self.outcome {
             CheckOutcome::Updated { runs, comparison } => r.out(match comparison {
                 Some(Ok(c)) if !c.changes.is_empty() => format!(
-                    "updated {baseline}: {} values changed beyond {tol}%:\n{}",
+                    "updated {baseline}: {} values changed beyond {tol}:\n{}",
                     c.changes.len(),
                     compare::table(&c.changes, usize::MAX)
                 ),
                 Some(Ok(_)) => {
-                    format!("updated {baseline} ({runs} runs; no value changed beyond {tol}%)")
+                    format!("updated {baseline} ({runs} runs; no value changed beyond {tol})")
                 }
                 Some(Err(e)) => format!("updated {baseline} (it had another shape: {e})"),
                 None => format!("created {baseline} ({runs} runs)"),
@@ -224,7 +243,7 @@ impl Checked {
                 }
                 if self.passed() {
                     r.out(format!(
-                        "settle check {name}: ok: {} values ({} runs) match {baseline} within {tol}%{}",
+                        "settle check {name}: ok: {} values ({} runs) match {baseline} within {tol}{}",
                         c.cells,
                         c.runs,
                         if c.changes.is_empty() {
@@ -237,7 +256,7 @@ impl Checked {
                     ));
                 } else {
                     r.err(format!(
-                        "settle check {name}: FAILED: {} of {} values ({} runs) differ from {baseline} by more than {tol}% ({counts}).\n\
+                        "settle check {name}: FAILED: {} of {} values ({} runs) differ from {baseline} by more than {tol} ({counts}).\n\
 If the change is intended, rewrite the baseline and commit it:\n  settle check {} --baseline {baseline} --update",
                         c.changes.len(),
                         c.cells,

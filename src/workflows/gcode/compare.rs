@@ -15,6 +15,9 @@ use crate::error::Error;
 use crate::output::atomic::write_atomic;
 use crate::output::plot::ringing::RingingMap;
 
+/// The comparison table's file name in the output folder.
+pub const FILE: &str = "compare.md";
+
 /// A setting as written after `--versus`: `FIRMWARE` (unshaped) or `FIRMWARE:SHAPERS`
 /// (`klipper:mzv@48`, `settle:none`, `klipper:x=mzv@52,y=ei@41`; [`XyShapers`]).
 pub fn parse_setting(s: &str) -> Result<(Firmware, XyShapers), String> {
@@ -100,7 +103,7 @@ pub fn compare(
         files.push(dir.join(format!("{stem}.svg")));
         files.push(dir.join(format!("{stem}.png")));
     }
-    let md = dir.join("compare.md");
+    let md = dir.join(FILE);
     let text = format!(
         "# {} on {}\n\n{}",
         a.file.display(),

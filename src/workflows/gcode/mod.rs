@@ -5,17 +5,18 @@
 //! axes of the same names, in the G-code's coordinates (position 0 of a machine axis is
 //! G-code 0). Per sample the toolhead's contour error ([`crate::studies::gcode::contour`]) is measured, per move
 //! its largest value (the ringing after the corner at the move's start), per layer the
-//! worst and 95th percentile over printing samples ([`crate::studies::gcode::stats`]); the outputs are
+//! worst and 95th percentile over working samples ([`crate::studies::gcode::stats`]); the outputs are
 //! `layers.csv`, `summary.md` and the ringing maps of the worst layers ([`report`]).
 //! Everything is computed before anything is written: a bad file writes nothing.
 //!
 //! On the modal backend a machine whose stiffness depends on position (a belt's spans) is
 //! linearised at one point for the whole file, where the print is
-//! ([`crate::studies::gcode::linpoint`]: the centre of the printing moves' bounding box),
+//! ([`crate::studies::gcode::linpoint`]: the centre of the working moves' bounding box),
 //! for the whole run and for any layer range alike; the `[gcode]` study uses the same
 //! point, so both give the same numbers.
 
 pub mod compare;
+pub mod features;
 pub mod record;
 pub mod report;
 pub mod stream;
@@ -78,6 +79,8 @@ pub struct GcodeOptions {
     pub mcap: bool,
     /// The firmware configuration the planner's settings come from (`--config`).
     pub config: Option<ConfigSource>,
+    /// Overwrite the results of an earlier run in the output folder (refused without it).
+    pub force: bool,
 }
 
 /// A firmware configuration read for `--config`.
@@ -89,6 +92,8 @@ pub struct ConfigSource {
     pub job: JobConfig,
     /// What the reader noted (SAVE_CONFIG values overridden, blocks not read).
     pub notes: Vec<String>,
+    /// The files read (the configuration and what it includes or runs).
+    pub files: Vec<PathBuf>,
 }
 
 /// `--shaper` as written: `KIND@FREQ_HZ[/DAMPING]` or `none` for X and Y, or per axis
@@ -177,6 +182,7 @@ impl GcodeOptions {
             versus: None,
             mcap: false,
             config: None,
+            force: false,
         })
     }
 
@@ -198,25 +204,34 @@ impl GcodeOptions {
         } else {
             Firmware::Klipper
         });
-        let (job, notes) = match firmware {
+        let (job, notes, files) = match firmware {
             Firmware::Klipper => {
                 let c = settle_gcode::config::KlipperConfig::read(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
                 let job = JobConfig::from_klipper(&c).map_err(gcode_error(&config))?;
-                (job, c.notes.iter().map(ToString::to_string).collect())
+                let notes = c.notes.iter().map(ToString::to_string).collect();
+                (job, notes, c.files)
             }
             Firmware::Rrf => {
                 let c = settle_gcode::config::RrfConfig::read(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
                 let job = JobConfig::from_rrf(&c).map_err(gcode_error(&config))?;
-                (job, c.notes.iter().map(ToString::to_string).collect())
+                let notes = c.notes.iter().map(ToString::to_string).collect();
+                (job, notes, c.files)
+            }
+            Firmware::Grbl => {
+                let c = settle_gcode::config::GrblSettings::read(&config)
+                    .map_err(|e| crate::workflows::import::config_error(&config, e))?;
+                let job = JobConfig::from_grbl(&c).map_err(gcode_error(&config))?;
+                let notes = c.notes.iter().map(ToString::to_string).collect();
+                (job, notes, c.files)
             }
             Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => {
                 return Err(Error::input_key(
                     &config,
                     "--config",
                     format!(
-                        "--config reads a Klipper printer.cfg (--firmware klipper) or a RepRapFirmware config.g (--firmware rrf), not {firmware}'s settings{}",
+                        "--config reads a Klipper printer.cfg (--firmware klipper), a RepRapFirmware config.g (--firmware rrf) or GRBL's $$ settings (--firmware grbl), not {firmware}'s settings{}",
                         if firmware == Firmware::Marlin {
                             " (Marlin's M201/M203/M204/M205/M593 lines in the G-code file set them)"
                         } else {
@@ -232,6 +247,7 @@ impl GcodeOptions {
             path: config,
             job,
             notes,
+            files,
         });
         Ok(opts)
     }
@@ -298,6 +314,10 @@ pub struct GcodeOutcome {
     pub skipped_lines: u64,
     /// Commands read but not followed, with why, and how often.
     pub ignored: BTreeMap<String, u64>,
+    /// The slicer feature types the file names ([`settle_gcode::Reader::features`]).
+    pub features: Vec<String>,
+    /// The file's limit commands that raise a limit above the configuration's.
+    pub overrides: Vec<settle_gcode::job::LimitOverride>,
     /// Files written.
     pub files: Vec<PathBuf>,
     /// The outcome of the `--versus` setting.
@@ -322,10 +342,11 @@ impl GcodeOutcome {
         &self.streamed.maps
     }
 
-    /// What the binary prints, and exit 1 when the simulation failed.
+    /// What the binary prints; [`Exit::RunsFailed`] when the simulation failed (lost steps,
+    /// a fault): a result, written and reported, not a failure of the command.
     pub fn report(&self) -> Report {
         let failed = self.streamed.fault.is_some() || self.streamed.lost_steps > 0;
-        let mut r = Report::new(if failed { Exit::Failed } else { Exit::Ok });
+        let mut r = Report::new(if failed { Exit::RunsFailed } else { Exit::Ok });
         r.out(format!(
             "{}: {} on {} ({}): print time {:.1} s, contour error worst {:.2} um, p95 {:.2} um",
             self.file.display(),
@@ -351,6 +372,9 @@ impl GcodeOutcome {
                 s.line, s.layer, s.x_mm, s.y_mm
             ));
         }
+        if let Some(f) = features::fly_words(self) {
+            r.out(f);
+        }
         if let Some(t) = &self.streamed.tail {
             r.out(format!(
                 "ringing after the last move: {:.2} um at most, {:.3} um after {:.2} s",
@@ -374,15 +398,60 @@ impl GcodeOutcome {
                 )
             });
             r.err(format!(
-                "result: the machine loses steps ({} full steps{at}): the motion asks more of a motor than its torque gives (its load angle passed 90 electrical degrees); what it prints after that is not this simulation's toolpath (exit 1: a failed run, not a tool error)",
+                "result: the machine loses steps ({} full steps{at}): the motion asks more of a motor than its torque gives (its load angle passed 90 electrical degrees); what it prints after that is not this simulation's toolpath (a failed run: a result, exit 0; --fail-on-failed-runs makes it exit 1)",
                 self.streamed.lost_steps
             ));
         }
         if self.skipped_lines > 0 {
             r.err(format!("skipped {} bad lines", self.skipped_lines));
         }
+        for o in &self.overrides {
+            r.err(format!("note: {}", override_words(o)));
+        }
+        if !self.ignored.is_empty() {
+            const SHOWN: usize = 8;
+            let mut names: Vec<String> = self
+                .ignored
+                .iter()
+                .take(SHOWN)
+                .map(|(what, n)| {
+                    let name = what.split(':').next().unwrap_or(what);
+                    format!("{name} ({n}x)")
+                })
+                .collect();
+            if self.ignored.len() > SHOWN {
+                names.push(format!("and {} more", self.ignored.len() - SHOWN));
+            }
+            r.err(format!(
+                "not followed: {} (why: summary.md, Commands not followed)",
+                names.join(", ")
+            ));
+        }
         r
     }
+}
+
+/// A limit the file raises, in words: `line 12: M204 raises max_accel (mm/s^2) from the
+/// configuration's 7000 to 15000; the firmware follows the file`.
+pub fn override_words(o: &settle_gcode::job::LimitOverride) -> String {
+    // Klipper reads M204 S as its SET_VELOCITY_LIMIT ACCEL.
+    let command = match o.command.as_str() {
+        "SET_VELOCITY_LIMIT" => "M204 (or SET_VELOCITY_LIMIT)",
+        c => c,
+    };
+    format!(
+        "line {}: {} raises {} from the configuration's {} to {}; the firmware follows the file",
+        o.line,
+        command,
+        o.limit,
+        plot_num(o.configured),
+        plot_num(o.file)
+    )
+}
+
+/// A setting's value as written (`7000`, `0.5`), without float noise.
+fn plot_num(v: f64) -> String {
+    format!("{}", (v * 1e6).round() / 1e6)
 }
 
 /// A settle-gcode error as the harness reports it: a located one is bad input at its
@@ -390,13 +459,14 @@ impl GcodeOutcome {
 /// the setting.
 pub fn gcode_error(file: &Path) -> impl Fn(GcodeError) -> Error + '_ {
     move |e| {
-        if let GcodeError::Io {
-            source_name,
-            source,
-        } = e
-        {
-            return Error::read(PathBuf::from(&*source_name), source);
-        }
+        let e = match e {
+            GcodeError::Io {
+                source_name,
+                source,
+            } => return Error::read(PathBuf::from(&*source_name), source),
+            GcodeError::File(f) => return (*f).into(),
+            e => e,
+        };
         if let Some(at) = e.location() {
             let prefix = format!("{at}: ");
             let text = e.to_string();
@@ -468,6 +538,46 @@ fn longest_period_s(linear_axes: &[AxisModel]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The fastest natural frequency (Hz) of the axes' modes, 0 when they have none.
+fn fastest_mode_hz(linear_axes: &[AxisModel]) -> f64 {
+    let rest = Profile::empty(State::default());
+    linear_axes
+        .iter()
+        .filter_map(|a| LinearResponse::new(a, &rest).ok())
+        .flat_map(|lr| lr.poles().to_vec())
+        .map(|p| p.norm() / std::f64::consts::TAU)
+        .fold(0.0, f64::max)
+}
+
+/// The highest `--sample-rate-hz` (Hz): fifty samples per period of a 2 kHz mode, far
+/// above a printer's (a toolhead's highest modes are 100-300 Hz); a job's simulation time
+/// grows with the rate.
+pub const MAX_SAMPLE_RATE_HZ: f64 = 100_000.0;
+
+/// `--sample-rate-hz` checked before any work: at least two samples per period of the
+/// machine's fastest mode (`fastest_hz`; fewer alias it, and the contour error between
+/// samples far apart is not seen: a scenario's `observe.sample_rate_hz` is held to the
+/// same), at most [`MAX_SAMPLE_RATE_HZ`].
+fn check_sample_rate(rate_hz: f64, fastest_hz: f64) -> Result<(), Error> {
+    let min = 2.0 * fastest_hz;
+    if rate_hz.is_finite() && rate_hz >= min && rate_hz > 0.0 && rate_hz <= MAX_SAMPLE_RATE_HZ {
+        return Ok(());
+    }
+    Err(Error::input(
+        "--sample-rate-hz",
+        if !(rate_hz.is_finite() && rate_hz > 0.0) {
+            format!("{rate_hz}: give a finite number of Hz > 0")
+        } else if rate_hz > MAX_SAMPLE_RATE_HZ {
+            format!("{rate_hz} Hz is above the limit of {MAX_SAMPLE_RATE_HZ} Hz")
+        } else {
+            format!(
+                "{rate_hz} Hz gives fewer than two samples per period of the machine's fastest mode ({fastest_hz:.1} Hz): give at least {min:.1} Hz (the default {DEFAULT_SAMPLE_RATE_HZ} Hz, or twenty samples per period, {:.0} Hz, for contour errors to a few percent)",
+                20.0 * fastest_hz
+            )
+        },
+    ))
+}
+
 /// How much the ringing after the last move decays over the longest tail: 1e-3.
 pub const TAIL_DECAY: f64 = 1e-3;
 
@@ -536,12 +646,7 @@ fn simulate(
     if !opts.backend.available() {
         return Err(Error::input("--backend", NO_MUJOCO));
     }
-    if !(opts.sample_rate_hz.is_finite() && opts.sample_rate_hz > 0.0) {
-        return Err(Error::input(
-            "--sample-rate-hz",
-            "the sample rate must be a positive number of Hz",
-        ));
-    }
+    check_sample_rate(opts.sample_rate_hz, fastest_mode_hz(&linear_axes))?;
     let names = axes.iter().map(|a| a.name.clone()).collect();
     let sopts = StreamOptions {
         sample_rate_hz: opts.sample_rate_hz,
@@ -558,7 +663,7 @@ fn simulate(
     let err = gcode_error(&opts.file);
     let reader_options = ReaderOptions {
         skip_bad_lines: opts.skip_bad_lines,
-        ..ReaderOptions::new(opts.job.dialect)
+        ..opts.job.reader_options()
     };
     // The modal backend's linearisation point, where a position-dependent stiffness
     // makes it matter: one pass of the reader over the whole file.
@@ -601,6 +706,11 @@ fn simulate(
     )?;
     job.run_to_end().map_err(&err)?;
     let summary = job.summary();
+    if let Some(why) =
+        crate::studies::gcode::work::nothing_to_measure(&summary, job.reader().lines_read())
+    {
+        return Err(Error::input(&opts.file, why));
+    }
     let mut by_layer: BTreeMap<u32, stats::LayerStats> = streamed
         .layers
         .iter()
@@ -631,6 +741,8 @@ fn simulate(
         streamed,
         skipped_lines: job.reader().skipped().count,
         ignored: summary.ignored,
+        features: summary.features,
+        overrides: summary.overrides,
         files: Vec::new(),
         versus: None,
         recording: None,
@@ -672,6 +784,15 @@ pub fn config_settings(job: &JobConfig) -> String {
             mm(c.travel_accel_m_s2),
             mm(c.instant_dv_m_s[0]),
             mm(c.instant_dv_m_s[1])
+        ),
+        PlannerConfig::Grbl(g) => format!(
+            "$110 {} $111 {} mm/min, $120 {} $121 {} mm/s^2, $11 {} mm, $32={}",
+            g.max_rate_mm_min[0],
+            g.max_rate_mm_min[1],
+            g.accel_mm_s2[0],
+            g.accel_mm_s2[1],
+            g.junction_deviation_mm,
+            u8::from(g.laser_mode)
         ),
         PlannerConfig::Marlin(_) | PlannerConfig::Settle(_) => "the firmware's defaults".into(),
     };
@@ -733,11 +854,6 @@ pub fn gcode_with_progress(
     opts: &GcodeOptions,
     progress: Option<Progress<'_>>,
 ) -> Result<GcodeOutcome, Error> {
-    let rec = match opts.mcap {
-        true => Some(record::Recorder::start(recording_metadata(opts))?),
-        false => None,
-    };
-    let (mut outcome, rec) = simulate(opts, rec, progress)?;
     let dir = match &opts.out {
         Some(d) => d.clone(),
         None => {
@@ -748,6 +864,29 @@ pub fn gcode_with_progress(
             PathBuf::from("results").join(format!("{stem}-gcode"))
         }
     };
+    // The output folder, before any work: never an input, nor earlier results unasked.
+    crate::output::folder::check(&dir, &RESULTS, opts.force, &opts.inputs(), writes)?;
+    // The recording streams into a temporary file inside the folder, made for it (and
+    // removed again, with the folder it needed, when the run fails: a bad file writes
+    // nothing).
+    let made = opts.mcap && std::fs::symlink_metadata(&dir).is_err();
+    let simulated = (|| {
+        let rec = match opts.mcap {
+            true => {
+                crate::output::atomic::create_dir(&dir)?;
+                Some(record::Recorder::start(
+                    recording_metadata(opts),
+                    &dir.join(RECORDING),
+                )?)
+            }
+            false => None,
+        };
+        simulate(opts, rec, progress)
+    })();
+    if simulated.is_err() && made {
+        let _ = std::fs::remove_dir(&dir);
+    }
+    let (mut outcome, rec) = simulated?;
     let b_opts = match opts.versus {
         Some((fw, shapers)) => Some(compare::versus(opts, fw, shapers)?),
         None => None,
@@ -758,7 +897,7 @@ pub fn gcode_with_progress(
     };
     outcome.files = report::write(&outcome, &dir)?;
     if let Some(rec) = rec {
-        let path = dir.join("recording.mcap");
+        let path = dir.join(RECORDING);
         outcome.recording = Some(rec.finish(recording_metrics(&outcome), &path)?);
         outcome.files.push(path);
     }
@@ -770,6 +909,58 @@ pub fn gcode_with_progress(
     let html = report::write_html(&outcome, opts, &dir)?;
     outcome.files.push(html);
     Ok(outcome)
+}
+
+/// `--mcap`'s recording in the output folder.
+const RECORDING: &str = "recording.mcap";
+
+/// An earlier run's results in the output folder, which `--force` overwrites.
+const RESULTS: crate::output::folder::Results<'static> = crate::output::folder::Results {
+    what: "settle gcode",
+    marks: &[
+        "layers.csv",
+        "summary.md",
+        "features.csv",
+        "layer_features.csv",
+        "error-z.svg",
+        "error-z.png",
+        report::REPORT,
+        compare::FILE,
+        RECORDING,
+    ],
+};
+
+/// Whether `settle gcode` writes `rel` in its output folder.
+fn writes(rel: &Path) -> bool {
+    crate::output::folder::written(
+        rel,
+        RESULTS.marks,
+        &[],
+        &[
+            ("ringing-layer-", ".svg"),
+            ("ringing-layer-", ".png"),
+            ("split-layer-", ".svg"),
+            ("split-layer-", ".png"),
+            ("compare-layer-", ".svg"),
+            ("compare-layer-", ".png"),
+        ],
+    )
+}
+
+impl GcodeOptions {
+    /// The files the run reads: the G-code, the machine file or scenario (a path), the
+    /// configuration and what it includes.
+    pub fn inputs(&self) -> settle_files::write::Inputs {
+        let mut inputs = settle_files::write::Inputs::of([&self.file]);
+        inputs.add(Path::new(&self.machine));
+        if let Some(c) = &self.config {
+            inputs.add(&c.path);
+            for f in &c.files {
+                inputs.add(f);
+            }
+        }
+        inputs
+    }
 }
 
 /// The `settle` metadata record of `--mcap`'s recording.

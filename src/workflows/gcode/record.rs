@@ -63,16 +63,10 @@ impl Drop for Recorder {
 }
 
 impl Recorder {
-    /// Start a recording in a temporary file, with `metadata` in its `settle` record.
-    pub fn start(metadata: BTreeMap<String, String>) -> Result<Self, Error> {
-        let tmp = std::env::temp_dir().join(format!(
-            "settle-gcode-{}-{}.mcap.tmp",
-            std::process::id(),
-            std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
-                .map_or(0, |d| d.as_nanos())
-        ));
-        let file = File::create(&tmp).map_err(|e| Error::write(&tmp, e))?;
+    /// Start a recording that becomes `path`, in a temporary file beside it (inside the
+    /// output folder), with `metadata` in its `settle` record.
+    pub fn start(metadata: BTreeMap<String, String>, path: &Path) -> Result<Self, Error> {
+        let (tmp, file) = crate::output::atomic::create_tmp(path)?;
         let stream = Stream::new(
             BufWriter::new(file),
             env!("CARGO_PKG_VERSION"),
@@ -94,7 +88,7 @@ impl Recorder {
         if let Some(s) = self.stream.as_mut()
             && let Err(e) = s.sample(t_s, values)
         {
-            self.error = Some(e.to_string());
+            self.error = Some(crate::output::atomic::io_cause(&e).to_string());
             self.stream = None;
         }
     }
@@ -115,30 +109,16 @@ impl Recorder {
         };
         let finished = stream
             .finish(metrics)
-            .map_err(|e| fail(e.to_string()))
+            .map_err(|e| fail(crate::output::atomic::io_cause(&e).to_string()))
             .and_then(|(info, w)| {
                 w.into_inner().map_err(|e| fail(e.error().to_string()))?;
                 Ok(info)
             });
         let info = finished.inspect_err(|e| self.error = Some(e.to_string()))?;
-        move_file(&self.tmp, path).inspect_err(|e| self.error = Some(e.to_string()))?;
+        crate::output::atomic::commit(&self.tmp, path)
+            .inspect_err(|e| self.error = Some(e.to_string()))?;
         Ok(info)
     }
-}
-
-/// Move `from` to `to`: a rename, or a copy into a temporary file beside `to` and a rename
-/// when they are on different file systems.
-fn move_file(from: &Path, to: &Path) -> Result<(), Error> {
-    if std::fs::rename(from, to).is_ok() {
-        return Ok(());
-    }
-    let tmp = crate::output::atomic::tmp_path(to);
-    let copied = std::fs::copy(from, &tmp).and_then(|_| std::fs::rename(&tmp, to));
-    let _ = std::fs::remove_file(from);
-    copied.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        Error::write(to, e)
-    })
 }
 
 /// The `/metrics` message of a recording.

@@ -139,11 +139,12 @@ pub fn summary_md(o: &GcodeOutcome, maps: &[String]) -> String {
     let _ = writeln!(
         s,
         "Contour error: distance in XY from the simulated toolhead to the commanded path of \
-the moves active at that time, over printing moves; p95 is the 95th percentile of all \
-printing samples. It has two parts: smoothing, the distance from the commanded (shaped) \
-position to that path, what the shaper trades for speed (zero without one), and vibration, \
-the distance from the toolhead to the commanded position, what the machine adds (zero on a \
-rigid one); each column is that part's own largest.\n"
+the moves active at that time, over working moves (extruding, or the laser or spindle on \
+in a feed move); p95 is the 95th percentile of all working samples. It has two parts: \
+smoothing, the distance from the commanded (shaped) position to that path, what the shaper \
+trades for speed (zero without one), and vibration, the distance from the toolhead to the \
+commanded position, what the machine adds (zero on a rigid one); each column is that part's \
+own largest.\n"
     );
     if let Some((settings, _)) = &o.config {
         let _ = writeln!(s, "Planner {settings}.\n");
@@ -192,11 +193,21 @@ not counted), so that it starts from the vibration the layers before leave.\n",
         );
     }
     let _ = writeln!(s, "\n## Layers\n");
+    let outer = super::features::has_outer_wall(o);
     let _ = writeln!(
         s,
-        "| layer | Z (mm) | time (s) | moves | worst (um) | p95 (um) | worst line | smoothing (um) | vibration (um) |"
+        "| layer | Z (mm) | time (s) | moves | worst (um) | p95 (um) | worst line | smoothing (um) | vibration (um) |{}",
+        if outer {
+            " outer wall worst (um) | outer wall p95 (um) |"
+        } else {
+            ""
+        }
     );
-    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(
+        s,
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|{}",
+        if outer { "---:|---:|" } else { "" }
+    );
     for l in &o.layers {
         let z = l.z_mm.map_or(String::new(), |z| format!("{z:.2}"));
         let (w, p, line, sm, vib) = match &l.stats {
@@ -211,11 +222,27 @@ not counted), so that it starts from the vibration the layers before leave.\n",
             ),
             None => ("-".into(), "-".into(), "-".into(), "-".into(), "-".into()),
         };
+        let wall = if !outer {
+            String::new()
+        } else {
+            match super::features::layer_outer_wall(o, l.layer) {
+                Some((w, p)) if p.is_nan() => format!(" {w:.2} | - |"),
+                Some((w, p)) => format!(" {w:.2} | {p:.2} |"),
+                None => " - | - |".into(),
+            }
+        };
         let _ = writeln!(
             s,
-            "| {} | {z} | {:.2} | {} | {w} | {p} | {line} | {sm} | {vib} |",
+            "| {} | {z} | {:.2} | {} | {w} | {p} | {line} | {sm} | {vib} |{wall}",
             l.layer, l.duration_s, l.moves
         );
+    }
+    s.push_str(&super::features::summary_sections(o));
+    if !o.overrides.is_empty() {
+        let _ = writeln!(s, "\n## Limits the file raises\n");
+        for v in &o.overrides {
+            let _ = writeln!(s, "- {}", super::override_words(v));
+        }
     }
     if !o.ignored.is_empty() {
         let _ = writeln!(s, "\n## Commands not followed\n");
@@ -312,6 +339,22 @@ pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         files.push(dir.join(format!("{stem}.png")));
         stems.push(stem);
     }
+    if super::features::has_features(o) {
+        for (file, bytes) in [
+            ("features.csv", super::features::features_csv(o)),
+            ("layer_features.csv", super::features::layer_features_csv(o)),
+        ] {
+            let path = dir.join(file);
+            let bytes = bytes.map_err(|e| Error::write(&path, std::io::Error::other(e)))?;
+            write_atomic(&path, &bytes)?;
+            files.push(path);
+        }
+    }
+    if let Some(fig) = super::features::z_figure(o) {
+        crate::output::plot::write(&fig, dir, "error-z")?;
+        files.push(dir.join("error-z.svg"));
+        files.push(dir.join("error-z.png"));
+    }
     let md = dir.join("summary.md");
     write_atomic(&md, summary_md(o, &stems).as_bytes())?;
     files.push(md);
@@ -326,7 +369,7 @@ const LINE_CHARS: usize = 160;
 
 /// One pass over `file`: its SHA-256 and the text of the lines `wanted` (1-based).
 fn digest_and_lines(file: &Path, wanted: &[u64]) -> Result<(String, BTreeMap<u64, String>), Error> {
-    let f = std::fs::File::open(file).map_err(|e| Error::read(file, e))?;
+    let f = crate::input::file::open(file, crate::input::file::limit::GCODE)?;
     let mut reader = std::io::BufReader::new(f);
     let mut sha = Sha256::default();
     let mut lines = BTreeMap::new();
@@ -336,7 +379,7 @@ fn digest_and_lines(file: &Path, wanted: &[u64]) -> Result<(String, BTreeMap<u64
         buf.clear();
         let read = reader
             .read_until(b'\n', &mut buf)
-            .map_err(|e| Error::read(file, e))?;
+            .map_err(|e| crate::input::file::stream_error(file, e))?;
         if read == 0 {
             break;
         }
@@ -483,9 +526,15 @@ pub fn html_report(
             texts.get(&w.line).map_or("", String::as_str)
         ));
     }
+    if let Some(f) = super::features::fly_words(o) {
+        intro.push(f);
+    }
+    for v in &o.overrides {
+        intro.push(format!("Note: {}", super::override_words(v)));
+    }
     let mut tables = vec![Table {
         title: "Worst spots".into(),
-        note: "The largest contour errors, at most one per move, with the G-code line of the move. Contour error: distance in XY from the simulated toolhead to the commanded path of the moves active at that time, over printing moves.".into(),
+        note: "The largest contour errors, at most one per move, with the G-code line of the move. Contour error: distance in XY from the simulated toolhead to the commanded path of the moves active at that time, over working moves (extruding, or the laser or spindle on in a feed move).".into(),
         header: ["error (um)", "line", "G-code", "layer", "X (mm)", "Y (mm)", "time (s)"]
             .map(String::from)
             .to_vec(),
@@ -534,6 +583,18 @@ pub fn html_report(
                 .collect(),
         });
     }
+    tables.extend(super::features::features_table(o));
+    if super::features::has_features(o) {
+        let csv = super::features::layer_features_csv(o)
+            .map_err(|e| Error::write(dir.join("layer_features.csv"), std::io::Error::other(e)))?;
+        tables.extend(
+            Table::from_csv(
+                "Feature types per layer (layer_features.csv)",
+                &String::from_utf8_lossy(&csv),
+            )
+            .ok(),
+        );
+    }
     if !o.ignored.is_empty() {
         tables.push(Table {
             title: "Commands not followed".into(),
@@ -555,7 +616,7 @@ pub fn html_report(
     if opts.machine.ends_with(".toml") && machine.is_file() {
         inputs.push(InputFile {
             name: opts.machine.clone(),
-            text: crate::input::file::read_text(machine)?,
+            text: crate::input::file::read_text(machine, crate::input::file::limit::SETTINGS)?,
         });
     }
     Ok(Report {
@@ -563,6 +624,7 @@ pub fn html_report(
         intro,
         winners: Vec::new(),
         tables,
+        sections: Vec::new(),
         figures: figures
             .into_iter()
             .map(|(title, svg)| Figure {
@@ -639,11 +701,15 @@ pub fn write_html(o: &GcodeOutcome, opts: &GcodeOptions, dir: &Path) -> Result<P
                         "Layer {n}: the shaper's smoothing (command against the G-code path) and the machine's vibration (toolhead against the command's path), on one colour scale ({})",
                         o.setting
                     ),
+                    None if stem == "error-z" => {
+                        "Contour error against Z: per layer the worst and the 95th percentile"
+                            .into()
+                    }
                     None => stem.clone(),
                 },
             },
         };
-        let svg = std::fs::read_to_string(f).map_err(|e| Error::read(f, e))?;
+        let svg = crate::input::file::read_text(f, crate::input::file::limit::RESULTS)?;
         figures.push((title, svg));
     }
     let report = html_report(o, opts, dir, figures)?;

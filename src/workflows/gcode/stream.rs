@@ -24,7 +24,6 @@ use std::io::BufRead;
 use std::ops::ControlFlow;
 use std::path::Path;
 
-use settle_gcode::MoveKind;
 use settle_gcode::job::Job;
 use settle_planner::{Profile, State, Trajectory};
 use settle_sim::{AxisModel, Observation, Plant, SimError};
@@ -37,6 +36,8 @@ use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
 use crate::studies::gcode::command_path::CommandPath;
 use crate::studies::gcode::contour::ActiveMoves;
+use crate::studies::gcode::features::FeatureAccount;
+use crate::studies::gcode::fly::FlyAxis;
 use crate::studies::gcode::stats::{
     Histogram, LayerMap, LayerStats, MapPoint, Split, Spot, TopSpots,
 };
@@ -113,6 +114,10 @@ pub struct Streamed {
     pub tail: Option<Tail>,
     /// Where a motor was first seen past its stability limit (see [`LostStep`]).
     pub first_lost_step: Option<LostStep>,
+    /// The error per slicer feature type.
+    pub features: FeatureAccount,
+    /// The along-line error of scan lines (raster jobs).
+    pub fly: FlyAxis,
 }
 
 /// Where a motor's load angle was first seen past 90 electrical degrees (the driver
@@ -136,7 +141,8 @@ pub struct LostStep {
 #[derive(Debug, Clone, Copy)]
 struct Owner {
     index: u64,
-    kind: MoveKind,
+    working: bool,
+    feature: u16,
     layer: u32,
     line: u64,
 }
@@ -172,9 +178,12 @@ struct Account {
     hist: Histogram,
     map: Vec<MapPoint>,
     layer_top: TopSpots,
-    /// The move the last sample belonged to: index, kind, layer, line, worst spot.
-    owner: Option<(u64, MoveKind, u32, u64, Option<Spot>)>,
+    /// The move the last sample belonged to: index, whether it works, layer, line, worst
+    /// spot.
+    owner: Option<(u64, bool, u32, u64, Option<Spot>)>,
     map_every: u64,
+    /// The current layer's map stride: `map_every`, doubled each time its map is halved.
+    map_stride: u64,
     /// The MCAP recording of the counted samples.
     rec: Option<Recorder>,
     /// The ringing after the last move, while it is simulated.
@@ -201,6 +210,7 @@ impl Account {
             map: Vec::new(),
             owner: None,
             map_every,
+            map_stride: map_every,
             rec,
             ringing: None,
         }
@@ -222,7 +232,7 @@ impl Account {
     }
 
     fn end_move(&mut self) {
-        if let Some((_, MoveKind::Print, _, _, Some(spot))) = self.owner.take()
+        if let Some((_, true, _, _, Some(spot))) = self.owner.take()
             && let Some(l) = self.layer.as_mut()
         {
             l.add_move(&spot);
@@ -236,9 +246,11 @@ impl Account {
         let Some(mut l) = self.layer.take() else {
             return;
         };
+        self.out.features.end_layer(l.layer);
         l.p95_um = self.hist.quantile_um(0.95);
         self.out.all.merge(&self.hist);
         self.hist = Histogram::default();
+        self.map_stride = self.map_every;
         let map = LayerMap {
             layer: l.layer,
             points: std::mem::take(&mut self.map),
@@ -333,12 +345,6 @@ impl Account {
         let Some((err_mm, m)) = self.active.at(t, [x, y]) else {
             return;
         };
-        let m = Owner {
-            index: m.index,
-            kind: m.kind,
-            layer: m.layer,
-            line: m.line,
-        };
         if self
             .opts
             .layers
@@ -346,6 +352,16 @@ impl Account {
         {
             return;
         }
+        if m.working {
+            self.out.fly.sample(m, t, [cx, cy], [x, y]);
+        }
+        let m = Owner {
+            index: m.index,
+            working: m.working,
+            feature: m.feature,
+            layer: m.layer,
+            line: m.line,
+        };
         if self.owner.as_ref().is_none_or(|o| o.0 != m.index) {
             if self.layer.as_ref().is_none_or(|l| l.layer != m.layer) {
                 self.end_layer();
@@ -353,7 +369,7 @@ impl Account {
             } else {
                 self.end_move();
             }
-            self.owner = Some((m.index, m.kind, m.layer, m.line, None));
+            self.owner = Some((m.index, m.working, m.layer, m.line, None));
         }
         let err_um = err_mm * 1e3;
         if let Some(r) = self.rec.as_mut() {
@@ -370,7 +386,7 @@ impl Account {
                 ],
             );
         }
-        let print = m.kind == MoveKind::Print;
+        let print = m.working;
         let mut split = Split::default();
         if print {
             split = Split {
@@ -382,22 +398,24 @@ impl Account {
                 l.split_worst = l.split_worst.max(split);
             }
             self.hist.push(err_um);
+            let spot = || Spot {
+                error_um: err_um,
+                time_s: t,
+                x_mm: x,
+                y_mm: y,
+                line: m.line,
+                layer: m.layer,
+                move_index: m.index,
+                split,
+            };
+            self.out.features.sample(m.feature, m.layer, err_um, spot);
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
             {
-                o.4 = Some(Spot {
-                    error_um: err_um,
-                    time_s: t,
-                    x_mm: x,
-                    y_mm: y,
-                    line: m.line,
-                    layer: m.layer,
-                    move_index: m.index,
-                    split,
-                });
+                o.4 = Some(spot());
             }
         }
-        if k.is_multiple_of(self.map_every) {
+        if k.is_multiple_of(self.map_stride) {
             self.map.push(MapPoint {
                 x_mm: x as f32,
                 y_mm: y as f32,
@@ -406,8 +424,41 @@ impl Account {
                 vibration_um: split.vibration_um as f32,
                 print,
             });
+            if self.map.len() >= 2 * MAX_MAP_POINTS {
+                halve_map(&mut self.map);
+                self.map_stride *= 2;
+            }
         }
     }
+}
+
+/// The most points a layer's ringing map keeps: far more than the figure's 560 x 640
+/// pixels show, and a bounded memory whatever the layer's length (a long layer's map is
+/// halved, the worse of each pair of points kept, each time it reaches twice this).
+pub const MAX_MAP_POINTS: usize = 50_000;
+
+/// Halve a ringing map: each pair of neighbours becomes the one with the larger error
+/// (peaks are kept: the map is read for its worst spots), with the larger of each part
+/// of the split (the split map is read for its peaks too), printing only if both are (a
+/// break in the drawn path stays a break).
+fn halve_map(map: &mut Vec<MapPoint>) {
+    let halved: Vec<MapPoint> = map
+        .chunks(2)
+        .map(|pair| {
+            let worst = pair
+                .iter()
+                .copied()
+                .fold(pair[0], |a, b| if b.error_um > a.error_um { b } else { a });
+            let part = |f: fn(&MapPoint) -> f32| pair.iter().map(f).fold(0.0, f32::max);
+            MapPoint {
+                print: pair.iter().all(|p| p.print),
+                smoothing_um: part(|p| p.smoothing_um),
+                vibration_um: part(|p| p.vibration_um),
+                ..worst
+            }
+        })
+        .collect();
+    *map = halved;
 }
 
 impl Tail {

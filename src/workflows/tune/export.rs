@@ -5,18 +5,26 @@
 //!   `shaper_freq_x/y`, `damping_ratio_x/y`, and `[printer]` `max_accel` only when the
 //!   recommended acceleration differs from the current one (settle-gcode's
 //!   `KlipperExport`). Written when both X and Y are known: tuned, or their current
-//!   settings given in `[tune.axis.<name>]` (an axis left out would be written as "off").
+//!   settings given in `[tune.axis.<name>]` (an axis left out would be written as "off"),
+//!   and only when every tuned axis's recommendation is something Klipper runs (a
+//!   trapezoid with one of its shapers: [`super::target::expressible`]).
 //! - `rrf.g`: RepRapFirmware's one `M593` line (one shaper for every axis; settle-gcode's
 //!   `RrfExport`), the shaper of the lowest-frequency tuned axis, since a shaper tuned
 //!   below a mode still reduces it, one tuned above it much less (the responses in
-//!   `planner/src/shaper/response.rs`); `M204` when the acceleration changes.
+//!   `planner/src/shaper/response.rs`); `M204` when the acceleration changes; `M593
+//!   P"none"` alone for an unshaped trapezoid; nothing for what RepRapFirmware does not
+//!   plan.
+//!
+//! Every value that differs from the current one carries a comment above it: what it was
+//! and why it changed ([`super::changes`]); a machine that is a built-in preset standing in
+//! for the user's printer is named in the header.
 //! - `tmc4361a.txt`: per axis, the TMC4361A ramp registers of the recommended move, from
 //!   the axis's own microsteps per mm; refused, with the reason, for what the chip cannot
 //!   run (a trapezoid's infinite bows, an input shaper, a value outside a register).
 
 use std::fmt::Write as _;
 
-use settle_gcode::config::{KlipperExport, RrfExport, ShaperSetting as FirmwareShaper};
+use settle_gcode::config::{KlipperExport, Note, RrfExport, ShaperSetting as FirmwareShaper};
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
 use settle_planner::tmc::ramp::SRampParams;
@@ -24,6 +32,7 @@ use settle_planner::tmc::registers::{TmcUnits, export};
 
 use super::Outcome;
 use super::search::Score;
+use super::{changes, head, target};
 use crate::studies::corner::Corner;
 use crate::studies::shaping::DEFAULT_DAMPING_RATIO;
 
@@ -56,8 +65,19 @@ fn klipper_off() -> FirmwareShaper {
     FirmwareShaper {
         name: "mzv".into(),
         frequency_hz: 0.0,
-        damping_ratio: DEFAULT_DAMPING_RATIO,
+        damping_ratio: target::KLIPPER_OFF_DAMPING,
     }
+}
+
+/// The header notes of an export: the stand-in machine, if any.
+fn header_notes(axes: &[(String, Outcome)]) -> Vec<Note> {
+    head::stand_in(axes)
+        .into_iter()
+        .map(|text| Note {
+            key: String::new(),
+            text,
+        })
+        .collect()
 }
 
 /// Axis `letter`'s shaper for Klipper: the tuned winner's, else the current one from
@@ -65,16 +85,13 @@ fn klipper_off() -> FirmwareShaper {
 fn klipper_axis(axes: &[(String, Outcome)], letter: &str) -> Result<FirmwareShaper, String> {
     if let Some(o) = winner_of(axes, letter) {
         let w = &o.scores[o.winner];
-        let Some(s) = shaper_of(w) else {
-            return Ok(klipper_off());
-        };
-        return match w.candidate.shaper.and_then(|sh| sh.shaper_type) {
-            Some(k) if k.firmware() == Firmware::Klipper => Ok(s),
-            _ => Err(format!(
-                "the recommended shaper on {letter}, {}, is not one of Klipper's; tune with --firmware klipper",
-                s.name
-            )),
-        };
+        if let Err(why) = target::expressible(Firmware::Klipper, &w.candidate) {
+            return Err(format!(
+                "the recommendation on {letter}, {}, is not something Klipper runs ({why}); tune with --firmware klipper",
+                w.candidate.label()
+            ));
+        }
+        return Ok(shaper_of(w).unwrap_or_else(klipper_off));
     }
     let current = axes
         .first()
@@ -111,20 +128,9 @@ fn accel(axes: &[(String, Outcome)]) -> Option<(f64, bool)> {
 
 /// `klipper.cfg`: the snippet, or comments saying why it is not written.
 pub fn klipper(axes: &[(String, Outcome)], produced_by: &str) -> String {
-    let mut head = String::new();
-    for (axis, o) in axes {
-        let w = &o.scores[o.winner];
-        if w.candidate.kind != ProfileKind::Trapezoid {
-            let _ = writeln!(
-                head,
-                "# note: Klipper plans trapezoids; the winner on {axis} is a {} move whose jerk has no Klipper setting",
-                w.candidate.kind
-            );
-        }
-    }
     let (x, y) = match (klipper_axis(axes, "x"), klipper_axis(axes, "y")) {
         (Ok(x), Ok(y)) => (x, y),
-        (Err(e), _) | (_, Err(e)) => return format!("{head}# no Klipper configuration: {e}\n"),
+        (Err(e), _) | (_, Err(e)) => return format!("# no Klipper configuration: {e}\n"),
     };
     let scv = axes.iter().find_map(|(_, o)| {
         o.plan
@@ -133,23 +139,38 @@ pub fn klipper(axes: &[(String, Outcome)], produced_by: &str) -> String {
             .filter(|c| c.strategy.name() == "square_corner_velocity")
             .map(|c| c.square_corner_velocity_mm_s)
     });
+    let max_accel = accel(axes).and_then(|(a, changed)| changed.then_some(a));
     let e = KlipperExport {
         produced_by: produced_by.to_string(),
         x,
         y,
-        max_accel_mm_s2: accel(axes).and_then(|(a, changed)| changed.then_some(a)),
+        max_accel_mm_s2: max_accel,
         minimum_cruise_ratio: None,
         square_corner_velocity_mm_s: scv,
     };
-    match e.to_config() {
-        Ok(text) => format!("{head}{text}"),
-        Err(err) => format!("{head}# no Klipper configuration: {err}\n"),
+    let mut notes = header_notes(axes);
+    notes.extend(
+        changes::klipper(axes, max_accel)
+            .iter()
+            .map(changes::Change::note),
+    );
+    match e.to_config_with_notes(&notes) {
+        Ok(text) => text,
+        Err(err) => format!("# no Klipper configuration: {err}\n"),
     }
 }
 
-/// `rrf.g`: the `M593` line (and `M204` when the acceleration changes), or comments saying
-/// why it is not written.
-pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
+/// The changes `klipper.cfg` makes (empty when it is not written).
+pub fn klipper_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
+    klipper_axis(axes, "x").ok()?;
+    klipper_axis(axes, "y").ok()?;
+    let max_accel = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    Some(changes::klipper(axes, max_accel))
+}
+
+/// The axis whose shaper `rrf.g` writes (the lowest-frequency tuned axis's), and its
+/// recommendation.
+fn rrf_axis(axes: &[(String, Outcome)]) -> Option<(&str, &Score)> {
     let mut shaped: Vec<(&str, &Score)> = axes
         .iter()
         .map(|(a, o)| (a.as_str(), &o.scores[o.winner]))
@@ -163,29 +184,48 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
         };
         f(a.1).total_cmp(&f(b.1))
     });
-    let Some((axis, w)) = shaped.first() else {
-        return "# no RepRapFirmware configuration: nothing was tuned\n".into();
+    shaped.first().copied()
+}
+
+/// Why `rrf.g` is not written, if it is not: a tuned axis's recommendation that
+/// RepRapFirmware does not run.
+fn rrf_refusal(axes: &[(String, Outcome)]) -> Option<String> {
+    if axes.is_empty() {
+        return Some("nothing was tuned".into());
+    }
+    axes.iter().find_map(|(a, o)| {
+        let w = &o.scores[o.winner];
+        target::expressible(Firmware::Rrf, &w.candidate)
+            .err()
+            .map(|why| {
+                format!(
+                    "the recommendation on {a}, {}, is not something RepRapFirmware runs ({why}); tune with --firmware rrf",
+                    w.candidate.label()
+                )
+            })
+    })
+}
+
+/// `rrf.g`: the `M593` line (and `M204` when the acceleration changes), or comments saying
+/// why it is not written.
+pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
+    if let Some(why) = rrf_refusal(axes) {
+        return format!("; no RepRapFirmware configuration: {why}\n");
+    }
+    let Some((axis, w)) = rrf_axis(axes) else {
+        return "; no RepRapFirmware configuration: nothing was tuned\n".into();
     };
-    let shaper = match (shaper_of(w), w.candidate.shaper.and_then(|s| s.shaper_type)) {
-        (None, _) => FirmwareShaper {
-            name: "none".into(),
-            frequency_hz: 40.0,
-            damping_ratio: 0.1,
-        },
-        (Some(s), Some(k)) if k.firmware() == Firmware::Rrf => s,
-        (Some(s), _) => {
-            return format!(
-                "# no RepRapFirmware configuration: the recommended shaper on {axis}, {}, is not one of RepRapFirmware's; tune with --firmware rrf\n",
-                s.name
-            );
-        }
-    };
-    let mut head = String::new();
-    for (a, s) in shaped.iter().skip(1) {
+    let shaper = shaper_of(w).unwrap_or(FirmwareShaper {
+        name: "none".into(),
+        frequency_hz: f64::NAN,
+        damping_ratio: f64::NAN,
+    });
+    let mut others = String::new();
+    for (a, o) in axes.iter().filter(|(a, _)| a != axis) {
         let _ = writeln!(
-            head,
+            others,
             "; axis {a} alone would take {} (RepRapFirmware has one shaper for all axes: the lowest-frequency axis's is written)",
-            super::report::shaper_text(s)
+            super::cells::shaper_text(&o.scores[o.winner])
         );
     }
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
@@ -195,10 +235,27 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
         print_accel_mm_s2: a,
         travel_accel_mm_s2: a,
     };
-    match e.to_config() {
-        Ok(text) => format!("{head}{text}"),
-        Err(err) => format!("{head}; no RepRapFirmware configuration: {err}\n"),
+    let mut notes = header_notes(axes);
+    notes.extend(
+        changes::rrf(axes, axis, a)
+            .iter()
+            .map(changes::Change::note),
+    );
+    // The other axes' own choices follow the lines (the file starts with its header).
+    match e.to_config_with_notes(&notes) {
+        Ok(text) => format!("{text}{others}"),
+        Err(err) => format!("; no RepRapFirmware configuration: {err}\n{others}"),
     }
+}
+
+/// The changes `rrf.g` makes (`None` when it is not written).
+pub fn rrf_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
+    if rrf_refusal(axes).is_some() {
+        return None;
+    }
+    let (axis, _) = rrf_axis(axes)?;
+    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    Some(changes::rrf(axes, axis, a))
 }
 
 /// `tmc4361a.txt`: per axis, the register file of the recommended move (the first of the

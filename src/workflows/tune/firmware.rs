@@ -51,6 +51,11 @@ impl Candidates {
         }
         match Firmware::parse(name) {
             Some(f) if TUNED.contains(&f) => Ok(Self::of(f)),
+            Some(Firmware::Grbl) => Err(format!(
+                "grbl is not a firmware settle tune searches for: GRBL has no input shaper and \
+                 settle writes no GRBL settings (settle gcode --firmware grbl replays a GRBL \
+                 job); allowed: {ALLOWED}"
+            )),
             Some(f) => Err(format!(
                 "{f} is not a firmware settle tune searches for; allowed: {ALLOWED}"
             )),
@@ -67,7 +72,7 @@ impl Candidates {
     pub fn kinds(self) -> Vec<ProfileKind> {
         match self.0 {
             None | Some(Firmware::Settle) => ProfileKind::ALL.to_vec(),
-            Some(Firmware::Klipper | Firmware::Marlin | Firmware::Rrf) => {
+            Some(Firmware::Klipper | Firmware::Marlin | Firmware::Rrf | Firmware::Grbl) => {
                 vec![ProfileKind::Trapezoid]
             }
             Some(Firmware::Tmc4361a) => vec![ProfileKind::SCurve, ProfileKind::FourJerk],
@@ -80,7 +85,8 @@ impl Candidates {
             None | Some(Firmware::Klipper | Firmware::Settle) => ShaperType::KLIPPER.to_vec(),
             Some(Firmware::Marlin) => ShaperType::MARLIN.to_vec(),
             Some(Firmware::Rrf) => ShaperType::RRF.to_vec(),
-            Some(Firmware::Tmc4361a) => Vec::new(),
+            // GRBL has no input shaper.
+            Some(Firmware::Tmc4361a | Firmware::Grbl) => Vec::new(),
         }
     }
 
@@ -117,8 +123,9 @@ impl Candidates {
             Err("the TMC4361A has no input shaper: give shapers = [\"none\"]".into())
         } else {
             Err(format!(
-                "{} does not run the shaper `{}`; it runs: {}",
+                "{} does not run {}'s shaper `{}`; it runs: {}",
                 self.name(),
+                k.firmware().name(),
                 k.name(),
                 self.shapers()
                     .iter()
@@ -127,5 +134,33 @@ impl Candidates {
                     .join(", ")
             ))
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_the_planner_s_and_grbl_is_refused_with_its_reason() {
+        assert_eq!(Candidates::parse("duet"), Ok(Candidates::of(Firmware::Rrf)));
+        assert_eq!(Candidates::parse("ANY"), Ok(Candidates::ANY));
+        for name in ["grbl", "grblHAL"] {
+            let err = Candidates::parse(name).expect_err("refused");
+            assert!(
+                err.starts_with(
+                    "grbl is not a firmware settle tune searches for: GRBL has no input shaper"
+                ),
+                "{err}"
+            );
+            assert!(
+                err.ends_with("allowed: klipper, marlin, rrf, tmc4361a, any"),
+                "{err}"
+            );
+        }
+        assert_eq!(
+            Candidates::parse("linuxcnc"),
+            Err("unknown firmware `linuxcnc`; allowed: klipper, marlin, rrf, tmc4361a, any".into())
+        );
     }
 }

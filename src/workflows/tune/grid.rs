@@ -12,6 +12,7 @@ use crate::studies::corner::Corner;
 use crate::studies::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
 use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::search::{BandSource, Candidate, Plan};
+use crate::workflows::tune::target;
 use settle_planner::firmware::Firmware;
 
 /// Four-jerk BOW1..4 patterns searched (multiples of jmax; each <= 1).
@@ -41,6 +42,13 @@ pub const DEFAULT_MARGIN: f64 = 0.8;
 /// (`TARGET_SMOOTHING` of shaper_calibrate.py); the default `max_smoothing_mm`.
 pub const DEFAULT_MAX_SMOOTHING_MM: f64 = settle_planner::shaper_select::TARGET_SMOOTHING_MM;
 
+/// The most values a list of `[tune]` may hold: the search is their product.
+pub const MAX_LIST: usize = 64;
+
+/// The most candidates a search may have (each is simulated over the move family; the
+/// default search of a printer axis has a few hundred).
+pub const MAX_CANDIDATES: usize = 100_000;
+
 /// Resolve the scenario's search on `axis` (default: the move's axis), with `axis`'s
 /// current settings (`[tune.axis.<name>]`) as the baseline candidate. Errors name the
 /// `[tune]` key. A `[sweep]` is refused unless the scenario marks a `[current]` point (an
@@ -52,6 +60,31 @@ pub fn plan(
     axis: Option<&str>,
 ) -> Result<Plan, Error> {
     let spec = sc.tune.clone().unwrap_or_default();
+    for (key, len) in [
+        (
+            "tune.distances_mm",
+            spec.distances_mm.as_ref().map(Vec::len),
+        ),
+        ("tune.angles_deg", spec.angles_deg.as_ref().map(Vec::len)),
+        ("tune.kinds", spec.kinds.as_ref().map(Vec::len)),
+        ("tune.shapers", spec.shapers.as_ref().map(Vec::len)),
+        (
+            "tune.frequency_scales",
+            spec.frequency_scales.as_ref().map(Vec::len),
+        ),
+        ("tune.axes", spec.axes.as_ref().map(Vec::len)),
+        (
+            "tune.accelerations_mm_s2",
+            spec.accelerations_mm_s2.as_ref().map(Vec::len),
+        ),
+    ] {
+        if let Some(n) = len.filter(|n| *n > MAX_LIST) {
+            return Err(src.error_at(
+                key,
+                format!("{n} values; at most {MAX_LIST} (the search is their product)"),
+            ));
+        }
+    }
     if !sc.sweep.is_empty() && sc.current.is_empty() {
         return Err(src.error_at(
             "sweep",
@@ -78,6 +111,16 @@ pub fn plan(
         }
     }
 
+    let builtin_preset = sc
+        .machine
+        .preset
+        .as_ref()
+        .filter(|p| {
+            crate::input::machine_file::PRESETS
+                .iter()
+                .any(|(n, _, _)| n == p)
+        })
+        .cloned();
     let distances_mm = spec
         .distances_mm
         .clone()
@@ -231,8 +274,76 @@ pub fn plan(
     if spec.refine_rounds.is_some_and(|r| r > 20) {
         return Err(src.error_at("tune.refine_rounds", "must be 0 to 20"));
     }
+    if let Some(hz) = spec.tmc_clock_hz
+        && !(4_000_000..=32_000_000).contains(&hz)
+    {
+        return Err(src.error_at(
+            "tune.tmc_clock_hz",
+            format!("{hz} Hz: the TMC4361A takes a clock of 4 to 32 MHz (4000000 to 32000000)"),
+        ));
+    }
+    let mut notes: Vec<String> = Vec::new();
+    let tmc = match firmware.firmware() {
+        Some(Firmware::Tmc4361a) => {
+            let usteps = spec
+                .axis
+                .as_ref()
+                .and_then(|m| m.get(&base.axis))
+                .and_then(|a| a.usteps_per_mm)
+                .or(spec.usteps_per_mm)
+                .ok_or_else(|| {
+                    src.error_at(
+                        "tune.usteps_per_mm",
+                        format!(
+                            "firmware tmc4361a searches only what the chip's registers hold, which depends on the axis's resolution: give [tune.axis.{}] usteps_per_mm or [tune] usteps_per_mm (microsteps per mm)",
+                            base.axis
+                        ),
+                    )
+                })?;
+            let clock = spec
+                .tmc_clock_hz
+                .unwrap_or(super::export::DEFAULT_TMC_CLOCK_HZ);
+            let r = target::tmc_ranges(usteps, clock);
+            for (key, a) in std::iter::once(("limits.amax_mm_s2", base.amax_mm_s2)).chain(
+                accels
+                    .iter()
+                    .flatten()
+                    .map(|a| ("tune.accelerations_mm_s2", *a)),
+            ) {
+                if a > r.accel_mm_s2 {
+                    return Err(src.error_at(
+                        key,
+                        format!(
+                            "{a} mm/s^2 is more than the TMC4361A's AMAX holds at {usteps} microsteps/mm ({:.0} mm/s^2)",
+                            r.accel_mm_s2
+                        ),
+                    ));
+                }
+            }
+            if base.vmax_mm_s > r.speed_mm_s {
+                return Err(src.error_at(
+                    "limits.vmax_mm_s",
+                    format!(
+                        "{} mm/s is more than the TMC4361A's VMAX holds at {usteps} microsteps/mm ({:.0} mm/s)",
+                        base.vmax_mm_s, r.speed_mm_s
+                    ),
+                ));
+            }
+            Some((usteps, r))
+        }
+        _ => None,
+    };
     let jmax = match base.jmax_mm_s3 {
-        Some(j) => j,
+        Some(j) => match tmc {
+            Some((usteps, r)) if j > r.jerk_mm_s3.1 => {
+                notes.push(format!(
+                    "Jerks searched up to {:.0} mm/s^3, not the scenario's {j}: the most the TMC4361A's BOW1..4 registers hold at {usteps} microsteps/mm.",
+                    r.jerk_mm_s3.1
+                ));
+                r.jerk_mm_s3.1
+            }
+            _ => j,
+        },
         // Only trapezoids: no jerk to search.
         None if kinds.iter().all(|k| *k == ProfileKind::Trapezoid) => 0.0,
         None => {
@@ -250,32 +361,53 @@ pub fn plan(
     if !(span.is_finite() && span >= 1.0) {
         return Err(src.error_at("tune.jerk_span", "must be a finite number >= 1"));
     }
-    let jerks: Vec<f64> = (0..steps)
+    let lowest_jerk = tmc.map_or(0.0, |(_, r)| r.jerk_mm_s3.0);
+    let mut jerks: Vec<f64> = (0..steps)
         .map(|i| {
             if steps == 1 {
                 jmax
             } else {
                 let f = i as f64 / (steps - 1) as f64;
-                jmax / span.powf(1.0 - f)
+                (jmax / span.powf(1.0 - f)).max(lowest_jerk)
             }
         })
         .collect();
-    let mut modes = tuning_modes(&base);
-    if firmware.firmware() == Some(Firmware::Tmc4361a) {
-        modes.clear();
-    }
+    jerks.dedup();
+    let modes = tuning_modes(&base);
     if modes.is_empty() && shapers.iter().any(Option::is_some) {
         return Err(src.error_at(
             "machine",
             "found no vibration mode of the moving axis to tune shapers to",
         ));
     }
+    if let Some(z) = spec.shaper_damping_ratio
+        && !(z.is_finite() && (0.0..1.0).contains(&z))
+    {
+        return Err(src.error_at(
+            "tune.shaper_damping_ratio",
+            format!("must be 0 to under 1, got {z}"),
+        ));
+    }
+    let (fixed_damping, damping_source) = design_damping_source(&spec, &base);
     let mut shaper_settings: Vec<Option<ShaperSetting>> = Vec::new();
     for s in &shapers {
         match s {
             None => shaper_settings.push(None),
             Some(k) => {
-                for (f, _) in &modes {
+                for (f, zeta) in &modes {
+                    // Designed for the mode's own damping (or the fixed one), as far as
+                    // the firmware takes it.
+                    let (damping_ratio, moved) =
+                        target::design_damping(*k, fixed_damping.unwrap_or(*zeta));
+                    if let Some(why) = moved {
+                        let note = format!(
+                            "{} is designed for damping {damping_ratio} on the {f:.1} Hz mode: {why}.",
+                            k.name()
+                        );
+                        if !notes.contains(&note) {
+                            notes.push(note);
+                        }
+                    }
                     for x in &scales {
                         // To 0.1 Hz, as firmware configurations write it (Klipper's
                         // calibrate_shaper.py prints `%.1f`): the exported value is the
@@ -283,7 +415,7 @@ pub fn plan(
                         let s = ShaperSetting {
                             shaper_type: Some(*k),
                             frequency_hz: (f * x * 10.0).round() / 10.0,
-                            damping_ratio: DEFAULT_DAMPING_RATIO,
+                            damping_ratio,
                         };
                         if !shaper_settings.contains(&Some(s)) {
                             shaper_settings.push(Some(s));
@@ -292,6 +424,32 @@ pub fn plan(
                 }
             }
         }
+    }
+    let per_shape = shaper_settings.len() * accels.len();
+    let count: usize = 1 + kinds
+        .iter()
+        .map(|&k| {
+            let jerks_n = if k == ProfileKind::Trapezoid {
+                1
+            } else {
+                jerks.len()
+            };
+            let params_n = match k {
+                _ if base.state::<Corner>().is_some() => 1,
+                ProfileKind::PvtAsym => PVT_KI.len(),
+                ProfileKind::FourJerk => BOW_PATTERNS.len(),
+                _ => 1,
+            };
+            jerks_n * params_n * per_shape
+        })
+        .sum::<usize>();
+    if count > MAX_CANDIDATES {
+        return Err(src.error_at(
+            "tune",
+            format!(
+                "{count} candidates (kinds x jerks x kind parameters x shapers x frequencies x accelerations); at most {MAX_CANDIDATES}: give fewer values"
+            ),
+        ));
     }
     let default = Candidate::of(&base);
     let mut candidates = vec![default];
@@ -336,6 +494,7 @@ pub fn plan(
             }
         }
     }
+    let modes_source = modes_source(&base, builtin_preset.as_deref());
     Ok(Plan {
         base,
         distances_mm,
@@ -350,7 +509,60 @@ pub fn plan(
         frequency_tolerance: tolerance_pct / 100.0,
         band_source,
         max_smoothing_mm,
+        firmware,
+        notes,
+        modes_source,
+        builtin_preset,
+        damping_source,
+        shaper_damping: fixed_damping,
     })
+}
+
+/// The damping ratio the shapers are designed for when it is one for all (`None`: each
+/// mode's own), and the report's sentence saying which and why: `[tune]
+/// shaper_damping_ratio`, else the modes' own on a machine given by its modes, else
+/// Klipper's default 0.1 (a physical machine's modal damping is an estimate from its
+/// parts).
+pub fn design_damping_source(
+    spec: &crate::input::tune_spec::TuneSpec,
+    base: &RunSpec,
+) -> (Option<f64>, String) {
+    match (spec.shaper_damping_ratio, base.machine.physical()) {
+        (Some(z), _) => (
+            Some(z),
+            format!("Shapers are designed for damping ratio {z} (`[tune] shaper_damping_ratio`)."),
+        ),
+        (None, Some(_)) => (
+            Some(DEFAULT_DAMPING_RATIO),
+            format!(
+                "Shapers are designed for Klipper's default damping ratio {DEFAULT_DAMPING_RATIO}: the damping of a physical machine's linearised modes is an estimate from its parts, not a measurement (`[tune] shaper_damping_ratio` sets another)."
+            ),
+        ),
+        (None, None) => (
+            None,
+            "Shapers are designed for the damping ratio of the mode they are tuned to (the machine's, not Klipper's default 0.1).".into(),
+        ),
+    }
+}
+
+/// Where the modes of `base`'s machine come from, in a few words: identified (the modes
+/// carry their standard deviations, as `settle identify` writes them), given, or
+/// linearised from a physical machine (`preset`: the built-in preset it is).
+pub fn modes_source(base: &RunSpec, preset: Option<&str>) -> String {
+    let name = &base.machine_name;
+    let identified = base.axis.split('+').any(|a| {
+        base.machine
+            .modes_of(a)
+            .iter()
+            .any(|m| m.frequency_sigma_hz.is_some())
+    });
+    match (base.machine.physical(), preset) {
+        (Some(_), Some(p)) => format!("linearised from the built-in preset `{p}`"),
+        (Some(_), None) => format!("linearised from the machine `{name}`"),
+        (None, _) if identified => format!("identified, machine `{name}`"),
+        (None, Some(p)) => format!("given by the built-in preset `{p}`"),
+        (None, None) => format!("given, machine `{name}`"),
+    }
 }
 
 /// The band (percent) a search scores its shapers over and where it came from: the

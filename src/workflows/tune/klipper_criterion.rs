@@ -1,60 +1,268 @@
-//! `settle tune --criterion klipper FILE.csv`: Klipper's own shaper choice on a processed
-//! resonance CSV (`resonances_*.csv`, `calibration_data_*.csv`), as its
-//! `scripts/calibrate_shaper.py` makes it: read the PSD columns (one data set per column,
-//! or `psd_xyz` of the per-axis layout), normalise them to the test's frequencies unless
-//! the header holds the `shapers:` column (the script's rule), then `find_best_shaper` with
-//! Klipper's defaults (settle-planner's `shaper_select`, matched against the script). The
-//! output repeats the script's lines, so the two can be compared word for word.
+//! `settle tune --criterion klipper FILE...`: Klipper's own shaper choice, as its
+//! `scripts/calibrate_shaper.py` makes it, on the files a Klipper user has:
+//!
+//! - processed resonance CSVs (`resonances_*.csv`, `calibration_data_*.csv`): the PSD
+//!   columns (one data set per column, or `psd_xyz` of the per-axis layout), normalised
+//!   to the test's frequencies unless the header holds the `shapers:` column (the
+//!   script's rule);
+//! - raw accelerometer CSVs (`raw_data_*.csv`): the PSD computed as Klipper computes it
+//!   (settle-identify's [`klipper_response`]), summed over the axes and normalised.
+//!
+//! Then `find_best_shaper` with the script's options (settle-planner's `shaper_select`,
+//! matched against the script). Files name their machine axis like Klipper's
+//! (`calibration_data_x_*.csv`); the files of one axis are combined into one choice as the
+//! script combines the files it is given, and each axis gets its own. The output repeats
+//! the script's lines, so the two can be compared word for word; `--out` writes the
+//! `[input_shaper]` lines and, per axis, the graph the script draws (the spectrum, each
+//! shaper's remaining vibration and the spectrum after the recommended one).
 
-use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use settle_identify::read::klipper_psd;
+use settle_identify::read::{FileData, klipper_psd};
+use settle_identify::welch::klipper_response;
+use settle_planner::shaper::ShaperType;
 use settle_planner::shaper_select::{CalibrationData, SelectOptions, Selection, find_best_shaper};
 
 use crate::error::Error;
+use crate::output::atomic::{create_dir, write_atomic};
 use crate::workflows::{Exit, Report};
 
-/// Klipper's choice on the processed CSV at `path`.
-pub fn choose(path: &Path) -> Result<Selection, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
-    let psd = klipper_psd::parse(&path.display().to_string(), &text)
-        .map_err(|e| Error::input(path, e.to_string()))?;
-    // calibrate_shaper.py normalises unless the header has the `shapers:` column.
-    let header = text
-        .lines()
-        .find(|l| !l.trim_start().starts_with('#'))
-        .unwrap_or_default();
-    let normalise = !header.contains(",shapers:");
-    let columns: Vec<&Vec<f64>> = if psd.per_axis {
-        vec![&psd.columns[3].1]
+/// What `settle tune --criterion klipper` does.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KlipperCriterion {
+    /// The resonance files (processed or raw CSVs).
+    pub files: Vec<PathBuf>,
+    /// Folder for `input_shaper.cfg` and the graphs, if any.
+    pub out: Option<PathBuf>,
+    /// calibrate_shaper.py's options (`--shapers`, `--scv`, `--max_smoothing`, ...).
+    pub select: SelectOptions,
+    /// Overwrite the results of an earlier run in `out` (refused without it).
+    pub force: bool,
+}
+
+/// The files `--criterion klipper` writes in its output folder: `input_shaper.cfg` and
+/// one figure per axis group ([`FIGURES`]).
+const FILES: [&str; 1] = ["input_shaper.cfg"];
+
+/// The figures, `klipper-shapers-<axis>.svg/png` (`<axis>`: x, y, z or all).
+const FIGURES: [(&str, &str); 2] = [("klipper-shapers-", ".svg"), ("klipper-shapers-", ".png")];
+
+/// What marks an earlier run's results in the output folder.
+const MARKS: [&str; 5] = [
+    "input_shaper.cfg",
+    "klipper-shapers-x.svg",
+    "klipper-shapers-y.svg",
+    "klipper-shapers-z.svg",
+    "klipper-shapers-all.svg",
+];
+
+/// An earlier run's results, which `--force` overwrites.
+const RESULTS: crate::output::folder::Results<'static> = crate::output::folder::Results {
+    what: "settle tune --criterion klipper",
+    marks: &MARKS,
+};
+
+impl KlipperCriterion {
+    /// From the command line: the files, `--out`, and calibrate_shaper.py's `--shapers`
+    /// (comma-separated, commas inside parentheses kept: `mzv(n=4,t=0.8),ei`), `--scv`
+    /// (0.1 to 1000 mm/s) and `--max_smoothing` (0.05 to 10 mm; the script's own lower
+    /// bound).
+    pub fn from_args(
+        files: Vec<PathBuf>,
+        out: Option<PathBuf>,
+        shapers: Option<&str>,
+        scv_mm_s: Option<f64>,
+        max_smoothing_mm: Option<f64>,
+    ) -> Result<Self, Error> {
+        let mut select = SelectOptions::default();
+        if let Some(list) = shapers {
+            select.shapers = split_shapers(list)
+                .iter()
+                .map(|name| {
+                    ShaperType::parse(name).map_err(|e| Error::input("--shapers", e.to_string()))
+                })
+                .collect::<Result<_, _>>()?;
+            if select.shapers.is_empty() {
+                return Err(Error::input("--shapers", "name at least one shaper"));
+            }
+        }
+        if let Some(v) = scv_mm_s {
+            if !(0.1..=1000.0).contains(&v) {
+                return Err(Error::input(
+                    "--scv",
+                    format!("{v} mm/s is out of range; allowed 0.1 to 1000"),
+                ));
+            }
+            select.scv_mm_s = v;
+        }
+        if let Some(v) = max_smoothing_mm {
+            if !(0.05..=10.0).contains(&v) {
+                return Err(Error::input(
+                    "--max-smoothing",
+                    format!("{v} mm is out of range; allowed 0.05 to 10"),
+                ));
+            }
+            select.max_smoothing_mm = Some(v);
+        }
+        Ok(Self {
+            files,
+            out,
+            select,
+            force: false,
+        })
+    }
+}
+
+/// Split a shaper list at commas outside parentheses (the script's
+/// `re.split(r",(?![^(]*\))", ...)`), lower-cased.
+fn split_shapers(list: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    let mut depth = 0usize;
+    for c in list.to_ascii_lowercase().chars() {
+        match c {
+            '(' => {
+                depth += 1;
+                cur.push(c);
+            }
+            ')' => {
+                depth = depth.saturating_sub(1);
+                cur.push(c);
+            }
+            ',' if depth == 0 => out.push(std::mem::take(&mut cur)),
+            _ => cur.push(c),
+        }
+    }
+    out.push(cur);
+    out.into_iter()
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .collect()
+}
+
+/// The files of one machine axis and Klipper's choice on them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxisChoice {
+    /// The machine axis (`x`, `y`, `z`) from the file names, `None` when they name none.
+    pub axis: Option<char>,
+    /// The files, in the order given.
+    pub files: Vec<PathBuf>,
+    /// Their data sets, as calibrate_shaper.py holds them.
+    pub data: Vec<CalibrationData>,
+    /// The choice.
+    pub selection: Selection,
+}
+
+/// The machine axis a Klipper file name names: a token `x`, `y` or `z` of its stem split
+/// at `_`, `-`, `.` and spaces (`calibration_data_x_20220317.csv`).
+fn axis_token(path: &Path) -> Option<char> {
+    let stem = path.file_stem()?.to_string_lossy().to_ascii_lowercase();
+    stem.split(['_', '-', '.', ' '])
+        .find(|t| matches!(*t, "x" | "y" | "z"))
+        .and_then(|t| t.chars().next())
+}
+
+/// The data sets of one file as calibrate_shaper.py's `parse_log` makes them.
+pub fn load(path: &Path) -> Result<Vec<CalibrationData>, Error> {
+    match settle_identify::read_file(path)? {
+        FileData::Spectrum(psd) => Ok(processed(&psd)),
+        FileData::Recordings(recs) => recs
+            .iter()
+            .map(|rec| {
+                let (freq_hz, [x, y, z]) = klipper_response(rec).ok_or_else(|| {
+                    Error::input(
+                        path,
+                        "a raw recording with all three axes, longer than Klipper's half-second segment",
+                    )
+                })?;
+                let psd_sum = x.iter().zip(&y).zip(&z).map(|((a, b), c)| a + b + c).collect();
+                let mut d = CalibrationData {
+                    freq_hz,
+                    psd_sum,
+                    psd_x: Some(x),
+                    psd_y: Some(y),
+                    psd_z: Some(z),
+                };
+                d.normalize_to_frequencies();
+                Ok(d)
+            })
+            .collect(),
+    }
+}
+
+/// A processed file's data sets: `psd_xyz` (with the axes) of the per-axis layout, else
+/// one per column; normalised unless the file holds the `shapers:` column.
+fn processed(psd: &klipper_psd::ProcessedPsd) -> Vec<CalibrationData> {
+    let normalise = !psd.shapers_marker;
+    let col = |k: usize| Some(psd.columns[k].1.clone());
+    let sets: Vec<CalibrationData> = if psd.per_axis {
+        vec![CalibrationData {
+            freq_hz: psd.freq_hz.clone(),
+            psd_sum: psd.columns[3].1.clone(),
+            psd_x: col(0),
+            psd_y: col(1),
+            psd_z: col(2),
+        }]
     } else {
-        psd.columns.iter().map(|(_, c)| c).collect()
-    };
-    let data: Vec<CalibrationData> = columns
-        .into_iter()
-        .map(|c| {
-            let mut d = CalibrationData {
+        psd.columns
+            .iter()
+            .map(|(_, c)| CalibrationData {
                 freq_hz: psd.freq_hz.clone(),
                 psd_sum: c.clone(),
                 ..CalibrationData::default()
-            };
+            })
+            .collect()
+    };
+    sets.into_iter()
+        .map(|mut d| {
             if normalise {
                 d.normalize_to_frequencies();
             }
             d
         })
-        .collect();
-    find_best_shaper(&data, &SelectOptions::default())
-        .map_err(|e| Error::input(path, e.to_string()))
+        .collect()
 }
 
-/// What `settle tune --criterion klipper FILE.csv` prints: calibrate_shaper.py's lines.
-pub fn report(path: &Path) -> Result<Report, Error> {
-    let sel = choose(path)?;
-    let mut r = Report::new(Exit::Ok);
-    r.out(format!("Processing resonances from {}", path.display()));
-    for s in &sel.per_shaper {
+/// Klipper's choice per machine axis.
+pub fn choose(c: &KlipperCriterion) -> Result<Vec<AxisChoice>, Error> {
+    if c.files.is_empty() {
+        return Err(Error::input(
+            "FILE",
+            "give one or more Klipper resonance CSVs",
+        ));
+    }
+    let mut groups: Vec<(Option<char>, Vec<PathBuf>, Vec<CalibrationData>)> = Vec::new();
+    for f in &c.files {
+        let axis = axis_token(f);
+        let data = load(f)?;
+        match groups.iter_mut().find(|g| g.0 == axis) {
+            Some(g) => {
+                g.1.push(f.clone());
+                g.2.extend(data);
+            }
+            None => groups.push((axis, vec![f.clone()], data)),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(axis, files, data)| {
+            let selection = find_best_shaper(&data, &c.select)
+                .map_err(|e| Error::input(&files[0], e.to_string()))?;
+            Ok(AxisChoice {
+                axis,
+                files,
+                data,
+                selection,
+            })
+        })
+        .collect()
+}
+
+/// calibrate_shaper.py's lines for one axis.
+fn script_lines(a: &AxisChoice, r: &mut Report) {
+    let names: Vec<String> = a.files.iter().map(|f| f.display().to_string()).collect();
+    r.out(format!("Processing resonances from {}", names.join(",")));
+    for s in &a.selection.per_shaper {
         r.out(format!(
             "Fitted shaper '{}' frequency = {:.1} Hz (vibrations = {:.1}%, smoothing ~= {:.3})",
             s.shaper_type.name(),
@@ -62,19 +270,83 @@ pub fn report(path: &Path) -> Result<Report, Error> {
             s.vibrations * 100.0,
             s.smoothing_mm
         ));
-        let mut line = String::new();
-        let _ = write!(
-            line,
+        r.out(format!(
             "To avoid too much smoothing with '{}', suggested max_accel <= {:.0} mm/sec^2",
             s.shaper_type.name(),
             (s.max_accel_mm_s2 / 100.0).round_ties_even() * 100.0 // Python 3 round()
-        );
-        r.out(line);
+        ));
     }
     r.out(format!(
         "Recommended shaper is {} @ {:.1} Hz",
-        sel.recommended.shaper_type.name(),
-        sel.recommended.frequency_hz
+        a.selection.recommended.shaper_type.name(),
+        a.selection.recommended.frequency_hz
     ));
+}
+
+/// The `[input_shaper]` lines of the recommendations (`shaper_type_x` / `shaper_freq_x`
+/// per named axis, `shaper_type` / `shaper_freq` for files that name none), with the
+/// suggested acceleration limit as a comment.
+pub fn input_shaper_cfg(choices: &[AxisChoice]) -> String {
+    let mut s = String::from(
+        "# Klipper's recommendation (scripts/calibrate_shaper.py's choice), from settle tune --criterion klipper\n[input_shaper]\n",
+    );
+    for a in choices {
+        let suffix = a.axis.map_or(String::new(), |c| format!("_{c}"));
+        let r = &a.selection.recommended;
+        s.push_str(&format!(
+            "shaper_type{suffix}: {}\nshaper_freq{suffix}: {:.1}\n",
+            r.shaper_type.name(),
+            r.frequency_hz
+        ));
+    }
+    for a in choices {
+        let r = &a.selection.recommended;
+        s.push_str(&format!(
+            "# {}: suggested max_accel <= {:.0} mm/s^2 with {}\n",
+            a.axis.map_or("all".to_string(), |c| c.to_string()),
+            (r.max_accel_mm_s2 / 100.0).round_ties_even() * 100.0,
+            r.shaper_type.name()
+        ));
+    }
+    s
+}
+
+/// What `settle tune --criterion klipper FILE...` prints (calibrate_shaper.py's lines per
+/// axis) and writes (with `--out`).
+pub fn report(c: &KlipperCriterion) -> Result<Report, Error> {
+    // The output folder, before any work: never one of the files read, a file, a link out
+    // or a device where a file goes, nor earlier results unasked.
+    if let Some(dir) = &c.out {
+        let inputs = settle_files::write::Inputs::of(&c.files);
+        let writes = |rel: &Path| crate::output::folder::written(rel, &FILES, &[], &FIGURES);
+        crate::output::folder::check(dir, &RESULTS, c.force, &inputs, writes)?;
+    }
+    let choices = choose(c)?;
+    let mut r = Report::new(Exit::Ok);
+    for a in &choices {
+        script_lines(a, &mut r);
+    }
+    if let Some(dir) = &c.out {
+        create_dir(dir)?;
+        let cfg = dir.join("input_shaper.cfg");
+        write_atomic(&cfg, input_shaper_cfg(&choices).as_bytes())?;
+        r.err(format!("wrote {}", cfg.display()));
+        for a in &choices {
+            let axis = a.axis.map_or("all".to_string(), |c| c.to_string());
+            let stem = format!("klipper-shapers-{axis}");
+            let figure = crate::output::plot::klipper_shapers::figure(
+                &axis,
+                &a.files,
+                &a.data[0],
+                &a.selection,
+                &c.select,
+            );
+            crate::output::plot::write(&figure, dir, &stem)?;
+            r.err(format!(
+                "wrote {} (and .png)",
+                dir.join(format!("{stem}.svg")).display()
+            ));
+        }
+    }
     Ok(r)
 }

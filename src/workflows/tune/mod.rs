@@ -1,17 +1,31 @@
 //! `settle tune SCENARIO.toml`: the search grid ([`grid`], candidates and scores in
-//! [`search`], restricted to a [`firmware`]), evaluated and refined ([`rank`]), optionally
-//! re-checked on a second backend, per axis; the outputs ([`report`], the firmware
-//! configurations in [`export`]); and Klipper's own choice on a resonance CSV
-//! ([`klipper_criterion`]).
+//! [`search`], restricted to what a [`firmware`] can express, [`target`]), evaluated and
+//! refined ([`rank`]), per axis; the axes made to share one acceleration where the
+//! firmware has one ([`joint`]); Klipper's own choice on the same machine
+//! ([`klipper_choice`]); optionally re-checked on a second backend; the outputs (the
+//! report: [`head`], [`report`], [`changes`]; [`candidates`]; the figures, [`figure`];
+//! report.html, [`html`]; the firmware configurations, [`export`]); and Klipper's own
+//! choice on a resonance CSV ([`klipper_criterion`]).
 
+pub mod candidates;
+pub mod cells;
+pub mod changes;
+pub mod checks;
 pub mod export;
+pub mod figure;
 pub mod firmware;
 pub mod grid;
+pub mod head;
+pub mod html;
+pub mod joint;
+pub mod klipper_choice;
 pub mod klipper_criterion;
+pub mod klipper_section;
 pub mod rank;
 pub mod report;
 pub mod scan_figures;
 pub mod search;
+pub mod target;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -40,6 +54,12 @@ pub struct Outcome {
     pub front: Vec<usize>,
     /// `(backend, current, winner)` re-run on a second backend, if asked.
     pub check: Option<(Backend, Score, Score)>,
+    /// The axis's own best, where sharing one acceleration with the other axes moved the
+    /// recommendation ([`joint::share_acceleration`]).
+    pub alone: Option<usize>,
+    /// Klipper's choice on the same machine, scored by settle (Klipper or unrestricted
+    /// searches of shapers: [`klipper_choice::applies`]).
+    pub klipper: Option<klipper_choice::KlipperChoice>,
 }
 
 /// How `settle tune` runs: the backends, the workers, and what the command line sets over
@@ -56,6 +76,9 @@ pub struct Options {
     pub firmware: Option<String>,
     /// `--frequency-tolerance PCT`: over `[tune] frequency_tolerance_pct`.
     pub frequency_tolerance_pct: Option<f64>,
+    /// Overwrite the results of an earlier tuning in the output folder (refused without
+    /// it).
+    pub force: bool,
 }
 
 impl Options {
@@ -67,6 +90,7 @@ impl Options {
             jobs: None,
             firmware: None,
             frequency_tolerance_pct: None,
+            force: false,
         }
     }
 }
@@ -118,15 +142,52 @@ fn axes(sc: &Scenario) -> Vec<Option<String>> {
     }
 }
 
-/// Tune one axis of `path` (`None`: the move's axis).
+/// Tune one axis of `path` (`None`: the move's axis): search, compare with Klipper's
+/// choice, and re-check on the second backend if asked.
 pub fn tune_axis(
     path: &Path,
     axis: Option<&str>,
     opts: &Options,
     progress: Progress,
 ) -> Result<Outcome, Error> {
+    let mut o = search_axis(path, axis, opts, progress)?;
+    finish(path, &mut o, opts)?;
+    Ok(o)
+}
+
+/// Why no candidate is feasible, counted by reason.
+fn none_feasible(path: &Path, scores: &[Score]) -> Error {
+    let mut groups: Vec<(&str, usize, String)> = Vec::new();
+    for s in scores {
+        if let Some(why) = &s.infeasible {
+            match groups.iter_mut().find(|g| g.0 == why.group()) {
+                Some(g) => g.1 += 1,
+                None => groups.push((why.group(), 1, why.short())),
+            }
+        }
+    }
+    let list: Vec<String> = groups
+        .iter()
+        .map(|(g, n, e)| format!("{n} {} (e.g. {e})", g.trim_start_matches("out: ")))
+        .collect();
+    Error::input_key(
+        path,
+        "observe.window_s",
+        format!(
+            "no candidate is feasible: {}; lengthen window_s, widen the band or raise max_smoothing_mm",
+            list.join(", ")
+        ),
+    )
+}
+
+/// The search of one axis, refined, without the second backend or Klipper's choice.
+pub fn search_axis(
+    path: &Path,
+    axis: Option<&str>,
+    opts: &Options,
+    progress: Progress,
+) -> Result<Outcome, Error> {
     let (sc, src) = load(path, opts)?;
-    let (backend, check_on, jobs) = (opts.backend, opts.check_on, opts.jobs);
     // An imported scenario's [sweep] is for `settle sweep`; the search starts from the
     // scenario's own point, the user's current settings (its [current] marks a point of
     // that sweep, so it goes with it).
@@ -134,120 +195,41 @@ pub fn tune_axis(
     point.sweep.clear();
     point.current.clear();
     let mut runs = crate::expand::expand(&point, &src)?;
-    crate::execute::set_backend(path, &mut runs, backend)?;
+    crate::execute::set_backend(path, &mut runs, opts.backend)?;
     let plan = grid::plan(&sc, &src, &runs, axis)?;
-    let mut scores = rank::evaluate(&plan, &plan.candidates, jobs, progress)?;
-    let grid_winner = rank::best(&scores).ok_or_else(|| {
-        Error::input_key(
-            path,
-            "observe.window_s",
-            "no candidate settles within the observation window; lengthen window_s or widen the band",
-        )
-    })?;
-    let winner = rank::refine(&plan, &mut scores, grid_winner, jobs)?;
+    let mut scores = rank::evaluate(&plan, &plan.candidates, opts.jobs, progress)?;
+    let grid_winner = rank::best(&scores).ok_or_else(|| none_feasible(path, &scores))?;
+    let winner = rank::refine(&plan, &mut scores, grid_winner, opts.jobs)?;
     let front = rank::pareto(&scores);
-    let check = match check_on {
-        None => None,
-        Some(b) => {
-            let mut other = plan.clone();
-            let mut base = vec![other.base.clone()];
-            crate::execute::set_backend(path, &mut base, b)?;
-            other.base.backend = b;
-            let pair = [scores[0].candidate, scores[winner].candidate];
-            let s = rank::evaluate(&other, &pair, jobs, &quiet)?;
-            Some((b, s[0].clone(), s[1].clone()))
-        }
-    };
     Ok(Outcome {
         plan,
         scores,
         winner,
         grid_winner,
         front,
-        check,
+        check: None,
+        alone: None,
+        klipper: None,
     })
 }
 
-/// The refinement paragraph of the report: the grid winner, how many candidates the
-/// refinement evaluated, and what it gained.
-pub fn refine_text(o: &Outcome) -> String {
-    let extra = o.scores.len() - o.plan.candidates.len();
-    if o.plan
-        .spec
-        .refine_rounds
-        .unwrap_or(rank::DEFAULT_REFINE_ROUNDS)
-        == 0
-    {
-        return String::new();
-    }
-    let (g, w) = (&o.scores[o.grid_winner], &o.scores[o.winner]);
-    let [_, _, h_score] = report::headings(&o.plan);
-    let mut out = format!(
-        "\n## Refinement around the grid winner\n\n{} grid candidates, then {} rounds around the grid winner ({extra} more candidates). ",
-        o.plan.candidates.len(),
-        o.plan
-            .spec
-            .refine_rounds
-            .unwrap_or(rank::DEFAULT_REFINE_ROUNDS),
-    );
-    if o.winner == o.grid_winner {
-        let _ = writeln!(
-            out,
-            "The grid winner {} stays the winner.",
-            g.candidate.label()
-        );
-    } else {
-        let _ = writeln!(
-            out,
-            "Grid winner {}: {} {:.2} ms; refined {}: {:.2} ms ({:.2} ms better).",
-            g.candidate.label(),
-            h_score.trim_end_matches(" (ms)"),
-            g.move_and_settle_s * 1e3,
-            w.candidate.label(),
-            w.move_and_settle_s * 1e3,
-            (g.move_and_settle_s - w.move_and_settle_s) * 1e3
-        );
-    }
-    out
-}
-
-/// The second-backend paragraph of the report.
-pub fn check_text(o: &Outcome) -> String {
-    let Some((b, d, w)) = &o.check else {
-        return String::new();
-    };
-    let plan = &o.plan;
-    let band = plan.base.bands_um[plan.band_index];
-    let [h_move, h_res, h_score] = report::headings(plan);
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "\n## Checked on a second backend: {b}\n\n| | candidate | {h_move} | {h_res} | {h_score} | into {band} um (ms) |\n|---|---|---:|---:|---:|---:|"
-    );
-    report::default_and_winner_rows(&mut out, d, w, "winner");
-    let verdict = if w.move_and_settle_s < d.simulated_move_and_settle_s {
-        format!(
-            "the winner still beats the current settings on {b}: {:.1}% better",
-            100.0 * (1.0 - w.move_and_settle_s / d.simulated_move_and_settle_s)
-        )
-    } else {
-        format!("the winner does NOT beat the current settings on {b}")
-    };
-    let _ = writeln!(out, "\nVerdict: {verdict}.");
-    let searched = &o.scores[o.winner];
-    let _ = writeln!(
-        out,
-        "Into the {band} um band the winner takes {} ms on {b} ({} ms on {}, {}).",
-        report::ms(w.at_band_s),
-        report::ms(searched.at_band_s),
-        plan.base.backend,
-        if w.at_band_s <= searched.at_band_s + 1.0 / plan.base.sample_rate_hz {
-            "confirmed within one sample"
-        } else {
-            "later than predicted: consider a smaller [tune] margin"
+/// Klipper's choice on the axis's machine, and the re-check of the current settings and
+/// the recommendation on `opts.check_on`.
+fn finish(path: &Path, o: &mut Outcome, opts: &Options) -> Result<(), Error> {
+    o.klipper = klipper_choice::compare(&o.plan, &o.scores[o.winner], opts.jobs)?;
+    o.check = match opts.check_on {
+        None => None,
+        Some(b) => {
+            let mut other = o.plan.clone();
+            let mut base = vec![other.base.clone()];
+            crate::execute::set_backend(path, &mut base, b)?;
+            other.base.backend = b;
+            let pair = [o.scores[0].candidate, o.scores[o.winner].candidate];
+            let s = rank::evaluate(&other, &pair, opts.jobs, &quiet)?;
+            Some((b, s[0].clone(), s[1].clone()))
         }
-    );
-    out
+    };
+    Ok(())
 }
 
 /// What `settle tune` found and wrote.
@@ -293,84 +275,126 @@ pub fn tune_to(
     tune_with(path, out, &opts, progress)
 }
 
-/// Tune every axis of `[tune] axes` (default: the move's axis) of `path`, and write into
-/// `out` (default: `results/<name>-tune/`): `tune.md` (your current settings ->
-/// recommended per axis, then each axis's search), `candidates.csv` (every candidate of
-/// every axis with its smoothing and max_accel), `pareto.svg/png` (the first axis),
-/// `klipper.cfg`, `rrf.g` and `tmc4361a.txt` (see [`export`]).
+/// The files `settle tune` writes in its output folder (with `pareto-<axis>.svg/png`
+/// for several axes: [`PATTERNS`]).
+const FILES: [&str; 8] = [
+    "tune.md",
+    "candidates.csv",
+    "klipper.cfg",
+    "rrf.g",
+    "tmc4361a.txt",
+    "pareto.svg",
+    "pareto.png",
+    crate::output::sweep_files::REPORT,
+];
+
+/// An earlier tuning's results, which `--force` overwrites.
+const RESULTS: crate::output::folder::Results<'static> = crate::output::folder::Results {
+    what: "settle tune",
+    marks: &FILES,
+};
+
+/// The per-axis Pareto figures of a tuning of several axes ([`figure_name`]).
+const PATTERNS: [(&str, &str); 2] = [("pareto-", ".svg"), ("pareto-", ".png")];
+
+/// Tune every axis of `[tune] axes` (default: the move's axis) of `path`, sharing one
+/// acceleration where the firmware has one, and write into `out` (default:
+/// `results/<name>-tune/`): `tune.md` (the machine, your current settings ->
+/// recommended, what changes in each export, then one section per axis), `candidates.csv`
+/// (every candidate of every axis), the Pareto figure of each axis (`pareto.svg/png`, or
+/// `pareto-<axis>.svg/png` for several axes), `report.html`, and `klipper.cfg`, `rrf.g`
+/// and `tmc4361a.txt` (see [`export`]).
 pub fn tune_with(
     path: &Path,
     out: Option<PathBuf>,
     opts: &Options,
     progress: Progress,
 ) -> Result<Tuned, Error> {
-    let (sc, _) = load(path, opts)?;
+    let (sc, src) = load(path, opts)?;
+    let out = out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-tune", sc.name)));
+    // The output folder, before the search: never an input, nor earlier results unasked.
+    let inputs = crate::expand::machine::input_files(&sc, &src);
+    let writes = |rel: &Path| crate::output::folder::written(rel, &FILES, &[], &PATTERNS);
+    crate::output::folder::check(&out, &RESULTS, opts.force, &inputs, writes)?;
     let mut done: Vec<(String, Outcome)> = Vec::new();
     for axis in axes(&sc) {
-        let o = tune_axis(path, axis.as_deref(), opts, progress)?;
+        let o = search_axis(path, axis.as_deref(), opts, progress)?;
         done.push((o.plan.base.axis.clone(), o));
     }
-    let out = out.unwrap_or_else(|| PathBuf::from("results").join(format!("{}-tune", sc.name)));
-    create_dir(&out)?;
-    let mut md = format!("# settle tune: {}\n\n", sc.name);
-    md.push_str(&report::current_to_recommended(&done));
-    let several = done.len() > 1;
-    for (axis, o) in &done {
-        let mut body = report::markdown(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
-        body.push_str(&refine_text(o));
-        body.push_str(&check_text(o));
-        let body = body
-            .split_once('\n')
-            .map_or(body.as_str(), |(_, rest)| rest)
-            .to_string();
-        if several {
-            let _ = write!(md, "\n## Axis {axis}\n{}", report::demote(&body));
-        } else {
-            md.push_str(&body);
-        }
+    let shared = if target::one_acceleration(done[0].1.plan.firmware) {
+        joint::share_acceleration(&mut done)
+    } else {
+        None
+    };
+    for (_, o) in &mut done {
+        finish(path, o, opts)?;
     }
+    create_dir(&out)?;
     let produced_by = format!("settle tune {}", path.display());
     let klipper = export::klipper(&done, &produced_by);
     let rrf = export::rrf(&done, &produced_by);
     let tmc = export::tmc4361a(&done);
+    let mut md = format!("# settle tune: {}\n\n", sc.name);
+    md.push_str(&head::current_to_recommended(&done, shared.as_deref()));
+    if let Some(c) = export::klipper_changes(&done) {
+        md.push_str(&changes::table("klipper.cfg", &c));
+    }
+    if let Some(c) = export::rrf_changes(&done) {
+        md.push_str(&changes::table("rrf.g", &c));
+    }
+    let mut figures = Vec::new();
+    for (axis, o) in &done {
+        let name = figure_name(axis, done.len());
+        let fig = figure::pareto_figure(&sc.name, axis, o);
+        crate::output::plot::write(&fig, &out, &name)?;
+        md.push_str(&report::axis_section(axis, o, &format!("{name}.svg")));
+        md.push_str(&checks::refine_text(o));
+        md.push_str(&checks::check_text(o));
+        md.push('\n');
+        figures.push(out.join(format!("{name}.svg")));
+    }
     let _ = write!(
         md,
-        "\n## Export\n\nKlipper (`klipper.cfg`; paste at the end of printer.cfg, above any SAVE_CONFIG block):\n\n```ini\n{klipper}```\n\nRepRapFirmware (`rrf.g`; config.g lines):\n\n```\n{rrf}```\n\nTMC4361A ramp registers (`tmc4361a.txt`):\n\n```\n{tmc}```\n\n![Pareto front](pareto.svg)\n"
+        "## Export\n\nKlipper (`klipper.cfg`; paste at the end of printer.cfg, above any SAVE_CONFIG block):\n\n```ini\n{klipper}```\n\nRepRapFirmware (`rrf.g`; config.g lines):\n\n```\n{rrf}```\n\nTMC4361A ramp registers (`tmc4361a.txt`):\n\n```\n{tmc}```\n"
     );
     let write = |name: &str, text: &str| write_atomic(&out.join(name), text.as_bytes());
     write("tune.md", &md)?;
-    write("candidates.csv", &report::candidates_csv(&done))?;
+    write("candidates.csv", &candidates::csv(&done))?;
     write("klipper.cfg", &klipper)?;
     write("rrf.g", &rrf)?;
     write("tmc4361a.txt", &tmc)?;
-    let o = &done[0].1;
-    let fig = report::pareto_figure(&sc.name, &o.plan, &o.scores, o.winner, &o.front);
-    crate::output::plot::write(&fig, &out, "pareto")?;
-    // report.html: tune.md's tables, every candidate, the Pareto figure, the provenance.
-    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
-    let file = crate::output::report::ScenarioFile { path, text: &text };
-    let svg_path = out.join("pareto.svg");
-    let svg = std::fs::read_to_string(&svg_path).map_err(|e| Error::read(&svg_path, e))?;
-    let html = crate::output::report::markdown_report(
-        &format!("{} (tune)", sc.name),
-        &md,
-        &report::candidates_csv(&done),
-        &[("Pareto front".to_string(), svg)],
-        crate::output::report::provenance(
-            file,
+    let text = crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)?;
+    let page = html::page(html::Page {
+        name: &sc.name,
+        markdown: &md,
+        axes: &done,
+        figures: &figures,
+        exports: [
+            ("klipper.cfg", klipper.as_str()),
+            ("rrf.g", rrf.as_str()),
+            ("tmc4361a.txt", tmc.as_str()),
+        ],
+        provenance: crate::output::report::provenance(
+            crate::output::report::ScenarioFile { path, text: &text },
             opts.backend.name(),
-            format!("settle tune {}", path.display()),
+            produced_by.clone(),
         ),
-    );
-    write(
-        crate::output::sweep_files::REPORT,
-        &crate::output::html::render(&html),
-    )?;
-    let outcome = o.clone();
+    })?;
+    write(crate::output::sweep_files::REPORT, &page)?;
+    let outcome = done[0].1.clone();
     Ok(Tuned {
         outcome,
         axes: done,
         markdown: md,
         out,
     })
+}
+
+/// The file name (without extension) of axis `axis`'s Pareto figure among `n` axes.
+pub fn figure_name(axis: &str, n: usize) -> String {
+    if n > 1 {
+        format!("pareto-{axis}")
+    } else {
+        "pareto".into()
+    }
 }

@@ -16,8 +16,9 @@ use crate::workflows::tune::search::{Candidate, Plan, Score};
 /// the refined winner 4.9 ms later than modal predicted; the grid winner on time).
 pub const DEFAULT_REFINE_ROUNDS: usize = 0;
 
-/// Index of the best score: lowest move-and-settle, then lowest residual (candidates that
-/// are inside the band when their move ends tie on move-and-settle); the first among equals.
+/// Index of the best feasible score: lowest move-and-settle, then lowest residual
+/// (candidates that are inside the band when their move ends tie on move-and-settle); the
+/// first among equals.
 pub fn best(scores: &[Score]) -> Option<usize> {
     let mut best: Option<usize> = None;
     for (i, s) in scores.iter().enumerate() {
@@ -26,18 +27,26 @@ pub fn best(scores: &[Score]) -> Option<usize> {
                 || (s.move_and_settle_s == b.move_and_settle_s
                     && s.residual_peak_um < b.residual_peak_um)
         };
-        if s.move_and_settle_s.is_finite() && best.is_none_or(|b| better(&scores[b])) {
+        if s.is_feasible()
+            && s.move_and_settle_s.is_finite()
+            && best.is_none_or(|b| better(&scores[b]))
+        {
             best = Some(i);
         }
     }
     best
 }
 
-/// Indices of the Pareto front of (move time, residual peak): no other candidate is at
-/// least as good in both and better in one. Sorted by move time.
+/// Indices of the Pareto front of (move time, residual peak) among the feasible
+/// candidates: no other feasible candidate is at least as good in both and better in one.
+/// Sorted by move time.
 pub fn pareto(scores: &[Score]) -> Vec<usize> {
     let ok: Vec<usize> = (0..scores.len())
-        .filter(|&i| scores[i].move_time_s.is_finite() && scores[i].residual_peak_um.is_finite())
+        .filter(|&i| {
+            scores[i].is_feasible()
+                && scores[i].move_time_s.is_finite()
+                && scores[i].residual_peak_um.is_finite()
+        })
         .collect();
     let mut idx: Vec<usize> = ok
         .iter()

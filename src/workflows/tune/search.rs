@@ -31,7 +31,6 @@
 //! residual, then grid order, so the result is deterministic.
 
 use settle_planner::shaper::Shaper;
-use settle_planner::shaper_select::max_accel_mm_s2;
 use settle_planner::{ProfileKind, ProfileParams};
 
 use crate::error::Error;
@@ -40,7 +39,7 @@ use crate::measure::metrics::Metrics;
 use crate::spec::run_spec::RunSpec;
 use crate::studies::corner::Corner;
 use crate::studies::scan::ScanSpec;
-use crate::studies::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting};
+use crate::studies::shaping::{SMOOTHING_SCV_MM_S, ShaperSetting, max_accel_mm_s2};
 use crate::workflows::tune::scan_figures::scan_figures;
 
 /// One point of the search grid.
@@ -138,15 +137,114 @@ pub struct Score {
     pub move_time_s: f64,
     /// Mean residual peak (um).
     pub residual_peak_um: f64,
-    /// Mean move-and-settle at the band (s); infinite when some move does not settle (or
-    /// a corner exceeds `max_contour_error_um`).
+    /// Mean move-and-settle at the band (s), the ranking key: infinite when some move does
+    /// not settle, a corner exceeds `max_contour_error_um` or the shaper smooths too much
+    /// (see [`Score::infeasible`]).
     pub move_and_settle_s: f64,
     /// Largest contour error over the family (um), NaN for point-to-point moves.
     pub max_contour_error_um: f64,
-    /// Mean move-and-settle into the band itself, `band_um` (s): equal to
-    /// `move_and_settle_s` when the margin is 1. For scan steps: the overhead per line at
-    /// which the step is settled into the band.
+    /// Mean move-and-settle into the band itself, `band_um` (s), as simulated: equal to
+    /// `simulated_move_and_settle_s` when the margin is 1. For scan steps: the overhead
+    /// per line at which the step is settled into the band.
     pub at_band_s: f64,
+    /// Why the candidate is out of the running (`None`: it is in); an infeasible
+    /// candidate never wins and is not on the Pareto front.
+    pub infeasible: Option<Infeasible>,
+}
+
+impl Score {
+    /// Whether the candidate is in the running.
+    pub fn is_feasible(&self) -> bool {
+        self.infeasible.is_none()
+    }
+}
+
+/// Why a candidate is out of the running, first reason first: a failed run, then the
+/// smoothing limit, then the contour limit, then not settling.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Infeasible {
+    /// A run of its move family failed (lost steps, a broken-down simulation): the reason.
+    Failed(String),
+    /// Its shaper smooths more than the limit at its acceleration (Klipper's figure).
+    Smoothing {
+        /// Smoothing at its acceleration (mm).
+        smoothing_mm: f64,
+        /// The limit, `max_smoothing_mm` (mm).
+        limit_mm: f64,
+        /// The acceleration (mm/s^2).
+        accel_mm_s2: f64,
+    },
+    /// A corner's toolhead leaves the path by more than `max_contour_error_um`.
+    Contour {
+        /// The largest contour error over the family (um).
+        error_um: f64,
+        /// The limit (um).
+        limit_um: f64,
+    },
+    /// Some move of the family is not settled into the scored band by the end of the
+    /// observation window (with a frequency band: at its frequency or at an edge).
+    NotSettled {
+        /// The scored band (um).
+        band_um: f64,
+        /// The observation window (s).
+        window_s: f64,
+    },
+    /// The target firmware cannot take it: why.
+    NotExportable(String),
+}
+
+impl Infeasible {
+    /// A short phrase for tables and plots (`smooths 0.154 mm > 0.12 mm`).
+    pub fn short(&self) -> String {
+        match self {
+            Infeasible::Failed(why) => format!("failed: {why}"),
+            Infeasible::Smoothing {
+                smoothing_mm,
+                limit_mm,
+                ..
+            } => format!("smooths {smoothing_mm:.3} mm > {limit_mm} mm"),
+            Infeasible::Contour { error_um, limit_um } => {
+                format!("contour error {error_um:.1} um > {limit_um} um")
+            }
+            Infeasible::NotSettled { band_um, window_s } => {
+                format!(
+                    "not settled into {band_um} um within the {:.0} ms window",
+                    window_s * 1e3
+                )
+            }
+            Infeasible::NotExportable(why) => format!("not exportable: {why}"),
+        }
+    }
+
+    /// The group a plot draws it in (`over the smoothing limit`, ...).
+    pub fn group(&self) -> &'static str {
+        match self {
+            Infeasible::Failed(_) => "out: failed run",
+            Infeasible::Smoothing { .. } => "out: over the smoothing limit",
+            Infeasible::Contour { .. } => "out: over the contour limit",
+            Infeasible::NotSettled { .. } => "out: not settled in the window",
+            Infeasible::NotExportable(_) => "out: not exportable",
+        }
+    }
+
+    /// The order of precedence (lower first): see [`Infeasible`].
+    fn rank(&self) -> u8 {
+        match self {
+            Infeasible::Failed(_) => 0,
+            Infeasible::NotExportable(_) => 1,
+            Infeasible::Smoothing { .. } => 2,
+            Infeasible::Contour { .. } => 3,
+            Infeasible::NotSettled { .. } => 4,
+        }
+    }
+
+    /// The first of `a` and `b` by precedence.
+    pub fn first(a: Option<Self>, b: Option<Self>) -> Option<Self> {
+        match (a, b) {
+            (Some(x), Some(y)) => Some(if y.rank() < x.rank() { y } else { x }),
+            (x, y) => x.or(y),
+        }
+    }
 }
 
 /// The resolved search.
@@ -179,6 +277,22 @@ pub struct Plan {
     pub band_source: BandSource,
     /// Largest smoothing a shaped candidate may have (mm).
     pub max_smoothing_mm: f64,
+    /// The target whose candidates are searched.
+    pub firmware: crate::workflows::tune::firmware::Candidates,
+    /// How the target or the machine shaped the search, as sentences for the report
+    /// (the jerks a register holds, a damping ratio a shaper does not take).
+    pub notes: Vec<String>,
+    /// Where the machine's modes come from, in words ([`super::grid::modes_source`]).
+    pub modes_source: String,
+    /// The built-in preset the machine is, if it is one (a model, not a measured machine).
+    pub builtin_preset: Option<String>,
+    /// Which damping ratio the shapers are designed for, as a sentence for the report
+    /// ([`super::grid::design_damping_source`]).
+    pub damping_source: String,
+    /// The damping ratio every shaper is designed for, when it is one for all (`[tune]
+    /// shaper_damping_ratio`, or Klipper's default on a physical machine); `None`: each
+    /// the damping of the mode it is tuned to.
+    pub shaper_damping: Option<f64>,
 }
 
 impl Plan {
@@ -230,12 +344,7 @@ impl Plan {
             None => (0.0, f64::INFINITY),
             Some(s) => (
                 s.smoothing_mm(accel_mm_s2, SMOOTHING_SCV_MM_S),
-                max_accel_mm_s2(
-                    s.amplitudes(),
-                    s.times_s(),
-                    SMOOTHING_SCV_MM_S,
-                    self.max_smoothing_mm,
-                ),
+                max_accel_mm_s2(&s, self.max_smoothing_mm),
             ),
         }
     }
@@ -281,7 +390,14 @@ impl Plan {
                 s.simulated_move_and_settle_s = s.move_and_settle_s;
                 if smoothing > self.max_smoothing_mm {
                     s.move_and_settle_s = f64::INFINITY;
-                    s.at_band_s = f64::INFINITY;
+                    s.infeasible = Infeasible::first(
+                        s.infeasible.take(),
+                        Some(Infeasible::Smoothing {
+                            smoothing_mm: smoothing,
+                            limit_mm: self.max_smoothing_mm,
+                            accel_mm_s2: s.accel_mm_s2,
+                        }),
+                    );
                 }
                 s
             })
@@ -294,8 +410,10 @@ impl Plan {
         let limit = self.spec.max_contour_error_um.unwrap_or(f64::INFINITY);
         let (mut t, mut r, mut mas, mut at_band) = (0.0, 0.0, 0.0, 0.0);
         let mut contour = f64::NAN;
+        let mut failed: Option<String> = None;
         if rs.len() != n {
             (t, mas, at_band) = (f64::NAN, f64::INFINITY, f64::INFINITY);
+            failed = Some("its runs are missing".into());
         }
         for m in rs {
             match m {
@@ -331,7 +449,16 @@ impl Plan {
                         }
                     }
                 }
-                _ => {
+                Ok(m) => {
+                    failed.get_or_insert_with(|| {
+                        format!("{}: {}", m.status.name(), m.status.reason())
+                    });
+                    t = f64::NAN;
+                    mas = f64::INFINITY;
+                    at_band = f64::INFINITY;
+                }
+                Err(e) => {
+                    failed.get_or_insert_with(|| e.to_string());
                     t = f64::NAN;
                     mas = f64::INFINITY;
                     at_band = f64::INFINITY;
@@ -339,6 +466,21 @@ impl Plan {
             }
         }
         let k = n as f64;
+        let infeasible = if let Some(why) = failed {
+            Some(Infeasible::Failed(why))
+        } else if contour > limit {
+            Some(Infeasible::Contour {
+                error_um: contour,
+                limit_um: limit,
+            })
+        } else if !mas.is_finite() {
+            Some(Infeasible::NotSettled {
+                band_um: self.bands_um[self.score_band_index],
+                window_s: self.base.window_s,
+            })
+        } else {
+            None
+        };
         Score {
             candidate: *c,
             accel_mm_s2: c.amax_mm_s2.unwrap_or(self.base.amax_mm_s2),
@@ -350,6 +492,7 @@ impl Plan {
             move_and_settle_s: mas / k,
             max_contour_error_um: contour,
             at_band_s: at_band / k,
+            infeasible,
         }
     }
 }

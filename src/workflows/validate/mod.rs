@@ -5,7 +5,7 @@
 //! Per case and backend (linear driver, belt stiffness frozen at the start: the model the
 //! closed form solves):
 //! - **frequency**: the dominant mode measured from the simulated free response after the
-//!   move (matrix pencil, [`settle_sim::pencil`]) against the analytic eigenvalue;
+//!   move (matrix pencil, [`settle_identify::fit::pencil`]) against the analytic eigenvalue;
 //! - **numerical damping**: the measured damping ratio of that mode against the analytic
 //!   one, as a share of the physical damping;
 //! - **residual**: the peak residual vibration against the closed form
@@ -329,7 +329,8 @@ pub fn run(backends: &[Backend]) -> Result<Validation, String> {
             let (m, series) = simulate(&case, backend, &frozen, case.axes.clone())?;
             let e = post_move_error(&series, &axis.name, t_end, target);
             let ys: Vec<f64> = e.iter().step_by(decimate).take(400).copied().collect();
-            let fit = settle_sim::pencil::fit(&ys, dt * decimate as f64, order).unwrap_or_default();
+            let fit = settle_identify::fit::pencil::fit(&ys, dt * decimate as f64, order)
+                .unwrap_or_default();
             // The measured mode nearest the analytic dominant one.
             let measured = fit.iter().min_by(|a, b| {
                 (a.frequency_hz - f_an)
@@ -462,6 +463,10 @@ pub fn validate(backend: Option<Backend>, out: Option<&Path>) -> Result<Validate
         Some(b) => vec![b],
         None => Backend::ALL.into_iter().filter(|b| b.available()).collect(),
     };
+    if let Some(path) = out {
+        // Checked before the work: a link or a device is not written.
+        settle_files::write::check_target(path)?;
+    }
     let started = std::time::Instant::now();
     let validation = run(&backends).map_err(|e| Error::input("--backend", e))?;
     let markdown = markdown(&validation);

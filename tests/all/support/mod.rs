@@ -35,6 +35,37 @@ pub fn run_ok(cmd: &mut Command) -> std::process::Output {
     out
 }
 
+/// `settle run SCENARIO --case 1 --out TRACE EXTRA...`, the case of the failure tests
+/// (run 1 of their two-run sweeps fails); its output.
+pub fn run_case_1(scenario: &Path, trace: &Path, extra: &[&str]) -> std::process::Output {
+    settle()
+        .arg("run")
+        .arg(scenario)
+        .args(["--case", "1", "--out"])
+        .arg(trace)
+        .args(extra)
+        .output()
+        .expect("runs")
+}
+
+/// Every file under `dir`, relative to it, sorted.
+pub fn files_under(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).expect("read_dir") {
+            let p = e.expect("entry").path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.push(p.strip_prefix(dir).expect("prefix").to_path_buf());
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
 /// The repository root.
 pub fn root() -> PathBuf {
     PathBuf::from(manifest_dir())
@@ -55,4 +86,14 @@ pub fn extra(m: &settle::Metrics, name: &str) -> f64 {
         .unwrap_or_else(|| panic!("no column {name}"))
         .1
 }
+pub mod one_mode;
 pub mod resonance;
+
+/// The one run of `scenario`, on the modal backend.
+pub fn one_modal_run(scenario: &Path) -> settle::spec::run_spec::RunSpec {
+    let (_, mut runs) = settle::load_runs(scenario).expect("loads");
+    settle::execute::set_backend(scenario, &mut runs, settle::spec::backend::Backend::Modal)
+        .expect("modal");
+    assert_eq!(runs.len(), 1, "one run");
+    runs.remove(0)
+}

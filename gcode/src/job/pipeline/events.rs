@@ -9,14 +9,19 @@ use settle_planner::firmware::{LinearMove, PlannedMove};
 use settle_planner::{PlanError, Trajectory};
 
 use super::{Job, MM, Planner, Range, build};
+use crate::config::GrblSettings;
 use crate::error::{GcodeError, Location};
+use crate::job::chunk::LimitOverride;
 use crate::job::chunk::{JobChunk, MoveGeometry, MoveInfo};
 use crate::job::driver::{Driver, LimitOutcome};
 use crate::job::input::AxisShapers;
 use crate::job::shapers::ShaperProblem;
+use crate::job::travel::TravelCheck;
 use crate::read::event::{Event, EventKind, Note};
-use crate::read::geometry::{Move, MoveKind, Path, Point};
+use crate::read::geometry::{Move, MoveKind, Path, Point, Tool};
 use crate::read::limits::{AxisFlags, LimitChange};
+use crate::read::setting::Setting;
+use crate::{ArcSegmentation, GrblArcs};
 
 /// The planner's refusal of what line `line` asks for.
 fn plan_error(source: &Arc<str>, line: u64, command: &str, e: PlanError) -> GcodeError {
@@ -81,14 +86,45 @@ impl<R: BufRead> Job<R> {
             }
             EventKind::Limits(c) => self.on_limits(ev.line, &c),
             EventKind::Note(Note::Homed { axes }) => self.on_home(ev.line, ev.layer, axes),
-            EventKind::Note(_) => Ok(()),
-            // Configuration commands (steps per mm, currents, axis ranges) do not change
-            // the planned motion.
-            EventKind::Setting(_) => Ok(()),
+            EventKind::Note(Note::IgnoredByFirmware { command, reason }) => {
+                let name = command.split_whitespace().next().unwrap_or("").to_string();
+                self.ignore(format!("{name}: {reason}"));
+                Ok(())
+            }
+            EventKind::Note(Note::MacroCall { command, .. }) => {
+                self.ignore(format!(
+                    "{command}: a macro file the job does not open (config.g's reader runs them)"
+                ));
+                Ok(())
+            }
+            EventKind::Setting(Setting::Grbl { number, value }) => {
+                self.on_grbl_setting(ev.line, number, value)
+            }
+            // Configuration commands (steps per mm, currents, axis ranges, kinematics) in a
+            // job are not simulated: the job runs with its configuration.
+            EventKind::Setting(s) => {
+                self.ignore(format!(
+                    "{}: a configuration command; the job keeps its configuration",
+                    s.command_name()
+                ));
+                Ok(())
+            }
         }
     }
 
     fn on_move(&mut self, line: u64, layer: u32, mv: &Move) -> Result<(), GcodeError> {
+        self.plan_move(line, layer, mv, true)
+    }
+
+    /// A move; `check_travel` false for the travel a `G28` stands for (homing ends on the
+    /// endstops, inside the travel).
+    fn plan_move(
+        &mut self,
+        line: u64,
+        layer: u32,
+        mv: &Move,
+        check_travel: bool,
+    ) -> Result<(), GcodeError> {
         let command = match (&mv.path, mv.rapid) {
             (Path::Arc(a), _) if a.clockwise() => "G2",
             (Path::Arc(_), _) => "G3",
@@ -97,15 +133,67 @@ impl<R: BufRead> Job<R> {
         };
         let mut points = std::mem::take(&mut self.points);
         mv.segments_into(&self.cfg.arcs, &mut points);
+        if check_travel {
+            if let (Path::Arc(_), Some(message)) = (&mv.path, self.travel.arc_refused(&mv.end)) {
+                self.points = points;
+                return Err(GcodeError::OutOfTravel {
+                    at: self.at(line),
+                    command: command.to_string(),
+                    message,
+                });
+            }
+            if matches!(mv.path, Path::Arc(_))
+                && self.travel.clamps()
+                && let Some(i) = points.iter().position(|p| !self.travel.inside(p))
+            {
+                points.truncate(i);
+                self.ignore(format!(
+                    "{command}: an arc past the M208 limits on the way: RepRapFirmware stops it at its last segment inside (\"intermediate position outside machine limits\") and goes on from there"
+                ));
+            }
+            let mut from = mv.start;
+            for p in &points {
+                match self.travel.check(&from, p) {
+                    TravelCheck::Inside => {}
+                    TravelCheck::Listed(text) => self.ignore(format!("{command}: {text}")),
+                    TravelCheck::Refused(message) => {
+                        self.points = points;
+                        return Err(GcodeError::OutOfTravel {
+                            at: self.at(line),
+                            command: command.to_string(),
+                            message,
+                        });
+                    }
+                }
+                from = *p;
+            }
+        }
+        // What the firmware runs: the file's points, or RepRapFirmware's clamped ones, from
+        // where the firmware stands.
+        let (mut start, mut end) = (self.resync.take().unwrap_or(mv.start), mv.end);
+        if check_travel && self.travel.clamps() {
+            self.travel.clamp(&mut start);
+            for p in &mut points {
+                self.travel.clamp(p);
+            }
+            end = points.last().copied().unwrap_or(start);
+            if end != mv.end {
+                self.resync = Some(end);
+            }
+            if points.is_empty() {
+                self.points = points;
+                return Ok(());
+            }
+        }
         let xyz = |p: &Point| [p.x_mm, p.y_mm, p.z_mm];
         let geometry = match &mv.path {
             Path::Line => MoveGeometry::Line {
-                from_mm: xyz(&mv.start),
-                to_mm: xyz(&mv.end),
+                from_mm: xyz(&start),
+                to_mm: xyz(&end),
             },
             Path::Arc(a) => MoveGeometry::Arc {
                 arc: *a,
-                points_mm: std::iter::once(xyz(&mv.start))
+                points_mm: std::iter::once(xyz(&start))
                     .chain(points.iter().map(xyz))
                     .collect(),
             },
@@ -115,15 +203,18 @@ impl<R: BufRead> Job<R> {
             line,
             layer,
             kind: mv.kind,
+            working: mv.is_working(),
+            tool: mv.tool,
+            feature: mv.feature,
             start_time_s: 0.0,
             duration_s: 0.0,
-            start_mm: mv.start,
-            end_mm: mv.end,
+            start_mm: start,
+            end_mm: end,
             feed_mm_s: mv.feed_mm_s,
             geometry,
         };
         self.moves += 1;
-        self.last_end = mv.end;
+        self.last_end = end;
         self.last_feed_mm_s = mv.feed_mm_s;
         let first = self.seq;
         let extruder_only = mv.kind == MoveKind::Extruder;
@@ -134,7 +225,14 @@ impl<R: BufRead> Job<R> {
         };
         self.table.add(info, first, first + n);
         let speed = mv.feed_mm_s * MM;
-        let mut prev = mv.start;
+        // GRBL runs a G0 at its rapid rate, whatever the feed (which may be undefined).
+        let grbl_rapid = mv.rapid && self.grbl.is_some();
+        let speed = if grbl_rapid && !(speed > 0.0) {
+            1.0
+        } else {
+            speed
+        };
+        let mut prev = start;
         let result = (|| -> Result<(), GcodeError> {
             if extruder_only {
                 let de = mv.extrusion_mm() * MM;
@@ -167,8 +265,9 @@ impl<R: BufRead> Job<R> {
                 let seq = self.seq;
                 let r = match &mut self.planner {
                     Planner::Firmware(d, _) => {
-                        d.planner()
-                            .push(&LinearMove::new(a, b, (p.e_mm - prev.e_mm) * MM, speed))
+                        let mut lm = LinearMove::new(a, b, (p.e_mm - prev.e_mm) * MM, speed);
+                        lm.rapid = grbl_rapid;
+                        d.planner().push(&lm)
                     }
                     Planner::Settle(s) => s.push(b, speed, seq),
                 };
@@ -208,8 +307,50 @@ impl<R: BufRead> Job<R> {
             kind: MoveKind::Travel,
             rapid: true,
             path: Path::Line,
+            tool: Tool::Off,
+            feature: 0,
         };
-        self.on_move(line, layer, &mv)
+        self.plan_move(line, layer, &mv, false)
+    }
+
+    /// A GRBL `$` setting read while the machine stood still (the reader passes no other):
+    /// the planner's settings and the arc tolerance change from here on.
+    fn on_grbl_setting(&mut self, line: u64, number: u16, value: f64) -> Result<(), GcodeError> {
+        let at = self.at(line);
+        let Some(g) = self.grbl.as_mut() else {
+            self.ignore(format!("${number}: not a setting of this firmware"));
+            return Ok(());
+        };
+        g.apply(number, value)
+            .map_err(|allowed| GcodeError::OutOfRange {
+                at,
+                command: format!("${number}"),
+                param: "value".into(),
+                value,
+                allowed,
+            })?;
+        if number == 398 {
+            self.ignore("$398: grblHAL changes its planner blocks at the next reboot".into());
+            return Ok(());
+        }
+        if !GrblSettings::is_motion_setting(number) {
+            return Ok(());
+        }
+        let planner = g.planner();
+        self.cfg.arcs = ArcSegmentation::Grbl(GrblArcs {
+            tolerance_mm: g.arc_tolerance_mm,
+        });
+        if let Planner::Firmware(d @ Driver::Grbl(_), _) = &mut self.planner {
+            let before = d.limits();
+            if let Driver::Grbl(p) = d {
+                p.set_config(planner)
+                    .map_err(|e| plan_error(&self.source, line, "$", e))?;
+            }
+            let after = d.limits();
+            self.limit_changes += 1;
+            self.note_overrides(line, &format!("${number}"), &before, &after);
+        }
+        Ok(())
     }
 
     fn on_limits(&mut self, line: u64, change: &LimitChange) -> Result<(), GcodeError> {
@@ -248,14 +389,43 @@ impl<R: BufRead> Job<R> {
         let Planner::Firmware(d, _) = &mut self.planner else {
             return Ok(());
         };
-        match d
+        let before = d.limits();
+        let outcome = d
             .apply(change)
-            .map_err(|e| plan_error(&self.source, line, command, e))?
-        {
+            .map_err(|e| plan_error(&self.source, line, command, e))?;
+        let after = d.limits();
+        match outcome {
             LimitOutcome::Applied => self.limit_changes += 1,
             LimitOutcome::Ignored(why) => self.ignore(format!("{command}: {why}")),
         }
+        self.note_overrides(line, command, &before, &after);
         Ok(())
+    }
+
+    /// Record the limits the file just raised above the configuration's (the first time
+    /// for each limit).
+    fn note_overrides(
+        &mut self,
+        line: u64,
+        command: &str,
+        before: &[(&'static str, f64)],
+        after: &[(&'static str, f64)],
+    ) {
+        for ((name, old), (_, new)) in before.iter().zip(after) {
+            let Some(&(_, configured)) = self.start_limits.iter().find(|(n, _)| n == name) else {
+                continue;
+            };
+            let seen = self.overrides.iter().any(|o| o.limit == *name);
+            if new != old && *new > configured * (1.0 + 1e-9) && !seen {
+                self.overrides.push(LimitOverride {
+                    line,
+                    command: command.to_string(),
+                    limit: name,
+                    configured,
+                    file: *new,
+                });
+            }
+        }
     }
 
     /// A shaper command: the firmware waits for a standstill (Klipper then also for its

@@ -141,6 +141,7 @@ pub fn quickstart_report() -> Report {
         ],
         winners,
         tables: vec![table],
+        sections: Vec::new(),
         figures: vec![
             Figure {
                 title: "Move and settle to within 10 um (ms; red: not settled)".into(),

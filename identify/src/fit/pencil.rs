@@ -3,10 +3,10 @@
 //! A free decay sampled every `dt` is a sum of damped exponentials
 //! `y[n] = sum_k a_k z_k^n` with `z_k = e^{lambda_k dt}`. The Hankel matrix of the samples
 //! has rank equal to the number of exponentials; the shift between its first and last
-//! rows (the "pencil") has the `z_k` as eigenvalues (Hua & Sarkar, 1990). This measures
-//! what a backend actually simulated (including its integrator's frequency and damping
-//! errors) without knowing the model: `settle validate` compares it with the analytic
-//! eigenvalues.
+//! rows (the "pencil") has the `z_k` as eigenvalues (Hua & Sarkar, 1990). The ring-down
+//! fit ([`super::ringdown`]) starts from it; `settle validate` uses it to measure what a
+//! simulation backend actually simulated (including its integrator's frequency and
+//! damping errors) without knowing the model, against the analytic eigenvalues.
 
 use nalgebra::{Complex, DMatrix, DVector};
 

@@ -1,12 +1,12 @@
-//! Lines from any `BufRead` with a hard length limit: an over-long line is skipped
-//! without ever being held in memory whole.
+//! BoundedLines from any `BufRead` with a hard length limit: an over-long line is skipped
+//! without ever being held in memory whole (G-code files, `settle plan`'s input).
 
 use std::io::{self, BufRead, Read};
 
-/// What [`Lines::next_line`] found.
+/// What [`BoundedLines::next_line`] found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum LineStatus {
-    /// The line is in [`Lines::bytes`] (without its `\n` and a trailing `\r`).
+pub enum LineStatus {
+    /// The line is in [`BoundedLines::bytes`] (without its `\n` and a trailing `\r`).
     Complete,
     /// The line was longer than the limit; its bytes were discarded.
     TooLong,
@@ -14,7 +14,7 @@ pub(crate) enum LineStatus {
 
 /// A line splitter with a bounded buffer.
 #[derive(Debug)]
-pub(crate) struct Lines<R> {
+pub struct BoundedLines<R> {
     input: R,
     buf: Vec<u8>,
     line_no: u64,
@@ -22,9 +22,10 @@ pub(crate) struct Lines<R> {
     bytes_read: u64,
 }
 
-impl<R: BufRead> Lines<R> {
-    pub(crate) fn new(input: R, max_bytes: usize) -> Self {
-        Lines {
+impl<R: BufRead> BoundedLines<R> {
+    /// Lines of `input`, each at most `max_bytes` long (without its line end).
+    pub fn new(input: R, max_bytes: usize) -> Self {
+        BoundedLines {
             input,
             buf: Vec::new(),
             line_no: 0,
@@ -34,7 +35,7 @@ impl<R: BufRead> Lines<R> {
     }
 
     /// Reads the next line; `Ok(None)` at the end of the input.
-    pub(crate) fn next_line(&mut self) -> io::Result<Option<LineStatus>> {
+    pub fn next_line(&mut self) -> io::Result<Option<LineStatus>> {
         self.buf.clear();
         // Two bytes more than the limit hold a `\r\n`; a line that fills them without a
         // newline is too long.
@@ -68,17 +69,22 @@ impl<R: BufRead> Lines<R> {
     }
 
     /// The bytes of the last complete line.
-    pub(crate) fn bytes(&self) -> &[u8] {
+    pub fn bytes(&self) -> &[u8] {
         &self.buf
     }
 
     /// The 1-based number of the last line read.
-    pub(crate) fn line_no(&self) -> u64 {
+    pub fn line_no(&self) -> u64 {
         self.line_no
     }
 
+    /// The input, to look at what it has buffered.
+    pub fn get_ref(&self) -> &R {
+        &self.input
+    }
+
     /// Total bytes consumed from the input so far.
-    pub(crate) fn bytes_read(&self) -> u64 {
+    pub fn bytes_read(&self) -> u64 {
         self.bytes_read
     }
 }
@@ -90,7 +96,7 @@ mod tests {
     #[test]
     fn splits_and_limits() {
         let text = b"G1 X1\r\n\nabcdefghijk\nG1 X2";
-        let mut l = Lines::new(&text[..], 5);
+        let mut l = BoundedLines::new(&text[..], 5);
         assert_eq!(
             l.next_line().expect("test input"),
             Some(LineStatus::Complete)

@@ -1,0 +1,114 @@
+//! GRBL's `$` lines (grbl/system.c `system_execute_line`): `$N=V` settings, `$H` homing,
+//! and the commands that only report or unlock.
+
+use crate::error::{GcodeError, Location};
+use crate::read::event::{EventKind, Note};
+use crate::read::grbl::GrblState;
+use crate::read::limits::AxisFlags;
+use crate::read::motion::Motion;
+use crate::read::setting::Setting;
+
+/// What a `$` line does.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Dollar {
+    /// Events to emit.
+    Events,
+    /// Nothing for motion: counted among the ignored commands under this name.
+    Ignored(&'static str),
+}
+
+/// Runs the `$` line `text` (its code, comments cut; it starts with `$`).
+pub(crate) fn line(
+    state: &mut GrblState,
+    motion: &mut Motion,
+    text: &str,
+    at: &dyn Fn(Option<usize>) -> Location,
+    out: &mut Vec<EventKind>,
+) -> Result<Dollar, GcodeError> {
+    let body: String = text[1..]
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .collect::<String>()
+        .to_ascii_uppercase();
+    let unsupported = |why: &'static str| GcodeError::Unsupported {
+        at: at(None),
+        command: format!("${}", body.split('=').next().unwrap_or("")),
+        why,
+    };
+    // Commands that need an idle machine answer error:8 while it moves.
+    let busy = |what: String, out: &mut Vec<EventKind>| {
+        out.push(EventKind::Note(Note::IgnoredByFirmware {
+            command: what,
+            reason: "GRBL runs $ commands only while idle (error:8, grbl/system.c); the machine is still moving here",
+        }));
+        Ok(Dollar::Events)
+    };
+    match body.as_str() {
+        "" | "$" | "#" | "G" | "I" | "N" | "C" => return Ok(Dollar::Ignored("$ (report)")),
+        "X" => return Ok(Dollar::Ignored("$X")),
+        "SLP" => return Err(unsupported("$SLP puts GRBL to sleep: the job cannot go on")),
+        _ => {}
+    }
+    if body.starts_with("J=") {
+        return Err(unsupported(
+            "jogging ($J=) is interactive; a job settle replays moves with G0-G3",
+        ));
+    }
+    if body.starts_with("RST=") || body.starts_with('N') || body.starts_with("I=") {
+        return Ok(Dollar::Ignored("$ (stored data)"));
+    }
+    if let Some(which) = body.strip_prefix('H') {
+        if state.moving {
+            return busy(format!("${body}"), out);
+        }
+        let axes = match which {
+            "" => AxisFlags {
+                x: true,
+                y: true,
+                z: true,
+                e: false,
+            },
+            "X" | "Y" | "Z" => AxisFlags {
+                x: which == "X",
+                y: which == "Y",
+                z: which == "Z",
+                e: false,
+            },
+            _ => return Err(unsupported("$H homes all axes, or one with $HX, $HY, $HZ")),
+        };
+        motion.home_axes(axes);
+        out.push(EventKind::Note(Note::Homed { axes }));
+        return Ok(Dollar::Events);
+    }
+    let Some((n, v)) = body.split_once('=') else {
+        return Err(unsupported(
+            "not a GRBL $ command: settings are $N=VALUE (error:3, grbl/system.c)",
+        ));
+    };
+    let number = n
+        .parse::<u16>()
+        .map_err(|_| unsupported("a setting's number is a whole number 0-65535"))?;
+    let value = v
+        .parse::<f64>()
+        .ok()
+        .filter(|x| x.is_finite())
+        .ok_or_else(|| unsupported("a setting's value is a number (error:2, grbl/system.c)"))?;
+    if value < 0.0 {
+        return Err(GcodeError::OutOfRange {
+            at: at(None),
+            command: format!("${number}"),
+            param: "value".into(),
+            value,
+            allowed: "0 or more (error:4, grbl/settings.c)",
+        });
+    }
+    if state.moving {
+        return busy(format!("${number}={v}"), out);
+    }
+    if number == 32 {
+        // grbl/settings.c: any non-zero value; grblHAL's $32 is a mode (1 laser, 2 lathe).
+        state.laser_mode = value.trunc() == 1.0;
+    }
+    out.push(EventKind::Setting(Setting::Grbl { number, value }));
+    Ok(Dollar::Events)
+}

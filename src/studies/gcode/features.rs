@@ -1,0 +1,85 @@
+//! The error per slicer feature type (`;TYPE:External perimeter`, Cura's
+//! `;TYPE:WALL-OUTER`, ...; [`settle_gcode::Reader::features`]): over each type's working
+//! samples, the worst (with its spot) and the 95th percentile, and per layer the worst
+//! and the 95th percentile of each type (the error-against-Z figure, layer_features.csv,
+//! the outer wall's columns of the layers table). The outer wall is what a print is judged
+//! by ([`is_outer_wall`]).
+//!
+//! Memory: two histograms per type (the whole job's and the current layer's; at most
+//! [`settle_gcode::MAX_FEATURES`] types) and two numbers per layer and type.
+
+use std::collections::BTreeMap;
+
+use super::stats::{Histogram, Spot};
+
+/// One feature type's account.
+#[derive(Debug, Clone, Default)]
+pub struct FeatureStats {
+    /// Its errors (um).
+    pub errors: Histogram,
+    /// Its largest error.
+    pub worst: Option<Spot>,
+}
+
+impl FeatureStats {
+    /// Its largest error (um), 0 without samples.
+    pub fn worst_um(&self) -> f64 {
+        self.worst.as_ref().map_or(0.0, |s| s.error_um)
+    }
+}
+
+/// The account by feature type: index as [`settle_gcode::Move::feature`].
+#[derive(Debug, Clone, Default)]
+pub struct FeatureAccount {
+    /// Per feature index.
+    pub stats: BTreeMap<u16, FeatureStats>,
+    /// Per (layer, feature index), its worst error (um).
+    pub layer_worst: BTreeMap<(u32, u16), f64>,
+    /// Per (layer, feature index), the 95th percentile of its errors (um); NaN when the
+    /// layer's samples came in two separate runs (its percentile is then not known).
+    pub layer_p95: BTreeMap<(u32, u16), f64>,
+    /// Per feature index, the current layer's errors (cleared at each layer's end).
+    current: BTreeMap<u16, Histogram>,
+}
+
+impl FeatureAccount {
+    /// A working sample of feature `feature`: its error (um) and, when it may be the
+    /// feature's worst, where it is (`spot` is called only then).
+    pub fn sample(&mut self, feature: u16, layer: u32, err_um: f64, spot: impl FnOnce() -> Spot) {
+        let s = self.stats.entry(feature).or_default();
+        s.errors.push(err_um);
+        if s.worst.as_ref().is_none_or(|w| err_um > w.error_um) {
+            s.worst = Some(spot());
+        }
+        let w = self.layer_worst.entry((layer, feature)).or_insert(0.0);
+        *w = w.max(err_um);
+        self.current.entry(feature).or_default().push(err_um);
+    }
+
+    /// The end of layer `layer`'s samples: each type's 95th percentile over them.
+    pub fn end_layer(&mut self, layer: u32) {
+        for (&f, h) in &mut self.current {
+            if h.total() == 0 {
+                continue;
+            }
+            let p95 = h.quantile_um(0.95);
+            self.layer_p95
+                .entry((layer, f))
+                .and_modify(|v| *v = f64::NAN)
+                .or_insert(p95);
+            h.clear();
+        }
+    }
+
+    /// Whether any sample came from a named feature type (index above 0).
+    pub fn has_named(&self) -> bool {
+        self.stats.keys().any(|&f| f > 0)
+    }
+}
+
+/// Whether a slicer's feature name is the outer wall: PrusaSlicer and SuperSlicer's
+/// `External perimeter`, OrcaSlicer and BambuStudio's `Outer wall`, Cura's `WALL-OUTER`.
+pub fn is_outer_wall(name: &str) -> bool {
+    let n = name.trim().to_ascii_lowercase();
+    matches!(n.as_str(), "external perimeter" | "outer wall" | "wall-outer")
+}

@@ -1,0 +1,32 @@
+//! A G-code job must hold work to measure. A file without a move (prose, a configuration
+//! given as G-code) is not a job; one whose moves never work the material has no error
+//! that counts. Working moves are [`settle_gcode::Move::is_working`]: extruding moves on
+//! a printer, feed moves (`G1`, `G2`, `G3`) with the laser or spindle on at `S > 0` on a
+//! GRBL laser or mill. Both cases are refused rather than answered with zeros; neither
+//! message repeats the file's text (it is not the G-code it was said to be).
+
+use settle_gcode::job::JobSummary;
+use settle_planner::firmware::Firmware;
+
+/// Why the planned job holds nothing to measure (`lines`: lines read), `None` when it
+/// does.
+pub fn nothing_to_measure(summary: &JobSummary, lines: u64) -> Option<String> {
+    if summary.moves == 0 {
+        return Some(format!(
+            "no move (G0, G1, G2, G3) in its {lines} lines: not a G-code job settle can replay"
+        ));
+    }
+    if summary.layers.iter().any(|l| l.working_s > 0.0) {
+        return None;
+    }
+    let what = match summary.firmware {
+        Some(Firmware::Grbl) => {
+            "a feed move (G1, G2, G3) with the laser or spindle on (M3 or M4, S above 0)"
+        }
+        _ => "an extruding move (E rising while X, Y or Z moves)",
+    };
+    Some(format!(
+        "{} moves, none of them working: the error is measured on working moves, here {what}, so this file has nothing to measure",
+        summary.moves
+    ))
+}

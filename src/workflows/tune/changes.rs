@@ -1,0 +1,294 @@
+//! Every exported value that differs from the user's current one, with what it was, what
+//! it is and why: shown in the report ("What changes in klipper.cfg") and written as a
+//! comment above the value in the export. One function per export target.
+//!
+//! The reasons are the search's own numbers: the shaper's by the gain over the current
+//! settings (or why the current settings are out), its frequency by the mode it is tuned
+//! to, its damping ratio by the mode's damping and where that comes from, the
+//! acceleration by the best candidate at the current acceleration against the
+//! recommendation.
+
+use std::fmt::Write as _;
+
+use settle_gcode::config::Note;
+
+use super::Outcome;
+use super::cells::ms;
+use super::search::Score;
+
+/// One changed setting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Change {
+    /// The setting as the export names it (`shaper_freq_x`, `max_accel`, `M593 F`).
+    pub key: String,
+    /// The current value, as the export would write it.
+    pub was: String,
+    /// The recommended value, as the export writes it.
+    pub now: String,
+    /// Why.
+    pub why: String,
+}
+
+impl Change {
+    /// The export's comment for it.
+    pub fn note(&self) -> Note {
+        Note {
+            key: self.key.clone(),
+            text: format!("{}: {} -> {}: {}", self.key, self.was, self.now, self.why),
+        }
+    }
+}
+
+/// A shaper as `(type, frequency, damping)` text; `None` unshaped.
+fn shaper_values(s: &Score) -> Option<(String, f64, f64)> {
+    let sh = s.candidate.shaper?;
+    Some((sh.shaper_type?.name(), sh.frequency_hz, sh.damping_ratio))
+}
+
+/// Why the recommendation `w` replaces the current `d` on `axis`: the gain, or why the
+/// current settings are out.
+fn gain_why(axis: &str, o: &Outcome) -> String {
+    let (d, w) = (&o.scores[0], &o.scores[o.winner]);
+    let now = format!(
+        "the recommendation settles axis {axis}'s moves in {} ms",
+        ms(w.move_and_settle_s)
+    );
+    match &d.infeasible {
+        Some(why) => format!(
+            "your current setting on {axis} is out ({}); {now}",
+            why.short()
+        ),
+        None => format!(
+            "{now}, your current setting in {} ms ({:.1}% faster)",
+            ms(d.simulated_move_and_settle_s),
+            100.0 * (1.0 - w.move_and_settle_s / d.simulated_move_and_settle_s)
+        ),
+    }
+}
+
+/// The `(frequency, damping)` of the tuned mode nearest to `f` Hz (by ratio).
+fn nearest_mode(o: &Outcome, f: f64) -> Option<(f64, f64)> {
+    o.plan
+        .modes
+        .iter()
+        .copied()
+        .min_by(|a, b| (f / a.0 - 1.0).abs().total_cmp(&(f / b.0 - 1.0).abs()))
+}
+
+/// Why the shaper is tuned to `f`: the mode it is nearest to as a multiple.
+fn frequency_why(axis: &str, o: &Outcome, f: f64) -> String {
+    match nearest_mode(o, f) {
+        Some((m, _)) => format!(
+            "tuned to axis {axis}'s {m:.1} Hz mode ({}; {:.2} x its frequency)",
+            o.plan.modes_source,
+            f / m
+        ),
+        None => "the search's best frequency".into(),
+    }
+}
+
+/// Why the damping ratio is `z`.
+fn damping_why(axis: &str, o: &Outcome, f: f64, z: f64) -> String {
+    let spec = &o.plan.spec;
+    match (o.plan.shaper_damping, spec.shaper_damping_ratio) {
+        (Some(d), Some(_)) if (d - z).abs() < 5e-4 => {
+            return "the damping ratio every shaper is designed for (`[tune] shaper_damping_ratio`)"
+                .into();
+        }
+        (Some(d), None) if (d - z).abs() < 5e-4 => {
+            return format!(
+                "Klipper's default: the damping of the modes of a physical machine ({}) is an estimate from its parts, not a measurement",
+                o.plan.modes_source
+            );
+        }
+        _ => {}
+    }
+    match nearest_mode(o, f) {
+        Some((m, zeta)) if (zeta - z).abs() < 5e-4 => format!(
+            "the damping ratio of axis {axis}'s {m:.1} Hz mode ({})",
+            o.plan.modes_source
+        ),
+        Some((m, zeta)) => format!(
+            "the shaper's damping ratio nearest to that of axis {axis}'s {m:.1} Hz mode ({zeta:.3}) that the firmware takes"
+        ),
+        None => "the search's damping ratio".into(),
+    }
+}
+
+/// The changes of one axis's shaper, keyed `{type_key}`, `{freq_key}`, `{damping_key}`;
+/// `off` is how the export writes "no shaping" (type, frequency, damping).
+fn shaper_changes(axis: &str, o: &Outcome, keys: [&str; 3], off: (&str, f64, f64)) -> Vec<Change> {
+    let (d, w) = (&o.scores[0], &o.scores[o.winner]);
+    let as_written = |s: &Score| shaper_values(s).unwrap_or((off.0.to_string(), off.1, off.2));
+    let (was, now) = (as_written(d), as_written(w));
+    // "No shaping" may carry no frequency or damping (NaN): shown as `-`.
+    let text = |x: f64| {
+        if x.is_nan() {
+            "-".to_string()
+        } else {
+            x.to_string()
+        }
+    };
+    let mut out = Vec::new();
+    let mut gain = Some(gain_why(axis, o));
+    let mut push = |key: &str, a: String, b: String, specific: String| {
+        let why = match gain.take() {
+            Some(g) if specific.is_empty() => g,
+            Some(g) => format!("{g}; {specific}"),
+            None => specific,
+        };
+        out.push(Change {
+            key: key.to_string(),
+            was: a,
+            now: b,
+            why,
+        });
+    };
+    if was.0 != now.0 {
+        push(keys[0], was.0.clone(), now.0.clone(), String::new());
+    }
+    if text(was.1) != text(now.1) {
+        let why = if shaper_values(w).is_some() {
+            frequency_why(axis, o, now.1)
+        } else {
+            "shaping off".into()
+        };
+        push(keys[1], text(was.1), text(now.1), why);
+    }
+    if text(was.2) != text(now.2) {
+        let why = if shaper_values(w).is_some() {
+            damping_why(axis, o, now.1, now.2)
+        } else {
+            "shaping off".into()
+        };
+        push(keys[2], text(was.2), text(now.2), why);
+    }
+    out
+}
+
+/// Why the shared acceleration moved from `was` to `now`: per axis, its best feasible
+/// candidate at `was` against its recommendation at `now`.
+fn accel_why(axes: &[(String, Outcome)], was: f64, now: f64) -> String {
+    let mut out = String::new();
+    for (axis, o) in axes {
+        let w = &o.scores[o.winner];
+        let at_was = o
+            .scores
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.accel_mm_s2 == was && s.is_feasible())
+            .min_by(|a, b| a.1.move_and_settle_s.total_cmp(&b.1.move_and_settle_s));
+        if !out.is_empty() {
+            out.push_str("; ");
+        }
+        match at_was {
+            Some((_, b)) => {
+                let _ = write!(
+                    out,
+                    "axis {axis}: {} ms at {now} mm/s^2 against {} ms at {was} mm/s^2 (its best there, {})",
+                    ms(w.move_and_settle_s),
+                    ms(b.move_and_settle_s),
+                    b.candidate.label()
+                );
+            }
+            None => {
+                let why = o
+                    .scores
+                    .iter()
+                    .filter(|s| s.accel_mm_s2 == was)
+                    .filter_map(|s| s.infeasible.as_ref().map(|i| (s, i)))
+                    .min_by(|a, b| {
+                        a.0.simulated_move_and_settle_s
+                            .total_cmp(&b.0.simulated_move_and_settle_s)
+                    })
+                    .map_or("no candidate was searched there".to_string(), |(s, i)| {
+                        format!(
+                            "no candidate is feasible there (the fastest, {}, {})",
+                            s.candidate.label(),
+                            i.short()
+                        )
+                    });
+                let _ = write!(
+                    out,
+                    "axis {axis}: {} ms at {now} mm/s^2; at {was} mm/s^2 {why}",
+                    ms(w.move_and_settle_s)
+                );
+            }
+        }
+    }
+    if axes.len() > 1 {
+        out.push_str(
+            " (one acceleration for every axis: the least move-and-settle summed over them)",
+        );
+    }
+    out
+}
+
+/// The shared acceleration's change, keyed `key`, if it changed.
+fn accel_change(axes: &[(String, Outcome)], key: &str, now: Option<f64>) -> Option<Change> {
+    let now = now?;
+    let was = axes
+        .iter()
+        .map(|(_, o)| o.scores[0].accel_mm_s2)
+        .fold(f64::INFINITY, f64::min);
+    (was != now && was.is_finite()).then(|| Change {
+        key: key.to_string(),
+        was: was.to_string(),
+        now: now.to_string(),
+        why: accel_why(axes, was, now),
+    })
+}
+
+/// The changes `klipper.cfg` makes: per tuned axis `x`/`y` its shaper (Klipper's "off" is
+/// frequency 0), and `max_accel` (`accel`: the one written, when it changes).
+pub fn klipper(axes: &[(String, Outcome)], accel: Option<f64>) -> Vec<Change> {
+    let mut out = Vec::new();
+    for letter in ["x", "y"] {
+        if let Some((axis, o)) = axes.iter().find(|(a, _)| a.split('+').any(|x| x == letter)) {
+            out.extend(shaper_changes(
+                axis,
+                o,
+                [
+                    &format!("shaper_type_{letter}"),
+                    &format!("shaper_freq_{letter}"),
+                    &format!("damping_ratio_{letter}"),
+                ],
+                ("mzv", 0.0, super::target::KLIPPER_OFF_DAMPING),
+            ));
+        }
+    }
+    out.extend(accel_change(axes, "max_accel", accel));
+    out
+}
+
+/// The changes `rrf.g` makes: the one shaper (axis `axis`'s) and `M204 P`/`T`.
+pub fn rrf(axes: &[(String, Outcome)], axis: &str, accel: Option<f64>) -> Vec<Change> {
+    let mut out = Vec::new();
+    if let Some((a, o)) = axes.iter().find(|(a, _)| a == axis) {
+        out.extend(shaper_changes(
+            a,
+            o,
+            ["M593 P", "M593 F", "M593 S"],
+            ("none", f64::NAN, f64::NAN),
+        ));
+    }
+    for key in ["M204 P", "M204 T"] {
+        out.extend(accel_change(axes, key, accel));
+    }
+    out
+}
+
+/// The report's table of `changes` for the export `file`.
+pub fn table(file: &str, changes: &[Change]) -> String {
+    let mut out = format!("## What changes in {file}\n\n");
+    if changes.is_empty() {
+        out.push_str("Nothing: the recommendation is your current setting.\n\n");
+        return out;
+    }
+    out.push_str("| setting | yours | recommended | why |\n|---|---|---|---|\n");
+    for c in changes {
+        let _ = writeln!(out, "| {} | {} | {} | {} |", c.key, c.was, c.now, c.why);
+    }
+    out.push('\n');
+    out
+}

@@ -1,0 +1,270 @@
+//! Answers settle cannot stand behind, refused (exit 2) or said: a G-code file without a
+//! move (prose, a system file as a scenario's `[gcode] file`), a sample rate under
+//! Nyquist, a ring-down fit of a record that holds no free decay, a move, corner or scan
+//! where f64 cannot resolve it, a shaper Klipper refuses in an imported
+//! configuration, a mode too slow for the window, two-value keys given three, a fly axis
+//! that is none, a clock of 0 Hz, a plan without its start; and unknown G-code words
+//! listed as not followed.
+
+use super::params::scenario_with;
+use super::sandbox::SECRET;
+use super::{Case, Expect, Sandbox, check_all};
+
+/// A G-code scenario whose file is not G-code (a file with a secret in it).
+const GCODE_SECRET: &str = r#"name = "gcode_secret"
+[machine]
+preset = "printer_xy"
+driver_model = "linear"
+[gcode]
+file = "secret.txt"
+firmware = "klipper"
+[limits]
+vmax_mm_s = 100.0
+amax_mm_s2 = 3000.0
+jmax_mm_s3 = 100000.0
+[observe]
+window_s = 0.2
+sample_rate_hz = 10000
+bands_um = [10.0]
+"#;
+
+/// A corner scenario whose corner point has three coordinates.
+const CORNER3: &str = r#"name = "corner3"
+[machine]
+preset = "printer_xy"
+driver_model = "linear"
+[corner]
+angle_deg = 90.0
+leg_in_mm = 20.0
+leg_out_mm = 20.0
+corner_mm = [1, 2, 3]
+[limits]
+vmax_mm_s = 200.0
+amax_mm_s2 = 3000.0
+jmax_mm_s3 = 100000.0
+[observe]
+window_s = 0.2
+sample_rate_hz = 10000
+bands_um = [10.0]
+"#;
+
+/// A corner path on two modal axes (no belt travel to keep it in), its corner at `at`.
+fn corner_at(at: &str) -> String {
+    CORNER3
+        .replace(
+            "preset = \"printer_xy\"\ndriver_model = \"linear\"",
+            "[machine.axis.x]\nmodes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]\n[machine.axis.y]\nmodes = [{ frequency_hz = 50.0, damping_ratio = 0.05 }]",
+        )
+        .replace("corner_mm = [1, 2, 3]", &format!("corner_mm = {at}"))
+}
+
+/// Every case of the class.
+pub fn cases(sb: &Sandbox) -> Vec<Case> {
+    sb.write(
+        "prose.gcode",
+        "This is a note about my print.\nIt has no G-code in it.\n",
+    );
+    sb.write(
+        "words.gcode",
+        "G28\nM83\nG1 X10 Y10 F3000\nG999\nFOO\nhello\nG1 X20 Y10 E1\nG1 X20 Y20 E1\n",
+    );
+    sb.write("sc_secret.toml", GCODE_SECRET);
+    sb.write(
+        "far.toml",
+        &scenario_with("distance_mm = 5.0", "distance_mm = 1.0\nstart_mm = 1e15"),
+    );
+    sb.write(
+        "slow_mode.toml",
+        &scenario_with(
+            "modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]",
+            "modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }, { frequency_hz = 1e-7, damping_ratio = 0.05 }]",
+        ),
+    );
+    sb.write(
+        "long_window.toml",
+        &scenario_with("window_s = 0.2", "window_s = 7894.0"),
+    );
+    sb.write("corner3.toml", CORNER3);
+    sb.write("corner_far.toml", &corner_at("[1e15, 0.0]"));
+    sb.write(
+        "scan_wide.toml",
+        &scenario_with(
+            "[observe]",
+            "[scan]\nv_scan_mm_s = 100.0\nfly_amax_mm_s2 = 10000.0\nwidth_mm = 1e15\n[observe]",
+        ),
+    );
+    sb.write(
+        "fly.toml",
+        &scenario_with(
+            "[observe]",
+            "[scan]\nv_scan_mm_s = 100.0\nfly_amax_mm_s2 = 10000.0\nfly_axis = \"bogus\"\n[observe]",
+        ),
+    );
+    sb.write(
+        "tmc.toml",
+        &(scenario_with("[sweep]\nprofile = [\"trapezoid\", \"scurve\"]\n", "")
+            + "[tune]\ntmc_clock_hz = 0\n"),
+    );
+    sb.write(
+        "mzvn.cfg",
+        "[printer]\nkinematics: cartesian\nmax_velocity: 300\nmax_accel: 3000\n[stepper_x]\nrotation_distance: 40\nmicrosteps: 16\n[stepper_y]\nrotation_distance: 40\nmicrosteps: 16\n[input_shaper]\nshaper_type_x: mzv(n=1000000,t=0.8)\nshaper_freq_x: 50\n",
+    );
+    let refused = |what: &str, line: &str, parts: &[&str]| {
+        Case::line(what, line, &[], Expect::refused(parts))
+    };
+    vec![
+        refused(
+            "gcode on prose",
+            "gcode prose.gcode --machine printer_xy --out o",
+            &["prose.gcode", "no move"],
+        )
+        .never_says("This is a note"),
+        refused(
+            "[gcode] file = a file that is not G-code",
+            "sweep sc_secret.toml --backend modal --out o",
+            &["gcode.file", "no move"],
+        )
+        .never_says(SECRET),
+        refused(
+            "gcode --sample-rate-hz 1 (under Nyquist)",
+            "gcode print.gcode --machine printer_xy --sample-rate-hz 1 --out o",
+            &["--sample-rate-hz", "two samples per period"],
+        ),
+        refused(
+            "gcode --sample-rate-hz 1e-9",
+            "gcode print.gcode --machine printer_xy --sample-rate-hz 1e-9 --out o",
+            &["--sample-rate-hz"],
+        ),
+        refused(
+            "a 1 mm move at 1e15 mm",
+            "run far.toml --case 0 --backend modal --out o/t.csv",
+            &["move.start_mm", "1e5 mm"],
+        ),
+        refused(
+            "identify a resonance sweep without its test's options",
+            "identify rec_x.csv --out o/m.toml",
+            &["rec_x.csv", "no clean decay", "--hz-per-sec"],
+        ),
+        Case::line(
+            "run of a trace too long to keep: failed, with its reason",
+            "run long_window.toml --case 0 --backend modal --out o_long/t.csv --fail-on-failed-runs",
+            &["o_long"],
+            Expect::failed(&[
+                "FAILED (fault): its trace is kept in memory",
+                "over the limit of 1.6e7",
+            ]),
+        ),
+        refused(
+            "a corner at 1e15 mm",
+            "run corner_far.toml --case 0 --backend modal --out o/t.csv",
+            &["corner.corner_mm", "1e5 mm"],
+        ),
+        refused(
+            "a scan 1e15 mm wide",
+            "run scan_wide.toml --case 0 --backend modal --out o/t.csv",
+            &["scan.width_mm", "1e5 mm"],
+        ),
+        refused(
+            "a mode of 1e-7 Hz",
+            "sweep slow_mode.toml --backend modal --out o",
+            &["observe.window_s", "slowest mode"],
+        ),
+        refused(
+            "import a shaper Klipper refuses",
+            "import klipper mzvn.cfg --out o/x.toml",
+            &["mzvn.cfg", "shaper_type_x", "at most 10"],
+        ),
+        refused(
+            "corner_mm = [1, 2, 3]",
+            "sweep corner3.toml --backend modal --out o",
+            &["corner.corner_mm", "give exactly 2"],
+        ),
+        refused(
+            "scan.fly_axis = \"bogus\"",
+            "sweep fly.toml --backend modal --out o",
+            &["scan.fly_axis", "bogus"],
+        ),
+        refused(
+            "[tune] tmc_clock_hz = 0",
+            "tune tmc.toml --out o",
+            &["tune.tmc_clock_hz", "4 to 32 MHz"],
+        ),
+        Case::line(
+            "plan without p0",
+            "plan",
+            &[],
+            Expect::answered(&["`p0` is missing"]),
+        )
+        .stdin("{\"pf\":[1],\"vmax\":[1],\"amax\":[2],\"jmax\":[10]}\n"),
+        Case::line(
+            "gcode lists unknown words as not followed",
+            "gcode words.gcode --machine printer_xy --out o_words",
+            &["o_words"],
+            Expect::answered(&["not followed: FOO (1x), G999 (1x), HELLO (1x)"]),
+        ),
+    ]
+}
+
+#[test]
+fn no_answer_settle_cannot_stand_behind() {
+    let sb = Sandbox::new();
+    let cases = cases(&sb);
+    check_all(&sb, &cases);
+}
+
+/// The residual peak `settle run` prints for `scenario`.
+fn residual_peak(dir: &std::path::Path, scenario: &str) -> String {
+    let out = crate::support::settle()
+        .current_dir(dir)
+        .args([
+            "run",
+            scenario,
+            "--case",
+            "0",
+            "--backend",
+            "modal",
+            "--out",
+        ])
+        .arg(format!("o_{scenario}.csv"))
+        .output()
+        .expect("runs");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("residual_peak_um"))
+        .unwrap_or_else(|| panic!("no residual in {stdout}"))
+        .to_string()
+}
+
+/// The position limit is where f64 still resolves a move: a 1 mm move (and a corner) at
+/// the edge of the limit has the residual it has at 0 (physics does not depend on where
+/// the machine stands), to the last digit printed.
+#[test]
+fn a_move_at_the_position_limit_has_the_residual_it_has_at_zero() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let moved = |start: &str| {
+        scenario_with(
+            "distance_mm = 5.0",
+            &format!("distance_mm = 1.0\nstart_mm = {start}"),
+        )
+    };
+    crate::support::write(d, "at0.toml", &moved("0.0"));
+    crate::support::write(d, "far.toml", &moved("99999.0"));
+    crate::support::write(d, "c0.toml", &corner_at("[0.0, 0.0]"));
+    crate::support::write(d, "cfar.toml", &corner_at("[99990.0, -99990.0]"));
+    let at0 = residual_peak(d, "at0.toml");
+    let um: f64 = at0
+        .split_whitespace()
+        .nth(1)
+        .and_then(|v| v.parse().ok())
+        .expect("a number");
+    assert!(um > 1.0, "a 1 mm move on a 40 Hz mode rings: {at0}");
+    assert_eq!(residual_peak(d, "far.toml"), at0);
+    assert_eq!(residual_peak(d, "cfar.toml"), residual_peak(d, "c0.toml"));
+}

@@ -1,0 +1,173 @@
+//! `settle gcode` on lasers, mills and slicer features: the working moves (the laser on at
+//! `S > 0`) are what count, a file without one is refused, the fly-axis error of a scan
+//! line is the closed-form following error of the mode, and the error per feature type.
+
+use settle::workflows::gcode::{GcodeOptions, measure};
+use settle_gcode::config::GrblSettings;
+use settle_gcode::job::JobConfig;
+use settle_planner::firmware::Firmware;
+
+use crate::support::one_mode::OneMode;
+use crate::support::write;
+
+const ONE_MODE: &str = "name = \"one mode\"\n\
+     [axis.x]\nmodes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]\n\
+     [axis.y]\nmodes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]\n";
+
+/// GRBL at 6000 mm/min and 3000 mm/s^2 on X and Y, 1000 steps/mm, laser mode.
+fn grbl(file: std::path::PathBuf, machine: &str) -> GcodeOptions {
+    let s = GrblSettings::parse(
+        "$100=1000\n$101=1000\n$110=6000\n$111=6000\n$120=3000\n$121=3000\n$32=1\n",
+        "grbl.txt",
+    )
+    .expect("settings");
+    let mut o = GcodeOptions::new(file, machine, Firmware::Grbl).expect("options");
+    o.job = JobConfig::from_grbl(&s).expect("job");
+    o
+}
+
+/// One scan line along X with the laser on (GRBL, one block from rest to rest: the
+/// trapezoid at 3000 mm/s^2 to 100 mm/s over 30 mm) on a one-mode machine (40 Hz, zeta
+/// 0.05): the error along X, `e = x - x_cmd`, obeys `e'' + 2 zeta w e' + w^2 e = -a(t)`,
+/// phase by phase the free vibration of `e + a/w^2` about `-a/w^2`; the fly-axis error is
+/// `|e|` at the samples of the working move and of the ringing after it (which belongs
+/// to the last move). Y never moves: the contour error, the distance to the line, sees
+/// only the overshoot past its end. Before
+/// working moves counted, a laser line measured nothing (every error 0 um).
+#[test]
+fn a_scan_line_measures_the_closed_form_error_along_the_fly_axis() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let machine = write(dir.path(), "one_mode.toml", ONE_MODE);
+    let file = write(dir.path(), "line.nc", "G90\nM3 S500\nG1 X30 F6000\n");
+    let o = measure(&grbl(file, machine.to_str().expect("utf-8"))).expect("runs");
+    let mode = OneMode::new(40.0, 0.05);
+    let (vmax, amax, d) = (0.1, 3.0, 0.03);
+    let ta = vmax / amax;
+    let tc = (d - vmax * vmax / amax) / vmax;
+    let t_end = 2.0 * ta + tc;
+    assert!(
+        (o.print_time_s - t_end).abs() <= 1e-12,
+        "{}",
+        o.print_time_s
+    );
+    // e at time t of the move (or after it).
+    let e_at = |t: f64| {
+        let (mut e, mut v) = (0.0, 0.0);
+        let mut t0 = 0.0;
+        for (acc, dur) in [(amax, ta), (0.0, tc), (-amax, ta), (0.0, f64::INFINITY)] {
+            if t <= t0 + dur {
+                return mode.phase(e, v, acc, t - t0).0;
+            }
+            (e, v) = mode.phase(e, v, acc, dur);
+            t0 += dur;
+        }
+        e
+    };
+    let tail = o.streamed.tail.expect("ringing after the move");
+    let dt = 1.0 / 2000.0;
+    let last = ((t_end + tail.duration_s) / dt).round() as u64;
+    let expected = (1..=last)
+        .map(|k| e_at(k as f64 * dt).abs() * 1e6)
+        .fold(0.0, f64::max);
+    let fly = &o.streamed.fly;
+    assert_eq!(fly.raster(), Some(0), "a scan line along X");
+    let got = fly.worst[0].as_ref().expect("a worst").error_um;
+    assert!(
+        (got - expected).abs() <= 1e-9 * expected,
+        "fly-axis error {got} vs closed form {expected}"
+    );
+    assert!(expected > 50.0, "{expected}");
+    // The contour error sees only what leaves the segment (the overshoot past its end).
+    assert!(o.worst_um < got, "contour {} vs fly {got}", o.worst_um);
+}
+
+#[test]
+fn a_file_without_a_working_move_is_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let machine = write(dir.path(), "one_mode.toml", ONE_MODE);
+    // The laser is never switched on: nothing is engraved, nothing to measure.
+    let file = write(dir.path(), "off.nc", "G90\nG1 X30 F6000\nG1 Y10\n");
+    let err = measure(&grbl(file, machine.to_str().expect("utf-8")))
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        err.contains("none of them working") && err.contains("M3 or M4"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_error_is_given_per_feature_type_with_the_outer_wall_first() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let machine = write(dir.path(), "one_mode.toml", ONE_MODE);
+    // A square of outer wall with a sharp corner, then infill across it.
+    let file = write(
+        dir.path(),
+        "walls.gcode",
+        "G90\nM83\nG1 X10 Y10 F6000\n;TYPE:External perimeter\nG1 X40 E1 F6000\nG1 Y40 E1\n\
+         G1 X10 E1\nG1 Y10 E1\n;TYPE:Solid infill\nG1 X40 Y40 E2 F3000\n",
+    );
+    let o = measure(
+        &GcodeOptions::new(file, machine.to_str().expect("utf-8"), Firmware::Klipper)
+            .expect("options"),
+    )
+    .expect("runs");
+    assert_eq!(o.features, ["", "External perimeter", "Solid infill"]);
+    let f = &o.streamed.features.stats;
+    let (wall, infill) = (&f[&1], &f[&2]);
+    assert!(wall.errors.total() > 0 && infill.errors.total() > 0);
+    // Every working sample is one of the two: their worst is the job's.
+    assert_eq!(wall.worst_um().max(infill.worst_um()), o.worst_um);
+    let csv = String::from_utf8(settle::workflows::gcode::features::features_csv(&o).expect("csv"))
+        .expect("utf-8");
+    let second = csv.lines().nth(1).expect("a row");
+    assert!(second.starts_with("External perimeter,true,"), "{csv}");
+}
+
+#[test]
+fn each_layer_gives_each_feature_types_worst_and_p95() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let machine = write(dir.path(), "one_mode.toml", ONE_MODE);
+    // Layer 1: outer wall only; layer 2: outer wall, then infill across it.
+    let square = "G1 X40 E1 F6000\nG1 Y40 E1\nG1 X10 E1\nG1 Y10 E1\n";
+    let file = write(
+        dir.path(),
+        "layers.gcode",
+        &format!(
+            "G90\nM83\nG1 X10 Y10 F6000\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2\n;TYPE:External perimeter\n\
+             {square};LAYER_CHANGE\n;Z:0.4\nG1 Z0.4\n{square};TYPE:Solid infill\nG1 X40 Y40 E2 F3000\n"
+        ),
+    );
+    let o = measure(
+        &GcodeOptions::new(file, machine.to_str().expect("utf-8"), Firmware::Klipper)
+            .expect("options"),
+    )
+    .expect("runs");
+    use settle::workflows::gcode::features::{layer_features_csv, layer_outer_wall};
+    let stats = |layer: u32| {
+        o.layers
+            .iter()
+            .find(|l| l.layer == layer)
+            .and_then(|l| l.stats.clone())
+            .expect("simulated layer")
+    };
+    // A layer of outer wall alone: its outer wall's numbers are the layer's, counted by
+    // the layer's own histogram.
+    let (l1, l2) = (stats(1), stats(2));
+    let (w1, p1) = layer_outer_wall(&o, 1).expect("outer wall in layer 1");
+    assert_eq!((w1, p1), (l1.worst_um(), l1.p95_um));
+    // With infill too, the larger of the two types' worst is the layer's.
+    let f = &o.streamed.features;
+    let (w2, p2) = layer_outer_wall(&o, 2).expect("outer wall in layer 2");
+    let infill = f.layer_worst[&(2, 2)];
+    assert_eq!(w2.max(infill), l2.worst_um());
+    assert!(p2 > 0.0 && p2 <= w2 * 1.001 && f.layer_p95[&(2, 2)] > 0.0);
+    let csv = String::from_utf8(layer_features_csv(&o).expect("csv")).expect("utf-8");
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows.len(), 4, "{csv}");
+    assert!(
+        rows[1].starts_with("1,0.2,External perimeter,true,")
+            && rows[3].starts_with("2,0.4,Solid infill,false,"),
+        "{csv}"
+    );
+}

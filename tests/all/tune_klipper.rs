@@ -1,0 +1,77 @@
+//! Klipper's choice next to settle's: the spectrum settle builds from a machine's modes
+//! gives Klipper the choice it makes on a recording of that machine.
+
+use settle::workflows::tune::klipper_choice::spectrum_of;
+use settle::workflows::tune::klipper_criterion::load;
+use settle_gcode::config::KlipperConfig;
+use settle_identify::SweepTest;
+use settle_planner::shaper_select::{SelectOptions, find_best_shaper};
+
+use crate::support::root;
+
+/// The example recordings' test (examples/resonance_data.rs): 30-90 Hz at 10 Hz/s, the
+/// default acceleration and sweeping motion, at 800 samples per second.
+fn example_test() -> SweepTest {
+    SweepTest {
+        freq_start_hz: 30.0,
+        freq_end_hz: 90.0,
+        hz_per_sec: 10.0,
+        ..SweepTest::klipper()
+    }
+}
+
+/// Also: the example printer.cfg's SAVE_CONFIG block holds what Klipper chooses on the
+/// example recordings.
+#[test]
+fn klippers_choice_on_the_modes_is_its_choice_on_the_recording() {
+    let cfg = root().join("examples/klipper/printer.cfg");
+    let text = std::fs::read_to_string(&cfg).expect("example printer.cfg");
+    let saved = KlipperConfig::parse(&text, &cfg)
+        .expect("reads")
+        .input_shaper
+        .expect("[input_shaper]");
+    // The modes the example recordings were made from (examples/resonance_data.rs).
+    for (file, modes, saved) in [
+        (
+            "examples/data/raw_data_x_example.csv",
+            vec![(45.0, 0.05, 0.8), (75.0, 0.07, 0.2)],
+            &saved.x,
+        ),
+        (
+            "examples/data/raw_data_y_example.csv",
+            vec![(39.0, 0.05, 1.0)],
+            &saved.y,
+        ),
+    ] {
+        let opts = SelectOptions::default();
+        // The recording's data as `settle tune --criterion klipper` reads it (Klipper's
+        // PSD of the three axes, summed and normalised: calibrate_shaper.py's).
+        let recorded = load(&root().join(file)).expect("reads");
+        let from_recording = find_best_shaper(&recorded, &opts).expect("chooses");
+        let model = spectrum_of(&modes, &example_test(), 800.0);
+        let from_modes = find_best_shaper(&[model], &opts).expect("chooses");
+        let (r, m) = (from_recording.recommended, from_modes.recommended);
+        eprintln!(
+            "{file}: recording {} @ {:.2} Hz (v {:.4}, max_accel {:.0}); modes {} @ {:.2} Hz (v {:.4}, max_accel {:.0})",
+            r.shaper_type.name(),
+            r.frequency_hz,
+            r.vibrations,
+            r.max_accel_mm_s2,
+            m.shaper_type.name(),
+            m.frequency_hz,
+            m.vibrations,
+            m.max_accel_mm_s2
+        );
+        assert_eq!(r.shaper_type, m.shaper_type, "{file}");
+        assert!((r.frequency_hz - m.frequency_hz).abs() <= 0.41, "{file}");
+        // SHAPER_CALIBRATE saves the frequency to 0.1 Hz.
+        assert_eq!(
+            (saved.name.as_str(), saved.frequency_hz),
+            (
+                r.shaper_type.name().as_str(),
+                (r.frequency_hz * 10.0).round() / 10.0
+            ),
+            "{file}"
+        );
+    }
+}
