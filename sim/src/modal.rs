@@ -578,17 +578,7 @@ impl ModalPlant {
     /// equilibrium of its axis position here. A machine whose stiffness does not depend
     /// on position gives the same model at any point.
     pub fn linearised_at(mut self, positions_m: Vec<f64>) -> Result<Self, SimError> {
-        if positions_m.len() != self.axes.len() {
-            return Err(SimError::AxisCount {
-                expected: self.axes.len(),
-                got: positions_m.len(),
-            });
-        }
-        if let Some(p) = positions_m.iter().find(|p| !p.is_finite()) {
-            return Err(SimError::InvalidModel {
-                what: format!("the linearisation point {p} m is not a finite position"),
-            });
-        }
+        crate::plant::check_positions(self.axes.len(), &positions_m, "the linearisation point")?;
         self.linearise_at_m = Some(positions_m);
         Ok(self)
     }

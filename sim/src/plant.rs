@@ -154,6 +154,24 @@ pub fn check_step(axes: usize, cmd: &[Sample], dt_s: f64) -> Result<(), SimError
     Ok(())
 }
 
+/// Check positions given one per axis (m): their count, and that each is finite (`what`
+/// names the position in the error, e.g. "the linearisation point"). Shared by the
+/// backends that take a reference position for the whole job.
+pub fn check_positions(axes: usize, positions_m: &[f64], what: &str) -> Result<(), SimError> {
+    if positions_m.len() != axes {
+        return Err(SimError::AxisCount {
+            expected: axes,
+            got: positions_m.len(),
+        });
+    }
+    if let Some(p) = positions_m.iter().find(|p| !p.is_finite()) {
+        return Err(SimError::InvalidModel {
+            what: format!("{what} {p} m is not finite"),
+        });
+    }
+    Ok(())
+}
+
 /// The command polynomial of a sample `tau` s later (constant jerk).
 #[inline]
 pub fn advance_sample(s: &Sample, tau: f64) -> Sample {

@@ -232,17 +232,11 @@ impl RapierPlant {
     /// different places (a G-code layer range and the whole file) then step alike where
     /// their states agree.
     pub fn stepped_from(mut self, positions_m: Vec<f64>) -> Result<Self, SimError> {
-        if positions_m.len() != self.axes.len() {
-            return Err(SimError::AxisCount {
-                expected: self.axes.len(),
-                got: positions_m.len(),
-            });
-        }
-        if let Some(p) = positions_m.iter().find(|p| !p.is_finite()) {
-            return Err(SimError::InvalidModel {
-                what: format!("the step's reference position {p} m is not finite"),
-            });
-        }
+        crate::plant::check_positions(
+            self.axes.len(),
+            &positions_m,
+            "the step's reference position",
+        )?;
         self.step_at_m = Some(positions_m);
         Ok(self)
     }
