@@ -18,20 +18,77 @@
 //! in a sample: 1 um at 5 mm/s and 2 kHz).
 //!
 //! The distance is to the nearest of all the window's segments, measured only for the
-//! samples that count (printing moves), each segment first against its bounding box
-//! (tracking the nearest segment from one sample to the next is cheaper still but stops
-//! at local minima when the toolhead rings far from a fast command: a few um more than
-//! the nearest on the ringing tower).
+//! samples that count (printing moves). Segments are skipped by bounding boxes, first of
+//! runs of [`RUN`] consecutive segments, then of each segment of a run that may be nearer:
+//! a box no nearer than the nearest distance so far holds no nearer segment, so the
+//! distance is the least over all segments whichever are skipped (tracking the nearest
+//! segment from one sample to the next is cheaper still but stops at local minima when
+//! the toolhead rings far from a fast command: a few um more than the nearest on the
+//! ringing tower).
 
 use std::collections::VecDeque;
 
 use super::contour::{ACTIVE_WINDOW_S, segment_distance_sq};
 
+/// Consecutive segments sharing a bounding box ([`CommandPath::distance_mm`]): about
+/// 12 boxes over a window of 2 x 20 ms at 2 kHz, of which the toolhead is near one or two.
+pub const RUN: u64 = 8;
+
+/// An axis-aligned box (XY, mm): least X and Y, then largest.
+#[derive(Debug, Clone, Copy)]
+struct Box2 {
+    min: [f64; 2],
+    max: [f64; 2],
+}
+
+impl Box2 {
+    fn at(c: [f64; 2]) -> Self {
+        Self { min: c, max: c }
+    }
+
+    fn add(&mut self, c: [f64; 2]) {
+        for i in 0..2 {
+            self.min[i] = self.min[i].min(c[i]);
+            self.max[i] = self.max[i].max(c[i]);
+        }
+    }
+
+    /// The square of the distance (mm^2) from `p` to the box: at most the square of the
+    /// distance to anything in it (as each segment's own box was tested before: the same
+    /// bits).
+    #[inline]
+    fn distance_sq(&self, p: [f64; 2]) -> f64 {
+        let dx = (self.min[0] - p[0]).max(p[0] - self.max[0]).max(0.0);
+        let dy = (self.min[1] - p[1]).max(p[1] - self.max[1]).max(0.0);
+        dx * dx + dy * dy
+    }
+}
+
+/// A point of the command's path.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    /// Print-clock time (s).
+    t_s: f64,
+    /// Commanded XY (mm).
+    c: [f64; 2],
+    /// The bounding box of the segment from the point before to this one.
+    segment: Box2,
+}
+
 /// The command's path around the measured sample (module doc).
 #[derive(Debug, Default)]
 pub struct CommandPath {
-    /// Print-clock time (s) and commanded XY (mm) of the points, oldest first.
-    points: VecDeque<(f64, [f64; 2])>,
+    /// The points, oldest first.
+    points: VecDeque<Point>,
+    /// The number of points ever forgotten: the first point's index among all pushed.
+    forgotten: u64,
+    /// The bounding boxes of runs of segments, oldest first: run `k` holds the segments
+    /// from point `k RUN + i` to the next (`i < RUN`), so its box holds the points
+    /// `k RUN ..= (k + 1) RUN` (a run is kept while any of its segments is; its box may
+    /// hold points forgotten since, which only makes it larger).
+    boxes: VecDeque<Box2>,
+    /// The index of the first box's run.
+    first_run: u64,
 }
 
 impl CommandPath {
@@ -43,7 +100,42 @@ impl CommandPath {
 
     /// The command is at `c` (XY, mm) at `t_s` (not before the last point's time).
     pub fn push(&mut self, t_s: f64, c: [f64; 2]) {
-        self.points.push_back((t_s, c));
+        let n = self.forgotten + self.points.len() as u64;
+        let mut segment = Box2::at(c);
+        if let Some(last) = self.points.back() {
+            segment.add(last.c);
+        }
+        if let Some(b) = self.boxes.back_mut() {
+            // The end of the segment from the last point (in the last run).
+            b.add(c);
+        }
+        if n.is_multiple_of(RUN) {
+            if self.boxes.is_empty() {
+                self.first_run = n / RUN;
+            }
+            self.boxes.push_back(Box2::at(c));
+        }
+        self.points.push_back(Point { t_s, c, segment });
+    }
+
+    /// Forget the points older than [`ACTIVE_WINDOW_S`] before `t_s` (but for the one
+    /// starting the segment that reaches into the window).
+    pub fn forget_before(&mut self, t_s: f64) {
+        while self.points.len() > 1 && self.points[1].t_s < t_s - ACTIVE_WINDOW_S {
+            self.points.pop_front();
+            self.forgotten += 1;
+        }
+        // Runs whose last segment (from point (k + 1) RUN - 1) is forgotten.
+        while !self.boxes.is_empty() && (self.first_run + 1) * RUN <= self.forgotten {
+            self.boxes.pop_front();
+            self.first_run += 1;
+        }
+    }
+
+    /// What [`CommandPath::distance_mm`] can be no larger than for a toolhead at `p` with
+    /// the command at `c` (mm; bit for bit its starting bound).
+    pub fn bound_mm(p: [f64; 2], c: [f64; 2]) -> f64 {
+        segment_distance_sq(p, c, c).sqrt()
     }
 
     /// The toolhead's vibration at `t_s`: its distance (mm) from `p` (XY, mm) to the path
@@ -51,23 +143,30 @@ impl CommandPath {
     /// point (module doc), `c` being the commanded point at `t_s` (on the path); `None`
     /// before the first command.
     pub fn distance_mm(&mut self, t_s: f64, p: [f64; 2], c: [f64; 2]) -> Option<f64> {
-        while self.points.len() > 1 && self.points[1].0 < t_s - ACTIVE_WINDOW_S {
-            self.points.pop_front();
-        }
-        let first = self.points.front()?.1;
-        let (a, b) = self.points.as_slices();
-        // The commanded point bounds the distance; a segment whose bounding box is no
-        // nearer cannot be nearer (most of the window's segments, skipped cheaply).
+        self.forget_before(t_s);
+        let first = self.points.front()?.c;
+        // The commanded point bounds the distance; a box no nearer holds no nearer
+        // segment (most of the window's runs and segments, skipped cheaply).
         let mut best = segment_distance_sq(p, c, c).min(segment_distance_sq(p, first, first));
-        let mut prev = first;
-        for &(_, q) in a.iter().chain(b).skip(1) {
-            let dx = (prev[0].min(q[0]) - p[0]).max(p[0] - prev[0].max(q[0]));
-            let dy = (prev[1].min(q[1]) - p[1]).max(p[1] - prev[1].max(q[1]));
-            let (dx, dy) = (dx.max(0.0), dy.max(0.0));
-            if dx * dx + dy * dy < best {
-                best = best.min(segment_distance_sq(p, prev, q));
+        // Segments from point index `i` (among the kept points) to `i + 1`.
+        let segments = self.points.len() as u64 - 1;
+        for (k, b) in self.boxes.iter().enumerate() {
+            if b.distance_sq(p) >= best {
+                continue;
             }
-            prev = q;
+            let run = (self.first_run + k as u64) * RUN;
+            let from = run.saturating_sub(self.forgotten);
+            let to = (run + RUN - self.forgotten.min(run + RUN)).min(segments);
+            let mut run = self.points.range(from as usize..=to as usize);
+            let Some(mut a) = run.next().map(|q| q.c) else {
+                continue;
+            };
+            for q in run {
+                let a = std::mem::replace(&mut a, q.c);
+                if q.segment.distance_sq(p) < best {
+                    best = best.min(segment_distance_sq(p, a, q.c));
+                }
+            }
         }
         Some(best.sqrt())
     }

@@ -29,6 +29,22 @@ const HIST_RATIO: f64 = 1.001;
 /// Bins from 1e-3 um to 1e5 um (100 mm: beyond is a blow-up, counted in the last bin).
 const HIST_BINS: usize = 18_432;
 
+/// The bin of an error in a [`Histogram`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Bin(usize);
+
+impl Bin {
+    /// The bin of `err_um` (um).
+    pub fn of(err_um: f64) -> Self {
+        let i = if err_um <= HIST_MIN_UM {
+            0
+        } else {
+            ((err_um / HIST_MIN_UM).ln() / HIST_RATIO.ln()).ceil() as usize
+        };
+        Self(i.min(HIST_BINS - 1))
+    }
+}
+
 /// A histogram of contour errors with log-spaced bins (bounded memory whatever the job's
 /// length).
 #[derive(Debug, Clone)]
@@ -49,12 +65,13 @@ impl Default for Histogram {
 impl Histogram {
     /// Count one error (um).
     pub fn push(&mut self, err_um: f64) {
-        let i = if err_um <= HIST_MIN_UM {
-            0
-        } else {
-            ((err_um / HIST_MIN_UM).ln() / HIST_RATIO.ln()).ceil() as usize
-        };
-        self.counts[i.min(HIST_BINS - 1)] += 1;
+        self.push_bin(Bin::of(err_um));
+    }
+
+    /// Count one error by its bin (one error counted in several histograms is binned
+    /// once).
+    pub fn push_bin(&mut self, bin: Bin) {
+        self.counts[bin.0] += 1;
         self.total += 1;
     }
 

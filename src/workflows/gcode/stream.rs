@@ -39,7 +39,7 @@ use crate::studies::gcode::contour::ActiveMoves;
 use crate::studies::gcode::features::FeatureAccount;
 use crate::studies::gcode::fly::FlyAxis;
 use crate::studies::gcode::stats::{
-    Histogram, LayerMap, LayerStats, MapPoint, Split, Spot, TopSpots,
+    Bin, Histogram, LayerMap, LayerStats, MapPoint, Split, Spot, TopSpots,
 };
 
 /// How the job is sampled and what is kept.
@@ -335,6 +335,31 @@ impl Account {
         }
     }
 
+    /// The vibration (um) of a printing sample `w` of move `m` whose contour error is
+    /// `err_um` (module doc), measured where it is read: on the ringing map
+    /// (`map_point`), in a spot (a move's or a feature's worst error so far), or where it
+    /// may be the layer's largest. Elsewhere it is no larger than the layer's largest and
+    /// changes nothing: its bound ([`CommandPath::bound_mm`]) is given instead.
+    fn vibration_um(&mut self, w: &Waiting, err_um: f64, map_point: bool, m: Owner) -> f64 {
+        let p = [w.toolhead[0] * 1e3, w.toolhead[1] * 1e3];
+        let c = [w.cmd[0] * 1e3, w.cmd[1] * 1e3];
+        let bound_um = CommandPath::bound_mm(p, c) * 1e3;
+        let largest = self
+            .layer
+            .as_ref()
+            .map_or(0.0, |l| l.split_worst.vibration_um);
+        let spot = self
+            .owner
+            .as_ref()
+            .is_none_or(|o| o.4.as_ref().is_none_or(|s| err_um > s.error_um))
+            || self.out.features.is_worst(m.feature, err_um);
+        if map_point || spot || bound_um > largest {
+            self.command.distance_mm(w.t, p, c).unwrap_or(0.0) * 1e3
+        } else {
+            bound_um
+        }
+    }
+
     /// Measure a sample (module doc).
     fn measure(&mut self, w: Waiting) {
         let Waiting { k, t, .. } = w;
@@ -342,7 +367,9 @@ impl Account {
         self.active.retire(t);
         let (x, y) = (w.toolhead[0] * 1e3, w.toolhead[1] * 1e3);
         let (cx, cy) = (w.cmd[0] * 1e3, w.cmd[1] * 1e3);
-        let Some((err_mm, m)) = self.active.at(t, [x, y]) else {
+        // The toolhead's and the command's distances to the G-code path: the contour error
+        // and the smoothing.
+        let Some(([err_mm, smoothing_mm], m)) = self.active.at_each(t, [[x, y], [cx, cy]]) else {
             return;
         };
         if self
@@ -387,17 +414,20 @@ impl Account {
             );
         }
         let print = m.working;
+        let map_point = k.is_multiple_of(self.map_stride);
         let mut split = Split::default();
+        self.command.forget_before(t);
         if print {
             split = Split {
-                smoothing_um: self.active.at(t, [cx, cy]).map_or(0.0, |(e, _)| e * 1e3),
-                vibration_um: self.command.distance_mm(t, [x, y], [cx, cy]).unwrap_or(0.0) * 1e3,
+                smoothing_um: smoothing_mm * 1e3,
+                vibration_um: self.vibration_um(&w, err_um, map_point, m),
             };
             self.out.split_worst = self.out.split_worst.max(split);
             if let Some(l) = self.layer.as_mut() {
                 l.split_worst = l.split_worst.max(split);
             }
-            self.hist.push(err_um);
+            let bin = Bin::of(err_um);
+            self.hist.push_bin(bin);
             let spot = || Spot {
                 error_um: err_um,
                 time_s: t,
@@ -408,14 +438,16 @@ impl Account {
                 move_index: m.index,
                 split,
             };
-            self.out.features.sample(m.feature, m.layer, err_um, spot);
+            self.out
+                .features
+                .sample(m.feature, m.layer, (err_um, bin), spot);
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
             {
                 o.4 = Some(spot());
             }
         }
-        if k.is_multiple_of(self.map_stride) {
+        if map_point {
             self.map.push(MapPoint {
                 x_mm: x as f32,
                 y_mm: y as f32,
