@@ -17,7 +17,7 @@ use std::io::BufRead as _;
 
 use super::{DEFAULT_SAMPLE_RATE_HZ, GcodeOptions, GcodeOutcome, XyShapers};
 use crate::error::Error;
-use crate::output::atomic::{create_dir, write_atomic};
+use crate::output::atomic::{create_dir, write_atomic, write_atomic_with};
 use crate::output::html::{Cell, Figure, Image, InputFile, Provenance, Report, Stat, Table};
 use crate::output::plot::ringing::{MapPanel, MapSpot, RingingMap};
 use crate::output::sha256::Sha256;
@@ -484,12 +484,12 @@ fn num(value: f64, prec: usize) -> Cell {
 }
 
 /// The page of `o` (run with `opts`, written into `dir`, whose figures `figures` are given
-/// as caption and SVG markup).
+/// as caption and SVG file, read as the page is written).
 pub fn html_report(
     o: &GcodeOutcome,
     opts: &GcodeOptions,
     dir: &Path,
-    figures: Vec<(String, String)>,
+    figures: Vec<(String, PathBuf)>,
 ) -> Result<Report, Error> {
     let wanted: Vec<u64> = o.worst().iter().map(|w| w.line).collect();
     let (sha, texts) = digest_and_lines(&o.file, &wanted)?;
@@ -629,7 +629,7 @@ pub fn html_report(
             .into_iter()
             .map(|(title, svg)| Figure {
                 title,
-                image: Image::Svg(svg),
+                image: Image::SvgFile(svg),
             })
             .collect(),
         runs: layers,
@@ -709,11 +709,14 @@ pub fn write_html(o: &GcodeOutcome, opts: &GcodeOptions, dir: &Path) -> Result<P
                 },
             },
         };
-        let svg = crate::input::file::read_text(f, crate::input::file::limit::RESULTS)?;
-        figures.push((title, svg));
+        figures.push((title, f.clone()));
     }
     let report = html_report(o, opts, dir, figures)?;
     let path = dir.join(REPORT);
-    write_atomic(&path, crate::output::html::render(&report).as_bytes())?;
+    // The figures are copied from their files as the page is written: neither they nor
+    // the page are held whole (a benchy's maps are several MB of SVG).
+    write_atomic_with(&path, |w| {
+        crate::output::html::render_to(&report, None, &(), w, &path)
+    })?;
     Ok(path)
 }
