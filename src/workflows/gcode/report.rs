@@ -19,7 +19,7 @@ use super::{DEFAULT_SAMPLE_RATE_HZ, GcodeOptions, GcodeOutcome, XyShapers};
 use crate::error::Error;
 use crate::output::atomic::{create_dir, write_atomic, write_atomic_with};
 use crate::output::html::{Cell, Figure, Image, InputFile, Provenance, Report, Stat, Table};
-use crate::output::plot::ringing::{MapPanel, MapSpot, RingingMap};
+use crate::output::plot::ringing::{CONTOUR_ERROR, MapPanel, MapSpot, RingingMap};
 use crate::output::sha256::Sha256;
 use crate::spec::backend::Backend;
 use crate::studies::gcode::stats::LayerMap;
@@ -320,6 +320,7 @@ pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         RingingMap {
             title: format!("Contour error, {}", o.file.display()),
             panels: vec![map_panel(m, &setting)],
+            quantity: CONTOUR_ERROR.into(),
         }
         .write(dir, &stem)?;
         files.push(dir.join(format!("{stem}.svg")));
@@ -333,6 +334,7 @@ pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
                 part_panel(m, &setting, false),
                 part_panel(m, &setting, true),
             ],
+            quantity: "smoothing or vibration (um)".into(),
         }
         .write(dir, &stem)?;
         files.push(dir.join(format!("{stem}.svg")));
