@@ -28,6 +28,8 @@
 
 use std::collections::VecDeque;
 
+use settle_planner::Profile;
+
 use super::contour::{ACTIVE_WINDOW_S, segment_distance_sq};
 
 /// Consecutive segments sharing a bounding box ([`CommandPath::distance_mm`]): about
@@ -169,6 +171,63 @@ impl CommandPath {
             }
         }
         Some(best.sqrt())
+    }
+}
+
+/// The command's path as a simulation makes it: the commanded XY of each sample, and
+/// the breakpoints of the chunks being followed before it (module doc), every chunk's to
+/// its end (a chunk's last breakpoints come after its last sample).
+#[derive(Debug, Default)]
+pub struct CommandTrack {
+    /// The path.
+    pub path: CommandPath,
+    /// The chunks followed whose breakpoints are not all on the path yet, oldest first:
+    /// each one's start (s, print clock), X and Y profiles and the index of each one's
+    /// next breakpoint to put on the path.
+    chunks: VecDeque<(f64, [Profile; 2], [usize; 2])>,
+}
+
+impl CommandTrack {
+    /// Follow a chunk whose X and Y are `xy` from `t0_s` (print clock), after the ones
+    /// before: its breakpoints go on the path.
+    pub fn follow(&mut self, t0_s: f64, xy: [Profile; 2]) {
+        self.chunks.push_back((t0_s, xy, [0, 0]));
+    }
+
+    /// A sample at `t_s` commanded at `c` (XY, mm): the chunks' breakpoints before it,
+    /// then its point, go on the path.
+    pub fn sample(&mut self, t_s: f64, c: [f64; 2]) {
+        self.breakpoints_before(t_s);
+        self.path.push(t_s, c);
+    }
+
+    /// Put the chunks' breakpoints before `t_s` on the path, in time order.
+    fn breakpoints_before(&mut self, t_s: f64) {
+        while let Some((t0, xy, next)) = self.chunks.front_mut() {
+            let at = |next: &[usize; 2], i: usize| {
+                let p: &Profile = &xy[i];
+                (next[i] < p.segments().len()).then(|| *t0 + p.segment_start(next[i]).0)
+            };
+            let tb = match (at(next, 0), at(next, 1)) {
+                (Some(a), Some(b)) => a.min(b),
+                (Some(a), None) | (None, Some(a)) => a,
+                (None, None) => {
+                    self.chunks.pop_front();
+                    continue;
+                }
+            };
+            if tb >= t_s {
+                return;
+            }
+            for i in 0..2 {
+                if at(next, i) == Some(tb) {
+                    next[i] += 1;
+                }
+            }
+            let tau = tb - *t0;
+            let c = [xy[0].state_at(tau).p * 1e3, xy[1].state_at(tau).p * 1e3];
+            self.path.push(tb, c);
+        }
     }
 }
 

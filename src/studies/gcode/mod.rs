@@ -80,13 +80,15 @@ use crate::studies::{
 };
 
 /// runs.csv columns of a G-code run.
-pub const COLUMNS: [&str; 6] = [
+pub const COLUMNS: [&str; 8] = [
     "gcode_file",
     "firmware",
     "print_time_s",
     "contour_worst_um",
     "contour_p95_um",
     "contour_worst_line",
+    "smoothing_worst_um",
+    "vibration_worst_um",
 ];
 
 /// The `[gcode]` table.
@@ -410,8 +412,13 @@ impl Study for GcodeRun {
             None => None,
         };
         let outline = stream::Outline::of(open(run, job).map_err(failed)?, &map, dt, range)?;
-        let chunks =
-            stream::JobChunks::new(open(run, job).map_err(failed)?, map, &outline, job.layers)?;
+        let chunks = stream::JobChunks::new(
+            open(run, job).map_err(failed)?,
+            map,
+            &outline,
+            job.layers,
+            run.sample_rate_hz,
+        )?;
         let linearise_at_m = linearise_at(run, job, ctx.axes).map_err(failed)?;
         Ok(Planned {
             motion: Motion::Stream(Streamed {

@@ -34,7 +34,7 @@ use crate::error::Error;
 use crate::execute::driver::{Batched, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
-use crate::studies::gcode::command_path::CommandPath;
+use crate::studies::gcode::command_path::{CommandPath, CommandTrack};
 use crate::studies::gcode::contour::ActiveMoves;
 use crate::studies::gcode::features::FeatureAccount;
 use crate::studies::gcode::fly::FlyAxis;
@@ -163,10 +163,7 @@ struct Account {
     opts: StreamOptions,
     active: ActiveMoves,
     /// The command's path around the sample being measured.
-    command: CommandPath,
-    /// The chunk being followed: its start (s, print clock), X and Y profiles and the
-    /// index of each one's next breakpoint to put on the command's path.
-    chunk: Option<(f64, [Profile; 2], [usize; 2])>,
+    command: CommandTrack,
     /// The samples not measured yet, oldest first.
     waiting: VecDeque<Waiting>,
     /// How many samples wait.
@@ -200,8 +197,7 @@ impl Account {
             layer_top: TopSpots::new(5),
             opts,
             active: ActiveMoves::default(),
-            command: CommandPath::default(),
-            chunk: None,
+            command: CommandTrack::default(),
             waiting: VecDeque::new(),
             delay: CommandPath::delay(sample_rate_hz),
             out: Streamed::default(),
@@ -281,8 +277,7 @@ impl Account {
         };
         // Every sample's command is on the path, counted or not (the pre-roll's too),
         // with the breakpoints before it.
-        self.breakpoints_before(t);
-        self.command.push(t, [w.cmd[0] * 1e3, w.cmd[1] * 1e3]);
+        self.command.sample(t, [w.cmd[0] * 1e3, w.cmd[1] * 1e3]);
         self.waiting.push_back(w);
         if self.waiting.len() > self.delay
             && let Some(w) = self.waiting.pop_front()
@@ -296,36 +291,7 @@ impl Account {
     fn follow(&mut self, t0_s: f64, tr: &Trajectory) {
         let [ix, iy] = self.opts.xy;
         let xy = [tr.axes()[ix].clone(), tr.axes()[iy].clone()];
-        self.chunk = Some((t0_s, xy, [0, 0]));
-    }
-
-    /// Put the chunk's breakpoints before `t_s` on the command's path, in time order.
-    fn breakpoints_before(&mut self, t_s: f64) {
-        let Some((t0, xy, next)) = self.chunk.as_mut() else {
-            return;
-        };
-        let at = |next: &[usize; 2], i: usize| {
-            let p: &Profile = &xy[i];
-            (next[i] < p.segments().len()).then(|| *t0 + p.segment_start(next[i]).0)
-        };
-        loop {
-            let tb = match (at(next, 0), at(next, 1)) {
-                (Some(a), Some(b)) => a.min(b),
-                (Some(a), None) | (None, Some(a)) => a,
-                (None, None) => return,
-            };
-            if tb >= t_s {
-                return;
-            }
-            for i in 0..2 {
-                if at(next, i) == Some(tb) {
-                    next[i] += 1;
-                }
-            }
-            let tau = tb - *t0;
-            let c = [xy[0].state_at(tau).p * 1e3, xy[1].state_at(tau).p * 1e3];
-            self.command.push(tb, c);
-        }
+        self.command.follow(t0_s, xy);
     }
 
     /// Measure the samples still waiting (the path after them is all there will be).
@@ -354,7 +320,7 @@ impl Account {
             .is_none_or(|o| o.4.as_ref().is_none_or(|s| err_um > s.error_um))
             || self.out.features.is_worst(m.feature, err_um);
         if map_point || spot || bound_um > largest {
-            self.command.distance_mm(w.t, p, c).unwrap_or(0.0) * 1e3
+            self.command.path.distance_mm(w.t, p, c).unwrap_or(0.0) * 1e3
         } else {
             bound_um
         }
@@ -416,7 +382,7 @@ impl Account {
         let print = m.working;
         let map_point = k.is_multiple_of(self.map_stride);
         let mut split = Split::default();
-        self.command.forget_before(t);
+        self.command.path.forget_before(t);
         if print {
             split = Split {
                 smoothing_um: smoothing_mm * 1e3,
