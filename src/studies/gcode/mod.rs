@@ -29,7 +29,9 @@
 //! error against the G-code's own geometry ([`contour`]) and adds to runs.csv
 //! `print_time_s` (the whole file's, by the firmware's planner), `contour_worst_um`,
 //! `contour_p95_um` (working samples of the range's moves, during the job; never the
-//! pre-roll's) and `contour_worst_line`. Bad G-code is reported when the sweep is
+//! pre-roll's), `contour_worst_line`, and the largest of each of the error's two parts
+//! over the same samples ([`stats::Split`]): `smoothing_worst_um` and
+//! `vibration_worst_um`. Bad G-code is reported when the sweep is
 //! checked, with the file and line.
 //!
 //! A physical machine on the modal backend is linearised where the print is

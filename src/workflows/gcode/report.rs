@@ -143,8 +143,8 @@ the moves active at that time, over working moves (extruding, or the laser or sp
 in a feed move); p95 is the 95th percentile of all working samples. It has two parts: \
 smoothing, the distance from the commanded (shaped) position to that path, what the shaper \
 trades for speed (zero without one), and vibration, the distance from the toolhead to the \
-commanded position, what the machine adds (zero on a rigid one); each column is that part's \
-own largest.\n"
+commanded position's own path (a lag along it is not vibration), what the machine adds \
+(zero on a rigid one); each column is that part's own largest.\n"
     );
     if let Some((settings, _)) = &o.config {
         let _ = writeln!(s, "Planner {settings}.\n");
@@ -515,7 +515,7 @@ pub fn html_report(
         o.streamed.simulated_s
     ));
     intro.push(format!(
-        "Of the contour error, smoothing (the shaped command against the G-code path, what the shaper trades for speed) reaches {:.2} um and vibration (the toolhead against the shaped command, what the machine adds) {:.2} um.",
+        "Of the contour error, smoothing (the shaped command against the G-code path, what the shaper trades for speed) reaches {:.2} um and vibration (the toolhead against the shaped command's path, what the machine adds) {:.2} um.",
         o.streamed.split_worst.smoothing_um, o.streamed.split_worst.vibration_um
     ));
     if let Some(w) = o.worst().first() {
