@@ -49,9 +49,9 @@ impl Box2 {
     }
 
     fn add(&mut self, c: [f64; 2]) {
-        for i in 0..2 {
-            self.min[i] = self.min[i].min(c[i]);
-            self.max[i] = self.max[i].max(c[i]);
+        for ((lo, hi), c) in self.min.iter_mut().zip(&mut self.max).zip(c) {
+            *lo = lo.min(c);
+            *hi = hi.max(c);
         }
     }
 
