@@ -15,7 +15,8 @@ use crate::support::{extra, one_modal_run, root, write};
 /// sample the same instants of the print clock, so the worst error agrees to rounding
 /// (1e-9 relative: far above the modal plant's rounding, 1e-16 per step, and far below
 /// what a sample grid moved by a fraction of a sample changes), on the same line, with
-/// the same 95th percentile and print time.
+/// the same 95th percentile and print time, and the same largest smoothing and
+/// vibration.
 /// The run's motion is streamed: its plan holds no trajectory.
 #[test]
 fn the_gcode_study_streams_the_whole_job_with_settle_gcodes_numbers() {
@@ -66,4 +67,17 @@ fn the_gcode_study_streams_the_whole_job_with_settle_gcodes_numbers() {
         extra(&m, "print_time_s").to_bits(),
         whole.print_time_s.to_bits()
     );
+    // The error's two parts: the command evaluated as the runner evaluates it, the
+    // command's path built and measured 20 ms late as `settle gcode` does.
+    let split = whole.streamed.split_worst;
+    for (column, theirs) in [
+        ("smoothing_worst_um", split.smoothing_um),
+        ("vibration_worst_um", split.vibration_um),
+    ] {
+        let ours = extra(&m, column);
+        assert!(
+            theirs > 0.0 && (ours - theirs).abs() <= 1e-9 * theirs,
+            "{column}: study {ours} um vs settle gcode {theirs} um"
+        );
+    }
 }

@@ -378,8 +378,10 @@ fn the_gcode_report_renders_sorts_and_logs_nothing_in_chromium() {
         first_row.contains(&format!("{line}<td>{gcode_line}")),
         "line {line} `{gcode_line}` in {first_row}"
     );
-    // Three figures: the ringing map, the error against Z and the comparison.
-    assert_eq!(html.matches("<figure id=").count(), 3);
+    // Four figures: the ringing map, its smoothing and vibration, the error against Z
+    // and the comparison.
+    assert_eq!(html.matches("<figure id=").count(), 4);
+    assert!(html.contains("smoothing (command against the G-code path)"));
 
     let Some(chrome) = browser() else { return };
     let (_keep, page) = write_page("gcode", &html);

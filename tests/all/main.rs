@@ -14,6 +14,7 @@ mod gcode_grbl;
 mod gcode_job;
 mod gcode_range;
 mod gcode_range_random;
+mod gcode_split;
 mod gcode_stream;
 mod hardening_input;
 mod html_report;

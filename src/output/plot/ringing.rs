@@ -42,7 +42,13 @@ pub struct RingingMap {
     pub title: String,
     /// Panels side by side.
     pub panels: Vec<MapPanel>,
+    /// What the colours show, with its unit: the colour bar's label
+    /// ([`CONTOUR_ERROR`] on a ringing map).
+    pub quantity: String,
 }
+
+/// The colour bar's label of a map coloured by contour error.
+pub const CONTOUR_ERROR: &str = "contour error (um)";
 
 /// Colour of `f` in 0..=1: dark blue (small) through green and yellow to red (large).
 fn color_of(f: f64) -> RGBColor {
@@ -125,7 +131,7 @@ impl RingingMap {
         for (area, p) in maps.split_evenly((1, n)).iter().zip(&self.panels) {
             self.draw_panel(area, p, top)?;
         }
-        draw_bar(&bar, top)?;
+        draw_bar(&bar, top, &self.quantity)?;
         root.present().map_err(err)
     }
 
@@ -180,8 +186,12 @@ impl RingingMap {
     }
 }
 
-/// The colour bar: 0 at the bottom, `top` um at the top.
-fn draw_bar<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, top: f64) -> DrawResult {
+/// The colour bar of `quantity`: 0 at the bottom, `top` um at the top.
+fn draw_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    top: f64,
+    quantity: &str,
+) -> DrawResult {
     let mut chart = ChartBuilder::on(area)
         .margin_top(40)
         .margin_bottom(44)
@@ -193,7 +203,7 @@ fn draw_bar<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, top: f64) -> Draw
         .configure_mesh()
         .disable_x_mesh()
         .disable_x_axis()
-        .y_desc("contour error (um)")
+        .y_desc(quantity)
         .label_style((FONT, 13))
         .draw()
         .map_err(err)?;

@@ -32,7 +32,7 @@ pub fn segment_distance_mm(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 /// root is monotone and correctly rounded, so the root of the least square is the least
 /// root, bit for bit).
 #[inline]
-fn segment_distance_sq(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+pub(crate) fn segment_distance_sq(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let (px, py) = (p[0] - a[0], p[1] - a[1]);
     let l2 = dx * dx + dy * dy;
@@ -106,7 +106,17 @@ impl ActiveMoves {
     /// distance to the nearest active move, or to the move the sample belongs to when
     /// none is active (a pause); `None` before the first move has started.
     pub fn at(&self, t_s: f64, p: [f64; 2]) -> Option<(f64, &MoveInfo)> {
-        let mut best: Option<f64> = None;
+        self.at_each(t_s, [p]).map(|([e], m)| (e, m))
+    }
+
+    /// [`ActiveMoves::at`] of each of the points `ps` at `t_s` (the same moves, one pass).
+    pub fn at_each<const N: usize>(
+        &self,
+        t_s: f64,
+        ps: [[f64; 2]; N],
+    ) -> Option<([f64; N], &MoveInfo)> {
+        let mut best = [f64::INFINITY; N];
+        let mut active = false;
         let mut owner: Option<&Arc<MoveInfo>> = None;
         // Moves are in order of their start times: every move after the first that starts
         // beyond the window starts after `t_s` too (neither active nor the owner).
@@ -120,12 +130,22 @@ impl ActiveMoves {
             if m.end_time_s() + ACTIVE_WINDOW_S < t_s {
                 continue;
             }
-            let d = geometry_distance_sq(&m.geometry, p);
-            best = Some(best.map_or(d, |b: f64| b.min(d)));
+            for (b, &p) in best.iter_mut().zip(&ps) {
+                let d = geometry_distance_sq(&m.geometry, p);
+                // The first active move's distance as it is (an infinite one too).
+                *b = if active { b.min(d) } else { d };
+            }
+            active = true;
         }
         let owner = owner?;
-        let err = best.map_or_else(|| geometry_distance_mm(&owner.geometry, p), f64::sqrt);
-        Some((err, owner))
+        for (b, &p) in best.iter_mut().zip(&ps) {
+            *b = if active {
+                b.sqrt()
+            } else {
+                geometry_distance_mm(&owner.geometry, p)
+            };
+        }
+        Some((best, owner))
     }
 }
 

@@ -10,7 +10,7 @@
 
 use std::collections::BTreeMap;
 
-use super::stats::{Histogram, Spot};
+use super::stats::{Bin, Histogram, Spot};
 
 /// One feature type's account.
 #[derive(Debug, Clone, Default)]
@@ -40,24 +40,79 @@ pub struct FeatureAccount {
     pub layer_p95: BTreeMap<(u32, u16), f64>,
     /// Per feature index, the current layer's errors (cleared at each layer's end).
     current: BTreeMap<u16, Histogram>,
+    /// The account of the feature and layer of the last sample, taken out of the maps
+    /// while their samples come (samples come feature after feature: one look-up per
+    /// change, not per sample), put back when another comes or the layer ends.
+    hot: Option<Hot>,
+}
+
+/// One feature's account in one layer, out of [`FeatureAccount`]'s maps.
+#[derive(Debug, Clone)]
+struct Hot {
+    feature: u16,
+    layer: u32,
+    stats: FeatureStats,
+    current: Histogram,
+    /// The largest error (um) of its samples since it was taken out, from 0.
+    layer_worst: f64,
 }
 
 impl FeatureAccount {
-    /// A working sample of feature `feature`: its error (um) and, when it may be the
-    /// feature's worst, where it is (`spot` is called only then).
-    pub fn sample(&mut self, feature: u16, layer: u32, err_um: f64, spot: impl FnOnce() -> Spot) {
-        let s = self.stats.entry(feature).or_default();
-        s.errors.push(err_um);
-        if s.worst.as_ref().is_none_or(|w| err_um > w.error_um) {
-            s.worst = Some(spot());
+    /// A working sample of feature `feature`: its error (um) and its bin, and, when it may
+    /// be the feature's worst ([`FeatureAccount::is_worst`]), where it is (`spot` is
+    /// called only then).
+    pub fn sample(
+        &mut self,
+        feature: u16,
+        layer: u32,
+        (err_um, bin): (f64, Bin),
+        spot: impl FnOnce() -> Spot,
+    ) {
+        let h = match &mut self.hot {
+            Some(h) if h.feature == feature && h.layer == layer => h,
+            _ => {
+                self.put_back();
+                self.hot.insert(Hot {
+                    feature,
+                    layer,
+                    stats: self.stats.remove(&feature).unwrap_or_default(),
+                    current: self.current.remove(&feature).unwrap_or_default(),
+                    layer_worst: 0.0,
+                })
+            }
+        };
+        h.stats.errors.push_bin(bin);
+        if h.stats.worst.as_ref().is_none_or(|w| err_um > w.error_um) {
+            h.stats.worst = Some(spot());
         }
-        let w = self.layer_worst.entry((layer, feature)).or_insert(0.0);
-        *w = w.max(err_um);
-        self.current.entry(feature).or_default().push(err_um);
+        h.layer_worst = h.layer_worst.max(err_um);
+        h.current.push_bin(bin);
     }
 
-    /// The end of layer `layer`'s samples: each type's 95th percentile over them.
+    /// Whether an error of `err_um` of feature `feature` would be its worst so far.
+    pub fn is_worst(&self, feature: u16, err_um: f64) -> bool {
+        let stats = match &self.hot {
+            Some(h) if h.feature == feature => Some(&h.stats),
+            _ => self.stats.get(&feature),
+        };
+        stats.is_none_or(|s| s.worst.as_ref().is_none_or(|w| err_um > w.error_um))
+    }
+
+    /// Put the hot account back into the maps.
+    fn put_back(&mut self) {
+        let Some(h) = self.hot.take() else {
+            return;
+        };
+        self.stats.insert(h.feature, h.stats);
+        self.current.insert(h.feature, h.current);
+        let w = self.layer_worst.entry((h.layer, h.feature)).or_insert(0.0);
+        *w = w.max(h.layer_worst);
+    }
+
+    /// The end of layer `layer`'s samples: each type's 95th percentile over them (and
+    /// every account back in the maps, where they are read).
     pub fn end_layer(&mut self, layer: u32) {
+        self.put_back();
         for (&f, h) in &mut self.current {
             if h.total() == 0 {
                 continue;

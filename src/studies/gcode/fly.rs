@@ -11,7 +11,7 @@
 //! axis is its fly axis. Printers and mills draw contours, not rasters: their moves are
 //! not counted.
 
-use super::stats::{Histogram, Spot};
+use super::stats::{Histogram, Split, Spot};
 use settle_gcode::job::{MoveGeometry, MoveInfo};
 
 /// A line is along an axis when its other components are below this fraction of its
@@ -78,6 +78,8 @@ impl FlyAxis {
                 line: m.line,
                 layer: m.layer,
                 move_index: m.index,
+                // The split is the contour error's; the along-line error has none.
+                split: Split::default(),
             });
         }
     }

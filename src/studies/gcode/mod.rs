@@ -29,7 +29,9 @@
 //! error against the G-code's own geometry ([`contour`]) and adds to runs.csv
 //! `print_time_s` (the whole file's, by the firmware's planner), `contour_worst_um`,
 //! `contour_p95_um` (working samples of the range's moves, during the job; never the
-//! pre-roll's) and `contour_worst_line`. Bad G-code is reported when the sweep is
+//! pre-roll's), `contour_worst_line`, and the largest of each of the error's two parts
+//! over the same samples ([`stats::Split`]): `smoothing_worst_um` and
+//! `vibration_worst_um`. Bad G-code is reported when the sweep is
 //! checked, with the file and line.
 //!
 //! A physical machine on the modal backend is linearised where the print is
@@ -45,6 +47,7 @@
 //! real job goes on); they measure that stop, not the print, and `settle gcode --layers`
 //! reports no such ringing for a range that ends before the file.
 
+pub mod command_path;
 pub mod contour;
 pub mod features;
 pub mod fly;
@@ -79,13 +82,15 @@ use crate::studies::{
 };
 
 /// runs.csv columns of a G-code run.
-pub const COLUMNS: [&str; 6] = [
+pub const COLUMNS: [&str; 8] = [
     "gcode_file",
     "firmware",
     "print_time_s",
     "contour_worst_um",
     "contour_p95_um",
     "contour_worst_line",
+    "smoothing_worst_um",
+    "vibration_worst_um",
 ];
 
 /// The `[gcode]` table.
@@ -409,8 +414,13 @@ impl Study for GcodeRun {
             None => None,
         };
         let outline = stream::Outline::of(open(run, job).map_err(failed)?, &map, dt, range)?;
-        let chunks =
-            stream::JobChunks::new(open(run, job).map_err(failed)?, map, &outline, job.layers)?;
+        let chunks = stream::JobChunks::new(
+            open(run, job).map_err(failed)?,
+            map,
+            &outline,
+            job.layers,
+            run.sample_rate_hz,
+        )?;
         let linearise_at_m = linearise_at(run, job, ctx.axes).map_err(failed)?;
         Ok(Planned {
             motion: Motion::Stream(Streamed {

@@ -4,8 +4,9 @@
 
 use crate::measure::log_bins::LogBins;
 
-/// A point of a ringing map: the toolhead (mm) and its contour error (um); `print` false
-/// breaks the drawn path (travel, pauses).
+/// A point of a ringing map: the toolhead (mm), its contour error and the error's two
+/// parts ([`Split`], um; 0 off printing moves); `print` false breaks the drawn path
+/// (travel, pauses).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MapPoint {
     /// X (mm).
@@ -14,6 +15,10 @@ pub struct MapPoint {
     pub y_mm: f32,
     /// Contour error (um).
     pub error_um: f32,
+    /// Smoothing (um).
+    pub smoothing_um: f32,
+    /// Vibration (um).
+    pub vibration_um: f32,
     /// Whether the toolhead is printing here.
     pub print: bool,
 }
@@ -25,6 +30,23 @@ const HIST_MIN_UM: f64 = 1e-3;
 const HIST_RATIO: f64 = 1.001;
 /// Bins from 1e-3 um to 1e5 um (100 mm: beyond is a blow-up, counted in the last bin).
 const HIST_BINS: usize = 18_432;
+
+/// The bin of an error in a [`Histogram`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Bin(usize);
+
+impl Bin {
+    /// The bin of `err_um` (um).
+    pub fn of(err_um: f64) -> Self {
+        // `ceil(ln(err / HIST_MIN_UM) / ln(HIST_RATIO))`, clamped to the bins, without
+        // the logarithm (crate::measure::log_bins).
+        static BINS: std::sync::OnceLock<LogBins> = std::sync::OnceLock::new();
+        Self(
+            BINS.get_or_init(|| LogBins::new(HIST_MIN_UM, HIST_RATIO, HIST_BINS))
+                .bin(err_um),
+        )
+    }
+}
 
 /// A histogram of contour errors with log-spaced bins (bounded memory whatever the job's
 /// length).
@@ -46,27 +68,13 @@ impl Default for Histogram {
 impl Histogram {
     /// Count one error (um).
     pub fn push(&mut self, err_um: f64) {
-        // `ceil(ln(err / HIST_MIN_UM) / ln(HIST_RATIO))`, clamped to the bins, without
-        // the logarithm (crate::measure::log_bins). A sample's error is counted in a few
-        // histograms one after the other (the layer's, its feature's): the last value's
-        // bin is kept (the initial key, a NaN, is in bin 0 as every NaN is).
-        static BINS: std::sync::OnceLock<LogBins> = std::sync::OnceLock::new();
-        thread_local! {
-            static LAST: std::cell::Cell<(u64, usize)> = const { std::cell::Cell::new((u64::MAX, 0)) };
-        }
-        let key = err_um.to_bits();
-        let i = LAST.with(|last| {
-            let (k, i) = last.get();
-            if k == key {
-                return i;
-            }
-            let i = BINS
-                .get_or_init(|| LogBins::new(HIST_MIN_UM, HIST_RATIO, HIST_BINS))
-                .bin(err_um);
-            last.set((key, i));
-            i
-        });
-        self.counts[i] += 1;
+        self.push_bin(Bin::of(err_um));
+    }
+
+    /// Count one error by its bin (one error counted in several histograms is binned
+    /// once).
+    pub fn push_bin(&mut self, bin: Bin) {
+        self.counts[bin.0] += 1;
         self.total += 1;
     }
 
@@ -123,6 +131,42 @@ pub struct Spot {
     pub layer: u32,
     /// The move's index in the file.
     pub move_index: u64,
+    /// The error's two parts here.
+    pub split: Split,
+}
+
+/// A contour error told apart (um), each part a contour error of its own:
+///
+/// - *smoothing*: the commanded (shaped) position's distance in XY to the G-code path of
+///   the moves active at that time, as the toolhead's contour error is measured. What the
+///   shaper trades for speed. Without a shaper it is the planner model's corner bridge
+///   only: a profile cannot jump in speed, so each corner's speed jump `dv` is spread over
+///   a 100 us window (`settle_planner::firmware::profiles`), off the path by at most
+///   `|dv| w / 8 + |da| w^2 / 8` per axis (0.07 um for a 5 mm/s square corner at
+///   4,000 mm/s^2).
+/// - *vibration*: the toolhead's distance in XY to the command's own recent path
+///   ([`crate::studies::gcode::command_path`]): what the machine adds. The lag along the
+///   path is not vibration; a rigid machine has none.
+///
+/// Neither is the contour error's share: the toolhead's distance to the G-code path is at
+/// most the sum of its distance to the command's path and that path's distance to the
+/// G-code path.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Split {
+    /// Commanded position to the G-code path (um).
+    pub smoothing_um: f64,
+    /// Toolhead to the command's path (um).
+    pub vibration_um: f64,
+}
+
+impl Split {
+    /// Each part's larger value of `self` and `other`.
+    pub fn max(self, other: Split) -> Split {
+        Split {
+            smoothing_um: self.smoothing_um.max(other.smoothing_um),
+            vibration_um: self.vibration_um.max(other.vibration_um),
+        }
+    }
 }
 
 /// The largest `n` spots, at most one per move, largest first.
@@ -182,6 +226,9 @@ pub struct LayerStats {
     /// the toolhead to the end point after the last command (the ringing after the final
     /// stop).
     pub end_residual_um: Option<f64>,
+    /// The largest smoothing and the largest vibration of its printing samples (each
+    /// part's own largest, not the parts of the largest error).
+    pub split_worst: Split,
 }
 
 impl LayerStats {
@@ -194,6 +241,7 @@ impl LayerStats {
             print_moves: 0,
             mean_move_worst_um: 0.0,
             end_residual_um: None,
+            split_worst: Split::default(),
         }
     }
 
@@ -260,6 +308,7 @@ mod tests {
                 line: i as u64,
                 layer: 0,
                 move_index: i as u64,
+                split: Split::default(),
             });
         }
         let e: Vec<f64> = t.spots().iter().map(|s| s.error_um).collect();

@@ -14,6 +14,9 @@ use settle_gcode::job::{Job, JobChunk};
 use settle_planner::shaper::stream::cut;
 use settle_planner::{PlanError, Profile, Segment, State, Trajectory};
 
+use std::collections::VecDeque;
+
+use super::command_path::{CommandPath, CommandTrack};
 use super::contour::ActiveMoves;
 use super::stats::Histogram;
 use crate::measure::metrics::Metrics;
@@ -194,8 +197,6 @@ pub(super) struct JobChunks {
     cut_s: f64,
     /// The standing start, until taken.
     rest: Option<Trajectory>,
-    /// The next chunk's time 0 on the run's clock (s).
-    t0_s: f64,
     duration_s: f64,
     /// Machine indices of X and Y.
     xy: [usize; 2],
@@ -204,17 +205,41 @@ pub(super) struct JobChunks {
     hist: Histogram,
     /// The largest error (um) and its G-code line.
     worst: (f64, f64),
+    /// The largest smoothing and vibration (um) of the counted samples (see
+    /// [`super::stats::Split`]).
+    split_worst: [f64; 2],
     print_time_s: f64,
+    /// The chunks handed out whose samples may still come: their start (s, run clock),
+    /// duration and X and Y; the start of the next.
+    handed: VecDeque<(f64, f64, [Profile; 2])>,
+    /// The next chunk's time 0 on the run's clock (s).
+    next_t0_s: f64,
+    /// The command's path, and the samples waiting to be measured against it
+    /// ([`CommandPath::delay`] of them).
+    command: CommandTrack,
+    waiting: VecDeque<Waiting>,
+    delay: usize,
+}
+
+/// A sample waiting for its vibration: time (s, run clock), toolhead and command (XY,
+/// mm), and whether it counts.
+#[derive(Debug, Clone, Copy)]
+struct Waiting {
+    t_s: f64,
+    p: [f64; 2],
+    c: [f64; 2],
+    counted: bool,
 }
 
 impl JobChunks {
-    /// The chunks of `job` (opened again as the outline's was) from `outline`'s start;
-    /// only samples of moves in `layers` count.
+    /// The chunks of `job` (opened again as the outline's was) from `outline`'s start,
+    /// sampled at `sample_rate_hz`; only samples of moves in `layers` count.
     pub(super) fn new(
         job: Job<FileInput>,
         map: Vec<usize>,
         outline: &Outline,
         layers: Option<(u32, u32)>,
+        sample_rate_hz: f64,
     ) -> Result<Self, PlanError> {
         let find = |j: usize| map.iter().position(|&m| m == j);
         let (Some(ix), Some(iy)) = (find(0), find(1)) else {
@@ -232,34 +257,97 @@ impl JobChunks {
             origin_s: outline.origin_s,
             cut_s: outline.cut_s,
             rest,
-            t0_s: 0.0,
             duration_s: outline.duration_s,
             xy: [ix, iy],
             layers,
             active: ActiveMoves::default(),
             hist: Histogram::default(),
             worst: (0.0, f64::NAN),
+            split_worst: [0.0; 2],
             print_time_s: outline.print_time_s,
+            handed: VecDeque::new(),
+            next_t0_s: 0.0,
+            command: CommandTrack::default(),
+            waiting: VecDeque::new(),
+            delay: CommandPath::delay(sample_rate_hz),
         })
+    }
+
+    /// A chunk handed out with its time 0: it starts where the one before ended (run
+    /// clock).
+    fn hand(&mut self, tr: Trajectory) -> (f64, Trajectory) {
+        let [ix, iy] = self.xy;
+        let t0 = self.next_t0_s;
+        let d = tr.duration_s();
+        let xy = [tr.axes()[ix].clone(), tr.axes()[iy].clone()];
+        self.handed.push_back((t0, d, xy.clone()));
+        self.command.follow(t0, xy);
+        self.next_t0_s += d;
+        (t0, tr)
+    }
+
+    /// The commanded X and Y (mm) at `t_s` (run clock), as the runner evaluates them: by
+    /// the chunk that takes the sample (a chunk followed by another takes a sample at its
+    /// end; the last one's end is its end state, held).
+    fn commanded_mm(&mut self, t_s: f64) -> Option<[f64; 2]> {
+        while self.handed.len() > 1 && self.handed.front().is_some_and(|c| t_s - c.0 > c.1) {
+            self.handed.pop_front();
+        }
+        let (t0, _, xy) = self.handed.front()?;
+        let tau = t_s - t0;
+        Some([xy[0].state_at(tau).p * 1e3, xy[1].state_at(tau).p * 1e3])
+    }
+
+    /// Count a sample at `tp` (print clock) with the toolhead at `p` and the command at
+    /// `c` (XY, mm): its contour error and smoothing, when it is a working sample of the
+    /// range; whether it counts.
+    fn count(&mut self, tp: f64, p: [f64; 2], c: [f64; 2]) -> bool {
+        let Some(([e, smoothing], owner)) = self.active.at_each(tp, [p, c]) else {
+            return false;
+        };
+        if !owner.working
+            || self
+                .layers
+                .is_some_and(|(a, b)| !(a..=b).contains(&owner.layer))
+        {
+            return false;
+        }
+        let e_um = e * 1e3;
+        self.hist.push(e_um);
+        if e_um > self.worst.0 {
+            self.worst = (e_um, owner.line as f64);
+        }
+        self.split_worst[0] = self.split_worst[0].max(smoothing * 1e3);
+        true
+    }
+
+    /// Measure the oldest waiting sample's vibration, where it may be the largest (its
+    /// bound, [`CommandPath::bound_mm`], is larger than the largest so far).
+    fn measure_waiting(&mut self) {
+        let Some(w) = self.waiting.pop_front() else {
+            return;
+        };
+        self.command.path.forget_before(w.t_s);
+        if w.counted && CommandPath::bound_mm(w.p, w.c) * 1e3 > self.split_worst[1] {
+            let v = self.command.path.distance_mm(w.t_s, w.p, w.c).unwrap_or(0.0) * 1e3;
+            self.split_worst[1] = self.split_worst[1].max(v);
+        }
     }
 }
 
 impl MotionStream for JobChunks {
     fn next_chunk(&mut self) -> Result<Option<(f64, Trajectory)>, PlanError> {
-        let mut next = self.rest.take();
-        while next.is_none()
-            && let Some(c) = self.job.next_chunk().map_err(failed)?
-        {
-            next = from(c.start_time_s, on_machine(&c, &self.map)?, self.cut_s)?;
-            if next.is_some() {
+        if let Some(r) = self.rest.take() {
+            return Ok(Some(self.hand(r)));
+        }
+        while let Some(c) = self.job.next_chunk().map_err(failed)? {
+            let tr = on_machine(&c, &self.map)?;
+            if let Some(tr) = from(c.start_time_s, tr, self.cut_s)? {
                 self.active.add(&c.moves);
+                return Ok(Some(self.hand(tr)));
             }
         }
-        Ok(next.map(|tr| {
-            let t0 = self.t0_s;
-            self.t0_s += tr.duration_s();
-            (t0, tr)
-        }))
+        Ok(None)
     }
 
     fn sample(&mut self, t_s: f64, toolhead_m: &[f64]) {
@@ -270,28 +358,34 @@ impl MotionStream for JobChunks {
         self.active.retire(tp);
         let [ix, iy] = self.xy;
         let p = [toolhead_m[ix] * 1e3, toolhead_m[iy] * 1e3];
-        let Some((e, owner)) = self.active.at(tp, p) else {
+        let Some(c) = self.commanded_mm(t_s) else {
             return;
         };
-        if !owner.working
-            || self
-                .layers
-                .is_some_and(|(a, b)| !(a..=b).contains(&owner.layer))
-        {
-            return;
-        }
-        let e_um = e * 1e3;
-        self.hist.push(e_um);
-        if e_um > self.worst.0 {
-            self.worst = (e_um, owner.line as f64);
+        // The command's path takes every sample's command; each sample's vibration is
+        // measured once the path is known 20 ms after it (as `settle gcode` measures it).
+        self.command.sample(t_s, c);
+        let counted = self.count(tp, p, c);
+        self.waiting.push_back(Waiting {
+            t_s,
+            p,
+            c,
+            counted,
+        });
+        if self.waiting.len() > self.delay {
+            self.measure_waiting();
         }
     }
 
     fn measure(&mut self, m: &mut Metrics) {
+        while !self.waiting.is_empty() {
+            self.measure_waiting();
+        }
         m.extra.push(("print_time_s".into(), self.print_time_s));
         m.extra.push(("contour_worst_um".into(), self.worst.0));
         m.extra
             .push(("contour_p95_um".into(), self.hist.quantile_um(0.95)));
         m.extra.push(("contour_worst_line".into(), self.worst.1));
+        m.extra.push(("smoothing_worst_um".into(), self.split_worst[0]));
+        m.extra.push(("vibration_worst_um".into(), self.split_worst[1]));
     }
 }

@@ -13,7 +13,7 @@ use super::report::map_panel;
 use super::{GcodeOptions, GcodeOutcome, XyShapers, measure, parse_shapers};
 use crate::error::Error;
 use crate::output::atomic::write_atomic;
-use crate::output::plot::ringing::RingingMap;
+use crate::output::plot::ringing::{CONTOUR_ERROR, RingingMap};
 
 /// The comparison table's file name in the output folder.
 pub const FILE: &str = "compare.md";
@@ -98,6 +98,7 @@ pub fn compare(
         RingingMap {
             title: format!("Contour error, {}", a.file.display()),
             panels,
+            quantity: CONTOUR_ERROR.into(),
         }
         .write(dir, &stem)?;
         files.push(dir.join(format!("{stem}.svg")));

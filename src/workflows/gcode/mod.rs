@@ -939,6 +939,8 @@ fn writes(rel: &Path) -> bool {
         &[
             ("ringing-layer-", ".svg"),
             ("ringing-layer-", ".png"),
+            ("split-layer-", ".svg"),
+            ("split-layer-", ".png"),
             ("compare-layer-", ".svg"),
             ("compare-layer-", ".png"),
         ],

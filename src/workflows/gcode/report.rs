@@ -1,6 +1,7 @@
 //! The outputs of `settle gcode`: `layers.csv` (one row per layer), `summary.md` (print
 //! time, worst and 95th-percentile contour error, the worst spots with their G-code
-//! lines, the layers), `ringing-layer-<n>.svg/.png` (the maps of the worst layers) and,
+//! lines, the layers), `ringing-layer-<n>.svg/.png` (the maps of the worst layers),
+//! `split-layer-<n>.svg/.png` (each of those layers' smoothing and vibration) and,
 //! written last, `report.html` ([`write_html`]): the same in one self-contained page with
 //! the figures embedded, the layers in a sortable, filterable table, the worst spots with
 //! the text of their G-code lines, and the provenance (the file's SHA-256, the machine,
@@ -16,15 +17,15 @@ use std::io::BufRead as _;
 
 use super::{DEFAULT_SAMPLE_RATE_HZ, GcodeOptions, GcodeOutcome, XyShapers};
 use crate::error::Error;
-use crate::output::atomic::{create_dir, write_atomic};
+use crate::output::atomic::{create_dir, write_atomic, write_atomic_with};
 use crate::output::html::{Cell, Figure, Image, InputFile, Provenance, Report, Stat, Table};
-use crate::output::plot::ringing::{MapPanel, MapSpot, RingingMap};
+use crate::output::plot::ringing::{CONTOUR_ERROR, MapPanel, MapSpot, RingingMap};
 use crate::output::sha256::Sha256;
 use crate::spec::backend::Backend;
 use crate::studies::gcode::stats::LayerMap;
 
 /// layers.csv's columns.
-pub const LAYER_COLUMNS: [&str; 14] = [
+pub const LAYER_COLUMNS: [&str; 16] = [
     "layer",
     "z_mm",
     "start_s",
@@ -39,6 +40,8 @@ pub const LAYER_COLUMNS: [&str; 14] = [
     "worst_x_mm",
     "worst_y_mm",
     "end_residual_um",
+    "smoothing_worst_um",
+    "vibration_worst_um",
 ];
 
 /// layers.csv as bytes.
@@ -66,10 +69,12 @@ pub fn layers_csv(o: &GcodeOutcome) -> Result<Vec<u8>, csv::Error> {
                     None => row.extend([String::new(), String::new(), String::new()]),
                 }
                 row.push(s.end_residual_um.map(num).unwrap_or_default());
+                row.push(num(s.split_worst.smoothing_um));
+                row.push(num(s.split_worst.vibration_um));
             }
             None => {
                 row.push("false".into());
-                row.extend(std::iter::repeat_n(String::new(), 8));
+                row.extend(std::iter::repeat_n(String::new(), 10));
             }
         }
         w.write_record(&row)?;
@@ -117,23 +122,29 @@ pub fn summary_md(o: &GcodeOutcome, maps: &[String]) -> String {
     );
     let _ = writeln!(
         s,
-        "| print time | worst contour error | p95 contour error | simulated |"
+        "| print time | worst contour error | p95 contour error | worst smoothing | worst vibration | simulated |"
     );
-    let _ = writeln!(s, "|---:|---:|---:|---:|");
+    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|");
     let _ = writeln!(
         s,
-        "| {:.1} s ({:.1} min) | {:.2} um | {:.2} um | {:.1} s of print |\n",
+        "| {:.1} s ({:.1} min) | {:.2} um | {:.2} um | {:.2} um | {:.2} um | {:.1} s of print |\n",
         o.print_time_s,
         o.print_time_s / 60.0,
         o.worst_um,
         o.p95_um,
+        o.streamed.split_worst.smoothing_um,
+        o.streamed.split_worst.vibration_um,
         o.streamed.simulated_s
     );
     let _ = writeln!(
         s,
         "Contour error: distance in XY from the simulated toolhead to the commanded path of \
 the moves active at that time, over working moves (extruding, or the laser or spindle on \
-in a feed move); p95 is the 95th percentile of all working samples.\n"
+in a feed move); p95 is the 95th percentile of all working samples. It has two parts: \
+smoothing, the distance from the commanded (shaped) position to that path, what the shaper \
+trades for speed (zero without one), and vibration, the distance from the toolhead to the \
+commanded position's own path (a lag along it is not vibration), what the machine adds \
+(zero on a rigid one); each column is that part's own largest.\n"
     );
     if let Some((settings, _)) = &o.config {
         let _ = writeln!(s, "Planner {settings}.\n");
@@ -164,21 +175,28 @@ not counted), so that it starts from the vibration the layers before leave.\n",
     let _ = writeln!(s, "## Worst spots\n");
     let _ = writeln!(
         s,
-        "| error (um) | line | layer | X (mm) | Y (mm) | time (s) |"
+        "| error (um) | smoothing (um) | vibration (um) | line | layer | X (mm) | Y (mm) | time (s) |"
     );
-    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|");
     for w in o.worst() {
         let _ = writeln!(
             s,
-            "| {:.2} | {} | {} | {:.2} | {:.2} | {:.3} |",
-            w.error_um, w.line, w.layer, w.x_mm, w.y_mm, w.time_s
+            "| {:.2} | {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {:.3} |",
+            w.error_um,
+            w.split.smoothing_um,
+            w.split.vibration_um,
+            w.line,
+            w.layer,
+            w.x_mm,
+            w.y_mm,
+            w.time_s
         );
     }
     let _ = writeln!(s, "\n## Layers\n");
     let outer = super::features::has_outer_wall(o);
     let _ = writeln!(
         s,
-        "| layer | Z (mm) | time (s) | moves | worst (um) | p95 (um) | worst line |{}",
+        "| layer | Z (mm) | time (s) | moves | worst (um) | p95 (um) | worst line | smoothing (um) | vibration (um) |{}",
         if outer {
             " outer wall worst (um) | outer wall p95 (um) |"
         } else {
@@ -187,20 +205,22 @@ not counted), so that it starts from the vibration the layers before leave.\n",
     );
     let _ = writeln!(
         s,
-        "|---:|---:|---:|---:|---:|---:|---:|{}",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|{}",
         if outer { "---:|---:|" } else { "" }
     );
     for l in &o.layers {
         let z = l.z_mm.map_or(String::new(), |z| format!("{z:.2}"));
-        let (w, p, line) = match &l.stats {
+        let (w, p, line, sm, vib) = match &l.stats {
             Some(st) => (
                 format!("{:.2}", st.worst_um()),
                 format!("{:.2}", st.p95_um),
                 st.worst
                     .as_ref()
                     .map_or(String::new(), |w| w.line.to_string()),
+                format!("{:.2}", st.split_worst.smoothing_um),
+                format!("{:.2}", st.split_worst.vibration_um),
             ),
-            None => ("-".into(), "-".into(), "-".into()),
+            None => ("-".into(), "-".into(), "-".into(), "-".into(), "-".into()),
         };
         let wall = if !outer {
             String::new()
@@ -213,7 +233,7 @@ not counted), so that it starts from the vibration the layers before leave.\n",
         };
         let _ = writeln!(
             s,
-            "| {} | {z} | {:.2} | {} | {w} | {p} | {line} |{wall}",
+            "| {} | {z} | {:.2} | {} | {w} | {p} | {line} | {sm} | {vib} |{wall}",
             l.layer, l.duration_s, l.moves
         );
     }
@@ -258,6 +278,33 @@ pub fn map_panel(m: &LayerMap, setting: &str) -> MapPanel {
     }
 }
 
+/// The figure of one layer's smoothing or vibration (`vibration`), as [`map_panel`]'s:
+/// each point coloured by that part, the worst spots (of the contour error) labelled
+/// with it.
+fn part_panel(m: &LayerMap, setting: &str, vibration: bool) -> MapPanel {
+    let mut p = map_panel(m, setting);
+    p.title = format!(
+        "layer {}, {}, {setting}",
+        m.layer,
+        if vibration { "vibration" } else { "smoothing" }
+    );
+    for q in &mut p.points {
+        q.error_um = if vibration {
+            q.vibration_um
+        } else {
+            q.smoothing_um
+        };
+    }
+    for (spot, s) in p.spots.iter_mut().zip(&m.spots) {
+        spot.error_um = if vibration {
+            s.split.vibration_um
+        } else {
+            s.split.smoothing_um
+        };
+    }
+    p
+}
+
 /// Write the outputs into `dir`; returns the files written.
 pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     create_dir(dir)?;
@@ -273,6 +320,21 @@ pub fn write(o: &GcodeOutcome, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         RingingMap {
             title: format!("Contour error, {}", o.file.display()),
             panels: vec![map_panel(m, &setting)],
+            quantity: CONTOUR_ERROR.into(),
+        }
+        .write(dir, &stem)?;
+        files.push(dir.join(format!("{stem}.svg")));
+        files.push(dir.join(format!("{stem}.png")));
+        stems.push(stem);
+        // The same layer's two parts, side by side on one colour scale.
+        let stem = format!("split-layer-{}", m.layer);
+        RingingMap {
+            title: format!("Smoothing and vibration, {}", o.file.display()),
+            panels: vec![
+                part_panel(m, &setting, false),
+                part_panel(m, &setting, true),
+            ],
+            quantity: "smoothing or vibration (um)".into(),
         }
         .write(dir, &stem)?;
         files.push(dir.join(format!("{stem}.svg")));
@@ -424,12 +486,12 @@ fn num(value: f64, prec: usize) -> Cell {
 }
 
 /// The page of `o` (run with `opts`, written into `dir`, whose figures `figures` are given
-/// as caption and SVG markup).
+/// as caption and SVG file, read as the page is written).
 pub fn html_report(
     o: &GcodeOutcome,
     opts: &GcodeOptions,
     dir: &Path,
-    figures: Vec<(String, String)>,
+    figures: Vec<(String, PathBuf)>,
 ) -> Result<Report, Error> {
     let wanted: Vec<u64> = o.worst().iter().map(|w| w.line).collect();
     let (sha, texts) = digest_and_lines(&o.file, &wanted)?;
@@ -451,6 +513,10 @@ pub fn html_report(
         o.worst_um,
         o.p95_um,
         o.streamed.simulated_s
+    ));
+    intro.push(format!(
+        "Of the contour error, smoothing (the shaped command against the G-code path, what the shaper trades for speed) reaches {:.2} um and vibration (the toolhead against the shaped command's path, what the machine adds) {:.2} um.",
+        o.streamed.split_worst.smoothing_um, o.streamed.split_worst.vibration_um
     ));
     if let Some(w) = o.worst().first() {
         intro.push(format!(
@@ -565,7 +631,7 @@ pub fn html_report(
             .into_iter()
             .map(|(title, svg)| Figure {
                 title,
-                image: Image::Svg(svg),
+                image: Image::SvgFile(svg),
             })
             .collect(),
         runs: layers,
@@ -632,17 +698,27 @@ pub fn write_html(o: &GcodeOutcome, opts: &GcodeOptions, dir: &Path) -> Result<P
             ),
             None => match stem.strip_prefix("compare-layer-") {
                 Some(n) => format!("Layer {n} under both settings, on one colour scale"),
-                None if stem == "error-z" => {
-                    "Contour error against Z: per layer the worst and the 95th percentile".into()
-                }
-                None => stem.clone(),
+                None => match stem.strip_prefix("split-layer-") {
+                    Some(n) => format!(
+                        "Layer {n}: the shaper's smoothing (command against the G-code path) and the machine's vibration (toolhead against the command's path), on one colour scale ({})",
+                        o.setting
+                    ),
+                    None if stem == "error-z" => {
+                        "Contour error against Z: per layer the worst and the 95th percentile"
+                            .into()
+                    }
+                    None => stem.clone(),
+                },
             },
         };
-        let svg = crate::input::file::read_text(f, crate::input::file::limit::RESULTS)?;
-        figures.push((title, svg));
+        figures.push((title, f.clone()));
     }
     let report = html_report(o, opts, dir, figures)?;
     let path = dir.join(REPORT);
-    write_atomic(&path, crate::output::html::render(&report).as_bytes())?;
+    // The figures are copied from their files as the page is written: neither they nor
+    // the page are held whole (a benchy's maps are several MB of SVG).
+    write_atomic_with(&path, |w| {
+        crate::output::html::render_to(&report, None, &(), w, &path)
+    })?;
     Ok(path)
 }

@@ -5,6 +5,10 @@
 //! ([`crate::studies::gcode::contour`]) feeds the per-move, per-layer and whole-job account
 //! ([`crate::studies::gcode::stats`]).
 //!
+//! - Each sample is measured [`CommandPath::delay`] samples late (20 ms), when the
+//!   command's path is known that far after it too: its vibration is measured against the
+//!   command's path around it ([`crate::studies::gcode::command_path`]). The samples still
+//!   waiting are measured when the job's simulation ends.
 //! - With a layer range the job's chunks start a pre-roll before the range (see
 //!   [`crate::studies::gcode::preroll`]): the plant is stepped through it, but only samples of moves in
 //!   the range are counted.
@@ -16,6 +20,7 @@
 //!   [`LayerStats::end_residual_um`].
 
 use std::borrow::Cow;
+use std::collections::VecDeque;
 use std::io::BufRead;
 use std::ops::ControlFlow;
 use std::path::Path;
@@ -30,10 +35,13 @@ use crate::error::Error;
 use crate::execute::driver::{Batched, Chunk, Driver, Full, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
+use crate::studies::gcode::command_path::{CommandPath, CommandTrack};
 use crate::studies::gcode::contour::ActiveMoves;
 use crate::studies::gcode::features::FeatureAccount;
 use crate::studies::gcode::fly::FlyAxis;
-use crate::studies::gcode::stats::{Histogram, LayerMap, LayerStats, MapPoint, Spot, TopSpots};
+use crate::studies::gcode::stats::{
+    Bin, Histogram, LayerMap, LayerStats, MapPoint, Split, Spot, TopSpots,
+};
 
 /// How the job is sampled and what is kept.
 #[derive(Debug, Clone, PartialEq)]
@@ -84,6 +92,8 @@ pub struct Streamed {
     pub layers: Vec<LayerStats>,
     /// Every printing sample's contour error.
     pub all: Histogram,
+    /// The largest smoothing and the largest vibration of the printing samples.
+    pub split_worst: Split,
     /// The worst spots of the job (one per move).
     pub worst: Vec<Spot>,
     /// The ringing maps of the worst layers, largest error first.
@@ -138,11 +148,27 @@ struct Owner {
     line: u64,
 }
 
+/// A sample waiting to be measured: its clock index and time, and the commanded and
+/// toolhead XY (m).
+#[derive(Debug, Clone, Copy)]
+struct Waiting {
+    k: u64,
+    t: f64,
+    cmd: [f64; 2],
+    toolhead: [f64; 2],
+}
+
 /// The running account (module doc).
 #[derive(Debug)]
 struct Account {
     opts: StreamOptions,
     active: ActiveMoves,
+    /// The command's path around the sample being measured.
+    command: CommandTrack,
+    /// The samples not measured yet, oldest first.
+    waiting: VecDeque<Waiting>,
+    /// How many samples wait.
+    delay: usize,
     out: Streamed,
     top: TopSpots,
     layer: Option<LayerStats>,
@@ -165,12 +191,16 @@ struct Account {
 impl Account {
     fn new(opts: StreamOptions, rec: Option<Recorder>) -> Self {
         // About 1 kHz of map points.
-        let map_every = (opts.sample_rate_hz / 1000.0).round().max(1.0) as u64;
+        let sample_rate_hz = opts.sample_rate_hz;
+        let map_every = (sample_rate_hz / 1000.0).round().max(1.0) as u64;
         Self {
             top: TopSpots::new(opts.top_spots),
             layer_top: TopSpots::new(5),
             opts,
             active: ActiveMoves::default(),
+            command: CommandTrack::default(),
+            waiting: VecDeque::new(),
+            delay: CommandPath::delay(sample_rate_hz),
             out: Streamed::default(),
             layer: None,
             hist: Histogram::default(),
@@ -237,12 +267,76 @@ impl Account {
         self.out.layers.push(l);
     }
 
+    /// A sample: its command joins the path, and the sample `delay` before it is measured.
     fn add_sample(&mut self, k: u64, t: f64, cmd_m: &[f64], toolhead_m: &[f64]) {
+        let [ix, iy] = self.opts.xy;
+        let w = Waiting {
+            k,
+            t,
+            cmd: [cmd_m[ix], cmd_m[iy]],
+            toolhead: [toolhead_m[ix], toolhead_m[iy]],
+        };
+        // Every sample's command is on the path, counted or not (the pre-roll's too),
+        // with the breakpoints before it.
+        self.command.sample(t, [w.cmd[0] * 1e3, w.cmd[1] * 1e3]);
+        self.waiting.push_back(w);
+        if self.waiting.len() > self.delay
+            && let Some(w) = self.waiting.pop_front()
+        {
+            self.measure(w);
+        }
+    }
+
+    /// Follow the chunk of `tr` from `t0_s` (print clock): its breakpoints go on the
+    /// command's path.
+    fn follow(&mut self, t0_s: f64, tr: &Trajectory) {
+        let [ix, iy] = self.opts.xy;
+        let xy = [tr.axes()[ix].clone(), tr.axes()[iy].clone()];
+        self.command.follow(t0_s, xy);
+    }
+
+    /// Measure the samples still waiting (the path after them is all there will be).
+    fn flush(&mut self) {
+        while let Some(w) = self.waiting.pop_front() {
+            self.measure(w);
+        }
+    }
+
+    /// The vibration (um) of a printing sample `w` of move `m` whose contour error is
+    /// `err_um` (module doc), measured where it is read: on the ringing map
+    /// (`map_point`), in a spot (a move's or a feature's worst error so far), or where it
+    /// may be the layer's largest. Elsewhere it is no larger than the layer's largest and
+    /// changes nothing: its bound ([`CommandPath::bound_mm`]) is given instead.
+    fn vibration_um(&mut self, w: &Waiting, err_um: f64, map_point: bool, m: Owner) -> f64 {
+        let p = [w.toolhead[0] * 1e3, w.toolhead[1] * 1e3];
+        let c = [w.cmd[0] * 1e3, w.cmd[1] * 1e3];
+        let bound_um = CommandPath::bound_mm(p, c) * 1e3;
+        let largest = self
+            .layer
+            .as_ref()
+            .map_or(0.0, |l| l.split_worst.vibration_um);
+        let spot = self
+            .owner
+            .as_ref()
+            .is_none_or(|o| o.4.as_ref().is_none_or(|s| err_um > s.error_um))
+            || self.out.features.is_worst(m.feature, err_um);
+        if map_point || spot || bound_um > largest {
+            self.command.path.distance_mm(w.t, p, c).unwrap_or(0.0) * 1e3
+        } else {
+            bound_um
+        }
+    }
+
+    /// Measure a sample (module doc).
+    fn measure(&mut self, w: Waiting) {
+        let Waiting { k, t, .. } = w;
         self.out.samples += 1;
         self.active.retire(t);
-        let [ix, iy] = self.opts.xy;
-        let (x, y) = (toolhead_m[ix] * 1e3, toolhead_m[iy] * 1e3);
-        let Some((err_mm, m)) = self.active.at(t, [x, y]) else {
+        let (x, y) = (w.toolhead[0] * 1e3, w.toolhead[1] * 1e3);
+        let (cx, cy) = (w.cmd[0] * 1e3, w.cmd[1] * 1e3);
+        // The toolhead's and the command's distances to the G-code path: the contour error
+        // and the smoothing.
+        let Some(([err_mm, smoothing_mm], m)) = self.active.at_each(t, [[x, y], [cx, cy]]) else {
             return;
         };
         if self
@@ -253,8 +347,7 @@ impl Account {
             return;
         }
         if m.working {
-            let cmd = [cmd_m[ix] * 1e3, cmd_m[iy] * 1e3];
-            self.out.fly.sample(m, t, cmd, [x, y]);
+            self.out.fly.sample(m, t, [cx, cy], [x, y]);
         }
         let m = Owner {
             index: m.index,
@@ -277,10 +370,10 @@ impl Account {
             r.sample(
                 t,
                 &[
-                    cmd_m[ix],
-                    cmd_m[iy],
-                    toolhead_m[ix],
-                    toolhead_m[iy],
+                    w.cmd[0],
+                    w.cmd[1],
+                    w.toolhead[0],
+                    w.toolhead[1],
                     err_mm * 1e-3,
                     m.line as f64,
                     f64::from(m.layer),
@@ -288,8 +381,20 @@ impl Account {
             );
         }
         let print = m.working;
+        let map_point = k.is_multiple_of(self.map_stride);
+        let mut split = Split::default();
+        self.command.path.forget_before(t);
         if print {
-            self.hist.push(err_um);
+            split = Split {
+                smoothing_um: smoothing_mm * 1e3,
+                vibration_um: self.vibration_um(&w, err_um, map_point, m),
+            };
+            self.out.split_worst = self.out.split_worst.max(split);
+            if let Some(l) = self.layer.as_mut() {
+                l.split_worst = l.split_worst.max(split);
+            }
+            let bin = Bin::of(err_um);
+            self.hist.push_bin(bin);
             let spot = || Spot {
                 error_um: err_um,
                 time_s: t,
@@ -298,19 +403,24 @@ impl Account {
                 line: m.line,
                 layer: m.layer,
                 move_index: m.index,
+                split,
             };
-            self.out.features.sample(m.feature, m.layer, err_um, spot);
+            self.out
+                .features
+                .sample(m.feature, m.layer, (err_um, bin), spot);
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
             {
                 o.4 = Some(spot());
             }
         }
-        if k.is_multiple_of(self.map_stride) {
+        if map_point {
             self.map.push(MapPoint {
                 x_mm: x as f32,
                 y_mm: y as f32,
                 error_um: err_um as f32,
+                smoothing_um: split.smoothing_um as f32,
+                vibration_um: split.vibration_um as f32,
                 print,
             });
             if self.map.len() >= 2 * MAX_MAP_POINTS {
@@ -327,7 +437,8 @@ impl Account {
 pub const MAX_MAP_POINTS: usize = 50_000;
 
 /// Halve a ringing map: each pair of neighbours becomes the one with the larger error
-/// (peaks are kept: the map is read for its worst spots), printing only if both are (a
+/// (peaks are kept: the map is read for its worst spots), with the larger of each part
+/// of the split (the split map is read for its peaks too), printing only if both are (a
 /// break in the drawn path stays a break).
 fn halve_map(map: &mut Vec<MapPoint>) {
     let halved: Vec<MapPoint> = map
@@ -337,8 +448,11 @@ fn halve_map(map: &mut Vec<MapPoint>) {
                 .iter()
                 .copied()
                 .fold(pair[0], |a, b| if b.error_um > a.error_um { b } else { a });
+            let part = |f: fn(&MapPoint) -> f32| pair.iter().map(f).fold(0.0, f32::max);
             MapPoint {
                 print: pair.iter().all(|p| p.print),
+                smoothing_um: part(|p| p.smoothing_um),
+                vibration_um: part(|p| p.vibration_um),
                 ..worst
             }
         })
@@ -510,6 +624,7 @@ impl<R: BufRead> JobChunks<'_, R> {
                 .map(|m| m.start_time_s);
         }
         self.end = sub.axes().iter().map(Profile::end).collect();
+        acc.follow(chunk.start_time_s, &sub);
         Ok(Some((chunk.start_time_s, Cow::Owned(sub))))
     }
 }
@@ -573,6 +688,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                 stopped(d.hold_on(&hold, last_k, &mut acc), &mut acc)?;
                 let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
                 tail.duration_s = d.time_s() - t_end;
+                acc.flush();
                 if let Some(l) = acc.layer.as_mut() {
                     l.end_residual_um = Some(tail.residual_peak_um);
                 }
@@ -582,6 +698,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
             acc.out.preroll_s = preroll_s.unwrap_or(0.0);
             acc.out.lost_steps = d.observe().iter().map(|o| o.lost_steps).sum();
         }
+        acc.flush();
         acc.end_layer();
         acc.out.worst = acc.top.spots().to_vec();
         Ok((acc.out, acc.rec))

@@ -58,6 +58,10 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "o_self/layers.csv",
             &std::fs::read_to_string(sb.root().join("print.gcode")).expect("print"),
         ),
+        (
+            "o_split/split-layer-1.svg",
+            &std::fs::read_to_string(sb.root().join("print.gcode")).expect("print"),
+        ),
     ] {
         sb.write(file, text);
     }
@@ -255,6 +259,12 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "gcode o_self/layers.csv --machine printer_xy --out o_self",
             &[],
             Expect::refused(&["is the input", "o_self/layers.csv"]),
+        ),
+        Case::line(
+            "gcode --out a folder where its G-code is a split map it writes",
+            "gcode o_split/split-layer-1.svg --machine printer_xy --out o_split",
+            &[],
+            Expect::refused(&["is the input", "o_split/split-layer-1.svg"]),
         ),
         Case::line(
             "tune into earlier results",
