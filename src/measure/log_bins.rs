@@ -6,7 +6,7 @@
 //! the logarithm and `ceil` each are), so each bin `i >= 1` starts at a threshold `T_i`,
 //! the least `x` whose bin is `i` or more, found at construction by bisection around
 //! `min ratio^(i - 1)`; a value's bin is the number of thresholds at or below it. The
-//! values sharing an exponent and the top [`MANTISSA_BITS`] mantissa bits (a key) span
+//! values sharing an exponent and the top `MANTISSA_BITS` mantissa bits (a key) span
 //! less than a bin when the ratio is above `1 + 2^-10`, so at most one threshold falls
 //! among them: a value's bin is that of its key's lowest value, plus one from that
 //! threshold on. Two independent loads, no logarithm. The test module checks the lookup
