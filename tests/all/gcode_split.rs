@@ -101,3 +101,63 @@ fn an_unshaped_tower_smooths_only_within_the_corner_bridge_bound() {
     let (shaped, _) = split(tower, "printer_xy", "mzv@48", None);
     assert!(shaped.smoothing_um > 10.0, "{shaped:?}");
 }
+
+/// What a user reads first shows the split: the terminal's line gives the job's largest
+/// smoothing and vibration, the largest of layers.csv's columns, and `--versus`'s table
+/// (printed and in compare.md) gives each setting's, the second one's equal to that
+/// setting measured on its own.
+#[test]
+fn the_terminal_and_the_versus_table_show_smoothing_and_vibration() {
+    use crate::support::{run_ok, settle};
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let out = dir.path().join("out");
+    let file = root().join("gcode/prints/ringing_tower.gcode");
+    let run = run_ok(
+        settle()
+            .arg("gcode")
+            .arg(&file)
+            .args(["--machine", "printer_xy", "--firmware", "klipper"])
+            .args(["--shaper", "mzv@48", "--versus", "klipper", "--out"])
+            .arg(&out),
+    );
+    let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
+    let csv = std::fs::read_to_string(out.join("layers.csv")).expect("layers.csv");
+    let rows = settle::input::runs_table::RunsTable::parse(&csv).expect("layers.csv");
+    let largest = |col: &str| {
+        (0..rows.rows.len())
+            .filter_map(|k| rows.num(k, col))
+            .fold(0.0_f64, f64::max)
+    };
+    let (smooth, vib) = (largest("smoothing_worst_um"), largest("vibration_worst_um"));
+    assert!(smooth > 1.0 && vib > 1.0, "a shaped tower: {smooth}, {vib}");
+    let words = format!("(smoothing worst {smooth:.2} um, vibration worst {vib:.2} um)");
+    assert!(
+        stdout.lines().next().expect("a line").ends_with(&words),
+        "{words} in {stdout}"
+    );
+    let (unshaped, _) = split(file, "printer_xy", "none", None);
+    let compare = std::fs::read_to_string(out.join("compare.md")).expect("compare.md");
+    let row = |setting: &str| {
+        compare
+            .lines()
+            .find(|l| l.starts_with(&format!("| {setting} |")))
+            .unwrap_or_else(|| panic!("{setting} in {compare}"))
+            .split('|')
+            .map(str::trim)
+            .map(str::to_owned)
+            .collect::<Vec<_>>()
+    };
+    let (shaped_row, unshaped_row) = (row("klipper + mzv@48 Hz"), row("klipper"));
+    assert_eq!(
+        shaped_row[5..7],
+        [format!("{smooth:.2}"), format!("{vib:.2}")]
+    );
+    assert_eq!(
+        unshaped_row[5..7],
+        [
+            format!("{:.2}", unshaped.smoothing_um),
+            format!("{:.2}", unshaped.vibration_um)
+        ]
+    );
+    assert!(stdout.contains(&compare[compare.find("| setting").expect("a table")..]));
+}

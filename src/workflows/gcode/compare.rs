@@ -55,9 +55,9 @@ pub fn table(outcomes: &[&GcodeOutcome]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| setting | print time (s) | worst contour error (um) | p95 (um) | worst line |"
+        "| setting | print time (s) | worst contour error (um) | p95 (um) | worst smoothing (um) | worst vibration (um) | worst line |"
     );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|");
     for o in outcomes {
         let line = o
             .worst()
@@ -65,8 +65,13 @@ pub fn table(outcomes: &[&GcodeOutcome]) -> String {
             .map_or(String::new(), |w| w.line.to_string());
         let _ = writeln!(
             s,
-            "| {} | {:.2} | {:.2} | {:.2} | {line} |",
-            o.setting, o.print_time_s, o.worst_um, o.p95_um
+            "| {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {line} |",
+            o.setting,
+            o.print_time_s,
+            o.worst_um,
+            o.p95_um,
+            o.streamed.split_worst.smoothing_um,
+            o.streamed.split_worst.vibration_um
         );
     }
     s

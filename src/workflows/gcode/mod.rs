@@ -348,14 +348,16 @@ impl GcodeOutcome {
         let failed = self.streamed.fault.is_some() || self.streamed.lost_steps > 0;
         let mut r = Report::new(if failed { Exit::RunsFailed } else { Exit::Ok });
         r.out(format!(
-            "{}: {} on {} ({}): print time {:.1} s, contour error worst {:.2} um, p95 {:.2} um",
+            "{}: {} on {} ({}): print time {:.1} s, contour error worst {:.2} um, p95 {:.2} um (smoothing worst {:.2} um, vibration worst {:.2} um)",
             self.file.display(),
             self.firmware,
             self.machine,
             self.backend.name(),
             self.print_time_s,
             self.worst_um,
-            self.p95_um
+            self.p95_um,
+            self.streamed.split_worst.smoothing_um,
+            self.streamed.split_worst.vibration_um
         ));
         if let Some((settings, notes)) = &self.config {
             r.out(settings.clone());
