@@ -227,7 +227,7 @@ impl Simulation for Run<'_> {
         let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
         let window = Clock {
             origin_s: t_end,
-            dt_s: driver.dt_s(),
+            dt_s: driver.clock().dt_s,
         };
         let ran = ran.and_then(|()| {
             driver.sample(0, t_end, Some(&at_end), &mut sink)?;

@@ -684,7 +684,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                     band: Band::new(acc.opts.tail_hold_s),
                     end_xy: [hold[ix].p, hold[iy].p],
                 });
-                let last_k = ((t_end + tail_s) / d.dt_s()).floor() as u64;
+                let last_k = ((t_end + tail_s) / d.clock().dt_s).floor() as u64;
                 stopped(d.hold_on(&hold, last_k, &mut acc), &mut acc)?;
                 let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
                 tail.duration_s = d.time_s() - t_end;
