@@ -648,10 +648,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
     type Output = Result<(Streamed, Option<Recorder>), Error>;
 
     fn run<P: Plant>(self, plant: &P) -> Self::Output {
-        let JobSim {
-            mut chunks,
-            mut acc,
-        } = self;
+        let (mut chunks, mut acc) = (self.chunks, self.acc);
         let names = acc.opts.names.clone();
         if let Some(first) = chunks.next(&mut acc)? {
             let t_first = first.0;
