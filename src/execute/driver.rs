@@ -73,28 +73,11 @@ impl Clock {
     }
 }
 
-/// A sample evaluated in full.
+/// Samples handed to a [`Sink`], sample-major: those of one [`Plant::step_samples`] call
+/// (positions only: the plant vouched for them), or one sample evaluated in full (with
+/// its command, and what the plant shows when it was observed).
 #[derive(Debug)]
-pub struct Full<'a> {
-    /// Its index on the clock.
-    pub k: u64,
-    /// Its time (s).
-    pub t_s: f64,
-    /// The command at that time, per axis.
-    pub cmd: &'a [Sample],
-    /// The commanded positions per axis (m).
-    pub commanded_m: &'a [f64],
-    /// The toolhead positions per axis (m).
-    pub toolhead_m: &'a [f64],
-    /// What the plant shows, when it was observed (always when recording, or when the
-    /// sink asked through [`Sink::observes`]).
-    pub observed: Option<&'a [Observation]>,
-}
-
-/// Samples of one [`Plant::step_samples`] call, positions only (the plant vouched for
-/// them), sample-major.
-#[derive(Debug)]
-pub struct Batched<'a> {
+pub struct Samples<'a> {
     /// The first one's index on the clock.
     pub k0: u64,
     /// How many.
@@ -107,10 +90,15 @@ pub struct Batched<'a> {
     pub commanded_m: &'a [f64],
     /// The toolhead positions (m), the same layout.
     pub toolhead_m: &'a [f64],
+    /// A sample evaluated in full: the command at that time, per axis.
+    pub cmd: Option<&'a [Sample]>,
+    /// A sample evaluated in full: what the plant shows, when it was observed (always
+    /// when recording, or when the sink asked through [`Sink::observes`]).
+    pub observed: Option<&'a [Observation]>,
 }
 
-impl Batched<'_> {
-    /// The time of sample `i` of the batch (s).
+impl Samples<'_> {
+    /// The time of sample `i` (s).
     #[inline]
     pub fn time(&self, i: usize) -> f64 {
         self.clock.time(self.k0 + i as u64)
@@ -132,11 +120,8 @@ pub trait Sink {
         false
     }
 
-    /// A sample evaluated in full; `Break` stops the driver ([`Stop::Sink`]).
-    fn sample(&mut self, s: &Full<'_>) -> ControlFlow<()>;
-
-    /// The samples of a batch, in order; `Break(i)` stops the driver at sample `i` (taken).
-    fn samples(&mut self, b: &Batched<'_>) -> ControlFlow<usize>;
+    /// Samples, in order; `Break(i)` stops the driver at sample `i` (taken): [`Stop::Sink`].
+    fn samples(&mut self, s: &Samples<'_>) -> ControlFlow<usize>;
 }
 
 /// A plant, its state and the sample clock (see the module doc).
@@ -333,7 +318,7 @@ impl<'p, P: Plant> Driver<'p, P> {
             if reached {
                 if takes(tau) {
                     cursor.at(tau, &mut self.cmd);
-                    self.sample(self.k, clock.time(self.k), None, sink)?;
+                    self.sample(self.k, clock, None, sink)?;
                 }
                 self.k += 1;
             }
@@ -387,7 +372,7 @@ impl<'p, P: Plant> Driver<'p, P> {
                 Some(Err(stop)) => return Err(stop),
                 _ => self.step(dt, clock.time(k) - dt)?,
             }
-            self.sample(k, clock.time(k), None, sink)?;
+            self.sample(k, clock, None, sink)?;
             k += 1;
         }
         Ok(())
@@ -405,7 +390,7 @@ impl<'p, P: Plant> Driver<'p, P> {
         if k <= last_k {
             self.cmd.copy_from_slice(cmd);
             self.step(clock.time(k) - t, t)?;
-            self.sample(k, clock.time(k), None, sink)?;
+            self.sample(k, clock, None, sink)?;
             self.hold(cmd, k + 1..=last_k, clock, sink)?;
         }
         Ok(())
@@ -461,14 +446,15 @@ impl<'p, P: Plant> Driver<'p, P> {
                 (failed.min(m), Err(Stop::Backend { t_s, error }))
             }
         };
-        let (commanded_m, toolhead_m) = (&self.cmd_p[..], &self.toolhead[..]);
-        let view = Batched {
+        let view = Samples {
             k0,
             count,
             clock,
             axes,
-            commanded_m,
-            toolhead_m,
+            commanded_m: &self.cmd_p,
+            toolhead_m: &self.toolhead,
+            cmd: None,
+            observed: None,
         };
         if count > 0 {
             let stop = sink.samples(&view);
@@ -480,15 +466,16 @@ impl<'p, P: Plant> Driver<'p, P> {
         outcome
     }
 
-    /// Evaluate the plant now in full as sample `k` at `t` (command `cmd`, else the
+    /// Evaluate the plant now in full as sample `k` of `clock` (command `cmd`, else the
     /// driver's current one): checked, handed to the sink, and an interruption looked for.
     pub fn sample(
         &mut self,
         k: u64,
-        t: f64,
+        clock: Clock,
         cmd: Option<&[Sample]>,
         sink: &mut impl Sink,
     ) -> Result<(), Stop> {
+        let t = clock.time(k);
         self.t = t;
         let (plant, n) = (self.plant, self.cmd.len());
         let (cmd_p, toolhead) = (&mut self.cmd_p[..n], &mut self.toolhead[..n]);
@@ -510,15 +497,17 @@ impl<'p, P: Plant> Driver<'p, P> {
                 return Err(Stop::Fault(reason));
             }
         }
-        let s = Full {
-            k,
-            t_s: t,
-            cmd: cmd.unwrap_or(&self.cmd),
+        let view = Samples {
+            k0: k,
+            count: 1,
+            clock,
+            axes: n,
             commanded_m: cmd_p,
             toolhead_m: toolhead,
+            cmd: Some(cmd.unwrap_or(&self.cmd)),
             observed: observed.then_some(&self.obs[..]),
         };
-        if sink.sample(&s).is_break() {
+        if sink.samples(&view).is_break() {
             return Err(Stop::Sink);
         }
         self.polls += 1;

@@ -9,7 +9,7 @@ use settle_planner::{PlanError, Profile, Sample, State};
 use settle_sim::{AxisModel, DriverMode, Observation, Plant, SimError};
 
 use crate::execute::Observe;
-use crate::execute::driver::{Batched, Chunk, Clock, Driver, Full, Sink, Stop, standing_at};
+use crate::execute::driver::{Chunk, Clock, Driver, Samples, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::measure::accumulator::Accumulator;
 use crate::measure::metrics::{Metrics, Status};
@@ -222,7 +222,7 @@ impl Simulation for Run<'_> {
             ..driver.clock()
         };
         let ran = ran.and_then(|()| {
-            driver.sample(0, t_end, Some(&at_end), &mut sink)?;
+            driver.sample(0, window, Some(&at_end), &mut sink)?;
             driver.hold(&hold, 1..=n, window, &mut sink)
         });
         Ok(Ok(sink.finish(&mut driver, self.names, ran)))
@@ -250,14 +250,6 @@ impl<'g> RunSink<'_, 'g> {
             return Ok(None);
         };
         Ok(s.next_chunk()?.map(|(t0, c)| (t0, Cow::Owned(c))))
-    }
-
-    /// The toolhead at `t_s` to the streamed motion and the path: the contour error.
-    fn follow(&mut self, t_s: f64, toolhead_m: &[f64]) -> Option<f64> {
-        if let Some(s) = self.stream.as_deref_mut() {
-            s.sample(t_s, toolhead_m);
-        }
-        self.path.as_mut().map(|p| p.push(t_s, toolhead_m))
     }
 
     /// The run's metrics: a fault, a backend failure or an interruption makes it a failed
@@ -304,30 +296,30 @@ impl<'g> RunSink<'_, 'g> {
 }
 
 impl Sink for RunSink<'_, '_> {
-    fn sample(&mut self, s: &Full<'_>) -> ControlFlow<()> {
-        self.acc.push(s.t_s, s.commanded_m, s.toolhead_m);
-        let contour = self.follow(s.t_s, s.toolhead_m);
-        if let (Some(rec), Some(obs)) = (self.record.as_deref_mut(), s.observed) {
+    fn samples(&mut self, s: &Samples<'_>) -> ControlFlow<usize> {
+        self.acc
+            .push_run(s.count, |i| s.time(i), s.commanded_m, s.toolhead_m);
+        for i in 0..s.count {
+            let (t, toolhead) = (s.time(i), s.positions(i).1);
+            if let Some(st) = self.stream.as_deref_mut() {
+                st.sample(t, toolhead);
+            }
+            let contour = self.path.as_mut().map(|p| p.push(t, toolhead));
+            let (Some(rec), Some(obs), Some(cmd)) = (self.record.as_deref_mut(), s.observed, s.cmd)
+            else {
+                continue;
+            };
             let row = &mut self.row;
             row.clear();
             let mut f2 = 0.0;
-            for ((o, c), m) in obs.iter().zip(s.cmd).zip(self.meta) {
+            for ((o, c), m) in obs.iter().zip(cmd).zip(self.meta) {
                 let f = o.toolhead_m - o.commanded_m;
                 f2 += f * f;
                 row.extend(m.columns.iter().map(|(_, _, value)| value(c, o)));
             }
             row.push(f2.sqrt());
             row.extend(contour);
-            rec.push(s.t_s, row);
-        }
-        ControlFlow::Continue(())
-    }
-
-    fn samples(&mut self, b: &Batched<'_>) -> ControlFlow<usize> {
-        self.acc
-            .push_run(b.count, |i| b.time(i), b.commanded_m, b.toolhead_m);
-        for i in 0..b.count {
-            self.follow(b.time(i), b.positions(i).1);
+            rec.push(t, row);
         }
         ControlFlow::Continue(())
     }
