@@ -349,8 +349,9 @@ impl<'p, P: Plant> Driver<'p, P> {
         Ok(Ok(()))
     }
 
-    /// Hold `cmd` (one sample per axis): a step of one sample period to each sample `k` of
-    /// `ks`, taken at `clock.time(k)`. The driver's own clock is left alone.
+    /// Hold `cmd` (one sample per axis, the driver's command from now on): a step of one
+    /// sample period to each sample `k` of `ks`, taken at `clock.time(k)`. The driver's own
+    /// clock is left alone.
     pub fn hold(
         &mut self,
         cmd: &[Sample],
