@@ -73,28 +73,11 @@ impl Clock {
     }
 }
 
-/// A sample evaluated in full.
+/// Samples handed to a [`Sink`], sample-major: those of one [`Plant::step_samples`] call
+/// (positions only: the plant vouched for them), or one sample evaluated in full (with
+/// its command, and what the plant shows when it was observed).
 #[derive(Debug)]
-pub struct Full<'a> {
-    /// Its index on the clock.
-    pub k: u64,
-    /// Its time (s).
-    pub t_s: f64,
-    /// The command at that time, per axis.
-    pub cmd: &'a [Sample],
-    /// The commanded positions per axis (m).
-    pub commanded_m: &'a [f64],
-    /// The toolhead positions per axis (m).
-    pub toolhead_m: &'a [f64],
-    /// What the plant shows, when it was observed (always when recording, or when the
-    /// sink asked through [`Sink::observes`]).
-    pub observed: Option<&'a [Observation]>,
-}
-
-/// Samples of one [`Plant::step_samples`] call, positions only (the plant vouched for
-/// them), sample-major.
-#[derive(Debug)]
-pub struct Batched<'a> {
+pub struct Samples<'a> {
     /// The first one's index on the clock.
     pub k0: u64,
     /// How many.
@@ -107,10 +90,15 @@ pub struct Batched<'a> {
     pub commanded_m: &'a [f64],
     /// The toolhead positions (m), the same layout.
     pub toolhead_m: &'a [f64],
+    /// A sample evaluated in full: the command at that time, per axis.
+    pub cmd: Option<&'a [Sample]>,
+    /// A sample evaluated in full: what the plant shows, when it was observed (always
+    /// when recording, or when the sink asked through [`Sink::observes`]).
+    pub observed: Option<&'a [Observation]>,
 }
 
-impl Batched<'_> {
-    /// The time of sample `i` of the batch (s).
+impl Samples<'_> {
+    /// The time of sample `i` (s).
     #[inline]
     pub fn time(&self, i: usize) -> f64 {
         self.clock.time(self.k0 + i as u64)
@@ -132,11 +120,8 @@ pub trait Sink {
         false
     }
 
-    /// A sample evaluated in full; `Break` stops the driver ([`Stop::Sink`]).
-    fn sample(&mut self, s: &Full<'_>) -> ControlFlow<()>;
-
-    /// The samples of a batch, in order; `Break(i)` stops the driver at sample `i` (taken).
-    fn samples(&mut self, b: &Batched<'_>) -> ControlFlow<usize>;
+    /// Samples, in order; `Break(i)` stops the driver at sample `i` (taken): [`Stop::Sink`].
+    fn samples(&mut self, s: &Samples<'_>) -> ControlFlow<usize>;
 }
 
 /// A plant, its state and the sample clock (see the module doc).
@@ -144,15 +129,17 @@ pub struct Driver<'p, P: Plant> {
     plant: &'p P,
     state: P::State,
     names: &'p [String],
-    axes: usize,
-    dt: f64,
+    /// Sample `k` at `k / sample_rate` s.
+    clock: Clock,
     /// The next sample's index on the clock.
     k: u64,
     /// The time of the last thing done (s): a step's end, or a sample.
     t: f64,
     /// Every sample observed in full (a recording): no batches.
     record: bool,
-    batch: Option<Buffers>,
+    /// Whole samples go to the plant in batches: not when recording, nor once the plant
+    /// has declined one ([`Plant::step_samples`] returned `None`).
+    batches: bool,
     /// The fewest samples a batch takes (fewer are stepped one by one).
     min_batch: usize,
     /// Batches go across breakpoints where the plant can ([`Driver::across_breakpoints`]).
@@ -160,7 +147,12 @@ pub struct Driver<'p, P: Plant> {
     /// Per axis, the breakpoints inside the steps of the batch being made.
     breaks: Vec<Vec<InnerBreak>>,
     obs: Vec<Observation>,
+    /// The command now, one sample per axis.
     cmd: Vec<Sample>,
+    /// A batch's commands at its steps' starts (up to [`CHUNK`] samples, sample-major).
+    cmds: Vec<Sample>,
+    /// The commanded and toolhead positions (m) of the sample evaluated in full (the
+    /// first axes' worth), or of a batch's samples (sample-major).
     cmd_p: Vec<f64>,
     toolhead: Vec<f64>,
     polls: usize,
@@ -168,15 +160,7 @@ pub struct Driver<'p, P: Plant> {
 
 impl<P: Plant> std::fmt::Debug for Driver<'_, P> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Driver")
-            .field("axes", &self.names)
-            .field("dt_s", &self.dt)
-            .field("next_sample", &self.k)
-            .field("time_s", &self.t)
-            .field("record", &self.record)
-            .field("batches", &self.batch.is_some())
-            .field("min_batch", &self.min_batch)
-            .finish_non_exhaustive()
+        write!(f, "Driver {{ next_sample: {}, .. }}", self.k)
     }
 }
 
@@ -192,25 +176,27 @@ impl<'p, P: Plant> Driver<'p, P> {
         t0_s: f64,
         record: bool,
     ) -> Result<Self, SimError> {
-        let axes = start.len();
-        let dt = 1.0 / sample_rate_hz;
+        let (axes, dt) = (start.len(), 1.0 / sample_rate_hz);
         Ok(Self {
             state: plant.initial_state(start)?,
             plant,
             names,
-            axes,
-            dt,
+            clock: Clock {
+                origin_s: 0.0,
+                dt_s: dt,
+            },
             k: (t0_s / dt).ceil() as u64,
             t: 0.0,
             record,
-            batch: (!record).then(|| Buffers::new(axes)),
+            batches: !record,
             min_batch: 1,
             across: false,
             breaks: vec![Vec::new(); axes],
             obs: vec![Observation::default(); axes],
             cmd: vec![Sample::default(); axes],
-            cmd_p: vec![0.0; axes],
-            toolhead: vec![0.0; axes],
+            cmds: vec![Sample::default(); CHUNK * axes],
+            cmd_p: vec![0.0; CHUNK * axes],
+            toolhead: vec![0.0; CHUNK * axes],
             polls: 0,
         })
     }
@@ -241,9 +227,9 @@ impl<'p, P: Plant> Driver<'p, P> {
         self.t
     }
 
-    /// The sample period (s).
-    pub fn dt_s(&self) -> f64 {
-        self.dt
+    /// The driver's clock (origin 0).
+    pub fn clock(&self) -> Clock {
+        self.clock
     }
 
     /// What the plant shows now.
@@ -268,8 +254,8 @@ impl<'p, P: Plant> Driver<'p, P> {
         with_end: bool,
         sink: &mut impl Sink,
     ) -> Result<(), Stop> {
-        let (n, dt) = (self.axes, self.dt);
-        let t1 = traj.duration_s();
+        let (clock, t1) = (self.clock, traj.duration_s());
+        let dt = clock.dt_s;
         // Sample `k` in the trajectory's own time. The trajectory is stepped in its own
         // time so that a step ends exactly on each breakpoint and the next step's command
         // comes from the next piece (a clock time `t0 + bp` taken back to the
@@ -277,21 +263,14 @@ impl<'p, P: Plant> Driver<'p, P> {
         // piece's acceleration, held for a whole step, would be a large error of the
         // command).
         let local = |k: u64| k as f64 * dt - t0_s;
-        let takes = |tau: f64| with_end || tau < t1;
-        let clock = Clock {
-            origin_s: 0.0,
-            dt_s: dt,
-        };
-        let breakpoints = traj.breakpoints();
-        let mut next_bp = 0usize;
+        let takes = |tau: f64| tau < t1 || (with_end && tau <= t1);
+        let mut breakpoints = traj.breakpoints().into_iter().peekable();
         let mut cursor = Cursor::new(traj);
         let mut inner = self.across.then(|| AxisBreaks::new(traj));
         let mut tau = 0.0_f64;
         while tau < t1 {
-            while next_bp < breakpoints.len() && breakpoints[next_bp] <= tau {
-                next_bp += 1;
-            }
-            let bp = breakpoints.get(next_bp).copied().unwrap_or(t1).min(t1);
+            while breakpoints.next_if(|&b| b <= tau).is_some() {}
+            let bp = breakpoints.peek().map_or(t1, |&b| b.min(t1));
             let t_sample = local(self.k);
             let next = t_sample.min(bp);
             let at_sample = self.k > 0 && tau == local(self.k - 1);
@@ -300,62 +279,46 @@ impl<'p, P: Plant> Driver<'p, P> {
             // every step lies in one piece of every axis's command, or, across
             // breakpoints, up to the trajectory's end.
             let across = inner.is_some();
-            let batch = if across { t_sample <= t1 } else { whole };
-            if batch && at_sample && takes(t_sample) && self.batch.is_some() {
-                let (k0, end) = (self.k, if across { t1 } else { bp });
-                let mut m = 1;
-                while m < CHUNK {
-                    let ts = local(k0 + m as u64);
-                    if ts > end || !takes(ts) {
-                        break;
-                    }
-                    m += 1;
+            let (k0, end) = (self.k, if across { t1 } else { bp });
+            let m = if self.batches && at_sample && takes(t_sample) && (across || whole) {
+                let more = (1..CHUNK as u64).map(|i| local(k0 + i));
+                1 + more.take_while(|&ts| ts <= end && takes(ts)).count()
+            } else {
+                0
+            };
+            let reached = if m >= self.min_batch {
+                let n = self.cmd.len();
+                for (i, c) in self.cmds.chunks_exact_mut(n).take(m).enumerate() {
+                    cursor.at(local(k0 - 1 + i as u64), c);
                 }
-                if m >= self.min_batch
-                    && let Some(b) = self.batch.as_mut()
-                {
-                    for (i, c) in b.cmds.chunks_exact_mut(n).take(m).enumerate() {
-                        cursor.at(local(k0 - 1 + i as u64), c);
-                    }
-                    if let Some(walk) = inner.as_mut() {
-                        walk.fill(m, |i| local(k0 - 1 + i as u64), &mut self.breaks);
-                    }
-                    let fail = |i: usize| clock.time(k0 - 1 + i as u64);
-                    match self.step_batch(m, k0, clock, &fail, across, sink)? {
-                        Some(done) => {
-                            if done < m {
-                                // The walk went past steps not taken.
-                                inner = None;
-                            }
-                            self.k = k0 + done as u64 - 1;
-                            tau = local(self.k);
-                            // The command at the last sample serves it.
-                            cursor.at(tau, &mut self.cmd);
-                            self.sample(self.k, clock.time(self.k), None, sink)?;
-                            self.k += 1;
-                            continue;
-                        }
-                        // The plant splits these steps: so does the rest of the
-                        // trajectory, from this sample on.
-                        None if across => {
-                            inner = None;
-                            continue;
-                        }
-                        None => {}
-                    }
+                if let Some(walk) = inner.as_mut() {
+                    walk.fill(m, |i| local(k0 - 1 + i as u64), &mut self.breaks);
                 }
-            }
-            cursor.at(tau, &mut self.cmd);
-            let h = if whole { dt } else { next - tau };
-            if h > 0.0 {
-                self.step(None, h, t0_s + tau)?;
-            }
-            tau = next;
-            self.t = t0_s + tau;
-            if next == t_sample {
-                if takes(t_sample) {
+                let fail = |i: usize| clock.time(k0 - 1 + i as u64);
+                let Some(done) = self.batch(m, k0, clock, fail, across, sink)? else {
+                    // The plant steps these samples one by one: so does the rest of the
+                    // trajectory, from this sample on.
+                    inner = None;
+                    continue;
+                };
+                if done < m {
+                    // The walk went past steps not taken.
+                    inner = None;
+                }
+                self.k = k0 + done as u64 - 1;
+                tau = local(self.k);
+                true
+            } else {
+                cursor.at(tau, &mut self.cmd);
+                self.step(if whole { dt } else { next - tau }, t0_s + tau)?;
+                tau = next;
+                self.t = t0_s + tau;
+                next == t_sample
+            };
+            if reached {
+                if takes(tau) {
                     cursor.at(tau, &mut self.cmd);
-                    self.sample(self.k, clock.time(self.k), None, sink)?;
+                    self.sample(self.k, clock, None, sink)?;
                 }
                 self.k += 1;
             }
@@ -386,8 +349,9 @@ impl<'p, P: Plant> Driver<'p, P> {
         Ok(Ok(()))
     }
 
-    /// Hold `cmd` (one sample per axis): steps of one sample period, sample `k` at
-    /// `clock.time(k)` for every `k` of `ks`. The driver's own clock is left alone.
+    /// Hold `cmd` (one sample per axis, the driver's command from now on): a step of one
+    /// sample period to each sample `k` of `ks`, taken at `clock.time(k)`. The driver's own
+    /// clock is left alone.
     pub fn hold(
         &mut self,
         cmd: &[Sample],
@@ -395,32 +359,21 @@ impl<'p, P: Plant> Driver<'p, P> {
         clock: Clock,
         sink: &mut impl Sink,
     ) -> Result<(), Stop> {
-        let (first, last) = (*ks.start(), *ks.end());
-        if let Some(b) = self.batch.as_mut() {
-            for c in b.cmds.chunks_exact_mut(self.axes) {
-                c.copy_from_slice(cmd);
-            }
+        self.cmd.copy_from_slice(cmd);
+        for c in self.cmds.chunks_exact_mut(cmd.len()) {
+            c.copy_from_slice(cmd);
         }
-        let dt = self.dt;
-        let mut k = first;
+        let (mut k, last, dt) = (*ks.start(), *ks.end(), self.clock.dt_s);
         while k <= last {
             let m = (last - k + 1).min(CHUNK as u64) as usize;
-            if self.batch.is_some() && m >= self.min_batch {
-                let fail = |i: usize| clock.time(k + i as u64) - dt;
-                if let Some(done) = self.step_batch(m, k, clock, &fail, false, sink)? {
-                    self.sample(
-                        k + done as u64 - 1,
-                        clock.time(k + done as u64 - 1),
-                        Some(cmd),
-                        sink,
-                    )?;
-                    k += done as u64;
-                    continue;
-                }
+            let fail = |i: usize| clock.time(k + i as u64) - dt;
+            let batched = self.batches && m >= self.min_batch;
+            match batched.then(|| self.batch(m, k, clock, fail, false, sink)) {
+                Some(Ok(Some(done))) => k += done as u64 - 1,
+                Some(Err(stop)) => return Err(stop),
+                _ => self.step(dt, clock.time(k) - dt)?,
             }
-            let t = clock.time(k);
-            self.step(Some(cmd), dt, t - dt)?;
-            self.sample(k, t, Some(cmd), sink)?;
+            self.sample(k, clock, None, sink)?;
             k += 1;
         }
         Ok(())
@@ -434,33 +387,28 @@ impl<'p, P: Plant> Driver<'p, P> {
         last_k: u64,
         sink: &mut impl Sink,
     ) -> Result<(), Stop> {
-        let k = self.k;
-        if k > last_k {
-            return Ok(());
+        let (k, t, clock) = (self.k, self.t, self.clock);
+        if k <= last_k {
+            self.cmd.copy_from_slice(cmd);
+            self.step(clock.time(k) - t, t)?;
+            self.sample(k, clock, None, sink)?;
+            self.hold(cmd, k + 1..=last_k, clock, sink)?;
         }
-        let clock = Clock {
-            origin_s: 0.0,
-            dt_s: self.dt,
-        };
-        let (t, h) = (self.t, clock.time(k) - self.t);
-        if h > 0.0 {
-            self.step(Some(cmd), h, t)?;
-        }
-        self.sample(k, clock.time(k), Some(cmd), sink)?;
-        self.hold(cmd, k + 1..=last_k, clock, sink)
+        Ok(())
     }
 
-    /// One step of `h` s with `cmd` (else the driver's current command); a failure is
-    /// reported at `t_fail`.
-    fn step(&mut self, cmd: Option<&[Sample]>, h: f64, t_fail: f64) -> Result<(), Stop> {
-        let cmd = cmd.unwrap_or(&self.cmd);
-        self.plant
-            .step(&mut self.state, cmd, h)
-            .map_err(|error| Stop::Backend { t_s: t_fail, error })
+    /// A step of `h` s (none if `h` is not positive) with the current command; a failure
+    /// is reported at `t_fail`.
+    fn step(&mut self, h: f64, t_fail: f64) -> Result<(), Stop> {
+        if h > 0.0 {
+            let result = self.plant.step(&mut self.state, &self.cmd, h);
+            result.map_err(|error| Stop::Backend { t_s: t_fail, error })?;
+        }
+        Ok(())
     }
 
     /// `m` whole samples in one call from sample `k0` on, the commands at their step
-    /// starts in the buffers. The sink gets every sample but the last one done;
+    /// starts in [`Driver::cmds`]. The sink gets every sample but the last one done;
     /// `Some(done)`: `done` samples stepped, the state at the last one, which the caller
     /// evaluates in full. That also covers a plant that stopped at an unvouched last
     /// sample of the call (it returns `done == m` then, which reads as "all vouched
@@ -468,113 +416,99 @@ impl<'p, P: Plant> Driver<'p, P> {
     /// (nothing was done; batches are off from now on). A step `i` that fails is reported
     /// at `fail(i)`. `across`: the steps hold the breakpoints in [`Driver::breaks`]
     /// ([`Plant::step_samples_across`]); `None` then leaves batches on.
-    fn step_batch(
+    fn batch(
         &mut self,
         m: usize,
         k0: u64,
         clock: Clock,
-        fail: &dyn Fn(usize) -> f64,
+        fail: impl Fn(usize) -> f64,
         across: bool,
         sink: &mut impl Sink,
     ) -> Result<Option<usize>, Stop> {
-        let Some(b) = self.batch.as_mut() else {
-            return Ok(None);
-        };
-        let len = m * self.axes;
+        let (axes, len) = (self.cmd.len(), m * self.cmd.len());
+        let (cmds, dt, state) = (&self.cmds[..len], self.clock.dt_s, &mut self.state);
+        let (cmd_p, toolhead) = (&mut self.cmd_p[..len], &mut self.toolhead[..len]);
         let result = if across {
             let breaks: Vec<&[InnerBreak]> = self.breaks.iter().map(Vec::as_slice).collect();
-            self.plant.step_samples_across(
-                &mut self.state,
-                &b.cmds[..len],
-                &breaks,
-                self.dt,
-                BLOWUP_M,
-                &mut b.cmd_p[..len],
-                &mut b.toolhead[..len],
-            )
+            let p = self.plant;
+            p.step_samples_across(state, cmds, &breaks, dt, BLOWUP_M, cmd_p, toolhead)
         } else {
-            self.plant.step_samples(
-                &mut self.state,
-                &b.cmds[..len],
-                self.dt,
-                BLOWUP_M,
-                &mut b.cmd_p[..len],
-                &mut b.toolhead[..len],
-            )
+            self.plant
+                .step_samples(state, cmds, dt, BLOWUP_M, cmd_p, toolhead)
         };
         let (count, outcome) = match result {
             Ok(Some(done)) if (1..=m).contains(&done) => (done - 1, Ok(Some(done))),
-            Ok(_) if across => return Ok(None),
             Ok(_) => {
-                self.batch = None;
+                self.batches &= across;
                 return Ok(None);
             }
-            Err((failed, error)) => (
-                failed.min(m),
-                Err(Stop::Backend {
-                    t_s: fail(failed),
-                    error,
-                }),
-            ),
+            Err((failed, error)) => {
+                let t_s = fail(failed);
+                (failed.min(m), Err(Stop::Backend { t_s, error }))
+            }
         };
-        let view = Batched {
+        let view = Samples {
             k0,
             count,
             clock,
-            axes: self.axes,
-            commanded_m: &b.cmd_p,
-            toolhead_m: &b.toolhead,
+            axes,
+            commanded_m: &self.cmd_p,
+            toolhead_m: &self.toolhead,
+            cmd: None,
+            observed: None,
         };
         if count > 0 {
-            if let ControlFlow::Break(i) = sink.samples(&view) {
-                self.t = view.time(i);
+            let stop = sink.samples(&view);
+            self.t = view.time(stop.break_value().unwrap_or(count - 1));
+            if stop.is_break() {
                 return Err(Stop::Sink);
             }
-            self.t = view.time(count - 1);
         }
         outcome
     }
 
-    /// Evaluate the plant now in full as sample `k` at `t` (command `cmd`, else the
+    /// Evaluate the plant now in full as sample `k` of `clock` (command `cmd`, else the
     /// driver's current one): checked, handed to the sink, and an interruption looked for.
     pub fn sample(
         &mut self,
         k: u64,
-        t: f64,
+        clock: Clock,
         cmd: Option<&[Sample]>,
         sink: &mut impl Sink,
     ) -> Result<(), Stop> {
+        let t = clock.time(k);
         self.t = t;
-        let plant = self.plant;
+        let (plant, n) = (self.plant, self.cmd.len());
+        let (cmd_p, toolhead) = (&mut self.cmd_p[..n], &mut self.toolhead[..n]);
         let observed = self.record
             || sink.observes()
-            || !(plant.positions(&self.state, &mut self.cmd_p, &mut self.toolhead)
-                && self
-                    .cmd_p
+            || !(plant.positions(&self.state, cmd_p, toolhead)
+                && cmd_p
                     .iter()
-                    .zip(&self.toolhead)
+                    .zip(&*toolhead)
                     .all(|(c, h)| (h - c).abs() <= BLOWUP_M));
         if observed {
             // Every value finite and no blow-up is what `fault_in` checks; otherwise it
             // names the fault.
             plant.observe(&self.state, &mut self.obs);
-            for ((c, h), o) in self.cmd_p.iter_mut().zip(&mut self.toolhead).zip(&self.obs) {
-                *c = o.commanded_m;
-                *h = o.toolhead_m;
+            for ((c, h), o) in cmd_p.iter_mut().zip(toolhead.iter_mut()).zip(&self.obs) {
+                (*c, *h) = (o.commanded_m, o.toolhead_m);
             }
             if let Some(reason) = fault_in(t, self.names, &self.obs) {
                 return Err(Stop::Fault(reason));
             }
         }
-        let s = Full {
-            k,
-            t_s: t,
-            cmd: cmd.unwrap_or(&self.cmd),
-            commanded_m: &self.cmd_p,
-            toolhead_m: &self.toolhead,
+        let view = Samples {
+            k0: k,
+            count: 1,
+            clock,
+            axes: n,
+            commanded_m: cmd_p,
+            toolhead_m: toolhead,
+            cmd: Some(cmd.unwrap_or(&self.cmd)),
             observed: observed.then_some(&self.obs[..]),
         };
-        if sink.sample(&s).is_break() {
+        if sink.samples(&view).is_break() {
             return Err(Stop::Sink);
         }
         self.polls += 1;
@@ -598,28 +532,10 @@ pub fn standing_at(ends: &[State]) -> Vec<Sample> {
         .collect()
 }
 
-/// The buffers of [`Plant::step_samples`] calls (up to [`CHUNK`] samples, sample-major).
-#[derive(Debug)]
-struct Buffers {
-    cmds: Vec<Sample>,
-    cmd_p: Vec<f64>,
-    toolhead: Vec<f64>,
-}
-
-impl Buffers {
-    fn new(axes: usize) -> Self {
-        Self {
-            cmds: vec![Sample::default(); CHUNK * axes],
-            cmd_p: vec![0.0; CHUNK * axes],
-            toolhead: vec![0.0; CHUNK * axes],
-        }
-    }
-}
-
 /// A simulation fault in the observations at `t`: a non-finite value, or an error beyond
 /// [`BLOWUP_M`] (see there). `None` when everything is physical.
 pub fn fault_in(t: f64, names: &[String], obs: &[Observation]) -> Option<String> {
-    for (i, o) in obs.iter().enumerate() {
+    obs.iter().enumerate().find_map(|(i, o)| {
         let axis = names.get(i).map_or("?", String::as_str);
         let values = [
             ("toolhead position", Some(o.toolhead_m)),
@@ -627,20 +543,18 @@ pub fn fault_in(t: f64, names: &[String], obs: &[Observation]) -> Option<String>
             ("carriage position", o.carriage_m),
             ("motor angle", o.motor_angle_rad),
         ];
-        for (what, v) in values {
-            if let Some(v) = v
-                && !v.is_finite()
-            {
-                return Some(format!("{what} of axis {axis} became {v} at t = {t:.6} s"));
-            }
+        let bad = values
+            .into_iter()
+            .find(|(_, v)| v.is_some_and(|v| !v.is_finite()));
+        if let Some((what, Some(v))) = bad {
+            return Some(format!("{what} of axis {axis} became {v} at t = {t:.6} s"));
         }
         let err = o.toolhead_m - o.commanded_m;
-        if err.abs() > BLOWUP_M {
-            return Some(format!(
-                "blow-up: axis {axis}'s toolhead is {:.3e} m from its command at t = {t:.6} s (limit {} m)",
-                err, BLOWUP_M
-            ));
-        }
-    }
-    None
+        (err.abs() > BLOWUP_M).then(|| {
+            format!(
+                "blow-up: axis {axis}'s toolhead is {err:.3e} m from its command \
+                 at t = {t:.6} s (limit {BLOWUP_M} m)"
+            )
+        })
+    })
 }

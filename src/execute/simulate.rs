@@ -9,7 +9,7 @@ use settle_planner::{PlanError, Profile, Sample, State};
 use settle_sim::{AxisModel, DriverMode, Observation, Plant, SimError};
 
 use crate::execute::Observe;
-use crate::execute::driver::{Batched, Chunk, Clock, Driver, Full, Sink, Stop, standing_at};
+use crate::execute::driver::{Chunk, Clock, Driver, Samples, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::measure::accumulator::Accumulator;
 use crate::measure::metrics::{Metrics, Status};
@@ -181,34 +181,26 @@ impl Simulation for Run<'_> {
     type Output = Result<Result<Metrics, SimError>, PlanError>;
 
     fn run<P: Plant>(self, plant: &P) -> Self::Output {
-        let Run {
-            names,
-            meta,
-            motion,
-            observe,
-            record,
-        } = self;
-        let (starts, ends) = bounds(motion);
-        let t_end = motion.duration_s();
+        let (starts, ends) = bounds(self.motion);
+        let (t_end, observe) = (self.motion.duration_s(), self.observe);
         let hold = standing_at(&ends);
         // The command at the move's end; a move of no duration: the trajectory at 0.
         let mut at_end = hold.clone();
-        let (whole, stream) = match motion {
+        let (whole, stream) = match self.motion {
             Motion::Whole(t) => (Some(&*t), None),
             Motion::Stream(s) => (None, Some(&mut *s.chunks as &mut dyn MotionStream)),
         };
         if let Some(t) = whole.filter(|_| t_end <= 0.0) {
             t.state_at(0.0, &mut at_end);
         }
-        let path = whole.and_then(|t| t.path().map(|g| PathAccumulator::new(g, t_end)));
         let target: Vec<f64> = ends.iter().map(|e| e.p).collect();
         let direction: Vec<f64> = starts.iter().zip(&ends).map(|(s, e)| e.p - s.p).collect();
         let mut sink = RunSink {
             acc: Accumulator::new(&target, &direction, t_end, &observe.bands_um),
-            path,
+            path: whole.and_then(|t| t.path().map(|g| PathAccumulator::new(g, t_end))),
             stream,
-            record,
-            meta,
+            record: self.record,
+            meta: self.meta,
             row: Vec::new(),
         };
         // A whole trajectory is a stream of one chunk.
@@ -217,69 +209,24 @@ impl Simulation for Run<'_> {
             None => sink.next_chunk()?,
         };
         let (rate, full) = (observe.sample_rate_hz, sink.record.is_some());
-        let mut driver = match Driver::new(plant, names, &starts, rate, 0.0, full) {
+        let mut driver = match Driver::new(plant, self.names, &starts, rate, 0.0, full) {
             Ok(d) if sink.stream.is_some() => d.streamed(),
             Ok(d) => d,
             Err(e) => return Ok(Err(e)),
         };
         let ran = driver.follow_chunks(first, RunSink::next_chunk, false, &mut sink)?;
         // The end of the move, then the observation window at the end point.
-        let n = (observe.window_s * observe.sample_rate_hz).ceil() as u64;
+        let n = (observe.window_s * rate).ceil() as u64;
         let window = Clock {
             origin_s: t_end,
-            dt_s: driver.dt_s(),
+            ..driver.clock()
         };
         let ran = ran.and_then(|()| {
-            driver.sample(0, t_end, Some(&at_end), &mut sink)?;
+            driver.sample(0, window, Some(&at_end), &mut sink)?;
             driver.hold(&hold, 1..=n, window, &mut sink)
         });
-        Ok(Ok(finish(&mut driver, sink, names, ran)))
+        Ok(Ok(sink.finish(&mut driver, self.names, ran)))
     }
-}
-
-/// The run's metrics: a fault, a backend failure or an interruption makes it a failed
-/// run, lost steps another; a streamed motion adds its figures to an ok run's.
-fn finish<P: Plant>(
-    driver: &mut Driver<'_, P>,
-    sink: RunSink<'_, '_>,
-    names: &[String],
-    ran: Result<(), Stop>,
-) -> Metrics {
-    let status = match ran {
-        Ok(()) => None,
-        Err(Stop::Fault(reason)) => Some(reason),
-        Err(Stop::Backend { t_s, error }) => {
-            Some(format!("the backend failed at t = {t_s:.6} s: {error}"))
-        }
-        Err(Stop::Interrupted) => Some(INTERRUPTED.to_string()),
-        Err(Stop::Sink) => None,
-    };
-    // A recording observed every sample, the last one too.
-    let obs = if sink.record.is_none() {
-        driver.observe()
-    } else {
-        driver.observations()
-    };
-    let angles: Vec<Option<f64>> = obs.iter().map(|o| o.max_load_angle_rad).collect();
-    if let Some(reason) = status {
-        return sink
-            .acc
-            .finish_with(names, &angles, Status::Fault { reason });
-    }
-    let lost: u32 = obs.iter().map(|o| o.lost_steps).sum();
-    let status = match obs.iter().position(|o| o.lost_steps > 0) {
-        Some(i) => Status::LostSteps {
-            axis: names[i].clone(),
-            steps: lost,
-        },
-        None => Status::Ok,
-    };
-    let mut metrics = sink.acc.finish_with(names, &angles, status);
-    metrics.path = sink.path.map(|p| p.finish());
-    if let Some(s) = sink.stream.filter(|_| metrics.is_ok()) {
-        s.measure(&mut metrics);
-    }
-    metrics
 }
 
 /// The fault reason of a run ended by an interruption.
@@ -304,43 +251,75 @@ impl<'g> RunSink<'_, 'g> {
         };
         Ok(s.next_chunk()?.map(|(t0, c)| (t0, Cow::Owned(c))))
     }
+
+    /// The run's metrics: a fault, a backend failure or an interruption makes it a failed
+    /// run, lost steps another; a streamed motion adds its figures to an ok run's.
+    fn finish<P: Plant>(
+        self,
+        driver: &mut Driver<'_, P>,
+        names: &[String],
+        ran: Result<(), Stop>,
+    ) -> Metrics {
+        let reason = match ran {
+            Ok(()) | Err(Stop::Sink) => None,
+            Err(Stop::Fault(reason)) => Some(reason),
+            Err(Stop::Backend { t_s, error }) => {
+                Some(format!("the backend failed at t = {t_s:.6} s: {error}"))
+            }
+            Err(Stop::Interrupted) => Some(INTERRUPTED.to_string()),
+        };
+        // A recording observed every sample, the last one too.
+        if self.record.is_none() {
+            driver.observe();
+        }
+        let obs = driver.observations();
+        let angles: Vec<Option<f64>> = obs.iter().map(|o| o.max_load_angle_rad).collect();
+        if let Some(reason) = reason {
+            return self
+                .acc
+                .finish_with(names, &angles, Status::Fault { reason });
+        }
+        let status = match obs.iter().position(|o| o.lost_steps > 0) {
+            Some(i) => Status::LostSteps {
+                axis: names[i].clone(),
+                steps: obs.iter().map(|o| o.lost_steps).sum(),
+            },
+            None => Status::Ok,
+        };
+        let mut metrics = self.acc.finish_with(names, &angles, status);
+        metrics.path = self.path.map(|p| p.finish());
+        if let Some(s) = self.stream.filter(|_| metrics.is_ok()) {
+            s.measure(&mut metrics);
+        }
+        metrics
+    }
 }
 
 impl Sink for RunSink<'_, '_> {
-    fn sample(&mut self, s: &Full<'_>) -> ControlFlow<()> {
-        self.acc.push(s.t_s, s.commanded_m, s.toolhead_m);
-        if let Some(st) = self.stream.as_deref_mut() {
-            st.sample(s.t_s, s.toolhead_m);
-        }
-        let contour = self.path.as_mut().map(|p| p.push(s.t_s, s.toolhead_m));
-        if let (Some(rec), Some(obs)) = (self.record.as_deref_mut(), s.observed) {
+    fn samples(&mut self, s: &Samples<'_>) -> ControlFlow<usize> {
+        self.acc
+            .push_run(s.count, |i| s.time(i), s.commanded_m, s.toolhead_m);
+        for i in 0..s.count {
+            let (t, toolhead) = (s.time(i), s.positions(i).1);
+            if let Some(st) = self.stream.as_deref_mut() {
+                st.sample(t, toolhead);
+            }
+            let contour = self.path.as_mut().map(|p| p.push(t, toolhead));
+            let (Some(rec), Some(obs), Some(cmd)) = (self.record.as_deref_mut(), s.observed, s.cmd)
+            else {
+                continue;
+            };
             let row = &mut self.row;
             row.clear();
             let mut f2 = 0.0;
-            for ((o, c), m) in obs.iter().zip(s.cmd).zip(self.meta) {
+            for ((o, c), m) in obs.iter().zip(cmd).zip(self.meta) {
                 let f = o.toolhead_m - o.commanded_m;
                 f2 += f * f;
                 row.extend(m.columns.iter().map(|(_, _, value)| value(c, o)));
             }
             row.push(f2.sqrt());
             row.extend(contour);
-            rec.push(s.t_s, row);
-        }
-        ControlFlow::Continue(())
-    }
-
-    fn samples(&mut self, b: &Batched<'_>) -> ControlFlow<usize> {
-        self.acc
-            .push_run(b.count, |i| b.time(i), b.commanded_m, b.toolhead_m);
-        if let Some(p) = self.path.as_mut() {
-            for i in 0..b.count {
-                p.push(b.time(i), b.positions(i).1);
-            }
-        }
-        if let Some(st) = self.stream.as_deref_mut() {
-            for i in 0..b.count {
-                st.sample(b.time(i), b.positions(i).1);
-            }
+            rec.push(t, row);
         }
         ControlFlow::Continue(())
     }

@@ -17,7 +17,7 @@ use std::ops::ControlFlow;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use settle::execute::driver::{Batched, Driver, Full, Sink};
+use settle::execute::driver::{Driver, Samples, Sink};
 use settle_planner::{Profile, Segment, State, Trajectory};
 use settle_sim::{AxisModel, DriverMode, ModalPlant, Mode};
 
@@ -28,12 +28,7 @@ struct Record {
 }
 
 impl Sink for Record {
-    fn sample(&mut self, s: &Full<'_>) -> ControlFlow<()> {
-        self.samples.push((s.k, s.toolhead_m.to_vec()));
-        ControlFlow::Continue(())
-    }
-
-    fn samples(&mut self, b: &Batched<'_>) -> ControlFlow<usize> {
+    fn samples(&mut self, b: &Samples<'_>) -> ControlFlow<usize> {
         for i in 0..b.count {
             self.samples
                 .push((b.k0 + i as u64, b.positions(i).1.to_vec()));

@@ -32,7 +32,7 @@ use settle_sim::{AxisModel, Observation, Plant, SimError};
 use super::Progress;
 use super::record::Recorder;
 use crate::error::Error;
-use crate::execute::driver::{Batched, Chunk, Driver, Full, Sink, Stop, standing_at};
+use crate::execute::driver::{Chunk, Driver, Samples, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
 use crate::studies::gcode::command_path::{CommandPath, CommandTrack};
@@ -517,28 +517,16 @@ impl Sink for Account {
         self.out.first_lost_step.is_none()
     }
 
-    fn sample(&mut self, s: &Full<'_>) -> ControlFlow<()> {
-        self.add_sample(s.k, s.t_s, s.commanded_m, s.toolhead_m);
-        if let Some(obs) = s.observed
-            && self.out.first_lost_step.is_none()
-        {
-            self.lost_step_check(s.t_s, obs);
-        }
+    fn samples(&mut self, s: &Samples<'_>) -> ControlFlow<usize> {
         let xy = self.opts.xy;
-        if let Some(r) = self.ringing.as_mut()
-            && r.stops(xy, s.t_s, s.toolhead_m)
-        {
-            return ControlFlow::Break(());
-        }
-        ControlFlow::Continue(())
-    }
-
-    fn samples(&mut self, b: &Batched<'_>) -> ControlFlow<usize> {
-        let xy = self.opts.xy;
-        for i in 0..b.count {
-            let (c, h) = b.positions(i);
-            let t = b.time(i);
-            self.add_sample(b.k0 + i as u64, t, c, h);
+        for i in 0..s.count {
+            let ((c, h), t) = (s.positions(i), s.time(i));
+            self.add_sample(s.k0 + i as u64, t, c, h);
+            if let Some(obs) = s.observed
+                && self.out.first_lost_step.is_none()
+            {
+                self.lost_step_check(t, obs);
+            }
             if let Some(r) = self.ringing.as_mut()
                 && r.stops(xy, t, h)
             {
@@ -648,10 +636,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
     type Output = Result<(Streamed, Option<Recorder>), Error>;
 
     fn run<P: Plant>(self, plant: &P) -> Self::Output {
-        let JobSim {
-            mut chunks,
-            mut acc,
-        } = self;
+        let (mut chunks, mut acc) = (self.chunks, self.acc);
         let names = acc.opts.names.clone();
         if let Some(first) = chunks.next(&mut acc)? {
             let t_first = first.0;
@@ -684,7 +669,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                     band: Band::new(acc.opts.tail_hold_s),
                     end_xy: [hold[ix].p, hold[iy].p],
                 });
-                let last_k = ((t_end + tail_s) / d.dt_s()).floor() as u64;
+                let last_k = ((t_end + tail_s) / d.clock().dt_s).floor() as u64;
                 stopped(d.hold_on(&hold, last_k, &mut acc), &mut acc)?;
                 let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
                 tail.duration_s = d.time_s() - t_end;
