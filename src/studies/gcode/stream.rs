@@ -19,6 +19,7 @@ use std::collections::VecDeque;
 use super::command_path::{CommandPath, CommandTrack};
 use super::contour::ActiveMoves;
 use super::stats::Histogram;
+use crate::execute::cursor::profile_at;
 use crate::measure::metrics::Metrics;
 use crate::studies::MotionStream;
 
@@ -120,8 +121,11 @@ impl Outline {
         let mut end = Vec::new();
         let mut first_s = None;
         while let Some(c) = job.next_chunk().map_err(failed)? {
-            let tr = on_machine(&c, map)?;
-            end = tr.axes().iter().map(Profile::end).collect();
+            // The chunk's profiles on the machine's axes, read in place (a chunk is
+            // copied only when kept).
+            let axes = map.iter().map(|&i| &c.trajectory.axes()[i]);
+            end.clear();
+            end.extend(axes.clone().map(Profile::end));
             if let (Some((a, _)), None) = (range, range_start) {
                 range_start = c
                     .moves
@@ -131,9 +135,10 @@ impl Outline {
             }
             let first = *first_s.get_or_insert(c.start_time_s);
             if c.start_time_s < first + 2.0 * dt {
-                early.push((c.start_time_s, tr));
+                early.push((c.start_time_s, on_machine(&c, map)?));
             } else {
-                later.push(tr.duration_s());
+                // As `Trajectory::new` sums it up.
+                later.push(axes.map(|p| p.duration_s()).fold(0.0, f64::max));
             }
         }
         job.run_to_end().map_err(failed)?;
@@ -210,8 +215,9 @@ pub(super) struct JobChunks {
     split_worst: [f64; 2],
     print_time_s: f64,
     /// The chunks handed out whose samples may still come: their start (s, run clock),
-    /// duration and X and Y; the start of the next.
-    handed: VecDeque<(f64, f64, [Profile; 2])>,
+    /// duration and X and Y, and the segment of X and Y the last sample fell in
+    /// ([`profile_at`]'s cursor).
+    handed: VecDeque<(f64, f64, [Profile; 2], [usize; 2])>,
     /// The next chunk's time 0 on the run's clock (s).
     next_t0_s: f64,
     /// The command's path, and the samples waiting to be measured against it
@@ -280,7 +286,7 @@ impl JobChunks {
         let t0 = self.next_t0_s;
         let d = tr.duration_s();
         let xy = [tr.axes()[ix].clone(), tr.axes()[iy].clone()];
-        self.handed.push_back((t0, d, xy.clone()));
+        self.handed.push_back((t0, d, xy.clone(), [0, 0]));
         self.command.follow(t0, xy);
         self.next_t0_s += d;
         (t0, tr)
@@ -293,9 +299,12 @@ impl JobChunks {
         while self.handed.len() > 1 && self.handed.front().is_some_and(|c| t_s - c.0 > c.1) {
             self.handed.pop_front();
         }
-        let (t0, _, xy) = self.handed.front()?;
-        let tau = t_s - t0;
-        Some([xy[0].state_at(tau).p * 1e3, xy[1].state_at(tau).p * 1e3])
+        let (t0, _, xy, seg) = self.handed.front_mut()?;
+        let tau = t_s - *t0;
+        Some([
+            profile_at(&xy[0], &mut seg[0], tau).p * 1e3,
+            profile_at(&xy[1], &mut seg[1], tau).p * 1e3,
+        ])
     }
 
     /// Count a sample at `tp` (print clock) with the toolhead at `p` and the command at
