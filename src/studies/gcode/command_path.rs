@@ -27,6 +27,7 @@
 //! ringing tower).
 
 use std::collections::VecDeque;
+use std::sync::Arc;
 
 use settle_planner::Profile;
 
@@ -186,13 +187,14 @@ pub struct CommandTrack {
     /// each one's start (s, print clock), X and Y profiles, the index of each one's
     /// next breakpoint to put on the path, and each one's segment of the last breakpoint
     /// put ([`profile_at`]'s cursor).
-    chunks: VecDeque<(f64, [Profile; 2], [usize; 2], [usize; 2])>,
+    chunks: VecDeque<(f64, Arc<[Profile; 2]>, [usize; 2], [usize; 2])>,
 }
 
 impl CommandTrack {
-    /// Follow a chunk whose X and Y are `xy` from `t0_s` (print clock), after the ones
+    /// Follow a chunk whose X and Y are `xy` (shared, not copied) from `t0_s` (print
+    /// clock), after the ones
     /// before: its breakpoints go on the path.
-    pub fn follow(&mut self, t0_s: f64, xy: [Profile; 2]) {
+    pub fn follow(&mut self, t0_s: f64, xy: Arc<[Profile; 2]>) {
         self.chunks.push_back((t0_s, xy, [0, 0], [0, 0]));
     }
 

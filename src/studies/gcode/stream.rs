@@ -15,6 +15,7 @@ use settle_planner::shaper::stream::cut;
 use settle_planner::{PlanError, Profile, Segment, State, Trajectory};
 
 use std::collections::VecDeque;
+use std::sync::Arc;
 
 use super::command_path::{CommandPath, CommandTrack};
 use super::contour::ActiveMoves;
@@ -217,7 +218,7 @@ pub(super) struct JobChunks {
     /// The chunks handed out whose samples may still come: their start (s, run clock),
     /// duration and X and Y, and the segment of X and Y the last sample fell in
     /// ([`profile_at`]'s cursor).
-    handed: VecDeque<(f64, f64, [Profile; 2], [usize; 2])>,
+    handed: VecDeque<(f64, f64, Arc<[Profile; 2]>, [usize; 2])>,
     /// The next chunk's time 0 on the run's clock (s).
     next_t0_s: f64,
     /// The command's path, and the samples waiting to be measured against it
@@ -285,8 +286,8 @@ impl JobChunks {
         let [ix, iy] = self.xy;
         let t0 = self.next_t0_s;
         let d = tr.duration_s();
-        let xy = [tr.axes()[ix].clone(), tr.axes()[iy].clone()];
-        self.handed.push_back((t0, d, xy.clone(), [0, 0]));
+        let xy = Arc::new([tr.axes()[ix].clone(), tr.axes()[iy].clone()]);
+        self.handed.push_back((t0, d, Arc::clone(&xy), [0, 0]));
         self.command.follow(t0, xy);
         self.next_t0_s += d;
         (t0, tr)
