@@ -215,10 +215,8 @@ pub(super) struct JobChunks {
     /// [`super::stats::Split`]).
     split_worst: [f64; 2],
     print_time_s: f64,
-    /// The chunks handed out whose samples may still come: their start (s, run clock),
-    /// duration and X and Y, and the segment of X and Y the last sample fell in
-    /// ([`profile_at`]'s cursor).
-    handed: VecDeque<(f64, f64, Arc<[Profile; 2]>, [usize; 2])>,
+    /// The chunks handed out whose samples may still come.
+    handed: VecDeque<Handed>,
     /// The next chunk's time 0 on the run's clock (s).
     next_t0_s: f64,
     /// The command's path, and the samples waiting to be measured against it
@@ -226,6 +224,18 @@ pub(super) struct JobChunks {
     command: CommandTrack,
     waiting: VecDeque<Waiting>,
     delay: usize,
+}
+
+/// A chunk handed out whose samples may still come.
+#[derive(Debug)]
+struct Handed {
+    /// Its start (s, run clock).
+    t0_s: f64,
+    duration_s: f64,
+    /// Its X and Y.
+    xy: Arc<[Profile; 2]>,
+    /// The segment of X and Y the last sample fell in ([`profile_at`]'s cursor).
+    seg: [usize; 2],
 }
 
 /// A sample waiting for its vibration: time (s, run clock), toolhead and command (XY,
@@ -287,7 +297,12 @@ impl JobChunks {
         let t0 = self.next_t0_s;
         let d = tr.duration_s();
         let xy = Arc::new([tr.axes()[ix].clone(), tr.axes()[iy].clone()]);
-        self.handed.push_back((t0, d, Arc::clone(&xy), [0, 0]));
+        self.handed.push_back(Handed {
+            t0_s: t0,
+            duration_s: d,
+            xy: Arc::clone(&xy),
+            seg: [0, 0],
+        });
         self.command.follow(t0, xy);
         self.next_t0_s += d;
         (t0, tr)
@@ -297,11 +312,16 @@ impl JobChunks {
     /// the chunk that takes the sample (a chunk followed by another takes a sample at its
     /// end; the last one's end is its end state, held).
     fn commanded_mm(&mut self, t_s: f64) -> Option<[f64; 2]> {
-        while self.handed.len() > 1 && self.handed.front().is_some_and(|c| t_s - c.0 > c.1) {
+        while self.handed.len() > 1
+            && self
+                .handed
+                .front()
+                .is_some_and(|c| t_s - c.t0_s > c.duration_s)
+        {
             self.handed.pop_front();
         }
-        let (t0, _, xy, seg) = self.handed.front_mut()?;
-        let tau = t_s - *t0;
+        let Handed { t0_s, xy, seg, .. } = self.handed.front_mut()?;
+        let tau = t_s - *t0_s;
         Some([
             profile_at(&xy[0], &mut seg[0], tau).p * 1e3,
             profile_at(&xy[1], &mut seg[1], tau).p * 1e3,
