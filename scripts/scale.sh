@@ -138,7 +138,7 @@ gcode() {
     awk -v sim="$simulated" -v rate_min="$rate_min" -v mb_max="$mb_max" -F: '
         /User time/ { cpu += $2 } /System time/ { cpu += $2 }
         /Maximum resident set size/ { kb = $2 }
-        /Elapsed/ { sub(/^[^:]*: /, ""); wall = $0 }
+        /Elapsed/ { sub(/.*\): /, ""); wall = $0 }
         END {
             rate = sim / cpu
             printf "settle gcode, benchy: %.1f s of print simulated in %.2f CPU s (wall %s): %.0f simulated s per CPU s (limit %d), peak RSS %.1f MB (limit %d MB)\n", sim, cpu, wall, rate, rate_min, kb / 1024, mb_max

@@ -27,10 +27,12 @@
 //! ringing tower).
 
 use std::collections::VecDeque;
+use std::sync::Arc;
 
 use settle_planner::Profile;
 
 use super::contour::{ACTIVE_WINDOW_S, segment_distance_sq};
+use crate::execute::cursor::profile_at;
 
 /// Consecutive segments sharing a bounding box ([`CommandPath::distance_mm`]): about
 /// 12 boxes over a window of 2 x 20 ms at 2 kHz, of which the toolhead is near one or two.
@@ -181,17 +183,33 @@ impl CommandPath {
 pub struct CommandTrack {
     /// The path.
     pub path: CommandPath,
-    /// The chunks followed whose breakpoints are not all on the path yet, oldest first:
-    /// each one's start (s, print clock), X and Y profiles and the index of each one's
-    /// next breakpoint to put on the path.
-    chunks: VecDeque<(f64, [Profile; 2], [usize; 2])>,
+    /// The chunks followed whose breakpoints are not all on the path yet, oldest first.
+    chunks: VecDeque<Followed>,
+}
+
+/// A chunk [`CommandTrack`] follows.
+#[derive(Debug)]
+struct Followed {
+    /// Its start (s, print clock).
+    t0_s: f64,
+    /// Its X and Y.
+    xy: Arc<[Profile; 2]>,
+    /// The index of each one's next breakpoint to put on the path.
+    next: [usize; 2],
+    /// Each one's segment of the last breakpoint put ([`profile_at`]'s cursor).
+    seg: [usize; 2],
 }
 
 impl CommandTrack {
-    /// Follow a chunk whose X and Y are `xy` from `t0_s` (print clock), after the ones
-    /// before: its breakpoints go on the path.
-    pub fn follow(&mut self, t0_s: f64, xy: [Profile; 2]) {
-        self.chunks.push_back((t0_s, xy, [0, 0]));
+    /// Follow a chunk whose X and Y are `xy` (shared, not copied) from `t0_s` (print
+    /// clock), after the ones before: its breakpoints go on the path.
+    pub fn follow(&mut self, t0_s: f64, xy: Arc<[Profile; 2]>) {
+        self.chunks.push_back(Followed {
+            t0_s,
+            xy,
+            next: [0, 0],
+            seg: [0, 0],
+        });
     }
 
     /// A sample at `t_s` commanded at `c` (XY, mm): the chunks' breakpoints before it,
@@ -203,7 +221,13 @@ impl CommandTrack {
 
     /// Put the chunks' breakpoints before `t_s` on the path, in time order.
     fn breakpoints_before(&mut self, t_s: f64) {
-        while let Some((t0, xy, next)) = self.chunks.front_mut() {
+        while let Some(Followed {
+            t0_s: t0,
+            xy,
+            next,
+            seg,
+        }) = self.chunks.front_mut()
+        {
             let at = |next: &[usize; 2], i: usize| {
                 let p: &Profile = &xy[i];
                 (next[i] < p.segments().len()).then(|| *t0 + p.segment_start(next[i]).0)
@@ -225,7 +249,10 @@ impl CommandTrack {
                 }
             }
             let tau = tb - *t0;
-            let c = [xy[0].state_at(tau).p * 1e3, xy[1].state_at(tau).p * 1e3];
+            let c = [
+                profile_at(&xy[0], &mut seg[0], tau).p * 1e3,
+                profile_at(&xy[1], &mut seg[1], tau).p * 1e3,
+            ];
             self.path.push(tb, c);
         }
     }

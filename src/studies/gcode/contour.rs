@@ -64,10 +64,52 @@ fn geometry_distance_sq(g: &MoveGeometry, p: [f64; 2]) -> f64 {
     }
 }
 
+/// A move of [`ActiveMoves`] with what the search reads inline (no pointer to follow for
+/// the moves it passes over): its span and, for a line, its XY ends.
+#[derive(Debug)]
+struct Active {
+    /// [`MoveInfo::start_time_s`].
+    start_s: f64,
+    /// [`MoveInfo::end_time_s`].
+    end_s: f64,
+    /// Whether it runs (a positive duration): only those own samples.
+    runs: bool,
+    /// A line's XY ends (mm); `None` for an arc.
+    line: Option<[[f64; 2]; 2]>,
+    info: Arc<MoveInfo>,
+}
+
+impl Active {
+    fn new(m: &Arc<MoveInfo>) -> Self {
+        let line = match &m.geometry {
+            MoveGeometry::Line { from_mm, to_mm } => {
+                Some([[from_mm[0], from_mm[1]], [to_mm[0], to_mm[1]]])
+            }
+            MoveGeometry::Arc { .. } => None,
+        };
+        Self {
+            start_s: m.start_time_s,
+            end_s: m.end_time_s(),
+            runs: m.duration_s > 0.0,
+            line,
+            info: Arc::clone(m),
+        }
+    }
+
+    /// [`geometry_distance_sq`] of its geometry, bit for bit.
+    #[inline]
+    fn distance_sq(&self, p: [f64; 2]) -> f64 {
+        match &self.line {
+            Some([a, b]) => segment_distance_sq(p, *a, *b),
+            None => geometry_distance_sq(&self.info.geometry, p),
+        }
+    }
+}
+
 /// The moves of the chunks seen so far that can still be active (module doc).
 #[derive(Debug, Default)]
 pub struct ActiveMoves {
-    moves: VecDeque<Arc<MoveInfo>>,
+    moves: VecDeque<Active>,
     last_index: Option<u64>,
 }
 
@@ -77,7 +119,7 @@ impl ActiveMoves {
         for m in moves {
             if self.last_index.is_none_or(|i| m.index > i) {
                 self.last_index = Some(m.index);
-                self.moves.push_back(Arc::clone(m));
+                self.moves.push_back(Active::new(m));
             }
         }
     }
@@ -87,15 +129,16 @@ impl ActiveMoves {
         self.moves
             .iter()
             .rev()
-            .find(|m| m.duration_s > 0.0 && m.start_time_s <= t_s)
+            .find(|m| m.runs && m.start_s <= t_s)
+            .map(|m| &m.info)
     }
 
     /// Forget the moves that can no longer be active after `t_s` (keeping the latest
     /// started one: a sample during a pause still belongs to it).
     pub fn retire(&mut self, t_s: f64) {
         while self.moves.len() > 1
-            && self.moves[0].end_time_s() + ACTIVE_WINDOW_S < t_s
-            && self.moves[1].start_time_s <= t_s
+            && self.moves[0].end_s + ACTIVE_WINDOW_S < t_s
+            && self.moves[1].start_s <= t_s
         {
             self.moves.pop_front();
         }
@@ -117,21 +160,21 @@ impl ActiveMoves {
     ) -> Option<([f64; N], &MoveInfo)> {
         let mut best = [f64::INFINITY; N];
         let mut active = false;
-        let mut owner: Option<&Arc<MoveInfo>> = None;
+        let mut owner: Option<&Active> = None;
         // Moves are in order of their start times: every move after the first that starts
         // beyond the window starts after `t_s` too (neither active nor the owner).
         for m in &self.moves {
-            if m.start_time_s - ACTIVE_WINDOW_S > t_s {
+            if m.start_s - ACTIVE_WINDOW_S > t_s {
                 break;
             }
-            if m.duration_s > 0.0 && m.start_time_s <= t_s {
+            if m.runs && m.start_s <= t_s {
                 owner = Some(m);
             }
-            if m.end_time_s() + ACTIVE_WINDOW_S < t_s {
+            if m.end_s + ACTIVE_WINDOW_S < t_s {
                 continue;
             }
             for (b, &p) in best.iter_mut().zip(&ps) {
-                let d = geometry_distance_sq(&m.geometry, p);
+                let d = m.distance_sq(p);
                 // The first active move's distance as it is (an infinite one too).
                 *b = if active { b.min(d) } else { d };
             }
@@ -142,10 +185,10 @@ impl ActiveMoves {
             *b = if active {
                 b.sqrt()
             } else {
-                geometry_distance_mm(&owner.geometry, p)
+                owner.distance_sq(p).sqrt()
             };
         }
-        Some((best, owner))
+        Some((best, &owner.info))
     }
 }
 

@@ -57,7 +57,7 @@ pub mod stats;
 pub mod stream;
 pub mod work;
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use std::sync::Mutex;
 
@@ -269,10 +269,32 @@ fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option
     let options = JobConfig::defaults(job.firmware)
         .map_err(|e| e.to_string())?
         .reader_options();
-    let reader = Reader::open(&job.file, options).map_err(|e| e.to_string())?;
-    let point = linpoint::linearisation_point(reader).map_err(|e| e.to_string())?;
+    // Runs of a sweep over one file (its shaper, its limits) share the point: read once.
+    let meta = std::fs::metadata(&job.file).map_err(|e| format!("{}: {e}", job.file.display()))?;
+    let key = format!(
+        "{}|{}|{:?}|{options:?}",
+        job.file.display(),
+        meta.len(),
+        meta.modified().ok()
+    );
+    let known = LINEARISED.lock().ok().and_then(|m| m.get(&key).copied());
+    let point = match known {
+        Some(p) => p,
+        None => {
+            let reader = Reader::open(&job.file, options).map_err(|e| e.to_string())?;
+            let p = linpoint::linearisation_point(reader).map_err(|e| e.to_string())?;
+            if let Ok(mut m) = LINEARISED.lock() {
+                m.insert(key, p);
+            }
+            p
+        }
+    };
     Ok(Some(point.on_axes(axes)))
 }
+
+/// The linearisation points found so far ([`linearise_at`]), by file (its path, size and
+/// modification time) and reader options.
+static LINEARISED: Mutex<BTreeMap<String, linpoint::LinPoint>> = Mutex::new(BTreeMap::new());
 
 /// The job of `run` opened, limited to its layers with their pre-roll ([`preroll_of`]).
 fn open(run: &RunSpec, job: &GcodeJob) -> Result<Job<settle_gcode::FileInput>, String> {

@@ -15,10 +15,12 @@ use settle_planner::shaper::stream::cut;
 use settle_planner::{PlanError, Profile, Segment, State, Trajectory};
 
 use std::collections::VecDeque;
+use std::sync::Arc;
 
 use super::command_path::{CommandPath, CommandTrack};
 use super::contour::ActiveMoves;
 use super::stats::Histogram;
+use crate::execute::cursor::profile_at;
 use crate::measure::metrics::Metrics;
 use crate::studies::MotionStream;
 
@@ -120,8 +122,11 @@ impl Outline {
         let mut end = Vec::new();
         let mut first_s = None;
         while let Some(c) = job.next_chunk().map_err(failed)? {
-            let tr = on_machine(&c, map)?;
-            end = tr.axes().iter().map(Profile::end).collect();
+            // The chunk's profiles on the machine's axes, read in place (a chunk is
+            // copied only when kept).
+            let axes = map.iter().map(|&i| &c.trajectory.axes()[i]);
+            end.clear();
+            end.extend(axes.clone().map(Profile::end));
             if let (Some((a, _)), None) = (range, range_start) {
                 range_start = c
                     .moves
@@ -131,9 +136,10 @@ impl Outline {
             }
             let first = *first_s.get_or_insert(c.start_time_s);
             if c.start_time_s < first + 2.0 * dt {
-                early.push((c.start_time_s, tr));
+                early.push((c.start_time_s, on_machine(&c, map)?));
             } else {
-                later.push(tr.duration_s());
+                // As `Trajectory::new` sums it up.
+                later.push(axes.map(|p| p.duration_s()).fold(0.0, f64::max));
             }
         }
         job.run_to_end().map_err(failed)?;
@@ -209,9 +215,8 @@ pub(super) struct JobChunks {
     /// [`super::stats::Split`]).
     split_worst: [f64; 2],
     print_time_s: f64,
-    /// The chunks handed out whose samples may still come: their start (s, run clock),
-    /// duration and X and Y; the start of the next.
-    handed: VecDeque<(f64, f64, [Profile; 2])>,
+    /// The chunks handed out whose samples may still come.
+    handed: VecDeque<Handed>,
     /// The next chunk's time 0 on the run's clock (s).
     next_t0_s: f64,
     /// The command's path, and the samples waiting to be measured against it
@@ -219,6 +224,18 @@ pub(super) struct JobChunks {
     command: CommandTrack,
     waiting: VecDeque<Waiting>,
     delay: usize,
+}
+
+/// A chunk handed out whose samples may still come.
+#[derive(Debug)]
+struct Handed {
+    /// Its start (s, run clock).
+    t0_s: f64,
+    duration_s: f64,
+    /// Its X and Y.
+    xy: Arc<[Profile; 2]>,
+    /// The segment of X and Y the last sample fell in ([`profile_at`]'s cursor).
+    seg: [usize; 2],
 }
 
 /// A sample waiting for its vibration: time (s, run clock), toolhead and command (XY,
@@ -279,8 +296,13 @@ impl JobChunks {
         let [ix, iy] = self.xy;
         let t0 = self.next_t0_s;
         let d = tr.duration_s();
-        let xy = [tr.axes()[ix].clone(), tr.axes()[iy].clone()];
-        self.handed.push_back((t0, d, xy.clone()));
+        let xy = Arc::new([tr.axes()[ix].clone(), tr.axes()[iy].clone()]);
+        self.handed.push_back(Handed {
+            t0_s: t0,
+            duration_s: d,
+            xy: Arc::clone(&xy),
+            seg: [0, 0],
+        });
         self.command.follow(t0, xy);
         self.next_t0_s += d;
         (t0, tr)
@@ -290,12 +312,20 @@ impl JobChunks {
     /// the chunk that takes the sample (a chunk followed by another takes a sample at its
     /// end; the last one's end is its end state, held).
     fn commanded_mm(&mut self, t_s: f64) -> Option<[f64; 2]> {
-        while self.handed.len() > 1 && self.handed.front().is_some_and(|c| t_s - c.0 > c.1) {
+        while self.handed.len() > 1
+            && self
+                .handed
+                .front()
+                .is_some_and(|c| t_s - c.t0_s > c.duration_s)
+        {
             self.handed.pop_front();
         }
-        let (t0, _, xy) = self.handed.front()?;
-        let tau = t_s - t0;
-        Some([xy[0].state_at(tau).p * 1e3, xy[1].state_at(tau).p * 1e3])
+        let Handed { t0_s, xy, seg, .. } = self.handed.front_mut()?;
+        let tau = t_s - *t0_s;
+        Some([
+            profile_at(&xy[0], &mut seg[0], tau).p * 1e3,
+            profile_at(&xy[1], &mut seg[1], tau).p * 1e3,
+        ])
     }
 
     /// Count a sample at `tp` (print clock) with the toolhead at `p` and the command at

@@ -24,6 +24,7 @@ use std::collections::VecDeque;
 use std::io::BufRead;
 use std::ops::ControlFlow;
 use std::path::Path;
+use std::sync::Arc;
 
 use settle_gcode::job::Job;
 use settle_planner::{Profile, State, Trajectory};
@@ -246,7 +247,7 @@ impl Account {
         self.out.features.end_layer(l.layer);
         l.p95_um = self.hist.quantile_um(0.95);
         self.out.all.merge(&self.hist);
-        self.hist = Histogram::default();
+        self.hist.clear();
         self.map_stride = self.map_every;
         let map = LayerMap {
             layer: l.layer,
@@ -292,7 +293,7 @@ impl Account {
     fn follow(&mut self, t0_s: f64, tr: &Trajectory) {
         let [ix, iy] = self.opts.xy;
         let xy = [tr.axes()[ix].clone(), tr.axes()[iy].clone()];
-        self.command.follow(t0_s, xy);
+        self.command.follow(t0_s, Arc::new(xy));
     }
 
     /// Measure the samples still waiting (the path after them is all there will be).
