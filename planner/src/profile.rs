@@ -210,4 +210,28 @@ impl Profile {
         let (ts, s) = self.starts[idx];
         self.segments[idx].sample(&s, t - ts)
     }
+
+    /// [`Profile::state_at`] for times that mostly increase (a sample clock), bit for bit:
+    /// `seg` is the index of the segment the last query fell in (updated), and the segment
+    /// of `t` is found by walking forward from it instead of searching. Any `t` is
+    /// allowed; a `t` before segment `seg`'s start restarts the walk from the first
+    /// segment.
+    #[inline]
+    pub fn state_at_from(&self, seg: &mut usize, t: f64) -> Sample {
+        if self.segments.is_empty() || t < 0.0 || t >= self.duration_s {
+            // Before the start or at and after the end: no segment to find.
+            return self.state_at(t);
+        }
+        // The last segment whose start time is <= t (right-continuous at boundaries, as
+        // `state_at`): segment 0 starts at 0 <= t, and start times never decrease, so
+        // walking forward while the next one starts at or before `t` lands on it.
+        if *seg >= self.segments.len() || self.starts[*seg].0 > t {
+            *seg = 0;
+        }
+        while *seg + 1 < self.segments.len() && self.starts[*seg + 1].0 <= t {
+            *seg += 1;
+        }
+        let (ts, s) = self.starts[*seg];
+        self.segments[*seg].sample(&s, t - ts)
+    }
 }

@@ -35,34 +35,10 @@ impl<'a> Cursor<'a> {
         for (((o, p), i), fixed) in axes.zip(&self.fixed) {
             *o = match fixed {
                 Some(s) => *s,
-                None => profile_at(p, i, t),
+                None => p.state_at_from(i, t),
             };
         }
     }
-}
-
-/// `p` at time `t` (s), `i` the index of the segment the last query fell in (updated):
-/// bit for bit [`Profile::state_at`] (the same segment, found by walking forward from
-/// `i` instead of searching, and the same evaluation). Any `t` is allowed; a `t` before
-/// segment `i`'s start restarts the walk from the first segment.
-#[inline]
-pub fn profile_at(p: &Profile, i: &mut usize, t: f64) -> Sample {
-    let segments = p.segments();
-    if segments.is_empty() || t < 0.0 || t >= p.duration_s() {
-        // Before the start or at and after the end: no segment to find.
-        return p.state_at(t);
-    }
-    // The last segment whose start time is <= t (right-continuous at boundaries, as
-    // `Profile::state_at`): segment 0 starts at 0 <= t, and start times never decrease,
-    // so walking forward while the next one starts at or before `t` lands on it.
-    if *i >= segments.len() || p.segment_start(*i).0 > t {
-        *i = 0;
-    }
-    while *i + 1 < segments.len() && p.segment_start(*i + 1).0 <= t {
-        *i += 1;
-    }
-    let (ts, s) = p.segment_start(*i);
-    segments[*i].sample(&s, t - ts)
 }
 
 #[cfg(test)]

@@ -32,7 +32,6 @@ use std::sync::Arc;
 use settle_planner::Profile;
 
 use super::contour::{ACTIVE_WINDOW_S, segment_distance_sq};
-use crate::execute::cursor::profile_at;
 
 /// Consecutive segments sharing a bounding box ([`CommandPath::distance_mm`]): about
 /// 12 boxes over a window of 2 x 20 ms at 2 kHz, of which the toolhead is near one or two.
@@ -196,7 +195,7 @@ struct Followed {
     xy: Arc<[Profile; 2]>,
     /// The index of each one's next breakpoint to put on the path.
     next: [usize; 2],
-    /// Each one's segment of the last breakpoint put ([`profile_at`]'s cursor).
+    /// Each one's segment of the last breakpoint put ([`Profile::state_at_from`]'s cursor).
     seg: [usize; 2],
 }
 
@@ -250,8 +249,8 @@ impl CommandTrack {
             }
             let tau = tb - *t0;
             let c = [
-                profile_at(&xy[0], &mut seg[0], tau).p * 1e3,
-                profile_at(&xy[1], &mut seg[1], tau).p * 1e3,
+                xy[0].state_at_from(&mut seg[0], tau).p * 1e3,
+                xy[1].state_at_from(&mut seg[1], tau).p * 1e3,
             ];
             self.path.push(tb, c);
         }

@@ -20,7 +20,6 @@ use std::sync::Arc;
 use super::command_path::{CommandPath, CommandTrack};
 use super::contour::ActiveMoves;
 use super::stats::Histogram;
-use crate::execute::cursor::profile_at;
 use crate::measure::metrics::Metrics;
 use crate::studies::MotionStream;
 
@@ -234,7 +233,7 @@ struct Handed {
     duration_s: f64,
     /// Its X and Y.
     xy: Arc<[Profile; 2]>,
-    /// The segment of X and Y the last sample fell in ([`profile_at`]'s cursor).
+    /// The segment of X and Y the last sample fell in ([`Profile::state_at_from`]'s cursor).
     seg: [usize; 2],
 }
 
@@ -323,8 +322,8 @@ impl JobChunks {
         let Handed { t0_s, xy, seg, .. } = self.handed.front_mut()?;
         let tau = t_s - *t0_s;
         Some([
-            profile_at(&xy[0], &mut seg[0], tau).p * 1e3,
-            profile_at(&xy[1], &mut seg[1], tau).p * 1e3,
+            xy[0].state_at_from(&mut seg[0], tau).p * 1e3,
+            xy[1].state_at_from(&mut seg[1], tau).p * 1e3,
         ])
     }
 
