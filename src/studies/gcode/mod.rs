@@ -270,13 +270,7 @@ fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option
         .map_err(|e| e.to_string())?
         .reader_options();
     // Runs of a sweep over one file (its shaper, its limits) share the point: read once.
-    let meta = std::fs::metadata(&job.file).map_err(|e| format!("{}: {e}", job.file.display()))?;
-    let key = format!(
-        "{}|{}|{:?}|{options:?}",
-        job.file.display(),
-        meta.len(),
-        meta.modified().ok()
-    );
+    let key = format!("{}|{options:?}", file_key(job)?);
     let known = LINEARISED.lock().ok().and_then(|m| m.get(&key).copied());
     let point = match known {
         Some(p) => p,
@@ -318,16 +312,24 @@ static VALIDATED: Mutex<BTreeSet<String>> = Mutex::new(BTreeSet::new());
 /// time), the planner's settings without the shapers, and the layer range with its
 /// pre-roll. (A shaper only shapes the planned moves.)
 fn validation_key(run: &RunSpec, job: &GcodeJob) -> Result<String, String> {
-    let meta = std::fs::metadata(&job.file).map_err(|e| format!("{}: {e}", job.file.display()))?;
     let mut cfg = job_config(run, job, None)?;
     cfg.shapers = [None; 3];
     Ok(format!(
-        "{}|{}|{:?}|{cfg:?}|{:?}|{:?}",
-        job.file.display(),
-        meta.len(),
-        meta.modified().ok(),
+        "{}|{cfg:?}|{:?}|{:?}",
+        file_key(job)?,
         job.layers,
         preroll_of(run, job)?
+    ))
+}
+
+/// `job`'s file as the sweep's caches know it: its path, size and modification time.
+fn file_key(job: &GcodeJob) -> Result<String, String> {
+    let meta = std::fs::metadata(&job.file).map_err(|e| format!("{}: {e}", job.file.display()))?;
+    Ok(format!(
+        "{}|{}|{:?}",
+        job.file.display(),
+        meta.len(),
+        meta.modified().ok()
     ))
 }
 

@@ -2,8 +2,6 @@
 //! 95th percentile from a bounded histogram), the worst spots (one per move) and the
 //! toolpath points of the ringing maps.
 
-use std::collections::BTreeMap;
-
 use crate::measure::log_bins::LogBins;
 
 /// A point of a ringing map: the toolhead (mm), its contour error and the error's two
@@ -51,13 +49,10 @@ impl Bin {
 }
 
 /// A histogram of contour errors with log-spaced bins (bounded memory whatever the job's
-/// length). Counts are 32 bits (half the memory a sample's update touches); a bin that
-/// reaches `u32::MAX` carries its count into `carried` (exact whatever the job's length).
+/// length).
 #[derive(Debug, Clone)]
 pub struct Histogram {
-    counts: Vec<u32>,
-    /// Per bin, the counts carried out of `counts` (only bins that overflowed).
-    carried: BTreeMap<usize, u64>,
+    counts: Vec<u64>,
     total: u64,
 }
 
@@ -65,7 +60,6 @@ impl Default for Histogram {
     fn default() -> Self {
         Self {
             counts: vec![0; HIST_BINS],
-            carried: BTreeMap::new(),
             total: 0,
         }
     }
@@ -79,39 +73,15 @@ impl Histogram {
 
     /// Count one error by its bin (one error counted in several histograms is binned
     /// once).
-    #[inline]
     pub fn push_bin(&mut self, bin: Bin) {
-        self.add(bin.0, 1);
+        self.counts[bin.0] += 1;
         self.total += 1;
-    }
-
-    /// Add `n` to bin `i`'s count, carrying what its 32 bits cannot hold.
-    #[inline]
-    fn add(&mut self, i: usize, n: u64) {
-        let sum = u64::from(self.counts[i]) + n;
-        match u32::try_from(sum) {
-            Ok(c) if c < u32::MAX => self.counts[i] = c,
-            _ => {
-                *self.carried.entry(i).or_default() += sum;
-                self.counts[i] = 0;
-            }
-        }
-    }
-
-    /// Bin `i`'s count.
-    fn count(&self, i: usize) -> u64 {
-        u64::from(self.counts[i]) + self.carried.get(&i).copied().unwrap_or(0)
     }
 
     /// Add another histogram's counts.
     pub fn merge(&mut self, other: &Histogram) {
-        for (i, &b) in other.counts.iter().enumerate() {
-            if b > 0 {
-                self.add(i, u64::from(b));
-            }
-        }
-        for (&i, &b) in &other.carried {
-            *self.carried.entry(i).or_default() += b;
+        for (a, b) in self.counts.iter_mut().zip(&other.counts) {
+            *a += b;
         }
         self.total += other.total;
     }
@@ -119,7 +89,6 @@ impl Histogram {
     /// Forget every count (keeps the bins' memory).
     pub fn clear(&mut self) {
         self.counts.fill(0);
-        self.carried.clear();
         self.total = 0;
     }
 
@@ -135,8 +104,8 @@ impl Histogram {
         }
         let rank = ((q * self.total as f64).ceil() as u64).clamp(1, self.total);
         let mut seen = 0;
-        for i in 0..HIST_BINS {
-            seen += self.count(i);
+        for (i, c) in self.counts.iter().enumerate() {
+            seen += c;
             if seen >= rank {
                 return HIST_MIN_UM * HIST_RATIO.powi(i as i32);
             }
@@ -327,24 +296,24 @@ mod tests {
         assert_eq!(Histogram::default().quantile_um(0.95), 0.0);
     }
 
-    /// A bin past 32 bits carries: the counts stay exact (5e9 errors of 2 um and 1e9 of
-    /// 1 um: the 95th percentile is in 2 um's bin, the 10th in 1 um's), merged too.
+    /// Counts past 32 bits stay exact (5e9 errors of 2 um and 1e9 of 1 um: the 95th
+    /// percentile is in 2 um's bin, the 10th in 1 um's), merged too.
     #[test]
-    fn counts_past_32_bits_are_carried_exactly() {
+    fn counts_past_32_bits_stay_exact() {
         let (one, two) = (Bin::of(1.0).0, Bin::of(2.0).0);
         let mut h = Histogram::default();
-        h.add(two, 5_000_000_000 - 1);
+        h.counts[two] += 5_000_000_000 - 1;
         h.push(2.0);
-        h.add(one, 1_000_000_000);
+        h.counts[one] += 1_000_000_000;
         h.total += 5_000_000_000 - 1 + 1_000_000_000;
-        assert_eq!(h.count(two), 5_000_000_000);
-        assert_eq!(h.count(one), 1_000_000_000);
+        assert_eq!(h.counts[two], 5_000_000_000);
+        assert_eq!(h.counts[one], 1_000_000_000);
         let edge = |i: usize| HIST_MIN_UM * HIST_RATIO.powi(i as i32);
         assert_eq!(h.quantile_um(0.95), edge(two));
         assert_eq!(h.quantile_um(0.1), edge(one));
         let mut m = h.clone();
         m.merge(&h);
-        assert_eq!(m.count(two), 10_000_000_000);
+        assert_eq!(m.counts[two], 10_000_000_000);
         assert_eq!(m.total(), 12_000_000_000);
         assert_eq!(m.quantile_um(0.5), edge(two));
     }
