@@ -19,6 +19,7 @@ use std::sync::Arc;
 
 use super::command_path::{CommandPath, CommandTrack};
 use super::contour::ActiveMoves;
+use super::position::PositionCursor;
 use super::stats::Histogram;
 use crate::measure::metrics::Metrics;
 use crate::studies::MotionStream;
@@ -213,6 +214,9 @@ pub(super) struct JobChunks {
     /// The largest smoothing and vibration (um) of the counted samples (see
     /// [`super::stats::Split`]).
     split_worst: [f64; 2],
+    /// A square (mm^2) at or below which a sample's bound ([`CommandPath::bound_mm`])
+    /// squared is surely no larger than the largest vibration (`-1` until there is one).
+    below_vibration_sq: f64,
     print_time_s: f64,
     /// The chunks handed out whose samples may still come.
     handed: VecDeque<Handed>,
@@ -233,8 +237,8 @@ struct Handed {
     duration_s: f64,
     /// Its X and Y.
     xy: Arc<[Profile; 2]>,
-    /// The segment of X and Y the last sample fell in ([`Profile::state_at_from`]'s cursor).
-    seg: [usize; 2],
+    /// The segment of X and Y the last sample fell in.
+    seg: [PositionCursor; 2],
 }
 
 /// A sample waiting for its vibration: time (s, run clock), toolhead and command (XY,
@@ -280,6 +284,7 @@ impl JobChunks {
             hist: Histogram::default(),
             worst: (0.0, f64::NAN),
             split_worst: [0.0; 2],
+            below_vibration_sq: -1.0,
             print_time_s: outline.print_time_s,
             handed: VecDeque::new(),
             next_t0_s: 0.0,
@@ -300,7 +305,7 @@ impl JobChunks {
             t0_s: t0,
             duration_s: d,
             xy: Arc::clone(&xy),
-            seg: [0, 0],
+            seg: Default::default(),
         });
         self.command.follow(t0, xy);
         self.next_t0_s += d;
@@ -322,8 +327,8 @@ impl JobChunks {
         let Handed { t0_s, xy, seg, .. } = self.handed.front_mut()?;
         let tau = t_s - *t0_s;
         Some([
-            xy[0].state_at_from(&mut seg[0], tau).p * 1e3,
-            xy[1].state_at_from(&mut seg[1], tau).p * 1e3,
+            seg[0].position(&xy[0], tau) * 1e3,
+            seg[1].position(&xy[1], tau) * 1e3,
         ])
     }
 
@@ -357,9 +362,23 @@ impl JobChunks {
             return;
         };
         self.command.path.forget_before(w.t_s);
-        if w.counted && CommandPath::bound_mm(w.p, w.c) * 1e3 > self.split_worst[1] {
+        if !w.counted {
+            return;
+        }
+        // The bound's square well below the largest vibration's: the bound is no larger
+        // (the margin, 1e-9, is far above the rounding of the root and the products).
+        let (dx, dy) = (w.p[0] - w.c[0], w.p[1] - w.c[1]);
+        if dx * dx + dy * dy <= self.below_vibration_sq {
+            return;
+        }
+        if CommandPath::bound_mm(w.p, w.c) * 1e3 > self.split_worst[1] {
             let v = self.command.path.distance_mm(w.t_s, w.p, w.c).unwrap_or(0.0) * 1e3;
             self.split_worst[1] = self.split_worst[1].max(v);
+            let mm = self.split_worst[1] * 1e-3;
+            // Far from the smallest numbers (where a square loses its relative precision).
+            if mm >= 1e-100 {
+                self.below_vibration_sq = mm * mm * (1.0 - 1e-9);
+            }
         }
     }
 }
