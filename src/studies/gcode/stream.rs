@@ -209,6 +209,9 @@ pub(super) struct JobChunks {
     layers: Option<(u32, u32)>,
     active: ActiveMoves,
     hist: Histogram,
+    /// Errors (um) counted but not in [`JobChunks::hist`] yet (fewer than
+    /// [`ERRORS_BATCH`]).
+    errors_um: Vec<f64>,
     /// The largest error (um) and its G-code line.
     worst: (f64, f64),
     /// The largest smoothing and vibration (um) of the counted samples (see
@@ -228,6 +231,9 @@ pub(super) struct JobChunks {
     waiting: VecDeque<Waiting>,
     delay: usize,
 }
+
+/// Errors put in the histogram at a time.
+const ERRORS_BATCH: usize = 128;
 
 /// A chunk handed out whose samples may still come.
 #[derive(Debug)]
@@ -282,6 +288,7 @@ impl JobChunks {
             layers,
             active: ActiveMoves::default(),
             hist: Histogram::default(),
+            errors_um: Vec::with_capacity(ERRORS_BATCH),
             worst: (0.0, f64::NAN),
             split_worst: [0.0; 2],
             below_vibration_sq: -1.0,
@@ -347,7 +354,12 @@ impl JobChunks {
             return false;
         }
         let e_um = e * 1e3;
-        self.hist.push(e_um);
+        // Binned and counted a batch at a time (the lookups of a batch overlap).
+        self.errors_um.push(e_um);
+        if self.errors_um.len() == ERRORS_BATCH {
+            self.hist.push_all(&self.errors_um);
+            self.errors_um.clear();
+        }
         if e_um > self.worst.0 {
             self.worst = (e_um, owner.line as f64);
         }
@@ -398,6 +410,33 @@ impl MotionStream for JobChunks {
         Ok(None)
     }
 
+    fn samples(&mut self, [origin_s, dt_s]: [f64; 2], k0: u64, toolhead_m: &[f64], axes: usize) {
+        for (i, toolhead) in toolhead_m.chunks_exact(axes).enumerate() {
+            // As the driver's clock times it.
+            self.sample(origin_s + (k0 + i as u64) as f64 * dt_s, toolhead);
+        }
+    }
+
+    fn measure(&mut self, m: &mut Metrics) {
+        while !self.waiting.is_empty() {
+            self.measure_waiting();
+        }
+        self.hist.push_all(&self.errors_um);
+        self.errors_um.clear();
+        m.extra.push(("print_time_s".into(), self.print_time_s));
+        m.extra.push(("contour_worst_um".into(), self.worst.0));
+        m.extra
+            .push(("contour_p95_um".into(), self.hist.quantile_um(0.95)));
+        m.extra.push(("contour_worst_line".into(), self.worst.1));
+        m.extra.push(("smoothing_worst_um".into(), self.split_worst[0]));
+        m.extra.push(("vibration_worst_um".into(), self.split_worst[1]));
+    }
+}
+
+impl JobChunks {
+    /// A sample at `t_s` (the run's clock) with the toolhead at `toolhead_m` (per machine
+    /// axis).
+    #[inline]
     fn sample(&mut self, t_s: f64, toolhead_m: &[f64]) {
         if t_s > self.duration_s {
             return;
@@ -422,18 +461,5 @@ impl MotionStream for JobChunks {
         if self.waiting.len() > self.delay {
             self.measure_waiting();
         }
-    }
-
-    fn measure(&mut self, m: &mut Metrics) {
-        while !self.waiting.is_empty() {
-            self.measure_waiting();
-        }
-        m.extra.push(("print_time_s".into(), self.print_time_s));
-        m.extra.push(("contour_worst_um".into(), self.worst.0));
-        m.extra
-            .push(("contour_p95_um".into(), self.hist.quantile_um(0.95)));
-        m.extra.push(("contour_worst_line".into(), self.worst.1));
-        m.extra.push(("smoothing_worst_um".into(), self.split_worst[0]));
-        m.extra.push(("vibration_worst_um".into(), self.split_worst[1]));
     }
 }
