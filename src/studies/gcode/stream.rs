@@ -230,7 +230,24 @@ pub(super) struct JobChunks {
     command: CommandTrack,
     waiting: VecDeque<Waiting>,
     delay: usize,
+    /// Samples measured.
+    measured: u64,
 }
+
+/// A square (mm^2) such that a distance (mm) whose square is no larger is, once taken
+/// the root of and scaled to um, surely no larger than `largest_um`: below it by a margin
+/// (1e-9 relative) far above the rounding of the root and the products; `-1` (none) near
+/// the smallest numbers, where a square loses its relative precision.
+fn below_sq(largest_um: f64) -> f64 {
+    let mm = largest_um * 1e-3;
+    match mm >= 1e-100 {
+        true => mm * mm * (1.0 - 1e-9),
+        false => -1.0,
+    }
+}
+
+/// Samples measured between two trims of the command's path.
+const FORGET_EVERY: u64 = 64;
 
 /// Errors put in the histogram at a time.
 const ERRORS_BATCH: usize = 128;
@@ -298,6 +315,7 @@ impl JobChunks {
             command: CommandTrack::default(),
             waiting: VecDeque::new(),
             delay: CommandPath::delay(sample_rate_hz),
+            measured: 0,
         })
     }
 
@@ -373,7 +391,12 @@ impl JobChunks {
         let Some(w) = self.waiting.pop_front() else {
             return;
         };
-        self.command.path.forget_before(w.t_s);
+        // The path forgets as it is asked for a distance (the same points whichever
+        // times came before): here only now and then, to bound its memory.
+        self.measured += 1;
+        if self.measured.is_multiple_of(FORGET_EVERY) {
+            self.command.path.forget_before(w.t_s);
+        }
         if !w.counted {
             return;
         }
@@ -386,11 +409,7 @@ impl JobChunks {
         if CommandPath::bound_mm(w.p, w.c) * 1e3 > self.split_worst[1] {
             let v = self.command.path.distance_mm(w.t_s, w.p, w.c).unwrap_or(0.0) * 1e3;
             self.split_worst[1] = self.split_worst[1].max(v);
-            let mm = self.split_worst[1] * 1e-3;
-            // Far from the smallest numbers (where a square loses its relative precision).
-            if mm >= 1e-100 {
-                self.below_vibration_sq = mm * mm * (1.0 - 1e-9);
-            }
+            self.below_vibration_sq = below_sq(self.split_worst[1]);
         }
     }
 }
