@@ -274,7 +274,8 @@ impl CommandTrack {
     #[inline]
     pub fn sample(&mut self, t_s: f64, c: [f64; 2]) {
         // Most samples come before the next breakpoint (one compare).
-        if !(self.next_s >= t_s) {
+        // (`next_s` is never NaN; a NaN time looks, as it did, at the breakpoints.)
+        if self.next_s < t_s || t_s.is_nan() {
             self.breakpoints_before(t_s);
         }
         self.path.push(t_s, c);

@@ -61,7 +61,7 @@ impl PositionCursor {
     #[cold]
     fn hold(&mut self, profile: &Profile, t: f64) {
         let segments = profile.segments();
-        if segments.is_empty() || !(t >= 0.0) || t >= profile.duration_s() {
+        if segments.is_empty() || t.is_nan() || t < 0.0 || t >= profile.duration_s() {
             self.held = Self::default().held;
             return;
         }
