@@ -326,6 +326,17 @@ impl CommandTrack {
 mod tests {
     use super::*;
 
+    /// Uniform numbers in `[0, 1)` from a fixed linear congruential generator seeded with
+    /// `seed`: the same walks on every run.
+    fn uniform_from(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// The path with its boxes grown as each point is pushed (what [`CommandPath`] makes
     /// only when a distance is asked for): the reference its distances must equal bit for
     /// bit.
@@ -400,13 +411,7 @@ mod tests {
     /// the window forgotten every sample or only when asked.
     #[test]
     fn boxes_made_when_asked_are_the_boxes_grown() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut uniform = move || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = uniform_from(0x9e37_79b9_7f4a_7c15);
         for case in 0..60 {
             let (ask_every, forget_each) = ([1, 3, 37, 400][case % 4], case % 8 < 4);
             let (mut lazy, mut grown) = (CommandPath::default(), Grown::default());
@@ -482,14 +487,7 @@ mod tests {
     /// can come out an ulp below it (a segment skipped for a tie).
     #[test]
     fn boxes_give_the_least_distance_over_every_segment() {
-        // A fixed linear congruential generator: the same walks on every run.
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = move || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = uniform_from(0x2545_f491_4f6c_dd1d);
         for _ in 0..20 {
             let mut c = CommandPath::default();
             let mut all: Vec<(f64, [f64; 2])> = Vec::new();
