@@ -299,11 +299,15 @@ impl Sink for RunSink<'_, '_> {
     fn samples(&mut self, s: &Samples<'_>) -> ControlFlow<usize> {
         self.acc
             .push_run(s.count, |i| s.time(i), s.commanded_m, s.toolhead_m);
+        if let Some(st) = self.stream.as_deref_mut() {
+            let clock = [s.clock.origin_s, s.clock.dt_s];
+            st.samples(clock, s.k0, &s.toolhead_m[..s.count * s.axes], s.axes);
+        }
+        if self.path.is_none() && self.record.is_none() {
+            return ControlFlow::Continue(());
+        }
         for i in 0..s.count {
             let (t, toolhead) = (s.time(i), s.positions(i).1);
-            if let Some(st) = self.stream.as_deref_mut() {
-                st.sample(t, toolhead);
-            }
             let contour = self.path.as_mut().map(|p| p.push(t, toolhead));
             let (Some(rec), Some(obs), Some(cmd)) = (self.record.as_deref_mut(), s.observed, s.cmd)
             else {

@@ -175,9 +175,11 @@ pub trait MotionStream: Send {
     /// before, in order; `None` after the last.
     fn next_chunk(&mut self) -> Result<Option<(f64, Trajectory)>, PlanError>;
 
-    /// A sample at `t_s` (the run's clock) with the toolhead at `toolhead_m` (per machine
-    /// axis): every sample, in order, the observation window's too.
-    fn sample(&mut self, t_s: f64, toolhead_m: &[f64]);
+    /// Samples `k0, k0 + 1, ...` of a clock whose sample `k` is at `origin_s + k dt_s` (s,
+    /// the run's clock; `clock` is `[origin_s, dt_s]`), with the toolhead at `toolhead_m`
+    /// (`axes` values a sample, one per machine axis, sample after sample): every sample,
+    /// in order, the observation window's too.
+    fn samples(&mut self, clock: [f64; 2], k0: u64, toolhead_m: &[f64], axes: usize);
 
     /// Add its figures to an ok run's metrics.
     fn measure(&mut self, m: &mut Metrics);

@@ -74,21 +74,28 @@ struct Point {
     t_s: f64,
     /// Commanded XY (mm).
     c: [f64; 2],
-    /// The bounding box of the segment from the point before to this one.
-    segment: Box2,
 }
 
 /// The command's path around the measured sample (module doc).
+///
+/// A push only stores the point: the bounding boxes are made when a distance is asked
+/// for (most samples never ask: their bound is below the largest vibration so far), each
+/// run's box once it is whole, from its points in the order they came, the same bits as
+/// a box grown point by point.
 #[derive(Debug, Default)]
 pub struct CommandPath {
-    /// The points, oldest first.
+    /// The points from index [`CommandPath::base`] among all pushed on, oldest first: the
+    /// kept ones, after the forgotten ones of the first kept one's run (its box holds
+    /// them).
     points: VecDeque<Point>,
-    /// The number of points ever forgotten: the first point's index among all pushed.
+    /// The first held point's index among all pushed (a multiple of [`RUN`]).
+    base: u64,
+    /// The number of points ever forgotten: the first kept point's index among all pushed.
     forgotten: u64,
-    /// The bounding boxes of runs of segments, oldest first: run `k` holds the segments
-    /// from point `k RUN + i` to the next (`i < RUN`), so its box holds the points
-    /// `k RUN ..= (k + 1) RUN` (a run is kept while any of its segments is; its box may
-    /// hold points forgotten since, which only makes it larger).
+    /// The bounding boxes of whole runs made so far, oldest first: run `k` holds the
+    /// segments from point `k RUN + i` to the next (`i < RUN`), so its box holds the
+    /// points `k RUN ..= (k + 1) RUN` (a run is kept while any of its segments is; its
+    /// box may hold points forgotten since, which only makes it larger).
     boxes: VecDeque<Box2>,
     /// The index of the first box's run.
     first_run: u64,
@@ -102,36 +109,64 @@ impl CommandPath {
     }
 
     /// The command is at `c` (XY, mm) at `t_s` (not before the last point's time).
+    #[inline]
     pub fn push(&mut self, t_s: f64, c: [f64; 2]) {
-        let n = self.forgotten + self.points.len() as u64;
-        let mut segment = Box2::at(c);
-        if let Some(last) = self.points.back() {
-            segment.add(last.c);
-        }
-        if let Some(b) = self.boxes.back_mut() {
-            // The end of the segment from the last point (in the last run).
-            b.add(c);
-        }
-        if n.is_multiple_of(RUN) {
-            if self.boxes.is_empty() {
-                self.first_run = n / RUN;
-            }
-            self.boxes.push_back(Box2::at(c));
-        }
-        self.points.push_back(Point { t_s, c, segment });
+        self.points.push_back(Point { t_s, c });
+    }
+
+    /// The points ever pushed.
+    fn pushed(&self) -> u64 {
+        self.base + self.points.len() as u64
+    }
+
+    /// Point `i` among all pushed (held: at or after [`CommandPath::base`]).
+    fn at(&self, i: u64) -> &Point {
+        &self.points[(i - self.base) as usize]
     }
 
     /// Forget the points older than [`ACTIVE_WINDOW_S`] before `t_s` (but for the one
     /// starting the segment that reaches into the window).
     pub fn forget_before(&mut self, t_s: f64) {
-        while self.points.len() > 1 && self.points[1].t_s < t_s - ACTIVE_WINDOW_S {
-            self.points.pop_front();
+        let n = self.pushed();
+        while self.forgotten + 1 < n && self.at(self.forgotten + 1).t_s < t_s - ACTIVE_WINDOW_S {
             self.forgotten += 1;
         }
-        // Runs whose last segment (from point (k + 1) RUN - 1) is forgotten.
-        while !self.boxes.is_empty() && (self.first_run + 1) * RUN <= self.forgotten {
+        // The first kept point's run is held whole.
+        let base = self.forgotten / RUN * RUN;
+        while self.base < base {
+            self.points.pop_front();
+            self.base += 1;
+        }
+    }
+
+    /// The box of run `k`: its points as pushed so far, in order.
+    fn run_box(&self, k: u64) -> Box2 {
+        let last = ((k + 1) * RUN).min(self.pushed() - 1);
+        let mut b = Box2::at(self.at(k * RUN).c);
+        for i in k * RUN + 1..=last {
+            b.add(self.at(i).c);
+        }
+        b
+    }
+
+    /// Make the boxes of the whole runs from the first kept point's on (a run is whole
+    /// once the point after its last segment is pushed).
+    fn make_boxes(&mut self) {
+        let first = self.forgotten / RUN;
+        while !self.boxes.is_empty() && self.first_run < first {
             self.boxes.pop_front();
             self.first_run += 1;
+        }
+        if self.boxes.is_empty() {
+            self.first_run = first;
+        }
+        loop {
+            let k = self.first_run + self.boxes.len() as u64;
+            if (k + 1) * RUN >= self.pushed() {
+                return;
+            }
+            let b = self.run_box(k);
+            self.boxes.push_back(b);
         }
     }
 
@@ -147,27 +182,36 @@ impl CommandPath {
     /// before the first command.
     pub fn distance_mm(&mut self, t_s: f64, p: [f64; 2], c: [f64; 2]) -> Option<f64> {
         self.forget_before(t_s);
-        let first = self.points.front()?.c;
+        if self.points.is_empty() {
+            return None;
+        }
+        self.make_boxes();
+        let first = self.at(self.forgotten).c;
         // The commanded point bounds the distance; a box no nearer holds no nearer
         // segment (most of the window's runs and segments, skipped cheaply).
         let mut best = segment_distance_sq(p, c, c).min(segment_distance_sq(p, first, first));
-        // Segments from point index `i` (among the kept points) to `i + 1`.
-        let segments = self.points.len() as u64 - 1;
-        for (k, b) in self.boxes.iter().enumerate() {
+        let last = self.pushed() - 1;
+        // The whole runs' boxes, then the last run's (whole or not) made now.
+        let whole = self.boxes.len() as u64;
+        for k in self.first_run..=last / RUN {
+            let b = match k - self.first_run < whole {
+                true => self.boxes[(k - self.first_run) as usize],
+                false => self.run_box(k),
+            };
             if b.distance_sq(p) >= best {
                 continue;
             }
-            let run = (self.first_run + k as u64) * RUN;
-            let from = run.saturating_sub(self.forgotten);
-            let to = (run + RUN - self.forgotten.min(run + RUN)).min(segments);
-            let mut run = self.points.range(from as usize..=to as usize);
-            let Some(mut a) = run.next().map(|q| q.c) else {
-                continue;
-            };
-            for q in run {
-                let a = std::mem::replace(&mut a, q.c);
-                if q.segment.distance_sq(p) < best {
-                    best = best.min(segment_distance_sq(p, a, q.c));
+            // Segments from point `i` to `i + 1` for the kept `i` of run `k`.
+            let from = (k * RUN).max(self.forgotten);
+            let to = ((k + 1) * RUN).min(last);
+            let mut a = self.at(from).c;
+            for i in from + 1..=to {
+                let q = self.at(i).c;
+                let a = std::mem::replace(&mut a, q);
+                let mut segment = Box2::at(q);
+                segment.add(a);
+                if segment.distance_sq(p) < best {
+                    best = best.min(segment_distance_sq(p, a, q));
                 }
             }
         }
@@ -178,12 +222,25 @@ impl CommandPath {
 /// The command's path as a simulation makes it: the commanded XY of each sample, and
 /// the breakpoints of the chunks being followed before it (module doc), every chunk's to
 /// its end (a chunk's last breakpoints come after its last sample).
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct CommandTrack {
     /// The path.
     pub path: CommandPath,
     /// The chunks followed whose breakpoints are not all on the path yet, oldest first.
     chunks: VecDeque<Followed>,
+    /// The time of the next breakpoint to put on the path (s, print clock): infinite when
+    /// there is none, minus infinity when it is to be found.
+    next_s: f64,
+}
+
+impl Default for CommandTrack {
+    fn default() -> Self {
+        Self {
+            path: CommandPath::default(),
+            chunks: VecDeque::new(),
+            next_s: f64::NEG_INFINITY,
+        }
+    }
 }
 
 /// A chunk [`CommandTrack`] follows.
@@ -209,12 +266,18 @@ impl CommandTrack {
             next: [0, 0],
             seg: [0, 0],
         });
+        self.next_s = f64::NEG_INFINITY;
     }
 
     /// A sample at `t_s` commanded at `c` (XY, mm): the chunks' breakpoints before it,
     /// then its point, go on the path.
+    #[inline]
     pub fn sample(&mut self, t_s: f64, c: [f64; 2]) {
-        self.breakpoints_before(t_s);
+        // Most samples come before the next breakpoint (one compare).
+        // (`next_s` is never NaN; a NaN time looks, as it did, at the breakpoints.)
+        if self.next_s < t_s || t_s.is_nan() {
+            self.breakpoints_before(t_s);
+        }
         self.path.push(t_s, c);
     }
 
@@ -240,6 +303,7 @@ impl CommandTrack {
                 }
             };
             if tb >= t_s {
+                self.next_s = tb;
                 return;
             }
             for i in 0..2 {
@@ -254,12 +318,136 @@ impl CommandTrack {
             ];
             self.path.push(tb, c);
         }
+        self.next_s = f64::INFINITY;
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Uniform numbers in `[0, 1)` from a fixed linear congruential generator seeded with
+    /// `seed`: the same walks on every run.
+    fn uniform_from(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// The path with its boxes grown as each point is pushed (what [`CommandPath`] makes
+    /// only when a distance is asked for): the reference its distances must equal bit for
+    /// bit.
+    #[derive(Default)]
+    struct Grown {
+        points: VecDeque<(f64, [f64; 2], Box2)>,
+        forgotten: u64,
+        boxes: VecDeque<Box2>,
+        first_run: u64,
+    }
+
+    impl Grown {
+        fn push(&mut self, t_s: f64, c: [f64; 2]) {
+            let n = self.forgotten + self.points.len() as u64;
+            let mut segment = Box2::at(c);
+            if let Some(last) = self.points.back() {
+                segment.add(last.1);
+            }
+            if let Some(b) = self.boxes.back_mut() {
+                b.add(c);
+            }
+            if n.is_multiple_of(RUN) {
+                if self.boxes.is_empty() {
+                    self.first_run = n / RUN;
+                }
+                self.boxes.push_back(Box2::at(c));
+            }
+            self.points.push_back((t_s, c, segment));
+        }
+
+        fn forget_before(&mut self, t_s: f64) {
+            while self.points.len() > 1 && self.points[1].0 < t_s - ACTIVE_WINDOW_S {
+                self.points.pop_front();
+                self.forgotten += 1;
+            }
+            while !self.boxes.is_empty() && (self.first_run + 1) * RUN <= self.forgotten {
+                self.boxes.pop_front();
+                self.first_run += 1;
+            }
+        }
+
+        fn distance_mm(&mut self, t_s: f64, p: [f64; 2], c: [f64; 2]) -> Option<f64> {
+            self.forget_before(t_s);
+            let first = self.points.front()?.1;
+            let mut best = segment_distance_sq(p, c, c).min(segment_distance_sq(p, first, first));
+            let segments = self.points.len() as u64 - 1;
+            for (k, b) in self.boxes.iter().enumerate() {
+                if b.distance_sq(p) >= best {
+                    continue;
+                }
+                let run = (self.first_run + k as u64) * RUN;
+                let from = run.saturating_sub(self.forgotten);
+                let to = (run + RUN - self.forgotten.min(run + RUN)).min(segments);
+                let mut run = self.points.range(from as usize..=to as usize);
+                let Some(mut a) = run.next().map(|q| q.1) else {
+                    continue;
+                };
+                for q in run {
+                    let a = std::mem::replace(&mut a, q.1);
+                    if q.2.distance_sq(p) < best {
+                        best = best.min(segment_distance_sq(p, a, q.1));
+                    }
+                }
+            }
+            Some(best.sqrt())
+        }
+    }
+
+    /// Boxes made when asked give the distances of boxes grown point by point, bit for
+    /// bit: on random walks with points at irregular times (several at one time too, as
+    /// breakpoints between samples), asked every sample, now and then, or rarely, with
+    /// the window forgotten every sample or only when asked.
+    #[test]
+    fn boxes_made_when_asked_are_the_boxes_grown() {
+        let mut uniform = uniform_from(0x9e37_79b9_7f4a_7c15);
+        for case in 0..60 {
+            let (ask_every, forget_each) = ([1, 3, 37, 400][case % 4], case % 8 < 4);
+            let (mut lazy, mut grown) = (CommandPath::default(), Grown::default());
+            let mut times: VecDeque<(f64, [f64; 2])> = VecDeque::new();
+            let (mut t, mut q) = (0.0, [0.0, 0.0]);
+            let mut asked = 0;
+            for k in 0..3_000 {
+                // A step of 0 to 1 ms (a few of none), a point on a zigzag or still.
+                let r = uniform();
+                t += if r < 0.1 { 0.0 } else { 1e-3 * uniform() };
+                if uniform() < 0.8 {
+                    q = [q[0] + uniform() - 0.5, q[1] + 2.0 * uniform() - 1.0];
+                }
+                lazy.push(t, q);
+                grown.push(t, q);
+                times.push_back((t, q));
+                if times.len() <= 40 {
+                    continue;
+                }
+                let (tm, cm) = times.pop_front().expect("a waiting point");
+                if forget_each {
+                    lazy.forget_before(tm);
+                    grown.forget_before(tm);
+                }
+                if k % ask_every == 0 {
+                    asked += 1;
+                    let p = [cm[0] + 3.0 * uniform() - 1.5, cm[1] + 3.0 * uniform() - 1.5];
+                    let (a, b) = (lazy.distance_mm(tm, p, cm), grown.distance_mm(tm, p, cm));
+                    assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "case {case}, point {k}");
+                }
+            }
+            assert!(asked >= 7, "case {case}");
+            // Memory stays bounded: the window and one run.
+            assert!(lazy.points.len() < 3_000 / 2, "case {case}: {}", lazy.points.len());
+        }
+    }
 
     /// A toolhead lagging on the first leg of a corner the command has turned is on the
     /// path (distance 0); one off the path by 3 mm is 3 mm away; past the current command
@@ -299,14 +487,7 @@ mod tests {
     /// can come out an ulp below it (a segment skipped for a tie).
     #[test]
     fn boxes_give_the_least_distance_over_every_segment() {
-        // A fixed linear congruential generator: the same walks on every run.
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = move || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = uniform_from(0x2545_f491_4f6c_dd1d);
         for _ in 0..20 {
             let mut c = CommandPath::default();
             let mut all: Vec<(f64, [f64; 2])> = Vec::new();

@@ -52,6 +52,7 @@ pub mod contour;
 pub mod features;
 pub mod fly;
 pub mod linpoint;
+pub mod position;
 pub mod preroll;
 pub mod stats;
 pub mod stream;

@@ -35,16 +35,17 @@ const HIST_BINS: usize = 18_432;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Bin(usize);
 
+/// The bins' lookup: `ceil(ln(err / HIST_MIN_UM) / ln(HIST_RATIO))`, clamped to the
+/// bins, without the logarithm (crate::measure::log_bins).
+fn bins() -> &'static LogBins {
+    static BINS: std::sync::OnceLock<LogBins> = std::sync::OnceLock::new();
+    BINS.get_or_init(|| LogBins::new(HIST_MIN_UM, HIST_RATIO, HIST_BINS))
+}
+
 impl Bin {
     /// The bin of `err_um` (um).
     pub fn of(err_um: f64) -> Self {
-        // `ceil(ln(err / HIST_MIN_UM) / ln(HIST_RATIO))`, clamped to the bins, without
-        // the logarithm (crate::measure::log_bins).
-        static BINS: std::sync::OnceLock<LogBins> = std::sync::OnceLock::new();
-        Self(
-            BINS.get_or_init(|| LogBins::new(HIST_MIN_UM, HIST_RATIO, HIST_BINS))
-                .bin(err_um),
-        )
+        Self(bins().bin(err_um))
     }
 }
 
@@ -69,6 +70,16 @@ impl Histogram {
     /// Count one error (um).
     pub fn push(&mut self, err_um: f64) {
         self.push_bin(Bin::of(err_um));
+    }
+
+    /// Count errors (um): as many [`Histogram::push`]es, the lookups of one not waiting
+    /// for the count of the one before.
+    pub fn push_all(&mut self, errs_um: &[f64]) {
+        let bins = bins();
+        for &e in errs_um {
+            self.counts[bins.bin(e)] += 1;
+        }
+        self.total += errs_um.len() as u64;
     }
 
     /// Count one error by its bin (one error counted in several histograms is binned

@@ -19,6 +19,7 @@ use std::sync::Arc;
 
 use super::command_path::{CommandPath, CommandTrack};
 use super::contour::ActiveMoves;
+use super::position::PositionCursor;
 use super::stats::Histogram;
 use crate::measure::metrics::Metrics;
 use crate::studies::MotionStream;
@@ -208,11 +209,17 @@ pub(super) struct JobChunks {
     layers: Option<(u32, u32)>,
     active: ActiveMoves,
     hist: Histogram,
+    /// Errors (um) counted but not in [`JobChunks::hist`] yet (fewer than
+    /// [`ERRORS_BATCH`]).
+    errors_um: Vec<f64>,
     /// The largest error (um) and its G-code line.
     worst: (f64, f64),
     /// The largest smoothing and vibration (um) of the counted samples (see
     /// [`super::stats::Split`]).
     split_worst: [f64; 2],
+    /// A square (mm^2) at or below which a sample's bound ([`CommandPath::bound_mm`])
+    /// squared is surely no larger than the largest vibration (`-1` until there is one).
+    below_vibration_sq: f64,
     print_time_s: f64,
     /// The chunks handed out whose samples may still come.
     handed: VecDeque<Handed>,
@@ -223,7 +230,27 @@ pub(super) struct JobChunks {
     command: CommandTrack,
     waiting: VecDeque<Waiting>,
     delay: usize,
+    /// Samples measured.
+    measured: u64,
 }
+
+/// A square (mm^2) such that a distance (mm) whose square is no larger is, once taken
+/// the root of and scaled to um, surely no larger than `largest_um`: below it by a margin
+/// (1e-9 relative) far above the rounding of the root and the products; `-1` (none) near
+/// the smallest numbers, where a square loses its relative precision.
+fn below_sq(largest_um: f64) -> f64 {
+    let mm = largest_um * 1e-3;
+    match mm >= 1e-100 {
+        true => mm * mm * (1.0 - 1e-9),
+        false => -1.0,
+    }
+}
+
+/// Samples measured between two trims of the command's path.
+const FORGET_EVERY: u64 = 64;
+
+/// Errors put in the histogram at a time.
+const ERRORS_BATCH: usize = 128;
 
 /// A chunk handed out whose samples may still come.
 #[derive(Debug)]
@@ -233,8 +260,8 @@ struct Handed {
     duration_s: f64,
     /// Its X and Y.
     xy: Arc<[Profile; 2]>,
-    /// The segment of X and Y the last sample fell in ([`Profile::state_at_from`]'s cursor).
-    seg: [usize; 2],
+    /// The segment of X and Y the last sample fell in.
+    seg: [PositionCursor; 2],
 }
 
 /// A sample waiting for its vibration: time (s, run clock), toolhead and command (XY,
@@ -278,14 +305,17 @@ impl JobChunks {
             layers,
             active: ActiveMoves::default(),
             hist: Histogram::default(),
+            errors_um: Vec::with_capacity(ERRORS_BATCH),
             worst: (0.0, f64::NAN),
             split_worst: [0.0; 2],
+            below_vibration_sq: -1.0,
             print_time_s: outline.print_time_s,
             handed: VecDeque::new(),
             next_t0_s: 0.0,
             command: CommandTrack::default(),
             waiting: VecDeque::new(),
             delay: CommandPath::delay(sample_rate_hz),
+            measured: 0,
         })
     }
 
@@ -300,7 +330,7 @@ impl JobChunks {
             t0_s: t0,
             duration_s: d,
             xy: Arc::clone(&xy),
-            seg: [0, 0],
+            seg: Default::default(),
         });
         self.command.follow(t0, xy);
         self.next_t0_s += d;
@@ -322,8 +352,8 @@ impl JobChunks {
         let Handed { t0_s, xy, seg, .. } = self.handed.front_mut()?;
         let tau = t_s - *t0_s;
         Some([
-            xy[0].state_at_from(&mut seg[0], tau).p * 1e3,
-            xy[1].state_at_from(&mut seg[1], tau).p * 1e3,
+            seg[0].position(&xy[0], tau) * 1e3,
+            seg[1].position(&xy[1], tau) * 1e3,
         ])
     }
 
@@ -342,7 +372,12 @@ impl JobChunks {
             return false;
         }
         let e_um = e * 1e3;
-        self.hist.push(e_um);
+        // Binned and counted a batch at a time (the lookups of a batch overlap).
+        self.errors_um.push(e_um);
+        if self.errors_um.len() == ERRORS_BATCH {
+            self.hist.push_all(&self.errors_um);
+            self.errors_um.clear();
+        }
         if e_um > self.worst.0 {
             self.worst = (e_um, owner.line as f64);
         }
@@ -356,10 +391,25 @@ impl JobChunks {
         let Some(w) = self.waiting.pop_front() else {
             return;
         };
-        self.command.path.forget_before(w.t_s);
-        if w.counted && CommandPath::bound_mm(w.p, w.c) * 1e3 > self.split_worst[1] {
+        // The path forgets as it is asked for a distance (the same points whichever
+        // times came before): here only now and then, to bound its memory.
+        self.measured += 1;
+        if self.measured.is_multiple_of(FORGET_EVERY) {
+            self.command.path.forget_before(w.t_s);
+        }
+        if !w.counted {
+            return;
+        }
+        // The bound's square well below the largest vibration's: the bound is no larger
+        // (the margin, 1e-9, is far above the rounding of the root and the products).
+        let (dx, dy) = (w.p[0] - w.c[0], w.p[1] - w.c[1]);
+        if dx * dx + dy * dy <= self.below_vibration_sq {
+            return;
+        }
+        if CommandPath::bound_mm(w.p, w.c) * 1e3 > self.split_worst[1] {
             let v = self.command.path.distance_mm(w.t_s, w.p, w.c).unwrap_or(0.0) * 1e3;
             self.split_worst[1] = self.split_worst[1].max(v);
+            self.below_vibration_sq = below_sq(self.split_worst[1]);
         }
     }
 }
@@ -379,6 +429,33 @@ impl MotionStream for JobChunks {
         Ok(None)
     }
 
+    fn samples(&mut self, [origin_s, dt_s]: [f64; 2], k0: u64, toolhead_m: &[f64], axes: usize) {
+        for (i, toolhead) in toolhead_m.chunks_exact(axes).enumerate() {
+            // As the driver's clock times it.
+            self.sample(origin_s + (k0 + i as u64) as f64 * dt_s, toolhead);
+        }
+    }
+
+    fn measure(&mut self, m: &mut Metrics) {
+        while !self.waiting.is_empty() {
+            self.measure_waiting();
+        }
+        self.hist.push_all(&self.errors_um);
+        self.errors_um.clear();
+        m.extra.push(("print_time_s".into(), self.print_time_s));
+        m.extra.push(("contour_worst_um".into(), self.worst.0));
+        m.extra
+            .push(("contour_p95_um".into(), self.hist.quantile_um(0.95)));
+        m.extra.push(("contour_worst_line".into(), self.worst.1));
+        m.extra.push(("smoothing_worst_um".into(), self.split_worst[0]));
+        m.extra.push(("vibration_worst_um".into(), self.split_worst[1]));
+    }
+}
+
+impl JobChunks {
+    /// A sample at `t_s` (the run's clock) with the toolhead at `toolhead_m` (per machine
+    /// axis).
+    #[inline]
     fn sample(&mut self, t_s: f64, toolhead_m: &[f64]) {
         if t_s > self.duration_s {
             return;
@@ -403,18 +480,5 @@ impl MotionStream for JobChunks {
         if self.waiting.len() > self.delay {
             self.measure_waiting();
         }
-    }
-
-    fn measure(&mut self, m: &mut Metrics) {
-        while !self.waiting.is_empty() {
-            self.measure_waiting();
-        }
-        m.extra.push(("print_time_s".into(), self.print_time_s));
-        m.extra.push(("contour_worst_um".into(), self.worst.0));
-        m.extra
-            .push(("contour_p95_um".into(), self.hist.quantile_um(0.95)));
-        m.extra.push(("contour_worst_line".into(), self.worst.1));
-        m.extra.push(("smoothing_worst_um".into(), self.split_worst[0]));
-        m.extra.push(("vibration_worst_um".into(), self.split_worst[1]));
     }
 }
