@@ -33,10 +33,18 @@ impl<'a> Cursor<'a> {
     pub fn at(&mut self, t: f64, out: &mut [Sample]) {
         let axes = out.iter_mut().zip(self.axes).zip(&mut self.seg);
         for (((o, p), i), fixed) in axes.zip(&self.fixed) {
-            *o = match fixed {
-                Some(s) => *s,
-                None => p.state_at_from(i, t),
-            };
+            // Each case writes its own sample (not one value merged from the three): the
+            // walk's sample is then written from registers, not through the return slot
+            // of `state_at`, which a whole copy would read back in wider pieces than it
+            // was written (a stall per axis per sample). Inside the profile
+            // `state_at_from` walks (its own test for the ends is the same and so never
+            // holds).
+            let outside = p.segments().is_empty() || t < 0.0 || t >= p.duration_s();
+            match fixed {
+                Some(s) => *o = *s,
+                None if outside => *o = p.state_at(t),
+                None => *o = p.state_at_from(i, t),
+            }
         }
     }
 }
