@@ -50,6 +50,7 @@ mod profile;
 pub mod pvt;
 mod ramp;
 pub mod raster;
+mod runs;
 pub mod scurve;
 mod second_order;
 mod segs;

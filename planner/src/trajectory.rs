@@ -10,6 +10,7 @@
 use std::sync::Arc;
 
 use crate::path::PathGeometry;
+use crate::runs::RunSort;
 use crate::{PlanError, Profile, Sample};
 
 /// Several axes in time (axis 0 = X, 1 = Y, 2 = Z by convention).
@@ -83,16 +84,18 @@ impl Trajectory {
     /// Every segment boundary of every axis, sorted and deduplicated (s): the instants
     /// where some axis changes its jerk, so a simulation can split its steps there.
     pub fn breakpoints(&self) -> Vec<f64> {
-        let mut ts: Vec<f64> = self
-            .axes
-            .iter()
-            .flat_map(|p| {
-                p.iter()
-                    .map(|(t0, _, seg)| t0 + seg.duration_s())
-                    .chain(std::iter::once(0.0))
-            })
-            .collect();
-        ts.sort_by(f64::total_cmp);
+        // Each axis's segment ends are in order (each is the next segment's start): sorted
+        // by merging them, with a run of each axis's 0.
+        let n = self.axes.iter().map(|p| p.segments().len()).sum::<usize>() + self.axes.len();
+        let mut ts = Vec::with_capacity(n);
+        let mut runs = RunSort::default();
+        for p in &self.axes {
+            runs.mark(ts.len());
+            ts.extend(p.iter().map(|(t0, _, seg)| t0 + seg.duration_s()));
+        }
+        runs.mark(ts.len());
+        ts.extend(self.axes.iter().map(|_| 0.0));
+        runs.sort(&mut ts);
         ts.dedup();
         ts
     }

@@ -90,7 +90,7 @@ impl Shaper {
 pub(super) fn segments_between(
     knots: &[f64],
     mut a_now: f64,
-    shaped: impl Fn(f64) -> Sample,
+    mut shaped: impl FnMut(f64) -> Sample,
 ) -> (Vec<Segment>, f64) {
     let mut segments = Vec::with_capacity(knots.len());
     for pair in knots.windows(2) {

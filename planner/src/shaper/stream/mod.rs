@@ -34,6 +34,7 @@
 mod alignment;
 mod axes;
 mod cut;
+mod history;
 mod regime;
 mod single;
 

@@ -76,21 +76,26 @@ impl Regime {
         [self.from.map(|e| e.0), self.until.map(|e| e.0)]
     }
 
-    /// Add this regime's share of the output at `t` to `out`; `input` evaluates the
-    /// stream's input.
-    pub(super) fn add_to(&self, out: &mut Sample, t: f64, input: &dyn Fn(f64) -> Sample) {
+    /// Add this regime's share of the output at `t` to `out`; `input(i, s)` evaluates the
+    /// stream's input at `s` for impulse `i` (its index in [`Self::taus`]).
+    pub(super) fn add_to(
+        &self,
+        out: &mut Sample,
+        t: f64,
+        mut input: impl FnMut(usize, f64) -> Sample,
+    ) {
         let line = |e: Edge, s: f64| Sample {
             p: e.1 + e.2 * (s - e.0),
             v: e.2,
             a: 0.0,
             j: 0.0,
         };
-        for (w, tau) in self.weights.iter().zip(&self.taus) {
+        for (i, (w, tau)) in self.weights.iter().zip(&self.taus).enumerate() {
             let s = t - tau;
             let x = match (self.from, self.until) {
                 (Some(e), _) if s < e.0 => line(e, s),
                 (_, Some(e)) if s > e.0 => line(e, s),
-                _ => input(s),
+                _ => input(i, s),
             };
             out.p += w * x.p;
             out.v += w * x.v;

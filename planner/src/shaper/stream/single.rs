@@ -3,24 +3,12 @@
 use std::collections::VecDeque;
 
 use super::alignment::Alignment;
+use super::history::{Held, History};
 use super::regime::Regime;
+use crate::runs::RunSort;
 use crate::shaper::Shaper;
 use crate::shaper::apply::segments_between;
 use crate::{PlanError, Profile, Sample, Segment, State};
-
-/// One input segment on the stream's clock.
-#[derive(Debug, Clone, Copy)]
-struct Held {
-    t0: f64,
-    start: State,
-    seg: Segment,
-}
-
-impl Held {
-    fn t1(&self) -> f64 {
-        self.t0 + self.seg.duration_s()
-    }
-}
 
 /// Shapes one axis's motion chunk by chunk (module doc).
 #[derive(Debug, Clone)]
@@ -31,7 +19,13 @@ pub struct ShaperStream {
     /// Position offset left by retired regimes (module doc).
     offset: f64,
     /// Input segments still needed, oldest first.
-    history: VecDeque<Held>,
+    history: History,
+    /// For each impulse of each regime in turn, where its input was last found in
+    /// `history` ([`History::at_from`]; any value is safe).
+    cursors: Vec<usize>,
+    /// The knots of the last emitted chunk and their sorter: buffers kept between chunks.
+    knots: Vec<f64>,
+    sorter: RunSort,
     /// Time and state of the first input instant.
     first: Option<(f64, State)>,
     /// Time and state at the end of the input so far.
@@ -52,7 +46,10 @@ impl ShaperStream {
             alignment,
             regimes,
             offset: 0.0,
-            history: VecDeque::new(),
+            history: History::default(),
+            cursors: Vec::new(),
+            knots: Vec::new(),
+            sorter: RunSort::default(),
             first: None,
             last: (0.0, State::default()),
             finished: false,
@@ -177,18 +174,39 @@ impl ShaperStream {
 
     /// The exact shaped state at `t` (right-continuous), for any `t` the input determines.
     pub fn shaped_at(&self, t: f64) -> Sample {
+        self.shaped_with(t, |_, x| self.input_at(x))
+    }
+
+    /// [`Self::shaped_at`] with `input(k, s)` the input at `s` for the `k`-th impulse
+    /// counted over all regimes in turn.
+    fn shaped_with(&self, t: f64, mut input: impl FnMut(usize, f64) -> Sample) -> Sample {
         let mut s = Sample {
             p: self.offset,
             ..Sample::default()
         };
+        let mut k = 0;
         for r in &self.regimes {
-            r.add_to(&mut s, t, &|x| self.input_at(x));
+            r.add_to(&mut s, t, |i, x| input(k + i, x));
+            k += r.taus().len();
         }
         s
     }
 
     /// The input (with its extensions) at `t`.
     fn input_at(&self, t: f64) -> Sample {
+        self.input_in(t, |h| h.at(t))
+    }
+
+    /// [`Self::input_at`], bit for bit, finding the input segment by walking from
+    /// `cursor` ([`History::at_from`]).
+    #[inline]
+    fn input_from(&self, cursor: &mut usize, t: f64) -> Sample {
+        self.input_in(t, |h| h.at_from(cursor, t))
+    }
+
+    /// The input at `t`, `index` giving the history segment in force there.
+    #[inline]
+    fn input_in(&self, t: f64, index: impl FnOnce(&History) -> usize) -> Sample {
         let extend = |t0: f64, st: State| Sample {
             p: st.p + st.v * (t - t0),
             v: st.v,
@@ -203,8 +221,8 @@ impl ShaperStream {
         if self.finished && t >= self.last.0 {
             return extend(self.last.0, self.last.1);
         }
-        let i = self.history.partition_point(|h| h.t0 <= t).max(1) - 1;
-        match self.history.get(i) {
+        let i = index(&self.history);
+        match self.history.held().get(i) {
             Some(h) => h.seg.sample(&h.start, t - h.t0),
             None => extend(self.last.0, self.last.1),
         }
@@ -229,14 +247,26 @@ impl ShaperStream {
         if self.regimes.len() == 1 && self.offset == 0.0 && self.regimes[0].is_identity() {
             return self.pass_through(a, b);
         }
-        let knots = self.knots(a, b);
-        let s0 = self.shaped_at(a);
+        let mut knots = std::mem::take(&mut self.knots);
+        let mut sorter = std::mem::take(&mut self.sorter);
+        self.knots_into(a, b, &mut knots, &mut sorter);
+        // Every evaluation below is at a time no earlier than the one before (`a`, then
+        // the middles of the sorted knots' intervals): each impulse's input is found by a
+        // cursor walking forward through the history.
+        let impulses = self.regimes.iter().map(|r| r.taus().len()).sum();
+        let mut cursors = std::mem::take(&mut self.cursors);
+        cursors.resize(impulses, usize::MAX);
+        let mut shaped = |t: f64| self.shaped_with(t, |k, x| self.input_from(&mut cursors[k], x));
+        let s0 = shaped(a);
         let start = State {
             p: s0.p,
             v: s0.v,
             a: self.a_now,
         };
-        let (segments, a_end) = segments_between(&knots, self.a_now, |t| self.shaped_at(t));
+        let (segments, a_end) = segments_between(&knots, self.a_now, &mut shaped);
+        self.cursors = cursors;
+        self.knots = knots;
+        self.sorter = sorter;
         self.a_now = a_end;
         self.cursor_s = b;
         self.forget();
@@ -248,9 +278,10 @@ impl ShaperStream {
     fn pass_through(&mut self, a: f64, b: f64) -> Result<(f64, Profile), PlanError> {
         let s0 = self.input_at(a);
         let mut segments = Vec::new();
-        let lo = self.history.partition_point(|h| h.t1() <= a && h.t0 < a);
+        let held = self.history.held();
+        let lo = held.partition_point(|h| h.t1() <= a && h.t0 < a);
         let mut covered = a;
-        for h in self.history.range(lo..) {
+        for h in held.range(lo..) {
             if h.t0 >= b {
                 break;
             }
@@ -291,38 +322,52 @@ impl ShaperStream {
         Ok((a, profile))
     }
 
-    /// Every breakpoint of every shifted copy inside `(a, b)`, with `a` and `b`.
-    fn knots(&self, a: f64, b: f64) -> Vec<f64> {
-        let mut knots = vec![a, b];
+    /// Every breakpoint of every shifted copy inside `(a, b)`, with `a` and `b`, sorted
+    /// and without repeats, into `knots` (its buffer reused).
+    fn knots_into(&self, a: f64, b: f64, knots: &mut Vec<f64>, sorter: &mut RunSort) {
+        knots.clear();
+        knots.extend([a, b]);
         let first_t = self.first.map(|(t, _)| t);
+        // Sorted by merging runs that are each in order: [a, b]; for each impulse, the
+        // span ends and the input's ends (a few), then the input's breakpoints, in order
+        // but for rounding (a chunk's segment times and the next chunk's start).
         for r in &self.regimes {
             for &tau in r.taus() {
-                let mut add = |t: f64| {
+                let add = |knots: &mut Vec<f64>, t: f64| {
                     let k = t + tau;
                     if k > a && k < b {
                         knots.push(k);
                     }
                 };
+                sorter.mark(knots.len());
                 for t in r.bounds().into_iter().flatten().chain(first_t) {
-                    add(t);
+                    add(knots, t);
                 }
                 if self.finished {
-                    add(self.last.0);
+                    add(knots, self.last.0);
                 }
-                // Input segments whose shifted span meets (a, b).
-                let lo = self.history.partition_point(|h| h.t1() + tau <= a);
-                for h in self.history.range(lo..) {
+                sorter.mark(knots.len());
+                // Input segments whose shifted span meets (a, b). A time with the same bits
+                // as the one before gives the same knot, which the sort and dedup would
+                // only remove again: it is left out.
+                let held = self.history.held();
+                let lo = held.partition_point(|h| h.t1() + tau <= a);
+                let mut last = None;
+                for h in held.range(lo..) {
                     if h.t0 + tau >= b {
                         break;
                     }
-                    add(h.t0);
-                    add(h.t1());
+                    for t in [h.t0, h.t1()] {
+                        if last != Some(t.to_bits()) {
+                            add(knots, t);
+                            last = Some(t.to_bits());
+                        }
+                    }
                 }
             }
         }
-        knots.sort_by(f64::total_cmp);
+        sorter.sort(knots);
         knots.dedup();
-        knots
     }
 
     /// Drop what later output no longer needs: regimes whose every copy has passed their
@@ -330,14 +375,22 @@ impl ShaperStream {
     fn forget(&mut self) {
         while self.regimes.len() > 1 && self.regimes[0].done_by(self.cursor_s) {
             if let Some(old) = self.regimes.pop_front() {
+                // The cursors of the impulses after it move up.
+                let n = old.taus().len().min(self.cursors.len());
+                self.cursors.drain(..n);
                 self.offset += old.retire_offset(&self.regimes[0]);
                 self.regimes[0].becomes_first();
             }
         }
         let reach = self.regimes.iter().map(Regime::max_tau).fold(0.0, f64::max);
         let keep_from = self.cursor_s - reach;
-        while self.history.len() > 1 && self.history[0].t1() < keep_from {
+        let mut dropped = 0;
+        while self.history.held().len() > 1 && self.history.held()[0].t1() < keep_from {
             self.history.pop_front();
+            dropped += 1;
+        }
+        for c in &mut self.cursors {
+            *c = c.saturating_sub(dropped);
         }
     }
 }
