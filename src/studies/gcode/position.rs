@@ -1,19 +1,19 @@
 //! A profile's position at times that mostly increase (a sample clock), as
 //! [`Profile::state_at_from`] gives it, bit for bit: the segment the last time fell in is
-//! held with what its position needs, so that a time in it costs two compares and the
-//! polynomial (no walk, no velocity or acceleration). The test module checks it against
+//! held with its start, so that a time in it costs two compares and the segment's own
+//! evaluation ([`Segment::sample`], of which only the position is used: no walk). The test module checks it against
 //! [`Profile::state_at`] at random times on random profiles.
 
-use settle_planner::{Profile, State};
+use settle_planner::{Profile, Segment, State};
 
-/// The held segment of [`PositionCursor`]: its span `[from_s, to_s)` and the polynomial.
+/// The held segment of [`PositionCursor`]: its span `[from_s, to_s)`, the state it
+/// starts from and the segment.
 #[derive(Debug, Clone, Copy)]
 struct Held {
     from_s: f64,
     to_s: f64,
     start: State,
-    a0: f64,
-    j: f64,
+    segment: Segment,
 }
 
 /// [`Profile::state_at_from`]'s position with the segment held (module doc).
@@ -33,8 +33,10 @@ impl Default for PositionCursor {
                 from_s: f64::INFINITY,
                 to_s: f64::NEG_INFINITY,
                 start: State::default(),
-                a0: 0.0,
-                j: 0.0,
+                segment: Segment::Jerk {
+                    duration_s: 0.0,
+                    jerk: 0.0,
+                },
             },
         }
     }
@@ -47,9 +49,7 @@ impl PositionCursor {
     pub fn position(&mut self, profile: &Profile, t: f64) -> f64 {
         let h = &self.held;
         if h.from_s <= t && t < h.to_s {
-            // `Segment::sample`'s position, as written there.
-            let tau = t - h.from_s;
-            return h.start.p + tau * (h.start.v + tau * (h.a0 / 2.0 + tau * h.j / 6.0));
+            return h.segment.sample(&h.start, t - h.from_s).p;
         }
         let p = profile.state_at_from(&mut self.seg, t).p;
         self.hold(profile, t);
@@ -74,13 +74,11 @@ impl PositionCursor {
             true => profile.segment_start(i + 1).0,
             false => profile.duration_s(),
         };
-        let (a0, j) = segments[i].accel_and_jerk(&start);
         self.held = Held {
             from_s,
             to_s,
             start,
-            a0,
-            j,
+            segment: segments[i],
         };
     }
 }
