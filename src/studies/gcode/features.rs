@@ -5,17 +5,25 @@
 //! the outer wall's columns of the layers table). The outer wall is what a print is judged
 //! by ([`is_outer_wall`]).
 //!
+//! A sample is counted in its type's current-layer histogram only (its error binned a
+//! batch at a time, [`Histogram::push_all`]); each layer's end adds those into the types'
+//! whole-job histograms and the layer's own ([`FeatureAccount::end_layer`]): the same
+//! counts, one histogram touched per sample instead of three.
+//!
 //! Memory: two histograms per type (the whole job's and the current layer's; at most
 //! [`settle_gcode::MAX_FEATURES`] types) and two numbers per layer and type.
 
 use std::collections::BTreeMap;
 
-use super::stats::{Bin, Histogram, Spot};
+use super::stats::{Histogram, Spot};
+
+/// Errors binned at a time ([`FeatureAccount::sample`]).
+const BATCH: usize = 256;
 
 /// One feature type's account.
 #[derive(Debug, Clone, Default)]
 pub struct FeatureStats {
-    /// Its errors (um).
+    /// Its errors (um), up to the last layer ended ([`FeatureAccount::end_layer`]).
     pub errors: Histogram,
     /// Its largest error.
     pub worst: Option<Spot>,
@@ -44,6 +52,9 @@ pub struct FeatureAccount {
     /// while their samples come (samples come feature after feature: one look-up per
     /// change, not per sample), put back when another comes or the layer ends.
     hot: Option<Hot>,
+    /// The errors (um) of the hot account's samples not counted in its current layer's
+    /// histogram yet (fewer than [`BATCH`]).
+    pending: Vec<f64>,
 }
 
 /// One feature's account in one layer, out of [`FeatureAccount`]'s maps.
@@ -58,16 +69,10 @@ struct Hot {
 }
 
 impl FeatureAccount {
-    /// A working sample of feature `feature`: its error (um) and its bin, and, when it may
+    /// A working sample of feature `feature` in `layer`: its error (um), and, when it may
     /// be the feature's worst ([`FeatureAccount::is_worst`]), where it is (`spot` is
     /// called only then).
-    pub fn sample(
-        &mut self,
-        feature: u16,
-        layer: u32,
-        (err_um, bin): (f64, Bin),
-        spot: impl FnOnce() -> Spot,
-    ) {
+    pub fn sample(&mut self, feature: u16, layer: u32, err_um: f64, spot: impl FnOnce() -> Spot) {
         let h = match &mut self.hot {
             Some(h) if h.feature == feature && h.layer == layer => h,
             _ => {
@@ -81,12 +86,15 @@ impl FeatureAccount {
                 })
             }
         };
-        h.stats.errors.push_bin(bin);
         if h.stats.worst.as_ref().is_none_or(|w| err_um > w.error_um) {
             h.stats.worst = Some(spot());
         }
         h.layer_worst = h.layer_worst.max(err_um);
-        h.current.push_bin(bin);
+        self.pending.push(err_um);
+        if self.pending.len() >= BATCH {
+            h.current.push_all(&self.pending);
+            self.pending.clear();
+        }
     }
 
     /// Whether an error of `err_um` of feature `feature` would be its worst so far.
@@ -100,20 +108,24 @@ impl FeatureAccount {
 
     /// Put the hot account back into the maps.
     fn put_back(&mut self) {
-        let Some(h) = self.hot.take() else {
+        let Some(mut h) = self.hot.take() else {
             return;
         };
+        h.current.push_all(&self.pending);
+        self.pending.clear();
         self.stats.insert(h.feature, h.stats);
         self.current.insert(h.feature, h.current);
         let w = self.layer_worst.entry((h.layer, h.feature)).or_insert(0.0);
         *w = w.max(h.layer_worst);
     }
 
-    /// The end of layer `layer`'s samples: each type's 95th percentile over them (and
-    /// every account back in the maps, where they are read).
-    pub fn end_layer(&mut self, layer: u32) {
+    /// The end of layer `layer`'s samples: each type's 95th percentile over them, its
+    /// errors added to its whole job's and to `layer_errors` (every account back in the
+    /// maps, where they are read).
+    pub fn end_layer(&mut self, layer: u32, layer_errors: &mut Histogram) {
         self.put_back();
-        for (&f, h) in &mut self.current {
+        // The two maps hold the same types (put back together).
+        for ((&f, h), s) in self.current.iter_mut().zip(self.stats.values_mut()) {
             if h.total() == 0 {
                 continue;
             }
@@ -122,6 +134,8 @@ impl FeatureAccount {
                 .entry((layer, f))
                 .and_modify(|v| *v = f64::NAN)
                 .or_insert(p95);
+            s.errors.merge(h);
+            layer_errors.merge(h);
             h.clear();
         }
     }
