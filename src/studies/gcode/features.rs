@@ -152,3 +152,75 @@ pub fn is_outer_wall(name: &str) -> bool {
     let n = name.trim().to_ascii_lowercase();
     matches!(n.as_str(), "external perimeter" | "outer wall" | "wall-outer")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::studies::gcode::stats::Split;
+
+    /// The deferred account counts what counting every sample in every histogram at once
+    /// counts: each type's whole-job histogram, each layer's, each type's percentile per
+    /// layer, on random runs of samples (types switching within layers, a type back in a
+    /// later layer, errors over the histogram's whole range).
+    #[test]
+    fn deferred_counts_are_the_direct_counts() {
+        let mut x: u64 = 0x2545_F491_4F6C_DD1D;
+        let mut next = |n: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % n
+        };
+        let mut acc = FeatureAccount::default();
+        let mut layer_errors = Histogram::default();
+        let (mut direct_job, mut direct_layer) = (BTreeMap::new(), Histogram::default());
+        let mut direct_current: BTreeMap<u16, Histogram> = BTreeMap::new();
+        let quantiles = |h: &Histogram| -> Vec<u64> {
+            (0..=50).map(|i| h.quantile_um(f64::from(i) / 50.0).to_bits()).collect()
+        };
+        for layer in 0..6u32 {
+            for _ in 0..40 {
+                let feature = next(5) as u16;
+                for _ in 0..next(700) {
+                    // 1e-4 um to 1e6 um: below the first bin's edge to past the last.
+                    let err_um = 10f64.powf(next(1_000_000) as f64 / 1e5 - 4.0);
+                    let spot = || Spot {
+                        error_um: err_um,
+                        time_s: 0.0,
+                        x_mm: 0.0,
+                        y_mm: 0.0,
+                        line: 0,
+                        layer,
+                        move_index: 0,
+                        split: Split::default(),
+                    };
+                    acc.sample(feature, layer, err_um, spot);
+                    direct_job
+                        .entry(feature)
+                        .or_insert_with(Histogram::default)
+                        .push(err_um);
+                    direct_current.entry(feature).or_default().push(err_um);
+                    direct_layer.push(err_um);
+                }
+            }
+            acc.end_layer(layer, &mut layer_errors);
+            assert!(layer_errors == direct_layer, "layer {layer}");
+            assert_eq!(quantiles(&layer_errors), quantiles(&direct_layer));
+            for (f, h) in &mut direct_current {
+                if h.total() > 0 {
+                    let p95 = acc.layer_p95[&(layer, *f)];
+                    assert_eq!(p95.to_bits(), h.quantile_um(0.95).to_bits());
+                }
+                h.clear();
+            }
+            layer_errors.clear();
+            direct_layer.clear();
+        }
+        assert_eq!(acc.stats.len(), direct_job.len());
+        for (f, h) in &direct_job {
+            let got = &acc.stats[f].errors;
+            assert!(got == h, "feature {f}");
+            assert_eq!(quantiles(got), quantiles(h), "feature {f}");
+        }
+    }
+}

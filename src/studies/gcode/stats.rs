@@ -73,6 +73,13 @@ impl Default for Histogram {
     }
 }
 
+/// Histograms are equal when they hold the same counts (however they were counted).
+impl PartialEq for Histogram {
+    fn eq(&self, other: &Self) -> bool {
+        self.total == other.total && self.counts == other.counts
+    }
+}
+
 impl Histogram {
     /// Count one error (um).
     pub fn push(&mut self, err_um: f64) {

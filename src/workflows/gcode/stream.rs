@@ -405,9 +405,7 @@ impl Account {
                 move_index: m.index,
                 split,
             };
-            self.out
-                .features
-                .sample(m.feature, m.layer, err_um, spot);
+            self.out.features.sample(m.feature, m.layer, err_um, spot);
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
             {
