@@ -50,11 +50,16 @@ impl Bin {
 }
 
 /// A histogram of contour errors with log-spaced bins (bounded memory whatever the job's
-/// length).
+/// length). It knows the range of bins it has counted in, so that merging, clearing and
+/// reading a histogram of a few samples (a feature type's in one layer) costs that range,
+/// not every bin.
 #[derive(Debug, Clone)]
 pub struct Histogram {
     counts: Vec<u64>,
     total: u64,
+    /// The bins counted in are within `lo..=hi` (none when `lo > hi`).
+    lo: usize,
+    hi: usize,
 }
 
 impl Default for Histogram {
@@ -62,7 +67,16 @@ impl Default for Histogram {
         Self {
             counts: vec![0; HIST_BINS],
             total: 0,
+            lo: usize::MAX,
+            hi: 0,
         }
+    }
+}
+
+/// Histograms are equal when they hold the same counts (however they were counted).
+impl PartialEq for Histogram {
+    fn eq(&self, other: &Self) -> bool {
+        self.total == other.total && self.counts == other.counts
     }
 }
 
@@ -76,9 +90,14 @@ impl Histogram {
     /// for the count of the one before.
     pub fn push_all(&mut self, errs_um: &[f64]) {
         let bins = bins();
+        let (mut lo, mut hi) = (self.lo, self.hi);
         for &e in errs_um {
-            self.counts[bins.bin(e)] += 1;
+            let b = bins.bin(e);
+            self.counts[b] += 1;
+            lo = lo.min(b);
+            hi = hi.max(b);
         }
+        (self.lo, self.hi) = (lo, hi);
         self.total += errs_um.len() as u64;
     }
 
@@ -87,20 +106,35 @@ impl Histogram {
     pub fn push_bin(&mut self, bin: Bin) {
         self.counts[bin.0] += 1;
         self.total += 1;
+        self.lo = self.lo.min(bin.0);
+        self.hi = self.hi.max(bin.0);
+    }
+
+    /// The bins that may hold counts.
+    fn range(&self) -> std::ops::Range<usize> {
+        match self.lo <= self.hi {
+            true => self.lo..self.hi + 1,
+            false => 0..0,
+        }
     }
 
     /// Add another histogram's counts.
     pub fn merge(&mut self, other: &Histogram) {
-        for (a, b) in self.counts.iter_mut().zip(&other.counts) {
+        let r = other.range();
+        for (a, b) in self.counts[r.clone()].iter_mut().zip(&other.counts[r]) {
             *a += b;
         }
         self.total += other.total;
+        self.lo = self.lo.min(other.lo);
+        self.hi = self.hi.max(other.hi);
     }
 
     /// Forget every count (keeps the bins' memory).
     pub fn clear(&mut self) {
-        self.counts.fill(0);
+        let r = self.range();
+        self.counts[r].fill(0);
         self.total = 0;
+        (self.lo, self.hi) = (usize::MAX, 0);
     }
 
     /// Samples counted.
@@ -115,10 +149,11 @@ impl Histogram {
         }
         let rank = ((q * self.total as f64).ceil() as u64).clamp(1, self.total);
         let mut seen = 0;
-        for (i, c) in self.counts.iter().enumerate() {
+        let r = self.range();
+        for (i, c) in self.counts[r.clone()].iter().enumerate() {
             seen += c;
             if seen >= rank {
-                return HIST_MIN_UM * HIST_RATIO.powi(i as i32);
+                return HIST_MIN_UM * HIST_RATIO.powi((r.start + i) as i32);
             }
         }
         HIST_MIN_UM * HIST_RATIO.powi(HIST_BINS as i32 - 1)
@@ -315,8 +350,9 @@ mod tests {
         let mut h = Histogram::default();
         h.counts[two] += 5_000_000_000 - 1;
         h.push(2.0);
-        h.counts[one] += 1_000_000_000;
-        h.total += 5_000_000_000 - 1 + 1_000_000_000;
+        h.counts[one] += 1_000_000_000 - 1;
+        h.push(1.0);
+        h.total += 5_000_000_000 - 1 + 1_000_000_000 - 1;
         assert_eq!(h.counts[two], 5_000_000_000);
         assert_eq!(h.counts[one], 1_000_000_000);
         let edge = |i: usize| HIST_MIN_UM * HIST_RATIO.powi(i as i32);

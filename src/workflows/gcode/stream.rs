@@ -41,7 +41,7 @@ use crate::studies::gcode::contour::ActiveMoves;
 use crate::studies::gcode::features::FeatureAccount;
 use crate::studies::gcode::fly::FlyAxis;
 use crate::studies::gcode::stats::{
-    Bin, Histogram, LayerMap, LayerStats, MapPoint, Split, Spot, TopSpots,
+    Histogram, LayerMap, LayerStats, MapPoint, Split, Spot, TopSpots,
 };
 
 /// How the job is sampled and what is kept.
@@ -173,7 +173,8 @@ struct Account {
     out: Streamed,
     top: TopSpots,
     layer: Option<LayerStats>,
-    /// The current layer's errors.
+    /// The current layer's errors, added up from its feature types' at its end
+    /// ([`FeatureAccount::end_layer`]).
     hist: Histogram,
     map: Vec<MapPoint>,
     layer_top: TopSpots,
@@ -244,7 +245,7 @@ impl Account {
         let Some(mut l) = self.layer.take() else {
             return;
         };
-        self.out.features.end_layer(l.layer);
+        self.out.features.end_layer(l.layer, &mut self.hist);
         l.p95_um = self.hist.quantile_um(0.95);
         self.out.all.merge(&self.hist);
         self.hist.clear();
@@ -394,8 +395,6 @@ impl Account {
             if let Some(l) = self.layer.as_mut() {
                 l.split_worst = l.split_worst.max(split);
             }
-            let bin = Bin::of(err_um);
-            self.hist.push_bin(bin);
             let spot = || Spot {
                 error_um: err_um,
                 time_s: t,
@@ -406,9 +405,7 @@ impl Account {
                 move_index: m.index,
                 split,
             };
-            self.out
-                .features
-                .sample(m.feature, m.layer, (err_um, bin), spot);
+            self.out.features.sample(m.feature, m.layer, err_um, spot);
             if let Some(o) = self.owner.as_mut()
                 && o.4.as_ref().is_none_or(|s| err_um > s.error_um)
             {
