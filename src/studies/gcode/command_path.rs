@@ -89,7 +89,7 @@ fn compact<T>(v: &mut Vec<T>, gap: usize) -> usize {
 /// (most samples never ask: their bound is below the largest vibration so far), each
 /// from its points in the order they came, the same bits as a box grown point by point.
 /// Points and boxes are held in vectors, oldest first, the forgotten front dropped now
-/// and then ([`COMPACT`]).
+/// and then (`COMPACT`).
 #[derive(Debug, Default)]
 pub struct CommandPath {
     /// The commanded XY (mm) of the points from index [`CommandPath::base`] among all
