@@ -67,38 +67,51 @@ impl Box2 {
     }
 }
 
-/// A point of the command's path.
-#[derive(Debug, Clone, Copy)]
-struct Point {
-    /// Print-clock time (s).
-    t_s: f64,
-    /// Commanded XY (mm).
-    c: [f64; 2],
+/// Held items from `gap` on at most this many behind: a vector drops its forgotten front
+/// only once it is this long and at least half the vector (each item moved at most once
+/// or twice, the vector at most twice the window and this).
+const COMPACT: usize = 256;
+
+/// Drop the first `gap` items of `v` if they are many (see [`COMPACT`]): returns how many
+/// were dropped.
+fn compact<T>(v: &mut Vec<T>, gap: usize) -> usize {
+    if gap >= COMPACT && 2 * gap >= v.len() {
+        v.drain(..gap);
+        gap
+    } else {
+        0
+    }
 }
 
 /// The command's path around the measured sample (module doc).
 ///
-/// A push only stores the point: the bounding boxes are made when a distance is asked
-/// for (most samples never ask: their bound is below the largest vibration so far), each
-/// run's box once it is whole, from its points in the order they came, the same bits as
-/// a box grown point by point.
+/// A push only stores the point: the bounding boxes grow when a distance is asked for
+/// (most samples never ask: their bound is below the largest vibration so far), each
+/// from its points in the order they came, the same bits as a box grown point by point.
+/// Points and boxes are held in vectors, oldest first, the forgotten front dropped now
+/// and then (`COMPACT`).
 #[derive(Debug, Default)]
 pub struct CommandPath {
-    /// The points from index [`CommandPath::base`] among all pushed on, oldest first: the
-    /// kept ones, after the forgotten ones of the first kept one's run (its box holds
-    /// them).
-    points: VecDeque<Point>,
-    /// The first held point's index among all pushed (a multiple of [`RUN`]).
+    /// The commanded XY (mm) of the points from index [`CommandPath::base`] among all
+    /// pushed on, oldest first: the kept ones, after forgotten ones (at least those of
+    /// the first kept one's run: its box holds them).
+    c: Vec<[f64; 2]>,
+    /// Their print-clock times (s).
+    t: Vec<f64>,
+    /// The first held point's index among all pushed.
     base: u64,
     /// The number of points ever forgotten: the first kept point's index among all pushed.
     forgotten: u64,
-    /// The bounding boxes of whole runs made so far, oldest first: run `k` holds the
-    /// segments from point `k RUN + i` to the next (`i < RUN`), so its box holds the
-    /// points `k RUN ..= (k + 1) RUN` (a run is kept while any of its segments is; its
-    /// box may hold points forgotten since, which only makes it larger).
-    boxes: VecDeque<Box2>,
-    /// The index of the first box's run.
+    /// The bounding boxes of the runs from [`CommandPath::first_run`] on, oldest first:
+    /// run `k` holds the segments from point `k RUN + i` to the next (`i < RUN`), so its
+    /// box holds the points `k RUN ..= (k + 1) RUN`, those grown so far (a run is kept
+    /// while any of its segments is; its box may hold points forgotten since, which only
+    /// makes it larger).
+    boxes: Vec<Box2>,
+    /// The run of `boxes[0]`.
     first_run: u64,
+    /// The points added to the boxes: those before this index among all pushed.
+    grown: u64,
 }
 
 impl CommandPath {
@@ -111,63 +124,57 @@ impl CommandPath {
     /// The command is at `c` (XY, mm) at `t_s` (not before the last point's time).
     #[inline]
     pub fn push(&mut self, t_s: f64, c: [f64; 2]) {
-        self.points.push_back(Point { t_s, c });
+        self.c.push(c);
+        self.t.push(t_s);
     }
 
     /// The points ever pushed.
     fn pushed(&self) -> u64 {
-        self.base + self.points.len() as u64
-    }
-
-    /// Point `i` among all pushed (held: at or after [`CommandPath::base`]).
-    fn at(&self, i: u64) -> &Point {
-        &self.points[(i - self.base) as usize]
+        self.base + self.c.len() as u64
     }
 
     /// Forget the points older than [`ACTIVE_WINDOW_S`] before `t_s` (but for the one
     /// starting the segment that reaches into the window).
     pub fn forget_before(&mut self, t_s: f64) {
-        let n = self.pushed();
-        while self.forgotten + 1 < n && self.at(self.forgotten + 1).t_s < t_s - ACTIVE_WINDOW_S {
-            self.forgotten += 1;
+        let from = t_s - ACTIVE_WINDOW_S;
+        let mut i = (self.forgotten - self.base) as usize;
+        while i + 1 < self.t.len() && self.t[i + 1] < from {
+            i += 1;
         }
+        self.forgotten = self.base + i as u64;
         // The first kept point's run is held whole.
-        let base = self.forgotten / RUN * RUN;
-        while self.base < base {
-            self.points.pop_front();
-            self.base += 1;
-        }
+        let gap = (self.forgotten / RUN * RUN - self.base) as usize;
+        let dropped = compact(&mut self.c, gap);
+        compact(&mut self.t, dropped);
+        self.base += dropped as u64;
     }
 
-    /// The box of run `k`: its points as pushed so far, in order.
-    fn run_box(&self, k: u64) -> Box2 {
-        let last = ((k + 1) * RUN).min(self.pushed() - 1);
-        let mut b = Box2::at(self.at(k * RUN).c);
-        for i in k * RUN + 1..=last {
-            b.add(self.at(i).c);
-        }
-        b
-    }
-
-    /// Make the boxes of the whole runs from the first kept point's on (a run is whole
-    /// once the point after its last segment is pushed).
-    fn make_boxes(&mut self) {
+    /// Drop the boxes of the runs before the first kept point's, and grow the boxes with
+    /// the points pushed since (a point starting a run starts its box and ends the run
+    /// before's).
+    fn grow_boxes(&mut self) {
         let first = self.forgotten / RUN;
-        while !self.boxes.is_empty() && self.first_run < first {
-            self.boxes.pop_front();
-            self.first_run += 1;
-        }
+        let gone = first.saturating_sub(self.first_run).min(self.boxes.len() as u64);
+        self.boxes.drain(..gone as usize);
+        self.first_run += gone;
         if self.boxes.is_empty() {
             self.first_run = first;
+            self.grown = self.grown.max(first * RUN);
         }
-        loop {
-            let k = self.first_run + self.boxes.len() as u64;
-            if (k + 1) * RUN >= self.pushed() {
-                return;
+        for i in self.grown..self.pushed() {
+            let c = self.c[(i - self.base) as usize];
+            match i % RUN == 0 {
+                true => {
+                    let ends = self.first_run + self.boxes.len() as u64 == i / RUN;
+                    if let Some(b) = self.boxes.last_mut().filter(|_| ends) {
+                        b.add(c);
+                    }
+                    self.boxes.push(Box2::at(c));
+                }
+                false => self.boxes.last_mut().expect("a run's box").add(c),
             }
-            let b = self.run_box(k);
-            self.boxes.push_back(b);
         }
+        self.grown = self.pushed();
     }
 
     /// What [`CommandPath::distance_mm`] can be no larger than for a toolhead at `p` with
@@ -182,32 +189,27 @@ impl CommandPath {
     /// before the first command.
     pub fn distance_mm(&mut self, t_s: f64, p: [f64; 2], c: [f64; 2]) -> Option<f64> {
         self.forget_before(t_s);
-        if self.points.is_empty() {
+        if self.c.is_empty() {
             return None;
         }
-        self.make_boxes();
-        let first = self.at(self.forgotten).c;
+        self.grow_boxes();
+        let points = &self.c[..];
+        let base = self.base;
+        let first = points[(self.forgotten - base) as usize];
         // The commanded point bounds the distance; a box no nearer holds no nearer
         // segment (most of the window's runs and segments, skipped cheaply).
         let mut best = segment_distance_sq(p, c, c).min(segment_distance_sq(p, first, first));
         let last = self.pushed() - 1;
-        // The whole runs' boxes, then the last run's (whole or not) made now.
-        let whole = self.boxes.len() as u64;
-        for k in self.first_run..=last / RUN {
-            let b = match k - self.first_run < whole {
-                true => self.boxes[(k - self.first_run) as usize],
-                false => self.run_box(k),
-            };
+        for (k, b) in (self.first_run..).zip(&self.boxes) {
             if b.distance_sq(p) >= best {
                 continue;
             }
             // Segments from point `i` to `i + 1` for the kept `i` of run `k`.
             let from = (k * RUN).max(self.forgotten);
             let to = ((k + 1) * RUN).min(last);
-            let mut a = self.at(from).c;
-            for i in from + 1..=to {
-                let q = self.at(i).c;
-                let a = std::mem::replace(&mut a, q);
+            let run = &points[(from - base) as usize..=(to - base) as usize];
+            for s in run.windows(2) {
+                let (a, q) = (s[0], s[1]);
                 let mut segment = Box2::at(q);
                 segment.add(a);
                 if segment.distance_sq(p) < best {
@@ -445,7 +447,7 @@ mod tests {
             }
             assert!(asked >= 7, "case {case}");
             // Memory stays bounded: the window and one run.
-            assert!(lazy.points.len() < 3_000 / 2, "case {case}: {}", lazy.points.len());
+            assert!(lazy.c.len() < 3_000 / 2, "case {case}: {}", lazy.c.len());
         }
     }
 
