@@ -87,7 +87,7 @@ impl Jumps {
     /// degree, so the first entry `>= x` is found by bisection.
     #[inline]
     fn degree(&self, x: f64) -> usize {
-        let first = self.reach.partition_point(|&r| !(x <= r));
+        let first = self.reach.partition_point(|&r| x.is_nan() || x > r);
         (first + 1).min(JUMP_TERMS)
     }
 
@@ -215,7 +215,11 @@ mod tests {
             let pattern = rng.next() % 10;
             for (c, v) in d.iter_mut().enumerate() {
                 if pattern < 8 && (pattern >> c) & 1 == 0 {
-                    *v = if rng.next() % 2 == 0 { 0.0 } else { -0.0 };
+                    *v = if rng.next().is_multiple_of(2) {
+                        0.0
+                    } else {
+                        -0.0
+                    };
                 }
             }
             let got = j.response::<N2>(s, d);
