@@ -840,7 +840,20 @@ fn run_axis<const M: usize, const N2: usize>(
             }
         }
     } else {
+        // What each breakpoint adds to the state ([`crate::modal_jump`]), formed ahead:
+        // the sums do not depend on the state, so those of successive breakpoints overlap.
+        let responses: Vec<[f64; N2]> = match breaks.is_empty() {
+            true => Vec::new(),
+            false => {
+                let jumps = disc.jumps();
+                breaks
+                    .iter()
+                    .map(|b| jumps.response::<N2>(b.before_end_s, [b.dv, b.da, b.dj]))
+                    .collect()
+            }
+        };
         let mut rest = breaks;
+        let mut rest_responses = &responses[..];
         for (i, ((cm, th), c)) in outs.zip(io.cmds.chunks_exact(axes)).enumerate() {
             let c = &c[a];
             last = *c;
@@ -849,13 +862,16 @@ fn run_axis<const M: usize, const N2: usize>(
             let here = rest.iter().take_while(|b| b.step == i).count();
             let (jumps, after) = rest.split_at(here);
             rest = after;
+            let (adds, after) = rest_responses.split_at(here);
+            rest_responses = after;
             last_breaks = jumps;
             if !(idle && c.v == 0.0 && c.a == 0.0 && c.j == 0.0 && jumps.is_empty()) {
                 idle = false;
                 advance(&phi, &phi_cmd, &mut z, Some([c.v, c.a, c.j]));
-                for b in jumps {
-                    disc.jumps()
-                        .add_to(b.before_end_s, [b.dv, b.da, b.dj], &mut z);
+                for (b, r) in jumps.iter().zip(adds) {
+                    for (zi, r) in z.iter_mut().zip(r) {
+                        *zi += r;
+                    }
                     let s = b.before_end_s;
                     x += s * (b.dv + s * (b.da / 2.0 + s * b.dj / 6.0));
                     probe += b.dv * 0.0 + b.da * 0.0 + b.dj * 0.0;
