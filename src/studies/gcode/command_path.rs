@@ -67,9 +67,10 @@ impl Box2 {
     }
 }
 
-/// Held items from `gap` on at most this many behind: a vector drops its forgotten front
-/// only once it is this long and at least half the vector (each item moved at most once
-/// or twice, the vector at most twice the window and this).
+/// The fewest forgotten points a vector of held points drops at a time: its forgotten
+/// front is dropped once it is at least this long and at least half the vector, so each
+/// point is moved a bounded number of times and the vector holds at most about twice the
+/// window's points, or the window's and this many.
 const COMPACT: usize = 256;
 
 /// Drop the first `gap` items of `v` if they are many (see [`COMPACT`]): returns how many
@@ -446,7 +447,8 @@ mod tests {
                 }
             }
             assert!(asked >= 7, "case {case}");
-            // Memory stays bounded: the window and one run.
+            // Memory stays bounded: the window, its first run, and a forgotten front
+            // dropped now and then (`COMPACT`).
             assert!(lazy.c.len() < 3_000 / 2, "case {case}: {}", lazy.c.len());
         }
     }
