@@ -31,22 +31,11 @@ const HIST_RATIO: f64 = 1.001;
 /// Bins from 1e-3 um to 1e5 um (100 mm: beyond is a blow-up, counted in the last bin).
 const HIST_BINS: usize = 18_432;
 
-/// The bin of an error in a [`Histogram`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Bin(usize);
-
 /// The bins' lookup: `ceil(ln(err / HIST_MIN_UM) / ln(HIST_RATIO))`, clamped to the
 /// bins, without the logarithm (crate::measure::log_bins).
 fn bins() -> &'static LogBins {
     static BINS: std::sync::OnceLock<LogBins> = std::sync::OnceLock::new();
     BINS.get_or_init(|| LogBins::new(HIST_MIN_UM, HIST_RATIO, HIST_BINS))
-}
-
-impl Bin {
-    /// The bin of `err_um` (um).
-    pub fn of(err_um: f64) -> Self {
-        Self(bins().bin(err_um))
-    }
 }
 
 /// A histogram of contour errors with log-spaced bins (bounded memory whatever the job's
@@ -83,7 +72,7 @@ impl PartialEq for Histogram {
 impl Histogram {
     /// Count one error (um).
     pub fn push(&mut self, err_um: f64) {
-        self.push_bin(Bin::of(err_um));
+        self.push_all(std::slice::from_ref(&err_um));
     }
 
     /// Count errors (um): as many [`Histogram::push`]es, the lookups of one not waiting
@@ -99,15 +88,6 @@ impl Histogram {
         }
         (self.lo, self.hi) = (lo, hi);
         self.total += errs_um.len() as u64;
-    }
-
-    /// Count one error by its bin (one error counted in several histograms is binned
-    /// once).
-    pub fn push_bin(&mut self, bin: Bin) {
-        self.counts[bin.0] += 1;
-        self.total += 1;
-        self.lo = self.lo.min(bin.0);
-        self.hi = self.hi.max(bin.0);
     }
 
     /// The bins that may hold counts.
@@ -346,7 +326,7 @@ mod tests {
     /// percentile is in 2 um's bin, the 10th in 1 um's), merged too.
     #[test]
     fn counts_past_32_bits_stay_exact() {
-        let (one, two) = (Bin::of(1.0).0, Bin::of(2.0).0);
+        let (one, two) = (bins().bin(1.0), bins().bin(2.0));
         let mut h = Histogram::default();
         h.counts[two] += 5_000_000_000 - 1;
         h.push(2.0);
