@@ -50,8 +50,9 @@ impl Results<'_> {
 
 /// Check the output folder `dir` of a command that writes `results` and the files
 /// `writes` accepts (relative paths), with `inputs` read, before any work: refused when it
-/// is not a folder, is an input or holds one where the command writes, or (without
-/// `force`) when it holds earlier results. Nothing is made: see [`claim`].
+/// is not a folder, is an input or holds one where the command writes, holds something
+/// other than a regular file where the command writes one ([`refuse_unwritable`]), or
+/// (without `force`) when it holds earlier results. Nothing is made: see [`claim`].
 pub fn check(
     dir: &Path,
     results: &Results<'_>,
@@ -65,9 +66,32 @@ pub fn check(
         // What create_dir says of it, before any work.
         return crate::output::atomic::create_dir(dir);
     }
-    inputs.refuse_folder(dir, writes)?;
+    inputs.refuse_folder(dir, &writes)?;
     if !force {
         results.refuse_earlier(dir)?;
+    }
+    refuse_unwritable(dir, Path::new(""), &writes)
+}
+
+/// The entries of `dir` (below `rel`) that the command writes, refused before any work as
+/// they would be when written, `--force` or not: where a file goes, anything but a regular
+/// file (a link, a folder, a device, a FIFO: [`settle_files::write::check_target`]);
+/// where the command writes into a folder of its own (`plots/`: it writes `plots/NAME`),
+/// anything but a real folder, whose entries are then checked the same way.
+fn refuse_unwritable(dir: &Path, rel: &Path, writes: &impl Fn(&Path) -> bool) -> Result<(), Error> {
+    let Ok(entries) = std::fs::read_dir(dir.join(rel)) else {
+        return Ok(()); // a new folder
+    };
+    for entry in entries.flatten() {
+        let rel = rel.join(entry.file_name());
+        let path = dir.join(&rel);
+        if writes(&rel.join("NAME")) {
+            // It exists: nothing is made, only its kind checked.
+            crate::output::atomic::create_subdir(&path)?;
+            refuse_unwritable(dir, &rel, writes)?;
+        } else if writes(&rel) {
+            settle_files::write::check_target(&path)?;
+        }
     }
     Ok(())
 }

@@ -66,11 +66,18 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         sb.write(file, text);
     }
     #[cfg(unix)]
-    for (dir, sub) in [("o_plots", "plots"), ("o_rec", "recordings")] {
+    for (dir, sub) in [
+        ("o_plots", "plots"),
+        ("o_rec", "recordings"),
+        ("o_glink", "summary.md"),
+        ("o_slink", "runs.csv"),
+    ] {
         std::fs::create_dir_all(sb.root().join(dir)).expect("mkdir");
         std::os::unix::fs::symlink(sb.root().join("elsewhere"), sb.root().join(dir).join(sub))
             .expect("link");
     }
+    // A folder where `settle gcode` writes a file.
+    std::fs::create_dir_all(sb.root().join("o_gdir/layers.csv")).expect("mkdir");
     let dev = sb.device();
     let mcap_run = |k: &str| {
         let a = [
@@ -241,6 +248,26 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "gcode print.gcode --machine printer_xy --out o_gcode --force",
             &["o_gcode"],
             Expect::answered(&["wrote o_gcode/summary.md"]),
+        ),
+        // `--force` overwrites earlier results, never through a link: refused before any
+        // work, nothing written beside it.
+        Case::line(
+            "gcode --force with summary.md a link out",
+            "gcode print.gcode --machine printer_xy --out o_glink --force",
+            &[],
+            Expect::refused(&["o_glink/summary.md", "never through a link"]),
+        ),
+        Case::line(
+            "gcode --force with a folder where layers.csv goes",
+            "gcode print.gcode --machine printer_xy --out o_gdir --force",
+            &[],
+            Expect::refused(&["o_gdir/layers.csv", "a folder"]),
+        ),
+        Case::line(
+            "sweep --force with runs.csv a link out",
+            "sweep sc.toml --backend modal --out o_slink --force",
+            &[],
+            Expect::refused(&["o_slink/runs.csv", "never through a link"]),
         ),
         Case::line(
             "gcode over an earlier features.csv alone",
