@@ -18,6 +18,7 @@
 
 use std::path::{Path, PathBuf};
 
+use settle_identify::SweepTest;
 use settle_identify::read::{FileData, klipper_psd};
 use settle_identify::welch::klipper_response;
 use settle_planner::shaper::ShaperType;
@@ -169,6 +170,7 @@ pub fn load(path: &Path) -> Result<Vec<CalibrationData>, Error> {
         FileData::Recordings(recs) => recs
             .iter()
             .map(|rec| {
+                sees_the_test(path, rec.sample_rate_hz)?;
                 let (freq_hz, [x, y, z]) = klipper_response(rec).ok_or_else(|| {
                     Error::input(
                         path,
@@ -188,6 +190,26 @@ pub fn load(path: &Path) -> Result<Vec<CalibrationData>, Error> {
             })
             .collect(),
     }
+}
+
+/// A raw recording sampled at `sample_rate_hz` resolves frequencies up to its Nyquist
+/// frequency only: below the top of Klipper's resonance test (`max_freq` of
+/// `[resonance_tester]`, [`SweepTest::klipper`]), it cannot show the resonances the test
+/// excites, and a shaper fitted to its spectrum (Klipper's fit scores shapers up to
+/// 200 Hz) answers for what it never saw. Refused, with the rate that would do.
+fn sees_the_test(path: &Path, sample_rate_hz: f64) -> Result<(), Error> {
+    let top_hz = SweepTest::klipper().freq_end_hz;
+    let nyquist_hz = sample_rate_hz / 2.0;
+    if nyquist_hz > top_hz {
+        return Ok(());
+    }
+    Err(Error::input(
+        path,
+        format!(
+            "sampled at {sample_rate_hz:.1} Hz, it resolves frequencies up to {nyquist_hz:.1} Hz (Nyquist), not the {top_hz:.0} Hz at the top of Klipper's resonance test: a shaper fitted to it would answer for resonances it cannot show; record at more than {:.0} Hz (an ADXL345 records at 3,200 Hz)",
+            2.0 * top_hz
+        ),
+    ))
 }
 
 /// A processed file's data sets: `psd_xyz` (with the axes) of the per-axis layout, else

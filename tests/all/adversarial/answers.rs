@@ -1,10 +1,10 @@
 //! Answers settle cannot stand behind, refused (exit 2) or said: a G-code file without a
 //! move (prose, a system file as a scenario's `[gcode] file`), a sample rate under
-//! Nyquist, a ring-down fit of a record that holds no free decay, a move, corner or scan
-//! where f64 cannot resolve it, a shaper Klipper refuses in an imported
-//! configuration, a mode too slow for the window, two-value keys given three, a fly axis
-//! that is none, a clock of 0 Hz, a plan without its start; and unknown G-code words
-//! listed as not followed.
+//! Nyquist (a replay's; a recording's for Klipper's shaper choice), a ring-down fit of a
+//! record that holds no free decay, a move, corner or scan where f64 cannot resolve it, a
+//! shaper Klipper refuses in an imported configuration, a mode too slow for the window,
+//! two-value keys given three, a fly axis that is none, a clock of 0 Hz, a plan without
+//! its start; and unknown G-code words listed as not followed.
 
 use super::params::scenario_with;
 use super::sandbox::SECRET;
@@ -109,6 +109,15 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         "mzvn.cfg",
         "[printer]\nkinematics: cartesian\nmax_velocity: 300\nmax_accel: 3000\n[stepper_x]\nrotation_distance: 40\nmicrosteps: 16\n[stepper_y]\nrotation_distance: 40\nmicrosteps: 16\n[input_shaper]\nshaper_type_x: mzv(n=1000000,t=0.8)\nshaper_freq_x: 50\n",
     );
+    // The example recording (800 Hz) kept one sample in 16: 50 Hz, Nyquist 25 Hz.
+    let rec = std::fs::read_to_string(sb.root().join("rec_x.csv")).expect("recording");
+    let slow: Vec<&str> = rec
+        .lines()
+        .enumerate()
+        .filter(|(i, l)| l.starts_with('#') || i % 16 == 0)
+        .map(|(_, l)| l)
+        .collect();
+    sb.write("slow_x.csv", &(slow.join("\n") + "\n"));
     let refused = |what: &str, line: &str, parts: &[&str]| {
         Case::line(what, line, &[], Expect::refused(parts))
     };
@@ -139,6 +148,16 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "a 1 mm move at 1e15 mm",
             "run far.toml --case 0 --backend modal --out o/t.csv",
             &["move.start_mm", "1e5 mm"],
+        ),
+        refused(
+            "tune --criterion klipper on a recording sampled at 50 Hz",
+            "tune --criterion klipper slow_x.csv",
+            &[
+                "slow_x.csv",
+                "sampled at 50.",
+                "Nyquist",
+                "more than 270 Hz",
+            ],
         ),
         refused(
             "identify a resonance sweep without its test's options",
