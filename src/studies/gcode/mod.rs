@@ -416,6 +416,12 @@ impl Study for GcodeRun {
                 format!("{}: {why}", job.file.display()),
             ));
         }
+        if let Some(why) = job.layers.and_then(|r| work::no_work_in(&j.summary(), r)) {
+            return Err((
+                run.blame("gcode.layers"),
+                format!("{}: {why}", job.file.display()),
+            ));
+        }
         // Only a job that passed every check is remembered as checked.
         if let Ok(mut v) = VALIDATED.lock() {
             v.insert(key);

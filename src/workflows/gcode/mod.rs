@@ -713,6 +713,12 @@ fn simulate(
     {
         return Err(Error::input(&opts.file, why));
     }
+    if let Some(why) = opts
+        .layers
+        .and_then(|r| crate::studies::gcode::work::no_work_in(&summary, r))
+    {
+        return Err(Error::input("--layers", why));
+    }
     let mut by_layer: BTreeMap<u32, stats::LayerStats> = streamed
         .layers
         .iter()

@@ -1,10 +1,11 @@
 //! Answers settle cannot stand behind, refused (exit 2) or said: a G-code file without a
-//! move (prose, a system file as a scenario's `[gcode] file`), a sample rate under
-//! Nyquist (a replay's; a recording's for Klipper's shaper choice), a ring-down fit of a
-//! record that holds no free decay, a move, corner or scan where f64 cannot resolve it, a
-//! shaper Klipper refuses in an imported configuration, a mode too slow for the window,
-//! two-value keys given three, a fly axis that is none, a clock of 0 Hz, a plan without
-//! its start; and unknown G-code words listed as not followed.
+//! move (prose, a system file as a scenario's `[gcode] file`) or a layer range without
+//! a working one, a sample rate under Nyquist (a replay's; a recording's for Klipper's
+//! shaper choice), a ring-down fit of a record that holds no free decay, a move, corner or
+//! scan where f64 cannot resolve it, a shaper Klipper refuses in an imported
+//! configuration, a mode too slow for the window, two-value keys given three, a fly axis
+//! that is none, a clock of 0 Hz, a plan without its start; and unknown G-code words
+//! listed as not followed.
 
 use super::params::scenario_with;
 use super::sandbox::SECRET;
@@ -118,6 +119,13 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         .map(|(_, l)| l)
         .collect();
     sb.write("slow_x.csv", &(slow.join("\n") + "\n"));
+    sb.write(
+        "sc_past.toml",
+        &GCODE_SECRET.replace("gcode_secret", "gcode_past").replace(
+            "file = \"secret.txt\"",
+            "file = \"print.gcode\"\nlayers = \"50..60\"",
+        ),
+    );
     let refused = |what: &str, line: &str, parts: &[&str]| {
         Case::line(what, line, &[], Expect::refused(parts))
     };
@@ -134,6 +142,20 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             &["gcode.file", "no move"],
         )
         .never_says(SECRET),
+        refused(
+            "gcode --layers past the file's last layer",
+            "gcode print.gcode --machine printer_xy --layers 50..60 --out o",
+            &[
+                "--layers",
+                "layers 50 to 60 hold no working move",
+                "on layers 1 to",
+            ],
+        ),
+        refused(
+            "[gcode] layers past the file's last layer",
+            "sweep sc_past.toml --backend modal --out o",
+            &["gcode.layers", "layers 50 to 60 hold no working move"],
+        ),
         refused(
             "gcode --sample-rate-hz 1 (under Nyquist)",
             "gcode print.gcode --machine printer_xy --sample-rate-hz 1 --out o",
