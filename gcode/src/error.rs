@@ -303,6 +303,21 @@ pub enum GcodeError {
         /// What the firmware says, and the travel.
         message: String,
     },
+    /// A move or a dwell longer than [`crate::MAX_STEP_DURATION_S`]: a unit mistake (a feed
+    /// of 0.0001 mm/min, a dwell of 1e9 ms), which would keep the replay busy for weeks.
+    #[error(
+        "{at}: `{command}` would last {duration_s:.4e} s ({what}): settle replays a move or a dwell of at most 3600 s (an hour), a real one lasts seconds: check the units (F is in mm/min; G4's P and S; the velocity and acceleration limits)"
+    )]
+    TooLong {
+        /// The line.
+        at: Location,
+        /// The command (`G1`, `G4`).
+        command: String,
+        /// How long it would last (s).
+        duration_s: f64,
+        /// Its length and feed, or "a dwell".
+        what: String,
+    },
     /// A job setting (not from the file) that cannot be used.
     #[error("job setting `{key}`: {reason}")]
     JobSetting {
@@ -366,7 +381,8 @@ impl GcodeError {
             | GcodeError::IncludeCycle { at, .. }
             | GcodeError::Include { at, .. }
             | GcodeError::Plan { at, .. }
-            | GcodeError::OutOfTravel { at, .. } => Some(at),
+            | GcodeError::OutOfTravel { at, .. }
+            | GcodeError::TooLong { at, .. } => Some(at),
         }
     }
 

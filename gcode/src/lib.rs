@@ -59,6 +59,11 @@ pub mod job;
 mod read;
 
 pub use error::{GcodeError, Location};
+
+/// The longest move (its length at its feed) or dwell a job may hold (s): an hour. A real
+/// one lasts seconds (a slow CNC finishing pass minutes); longer is a unit mistake that
+/// would keep the replay busy for weeks ([`GcodeError::TooLong`]).
+pub const MAX_STEP_DURATION_S: f64 = 3600.0;
 pub use read::arc::{
     Arc, FULL_CIRCLE_TOLERANCE_MM, RADIUS_TOLERANCE_MAX_MM, RADIUS_TOLERANCE_MM,
     RADIUS_TOLERANCE_REL,

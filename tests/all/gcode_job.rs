@@ -69,11 +69,22 @@ fn the_cube_layer_writes_layers_summary_and_a_ringing_map() {
     }
     // The print time is the planner's, whatever is simulated.
     let one = measure(&GcodeOptions {
-        layers: Some((0, 0)),
+        layers: Some((1, 1)),
         ..opts.clone()
     })
     .expect("runs");
     assert_eq!(one.print_time_s.to_bits(), o.print_time_s.to_bits());
+    // Layer 0 (before the first layer's Z) holds travel only: nothing to measure.
+    let none = measure(&GcodeOptions {
+        layers: Some((0, 0)),
+        ..opts.clone()
+    })
+    .expect_err("refused");
+    assert!(
+        none.to_string()
+            .contains("layers 0 to 0 hold no working move, so nothing to measure"),
+        "{none}"
+    );
 }
 
 /// The same corner as G-code through settle's planner (`[gcode]`) and as a `[corner]` run

@@ -31,6 +31,9 @@ pub(crate) struct MoveTable {
     /// End of the last segment seen (s).
     last_end_s: f64,
     account: Account,
+    /// The first move planned longer than [`crate::MAX_STEP_DURATION_S`]: its line and
+    /// duration (s).
+    too_long: Option<(u64, f64)>,
 }
 
 impl MoveTable {
@@ -58,12 +61,22 @@ impl MoveTable {
             p.info.start_time_s = t0_s;
         }
         p.info.duration_s = t1_s - p.info.start_time_s;
+        if p.info.duration_s > crate::MAX_STEP_DURATION_S {
+            self.too_long
+                .get_or_insert((p.info.line, p.info.duration_s));
+        }
         self.last_end_s = t1_s;
         let layer = p.info.layer;
         if seq + 1 >= p.end {
             self.complete_front(t1_s);
         }
         Some(layer)
+    }
+
+    /// The first move planned longer than [`crate::MAX_STEP_DURATION_S`] (its line and
+    /// duration, s), once.
+    pub(crate) fn take_too_long(&mut self) -> Option<(u64, f64)> {
+        self.too_long.take()
     }
 
     /// The planner is done: every move is complete (those without segments at `at_s`).

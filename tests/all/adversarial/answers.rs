@@ -1,11 +1,11 @@
 //! Answers settle cannot stand behind, refused (exit 2) or said: a G-code file without a
 //! move (prose, a system file as a scenario's `[gcode] file`) or a layer range without
-//! a working one, a sample rate under Nyquist (a replay's; a recording's for Klipper's
-//! shaper choice), a ring-down fit of a record that holds no free decay, a move, corner or
-//! scan where f64 cannot resolve it, a shaper Klipper refuses in an imported
-//! configuration, a mode too slow for the window, two-value keys given three, a fly axis
-//! that is none, a clock of 0 Hz, a plan without its start; and unknown G-code words
-//! listed as not followed.
+//! a working one, a move or dwell of more than an hour, a sample rate under Nyquist (a
+//! replay's; a recording's for Klipper's shaper choice), a ring-down fit of a record that
+//! holds no free decay, a move, corner or scan where f64 cannot resolve it, a shaper
+//! Klipper refuses in an imported configuration, a mode too slow for the window,
+//! two-value keys given three, a fly axis that is none, a clock of 0 Hz, a plan without
+//! its start; and unknown G-code words listed as not followed.
 
 use super::params::scenario_with;
 use super::sandbox::SECRET;
@@ -126,6 +126,15 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "file = \"print.gcode\"\nlayers = \"50..60\"",
         ),
     );
+    sb.write(
+        "dwell.gcode",
+        "G28\nG1 X10 Y10 F3000\nG1 X50 Y10 E1\nG4 P1000000000\nG1 X50 Y50 E2\n",
+    );
+    sb.write("crawl.gcode", "G28\nG1 X10 Y10 F0.0001\nG1 X50 Y10 E1\n");
+    sb.write(
+        "crawl.cfg",
+        "[printer]\nkinematics: cartesian\nmax_velocity: 0.0001\nmax_accel: 3000\n",
+    );
     let refused = |what: &str, line: &str, parts: &[&str]| {
         Case::line(what, line, &[], Expect::refused(parts))
     };
@@ -155,6 +164,22 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "[gcode] layers past the file's last layer",
             "sweep sc_past.toml --backend modal --out o",
             &["gcode.layers", "layers 50 to 60 hold no working move"],
+        ),
+        // A unit mistake that would keep the replay busy for weeks.
+        refused(
+            "gcode with a dwell of 1e9 ms",
+            "gcode dwell.gcode --machine printer_xy --out o",
+            &["dwell.gcode:4", "a dwell", "at most 3600 s"],
+        ),
+        refused(
+            "gcode at F0.0001",
+            "gcode crawl.gcode --machine printer_xy --out o",
+            &["crawl.gcode:2", "0.000100 mm/min", "at most 3600 s"],
+        ),
+        refused(
+            "gcode under max_velocity: 0.0001",
+            "gcode print.gcode --config crawl.cfg --machine printer_xy --out o",
+            &["as planned within", "at most 3600 s"],
         ),
         refused(
             "gcode --sample-rate-hz 1 (under Nyquist)",

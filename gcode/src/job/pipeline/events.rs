@@ -73,6 +73,14 @@ impl<R: BufRead> Job<R> {
         match ev.kind {
             EventKind::Move(mv) => self.on_move(ev.line, ev.layer, &mv),
             EventKind::Dwell { duration_s } => {
+                if duration_s > crate::MAX_STEP_DURATION_S {
+                    return Err(GcodeError::TooLong {
+                        at: self.at(ev.line),
+                        command: "G4".to_string(),
+                        duration_s,
+                        what: "a dwell".to_string(),
+                    });
+                }
                 let r = match &mut self.planner {
                     Planner::Firmware(d, _) => d.planner().dwell(duration_s),
                     Planner::Settle(s) => s.dwell(duration_s),
@@ -131,6 +139,21 @@ impl<R: BufRead> Job<R> {
             (Path::Line, true) => "G0",
             (Path::Line, false) => "G1",
         };
+        // At its feed (or slower: the limits only slow it), an extruder-only move over its
+        // extrusion.
+        let length_mm = match mv.length_mm() {
+            0.0 => mv.extrusion_mm().abs(),
+            l => l,
+        };
+        let duration_s = length_mm / mv.feed_mm_s;
+        if mv.feed_mm_s > 0.0 && duration_s > crate::MAX_STEP_DURATION_S {
+            return Err(GcodeError::TooLong {
+                at: self.at(line),
+                command: command.to_string(),
+                duration_s,
+                what: format!("{length_mm:.3} mm at {:.6} mm/min", mv.feed_mm_s * 60.0),
+            });
+        }
         let mut points = std::mem::take(&mut self.points);
         mv.segments_into(&self.cfg.arcs, &mut points);
         if check_travel {
@@ -253,6 +276,7 @@ impl<R: BufRead> Job<R> {
                         self.seq += 1;
                         self.on_span(seq, t0, t1)
                             .map_err(|e| plan_error(&self.source, line, command, e))?;
+                        self.refuse_too_long()?;
                     }
                 }
                 return self.drain(line);
@@ -474,6 +498,7 @@ impl<R: BufRead> Job<R> {
                     }
                     self.on_planned(&pm)
                         .map_err(|e| plan_error(&self.source, line, "G1", e))?;
+                    self.refuse_too_long()?;
                 }
                 Planner::Settle(s) => {
                     let Some(c) = s.pop() else {
@@ -484,6 +509,7 @@ impl<R: BufRead> Job<R> {
                         self.on_span(m.seq, m.start_time_s, m.end_time_s)
                             .map_err(|e| plan_error(&self.source, line, "G1", e))?;
                     }
+                    self.refuse_too_long()?;
                     if !done {
                         self.on_input(line, c.start_time_s, c.trajectory)?;
                     }
@@ -497,6 +523,20 @@ impl<R: BufRead> Job<R> {
             }
         }
         Ok(())
+    }
+
+    /// A move planned longer than [`crate::MAX_STEP_DURATION_S`] (a feed, or velocity or
+    /// acceleration limits, so low that it would run for hours), refused at its line.
+    fn refuse_too_long(&mut self) -> Result<(), GcodeError> {
+        match self.table.take_too_long() {
+            None => Ok(()),
+            Some((line, duration_s)) => Err(GcodeError::TooLong {
+                at: self.at(line),
+                command: "move".to_string(),
+                duration_s,
+                what: "as planned within the job's velocity and acceleration limits".to_string(),
+            }),
+        }
     }
 
     fn on_planned(&mut self, pm: &PlannedMove) -> Result<(), PlanError> {
