@@ -56,15 +56,57 @@ impl Box2 {
         }
     }
 
-    /// The square of the distance (mm^2) from `p` to the box: at most the square of the
-    /// distance to anything in it (as each segment's own box was tested before: the same
-    /// bits).
-    #[inline]
+    /// [`Box2::near_sq`] with [`f64::max`] (which passes over a NaN): the reference it
+    /// equals bit for bit on finite numbers.
+    #[cfg(test)]
     fn distance_sq(&self, p: [f64; 2]) -> f64 {
         let dx = (self.min[0] - p[0]).max(p[0] - self.max[0]).max(0.0);
         let dy = (self.min[1] - p[1]).max(p[1] - self.max[1]).max(0.0);
         dx * dx + dy * dy
     }
+
+    /// The square of the distance (mm^2) from `p` to the box: at most the square of the
+    /// distance to anything in it. The larger of two numbers is taken without looking
+    /// for a NaN ([`larger`]; the sign of a zero is squared away). A NaN only comes from
+    /// a NaN `p` or a box of NaN points, whose segments' distances are NaN, which the
+    /// least distance ignores: which of them are computed changes nothing.
+    #[inline]
+    fn near_sq(&self, p: [f64; 2]) -> f64 {
+        let dx = larger(larger(self.min[0] - p[0], p[0] - self.max[0]), 0.0);
+        let dy = larger(larger(self.min[1] - p[1], p[1] - self.max[1]), 0.0);
+        dx * dx + dy * dy
+    }
+}
+
+/// The larger of `a` and `b`, `b` when either is NaN (one instruction where
+/// [`f64::max`] needs four to pass over a NaN).
+#[inline]
+fn larger(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
+}
+
+/// The smaller of `a` and `b`, `b` when either is NaN.
+#[inline]
+fn smaller(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
+}
+
+/// The offset (mm) of `q` from `p`, each coordinate rounded as in [`Box2::near_sq`].
+#[inline]
+fn offset(q: [f64; 2], p: [f64; 2]) -> [f64; 2] {
+    [q[0] - p[0], q[1] - p[1]]
+}
+
+/// [`Box2::near_sq`] of the box of the segment from `a` to `q` for the point `p`, from
+/// the ends' offsets from `p` ([`offset`]), bit for bit for finite numbers: rounding is
+/// monotone and odd, so the rounded `min(a, q) - p` is the smaller rounded offset and the
+/// rounded `p - max(a, q)` the larger one's negative. (A NaN end gives a NaN segment
+/// distance, which the least distance ignores: whether it is computed changes nothing.)
+#[inline]
+fn segment_box_sq(da: [f64; 2], dq: [f64; 2]) -> f64 {
+    let near = |a: f64, q: f64| larger(larger(smaller(a, q), -larger(a, q)), 0.0);
+    let (dx, dy) = (near(da[0], dq[0]), near(da[1], dq[1]));
+    dx * dx + dy * dy
 }
 
 /// The fewest forgotten points a vector of held points drops at a time: its forgotten
@@ -202,20 +244,22 @@ impl CommandPath {
         let mut best = segment_distance_sq(p, c, c).min(segment_distance_sq(p, first, first));
         let last = self.pushed() - 1;
         for (k, b) in (self.first_run..).zip(&self.boxes) {
-            if b.distance_sq(p) >= best {
+            if b.near_sq(p) >= best {
                 continue;
             }
             // Segments from point `i` to `i + 1` for the kept `i` of run `k`.
             let from = (k * RUN).max(self.forgotten);
             let to = ((k + 1) * RUN).min(last);
             let run = &points[(from - base) as usize..=(to - base) as usize];
-            for s in run.windows(2) {
-                let (a, q) = (s[0], s[1]);
-                let mut segment = Box2::at(q);
-                segment.add(a);
-                if segment.distance_sq(p) < best {
+            // Each point's offset from `p`, shared by the two segments it ends.
+            let mut a = run[0];
+            let mut da = offset(a, p);
+            for &q in &run[1..] {
+                let dq = offset(q, p);
+                if segment_box_sq(da, dq) < best {
                     best = best.min(segment_distance_sq(p, a, q));
                 }
+                (a, da) = (q, dq);
             }
         }
         Some(best.sqrt())
@@ -451,6 +495,32 @@ mod tests {
             // dropped now and then (`COMPACT`).
             assert!(lazy.c.len() < 3_000 / 2, "case {case}: {}", lazy.c.len());
         }
+    }
+
+    /// A segment's box distance from its ends' offsets, and a box's without looking for
+    /// NaN, are the box distances with [`f64::max`] bit for bit: on random points (on a
+    /// coarse grid too, so that ends, the point and box sides coincide, zeros of both
+    /// signs), a NaN segment end giving a NaN segment distance.
+    #[test]
+    fn box_distances_from_offsets_are_the_box_distances() {
+        let mut uniform = uniform_from(0x5851_f42d_4c95_7f2d);
+        for k in 0..200_000 {
+            let mut coordinate = || match k % 3 {
+                0 => 200.0 * uniform() - 100.0,
+                1 => (8.0 * uniform()).floor() * 0.5 - 2.0,
+                _ => 1e-3 * (2.0 * uniform() - 1.0) + 0.1,
+            };
+            let [a, q, p] = [0; 3].map(|_| [coordinate(), coordinate()]);
+            let mut segment = Box2::at(q);
+            segment.add(a);
+            let want = segment.distance_sq(p).to_bits();
+            assert_eq!(segment.near_sq(p).to_bits(), want, "{a:?} {q:?} {p:?}");
+            let from_offsets = segment_box_sq(offset(a, p), offset(q, p));
+            assert_eq!(from_offsets.to_bits(), want, "{a:?} {q:?} {p:?}");
+        }
+        let nan = [f64::NAN, 1.0];
+        assert!(segment_distance_sq([0.0, 0.0], nan, [1.0, 1.0]).is_nan());
+        assert!(segment_distance_sq([0.0, 0.0], [1.0, 1.0], nan).is_nan());
     }
 
     /// A toolhead lagging on the first leg of a corner the command has turned is on the

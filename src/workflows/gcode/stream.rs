@@ -312,18 +312,24 @@ impl Account {
     fn vibration_um(&mut self, w: &Waiting, err_um: f64, map_point: bool, m: Owner) -> f64 {
         let p = [w.toolhead[0] * 1e3, w.toolhead[1] * 1e3];
         let c = [w.cmd[0] * 1e3, w.cmd[1] * 1e3];
+        let measured = |path: &mut CommandPath| path.distance_mm(w.t, p, c).unwrap_or(0.0) * 1e3;
+        let spot = || {
+            self.owner
+                .as_ref()
+                .is_none_or(|o| o.4.as_ref().is_none_or(|s| err_um > s.error_um))
+                || self.out.features.is_worst(m.feature, err_um)
+        };
+        // The bound only where the distance is not read anyway (a map point, a spot).
+        if map_point || spot() {
+            return measured(&mut self.command.path);
+        }
         let bound_um = CommandPath::bound_mm(p, c) * 1e3;
         let largest = self
             .layer
             .as_ref()
             .map_or(0.0, |l| l.split_worst.vibration_um);
-        let spot = self
-            .owner
-            .as_ref()
-            .is_none_or(|o| o.4.as_ref().is_none_or(|s| err_um > s.error_um))
-            || self.out.features.is_worst(m.feature, err_um);
-        if map_point || spot || bound_um > largest {
-            self.command.path.distance_mm(w.t, p, c).unwrap_or(0.0) * 1e3
+        if bound_um > largest {
+            measured(&mut self.command.path)
         } else {
             bound_um
         }
