@@ -51,7 +51,7 @@ impl Results<'_> {
 /// Check the output folder `dir` of a command that writes `results` and the files
 /// `writes` accepts (relative paths), with `inputs` read, before any work: refused when it
 /// is not a folder, is an input or holds one where the command writes, holds something
-/// other than a regular file where the command writes one ([`refuse_unwritable`]), or
+/// other than a regular file where the command writes one (see `refuse_unwritable`), or
 /// (without `force`) when it holds earlier results. Nothing is made: see [`claim`].
 pub fn check(
     dir: &Path,
