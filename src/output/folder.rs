@@ -4,7 +4,7 @@
 //! holds the results of an earlier run is refused without `--force` (they would be
 //! overwritten, or mixed with the new ones); then the folder is made.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use settle_files::write::Inputs;
 
@@ -70,25 +70,29 @@ pub fn check(
     if !force {
         results.refuse_earlier(dir)?;
     }
-    refuse_unwritable(dir, Path::new(""), &writes)
+    refuse_unwritable(dir, &writes)
 }
 
-/// The entries of `dir` (below `rel`) that the command writes, refused before any work as
-/// they would be when written, `--force` or not: where a file goes, anything but a regular
-/// file (a link, a folder, a device, a FIFO: [`settle_files::write::check_target`]);
-/// where the command writes into a folder of its own (`plots/`: it writes `plots/NAME`),
-/// anything but a real folder, whose entries are then checked the same way.
-fn refuse_unwritable(dir: &Path, rel: &Path, writes: &impl Fn(&Path) -> bool) -> Result<(), Error> {
-    let Ok(entries) = std::fs::read_dir(dir.join(rel)) else {
+/// The entries of `dir` that the command writes, refused before any work as they would be
+/// when written, `--force` or not: where a file goes, anything but a regular file (a link,
+/// a folder, a device, a FIFO: [`settle_files::write::check_target`]); where the command
+/// writes into a folder of its own (`plots/`: it writes `plots/NAME`), anything but a real
+/// folder. (What lies inside such a folder is checked as each file is written: a sweep
+/// then stops with its journal kept for `--resume`.) Names starting with a dot are
+/// settle's temporary files (`.NAME.tmpPID`), which the writers replace whatever they are.
+fn refuse_unwritable(dir: &Path, writes: &impl Fn(&Path) -> bool) -> Result<(), Error> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(()); // a new folder
     };
     for entry in entries.flatten() {
-        let rel = rel.join(entry.file_name());
+        let rel = PathBuf::from(entry.file_name());
+        if rel.to_string_lossy().starts_with('.') {
+            continue;
+        }
         let path = dir.join(&rel);
         if writes(&rel.join("NAME")) {
             // It exists: nothing is made, only its kind checked.
             crate::output::atomic::create_subdir(&path)?;
-            refuse_unwritable(dir, &rel, writes)?;
         } else if writes(&rel) {
             settle_files::write::check_target(&path)?;
         }
