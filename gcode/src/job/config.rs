@@ -246,12 +246,15 @@ fn planner_kinematics(name: &str, key: &'static str) -> Result<Kinematics, Gcode
 }
 
 /// An axis's shaper as a configuration file sets it, as a job setting (`None`: the
-/// firmware does not shape the axis).
+/// firmware does not shape the axis). An error names `keys`' first (the shaper's type),
+/// or its second for a frequency below settle's lowest.
 fn config_shaper(
     s: &crate::config::ShaperSetting,
     dialect: Dialect,
-    key: &'static str,
+    keys: [&'static str; 2],
 ) -> Result<Option<ShaperSetting>, GcodeError> {
+    let min = settle_planner::shaper::MIN_FREQUENCY_HZ;
+    let key = keys[usize::from(s.frequency_hz < min && s.type_name(dialect).is_some())];
     let bad = |reason: String| GcodeError::JobSetting { key, reason };
     let Some(name) = s.type_name(dialect) else {
         if s.is_enabled(dialect) {
@@ -301,9 +304,9 @@ impl JobConfig {
         }
         if let Some(s) = &c.input_shaper {
             let keys = [
-                "input_shaper.shaper_type_x",
-                "input_shaper.shaper_type_y",
-                "input_shaper.shaper_type_z",
+                ["input_shaper.shaper_type_x", "input_shaper.shaper_freq_x"],
+                ["input_shaper.shaper_type_y", "input_shaper.shaper_freq_y"],
+                ["input_shaper.shaper_type_z", "input_shaper.shaper_freq_z"],
             ];
             for (i, ((_, axis), key)) in s.iter().zip(keys).enumerate() {
                 cfg.shapers[i] = config_shaper(axis, Dialect::Klipper, key)?;
@@ -339,7 +342,7 @@ impl JobConfig {
                 .position_max_mm
                 .map(|hi| (a.drive.position_min_mm, hi));
         }
-        let shaper = config_shaper(&c.input_shaper, Dialect::Rrf, "M593")?;
+        let shaper = config_shaper(&c.input_shaper, Dialect::Rrf, ["M593", "M593 F"])?;
         cfg.shapers[0] = shaper;
         cfg.shapers[1] = shaper;
         Ok(cfg)
@@ -382,6 +385,23 @@ mod from_config_tests {
         );
         assert_eq!(z, None, "Klipper leaves Z unshaped without shaper_freq_z");
         assert_eq!(cfg.dialect, Dialect::Klipper);
+    }
+
+    #[test]
+    fn a_shaper_error_names_the_key_at_fault() {
+        let cfg = |shaper: &str| {
+            let text = format!(
+                "[printer]\nkinematics: cartesian\nmax_velocity: 200\nmax_accel: 3000\n\
+                 [input_shaper]\n{shaper}"
+            );
+            let err = JobConfig::from_klipper(&KlipperFile::parse(&text, "p.cfg").expect("ok"))
+                .expect_err("refused");
+            err.to_string()
+        };
+        // Klipper shapes Y with its default type (mzv): the frequency is at fault.
+        let low = cfg("shaper_freq_x: 40\nshaper_freq_y: 0.5\n");
+        assert!(low.contains("input_shaper.shaper_freq_y"), "{low}");
+        assert!(low.contains("0.5 Hz is below 1 Hz"), "{low}");
     }
 
     #[test]
