@@ -76,6 +76,14 @@ pub enum PlanError {
         /// The allowed names, comma separated.
         allowed: &'static str,
     },
+    /// An unknown input shaper name.
+    #[error("unknown shaper `{name}`; allowed: {allowed}")]
+    UnknownShaper {
+        /// The name given.
+        name: String,
+        /// The allowed names.
+        allowed: &'static str,
+    },
     /// A shaper name that parses but whose parameters, frequency or damping ratio its
     /// firmware refuses.
     #[error("shaper `{name}`: {reason}")]

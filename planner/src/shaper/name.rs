@@ -35,7 +35,7 @@ fn invalid(name: &str, reason: String) -> PlanError {
 }
 
 fn unknown(name: &str) -> PlanError {
-    PlanError::UnknownKind {
+    PlanError::UnknownShaper {
         name: name.to_string(),
         allowed: ShaperType::ALLOWED,
     }
@@ -157,7 +157,7 @@ fn assign<'a>(
 
 impl ShaperType {
     /// Parse a shaper name (syntax in this module's documentation). Unknown names give
-    /// [`PlanError::UnknownKind`] listing the allowed names; bad parameters give
+    /// [`PlanError::UnknownShaper`] listing the allowed names; bad parameters give
     /// [`PlanError::InvalidShaper`] saying what is allowed.
     pub fn parse(name: &str) -> Result<Self, PlanError> {
         let lower = name.trim().to_ascii_lowercase();

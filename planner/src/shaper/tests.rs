@@ -199,6 +199,6 @@ fn bad_input_is_rejected() {
     assert!(ShaperType::parse("2HUMP_EI").is_ok());
     assert!(matches!(
         ShaperType::parse("zvdd"),
-        Err(PlanError::UnknownKind { .. })
+        Err(PlanError::UnknownShaper { .. })
     ));
 }

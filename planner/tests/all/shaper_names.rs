@@ -99,10 +99,14 @@ fn written_forms() {
 fn bad_names_list_what_is_allowed() {
     for bad in ["zvdd", "rrf:zv", "marlin:2hump_ei", "prusa:zv", "", "mzv2"] {
         match ShaperType::parse(bad) {
-            Err(PlanError::UnknownKind { name, allowed }) => {
+            Err(PlanError::UnknownShaper { name, allowed }) => {
                 assert_eq!(name, bad);
                 assert_eq!(allowed, ShaperType::ALLOWED);
-                let text = PlanError::UnknownKind { name, allowed }.to_string();
+                let text = PlanError::UnknownShaper { name, allowed }.to_string();
+                assert!(
+                    text.starts_with(&format!("unknown shaper `{bad}`")),
+                    "{text}"
+                );
                 for family in ["2hump_ei", "marlin:zvdd", "rrf:ei3", "mzv(n=N,t=T)"] {
                     assert!(text.contains(family), "{text}");
                 }

@@ -391,7 +391,7 @@ impl<R: BufRead> Job<R> {
                 &self.source,
                 line,
                 command,
-                PlanError::UnknownKind {
+                PlanError::UnknownShaper {
                     name,
                     allowed: settle_planner::shaper::ShaperType::ALLOWED,
                 },
