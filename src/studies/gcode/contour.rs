@@ -76,7 +76,94 @@ struct Active {
     runs: bool,
     /// A line's XY ends (mm); `None` for an arc.
     line: Option<[[f64; 2]; 2]>,
+    /// An arc's chunks of [`ARC_CHUNK`] segments ([`ArcChunks`]).
+    arc: Option<ArcChunks>,
     info: Arc<MoveInfo>,
+}
+
+/// Segments per box of an arc's search ([`ArcChunks`]).
+const ARC_CHUNK: usize = 32;
+
+/// An arc's chord segments in chunks of [`ARC_CHUNK`], each with its XY box, and the
+/// chunks in groups of [`ARC_CHUNK`] with the box around theirs, so that a distance skips
+/// what cannot hold the nearest segment: one to an arc of thousands of segments costs a
+/// few boxes and segments, not a scan of all of them.
+#[derive(Debug)]
+struct ArcChunks {
+    /// Per chunk, `[min x, min y, max x, max y]` of its points (mm).
+    boxes: Vec<[f64; 4]>,
+    /// Per [`ARC_CHUNK`] chunks, the box around their boxes.
+    outer: Vec<[f64; 4]>,
+    /// The largest `x^2 + y^2` of its points (mm^2): the scale of the rounding errors.
+    scale_sq: f64,
+}
+
+impl ArcChunks {
+    fn new(points: &[[f64; 3]]) -> Self {
+        let boxes: Vec<[f64; 4]> = (0..points.len().saturating_sub(1))
+            .step_by(ARC_CHUNK)
+            .map(|i| {
+                let chunk = &points[i..(i + ARC_CHUNK + 1).min(points.len())];
+                chunk.iter().fold(
+                    [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY],
+                    |b, q| [b[0].min(q[0]), b[1].min(q[1]), b[2].max(q[0]), b[3].max(q[1])],
+                )
+            })
+            .collect();
+        let outer = boxes
+            .chunks(ARC_CHUNK)
+            .map(|c: &[[f64; 4]]| {
+                c.iter().fold(
+                    [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY],
+                    |b, q| [b[0].min(q[0]), b[1].min(q[1]), b[2].max(q[2]), b[3].max(q[3])],
+                )
+            })
+            .collect();
+        let scale_sq = points
+            .iter()
+            .fold(0.0, |m: f64, q| m.max(q[0] * q[0] + q[1] * q[1]));
+        Self {
+            boxes,
+            outer,
+            scale_sq,
+        }
+    }
+
+    /// The least [`segment_distance_sq`] from `p` to the segments of `points` (the arc's),
+    /// bit for bit the scan's ([`geometry_distance_sq`]). A chunk is skipped only when its
+    /// box's squared distance exceeds the least so far by a relative 1e-9 plus
+    /// `1e-12 (1 + |p|^2 + scale_sq)`: far more than the rounding of either computation
+    /// (a few ulps of the box distance; of a segment's, relative to its coordinates), so a
+    /// skipped segment's computed distance is never below the least, and the least of the
+    /// rest is the scan's. A NaN point of `p` skips nothing; NaN segments are ignored by
+    /// the minimum as in the scan.
+    fn distance_sq(&self, points: &[[f64; 3]], p: [f64; 2]) -> f64 {
+        let margin = 1e-12 * (1.0 + p[0] * p[0] + p[1] * p[1] + self.scale_sq);
+        let far = |b: &[f64; 4], best: f64| {
+            let dx = (b[0] - p[0]).max(p[0] - b[2]).max(0.0);
+            let dy = (b[1] - p[1]).max(p[1] - b[3]).max(0.0);
+            dx * dx + dy * dy > best * (1.0 + 1e-9) + margin
+        };
+        let mut best = f64::INFINITY;
+        for (o, ob) in self.outer.iter().enumerate() {
+            if far(ob, best) {
+                continue;
+            }
+            let first = o * ARC_CHUNK;
+            let inner = &self.boxes[first..(first + ARC_CHUNK).min(self.boxes.len())];
+            for (k, b) in inner.iter().enumerate() {
+                if far(b, best) {
+                    continue;
+                }
+                let i = (first + k) * ARC_CHUNK;
+                for w in points[i..(i + ARC_CHUNK + 1).min(points.len())].windows(2) {
+                    let (a, b) = ([w[0][0], w[0][1]], [w[1][0], w[1][1]]);
+                    best = best.min(segment_distance_sq(p, a, b));
+                }
+            }
+        }
+        best
+    }
 }
 
 impl Active {
@@ -87,11 +174,16 @@ impl Active {
             }
             MoveGeometry::Arc { .. } => None,
         };
+        let arc = match &m.geometry {
+            MoveGeometry::Arc { points_mm, .. } => Some(ArcChunks::new(points_mm)),
+            MoveGeometry::Line { .. } => None,
+        };
         Self {
             start_s: m.start_time_s,
             end_s: m.end_time_s(),
             runs: m.duration_s > 0.0,
             line,
+            arc,
             info: Arc::clone(m),
         }
     }
@@ -99,9 +191,10 @@ impl Active {
     /// [`geometry_distance_sq`] of its geometry, bit for bit.
     #[inline]
     fn distance_sq(&self, p: [f64; 2]) -> f64 {
-        match &self.line {
-            Some([a, b]) => segment_distance_sq(p, *a, *b),
-            None => geometry_distance_sq(&self.info.geometry, p),
+        match (&self.line, &self.arc, &self.info.geometry) {
+            (Some([a, b]), _, _) => segment_distance_sq(p, *a, *b),
+            (None, Some(c), MoveGeometry::Arc { points_mm, .. }) => c.distance_sq(points_mm, p),
+            _ => geometry_distance_sq(&self.info.geometry, p),
         }
     }
 }
@@ -195,6 +288,85 @@ impl ActiveMoves {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An arc geometry through `points` (the scan reads the points only).
+    fn arc_of(points: &[[f64; 3]]) -> MoveGeometry {
+        MoveGeometry::Arc {
+            arc: settle_gcode::Arc {
+                centre_x_mm: 0.0,
+                centre_y_mm: 0.0,
+                offset_i_mm: 0.0,
+                offset_j_mm: 0.0,
+                radius_mm: 0.0,
+                start_angle_rad: 0.0,
+                sweep_rad: 0.0,
+                radius_word_mm: None,
+            },
+            points_mm: points.to_vec(),
+        }
+    }
+
+    #[test]
+    fn an_arcs_chunked_distance_is_the_scans_bit_for_bit() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut uniform = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..300 {
+            // Arcs of 1 to 3,000 segments, radius 0.01 mm to 50 m, centre up to 1e5 mm out.
+            let n = 1 + (uniform() * 3000.0) as usize;
+            let r = 10f64.powf(-2.0 + 6.7 * uniform());
+            let c = [(uniform() - 0.5) * 2e5, (uniform() - 0.5) * 2e5];
+            let (a0, sweep) = (uniform() * 6.3, (uniform() - 0.5) * 12.6);
+            let points: Vec<[f64; 3]> = (0..=n)
+                .map(|i| {
+                    let a = a0 + sweep * i as f64 / n as f64;
+                    [c[0] + r * a.cos(), c[1] + r * a.sin(), 0.0]
+                })
+                .collect();
+            let geometry = arc_of(&points);
+            let chunks = ArcChunks::new(&points);
+            for k in 0..200 {
+                let p = match k % 4 {
+                    // On a point of the arc, or a hair off it.
+                    0 => {
+                        let q = points[(uniform() * n as f64) as usize];
+                        [q[0], q[1]]
+                    }
+                    1 => {
+                        let q = points[(uniform() * n as f64) as usize];
+                        let e = r * 1e-9 * (uniform() - 0.5);
+                        [q[0] + e, q[1] - e]
+                    }
+                    // Near the circle, or anywhere around it.
+                    2 => {
+                        let a = uniform() * 6.3;
+                        let rr = r * (1.0 + (uniform() - 0.5) * 1e-3);
+                        [c[0] + rr * a.cos(), c[1] + rr * a.sin()]
+                    }
+                    _ => [
+                        c[0] + (uniform() - 0.5) * 4.0 * r,
+                        c[1] + (uniform() - 0.5) * 4.0 * r,
+                    ],
+                };
+                let scan = geometry_distance_sq(&geometry, p);
+                let fast = chunks.distance_sq(&points, p);
+                assert_eq!(fast.to_bits(), scan.to_bits(), "case {case}, point {p:?}");
+            }
+        }
+        // A NaN point: NaN from both (no segment is skipped, every one is NaN).
+        let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]];
+        let geometry = arc_of(&points);
+        let p = [f64::NAN, 0.0];
+        let chunks = ArcChunks::new(&points);
+        assert_eq!(
+            chunks.distance_sq(&points, p).is_nan(),
+            geometry_distance_sq(&geometry, p).is_nan()
+        );
+    }
 
     #[test]
     fn distances_to_a_segment_and_its_ends() {
