@@ -31,59 +31,12 @@ use std::sync::Arc;
 
 use settle_planner::Profile;
 
+use super::box2::{Box2, larger};
 use super::contour::{ACTIVE_WINDOW_S, segment_distance_sq};
 
 /// Consecutive segments sharing a bounding box ([`CommandPath::distance_mm`]): about
 /// 12 boxes over a window of 2 x 20 ms at 2 kHz, of which the toolhead is near one or two.
 pub const RUN: u64 = 8;
-
-/// An axis-aligned box (XY, mm): least X and Y, then largest.
-#[derive(Debug, Clone, Copy)]
-struct Box2 {
-    min: [f64; 2],
-    max: [f64; 2],
-}
-
-impl Box2 {
-    fn at(c: [f64; 2]) -> Self {
-        Self { min: c, max: c }
-    }
-
-    fn add(&mut self, c: [f64; 2]) {
-        for ((lo, hi), c) in self.min.iter_mut().zip(&mut self.max).zip(c) {
-            *lo = lo.min(c);
-            *hi = hi.max(c);
-        }
-    }
-
-    /// [`Box2::near_sq`] with [`f64::max`] (which passes over a NaN): the reference it
-    /// equals bit for bit on finite numbers.
-    #[cfg(test)]
-    fn distance_sq(&self, p: [f64; 2]) -> f64 {
-        let dx = (self.min[0] - p[0]).max(p[0] - self.max[0]).max(0.0);
-        let dy = (self.min[1] - p[1]).max(p[1] - self.max[1]).max(0.0);
-        dx * dx + dy * dy
-    }
-
-    /// The square of the distance (mm^2) from `p` to the box: at most the square of the
-    /// distance to anything in it. The larger of two numbers is taken without looking
-    /// for a NaN ([`larger`]; the sign of a zero is squared away). A NaN only comes from
-    /// a NaN `p` or a box of NaN points, whose segments' distances are NaN, which the
-    /// least distance ignores: which of them are computed changes nothing.
-    #[inline]
-    fn near_sq(&self, p: [f64; 2]) -> f64 {
-        let dx = larger(larger(self.min[0] - p[0], p[0] - self.max[0]), 0.0);
-        let dy = larger(larger(self.min[1] - p[1], p[1] - self.max[1]), 0.0);
-        dx * dx + dy * dy
-    }
-}
-
-/// The larger of `a` and `b`, `b` when either is NaN (one instruction where
-/// [`f64::max`] needs four to pass over a NaN).
-#[inline]
-fn larger(a: f64, b: f64) -> f64 {
-    if a > b { a } else { b }
-}
 
 /// The smaller of `a` and `b`, `b` when either is NaN.
 #[inline]

@@ -17,6 +17,8 @@ use std::sync::Arc;
 
 use settle_gcode::job::{MoveGeometry, MoveInfo};
 
+use super::box2::Box2;
+
 /// How far (s) a move's span is widened for [`ActiveMoves::at`]: 20 ms is longer
 /// than half the longest Klipper shaper at 20 Hz (2DHUMP_EI at 20 Hz lasts 75 ms: the
 /// shaped command leads by at most half of it, 37 ms, only on shapers tuned below 40 Hz)
@@ -90,33 +92,34 @@ const ARC_CHUNK: usize = 32;
 /// few boxes and segments, not a scan of all of them.
 #[derive(Debug)]
 struct ArcChunks {
-    /// Per chunk, `[min x, min y, max x, max y]` of its points (mm).
-    boxes: Vec<[f64; 4]>,
+    /// Per chunk, the box of its points.
+    boxes: Vec<Box2>,
     /// Per [`ARC_CHUNK`] chunks, the box around their boxes.
-    outer: Vec<[f64; 4]>,
+    outer: Vec<Box2>,
     /// The largest `x^2 + y^2` of its points (mm^2): the scale of the rounding errors.
     scale_sq: f64,
 }
 
 impl ArcChunks {
     fn new(points: &[[f64; 3]]) -> Self {
-        let boxes: Vec<[f64; 4]> = (0..points.len().saturating_sub(1))
+        let boxes: Vec<Box2> = (0..points.len().saturating_sub(1))
             .step_by(ARC_CHUNK)
             .map(|i| {
                 let chunk = &points[i..(i + ARC_CHUNK + 1).min(points.len())];
-                chunk.iter().fold(
-                    [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY],
-                    |b, q| [b[0].min(q[0]), b[1].min(q[1]), b[2].max(q[0]), b[3].max(q[1])],
-                )
+                let mut b = Box2::at([chunk[0][0], chunk[0][1]]);
+                chunk[1..].iter().for_each(|q| b.add([q[0], q[1]]));
+                b
             })
             .collect();
         let outer = boxes
             .chunks(ARC_CHUNK)
-            .map(|c: &[[f64; 4]]| {
-                c.iter().fold(
-                    [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY],
-                    |b, q| [b[0].min(q[0]), b[1].min(q[1]), b[2].max(q[2]), b[3].max(q[3])],
-                )
+            .map(|c| {
+                let mut b = c[0];
+                c[1..].iter().for_each(|q| {
+                    b.add(q.min);
+                    b.add(q.max);
+                });
+                b
             })
             .collect();
         let scale_sq = points
@@ -139,11 +142,7 @@ impl ArcChunks {
     /// the minimum as in the scan.
     fn distance_sq(&self, points: &[[f64; 3]], p: [f64; 2]) -> f64 {
         let margin = 1e-12 * (1.0 + p[0] * p[0] + p[1] * p[1] + self.scale_sq);
-        let far = |b: &[f64; 4], best: f64| {
-            let dx = (b[0] - p[0]).max(p[0] - b[2]).max(0.0);
-            let dy = (b[1] - p[1]).max(p[1] - b[3]).max(0.0);
-            dx * dx + dy * dy > best * (1.0 + 1e-9) + margin
-        };
+        let far = |b: &Box2, best: f64| b.near_sq(p) > best * (1.0 + 1e-9) + margin;
         let mut best = f64::INFINITY;
         for (o, ob) in self.outer.iter().enumerate() {
             if far(ob, best) {

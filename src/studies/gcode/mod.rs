@@ -47,6 +47,7 @@
 //! real job goes on); they measure that stop, not the print, and `settle gcode --layers`
 //! reports no such ringing for a range that ends before the file.
 
+pub mod box2;
 pub mod command_path;
 pub mod contour;
 pub mod features;
