@@ -83,26 +83,28 @@ struct Active {
     info: Arc<MoveInfo>,
 }
 
-/// Segments per box of an arc's search ([`ArcChunks`]).
+/// Segments per box of an arc's search, and boxes per box of the level above
+/// ([`ArcChunks`]).
 const ARC_CHUNK: usize = 32;
 
-/// An arc's chord segments in chunks of [`ARC_CHUNK`], each with its XY box, and the
-/// chunks in groups of [`ARC_CHUNK`] with the box around theirs, so that a distance skips
-/// what cannot hold the nearest segment: one to an arc of thousands of segments costs a
-/// few boxes and segments, not a scan of all of them.
+/// An arc's chord segments in chunks of [`ARC_CHUNK`], each with its XY box, and above
+/// them levels of boxes, each around [`ARC_CHUNK`] boxes of the level below, up to a top
+/// of at most [`ARC_CHUNK`]: a distance descends to the nearest-looking chunk first and
+/// skips every box that cannot hold the nearest segment, so that one to an arc of
+/// hundreds of thousands of segments costs a few dozen boxes and segments per level
+/// (logarithmic in the segments), not a scan of all of them.
 #[derive(Debug)]
 struct ArcChunks {
-    /// Per chunk, the box of its points.
-    boxes: Vec<Box2>,
-    /// Per [`ARC_CHUNK`] chunks, the box around their boxes.
-    outer: Vec<Box2>,
+    /// Level 0: per chunk, the box of its points; level `k + 1`: per [`ARC_CHUNK`] boxes
+    /// of level `k`, the box around them. The last level has at most [`ARC_CHUNK`].
+    levels: Vec<Vec<Box2>>,
     /// The largest `x^2 + y^2` of its points (mm^2): the scale of the rounding errors.
     scale_sq: f64,
 }
 
 impl ArcChunks {
     fn new(points: &[[f64; 3]]) -> Self {
-        let boxes: Vec<Box2> = (0..points.len().saturating_sub(1))
+        let chunks: Vec<Box2> = (0..points.len().saturating_sub(1))
             .step_by(ARC_CHUNK)
             .map(|i| {
                 let chunk = &points[i..(i + ARC_CHUNK + 1).min(points.len())];
@@ -111,57 +113,81 @@ impl ArcChunks {
                 b
             })
             .collect();
-        let outer = boxes
-            .chunks(ARC_CHUNK)
-            .map(|c| {
-                let mut b = c[0];
-                c[1..].iter().for_each(|q| {
-                    b.add(q.min);
-                    b.add(q.max);
-                });
-                b
-            })
-            .collect();
+        let mut levels = vec![chunks];
+        while let Some(below) = levels.last().filter(|l| l.len() > ARC_CHUNK) {
+            let above = below
+                .chunks(ARC_CHUNK)
+                .map(|c| {
+                    let mut b = c[0];
+                    c[1..].iter().for_each(|q| {
+                        b.add(q.min);
+                        b.add(q.max);
+                    });
+                    b
+                })
+                .collect();
+            levels.push(above);
+        }
         let scale_sq = points
             .iter()
             .fold(0.0, |m: f64, q| m.max(q[0] * q[0] + q[1] * q[1]));
-        Self {
-            boxes,
-            outer,
-            scale_sq,
-        }
+        Self { levels, scale_sq }
     }
 
     /// The least [`segment_distance_sq`] from `p` to the segments of `points` (the arc's),
-    /// bit for bit the scan's ([`geometry_distance_sq`]). A chunk is skipped only when its
-    /// box's squared distance exceeds the least so far by a relative 1e-9 plus
+    /// bit for bit the scan's ([`geometry_distance_sq`]): the least of a set of numbers
+    /// does not depend on the order they are visited in. A box is skipped only when its
+    /// squared distance exceeds the least so far by a relative 1e-9 plus
     /// `1e-12 (1 + |p|^2 + scale_sq)`: far more than the rounding of either computation
-    /// (a few ulps of the box distance; of a segment's, relative to its coordinates), so a
+    /// (a few ulps of the box distance, a box being the exact least and largest
+    /// coordinates of its points; of a segment's, relative to its coordinates), so a
     /// skipped segment's computed distance is never below the least, and the least of the
     /// rest is the scan's. A NaN point of `p` skips nothing; NaN segments are ignored by
     /// the minimum as in the scan.
     fn distance_sq(&self, points: &[[f64; 3]], p: [f64; 2]) -> f64 {
         let margin = 1e-12 * (1.0 + p[0] * p[0] + p[1] * p[1] + self.scale_sq);
-        let far = |b: &Box2, best: f64| b.near_sq(p) > best * (1.0 + 1e-9) + margin;
         let mut best = f64::INFINITY;
-        for (o, ob) in self.outer.iter().enumerate() {
-            if far(ob, best) {
+        let top = self.levels.len() - 1;
+        self.visit(top, 0, points, p, margin, &mut best);
+        best
+    }
+
+    /// Visit the boxes of `level` from `first` (at most [`ARC_CHUNK`] of them, those of
+    /// one box of the level above), the nearest first, each not skipped ([`Self::distance_sq`])
+    /// down to its segments.
+    fn visit(
+        &self,
+        level: usize,
+        first: usize,
+        points: &[[f64; 3]],
+        p: [f64; 2],
+        margin: f64,
+        best: &mut f64,
+    ) {
+        let boxes = &self.levels[level][first..(first + ARC_CHUNK).min(self.levels[level].len())];
+        let mut near = [0.0; ARC_CHUNK];
+        let mut nearest = 0;
+        for (k, b) in boxes.iter().enumerate() {
+            near[k] = b.near_sq(p);
+            if near[k] < near[nearest] {
+                nearest = k;
+            }
+        }
+        let order = std::iter::once(nearest).chain((0..boxes.len()).filter(|&k| k != nearest));
+        for k in order {
+            if near[k] > *best * (1.0 + 1e-9) + margin {
                 continue;
             }
-            let first = o * ARC_CHUNK;
-            let inner = &self.boxes[first..(first + ARC_CHUNK).min(self.boxes.len())];
-            for (k, b) in inner.iter().enumerate() {
-                if far(b, best) {
-                    continue;
-                }
-                let i = (first + k) * ARC_CHUNK;
-                for w in points[i..(i + ARC_CHUNK + 1).min(points.len())].windows(2) {
+            let below = (first + k) * ARC_CHUNK;
+            if level > 0 {
+                self.visit(level - 1, below, points, p, margin, best);
+            } else {
+                for w in points[below..(below + ARC_CHUNK + 1).min(points.len())].windows(2) {
                     let (a, b) = ([w[0][0], w[0][1]], [w[1][0], w[1][1]]);
-                    best = best.min(segment_distance_sq(p, a, b));
+                    *best = best.min(segment_distance_sq(p, a, b));
                 }
             }
         }
-        best
     }
 }
 
@@ -314,9 +340,15 @@ mod tests {
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
-        for case in 0..300 {
-            // Arcs of 1 to 3,000 segments, radius 0.01 mm to 50 m, centre up to 1e5 mm out.
-            let n = 1 + (uniform() * 3000.0) as usize;
+        for case in 0..302 {
+            // Arcs of 1 to 3,000 segments (one or two levels of boxes), and two of 40,000
+            // to 700,000 (three levels: the reader's largest arcs are circles of 100 m
+            // radius cut at 1 mm), radius 0.01 mm to 50 m, centre up to 1e5 mm out.
+            let n = if case < 300 {
+                1 + (uniform() * 3000.0) as usize
+            } else {
+                40_000 + (uniform() * 660_000.0) as usize
+            };
             let r = 10f64.powf(-2.0 + 6.7 * uniform());
             let c = [(uniform() - 0.5) * 2e5, (uniform() - 0.5) * 2e5];
             let (a0, sweep) = (uniform() * 6.3, (uniform() - 0.5) * 12.6);
@@ -328,7 +360,8 @@ mod tests {
                 .collect();
             let geometry = arc_of(&points);
             let chunks = ArcChunks::new(&points);
-            for k in 0..200 {
+            assert_eq!(chunks.levels.len(), if n > 32 * 32 * 32 { 3 } else { 1 + usize::from(n > 32 * 32) });
+            for k in 0..if case < 300 { 200 } else { 12 } {
                 let p = match k % 4 {
                     // On a point of the arc, or a hair off it.
                     0 => {
