@@ -280,6 +280,24 @@ pub enum GcodeError {
         /// What is degenerate.
         why: &'static str,
     },
+    /// An arc the firmware would cut into more than [`crate::MAX_ARC_SEGMENTS`] segments.
+    #[error(
+        "{at}: `{command}`: {firmware} cuts this arc ({length_mm:.0} mm long) into {segments} straight segments; settle replays an arc of at most {max} (a 100 m arc at 1 mm): split it into several {command}s, or check the units (I, J, R in mm)"
+    )]
+    ArcTooManySegments {
+        /// Where.
+        at: Location,
+        /// `G2` or `G3`.
+        command: String,
+        /// The firmware whose segmentation was used.
+        firmware: String,
+        /// The arc's length (mm).
+        length_mm: f64,
+        /// How many segments the firmware cuts it into.
+        segments: usize,
+        /// [`crate::MAX_ARC_SEGMENTS`].
+        max: usize,
+    },
     /// The firmware's planner or shaper refuses what a line asks for (a move, a limit, a
     /// shaper setting).
     #[error("{at}: `{command}`: {source}")]
@@ -375,6 +393,7 @@ impl GcodeError {
             | GcodeError::ArcRadiusMismatch { at, .. }
             | GcodeError::ArcRadiusTooSmall { at, .. }
             | GcodeError::ArcDegenerate { at, .. }
+            | GcodeError::ArcTooManySegments { at, .. }
             | GcodeError::ConfigSyntax { at, .. }
             | GcodeError::ConfigValue { at, .. }
             | GcodeError::IncludeNotFound { at, .. }

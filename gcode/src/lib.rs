@@ -64,6 +64,12 @@ pub use error::{GcodeError, Location};
 /// one lasts seconds (a slow CNC finishing pass minutes); longer is a unit mistake that
 /// would keep the replay busy for weeks ([`GcodeError::TooLong`]).
 pub const MAX_STEP_DURATION_S: f64 = 3600.0;
+
+/// The most straight segments one arc may be cut into: 100,000 (a 100 m arc at Klipper's
+/// 1 mm resolution). The replay holds an arc's planned and shaped segments until the arc
+/// ends (a move's timing is complete only then), a few KB each with a shaper; a longer
+/// arc is refused ([`GcodeError::ArcTooManySegments`]) rather than held in gigabytes.
+pub const MAX_ARC_SEGMENTS: usize = 100_000;
 pub use read::arc::{
     Arc, FULL_CIRCLE_TOLERANCE_MM, RADIUS_TOLERANCE_MAX_MM, RADIUS_TOLERANCE_MM,
     RADIUS_TOLERANCE_REL,

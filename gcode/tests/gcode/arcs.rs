@@ -185,3 +185,47 @@ fn malformed_arcs_are_errors() {
         GcodeError::Unsupported { .. }
     ));
 }
+
+/// The first error of a Klipper job on `text` (its chunks pulled until one fails).
+fn job_error(text: &str) -> GcodeError {
+    use settle_gcode::job::{Job, JobConfig};
+    let cfg = JobConfig::defaults(settle_planner::firmware::Firmware::Klipper).expect("defaults");
+    let reader = settle_gcode::Reader::new(
+        text.as_bytes(),
+        settle_gcode::ReaderOptions::new(cfg.dialect),
+    );
+    let mut job = Job::new(reader, cfg).expect("job");
+    match job.by_ref().collect::<Result<Vec<_>, _>>() {
+        Err(e) => e,
+        Ok(c) => panic!("{} chunks, no error", c.len()),
+    }
+}
+
+#[test]
+fn an_arc_cut_into_more_than_the_segment_bound_is_refused_at_its_line() {
+    // Klipper cuts an arc into floor(length / 1 mm) segments (gcode_arcs' resolution):
+    // a full circle of radius 15,916 mm is 2 pi 15,916 = 100,003.2 mm, 100,003 segments,
+    // three past the bound; nothing of it is planned.
+    let text = "G28\nG1 X10 Y10 F6000\nG2 X10 Y10 I15916 J0 F600000\n";
+    match job_error(text) {
+        GcodeError::ArcTooManySegments {
+            at,
+            command,
+            segments,
+            max,
+            length_mm,
+            ..
+        } => {
+            assert_eq!((at.line, command.as_str()), (3, "G2"));
+            assert_eq!((segments, max), (100_003, settle_gcode::MAX_ARC_SEGMENTS));
+            assert!(close_rel(length_mm, TAU * 15_916.0, 1e-12), "{length_mm}");
+        }
+        e => panic!("{e}"),
+    }
+    // The same circle a hair smaller, 15,915 mm (99,996 segments), is planned.
+    let text = "G28\nG1 X10 Y10 F6000\nG2 X10 Y10 I15915 J0 F600000\nG1 X20 Y10 F0.1\n";
+    match job_error(text) {
+        GcodeError::TooLong { at, .. } => assert_eq!(at.line, 4),
+        e => panic!("{e}"),
+    }
+}

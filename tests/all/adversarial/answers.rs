@@ -132,6 +132,10 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
     );
     sb.write("crawl.gcode", "G28\nG1 X10 Y10 F0.0001\nG1 X50 Y10 E1\n");
     sb.write(
+        "circle.gcode",
+        "G28\nG1 X10 Y10 F3000\nG2 X10 Y10 I15916 J0 E1 F600000\n",
+    );
+    sb.write(
         "crawl.cfg",
         "[printer]\nkinematics: cartesian\nmax_velocity: 0.0001\nmax_accel: 3000\n",
     );
@@ -175,6 +179,12 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "gcode at F0.0001",
             "gcode crawl.gcode --machine printer_xy --out o",
             &["crawl.gcode:2", "0.000100 mm/min", "at most 3600 s"],
+        ),
+        // A 100 m circle at 1 mm: its segments would be held until it ends.
+        refused(
+            "gcode with an arc of 100,003 segments",
+            "gcode circle.gcode --machine printer_xy --out o",
+            &["circle.gcode:3", "100003 straight segments", "at most 100000"],
         ),
         refused(
             "gcode under max_velocity: 0.0001",

@@ -156,6 +156,18 @@ impl<R: BufRead> Job<R> {
         }
         let mut points = std::mem::take(&mut self.points);
         mv.segments_into(&self.cfg.arcs, &mut points);
+        if points.len() > crate::MAX_ARC_SEGMENTS {
+            let segments = points.len();
+            self.points = points;
+            return Err(GcodeError::ArcTooManySegments {
+                at: self.at(line),
+                command: command.to_string(),
+                firmware: self.cfg.firmware().to_string(),
+                length_mm,
+                segments,
+                max: crate::MAX_ARC_SEGMENTS,
+            });
+        }
         if check_travel {
             if let (Path::Arc(_), Some(message)) = (&mv.path, self.travel.arc_refused(&mv.end)) {
                 self.points = points;
