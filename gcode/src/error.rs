@@ -217,11 +217,15 @@ pub enum GcodeError {
         what: String,
     },
     /// A configuration value that is malformed or out of the range the firmware accepts.
-    #[error("{at}: [{section}] {key} = `{value}`: not allowed (allowed: {allowed})")]
+    #[error(
+        "{at}: {} = `{value}`: not allowed (allowed: {allowed})",
+        config_setting(section, key)
+    )]
     ConfigValue {
         /// Where the option (or command) is.
         at: Location,
-        /// The section (Klipper) or command (RepRapFirmware, `M350`).
+        /// The section (Klipper), command (RepRapFirmware, `M350`) or `$` (a GRBL
+        /// setting `$N`, `key` its number).
         section: String,
         /// The option (Klipper) or parameter (RepRapFirmware).
         key: String,
@@ -344,6 +348,16 @@ pub enum GcodeError {
         /// What is wrong and what is allowed.
         reason: String,
     },
+}
+
+/// A configuration setting as its firmware writes it: `[section] key` (Klipper's option,
+/// RepRapFirmware's command and parameter), `$N` for GRBL's setting N.
+fn config_setting(section: &str, key: &str) -> String {
+    if section == "$" {
+        format!("${key}")
+    } else {
+        format!("[{section}] {key}")
+    }
 }
 
 impl From<settle_files::FileError> for GcodeError {

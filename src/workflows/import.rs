@@ -151,6 +151,10 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
         Some(at) => {
             let prefix = format!("{at}: ");
             let key = match &e {
+                // GRBL's `$110` as it is written; `section.key` elsewhere.
+                settle_gcode::GcodeError::ConfigValue { section, key, .. } if section == "$" => {
+                    Some(format!("${key}"))
+                }
                 settle_gcode::GcodeError::ConfigValue { section, key, .. } => {
                     Some(format!("{section}.{key}"))
                 }

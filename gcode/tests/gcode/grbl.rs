@@ -289,3 +289,13 @@ fn the_shipped_laser_and_cnc_jobs_work_where_their_text_says() {
         );
     }
 }
+
+#[test]
+fn a_setting_grbl_refuses_is_named_as_grbl_writes_it() {
+    let e = settle_gcode::config::GrblSettings::parse("$100=80\n$110=0\n", "grbl.txt")
+        .expect_err("GRBL refuses a max rate of 0");
+    assert_eq!(
+        e.to_string(),
+        "grbl.txt:2: $110 = `0`: not allowed (allowed: greater than 0)"
+    );
+}

@@ -132,6 +132,11 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
     );
     sb.write("crawl.gcode", "G28\nG1 X10 Y10 F0.0001\nG1 X50 Y10 E1\n");
     sb.write(
+        "raster.nc",
+        "G21 G90\nM4 S0\nG0 X10 Y10\nG1 X50 Y10 S800 F3000\nM5\n",
+    );
+    sb.write("grbl_zero.txt", "$100=80\n$110=0\n");
+    sb.write(
         "circle.gcode",
         "G28\nG1 X10 Y10 F3000\nG2 X10 Y10 I15916 J0 E1 F600000\n",
     );
@@ -180,11 +185,25 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "gcode crawl.gcode --machine printer_xy --out o",
             &["crawl.gcode:2", "0.000100 mm/min", "at most 3600 s"],
         ),
+        refused(
+            "gcode --config with GRBL's $110=0",
+            "gcode raster.nc --firmware grbl --config grbl_zero.txt --machine printer_xy --out o",
+            &[
+                "grbl_zero.txt:2",
+                "key `$110`",
+                "$110 = `0`",
+                "greater than 0",
+            ],
+        ),
         // A 100 m circle at 1 mm: its segments would be held until it ends.
         refused(
             "gcode with an arc of 100,003 segments",
             "gcode circle.gcode --machine printer_xy --out o",
-            &["circle.gcode:3", "100003 straight segments", "at most 100000"],
+            &[
+                "circle.gcode:3",
+                "100003 straight segments",
+                "at most 100000",
+            ],
         ),
         refused(
             "gcode under max_velocity: 0.0001",
