@@ -166,7 +166,10 @@ fn axis_token(path: &Path) -> Option<char> {
 /// The data sets of one file as calibrate_shaper.py's `parse_log` makes them.
 pub fn load(path: &Path) -> Result<Vec<CalibrationData>, Error> {
     match settle_identify::read_file(path)? {
-        FileData::Spectrum(psd) => Ok(processed(&psd)),
+        FileData::Spectrum(psd) => {
+            spectrum_sees_the_test(path, psd.freq_hz.last().copied())?;
+            Ok(processed(&psd))
+        }
         FileData::Recordings(recs) => recs
             .iter()
             .map(|rec| {
@@ -210,6 +213,25 @@ fn sees_the_test(path: &Path, sample_rate_hz: f64) -> Result<(), Error> {
             2.0 * top_hz
         ),
     ))
+}
+
+/// A processed spectrum (a PSD CSV) whose rows end at `last_hz`: [`sees_the_test`] for
+/// spectra. calibrate_shaper.py writes its rows up to 200 Hz (every file of the corpus
+/// ends at 198.5-199.9 Hz); one that ends below the top of Klipper's resonance test
+/// (a cut copy) holds nothing of the resonances above its end, and a shaper fitted to it
+/// answers for them. Refused, with the range that would do.
+fn spectrum_sees_the_test(path: &Path, last_hz: Option<f64>) -> Result<(), Error> {
+    let top_hz = SweepTest::klipper().freq_end_hz;
+    match last_hz {
+        Some(last) if last >= top_hz => Ok(()),
+        _ => Err(Error::input(
+            path,
+            format!(
+                "its spectrum ends at {:.1} Hz, below the {top_hz:.0} Hz at the top of Klipper's resonance test: a shaper fitted to it would answer for resonances it does not show; give the whole file (calibrate_shaper.py writes its rows up to 200 Hz)",
+                last_hz.unwrap_or(0.0)
+            ),
+        )),
+    }
 }
 
 /// A processed file's data sets: `psd_xyz` (with the axes) of the per-axis layout, else

@@ -119,6 +119,22 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         .map(|(_, l)| l)
         .collect();
     sb.write("slow_x.csv", &(slow.join("\n") + "\n"));
+    // A processed spectrum of the corpus (rows to 199.9 Hz) cut after its 90 Hz row.
+    let corpus = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/identify/tests/corpus/voronpi_resonances_x_20211217_070942.csv"
+    );
+    let psd = std::fs::read_to_string(corpus).expect("corpus spectrum");
+    let cut: Vec<&str> = psd
+        .lines()
+        .take_while(|l| {
+            l.split(',')
+                .next()
+                .and_then(|f| f.parse::<f64>().ok())
+                .is_none_or(|f| f <= 90.0)
+        })
+        .collect();
+    sb.write("cut_x.csv", &(cut.join("\n") + "\n"));
     sb.write(
         "sc_past.toml",
         &GCODE_SECRET.replace("gcode_secret", "gcode_past").replace(
@@ -234,6 +250,11 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
                 "Nyquist",
                 "more than 270 Hz",
             ],
+        ),
+        refused(
+            "tune --criterion klipper on a spectrum that ends at 90 Hz",
+            "tune --criterion klipper cut_x.csv",
+            &["cut_x.csv", "ends at 89.9 Hz", "below the 135 Hz", "200 Hz"],
         ),
         refused(
             "identify a resonance sweep without its test's options",
