@@ -75,7 +75,9 @@ pub use klipper::{
     KlipperStepper,
 };
 pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
-pub use rrf::{RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RrfAxis, RrfConfig};
+pub use rrf::{
+    RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RRF_MINIMUM_JERK_MM_S, RrfAxis, RrfConfig,
+};
 
 use std::sync::Arc;
 

@@ -28,6 +28,11 @@ use crate::read::event::{EventKind, Note};
 use crate::read::limits::{AxisValues, LimitChange};
 use crate::read::setting::Setting;
 
+/// The least jerk RepRapFirmware keeps (mm/s): `MinimumJerk` in
+/// src/Config/Configuration.h, applied by `Platform::SetInstantDv` to every `M566` value,
+/// in config.g as in a job (`M566 X0` runs at 0.1 mm/s).
+pub const RRF_MINIMUM_JERK_MM_S: f64 = 0.1;
+
 /// The kinematics by `M669 K` code (`KinematicsType`,
 /// `src/Movement/Kinematics/Kinematics.h`), named as Klipper names the same ones.
 const KINEMATICS: [&str; 15] = [
@@ -375,7 +380,12 @@ impl RrfConfig {
                 per_axis_mm_s,
                 sets_maximum: true,
                 ..
-            } => self.set_axes(per_axis_mm_s, |a| &mut a.max_jerk_mm_s),
+            } => {
+                self.set_axes(per_axis_mm_s, |a| &mut a.max_jerk_mm_s);
+                for a in self.axes_mut() {
+                    a.max_jerk_mm_s = a.max_jerk_mm_s.max(RRF_MINIMUM_JERK_MM_S);
+                }
+            }
             LimitChange::Accel {
                 print_mm_s2,
                 travel_mm_s2,

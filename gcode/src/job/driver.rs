@@ -245,11 +245,9 @@ impl Driver {
                         sets_maximum: true,
                     } => {
                         set_axes(&mut c.instant_dv_m_s, per_axis_mm_s);
-                        // RepRapFirmware keeps every jerk at least 0.1 mm/s
-                        // (`MinimumJerk` in src/Config/Configuration.h, applied by
-                        // `Platform::SetInstantDv`).
+                        // RepRapFirmware keeps every jerk at least its minimum.
                         for j in &mut c.instant_dv_m_s {
-                            *j = j.max(0.1 * MM);
+                            *j = j.max(crate::config::RRF_MINIMUM_JERK_MM_S * MM);
                         }
                         if let Some(p) = policy {
                             c.jerk_policy = *p;

@@ -170,6 +170,19 @@ fn defaults_are_the_firmwares() {
 }
 
 #[test]
+fn a_jerk_under_the_minimum_is_raised_to_it_as_the_firmware_does() {
+    // M566 is in mm/min: X0 is raised to RepRapFirmware's 0.1 mm/s (`MinimumJerk`), Y30
+    // (0.5 mm/s) is kept; the job then plans (a zero jerk used to be refused).
+    let c = parse("M566 X0 Y30\n");
+    assert_eq!((c.axes.x.max_jerk_mm_s, c.axes.y.max_jerk_mm_s), (0.1, 0.5));
+    let job = settle_gcode::job::JobConfig::from_rrf(&c).expect("plans");
+    let settle_gcode::job::PlannerConfig::Rrf(r) = job.planner else {
+        panic!("an RRF planner")
+    };
+    assert_eq!(&r.instant_dv_m_s[..2], &[0.1 * 1e-3, 0.5 * 1e-3]);
+}
+
+#[test]
 fn m593_without_a_type_selects_zvd_and_types_are_reduced() {
     let c = parse("M593 F48.5\n");
     assert_eq!(
