@@ -560,3 +560,114 @@ fn the_search_holds_only_what_the_target_can_take() {
         "{rrf}"
     );
 }
+
+/// `marlin.gcode` read back by settle's G-code reader (Marlin dialect) as a job would read
+/// it: Fixed-Time Motion on, and per tuned axis the winner's shaper (`M493 C`), frequency
+/// (`A`), damping (`I`) and, for the EI family, vibration tolerance (`Q`), bit for bit;
+/// a job starting with it shapes with them.
+#[test]
+fn marlin_export_reads_back_as_the_recommendation() {
+    use settle_gcode::{Dialect, EventKind, FtShaper, LimitChange, Reader, ReaderOptions};
+    use settle_planner::shaper::{MarlinShaper, ShaperType};
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let text = std::fs::read_to_string(root().join("scenarios/tune_printer.toml"))
+        .expect("scenario")
+        .replace(
+            "frequency_scales = [0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.15]",
+            "frequency_scales = [1.0]\naxes = [\"x\", \"y\"]\nshapers = [\"none\", \"marlin:zvd\", \"marlin:ei\", \"marlin:mzv\"]",
+        )
+        .replace("distances_mm = [5.0, 20.0, 50.0]", "distances_mm = [20.0]")
+        .replace("jerk_steps = 5", "jerk_steps = 1");
+    let p = write(dir.path(), "marlin.toml", &text);
+    let opts = Options {
+        firmware: Some("marlin".into()),
+        ..modal()
+    };
+    let t = settle::workflows::tune::tune_with(
+        &p,
+        Some(dir.path().join("out")),
+        &opts,
+        &settle::execute::pool::quiet,
+    )
+    .expect("tunes");
+    let g = std::fs::read_to_string(t.out.join("marlin.gcode")).expect("marlin.gcode");
+    let events: Vec<_> = Reader::new(g.as_bytes(), ReaderOptions::new(Dialect::Marlin))
+        .collect::<Result<_, _>>()
+        .expect("settle reads its own export");
+    let ft: Vec<&LimitChange> = events
+        .iter()
+        .filter_map(|e| match &e.kind {
+            EventKind::Limits(l @ LimitChange::FtMotion { .. }) => Some(l),
+            _ => None,
+        })
+        .collect();
+    assert!(
+        matches!(
+            ft.first(),
+            Some(LimitChange::FtMotion {
+                enabled: Some(true),
+                ..
+            })
+        ),
+        "{g}"
+    );
+    assert_eq!(ft.len(), 3, "M493 S1, then X and Y\n{g}");
+    let mut shaped = 0;
+    for (line, letter) in ft[1..].iter().zip(["x", "y"]) {
+        let o = &t.axes.iter().find(|(a, _)| a == letter).expect("tuned").1;
+        let w = &o.scores[o.winner].candidate;
+        let LimitChange::FtMotion {
+            axes,
+            shaper,
+            frequency_hz,
+            damping_ratio,
+            vibration_tolerance,
+            ..
+        } = line
+        else {
+            unreachable!()
+        };
+        assert_eq!((axes.x, axes.y), (letter == "x", letter == "y"), "{g}");
+        match w.shaper.and_then(|s| s.shaper_type.map(|k| (k, s))) {
+            Some((
+                ShaperType::Marlin {
+                    shaper: s, v_tol, ..
+                },
+                sh,
+            )) => {
+                shaped += 1;
+                let code = MarlinShaper::ALL
+                    .iter()
+                    .position(|f| *f == s)
+                    .expect("family");
+                assert_eq!(*shaper, FtShaper::from_code(code as u32 + 1), "{g}");
+                assert_eq!(*frequency_hz, Some(sh.frequency_hz), "{g}");
+                assert_eq!(*damping_ratio, Some(sh.damping_ratio), "{g}");
+                assert_eq!(*vibration_tolerance, s.has_v_tol().then_some(v_tol), "{g}");
+            }
+            Some((k, _)) => panic!("{letter}: not a Marlin shaper: {k:?}"),
+            None => assert_eq!(*shaper, Some(FtShaper::None), "{g}"),
+        }
+    }
+    assert!(
+        shaped > 0,
+        "a shaper wins on printer_xy's 39 Hz Y mode\n{g}"
+    );
+    // A Marlin job that starts with the file runs with its settings and ignores none.
+    let job = format!("{g}G28\nG1 X10 Y10 F6000\nG1 X50 Y10 E1\nG1 X50 Y50 E2\n");
+    let cfg = settle_gcode::job::JobConfig::defaults(Firmware::Marlin).expect("defaults");
+    let reader = Reader::new(job.as_bytes(), ReaderOptions::new(Dialect::Marlin));
+    let mut j = settle_gcode::job::Job::new(reader, cfg).expect("job");
+    j.by_ref().collect::<Result<Vec<_>, _>>().expect("plans");
+    let summary = j.summary();
+    assert!(summary.shaper_changes >= 1, "{summary:?}");
+    assert!(
+        summary
+            .ignored
+            .keys()
+            .all(|k| !k.contains("M493") && !k.contains("M204")),
+        "{:?}",
+        summary.ignored
+    );
+}

@@ -3,7 +3,8 @@
 //! `$$` settings read into plain data ([`KlipperConfig`], [`RrfConfig`],
 //! [`GrblSettings`]) with the values the firmware would use,
 //! and input shaper settings written back in each firmware's own syntax, ready to paste
-//! ([`KlipperExport`], [`RrfExport`]).
+//! ([`KlipperExport`], [`RrfExport`], and Marlin's Fixed-Time Motion `M493` lines,
+//! [`MarlinExport`]).
 //!
 //! Both readers return per-axis [`AxisDrive`]s (microsteps per mm, microstepping, current,
 //! travel) and [`ShaperSetting`]s (shaper name, frequency, damping ratio; Klipper per axis,
@@ -50,6 +51,7 @@
 
 mod budget;
 mod export_klipper;
+mod export_marlin;
 mod export_rrf;
 mod export_text;
 mod glob;
@@ -65,6 +67,7 @@ mod rrf_script;
 
 pub use budget::{MAX_BYTES as MAX_CONFIG_BYTES, MAX_FILES as MAX_CONFIG_FILES};
 pub use export_klipper::KlipperExport;
+pub use export_marlin::{FtAxisShaper, MarlinExport};
 
 pub use export_rrf::RrfExport;
 pub use export_text::Note;

@@ -278,6 +278,31 @@ pub fn rrf(axes: &[(String, Outcome)], axis: &str, accel: Option<f64>) -> Vec<Ch
     out
 }
 
+/// The changes `marlin.gcode` makes: per tuned axis `x`/`y` its `M493` shaper, and
+/// `M204 P`/`T`.
+pub fn marlin(axes: &[(String, Outcome)], accel: Option<f64>) -> Vec<Change> {
+    let mut out = Vec::new();
+    for letter in ["X", "Y"] {
+        let lower = letter.to_ascii_lowercase();
+        if let Some((axis, o)) = axes.iter().find(|(a, _)| a.split('+').any(|x| x == lower)) {
+            out.extend(shaper_changes(
+                axis,
+                o,
+                [
+                    &format!("M493 {letter} C"),
+                    &format!("M493 {letter} A"),
+                    &format!("M493 {letter} I"),
+                ],
+                ("none", f64::NAN, f64::NAN),
+            ));
+        }
+    }
+    for key in ["M204 P", "M204 T"] {
+        out.extend(accel_change(axes, key, accel));
+    }
+    out
+}
+
 /// The report's table of `changes` for the export `file`.
 pub fn table(file: &str, changes: &[Change]) -> String {
     let mut out = format!("## What changes in {file}\n\n");

@@ -18,15 +18,23 @@
 //! Every value that differs from the current one carries a comment above it: what it was
 //! and why it changed ([`super::changes`]); a machine that is a built-in preset standing in
 //! for the user's printer is named in the header.
+//! - `marlin.gcode`: Marlin Fixed-Time Motion's `M493 S1` and one `M493 <axis> C A I [Q]`
+//!   line per tuned axis (Marlin shapes X and Y apart; settle-gcode's `MarlinExport`), and
+//!   `M204 P T` when the acceleration changes; read back by settle's G-code reader in
+//!   `tests/all/tune_firmware.rs`. An axis not tuned is left as it is, and said.
 //! - `tmc4361a.txt`: per axis, the TMC4361A ramp registers of the recommended move, from
 //!   the axis's own microsteps per mm; refused, with the reason, for what the chip cannot
 //!   run (a trapezoid's infinite bows, an input shaper, a value outside a register).
 
 use std::fmt::Write as _;
 
-use settle_gcode::config::{KlipperExport, Note, RrfExport, ShaperSetting as FirmwareShaper};
+use settle_gcode::FtShaper;
+use settle_gcode::config::{
+    FtAxisShaper, KlipperExport, MarlinExport, Note, RrfExport, ShaperSetting as FirmwareShaper,
+};
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
+use settle_planner::shaper::{MARLIN_FTM_FS_HZ, MarlinShaper, ShaperType};
 use settle_planner::tmc::ramp::SRampParams;
 use settle_planner::tmc::registers::{TmcUnits, export};
 
@@ -256,6 +264,111 @@ pub fn rrf_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
     let (axis, _) = rrf_axis(axes)?;
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
     Some(changes::rrf(axes, axis, a))
+}
+
+/// Why `marlin.gcode` is not written, if it is not: a tuned axis's recommendation that
+/// Marlin's Fixed-Time Motion does not run.
+fn marlin_refusal(axes: &[(String, Outcome)]) -> Option<String> {
+    if axes.is_empty() {
+        return Some("nothing was tuned".into());
+    }
+    axes.iter().find_map(|(a, o)| {
+        let w = &o.scores[o.winner];
+        target::expressible(Firmware::Marlin, &w.candidate)
+            .err()
+            .map(|why| {
+                format!(
+                    "the recommendation on {a}, {}, is not something Marlin runs ({why}); tune with --firmware marlin",
+                    w.candidate.label()
+                )
+            })
+    })
+}
+
+/// Axis `letter`'s `M493` values from its tuned winner (`C0` unshaped), and the `FTM_FS`
+/// it was designed for; `None` when the axis was not tuned.
+fn marlin_axis(axes: &[(String, Outcome)], letter: &str) -> Option<(FtAxisShaper, Option<u32>)> {
+    let o = winner_of(axes, letter)?;
+    let w = &o.scores[o.winner];
+    let axis = letter.to_ascii_uppercase().chars().next()?;
+    let off = FtAxisShaper {
+        axis,
+        shaper: FtShaper::None,
+        frequency_hz: f64::NAN,
+        damping_ratio: f64::NAN,
+        vibration_tolerance: None,
+    };
+    let Some(sh) = w.candidate.shaper else {
+        return Some((off, None));
+    };
+    match sh.shaper_type {
+        Some(ShaperType::Marlin {
+            shaper,
+            v_tol,
+            ftm_fs_hz,
+        }) => {
+            let code =
+                u32::try_from(MarlinShaper::ALL.iter().position(|s| *s == shaper)? + 1).ok()?;
+            let ft = FtAxisShaper {
+                shaper: FtShaper::from_code(code)?,
+                frequency_hz: sh.frequency_hz,
+                damping_ratio: sh.damping_ratio,
+                vibration_tolerance: shaper.has_v_tol().then_some(v_tol),
+                ..off
+            };
+            Some((ft, Some(ftm_fs_hz)))
+        }
+        _ => Some((off, None)),
+    }
+}
+
+/// `marlin.gcode`: Marlin Fixed-Time Motion's `M493` lines per tuned axis (and `M204` when
+/// the acceleration changes), or comments saying why it is not written.
+pub fn marlin(axes: &[(String, Outcome)], produced_by: &str) -> String {
+    if let Some(why) = marlin_refusal(axes) {
+        return format!("; no Marlin configuration: {why}\n");
+    }
+    let mut shapers = Vec::new();
+    let mut untuned = String::new();
+    let mut ftm_fs_hz = MARLIN_FTM_FS_HZ;
+    for letter in ["x", "y"] {
+        match marlin_axis(axes, letter) {
+            Some((ft, fs)) => {
+                shapers.push(ft);
+                ftm_fs_hz = fs.unwrap_or(ftm_fs_hz);
+            }
+            None => {
+                let _ = writeln!(
+                    untuned,
+                    "; axis {letter} was not tuned: its M493 {} settings stay as they are (Marlin shapes X and Y apart; set both)",
+                    letter.to_ascii_uppercase()
+                );
+            }
+        }
+    }
+    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    let e = MarlinExport {
+        produced_by: produced_by.to_string(),
+        ftm_fs_hz,
+        axes: shapers,
+        print_accel_mm_s2: a,
+        travel_accel_mm_s2: a,
+    };
+    let mut notes = header_notes(axes);
+    notes.extend(changes::marlin(axes, a).iter().map(changes::Change::note));
+    match e.to_config_with_notes(&notes) {
+        Ok(text) => format!("{text}{untuned}"),
+        Err(err) => format!("; no Marlin configuration: {err}\n"),
+    }
+}
+
+/// The changes `marlin.gcode` makes (`None` when it is not written).
+pub fn marlin_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
+    if marlin_refusal(axes).is_some() {
+        return None;
+    }
+    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    Some(changes::marlin(axes, a))
 }
 
 /// `tmc4361a.txt`: per axis, the register file of the recommended move (the first of the

@@ -277,11 +277,12 @@ pub fn tune_to(
 
 /// The files `settle tune` writes in its output folder (with `pareto-<axis>.svg/png`
 /// for several axes: [`PATTERNS`]).
-const FILES: [&str; 8] = [
+const FILES: [&str; 9] = [
     "tune.md",
     "candidates.csv",
     "klipper.cfg",
     "rrf.g",
+    "marlin.gcode",
     "tmc4361a.txt",
     "pareto.svg",
     "pareto.png",
@@ -302,8 +303,8 @@ const PATTERNS: [(&str, &str); 2] = [("pareto-", ".svg"), ("pareto-", ".png")];
 /// `results/<name>-tune/`): `tune.md` (the machine, your current settings ->
 /// recommended, what changes in each export, then one section per axis), `candidates.csv`
 /// (every candidate of every axis), the Pareto figure of each axis (`pareto.svg/png`, or
-/// `pareto-<axis>.svg/png` for several axes), `report.html`, and `klipper.cfg`, `rrf.g`
-/// and `tmc4361a.txt` (see [`export`]).
+/// `pareto-<axis>.svg/png` for several axes), `report.html`, and `klipper.cfg`, `rrf.g`,
+/// `marlin.gcode` and `tmc4361a.txt` (see [`export`]).
 pub fn tune_with(
     path: &Path,
     out: Option<PathBuf>,
@@ -333,6 +334,7 @@ pub fn tune_with(
     let produced_by = format!("settle tune {}", path.display());
     let klipper = export::klipper(&done, &produced_by);
     let rrf = export::rrf(&done, &produced_by);
+    let marlin = export::marlin(&done, &produced_by);
     let tmc = export::tmc4361a(&done);
     let mut md = format!("# settle tune: {}\n\n", sc.name);
     md.push_str(&head::current_to_recommended(&done, shared.as_deref()));
@@ -341,6 +343,9 @@ pub fn tune_with(
     }
     if let Some(c) = export::rrf_changes(&done) {
         md.push_str(&changes::table("rrf.g", &c));
+    }
+    if let Some(c) = export::marlin_changes(&done) {
+        md.push_str(&changes::table("marlin.gcode", &c));
     }
     let mut figures = Vec::new();
     for (axis, o) in &done {
@@ -355,13 +360,14 @@ pub fn tune_with(
     }
     let _ = write!(
         md,
-        "## Export\n\nKlipper (`klipper.cfg`; paste at the end of printer.cfg, above any SAVE_CONFIG block):\n\n```ini\n{klipper}```\n\nRepRapFirmware (`rrf.g`; config.g lines):\n\n```\n{rrf}```\n\nTMC4361A ramp registers (`tmc4361a.txt`):\n\n```\n{tmc}```\n"
+        "## Export\n\nKlipper (`klipper.cfg`; paste at the end of printer.cfg, above any SAVE_CONFIG block):\n\n```ini\n{klipper}```\n\nRepRapFirmware (`rrf.g`; config.g lines):\n\n```\n{rrf}```\n\nMarlin (`marlin.gcode`; Fixed-Time Motion, M493):\n\n```\n{marlin}```\n\nTMC4361A ramp registers (`tmc4361a.txt`):\n\n```\n{tmc}```\n"
     );
     let write = |name: &str, text: &str| write_atomic(&out.join(name), text.as_bytes());
     write("tune.md", &md)?;
     write("candidates.csv", &candidates::csv(&done))?;
     write("klipper.cfg", &klipper)?;
     write("rrf.g", &rrf)?;
+    write("marlin.gcode", &marlin)?;
     write("tmc4361a.txt", &tmc)?;
     let text = crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)?;
     let page = html::page(html::Page {
@@ -372,6 +378,7 @@ pub fn tune_with(
         exports: [
             ("klipper.cfg", klipper.as_str()),
             ("rrf.g", rrf.as_str()),
+            ("marlin.gcode", marlin.as_str()),
             ("tmc4361a.txt", tmc.as_str()),
         ],
         provenance: crate::output::report::provenance(

@@ -1,0 +1,228 @@
+//! Input shaping written as Marlin G-code for its Fixed-Time Motion (`FT_MOTION`, Marlin
+//! 2.1.3 and later), with `M493` as MarlinDocumentation's `_gcode/M493.md` documents it:
+//! `M493 S1` turns Fixed-Time Motion on, and one `M493 <axis> C<shaper> A<Hz> I<zeta>`
+//! line per axis (`Q<vtol>` for the EI family) sets that axis's shaper: Marlin shapes X
+//! and Y apart, and the page asks for both to be set. `M204 P T` follows when
+//! accelerations are given. The settings live in EEPROM (`M500` keeps them). Numbers are
+//! written shortest-exact, so settle's G-code reader reads back the same values bit for
+//! bit.
+
+use super::export_text::{Note, annotate, comment_text, refuse};
+use crate::FtShaper;
+use crate::error::GcodeError;
+
+/// Marlin's default trajectory rate `FTM_FS` (Hz, Configuration_adv.h): the highest shaper
+/// frequency it takes is half of it.
+const DEFAULT_FTM_FS_HZ: u32 = 1000;
+
+/// One axis's shaper (`M493 C A I Q`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FtAxisShaper {
+    /// `X`, `Y` or `Z`.
+    pub axis: char,
+    /// `C`: the shaper; [`FtShaper::None`] writes `C0` alone (no shaping on the axis).
+    pub shaper: FtShaper,
+    /// `A`: frequency, Hz.
+    pub frequency_hz: f64,
+    /// `I`: damping ratio zeta.
+    pub damping_ratio: f64,
+    /// `Q`: vibration tolerance of the EI family (written only when given).
+    pub vibration_tolerance: Option<f64>,
+}
+
+/// What to write.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MarlinExport {
+    /// What produced the values (a scenario, a command line); written as a comment.
+    pub produced_by: String,
+    /// The trajectory rate `FTM_FS` the shapers were designed for (Hz); one other than
+    /// Marlin's default is said in the header (it is compiled in).
+    pub ftm_fs_hz: u32,
+    /// The axes' shapers, in the order written.
+    pub axes: Vec<FtAxisShaper>,
+    /// `M204 P`: acceleration of printing moves, mm/s^2 (written only when given).
+    pub print_accel_mm_s2: Option<f64>,
+    /// `M204 T`: acceleration of travel moves, mm/s^2 (written only when given).
+    pub travel_accel_mm_s2: Option<f64>,
+}
+
+impl MarlinExport {
+    /// The lines with each note as a `;` comment above the line it names ([`Note::key`]:
+    /// the command and its first word, e.g. `M493 X A`, `M204 P`), or an error naming the
+    /// first value the firmware would refuse.
+    pub fn to_config_with_notes(&self, notes: &[Note]) -> Result<String, GcodeError> {
+        let text = self.to_config()?;
+        Ok(annotate(&text, notes, ";", |line, key| {
+            let mut l = line.split_whitespace();
+            let mut k = key.split_whitespace();
+            match (k.next(), k.next()) {
+                (Some(c), Some(w)) if c == "M493" => l.next() == Some(c) && l.next() == Some(w),
+                (Some(c), _) => l.next() == Some(c),
+                _ => false,
+            }
+        }))
+    }
+
+    /// The lines, or an error naming the first value the firmware would refuse.
+    pub fn to_config(&self) -> Result<String, GcodeError> {
+        let by = comment_text(&self.produced_by);
+        let mut out = format!(
+            "; Written by settle: {by}\n\
+             ; Marlin Fixed-Time Motion (FT_MOTION, Marlin 2.1.3 or later): send these lines,\n\
+             ; then M500 to keep them.\n"
+        );
+        if self.ftm_fs_hz != DEFAULT_FTM_FS_HZ {
+            out.push_str(&format!(
+                "; Designed for FTM_FS = {} Hz (Configuration_adv.h; Marlin's default is {DEFAULT_FTM_FS_HZ}).\n",
+                self.ftm_fs_hz
+            ));
+        }
+        out.push_str("M493 S1\n");
+        for a in &self.axes {
+            out.push_str(&self.axis_line(a)?);
+        }
+        let mut m204 = String::new();
+        for (word, key, v) in [
+            ("P", "M204 P", self.print_accel_mm_s2),
+            ("T", "M204 T", self.travel_accel_mm_s2),
+        ] {
+            if let Some(a) = v {
+                if !(a.is_finite() && a > 0.0) {
+                    return Err(refuse(key, a, "a finite acceleration > 0 mm/s^2"));
+                }
+                m204.push_str(&format!(" {word}{a}"));
+            }
+        }
+        if !m204.is_empty() {
+            out.push_str(&format!("M204{m204}\n"));
+        }
+        Ok(out)
+    }
+
+    /// One axis's `M493` line.
+    fn axis_line(&self, a: &FtAxisShaper) -> Result<String, GcodeError> {
+        let axis = a.axis;
+        if !matches!(axis, 'X' | 'Y' | 'Z') {
+            return Err(refuse("M493 axis", axis, "X, Y or Z"));
+        }
+        let code = a.shaper.code();
+        if a.shaper == FtShaper::None {
+            return Ok(format!("M493 {axis} C0\n"));
+        }
+        let f_max = f64::from(self.ftm_fs_hz) / 2.0;
+        if !(a.frequency_hz > 0.0 && a.frequency_hz <= f_max) {
+            return Err(refuse(
+                &format!("M493 {axis} A"),
+                a.frequency_hz,
+                format!("above 0, up to FTM_FS / 2 = {f_max} Hz"),
+            ));
+        }
+        if !(0.01..1.0).contains(&a.damping_ratio) {
+            return Err(refuse(
+                &format!("M493 {axis} I"),
+                a.damping_ratio,
+                "0.01 to under 1",
+            ));
+        }
+        let mut line = format!(
+            "M493 {axis} C{code} A{} I{}",
+            a.frequency_hz, a.damping_ratio
+        );
+        if let Some(q) = a.vibration_tolerance {
+            if !(0.0..=1.0).contains(&q) {
+                return Err(refuse(&format!("M493 {axis} Q"), q, "0 to 1"));
+            }
+            line.push_str(&format!(" Q{q}"));
+        }
+        line.push('\n');
+        Ok(line)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ei(axis: char, f: f64) -> FtAxisShaper {
+        FtAxisShaper {
+            axis,
+            shaper: FtShaper::Ei,
+            frequency_hz: f,
+            damping_ratio: 0.1,
+            vibration_tolerance: Some(0.05),
+        }
+    }
+
+    #[test]
+    fn lines_and_their_notes() {
+        let e = MarlinExport {
+            produced_by: "test".into(),
+            ftm_fs_hz: 1000,
+            axes: vec![
+                ei('X', 45.2),
+                FtAxisShaper {
+                    shaper: FtShaper::None,
+                    ..ei('Y', f64::NAN)
+                },
+            ],
+            print_accel_mm_s2: Some(4000.0),
+            travel_accel_mm_s2: Some(4000.0),
+        };
+        let notes = [
+            Note {
+                key: "M493 X A".into(),
+                text: "why A".into(),
+            },
+            Note {
+                key: "M204 P".into(),
+                text: "why P".into(),
+            },
+        ];
+        let text = e.to_config_with_notes(&notes).expect("valid");
+        let lines: Vec<&str> = text
+            .lines()
+            .filter(|l| !l.starts_with("; Written"))
+            .collect();
+        assert_eq!(
+            lines,
+            [
+                "; Marlin Fixed-Time Motion (FT_MOTION, Marlin 2.1.3 or later): send these lines,",
+                "; then M500 to keep them.",
+                "M493 S1",
+                "; why A",
+                "M493 X C5 A45.2 I0.1 Q0.05",
+                "M493 Y C0",
+                "; why P",
+                "M204 P4000 T4000",
+            ]
+        );
+    }
+
+    #[test]
+    fn values_marlin_refuses_are_errors() {
+        let e = |a: FtAxisShaper, fs: u32| MarlinExport {
+            produced_by: String::new(),
+            ftm_fs_hz: fs,
+            axes: vec![a],
+            print_accel_mm_s2: None,
+            travel_accel_mm_s2: None,
+        };
+        let refused = |a, fs| e(a, fs).to_config().expect_err("refused").to_string();
+        assert!(refused(ei('X', 500.5), 1000).contains("FTM_FS / 2 = 500 Hz"));
+        assert!(e(ei('X', 500.0), 1000).to_config().is_ok());
+        assert!(refused(ei('X', 300.0), 500).contains("250 Hz"));
+        let z = |d| FtAxisShaper {
+            damping_ratio: d,
+            ..ei('Y', 40.0)
+        };
+        assert!(refused(z(1.0), 1000).contains("M493 Y I"));
+        assert!(refused(z(0.005), 1000).contains("0.01 to under 1"));
+        let q = FtAxisShaper {
+            vibration_tolerance: Some(1.5),
+            ..ei('X', 40.0)
+        };
+        assert!(refused(q, 1000).contains("M493 X Q"));
+        let text = e(ei('X', 40.0), 2000).to_config().expect("valid");
+        assert!(text.contains("FTM_FS = 2000 Hz"), "{text}");
+    }
+}
