@@ -565,6 +565,19 @@ fn check_sample_rate(rate_hz: f64, fastest_hz: f64) -> Result<(), Error> {
     if rate_hz.is_finite() && rate_hz >= min && rate_hz > 0.0 && rate_hz <= MAX_SAMPLE_RATE_HZ {
         return Ok(());
     }
+    if rate_hz.is_finite()
+        && rate_hz > 0.0
+        && rate_hz <= MAX_SAMPLE_RATE_HZ
+        && min > MAX_SAMPLE_RATE_HZ
+    {
+        // No rate the replay takes resolves the mode: the machine is what to look at.
+        return Err(Error::input(
+            "--machine",
+            format!(
+                "its fastest mode, {fastest_hz:.1} Hz, needs a sample rate of two samples per period at least, {min:.1} Hz, above the most `settle gcode` takes ({MAX_SAMPLE_RATE_HZ} Hz): a toolhead's modes lie at tens to hundreds of Hz; check the machine's frequency_hz (in Hz)"
+            ),
+        ));
+    }
     Err(Error::input(
         "--sample-rate-hz",
         if !(rate_hz.is_finite() && rate_hz > 0.0) {
@@ -572,9 +585,19 @@ fn check_sample_rate(rate_hz: f64, fastest_hz: f64) -> Result<(), Error> {
         } else if rate_hz > MAX_SAMPLE_RATE_HZ {
             format!("{rate_hz} Hz is above the limit of {MAX_SAMPLE_RATE_HZ} Hz")
         } else {
+            let better = if 20.0 * fastest_hz <= MAX_SAMPLE_RATE_HZ {
+                format!(
+                    "or twenty samples per period, {:.0} Hz, for contour errors to a few percent",
+                    20.0 * fastest_hz
+                )
+            } else {
+                format!(
+                    "or the most, {MAX_SAMPLE_RATE_HZ} Hz, {:.1} samples per period",
+                    MAX_SAMPLE_RATE_HZ / fastest_hz
+                )
+            };
             format!(
-                "{rate_hz} Hz gives fewer than two samples per period of the machine's fastest mode ({fastest_hz:.1} Hz): give at least {min:.1} Hz (the default {DEFAULT_SAMPLE_RATE_HZ} Hz, or twenty samples per period, {:.0} Hz, for contour errors to a few percent)",
-                20.0 * fastest_hz
+                "{rate_hz} Hz gives fewer than two samples per period of the machine's fastest mode ({fastest_hz:.1} Hz): give at least {min:.1} Hz (the default {DEFAULT_SAMPLE_RATE_HZ} Hz, {better})"
             )
         },
     ))

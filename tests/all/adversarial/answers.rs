@@ -153,6 +153,10 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
     );
     sb.write("grbl_zero.txt", "$100=80\n$110=0\n");
     sb.write(
+        "ghz.toml",
+        "name = \"ghz\"\n[axis.x]\nmodes = [{ frequency_hz = 1e9, damping_ratio = 0.05 }]\n[axis.y]\nmodes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]\n",
+    );
+    sb.write(
         "circle.gcode",
         "G28\nG1 X10 Y10 F3000\nG2 X10 Y10 I15916 J0 E1 F600000\n",
     );
@@ -279,6 +283,12 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "a scan 1e15 mm wide",
             "run scan_wide.toml --case 0 --backend modal --out o/t.csv",
             &["scan.width_mm", "1e5 mm"],
+        ),
+        // No sample rate the replay takes resolves it: the machine is named, not the rate.
+        refused(
+            "gcode on a machine with a mode of 1e9 Hz",
+            "gcode print.gcode --machine ghz.toml --out o",
+            &["--machine", "1000000000.0 Hz", "100000 Hz", "frequency_hz"],
         ),
         refused(
             "a mode of 1e-7 Hz",
