@@ -59,7 +59,7 @@ mod grbl;
 mod ini;
 mod klipper;
 mod klipper_files;
-mod klipper_shaper;
+pub(crate) mod klipper_shaper;
 mod klipper_values;
 mod machine;
 mod rrf;

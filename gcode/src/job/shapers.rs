@@ -3,7 +3,9 @@
 //! - Klipper `SET_INPUT_SHAPER` (klippy/extras/input_shaper.py, `InputShaperParams.update`):
 //!   `SHAPER_TYPE` sets every axis, else `SHAPER_TYPE_X/Y/Z`; frequencies and damping
 //!   ratios per axis; a frequency of 0 turns the axis's shaping off (its type is kept).
-//!   Unset values keep theirs. The default type is `mzv`, damping 0.1.
+//!   Unset values keep theirs. The default type is `mzv`, damping 0.1. A type Klipper's
+//!   `shaper_defs.py` does not know (settle's `marlin:`/`rrf:` names among them) is an
+//!   error, as in `printer.cfg` ([`crate::config`]'s check).
 //! - Marlin `M593` (`Marlin/src/gcode/feature/input_shaping/M593.cpp`): the stepper's ZV
 //!   shaper on X and Y (or the axes named), `F` (0 off) and `D` (0..=1). `M493`
 //!   (`Marlin/src/gcode/feature/ft_motion/M493.cpp`): FT_MOTION on or off (`S`), and per
@@ -17,6 +19,7 @@
 use settle_planner::shaper::{MarlinShaper, RrfShaper, ShaperType};
 
 use super::config::ShaperSetting;
+use crate::config::klipper_shaper;
 use crate::read::limits::{AxisFlags, FtShaper, LimitChange};
 use settle_planner::firmware::Firmware;
 
@@ -43,11 +46,15 @@ impl Axis {
 /// Why a shaper command cannot be followed.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum ShaperProblem {
-    /// A shaper name the firmware does not know.
-    UnknownName(String),
+    /// A shaper name the firmware does not know, and the names it does.
+    UnknownName(String, &'static str),
     /// A shaper settle does not model.
     Unsupported(&'static str),
 }
+
+/// The `M593 P` types RepRapFirmware takes that settle models.
+const RRF_ALLOWED: &str =
+    "none, zvd, zvdd, zvddd, mzv, ei2, ei3 (M593 P; \"custom\" is not modelled)";
 
 /// The shapers in force on X, Y, Z.
 #[derive(Debug, Clone)]
@@ -120,8 +127,12 @@ impl ShaperState {
                     let name = shaper_type.as_ref().or(shaper_type_xyz[i].as_ref());
                     let a = &mut self.axes[i];
                     if let Some(name) = name {
-                        let kind = ShaperType::parse(name)
-                            .map_err(|_| ShaperProblem::UnknownName(name.clone()))?;
+                        // Klipper's own names only (`klippy/extras/shaper_defs.py`): not
+                        // settle's `marlin:`/`rrf:` ones, which Klipper refuses.
+                        let unknown =
+                            || ShaperProblem::UnknownName(name.clone(), klipper_shaper::ALLOWED);
+                        klipper_shaper::check(name).map_err(|_| unknown())?;
+                        let kind = ShaperType::parse(name).map_err(|_| unknown())?;
                         a.shaper_type = Some(kind);
                     }
                     if let Some(f) = frequency_hz_xyz[i] {
@@ -217,7 +228,9 @@ impl ShaperState {
                         let family = RrfShaper::ALL
                             .into_iter()
                             .find(|f| f.name() == name)
-                            .ok_or_else(|| ShaperProblem::UnknownName(name.to_string()))?;
+                            .ok_or_else(|| {
+                                ShaperProblem::UnknownName(name.to_string(), RRF_ALLOWED)
+                            })?;
                         Some(Some(ShaperType::rrf(family)))
                     }
                 };

@@ -299,3 +299,39 @@ fn bad_shaper_commands_name_their_line() {
     let err = job.by_ref().find_map(Result::err).expect("refused");
     assert_eq!(err.line(), Some(1), "{err}");
 }
+
+/// The first error of a job of `firmware` on `text`.
+fn job_error(firmware: Firmware, text: &str) -> String {
+    let c = JobConfig::defaults(firmware).expect("defaults");
+    let r = settle_gcode::Reader::new(text.as_bytes(), settle_gcode::ReaderOptions::new(c.dialect));
+    let mut job = settle_gcode::job::Job::new(r, c).expect("job");
+    job.by_ref()
+        .find_map(Result::err)
+        .expect("refused")
+        .to_string()
+}
+
+#[test]
+fn a_shaper_name_is_one_the_firmware_knows_and_the_error_lists_its_own() {
+    // Klipper refuses settle's firmware-prefixed names (shaper_defs.py knows zv..3hump_ei).
+    for name in ["rrf:zvd", "marlin:ei", "klipper:mzv"] {
+        let e = job_error(
+            Firmware::Klipper,
+            &format!(
+                "G1 X10 F6000\nSET_INPUT_SHAPER SHAPER_TYPE_X={name} SHAPER_FREQ_X=40\nG1 X20\n"
+            ),
+        );
+        assert!(e.contains(&format!("unknown shaper `{name}`")), "{e}");
+        assert!(e.contains("zv, mzv, zvd, ei, 2hump_ei or 3hump_ei"), "{e}");
+        assert!(
+            !e.contains("rrf:") || e.contains(&format!("`{name}`")),
+            "{e}"
+        );
+        assert!(!e.contains("marlin:zv,"), "{e}");
+    }
+    // RepRapFirmware's M593 P lists its own types.
+    let e = job_error(Firmware::Rrf, "G1 X10 F6000\nM593 P\"ei\" F40\nG1 X20\n");
+    assert!(e.contains("unknown shaper `ei`"), "{e}");
+    assert!(e.contains("none, zvd, zvdd, zvddd, mzv, ei2, ei3"), "{e}");
+    assert!(!e.contains("2hump_ei"), "{e}");
+}

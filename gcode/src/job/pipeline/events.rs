@@ -399,14 +399,11 @@ impl<R: BufRead> Job<R> {
         }
         let old = self.shapers.settings();
         let is_shaper = self.shapers.apply(change).map_err(|p| match p {
-            ShaperProblem::UnknownName(name) => plan_error(
+            ShaperProblem::UnknownName(name, allowed) => plan_error(
                 &self.source,
                 line,
                 command,
-                PlanError::UnknownShaper {
-                    name,
-                    allowed: settle_planner::shaper::ShaperType::ALLOWED,
-                },
+                PlanError::UnknownShaper { name, allowed },
             ),
             ShaperProblem::Unsupported(why) => GcodeError::Unsupported {
                 at: self.at(line),
