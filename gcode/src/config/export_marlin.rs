@@ -7,7 +7,7 @@
 //! written shortest-exact, so settle's G-code reader reads back the same values bit for
 //! bit.
 
-use super::export_text::{Note, annotate, comment_text, refuse};
+use super::export_text::{Note, annotate, comment_text, m204_line, refuse};
 use crate::FtShaper;
 use crate::error::GcodeError;
 
@@ -81,21 +81,7 @@ impl MarlinExport {
         for a in &self.axes {
             out.push_str(&self.axis_line(a)?);
         }
-        let mut m204 = String::new();
-        for (word, key, v) in [
-            ("P", "M204 P", self.print_accel_mm_s2),
-            ("T", "M204 T", self.travel_accel_mm_s2),
-        ] {
-            if let Some(a) = v {
-                if !(a.is_finite() && a > 0.0) {
-                    return Err(refuse(key, a, "a finite acceleration > 0 mm/s^2"));
-                }
-                m204.push_str(&format!(" {word}{a}"));
-            }
-        }
-        if !m204.is_empty() {
-            out.push_str(&format!("M204{m204}\n"));
-        }
+        out.push_str(&m204_line(self.print_accel_mm_s2, self.travel_accel_mm_s2)?);
         Ok(out)
     }
 

@@ -7,7 +7,7 @@
 //!
 //! [`RrfConfig`]: super::RrfConfig
 
-use super::export_text::{Note, annotate, comment_text, refuse};
+use super::export_text::{Note, annotate, comment_text, m204_line, refuse};
 use super::machine::ShaperSetting;
 use super::rrf::{MAX_SHAPER_FREQUENCY_HZ, MIN_SHAPER_FREQUENCY_HZ};
 use crate::error::GcodeError;
@@ -62,21 +62,7 @@ impl RrfExport {
             self.shaper_line(name)?
         };
         let mut out = format!("{head}{m593}");
-        let mut m204 = String::new();
-        for (word, key, v) in [
-            ("P", "M204 P", self.print_accel_mm_s2),
-            ("T", "M204 T", self.travel_accel_mm_s2),
-        ] {
-            if let Some(a) = v {
-                if !(a.is_finite() && a > 0.0) {
-                    return Err(refuse(key, a, "a finite acceleration > 0 mm/s^2"));
-                }
-                m204.push_str(&format!(" {word}{a}"));
-            }
-        }
-        if !m204.is_empty() {
-            out.push_str(&format!("M204{m204}\n"));
-        }
+        out.push_str(&m204_line(self.print_accel_mm_s2, self.travel_accel_mm_s2)?);
         Ok(out)
     }
 

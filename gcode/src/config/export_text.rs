@@ -1,6 +1,6 @@
-//! What both exporters share: refusing a value the firmware would not accept, making a
-//! comment line of free text, and comments written above the values they explain
-//! ([`Note`]).
+//! What the exporters share: refusing a value the firmware would not accept, making a
+//! comment line of free text, comments written above the values they explain
+//! ([`Note`]), and the `M204 P T` line of RepRapFirmware and Marlin.
 
 use crate::error::GcodeError;
 
@@ -60,4 +60,23 @@ pub(crate) fn annotate(
         out.push('\n');
     }
     out
+}
+
+/// The `M204` line (`P` printing, `T` travel acceleration, mm/s^2, each written only when
+/// given; empty when neither is), or an error for one that is not finite and above 0.
+pub(crate) fn m204_line(print: Option<f64>, travel: Option<f64>) -> Result<String, GcodeError> {
+    let mut m204 = String::new();
+    for (word, key, v) in [("P", "M204 P", print), ("T", "M204 T", travel)] {
+        if let Some(a) = v {
+            if !(a.is_finite() && a > 0.0) {
+                return Err(refuse(key, a, "a finite acceleration > 0 mm/s^2"));
+            }
+            m204.push_str(&format!(" {word}{a}"));
+        }
+    }
+    Ok(if m204.is_empty() {
+        m204
+    } else {
+        format!("M204{m204}\n")
+    })
 }

@@ -195,23 +195,26 @@ fn rrf_axis(axes: &[(String, Outcome)]) -> Option<(&str, &Score)> {
     shaped.first().copied()
 }
 
-/// Why `rrf.g` is not written, if it is not: a tuned axis's recommendation that
-/// RepRapFirmware does not run.
-fn rrf_refusal(axes: &[(String, Outcome)]) -> Option<String> {
+/// Why the export for `fw` (named `who`) is not written, if it is not: a tuned axis's
+/// recommendation that the firmware does not run.
+fn refusal(axes: &[(String, Outcome)], fw: Firmware, who: &str) -> Option<String> {
     if axes.is_empty() {
         return Some("nothing was tuned".into());
     }
     axes.iter().find_map(|(a, o)| {
         let w = &o.scores[o.winner];
-        target::expressible(Firmware::Rrf, &w.candidate)
-            .err()
-            .map(|why| {
-                format!(
-                    "the recommendation on {a}, {}, is not something RepRapFirmware runs ({why}); tune with --firmware rrf",
-                    w.candidate.label()
-                )
-            })
+        target::expressible(fw, &w.candidate).err().map(|why| {
+            format!(
+                "the recommendation on {a}, {}, is not something {who} runs ({why}); tune with --firmware {fw}",
+                w.candidate.label()
+            )
+        })
     })
+}
+
+/// Why `rrf.g` is not written, if it is not.
+fn rrf_refusal(axes: &[(String, Outcome)]) -> Option<String> {
+    refusal(axes, Firmware::Rrf, "RepRapFirmware")
 }
 
 /// `rrf.g`: the `M593` line (and `M204` when the acceleration changes), or comments saying
@@ -266,23 +269,9 @@ pub fn rrf_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
     Some(changes::rrf(axes, axis, a))
 }
 
-/// Why `marlin.gcode` is not written, if it is not: a tuned axis's recommendation that
-/// Marlin's Fixed-Time Motion does not run.
+/// Why `marlin.gcode` is not written, if it is not.
 fn marlin_refusal(axes: &[(String, Outcome)]) -> Option<String> {
-    if axes.is_empty() {
-        return Some("nothing was tuned".into());
-    }
-    axes.iter().find_map(|(a, o)| {
-        let w = &o.scores[o.winner];
-        target::expressible(Firmware::Marlin, &w.candidate)
-            .err()
-            .map(|why| {
-                format!(
-                    "the recommendation on {a}, {}, is not something Marlin runs ({why}); tune with --firmware marlin",
-                    w.candidate.label()
-                )
-            })
-    })
+    refusal(axes, Firmware::Marlin, "Marlin")
 }
 
 /// Axis `letter`'s `M493` values from its tuned winner (`C0` unshaped), and the `FTM_FS`
