@@ -3,8 +3,10 @@
 //!
 //! Numbers in letter words are plain decimals (`-12.5`, `.5`, `3.`): no exponent, because
 //! `E` is a parameter letter (`X1E5` is X = 1 and E = 5 in Klipper's `klippy/gcode.py`
-//! splitting and in Marlin's `parser.h`). Klipper's `KEY=VALUE` values are read as Python's
-//! `float()` would (exponents allowed); NaN and infinities are refused everywhere.
+//! splitting and in Marlin's `parser.h`), except in RepRapFirmware, which reads an `E`
+//! right after a digit as the number's exponent ([`Params::with_exponents`]). Klipper's
+//! `KEY=VALUE` values are read as Python's `float()` would (exponents allowed); NaN and
+//! infinities are refused everywhere.
 
 use crate::read::lex::skip_ws;
 
@@ -42,6 +44,8 @@ pub(crate) struct Params {
     /// 0-based offset in the arguments of each parameter's letter.
     at: [usize; 26],
     present: u32,
+    /// Numbers take an exponent after a digit ([`Params::with_exponents`]).
+    exponents: bool,
 }
 
 impl Default for Params {
@@ -50,11 +54,23 @@ impl Default for Params {
             values: [Value::Absent; 26],
             at: [0; 26],
             present: 0,
+            exponents: false,
         }
     }
 }
 
 impl Params {
+    /// Parameters as RepRapFirmware reads them: an `E` (or `e`) right after a digit is the
+    /// number's exponent (`X1.5e2` is X = 150), not the `E` parameter
+    /// (`StringParser::Seen` skips an `E` that follows a digit; the number is read by
+    /// `SafeStrtof`, src/GCodes/GCodeBuffer/StringParser.cpp).
+    pub(crate) fn with_exponents() -> Self {
+        Params {
+            exponents: true,
+            ..Params::default()
+        }
+    }
+
     /// Parses `args` (the text after a letter-number command).
     pub(crate) fn parse(&mut self, args: &str) -> Result<(), ParamError> {
         let mut old = self.present;
@@ -128,6 +144,21 @@ impl Params {
                     loop {
                         while j < b.len() && (b[j].is_ascii_digit() || b[j] == b'.') {
                             j += 1;
+                        }
+                        // RepRapFirmware: an `E` right after a digit is the number's
+                        // exponent, not a parameter.
+                        if self.exponents
+                            && b[j - 1].is_ascii_digit()
+                            && matches!(b.get(j), Some(b'e' | b'E'))
+                        {
+                            let mut k = j + 1;
+                            if matches!(b.get(k), Some(b'-' | b'+')) {
+                                k += 1;
+                            }
+                            let digits = b[k..].iter().take_while(|c| c.is_ascii_digit()).count();
+                            // Without digits the text is no number (the firmware would
+                            // drop the `E`): refused below as not a number.
+                            j = k + digits;
                         }
                         // `:` continues a list with the next number.
                         if b.get(j) == Some(&b':') {
@@ -328,6 +359,30 @@ mod tests {
             (p.get(b'X'), p.get(b'E')),
             (Value::Num(1.0), Value::Num(5.0))
         );
+        // RepRapFirmware: an E after a digit is an exponent; after anything else, E.
+        let mut r = Params::with_exponents();
+        r.parse("X1.5e2 Y-2E-1 E2").expect("test input");
+        assert_eq!(
+            (r.get(b'X'), r.get(b'Y'), r.get(b'E')),
+            (Value::Num(150.0), Value::Num(-0.2), Value::Num(2.0))
+        );
+        r.parse("X1.E5").expect("test input");
+        assert_eq!(
+            (r.get(b'X'), r.get(b'E')),
+            (Value::Num(1.0), Value::Num(5.0))
+        );
+        r.parse("X1e-9Y2").expect("test input");
+        assert_eq!(
+            (r.get(b'X'), r.get(b'Y')),
+            (Value::Num(1e-9), Value::Num(2.0))
+        );
+        r.parse("E3000:1e3").expect("test input");
+        assert_eq!(r.get(b'E'), Value::List(1, 9));
+        assert!(matches!(r.parse("X1e"), Err(ParamError::NotANumber { .. })));
+        assert!(matches!(
+            r.parse("X1e+ Y2"),
+            Err(ParamError::NotANumber { .. })
+        ));
         p.parse(" X Y Z10").expect("test input");
         assert_eq!(
             (p.get(b'X'), p.get(b'Y'), p.get(b'Z')),

@@ -142,7 +142,11 @@ impl<R: BufRead> Reader<R> {
                 options.max_extruder_mm,
             ),
             layers: Layers::new(options.layers),
-            params: Params::default(),
+            params: if options.dialect == Dialect::Rrf {
+                Params::with_exponents()
+            } else {
+                Params::default()
+            },
             kv: KeyValues::default(),
             queue: VecDeque::new(),
             layer_buf: Vec::new(),

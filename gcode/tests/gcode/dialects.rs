@@ -387,3 +387,22 @@ fn klipper_limits() {
         ["M201 x1", "M205 x1", "PRINT_START x2"]
     );
 }
+
+#[test]
+fn an_e_after_a_digit_is_an_exponent_in_reprapfirmware_only() {
+    // RepRapFirmware's StringParser::Seen skips an `E` that follows a digit, and the number
+    // is read with its exponent; Klipper and Marlin split at every letter.
+    let text = "G1 X1.5e1 Y10 F600\n";
+    let rrf = moves(text, Dialect::Rrf);
+    assert_eq!(
+        (rrf[0].end.x_mm, rrf[0].end.y_mm, rrf[0].end.e_mm),
+        (15.0, 10.0, 0.0)
+    );
+    for d in [Dialect::Marlin, Dialect::Klipper] {
+        let m = moves(text, d);
+        assert_eq!((m[0].end.x_mm, m[0].end.e_mm), (1.5, 1.0), "{d:?}");
+    }
+    // `E` after a space or a dot is the parameter in every dialect.
+    let m = moves("G1 X2. E3 F600\n", Dialect::Rrf);
+    assert_eq!((m[0].end.x_mm, m[0].end.e_mm), (2.0, 3.0));
+}
