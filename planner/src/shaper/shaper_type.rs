@@ -64,6 +64,11 @@ impl MarlinShaper {
         Self::ALL.get(usize::from(code).checked_sub(1)?).copied()
     }
 
+    /// Its `M493 C<code>` value (1..=8), the inverse of [`MarlinShaper::from_m493_code`].
+    pub fn m493_code(self) -> u8 {
+        self as u8 + 1
+    }
+
     /// Whether the family takes a vibration tolerance (M493 `Q`).
     pub fn has_v_tol(self) -> bool {
         matches!(

@@ -93,6 +93,13 @@ fn written_forms() {
     assert_eq!(MarlinShaper::from_m493_code(6), Some(MarlinShaper::TwoHei));
     assert_eq!(MarlinShaper::from_m493_code(0), None);
     assert_eq!(MarlinShaper::from_m493_code(9), None);
+    // M493 C codes 1..=8 in MarlinDocumentation's order, and back.
+    assert_eq!(MarlinShaper::Zv.m493_code(), 1);
+    assert_eq!(MarlinShaper::Ei.m493_code(), 5);
+    assert_eq!(MarlinShaper::Mzv.m493_code(), 8);
+    for f in MarlinShaper::ALL {
+        assert_eq!(MarlinShaper::from_m493_code(f.m493_code()), Some(f));
+    }
 }
 
 #[test]

@@ -34,7 +34,7 @@ use settle_gcode::config::{
 };
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
-use settle_planner::shaper::{MARLIN_FTM_FS_HZ, MarlinShaper, ShaperType};
+use settle_planner::shaper::{MARLIN_FTM_FS_HZ, ShaperType};
 use settle_planner::tmc::ramp::SRampParams;
 use settle_planner::tmc::registers::{TmcUnits, export};
 
@@ -296,8 +296,7 @@ fn marlin_axis(axes: &[(String, Outcome)], letter: &str) -> Option<(FtAxisShaper
             v_tol,
             ftm_fs_hz,
         }) => {
-            let code =
-                u32::try_from(MarlinShaper::ALL.iter().position(|s| *s == shaper)? + 1).ok()?;
+            let code = u32::from(shaper.m493_code());
             let ft = FtAxisShaper {
                 shaper: FtShaper::from_code(code)?,
                 frequency_hz: sh.frequency_hz,
