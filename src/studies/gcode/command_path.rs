@@ -108,6 +108,23 @@ pub struct CommandPath {
     first_run: u64,
     /// The points added to the boxes: those before this index among all pushed.
     grown: u64,
+    /// Points from this index among all pushed on are held, forgotten or not, for
+    /// [`CommandPath::distances_mm`] (a run's first point).
+    held: Option<u64>,
+}
+
+/// A distance asked of the path later ([`CommandPath::distances_mm`]): what
+/// [`CommandPath::distance_mm`] was given, and the last point pushed then.
+#[derive(Debug, Clone, Copy)]
+pub struct Asked {
+    /// The time (s, print clock).
+    pub t_s: f64,
+    /// The toolhead (XY, mm).
+    pub p: [f64; 2],
+    /// The commanded point (XY, mm).
+    pub c: [f64; 2],
+    /// The index among all pushed of the last point pushed.
+    last: u64,
 }
 
 impl CommandPath {
@@ -138,8 +155,9 @@ impl CommandPath {
             i += 1;
         }
         self.forgotten = self.base + i as u64;
-        // The first kept point's run is held whole.
-        let gap = (self.forgotten / RUN * RUN - self.base) as usize;
+        // The first kept point's run is held whole, and the held points.
+        let keep = self.held.map_or(self.forgotten, |h| h.min(self.forgotten));
+        let gap = (keep / RUN * RUN - self.base) as usize;
         let dropped = compact(&mut self.c, gap);
         compact(&mut self.t, dropped);
         self.base += dropped as u64;
@@ -171,6 +189,58 @@ impl CommandPath {
             }
         }
         self.grown = self.pushed();
+    }
+
+    /// [`CommandPath::distance_mm`] of `p` and `c` at `t_s` (after
+    /// [`CommandPath::forget_before`] at `t_s`), to be asked later: the points it needs
+    /// are held from now on until [`CommandPath::release`].
+    pub fn ask_later(&mut self, t_s: f64, p: [f64; 2], c: [f64; 2]) -> Asked {
+        let from = self.forgotten / RUN * RUN;
+        self.held.get_or_insert(from);
+        Asked {
+            t_s,
+            p,
+            c,
+            last: self.pushed() - 1,
+        }
+    }
+
+    /// The distances (mm) [`CommandPath::distance_mm`] gave when each of `asked` was
+    /// made (in the order made, [`CommandPath::ask_later`]), bit for bit: the held points
+    /// are pushed again onto a path of their own, and each distance asked of it when its
+    /// last point is there. (A box's points are the same whenever it is grown, and
+    /// [`Box2::add`] is exact: the boxes, so the skipped segments, are the same.)
+    pub fn distances_mm(&self, asked: &[Asked]) -> Vec<f64> {
+        let Some(from) = self.held else {
+            return Vec::new();
+        };
+        let mut path = CommandPath {
+            base: from,
+            forgotten: from,
+            first_run: from / RUN,
+            grown: from,
+            ..CommandPath::default()
+        };
+        let at = |i: u64| (i - self.base) as usize;
+        asked
+            .iter()
+            .map(|a| {
+                for i in path.pushed()..=a.last {
+                    path.push(self.t[at(i)], self.c[at(i)]);
+                }
+                path.distance_mm(a.t_s, a.p, a.c).unwrap_or(0.0)
+            })
+            .collect()
+    }
+
+    /// How many points [`CommandPath::ask_later`] holds.
+    pub fn held(&self) -> u64 {
+        self.held.map_or(0, |h| self.pushed() - h)
+    }
+
+    /// Stop holding the points [`CommandPath::ask_later`] held.
+    pub fn release(&mut self) {
+        self.held = None;
     }
 
     /// What [`CommandPath::distance_mm`] can be no larger than for a toolhead at `p` with
@@ -448,6 +518,58 @@ mod tests {
             // dropped now and then (`COMPACT`).
             assert!(lazy.c.len() < 3_000 / 2, "case {case}: {}", lazy.c.len());
         }
+    }
+
+    /// Distances asked later ([`CommandPath::ask_later`], [`CommandPath::distances_mm`])
+    /// are those asked at the time, bit for bit: on random walks as above, the window
+    /// forgotten every sample, some distances asked at once (growing and dropping the
+    /// boxes in between), some asked later, released at random, over and over.
+    #[test]
+    fn distances_asked_later_are_those_asked_at_the_time() {
+        let mut uniform = uniform_from(0x2545_f491_4f6c_dd1d);
+        let mut later_asked = 0;
+        for case in 0..40 {
+            let (mut path, mut now) = (CommandPath::default(), CommandPath::default());
+            let mut times: VecDeque<(f64, [f64; 2])> = VecDeque::new();
+            let (mut t, mut q) = (0.0, [0.0, 0.0]);
+            let (mut asked, mut want) = (Vec::new(), Vec::new());
+            let ask_now = [0.0, 0.05, 0.5][case % 3];
+            for k in 0..4_000 {
+                t += if uniform() < 0.1 { 0.0 } else { 1e-3 * uniform() };
+                if uniform() < 0.8 {
+                    q = [q[0] + uniform() - 0.5, q[1] + 2.0 * uniform() - 1.0];
+                }
+                path.push(t, q);
+                now.push(t, q);
+                times.push_back((t, q));
+                if times.len() <= 40 {
+                    continue;
+                }
+                let (tm, cm) = times.pop_front().expect("a waiting point");
+                path.forget_before(tm);
+                now.forget_before(tm);
+                let p = [cm[0] + 3.0 * uniform() - 1.5, cm[1] + 3.0 * uniform() - 1.5];
+                let r = uniform();
+                if r < ask_now {
+                    let (a, b) = (path.distance_mm(tm, p, cm), now.distance_mm(tm, p, cm));
+                    assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "case {case}, {k}");
+                } else if r < ask_now + 0.3 {
+                    asked.push(path.ask_later(tm, p, cm));
+                    want.push(now.distance_mm(tm, p, cm).unwrap_or(0.0).to_bits());
+                }
+                if uniform() < 0.002 || k == 3_999 {
+                    let got: Vec<u64> = path.distances_mm(&asked).iter().map(|d| d.to_bits()).collect();
+                    assert_eq!(got, want, "case {case}, point {k}");
+                    later_asked += asked.len();
+                    (asked, want) = (Vec::new(), Vec::new());
+                    path.release();
+                }
+            }
+            // Released, the held points are dropped again.
+            path.forget_before(t);
+            assert!(path.c.len() < 4_000 / 2, "case {case}: {}", path.c.len());
+        }
+        assert!(later_asked > 40_000, "{later_asked}");
     }
 
     /// A segment's box distance from its ends' offsets, and a box's without looking for

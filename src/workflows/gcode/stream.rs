@@ -36,7 +36,7 @@ use crate::error::Error;
 use crate::execute::driver::{Chunk, Driver, Samples, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::spec::backend::Backend;
-use crate::studies::gcode::command_path::{CommandPath, CommandTrack};
+use crate::studies::gcode::command_path::{Asked, CommandPath, CommandTrack};
 use crate::studies::gcode::contour::ActiveMoves;
 use crate::studies::gcode::features::FeatureAccount;
 use crate::studies::gcode::fly::FlyAxis;
@@ -177,6 +177,9 @@ struct Account {
     /// ([`FeatureAccount::end_layer`]).
     hist: Histogram,
     map: Vec<MapPoint>,
+    /// The map's points whose vibration is measured only if the map is kept: their
+    /// index in it, and the distance to ask.
+    unmeasured: Vec<(usize, Asked)>,
     layer_top: TopSpots,
     /// The move the last sample belonged to: index, whether it works, layer, line, worst
     /// spot.
@@ -207,6 +210,7 @@ impl Account {
             layer: None,
             hist: Histogram::default(),
             map: Vec::new(),
+            unmeasured: Vec::new(),
             owner: None,
             map_every,
             map_stride: map_every,
@@ -250,18 +254,24 @@ impl Account {
         self.out.all.merge(&self.hist);
         self.hist.clear();
         self.map_stride = self.map_every;
-        let map = LayerMap {
+        let mut map = LayerMap {
             layer: l.layer,
-            points: std::mem::take(&mut self.map),
+            points: Vec::new(),
             spots: std::mem::replace(&mut self.layer_top, TopSpots::new(5))
                 .spots()
                 .to_vec(),
         };
-        if self.opts.map_layer == Some(map.layer) {
+        let chosen = self.opts.map_layer == Some(map.layer);
+        let at = self
+            .out
+            .maps
+            .partition_point(|m| m.worst_um() >= map.worst_um());
+        self.measure_map(chosen || at < self.opts.maps);
+        map.points = std::mem::take(&mut self.map);
+        if chosen {
             self.out.chosen = Some(map.clone());
         }
         let maps = &mut self.out.maps;
-        let at = maps.partition_point(|m| m.worst_um() >= map.worst_um());
         if at < self.opts.maps {
             maps.insert(at, map);
             maps.truncate(self.opts.maps);
@@ -305,23 +315,25 @@ impl Account {
     }
 
     /// The vibration (um) of a printing sample `w` of move `m` whose contour error is
-    /// `err_um` (module doc), measured where it is read: on the ringing map
-    /// (`map_point`), in a spot (a move's or a feature's worst error so far), or where it
-    /// may be the layer's largest. Elsewhere it is no larger than the layer's largest and
-    /// changes nothing: its bound ([`CommandPath::bound_mm`]) is given instead.
-    fn vibration_um(&mut self, w: &Waiting, err_um: f64, map_point: bool, m: Owner) -> f64 {
+    /// `err_um` (module doc), and whether it was measured: it is where it is read, in a
+    /// spot (a move's or a feature's worst error so far), or where it may be the layer's
+    /// largest. Elsewhere it is no larger than the layer's largest and changes nothing:
+    /// its bound ([`CommandPath::bound_mm`]) is given instead (a ringing map's point is
+    /// measured when its layer's map is kept, [`Account::end_layer`]).
+    fn vibration_um(&mut self, w: &Waiting, err_um: f64, m: Owner) -> (f64, bool) {
         let p = [w.toolhead[0] * 1e3, w.toolhead[1] * 1e3];
         let c = [w.cmd[0] * 1e3, w.cmd[1] * 1e3];
-        let measured = |path: &mut CommandPath| path.distance_mm(w.t, p, c).unwrap_or(0.0) * 1e3;
-        let spot = || {
-            self.owner
-                .as_ref()
-                .is_none_or(|o| o.4.as_ref().is_none_or(|s| err_um > s.error_um))
-                || self.out.features.is_worst(m.feature, err_um)
+        let mut measured = || {
+            let d = self.command.path.distance_mm(w.t, p, c);
+            (d.unwrap_or(0.0) * 1e3, true)
         };
-        // The bound only where the distance is not read anyway (a map point, a spot).
-        if map_point || spot() {
-            return measured(&mut self.command.path);
+        let spot = self
+            .owner
+            .as_ref()
+            .is_none_or(|o| o.4.as_ref().is_none_or(|s| err_um > s.error_um))
+            || self.out.features.is_worst(m.feature, err_um);
+        if spot {
+            return measured();
         }
         let bound_um = CommandPath::bound_mm(p, c) * 1e3;
         let largest = self
@@ -329,10 +341,25 @@ impl Account {
             .as_ref()
             .map_or(0.0, |l| l.split_worst.vibration_um);
         if bound_um > largest {
-            measured(&mut self.command.path)
+            measured()
         } else {
-            bound_um
+            (bound_um, false)
         }
+    }
+
+    /// Measure the vibration of the ringing map's points that wait for it
+    /// ([`Account::unmeasured`]) when `keep`, and hold the command's path for them no
+    /// more.
+    fn measure_map(&mut self, keep: bool) {
+        if keep && !self.unmeasured.is_empty() {
+            let asked: Vec<Asked> = self.unmeasured.iter().map(|u| u.1).collect();
+            let d = self.command.path.distances_mm(&asked);
+            for (&(i, _), d) in self.unmeasured.iter().zip(d) {
+                self.map[i].vibration_um = (d * 1e3) as f32;
+            }
+        }
+        self.unmeasured.clear();
+        self.command.path.release();
     }
 
     /// Measure a sample (module doc).
@@ -393,9 +420,15 @@ impl Account {
         let mut split = Split::default();
         self.command.path.forget_before(t);
         if print {
+            let (vibration_um, measured) = self.vibration_um(&w, err_um, m);
+            if map_point && !measured {
+                let p = [x, y];
+                let asked = self.command.path.ask_later(t, p, [cx, cy]);
+                self.unmeasured.push((self.map.len(), asked));
+            }
             split = Split {
                 smoothing_um: smoothing_mm * 1e3,
-                vibration_um: self.vibration_um(&w, err_um, map_point, m),
+                vibration_um,
             };
             self.out.split_worst = self.out.split_worst.max(split);
             if let Some(l) = self.layer.as_mut() {
@@ -427,6 +460,10 @@ impl Account {
                 vibration_um: split.vibration_um as f32,
                 print,
             });
+            let held = self.command.path.held();
+            if held > MAX_HELD_POINTS || self.map.len() >= 2 * MAX_MAP_POINTS {
+                self.measure_map(true);
+            }
             if self.map.len() >= 2 * MAX_MAP_POINTS {
                 halve_map(&mut self.map);
                 self.map_stride *= 2;
@@ -434,6 +471,11 @@ impl Account {
         }
     }
 }
+
+/// The most points of the command's path held for the ringing map's points waiting for
+/// their vibration ([`Account::unmeasured`], 24 bytes each): past it they are measured
+/// (a layer longer than about a minute at 2 kHz, whose map may not be kept).
+pub const MAX_HELD_POINTS: u64 = 1 << 18;
 
 /// The most points a layer's ringing map keeps: far more than the figure's 560 x 640
 /// pixels show, and a bounded memory whatever the layer's length (a long layer's map is
