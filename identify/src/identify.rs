@@ -139,6 +139,23 @@ pub fn identify_recording(
             ),
         });
     }
+    // What the test excited above the Nyquist frequency folds back to `fs - f`: into the
+    // band analysed (up to NYQUIST_USE * fs) once the test ends above (1 - NYQUIST_USE) * fs.
+    // There it would be fitted as modes the machine does not have, or move the ones it has.
+    if use_sweep && opts.test.freq_end_hz > (1.0 - NYQUIST_USE) * fs {
+        return Err(IdentifyError::NeedsTestParameters {
+            file: source,
+            reason: format!(
+                "the test sweeps up to {} Hz, past the Nyquist frequency {:.1} Hz of this recording's {fs:.1} Hz sample rate: what it excited above {:.1} Hz folds back to {:.1} Hz and up (aliasing), inside the band analysed (up to {:.1} Hz); record at more than {:.0} Hz, or give the test's band (--freq-start, --freq-end) if it was narrower",
+                opts.test.freq_end_hz,
+                fs / 2.0,
+                fs / 2.0,
+                fs - opts.test.freq_end_hz,
+                NYQUIST_USE * fs,
+                opts.test.freq_end_hz / (1.0 - NYQUIST_USE),
+            ),
+        });
+    }
     let welch = if use_sweep {
         // Klipper's window and segment length at a quarter-segment hop (see
         // `Welch::with_hop`): the sweep model is the time integral that hop samples.

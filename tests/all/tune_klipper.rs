@@ -75,3 +75,52 @@ fn klippers_choice_on_the_modes_is_its_choice_on_the_recording() {
         );
     }
 }
+
+/// `input_shaper.cfg` holds only keys Klipper's `[input_shaper]` reads (`shaper_type_x`,
+/// `shaper_freq_x`, `_y`): Klipper refuses an option it does not read, so the
+/// recommendation for a file that names no axis, or names z, is a comment saying where it
+/// goes, never `shaper_freq:` or `shaper_freq_z:`.
+#[test]
+fn input_shaper_cfg_holds_only_keys_klipper_reads() {
+    use settle::workflows::tune::klipper_criterion::{KlipperCriterion, choose, input_shaper_cfg};
+    let dir = tempfile::tempdir().expect("tempdir");
+    let corpus = root().join("identify/tests/corpus/zippy_resonances_x_20220317_143228.csv");
+    let mut files = Vec::new();
+    for name in ["resonances_x_1.csv", "resonances_z_1.csv", "spectrum.csv"] {
+        let f = dir.path().join(name);
+        std::fs::copy(&corpus, &f).expect("copy");
+        files.push(f);
+    }
+    let c = KlipperCriterion::from_args(files, None, None, None, None).expect("options");
+    let choices = choose(&c).expect("chooses");
+    let cfg = input_shaper_cfg(&choices);
+    let r = &choices[0].selection.recommended;
+    let keys: Vec<&str> = cfg
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with('['))
+        .filter_map(|l| l.split(':').next())
+        .collect();
+    assert_eq!(keys, ["shaper_type_x", "shaper_freq_x"], "{cfg}");
+    assert!(
+        cfg.contains(&format!("shaper_freq_x: {:.1}\n", r.frequency_hz)),
+        "{cfg}"
+    );
+    for name in [
+        "resonances_z_1.csv names axis z",
+        "spectrum.csv names no axis",
+    ] {
+        let line = cfg
+            .lines()
+            .find(|l| l.contains(name))
+            .unwrap_or_else(|| panic!("no comment on {name} in {cfg}"));
+        assert!(line.starts_with("# "), "{line}");
+        assert!(
+            line.contains(&format!(
+                "{} @ {:.1} Hz goes under the keys of the axis the test shook",
+                r.shaper_type.name(),
+                r.frequency_hz
+            )),
+            "{line}"
+        );
+    }
+}

@@ -321,3 +321,32 @@ fn random_sweeps_from_env() {
         "too few 2-sigma intervals cover the truth: {short:?}"
     );
 }
+
+/// A sweep recorded at a rate whose Nyquist frequency lies so far below the test's last
+/// frequency that what the test excited above it folds back into the band analysed (90 %
+/// of Nyquist): the fit would answer with modes the machine does not have. Refused,
+/// naming the rate; recorded where the folded excitation stays above that band, the same
+/// test is identified.
+#[test]
+fn sweep_aliased_into_the_band_is_refused() {
+    let truth = [(42.0, 0.05, 0.75), (80.0, 0.06, 0.25)];
+    let recording = |fs: f64| {
+        let axes = sweep_axes(&truth, &fast_test(), fs, 5);
+        let text = synth::klipper_raw_csv(&axes, 0.0, fs);
+        klipper_raw::parse("raw_data_x.csv", &text).expect("parse")
+    };
+    // 200 Hz: the test's 110 to 135 Hz fold back to 90 down to 65 Hz, over the 80 Hz mode.
+    let e = identify_recording(&recording(200.0), &opts()).expect_err("aliased sweep");
+    let msg = e.to_string();
+    assert!(
+        msg.starts_with(
+            "raw_data_x.csv: the test sweeps up to 135 Hz, past the Nyquist frequency 100.0 Hz of this recording's 200.0 Hz sample rate: what it excited above 100.0 Hz folds back to 65.0 Hz and up"
+        ),
+        "{msg}"
+    );
+    assert!(msg.contains("--freq-end"), "{msg}");
+    // 250 Hz: the fold lands at 115 Hz and up, above the band analysed (112.5 Hz).
+    let id = identify_recording(&recording(250.0), &opts()).expect("identify");
+    assert_eq!(id.method, Method::SweepFit);
+    check_modes(&id, &truth, true);
+}

@@ -134,6 +134,18 @@ pub fn fit_shaper(
                 .unzip()
         })
         .collect();
+    // Klipper's remaining vibration is the vibration over its threshold after the shaper
+    // divided by that before it: on a spectrum without a positive finite value (a sensor
+    // that read a constant, a file of zeros) it is 0 / 0, which Klipper's numpy makes NaN
+    // and a comparison would make a confident "0 % left". Nothing was measured.
+    if sets.iter().any(|(_, psd)| {
+        let max = psd.iter().copied().fold(0.0, f64::max);
+        !(max > 0.0 && max.is_finite())
+    }) {
+        return Err(PlanError::InvalidInput {
+            reason: "the spectrum holds no vibration to shape (no positive finite PSD value up to the highest frequency fitted): nothing was measured",
+        });
+    }
     let mut results: Vec<Fit> = Vec::with_capacity(freqs.len());
     let mut best: Option<Fit> = None;
     for &f in freqs.iter().rev() {

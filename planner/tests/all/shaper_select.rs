@@ -249,3 +249,29 @@ fn recommendations_equal_calibrate_shaper_py() {
         }
     }
 }
+
+/// A spectrum without a positive value (a sensor that read a constant, a file of zeros)
+/// leaves Klipper's remaining vibration at 0 / 0: refused, not chosen on as "0 % left".
+#[test]
+fn a_spectrum_without_vibration_is_refused() {
+    let freq_hz: Vec<f64> = (0..128).map(|k| f64::from(k) * 3200.0 / 2048.0).collect();
+    let flat = |v: f64| CalibrationData {
+        freq_hz: freq_hz.clone(),
+        psd_sum: vec![v; freq_hz.len()],
+        ..CalibrationData::default()
+    };
+    let opts = SelectOptions::default();
+    for data in [flat(0.0), flat(f64::INFINITY)] {
+        let e = find_best_shaper(&[data], &opts).expect_err("no vibration");
+        assert!(
+            e.to_string()
+                .contains("the spectrum holds no vibration to shape"),
+            "{e}"
+        );
+    }
+    // One data set of several without vibration is enough to refuse.
+    let e = find_best_shaper(&[flat(1.0), flat(0.0)], &opts).expect_err("one empty set");
+    assert!(e.to_string().contains("nothing was measured"), "{e}");
+    // A flat but positive spectrum is a spectrum: Klipper chooses on it.
+    find_best_shaper(&[flat(1.0)], &opts).expect("a positive spectrum");
+}

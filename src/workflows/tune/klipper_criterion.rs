@@ -327,21 +327,26 @@ fn script_lines(a: &AxisChoice, r: &mut Report) {
     ));
 }
 
-/// The `[input_shaper]` lines of the recommendations (`shaper_type_x` / `shaper_freq_x`
-/// per named axis, `shaper_type` / `shaper_freq` for files that name none), with the
-/// suggested acceleration limit as a comment.
+/// The `[input_shaper]` lines of the recommendations (`shaper_type_x` / `shaper_freq_x`,
+/// `_y`, per axis the file names name), with the suggested acceleration limit as a comment.
+/// Klipper's `[input_shaper]` reads `shaper_freq_x` and `shaper_freq_y` only (and refuses
+/// an option it does not read, klippy/configfile.py's `check_unused_options`): the
+/// recommendation for files that name no axis, or name `z`, is written as a comment that
+/// says where it goes ([`unplaced`]).
 pub fn input_shaper_cfg(choices: &[AxisChoice]) -> String {
     let mut s = String::from(
         "# Klipper's recommendation (scripts/calibrate_shaper.py's choice), from settle tune --criterion klipper\n[input_shaper]\n",
     );
     for a in choices {
-        let suffix = a.axis.map_or(String::new(), |c| format!("_{c}"));
         let r = &a.selection.recommended;
-        s.push_str(&format!(
-            "shaper_type{suffix}: {}\nshaper_freq{suffix}: {:.1}\n",
-            r.shaper_type.name(),
-            r.frequency_hz
-        ));
+        match a.axis {
+            Some(c @ ('x' | 'y')) => s.push_str(&format!(
+                "shaper_type_{c}: {}\nshaper_freq_{c}: {:.1}\n",
+                r.shaper_type.name(),
+                r.frequency_hz
+            )),
+            _ => s.push_str(&format!("# {}\n", unplaced(a))),
+        }
     }
     for a in choices {
         let r = &a.selection.recommended;
@@ -353,6 +358,26 @@ pub fn input_shaper_cfg(choices: &[AxisChoice]) -> String {
         ));
     }
     s
+}
+
+/// Why a recommendation has no `[input_shaper]` key (its files name no axis Klipper
+/// shapes), and where it goes.
+fn unplaced(a: &AxisChoice) -> String {
+    let r = &a.selection.recommended;
+    let names: Vec<String> = a.files.iter().map(|f| f.display().to_string()).collect();
+    let why = match a.axis {
+        Some(c) => format!("name{} axis {c}", if names.len() == 1 { "s" } else { "" }),
+        None => format!(
+            "name{} no axis (an x or y in the name, as calibration_data_x_*.csv)",
+            if names.len() == 1 { "s" } else { "" }
+        ),
+    };
+    format!(
+        "{} {why}, and Klipper's [input_shaper] shapes x and y only (shaper_type_x, shaper_freq_x, shaper_type_y, shaper_freq_y): {} @ {:.1} Hz goes under the keys of the axis the test shook",
+        names.join(", "),
+        r.shaper_type.name(),
+        r.frequency_hz
+    )
 }
 
 /// What `settle tune --criterion klipper FILE...` prints (calibrate_shaper.py's lines per
@@ -369,6 +394,12 @@ pub fn report(c: &KlipperCriterion) -> Result<Report, Error> {
     let mut r = Report::new(Exit::Ok);
     for a in &choices {
         script_lines(a, &mut r);
+    }
+    for a in choices
+        .iter()
+        .filter(|a| !matches!(a.axis, Some('x' | 'y')))
+    {
+        r.err(format!("note: {}", unplaced(a)));
     }
     if let Some(dir) = &c.out {
         create_dir(dir)?;

@@ -119,6 +119,16 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         .map(|(_, l)| l)
         .collect();
     sb.write("slow_x.csv", &(slow.join("\n") + "\n"));
+    // The example recording with every acceleration held at one value: a machine that
+    // never moved (or a sensor that read a constant).
+    let still: Vec<String> = rec
+        .lines()
+        .map(|l| match l.split_once(',') {
+            Some((t, _)) if !l.starts_with('#') => format!("{t},12.5,-3.25,9807.5"),
+            _ => l.to_string(),
+        })
+        .collect();
+    sb.write("still_x.csv", &(still.join("\n") + "\n"));
     // A processed spectrum of the corpus (rows to 199.9 Hz) cut after its 90 Hz row.
     let corpus = concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -253,6 +263,16 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
                 "sampled at 50.",
                 "Nyquist",
                 "more than 270 Hz",
+            ],
+        ),
+        // Klipper's remaining vibration is 0 / 0 there: no "0 %" and no input_shaper.cfg.
+        refused(
+            "tune --criterion klipper on a recording without vibration",
+            "tune --criterion klipper still_x.csv --out o_still",
+            &[
+                "still_x.csv",
+                "the spectrum holds no vibration to shape",
+                "nothing was measured",
             ],
         ),
         refused(
