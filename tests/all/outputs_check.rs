@@ -204,6 +204,27 @@ fn a_baseline_of_another_shape_is_a_failure_with_the_reason() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
 }
 
+/// A baseline settle cannot have written (a run listed twice) is bad input, exit 2, and
+/// refused before the scenario runs; `--update` rewrites it.
+#[test]
+fn a_baseline_with_a_run_twice_is_bad_input() {
+    let mut b = baseline();
+    b.rows.push(b.rows[0].clone());
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("twice.csv");
+    std::fs::write(&path, b.to_csv()).expect("write");
+    let p = path.display().to_string();
+    let o = settle(&["check", SCENARIO, "--baseline", &p]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let t = text(&o);
+    assert!(t.contains("twice.csv") && t.contains("run 0 twice"), "{t}");
+    assert!(!t.contains("runs)"), "no run was simulated: {t}");
+    let o = settle(&["check", SCENARIO, "--baseline", &p, "--update"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let o = settle(&["check", SCENARIO, "--baseline", &p]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+}
+
 /// A move a ZV shaper at the mode's own frequency and damping cancels exactly: on the
 /// modal backend its residual is 0 um and its overshoot 2.5 nm.
 const CANCELLED: &str = r#"name = "zv_exact"

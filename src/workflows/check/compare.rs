@@ -25,6 +25,7 @@
 //! "improvement" is as often a bug (lost damping, a wrong unit) as a real gain. A caller that
 //! wants improvements to pass sets `allow_improvements`.
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 
 use crate::input::runs_table::{RunsTable, number};
@@ -199,6 +200,27 @@ fn compare_cell(
     }
 }
 
+/// The rows of `t` by their run (column `run_col`): an error if a run is listed twice.
+fn by_run(t: &RunsTable, run_col: usize) -> Result<HashMap<&str, &Vec<String>>, String> {
+    let mut by_run = HashMap::with_capacity(t.rows.len());
+    for r in &t.rows {
+        if by_run.insert(r[run_col].as_str(), r).is_some() {
+            return Err(format!(
+                "the baseline has run {} twice: a baseline is a runs.csv written by settle",
+                crate::error::echo(&r[run_col])
+            ));
+        }
+    }
+    Ok(by_run)
+}
+
+/// A baseline settle could have written, as far as can be told before the scenario runs:
+/// no run listed twice (one without a `run` column differs from every run's columns,
+/// which [`compare`] reports).
+pub fn check_baseline(t: &RunsTable) -> Result<(), String> {
+    t.column("run").map_or(Ok(()), |c| by_run(t, c).map(|_| ()))
+}
+
 /// Compare `now` with `baseline` at relative tolerance `tolerance_pct` (percent) and the
 /// absolute floor `floor_um` of length columns (um).
 ///
@@ -239,16 +261,7 @@ the outputs changed shape; if intended, rewrite the baseline with --update",
         .column("run")
         .ok_or("no `run` column: a baseline is a runs.csv written by settle")?;
     // Rows are matched by run, whatever their order in the file.
-    let mut by_run: std::collections::HashMap<&str, &Vec<String>> =
-        std::collections::HashMap::with_capacity(baseline.rows.len());
-    for r in &baseline.rows {
-        if by_run.insert(r[run_col].as_str(), r).is_some() {
-            return Err(format!(
-                "the baseline has run {} twice: a baseline is a runs.csv written by settle",
-                crate::error::echo(&r[run_col])
-            ));
-        }
-    }
+    let by_run = by_run(baseline, run_col)?;
     let sorted_ids = |t: &RunsTable| -> Vec<String> {
         let mut ids: Vec<String> = t.rows.iter().map(|r| r[run_col].clone()).collect();
         ids.sort_by_cached_key(|id| (id.parse::<u64>().ok(), id.clone()));

@@ -132,6 +132,11 @@ pub fn check(opts: &CheckOptions, progress: Progress) -> Result<Checked, Error> 
         .map(RunsTable::parse)
         .transpose()
         .map_err(|e| baseline_error(baseline, e))?;
+    // A malformed baseline is refused before any run (one being rewritten need not be
+    // well formed).
+    if let Some(t) = old_table.as_ref().filter(|_| !opts.update) {
+        compare::check_baseline(t).map_err(|e| baseline_error(baseline, e))?;
+    }
     // The backend: as asked, else the baseline's own; a baseline made on another backend
     // than the one asked for is an error (its numbers are not comparable), unless updating.
     let made_with = old_table
