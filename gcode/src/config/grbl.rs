@@ -168,12 +168,19 @@ impl GrblSettings {
         let source: Arc<str> = Arc::from(path.display().to_string());
         let mut s = Self::new();
         s.files.push(path.to_path_buf());
-        // A console copy: `ok` answers and `[...]`/`<...>` messages are not settings.
+        // A console copy: `ok` answers, `[...]`/`<...>` messages and the welcome line
+        // (`Grbl 1.1h ['$' for help]`, grblHAL's `GrblHAL ...`: a line that starts with
+        // `Grbl`, as senders such as CNCjs recognise it) are not settings.
         let kept: String = text
             .lines()
             .map(|l| {
                 let t = l.trim();
-                if t.eq_ignore_ascii_case("ok") || t.starts_with('[') || t.starts_with('<') {
+                let welcome = t.get(..4).is_some_and(|w| w.eq_ignore_ascii_case("grbl"));
+                if t.eq_ignore_ascii_case("ok")
+                    || t.starts_with('[')
+                    || t.starts_with('<')
+                    || welcome
+                {
                     ""
                 } else {
                     l
@@ -240,5 +247,28 @@ mod tests {
         assert!(neg.to_string().contains("error:4"), "{neg}");
         let junk = GrblSettings::parse("G0 X10\n", "g.txt").expect_err("refused");
         assert!(junk.to_string().contains("$N=VALUE"), "{junk}");
+    }
+
+    /// A console copy of a reset and `$$` (GRBL's and grblHAL's welcome lines, a message,
+    /// the answers) reads as the settings alone; the line after the welcome is still read.
+    #[test]
+    fn a_console_copy_reads_as_its_settings() {
+        for welcome in [
+            "Grbl 1.1h ['$' for help]",
+            "GrblHAL 1.1f ['$' or '$HELP' for help]",
+        ] {
+            let text = format!(
+                "\r\n{welcome}\r\n[MSG:'$H'|'$X' to unlock]\r\n$$\r\n$110=6000\r\n$120=500\r\nok\r\n"
+            );
+            let s = GrblSettings::parse(&text, "console.txt").expect("read");
+            assert_eq!(
+                s.planner().max_rate_m_s[0],
+                6000.0 * 1e-3 / 60.0,
+                "{welcome}"
+            );
+            assert_eq!(s.planner().accel_m_s2[0], 0.5, "{welcome}");
+        }
+        let bad = GrblSettings::parse("Grbl 1.1h\n$110=0\n", "g.txt").expect_err("refused");
+        assert!(bad.to_string().contains("g.txt:2"), "{bad}");
     }
 }
