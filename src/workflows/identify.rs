@@ -385,6 +385,9 @@ impl Identified {
                     a.axis, p.frequency_hz, p.reason
                 );
             }
+            for n in &a.id.notes {
+                let _ = writeln!(out, "{:<4} note: {n}", a.axis);
+            }
         }
         let _ = writeln!(
             out,
