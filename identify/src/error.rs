@@ -102,6 +102,16 @@ pub enum IdentifyError {
         /// The ratio required.
         needed: f64,
     },
+    /// The recording holds no vibration to identify: every sensor axis reads one value
+    /// throughout (a sensor that is not read, a file of zeros), or the values vary by less
+    /// than any accelerometer resolves.
+    #[error("{file}: no vibration to identify: {reason}")]
+    NoVibration {
+        /// The file.
+        file: String,
+        /// What the recording holds, and what is needed.
+        reason: String,
+    },
     /// No free decay (ring-down) could be found in the recording.
     #[error("{file}: {reason}")]
     NoRingDown {

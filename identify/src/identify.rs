@@ -8,7 +8,9 @@ use crate::read::klipper_grid::bin_grid;
 use crate::read::klipper_psd::ProcessedPsd;
 use crate::read::{Recording, RecordingFormat};
 use crate::result::{AxisIdentification, Figure, Method};
-use crate::trust::{check_duration, check_trust, free_recording};
+use crate::trust::{
+    check_duration, check_spectrum_vibration, check_trust, check_vibration, free_recording,
+};
 use crate::welch::Welch;
 
 /// Which fit to use on a recording.
@@ -106,6 +108,7 @@ pub fn identify_recording(
         Some(n) => format!("{} ({n})", rec.source),
         None => rec.source.clone(),
     };
+    check_vibration(&source, rec)?;
     let axes: Vec<usize> = (0..3).filter(|&k| rec.accel_mm_s2[k].is_some()).collect();
     let channels: Vec<&[f64]> = rec
         .accel_mm_s2
@@ -215,6 +218,18 @@ pub fn identify_recording(
             0,
             &ones,
         );
+        let mut notes = Vec::new();
+        if opts.test.freq_end_hz > NYQUIST_USE * fs {
+            notes.push(unseen_band(
+                fit.diagnostics.span,
+                opts.test.freq_end_hz,
+                format!(
+                    "{:.1} Hz, 0.45 x the sample rate of {fs:.1} Hz (above it accelerometers' anti-alias filters cut in); record at more than {:.0} Hz to see the whole test",
+                    NYQUIST_USE * fs,
+                    opts.test.freq_end_hz / NYQUIST_USE
+                ),
+            ));
+        }
         return Ok(AxisIdentification {
             source,
             direction: Some(dir),
@@ -223,6 +238,7 @@ pub fn identify_recording(
             modes: fit.modes,
             method: Method::SweepFit,
             diagnostics: fit.diagnostics,
+            notes,
             figure,
         });
     }
@@ -254,6 +270,7 @@ pub fn identify_recording(
         modes: fit.modes,
         method: Method::RingDownFit,
         diagnostics: fit.diagnostics,
+        notes: Vec::new(),
     })
 }
 
@@ -299,6 +316,17 @@ pub fn identify_spectrum(
             )
         })?,
     };
+    let name = match opts.column {
+        SpectrumColumn::Total => usize::from(psd.per_axis) * 3,
+        SpectrumColumn::Axis(k) => k,
+    };
+    check_spectrum_vibration(
+        &psd.source,
+        psd.columns.get(name).map_or("", |c| c.0.as_str()),
+        &psd.freq_hz,
+        column,
+        (opts.test.freq_start_hz, opts.test.freq_end_hz),
+    )?;
     stored[first_bin..].copy_from_slice(column);
     let factor: Vec<f64> = (0..len)
         .map(|k| {
@@ -346,6 +374,15 @@ pub fn identify_spectrum(
         fit.diagnostics.span,
         f64::INFINITY,
     )?;
+    let mut notes = Vec::new();
+    let last_hz = psd.freq_hz.last().copied().unwrap_or(0.0);
+    if opts.test.freq_end_hz > last_hz + bin_hz {
+        notes.push(unseen_band(
+            fit.diagnostics.span,
+            opts.test.freq_end_hz,
+            format!("the file's last row, {last_hz:.1} Hz"),
+        ));
+    }
     Ok(AxisIdentification {
         source: psd.source.clone(),
         direction: None,
@@ -354,8 +391,18 @@ pub fn identify_spectrum(
         modes: fit.modes,
         method: Method::SweepFit,
         diagnostics: fit.diagnostics,
+        notes,
         figure,
     })
+}
+
+/// The note for a test whose band reaches past what the data show: `span_hz` is the band
+/// fitted, `end_hz` the test's last frequency, `limit` what ends the data.
+fn unseen_band(span_hz: (f64, f64), end_hz: f64, limit: String) -> String {
+    format!(
+        "analysed {:.1} to {:.1} Hz of a test that swept up to {end_hz} Hz: the band analysed ends at {limit}; a mode between {:.1} and {end_hz} Hz is not seen here",
+        span_hz.0, span_hz.1, span_hz.1
+    )
 }
 
 /// A spectrum figure: `x[i]` and `measured[i]` are bin `offset + i`; the model is shown

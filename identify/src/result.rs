@@ -174,6 +174,10 @@ pub struct AxisIdentification {
     pub method: Method,
     /// How well the model fits.
     pub diagnostics: Diagnostics,
+    /// What the reader must know to read the result: a part of the test's band the data
+    /// could not show (above 0.45 x a recording's sample rate, past a spectrum's last
+    /// row), where a mode would go unseen.
+    pub notes: Vec<String>,
     /// Data for a figure.
     pub figure: Figure,
 }

@@ -4,7 +4,7 @@
 
 use crate::IdentifyError;
 use crate::excitation::SweepTest;
-use crate::read::{Recording, RecordingFormat};
+use crate::read::{MIN_PEAK_PSD, MIN_VIBRATION_MM_S2, Recording, RecordingFormat};
 use crate::result::{Diagnostics, IdentifiedMode};
 
 /// How much longer than the test a sweep recording may last (factor, plus seconds): Klipper
@@ -22,6 +22,79 @@ pub(crate) fn free_recording(rec: &Recording, duration_s: f64, test: &SweepTest)
     rec.format == RecordingFormat::KlipperRaw
         && !name.starts_with("raw_data")
         && duration_s < 0.5 * test.duration_s()
+}
+
+/// A recording must hold a vibration: some sensor axis must deviate from its mean by at
+/// least [`MIN_VIBRATION_MM_S2`]. Without one (a sensor that read a constant, a file of
+/// zeros) there is nothing to identify, and every spectrum of it is zero or rounding.
+pub(crate) fn check_vibration(source: &str, rec: &Recording) -> Result<(), IdentifyError> {
+    const NAMES: [&str; 3] = ["x", "y", "z"];
+    let mut largest = 0.0_f64;
+    let mut means = Vec::new();
+    for (k, c) in rec.accel_mm_s2.iter().enumerate() {
+        let Some(c) = c else { continue };
+        let mean = c.iter().sum::<f64>() / c.len() as f64;
+        let dev = c.iter().fold(0.0_f64, |m, v| m.max((v - mean).abs()));
+        largest = largest.max(dev);
+        means.push(format!("{} {mean}", NAMES[k]));
+    }
+    if largest >= MIN_VIBRATION_MM_S2 {
+        return Ok(());
+    }
+    let what = if largest == 0.0 {
+        format!(
+            "every sensor axis reads one value throughout ({} mm/s^2)",
+            means.join(", ")
+        )
+    } else {
+        format!(
+            "no sensor axis deviates from its mean by more than {largest:.3e} mm/s^2 ({} mm/s^2)",
+            means.join(", ")
+        )
+    };
+    Err(IdentifyError::NoVibration {
+        file: source.to_string(),
+        reason: format!(
+            "{what}; a recording of a moving machine varies by at least {MIN_VIBRATION_MM_S2:.0e} mm/s^2 (the resolution Klipper writes; an accelerometer's is far coarser): check the file's unit, and that the sensor was read while the machine moved"
+        ),
+    })
+}
+
+/// A processed spectrum's column `name` must hold a peak of at least [`MIN_PEAK_PSD`]
+/// inside `band_hz`: a spectrum of zeros (a sensor that read a constant) holds no
+/// vibration.
+pub(crate) fn check_spectrum_vibration(
+    source: &str,
+    name: &str,
+    freq_hz: &[f64],
+    column: &[f64],
+    band_hz: (f64, f64),
+) -> Result<(), IdentifyError> {
+    let largest = freq_hz
+        .iter()
+        .zip(column)
+        .filter(|(f, _)| **f >= band_hz.0 && **f <= band_hz.1)
+        .fold(0.0_f64, |m, (_, v)| m.max(*v));
+    if largest >= MIN_PEAK_PSD {
+        return Ok(());
+    }
+    let what = if largest == 0.0 {
+        format!(
+            "column `{name}` is 0 at every frequency from {} to {} Hz",
+            band_hz.0, band_hz.1
+        )
+    } else {
+        format!(
+            "column `{name}` peaks at {largest:.3e} (mm/s^2)^2/Hz between {} and {} Hz",
+            band_hz.0, band_hz.1
+        )
+    };
+    Err(IdentifyError::NoVibration {
+        file: source.to_string(),
+        reason: format!(
+            "{what}; a spectrum of a resonance test peaks at {MIN_PEAK_PSD:.0e} (mm/s^2)^2/Hz or more (the PSD of a vibration at the 1e-6 mm/s^2 resolution Klipper writes)"
+        ),
+    })
 }
 
 /// A sweep recording must last about as long as the test it is said to hold: the test's

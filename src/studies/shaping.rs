@@ -129,6 +129,20 @@ impl ShaperSetting {
                 format!("must be in [0, 1), got {}", self.damping_ratio),
             ));
         }
+        // What the firmware itself refuses (Klipper's damping ratio up to 0.99, 0.4 for ei,
+        // 0.3 for 2hump_ei, 0.2 for 3hump_ei; RepRapFirmware's and Marlin's ranges) is bad
+        // input too, found before any run, not a run that fails.
+        if let Err(e) = self.shaper() {
+            let m = e.to_string();
+            let key = if m.contains("damping_ratio") {
+                "shaper.damping_ratio"
+            } else if m.contains("frequency_hz") {
+                "shaper.frequency_hz"
+            } else {
+                "shaper.type"
+            };
+            return Err((key, m));
+        }
         Ok(())
     }
 }
@@ -285,5 +299,34 @@ impl Study for Shaping {
             _ => out.extend(["0", "100", "0"].map(String::from)),
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{ShaperSetting, parse_type};
+
+    fn setting(name: &str, frequency_hz: f64, damping_ratio: f64) -> ShaperSetting {
+        ShaperSetting {
+            shaper_type: parse_type(name).expect("type"),
+            frequency_hz,
+            damping_ratio,
+        }
+    }
+
+    /// A damping ratio the firmware refuses is bad input before any run (it was a run that
+    /// failed with the planner's reason, and the sweep exited 0).
+    #[test]
+    fn a_damping_ratio_the_firmware_refuses_is_bad_input() {
+        assert_eq!(setting("mzv", 50.0, 0.1).validate(), Ok(()));
+        assert_eq!(setting("none", 50.0, 0.995).validate(), Ok(()));
+        for (name, zeta) in [("mzv", 0.995), ("ei", 0.5), ("2hump_ei", 0.35), ("3hump_ei", 0.25)] {
+            let e = setting(name, 50.0, zeta).validate();
+            assert!(
+                e.as_ref()
+                    .is_err_and(|(key, m)| *key == "shaper.damping_ratio" && m.contains(&zeta.to_string())),
+                "{name} at {zeta}: {e:?}"
+            );
+        }
     }
 }

@@ -4,9 +4,10 @@
 //! machine file in the modes form that `settle sweep` and `settle tune` take
 //! (`preset = "machine.toml"` in a scenario's `[machine]`).
 //!
-//! Which machine axis a file excited: `--axis` when given, else the file name's own token
-//! `x`, `y` or `z` (Klipper names its files `raw_data_x_*.csv`, `resonances_y_*.csv`,
-//! `calibration_data_x_*.csv`), else the Shake&Tune measurement's name.
+//! Which machine axis a file excited: `--axis` when given, else the file's name: in
+//! Klipper's names (`raw_data_x_*.csv`, `resonances_y_*.csv`, `calibration_data_x_*.csv`)
+//! the word after the prefix, in others the one of the words `x`, `y`, `z` they hold (a
+//! name holding two is refused); else the Shake&Tune measurement's name.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -78,28 +79,91 @@ pub struct Identified {
     pub figures: Vec<PathBuf>,
 }
 
-/// The machine axis `file` (identified as `id`) excited: `axis` if given, else a token
-/// `x`, `y` or `z` of the file's name (split at `_`, `-`, `.` and spaces), else of the
-/// measurement's name, else the one axis the file holds (an M956 capture of one axis).
+/// The file-name prefixes of Klipper's resonance files: `get_filename` in
+/// `klippy/extras/resonance_tester.py` names them `<prefix>_<axis>[_<chip>][_<point>]_<NAME>`
+/// (`raw_data` for `OUTPUT=raw_data`, `resonances` for `TEST_RESONANCES`,
+/// `calibration_data` for `SHAPER_CALIBRATE`), where `<axis>` is `x`, `y` or, for a
+/// direction given as `AXIS=dx,dy`, `axis=dx,dy`, and `NAME` is the user's (the date and time
+/// by default).
+const KLIPPER_PREFIXES: [&str; 3] = ["raw_data_", "resonances_", "calibration_data_"];
+
+/// The machine axis a file's name `name` gives: in a Klipper name (see
+/// [`KLIPPER_PREFIXES`]) the word after the prefix, whatever the user's `NAME` holds;
+/// otherwise the one of `x`, `y`, `z` that its words (split at `_`, `-`, `.`, spaces and
+/// brackets) name. `Ok(None)`: no axis named; `Err`: why the name does not tell one (two
+/// axes named, or Klipper's diagonal direction).
+fn axis_in_name(name: &str) -> Result<Option<&'static str>, String> {
+    let lower = name.to_ascii_lowercase();
+    let as_axis = |t: &str| match t {
+        "x" => Some("x"),
+        "y" => Some("y"),
+        "z" => Some("z"),
+        _ => None,
+    };
+    if let Some(rest) = KLIPPER_PREFIXES.iter().find_map(|p| lower.strip_prefix(p)) {
+        let word = rest.split('_').next().unwrap_or("");
+        if let Some(a) = as_axis(word) {
+            return Ok(Some(a));
+        }
+        if word.starts_with("axis=") {
+            return Err(format!(
+                "its name holds Klipper's `{word}`, a direction between the machine axes (TEST_RESONANCES AXIS=dx,dy), not one of them"
+            ));
+        }
+    }
+    let mut found: Vec<&'static str> = lower
+        .split(['_', '-', '.', ' ', '(', ')'])
+        .filter_map(as_axis)
+        .collect();
+    found.sort_unstable();
+    found.dedup();
+    match found.as_slice() {
+        [] => Ok(None),
+        [a] => Ok(Some(a)),
+        many => Err(format!(
+            "its name holds the words {}, more than one machine axis (a Klipper name starts `raw_data_<axis>_`, `resonances_<axis>_` or `calibration_data_<axis>_`, where the axis comes first)",
+            many.iter()
+                .map(|a| format!("`{a}`"))
+                .collect::<Vec<_>>()
+                .join(" and ")
+        )),
+    }
+}
+
+/// The machine axis `file` (identified as `id`) excited: `axis` if given, else the one
+/// the file's name gives ([`axis_in_name`]), else the one a Shake&Tune measurement's name
+/// gives, else the one axis
+/// the file holds (an M956 capture of one axis). A name that names two axes is refused.
 fn axis_of(file: &Path, id: &AxisIdentification, axis: Option<&str>) -> Result<String, Error> {
     if let Some(a) = axis {
         return Ok(a.to_string());
     }
-    let token = |s: &str| {
-        s.to_ascii_lowercase()
-            .split(['_', '-', '.', ' ', '(', ')'])
-            .find(|t| matches!(*t, "x" | "y" | "z"))
-            .map(str::to_string)
+    let refuse = |why: String| {
+        Error::input(
+            file,
+            format!("cannot tell which machine axis this file excited: {why}: give --axis x|y|z"),
+        )
     };
-    let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned());
-    stem.as_deref()
-        .and_then(token)
-        .or_else(|| token(&id.source))
-        .or_else(|| id.named_axis.map(|k| ["x", "y", "z"][k.min(2)].to_string()))
+    let stem = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if let Some(a) = axis_in_name(&stem).map_err(refuse)? {
+        return Ok(a.to_string());
+    }
+    // A Shake&Tune measurement's name: the source is `<file> (<name>)`.
+    let measurement = id
+        .source
+        .strip_prefix(&file.display().to_string())
+        .unwrap_or("");
+    if let Some(a) = axis_in_name(measurement).map_err(refuse)? {
+        return Ok(a.to_string());
+    }
+    id.named_axis
+        .map(|k| ["x", "y", "z"][k.min(2)].to_string())
         .ok_or_else(|| {
-            Error::input(
-                file,
-                "cannot tell which machine axis this file excited (its name holds no `x`, `y` or `z` token as in Klipper's raw_data_x_*.csv, and it holds more than one sensor axis): give --axis x|y|z",
+            refuse(
+                "its name holds no `x`, `y` or `z` word as in Klipper's raw_data_x_*.csv, and it holds more than one sensor axis".to_string(),
             )
         })
 }
@@ -385,6 +449,9 @@ impl Identified {
                     a.axis, p.frequency_hz, p.reason
                 );
             }
+            for n in &a.id.notes {
+                let _ = writeln!(out, "{:<4} note: {n}", a.axis);
+            }
         }
         let _ = writeln!(
             out,
@@ -420,5 +487,52 @@ impl Identified {
             ));
         }
         r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::axis_in_name;
+
+    #[test]
+    fn klipper_names_give_the_word_after_their_prefix() {
+        for (name, axis) in [
+            ("raw_data_x_20260101_120000", "x"),
+            ("resonances_y_20260101_120000", "y"),
+            ("calibration_data_x_20260101_120000", "x"),
+            // The user's NAME may hold any word: the axis is the one after the prefix.
+            ("raw_data_y_z_test", "y"),
+            ("calibration_data_x_after_y_belt", "x"),
+            ("raw_data_x_adxl345_hotend_0.000_0.000_20.000_run1", "x"),
+            ("RAW_DATA_Y_20260101", "y"),
+        ] {
+            assert_eq!(axis_in_name(name), Ok(Some(axis)), "{name}");
+        }
+        let diagonal = axis_in_name("raw_data_axis=1.000,-1.000_20260101_120000");
+        assert!(
+            diagonal.as_ref().is_err_and(|e| e.contains("AXIS=dx,dy")),
+            "{diagonal:?}"
+        );
+    }
+
+    #[test]
+    fn other_names_give_their_one_axis_word_and_two_are_refused() {
+        for (name, axis) in [
+            ("neptune_inputshaper_20250707_143713_axis_X", "x"),
+            ("metis_resonances_20240206_200335_Y", "y"),
+            ("resonances_20240206_200114_X", "x"),
+            ("x_again_x", "x"),
+        ] {
+            assert_eq!(axis_in_name(name), Ok(Some(axis)), "{name}");
+        }
+        assert_eq!(axis_in_name("recording"), Ok(None));
+        for name in ["z_x", "y-belt x", "test x y", "raw_x_data_y"] {
+            let got = axis_in_name(name);
+            assert!(
+                got.as_ref()
+                    .is_err_and(|e| e.contains("more than one machine axis")),
+                "{name}: {got:?}"
+            );
+        }
     }
 }

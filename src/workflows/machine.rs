@@ -72,8 +72,10 @@ impl MachineModes {
             for (i, m) in modes.iter().enumerate() {
                 let _ = writeln!(
                     out,
-                    "{axis:<5} {i:>4} {:>14.3} {:>14.4} {:>10.4}",
-                    m.frequency_hz, m.damping_ratio, m.weight
+                    "{axis:<5} {i:>4} {:>14} {:>14} {:>10}",
+                    shown(m.frequency_hz, 3),
+                    shown(m.damping_ratio, 4),
+                    shown(m.weight, 4)
                 );
             }
         }
@@ -85,6 +87,18 @@ impl MachineModes {
         let mut r = Report::new(Exit::Ok);
         r.stdout = self.table();
         r
+    }
+}
+
+/// `v` with `decimals` decimals, or in scientific notation when those would show a value
+/// that is not 0 as 0 (a weight of 1e-5, a mode of 1e-300 Hz) or need more than 9 digits
+/// before the point (1e300 Hz): the table never shows a number other than the file's.
+fn shown(v: f64, decimals: usize) -> String {
+    let a = v.abs();
+    if v != 0.0 && (a < 0.5 * 10f64.powi(-(decimals as i32)) || a >= 1e9) {
+        format!("{v:.3e}")
+    } else {
+        format!("{v:.decimals$}")
     }
 }
 
@@ -142,4 +156,19 @@ fn as_given(axes: &[AxisModes]) -> Vec<(String, Vec<ModeRow>)> {
             (a.axis.clone(), rows)
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shown;
+
+    #[test]
+    fn a_value_is_never_shown_as_another() {
+        assert_eq!(shown(45.0, 3), "45.000");
+        assert_eq!(shown(0.0, 4), "0.0000");
+        assert_eq!(shown(0.05, 4), "0.0500");
+        assert_eq!(shown(1e-300, 3), "1.000e-300");
+        assert_eq!(shown(1e-5, 4), "1.000e-5");
+        assert_eq!(shown(1e300, 3), "1.000e300");
+    }
 }

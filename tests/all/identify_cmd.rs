@@ -224,3 +224,160 @@ fn a_single_axis_m956_capture_names_its_axis() {
     assert!((m.frequency_hz.value - f).abs() < 0.002 * f, "{m:?}");
     assert!((m.damping_ratio.value - zeta).abs() < 0.05 * zeta, "{m:?}");
 }
+
+/// `text` (a Klipper raw recording) with every acceleration times `k`.
+fn scaled(text: &str, k: f64) -> String {
+    let mut out = String::new();
+    for l in text.lines() {
+        if l.starts_with('#') {
+            out.push_str(l);
+        } else {
+            let mut fields = l.split(',');
+            out.push_str(fields.next().expect("time"));
+            for v in fields {
+                let v: f64 = v.parse().expect("number");
+                out.push_str(&format!(",{:e}", v * k));
+            }
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// Recordings no accelerometer writes are refused saying what is wrong with them, not
+/// with what the analysis then met (a NaN noise floor, no frequency bins in the band): an
+/// acceleration so large it is a unit mistake (and whose squares overflow) names its line
+/// and column; a recording or spectrum without vibration says so.
+#[test]
+fn absurd_recordings_say_what_is_wrong_with_them() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let text = resonance::recording(&[TRUTH], &short_test(), 0, 800.0, 0.1, 3);
+    let band = [
+        "--freq-start",
+        "30",
+        "--freq-end",
+        "70",
+        "--hz-per-sec",
+        "10",
+    ];
+    let figures = dir.path().join("figures");
+    let ident = |file: &Path| {
+        let mut args = vec!["identify", path_str(file), "--figures", path_str(&figures)];
+        args.extend(band);
+        run(&args)
+    };
+    for (name, k) in [
+        ("raw_data_x_e160.csv", 1e160),
+        ("raw_data_x_e150.csv", 1e150),
+    ] {
+        let file = write(dir.path(), name, &scaled(&text, k));
+        let (code, out, err) = ident(&file);
+        assert_eq!(code, Some(2), "{out}{err}");
+        assert!(
+            err.contains(&format!("{name}:2: ")) && err.contains("column `accel_x`"),
+            "{err}"
+        );
+        assert!(err.contains("within +-1e9 mm/s^2"), "{err}");
+        assert!(!err.contains("NaN") && !err.contains("bins"), "{err}");
+    }
+    let mut constant = String::from("#time,accel_x,accel_y,accel_z\n");
+    for l in text.lines().skip(1) {
+        let t = l.split(',').next().expect("time");
+        constant.push_str(&format!("{t},1.0,2.0,9806.65\n"));
+    }
+    for (name, text) in [
+        ("raw_data_x_constant.csv", constant),
+        ("raw_data_x_tiny.csv", scaled(&text, 1e-150)),
+    ] {
+        let file = write(dir.path(), name, &text);
+        let (code, out, err) = ident(&file);
+        assert_eq!(code, Some(2), "{out}{err}");
+        assert!(
+            err.contains(&format!("{name}: no vibration to identify")),
+            "{err}"
+        );
+        assert!(!err.contains("NaN") && !err.contains("bins"), "{err}");
+    }
+    // A processed spectrum of zeros, and one past any accelerometer's PSD.
+    let mut zeros = String::from("freq,psd_x,psd_y,psd_z,psd_xyz\n");
+    let mut huge = zeros.clone();
+    for i in 0..140 {
+        let f = i as f64 * 1.5625;
+        zeros.push_str(&format!("{f:.1},0.000e+00,0.000e+00,0.000e+00,0.000e+00\n"));
+        huge.push_str(&format!(
+            "{f:.1},1.000e+200,1.000e+200,1.000e+200,3.000e+200\n"
+        ));
+    }
+    let file = write(dir.path(), "resonances_x_zeros.csv", &zeros);
+    let (code, out, err) = ident(&file);
+    assert_eq!(code, Some(2), "{out}{err}");
+    assert!(
+        err.contains("resonances_x_zeros.csv: no vibration to identify")
+            && err.contains("`psd_xyz`"),
+        "{err}"
+    );
+    let file = write(dir.path(), "resonances_x_huge.csv", &huge);
+    let (code, out, err) = ident(&file);
+    assert_eq!(code, Some(2), "{out}{err}");
+    assert!(
+        err.contains("resonances_x_huge.csv:2: ") && err.contains("`psd_x`"),
+        "{err}"
+    );
+    assert!(!figures.exists(), "no figure of a refused file");
+}
+
+/// A test that sweeps past 0.45 x the sample rate (the top of the band analysed) but
+/// within the aliasing limit: the output says which band was analysed and that a mode above
+/// it is not seen, instead of leaving the modes found to stand for the whole test.
+#[test]
+fn a_test_past_the_band_analysed_is_noted() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // 30-70 Hz at 140 Hz: analysed up to 63 Hz; 70 Hz is below 0.55 x 140 = 77 Hz.
+    let text = resonance::recording(&[TRUTH], &short_test(), 0, 140.0, 0.25, 5);
+    let file = write(dir.path(), "raw_data_x_140hz.csv", &text);
+    let figures = dir.path().join("figures");
+    let (code, out, err) = run(&[
+        "identify",
+        path_str(&file),
+        "--figures",
+        path_str(&figures),
+        "--freq-start",
+        "30",
+        "--freq-end",
+        "70",
+        "--hz-per-sec",
+        "10",
+        "--max-modes",
+        "1",
+    ]);
+    assert_eq!(code, Some(0), "{out}{err}");
+    let note = out
+        .lines()
+        .find(|l| l.starts_with("x    note: "))
+        .unwrap_or_else(|| panic!("no note in {out}"));
+    for want in [
+        "analysed 33.9 to 62.3 Hz of a test that swept up to 70 Hz",
+        "63.0 Hz, 0.45 x the sample rate of 140.0 Hz",
+        "between 62.3 and 70 Hz is not seen",
+    ] {
+        assert!(note.contains(want), "missing `{want}` in {note}");
+    }
+    // The full-rate recording of the same test has no such note.
+    let text = resonance::recording(&[TRUTH], &short_test(), 0, 800.0, 0.25, 5);
+    let file = write(dir.path(), "raw_data_x_800hz.csv", &text);
+    let (code, out, err) = run(&[
+        "identify",
+        path_str(&file),
+        "--figures",
+        path_str(&figures),
+        "--force",
+        "--freq-start",
+        "30",
+        "--freq-end",
+        "70",
+        "--hz-per-sec",
+        "10",
+    ]);
+    assert_eq!(code, Some(0), "{out}{err}");
+    assert!(!out.contains("note:"), "{out}");
+}

@@ -12,6 +12,10 @@ use super::klipper_shaper::{self, Family};
 use super::klipper_values::{Range, Values, invalid};
 use super::machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
 use crate::error::GcodeError;
+// Klipper takes any max_velocity and max_accel above 0; settle takes them up to the bound
+// its G-code reader puts on SET_VELOCITY_LIMIT and M204 (1e9): at max_velocity 1e300 no
+// move can be planned (its square overflows) and every run of an import would fail.
+use crate::read::cmd::SANE;
 
 /// The kinematics Klipper has modules for (`klippy/kinematics/`).
 const KINEMATICS: [&str; 12] = [
@@ -170,10 +174,10 @@ fn printer(
         None => return Err(missing(&file(S), S, "kinematics", required)),
     };
     let max_velocity_mm_s = v
-        .float(S, "max_velocity", Range::above(0.0))?
+        .float(S, "max_velocity", Range::above(0.0).max(SANE))?
         .ok_or_else(|| missing(&file(S), S, "max_velocity", required))?;
     let max_accel_mm_s2 = v
-        .float(S, "max_accel", Range::above(0.0))?
+        .float(S, "max_accel", Range::above(0.0).max(SANE))?
         .ok_or_else(|| missing(&file(S), S, "max_accel", required))?;
     let minimum_cruise_ratio = match v.float(
         S,
@@ -198,7 +202,7 @@ fn printer(
         },
     };
     let square_corner_velocity_mm_s = v
-        .float(S, "square_corner_velocity", Range::min(0.0))?
+        .float(S, "square_corner_velocity", Range::min(0.0).max(SANE))?
         .unwrap_or(DEFAULT_SQUARE_CORNER_VELOCITY_MM_S);
     let max_z_velocity_mm_s = v
         .float(

@@ -16,7 +16,7 @@
 //! `exp(1 - (10 / (f + 0.1))^2)`. The reader tells these apart by the bins between 0 and
 //! 5 Hz: all exactly zero means the older rule.
 
-use super::{MAX_SPECTRUM_ROWS, parse_number, truncate};
+use super::{MAX_PSD, MAX_SPECTRUM_ROWS, parse_number, truncate};
 use crate::IdentifyError;
 
 /// Fewest frequency rows accepted.
@@ -179,6 +179,16 @@ pub fn parse(file: &str, text: &str) -> Result<ProcessedPsd, IdentifyError> {
                     n,
                     format!("{v} in column `{name}`"),
                     "a power spectral density >= 0",
+                ));
+            }
+            if v > MAX_PSD {
+                return Err(IdentifyError::format(
+                    file,
+                    n,
+                    format!("{v:.3e} in column `{name}`"),
+                    format!(
+                        "a power spectral density of at most {MAX_PSD:.0e} (mm/s^2)^2/Hz (that of accelerations up to 100,000 g; the file's unit or scale is wrong)"
+                    ),
                 ));
             }
             col.push(v);

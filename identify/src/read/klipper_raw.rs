@@ -8,7 +8,7 @@
 //! comments='#')`) skips every line starting with `#`; so does this one.
 
 use super::{
-    MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_times, parse_number,
+    MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_accel, check_times, parse_number,
     too_many_samples, truncate,
 };
 use crate::IdentifyError;
@@ -63,6 +63,9 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
                 ));
             };
             *v = parse_number(file, n, COLUMNS[k], text)?;
+            if k > 0 {
+                check_accel(file, n, COLUMNS[k], text, *v)?;
+            }
         }
         if fields.next().is_some() {
             return Err(IdentifyError::format(

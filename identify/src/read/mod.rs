@@ -44,6 +44,52 @@ pub(crate) fn too_many_samples(file: &str, line: usize) -> IdentifyError {
 /// values of RepRapFirmware's files use it.
 pub const STANDARD_GRAVITY_MM_S2: f64 = 9_806.65;
 
+/// Largest acceleration a recording may hold (mm/s^2): 1e9, about 100,000 g, 250 times
+/// the range of the widest-range MEMS accelerometers (+-400 g) and 6,000 times the
+/// ADXL345's +-16 g. A larger value is a unit or scale mistake, not a measurement; far
+/// beyond it (from about 1e70) the spectrum's squares overflow.
+pub const MAX_ACCEL_MM_S2: f64 = 1e9;
+
+/// Smallest vibration a recording may hold (mm/s^2): the largest deviation of a sensor
+/// axis from its mean must reach 1e-6 mm/s^2, the resolution Klipper writes (`%.6f`);
+/// no accelerometer resolves less (an ADXL345 step is 38 mm/s^2).
+pub const MIN_VIBRATION_MM_S2: f64 = 1e-6;
+
+/// Largest power spectral density a processed spectrum may hold ((mm/s^2)^2/Hz): 1e20,
+/// above the PSD of accelerations within [`MAX_ACCEL_MM_S2`] (`1e18 x` Klipper's 0.5 s
+/// window at most).
+pub const MAX_PSD: f64 = 1e20;
+
+/// Smallest peak a processed spectrum may hold ((mm/s^2)^2/Hz): 1e-12, about the PSD of a
+/// vibration at [`MIN_VIBRATION_MM_S2`] over Klipper's 0.5 s window.
+pub const MIN_PEAK_PSD: f64 = 1e-12;
+
+/// `value_mm_s2` (read as `text` in column `column` at `line`) as an acceleration within
+/// +-[`MAX_ACCEL_MM_S2`].
+pub(crate) fn check_accel(
+    file: &str,
+    line: usize,
+    column: &str,
+    text: &str,
+    value_mm_s2: f64,
+) -> Result<f64, IdentifyError> {
+    if value_mm_s2.abs() > MAX_ACCEL_MM_S2 {
+        return Err(IdentifyError::format(
+            file,
+            line,
+            format!(
+                "`{}` in column `{column}`, an acceleration of {value_mm_s2:.3e} mm/s^2 ({:.3e} g)",
+                truncate(text.trim()),
+                value_mm_s2 / STANDARD_GRAVITY_MM_S2
+            ),
+            format!(
+                "accelerations within +-{MAX_ACCEL_MM_S2:.0e} mm/s^2 (about 100,000 g; no accelerometer reads more: the file's unit or scale is wrong)"
+            ),
+        ));
+    }
+    Ok(value_mm_s2)
+}
+
 /// Fewest samples a reader accepts: below this no spectrum or decay can be measured.
 pub const MIN_SAMPLES: usize = 64;
 

@@ -10,7 +10,7 @@
 
 use super::{
     MAX_RATE_HZ, MAX_SAMPLES, MIN_RATE_HZ, MIN_SAMPLES, Recording, RecordingFormat,
-    STANDARD_GRAVITY_MM_S2, parse_number, too_many_samples, truncate,
+    STANDARD_GRAVITY_MM_S2, check_accel, parse_number, too_many_samples, truncate,
 };
 use crate::IdentifyError;
 
@@ -106,7 +106,8 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
                     ),
                 ));
             };
-            col.push(parse_number(file, n, name, v)? * STANDARD_GRAVITY_MM_S2);
+            let g = parse_number(file, n, name, v)?;
+            col.push(check_accel(file, n, name, v, g * STANDARD_GRAVITY_MM_S2)?);
         }
         if fields.next().is_some() {
             return Err(IdentifyError::format(

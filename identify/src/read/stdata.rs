@@ -8,7 +8,10 @@
 
 use serde::Deserialize;
 
-use super::{MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_times, too_many_samples};
+use super::{
+    MAX_ACCEL_MM_S2, MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_accel,
+    check_times, too_many_samples,
+};
 use crate::IdentifyError;
 
 #[derive(Deserialize)]
@@ -71,6 +74,14 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
         }
         let time_s: Vec<f64> = m.samples.iter().map(|s| s[0]).collect();
         check_times(file, &time_s, |_| n)?;
+        let too_large = |v: &f64| v.abs() > MAX_ACCEL_MM_S2;
+        if let Some(i) = m.samples.iter().position(|s| s[1..].iter().any(too_large)) {
+            for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                let v = m.samples[i][k + 1];
+                let column = format!("samples[{i}] {axis}");
+                check_accel(file, n, &column, &v.to_string(), v)?;
+            }
+        }
         let axis = |k: usize| Some(m.samples.iter().map(|s| s[k]).collect::<Vec<f64>>());
         let span = time_s[time_s.len() - 1] - time_s[0];
         out.push(Recording {

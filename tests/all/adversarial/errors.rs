@@ -56,6 +56,7 @@ fn garbage_journal(sb: &Sandbox) {
 pub fn cases(sb: &Sandbox) -> Vec<Case> {
     garbage_journal(sb);
     sb.write("accel.cfg", &printer_cfg("1e-300"));
+    sb.write("huge_accel.cfg", &printer_cfg("1e300"));
     sb.write("plain.cfg", &printer_cfg("3000"));
     sb.write(
         "far.gcode",
@@ -152,6 +153,13 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             Expect::refused(&["accel.cfg", "printer.max_accel"]),
         )
         .never_says("neither an x nor a y axis"),
+        Case::line(
+            "import of max_accel: 1e300 names the firmware key and its bound",
+            "import klipper huge_accel.cfg --out o/x.toml",
+            &[],
+            Expect::refused(&["huge_accel.cfg", "printer.max_accel", "1000000000"]),
+        )
+        .never_says("Wrote"),
         Case::line(
             "identify of a band too narrow names no line 0",
             "identify rec_x.csv --freq-start 30 --freq-end 35 --out o/m.toml",
