@@ -23,6 +23,16 @@ fn short_test() -> settle_identify::SweepTest {
     }
 }
 
+/// [`short_test`] on the command line.
+const SHORT_TEST: [&str; 6] = [
+    "--freq-start",
+    "30",
+    "--freq-end",
+    "70",
+    "--hz-per-sec",
+    "10",
+];
+
 const TRUTH: (f64, f64, f64) = (47.0, 0.06, 1.0);
 
 #[test]
@@ -110,16 +120,7 @@ fn bad_files_and_options_exit_2_naming_the_file_and_line() {
         "recording.csv",
         &resonance::recording(&[TRUTH], &short_test(), 0, 800.0, 0.1, 3),
     );
-    let (code, _, err) = run(&[
-        "identify",
-        path_str(&unnamed),
-        "--freq-start",
-        "30",
-        "--freq-end",
-        "70",
-        "--hz-per-sec",
-        "10",
-    ]);
+    let (code, _, err) = run(&[&["identify", path_str(&unnamed)][..], &SHORT_TEST].concat());
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("--axis"), "{err}");
     let (code, _, err) = run(&["identify", path_str(&unnamed), "--axis", "w"]);
@@ -252,14 +253,7 @@ fn scaled(text: &str, k: f64) -> String {
 fn absurd_recordings_say_what_is_wrong_with_them() {
     let dir = tempfile::tempdir().expect("tempdir");
     let text = resonance::recording(&[TRUTH], &short_test(), 0, 800.0, 0.1, 3);
-    let band = [
-        "--freq-start",
-        "30",
-        "--freq-end",
-        "70",
-        "--hz-per-sec",
-        "10",
-    ];
+    let band = SHORT_TEST;
     let figures = dir.path().join("figures");
     let ident = |file: &Path| {
         let mut args = vec!["identify", path_str(file), "--figures", path_str(&figures)];
@@ -336,20 +330,8 @@ fn a_test_past_the_band_analysed_is_noted() {
     let text = resonance::recording(&[TRUTH], &short_test(), 0, 140.0, 0.25, 5);
     let file = write(dir.path(), "raw_data_x_140hz.csv", &text);
     let figures = dir.path().join("figures");
-    let (code, out, err) = run(&[
-        "identify",
-        path_str(&file),
-        "--figures",
-        path_str(&figures),
-        "--freq-start",
-        "30",
-        "--freq-end",
-        "70",
-        "--hz-per-sec",
-        "10",
-        "--max-modes",
-        "1",
-    ]);
+    let args = ["identify", path_str(&file), "--figures", path_str(&figures)];
+    let (code, out, err) = run(&[&args[..], &SHORT_TEST, &["--max-modes", "1"]].concat());
     assert_eq!(code, Some(0), "{out}{err}");
     let note = out
         .lines()
@@ -365,19 +347,14 @@ fn a_test_past_the_band_analysed_is_noted() {
     // The full-rate recording of the same test has no such note.
     let text = resonance::recording(&[TRUTH], &short_test(), 0, 800.0, 0.25, 5);
     let file = write(dir.path(), "raw_data_x_800hz.csv", &text);
-    let (code, out, err) = run(&[
+    let args = [
         "identify",
         path_str(&file),
         "--figures",
         path_str(&figures),
         "--force",
-        "--freq-start",
-        "30",
-        "--freq-end",
-        "70",
-        "--hz-per-sec",
-        "10",
-    ]);
+    ];
+    let (code, out, err) = run(&[&args[..], &SHORT_TEST].concat());
     assert_eq!(code, Some(0), "{out}{err}");
     assert!(!out.contains("note:"), "{out}");
 }
