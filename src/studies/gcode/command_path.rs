@@ -208,8 +208,9 @@ impl CommandPath {
     /// The distances (mm) [`CommandPath::distance_mm`] gave when each of `asked` was
     /// made (in the order made, [`CommandPath::ask_later`]), bit for bit: the held points
     /// are pushed again onto a path of their own, and each distance asked of it when its
-    /// last point is there. (A box's points are the same whenever it is grown, and
-    /// [`Box2::add`] is exact: the boxes, so the skipped segments, are the same.)
+    /// last point is there. (A box's points are the same whenever it is grown, and it
+    /// grows by exact minima and maxima: the boxes, so the skipped segments, are the
+    /// same.)
     pub fn distances_mm(&self, asked: &[Asked]) -> Vec<f64> {
         let Some(from) = self.held else {
             return Vec::new();

@@ -473,7 +473,7 @@ impl Account {
 }
 
 /// The most points of the command's path held for the ringing map's points waiting for
-/// their vibration ([`Account::unmeasured`], 24 bytes each): past it they are measured
+/// their vibration (24 bytes each): past it they are measured
 /// (a layer longer than about a minute at 2 kHz, whose map may not be kept).
 pub const MAX_HELD_POINTS: u64 = 1 << 18;
 

@@ -332,7 +332,7 @@ fn script_lines(a: &AxisChoice, r: &mut Report) {
 /// Klipper's `[input_shaper]` reads `shaper_freq_x` and `shaper_freq_y` only (and refuses
 /// an option it does not read, klippy/configfile.py's `check_unused_options`): the
 /// recommendation for files that name no axis, or name `z`, is written as a comment that
-/// says where it goes ([`unplaced`]).
+/// says where it goes.
 pub fn input_shaper_cfg(choices: &[AxisChoice]) -> String {
     let mut s = String::from(
         "# Klipper's recommendation (scripts/calibrate_shaper.py's choice), from settle tune --criterion klipper\n[input_shaper]\n",
