@@ -166,4 +166,16 @@ fn shaketune_stdata_reads_and_rejects() {
         let e = stdata::parse("s.stdata", &bytes).expect_err("bad file");
         assert_eq!(line_of(&e), ("s.stdata".to_string(), l), "{e}");
     }
+    // An acceleration beyond +-1e9 mm/s^2 (a unit or scale mistake) in the second
+    // measurement: refused at its line, naming the sample and the axis; 1e9 itself reads.
+    let huge = line(100, false) + &line(80, false).replace("[0.5, 1.0, 2.0", "[0.5, 1.0, -2e9");
+    let e = stdata::parse("s.stdata", &pack(&huge)).expect_err("too large");
+    assert_eq!(line_of(&e), ("s.stdata".to_string(), 2), "{e}");
+    let m = e.to_string();
+    assert!(
+        m.contains("samples[50] y") && m.contains("1e9 mm/s^2"),
+        "{m}"
+    );
+    let edge = line(100, false).replace("[0.5, 1.0, 2.0", "[0.5, 1.0, -1e9");
+    stdata::parse("s.stdata", &pack(&edge)).expect("1e9 mm/s^2 is within the bound");
 }
