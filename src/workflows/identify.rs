@@ -92,7 +92,7 @@ const KLIPPER_PREFIXES: [&str; 3] = ["raw_data_", "resonances_", "calibration_da
 /// otherwise the one of `x`, `y`, `z` that its words (split at `_`, `-`, `.`, spaces and
 /// brackets) name. `Ok(None)`: no axis named; `Err`: why the name does not tell one (two
 /// axes named, or Klipper's diagonal direction).
-fn axis_in_name(name: &str) -> Result<Option<&'static str>, String> {
+pub(crate) fn axis_in_name(name: &str) -> Result<Option<&'static str>, String> {
     let lower = name.to_ascii_lowercase();
     let as_axis = |t: &str| match t {
         "x" => Some("x"),

@@ -124,3 +124,35 @@ fn input_shaper_cfg_holds_only_keys_klipper_reads() {
         );
     }
 }
+
+/// A file's axis comes from its name by `settle identify`'s rule: in Klipper's names the
+/// word after the prefix, whatever follows (`calibration_data_y_x-belt.csv` is y); a name
+/// that names two axes otherwise (`z_x.csv`, once read as z) is refused, naming the file.
+#[test]
+fn a_files_axis_is_read_as_identify_reads_it() {
+    use settle::workflows::tune::klipper_criterion::{KlipperCriterion, choose};
+    let dir = tempfile::tempdir().expect("tempdir");
+    let corpus = root().join("identify/tests/corpus/zippy_resonances_x_20220317_143228.csv");
+    let copy = |name: &str| {
+        let f = dir.path().join(name);
+        std::fs::copy(&corpus, &f).expect("copy");
+        vec![f]
+    };
+    let c = KlipperCriterion::from_args(
+        copy("calibration_data_y_x-belt.csv"),
+        None,
+        None,
+        None,
+        None,
+    );
+    let choices = choose(&c.expect("options")).expect("chooses");
+    assert_eq!(choices[0].axis, Some('y'));
+    let c = KlipperCriterion::from_args(copy("z_x.csv"), None, None, None, None);
+    let e = choose(&c.expect("options"))
+        .expect_err("two axes named")
+        .to_string();
+    assert!(
+        e.contains("z_x.csv") && e.contains("more than one machine axis"),
+        "{e}"
+    );
+}

@@ -154,13 +154,19 @@ pub struct AxisChoice {
     pub selection: Selection,
 }
 
-/// The machine axis a Klipper file name names: a token `x`, `y` or `z` of its stem split
-/// at `_`, `-`, `.` and spaces (`calibration_data_x_20220317.csv`).
-fn axis_token(path: &Path) -> Option<char> {
-    let stem = path.file_stem()?.to_string_lossy().to_ascii_lowercase();
-    stem.split(['_', '-', '.', ' '])
-        .find(|t| matches!(*t, "x" | "y" | "z"))
-        .and_then(|t| t.chars().next())
+/// The machine axis a Klipper file's name names (`calibration_data_x_20220317.csv`), by
+/// `settle identify`'s rule ([`crate::workflows::identify::axis_in_name`]); a name that
+/// names two axes, or Klipper's diagonal direction, is refused.
+fn axis_token(path: &Path) -> Result<Option<char>, Error> {
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+    let axis = crate::workflows::identify::axis_in_name(&stem.unwrap_or_default());
+    let axis = axis.map_err(|why| {
+        Error::input(
+            path,
+            format!("cannot tell which machine axis this file's test shook: {why}"),
+        )
+    })?;
+    Ok(axis.and_then(|a| a.chars().next()))
 }
 
 /// The data sets of one file as calibrate_shaper.py's `parse_log` makes them.
@@ -277,7 +283,7 @@ pub fn choose(c: &KlipperCriterion) -> Result<Vec<AxisChoice>, Error> {
     }
     let mut groups: Vec<(Option<char>, Vec<PathBuf>, Vec<CalibrationData>)> = Vec::new();
     for f in &c.files {
-        let axis = axis_token(f);
+        let axis = axis_token(f)?;
         let data = load(f)?;
         match groups.iter_mut().find(|g| g.0 == axis) {
             Some(g) => {
