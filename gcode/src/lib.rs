@@ -71,7 +71,7 @@ pub const MAX_STEP_DURATION_S: f64 = 3600.0;
 /// arc is refused ([`GcodeError::ArcTooManySegments`]) rather than held in gigabytes.
 pub const MAX_ARC_SEGMENTS: usize = 100_000;
 pub use read::arc::{
-    Arc, FULL_CIRCLE_TOLERANCE_MM, RADIUS_TOLERANCE_MAX_MM, RADIUS_TOLERANCE_MM,
+    Arc, FULL_CIRCLE_TOLERANCE_MM, Plane, RADIUS_TOLERANCE_MAX_MM, RADIUS_TOLERANCE_MM,
     RADIUS_TOLERANCE_REL,
 };
 pub use read::canonical::CanonicalWriter;

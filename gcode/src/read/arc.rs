@@ -1,5 +1,5 @@
-//! Exact arc geometry for G2/G3 in the XY plane (G17), from a centre offset I/J or a
-//! radius R.
+//! Exact arc geometry for G2/G3, from a centre offset I/J or a radius R, in the XY plane
+//! (G17), or in the ZX (G18) or YZ (G19) plane where the dialect reads them ([`Plane`]).
 //!
 //! - Centre = start + (I, J); radius = |(I, J)|; the sweep runs from the start angle to the
 //!   end point's angle, clockwise for G2 and counter-clockwise for G3, in (0, 2 pi]; an end
@@ -23,16 +23,64 @@ use std::f64::consts::{FRAC_PI_2, TAU};
 /// End points closer than this make a full circle, mm (Marlin's `NEAR`).
 pub const FULL_CIRCLE_TOLERANCE_MM: f64 = 1e-6;
 
-/// A circular arc in the XY plane; Z (helix) and E change linearly with the angle.
+/// The plane of an arc, as G17, G18 and G19 select it: its first and second axis (the
+/// arc's angle turns from the first towards the second: counter-clockwise for G3 seen
+/// from the positive side of the third) and the axis that moves linearly with the angle,
+/// as GRBL takes them (grbl/gcode.c, "Set active plane": G18 is Z then X, linear Y; G19 Y
+/// then Z, linear X).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Plane {
+    /// G17: X then Y, Z linear.
+    #[default]
+    Xy,
+    /// G18: Z then X, Y linear.
+    Zx,
+    /// G19: Y then Z, X linear.
+    Yz,
+}
+
+impl Plane {
+    /// The indices (0 X, 1 Y, 2 Z) of the plane's first and second axis and of its
+    /// linear axis.
+    pub fn axes(self) -> [usize; 3] {
+        match self {
+            Plane::Xy => [0, 1, 2],
+            Plane::Zx => [2, 0, 1],
+            Plane::Yz => [1, 2, 0],
+        }
+    }
+
+    /// The command that selects it.
+    pub fn code(self) -> &'static str {
+        match self {
+            Plane::Xy => "G17",
+            Plane::Zx => "G18",
+            Plane::Yz => "G19",
+        }
+    }
+
+    /// The offset words of its first and second axis (`I` X, `J` Y, `K` Z).
+    pub fn offset_words(self) -> [u8; 2] {
+        let [a, b, _] = self.axes();
+        [b"IJK"[a], b"IJK"[b]]
+    }
+}
+
+/// A circular arc in its [`Plane`] (XY unless the file selected another); the plane's
+/// linear axis (Z in XY: a helix) and E change linearly with the angle. Centre and offsets
+/// are along the plane's first and second axis (X and Y in the XY plane, Z and X in ZX,
+/// Y and Z in YZ).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Arc {
-    /// Centre X, mm (machine frame).
+    /// Centre along the plane's first axis (X in the XY plane), mm (machine frame).
     pub centre_x_mm: f64,
-    /// Centre Y, mm.
+    /// Centre along the plane's second axis (Y in the XY plane), mm.
     pub centre_y_mm: f64,
-    /// Centre minus start, X, mm (the I word, or derived from R).
+    /// Centre minus start along the plane's first axis, mm (the I word in the XY plane,
+    /// K in ZX, J in YZ; or derived from R).
     pub offset_i_mm: f64,
-    /// Centre minus start, Y, mm (the J word, or derived from R).
+    /// Centre minus start along the plane's second axis, mm (the J word in the XY plane,
+    /// I in ZX, K in YZ; or derived from R).
     pub offset_j_mm: f64,
     /// Radius at the start, mm.
     pub radius_mm: f64,
@@ -43,6 +91,8 @@ pub struct Arc {
     pub sweep_rad: f64,
     /// The R word as written, for arcs given in the R form.
     pub radius_word_mm: Option<f64>,
+    /// The plane the arc lies in.
+    pub plane: Plane,
 }
 
 /// Why an arc cannot be built.
@@ -63,8 +113,9 @@ pub const RADIUS_TOLERANCE_REL: f64 = 0.001;
 pub const RADIUS_TOLERANCE_MAX_MM: f64 = 0.5;
 
 impl Arc {
-    /// An arc from `start` to `end` (XY, mm) about `start + (i, j)`. `check_radius`
-    /// applies the end-radius tolerance.
+    /// An arc from `start` to `end` (along the plane's two axes, mm) about `start + (i,
+    /// j)`, in the XY plane until [`Arc::in_plane`] says otherwise. `check_radius` applies
+    /// the end-radius tolerance.
     pub(crate) fn from_offsets(
         start: [f64; 2],
         end: [f64; 2],
@@ -116,7 +167,13 @@ impl Arc {
             start_angle_rad: ry.atan2(rx),
             sweep_rad: sweep,
             radius_word_mm: None,
+            plane: Plane::Xy,
         })
+    }
+
+    /// The same arc, its coordinates read as along `plane`'s axes.
+    pub(crate) fn in_plane(self, plane: Plane) -> Arc {
+        Arc { plane, ..self }
     }
 
     /// An arc from `start` to `end` with radius `r` (negative: the long way round).
@@ -162,7 +219,8 @@ impl Arc {
         self.sweep_rad.abs() == TAU
     }
 
-    /// Exact length of the (helical) path with Z travel `dz_mm`, mm.
+    /// Exact length of the (helical) path with travel `dz_mm` along the plane's linear
+    /// axis (Z in the XY plane), mm.
     pub fn length_mm(&self, dz_mm: f64) -> f64 {
         (self.radius_mm * self.sweep_rad.abs()).hypot(dz_mm)
     }
@@ -172,7 +230,8 @@ impl Arc {
         self.start_angle_rad + self.sweep_rad * s
     }
 
-    /// XY a fraction `s` of the way along, mm.
+    /// The position along the plane's two axes (XY in the XY plane) a fraction `s` of the
+    /// way along, mm.
     pub(crate) fn xy_at(&self, s: f64) -> (f64, f64) {
         let (sin, cos) = self.angle_at(s).sin_cos();
         (
@@ -181,8 +240,9 @@ impl Arc {
         )
     }
 
-    /// The points (X, Y, mm) where the arc reaches its extreme X or Y: the quadrant points
-    /// it passes, in the order +X, +Y, -X, -Y.
+    /// The points (along the plane's two axes, mm: X, Y in the XY plane) where the arc
+    /// reaches an extreme of either axis: the quadrant points it passes, in the order +X,
+    /// +Y, -X, -Y (first axis, second, in the XY plane's names).
     pub(crate) fn extremes_xy(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
         let (cx, cy, r) = (self.centre_x_mm, self.centre_y_mm, self.radius_mm);
         let quadrants = [(cx + r, cy), (cx, cy + r), (cx - r, cy), (cx, cy - r)];

@@ -10,6 +10,7 @@
 
 use std::io::{self, Write};
 
+use crate::read::arc::Plane;
 use crate::read::dialect::Dialect;
 use crate::read::event::{Event, EventKind, LayerSource, Note};
 use crate::read::geometry::{Move, Path};
@@ -193,6 +194,11 @@ impl<W: Write> CanonicalWriter<W> {
 
     fn write_move(&mut self, mv: &Move) -> io::Result<()> {
         let e = &mv.end;
+        if let Path::Arc(a) = &mv.path
+            && a.plane != Plane::Xy
+        {
+            writeln!(self.out, "{}", a.plane.code())?;
+        }
         let word = match (&mv.path, mv.rapid) {
             (Path::Line, true) => "G0",
             (Path::Line, false) => "G1",
@@ -207,10 +213,19 @@ impl<W: Write> CanonicalWriter<W> {
         )?;
         match &mv.path {
             Path::Line => writeln!(self.out),
-            Path::Arc(a) => match a.radius_word_mm {
-                Some(r) => writeln!(self.out, " R{r}"),
-                None => writeln!(self.out, " I{} J{}", a.offset_i_mm, a.offset_j_mm),
-            },
+            Path::Arc(a) => {
+                let [i, j] = a.plane.offset_words().map(char::from);
+                match a.radius_word_mm {
+                    Some(r) => write!(self.out, " R{r}")?,
+                    None => write!(self.out, " {i}{} {j}{}", a.offset_i_mm, a.offset_j_mm)?,
+                }
+                writeln!(self.out)?;
+                if a.plane != Plane::Xy {
+                    // The plane holds for this arc only: the written file stays in G17.
+                    writeln!(self.out, "G17")?;
+                }
+                Ok(())
+            }
         }
     }
 

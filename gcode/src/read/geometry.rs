@@ -39,6 +39,11 @@ impl Point {
         );
         (dx * dx + dy * dy + dz * dz).sqrt()
     }
+
+    /// X, Y and Z, mm.
+    pub fn xyz(&self) -> [f64; 3] {
+        [self.x_mm, self.y_mm, self.z_mm]
+    }
 }
 
 /// What a move does, from its XYZ travel and its extrusion.
@@ -133,11 +138,14 @@ impl Move {
     }
 
     /// Length of the XYZ path, mm: the straight distance for a line, the exact helical
-    /// length `sqrt((r |sweep|)^2 + dz^2)` for an arc.
+    /// length `sqrt((r |sweep|)^2 + dz^2)` for an arc (`dz` along its plane's linear axis).
     pub fn length_mm(&self) -> f64 {
         match &self.path {
             Path::Line => self.start.distance_xyz_mm(&self.end),
-            Path::Arc(a) => a.length_mm(self.end.z_mm - self.start.z_mm),
+            Path::Arc(a) => {
+                let linear = a.plane.axes()[2];
+                a.length_mm(self.end.xyz()[linear] - self.start.xyz()[linear])
+            }
         }
     }
 
@@ -153,30 +161,33 @@ impl Move {
             return self.end;
         }
         let lerp = |a: f64, b: f64| a + (b - a) * s;
-        let (x_mm, y_mm) = match &self.path {
-            Path::Line => (
-                lerp(self.start.x_mm, self.end.x_mm),
-                lerp(self.start.y_mm, self.end.y_mm),
-            ),
-            Path::Arc(a) => a.xy_at(s),
-        };
+        let (a, b) = (self.start.xyz(), self.end.xyz());
+        let mut p = [lerp(a[0], b[0]), lerp(a[1], b[1]), lerp(a[2], b[2])];
+        if let Path::Arc(arc) = &self.path {
+            let [first, second, _] = arc.plane.axes();
+            (p[first], p[second]) = arc.xy_at(s);
+        }
         Point {
-            x_mm,
-            y_mm,
-            z_mm: lerp(self.start.z_mm, self.end.z_mm),
+            x_mm: p[0],
+            y_mm: p[1],
+            z_mm: p[2],
             e_mm: lerp(self.start.e_mm, self.end.e_mm),
         }
     }
 
-    /// The XY bounding box of the path (exact for arcs: it includes the quadrant points
-    /// the arc passes), with Z from the end points.
+    /// The bounding box of the path (exact for arcs: it includes the quadrant points the
+    /// arc passes in its plane), with the arc plane's linear axis (Z in the XY plane) from
+    /// the end points.
     pub fn bounds(&self) -> Bounds {
         let mut b = Bounds::empty();
         b.include(&self.start);
         b.include(&self.end);
         if let Path::Arc(a) = &self.path {
-            for [x, y] in a.extremes_xy() {
-                b.include_xyz([x, y, self.start.z_mm]);
+            let [first, second, _] = a.plane.axes();
+            for [u, v] in a.extremes_xy() {
+                let mut p = self.start.xyz();
+                (p[first], p[second]) = (u, v);
+                b.include_xyz(p);
             }
         }
         b

@@ -3,7 +3,7 @@
 //! that move or rename the position: G0-G4, G17-G21, G28, G90, G91, G92, M82, M83.
 
 use crate::error::GcodeError;
-use crate::read::arc::{Arc, ArcProblem};
+use crate::read::arc::{Arc, ArcProblem, Plane};
 use crate::read::cmd::{Check, Cmd, FINITE, NON_NEGATIVE, POSITIVE};
 use crate::read::dialect::Dialect;
 use crate::read::geometry::{Move, MoveKind, Path, Point, Tool};
@@ -25,8 +25,8 @@ pub(crate) struct Motion {
     e_relative: bool,
     /// The modal F, mm/min.
     feed_mm_min: f64,
-    /// G17 (XY) is the arc plane.
-    plane_xy: bool,
+    /// The arc plane (G17, G18, G19).
+    plane: Plane,
     max_coordinate_mm: f64,
     max_extruder_mm: f64,
     /// Millimetres per unit of X, Y, Z, I, J, R and F: 1 (G21) or 25.4 (G20).
@@ -48,7 +48,7 @@ impl Motion {
             axes_relative: false,
             e_relative: false,
             feed_mm_min: dialect.initial_feed_mm_s() * 60.0,
-            plane_xy: true,
+            plane: Plane::Xy,
             max_coordinate_mm,
             max_extruder_mm,
             unit_mm: 1.0,
@@ -136,9 +136,9 @@ impl Motion {
         self.e_relative = relative;
     }
 
-    /// G17 (true) or G18/G19 (false).
-    pub(crate) fn set_plane_xy(&mut self, xy: bool) {
-        self.plane_xy = xy;
+    /// G17, G18 or G19.
+    pub(crate) fn set_plane(&mut self, plane: Plane) {
+        self.plane = plane;
     }
 
     /// Reads F and X Y Z E: the target machine position and the feed, mm/min (committed
@@ -241,10 +241,11 @@ impl Motion {
         p: &Params,
         clockwise: bool,
     ) -> Result<Move, GcodeError> {
-        if !self.plane_xy {
-            return Err(
-                cmd.unsupported("arcs are read in the XY plane only (G17); G18/G19 arcs are not")
-            );
+        let grbl = self.dialect == Dialect::Grbl;
+        if self.plane != Plane::Xy && !grbl {
+            return Err(cmd.unsupported(
+                "arcs are read in the XY plane only (G17) under this firmware; G18/G19 arcs are read under GRBL (--firmware grbl)",
+            ));
         }
         if self.dialect == Dialect::Klipper {
             if self.axes_relative {
@@ -258,14 +259,27 @@ impl Motion {
                 ));
             }
         }
-        cmd.allow(p, b"XYZEFIJR", "X Y Z E F I J R")?;
+        if grbl {
+            // GRBL takes K (grbl/gcode.c reads I, J and K in every plane and uses the
+            // plane's two).
+            cmd.allow(p, b"XYZFIJKR", "X Y Z F I J K R")?;
+        } else {
+            cmd.allow(p, b"XYZEFIJR", "X Y Z E F I J R")?;
+        }
+        let [first, second, _] = self.plane.axes();
+        if grbl && !p.has(b"XYZ"[first]) && !p.has(b"XYZ"[second]) {
+            return Err(cmd.unsupported(
+                "no axis word in the arc's plane (G17 X Y, G18 Z X, G19 Y Z): GRBL refuses the line (error:32, grbl/gcode.c)",
+            ));
+        }
         let offset_check = Check {
             ok: |v| v.abs() <= 1e5,
             allowed: "within 1e5 mm",
         };
         let unit = |v: Option<f64>| v.map(|v| v * self.unit_mm);
-        let i = unit(cmd.num(p, b'I', offset_check)?);
-        let j = unit(cmd.num(p, b'J', offset_check)?);
+        let [word_i, word_j] = self.plane.offset_words();
+        let i = unit(cmd.num(p, word_i, offset_check)?);
+        let j = unit(cmd.num(p, word_j, offset_check)?);
         let r = unit(cmd.num(p, b'R', offset_check)?);
         if r.is_some() && (i.is_some() || j.is_some()) {
             return Err(GcodeError::ArcMixedForms {
@@ -274,7 +288,10 @@ impl Motion {
             });
         }
         let (target, feed) = self.target(cmd, p)?;
-        let (start, end) = ([self.pos[0], self.pos[1]], [target[0], target[1]]);
+        let (start, end) = (
+            [self.pos[first], self.pos[second]],
+            [target[first], target[second]],
+        );
         let built = match r {
             Some(r) if r != 0.0 => Arc::from_radius(start, end, r, clockwise),
             Some(_) => Err(ArcProblem::NoCentre),
@@ -287,7 +304,7 @@ impl Motion {
                 true,
             ),
         };
-        let arc = built.map_err(|e| arc_error(cmd, e))?;
+        let arc = built.map_err(|e| arc_error(cmd, e))?.in_plane(self.plane);
         self.feed_mm_min = feed;
         Ok(self.finish(target, false, Path::Arc(arc)))
     }

@@ -7,6 +7,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::error::{GcodeError, Location};
+use crate::read::arc::Plane;
 use crate::read::cmd::{Check, Cmd, CmdName};
 use crate::read::dialect::Dialect;
 use crate::read::event::{Event, EventKind, Note};
@@ -501,7 +502,11 @@ impl Interp {
             }
             (b'G', 17..=19) => {
                 cmd.allow(p, b"", "none")?;
-                self.motion.set_plane_xy(number == 17);
+                self.motion.set_plane(match number {
+                    17 => Plane::Xy,
+                    18 => Plane::Zx,
+                    _ => Plane::Yz,
+                });
             }
             (b'G', 20 | 21) => {
                 cmd.allow(p, b"", "none")?;

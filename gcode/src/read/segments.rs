@@ -148,10 +148,14 @@ impl Move {
     }
 }
 
-/// Centre offset and direction of an arc move.
+/// Centre offset and direction of an arc move (Klipper's, Marlin's and RepRapFirmware's
+/// cutters: only GRBL's reader takes arcs outside the XY plane).
 fn arc_of(mv: &Move) -> (f64, f64, bool) {
     match &mv.path {
-        Path::Arc(a) => (a.offset_i_mm, a.offset_j_mm, a.clockwise()),
+        Path::Arc(a) => {
+            debug_assert_eq!(a.plane, crate::read::arc::Plane::Xy);
+            (a.offset_i_mm, a.offset_j_mm, a.clockwise())
+        }
         Path::Line => (0.0, 0.0, false),
     }
 }

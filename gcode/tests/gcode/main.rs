@@ -8,6 +8,7 @@ mod dialects;
 mod errors;
 mod features;
 mod grbl;
+mod grbl_planes;
 mod job_changes;
 mod job_prints;
 mod job_settle;

@@ -326,6 +326,7 @@ mod tests {
                 start_angle_rad: 0.0,
                 sweep_rad: 0.0,
                 radius_word_mm: None,
+                plane: settle_gcode::Plane::Xy,
             },
             points_mm: points.to_vec(),
         }

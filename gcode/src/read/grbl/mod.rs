@@ -35,6 +35,7 @@ pub(crate) mod dollar;
 pub(crate) mod words;
 
 use crate::error::GcodeError;
+use crate::read::arc::Plane;
 use crate::read::cmd::{Cmd, NON_NEGATIVE, POSITIVE};
 use crate::read::event::{EventKind, Note};
 use crate::read::geometry::Tool;
@@ -208,8 +209,8 @@ impl GrblState {
             self.moving = false;
         }
         // [11, 17] Plane and distance mode.
-        if let Some(xy) = w.plane_xy {
-            motion.set_plane_xy(xy);
+        if let Some(plane) = w.plane {
+            motion.set_plane(plane);
         }
         if let Some(rel) = w.relative {
             motion.set_relative(rel);
@@ -343,7 +344,7 @@ impl GrblState {
             Some(Flow::End) => {
                 self.sync(out);
                 self.motion = MotionMode::Linear;
-                motion.set_plane_xy(true);
+                motion.set_plane(Plane::Xy);
                 motion.set_relative(false);
                 self.inverse_time = false;
                 self.coord_select = 0;

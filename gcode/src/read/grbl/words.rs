@@ -8,6 +8,7 @@
 //! run the line at all.
 
 use crate::error::GcodeError;
+use crate::read::arc::Plane;
 use crate::read::cmd::Cmd;
 
 /// The motion modes (modal group 1).
@@ -82,8 +83,8 @@ pub(crate) enum Flow {
 pub(crate) struct Words {
     pub(crate) motion: Option<MotionMode>,
     pub(crate) non_modal: Option<NonModal>,
-    /// G17 (true) or G18/G19.
-    pub(crate) plane_xy: Option<bool>,
+    /// G17, G18 or G19.
+    pub(crate) plane: Option<Plane>,
     /// G91 (true) or G90.
     pub(crate) relative: Option<bool>,
     /// G93 (true) or G94.
@@ -309,7 +310,12 @@ fn g_word(w: &mut Words, n: u32, m: u32, cmd: &Cmd, at: usize) -> Result<(), Gco
         }
         17..=19 => {
             plain()?;
-            once(&mut w.plane_xy, n == 17, cmd, at)
+            let plane = match n {
+                17 => Plane::Xy,
+                18 => Plane::Zx,
+                _ => Plane::Yz,
+            };
+            once(&mut w.plane, plane, cmd, at)
         }
         // G91.1 (incremental arc centres) is GRBL's only IJK mode; G90.1 is refused.
         90 | 91 if m == 10 => {
