@@ -171,3 +171,36 @@ fn each_layer_gives_each_feature_types_worst_and_p95() {
         "{csv}"
     );
 }
+
+/// A real Fusion 360 job for a GRBL mill (gcode/prints/cnc/PROVENANCE.md: passes led in
+/// and out along arcs in the ZX and YZ planes, G18/G19) reads whole and runs. Without a
+/// shaper its smoothing (the command's distance to the written path) is GRBL's rounding
+/// of every target to whole steps (grbl/planner.c): at most half a step on X and on Y,
+/// `hypot(0.5, 0.5) / steps_per_mm`, plus the corner bridge of a junction's speed jump
+/// (docs/guide/your-print.md: below 0.1 um here). At 40 steps/mm (the Shapeoko 3's
+/// `$100`, gcode/prints/shapeoko3_grbl_settings.txt) that is 17.68 um; at 1000 steps/mm,
+/// 0.71 um, and the job's smoothing falls with it: it is the step grid's.
+#[test]
+fn a_real_fusion_360_jobs_smoothing_is_grbls_step_grid() {
+    let file = crate::support::root().join("gcode/prints/cnc/1084_btn_18bit_first.nc");
+    let shapeoko = std::fs::read_to_string(
+        crate::support::root().join("gcode/prints/shapeoko3_grbl_settings.txt"),
+    )
+    .expect("settings");
+    let mut worst = Vec::new();
+    for steps in [40.0, 1000.0] {
+        let text = format!("{shapeoko}\n$100={steps}\n$101={steps}\n");
+        let s = GrblSettings::parse(&text, "grbl.txt").expect("settings");
+        let mut o = GcodeOptions::new(file.clone(), "printer_xy", Firmware::Grbl).expect("options");
+        o.job = JobConfig::from_grbl(&s).expect("job");
+        let out = measure(&o).expect("the job runs");
+        let smoothing = out.streamed.split_worst.smoothing_um;
+        let bound = 0.5f64.hypot(0.5) / steps * 1e3 + 0.1;
+        assert!(
+            smoothing > 0.0 && smoothing <= bound,
+            "{steps} steps/mm: smoothing {smoothing} um, bound {bound} um"
+        );
+        worst.push(smoothing);
+    }
+    assert!(worst[1] < worst[0] / 10.0, "{worst:?}");
+}

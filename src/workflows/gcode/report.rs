@@ -12,6 +12,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use settle_gcode::job::ShaperSetting;
+use settle_planner::firmware::Firmware;
 
 use std::io::BufRead as _;
 
@@ -146,6 +147,14 @@ trades for speed (zero without one), and vibration, the distance from the toolhe
 commanded position's own path (a lag along it is not vibration), what the machine adds \
 (zero on a rigid one); each column is that part's own largest.\n"
     );
+    if o.firmware == Firmware::Grbl {
+        let _ = writeln!(
+            s,
+            "GRBL rounds every target to whole steps (`$100`-`$102`, grbl/planner.c), so its \
+command runs up to half a step off the written path (12.5 um at 40 steps/mm): that counts \
+as smoothing, with a shaper or without.\n"
+        );
+    }
     if let Some((settings, _)) = &o.config {
         let _ = writeln!(s, "Planner {settings}.\n");
     }
