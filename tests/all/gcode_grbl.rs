@@ -204,3 +204,34 @@ fn a_real_fusion_360_jobs_smoothing_is_grbls_step_grid() {
     }
     assert!(worst[1] < worst[0] / 10.0, "{worst:?}");
 }
+
+/// A real Cura file (gcode/prints/cura/PROVENANCE.md) marks its layers `;LAYER:n` and
+/// names no Z: each layer's Z is where its first extruding move in a plane runs, 1 mm
+/// apart from the header's `;MINZ:` to its `;MAXZ:` (`;Layer height: 1`), so error-z can
+/// draw the layers (it had no Z to draw them at). One layer is simulated; every layer
+/// is planned.
+#[test]
+fn a_cura_files_layers_are_at_the_z_they_print_at() {
+    let file = crate::support::root().join("gcode/prints/cura/Kreistest.gcode");
+    let text = std::fs::read_to_string(&file).expect("print");
+    let header = |key: &str| -> f64 {
+        let v = text.lines().find_map(|l| l.strip_prefix(key)).expect(key);
+        v.trim().parse().expect("a number")
+    };
+    let (min_z, max_z) = (header(";MINZ:"), header(";MAXZ:"));
+    let opts = GcodeOptions {
+        layers: Some((1, 1)),
+        ..GcodeOptions::new(file, "printer_xy", Firmware::Marlin).expect("options")
+    };
+    let out = measure(&opts).expect("the job runs");
+    let z: Vec<f64> = out.layers.iter().map(|l| l.z_mm.expect("a Z")).collect();
+    assert_eq!(z.len() as f64, header(";LAYER_COUNT:"));
+    for (k, z) in z.iter().enumerate() {
+        assert!(
+            (z - (min_z + k as f64)).abs() < 1e-9,
+            "layer {}: {z}",
+            k + 1
+        );
+    }
+    assert_eq!(z.last(), Some(&max_z));
+}

@@ -94,7 +94,9 @@ impl JobChunk {
 pub struct LayerTime {
     /// Layer index.
     pub layer: u32,
-    /// The layer's Z (mm), where the file says.
+    /// The layer's Z (mm): where the file says (PrusaSlicer's `;Z:`, Simplify3D's layer
+    /// comment, a change of Z), else where the layer's first working move in a plane of
+    /// constant Z runs (Cura's `;LAYER:n` names no Z); none for a layer without one.
     pub z_mm: Option<f64>,
     /// When its first move starts (s; the first layer counted starts at 0).
     pub start_time_s: f64,

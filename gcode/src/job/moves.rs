@@ -186,6 +186,11 @@ impl Account {
             c.moves += 1;
             if m.working {
                 c.working_s += m.duration_s;
+                // A marker without a Z (Cura's `;LAYER:n`): the layer is where its first
+                // working move in a plane runs.
+                if c.z_mm.is_none() && m.start_mm.z_mm == m.end_mm.z_mm {
+                    c.z_mm = Some(m.end_mm.z_mm);
+                }
             }
         }
     }

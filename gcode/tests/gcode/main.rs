@@ -4,6 +4,7 @@ mod arcs;
 mod config_export;
 mod config_klipper;
 mod config_rrf;
+mod cura;
 mod dialects;
 mod errors;
 mod features;

@@ -274,7 +274,8 @@ impl GcodeOptions {
 pub struct LayerRow {
     /// Layer index.
     pub layer: u32,
-    /// Its Z (mm), where the file says.
+    /// Its Z (mm): where the file says, else where its first working move in a plane
+    /// runs ([`settle_gcode::job::LayerTime::z_mm`]).
     pub z_mm: Option<f64>,
     /// When it starts (s).
     pub start_s: f64,
