@@ -2,8 +2,6 @@
 //! the machine and the move's travel. Errors name the key to blame: the sweep axis when
 //! the value was swept.
 
-use settle_sim::Mode;
-
 use crate::error::Error;
 use crate::input::source::Source;
 use crate::spec::MAX_POSITION_MM;
@@ -355,23 +353,23 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
             }
         }
     }
-    // The modes as written were checked when the machine was read; swept values here.
+    // The modes as written were checked when the machine was read; swept values here,
+    // by the same check. The key blamed: the swept field itself, else another swept field
+    // of the same mode (a swept frequency below the written `frequency_sigma_hz`).
     for a in run.machine.modes() {
         for (i, m) in a.modes.iter().enumerate() {
-            if let Err(e) = Mode::new(m.frequency_hz, m.damping_ratio, m.weight) {
-                let field = if !(m.frequency_hz.is_finite() && m.frequency_hz > 0.0) {
-                    "frequency_hz"
-                } else if !(0.0..1.0).contains(&m.damping_ratio) {
-                    "damping_ratio"
-                } else {
-                    "weight"
+            if let Err(e) = m.check() {
+                let of_mode = |p: &str| {
+                    crate::spec::run_spec::mode_param(p)
+                        .is_some_and(|(axis, j, _)| axis == a.axis && j == i)
                 };
                 let key = run
                     .swept
                     .iter()
                     .find(|(p, _)| {
-                        crate::spec::run_spec::mode_param(p) == Some((a.axis.as_str(), i, field))
+                        crate::spec::run_spec::mode_param(p) == Some((a.axis.as_str(), i, e.field))
                     })
+                    .or_else(|| run.swept.iter().find(|(p, _)| of_mode(p)))
                     .map_or_else(|| "machine".to_string(), |(p, _)| format!("sweep.{p}"));
                 return Err(src.error_at(&key, format!("axis `{}`, mode {i}: {e}", a.axis)));
             }

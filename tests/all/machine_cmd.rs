@@ -111,3 +111,15 @@ fn settle_machine_prints_a_modes_file_as_written_and_a_scenarios_machine() {
         "{err}"
     );
 }
+
+#[test]
+fn the_modes_ranges_keep_what_settle_resolves_and_identify_writes() {
+    use settle::input::modes::{MAX_FREQUENCY_HZ, MIN_FREQUENCY_HZ};
+    // No sample rate settle gcode takes resolves a faster mode.
+    assert_eq!(
+        MAX_FREQUENCY_HZ,
+        settle::workflows::gcode::MAX_SAMPLE_RATE_HZ / 2.0
+    );
+    // settle identify's resonance tests start at 1 Hz at the lowest.
+    const { assert!(MIN_FREQUENCY_HZ < settle::workflows::identify::FREQ_MIN_HZ) };
+}

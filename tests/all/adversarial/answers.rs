@@ -308,12 +308,16 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         refused(
             "gcode on a machine with a mode of 1e9 Hz",
             "gcode print.gcode --machine ghz.toml --out o",
-            &["--machine", "1000000000.0 Hz", "100000 Hz", "frequency_hz"],
+            &["ghz.toml:3:1", "`frequency_hz` = 1000000000.0", "50000 Hz"],
         ),
         refused(
             "a mode of 1e-7 Hz",
             "sweep slow_mode.toml --backend modal --out o",
-            &["observe.window_s", "slowest mode"],
+            &[
+                "machine.modes",
+                "mode 1: `frequency_hz` = 1e-7",
+                "0.01 to 50000 Hz",
+            ],
         ),
         refused(
             "import a shaper Klipper refuses",

@@ -56,6 +56,15 @@ fn the_book_lists_every_limit_as_the_code_has_it() {
         settle::input::modes::MAX_MODES_PER_AXIS
     ));
     has(format!(
+        "`frequency_hz` {} to {} Hz",
+        settle::input::modes::MIN_FREQUENCY_HZ,
+        settle::input::modes::MAX_FREQUENCY_HZ
+    ));
+    has(format!(
+        "`weight` 0 to {}",
+        settle::input::modes::MAX_WEIGHT
+    ));
+    has(format!(
         "at most {} values each",
         settle::workflows::tune::grid::MAX_LIST
     ));

@@ -1,8 +1,10 @@
 //! Parameters without bounds, each refused before work with its key and its limit: a
 //! shaper of 1e-6 Hz (on the command line and in a G-code file), a sample rate of 1e12
 //! Hz, an integration step of 1e-300 s, scans of 1e9 and 2^63 lines, 100,000 modes, a
-//! search of a thousand frequencies, a figure count of a million; and memory that would
-//! grow with the job (the ringing map of a layer of 3,200 long lines, which must stay
+//! search of a thousand frequencies, a figure count of a million; modes of 1e300 Hz and
+//! 1e-300 Hz, a weight of 1e300 and a frequency standard deviation of 1e300 Hz (in a
+//! machine file each command reads, inline and swept); and memory that would grow with
+//! the job (the ringing map of a layer of 3,200 long lines, which must stay
 //! under the suite's 1 GiB like every case).
 
 use super::sandbox::SCENARIO;
@@ -69,6 +71,49 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         ));
     }
     sb.write("layer.gcode", &layer);
+    // Machines given by their modes, one field out of its range each (x and y, so that
+    // `settle gcode` takes them).
+    let machine = |x_mode: &str| {
+        format!(
+            "name = \"m\"\n[axis.x]\nmodes = [{{ {x_mode} }}]\n[axis.y]\nmodes = [{{ frequency_hz = 40.0, damping_ratio = 0.05 }}]\n"
+        )
+    };
+    sb.write(
+        "m_fast.toml",
+        &machine("frequency_hz = 1e300, damping_ratio = 0.05"),
+    );
+    sb.write(
+        "m_sigma.toml",
+        &machine("frequency_hz = 40.0, damping_ratio = 0.05, frequency_sigma_hz = 1e300"),
+    );
+    sb.write(
+        "m_weight.toml",
+        &machine("frequency_hz = 40.0, damping_ratio = 0.05, weight = 1e300"),
+    );
+    let on = |file: &str| {
+        scenario_with(
+            "modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]",
+            &format!("preset = \"{file}\""),
+        )
+    };
+    // Without [sweep] (settle tune does its own search): the sigma is what is refused.
+    sb.write(
+        "tune_sigma.toml",
+        &(on("m_sigma.toml").replace("[sweep]\nprofile = [\"trapezoid\", \"scurve\"]\n", "")
+            + "[tune]\ndistances_mm = [5.0]\njerk_steps = 2\n"),
+    );
+    sb.write("sweep_fast.toml", &on("m_fast.toml"));
+    sb.write(
+        "slow_inline.toml",
+        &scenario_with("frequency_hz = 40.0", "frequency_hz = 1e-300"),
+    );
+    sb.write(
+        "swept_fast.toml",
+        &scenario_with(
+            "profile = [\"trapezoid\", \"scurve\"]",
+            "\"machine.modes.0.frequency_hz\" = [40.0, 1e6]",
+        ),
+    );
     let gcode = |what: &str, more: &[&str], parts: &[&str]| {
         let mut a = vec![
             "gcode",
@@ -136,6 +181,59 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "gcode layer.gcode --machine printer_xy --out o_layer",
             &["o_layer"],
             Expect::answered(&["wrote o_layer/ringing-layer-1.png"]),
+        ),
+        refused(
+            "settle machine on a mode of 1e300 Hz",
+            "machine m_fast.toml",
+            &[
+                "m_fast.toml:3:1: key `axis.x.modes`: axis `x`, mode 0: `frequency_hz` = 1e300",
+                "0.01 to 50000 Hz",
+            ],
+        ),
+        refused(
+            "settle tune on a frequency_sigma_hz of 1e300 Hz (taken as its band)",
+            "tune tune_sigma.toml --out o",
+            &[
+                "m_sigma.toml:3:1: key `axis.x.modes`",
+                "`frequency_sigma_hz` = 1e300",
+                "0 <= frequency_sigma_hz < frequency_hz (40.0 Hz here)",
+            ],
+        ),
+        refused(
+            "settle gcode --machine with a weight of 1e300",
+            "gcode print.gcode --machine m_weight.toml --out o",
+            &[
+                "m_weight.toml:3:1: key `axis.x.modes`",
+                "`weight` = 1e300",
+                "0 to 10",
+            ],
+        ),
+        refused(
+            "settle sweep on a machine file with a mode of 1e300 Hz",
+            "sweep sweep_fast.toml --backend modal --out o",
+            &[
+                "m_fast.toml:3:1",
+                "`frequency_hz` = 1e300",
+                "0.01 to 50000 Hz",
+            ],
+        ),
+        refused(
+            "a scenario's mode of 1e-300 Hz",
+            "sweep slow_inline.toml --backend modal --out o",
+            &[
+                "slow_inline.toml:3:1: key `machine.modes`",
+                "`frequency_hz` = 1e-300",
+                "0.01 to 50000 Hz",
+            ],
+        ),
+        refused(
+            "a mode swept to 1e6 Hz",
+            "sweep swept_fast.toml --backend modal --out o",
+            &[
+                "key `sweep.machine.modes.0.frequency_hz`",
+                "mode 0: `frequency_hz` = 1000000.0",
+                "0.01 to 50000 Hz",
+            ],
         ),
         refused(
             "identify --sweeping-period 1e-9",
