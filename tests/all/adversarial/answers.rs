@@ -222,7 +222,7 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
                 "grbl_zero.txt:2",
                 "key `$110`",
                 "$110 = `0`",
-                "greater than 0",
+                "from 1e-9 to 1e9",
             ],
         ),
         // A 100 m circle at 1 mm: its segments would be held until it ends.
