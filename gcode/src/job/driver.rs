@@ -34,11 +34,7 @@ pub(crate) enum LimitOutcome {
 /// (0.01 to 0.3)" for any other (Marlin/src/gcode/config/M200-M205.cpp), mm.
 pub(crate) const MARLIN_JUNCTION_DEVIATION_MM: std::ops::RangeInclusive<f64> = 0.01..=0.3;
 
-/// RepRapFirmware's least acceleration, mm/s^2 (`MinimumAcceleration`,
-/// src/Config/Configuration.h): `Platform::SetAcceleration` (`M201`,
-/// src/Platform/Platform.h) and `GCodes::ConfigureAccelerations` (`M204`,
-/// src/GCodes/GCodes5.cpp) raise any value below it to it.
-pub(crate) const RRF_MINIMUM_ACCEL_MM_S2: f64 = 0.1;
+use crate::config::RRF_MINIMUM_ACCEL_MM_S2;
 
 /// RepRapFirmware's least minimum movement speed, mm/s (`AbsoluteMinFeedrate`,
 /// src/Config/Configuration.h; `Platform::SetMinMovementSpeed`, src/Platform/Platform.h).
