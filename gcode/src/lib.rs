@@ -65,6 +65,18 @@ pub use error::{GcodeError, Location};
 /// would keep the replay busy for weeks ([`GcodeError::TooLong`]).
 pub const MAX_STEP_DURATION_S: f64 = 3600.0;
 
+/// The largest value of a motion setting a G-code file may set (mm, mm/s, mm/s^2, mm/min,
+/// Hz, s, in the command's own units; `SET_VELOCITY_LIMIT`, `M201`-`M205`, `M566`,
+/// `M593`, `G1 F`, GRBL's `$` lines): none comes near it; larger is a typing error.
+pub const MAX_LIMIT_VALUE: f64 = 1e9;
+
+/// The least value of a motion setting that must be above 0 (a velocity, acceleration,
+/// feed, junction deviation): the other end of [`MAX_LIMIT_VALUE`]. Below it the
+/// planners' arithmetic leaves the range of `f64` (`SET_VELOCITY_LIMIT VELOCITY=1e-200`
+/// planned a segment of infinite duration), and a move at 1e-9 already lasts longer than
+/// [`MAX_STEP_DURATION_S`].
+pub const MIN_LIMIT_VALUE: f64 = 1e-9;
+
 /// The most straight segments one arc may be cut into: 100,000 (a 100 m arc at Klipper's
 /// 1 mm resolution). The replay holds an arc's planned and shaped segments until the arc
 /// ends (a move's timing is complete only then), a few KB each with a shaper; a longer

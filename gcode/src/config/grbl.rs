@@ -102,15 +102,16 @@ impl GrblSettings {
         }
     }
 
-    /// Sets `$number` to `value` (>= 0, checked by the caller as GRBL does): `Err` with
+    /// Sets `$number` to `value` (0 to 1e9, checked by the caller): `Err` with
     /// what is allowed when GRBL would refuse the value.
     pub fn apply(&mut self, number: u16, value: f64) -> Result<(), &'static str> {
         let axis = usize::from(number % 10);
+        // The bound the G-code reader puts on a velocity or acceleration of any dialect.
         let positive = |v: f64| {
-            if v > 0.0 {
+            if (crate::read::cmd::POSITIVE.ok)(v) {
                 Ok(v)
             } else {
-                Err("greater than 0")
+                Err(crate::read::cmd::POSITIVE.allowed)
             }
         };
         match number {

@@ -79,7 +79,8 @@ pub use klipper::{
 };
 pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
 pub use rrf::{
-    RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RRF_MINIMUM_JERK_MM_S, RrfAxis, RrfConfig,
+    RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RRF_MINIMUM_ACCEL_MM_S2, RRF_MINIMUM_JERK_MM_S,
+    RrfAxis, RrfConfig,
 };
 
 use std::sync::Arc;

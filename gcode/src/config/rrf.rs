@@ -33,6 +33,12 @@ use crate::read::setting::Setting;
 /// in config.g as in a job (`M566 X0` runs at 0.1 mm/s).
 pub const RRF_MINIMUM_JERK_MM_S: f64 = 0.1;
 
+/// The least acceleration RepRapFirmware keeps (mm/s^2): `MinimumAcceleration` in
+/// src/Config/Configuration.h, applied by `Platform::SetAcceleration` to every `M201`
+/// value and by `GCodes::ConfigureAccelerations` to `M204`'s (src/GCodes/GCodes5.cpp),
+/// in config.g as in a job.
+pub const RRF_MINIMUM_ACCEL_MM_S2: f64 = 0.1;
+
 /// The kinematics by `M669 K` code (`KinematicsType`,
 /// `src/Movement/Kinematics/Kinematics.h`), named as Klipper names the same ones.
 const KINEMATICS: [&str; 15] = [
@@ -368,9 +374,40 @@ impl RrfConfig {
     }
 
     fn limits(&mut self, l: &LimitChange, at: &Location) -> Result<(), GcodeError> {
+        // An acceleration below RepRapFirmware's least runs at it, as in a job
+        // (`crate::job`'s M201 and M204).
+        let least = RRF_MINIMUM_ACCEL_MM_S2;
+        let raised = |v: &Option<f64>| v.map(|v| v.max(least));
+        let given = match l {
+            LimitChange::MaxAccel {
+                per_axis_mm_s2: a, ..
+            } => vec![a.x, a.y, a.z, a.e],
+            LimitChange::Accel {
+                print_mm_s2,
+                travel_mm_s2,
+                ..
+            } => vec![*print_mm_s2, *travel_mm_s2],
+            _ => Vec::new(),
+        };
+        if given.iter().flatten().any(|&v| v < least) {
+            self.notes.push(ConfigNote::at(
+                at.clone(),
+                format!(
+                    "{}: an acceleration below {least} mm/s^2 runs at {least}, RepRapFirmware's least (MinimumAcceleration, src/Config/Configuration.h)",
+                    l.command_name()
+                ),
+            ));
+        }
         match l {
             LimitChange::MaxAccel { per_axis_mm_s2, .. } => {
-                self.set_axes(per_axis_mm_s2, |a| &mut a.max_accel_mm_s2);
+                let a = per_axis_mm_s2;
+                let a = AxisValues {
+                    x: raised(&a.x),
+                    y: raised(&a.y),
+                    z: raised(&a.z),
+                    e: raised(&a.e),
+                };
+                self.set_axes(&a, |a| &mut a.max_accel_mm_s2);
             }
             LimitChange::MaxFeedrate { per_axis_mm_s, .. } => {
                 self.set_axes(per_axis_mm_s, |a| &mut a.max_speed_mm_s);
@@ -391,11 +428,11 @@ impl RrfConfig {
                 travel_mm_s2,
                 ..
             } => {
-                if let Some(p) = print_mm_s2 {
-                    self.print_accel_mm_s2 = *p;
+                if let Some(p) = raised(print_mm_s2) {
+                    self.print_accel_mm_s2 = p;
                 }
-                if let Some(t) = travel_mm_s2 {
-                    self.travel_accel_mm_s2 = *t;
+                if let Some(t) = raised(travel_mm_s2) {
+                    self.travel_accel_mm_s2 = t;
                 }
             }
             LimitChange::RrfInputShaping {

@@ -26,7 +26,27 @@ pub(crate) enum LimitOutcome {
     Applied,
     /// Nothing changed, for this reason.
     Ignored(&'static str),
+    /// Nothing changed: every value was dropped, each with its note.
+    Dropped,
 }
+
+/// Marlin's `M205 J` range: it keeps its junction deviation and answers "?J out of range
+/// (0.01 to 0.3)" for any other (Marlin/src/gcode/config/M200-M205.cpp), mm.
+pub(crate) const MARLIN_JUNCTION_DEVIATION_MM: std::ops::RangeInclusive<f64> = 0.01..=0.3;
+
+use crate::config::RRF_MINIMUM_ACCEL_MM_S2;
+
+/// RepRapFirmware's least minimum movement speed, mm/s (`AbsoluteMinFeedrate`,
+/// src/Config/Configuration.h; `Platform::SetMinMovementSpeed`, src/Platform/Platform.h).
+pub(crate) const RRF_ABSOLUTE_MIN_SPEED_MM_S: f64 = 0.01;
+
+const MARLIN_J_OUT_OF_RANGE: &str = "J outside 0.01 to 0.3 mm is refused by Marlin, which keeps its junction deviation (\"?J out of range\", Marlin/src/gcode/config/M200-M205.cpp)";
+const MARLIN_JERK_IN_JD_BUILD: &str = "X Y Z E (classic jerk) are read only by a Marlin built with CLASSIC_JERK; this one uses junction deviation (Marlin/src/gcode/config/M200-M205.cpp)";
+const MARLIN_J_IN_CLASSIC_BUILD: &str = "J (junction deviation) is not read by a Marlin built with CLASSIC_JERK (Marlin/src/gcode/config/M200-M205.cpp)";
+const MARLIN_XY_FREQUENCY: &str = "F and S (the XY frequency limit) are read only by a Marlin built with XY_FREQUENCY_LIMIT, off in its example configuration (Marlin/src/gcode/config/M200-M205.cpp); not modelled";
+const RRF_ACCEL_RAISED: &str = "an acceleration below 0.1 mm/s^2 runs at 0.1, RepRapFirmware's least (MinimumAcceleration, src/Config/Configuration.h; Platform::SetAcceleration, GCodes::ConfigureAccelerations)";
+const RRF_MIN_SPEED_RAISED: &str = "I below 0.01 mm/s runs at 0.01, RepRapFirmware's least (AbsoluteMinFeedrate, src/Config/Configuration.h; Platform::SetMinMovementSpeed)";
+const RRF_MAX_SPEED_RAISED: &str = "a maximum speed below the minimum movement speed (M203 I, 0.5 mm/s unless set) runs at that speed (Platform::SetMaxFeedrate, src/Platform/Platform.h)";
 
 /// One of the firmware planners.
 #[derive(Debug)]
@@ -119,8 +139,14 @@ impl Driver {
         self.planner().pop()
     }
 
-    /// Apply a limit command for the moves queued from now on.
-    pub(crate) fn apply(&mut self, change: &LimitChange) -> Result<LimitOutcome, PlanError> {
+    /// Apply a limit command for the moves queued from now on. A value the firmware
+    /// refuses, does not read or raises to its least is dropped or raised as the firmware
+    /// does, and `notes` gets what was done (the list of commands not followed).
+    pub(crate) fn apply(
+        &mut self,
+        change: &LimitChange,
+        notes: &mut Vec<&'static str>,
+    ) -> Result<LimitOutcome, PlanError> {
         const OTHER: LimitOutcome = LimitOutcome::Ignored("not a command of this firmware");
         match self {
             Driver::Klipper(p) => match change {
@@ -157,7 +183,17 @@ impl Driver {
             Driver::Marlin(p) => {
                 let mut c = *p.config();
                 match change {
-                    LimitChange::MaxAccel { per_axis_mm_s2, .. } => {
+                    LimitChange::MaxAccel {
+                        per_axis_mm_s2,
+                        xy_frequency_limit_hz,
+                        xy_frequency_min_speed_pct,
+                    } => {
+                        if xy_frequency_limit_hz.is_some() || xy_frequency_min_speed_pct.is_some() {
+                            notes.push(MARLIN_XY_FREQUENCY);
+                            if per_axis_mm_s2 == &AxisValues::default() {
+                                return Ok(LimitOutcome::Dropped);
+                            }
+                        }
                         set_axes(&mut c.max_accel_m_s2, per_axis_mm_s2);
                     }
                     LimitChange::MaxFeedrate { per_axis_mm_s, .. } => {
@@ -181,13 +217,36 @@ impl Driver {
                     } => {
                         // A Marlin build has either junction deviation (`J`) or classic
                         // jerk (`X Y Z E`); M205 reads only its own.
+                        let jerk_given = jerk_mm_s != &AxisValues::default();
+                        let mut jerk_applied = false;
                         match &mut c.jerk {
                             MarlinJerk::JunctionDeviation { deviation_m, .. } => {
-                                set(deviation_m, junction_deviation_mm);
+                                match junction_deviation_mm {
+                                    Some(j) if MARLIN_JUNCTION_DEVIATION_MM.contains(j) => {
+                                        set(deviation_m, junction_deviation_mm);
+                                        jerk_applied = true;
+                                    }
+                                    Some(_) => notes.push(MARLIN_J_OUT_OF_RANGE),
+                                    None => {}
+                                }
+                                if jerk_given {
+                                    notes.push(MARLIN_JERK_IN_JD_BUILD);
+                                }
                             }
                             MarlinJerk::Classic { max_jerk_m_s, .. } => {
                                 set_axes(max_jerk_m_s, jerk_mm_s);
+                                jerk_applied = jerk_given;
+                                if junction_deviation_mm.is_some() {
+                                    notes.push(MARLIN_J_IN_CLASSIC_BUILD);
+                                }
                             }
+                        }
+                        if !jerk_applied
+                            && min_feedrate_mm_s.is_none()
+                            && min_travel_feedrate_mm_s.is_none()
+                            && min_segment_time_s.is_none()
+                        {
+                            return Ok(LimitOutcome::Dropped);
                         }
                         set(&mut c.min_feedrate_m_s, min_feedrate_mm_s);
                         set(&mut c.min_travel_feedrate_m_s, min_travel_feedrate_mm_s);
@@ -210,24 +269,67 @@ impl Driver {
             }
             Driver::Rrf(p) => {
                 let mut c = *p.config();
+                // A value RepRapFirmware raises to its least, raised, with a note.
+                let mut raise = |v: &Option<f64>, least_mm: f64, note: &'static str| {
+                    v.map(|v| {
+                        if v < least_mm {
+                            if !notes.contains(&note) {
+                                notes.push(note);
+                            }
+                            least_mm
+                        } else {
+                            v
+                        }
+                    })
+                };
                 match change {
                     LimitChange::MaxAccel { per_axis_mm_s2, .. } => {
-                        set_axes(&mut c.max_accel_m_s2, per_axis_mm_s2);
+                        let least = RRF_MINIMUM_ACCEL_MM_S2;
+                        let a = per_axis_mm_s2;
+                        let raised = AxisValues {
+                            x: raise(&a.x, least, RRF_ACCEL_RAISED),
+                            y: raise(&a.y, least, RRF_ACCEL_RAISED),
+                            z: raise(&a.z, least, RRF_ACCEL_RAISED),
+                            e: raise(&a.e, least, RRF_ACCEL_RAISED),
+                        };
+                        set_axes(&mut c.max_accel_m_s2, &raised);
                     }
                     LimitChange::MaxFeedrate {
                         per_axis_mm_s,
                         min_speed_mm_s,
                     } => {
-                        set_axes(&mut c.max_feedrate_m_s, per_axis_mm_s);
-                        set(&mut c.min_movement_speed_m_s, min_speed_mm_s);
+                        // `M203` sets the minimum first and keeps every maximum at least
+                        // that (src/GCodes/GCodes2.cpp case 203).
+                        let min = raise(
+                            min_speed_mm_s,
+                            RRF_ABSOLUTE_MIN_SPEED_MM_S,
+                            RRF_MIN_SPEED_RAISED,
+                        );
+                        set(&mut c.min_movement_speed_m_s, &min);
+                        let least = c.min_movement_speed_m_s / MM;
+                        let f = per_axis_mm_s;
+                        let raised = AxisValues {
+                            x: raise(&f.x, least, RRF_MAX_SPEED_RAISED),
+                            y: raise(&f.y, least, RRF_MAX_SPEED_RAISED),
+                            z: raise(&f.z, least, RRF_MAX_SPEED_RAISED),
+                            e: raise(&f.e, least, RRF_MAX_SPEED_RAISED),
+                        };
+                        set_axes(&mut c.max_feedrate_m_s, &raised);
                     }
                     LimitChange::Accel {
                         print_mm_s2,
                         travel_mm_s2,
                         ..
                     } => {
-                        set(&mut c.print_accel_m_s2, print_mm_s2);
-                        set(&mut c.travel_accel_m_s2, travel_mm_s2);
+                        let least = RRF_MINIMUM_ACCEL_MM_S2;
+                        set(
+                            &mut c.print_accel_m_s2,
+                            &raise(print_mm_s2, least, RRF_ACCEL_RAISED),
+                        );
+                        set(
+                            &mut c.travel_accel_m_s2,
+                            &raise(travel_mm_s2, least, RRF_ACCEL_RAISED),
+                        );
                     }
                     // `M205` sets the printing moves' jerk below the `M566` limit; this
                     // model has one jerk per axis (the limit), so it is not applied.

@@ -13,17 +13,18 @@ pub(crate) struct Check {
     pub(crate) allowed: &'static str,
 }
 
-/// No value of a motion setting in mm, s, Hz or their ratios comes near this; larger ones
-/// are typing errors or garbage.
-pub(crate) const SANE: f64 = 1e9;
+/// [`crate::MAX_LIMIT_VALUE`].
+pub(crate) const SANE: f64 = crate::MAX_LIMIT_VALUE;
+/// [`crate::MIN_LIMIT_VALUE`].
+pub(crate) const SANE_SMALL: f64 = crate::MIN_LIMIT_VALUE;
 
 pub(crate) const FINITE: Check = Check {
     ok: |v| v.abs() <= SANE,
     allowed: "a finite number up to 1e9 in size",
 };
 pub(crate) const POSITIVE: Check = Check {
-    ok: |v| v > 0.0 && v <= SANE,
-    allowed: "greater than 0, up to 1e9",
+    ok: |v| (SANE_SMALL..=SANE).contains(&v),
+    allowed: "from 1e-9 to 1e9",
 };
 pub(crate) const NON_NEGATIVE: Check = Check {
     ok: |v| (0.0..=SANE).contains(&v),
@@ -115,6 +116,27 @@ impl Cmd<'_> {
                 param: param.to_string(),
                 text: self.args[at..end].to_string(),
             },
+            // Letters glued to a number (`S3000mm`): the second `m` is a duplicate to the
+            // parser, the value's units junk to the user; name the value.
+            ParamError::Duplicate { at, .. }
+                if matches!(self.name, CmdName::Code { .. })
+                    && at > 0
+                    && self.args.as_bytes()[at - 1].is_ascii_alphabetic() =>
+            {
+                let word_at = self.args[..at]
+                    .rfind(|c: char| !(c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '+')))
+                    .map_or(0, |i| i + 1);
+                let end = self.args[at..]
+                    .find(|c: char| !c.is_ascii_alphanumeric())
+                    .map_or(self.args.len(), |i| at + i);
+                let word = &self.args[word_at..end];
+                GcodeError::NotANumber {
+                    at: self.at(Some(word_at)),
+                    command: self.name(),
+                    param: word[..1].to_ascii_uppercase(),
+                    text: word[1..].to_string(),
+                }
+            }
             ParamError::Duplicate { param, at } => {
                 let param = match self.name {
                     CmdName::Named(_) => self.args[at..]

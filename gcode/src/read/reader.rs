@@ -538,7 +538,11 @@ impl Interp {
                 self.motion.set_e_relative(number == 83);
             }
             (b'M', 400) => self.push(line, EventKind::Dwell { duration_s: 0.0 }),
-            (b'M', 220 | 221) => factor(&mut self.motion, self.opts.dialect, cmd, number, p)?,
+            (b'M', 220 | 221) => {
+                if let Some(note) = factor(&mut self.motion, self.opts.dialect, cmd, number, p)? {
+                    self.push(line, EventKind::Note(note));
+                }
+            }
             (b'M', n) if is_rrf_setting(n) => {
                 match setting_parse::m_code(self.opts.dialect, cmd, number, p)? {
                     setting_parse::Outcome::Setting(s) => self.push(line, EventKind::Setting(s)),
@@ -646,14 +650,15 @@ fn feature_name(comment: &str) -> Option<&str> {
 /// `M220 S` (feed factor) and `M221 S` (extrusion factor), percent: Klipper
 /// `cmd_M220`/`cmd_M221` (klippy/extras/gcode_move.py; without `S` they reset to
 /// 100 %), Marlin `M220.cpp`/`M221.cpp` (whole percent; without `S` they report),
-/// RepRapFirmware (`GCodes2.cpp`; without `S` they report).
+/// RepRapFirmware (`GCodes2.cpp`; without `S` they report; below 1 % they change nothing,
+/// returned as a note).
 fn factor(
     motion: &mut Motion,
     dialect: Dialect,
     cmd: &Cmd,
     number: u32,
     p: &Params,
-) -> Result<(), GcodeError> {
+) -> Result<Option<Note>, GcodeError> {
     let allowed: &[u8] = match dialect {
         Dialect::Marlin => b"SBRT",
         Dialect::Rrf => b"SD",
@@ -666,14 +671,23 @@ fn factor(
     };
     let percent = match (cmd.num(p, b'S', check)?, dialect) {
         (Some(s), Dialect::Marlin) => s.trunc().max(1.0),
+        // RepRapFirmware takes a factor of 0.01 or more: M220 answers "Invalid speed
+        // factor", M221 keeps its factor without a word (src/GCodes/GCodes2.cpp cases 220
+        // and 221).
+        (Some(s), Dialect::Rrf) if s < 1.0 => {
+            return Ok(Some(Note::IgnoredByFirmware {
+                command: format!("M{number}{}", cmd.args.trim_end()),
+                reason: "RepRapFirmware keeps its factor for S below 1 % (src/GCodes/GCodes2.cpp cases 220 and 221)",
+            }));
+        }
         (Some(s), _) => s,
         (None, Dialect::Klipper) => 100.0,
-        (None, _) => return Ok(()),
+        (None, _) => return Ok(None),
     };
     if number == 220 {
         motion.set_speed_factor(percent / 100.0);
     } else {
         motion.set_extrude_factor(percent / 100.0);
     }
-    Ok(())
+    Ok(None)
 }

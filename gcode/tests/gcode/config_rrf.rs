@@ -183,6 +183,28 @@ fn a_jerk_under_the_minimum_is_raised_to_it_as_the_firmware_does() {
 }
 
 #[test]
+fn an_acceleration_under_the_minimum_is_raised_to_it_as_the_firmware_does() {
+    // `Platform::SetAcceleration` and `GCodes::ConfigureAccelerations` keep 0.1 mm/s^2 at
+    // least (`MinimumAcceleration`), as a job does; the config's notes say so.
+    let c = parse("M201 X0.01 Y500\nM204 P0.05 T3000\n");
+    assert_eq!(
+        (c.axes.x.max_accel_mm_s2, c.axes.y.max_accel_mm_s2),
+        (0.1, 500.0)
+    );
+    assert_eq!((c.print_accel_mm_s2, c.travel_accel_mm_s2), (0.1, 3000.0));
+    let notes: Vec<_> = c.notes.iter().map(ToString::to_string).collect();
+    assert_eq!(notes.len(), 2, "{notes:?}");
+    assert!(
+        notes[0].contains("config.g:1") && notes[0].contains("M201"),
+        "{notes:?}"
+    );
+    assert!(
+        notes[1].contains("config.g:2") && notes[1].contains("M204"),
+        "{notes:?}"
+    );
+}
+
+#[test]
 fn m593_without_a_type_selects_zvd_and_types_are_reduced() {
     let c = parse("M593 F48.5\n");
     assert_eq!(

@@ -110,6 +110,89 @@ fn nan_infinite_and_huge_values() {
     ));
 }
 
+/// A velocity, acceleration or feed below 1e-9 (mm/s, mm/s^2, mm/min) is refused at its
+/// line, naming the command and the word, in every dialect: the planners' arithmetic
+/// leaves the range of `f64` below it (`VELOCITY=1e-200` planned a segment of infinite
+/// duration, `M204 P1e-300` in RepRapFirmware moves out of time order), and a move at
+/// 1e-9 already lasts longer than a replay runs.
+#[test]
+fn a_limit_below_1e_9_is_refused_at_its_line() {
+    let tiny = format!("0.{}1", "0".repeat(299)); // 1e-300 without an exponent
+    let cases: Vec<(String, Dialect, &str, &str)> = vec![
+        (
+            "SET_VELOCITY_LIMIT VELOCITY=1e-200".into(),
+            Dialect::Klipper,
+            "SET_VELOCITY_LIMIT",
+            "VELOCITY",
+        ),
+        (
+            "SET_VELOCITY_LIMIT ACCEL=5e-324".into(),
+            Dialect::Klipper,
+            "SET_VELOCITY_LIMIT",
+            "ACCEL",
+        ),
+        (
+            "SET_VELOCITY_LIMIT ACCEL_TO_DECEL=1e-300".into(),
+            Dialect::Klipper,
+            "SET_VELOCITY_LIMIT",
+            "ACCEL_TO_DECEL",
+        ),
+        (format!("M204 S{tiny}"), Dialect::Klipper, "M204", "S"),
+        (format!("M201 X{tiny}"), Dialect::Marlin, "M201", "X"),
+        (format!("M203 Y{tiny}"), Dialect::Marlin, "M203", "Y"),
+        (format!("M204 P{tiny}"), Dialect::Marlin, "M204", "P"),
+        (format!("M205 J{tiny}"), Dialect::Marlin, "M205", "J"),
+        ("M201 X1e-300".into(), Dialect::Rrf, "M201", "X"),
+        ("M204 P1e-300 T1e-300".into(), Dialect::Rrf, "M204", "P"),
+        ("M203 X1e-12".into(), Dialect::Rrf, "M203", "X"),
+        (format!("G1 X1 F{tiny}"), Dialect::Marlin, "G1", "F"),
+    ];
+    for (text, dialect, command, word) in cases {
+        match error(&text, dialect) {
+            GcodeError::OutOfRange {
+                at,
+                command: c,
+                param,
+                value,
+                allowed,
+            } => {
+                assert_eq!(
+                    (at.line, c.as_str(), param.as_str(), allowed),
+                    (1, command, word, "from 1e-9 to 1e9"),
+                    "{text}"
+                );
+                assert!(value > 0.0 && value < 1e-9, "{text}: {value}");
+            }
+            e => panic!("{text}: {e}"),
+        }
+    }
+    // 1e-9 itself is read.
+    let text = "SET_VELOCITY_LIMIT VELOCITY=1e-9 ACCEL=1e-9\nM204 S0.000000001\n";
+    assert_eq!(crate::limits(text, Dialect::Klipper).len(), 2);
+}
+
+/// A value with units glued to it (`M204 S3000mm`) is named as the value that is not a
+/// number, not as the second `m` seen twice; a letter given twice still is.
+#[test]
+fn units_after_a_value_name_the_value() {
+    for d in [Dialect::Klipper, Dialect::Marlin, Dialect::Rrf] {
+        let e = error("M204 S3000mm", d);
+        assert_eq!(
+            e.to_string(),
+            "<input>:1:6: `M204` parameter S: `3000mm` is not a number (allowed: decimal like -12.5)",
+            "{d:?}"
+        );
+    }
+    assert!(matches!(
+        error("M204 S3000 S4000", Dialect::Marlin),
+        GcodeError::DuplicateParameter { .. }
+    ));
+    assert!(matches!(
+        error("G1X10X20", Dialect::Marlin),
+        GcodeError::DuplicateParameter { .. }
+    ));
+}
+
 #[test]
 fn feed_must_be_positive() {
     for text in ["G1 X1 F0", "G1 X1 F-100", "G0 F0"] {
@@ -123,7 +206,7 @@ fn feed_must_be_positive() {
             } => {
                 assert_eq!((at.line, param.as_str()), (1, "F"));
                 assert!(value <= 0.0);
-                assert!(allowed.contains("greater than 0"));
+                assert_eq!(allowed, "from 1e-9 to 1e9");
             }
             e => panic!("{text}: {e}"),
         }
@@ -132,7 +215,7 @@ fn feed_must_be_positive() {
     let e = error("G1 X1\nG1 X2 F0", Dialect::Klipper).to_string();
     assert_eq!(
         e,
-        "<input>:2:7: `G1` parameter F = 0: out of range (allowed: greater than 0, up to 1e9)"
+        "<input>:2:7: `G1` parameter F = 0: out of range (allowed: from 1e-9 to 1e9)"
     );
 }
 

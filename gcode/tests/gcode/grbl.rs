@@ -296,6 +296,32 @@ fn a_setting_grbl_refuses_is_named_as_grbl_writes_it() {
         .expect_err("GRBL refuses a max rate of 0");
     assert_eq!(
         e.to_string(),
-        "grbl.txt:2: $110 = `0`: not allowed (allowed: greater than 0)"
+        "grbl.txt:2: $110 = `0`: not allowed (allowed: from 1e-9 to 1e9)"
     );
+}
+
+/// A `$` value GRBL would not read, or beyond the 1e9 every other dialect's limits stop
+/// at, is refused at its line: GRBL's `read_float` reads no exponent, so `$120=1e300`
+/// leaves `e300` after the number (error:3, grbl/nuts_bolts.c, grbl/system.c); the same
+/// in a settings file. A plain decimal up to 1e9 is read.
+#[test]
+fn a_setting_value_grbl_cannot_read_or_above_1e9_is_refused() {
+    for (text, part) in [
+        ("$120=1e300", "error:3"),
+        ("$120=3000mm", "error:3"),
+        ("$110=6e3", "error:3"),
+        ("$120=10000000000", "0 to 1e9"),
+        ("$11=1000000001", "0 to 1e9"),
+        ("$120=nan", "error:2"),
+    ] {
+        let e = crate::error(&format!("G21\n{text}\nG1 X1 F100\n"), Dialect::Grbl);
+        assert_eq!(e.line(), Some(2), "{text}");
+        assert!(e.to_string().contains(part), "{text}: {e}");
+        let e = settle_gcode::config::GrblSettings::parse(&format!("{text}\n"), "grbl.txt")
+            .expect_err(text);
+        assert!(e.to_string().contains(part), "{text}: {e}");
+    }
+    let s = settle_gcode::config::GrblSettings::parse("$120=1000000000\n$110=+6000.\n", "grbl.txt")
+        .expect("plain decimals");
+    assert_eq!((s.accel_mm_s2[0], s.max_rate_mm_min[0]), (1e9, 6000.0));
 }

@@ -335,3 +335,69 @@ fn a_shaper_name_is_one_the_firmware_knows_and_the_error_lists_its_own() {
     assert!(e.contains("none, zvd, zvdd, zvddd, mzv, ei2, ei3"), "{e}");
     assert!(!e.contains("2hump_ei"), "{e}");
 }
+
+/// What a firmware refuses, does not read or raises to its least, the job refuses, drops
+/// or raises the same way, and lists among the commands not followed: Marlin keeps its
+/// junction deviation for `M205 J` outside 0.01 to 0.3 mm and does not read classic
+/// jerk in a junction-deviation build or `M201 F`/`S` without XY_FREQUENCY_LIMIT
+/// (Marlin/src/gcode/config/M200-M205.cpp); RepRapFirmware raises an acceleration below
+/// 0.1 mm/s^2 to 0.1 (src/Platform/Platform.h, src/GCodes/GCodes5.cpp) and keeps its
+/// speed factor for `M220 S` below 1 (src/GCodes/GCodes2.cpp).
+#[test]
+fn values_a_firmware_refuses_or_raises_are_dropped_or_raised_and_listed() {
+    let not_followed = |s: &settle_gcode::job::JobSummary, command: &str, part: &str| {
+        assert!(
+            s.ignored
+                .keys()
+                .any(|k| k.starts_with(&format!("{command}: ")) && k.contains(part)),
+            "{command} {part}: {:?}",
+            s.ignored
+        );
+    };
+    let marlin = || job(PlannerConfig::Marlin(MarlinConfig::new()));
+    let base = "G1 X50 F6000\nG1 Y50\nG1 X0\n";
+    let (_, plain) = run(base, marlin());
+    for (line, part) in [
+        ("M205 J5", "0.01 to 0.3"),
+        ("M205 J0.001", "0.01 to 0.3"),
+        ("M205 X0.5 Y0.5", "CLASSIC_JERK"),
+        ("M201 F5 S50", "XY_FREQUENCY_LIMIT"),
+    ] {
+        let (_, s) = run(&format!("{line}\n{base}"), marlin());
+        assert_eq!(
+            s.print_time_s, plain.print_time_s,
+            "{line}: nothing changes"
+        );
+        assert_eq!(s.limit_changes, 0, "{line}");
+        not_followed(&s, &line[..4], part);
+    }
+    // The part Marlin reads still applies: J 0.3 beside X.
+    let (_, s) = run(&format!("M205 J0.3 X0.5\n{base}"), marlin());
+    assert_eq!(s.limit_changes, 1);
+    assert!(
+        s.print_time_s < plain.print_time_s,
+        "a larger deviation corners faster"
+    );
+    not_followed(&s, "M205", "CLASSIC_JERK");
+
+    // RepRapFirmware: M204 P0.01 runs as M204 P0.1.
+    let rrf = || job(PlannerConfig::Rrf(RrfConfig::new()));
+    let (_, low) = run(&format!("M204 P0.01 T0.01\n{base}"), rrf());
+    let (_, least) = run(&format!("M204 P0.1 T0.1\n{base}"), rrf());
+    assert_eq!(low.print_time_s, least.print_time_s);
+    not_followed(&low, "M204", "0.1 mm/s^2");
+    let (_, low) = run(&format!("M201 X0.01 Y0.01\n{base}"), rrf());
+    let (_, least) = run(&format!("M201 X0.1 Y0.1\n{base}"), rrf());
+    assert_eq!(low.print_time_s, least.print_time_s);
+    not_followed(&low, "M201", "0.1 mm/s^2");
+    // A maximum speed below the minimum movement speed runs at it.
+    let (_, low) = run(&format!("M203 X1 Y1\n{base}"), rrf());
+    let (_, least) = run(&format!("M203 X30 Y30\n{base}"), rrf());
+    assert_eq!(low.print_time_s, least.print_time_s);
+    not_followed(&low, "M203", "minimum movement speed");
+    // M220 S0.5 changes nothing.
+    let (_, plain) = run(base, rrf());
+    let (_, s) = run(&format!("M220 S0.5\n{base}"), rrf());
+    assert_eq!(s.print_time_s, plain.print_time_s);
+    not_followed(&s, "M220", "below 1 %");
+}

@@ -70,6 +70,24 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         "G28\nM83\nG1 X10 Y10 F3000\nG999\nFOO\nhello\nG1 X20 Y10 E1\nG1 X20 Y20 E1\n",
     );
     sb.write("sc_secret.toml", GCODE_SECRET);
+    // Motion limits a file sets that no planner can run at, or that its firmware refuses.
+    let square = "G1 X20 Y10 E1\nG1 X20 Y20 E1\nG1 X10 Y20 E1\n";
+    sb.write(
+        "crawl_limit.gcode",
+        &format!("M83\nG1 X10 Y10 F3000\nSET_VELOCITY_LIMIT VELOCITY=1e-200\n{square}"),
+    );
+    sb.write(
+        "rrf_crawl.gcode",
+        &format!("M83\nG1 X10 Y10 F3000\nM204 P1e-300 T1e-300\n{square}"),
+    );
+    sb.write(
+        "grbl_exponent.nc",
+        "G21\n$120=1e300\nM4 S1000\nG1 X10 Y10 F3000\nG1 X20 Y10\nM5\n",
+    );
+    sb.write(
+        "marlin_j.gcode",
+        &format!("M83\nG1 X10 Y10 F3000\nM205 J5\n{square}"),
+    );
     sb.write(
         "far.toml",
         &scenario_with("distance_mm = 5.0", "distance_mm = 1.0\nstart_mm = 1e15"),
@@ -222,7 +240,7 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
                 "grbl_zero.txt:2",
                 "key `$110`",
                 "$110 = `0`",
-                "greater than 0",
+                "from 1e-9 to 1e9",
             ],
         ),
         // A 100 m circle at 1 mm: its segments would be held until it ends.
@@ -346,6 +364,40 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             Expect::answered(&["`p0` is missing"]),
         )
         .stdin("{\"pf\":[1],\"vmax\":[1],\"amax\":[2],\"jmax\":[10]}\n"),
+        // A velocity or acceleration below 1e-9 overflowed the planners (a segment of
+        // infinite duration, moves out of time order): refused at its line, in every
+        // dialect; a GRBL `$` value GRBL cannot read (its read_float has no exponent).
+        refused(
+            "gcode with SET_VELOCITY_LIMIT VELOCITY=1e-200",
+            "gcode crawl_limit.gcode --machine printer_xy --out o",
+            &[
+                "crawl_limit.gcode:3",
+                "`SET_VELOCITY_LIMIT` parameter VELOCITY = 1e-200",
+                "from 1e-9 to 1e9",
+            ],
+        ),
+        refused(
+            "gcode --firmware rrf with M204 P1e-300",
+            "gcode rrf_crawl.gcode --firmware rrf --machine printer_xy --out o",
+            &[
+                "rrf_crawl.gcode:3",
+                "`M204` parameter P = 1e-300",
+                "from 1e-9 to 1e9",
+            ],
+        ),
+        refused(
+            "gcode --firmware grbl with $120=1e300",
+            "gcode grbl_exponent.nc --firmware grbl --machine printer_xy --out o",
+            &["grbl_exponent.nc:2", "`$120`", "error:3"],
+        ),
+        // Marlin keeps its junction deviation for J outside 0.01-0.3 mm: so does settle,
+        // and says so.
+        Case::line(
+            "gcode --firmware marlin with M205 J5",
+            "gcode marlin_j.gcode --firmware marlin --machine printer_xy --out o_j",
+            &["o_j"],
+            Expect::answered(&["not followed: M205 (1x)"]),
+        ),
         Case::line(
             "gcode lists unknown words as not followed",
             "gcode words.gcode --machine printer_xy --out o_words",

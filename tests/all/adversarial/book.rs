@@ -88,6 +88,11 @@ fn the_book_lists_every_limit_as_the_code_has_it() {
         "at most {} distinct names",
         settle_gcode::MAX_FEATURES
     ));
+    has(format!(
+        "{:e} to {:e} in the file's units",
+        settle_gcode::MIN_LIMIT_VALUE,
+        settle_gcode::MAX_LIMIT_VALUE
+    ));
     use settle_identify::read::{MAX_ACCEL_MM_S2, MAX_PSD, MIN_PEAK_PSD, MIN_VIBRATION_MM_S2};
     has(format!("within +-{MAX_ACCEL_MM_S2:.0e} mm/s^2"));
     has(format!("at least {MIN_VIBRATION_MM_S2:.0e} mm/s^2"));

@@ -423,13 +423,18 @@ impl<R: BufRead> Job<R> {
             return Ok(());
         };
         let before = d.limits();
+        let mut notes = Vec::new();
         let outcome = d
-            .apply(change)
+            .apply(change, &mut notes)
             .map_err(|e| plan_error(&self.source, line, command, e))?;
         let after = d.limits();
+        for why in notes {
+            self.ignore(format!("{command}: {why}"));
+        }
         match outcome {
             LimitOutcome::Applied => self.limit_changes += 1,
             LimitOutcome::Ignored(why) => self.ignore(format!("{command}: {why}")),
+            LimitOutcome::Dropped => {}
         }
         self.note_overrides(line, command, &before, &after);
         Ok(())

@@ -88,19 +88,50 @@ pub(crate) fn line(
     let number = n
         .parse::<u16>()
         .map_err(|_| unsupported("a setting's number is a whole number 0-65535"))?;
+    // grbl/nuts_bolts.c `read_float`: a sign, digits and one point; "'E' notation will not
+    // be recognized". No digit is error:2; anything after the number (`1e300`, `3000mm`)
+    // is error:3 (grbl/system.c `system_execute_line`).
+    let digits = v.trim_start_matches(['-', '+']);
+    let number_len = digits
+        .char_indices()
+        .scan(false, |point, (i, c)| match c {
+            '0'..='9' => Some(i + 1),
+            '.' if !*point => {
+                *point = true;
+                Some(i + 1)
+            }
+            _ => None,
+        })
+        .last()
+        .unwrap_or(0);
+    if !digits[..number_len].contains(|c: char| c.is_ascii_digit()) {
+        return Err(unsupported(
+            "a setting's value is a number (error:2, grbl/system.c)",
+        ));
+    }
+    if number_len < digits.len() {
+        return Err(unsupported(
+            "a setting's value is a plain decimal: GRBL reads no exponent and nothing after the number (error:3, grbl/system.c; grbl/nuts_bolts.c read_float)",
+        ));
+    }
     let value = v
         .parse::<f64>()
         .ok()
         .filter(|x| x.is_finite())
         .ok_or_else(|| unsupported("a setting's value is a number (error:2, grbl/system.c)"))?;
+    let out_of_range = |allowed| GcodeError::OutOfRange {
+        at: at(None),
+        command: format!("${number}"),
+        param: "value".into(),
+        value,
+        allowed,
+    };
     if value < 0.0 {
-        return Err(GcodeError::OutOfRange {
-            at: at(None),
-            command: format!("${number}"),
-            param: "value".into(),
-            value,
-            allowed: "0 or more (error:4, grbl/settings.c)",
-        });
+        return Err(out_of_range("0 or more (error:4, grbl/settings.c)"));
+    }
+    // The bound the reader puts on every motion word of the other dialects.
+    if value > crate::read::cmd::SANE {
+        return Err(out_of_range("0 to 1e9"));
     }
     if state.moving {
         return busy(format!("${number}={v}"), out);
