@@ -357,3 +357,49 @@ max_step_s = 0.002
     let own = status(&SCAN.replace("[sim]\nmax_step_s = 0.002\n", ""));
     assert_eq!(own.name(), "ok", "{own:?}");
 }
+
+/// `settle gcode` on a machine that blows up before the first extruding move (an
+/// undamped 0.01 Hz mode of weight 10 per axis: the toolhead drifts 0.1 m off its command
+/// within a second of the start G-code's travel): a failed run (exit 0, 1 with
+/// `--fail-on-failed-runs`) whose contour error was never measured, and says so on stdout,
+/// in summary.md and in report.html instead of a worst error of 0.00 um.
+#[test]
+fn a_gcode_job_that_faults_before_working_says_nothing_was_measured() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let machine = write(
+        dir.path(),
+        "drift.toml",
+        "name = \"drift\"\n\
+         [axis.x]\nmodes = [{ frequency_hz = 0.01, damping_ratio = 0.0, weight = 10.0 }]\n\
+         [axis.y]\nmodes = [{ frequency_hz = 0.01, damping_ratio = 0.0, weight = 10.0 }]\n",
+    );
+    let job = |out: &str, extra: &[&str]| {
+        settle()
+            .args(["gcode", "gcode/prints/ringing_tower.gcode", "--machine"])
+            .arg(&machine)
+            .arg("--out")
+            .arg(dir.path().join(out))
+            .args(extra)
+            .output()
+            .expect("runs")
+    };
+    let out = job("o", &[]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("simulation fault: blow-up"), "{stderr}");
+    assert!(
+        stdout.contains("contour error not measured") && !stdout.contains("0.00 um"),
+        "{stdout}"
+    );
+    let summary = std::fs::read_to_string(dir.path().join("o/summary.md")).expect("summary");
+    assert!(
+        summary.contains("| not measured | not measured |"),
+        "{summary}"
+    );
+    let html = std::fs::read_to_string(dir.path().join("o/report.html")).expect("report");
+    assert!(html.contains("contour error not measured"), "report.html");
+    assert_eq!(job("o2", &["--fail-on-failed-runs"]).status.code(), Some(1));
+}

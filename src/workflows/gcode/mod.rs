@@ -343,22 +343,41 @@ impl GcodeOutcome {
         &self.streamed.maps
     }
 
+    /// Whether the simulation faulted before any working sample: the contour error was
+    /// not measured at all (its numbers would read 0).
+    pub fn measured_nothing(&self) -> bool {
+        self.streamed.fault.is_some() && self.streamed.all.total() == 0
+    }
+
     /// What the binary prints; [`Exit::RunsFailed`] when the simulation failed (lost steps,
     /// a fault): a result, written and reported, not a failure of the command.
     pub fn report(&self) -> Report {
         let failed = self.streamed.fault.is_some() || self.streamed.lost_steps > 0;
         let mut r = Report::new(if failed { Exit::RunsFailed } else { Exit::Ok });
+        let error = if self.measured_nothing() {
+            "contour error not measured: the simulation faulted before any working sample (below)"
+                .to_string()
+        } else {
+            format!(
+                "contour error worst {:.2} um, p95 {:.2} um (smoothing worst {:.2} um, vibration worst {:.2} um){}",
+                self.worst_um,
+                self.p95_um,
+                self.streamed.split_worst.smoothing_um,
+                self.streamed.split_worst.vibration_um,
+                if self.streamed.fault.is_some() {
+                    ", before the simulation fault (below)"
+                } else {
+                    ""
+                }
+            )
+        };
         r.out(format!(
-            "{}: {} on {} ({}): print time {:.1} s, contour error worst {:.2} um, p95 {:.2} um (smoothing worst {:.2} um, vibration worst {:.2} um)",
+            "{}: {} on {} ({}): print time {:.1} s, {error}",
             self.file.display(),
             self.firmware,
             self.machine,
             self.backend.name(),
             self.print_time_s,
-            self.worst_um,
-            self.p95_um,
-            self.streamed.split_worst.smoothing_um,
-            self.streamed.split_worst.vibration_um
         ));
         if let Some((settings, notes)) = &self.config {
             r.out(settings.clone());

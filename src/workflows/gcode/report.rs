@@ -126,15 +126,19 @@ pub fn summary_md(o: &GcodeOutcome, maps: &[String]) -> String {
         "| print time | worst contour error | p95 contour error | worst smoothing | worst vibration | simulated |"
     );
     let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|");
+    let um = |v: f64| match o.measured_nothing() {
+        true => "not measured".to_string(),
+        false => format!("{v:.2} um"),
+    };
     let _ = writeln!(
         s,
-        "| {:.1} s ({:.1} min) | {:.2} um | {:.2} um | {:.2} um | {:.2} um | {:.1} s of print |\n",
+        "| {:.1} s ({:.1} min) | {} | {} | {} | {} | {:.1} s of print |\n",
         o.print_time_s,
         o.print_time_s / 60.0,
-        o.worst_um,
-        o.p95_um,
-        o.streamed.split_worst.smoothing_um,
-        o.streamed.split_worst.vibration_um,
+        um(o.worst_um),
+        um(o.p95_um),
+        um(o.streamed.split_worst.smoothing_um),
+        um(o.streamed.split_worst.vibration_um),
         o.streamed.simulated_s
     );
     let _ = writeln!(
@@ -508,8 +512,16 @@ pub fn html_report(
         .into_iter()
         .map(|(what, why)| format!("{what}: {why}"))
         .collect();
+    let error = if o.measured_nothing() {
+        "contour error not measured (the simulation faulted before any working sample)".to_string()
+    } else {
+        format!(
+            "contour error worst {:.2} um, p95 {:.2} um",
+            o.worst_um, o.p95_um
+        )
+    };
     intro.push(format!(
-        "{} planner on {} ({} backend): print time {:.2} s{}, contour error worst {:.2} um, p95 {:.2} um; {:.1} s of print simulated.",
+        "{} planner on {} ({} backend): print time {:.2} s{}, {error}; {:.1} s of print simulated.",
         o.setting,
         o.machine,
         o.backend.name(),
@@ -519,8 +531,6 @@ pub fn html_report(
         } else {
             String::new()
         },
-        o.worst_um,
-        o.p95_um,
         o.streamed.simulated_s
     ));
     intro.push(format!(
