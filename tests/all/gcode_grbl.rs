@@ -179,7 +179,8 @@ fn each_layer_gives_each_feature_types_worst_and_p95() {
 /// `hypot(0.5, 0.5) / steps_per_mm`, plus the corner bridge of a junction's speed jump
 /// (docs/guide/your-print.md: below 0.1 um here). At 40 steps/mm (the Shapeoko 3's
 /// `$100`, gcode/prints/shapeoko3_grbl_settings.txt) that is 17.68 um; at 1000 steps/mm,
-/// 0.71 um, and the job's smoothing falls with it: it is the step grid's.
+/// 0.71 um, and the job's smoothing falls with it: it is the step grid's. summary.md says
+/// so with the job's numbers.
 #[test]
 fn a_real_fusion_360_jobs_smoothing_is_grbls_step_grid() {
     let file = crate::support::root().join("gcode/prints/cnc/1084_btn_18bit_first.nc");
@@ -199,6 +200,14 @@ fn a_real_fusion_360_jobs_smoothing_is_grbls_step_grid() {
         assert!(
             smoothing > 0.0 && smoothing <= bound,
             "{steps} steps/mm: smoothing {smoothing} um, bound {bound} um"
+        );
+        // summary.md gives the job's own half step and the bound.
+        let summary = settle::workflows::gcode::report::summary_md(&out, &[]);
+        let half = format!("X {0:.2} um, Y {0:.2} um here", 0.5e3 / steps);
+        let together = format!("up to {:.2} um together", bound - 0.1);
+        assert!(
+            summary.contains(&half) && summary.contains(&together),
+            "{summary}"
         );
         worst.push(smoothing);
     }

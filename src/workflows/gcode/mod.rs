@@ -330,6 +330,9 @@ pub struct GcodeOutcome {
     pub linearised_at: Option<LinPoint>,
     /// The planner's settings read from `--config`, in words, and the reader's notes.
     pub config: Option<(String, Vec<String>)>,
+    /// GRBL's steps per mm of X and Y at the job's start (`$100`, `$101`): GRBL rounds
+    /// every target to whole steps. `None` for the other firmwares.
+    pub grbl_steps_per_mm: Option<[f64; 2]>,
 }
 
 impl GcodeOutcome {
@@ -808,6 +811,12 @@ fn simulate(
                 c.notes.clone(),
             )
         }),
+        grbl_steps_per_mm: match &opts.job.planner {
+            settle_gcode::job::PlannerConfig::Grbl(g) => {
+                Some([g.steps_per_mm[0], g.steps_per_mm[1]])
+            }
+            _ => None,
+        },
     };
     Ok((outcome, rec))
 }

@@ -12,7 +12,6 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use settle_gcode::job::ShaperSetting;
-use settle_planner::firmware::Firmware;
 
 use std::io::BufRead as _;
 
@@ -151,12 +150,15 @@ trades for speed (zero without one), and vibration, the distance from the toolhe
 commanded position's own path (a lag along it is not vibration), what the machine adds \
 (zero on a rigid one); each column is that part's own largest.\n"
     );
-    if o.firmware == Firmware::Grbl {
+    if let Some([x, y]) = o.grbl_steps_per_mm {
+        let (hx, hy) = (0.5e3 / x, 0.5e3 / y);
         let _ = writeln!(
             s,
             "GRBL rounds every target to whole steps (`$100`-`$102`, grbl/planner.c), so its \
-command runs up to half a step off the written path (12.5 um at 40 steps/mm): that counts \
-as smoothing, with a shaper or without.\n"
+command runs up to half a step off the written path on each axis: X {hx:.2} um, Y {hy:.2} um \
+here ($100 {x}, $101 {y} steps/mm at the job's start), up to {:.2} um together; that counts \
+as smoothing, with a shaper or without.\n",
+            hx.hypot(hy)
         );
     }
     if let Some((settings, _)) = &o.config {
