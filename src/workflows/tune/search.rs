@@ -519,6 +519,10 @@ impl BandSource {
         match *self {
             BandSource::None => "no frequency band (the shapers' own frequencies only)".into(),
             BandSource::Given => format!("+-{pct:.3}% (the given frequency tolerance)"),
+            BandSource::Identified(f, s) if 200.0 * s / f > pct * (1.0 + 1e-9) => format!(
+                "+-{pct:.3}%, the widest band a tune checks: 2 sigma of the identified {f:.2} +- {s:.3} Hz mode, from the machine file, is +-{:.3}%, so the shapers are not checked over all of it",
+                200.0 * s / f
+            ),
             BandSource::Identified(f, s) => format!(
                 "+-{pct:.3}% (2 sigma of the identified {f:.2} +- {s:.3} Hz mode, from the machine file)"
             ),
@@ -526,5 +530,23 @@ impl BandSource {
                 "+-{pct:.3}% (the given frequency tolerance; the identified {f:.2} +- {s:.3} Hz mode's 2 sigma band is narrower)"
             ),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::BandSource;
+
+    #[test]
+    fn an_identified_band_wider_than_a_tune_checks_says_so() {
+        // 2 sigma of 40 +- 4 Hz is 20 %: the band itself.
+        let fits = BandSource::Identified(40.0, 4.0).describe(0.2);
+        assert!(fits.starts_with("+-20.000% (2 sigma of"), "{fits}");
+        // 2 sigma of 40 +- 12 Hz is 60 %, more than the 49 % a tune checks.
+        let capped = BandSource::Identified(40.0, 12.0).describe(0.49);
+        assert!(
+            capped.contains("the widest band a tune checks") && capped.contains("+-60.000%"),
+            "{capped}"
+        );
     }
 }
