@@ -400,13 +400,7 @@ impl RrfConfig {
         }
         match l {
             LimitChange::MaxAccel { per_axis_mm_s2, .. } => {
-                let a = per_axis_mm_s2;
-                let a = AxisValues {
-                    x: raised(&a.x),
-                    y: raised(&a.y),
-                    z: raised(&a.z),
-                    e: raised(&a.e),
-                };
+                let a = per_axis_mm_s2.map(raised);
                 self.set_axes(&a, |a| &mut a.max_accel_mm_s2);
             }
             LimitChange::MaxFeedrate { per_axis_mm_s, .. } => {

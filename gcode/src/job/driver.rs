@@ -284,12 +284,8 @@ impl Driver {
                 };
                 match change {
                     LimitChange::MaxAccel { per_axis_mm_s2, .. } => {
-                        let raised = raise_axes(
-                            &mut raise,
-                            per_axis_mm_s2,
-                            RRF_MINIMUM_ACCEL_MM_S2,
-                            RRF_ACCEL_RAISED,
-                        );
+                        let raised = per_axis_mm_s2
+                            .map(|v| raise(v, RRF_MINIMUM_ACCEL_MM_S2, RRF_ACCEL_RAISED));
                         set_axes(&mut c.max_accel_m_s2, &raised);
                     }
                     LimitChange::MaxFeedrate {
@@ -305,8 +301,7 @@ impl Driver {
                         );
                         set(&mut c.min_movement_speed_m_s, &min);
                         let least = c.min_movement_speed_m_s / MM;
-                        let raised =
-                            raise_axes(&mut raise, per_axis_mm_s, least, RRF_MAX_SPEED_RAISED);
+                        let raised = per_axis_mm_s.map(|v| raise(v, least, RRF_MAX_SPEED_RAISED));
                         set_axes(&mut c.max_feedrate_m_s, &raised);
                     }
                     LimitChange::Accel {
@@ -384,20 +379,5 @@ fn set(to: &mut f64, from: &Option<f64>) {
 fn set_axes(to: &mut [f64; 4], from: &AxisValues) {
     for (t, f) in to.iter_mut().zip([from.x, from.y, from.z, from.e]) {
         set(t, &f);
-    }
-}
-
-/// Each axis of `v` through `raise` (a value below `least` raised to it, with `note`).
-fn raise_axes(
-    raise: &mut impl FnMut(&Option<f64>, f64, &'static str) -> Option<f64>,
-    v: &AxisValues,
-    least: f64,
-    note: &'static str,
-) -> AxisValues {
-    AxisValues {
-        x: raise(&v.x, least, note),
-        y: raise(&v.y, least, note),
-        z: raise(&v.z, least, note),
-        e: raise(&v.e, least, note),
     }
 }

@@ -16,6 +16,18 @@ pub struct AxisValues {
     pub e: Option<f64>,
 }
 
+impl AxisValues {
+    /// Each axis's value through `f`, in the order X, Y, Z, E.
+    pub fn map(&self, mut f: impl FnMut(&Option<f64>) -> Option<f64>) -> AxisValues {
+        AxisValues {
+            x: f(&self.x),
+            y: f(&self.y),
+            z: f(&self.z),
+            e: f(&self.e),
+        }
+    }
+}
+
 /// Which axes a Marlin `M593`/`M493` applies to (all false = the command's default).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct AxisFlags {
