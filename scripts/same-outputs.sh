@@ -14,7 +14,8 @@
 #   - `settle gcode` on every print in gcode/prints/: plain, with --layers (and --mcap),
 #     --versus and --config (Klipper's printer.cfg, RepRapFirmware's config.g), and a layer
 #     on rapier with the full driver model; GRBL's jobs on grbl with their $$ settings; the
-#     real Fusion 360 (GRBL) and Cura (Marlin) jobs in its cnc/ and cura/ folders;
+#     real Fusion 360 (GRBL), Cura (Marlin) and Slic3r (Klipper) jobs in its cnc/, cura/
+#     and slic3r/ folders;
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
 #     what identify wrote, `settle import` of the example configurations, `settle tune` on
 #     the tune scenarios, on the imported printer and with `--criterion klipper`;
@@ -109,11 +110,13 @@ cases() {
     echo "gcode-$stem-rapier gcode $p --machine printer_xy --firmware $fw --backend rapier --driver full --layers 1..1 --out {out}"
   done
   # The real jobs in gcode/prints' folders (their provenance there): Fusion 360's milling
-  # jobs on GRBL with the Shapeoko's settings, Cura's file on Marlin.
+  # jobs on GRBL with the Shapeoko's settings, Cura's file on Marlin, Slic3r's (arcs, layers
+  # from Z) on Klipper: two of its 240 layers.
   for p in "$P"/cnc/*.nc; do
     echo "gcode-fusion-$(basename "$p" .nc) gcode $p --machine printer_xy --firmware grbl --config $P/shapeoko3_grbl_settings.txt --out {out}"
   done
   echo "gcode-cura-kreistest gcode $P/cura/Kreistest.gcode --machine printer_xy --firmware marlin --shaper mzv@48 --out {out}"
+  echo "gcode-slic3r-benchy-arcs gcode $P/slic3r/benchy_arcs.gcode --machine printer_xy --shaper mzv@48 --layers 120..121 --out {out}"
   echo "gcode-corner-modes gcode $S/gcode_corner.gcode --machine out/identify/machine.toml --firmware settle --out {out}"
   echo "machine-printer_xy machine printer_xy"
   echo "machine-leadscrew_stage machine leadscrew_stage"

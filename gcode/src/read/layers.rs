@@ -1,8 +1,9 @@
 //! Layer changes from slicer comments, or from Z when a file has none.
 //!
-//! In [`LayerMode::Auto`] the Z fallback stays off once the file names a slicer known to
-//! write layer markers in its header comments (before the first move), and from the first
-//! marker on: a purge line in the start G-code must not count as a layer.
+//! In [`LayerMode::Auto`] the Z fallback stays off once the file names, in its header
+//! comments (before the first move), a slicer whose files mark every layer
+//! ([`marks_every_layer`]), and from the first marker on: a purge line in the start G-code
+//! must not count as a layer.
 
 use crate::read::event::{LayerChange, LayerSource};
 use crate::read::geometry::Move;
@@ -19,17 +20,43 @@ pub enum LayerMode {
     ZChange,
 }
 
-/// Slicers whose files carry layer markers (as they name themselves in the header).
-const MARKING_SLICERS: [&str; 8] = [
-    "prusaslicer",
-    "superslicer",
+/// Slicers whose every file marks every layer, as they name themselves in the header
+/// (lower case).
+const MARKING_SLICERS: [&str; 5] = [
     "orcaslicer",
     "bambustudio",
     "cura_steamengine",
     "simplify3d",
     "ideamaker",
-    "slic3r",
 ];
+
+/// Slicers that mark every layer from version 2.3 on: PrusaSlicer writes `;LAYER_CHANGE`
+/// and `;Z:` at every layer from 2.3.0 (`GCode::process_layer` in its
+/// src/libslic3r/GCode.cpp; 2.2.0 writes neither), and SuperSlicer, its fork, numbers its
+/// versions after the PrusaSlicer it follows. Slic3r itself (and Slic3r Prusa Edition,
+/// which names itself "Slic3r 1.x-prusa3d") writes no marker unless the user's layer
+/// G-code does.
+const MARKING_FROM_2_3: [&str; 2] = ["prusaslicer", "superslicer"];
+
+/// Whether a header comment (lower case) names a slicer whose files mark every layer.
+fn marks_every_layer(lower: &str) -> bool {
+    if MARKING_SLICERS.iter().any(|s| lower.contains(s)) {
+        return true;
+    }
+    MARKING_FROM_2_3.iter().any(|name| {
+        lower.match_indices(name).any(|(at, _)| {
+            let version = lower[at + name.len()..].trim_start();
+            let mut parts = version.split('.').map(|p| {
+                let digits = p.len() - p.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+                p[..digits].parse::<u32>().ok()
+            });
+            match (parts.next().flatten(), parts.next().flatten()) {
+                (Some(major), Some(minor)) => (major, minor) >= (2, 3),
+                _ => false,
+            }
+        })
+    })
+}
 
 /// Z differences smaller than this are the same layer, mm.
 const SAME_Z_MM: f64 = 1e-6;
@@ -65,8 +92,7 @@ impl Layers {
     ) {
         let t = text.trim();
         if !self.moved && self.mode == LayerMode::Auto {
-            let lower = t.to_ascii_lowercase();
-            if MARKING_SLICERS.iter().any(|s| lower.contains(s)) {
+            if marks_every_layer(&t.to_ascii_lowercase()) {
                 self.z_fallback_off = true;
             }
         }

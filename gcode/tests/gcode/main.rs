@@ -18,6 +18,7 @@ mod job_util;
 mod layers;
 mod roundtrip;
 mod segments;
+mod slic3r;
 mod summary;
 
 use settle_gcode::{
