@@ -209,6 +209,12 @@ fn a_standing_state_below_the_normal_numbers_is_set_to_rest_the_same_on_both_pat
     assert_eq!(bits(&wh), bits(&gh));
     assert_eq!(observed(&p, &a), observed(&p, &b));
     for s in [&a, &b] {
-        assert!(s.axes[0].r().iter().chain(s.axes[0].rd()).all(|v| v.to_bits() == 0));
+        assert!(
+            s.axes[0]
+                .r()
+                .iter()
+                .chain(s.axes[0].rd())
+                .all(|v| v.to_bits() == 0)
+        );
     }
 }
