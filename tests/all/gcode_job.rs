@@ -301,3 +301,46 @@ fn lost_steps_are_reported_as_a_result_with_where_they_happen() {
         "report.html opens with the lost steps"
     );
 }
+
+/// A spiral vase in a file that marks no layer: every printing move rises, so no planar
+/// printing move starts a layer from Z and the whole vase is one layer. That layer's
+/// numbers are over the vase's whole height: settle says so (in the outcome, summary.md
+/// and on standard error) with the height, the first and last Z of its extruding moves.
+/// A planar print says nothing.
+#[test]
+fn a_spiral_vase_without_layer_markers_is_said_to_be_one_layer_over_its_height() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // A 20 mm square, four sides a turn, rising 0.05 mm a side from Z 0.2: 10 turns, to
+    // Z 2.2 mm.
+    let mut text = String::from("G90\nM83\nG1 Z0.2 F600\nG1 X0 Y0 F6000\n");
+    let corners = [(20.0, 0.0), (20.0, 20.0), (0.0, 20.0), (0.0, 0.0)];
+    for side in 1..=40 {
+        let (x, y) = corners[(side - 1) % 4];
+        let z = 0.2 + 0.05 * side as f64;
+        text.push_str(&format!("G1 X{x} Y{y} Z{z:.2} E0.5 F3000\n"));
+    }
+    let file = write(dir.path(), "spiral.gcode", &text);
+    let o = measure(&options(file, Firmware::Klipper)).expect("runs");
+    let spans: Vec<_> = o.layers.iter().filter_map(|l| l.print_z_mm).collect();
+    assert_eq!(spans, [[0.2, 2.2]]);
+    let words = o.non_planar_words().expect("said");
+    assert!(
+        words.starts_with("layer 0's extruding moves rise from Z 0.20 to 2.20 mm:"),
+        "{words}"
+    );
+    let report = o.report();
+    assert!(
+        report.stderr.contains(&format!("note: {words}")),
+        "{}",
+        report.stderr
+    );
+    let summary = settle::workflows::gcode::report::summary_md(&o, &[]);
+    assert!(summary.contains(&format!("Note: {words}.")), "{summary}");
+
+    // A planar square of two layers: nothing to say.
+    let planar = "G90\nM83\nG1 Z0.2 F600\nG1 X20 E1 F3000\nG1 Y20 E1\nG1 Z0.4\nG1 X0 E1\n";
+    let file = write(dir.path(), "planar.gcode", planar);
+    let o = measure(&options(file, Firmware::Klipper)).expect("runs");
+    assert_eq!(o.layers.len(), 3);
+    assert!(o.non_planar_words().is_none());
+}

@@ -108,6 +108,10 @@ pub struct LayerTime {
     /// Time spent in its working moves (s): extruding on a printer, the laser or spindle
     /// on in a feed move on a laser or mill ([`crate::Move::is_working`]).
     pub working_s: f64,
+    /// The lowest and the highest Z (mm) of its extruding moves (a printer's working
+    /// moves), where it has any: one value in a planar layer; a spiral vase in a file that
+    /// marks no layer is one layer from its bottom to its top.
+    pub print_z_mm: Option<[f64; 2]>,
 }
 
 /// A limit the file raises above the configuration it started with.

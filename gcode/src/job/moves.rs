@@ -180,6 +180,7 @@ impl Account {
                 duration_s: 0.0,
                 moves: 0,
                 working_s: 0.0,
+                print_z_mm: None,
             });
         }
         if let Some(c) = self.current.as_mut() {
@@ -190,6 +191,11 @@ impl Account {
                 // working move in a plane runs.
                 if c.z_mm.is_none() && m.start_mm.z_mm == m.end_mm.z_mm {
                     c.z_mm = Some(m.end_mm.z_mm);
+                }
+                if m.tool == crate::Tool::Off {
+                    let (a, b) = (m.start_mm.z_mm, m.end_mm.z_mm);
+                    let [lo, hi] = c.print_z_mm.get_or_insert([a, a]);
+                    (*lo, *hi) = (lo.min(a).min(b), hi.max(a).max(b));
                 }
             }
         }

@@ -8,6 +8,7 @@ mod cura;
 mod dialects;
 mod errors;
 mod features;
+mod fullcontrol;
 mod grbl;
 mod grbl_planes;
 mod job_changes;

@@ -283,9 +283,16 @@ pub struct LayerRow {
     pub duration_s: f64,
     /// Moves in it.
     pub moves: u64,
+    /// The lowest and highest Z of its extruding moves (mm;
+    /// [`settle_gcode::job::LayerTime::print_z_mm`]).
+    pub print_z_mm: Option<[f64; 2]>,
     /// Its contour-error account, when it was simulated.
     pub stats: Option<stats::LayerStats>,
 }
+
+/// A layer whose extruding moves span more Z than this (mm) is not one plane: thicker
+/// than any layer a nozzle prints.
+pub const NON_PLANAR_MM: f64 = 1.0;
 
 /// What `settle gcode` measured.
 #[derive(Debug, Clone)]
@@ -344,6 +351,27 @@ impl GcodeOutcome {
     /// The ringing maps of the worst layers.
     pub fn maps(&self) -> &[LayerMap] {
         &self.streamed.maps
+    }
+
+    /// The layers whose extruding moves are not in one plane ([`NON_PLANAR_MM`]), in
+    /// words: a file that marks no layer and prints rising (a spiral vase, non-planar
+    /// moves) has its layers from Z, and one such layer holds all of that height, so its
+    /// numbers are not a layer's. `None` when every layer is planar.
+    pub fn non_planar_words(&self) -> Option<String> {
+        let spans: Vec<(u32, [f64; 2])> = self
+            .layers
+            .iter()
+            .filter_map(|l| l.print_z_mm.map(|z| (l.layer, z)))
+            .filter(|(_, [lo, hi])| hi - lo > NON_PLANAR_MM)
+            .collect();
+        let (layer, [lo, hi]) = *spans.first()?;
+        let more = match spans.len() {
+            1 => String::new(),
+            n => format!(" (and {} more such layers)", n - 1),
+        };
+        Some(format!(
+            "layer {layer}'s extruding moves rise from Z {lo:.2} to {hi:.2} mm{more}: not one plane (a spiral vase, or non-planar moves, in a file that marks no layers), so its per-layer numbers (Z, time, contour error) are over that whole height, not one layer's"
+        ))
     }
 
     /// Whether the simulation faulted before any working sample: the contour error was
@@ -432,6 +460,9 @@ impl GcodeOutcome {
         }
         for o in &self.overrides {
             r.err(format!("note: {}", override_words(o)));
+        }
+        if let Some(w) = self.non_planar_words() {
+            r.err(format!("note: {w}"));
         }
         if !self.ignored.is_empty() {
             const SHOWN: usize = 8;
@@ -779,6 +810,7 @@ fn simulate(
             start_s: l.start_time_s,
             duration_s: l.duration_s,
             moves: l.moves,
+            print_z_mm: l.print_z_mm,
             stats: by_layer.remove(&l.layer),
         })
         .collect();

@@ -252,6 +252,9 @@ not counted), so that it starts from the vibration the layers before leave.\n",
             l.layer, l.duration_s, l.moves
         );
     }
+    if let Some(w) = o.non_planar_words() {
+        let _ = writeln!(s, "\nNote: {w}.");
+    }
     s.push_str(&super::features::summary_sections(o));
     if !o.overrides.is_empty() {
         let _ = writeln!(s, "\n## Limits the file raises\n");
@@ -554,6 +557,9 @@ pub fn html_report(
     }
     for v in &o.overrides {
         intro.push(format!("Note: {}", super::override_words(v)));
+    }
+    if let Some(w) = o.non_planar_words() {
+        intro.push(format!("Note: {w}."));
     }
     let mut tables = vec![Table {
         title: "Worst spots".into(),
