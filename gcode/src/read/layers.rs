@@ -91,10 +91,9 @@ impl Layers {
         emit: &mut Vec<(u64, u32, LayerChange)>,
     ) {
         let t = text.trim();
-        if !self.moved && self.mode == LayerMode::Auto {
-            if marks_every_layer(&t.to_ascii_lowercase()) {
-                self.z_fallback_off = true;
-            }
+        if !self.moved && self.mode == LayerMode::Auto && marks_every_layer(&t.to_ascii_lowercase())
+        {
+            self.z_fallback_off = true;
         }
         if self.mode == LayerMode::ZChange {
             return;
