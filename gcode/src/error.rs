@@ -243,8 +243,8 @@ pub enum GcodeError {
         section: String,
         /// The option.
         key: String,
-        /// Why it is needed.
-        why: &'static str,
+        /// Why it is needed (and, when includes were skipped, that one of them may set it).
+        why: String,
     },
     /// A file that includes itself, directly or through others.
     #[error("{at}: `{path}` is already being read (include cycle: {chain})")]

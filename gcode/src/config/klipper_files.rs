@@ -42,6 +42,8 @@ pub(crate) struct Loaded {
     pub(crate) store: Store,
     pub(crate) files: Vec<PathBuf>,
     pub(crate) notes: Vec<ConfigNote>,
+    /// The `[include]`s skipped because their file is not there: where, and the include.
+    pub(crate) skipped: Vec<(Location, String)>,
 }
 
 /// `path` made absolute and normalised lexically (Python's `os.path.abspath`).
@@ -70,6 +72,7 @@ struct Ctx {
     /// Files being read (absolute), outermost first.
     stack: Vec<PathBuf>,
     notes: Vec<ConfigNote>,
+    skipped: Vec<(Location, String)>,
 }
 
 /// Reads `main` (its text given, or read from disk) with its includes and SAVE_CONFIG
@@ -89,6 +92,7 @@ pub(crate) fn load(main: &Path, text: Option<&str>) -> Result<Loaded, GcodeError
         files: vec![main.to_path_buf()],
         stack: vec![absolute(main)],
         notes,
+        skipped: Vec::new(),
     };
     parse_file(&mut ctx, main, regular, &source)?;
     let mut notes = std::mem::take(&mut ctx.notes);
@@ -115,6 +119,7 @@ pub(crate) fn load(main: &Path, text: Option<&str>) -> Result<Loaded, GcodeError
         store: ctx.store,
         files: ctx.files,
         notes,
+        skipped: ctx.skipped,
     })
 }
 
@@ -262,6 +267,7 @@ fn include(ctx: &mut Ctx, from: &Path, spec: &str, at: &Location) -> Result<(), 
     if names.is_empty() && !has_magic(&pattern.to_string_lossy()) {
         ctx.notes
             .push(missing_include(at, &what, &pattern, "is not there"));
+        ctx.skipped.push((at.clone(), what));
         return Ok(());
     }
     ctx.budget.reserve(names.len(), at, &what)?;
@@ -273,6 +279,7 @@ fn include(ctx: &mut Ctx, from: &Path, spec: &str, at: &Location) -> Result<(), 
         {
             ctx.notes
                 .push(missing_include(at, &what, &name, "is a link to nothing"));
+            ctx.skipped.push((at.clone(), what.clone()));
             continue;
         }
         let abs = absolute(&name);

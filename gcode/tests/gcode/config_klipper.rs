@@ -370,6 +370,23 @@ fn includes_missing_cyclic_and_misplaced() {
         "{}",
         c.notes[0].text
     );
+    // Where a skipped file may have set what Klipper requires, the error says so.
+    std::fs::write(
+        dir.path().join("split.cfg"),
+        "[include hardware.cfg]\n[mcu]\nserial: /dev/null\n",
+    )
+    .expect("write");
+    let e = read_err(dir.path(), "split.cfg");
+    assert!(
+        matches!(&e, GcodeError::ConfigMissing { key, .. } if key == "kinematics"),
+        "{e:?}"
+    );
+    let text = e.to_string();
+    assert!(
+        text.contains("1 [include]s of files that are not there were skipped, the first [include hardware.cfg] at ")
+            && text.contains("split.cfg:1"),
+        "{text}"
+    );
     // A link to nothing, by name or matched by a wildcard, is skipped the same way.
     #[cfg(unix)]
     {
