@@ -17,7 +17,8 @@
 #     real Fusion 360 (GRBL), Cura (Marlin) and Slic3r (Klipper) jobs in its cnc/, cura/
 #     and slic3r/ folders;
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
-#     what identify wrote, `settle import` of the example configurations, `settle tune` on
+#     what identify wrote, `settle import` of the example configurations and of the real
+#     ones of gcode/tests/data/real/ (two of them also under the Benchy), `settle tune` on
 #     the tune scenarios, on the imported printer and with `--criterion klipper`;
 #   - `settle validate --backend rapier`;
 #   - `settle identify` on every spectrum of identify/tests/corpus/ (and its refusals),
@@ -54,6 +55,7 @@ S=$root/scenarios
 P=$root/gcode/prints
 VORON=$root/gcode/tests/data/klipper/voron/printer.cfg
 MINI=$root/gcode/tests/data/rrf/mini5plus/sys/config.g
+REAL=$root/gcode/tests/data/real
 CORPUS=$root/identify/tests/corpus
 LOST=$root/tests/shards/big_lost_steps.toml
 FAULT=$root/tests/faults/blowup.toml
@@ -125,6 +127,14 @@ cases() {
   echo "import-voron import klipper $VORON --out {out}/printer.toml"
   echo "import-voron-identified import klipper $VORON --machine out/identify/machine.toml --out {out}/printer.toml"
   echo "import-mini import rrf $MINI --out {out}/printer.toml"
+  # The owners' real configurations (gcode/tests/data/real/MANIFEST.md), imported and
+  # under a real job.
+  for p in voronpi zippy metis vt627; do
+    echo "import-real-$p import klipper $REAL/$p/printer.cfg --out {out}/printer.toml"
+  done
+  echo "import-real-railcore import rrf $REAL/railcore/sys/config.g --out {out}/printer.toml"
+  echo "gcode-benchy-real-vt627 gcode $P/benchy/3DBenchy.gcode --machine printer_xy --config $REAL/vt627/printer.cfg --out {out}"
+  echo "gcode-benchy-real-railcore gcode $P/benchy/3DBenchy.gcode --machine printer_xy --config $REAL/railcore/sys/config.g --out {out}"
   for s in "$S"/tune_*.toml; do
     echo "tune-$(basename "$s" .toml) tune $s --jobs 2 --out {out}"
   done

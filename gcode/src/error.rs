@@ -243,16 +243,8 @@ pub enum GcodeError {
         section: String,
         /// The option.
         key: String,
-        /// Why it is needed.
-        why: &'static str,
-    },
-    /// An include that names a file (no wildcard) that does not exist.
-    #[error("{at}: included file `{path}` does not exist")]
-    IncludeNotFound {
-        /// The include line.
-        at: Location,
-        /// The path looked for.
-        path: String,
+        /// Why it is needed (and, when includes were skipped, that one of them may set it).
+        why: String,
     },
     /// A file that includes itself, directly or through others.
     #[error("{at}: `{path}` is already being read (include cycle: {chain})")]
@@ -410,7 +402,6 @@ impl GcodeError {
             | GcodeError::ArcTooManySegments { at, .. }
             | GcodeError::ConfigSyntax { at, .. }
             | GcodeError::ConfigValue { at, .. }
-            | GcodeError::IncludeNotFound { at, .. }
             | GcodeError::IncludeCycle { at, .. }
             | GcodeError::Include { at, .. }
             | GcodeError::Plan { at, .. }

@@ -11,7 +11,7 @@ use super::klipper_files::{Loaded, load};
 use super::klipper_shaper::{self, Family};
 use super::klipper_values::{Range, Values, invalid};
 use super::machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
-use crate::error::GcodeError;
+use crate::error::{GcodeError, Location};
 // Klipper takes any max_velocity and max_accel above 0; settle takes them up to the bound
 // its G-code reader puts on SET_VELOCITY_LIMIT and M204 (1e9): at max_velocity 1e300 no
 // move can be planned (its square overflows) and every run of an import would fail.
@@ -116,7 +116,8 @@ impl KlipperConfig {
         };
         let mut notes = loaded.notes;
         let main: Arc<str> = Arc::from(main.display().to_string());
-        let printer = printer(v, &main, &mut notes)?;
+        let skipped = |e| with_skipped(e, &loaded.skipped);
+        let printer = printer(v, &main, &mut notes).map_err(skipped)?;
         let input_shaper = match loaded.store.section("input_shaper") {
             Some(_) => Some(Xyz {
                 x: shaper(v, "x")?,
@@ -126,9 +127,9 @@ impl KlipperConfig {
             None => None,
         };
         let steppers = Xyz {
-            x: stepper(v, "stepper_x", &mut notes)?,
-            y: stepper(v, "stepper_y", &mut notes)?,
-            z: stepper(v, "stepper_z", &mut notes)?,
+            x: stepper(v, "stepper_x", &mut notes).map_err(skipped)?,
+            y: stepper(v, "stepper_y", &mut notes).map_err(skipped)?,
+            z: stepper(v, "stepper_z", &mut notes).map_err(skipped)?,
         };
         Ok(KlipperConfig {
             printer,
@@ -145,7 +146,32 @@ fn missing(source: &Arc<str>, section: &str, key: &str, why: &'static str) -> Gc
         source_name: source.clone(),
         section: section.to_string(),
         key: key.to_string(),
-        why,
+        why: why.to_string(),
+    }
+}
+
+/// A required option missing where includes were skipped: the error names the first
+/// skipped include, whose file may have set it.
+fn with_skipped(e: GcodeError, skipped: &[(Location, String)]) -> GcodeError {
+    match (e, skipped.first()) {
+        (
+            GcodeError::ConfigMissing {
+                source_name,
+                section,
+                key,
+                why,
+            },
+            Some((at, what)),
+        ) => GcodeError::ConfigMissing {
+            source_name,
+            section,
+            key,
+            why: format!(
+                "{why}; {} [include]s of files that are not there were skipped, the first {what} at {at}: copy the files beside the configuration",
+                skipped.len()
+            ),
+        },
+        (e, _) => e,
     }
 }
 

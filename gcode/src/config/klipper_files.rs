@@ -4,9 +4,15 @@
 //! - `\r\n` line ends become `\n`; each line is cut at its first `#`.
 //! - `[include PATTERN]` (at the start of a line) reads the files PATTERN matches,
 //!   relative to the including file's folder, sorted by name, in place: what they set
-//!   overrides what came before and is overridden by what follows. A pattern without
-//!   wildcards must match a file; one with wildcards may match none. Included files may
-//!   include others; a file that is already being read is an include cycle.
+//!   overrides what came before and is overridden by what follows. A pattern with
+//!   wildcards may match none. A pattern without wildcards must match a file for Klipper
+//!   (`_resolve_include` raises "Include file ... does not exist"), and a link to nothing
+//!   fails when Klipper opens it; settle reads on without such a file and lists each one
+//!   as a note (file and line of the `[include]`): a configuration copied off the printer
+//!   (a backup repository) lacks the files that were links out of the configuration
+//!   folder (KAMP, Happy Hare, mainsail.cfg, moonraker-timelapse), and what they would
+//!   set is then not known. Included files may include others; a file that is already
+//!   being read is an include cycle.
 //! - The SAVE_CONFIG block: everything after the exact three-line header
 //!   `#*# <---------------------- SAVE_CONFIG ---------------------->` ... at the end of
 //!   the main file, each line prefixed `#*# `. It is read after the rest (includes
@@ -36,6 +42,8 @@ pub(crate) struct Loaded {
     pub(crate) store: Store,
     pub(crate) files: Vec<PathBuf>,
     pub(crate) notes: Vec<ConfigNote>,
+    /// The `[include]`s skipped because their file is not there: where, and the include.
+    pub(crate) skipped: Vec<(Location, String)>,
 }
 
 /// `path` made absolute and normalised lexically (Python's `os.path.abspath`).
@@ -63,6 +71,8 @@ struct Ctx {
     files: Vec<PathBuf>,
     /// Files being read (absolute), outermost first.
     stack: Vec<PathBuf>,
+    notes: Vec<ConfigNote>,
+    skipped: Vec<(Location, String)>,
 }
 
 /// Reads `main` (its text given, or read from disk) with its includes and SAVE_CONFIG
@@ -81,8 +91,11 @@ pub(crate) fn load(main: &Path, text: Option<&str>) -> Result<Loaded, GcodeError
         budget,
         files: vec![main.to_path_buf()],
         stack: vec![absolute(main)],
+        notes,
+        skipped: Vec::new(),
     };
     parse_file(&mut ctx, main, regular, &source)?;
+    let mut notes = std::mem::take(&mut ctx.notes);
     if let Some(mut lines) = autosave {
         strip_duplicates(&mut lines, &ctx.store, &source, &mut notes);
         let cut: Vec<(u64, &str)> = lines.iter().map(|(n, l)| (*n, cut_comment(l))).collect();
@@ -106,6 +119,7 @@ pub(crate) fn load(main: &Path, text: Option<&str>) -> Result<Loaded, GcodeError
         store: ctx.store,
         files: ctx.files,
         notes,
+        skipped: ctx.skipped,
     })
 }
 
@@ -235,19 +249,39 @@ fn parse_file(ctx: &mut Ctx, path: &Path, data: &str, source: &Arc<str>) -> Resu
     parse_chunk(&mut ctx.store, source, buf)
 }
 
+/// The note for an included file that cannot be read because it is not there.
+fn missing_include(at: &Location, what: &str, path: &Path, why: &str) -> ConfigNote {
+    ConfigNote::at(
+        at.clone(),
+        format!(
+            "{what} skipped: `{}` {why}; Klipper would refuse to start without it, settle reads on without it, so whatever it sets is not known here",
+            path.display()
+        ),
+    )
+}
+
 fn include(ctx: &mut Ctx, from: &Path, spec: &str, at: &Location) -> Result<(), GcodeError> {
     let pattern = from.parent().unwrap_or(Path::new("")).join(spec);
     let what = format!("[include {spec}]");
     let mut names = glob(&pattern);
     if names.is_empty() && !has_magic(&pattern.to_string_lossy()) {
-        return Err(GcodeError::IncludeNotFound {
-            at: at.clone(),
-            path: pattern.display().to_string(),
-        });
+        ctx.notes
+            .push(missing_include(at, &what, &pattern, "is not there"));
+        ctx.skipped.push((at.clone(), what));
+        return Ok(());
     }
     ctx.budget.reserve(names.len(), at, &what)?;
     names.sort_by(|a, b| a.to_string_lossy().cmp(&b.to_string_lossy()));
     for name in names {
+        // A link to nothing (`glob` lists links, as Python's does).
+        if std::fs::symlink_metadata(&name).is_ok_and(|m| m.file_type().is_symlink())
+            && std::fs::metadata(&name).is_err()
+        {
+            ctx.notes
+                .push(missing_include(at, &what, &name, "is a link to nothing"));
+            ctx.skipped.push((at.clone(), what.clone()));
+            continue;
+        }
         let abs = absolute(&name);
         if ctx.stack.contains(&abs) {
             let mut chain: Vec<String> =

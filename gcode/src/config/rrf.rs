@@ -13,7 +13,8 @@
 //!   names are looked up in the folder of `config.g` (the SD card's `/sys`) whichever
 //!   file calls them, `/name` and `0:/name` from that folder's parent (the card's root).
 //!   A file that is not there is a note, as the firmware only warns.
-//! - Meta-commands and `{expressions}` are not evaluated (see the notes).
+//! - Meta-commands and `{expressions}` that name anything are not evaluated (see the
+//!   notes); an expression of numbers alone is worked out (`rrf_script`).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

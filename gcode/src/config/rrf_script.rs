@@ -2,10 +2,18 @@
 //! (line numbers kept) with a note each: meta-commands (`if`, `elif`, `else`, `while` and
 //! the lines indented under them, `var`, `global`, `set`, `echo`, `abort`, `break`,
 //! `continue`, `skip`; the keywords of `src/GCodes/GCodeBuffer/StringParser.cpp`) and
-//! commands with `{expressions}`. Only unconditional commands with literal values are
+//! commands with `{expressions}` that name anything. Only unconditional commands are
 //! read: a conditional block's settings are not applied, whatever its condition would
 //! give on the machine. A top-level `abort` ends the file, as it ends the firmware's
 //! reading.
+//!
+//! An expression of numbers alone (`M906 X{2800 * 0.65}`) is worked out and its value
+//! put in its place, as the firmware's `ExpressionParser` (`src/GCodes/GCodeBuffer/
+//! ExpressionParser.cpp`) would: `+` and `-` bind less tightly than `*` and `/`, left to
+//! right, unary `-` and `+` and brackets; `/` always divides as decimals; whole numbers
+//! stay whole under `+`, `-` and `*` (a result beyond 32 bits is not guessed: the line
+//! stays a note). settle works in double precision where the firmware uses single; the
+//! difference is below one part in ten million.
 
 use std::sync::Arc;
 
@@ -46,6 +54,153 @@ fn keyword(code: &str) -> Option<&str> {
     let next = code[end..].chars().next();
     let ends_word = next.is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '_' || c == '.'));
     (ends_word && (BLOCK_KEYWORDS.contains(&word) || LINE_KEYWORDS.contains(&word))).then_some(word)
+}
+
+/// A number as the expression parser holds it: whole (32 bits) or decimal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Num {
+    Int(i32),
+    Float(f64),
+}
+
+impl Num {
+    fn float(self) -> f64 {
+        match self {
+            Num::Int(i) => f64::from(i),
+            Num::Float(f) => f,
+        }
+    }
+}
+
+/// An expression of numbers, operators and brackets, worked out; `None` for anything
+/// else (a name, a function, a string, a division by zero, a whole number beyond 32 bits).
+struct Constant<'a> {
+    text: &'a [u8],
+    pos: usize,
+}
+
+impl Constant<'_> {
+    fn eval(text: &str) -> Option<Num> {
+        let mut p = Constant {
+            text: text.as_bytes(),
+            pos: 0,
+        };
+        let v = p.binary(0)?;
+        p.skip_space();
+        (p.pos == p.text.len()).then_some(v)
+    }
+
+    fn skip_space(&mut self) {
+        while self.text.get(self.pos).is_some_and(u8::is_ascii_whitespace) {
+            self.pos += 1;
+        }
+    }
+
+    /// Operands joined by operators binding tighter than `level` (0: `+ -`, 1: `* /`).
+    fn binary(&mut self, level: u8) -> Option<Num> {
+        let mut v = if level == 0 {
+            self.binary(1)?
+        } else {
+            self.unary()?
+        };
+        loop {
+            self.skip_space();
+            let op = match (level, self.text.get(self.pos)) {
+                (0, Some(&c)) if c == b'+' || c == b'-' => c,
+                (1, Some(&c)) if c == b'*' || c == b'/' => c,
+                _ => return Some(v),
+            };
+            self.pos += 1;
+            let w = if level == 0 {
+                self.binary(1)?
+            } else {
+                self.unary()?
+            };
+            v = match (op, v, w) {
+                (b'/', _, _) if w.float() == 0.0 => return None,
+                (b'/', _, _) => Num::Float(v.float() / w.float()),
+                (_, Num::Int(a), Num::Int(b)) => Num::Int(match op {
+                    b'+' => a.checked_add(b)?,
+                    b'-' => a.checked_sub(b)?,
+                    _ => a.checked_mul(b)?,
+                }),
+                (b'+', _, _) => Num::Float(v.float() + w.float()),
+                (b'-', _, _) => Num::Float(v.float() - w.float()),
+                _ => Num::Float(v.float() * w.float()),
+            };
+        }
+    }
+
+    fn unary(&mut self) -> Option<Num> {
+        self.skip_space();
+        match self.text.get(self.pos)? {
+            b'-' => {
+                self.pos += 1;
+                Some(match self.unary()? {
+                    Num::Int(i) => Num::Int(i.checked_neg()?),
+                    Num::Float(f) => Num::Float(-f),
+                })
+            }
+            b'+' => {
+                self.pos += 1;
+                self.unary()
+            }
+            b'(' => {
+                self.pos += 1;
+                let v = self.binary(0)?;
+                self.skip_space();
+                (self.text.get(self.pos) == Some(&b')')).then(|| {
+                    self.pos += 1;
+                    v
+                })
+            }
+            _ => self.number(),
+        }
+    }
+
+    /// Digits with at most one decimal point (`12`, `0.65`, `.5`).
+    fn number(&mut self) -> Option<Num> {
+        let start = self.pos;
+        while self
+            .text
+            .get(self.pos)
+            .is_some_and(|c| c.is_ascii_digit() || *c == b'.')
+        {
+            self.pos += 1;
+        }
+        let word = std::str::from_utf8(&self.text[start..self.pos]).ok()?;
+        if word.contains('.') {
+            word.parse::<f64>().ok().map(Num::Float)
+        } else {
+            word.parse::<i32>().ok().map(Num::Int)
+        }
+    }
+}
+
+/// `code` with each `{expression}` outside quotes replaced by its value, when every one
+/// is numbers alone; `None` when one is not (or a brace is not closed).
+fn constants_worked_out(code: &str) -> Option<String> {
+    let mut out = String::with_capacity(code.len());
+    let mut quoted = false;
+    let mut rest = code;
+    while let Some(c) = rest.chars().next() {
+        if c == '{' && !quoted {
+            let close = rest.find('}')?;
+            let value = Constant::eval(&rest[1..close])?;
+            match value {
+                Num::Int(i) => out.push_str(&i.to_string()),
+                Num::Float(f) => out.push_str(&f.to_string()),
+            }
+            rest = &rest[close + 1..];
+            continue;
+        }
+        if c == '"' {
+            quoted = !quoted;
+        }
+        out.push(c);
+        rest = &rest[c.len_utf8()..];
+    }
+    Some(out)
 }
 
 fn has_expression(code: &str) -> bool {
@@ -117,12 +272,18 @@ pub(crate) fn unconditional(text: &str, source: &Arc<str>) -> Unconditional {
                             false
                         }
                         None if has_expression(trimmed) => {
-                            notes.push(ConfigNote::at(
-                                at(no),
-                                format!(
-                                    "`{trimmed}` is not read: settle evaluates no {{expressions}}"
-                                ),
-                            ));
+                            match constants_worked_out(code) {
+                                Some(worked) => {
+                                    out.push_str(&worked);
+                                    out.push_str(&line[code.len()..]);
+                                }
+                                None => notes.push(ConfigNote::at(
+                                    at(no),
+                                    format!(
+                                        "`{trimmed}` is not read: settle works out only {{expressions}} of numbers alone"
+                                    ),
+                                )),
+                            }
                             false
                         }
                         None => true,
@@ -181,5 +342,40 @@ mod tests {
         );
         assert!(notes[3].contains("expressions"), "{}", notes[3]);
         assert!(notes[4].contains("ends the file"), "{}", notes[4]);
+    }
+
+    #[test]
+    fn expressions_of_numbers_are_worked_out() {
+        let v = |t: &str| Constant::eval(t);
+        assert_eq!(v("2800 * 0.65"), Some(Num::Float(2800.0 * 0.65)));
+        assert_eq!(v("1 + 2 * 3"), Some(Num::Int(7)));
+        assert_eq!(v("(1 + 2) * 3"), Some(Num::Int(9)));
+        assert_eq!(v("10 - 4 - 3"), Some(Num::Int(3)));
+        assert_eq!(v("7 / 2"), Some(Num::Float(3.5)));
+        assert_eq!(v("-(2) * -.5"), Some(Num::Float(1.0)));
+        for bad in [
+            "var.x",
+            "1 / 0",
+            "2147483647 + 1",
+            "(1",
+            "1 2",
+            "",
+            "max(1, 2)",
+            "1e3",
+        ] {
+            assert_eq!(v(bad), None, "{bad}");
+        }
+        let src: Arc<str> = Arc::from("config.g");
+        let u = unconditional(
+            "M906 X{2800 * 0.65} Y{1+1}:{3} I30 ; {comment}\nM906 X{move.axes[0].current}\n",
+            &src,
+        );
+        assert_eq!(
+            u.text, "M906 X1820 Y2:3 I30 ; {comment}\n\n\n",
+            "{:?}",
+            u.notes
+        );
+        assert_eq!(u.notes.len(), 1);
+        assert!(u.notes[0].to_string().starts_with("config.g:2:"));
     }
 }

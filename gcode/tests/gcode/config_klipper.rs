@@ -355,13 +355,63 @@ fn includes_missing_cyclic_and_misplaced() {
         ),
         ("sub/keep", ""),
     ]);
-    // A wildcard that matches nothing is fine; a plain name must exist.
-    match read_err(dir.path(), "printer.cfg") {
-        GcodeError::IncludeNotFound { at, path } => {
-            assert_eq!(at.line, 6);
-            assert!(path.ends_with("nope.cfg"), "{path}");
-        }
-        e => panic!("{e:?}"),
+    // A wildcard that matches nothing is fine; a plain name that is not there (Klipper
+    // refuses it) is skipped with a note naming the include's file and line.
+    let c = KlipperConfig::read(dir.path().join("printer.cfg")).expect("read on");
+    assert_eq!(c.notes.len(), 1, "{:?}", c.notes);
+    let at = c.notes[0].at.as_ref().expect("a place");
+    assert!(
+        at.source_name.ends_with("printer.cfg") && at.line == 6,
+        "{at}"
+    );
+    assert!(
+        c.notes[0].text.starts_with("[include nope.cfg] skipped: `")
+            && c.notes[0].text.contains("nope.cfg` is not there"),
+        "{}",
+        c.notes[0].text
+    );
+    // Where a skipped file may have set what Klipper requires, the error says so.
+    std::fs::write(
+        dir.path().join("split.cfg"),
+        "[include hardware.cfg]\n[mcu]\nserial: /dev/null\n",
+    )
+    .expect("write");
+    let e = read_err(dir.path(), "split.cfg");
+    assert!(
+        matches!(&e, GcodeError::ConfigMissing { key, .. } if key == "kinematics"),
+        "{e:?}"
+    );
+    let text = e.to_string();
+    assert!(
+        text.contains("1 [include]s of files that are not there were skipped, the first [include hardware.cfg] at ")
+            && text.contains("split.cfg:1"),
+        "{text}"
+    );
+    // A link to nothing, by name or matched by a wildcard, is skipped the same way.
+    #[cfg(unix)]
+    {
+        std::fs::write(
+            dir.path().join("links.cfg"),
+            format!("{PRINTER}[include gone.cfg]\n[include g*.cfg]\n"),
+        )
+        .expect("write");
+        std::os::unix::fs::symlink(dir.path().join("nowhere.cfg"), dir.path().join("gone.cfg"))
+            .expect("link");
+        let c = KlipperConfig::read(dir.path().join("links.cfg")).expect("read on");
+        let notes: Vec<String> = c.notes.iter().map(ToString::to_string).collect();
+        assert_eq!(notes.len(), 2, "{notes:?}");
+        assert!(
+            notes[0].contains("links.cfg:5: [include gone.cfg] skipped"),
+            "{notes:?}"
+        );
+        assert!(
+            notes[1].contains("links.cfg:6: [include g*.cfg] skipped"),
+            "{notes:?}"
+        );
+        assert!(
+            notes.iter().all(|n| n.contains("is a link to nothing")),
+            "{notes:?}"
+        );
     }
     match read_err(dir.path(), "loop.cfg") {
         GcodeError::IncludeCycle { at, chain, .. } => {
