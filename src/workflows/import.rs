@@ -385,15 +385,27 @@ fn scenario_text(
         types.push(q(&type_now));
     }
     let mut t = String::new();
-    let _ = writeln!(
+    let _ = write!(
         t,
         "# Written by `settle import {} {source}`: the current settings as this scenario's own\n\
          # point (marked in [current] among the [sweep]) and a search around them in [tune].\n\
          #   settle sweep THIS.toml   # the sweep around the current settings\n\
-         #   settle tune THIS.toml    # the recommendation per axis, with klipper.cfg / rrf.g\n\
-         name = {}\n\
-         description = {}\n",
+         #   settle tune THIS.toml    # the recommendation per axis, with klipper.cfg / rrf.g\n",
         fw.name(),
+    );
+    // What the reading passed over stays with the settings read (an include that was not
+    // there may set some of them).
+    if !cur.notes.is_empty() {
+        t.push_str(
+            "# What the reading of the configuration noted (it may bear on the settings below):\n",
+        );
+        for n in &cur.notes {
+            let _ = writeln!(t, "#   - {}", n.replace('\n', " "));
+        }
+    }
+    let _ = writeln!(
+        t,
+        "name = {}\ndescription = {}\n",
         q(name),
         q(&format!("Imported from {source} ({})", fw.name()))
     );

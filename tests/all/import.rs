@@ -304,5 +304,20 @@ fn real_configurations_import_with_their_owners_shapers() {
             "{file}: {:?}",
             i.notes
         );
+        // The scenario written keeps the reader's notes above the settings read, so a
+        // skipped include stays with what it may have set.
+        let written = std::fs::read_to_string(&out).expect("written");
+        let header: Vec<&str> = written.lines().take_while(|l| l.starts_with('#')).collect();
+        for n in &c.notes {
+            assert!(
+                header.contains(&format!("#   - {n}").as_str()),
+                "{file}: {n}"
+            );
+        }
+        assert_eq!(
+            header.iter().filter(|l| l.contains("skipped")).count(),
+            if file.starts_with("vt627") { 5 } else { 0 },
+            "{file}"
+        );
     }
 }
