@@ -77,6 +77,9 @@ impl Num {
 struct Constant<'a> {
     text: &'a [u8],
     pos: usize,
+    /// Signs and brackets open around the operand being read: at most
+    /// [`Constant::MAX_DEPTH`] (the reading recurses once per level).
+    depth: usize,
 }
 
 impl Constant<'_> {
@@ -84,6 +87,7 @@ impl Constant<'_> {
         let mut p = Constant {
             text: text.as_bytes(),
             pos: 0,
+            depth: 0,
         };
         let v = p.binary(0)?;
         p.skip_space();
@@ -131,9 +135,28 @@ impl Constant<'_> {
         }
     }
 
+    /// The most signs and brackets an operand may sit in: deeper is not worked out (the
+    /// line stays a note) rather than read by a recursion as deep as the line is long.
+    const MAX_DEPTH: usize = 64;
+
     fn unary(&mut self) -> Option<Num> {
         self.skip_space();
-        match self.text.get(self.pos)? {
+        let c = *self.text.get(self.pos)?;
+        if !matches!(c, b'-' | b'+' | b'(') {
+            return self.number();
+        }
+        if self.depth == Self::MAX_DEPTH {
+            return None;
+        }
+        self.depth += 1;
+        let v = self.signed_or_bracketed(c);
+        self.depth -= 1;
+        v
+    }
+
+    /// The operand after a sign or an opening bracket `c`.
+    fn signed_or_bracketed(&mut self, c: u8) -> Option<Num> {
+        match c {
             b'-' => {
                 self.pos += 1;
                 Some(match self.unary()? {
@@ -154,7 +177,7 @@ impl Constant<'_> {
                     v
                 })
             }
-            _ => self.number(),
+            _ => None,
         }
     }
 
@@ -365,6 +388,15 @@ mod tests {
         ] {
             assert_eq!(v(bad), None, "{bad}");
         }
+        // Signs and brackets to 64 levels are worked out; deeper is not read (a line of
+        // 300,000 brackets or a million signs overflowed the stack).
+        let nested = |n: usize| format!("{}1{}", "(".repeat(n), ")".repeat(n));
+        assert_eq!(v(&nested(63)), Some(Num::Int(1)));
+        assert_eq!(v(&format!("-{}", nested(63))), Some(Num::Int(-1)));
+        assert_eq!(v(&nested(65)), None);
+        assert_eq!(v(&nested(300_000)), None);
+        assert_eq!(v(&format!("{}1", "-".repeat(1_000_000))), None);
+        assert_eq!(v(&format!("{}1", "-".repeat(64))), Some(Num::Int(1)));
         let src: Arc<str> = Arc::from("config.g");
         let u = unconditional(
             "M906 X{2800 * 0.65} Y{1+1}:{3} I30 ; {comment}\nM906 X{move.axes[0].current}\n",
