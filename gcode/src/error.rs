@@ -218,8 +218,9 @@ pub enum GcodeError {
     },
     /// A configuration value that is malformed or out of the range the firmware accepts.
     #[error(
-        "{at}: {} = `{value}`: not allowed (allowed: {allowed})",
-        config_setting(section, key)
+        "{at}: {} = `{}`: not allowed (allowed: {allowed})",
+        config_setting(section, key),
+        quoted_value(value)
     )]
     ConfigValue {
         /// Where the option (or command) is.
@@ -344,6 +345,15 @@ pub enum GcodeError {
 
 /// A configuration setting as its firmware writes it: `[section] key` (Klipper's option,
 /// RepRapFirmware's command and parameter), `$N` for GRBL's setting N.
+/// A value as an error quotes it: whole up to 120 characters, else its start and `...`
+/// (the line named holds the rest).
+fn quoted_value(value: &str) -> std::borrow::Cow<'_, str> {
+    match value.char_indices().nth(120) {
+        Some((end, _)) => format!("{}...", &value[..end]).into(),
+        None => value.into(),
+    }
+}
+
 fn config_setting(section: &str, key: &str) -> String {
     if section == "$" {
         format!("${key}")

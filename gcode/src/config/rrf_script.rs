@@ -236,6 +236,18 @@ fn has_expression(code: &str) -> bool {
     })
 }
 
+/// A line as a note quotes it: whole up to [`SHOWN_CHARS`] characters, else its start
+/// and `...` (a note names the line; the file holds the rest).
+fn shown(line: &str) -> String {
+    match line.char_indices().nth(SHOWN_CHARS) {
+        Some((end, _)) => format!("{}...", &line[..end]),
+        None => line.to_string(),
+    }
+}
+
+/// The most characters of a line a note quotes.
+const SHOWN_CHARS: usize = 120;
+
 /// Blanks what `text` (from `source`) holds that settle does not evaluate.
 pub(crate) fn unconditional(text: &str, source: &Arc<str>) -> Unconditional {
     let at = |line: u64| Location {
@@ -258,7 +270,8 @@ pub(crate) fn unconditional(text: &str, source: &Arc<str>) -> Unconditional {
             notes.push(ConfigNote::at(
                 at(first),
                 format!(
-                    "`{head}` ({lines}) is not run: settle reads only unconditional commands and evaluates no conditions"
+                    "`{}` ({lines}) is not run: settle reads only unconditional commands and evaluates no conditions",
+                    shown(&head)
                 ),
             ));
         }
@@ -291,7 +304,10 @@ pub(crate) fn unconditional(text: &str, source: &Arc<str>) -> Unconditional {
                             } else {
                                 "is not evaluated"
                             };
-                            notes.push(ConfigNote::at(at(no), format!("`{trimmed}` {what}")));
+                            notes.push(ConfigNote::at(
+                                at(no),
+                                format!("`{}` {what}", shown(trimmed)),
+                            ));
                             false
                         }
                         None if has_expression(trimmed) => {
@@ -303,7 +319,8 @@ pub(crate) fn unconditional(text: &str, source: &Arc<str>) -> Unconditional {
                                 None => notes.push(ConfigNote::at(
                                     at(no),
                                     format!(
-                                        "`{trimmed}` is not read: settle works out only {{expressions}} of numbers alone"
+                                        "`{}` is not read: settle works out only {{expressions}} of numbers alone",
+                                        shown(trimmed)
                                     ),
                                 )),
                             }
@@ -397,6 +414,17 @@ mod tests {
         assert_eq!(v(&nested(300_000)), None);
         assert_eq!(v(&format!("{}1", "-".repeat(1_000_000))), None);
         assert_eq!(v(&format!("{}1", "-".repeat(64))), Some(Num::Int(1)));
+        // Such a line is a note that quotes its first 120 characters, not all of them.
+        let src: Arc<str> = Arc::from("config.g");
+        let long = format!("M906 X{{{}}}", nested(300_000));
+        let u = unconditional(&long, &src);
+        let note = u.notes[0].to_string();
+        assert!(
+            note.contains(&format!("`{}...`", &long[..120])),
+            "{}",
+            &note[..200]
+        );
+        assert!(note.len() < 300, "{} bytes", note.len());
         let src: Arc<str> = Arc::from("config.g");
         let u = unconditional(
             "M906 X{2800 * 0.65} Y{1+1}:{3} I30 ; {comment}\nM906 X{move.axes[0].current}\n",

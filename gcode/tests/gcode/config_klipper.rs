@@ -482,3 +482,21 @@ fn unreadable_files_are_errors() {
         GcodeError::File(f) if matches!(*f, settle_files::FileError::Read { .. })
     ));
 }
+
+#[test]
+fn a_long_malformed_value_is_quoted_by_its_start() {
+    // 200,000 characters of a value: the error names file, line and key, and quotes the
+    // first 120 characters.
+    let value = "x".repeat(200_000);
+    let (at, key, msg) = value_error(&format!("max_accel_to_decel: {value}\n"));
+    assert_eq!(
+        (at.as_str(), key.as_str()),
+        ("printer.cfg:5", "max_accel_to_decel")
+    );
+    assert!(
+        msg.contains(&format!("`{}...`", &value[..120])),
+        "{}",
+        &msg[..200]
+    );
+    assert!(msg.len() < 400, "{} bytes", msg.len());
+}
