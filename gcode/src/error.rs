@@ -220,7 +220,7 @@ pub enum GcodeError {
     #[error(
         "{at}: {} = `{}`: not allowed (allowed: {allowed})",
         config_setting(section, key),
-        quoted_value(value)
+        excerpt(value, QUOTED_CHARS)
     )]
     ConfigValue {
         /// Where the option (or command) is.
@@ -345,12 +345,15 @@ pub enum GcodeError {
 
 /// A configuration setting as its firmware writes it: `[section] key` (Klipper's option,
 /// RepRapFirmware's command and parameter), `$N` for GRBL's setting N.
-/// A value as an error quotes it: whole up to 120 characters, else its start and `...`
-/// (the line named holds the rest).
-fn quoted_value(value: &str) -> std::borrow::Cow<'_, str> {
-    match value.char_indices().nth(120) {
-        Some((end, _)) => format!("{}...", &value[..end]).into(),
-        None => value.into(),
+/// The most characters of a line or value a note or an error quotes.
+pub const QUOTED_CHARS: usize = 120;
+
+/// `text` as a message quotes it: whole up to `chars` characters, else its first `chars`
+/// and `...` (the file and line named hold the rest).
+pub fn excerpt(text: &str, chars: usize) -> std::borrow::Cow<'_, str> {
+    match text.char_indices().nth(chars) {
+        Some((end, _)) => format!("{}...", &text[..end]).into(),
+        None => text.into(),
     }
 }
 

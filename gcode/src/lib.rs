@@ -58,7 +58,7 @@ mod error;
 pub mod job;
 mod read;
 
-pub use error::{GcodeError, Location};
+pub use error::{GcodeError, Location, QUOTED_CHARS, excerpt};
 
 /// The longest move (its length at its feed) or dwell a job may hold (s): an hour. A real
 /// one lasts seconds (a slow CNC finishing pass minutes); longer is a unit mistake that

@@ -236,17 +236,10 @@ fn has_expression(code: &str) -> bool {
     })
 }
 
-/// A line as a note quotes it: whole up to [`SHOWN_CHARS`] characters, else its start
-/// and `...` (a note names the line; the file holds the rest).
-fn shown(line: &str) -> String {
-    match line.char_indices().nth(SHOWN_CHARS) {
-        Some((end, _)) => format!("{}...", &line[..end]),
-        None => line.to_string(),
-    }
+/// A line as a note quotes it ([`crate::excerpt`]).
+fn shown(line: &str) -> std::borrow::Cow<'_, str> {
+    crate::excerpt(line, crate::QUOTED_CHARS)
 }
-
-/// The most characters of a line a note quotes.
-const SHOWN_CHARS: usize = 120;
 
 /// Blanks what `text` (from `source`) holds that settle does not evaluate.
 pub(crate) fn unconditional(text: &str, source: &Arc<str>) -> Unconditional {

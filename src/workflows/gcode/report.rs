@@ -408,13 +408,7 @@ fn digest_and_lines(file: &Path, wanted: &[u64]) -> Result<(String, BTreeMap<u64
         if wanted.contains(&n) {
             let text = String::from_utf8_lossy(&buf);
             let text = text.trim_end_matches(['\n', '\r']);
-            let shown: String = text.chars().take(LINE_CHARS).collect();
-            let shown = if shown.len() < text.len() {
-                format!("{shown}...")
-            } else {
-                shown
-            };
-            lines.insert(n, shown);
+            lines.insert(n, settle_gcode::excerpt(text, LINE_CHARS).into_owned());
         }
     }
     Ok((sha.hex(), lines))
