@@ -74,9 +74,13 @@ impl Input {
     }
 }
 
-/// What a path that is not a regular file is, for messages.
+/// What the thing at a path is, for messages (`a file`, `a folder`, `a FIFO (named
+/// pipe)`).
 pub(crate) fn what_is(meta: &std::fs::Metadata) -> &'static str {
     let ft = meta.file_type();
+    if ft.is_file() {
+        return "a file";
+    }
     if ft.is_dir() {
         return "a folder";
     }
@@ -99,7 +103,7 @@ pub(crate) fn what_is(meta: &std::fs::Metadata) -> &'static str {
             return "a socket";
         }
     }
-    "not a file"
+    "an unknown kind of file"
 }
 
 /// Where the link at `path` leads, if `path` is a link.

@@ -181,13 +181,13 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "tune --criterion klipper --out a file",
             "tune --criterion klipper rec_x.csv --out print.gcode",
             &[],
-            Expect::refused(&["not a folder"]),
+            Expect::refused(&["print.gcode: it is a file, not a folder"]),
         ),
         Case::line(
             "tune --criterion klipper --out a device",
             "tune --criterion klipper rec_x.csv --out null.dev",
             &[],
-            Expect::refused(&["not a folder"]),
+            Expect::refused(&["it is a character device, not a folder"]),
         ),
         case(
             "run --out names its scenario",
@@ -223,7 +223,7 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "sweep --out a file",
             "sweep sc.toml --backend modal --out rec_x.csv",
             &[],
-            Expect::refused(&["not a folder"]),
+            Expect::refused(&["rec_x.csv: it is a file, not a folder"]),
         ),
         Case::line(
             "sweep with plots/ a link out",
