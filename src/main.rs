@@ -64,8 +64,8 @@ enum Command {
         /// Output folder [default: results/<scenario name>/].
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Worker threads [default: all cores].
-        #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+        /// Worker threads, at most 1024 [default: all cores].
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=i64::from(settle::execute::pool::MAX_JOBS)))]
         jobs: Option<u16>,
         /// Simulation backend: modal (exact, linear driver only), rapier, mujoco.
         #[arg(long, default_value = "rapier", value_parser = parse_backend)]
@@ -127,8 +127,8 @@ enum Command {
         /// with (its `backend` column); rapier for a new baseline].
         #[arg(long, value_parser = parse_backend)]
         backend: Option<Backend>,
-        /// Worker threads [default: all cores].
-        #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+        /// Worker threads, at most 1024 [default: all cores].
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=i64::from(settle::execute::pool::MAX_JOBS)))]
         jobs: Option<u16>,
     },
     /// Combine the folders of a sharded sweep into the outputs of an unsharded one.
@@ -154,8 +154,8 @@ enum Command {
         after_help = "Example:\n  echo '{\"p0\":[0],\"pf\":[1],\"vmax\":[1],\"amax\":[2],\"jmax\":[10],\"sync\":\"time\"}' | settle plan\n\nInput keys (arrays, one value per axis): p0 v0 a0 pf vf af vmax amax jmax [vmin amin];\n\"sync\": time|phase|none, \"kind\": scurve|trapezoid, \"interface\": position|velocity.\nOutput: {\"duration\":..,\"axes\":[{\"p0\",\"v0\",\"a0\",\"segments\":[[duration,jerk],..]}]}\n(a constant-acceleration segment is [duration,0,accel]) or {\"error\":\"..\"}."
     )]
     Plan {
-        /// Worker threads [default: all cores].
-        #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+        /// Worker threads, at most 1024 [default: all cores].
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=i64::from(settle::execute::pool::MAX_JOBS)))]
         jobs: Option<u16>,
     },
     /// Search the profile parameters (kind, jerk, PVT asymmetry, BOW1..4, input shaper)
@@ -192,8 +192,8 @@ enum Command {
         /// Re-run the default and the winner on this second backend and compare.
         #[arg(long, value_parser = parse_backend)]
         check_on: Option<Backend>,
-        /// Worker threads [default: all cores].
-        #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+        /// Worker threads, at most 1024 [default: all cores].
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=i64::from(settle::execute::pool::MAX_JOBS)))]
         jobs: Option<u16>,
         /// Overwrite the results of an earlier tuning in the output folder (refused
         /// without it).

@@ -201,7 +201,9 @@ pub fn plan_stream(
 ) -> Result<(), crate::error::Error> {
     use rayon::prelude::*;
     use settle_files::lines::{BoundedLines, LineStatus};
-    let pool = crate::execute::pool::thread_pool(jobs)?;
+    let max_batch = max_batch.clamp(1, BATCH);
+    // A batch is the most work handed out at once.
+    let pool = crate::execute::pool::thread_pool(jobs, max_batch)?;
     let read_err = |e| crate::error::Error::read("stdin", e);
     let write_err = |e| crate::error::Error::write("stdout", e);
     let limit = settle_files::limit::PLAN_LINE;
@@ -209,7 +211,6 @@ pub fn plan_stream(
         std::io::BufReader::with_capacity(1 << 16, input),
         usize::try_from(limit.bytes).unwrap_or(usize::MAX),
     );
-    let max_batch = max_batch.clamp(1, BATCH);
     // A line longer than the limit is answered with an error, unread (`None`).
     let mut batch: Vec<(u64, Option<Vec<u8>>)> = Vec::new();
     loop {

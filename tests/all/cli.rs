@@ -73,6 +73,55 @@ fn same_scenario_gives_identical_output() {
     }
 }
 
+/// `--jobs` takes at most `MAX_JOBS` threads, and a pool never starts more threads than it
+/// has work: `--jobs 65535` on a sweep of 16 runs started 65,535 threads, which kept it
+/// busy for minutes. The largest `--jobs` answers as `--jobs 2` does.
+#[test]
+fn jobs_are_bounded_by_the_limit_and_the_work() {
+    use settle::execute::pool::{MAX_JOBS, thread_pool};
+    let n = |jobs, work| {
+        thread_pool(Some(jobs), work)
+            .expect("pool")
+            .current_num_threads()
+    };
+    assert_eq!(n(65_535, 16), 16);
+    assert_eq!(n(3, 16), 3);
+    assert_eq!(n(4, 0), 1);
+    assert_eq!(MAX_JOBS, 1024);
+    let out = settle()
+        .args([
+            "sweep",
+            "scenarios/quickstart.toml",
+            "--jobs",
+            "1025",
+            "--out",
+        ])
+        .arg(tempfile::tempdir().expect("tempdir").path())
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("1025 is not in 1..=1024"), "{err}");
+    let (a, b) = (
+        tempfile::tempdir().expect("tempdir"),
+        tempfile::tempdir().expect("tempdir"),
+    );
+    for (dir, jobs) in [(&a, "1024"), (&b, "2")] {
+        let st = settle()
+            .args(["sweep", "scenarios/quickstart.toml", "--backend", "modal"])
+            .args(["--jobs", jobs, "--out"])
+            .arg(dir.path())
+            .status()
+            .expect("runs");
+        assert!(st.success());
+    }
+    let runs = |d: &tempfile::TempDir| std::fs::read(d.path().join("runs.csv")).expect("runs.csv");
+    assert!(
+        runs(&a) == runs(&b),
+        "runs.csv differs between --jobs 1024 and --jobs 2"
+    );
+}
+
 fn assert_input_error(args: &[&str], scenario_text: Option<&str>, expect: &str) {
     let dir = tempfile::tempdir().expect("tempdir");
     let out_dir = dir.path().join("out");
