@@ -171,7 +171,14 @@ fn a_gcode_corner_gives_the_metrics_of_the_corner_study() {
 fn bad_gcode_exits_2_with_file_and_line_and_writes_nothing() {
     let dir = tempfile::tempdir().expect("tempdir");
     let long = format!("G1 X1 ;{}\n", "x".repeat(10_000_000));
-    let cases: [(&str, Vec<u8>, &str); 5] = [
+    let mut bgcode = b"GCDE".to_vec();
+    bgcode.extend_from_slice(&[1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0x1a, 0, 0, 0]);
+    let cases: [(&str, Vec<u8>, &str); 6] = [
+        (
+            "benchy.bgcode",
+            bgcode,
+            "benchy.bgcode:1:1: binary G-code (bgcode",
+        ),
         (
             "garbage.gcode",
             (0..=255u8).cycle().take(4096).collect(),
