@@ -61,16 +61,17 @@ pub enum GcodeError {
         /// The limit ([`crate::ReaderOptions::max_line_bytes`]).
         limit_bytes: usize,
     },
-    /// The file is binary G-code (`.bgcode`, which PrusaSlicer writes for printers whose
-    /// "Supports binary G-code" is on): its first four bytes are `GCDE`, the magic number
-    /// of libbgcode's doc/specifications.md. Not a bad line: even skipping bad lines, no
-    /// line of it is G-code text.
-    #[error(
-        "{at}: binary G-code (bgcode: the file starts with GCDE, as PrusaSlicer writes it for printers that take binary G-code); settle reads G-code text: convert it (PrusaSlicer: File > Convert > Convert binary G-code to ASCII), or export text G-code (Printer Settings > General: untick \"Supports binary G-code\")"
-    )]
-    BinaryGcode {
+    /// The file is not G-code text but a format a slicer writes G-code into
+    /// (gcode/src/read/packaged.rs: binary G-code, a gzip stream, a zip archive), known by
+    /// its first bytes. Not a bad line: even skipping bad lines, no line of it is G-code text.
+    #[error("{at}: {what}; settle reads G-code text: {instead}")]
+    Packaged {
         /// Where (line 1, column 1).
         at: Location,
+        /// What the file is.
+        what: &'static str,
+        /// How to get its G-code as text.
+        instead: &'static str,
     },
     /// The line is not valid UTF-8.
     #[error("{at}: invalid UTF-8 (binary data?); G-code is text")]
@@ -408,7 +409,7 @@ impl GcodeError {
             | GcodeError::ExportValue { .. }
             | GcodeError::JobSetting { .. } => None,
             GcodeError::LineTooLong { at, .. }
-            | GcodeError::BinaryGcode { at }
+            | GcodeError::Packaged { at, .. }
             | GcodeError::InvalidUtf8 { at }
             | GcodeError::ControlCharacter { at, .. }
             | GcodeError::Syntax { at, .. }

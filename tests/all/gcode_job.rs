@@ -173,11 +173,21 @@ fn bad_gcode_exits_2_with_file_and_line_and_writes_nothing() {
     let long = format!("G1 X1 ;{}\n", "x".repeat(10_000_000));
     let mut bgcode = b"GCDE".to_vec();
     bgcode.extend_from_slice(&[1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0x1a, 0, 0, 0]);
-    let cases: [(&str, Vec<u8>, &str); 6] = [
+    let cases: [(&str, Vec<u8>, &str); 8] = [
         (
             "benchy.bgcode",
             bgcode,
             "benchy.bgcode:1:1: binary G-code (bgcode",
+        ),
+        (
+            "benchy.gcode.gz",
+            vec![0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 3],
+            "benchy.gcode.gz:1:1: gzip-compressed",
+        ),
+        (
+            "benchy.gcode.3mf",
+            b"PK\x03\x04\x14\x00\x00\x00\x08\x00".to_vec(),
+            "benchy.gcode.3mf:1:1: a zip archive",
         ),
         (
             "garbage.gcode",

@@ -8,7 +8,8 @@
 //! - what a line means: [`event`] (what the reader yields), [`layers`] (layer changes),
 //!   [`limits`] and [`limit_parse`] (motion-limit commands), [`setting`] and
 //!   [`setting_parse`] (RepRapFirmware's configuration commands);
-//! - [`reader`]: the reader itself; [`summary`]: a file's statistics;
+//! - [`reader`]: the reader itself, which names a file that holds G-code but is not
+//!   text ([`packaged`]: binary G-code, gzip, zip); [`summary`]: a file's statistics;
 //!   [`canonical`]: events written back as G-code.
 
 pub(crate) mod arc;
@@ -23,6 +24,7 @@ pub(crate) mod lex;
 pub(crate) mod limit_parse;
 pub(crate) mod limits;
 pub(crate) mod motion;
+pub(crate) mod packaged;
 pub(crate) mod params;
 pub(crate) mod reader;
 pub(crate) mod segments;

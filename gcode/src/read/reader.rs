@@ -268,14 +268,13 @@ impl<R: BufRead> Iterator for Reader<R> {
                     if line_no == 1 {
                         // A byte-order mark (editors on Windows write one) is not G-code.
                         bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
-                        if bytes.starts_with(BGCODE_MAGIC) {
-                            self.error = Some(GcodeError::BinaryGcode {
-                                at: Location {
-                                    source_name: self.source_name.clone(),
-                                    line: 1,
-                                    column: Some(1),
-                                },
-                            });
+                        if let Some((what, instead)) = super::packaged::packaged(bytes) {
+                            let at = Location {
+                                source_name: self.source_name.clone(),
+                                line: 1,
+                                column: Some(1),
+                            };
+                            self.error = Some(GcodeError::Packaged { at, what, instead });
                             continue;
                         }
                     }
@@ -290,9 +289,6 @@ impl<R: BufRead> Iterator for Reader<R> {
         }
     }
 }
-
-/// The first bytes of a binary G-code file ([`GcodeError::BinaryGcode`]).
-const BGCODE_MAGIC: &[u8] = b"GCDE";
 
 /// RepRapFirmware's configuration commands ([`setting_parse`]).
 fn is_rrf_setting(number: u32) -> bool {

@@ -307,32 +307,47 @@ fn io_errors_name_the_file() {
     );
 }
 
-/// A binary G-code file (PrusaSlicer's `.bgcode`): its 10-byte file header as libbgcode's
-/// doc/specifications.md gives it (magic `GCDE`, version 1, checksum type 1 = CRC32, all
-/// little-endian), then the start of a block header. Named for what it is, at line 1
-/// column 1, and not skipped as a bad line: no line of it is text.
+/// Files that hold G-code but are not its text, by their first bytes: a binary G-code file
+/// (PrusaSlicer's `.bgcode`: its 10-byte file header as libbgcode's doc/specifications.md
+/// gives it, magic `GCDE`, version 1, checksum type 1 = CRC32, little-endian, then the
+/// start of a block header), a gzip stream (RFC 1952's ID1 ID2 = 1f 8b, then CM = 8 and
+/// flags, as Cura's .gcode.gz starts) and a zip archive (a local file header, PK 3 4: a
+/// 3MF, Bambu Studio's .gcode.3mf, an UltiMaker .ufp). Each is named for what it is with
+/// the way to its text, at line 1 column 1, and not skipped as a bad line.
 #[test]
-fn binary_gcode_is_named_and_never_skipped() {
-    let mut bytes = b"GCDE".to_vec();
-    bytes.extend_from_slice(&1u32.to_le_bytes());
-    bytes.extend_from_slice(&1u16.to_le_bytes());
-    bytes.extend_from_slice(&[0, 0, 0, 0, 0x1a, 0, 0, 0, b'\n', b'G', b'1', b'\n']);
-    for options in [
-        ReaderOptions::new(Dialect::Klipper),
-        skipping(Dialect::Klipper),
-    ] {
-        let all: Vec<_> = Reader::new(&bytes[..], options).collect();
-        assert_eq!(all.len(), 1, "the error alone");
-        let e = all[0].as_ref().expect_err("an error");
-        assert!(matches!(e, GcodeError::BinaryGcode { .. }), "{e}");
-        let at = e.location().expect("a location");
-        assert_eq!((at.line, at.column), (1, Some(1)));
-        let text = e.to_string();
-        assert!(text.contains("binary G-code (bgcode"), "{text}");
-        assert!(text.contains("Convert binary G-code to ASCII"), "{text}");
+fn packaged_gcode_is_named_and_never_skipped() {
+    let mut bgcode = b"GCDE".to_vec();
+    bgcode.extend_from_slice(&1u32.to_le_bytes());
+    bgcode.extend_from_slice(&1u16.to_le_bytes());
+    bgcode.extend_from_slice(&[0, 0, 0, 0, 0x1a, 0, 0, 0, b'\n', b'G', b'1', b'\n']);
+    let gzip = vec![0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 3, b'\n', b'G'];
+    let zip = b"PK\x03\x04\x14\x00\x00\x00\x08\x00Metadata/plate_1.gcode\n".to_vec();
+    let cases = [
+        (
+            bgcode,
+            "binary G-code (bgcode",
+            "Convert binary G-code to ASCII",
+        ),
+        (gzip, "gzip-compressed", "gunzip -k FILE"),
+        (zip, "a zip archive", "Metadata/plate_1.gcode"),
+    ];
+    for (bytes, what, instead) in cases {
+        for options in [
+            ReaderOptions::new(Dialect::Klipper),
+            skipping(Dialect::Klipper),
+        ] {
+            let all: Vec<_> = Reader::new(&bytes[..], options).collect();
+            assert_eq!(all.len(), 1, "the error alone");
+            let e = all[0].as_ref().expect_err("an error");
+            assert!(matches!(e, GcodeError::Packaged { .. }), "{e}");
+            let at = e.location().expect("a location");
+            assert_eq!((at.line, at.column), (1, Some(1)));
+            let text = e.to_string();
+            assert!(text.contains(what) && text.contains(instead), "{text}");
+        }
     }
     // A text file whose first line merely contains the letters is G-code.
-    let text = b"; GCDE\nG1 X1\n";
+    let text = b"; GCDE PK\nG1 X1\n";
     let moves = Reader::new(&text[..], ReaderOptions::new(Dialect::Klipper))
         .map(|e| e.expect("text G-code"))
         .filter(|e| matches!(e.kind, EventKind::Move(_)))
