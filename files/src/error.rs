@@ -37,7 +37,7 @@ pub enum FileError {
         limit: Limit,
     },
     /// The file is not UTF-8 text.
-    #[error("{}:{line}:{column}: not UTF-8 text (binary data?); expected {expected}", path.display())]
+    #[error("{}:{line}:{column}: not UTF-8 text ({}); expected {expected}", path.display(), packed_text(packed))]
     NotText {
         /// The file.
         path: PathBuf,
@@ -47,6 +47,8 @@ pub enum FileError {
         column: usize,
         /// What the file should hold (`a G-code file` ...: the limit's kind).
         expected: &'static str,
+        /// What it is, when its first bytes say: an archive or a compressed stream.
+        packed: Option<crate::read::Packed>,
     },
     /// An output could not be written (a full disk, no permission).
     #[error("cannot write {}: {source}", path.display())]
@@ -89,5 +91,13 @@ impl FileError {
             found: found.into(),
             limit,
         }
+    }
+}
+
+/// Why a file is not text, in [`FileError::NotText`]'s words.
+fn packed_text(packed: &Option<crate::read::Packed>) -> String {
+    match packed {
+        Some(p) => format!("{}: unpack it and name the file inside", p.name()),
+        None => "binary data?".to_string(),
     }
 }

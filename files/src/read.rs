@@ -181,9 +181,47 @@ pub fn read_text(path: &Path, limit: Limit) -> Result<String, FileError> {
     text(path, read_bytes(path, limit)?, limit.what)
 }
 
+/// An archive or a compressed stream, known by the magic number its first bytes carry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Packed {
+    /// A zip archive: a local file header, `PK 3 4` (PKWARE's APPNOTE.TXT). 3MF projects,
+    /// UltiMaker `.ufp` packages and the configuration folders Mainsail and Fluidd
+    /// download are zip archives.
+    Zip,
+    /// A gzip stream: `1f 8b` (RFC 1952).
+    Gzip,
+    /// A zstd frame: `28 b5 2f fd` (RFC 8878).
+    Zstd,
+}
+
+impl Packed {
+    /// What `first`, the first bytes of a file, start, if a [`Packed`] kind.
+    pub fn of(first: &[u8]) -> Option<Packed> {
+        if first.starts_with(b"PK\x03\x04") {
+            Some(Packed::Zip)
+        } else if first.starts_with(&[0x1f, 0x8b]) {
+            Some(Packed::Gzip)
+        } else if first.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
+            Some(Packed::Zstd)
+        } else {
+            None
+        }
+    }
+
+    /// The kind in words: `a zip archive`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Packed::Zip => "a zip archive",
+            Packed::Gzip => "gzip-compressed",
+            Packed::Zstd => "zstd-compressed",
+        }
+    }
+}
+
 /// `bytes`, read from `path`, as text (see [`read_text`]); `expected` names what the file
 /// should be in the error.
 pub fn text(path: &Path, bytes: Vec<u8>, expected: &'static str) -> Result<String, FileError> {
+    let packed = Packed::of(&bytes);
     let text = String::from_utf8(bytes).map_err(|e| {
         let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
         let line_start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
@@ -192,6 +230,7 @@ pub fn text(path: &Path, bytes: Vec<u8>, expected: &'static str) -> Result<Strin
             line: 1 + good.iter().filter(|&&b| b == b'\n').count(),
             column: good.len() - line_start + 1,
             expected,
+            packed,
         }
     })?;
     Ok(match text.strip_prefix('\u{feff}') {
@@ -260,6 +299,36 @@ mod tests {
         let e = read_text(&p, SMALL).expect_err("not text").to_string();
         assert!(e.contains("a.txt:2:3: not UTF-8 text"), "{e}");
         assert!(!e.contains("zqx"), "{e}");
+    }
+
+    /// A zip archive (a configuration folder as Mainsail and Fluidd download it), a gzip
+    /// stream and a zstd frame are named by their magic numbers (PKWARE's APPNOTE.TXT,
+    /// RFC 1952, RFC 8878); other binary data stays "binary data?".
+    #[test]
+    fn archives_and_compressed_files_are_named() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let p = dir.path().join("config.zip");
+        let cases: [(&[u8], &str); 4] = [
+            (
+                b"PK\x03\x04\x14\x00\x00\x00\x08\xe3",
+                "a zip archive: unpack it",
+            ),
+            (
+                &[0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 3],
+                "gzip-compressed: unpack it",
+            ),
+            (
+                &[0x28, 0xb5, 0x2f, 0xfd, 0x24, 0x04],
+                "zstd-compressed: unpack it",
+            ),
+            (&[b'a', 0xff], "(binary data?)"),
+        ];
+        for (bytes, words) in cases {
+            std::fs::write(&p, bytes).expect("write");
+            let e = read_text(&p, SMALL).expect_err("not text").to_string();
+            assert!(e.contains(words), "{e}");
+            assert!(e.ends_with("; expected a test file"), "{e}");
+        }
     }
 
     #[test]

@@ -175,6 +175,22 @@ fn import_command_exit_codes() {
         .output()
         .expect("runs");
     assert_eq!(r.status.code(), Some(2), "{r:?}");
+    // A configuration folder as Mainsail downloads it is a zip archive: named as one.
+    let zip = dir.path().join("config.zip");
+    std::fs::write(&zip, b"PK\x03\x04\x14\x00\x00\x00\x08\x00\xe3\x9c").expect("writes");
+    let r = crate::support::settle()
+        .args(["import", "klipper"])
+        .arg(&zip)
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(
+            "config.zip:1:11: not UTF-8 text (a zip archive: unpack it and name the file inside)"
+        ),
+        "{err}"
+    );
 }
 
 /// One list of firmware names: `settle gcode` plans grbl (and grblHAL), `settle import`

@@ -1,6 +1,8 @@
 //! Files that hold G-code but are not G-code text, known by their first bytes: binary
-//! G-code, a gzip stream, a zip archive. Each is named with the way to its text, rather
+//! G-code, a gzip stream, a zip archive, a zstd frame. Each is named with the way to its text, rather
 //! than refused as "binary data" at its first odd byte.
+
+use settle_files::read::Packed;
 
 /// What a file whose first line starts with `first` is, and how to get its G-code as
 /// text; `None` for anything else (text, or binary data of no known kind).
@@ -12,19 +14,15 @@ pub(crate) fn packaged(first: &[u8]) -> Option<(&'static str, &'static str)> {
             "convert it (PrusaSlicer: File > Convert > Convert binary G-code to ASCII), or export text G-code (Printer Settings > General: untick \"Supports binary G-code\")",
         ));
     }
-    // RFC 1952: a gzip member starts with ID1 = 0x1f, ID2 = 0x8b.
-    if first.starts_with(&[0x1f, 0x8b]) {
-        return Some((
+    match Packed::of(first)? {
+        Packed::Gzip => Some((
             "gzip-compressed (the file starts with 1f 8b; Cura writes such .gcode.gz files)",
             "decompress it first (gunzip -k FILE)",
-        ));
-    }
-    // A zip archive's local file header starts with PK 3 4 (PKWARE's APPNOTE.TXT).
-    if first.starts_with(b"PK\x03\x04") {
-        return Some((
+        )),
+        Packed::Zip => Some((
             "a zip archive (a 3MF project, or a sliced one such as Bambu Studio's .gcode.3mf, which holds its G-code as Metadata/plate_1.gcode; or an UltiMaker .ufp, which holds it as 3D/model.gcode)",
             "take the G-code out of it (unzip -p FILE Metadata/plate_1.gcode > plate_1.gcode), or export plain G-code from the slicer",
-        ));
+        )),
+        Packed::Zstd => Some(("zstd-compressed", "decompress it first (zstd -d FILE)")),
     }
-    None
 }

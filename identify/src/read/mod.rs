@@ -187,7 +187,7 @@ pub enum FileData {
 pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     let file = path.display().to_string();
     let bytes = settle_files::read::read_bytes(path, settle_files::limit::RECORDING)?;
-    if bytes.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
+    if settle_files::read::Packed::of(&bytes) == Some(settle_files::read::Packed::Zstd) {
         return stdata::parse(&file, &bytes).map(FileData::Recordings);
     }
     let mut text = String::from_utf8(bytes).map_err(|e| {
