@@ -187,14 +187,20 @@ pub enum FileData {
 pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     let file = path.display().to_string();
     let bytes = settle_files::read::read_bytes(path, settle_files::limit::RECORDING)?;
-    if settle_files::read::Packed::of(&bytes) == Some(settle_files::read::Packed::Zstd) {
+    let packed = settle_files::read::Packed::of(&bytes);
+    if packed == Some(settle_files::read::Packed::Zstd) {
         return stdata::parse(&file, &bytes).map(FileData::Recordings);
     }
     let mut text = String::from_utf8(bytes).map_err(|e| {
+        let why = match packed {
+            // A zip or gzip of a recording: named, with what to do.
+            Some(p) => format!("{}, not text: unpack it and name the file inside", p.name()),
+            None => format!("bytes that are not UTF-8 text ({e})"),
+        };
         IdentifyError::format(
             &file,
             1,
-            format!("bytes that are not UTF-8 text ({e})"),
+            why,
             "a CSV text file or a zstd-compressed .stdata file",
         )
     })?;

@@ -52,6 +52,39 @@ fn folders_devices_and_oversized_files_are_refused_before_reading() {
     );
 }
 
+/// A recording gzipped or zipped (RFC 1952's 1f 8b, a zip's PK 3 4) is named as such,
+/// with what to do; other binary data is "not UTF-8 text".
+#[test]
+fn compressed_recordings_are_named() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cases: [(&str, &[u8], &str); 3] = [
+        (
+            "x.csv.gz",
+            &[0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 3, 0xe3],
+            "gzip-compressed, not text: unpack it",
+        ),
+        (
+            "x.zip",
+            b"PK\x03\x04\x14\x00\xe3",
+            "a zip archive, not text: unpack it",
+        ),
+        (
+            "x.csv",
+            b"#time,accel_x\n\xff",
+            "bytes that are not UTF-8 text",
+        ),
+    ];
+    for (name, bytes, found) in cases {
+        let file = dir.path().join(name);
+        std::fs::write(&file, bytes).expect("writes");
+        let e = read_file(&file).expect_err("not a recording");
+        assert!(matches!(e, IdentifyError::Format { line: 1, .. }), "{e:?}");
+        let text = e.to_string();
+        assert!(text.starts_with(&file.display().to_string()), "{text}");
+        assert!(text.contains(found), "{text}");
+    }
+}
+
 #[test]
 fn recordings_and_spectra_beyond_the_limits_are_refused() {
     let too_many = format!("more than {MAX_SAMPLES} samples");
