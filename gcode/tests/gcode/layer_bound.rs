@@ -139,3 +139,23 @@ fn layer_modes_by_name() {
         "{e}"
     );
 }
+
+/// A job (GRBL's planner) plans the 50,000 layers and stops at the line that opens one
+/// more, with the reader's error.
+#[test]
+fn a_job_stops_at_the_layer_past_the_bound() {
+    use settle_gcode::job::{Job, JobConfig};
+    use settle_planner::firmware::Firmware;
+    let text = z_layers(MAX_LAYERS + 1);
+    let cfg = JobConfig::defaults(Firmware::Grbl).expect("defaults");
+    let mut job = Job::new(
+        Reader::new(text.as_bytes(), cfg.reader_options()).with_name("job.nc"),
+        cfg,
+    )
+    .expect("job");
+    let error = job.run_to_end().expect_err("refused");
+    assert!(
+        matches!(&error, GcodeError::TooManyLayers { at, .. } if at.line == 100_003),
+        "{error}"
+    );
+}
