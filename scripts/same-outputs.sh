@@ -13,7 +13,8 @@
 #   - `settle check` of every baseline in results/baselines/ (without --update);
 #   - `settle gcode` on every print in gcode/prints/: plain, with --layers (and --mcap),
 #     --versus and --config (Klipper's printer.cfg, RepRapFirmware's config.g), and a layer
-#     on rapier with the full driver model; GRBL's jobs on grbl with their $$ settings; the
+#     on rapier with the full driver model; GRBL's jobs on grbl with their $$ settings (the
+#     milled contour also with --layer-source markers); the
 #     real Fusion 360 (GRBL), Cura (Marlin) and Slic3r (Klipper) jobs in its cnc/, cura/
 #     and slic3r/ folders;
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
@@ -117,6 +118,8 @@ cases() {
   for p in "$P"/cnc/*.nc; do
     echo "gcode-fusion-$(basename "$p" .nc) gcode $p --machine printer_xy --firmware grbl --config $P/shapeoko3_grbl_settings.txt --out {out}"
   done
+  # The milled contour's layers from slicer markers only (it has none: one layer).
+  echo "gcode-cnc_contour-markers gcode $P/cnc_contour.gcode --machine printer_xy --firmware grbl --config $P/shapeoko3_grbl_settings.txt --layer-source markers --out {out}"
   echo "gcode-cura-kreistest gcode $P/cura/Kreistest.gcode --machine printer_xy --firmware marlin --shaper mzv@48 --out {out}"
   echo "gcode-slic3r-benchy-arcs gcode $P/slic3r/benchy_arcs.gcode --machine printer_xy --shaper mzv@48 --layers 120..121 --out {out}"
   echo "gcode-corner-modes gcode $S/gcode_corner.gcode --machine out/identify/machine.toml --firmware settle --out {out}"

@@ -257,6 +257,12 @@ enum Command {
         /// Only these layers, A..B (both included) or A; the rest is planned, not simulated.
         #[arg(long, value_name = "A..B", value_parser = workflows::gcode::parse_layers)]
         layers: Option<(u32, u32)>,
+        /// Where layers come from: auto (slicer markers, else each working move in a
+        /// plane at a new Z), markers (slicer markers only: a file without them is one
+        /// layer; for milling and engraving jobs, whose changes of Z are not layers) or z
+        /// (changes of Z only).
+        #[arg(long, value_name = "SOURCE", default_value = "auto", value_parser = settle_gcode::LayerMode::parse)]
+        layer_source: settle_gcode::LayerMode,
         /// Input shaper: KIND@FREQ_HZ[/DAMPING] (or none) on X and Y, e.g. mzv@48, or per
         /// axis x=SPEC,y=SPEC, e.g. x=mzv@52,y=ei@41/0.08; an axis not named keeps its own
         /// [default: none, or --config's].
@@ -663,6 +669,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
             firmware,
             config,
             layers,
+            layer_source,
             shaper,
             backend,
             driver,
@@ -697,6 +704,7 @@ fn dispatch(command: Command) -> Result<Report, Error> {
                     )?,
                 }
                 .with_shapers(shaper.unwrap_or_default())
+                .with_layer_mode(layer_source)
             };
             let bar = gcode_progress_bar();
             let tell = |read: u64, size: u64| {

@@ -345,6 +345,22 @@ pub enum GcodeError {
         /// Its length and feed, or "a dwell".
         what: String,
     },
+    /// A layer change past [`crate::MAX_LAYERS`]: the line that would open it.
+    #[error(
+        "{at}: this line opens layer {layer} ({}), past the {max} layers settle reads in a job (2.5 m of print at 0.05 mm): each layer is a row kept in memory and written to layers.csv, summary.md and report.html; {}",
+        layer_cause(*from),
+        layer_way_out(*from)
+    )]
+    TooManyLayers {
+        /// The line of the layer change (the marker comment, or the move at a new Z).
+        at: Location,
+        /// The layer it would open ([`crate::MAX_LAYERS`] + 1).
+        layer: u32,
+        /// [`crate::MAX_LAYERS`].
+        max: u32,
+        /// How the layer change was found.
+        from: crate::LayerSource,
+    },
     /// A job setting (not from the file) that cannot be used.
     #[error("job setting `{key}`: {reason}")]
     JobSetting {
@@ -366,6 +382,26 @@ pub fn excerpt(text: &str, chars: usize) -> std::borrow::Cow<'_, str> {
     match text.char_indices().nth(chars) {
         Some((end, _)) => format!("{}...", &text[..end]).into(),
         None => text.into(),
+    }
+}
+
+/// What opened a layer, for [`GcodeError::TooManyLayers`].
+fn layer_cause(from: crate::LayerSource) -> &'static str {
+    match from {
+        crate::LayerSource::ZChange => "a working move at a new Z, in a file with no layer markers",
+        _ => "a slicer's layer marker",
+    }
+}
+
+/// How to read a file of more layers than [`crate::MAX_LAYERS`]: from the other source.
+fn layer_way_out(from: crate::LayerSource) -> &'static str {
+    match from {
+        crate::LayerSource::ZChange => {
+            "a milling or engraving job's changes of Z are not printed layers: give --layer-source markers (in a scenario, [gcode] layer_source = \"markers\") to take no layers from Z"
+        }
+        _ => {
+            "if the file's layer markers are not its printed layers, give --layer-source z (in a scenario, [gcode] layer_source = \"z\") to take layers from Z only"
+        }
     }
 }
 
@@ -432,7 +468,8 @@ impl GcodeError {
             | GcodeError::Include { at, .. }
             | GcodeError::Plan { at, .. }
             | GcodeError::OutOfTravel { at, .. }
-            | GcodeError::TooLong { at, .. } => Some(at),
+            | GcodeError::TooLong { at, .. }
+            | GcodeError::TooManyLayers { at, .. } => Some(at),
         }
     }
 

@@ -82,6 +82,15 @@ pub const MIN_LIMIT_VALUE: f64 = 1e-9;
 /// ends (a move's timing is complete only then), a few KB each with a shaper; a longer
 /// arc is refused ([`GcodeError::ArcTooManySegments`]) rather than held in gigabytes.
 pub const MAX_ARC_SEGMENTS: usize = 100_000;
+
+/// The most layers a job may have: 50,000 (2.5 m of print at 0.05 mm; a real print has a
+/// few thousand). Each layer is a row that every consumer keeps and writes (`settle
+/// gcode`'s layers.csv, summary.md and report.html), so their number bounds memory and
+/// output; a file that opens one more is refused ([`GcodeError::TooManyLayers`]). Without
+/// slicer markers a layer starts at every planar working move at a new Z, and a CNC
+/// finishing toolpath changes Z all the time: [`LayerMode::Comments`] takes no layers from
+/// Z.
+pub const MAX_LAYERS: u32 = 50_000;
 pub use read::arc::{
     Arc, FULL_CIRCLE_TOLERANCE_MM, Plane, RADIUS_TOLERANCE_MAX_MM, RADIUS_TOLERANCE_MM,
     RADIUS_TOLERANCE_REL,

@@ -12,6 +12,7 @@ mod faults;
 mod gcode_config;
 mod gcode_grbl;
 mod gcode_job;
+mod gcode_layer_source;
 mod gcode_range;
 mod gcode_range_random;
 mod gcode_split;

@@ -14,7 +14,7 @@ use settle_planner::shaper::{Shaper, ShaperType};
 use settle_planner::{Limits, PlanError, ProfileKind};
 
 use crate::config::GrblSettings;
-use crate::{ArcSegmentation, Dialect, GcodeError, GrblArcs, ReaderOptions};
+use crate::{ArcSegmentation, Dialect, GcodeError, GrblArcs, LayerMode, ReaderOptions};
 
 /// A firmware by name, for a G-code job: one of [`Firmware::GCODE`] (klipper, marlin,
 /// rrf, grbl, settle; `reprapfirmware` and `duet` are rrf, `grblhal` is grbl).
@@ -126,6 +126,9 @@ pub struct JobConfig {
     pub planner: PlannerConfig,
     /// The dialect the file is read in.
     pub dialect: Dialect,
+    /// Where the file's layer changes come from ([`LayerMode::Auto`] by default: slicer
+    /// markers, else changes of Z).
+    pub layer_mode: LayerMode,
     /// Input shapers on X, Y, Z at the start of the file (`None`: not shaped). The file's
     /// own shaper commands change them (see [`crate::job`]).
     pub shapers: [Option<ShaperSetting>; 3],
@@ -189,6 +192,7 @@ impl JobConfig {
         Ok(Self {
             planner,
             dialect,
+            layer_mode: LayerMode::Auto,
             shapers: [None; 3],
             alignment: Alignment::Centred,
             arcs: ArcSegmentation::default_for(dialect),
@@ -203,10 +207,11 @@ impl JobConfig {
         self.planner.firmware()
     }
 
-    /// How the file is read: in [`JobConfig::dialect`], with GRBL's laser mode (`$32`)
-    /// from its settings.
+    /// How the file is read: in [`JobConfig::dialect`], its layers as
+    /// [`JobConfig::layer_mode`] says, with GRBL's laser mode (`$32`) from its settings.
     pub fn reader_options(&self) -> ReaderOptions {
         let mut o = ReaderOptions::new(self.dialect);
+        o.layers = self.layer_mode;
         if let PlannerConfig::Grbl(g) = &self.planner {
             o.laser_mode = g.laser_mode;
         }

@@ -4,7 +4,12 @@
 //! comments (before the first move), a slicer whose files mark every layer
 //! ([`marks_every_layer`]), and from the first marker on: a purge line in the start G-code
 //! must not count as a layer.
+//!
+//! A job has at most [`MAX_LAYERS`] layers: the change that would open one more is not
+//! emitted but kept ([`Layers::refused`]), and the reader ends with
+//! [`crate::GcodeError::TooManyLayers`] at its line.
 
+use crate::MAX_LAYERS;
 use crate::read::event::{LayerChange, LayerSource};
 use crate::read::geometry::Move;
 
@@ -18,6 +23,38 @@ pub enum LayerMode {
     Comments,
     /// Planar printing moves at a new Z only.
     ZChange,
+}
+
+impl LayerMode {
+    /// Every mode by its name, as `--layer-source` and `[gcode] layer_source` take them.
+    pub const NAMES: [(&'static str, LayerMode); 3] = [
+        ("auto", LayerMode::Auto),
+        ("markers", LayerMode::Comments),
+        ("z", LayerMode::ZChange),
+    ];
+
+    /// The mode a name gives (`auto`, `markers`, `z`; any case); the error names what is
+    /// allowed.
+    pub fn parse(name: &str) -> Result<Self, String> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name.trim()))
+            .map(|&(_, m)| m)
+            .ok_or_else(|| {
+                format!(
+                    "`{}`: allowed: auto (slicer markers, else changes of Z), markers (slicer markers only: a file without them is one layer), z (changes of Z only)",
+                    crate::excerpt(name, crate::QUOTED_CHARS)
+                )
+            })
+    }
+
+    /// The mode's name ([`LayerMode::NAMES`]).
+    pub fn name(self) -> &'static str {
+        Self::NAMES
+            .iter()
+            .find(|(_, m)| *m == self)
+            .map_or("auto", |(n, _)| n)
+    }
 }
 
 /// Slicers whose every file marks every layer, as they name themselves in the header
@@ -71,6 +108,8 @@ pub(crate) struct Layers {
     z_fallback_off: bool,
     moved: bool,
     layer_z: Option<f64>,
+    /// The first layer change past [`MAX_LAYERS`]: (line, how it was found).
+    refused: Option<(u64, LayerSource)>,
 }
 
 impl Layers {
@@ -142,12 +181,34 @@ impl Layers {
     /// Emits the pending marker, if any, as the start of a new layer.
     pub(crate) fn flush(&mut self) -> Option<(u64, u32, LayerChange)> {
         let (line, c) = self.pending.take()?;
-        self.index += 1;
+        self.open(line, c.source)?;
         Some((line, self.index, c))
     }
 
-    /// Called for every move before it is emitted; returns a Z-fallback layer change.
-    pub(crate) fn before_move(&mut self, mv: &Move, printing: bool) -> Option<LayerChange> {
+    /// Counts a new layer opened at `line`; past [`MAX_LAYERS`] it is refused instead
+    /// (`None`).
+    fn open(&mut self, line: u64, source: LayerSource) -> Option<()> {
+        if self.index >= MAX_LAYERS {
+            self.refused.get_or_insert((line, source));
+            return None;
+        }
+        self.index += 1;
+        Some(())
+    }
+
+    /// The layer change past [`MAX_LAYERS`], once: its line and how it was found.
+    pub(crate) fn refused(&mut self) -> Option<(u64, LayerSource)> {
+        self.refused.take()
+    }
+
+    /// Called for every move (of line `line`) before it is emitted; returns a Z-fallback
+    /// layer change.
+    pub(crate) fn before_move(
+        &mut self,
+        line: u64,
+        mv: &Move,
+        printing: bool,
+    ) -> Option<LayerChange> {
         self.moved = true;
         if self.z_fallback_off || !printing || mv.start.z_mm != mv.end.z_mm {
             return None;
@@ -157,7 +218,7 @@ impl Layers {
             return None;
         }
         self.layer_z = Some(z);
-        self.index += 1;
+        self.open(line, LayerSource::ZChange)?;
         Some(change(LayerSource::ZChange, None, Some(z)))
     }
 }

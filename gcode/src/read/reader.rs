@@ -33,7 +33,7 @@ pub struct ReaderOptions {
     /// Longest line read, bytes (64 KiB by default: slicers write lines under 1 KiB; a
     /// longer one is binary data or a corrupt file, and is skipped unread).
     pub max_line_bytes: usize,
-    /// Where layer changes come from.
+    /// Where layer changes come from (at most [`crate::MAX_LAYERS`] of them).
     pub layers: LayerMode,
     /// Largest |X|, |Y|, |Z| accepted, mm (1e5: no printer or gantry spans 100 m; larger
     /// values are typing errors or garbage).
@@ -83,7 +83,8 @@ pub const MAX_FEATURES: usize = 64;
 ///
 /// Memory is bounded by [`ReaderOptions::max_line_bytes`] plus the input's buffer; the
 /// file is never held whole. After an error the iterator ends, unless
-/// [`ReaderOptions::skip_bad_lines`] is set.
+/// [`ReaderOptions::skip_bad_lines`] is set; a layer past [`crate::MAX_LAYERS`] ends it
+/// always ([`GcodeError::TooManyLayers`]).
 #[derive(Debug)]
 pub struct Reader<R> {
     lines: Lines<R>,
@@ -214,6 +215,26 @@ impl<R: BufRead> Reader<R> {
         self.interp.motion.position()
     }
 
+    /// Ends the read at a layer past [`crate::MAX_LAYERS`], with or without
+    /// [`ReaderOptions::skip_bad_lines`]: the line is not bad, the job has too many layers
+    /// (skipping the change would only refuse the next).
+    fn check_layers(&mut self) {
+        if let Some((line, from)) = self.interp.layers.refused() {
+            // A line error of the same line is reported first.
+            self.error.get_or_insert(GcodeError::TooManyLayers {
+                at: Location {
+                    source_name: self.source_name.clone(),
+                    line,
+                    column: None,
+                },
+                layer: crate::MAX_LAYERS + 1,
+                max: crate::MAX_LAYERS,
+                from,
+            });
+            self.finished = true;
+        }
+    }
+
     fn fail(&mut self, e: GcodeError) {
         if self.interp.opts.skip_bad_lines {
             let s = &mut self.interp.skipped;
@@ -250,6 +271,7 @@ impl<R: BufRead> Iterator for Reader<R> {
                 Ok(None) => {
                     self.finished = true;
                     self.interp.flush_layer();
+                    self.check_layers();
                 }
                 Ok(Some(LineStatus::TooLong)) => {
                     let at = Location {
@@ -284,6 +306,7 @@ impl<R: BufRead> Iterator for Reader<R> {
                     if let Err(e) = result {
                         self.fail(e);
                     }
+                    self.check_layers();
                 }
             }
         }
@@ -308,7 +331,7 @@ impl Interp {
     /// Z), tagged with the feature type in force.
     fn push_move(&mut self, line: u64, mut mv: Move) {
         mv.feature = self.feature;
-        if let Some(c) = self.layers.before_move(&mv, mv.is_working()) {
+        if let Some(c) = self.layers.before_move(line, &mv, mv.is_working()) {
             self.push(line, EventKind::Layer(c));
         }
         self.push(line, EventKind::Move(mv));

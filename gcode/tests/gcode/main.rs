@@ -17,6 +17,7 @@ mod job_prints;
 mod job_settle;
 mod job_times;
 mod job_util;
+mod layer_bound;
 mod layers;
 mod roundtrip;
 mod segments;

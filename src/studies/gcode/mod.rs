@@ -12,6 +12,9 @@
 //! layers = "0..0"
 //! ```
 //!
+//! `layer_source` says where the file's layers come from, as `settle gcode
+//! --layer-source` does: `auto` (slicer markers, else changes of Z), `markers`, `z`.
+//!
 //! The run's motion is the job's shaped X and Y (and Z), one trajectory. Without
 //! `layers` it runs from the job's first move to its end. With `layers` it starts from
 //! the whole job's state, as `settle gcode --layers` does: the job's chunks start a
@@ -65,7 +68,7 @@ use std::sync::Mutex;
 
 use serde::Deserialize;
 use settle_gcode::job::{Job, JobConfig, PlannerConfig, ShaperSetting, parse_firmware};
-use settle_gcode::Reader;
+use settle_gcode::{LayerMode, Reader};
 use settle_planner::PlanError;
 use settle_planner::firmware::Firmware;
 use settle_planner::path::CornerStrategy;
@@ -105,6 +108,9 @@ pub struct GcodeSpec {
     pub firmware: String,
     /// Layers to simulate, `A..B` or `A` (default: all).
     pub layers: Option<String>,
+    /// Where layers come from: `auto` (default), `markers` or `z`
+    /// ([`settle_gcode::LayerMode::parse`]).
+    pub layer_source: Option<String>,
     /// The speed law of settle's planner (`scurve`, `trapezoid`, ...; default `scurve`).
     #[serde(default = "default_profile")]
     pub profile: String,
@@ -131,6 +137,8 @@ pub struct GcodeJob {
     pub firmware: Firmware,
     /// Layer range (inclusive).
     pub layers: Option<(u32, u32)>,
+    /// Where layers come from.
+    pub layer_mode: LayerMode,
     /// Profile name (settle's planner), as written.
     pub profile: String,
     /// settle's planner: square-corner velocity (mm/s).
@@ -181,8 +189,8 @@ pub fn parse_layers(s: &str) -> Result<(u32, u32), String> {
     Ok((a, b))
 }
 
-/// The job configuration of `run`: its firmware's defaults, the run's limits, and
-/// `shaper` on X and Y.
+/// The job configuration of `run`: its firmware's defaults, the run's limits, `shaper`
+/// on X and Y, and the job's layer source.
 pub fn job_config(run: &RunSpec, job: &GcodeJob, shaper: Option<ShaperSetting>) -> Result<JobConfig, String> {
     let mut cfg = JobConfig::defaults(job.firmware).map_err(|e| e.to_string())?;
     let (v, a) = (run.vmax_mm_s * 1e-3, run.amax_mm_s2 * 1e-3);
@@ -226,6 +234,7 @@ pub fn job_config(run: &RunSpec, job: &GcodeJob, shaper: Option<ShaperSetting>) 
     }
     cfg.shapers[0] = shaper;
     cfg.shapers[1] = shaper;
+    cfg.layer_mode = job.layer_mode;
     Ok(cfg)
 }
 
@@ -268,9 +277,9 @@ fn linearise_at(run: &RunSpec, job: &GcodeJob, axes: &[String]) -> Result<Option
     if run.backend != Backend::Modal || !linpoint::depends_on_position(&linear_axes(run)?) {
         return Ok(None);
     }
-    let options = JobConfig::defaults(job.firmware)
-        .map_err(|e| e.to_string())?
-        .reader_options();
+    let mut cfg = JobConfig::defaults(job.firmware).map_err(|e| e.to_string())?;
+    cfg.layer_mode = job.layer_mode;
+    let options = cfg.reader_options();
     // Runs of a sweep over one file (its shaper, its limits) share the point: read once.
     let key = format!("{}|{options:?}", file_key(job)?);
     let known = LINEARISED.lock().ok().and_then(|m| m.get(&key).copied());
@@ -370,11 +379,19 @@ impl Study for GcodeRun {
             .map_err(|m| src.error_at("gcode.layers", m))?;
         settle_planner::ProfileKind::parse(&spec.profile)
             .map_err(|e| src.error_at("gcode.profile", e.to_string()))?;
+        let layer_mode = spec
+            .layer_source
+            .as_deref()
+            .map(LayerMode::parse)
+            .transpose()
+            .map_err(|m| src.error_at("gcode.layer_source", m))?
+            .unwrap_or_default();
         let base = src.path.parent().unwrap_or(std::path::Path::new("."));
         Ok(Some(Box::new(GcodeJob {
             file: base.join(&spec.file),
             firmware,
             layers,
+            layer_mode,
             profile: spec.profile,
             square_corner_velocity_mm_s: spec.square_corner_velocity_mm_s,
         })))

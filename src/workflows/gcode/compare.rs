@@ -31,7 +31,8 @@ pub fn parse_setting(s: &str) -> Result<(Firmware, XyShapers), String> {
 
 /// The options of `base` with another setting: the same firmware as a `--config` run
 /// keeps the configuration's settings (and, on an axis the shapers do not name, its
-/// shaper); another firmware starts from its defaults, unshaped.
+/// shaper); another firmware starts from its defaults, unshaped. Both read the file's
+/// layers alike (`--layer-source`).
 pub fn versus(
     base: &GcodeOptions,
     firmware: Firmware,
@@ -47,7 +48,8 @@ pub fn versus(
         config,
         ..base.clone()
     }
-    .with_shapers(shapers))
+    .with_shapers(shapers)
+    .with_layer_mode(base.job.layer_mode))
 }
 
 /// The comparison table (Markdown) of outcomes.

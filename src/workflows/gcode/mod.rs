@@ -257,6 +257,12 @@ impl GcodeOptions {
         self.with_shapers(XyShapers::both(shaper))
     }
 
+    /// Layers from `mode` (`--layer-source`).
+    pub fn with_layer_mode(mut self, mode: settle_gcode::LayerMode) -> Self {
+        self.job.layer_mode = mode;
+        self
+    }
+
     /// The shapers `--shaper` names; an axis it does not name keeps its own.
     pub fn with_shapers(mut self, shapers: XyShapers) -> Self {
         if let Some(x) = shapers.x {

@@ -464,6 +464,9 @@ pub fn command_line(opts: &GcodeOptions, dir: &Path) -> String {
         }
         None => {}
     }
+    if opts.job.layer_mode != settle_gcode::LayerMode::Auto {
+        let _ = write!(c, " --layer-source {}", opts.job.layer_mode.name());
+    }
     if let Some((a, b)) = opts.layers {
         let _ = write!(c, " --layers {a}..{b}");
     }

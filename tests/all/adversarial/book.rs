@@ -89,6 +89,10 @@ fn the_book_lists_every_limit_as_the_code_has_it() {
         settle_gcode::MAX_FEATURES
     ));
     has(format!(
+        "at most {} layers",
+        thousands(settle_gcode::MAX_LAYERS as usize)
+    ));
+    has(format!(
         "{:e} to {:e} in the file's units",
         settle_gcode::MIN_LIMIT_VALUE,
         settle_gcode::MAX_LIMIT_VALUE
