@@ -48,7 +48,7 @@ pub enum FileError {
         /// What the file should hold (`a G-code file` ...: the limit's kind).
         expected: &'static str,
         /// What it is, when its first bytes say: an archive or a compressed stream.
-        packed: Option<crate::read::Packed>,
+        packed: Option<crate::packed::Packed>,
     },
     /// An output could not be written (a full disk, no permission).
     #[error("cannot write {}: {source}", path.display())]
@@ -95,7 +95,7 @@ impl FileError {
 }
 
 /// Why a file is not text, in [`FileError::NotText`]'s words.
-fn packed_text(packed: &Option<crate::read::Packed>) -> String {
+fn packed_text(packed: &Option<crate::packed::Packed>) -> String {
     match packed {
         Some(p) => format!("{}: unpack it and name the file inside", p.name()),
         None => "binary data?".to_string(),

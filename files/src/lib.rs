@@ -7,7 +7,8 @@
 //!   not a file), refuses a file above its kind's [`Limit`] before reading it and stops at
 //!   the limit while reading (a file that grows). [`read::read_capped`] bounds what a
 //!   decompressor may produce. [`lines::BoundedLines`] splits a stream into lines of
-//!   bounded length without holding an over-long line.
+//!   bounded length without holding an over-long line. [`packed::Packed`] names an input
+//!   that is an archive or a compressed stream by its first bytes.
 //! - Outputs ([`mod@write`]): a file is written only where nothing is or where a regular file
 //!   is (never onto a link, a folder, a device or a FIFO), through a temporary file and a
 //!   rename; a folder settle makes inside its output folder is never a link out of it; and
@@ -22,6 +23,7 @@ pub mod error;
 pub mod identity;
 pub mod limit;
 pub mod lines;
+pub mod packed;
 pub mod read;
 pub mod write;
 

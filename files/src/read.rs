@@ -181,47 +181,10 @@ pub fn read_text(path: &Path, limit: Limit) -> Result<String, FileError> {
     text(path, read_bytes(path, limit)?, limit.what)
 }
 
-/// An archive or a compressed stream, known by the magic number its first bytes carry.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Packed {
-    /// A zip archive: a local file header, `PK 3 4` (PKWARE's APPNOTE.TXT). 3MF projects,
-    /// UltiMaker `.ufp` packages and the configuration folders Mainsail and Fluidd
-    /// download are zip archives.
-    Zip,
-    /// A gzip stream: `1f 8b` (RFC 1952).
-    Gzip,
-    /// A zstd frame: `28 b5 2f fd` (RFC 8878).
-    Zstd,
-}
-
-impl Packed {
-    /// What `first`, the first bytes of a file, start, if a [`Packed`] kind.
-    pub fn of(first: &[u8]) -> Option<Packed> {
-        if first.starts_with(b"PK\x03\x04") {
-            Some(Packed::Zip)
-        } else if first.starts_with(&[0x1f, 0x8b]) {
-            Some(Packed::Gzip)
-        } else if first.starts_with(&[0x28, 0xb5, 0x2f, 0xfd]) {
-            Some(Packed::Zstd)
-        } else {
-            None
-        }
-    }
-
-    /// The kind in words: `a zip archive`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Packed::Zip => "a zip archive",
-            Packed::Gzip => "gzip-compressed",
-            Packed::Zstd => "zstd-compressed",
-        }
-    }
-}
-
 /// `bytes`, read from `path`, as text (see [`read_text`]); `expected` names what the file
 /// should be in the error.
 pub fn text(path: &Path, bytes: Vec<u8>, expected: &'static str) -> Result<String, FileError> {
-    let packed = Packed::of(&bytes);
+    let packed = crate::packed::Packed::of(&bytes);
     let text = String::from_utf8(bytes).map_err(|e| {
         let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
         let line_start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);

@@ -2,7 +2,7 @@
 //! G-code, a gzip stream, a zip archive, a zstd frame. Each is named with the way to its text, rather
 //! than refused as "binary data" at its first odd byte.
 
-use settle_files::read::Packed;
+use settle_files::packed::Packed;
 
 /// What a file whose first line starts with `first` is, and how to get its G-code as
 /// text; `None` for anything else (text, or binary data of no known kind).

@@ -187,8 +187,8 @@ pub enum FileData {
 pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     let file = path.display().to_string();
     let bytes = settle_files::read::read_bytes(path, settle_files::limit::RECORDING)?;
-    let packed = settle_files::read::Packed::of(&bytes);
-    if packed == Some(settle_files::read::Packed::Zstd) {
+    let packed = settle_files::packed::Packed::of(&bytes);
+    if packed == Some(settle_files::packed::Packed::Zstd) {
         return stdata::parse(&file, &bytes).map(FileData::Recordings);
     }
     let mut text = String::from_utf8(bytes).map_err(|e| {
