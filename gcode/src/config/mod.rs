@@ -62,6 +62,7 @@ mod klipper_files;
 pub(crate) mod klipper_shaper;
 mod klipper_values;
 mod machine;
+mod marlin;
 mod rrf;
 mod rrf_script;
 
@@ -77,6 +78,7 @@ pub use klipper::{
     DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,
     KlipperStepper,
 };
+pub use marlin::MarlinSettings;
 pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
 pub use rrf::{
     RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RRF_MINIMUM_ACCEL_MM_S2, RRF_MINIMUM_JERK_MM_S,
