@@ -152,11 +152,7 @@ fn command_of(text: &str) -> Option<String> {
 
 /// `M92`'s values (X, Y, Z, E): positive steps per mm; `T` (an extruder of a
 /// `DISTINCT_E_FACTORS` build) is read, and only the first extruder's `E` kept.
-fn steps_words(
-    text: &str,
-    at: &Location,
-    steps: &mut [Option<f64>; 4],
-) -> Result<(), GcodeError> {
+fn steps_words(text: &str, at: &Location, steps: &mut [Option<f64>; 4]) -> Result<(), GcodeError> {
     let code = text.split(';').next().unwrap_or("");
     let mut words = code.split_whitespace();
     words.next(); // M92
@@ -228,47 +224,45 @@ impl MarlinSettings {
         for (i, raw) in text.lines().enumerate() {
             let line = i as u64 + 1;
             let keep = match reply_text(raw) {
-                Some(t) if !t.starts_with(';') && !t.starts_with("//") => {
-                    match command_of(t) {
-                        Some(c) if PLANNER_COMMANDS.contains(&c.as_str()) => {
-                            any = true;
-                            if c == "M92" {
-                                steps_words(t, &at(line), &mut steps)?;
-                                ""
-                            } else {
-                                if c == "M205" {
-                                    let code = t.split(';').next().unwrap_or("").to_uppercase();
-                                    let has = |l: char| {
-                                        code.split_whitespace().skip(1).any(|w| w.starts_with(l))
-                                    };
-                                    classic_jerk = has('X') && !has('J');
-                                }
-                                t
+                Some(t) if !t.starts_with(';') && !t.starts_with("//") => match command_of(t) {
+                    Some(c) if PLANNER_COMMANDS.contains(&c.as_str()) => {
+                        any = true;
+                        if c == "M92" {
+                            steps_words(t, &at(line), &mut steps)?;
+                            ""
+                        } else {
+                            if c == "M205" {
+                                let code = t.split(';').next().unwrap_or("").to_uppercase();
+                                let has = |l: char| {
+                                    code.split_whitespace().skip(1).any(|w| w.starts_with(l))
+                                };
+                                classic_jerk = has('X') && !has('J');
                             }
+                            t
                         }
-                        Some(c) if c == "G20" => {
-                            return Err(GcodeError::ConfigSyntax {
+                    }
+                    Some(c) if c == "G20" => {
+                        return Err(GcodeError::ConfigSyntax {
                                 at: at(line),
                                 what: "G20: the report's values are in inches (a Marlin built with INCH_MODE_SUPPORT); send G21, then M503, and save that reply".into(),
                             });
-                        }
-                        Some(c) => {
-                            if unused.insert(c.clone()) {
-                                let text = match unused_reason(&c) {
-                                    Some(what) => {
-                                        format!("{c} ({what}): read, not used by settle's planner")
-                                    }
-                                    None => format!(
-                                        "{c}: not a command Marlin's M503 report prints that settle knows; not used"
-                                    ),
-                                };
-                                notes.push(ConfigNote::at(at(line), text));
-                            }
-                            ""
-                        }
-                        None => "",
                     }
-                }
+                    Some(c) => {
+                        if unused.insert(c.clone()) {
+                            let text = match unused_reason(&c) {
+                                Some(what) => {
+                                    format!("{c} ({what}): read, not used by settle's planner")
+                                }
+                                None => format!(
+                                    "{c}: not a command Marlin's M503 report prints that settle knows; not used"
+                                ),
+                            };
+                            notes.push(ConfigNote::at(at(line), text));
+                        }
+                        ""
+                    }
+                    None => "",
+                },
                 _ => "",
             };
             kept.push(keep);
@@ -293,13 +287,12 @@ impl MarlinSettings {
                 travel_extra_xy_jerk_m_s: 0.0,
             };
         }
-        let plan_error = |line: u64, command: &str, e: settle_planner::PlanError| {
-            GcodeError::Plan {
+        let plan_error =
+            |line: u64, command: &str, e: settle_planner::PlanError| GcodeError::Plan {
                 at: at(line),
                 command: command.to_string(),
                 source: Box::new(e),
-            }
-        };
+            };
         let mut driver = Driver::new(&crate::job::PlannerConfig::Marlin(planner))
             .map_err(|e| plan_error(1, "M92", e))?
             .expect("Marlin's planner is a firmware's");
@@ -319,10 +312,12 @@ impl MarlinSettings {
             let command = change.command_name();
             followed.push((at.line, command));
             if matches!(change, LimitChange::MarlinInputShaping { .. }) {
-                shapers.apply(&change).map_err(|_| GcodeError::ConfigSyntax {
-                    at: at.clone(),
-                    what: "M593: not followed".into(),
-                })?;
+                shapers
+                    .apply(&change)
+                    .map_err(|_| GcodeError::ConfigSyntax {
+                        at: at.clone(),
+                        what: "M593: not followed".into(),
+                    })?;
                 continue;
             }
             let mut why = Vec::new();
@@ -363,4 +358,186 @@ fn followed_line(followed: &[(u64, &'static str)], command: &str) -> u64 {
         .rev()
         .find(|(_, c)| *c == command)
         .map_or(1, |(l, _)| *l)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use settle_planner::shaper::ShaperType;
+
+    /// The reply of a Marlin 2.1 build with junction deviation and input shaping, as
+    /// M503 prints it (settings.cpp, M200-M205.cpp, M92.cpp, M593.cpp).
+    const REPLY: &str = "echo:; Linear Units:\n\
+        echo:  G21 ; (mm)\n\
+        echo:; Steps per unit:\n\
+        echo:  M92 X80.00 Y80.00 Z400.00 E93.00\n\
+        echo:; Max feedrates (units/s):\n\
+        echo:  M203 X500.00 Y450.00 Z5.00 E25.00\n\
+        echo:; Max Acceleration (units/s2):\n\
+        echo:  M201 X1500.00 Y1400.00 Z100.00 E5000.00\n\
+        echo:; Acceleration (units/s2) (P<print-accel> R<retract-accel> T<travel-accel>):\n\
+        echo:  M204 P1200.00 R1500.00 T2000.00\n\
+        echo:; Advanced (B<min_segment_time_us> S<min_feedrate> T<min_travel_feedrate> J<junc_dev>):\n\
+        echo:  M205 B20000.00 S0.00 T0.00 J0.08\n\
+        echo:; PID settings:\n\
+        echo:  M301 P21.73 I1.54 D76.55\n\
+        echo:; Input Shaping:\n\
+        echo:  M593 X F40.00 D0.15\n\
+        echo:  M593 Y F35.50 D0.10\n\
+        echo:; Stepper driver current:\n\
+        echo:  M906 X580 Y580 Z580\n\
+        echo:  M906 I1 Z580\n";
+
+    fn check(s: &MarlinSettings, what: &str) {
+        let p = &s.planner;
+        // In mm units as the reply states them (the planner keeps metres).
+        let mm = |v: [f64; 4]| v.map(|x| x * 1e-3);
+        assert_eq!(p.steps_per_m, [80e3, 80e3, 400e3, 93e3], "{what}");
+        assert_eq!(p.max_feedrate_m_s, mm([500.0, 450.0, 5.0, 25.0]), "{what}");
+        assert_eq!(
+            p.max_accel_m_s2,
+            mm([1500.0, 1400.0, 100.0, 5000.0]),
+            "{what}"
+        );
+        assert_eq!(
+            [
+                p.print_accel_m_s2,
+                p.retract_accel_m_s2,
+                p.travel_accel_m_s2,
+                0.0
+            ],
+            mm([1200.0, 1500.0, 2000.0, 0.0]),
+            "{what}"
+        );
+        assert_eq!(p.min_segment_time_s, 0.02, "{what}");
+        assert_eq!((p.min_feedrate_m_s, p.min_travel_feedrate_m_s), (0.0, 0.0));
+        let MarlinJerk::JunctionDeviation { deviation_m, .. } = p.jerk else {
+            panic!("{what}: junction deviation expected")
+        };
+        assert_eq!(deviation_m, 0.08 * 1e-3, "{what}");
+        assert!(!s.classic_jerk, "{what}");
+        let x = s.shapers[0].expect("X shaped");
+        let y = s.shapers[1].expect("Y shaped");
+        assert_eq!(
+            (x.shaper_type, x.frequency_hz, x.damping_ratio),
+            (ShaperType::Zv, 40.0, 0.15),
+            "{what}"
+        );
+        assert_eq!((y.frequency_hz, y.damping_ratio), (35.5, 0.1), "{what}");
+        assert_eq!(s.shapers[2], None, "{what}");
+        let commands: Vec<&str> = s.followed.iter().map(|(_, c)| *c).collect();
+        assert_eq!(
+            commands,
+            ["M203", "M201", "M204", "M205", "M593", "M593"],
+            "{what}"
+        );
+        // G21, M301, M906: each listed once, M906's second line not again.
+        let notes: Vec<String> = s.notes.iter().map(|n| n.text.clone()).collect();
+        assert_eq!(notes.len(), 3, "{what}: {notes:?}");
+        assert!(notes[2].starts_with("M906 (stepper currents)"), "{notes:?}");
+    }
+
+    /// The reply as Marlin prints it, and as each terminal shows it: OctoPrint's
+    /// (`Send:`/`Recv:`, CRLF), Pronterface's (`>>>`, `SENDING:`), a bare copy with `//`
+    /// comments and `ok`, all give the same settings.
+    #[test]
+    fn a_reply_reads_the_same_from_every_terminal() {
+        let lines: Vec<&str> = REPLY.lines().collect();
+        let octoprint = std::iter::once("Send: M503".to_string())
+            .chain(lines.iter().map(|l| format!("Recv: {l}")))
+            .chain(["Recv: ok".to_string()])
+            .collect::<Vec<_>>()
+            .join("\r\n");
+        let pronterface = [">>> M503", "SENDING:M503"]
+            .into_iter()
+            .map(str::to_string)
+            .chain(lines.iter().map(|l| (*l).to_string()))
+            .chain(["ok".to_string()])
+            .collect::<Vec<_>>()
+            .join("\n");
+        let bare = std::iter::once("// copied from the printer".to_string())
+            .chain(
+                lines
+                    .iter()
+                    .map(|l| l.trim_start_matches("echo:").to_string()),
+            )
+            .chain(["".to_string(), "ok".to_string()])
+            .collect::<Vec<_>>()
+            .join("\n");
+        for (what, text) in [
+            ("marlin", REPLY.to_string()),
+            ("octoprint", octoprint),
+            ("pronterface", pronterface),
+            ("bare", bare),
+        ] {
+            let s = MarlinSettings::parse(&text, "m503.txt").expect(what);
+            check(&s, what);
+        }
+    }
+
+    /// Marlin 1.1's reply (headings without `; `, `M204 P R T`, `M205` with classic jerks
+    /// and no `J`): the planner follows classic jerk with the reply's values.
+    #[test]
+    fn a_classic_jerk_reply_sets_classic_jerk() {
+        let text = "echo:Steps per unit:\n\
+                    echo:  M92 X100.00 Y100.00 Z400.00 E95.00\n\
+                    echo:Maximum feedrates (units/s):\n\
+                    echo:  M203 X300.00 Y300.00 Z5.00 E25.00\n\
+                    echo:Maximum Acceleration (units/s2):\n\
+                    echo:  M201 X500 Y500 Z100 E5000\n\
+                    echo:Acceleration (units/s2): P<print_accel> R<retract_accel> T<travel_accel>\n\
+                    echo:  M204 P500.00 R500.00 T1000.00\n\
+                    echo:Advanced: S<min_feedrate> T<min_travel_feedrate> B<min_segment_time_us> X<max_xy_jerk> Z<max_z_jerk> E<max_e_jerk>\n\
+                    echo:  M205 S0.00 T0.00 B20000 X10.00 Y8.00 Z0.40 E5.00\n";
+        let s = MarlinSettings::parse(text, "m503.txt").expect("read");
+        assert!(s.classic_jerk);
+        let MarlinJerk::Classic { max_jerk_m_s, .. } = s.planner.jerk else {
+            panic!("classic jerk expected: {:?}", s.planner.jerk)
+        };
+        assert_eq!(max_jerk_m_s, [10.0, 8.0, 0.4, 5.0].map(|v| v * 1e-3));
+        assert_eq!(s.planner.steps_per_m[0], 100e3);
+        assert_eq!(s.planner.travel_accel_m_s2, 1000.0 * 1e-3);
+        assert_eq!(s.shapers, [None; 3]);
+        assert!(s.notes.is_empty(), "{:?}", s.notes);
+    }
+
+    /// A value the job's own commands would have refused, a report in inches and a file
+    /// that is no report: errors naming the file and the line.
+    #[test]
+    fn refused_values_and_other_files_are_errors_with_their_line() {
+        let cases = [
+            (
+                "echo:  M92 X80\necho:  M201 X-500 Y500\n",
+                "m503.txt:2",
+                "M201",
+            ),
+            ("M203 X300\nM92 X0 Y80\n", "m503.txt:2", "M92"),
+            ("M203 X300\nM593 X F40 D1.5\n", "m503.txt:2", "M593"),
+            ("echo:  G20 ; (in)\nM203 X10\n", "m503.txt:1", "G20"),
+            (
+                "[printer]\nmax_velocity: 300\n",
+                "m503.txt:1",
+                "not an M503 report",
+            ),
+            ("ok\nok\n", "m503.txt:1", "not an M503 report"),
+        ];
+        for (text, at, what) in cases {
+            let e = MarlinSettings::parse(text, "m503.txt")
+                .expect_err(text)
+                .to_string();
+            assert!(e.contains(at) && e.contains(what), "{text:?}: {e}");
+        }
+    }
+
+    /// A command settle does not know is a note, once.
+    #[test]
+    fn an_unknown_command_is_a_note() {
+        let s = MarlinSettings::parse("M203 X300\nM9999 S1\nM9999 S2\n", "m.txt").expect("read");
+        assert_eq!(s.notes.len(), 1, "{:?}", s.notes);
+        assert!(
+            s.notes[0]
+                .to_string()
+                .starts_with("m.txt:2: M9999: not a command")
+        );
+    }
 }
