@@ -67,6 +67,12 @@ fn unused_reason(command: &str) -> Option<&'static str> {
     Some(match command {
         "G21" => "units (millimetres)",
         "M149" => "temperature units",
+        "M86" => "hotend idle timeout",
+        "M104" => "hotend temperature (auto temperature)",
+        "M210" => "homing feedrates",
+        "M255" | "M256" => "display",
+        "M306" => "model predictive temperature control",
+        "M401" => "probe deployment (BLTouch high speed mode)",
         "M200" => "filament diameter (volumetric extrusion)",
         "M206" => "home offset",
         "M207" | "M208" | "M209" => "firmware retraction",
@@ -130,12 +136,13 @@ fn reply_text(line: &str) -> Option<&str> {
     Some(t)
 }
 
-/// The command a reply line holds (`M92`, `G21`): a `G` or `M` and its number, upper
-/// case, at the line's start; `None` for a heading, a comment or a message.
+/// The command a reply line holds (`M92`, `G21`, a firmware's own `C100`): a letter and
+/// its number, upper case, at the line's start; `None` for a heading, a comment or a
+/// message.
 fn command_of(text: &str) -> Option<String> {
     let b = text.as_bytes();
     let letter = b.first()?.to_ascii_uppercase();
-    if !matches!(letter, b'G' | b'M') {
+    if !letter.is_ascii_uppercase() {
         return None;
     }
     let digits = b[1..].iter().take_while(|c| c.is_ascii_digit()).count();
