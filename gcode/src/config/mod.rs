@@ -1,7 +1,8 @@
 //! Firmware configuration files in and out: Klipper's `printer.cfg` (with its includes and
-//! SAVE_CONFIG block), RepRapFirmware's `config.g` (with the macros it runs) and GRBL's
-//! `$$` settings read into plain data ([`KlipperConfig`], [`RrfConfig`],
-//! [`GrblSettings`]) with the values the firmware would use,
+//! SAVE_CONFIG block), RepRapFirmware's `config.g` (with the macros it runs), GRBL's
+//! `$$` settings and Marlin's `M503` reply read into plain data ([`KlipperConfig`],
+//! [`RrfConfig`], [`GrblSettings`], [`MarlinSettings`]) with the values the firmware
+//! would use,
 //! and input shaper settings written back in each firmware's own syntax, ready to paste
 //! ([`KlipperExport`], [`RrfExport`], and Marlin's Fixed-Time Motion `M493` lines,
 //! [`MarlinExport`]).
