@@ -321,7 +321,8 @@ fn a_jobs_m204_above_the_m503_reply_is_listed_as_raising_it() {
 }
 
 /// The command line: a reply is read (exit 0, the settings line, summary.md's
-/// "Planner settings from"); a refused value exits 2 naming the file and line.
+/// "Planner settings from" and report.html's); a refused value exits 2 naming the file
+/// and line.
 #[test]
 fn settle_gcode_reads_a_marlin_m503_reply_end_to_end() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -362,6 +363,8 @@ fn settle_gcode_reads_a_marlin_m503_reply_end_to_end() {
     assert!(stdout.contains(&line), "{stdout}");
     let summary = std::fs::read_to_string(out.join("summary.md")).expect("written");
     assert!(summary.contains(&format!("Planner {line}")), "{summary}");
+    let html = std::fs::read_to_string(out.join("report.html")).expect("written");
+    assert!(html.contains(&line), "report.html lacks {line}");
     let bad_out = d.join("bad-out");
     let refused = run(&bad, &bad_out);
     let stderr = String::from_utf8_lossy(&refused.stderr);
