@@ -19,7 +19,8 @@
 #     and slic3r/ folders;
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
 #     what identify wrote, `settle import` of the example configurations and of the real
-#     ones of gcode/tests/data/real/ (two of them also under the Benchy), `settle tune` on
+#     ones of gcode/tests/data/real/ (two of them, and a Marlin M503 reply, also under
+#     the Benchy), `settle tune` on
 #     the tune scenarios, on the imported printer and with `--criterion klipper`;
 #   - `settle validate --backend rapier`;
 #   - `settle identify` on every spectrum of identify/tests/corpus/ (and its refusals),
@@ -138,6 +139,8 @@ cases() {
   echo "import-real-railcore import rrf $REAL/railcore/sys/config.g --out {out}/printer.toml"
   echo "gcode-benchy-real-vt627 gcode $P/benchy/3DBenchy.gcode --machine printer_xy --config $REAL/vt627/printer.cfg --out {out}"
   echo "gcode-benchy-real-railcore gcode $P/benchy/3DBenchy.gcode --machine printer_xy --config $REAL/railcore/sys/config.g --out {out}"
+  # A Marlin owner's M503 reply (gcode/tests/data/real/marlin/PROVENANCE.md).
+  echo "gcode-benchy-real-marlin gcode $P/benchy/3DBenchy.gcode --machine printer_xy --firmware marlin --config $REAL/marlin/ender3v2neo/m503_20241028.gcode --out {out}"
   for s in "$S"/tune_*.toml; do
     echo "tune-$(basename "$s" .toml) tune $s --jobs 2 --out {out}"
   done

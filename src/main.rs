@@ -249,9 +249,9 @@ enum Command {
         #[arg(long, value_parser = parse_firmware)]
         firmware: Option<settle_planner::firmware::Firmware>,
         /// The firmware's configuration (Klipper printer.cfg with its includes,
-        /// RepRapFirmware config.g, or GRBL's settings as `$$` prints them, with --firmware
-        /// grbl): the planner's limits and the input shapers start as it sets them,
-        /// instead of the firmware's defaults.
+        /// RepRapFirmware config.g, GRBL's settings as `$$` prints them, with --firmware
+        /// grbl, or Marlin's reply to M503, with --firmware marlin): the planner's limits
+        /// and the input shapers start as it sets them, instead of the firmware's defaults.
         #[arg(long, value_name = "FILE")]
         config: Option<PathBuf>,
         /// Only these layers, A..B (both included) or A; the rest is planned, not simulated.

@@ -106,7 +106,7 @@ fn a_configurations_shapers_are_per_axis_as_on_the_command_line() {
 }
 
 /// A configuration settle cannot follow: exit 2 naming the file and the key, nothing
-/// written; a Marlin run has no configuration file to read.
+/// written; a printer.cfg is not Marlin's M503 reply.
 #[test]
 fn a_configuration_settle_cannot_follow_exits_2_and_writes_nothing() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -124,7 +124,7 @@ fn a_configuration_settle_cannot_follow_exits_2_and_writes_nothing() {
     let cases: [(&[&str], &Path, &str); 4] = [
         (&[], &delta, "printer.kinematics"),
         (&[], &bad_value, "printer.max_accel"),
-        (&["--firmware", "marlin"], &delta, "--config"),
+        (&["--firmware", "marlin"], &delta, "not an M503 report"),
         (&[], &dir.path().join("missing.cfg"), "missing.cfg"),
     ];
     for (extra, config, key) in cases {
@@ -199,4 +199,179 @@ fn the_real_configurations_replay_a_job() {
         let m = measure(&opts).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(m.print_time_s > 0.0 && m.worst_um.is_finite(), "{file}");
     }
+}
+
+/// A Marlin reply to `M503` (OctoPrint's terminal copy) with limits below Marlin's
+/// defaults and a ZV shaper per axis.
+const M503: &str = "Send: M503\r\n\
+    Recv: echo:; Steps per unit:\r\n\
+    Recv: echo:  M92 X100.00 Y100.00 Z400.00 E93.00\r\n\
+    Recv: echo:; Max feedrates (units/s):\r\n\
+    Recv: echo:  M203 X200.00 Y200.00 Z5.00 E25.00\r\n\
+    Recv: echo:; Max Acceleration (units/s2):\r\n\
+    Recv: echo:  M201 X2000.00 Y2000.00 Z100.00 E5000.00\r\n\
+    Recv: echo:; Acceleration (units/s2) (P<print-accel> R<retract-accel> T<travel-accel>):\r\n\
+    Recv: echo:  M204 P1200.00 R1500.00 T1800.00\r\n\
+    Recv: echo:; Advanced (B<min_segment_time_us> S<min_feedrate> T<min_travel_feedrate> J<junc_dev>):\r\n\
+    Recv: echo:  M205 B20000.00 S0.00 T0.00 J0.05\r\n\
+    Recv: echo:; Input Shaping:\r\n\
+    Recv: echo:  M593 X F40.00 D0.15\r\n\
+    Recv: echo:  M593 Y F35.50 D0.10\r\n\
+    Recv: echo:  M900 K0.05\r\n\
+    Recv: ok\r\n";
+
+/// The same commands written at the top of a G-code file.
+const M503_AS_GCODE: &str = "M203 X200.00 Y200.00 Z5.00 E25.00\n\
+    M201 X2000.00 Y2000.00 Z100.00 E5000.00\nM204 P1200.00 R1500.00 T1800.00\n\
+    M205 B20000.00 S0.00 T0.00 J0.05\nM593 X F40.00 D0.15\nM593 Y F35.50 D0.10\n";
+
+/// Marlin under its M503 reply plans a job exactly as under the same commands at the
+/// file's top (M92, which settle's G-code reader does not follow, set on the planner):
+/// print time, worst and p95 contour error bit for bit. One move from rest to rest is
+/// the trapezoid of `M204 P` (1200 mm/s^2, below `M201 X`) at the feed rate.
+#[test]
+fn a_marlin_m503_reply_plans_as_its_commands_at_the_files_top() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let m503 = write(d, "m503.txt", M503);
+    let job = "G90\nM83\nG1 X60 E1 F6000\nG1 X60 Y40 E1\nG1 X0 Y0 E1\n";
+    let file = write(d, "job.gcode", job);
+    let from_reply = measure(
+        &GcodeOptions::with_config(file, "printer_xy", Some(Firmware::Marlin), m503)
+            .expect("options"),
+    )
+    .expect("runs");
+    let prepended = write(d, "prepended.gcode", &format!("{M503_AS_GCODE}{job}"));
+    let mut opts = GcodeOptions::new(prepended, "printer_xy", Firmware::Marlin).expect("options");
+    let settle_gcode::job::PlannerConfig::Marlin(c) = &mut opts.job.planner else {
+        panic!("Marlin's planner")
+    };
+    c.steps_per_m = [100e3, 100e3, 400e3, 93e3];
+    let written = measure(&opts).expect("runs");
+    assert_eq!(
+        from_reply.print_time_s.to_bits(),
+        written.print_time_s.to_bits()
+    );
+    assert_eq!(from_reply.worst_um.to_bits(), written.worst_um.to_bits());
+    assert_eq!(from_reply.p95_um.to_bits(), written.p95_um.to_bits());
+    assert_eq!(from_reply.setting, "marlin + X zv@40 Hz, Y zv@35.5 Hz");
+    let (settings, notes) = from_reply.config.as_ref().expect("read");
+    assert!(
+        settings.ends_with(
+            "marlin: M203 X200 Y200 mm/s, M201 X2000 Y2000 mm/s^2, M204 P1200 T1800 mm/s^2, \
+             M205 J0.05 mm, M92 X100 Y100 steps/mm; shaper X zv@40 Hz, Y zv@35.5 Hz"
+        ),
+        "{settings}"
+    );
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(notes[0].contains(":15: M900 (linear advance)"), "{notes:?}");
+
+    // One move: 60 mm at 100 mm/s is the trapezoid of the reply's 1200 mm/s^2, d/v + v/a
+    // (0.683 s; Marlin's blocks start and end a little above rest, its least step rate
+    // and entry speed, so 0.6 % less), not of Marlin's default 3000 mm/s^2 (0.633 s).
+    let one = write(d, "one.gcode", "G90\nM83\nG1 X60 E1 F6000\n");
+    let t = measure(
+        &GcodeOptions::with_config(
+            one.clone(),
+            "printer_xy",
+            Some(Firmware::Marlin),
+            d.join("m503.txt"),
+        )
+        .expect("options"),
+    )
+    .expect("runs")
+    .print_time_s;
+    let want = 60.0 / 100.0 + 100.0 / 1200.0;
+    assert!(t < want && t > 0.99 * want, "{t} s, trapezoid {want} s");
+    let default =
+        measure(&GcodeOptions::new(one, "printer_xy", Firmware::Marlin).expect("options"))
+            .expect("runs")
+            .print_time_s;
+    let at_default = 60.0 / 100.0 + 100.0 / 3000.0;
+    assert!(
+        default < at_default && default > 0.99 * at_default,
+        "{default} s, trapezoid {at_default} s"
+    );
+}
+
+/// A job's `M204 S` above the reply's `M204 P` and `T` is listed as raising them.
+#[test]
+fn a_jobs_m204_above_the_m503_reply_is_listed_as_raising_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let m503 = write(d, "m503.txt", M503);
+    let file = write(d, "job.gcode", "G90\nM83\nM204 S3000\nG1 X60 E1 F6000\n");
+    let m = measure(
+        &GcodeOptions::with_config(file, "printer_xy", Some(Firmware::Marlin), m503)
+            .expect("options"),
+    )
+    .expect("runs");
+    let raised: Vec<(u64, &str, f64, f64)> = m
+        .overrides
+        .iter()
+        .map(|o| (o.line, o.limit, o.configured, o.file))
+        .collect();
+    assert_eq!(
+        raised,
+        [
+            (3, "M204 P print acceleration (mm/s^2)", 1200.0, 3000.0),
+            (3, "M204 T travel acceleration (mm/s^2)", 1800.0, 3000.0),
+        ]
+    );
+}
+
+/// The command line: a reply is read (exit 0, the settings line, summary.md's
+/// "Planner settings from" and report.html's); a refused value exits 2 naming the file
+/// and line.
+#[test]
+fn settle_gcode_reads_a_marlin_m503_reply_end_to_end() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let m503 = write(d, "m503.txt", M503);
+    let bad = write(d, "bad.txt", "echo:  M203 X200\necho:  M201 X-5\n");
+    let gcode = write(d, "m.gcode", "G90\nM83\nG1 X10 E1 F6000\n");
+    let run = |config: &Path, out: &Path| {
+        settle()
+            .arg("gcode")
+            .arg(&gcode)
+            .args([
+                "--machine",
+                "printer_xy",
+                "--firmware",
+                "marlin",
+                "--config",
+            ])
+            .arg(config)
+            .arg("--out")
+            .arg(out)
+            .output()
+            .expect("settle runs")
+    };
+    let out = d.join("out");
+    let ok = run(&m503, &out);
+    let stdout = String::from_utf8_lossy(&ok.stdout);
+    assert_eq!(
+        ok.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let line = format!(
+        "settings from {}: marlin: M203 X200 Y200 mm/s",
+        m503.display()
+    );
+    assert!(stdout.contains(&line), "{stdout}");
+    let summary = std::fs::read_to_string(out.join("summary.md")).expect("written");
+    assert!(summary.contains(&format!("Planner {line}")), "{summary}");
+    let html = std::fs::read_to_string(out.join("report.html")).expect("written");
+    assert!(html.contains(&line), "report.html lacks {line}");
+    let bad_out = d.join("bad-out");
+    let refused = run(&bad, &bad_out);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("bad.txt:2") && stderr.contains("M201"),
+        "{stderr}"
+    );
+    assert!(!bad_out.exists());
 }

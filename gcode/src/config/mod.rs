@@ -1,7 +1,8 @@
 //! Firmware configuration files in and out: Klipper's `printer.cfg` (with its includes and
-//! SAVE_CONFIG block), RepRapFirmware's `config.g` (with the macros it runs) and GRBL's
-//! `$$` settings read into plain data ([`KlipperConfig`], [`RrfConfig`],
-//! [`GrblSettings`]) with the values the firmware would use,
+//! SAVE_CONFIG block), RepRapFirmware's `config.g` (with the macros it runs), GRBL's
+//! `$$` settings and Marlin's `M503` reply read into plain data ([`KlipperConfig`],
+//! [`RrfConfig`], [`GrblSettings`], [`MarlinSettings`]) with the values the firmware
+//! would use,
 //! and input shaper settings written back in each firmware's own syntax, ready to paste
 //! ([`KlipperExport`], [`RrfExport`], and Marlin's Fixed-Time Motion `M493` lines,
 //! [`MarlinExport`]).
@@ -62,6 +63,7 @@ mod klipper_files;
 pub(crate) mod klipper_shaper;
 mod klipper_values;
 mod machine;
+mod marlin;
 mod rrf;
 mod rrf_script;
 
@@ -78,6 +80,7 @@ pub use klipper::{
     KlipperStepper,
 };
 pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
+pub use marlin::MarlinSettings;
 pub use rrf::{
     RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RRF_MINIMUM_ACCEL_MM_S2, RRF_MINIMUM_JERK_MM_S,
     RrfAxis, RrfConfig,

@@ -62,13 +62,13 @@
 
 mod chunk;
 mod config;
-mod driver;
+pub(crate) mod driver;
 mod input;
 mod moves;
 mod not_followed;
 mod pipeline;
 mod settle;
-mod shapers;
+pub(crate) mod shapers;
 mod slice;
 mod travel;
 

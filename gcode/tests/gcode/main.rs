@@ -3,6 +3,7 @@
 mod arcs;
 mod config_export;
 mod config_klipper;
+mod config_marlin;
 mod config_real;
 mod config_rrf;
 mod cura;

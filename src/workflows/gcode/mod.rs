@@ -226,17 +226,19 @@ impl GcodeOptions {
                 let notes = c.notes.iter().map(ToString::to_string).collect();
                 (job, notes, c.files)
             }
-            Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => {
+            Firmware::Marlin => {
+                let c = settle_gcode::config::MarlinSettings::read(&config)
+                    .map_err(|e| crate::workflows::import::config_error(&config, e))?;
+                let job = JobConfig::from_marlin(&c).map_err(gcode_error(&config))?;
+                let notes = c.notes.iter().map(ToString::to_string).collect();
+                (job, notes, c.files)
+            }
+            Firmware::Settle | Firmware::Tmc4361a => {
                 return Err(Error::input_key(
                     &config,
                     "--config",
                     format!(
-                        "--config reads a Klipper printer.cfg (--firmware klipper), a RepRapFirmware config.g (--firmware rrf) or GRBL's $$ settings (--firmware grbl), not {firmware}'s settings{}",
-                        if firmware == Firmware::Marlin {
-                            " (Marlin's M201/M203/M204/M205/M593 lines in the G-code file set them)"
-                        } else {
-                            ""
-                        }
+                        "--config reads a Klipper printer.cfg (--firmware klipper), a RepRapFirmware config.g (--firmware rrf), GRBL's $$ settings (--firmware grbl) or Marlin's M503 reply (--firmware marlin), not {firmware}'s settings"
                     ),
                 ));
             }
@@ -892,7 +894,33 @@ pub fn config_settings(job: &JobConfig) -> String {
             g.junction_deviation_mm,
             u8::from(g.laser_mode)
         ),
-        PlannerConfig::Marlin(_) | PlannerConfig::Settle(_) => "the firmware's defaults".into(),
+        PlannerConfig::Marlin(c) => {
+            use settle_planner::firmware::marlin::MarlinJerk;
+            let corner = match c.jerk {
+                MarlinJerk::JunctionDeviation { deviation_m, .. } => {
+                    format!("M205 J{} mm", mm(deviation_m))
+                }
+                MarlinJerk::Classic { max_jerk_m_s, .. } => format!(
+                    "M205 X{} Y{} mm/s (classic jerk)",
+                    mm(max_jerk_m_s[0]),
+                    mm(max_jerk_m_s[1])
+                ),
+            };
+            // Steps per m as steps per mm, rounded to 1e-6 (`80`, not `80.00000000000001`).
+            let per_mm = |v: f64| format!("{}", (v * 1e3).round() / 1e6);
+            format!(
+                "M203 X{} Y{} mm/s, M201 X{} Y{} mm/s^2, M204 P{} T{} mm/s^2, {corner}, M92 X{} Y{} steps/mm",
+                mm(c.max_feedrate_m_s[0]),
+                mm(c.max_feedrate_m_s[1]),
+                mm(c.max_accel_m_s2[0]),
+                mm(c.max_accel_m_s2[1]),
+                mm(c.print_accel_m_s2),
+                mm(c.travel_accel_m_s2),
+                per_mm(c.steps_per_m[0]),
+                per_mm(c.steps_per_m[1])
+            )
+        }
+        PlannerConfig::Settle(_) => "the firmware's defaults".into(),
     };
     format!(
         "{}: {limits}; {}",
