@@ -30,9 +30,9 @@ use settle_planner::firmware::marlin::{MarlinConfig, MarlinJerk};
 use super::budget::Budget;
 use super::machine::ConfigNote;
 use crate::error::{GcodeError, Location};
-use crate::job::ShaperSetting;
 use crate::job::driver::{Driver, LimitOutcome};
 use crate::job::shapers::ShaperState;
+use crate::job::{JobConfig, PlannerConfig, ShaperSetting};
 use crate::read::dialect::Dialect;
 use crate::read::event::{EventKind, Note};
 use crate::read::limits::LimitChange;
@@ -57,6 +57,24 @@ pub struct MarlinSettings {
     pub files: Vec<PathBuf>,
     /// What the reader noted: commands read and not used, values Marlin keeps.
     pub notes: Vec<ConfigNote>,
+}
+
+impl MarlinSettings {
+    /// What a Marlin printer starts a file with, from this reply: the planner's `M92`,
+    /// `M203`, `M201`, `M204` and `M205` settings and the `M593` shapers. Everything else
+    /// is [`JobConfig::defaults`]'.
+    pub fn job_config(&self) -> Result<JobConfig, GcodeError> {
+        let mut cfg = JobConfig::defaults(Firmware::Marlin)?;
+        self.planner
+            .validate()
+            .map_err(|e| GcodeError::JobSetting {
+                key: "M503 settings",
+                reason: e.to_string(),
+            })?;
+        cfg.planner = PlannerConfig::Marlin(self.planner);
+        cfg.shapers = self.shapers;
+        Ok(cfg)
+    }
 }
 
 /// The commands of an `M503` reply the planner follows.

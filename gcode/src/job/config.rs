@@ -236,23 +236,6 @@ impl JobConfig {
     }
 }
 
-impl JobConfig {
-    /// What a Marlin printer starts a file with, from its `M503` reply
-    /// ([`crate::config::MarlinSettings`]): the planner's `M92`, `M203`, `M201`, `M204`
-    /// and `M205` settings and the `M593` shapers. Everything else is
-    /// [`JobConfig::defaults`]'.
-    pub fn from_marlin(s: &crate::config::MarlinSettings) -> Result<Self, GcodeError> {
-        let mut cfg = Self::defaults(Firmware::Marlin)?;
-        s.planner.validate().map_err(|e| GcodeError::JobSetting {
-            key: "M503 settings",
-            reason: e.to_string(),
-        })?;
-        cfg.planner = PlannerConfig::Marlin(s.planner);
-        cfg.shapers = s.shapers;
-        Ok(cfg)
-    }
-}
-
 /// A printer's kinematics as settle's firmware planners model them: Cartesian and CoreXY.
 fn planner_kinematics(name: &str, key: &'static str) -> Result<Kinematics, GcodeError> {
     match name {

@@ -229,7 +229,7 @@ impl GcodeOptions {
             Firmware::Marlin => {
                 let c = settle_gcode::config::MarlinSettings::read(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
-                let job = JobConfig::from_marlin(&c).map_err(gcode_error(&config))?;
+                let job = c.job_config().map_err(gcode_error(&config))?;
                 let notes = c.notes.iter().map(ToString::to_string).collect();
                 (job, notes, c.files)
             }
