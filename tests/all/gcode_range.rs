@@ -7,7 +7,7 @@ use std::process::Command;
 
 use serde_json::Value;
 use settle::studies::gcode::preroll::{preroll_s, slowest_decay_per_s};
-use settle::workflows::gcode::{GcodeOptions, measure};
+use settle::workflows::gcode::{GcodeOptions, gcode, measure};
 use settle_planner::firmware::Firmware;
 
 use crate::support::one_mode::OneMode;
@@ -281,6 +281,63 @@ fn a_layer_range_is_recorded_as_mcap() {
     assert_eq!(out.status.code(), Some(2));
     assert!(!bad_out.exists());
     let _: PathBuf = bad_out;
+}
+
+/// A recording holds at most `mcap_max_samples` samples (`MAX_RECORDED_SAMPLES` from
+/// the command line): layer 2 of the tower recorded with its own sample count as the
+/// bound is written whole; with one sample less the job is refused (an input error, exit
+/// 2 on the command line) naming the sample refused (the last one of the full
+/// recording: its time, line and layer), and the output folder it would have made is
+/// not left behind.
+#[test]
+fn a_recording_past_its_bound_is_refused_and_writes_nothing() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let opts = |out: &str, bound: u64| GcodeOptions {
+        layers: Some((2, 2)),
+        mcap: true,
+        mcap_max_samples: bound,
+        out: Some(dir.path().join(out)),
+        ..tower(Firmware::Klipper)
+    };
+    let whole = gcode(&opts("whole", u64::MAX)).expect("runs");
+    let counts: Vec<u64> = whole
+        .recording
+        .as_ref()
+        .expect("recorded")
+        .iter()
+        .filter(|c| c.topic != "/metrics")
+        .map(|c| c.messages)
+        .collect();
+    let n = counts[0];
+    assert!(n > 1000 && counts.iter().all(|&c| c == n), "{counts:?}");
+    let exact = gcode(&opts("exact", n)).expect("a recording of exactly its bound");
+    let exact_counts = exact.recording.as_ref().expect("recorded");
+    assert!(exact_counts.iter().any(|c| c.messages == n));
+    let err = gcode(&opts("over", n - 1)).expect_err("one sample past the bound");
+    assert!(err.is_input_error(), "{err}");
+    let msg = err.to_string();
+    assert!(
+        msg.contains(&format!("bound of {} samples", n - 1)) && msg.contains("layer 2:"),
+        "{msg}"
+    );
+    // The refused sample is the whole recording's last: at the end of layer 2's moves
+    // or in the ringing after them, before layer 3 starts.
+    let t: f64 = msg
+        .split("at t = ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .expect("the time of the refused sample");
+    let row = |k: u32| whole.layers.iter().find(|l| l.layer == k).expect("layer");
+    let (l2, l3) = (row(2), row(3));
+    assert!(
+        t >= l2.start_s + l2.duration_s - 0.05 && t <= l3.start_s + 0.05,
+        "{t} vs layer 2 at {} + {} s, layer 3 at {} s",
+        l2.start_s,
+        l2.duration_s,
+        l3.start_s
+    );
+    assert!(!dir.path().join("over").exists(), "{msg}");
 }
 
 /// The `[gcode]` study with `layers = "2..2"` gives the contour error of layer 2 in

@@ -77,6 +77,9 @@ pub struct GcodeOptions {
     pub versus: Option<(Firmware, XyShapers)>,
     /// Write `recording.mcap` into the output folder ([`record`]).
     pub mcap: bool,
+    /// The most samples the recording holds ([`record::MAX_RECORDED_SAMPLES`], what the
+    /// command line uses): a job that reaches it is an error and writes nothing.
+    pub mcap_max_samples: u64,
     /// The firmware configuration the planner's settings come from (`--config`).
     pub config: Option<ConfigSource>,
     /// Overwrite the results of an earlier run in the output folder (refused without it).
@@ -181,6 +184,7 @@ impl GcodeOptions {
             map_layer: None,
             versus: None,
             mcap: false,
+            mcap_max_samples: record::MAX_RECORDED_SAMPLES,
             config: None,
             force: false,
         })
@@ -791,6 +795,10 @@ fn simulate(
         rec,
         (&opts.file, progress),
     )?;
+    if let Some(at) = rec.as_ref().and_then(record::Recorder::full) {
+        let (bound, rate) = (opts.mcap_max_samples, opts.sample_rate_hz);
+        return Err(Error::input("--mcap", recording_too_long(at, bound, rate)));
+    }
     job.run_to_end().map_err(&err)?;
     let summary = job.summary();
     if let Some(why) =
@@ -1003,6 +1011,7 @@ pub fn gcode_with_progress(
                 Some(record::Recorder::start(
                     recording_metadata(opts),
                     &dir.join(RECORDING),
+                    opts.mcap_max_samples,
                 )?)
             }
             false => None,
@@ -1035,6 +1044,23 @@ pub fn gcode_with_progress(
     let html = report::write_html(&outcome, opts, &dir)?;
     outcome.files.push(html);
     Ok(outcome)
+}
+
+/// Why a recording past its bound (`bound` samples) is refused, `at` the first sample it
+/// refused.
+fn recording_too_long(at: record::Refused, bound: u64, sample_rate_hz: f64) -> String {
+    format!(
+        "the recording reached its bound of {bound} samples ({:.0} s of print at {} Hz, \
+         about {:.1} GB of file) at t = {:.3} s, line {}, layer {}: nothing was written; \
+         record the layers you want to look at with --layers A..B, or sample less often \
+         with --sample-rate-hz",
+        bound as f64 / sample_rate_hz,
+        sample_rate_hz,
+        bound as f64 * record::BYTES_PER_SAMPLE / 1e9,
+        at.t_s,
+        at.line,
+        at.layer
+    )
 }
 
 /// `--mcap`'s recording in the output folder.

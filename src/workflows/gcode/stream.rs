@@ -578,6 +578,10 @@ impl Sink for Account {
             {
                 return ControlFlow::Break(i);
             }
+            if self.rec.as_ref().is_some_and(|r| r.full().is_some()) {
+                // The recording is past its bound: the job ends here, in an error.
+                return ControlFlow::Break(i);
+            }
         }
         ControlFlow::Continue(())
     }
