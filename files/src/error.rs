@@ -97,7 +97,7 @@ impl FileError {
 /// Why a file is not text, in [`FileError::NotText`]'s words.
 fn packed_text(packed: &Option<crate::packed::Packed>) -> String {
     match packed {
-        Some(p) => format!("{}: unpack it and name the file inside", p.name()),
+        Some(p) => format!("{}: {}", p.name(), p.instead()),
         None => "binary data?".to_string(),
     }
 }

@@ -185,6 +185,16 @@ pub fn read_text(path: &Path, limit: Limit) -> Result<String, FileError> {
 /// should be in the error.
 pub fn text(path: &Path, bytes: Vec<u8>, expected: &'static str) -> Result<String, FileError> {
     let packed = crate::packed::Packed::of(&bytes);
+    if packed.is_some_and(crate::packed::Packed::is_utf16) {
+        // Valid UTF-8 byte for byte when it is ASCII, but every other byte is zero.
+        return Err(FileError::NotText {
+            path: path.to_path_buf(),
+            line: 1,
+            column: 1,
+            expected,
+            packed,
+        });
+    }
     let text = String::from_utf8(bytes).map_err(|e| {
         let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
         let line_start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);

@@ -62,7 +62,8 @@ pub enum GcodeError {
         limit_bytes: usize,
     },
     /// The file is not G-code text but a format a slicer writes G-code into
-    /// (gcode/src/read/packaged.rs: binary G-code, a gzip stream, a zip archive), known by
+    /// (gcode/src/read/packaged.rs: binary G-code, a gzip stream, a zip archive, a zstd
+    /// frame; or UTF-16 text), known by
     /// its first bytes. Not a bad line: even skipping bad lines, no line of it is G-code text.
     #[error("{at}: {what}; settle reads G-code text: {instead}")]
     Packaged {

@@ -237,3 +237,114 @@ fn check_matches_rows_by_run_and_reads_a_bom() {
     assert!(out.status.success(), "{text}");
     assert!(text.contains("ok:"), "{text}");
 }
+
+/// Files saved as UTF-16 (Windows PowerShell 5's `>` writes UTF-16 little-endian with a
+/// byte-order mark; ASCII in it is valid UTF-8 byte for byte, a zero byte between the
+/// characters) are named as UTF-16 with how to save them as UTF-8, exit 2, by every
+/// reader: a real Marlin M503 reply (`settle gcode --config`), the start of the real
+/// Benchy (`settle gcode`), the example Klipper recording (`settle identify`) and the
+/// example Klipper configuration (`settle import`), each with and without the
+/// mark and in both byte orders.
+#[test]
+fn utf16_files_are_named_with_how_to_save_them_as_utf8() {
+    let root = crate::support::root();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let read = |rel: &str, lines: usize| -> String {
+        let text = std::fs::read_to_string(root.join(rel)).expect("reads");
+        text.lines().take(lines).map(|l| format!("{l}\n")).collect()
+    };
+    let benchy = read("gcode/prints/benchy/3DBenchy.gcode", 400);
+    let m503 = read(
+        "gcode/tests/data/real/marlin/ender3v2neo/m503_20241028.gcode",
+        1000,
+    );
+    let recording = read("examples/data/raw_data_x_example.csv", 2000);
+    let cfg = read("examples/klipper/printer.cfg", 1000);
+    for (le, bom) in [(true, true), (true, false), (false, true)] {
+        let utf16 = |name: &str, text: &str| {
+            let units = bom
+                .then_some(0xfeff_u16)
+                .into_iter()
+                .chain(text.encode_utf16());
+            let bytes: Vec<u8> = units
+                .flat_map(|u| if le { u.to_le_bytes() } else { u.to_be_bytes() })
+                .collect();
+            let path = dir.path().join(name);
+            std::fs::write(&path, bytes).expect("writes");
+            path
+        };
+        let (gcode, reply) = (utf16("job.gcode", &benchy), utf16("m503.txt", &m503));
+        let utf8_reply = write(dir.path(), "m503-utf8.txt", &m503);
+        let csv = utf16("raw_data_x_1.csv", &recording);
+        let printer = utf16("printer.cfg", &cfg);
+        let out = dir.path().join("out");
+        let runs: [(Vec<std::ffi::OsString>, &Path); 4] = [
+            (
+                vec![
+                    "gcode".into(),
+                    gcode.clone().into(),
+                    "--out".into(),
+                    out.clone().into(),
+                ],
+                &gcode,
+            ),
+            (
+                vec![
+                    "gcode".into(),
+                    write(dir.path(), "ok.gcode", &benchy).into(),
+                    "--firmware".into(),
+                    "marlin".into(),
+                    "--config".into(),
+                    reply.clone().into(),
+                    "--out".into(),
+                    out.clone().into(),
+                ],
+                &reply,
+            ),
+            (vec!["identify".into(), csv.clone().into()], &csv),
+            (
+                vec!["import".into(), "klipper".into(), printer.clone().into()],
+                &printer,
+            ),
+        ];
+        for (args, named) in runs {
+            let mut cmd = settle();
+            cmd.args(&args);
+            if args[0] == "gcode" {
+                cmd.args(["--machine", "printer_xy"]);
+            }
+            let r = cmd.output().expect("runs");
+            let err = String::from_utf8_lossy(&r.stderr);
+            assert_eq!(r.status.code(), Some(2), "{args:?}: {err}");
+            let order = if le {
+                "UTF-16 text, little-endian"
+            } else {
+                "UTF-16 text, big-endian"
+            };
+            let name = named.file_name().expect("name").to_string_lossy();
+            assert!(
+                err.contains(&*name) && err.contains(order) && err.contains("save it as UTF-8"),
+                "{args:?}: {err}"
+            );
+            assert!(!out.exists(), "{args:?}");
+        }
+        // The same reply in UTF-8 is read.
+        let r = settle()
+            .args([
+                "gcode",
+                "--machine",
+                "printer_xy",
+                "--firmware",
+                "marlin",
+                "--config",
+            ])
+            .arg(&utf8_reply)
+            .arg("--out")
+            .arg(&out)
+            .arg(write(dir.path(), "ok.gcode", &benchy))
+            .output()
+            .expect("runs");
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        std::fs::remove_dir_all(&out).expect("removes");
+    }
+}

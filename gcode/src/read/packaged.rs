@@ -1,5 +1,5 @@
 //! Files that hold G-code but are not G-code text, known by their first bytes: binary
-//! G-code, a gzip stream, a zip archive, a zstd frame. Each is named with the way to its text, rather
+//! G-code, a gzip stream, a zip archive, a zstd frame, UTF-16 text. Each is named with the way to its text, rather
 //! than refused as "binary data" at its first odd byte.
 
 use settle_files::packed::Packed;
@@ -24,5 +24,6 @@ pub(crate) fn packaged(first: &[u8]) -> Option<(&'static str, &'static str)> {
             "take the G-code out of it (unzip -p FILE Metadata/plate_1.gcode > plate_1.gcode), or export plain G-code from the slicer",
         )),
         Packed::Zstd => Some(("zstd-compressed", "decompress it first (zstd -d FILE)")),
+        p @ (Packed::Utf16Le | Packed::Utf16Be) => Some((p.name(), p.instead())),
     }
 }

@@ -191,18 +191,24 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     if packed == Some(settle_files::packed::Packed::Zstd) {
         return stdata::parse(&file, &bytes).map(FileData::Recordings);
     }
-    let mut text = String::from_utf8(bytes).map_err(|e| {
-        let why = match packed {
-            // A zip or gzip of a recording: named, with what to do.
-            Some(p) => format!("{}, not text: unpack it and name the file inside", p.name()),
-            None => format!("bytes that are not UTF-8 text ({e})"),
-        };
-        IdentifyError::format(
+    const EXPECTED: &str = "a CSV text file or a zstd-compressed .stdata file";
+    // A zip or gzip of a recording, or UTF-16 text (ASCII in UTF-16 is valid UTF-8 with
+    // a zero byte between characters): named, with what to do.
+    let named = |p: settle_files::packed::Packed| {
+        let why = format!("{}, not UTF-8 text: {}", p.name(), p.instead());
+        IdentifyError::format(&file, 1, why, EXPECTED)
+    };
+    if let Some(p) = packed.filter(|p| p.is_utf16()) {
+        return Err(named(p));
+    }
+    let mut text = String::from_utf8(bytes).map_err(|e| match packed {
+        Some(p) => named(p),
+        None => IdentifyError::format(
             &file,
             1,
-            why,
-            "a CSV text file or a zstd-compressed .stdata file",
-        )
+            format!("bytes that are not UTF-8 text ({e})"),
+            EXPECTED,
+        ),
     })?;
     // A byte-order mark (spreadsheet programs on Windows write one) is not the header.
     if text.starts_with('\u{feff}') {

@@ -61,12 +61,12 @@ fn compressed_recordings_are_named() {
         (
             "x.csv.gz",
             &[0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 3, 0xe3],
-            "gzip-compressed, not text: unpack it",
+            "gzip-compressed, not UTF-8 text: unpack it",
         ),
         (
             "x.zip",
             b"PK\x03\x04\x14\x00\xe3",
-            "a zip archive, not text: unpack it",
+            "a zip archive, not UTF-8 text: unpack it",
         ),
         (
             "x.csv",
