@@ -295,9 +295,9 @@ pub fn read_current_files(
     }
 }
 
-/// A speed or acceleration of Marlin's planner (m/s, m/s^2) in the millimetres `M503`
-/// printed: `M503` prints two decimals, so rounding to a millionth gives back the
-/// printed number (the planner keeps `value * 1e-3`).
+/// A length, speed or acceleration of Marlin's planner (m, m/s, m/s^2) in the millimetres
+/// `M503` printed: `M503` prints two or three decimals, so rounding to a millionth gives
+/// back the printed number (the planner keeps `value * 1e-3`).
 fn marlin_mm(v_m: f64) -> f64 {
     (v_m * 1e9).round() / 1e6
 }
