@@ -19,9 +19,10 @@
 #     and slic3r/ folders;
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
 #     what identify wrote, `settle import` of the example configurations and of the real
-#     ones of gcode/tests/data/real/ (two of them, and a Marlin M503 reply, also under
-#     the Benchy), `settle tune` on
-#     the tune scenarios, on the imported printer and with `--criterion klipper`;
+#     ones of gcode/tests/data/real/ (a Marlin M503 reply among them; two, and the reply,
+#     also under the Benchy), `settle tune` on
+#     the tune scenarios, on the imported printers (Klipper, RepRapFirmware, Marlin) and
+#     with `--criterion klipper`;
 #   - `settle validate --backend rapier`;
 #   - `settle identify` on every spectrum of identify/tests/corpus/ (and its refusals),
 #     `settle tune --criterion klipper` on them (per axis, with the script's options) and
@@ -137,6 +138,8 @@ cases() {
     echo "import-real-$p import klipper $REAL/$p/printer.cfg --out {out}/printer.toml"
   done
   echo "import-real-railcore import rrf $REAL/railcore/sys/config.g --out {out}/printer.toml"
+  # A Marlin owner's M503 reply (gcode/tests/data/real/marlin/PROVENANCE.md), imported.
+  echo "import-marlin-ender3v2neo import marlin $REAL/marlin/ender3v2neo/m503_20241028.gcode --out {out}/printer.toml"
   echo "gcode-benchy-real-vt627 gcode $P/benchy/3DBenchy.gcode --machine printer_xy --config $REAL/vt627/printer.cfg --out {out}"
   echo "gcode-benchy-real-railcore gcode $P/benchy/3DBenchy.gcode --machine printer_xy --config $REAL/railcore/sys/config.g --out {out}"
   # A Marlin owner's M503 reply (gcode/tests/data/real/marlin/PROVENANCE.md).
@@ -147,6 +150,7 @@ cases() {
   echo "tune-printer-checked tune $S/tune_printer.toml --check-on rapier --jobs 2 --out {out}"
   echo "tune-imported tune out/import-voron-identified/printer.toml --jobs 2 --out {out}"
   echo "tune-imported-rrf tune out/import-mini/printer.toml --firmware rrf --jobs 2 --out {out}"
+  echo "tune-imported-marlin tune out/import-marlin-ender3v2neo/printer.toml --firmware marlin --jobs 2 --out {out}"
   echo "tune-klipper-criterion tune --criterion klipper $root/planner/tests/data/klipper_two_peaks.csv"
   echo "validate-rapier validate --backend rapier --out {out}/validate.md"
   # Real recordings: every corpus spectrum, one sensor column, a raw recording without its

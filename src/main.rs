@@ -212,15 +212,17 @@ enum Command {
         #[arg(long, alias = "max_smoothing")]
         max_smoothing: Option<f64>,
     },
-    /// Read a firmware configuration (Klipper printer.cfg, RepRapFirmware config.g) into a
-    /// scenario with your current settings as its baseline and a search around them.
+    /// Read a firmware configuration (Klipper printer.cfg, RepRapFirmware config.g,
+    /// Marlin's reply to M503) into a scenario with your current settings as its baseline
+    /// and a search around them.
     #[command(
-        after_help = "Example:\n  settle import klipper printer.cfg --machine machine.toml --out printer.toml\n  settle tune printer.toml\n  (klipper.cfg in results/printer_import-tune/ holds the recommendation)"
+        after_help = "Example:\n  settle import klipper printer.cfg --machine machine.toml --out printer.toml\n  settle tune printer.toml\n  (klipper.cfg in results/printer_import-tune/ holds the recommendation)\n  settle import marlin m503.txt --out printer.toml\n  settle tune printer.toml --firmware marlin\n  (marlin.gcode holds Marlin's lines)"
     )]
     Import {
-        /// The firmware: klipper or rrf (also written reprapfirmware or duet).
+        /// The firmware: klipper, marlin or rrf (also written reprapfirmware or duet).
         firmware: String,
-        /// printer.cfg (with its includes) or config.g.
+        /// printer.cfg (with its includes), config.g, or Marlin's reply to M503 as a
+        /// terminal saves it.
         config: PathBuf,
         /// The machine file (from `settle identify`, or written by hand) [default: the
         /// preset printer_xy stands in, with a note].

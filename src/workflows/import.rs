@@ -1,15 +1,24 @@
-//! `settle import klipper printer.cfg` / `settle import rrf config.g`: a scenario that
-//! reproduces the user's current settings as its baseline, and a search around them.
+//! `settle import klipper printer.cfg` / `settle import rrf config.g` / `settle import
+//! marlin m503.txt`: a scenario that reproduces the user's current settings as its
+//! baseline, and a search around them.
 //!
 //! Read through settle-gcode's configuration readers (Klipper's includes and SAVE_CONFIG,
-//! RepRapFirmware's macros; a present but malformed value is an error naming the file,
-//! line and key; sections and commands settle does not need are ignored):
-//! - limits: Klipper `[printer]` `max_velocity`, `max_accel`; RepRapFirmware `M203` and
-//!   the lower of `M201` (per axis) and `M204 P` (printing moves);
+//! RepRapFirmware's macros, Marlin's `M503` reply as a terminal saves it; a present but
+//! malformed value is an error naming the file, line and key; sections and commands
+//! settle does not need are ignored):
+//! - limits: Klipper `[printer]` `max_velocity`, `max_accel`; RepRapFirmware and Marlin
+//!   `M203` (the lower of X and Y) and the lower of `M201` (per axis) and `M204 P`
+//!   (printing moves); a Marlin reply without `M203`, `M201` or `M204` is refused (its
+//!   limits would be Marlin's example configuration's, not the printer's);
 //! - the shaper per axis: Klipper `[input_shaper]` `shaper_type_x/y`, `shaper_freq_x/y`,
 //!   `damping_ratio_x/y` (frequency 0: off); RepRapFirmware's one `M593` for all axes;
-//! - microsteps per mm per axis (Klipper `[stepper_*]`, RepRapFirmware `M92`/`M350`), for
-//!   the TMC4361A export.
+//!   Marlin's `M593 X`/`M593 Y` (its built-in ZV shaper per axis, `F0`: off);
+//! - microsteps per mm per axis (Klipper `[stepper_*]`, RepRapFirmware `M92`/`M350`,
+//!   Marlin `M92`), for the TMC4361A export.
+//!
+//! Marlin's `M205` (junction deviation `J`, or a `CLASSIC_JERK` build's X and Y jerks)
+//! sets the speed through corners; the scenario's moves start and end at rest, so it has
+//! no place there: it is a note (`settle gcode --firmware marlin --config` follows it).
 //!
 //! The scenario written runs the current settings as its own point (`[move]` trapezoids,
 //! `[limits]`, `[shaper]` of the first axis), marks them in `[current]` among a `[sweep]`
@@ -25,7 +34,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use settle_gcode::Dialect;
-use settle_gcode::config::{KlipperConfig, RrfConfig, ShaperSetting as FirmwareShaper};
+use settle_gcode::config::{
+    KlipperConfig, MarlinSettings, RrfConfig, ShaperSetting as FirmwareShaper,
+};
 
 use crate::error::{Error, Location};
 use crate::input::machine_form::MachineForm;
@@ -34,6 +45,7 @@ use crate::workflows::tune::firmware::Candidates;
 use crate::workflows::tune::grid::{identified_band, tuning_modes};
 use crate::workflows::{Exit, Report};
 use settle_planner::firmware::Firmware;
+use settle_planner::firmware::marlin::MarlinJerk;
 
 /// Shaper frequencies of the search, as multiples of the current one.
 pub const FREQUENCY_SCALES: [f64; 5] = [0.9, 0.95, 1.0, 1.05, 1.1];
@@ -55,9 +67,9 @@ pub const STAND_IN_PRESET: &str = "printer_xy";
 /// What `settle import` reads and writes.
 #[derive(Debug, Clone)]
 pub struct ImportOptions {
-    /// `klipper` or `rrf`.
+    /// `klipper`, `marlin` or `rrf`.
     pub firmware: Firmware,
-    /// printer.cfg or config.g.
+    /// printer.cfg, config.g or Marlin's reply to `M503`.
     pub config: PathBuf,
     /// The machine file (`settle identify`'s, or written by hand).
     pub machine: Option<PathBuf>,
@@ -184,9 +196,9 @@ fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)
         .map(|n| (n, s.frequency_hz, s.damping_ratio))
 }
 
-/// The firmwares whose configurations `settle import` reads: Klipper (printer.cfg) and
-/// RepRapFirmware (config.g).
-pub const READ: [Firmware; 2] = [Firmware::Klipper, Firmware::Rrf];
+/// The firmwares whose configurations `settle import` reads: Klipper (printer.cfg),
+/// Marlin (its reply to `M503`) and RepRapFirmware (config.g).
+pub const READ: [Firmware; 3] = [Firmware::Klipper, Firmware::Marlin, Firmware::Rrf];
 
 /// A firmware of [`READ`] by name ([`Firmware::parse`]'s names); GRBL is refused with its
 /// reason (its `$$` settings feed `settle gcode`, not a tune: GRBL has no input shaper).
@@ -267,15 +279,99 @@ pub fn read_current_files(
             };
             Ok((cur, files))
         }
+        Firmware::Marlin => {
+            let c = MarlinSettings::read(path).map_err(|e| config_error(path, e))?;
+            c.job_config().map_err(|e| config_error(path, e))?;
+            Ok((marlin_current(&c, path)?, c.files.clone()))
+        }
         other => Err(Error::input_key(
             path,
             "firmware",
             format!(
-                "settle import reads klipper (printer.cfg) and rrf (config.g), not {}",
+                "settle import reads klipper (printer.cfg), marlin (M503 reply) and rrf (config.g), not {}",
                 other.name()
             ),
         )),
     }
+}
+
+/// A length, speed or acceleration of Marlin's planner (m, m/s, m/s^2) in the millimetres
+/// `M503` printed: `M503` prints two or three decimals, so rounding to a millionth gives
+/// back the printed number (the planner keeps `value * 1e-3`).
+fn marlin_mm(v_m: f64) -> f64 {
+    (v_m * 1e9).round() / 1e6
+}
+
+/// The current settings of a Marlin `M503` reply (read by settle-gcode's
+/// [`MarlinSettings`]).
+fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
+    // The baseline is the reply's: without these the speed or acceleration would be
+    // Marlin's example configuration's (MarlinSettings starts from it), not the printer's.
+    for (command, what) in [
+        ("M203", "max feedrates"),
+        ("M201", "max accelerations"),
+        ("M204", "printing acceleration"),
+    ] {
+        if !c.followed.iter().any(|(_, f)| *f == command) {
+            return Err(Error::input_key(
+                path,
+                command,
+                format!(
+                    "the M503 reply has no {command} line ({what}): the baseline needs the printer's own M203, M201 and M204 (send M503 to the printer and save its whole reply)"
+                ),
+            ));
+        }
+    }
+    let p = &c.planner;
+    let vmax = marlin_mm(p.max_feedrate_m_s[0].min(p.max_feedrate_m_s[1]));
+    let amax = marlin_mm(
+        p.print_accel_m_s2
+            .min(p.max_accel_m_s2[0])
+            .min(p.max_accel_m_s2[1]),
+    );
+    let axes = ["x", "y"]
+        .into_iter()
+        .enumerate()
+        .map(|(i, name)| AxisNow {
+            name: name.into(),
+            // M593 is Marlin's ZV (settle-gcode reads it as `zv`); `F0` is no shaper.
+            shaper: c.shapers[i].map(|s| (s.shaper_type.name(), s.frequency_hz, s.damping_ratio)),
+            // Marlin's steps per mm count microsteps.
+            usteps_per_mm: c.steps_per_mm[i],
+        })
+        .collect();
+    let mut notes: Vec<String> = c.notes.iter().map(ToString::to_string).collect();
+    let corner = match p.jerk {
+        MarlinJerk::JunctionDeviation { deviation_m, .. } => {
+            format!("M205 J{} (junction deviation, mm)", marlin_mm(deviation_m))
+        }
+        MarlinJerk::Classic { max_jerk_m_s, .. } => format!(
+            "M205 X{} Y{} (classic jerk of a CLASSIC_JERK build, mm/s)",
+            marlin_mm(max_jerk_m_s[0]),
+            marlin_mm(max_jerk_m_s[1])
+        ),
+    };
+    notes.push(format!(
+        "{corner} read, not in the scenario: it sets the speed through corners, and the scenario's moves start and end at rest (settle gcode --firmware marlin --config follows it)"
+    ));
+    // Marlin limits each move's acceleration by M201 too (planner.cpp `_populate_block`).
+    notes.push(format!(
+        "M201 X{} Y{} caps every move's acceleration: to take a higher acceleration from settle tune's marlin.gcode (its M204 P T), raise M201 X and Y to at least it as well",
+        marlin_mm(p.max_accel_m_s2[0]),
+        marlin_mm(p.max_accel_m_s2[1])
+    ));
+    if c.notes.iter().any(|n| n.text.starts_with("M493")) {
+        notes.push(
+            "the reply has FT_MOTION's M493: the current shaper is read from M593 only (none here if the reply has no M593); FT_MOTION's shaper is not part of the baseline".into(),
+        );
+    }
+    Ok(Current {
+        firmware: Firmware::Marlin,
+        vmax_mm_s: vmax,
+        amax_mm_s2: amax,
+        axes,
+        notes,
+    })
 }
 
 /// A TOML string.
@@ -390,8 +486,13 @@ fn scenario_text(
         "# Written by `settle import {} {source}`: the current settings as this scenario's own\n\
          # point (marked in [current] among the [sweep]) and a search around them in [tune].\n\
          #   settle sweep THIS.toml   # the sweep around the current settings\n\
-         #   settle tune THIS.toml    # the recommendation per axis, with klipper.cfg / rrf.g\n",
+         #   settle tune THIS.toml    # the recommendation per axis, with {}\n",
         fw.name(),
+        if fw == Firmware::Marlin {
+            "marlin.gcode (FT_MOTION's M493)"
+        } else {
+            "klipper.cfg / rrf.g"
+        },
     );
     // What the reading passed over stays with the settings read (an include that was not
     // there may set some of them).

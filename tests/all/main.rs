@@ -21,6 +21,7 @@ mod hardening_input;
 mod html_report;
 mod identify_cmd;
 mod import;
+mod import_marlin;
 mod import_roundtrip;
 mod klipper_corpus;
 mod layers;
