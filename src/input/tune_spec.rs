@@ -86,4 +86,10 @@ pub struct AxisCurrent {
     pub damping_ratio: Option<f64>,
     /// The axis's microsteps per mm (firmware steps per mm x microstepping).
     pub usteps_per_mm: Option<f64>,
+    /// The axis's own acceleration cap (mm/s^2): Marlin's and RepRapFirmware's `M201`,
+    /// which caps every move's acceleration as `M204` does. `marlin.gcode` and `rrf.g`
+    /// raise it with `M201` where it is below the recommended acceleration [default: not
+    /// known; the exports then set it to the recommended acceleration whenever that
+    /// changes].
+    pub max_accel_mm_s2: Option<f64>,
 }

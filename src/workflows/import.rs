@@ -14,7 +14,11 @@
 //!   `damping_ratio_x/y` (frequency 0: off); RepRapFirmware's one `M593` for all axes;
 //!   Marlin's `M593 X`/`M593 Y` (its built-in ZV shaper per axis, `F0`: off);
 //! - microsteps per mm per axis (Klipper `[stepper_*]`, RepRapFirmware `M92`/`M350`,
-//!   Marlin `M92`), for the TMC4361A export.
+//!   Marlin `M92`), for the TMC4361A export;
+//! - RepRapFirmware's and Marlin's `M201` per axis, written as `[tune.axis.<name>]
+//!   max_accel_mm_s2`: both cap every move's acceleration by it, so `settle tune`'s
+//!   `rrf.g` and `marlin.gcode` raise it with `M201` where it is below the recommended
+//!   acceleration.
 //!
 //! Marlin's `M205` (junction deviation `J`, or a `CLASSIC_JERK` build's X and Y jerks)
 //! sets the speed through corners; the scenario's moves start and end at rest, so it has
@@ -90,6 +94,9 @@ pub struct AxisNow {
     pub shaper: Option<(String, f64, f64)>,
     /// Microsteps per mm.
     pub usteps_per_mm: Option<f64>,
+    /// The axis's own acceleration cap, mm/s^2 (Marlin's and RepRapFirmware's `M201`;
+    /// Klipper has none but `max_accel`).
+    pub max_accel_mm_s2: Option<f64>,
 }
 
 /// The settings read from a firmware configuration.
@@ -243,6 +250,7 @@ pub fn read_current_files(
                         shaper_now(if name == "x" { &s.x } else { &s.y }, Dialect::Klipper)
                     }),
                     usteps_per_mm: st.as_ref().map(|s| s.drive.microsteps_per_mm),
+                    max_accel_mm_s2: None,
                 })
                 .collect();
             let cur = Current {
@@ -265,6 +273,7 @@ pub fn read_current_files(
                     name: name.into(),
                     shaper: shaper.clone(),
                     usteps_per_mm: Some(a.drive.microsteps_per_mm),
+                    max_accel_mm_s2: Some(a.max_accel_mm_s2),
                 })
                 .collect();
             let cur = Current {
@@ -338,6 +347,8 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
             shaper: c.shapers[i].map(|s| (s.shaper_type.name(), s.frequency_hz, s.damping_ratio)),
             // Marlin's steps per mm count microsteps.
             usteps_per_mm: c.steps_per_mm[i],
+            // M201, which the reply has (checked above).
+            max_accel_mm_s2: Some(marlin_mm(p.max_accel_m_s2[i])),
         })
         .collect();
     let mut notes: Vec<String> = c.notes.iter().map(ToString::to_string).collect();
@@ -353,12 +364,6 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
     };
     notes.push(format!(
         "{corner} read, not in the scenario: it sets the speed through corners, and the scenario's moves start and end at rest (settle gcode --firmware marlin --config follows it)"
-    ));
-    // Marlin limits each move's acceleration by M201 too (planner.cpp `_populate_block`).
-    notes.push(format!(
-        "M201 X{} Y{} caps every move's acceleration: to take a higher acceleration from settle tune's marlin.gcode (its M204 P T), raise M201 X and Y to at least it as well",
-        marlin_mm(p.max_accel_m_s2[0]),
-        marlin_mm(p.max_accel_m_s2[1])
     ));
     if c.notes.iter().any(|n| n.text.starts_with("M493")) {
         notes.push(
@@ -590,6 +595,13 @@ fn scenario_text(
         }
         if let Some(u) = a.usteps_per_mm {
             let _ = writeln!(t, "usteps_per_mm = {u:?}");
+        }
+        if let Some(m) = a.max_accel_mm_s2 {
+            let _ = writeln!(
+                t,
+                "max_accel_mm_s2 = {m:?}   # M201 {}: marlin.gcode / rrf.g raise it where it is below the recommended acceleration",
+                a.name.to_ascii_uppercase()
+            );
         }
     }
     t

@@ -83,6 +83,16 @@ fn the_real_ender_reply_becomes_the_baseline() {
         (x.shaper.as_deref(), x.usteps_per_mm),
         (Some("none"), Some(80.29))
     );
+    // Line 13 `M201 X500.00 Y500.00 Z100.00 E1000.00`: each axis's cap, for marlin.gcode to
+    // raise (so no note asks the owner to raise it by hand).
+    for a in ["x", "y"] {
+        assert_eq!(
+            t.axis.as_ref().expect("[tune.axis]")[a].max_accel_mm_s2,
+            Some(500.0),
+            "{a}"
+        );
+    }
+    assert!(!c.notes.iter().any(|n| n.contains("M201")), "{:?}", c.notes);
     assert!(
         i.scenario
             .contains("[limits]\nvmax_mm_s = 500.0\namax_mm_s2 = 500.0\n")
@@ -299,17 +309,40 @@ fn the_real_reply_imports_tunes_and_exports_marlin_lines() {
         }
     }
     assert_eq!(axes_seen, ["x", "y"], "{g}");
-    // One acceleration for both axes: the recommended one; M204 is written when it moves
-    // off the reply's 500.
+    // One acceleration for both axes: the recommended one, above the reply's M201 X500
+    // Y500 (line 13) on the stand-in's modes.
     let rec_accel = row(&md, "x", "**recommended**")[4];
     assert_eq!(row(&md, "y", "**recommended**")[4], rec_accel);
-    if rec_accel == "500" {
-        assert_eq!(accel, None, "{g}");
-    } else {
-        assert!(
-            g.lines()
-                .any(|l| l == format!("M204 P{rec_accel} T{rec_accel}")),
-            "{rec_accel}\n{g}"
-        );
-    }
+    let rec: f64 = rec_accel.parse().expect("a number");
+    assert!(rec > 500.0, "{md}");
+    assert!(accel.is_some(), "{g}");
+    let lines: Vec<&str> = g.lines().filter(|l| !l.starts_with(';')).collect();
+    let m201 = format!("M201 X{rec_accel} Y{rec_accel}");
+    let m204 = format!("M204 P{rec_accel} T{rec_accel}");
+    assert_eq!(
+        lines[lines.len() - 2..],
+        [m201.as_str(), m204.as_str()],
+        "{g}"
+    );
+    // The printer after the reply's settings and then these lines: Marlin's planner, as
+    // settle follows it (M201 and M204 both cap the move), runs at the recommendation.
+    // Without M201 it would stay at 500 mm/s^2.
+    let sent = dir.path().join("sent.txt");
+    let reply = std::fs::read_to_string(ender()).expect("reply");
+    std::fs::write(&sent, format!("{reply}{g}")).expect("writes");
+    let after = settle_gcode::config::MarlinSettings::read(&sent).expect("reads");
+    let p = after.planner;
+    let effective_mm_s2 = p
+        .print_accel_m_s2
+        .min(p.max_accel_m_s2[0])
+        .min(p.max_accel_m_s2[1])
+        * 1e3;
+    assert!(
+        (effective_mm_s2 - rec).abs() < 1e-9,
+        "{effective_mm_s2}\n{g}"
+    );
+    let without_m201 = g.replace(&format!("M201 X{rec_accel} Y{rec_accel}\n"), "");
+    std::fs::write(&sent, format!("{reply}{without_m201}")).expect("writes");
+    let capped = settle_gcode::config::MarlinSettings::read(&sent).expect("reads");
+    assert_eq!(capped.planner.max_accel_m_s2[0] * 1e3, 500.0);
 }

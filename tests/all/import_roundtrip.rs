@@ -13,6 +13,8 @@ use settle::workflows::import::{ImportOptions, import};
 use settle::workflows::tune::{Options, tune_with};
 use settle_planner::firmware::Firmware;
 
+use crate::support::root;
+
 /// A small Klipper configuration: cartesian, its current shapers on X and Y.
 const PRINTER_CFG: &str = "[printer]
 kinematics: cartesian
@@ -181,4 +183,49 @@ fn rrf_import_tune_export_import_gives_the_recommendation() {
     let want = recs.first().map(|(n, f, z)| (n.clone(), *f, *z));
     assert_eq!(again.current.axes[0].shaper, want, "{g}");
     assert_eq!(again.current.axes[1].shaper, want, "{g}");
+}
+
+/// The RailCore II's own `config.g` (gcode/tests/data/real/railcore, RepRapFirmware 3):
+/// `M201 X2500 Y2500 Z100` (line 82) and no `M204`, so it prints at 2500 mm/s^2.
+/// RepRapFirmware caps every move by `M201` as well as by `M204`: when tune recommends
+/// more, `rrf.g` raises both, and the configuration with `rrf.g` at its end reads back
+/// at the recommended acceleration.
+#[test]
+fn rrf_export_raises_m201_of_the_real_railcore_to_the_recommendation() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let real = root().join("gcode/tests/data/real/railcore/sys/config.g");
+    let scenario = dir.path().join("railcore.toml");
+    let i = import_to(Firmware::Rrf, &real, &scenario);
+    assert_eq!(i.current.amax_mm_s2, 2500.0);
+    for a in &i.current.axes {
+        assert_eq!(a.max_accel_mm_s2, Some(2500.0), "{}", a.name);
+    }
+    smaller(
+        &scenario,
+        "[\"none\", \"rrf:zvd\", \"rrf:mzv\", \"rrf:ei2\"]",
+    );
+    let t = tune(&scenario, dir.path().join("tuned"));
+    let o = &t.axes[0].1;
+    let rec = o.scores[o.winner].accel_mm_s2;
+    assert!(
+        rec > 2500.0,
+        "the stand-in's modes take more than 2500 mm/s^2"
+    );
+    let g = std::fs::read_to_string(t.out.join("rrf.g")).expect("rrf.g");
+    let lines: Vec<&str> = g.lines().filter(|l| !l.starts_with(';')).collect();
+    let (m201, m204) = (format!("M201 X{rec} Y{rec}"), format!("M204 P{rec} T{rec}"));
+    assert_eq!(lines[1..], [m201.as_str(), m204.as_str()], "{g}");
+    let pasted = dir.path().join("config.g");
+    let original = std::fs::read_to_string(&real).expect("reads");
+    std::fs::write(&pasted, format!("{original}\n{g}")).expect("writes");
+    let again = import_to(Firmware::Rrf, &pasted, &dir.path().join("again.toml"));
+    assert_eq!(again.current.amax_mm_s2, rec, "{g}");
+    for a in &again.current.axes {
+        assert_eq!(a.max_accel_mm_s2, Some(rec), "{}", a.name);
+    }
+    // Without the M201 line the RailCore would stay at its 2500.
+    let without = g.replace(&format!("M201 X{rec} Y{rec}\n"), "");
+    std::fs::write(&pasted, format!("{original}\n{without}")).expect("writes");
+    let capped = import_to(Firmware::Rrf, &pasted, &dir.path().join("capped.toml"));
+    assert_eq!(capped.current.amax_mm_s2, 2500.0, "{without}");
 }

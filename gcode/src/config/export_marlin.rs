@@ -2,12 +2,12 @@
 //! 2.1.3 and later), with `M493` as MarlinDocumentation's `_gcode/M493.md` documents it:
 //! `M493 S1` turns Fixed-Time Motion on, and one `M493 <axis> C<shaper> A<Hz> I<zeta>`
 //! line per axis (`Q<vtol>` for the EI family) sets that axis's shaper: Marlin shapes X
-//! and Y apart, and the page asks for both to be set. `M204 P T` follows when
-//! accelerations are given. The settings live in EEPROM (`M500` keeps them). Numbers are
+//! and Y apart, and the page asks for both to be set. `M201 X Y` and `M204 P T` follow
+//! when accelerations are given (Marlin caps each move by both). The settings live in EEPROM (`M500` keeps them). Numbers are
 //! written shortest-exact, so settle's G-code reader reads back the same values bit for
 //! bit.
 
-use super::export_text::{Note, annotate, comment_text, m204_line, refuse};
+use super::export_text::{Note, annotate, comment_text, m201_line, m204_line, refuse};
 use crate::FtShaper;
 use crate::error::GcodeError;
 
@@ -40,6 +40,9 @@ pub struct MarlinExport {
     pub ftm_fs_hz: u32,
     /// The axes' shapers, in the order written.
     pub axes: Vec<FtAxisShaper>,
+    /// `M201 X`, `M201 Y`: the axes' acceleration caps, mm/s^2 (each written only when
+    /// given, on one line before `M204`).
+    pub max_accel_xy_mm_s2: [Option<f64>; 2],
     /// `M204 P`: acceleration of printing moves, mm/s^2 (written only when given).
     pub print_accel_mm_s2: Option<f64>,
     /// `M204 T`: acceleration of travel moves, mm/s^2 (written only when given).
@@ -81,6 +84,8 @@ impl MarlinExport {
         for a in &self.axes {
             out.push_str(&self.axis_line(a)?);
         }
+        let [x, y] = self.max_accel_xy_mm_s2;
+        out.push_str(&m201_line(x, y)?);
         out.push_str(&m204_line(self.print_accel_mm_s2, self.travel_accel_mm_s2)?);
         Ok(out)
     }
@@ -151,6 +156,7 @@ mod tests {
                     ..ei('Y', f64::NAN)
                 },
             ],
+            max_accel_xy_mm_s2: [None, Some(4000.0)],
             print_accel_mm_s2: Some(4000.0),
             travel_accel_mm_s2: Some(4000.0),
         };
@@ -162,6 +168,10 @@ mod tests {
             Note {
                 key: "M204 P".into(),
                 text: "why P".into(),
+            },
+            Note {
+                key: "M201 Y".into(),
+                text: "why Y".into(),
             },
         ];
         let text = e.to_config_with_notes(&notes).expect("valid");
@@ -178,6 +188,8 @@ mod tests {
                 "; why A",
                 "M493 X C5 A45.2 I0.1 Q0.05",
                 "M493 Y C0",
+                "; why Y",
+                "M201 Y4000",
                 "; why P",
                 "M204 P4000 T4000",
             ]
@@ -190,6 +202,7 @@ mod tests {
             produced_by: String::new(),
             ftm_fs_hz: fs,
             axes: vec![a],
+            max_accel_xy_mm_s2: [None; 2],
             print_accel_mm_s2: None,
             travel_accel_mm_s2: None,
         };

@@ -1,13 +1,13 @@
 //! Input shaping written as RepRapFirmware `config.g` lines: one `M593` line, because the
 //! firmware has one shaper for every axis (`Move` holds a single `AxisShaper`, applied to
-//! each drive in `Move::AddLinearSegments`; `M593` takes no axis), and `M204` when
-//! accelerations are given. Numbers are written shortest-exact, so [`RrfConfig`] reads
-//! back the same values bit for bit. When the axes were tuned apart, the caller picks the
+//! each drive in `Move::AddLinearSegments`; `M593` takes no axis), and `M201 X Y` and
+//! `M204` when accelerations are given (RepRapFirmware caps each move by both). Numbers
+//! are written shortest-exact, so [`RrfConfig`] reads back the same values bit for bit. When the axes were tuned apart, the caller picks the
 //! one setting to write.
 //!
 //! [`RrfConfig`]: super::RrfConfig
 
-use super::export_text::{Note, annotate, comment_text, m204_line, refuse};
+use super::export_text::{Note, annotate, comment_text, m201_line, m204_line, refuse};
 use super::machine::ShaperSetting;
 use super::rrf::{MAX_SHAPER_FREQUENCY_HZ, MIN_SHAPER_FREQUENCY_HZ};
 use crate::error::GcodeError;
@@ -24,6 +24,9 @@ pub struct RrfExport {
     /// `rrf:` prefix, as in `ShaperType` names, is dropped), frequency in Hz, damping
     /// ratio.
     pub shaper: ShaperSetting,
+    /// `M201 X`, `M201 Y`: the axes' acceleration caps, mm/s^2 (each written only when
+    /// given, on one line before `M204`).
+    pub max_accel_xy_mm_s2: [Option<f64>; 2],
     /// `M204 P`: acceleration of printing moves, mm/s^2 (written only when given).
     pub print_accel_mm_s2: Option<f64>,
     /// `M204 T`: acceleration of travel moves, mm/s^2 (written only when given).
@@ -62,6 +65,8 @@ impl RrfExport {
             self.shaper_line(name)?
         };
         let mut out = format!("{head}{m593}");
+        let [x, y] = self.max_accel_xy_mm_s2;
+        out.push_str(&m201_line(x, y)?);
         out.push_str(&m204_line(self.print_accel_mm_s2, self.travel_accel_mm_s2)?);
         Ok(out)
     }

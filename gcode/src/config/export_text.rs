@@ -1,6 +1,6 @@
 //! What the exporters share: refusing a value the firmware would not accept, making a
 //! comment line of free text, comments written above the values they explain
-//! ([`Note`]), and the `M204 P T` line of RepRapFirmware and Marlin.
+//! ([`Note`]), and the `M201 X Y` and `M204 P T` lines of RepRapFirmware and Marlin.
 
 use crate::error::GcodeError;
 
@@ -78,5 +78,28 @@ pub(crate) fn m204_line(print: Option<f64>, travel: Option<f64>) -> Result<Strin
         m204
     } else {
         format!("M204{m204}\n")
+    })
+}
+
+/// The `M201` line of X and Y (each axis's acceleration cap, mm/s^2, written only when
+/// given; empty when neither is), or an error for one that is not finite and above 0.
+/// Both firmwares cap every move's acceleration per axis by `M201` as well as by `M204`
+/// (Marlin's `Planner::_populate_block` in `Marlin/src/module/planner.cpp`,
+/// RepRapFirmware's `DDA::InitStandardMove` in `src/Movement/DDA.cpp`), so an `M204` above
+/// `M201` is not what the printer runs.
+pub(crate) fn m201_line(x: Option<f64>, y: Option<f64>) -> Result<String, GcodeError> {
+    let mut m201 = String::new();
+    for (word, key, v) in [("X", "M201 X", x), ("Y", "M201 Y", y)] {
+        if let Some(a) = v {
+            if !(a.is_finite() && a > 0.0) {
+                return Err(refuse(key, a, "a finite acceleration > 0 mm/s^2"));
+            }
+            m201.push_str(&format!(" {word}{a}"));
+        }
+    }
+    Ok(if m201.is_empty() {
+        m201
+    } else {
+        format!("M201{m201}\n")
     })
 }

@@ -45,7 +45,7 @@
 //! assert!(klipper.to_config()?.contains("[input_shaper]\nshaper_type_x: mzv\n"));
 //! let mut one = shaper.y.clone();
 //! one.name = "ei2".into(); // RepRapFirmware's name for a two-hump EI
-//! let rrf = RrfExport { produced_by: "an example".into(), shaper: one, print_accel_mm_s2: None, travel_accel_mm_s2: None };
+//! let rrf = RrfExport { produced_by: "an example".into(), shaper: one, max_accel_xy_mm_s2: [None; 2], print_accel_mm_s2: None, travel_accel_mm_s2: None };
 //! assert!(rrf.to_config()?.ends_with("M593 P\"ei2\" F41.5 S0.1\n"));
 //! # Ok::<(), settle_gcode::GcodeError>(())
 //! ```

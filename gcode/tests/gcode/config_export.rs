@@ -129,6 +129,7 @@ fn rrf_export_is_one_m593_line_and_reads_back() {
     let e = RrfExport {
         produced_by: "settle tune scenarios/corner.toml".into(),
         shaper: shaper("rrf:ei2", 47.300000000000004, 0.07),
+        max_accel_xy_mm_s2: [None, Some(3500.0)],
         print_accel_mm_s2: Some(2500.0),
         travel_accel_mm_s2: None,
     };
@@ -139,7 +140,7 @@ fn rrf_export_is_one_m593_line_and_reads_back() {
         "{text}"
     );
     assert!(
-        text.contains("M593 P\"ei2\" F47.300000000000004 S0.07\nM204 P2500\n"),
+        text.contains("M593 P\"ei2\" F47.300000000000004 S0.07\nM201 Y3500\nM204 P2500\n"),
         "{text}"
     );
     let alone = RrfConfig::parse(&text, "sys/config.g").expect("valid");
@@ -154,6 +155,11 @@ fn rrf_export_is_one_m593_line_and_reads_back() {
         (c.print_accel_mm_s2, c.travel_accel_mm_s2),
         (2500.0, 4000.0)
     );
+    // Its M201 X3000.00 Y3000.00 (line 30): Y raised to 3500, X left as it is.
+    assert_eq!(
+        (c.axes.x.max_accel_mm_s2, c.axes.y.max_accel_mm_s2),
+        (3000.0, 3500.0)
+    );
 }
 
 #[test]
@@ -161,6 +167,7 @@ fn rrf_export_refuses_what_the_firmware_refuses() {
     let base = RrfExport {
         produced_by: String::new(),
         shaper: shaper("zvd", 40.0, 0.1),
+        max_accel_xy_mm_s2: [None; 2],
         print_accel_mm_s2: None,
         travel_accel_mm_s2: None,
     };
@@ -200,6 +207,13 @@ fn rrf_export_refuses_what_the_firmware_refuses() {
             },
             "M204 T",
         ),
+        (
+            RrfExport {
+                max_accel_xy_mm_s2: [None, Some(f64::INFINITY)],
+                ..base.clone()
+            },
+            "M201 Y",
+        ),
     ] {
         match change.to_config() {
             Err(GcodeError::ExportValue { key: k, .. }) => assert_eq!(k, key),
@@ -215,6 +229,7 @@ fn shaping_off_is_m593_none_alone_and_notes_sit_above_their_values() {
     let off = RrfExport {
         produced_by: "a test".into(),
         shaper: shaper("none", f64::NAN, f64::NAN),
+        max_accel_xy_mm_s2: [None; 2],
         print_accel_mm_s2: Some(2500.0),
         travel_accel_mm_s2: None,
     };

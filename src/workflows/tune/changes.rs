@@ -261,8 +261,45 @@ pub fn klipper(axes: &[(String, Outcome)], accel: Option<f64>) -> Vec<Change> {
     out
 }
 
-/// The changes `rrf.g` makes: the one shaper (axis `axis`'s) and `M204 P`/`T`.
-pub fn rrf(axes: &[(String, Outcome)], axis: &str, accel: Option<f64>) -> Vec<Change> {
+/// The `M201 X`/`Y` changes: `caps` per axis X, Y is what is written (if anything) and
+/// the cap as it was (`None`: not known); `who` the firmware and where it caps the moves.
+fn m201_changes(caps: [(Option<f64>, Option<f64>); 2], who: &str) -> Vec<Change> {
+    let mut out = Vec::new();
+    for ((now, was), letter) in caps.into_iter().zip(["X", "Y"]) {
+        let Some(now) = now else { continue };
+        let (was, why) = match was {
+            Some(c) => (
+                c.to_string(),
+                format!(
+                    "{who} caps every move's acceleration by M201 as well as by M204: raised to the recommended acceleration, so that moves run at it"
+                ),
+            ),
+            None => (
+                "not known".to_string(),
+                format!(
+                    "{who} caps every move's acceleration by M201 as well as by M204, and your M201 {letter} is not known (`settle import` writes it as [tune.axis.{}] max_accel_mm_s2): set to the recommended acceleration, so that moves run at it",
+                    letter.to_ascii_lowercase()
+                ),
+            ),
+        };
+        out.push(Change {
+            key: format!("M201 {letter}"),
+            was,
+            now: now.to_string(),
+            why,
+        });
+    }
+    out
+}
+
+/// The changes `rrf.g` makes: the one shaper (axis `axis`'s), `M201 X`/`Y` (`caps`: per
+/// axis what is written and the cap as it was) and `M204 P`/`T`.
+pub fn rrf(
+    axes: &[(String, Outcome)],
+    axis: &str,
+    caps: [(Option<f64>, Option<f64>); 2],
+    accel: Option<f64>,
+) -> Vec<Change> {
     let mut out = Vec::new();
     if let Some((a, o)) = axes.iter().find(|(a, _)| a == axis) {
         out.extend(shaper_changes(
@@ -272,15 +309,23 @@ pub fn rrf(axes: &[(String, Outcome)], axis: &str, accel: Option<f64>) -> Vec<Ch
             ("none", f64::NAN, f64::NAN),
         ));
     }
+    out.extend(m201_changes(
+        caps,
+        "RepRapFirmware (src/Movement/DDA.cpp, DDA::InitStandardMove)",
+    ));
     for key in ["M204 P", "M204 T"] {
         out.extend(accel_change(axes, key, accel));
     }
     out
 }
 
-/// The changes `marlin.gcode` makes: per tuned axis `x`/`y` its `M493` shaper, and
-/// `M204 P`/`T`.
-pub fn marlin(axes: &[(String, Outcome)], accel: Option<f64>) -> Vec<Change> {
+/// The changes `marlin.gcode` makes: per tuned axis `x`/`y` its `M493` shaper, `M201
+/// X`/`Y` (`caps`, as for [`rrf`]) and `M204 P`/`T`.
+pub fn marlin(
+    axes: &[(String, Outcome)],
+    caps: [(Option<f64>, Option<f64>); 2],
+    accel: Option<f64>,
+) -> Vec<Change> {
     let mut out = Vec::new();
     for letter in ["X", "Y"] {
         let lower = letter.to_ascii_lowercase();
@@ -297,6 +342,10 @@ pub fn marlin(axes: &[(String, Outcome)], accel: Option<f64>) -> Vec<Change> {
             ));
         }
     }
+    out.extend(m201_changes(
+        caps,
+        "Marlin (Marlin/src/module/planner.cpp, Planner::_populate_block)",
+    ));
     for key in ["M204 P", "M204 T"] {
         out.extend(accel_change(axes, key, accel));
     }

@@ -11,7 +11,8 @@
 //! - `rrf.g`: RepRapFirmware's one `M593` line (one shaper for every axis; settle-gcode's
 //!   `RrfExport`), the shaper of the lowest-frequency tuned axis, since a shaper tuned
 //!   below a mode still reduces it, one tuned above it much less (the responses in
-//!   `planner/src/shaper/response.rs`); `M204` when the acceleration changes; `M593
+//!   `planner/src/shaper/response.rs`); `M204` when the acceleration changes, and `M201`
+//!   where an axis's cap is below the recommended acceleration ([`m201`]); `M593
 //!   P"none"` alone for an unshaped trapezoid; nothing for what RepRapFirmware does not
 //!   plan.
 //!
@@ -20,7 +21,8 @@
 //! for the user's printer is named in the header.
 //! - `marlin.gcode`: Marlin Fixed-Time Motion's `M493 S1` and one `M493 <axis> C A I [Q]`
 //!   line per tuned axis (Marlin shapes X and Y apart; settle-gcode's `MarlinExport`), and
-//!   `M204 P T` when the acceleration changes; read back by settle's G-code reader in
+//!   `M204 P T` when the acceleration changes, with `M201` as in `rrf.g`; read back by
+//!   settle's G-code reader in
 //!   `tests/all/tune_firmware.rs`. An axis not tuned is left as it is, and said.
 //! - `tmc4361a.txt`: per axis, the TMC4361A ramp registers of the recommended move, from
 //!   the axis's own microsteps per mm; refused, with the reason, for what the chip cannot
@@ -134,6 +136,34 @@ fn accel(axes: &[(String, Outcome)]) -> Option<(f64, bool)> {
     rec.is_finite().then_some((rec, rec != cur))
 }
 
+/// Axis `letter`'s acceleration cap from `[tune.axis.<letter>] max_accel_mm_s2` (Marlin's
+/// and RepRapFirmware's `M201`, as `settle import` reads it); `None` when not known.
+fn cap_of(axes: &[(String, Outcome)], letter: &str) -> Option<f64> {
+    axes.first()
+        .and_then(|(_, o)| o.plan.spec.axis.as_ref())
+        .and_then(|m| m.get(letter))
+        .and_then(|a| a.max_accel_mm_s2)
+        .filter(|c| c.is_finite() && *c > 0.0)
+}
+
+/// The `M201 X`, `Y` that `marlin.gcode` and `rrf.g` write, with each axis's cap as it was:
+/// both firmwares cap every move's acceleration by `M201` too, so an axis whose cap is
+/// below the recommended acceleration is raised to it; one whose cap is not known is set
+/// to it when the acceleration changes. A cap at or above it is left as it is (lowering
+/// it would also cap what the slicer's own `M204` asks for).
+fn m201(axes: &[(String, Outcome)]) -> [(Option<f64>, Option<f64>); 2] {
+    let rec = accel(axes);
+    ["x", "y"].map(|letter| {
+        let cap = cap_of(axes, letter);
+        let write = match (rec, cap) {
+            (Some((a, _)), Some(c)) => (c < a).then_some(a),
+            (Some((a, changed)), None) => changed.then_some(a),
+            (None, _) => None,
+        };
+        (write, cap)
+    })
+}
+
 /// `klipper.cfg`: the snippet, or comments saying why it is not written.
 pub fn klipper(axes: &[(String, Outcome)], produced_by: &str) -> String {
     let (x, y) = match (klipper_axis(axes, "x"), klipper_axis(axes, "y")) {
@@ -240,15 +270,17 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
         );
     }
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    let caps = m201(axes);
     let e = RrfExport {
         produced_by: produced_by.to_string(),
         shaper,
+        max_accel_xy_mm_s2: caps.map(|(w, _)| w),
         print_accel_mm_s2: a,
         travel_accel_mm_s2: a,
     };
     let mut notes = header_notes(axes);
     notes.extend(
-        changes::rrf(axes, axis, a)
+        changes::rrf(axes, axis, caps, a)
             .iter()
             .map(changes::Change::note),
     );
@@ -266,7 +298,7 @@ pub fn rrf_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
     }
     let (axis, _) = rrf_axis(axes)?;
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
-    Some(changes::rrf(axes, axis, a))
+    Some(changes::rrf(axes, axis, m201(axes), a))
 }
 
 /// Why `marlin.gcode` is not written, if it is not.
@@ -335,15 +367,21 @@ pub fn marlin(axes: &[(String, Outcome)], produced_by: &str) -> String {
         }
     }
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    let caps = m201(axes);
     let e = MarlinExport {
         produced_by: produced_by.to_string(),
         ftm_fs_hz,
         axes: shapers,
+        max_accel_xy_mm_s2: caps.map(|(w, _)| w),
         print_accel_mm_s2: a,
         travel_accel_mm_s2: a,
     };
     let mut notes = header_notes(axes);
-    notes.extend(changes::marlin(axes, a).iter().map(changes::Change::note));
+    notes.extend(
+        changes::marlin(axes, caps, a)
+            .iter()
+            .map(changes::Change::note),
+    );
     match e.to_config_with_notes(&notes) {
         Ok(text) => format!("{text}{untuned}"),
         Err(err) => format!("; no Marlin configuration: {err}\n"),
@@ -356,7 +394,7 @@ pub fn marlin_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>
         return None;
     }
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
-    Some(changes::marlin(axes, a))
+    Some(changes::marlin(axes, m201(axes), a))
 }
 
 /// `tmc4361a.txt`: per axis, the register file of the recommended move (the first of the
