@@ -12,9 +12,9 @@
 //!   `RrfExport`), the shaper of the lowest-frequency tuned axis, since a shaper tuned
 //!   below a mode still reduces it, one tuned above it much less (the responses in
 //!   `planner/src/shaper/response.rs`); `M204` when the acceleration changes, and `M201`
-//!   where an axis's cap is below the recommended acceleration ([`m201`]); `M593
-//!   P"none"` alone for an unshaped trapezoid; nothing for what RepRapFirmware does not
-//!   plan.
+//!   where an axis's cap (`[tune.axis.<name>] max_accel_mm_s2`) is below the recommended
+//!   acceleration, or is not known while the acceleration changes; `M593 P"none"` alone
+//!   for an unshaped trapezoid; nothing for what RepRapFirmware does not plan.
 //!
 //! Every value that differs from the current one carries a comment above it: what it was
 //! and why it changed ([`super::changes`]); a machine that is a built-in preset standing in
