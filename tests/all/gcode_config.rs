@@ -375,3 +375,44 @@ fn settle_gcode_reads_a_marlin_m503_reply_end_to_end() {
     );
     assert!(!bad_out.exists());
 }
+
+/// What reading `--config` notes reaches the outputs, not only stderr: the real Voron's
+/// printer.cfg sets `max_accel_to_decel: 6500` (line 41), which settle reads as Klipper
+/// now does (`minimum_cruise_ratio = 0`, docs/Config_Changes.md of Klipper); summary.md's
+/// "Configuration notes" and report.html's table carry that note word for word, as
+/// stderr prints it.
+#[test]
+fn the_configurations_notes_are_in_summary_and_report() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cfg = root().join("gcode/tests/data/real/voronpi/printer.cfg");
+    let out = dir.path().join("out");
+    let r = settle()
+        .arg("gcode")
+        .arg(root().join("gcode/prints/cube_layer.gcode"))
+        .args(["--machine", "printer_xy", "--config"])
+        .arg(&cfg)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("settle runs");
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{stderr}");
+    let note = stderr
+        .lines()
+        .find_map(|l| l.strip_prefix("note: "))
+        .filter(|n| n.contains(":41: max_accel_to_decel = 6500 read as minimum_cruise_ratio = 0"))
+        .unwrap_or_else(|| panic!("no max_accel_to_decel note: {stderr}"));
+    let summary = std::fs::read_to_string(out.join("summary.md")).expect("written");
+    let section = summary
+        .split("## Configuration notes")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no notes section: {summary}"));
+    assert!(section.contains(&format!("- {note}\n")), "{section}");
+    let html = std::fs::read_to_string(out.join("report.html")).expect("written");
+    assert!(html.contains("Configuration notes (--config)"));
+    let escaped = note
+        .replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;");
+    assert!(html.contains(&escaped), "report.html lacks {note}");
+}

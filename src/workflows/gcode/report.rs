@@ -24,6 +24,10 @@ use crate::output::sha256::Sha256;
 use crate::spec::backend::Backend;
 use crate::studies::gcode::stats::LayerMap;
 
+/// The most configuration notes summary.md and report.html list (a configuration of
+/// 16 MiB may hold a note per line; stderr lists every one).
+pub const MAX_LISTED_NOTES: usize = 100;
+
 /// layers.csv's columns.
 pub const LAYER_COLUMNS: [&str; 16] = [
     "layer",
@@ -266,6 +270,21 @@ not counted), so that it starts from the vibration the layers before leave.\n",
         let _ = writeln!(s, "\n## Commands not followed\n");
         for (what, n) in &o.ignored {
             let _ = writeln!(s, "- {what}: {n}");
+        }
+    }
+    if let Some((_, notes)) = o.config.as_ref().filter(|(_, n)| !n.is_empty()) {
+        let _ = writeln!(s, "\n## Configuration notes\n");
+        let _ = writeln!(
+            s,
+            "What reading `--config` noted: values read another way than written, and \
+what the planner does not use.\n"
+        );
+        for n in notes.iter().take(MAX_LISTED_NOTES) {
+            let _ = writeln!(s, "- {n}");
+        }
+        if notes.len() > MAX_LISTED_NOTES {
+            let more = notes.len() - MAX_LISTED_NOTES;
+            let _ = writeln!(s, "- ... and {more} more (stderr lists every one)");
         }
     }
     if !maps.is_empty() {
@@ -630,6 +649,22 @@ pub fn html_report(
                 .ignored
                 .iter()
                 .map(|(what, n)| vec![Cell::text(what.as_str()), Cell::number(*n as f64)])
+                .collect(),
+        });
+    }
+    if let Some((_, notes)) = o.config.as_ref().filter(|(_, n)| !n.is_empty()) {
+        let more = notes.len().saturating_sub(MAX_LISTED_NOTES);
+        tables.push(Table {
+            title: "Configuration notes (--config)".into(),
+            note: match more {
+                0 => String::new(),
+                n => format!("The first {MAX_LISTED_NOTES}; {n} more on stderr."),
+            },
+            header: vec!["note".into()],
+            rows: notes
+                .iter()
+                .take(MAX_LISTED_NOTES)
+                .map(|n| vec![Cell::text(n.as_str())])
                 .collect(),
         });
     }
