@@ -389,8 +389,8 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
     // has Fixed-Time Motion; the export must be the one the build runs. A reply with
     // neither comes from a build with no input shaper: either export needs a new build,
     // and settle tunes for the built-in ZV shaper (INPUT_SHAPING_X/Y in
-    // Configuration_adv.h), the older release (Marlin 2.1.2; FT_MOTION is 2.1.3) and the
-    // smaller change to a stock configuration.
+    // Configuration_adv.h), the shaper of the older release (Marlin 2.1.2; FT_MOTION
+    // needs 2.1.3).
     let shaping = if has_m493 {
         MarlinShaping::FtMotion
     } else {

@@ -416,7 +416,7 @@ fn marlin_zv(axes: &[(String, Outcome)], produced_by: &str) -> String {
 
 /// `marlin.gcode`: Marlin Fixed-Time Motion's `M493` lines per tuned axis, or with
 /// `[tune] marlin_shaping = "input_shaping"` its built-in ZV shaper's `M593` lines
-/// ([`marlin_zv`]); `M201`/`M204` as the module documentation says; or comments saying why
+/// (`marlin_zv`); `M201`/`M204` as the module documentation says; or comments saying why
 /// it is not written.
 pub fn marlin(axes: &[(String, Outcome)], produced_by: &str) -> String {
     if let Some(why) = marlin_refusal(axes) {
