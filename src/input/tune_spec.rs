@@ -52,6 +52,10 @@ pub struct TuneSpec {
     /// trapezoids with that firmware's shapers), `tmc4361a` (the chip's S-ramps, no
     /// shaper) or `any` [default `any`].
     pub firmware: Option<String>,
+    /// With `firmware = "marlin"`: the printer's input shaper, `ft_motion` (Fixed-Time
+    /// Motion, `M493`, Marlin 2.1.3+) or `input_shaping` (the built-in ZV shaper, `M593`,
+    /// Marlin 2.1.2+) [default `ft_motion`; `settle import marlin` writes the reply's].
+    pub marlin_shaping: Option<String>,
     /// Accelerations searched (mm/s^2) [default: `limits.amax_mm_s2` alone].
     pub accelerations_mm_s2: Option<Vec<f64>>,
     /// Largest shaper smoothing a candidate may have at its acceleration (mm, Klipper's

@@ -45,7 +45,7 @@ use settle_gcode::config::{
 use crate::error::{Error, Location};
 use crate::input::machine_form::MachineForm;
 use crate::output::atomic::write_atomic;
-use crate::workflows::tune::firmware::Candidates;
+use crate::workflows::tune::firmware::{Candidates, MarlinShaping};
 use crate::workflows::tune::grid::{identified_band, tuning_modes};
 use crate::workflows::{Exit, Report};
 use settle_planner::firmware::Firmware;
@@ -112,6 +112,16 @@ pub struct Current {
     pub axes: Vec<AxisNow>,
     /// What the reader noted.
     pub notes: Vec<String>,
+    /// Marlin: the input shaper of the printer's build (`[tune] marlin_shaping`); `None`
+    /// for the other firmwares.
+    pub marlin_shaping: Option<MarlinShaping>,
+}
+
+impl Current {
+    /// The candidates `settle tune` searches for this firmware (and Marlin build).
+    pub fn candidates(&self) -> Candidates {
+        Candidates::of(self.firmware).with_marlin_shaping(self.marlin_shaping.unwrap_or_default())
+    }
 }
 
 /// What `settle import` wrote.
@@ -259,6 +269,7 @@ pub fn read_current_files(
                 amax_mm_s2: c.printer.max_accel_mm_s2,
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
+                marlin_shaping: None,
             };
             Ok((cur, files))
         }
@@ -285,6 +296,7 @@ pub fn read_current_files(
                     .min(c.axes.y.max_accel_mm_s2),
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
+                marlin_shaping: None,
             };
             Ok((cur, files))
         }
@@ -365,17 +377,37 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
     notes.push(format!(
         "{corner} read, not in the scenario: it sets the speed through corners, and the scenario's moves start and end at rest (settle gcode --firmware marlin --config follows it)"
     ));
-    if c.notes.iter().any(|n| n.text.starts_with("M493")) {
+    let has_m493 = c.notes.iter().any(|n| n.text.starts_with("M493"));
+    let has_m593 = c.followed.iter().any(|(_, f)| *f == "M593");
+    if has_m493 {
         notes.push(
             "the reply has FT_MOTION's M493: the current shaper is read from M593 only (none here if the reply has no M593); FT_MOTION's shaper is not part of the baseline".into(),
         );
     }
+    // M503 prints `M593 X/Y` when the build has Marlin's built-in input shaping
+    // (M593_report, Marlin/src/gcode/feature/input_shaping/M593.cpp) and `M493` when it
+    // has Fixed-Time Motion; the export must be the one the build runs. A reply with
+    // neither comes from a build with no input shaper: either export needs a new build,
+    // and settle tunes for the built-in ZV shaper (INPUT_SHAPING_X/Y in
+    // Configuration_adv.h), the shaper of the older release (Marlin 2.1.2; FT_MOTION
+    // needs 2.1.3).
+    let shaping = if has_m493 {
+        MarlinShaping::FtMotion
+    } else {
+        if !has_m593 {
+            notes.push(
+                "the reply has neither M593 nor M493: this build has no input shaper; the scenario tunes Marlin's built-in ZV shaper (marlin_shaping = \"input_shaping\", M593: INPUT_SHAPING_X and INPUT_SHAPING_Y in Configuration_adv.h, Marlin 2.1.2 or later); set marlin_shaping = \"ft_motion\" for a Fixed-Time Motion build (M493)".into(),
+            );
+        }
+        MarlinShaping::InputShaping
+    };
     Ok(Current {
         firmware: Firmware::Marlin,
         vmax_mm_s: vmax,
         amax_mm_s2: amax,
         axes,
         notes,
+        marlin_shaping: Some(shaping),
     })
 }
 
@@ -416,11 +448,10 @@ fn around(x: f64, scales: &[f64], step: f64) -> Vec<f64> {
 /// (at the search's highest frequency scale, designed for the mode's damping), keeps
 /// Klipper's smoothing within its 0.12 mm; above it every shaper that cancels the mode
 /// smooths more. `None` without a mode or a shaper.
-pub fn top_accel(firmware: Firmware, run: &crate::spec::run_spec::RunSpec) -> Option<f64> {
+pub fn top_accel(runs: Candidates, run: &crate::spec::run_spec::RunSpec) -> Option<f64> {
     let (f, zeta) = tuning_modes(run).first().copied()?;
     let highest = FREQUENCY_SCALES.iter().copied().fold(0.0, f64::max);
-    Candidates::of(firmware)
-        .shapers()
+    runs.shapers()
         .into_iter()
         .filter_map(|k| {
             let (z, _) = crate::workflows::tune::target::design_damping(k, zeta);
@@ -481,7 +512,7 @@ fn scenario_text(
     let tune_accels = tune_accels(cur.amax_mm_s2, top);
     let freqs = around(f_now, &FREQUENCY_SCALES, 0.1);
     let mut types = vec![q("none")];
-    types.extend(Candidates::of(fw).shapers().iter().map(|k| q(&k.name())));
+    types.extend(cur.candidates().shapers().iter().map(|k| q(&k.name())));
     if !types.contains(&q(&type_now)) {
         types.push(q(&type_now));
     }
@@ -493,10 +524,10 @@ fn scenario_text(
          #   settle sweep THIS.toml   # the sweep around the current settings\n\
          #   settle tune THIS.toml    # the recommendation per axis, with {}\n",
         fw.name(),
-        if fw == Firmware::Marlin {
-            "marlin.gcode (FT_MOTION's M493)"
-        } else {
-            "klipper.cfg / rrf.g"
+        match cur.marlin_shaping {
+            Some(MarlinShaping::FtMotion) => "marlin.gcode (FT_MOTION's M493)",
+            Some(MarlinShaping::InputShaping) => "marlin.gcode (input shaping's M593)",
+            None => "klipper.cfg / rrf.g",
         },
     );
     // What the reading passed over stays with the settings read (an include that was not
@@ -558,8 +589,16 @@ fn scenario_text(
     let names: Vec<String> = axes.iter().map(|a| q(&a.name)).collect();
     let _ = writeln!(
         t,
-        "[tune]\nfirmware = {}\naxes = [{}]\ndistances_mm = [5.0, 20.0]\nband_um = 10.0\nfrequency_scales = {}\n{}accelerations_mm_s2 = {}\n{}",
+        "[tune]\nfirmware = {}\n{}axes = [{}]\ndistances_mm = [5.0, 20.0]\nband_um = 10.0\nfrequency_scales = {}\n{}accelerations_mm_s2 = {}\n{}",
         q(fw.name()),
+        cur.marlin_shaping.map_or(String::new(), |m| format!(
+            "marlin_shaping = {}   # the reply's input shaper: {}\n",
+            q(m.name()),
+            match m {
+                MarlinShaping::FtMotion => "Fixed-Time Motion, M493",
+                MarlinShaping::InputShaping => "the built-in ZV, M593",
+            }
+        )),
         names.join(", "),
         list(&FREQUENCY_SCALES),
         match top {
@@ -754,7 +793,7 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
                     .map(|(f, _)| (f * 10.0).round() / 10.0);
             }
             band |= identified_band(run).is_some();
-            if let Some(t) = top_accel(cur.firmware, run) {
+            if let Some(t) = top_accel(cur.candidates(), run) {
                 top = Some(top.map_or(t, |m: f64| m.max(t)));
             }
             axes.push(a);

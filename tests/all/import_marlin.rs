@@ -78,6 +78,16 @@ fn the_real_ender_reply_becomes_the_baseline() {
     );
     let t = sc.tune.as_ref().expect("[tune]");
     assert_eq!(t.firmware.as_deref(), Some("marlin"));
+    // Neither M593 nor M493 in the reply: a build without an input shaper, tuned for
+    // Marlin's built-in ZV (M593), and said.
+    assert_eq!(t.marlin_shaping.as_deref(), Some("input_shaping"));
+    assert!(
+        c.notes
+            .iter()
+            .any(|n| n.starts_with("the reply has neither M593 nor M493")),
+        "{:?}",
+        c.notes
+    );
     let x = &t.axis.as_ref().expect("[tune.axis]")["x"];
     assert_eq!(
         (x.shaper.as_deref(), x.usteps_per_mm),
@@ -231,35 +241,45 @@ fn row<'a>(md: &'a str, first: &str, second: &str) -> Vec<&'a str> {
         .unwrap_or_else(|| panic!("no row {first} {second} in\n{md}"))
 }
 
-/// M503 reply -> `settle import marlin` -> `settle tune --firmware marlin` -> marlin.gcode,
-/// from the command line as an owner runs it: the Marlin lines, read back by settle's
-/// G-code reader, carry the winner tune.md recommends per axis, and the acceleration.
-#[test]
-fn the_real_reply_imports_tunes_and_exports_marlin_lines() {
-    use settle_gcode::{Dialect, EventKind, FtShaper, LimitChange, Reader, ReaderOptions};
-    use settle_planner::shaper::MarlinShaper;
+/// The real reply with `lines` added before its closing `ok`, written as `name` in `dir`.
+fn ender_with(dir: &Path, name: &str, lines: &str) -> PathBuf {
+    let reply = std::fs::read_to_string(ender()).expect("reply");
+    let at = reply.rfind("Recv: ok").expect("the reply ends with ok");
+    write(
+        dir,
+        name,
+        &format!("{}{lines}{}", &reply[..at], &reply[at..]),
+    )
+}
 
-    let dir = tempfile::tempdir().expect("tempdir");
-    let scenario = dir.path().join("ender.toml");
+/// `settle import marlin reply` then `settle tune --firmware marlin` on the scenario with
+/// the search cut down to keep the test fast (one move length, three frequency scales;
+/// `shapers`, when given, the shapers searched); the scenario text, tune.md and
+/// marlin.gcode.
+fn import_and_tune(dir: &Path, reply: &Path, shapers: Option<&str>) -> (String, String, String) {
+    let scenario = dir.join("scenario.toml");
     run_ok(
         settle()
             .args(["import", "marlin"])
-            .arg(ender())
+            .arg(reply)
             .arg("--out")
-            .arg(&scenario),
+            .arg(&scenario)
+            .arg("--force"),
     );
-    // The search cut down to keep the test fast (one move length, three frequency
-    // scales, three shapers); the rest as the import wrote it.
     let text = std::fs::read_to_string(&scenario).expect("reads");
+    let scales = "frequency_scales = [0.95, 1.0, 1.05]";
     let cut = text
         .replace("distances_mm = [5.0, 20.0]", "distances_mm = [20.0]")
         .replace(
             "frequency_scales = [0.9, 0.95, 1.0, 1.05, 1.1]",
-            "frequency_scales = [0.95, 1.0, 1.05]\nshapers = [\"none\", \"marlin:zv\", \"marlin:ei\"]",
+            &match shapers {
+                Some(list) => format!("{scales}\nshapers = {list}"),
+                None => scales.to_string(),
+            },
         );
     assert_ne!(cut, text, "the import's [tune] as expected");
-    std::fs::write(&scenario, cut).expect("writes");
-    let out = dir.path().join("tune");
+    std::fs::write(&scenario, &cut).expect("writes");
+    let out = dir.join("tune");
     run_ok(
         settle()
             .arg("tune")
@@ -269,80 +289,251 @@ fn the_real_reply_imports_tunes_and_exports_marlin_lines() {
     );
     let md = std::fs::read_to_string(out.join("tune.md")).expect("tune.md");
     let g = std::fs::read_to_string(out.join("marlin.gcode")).expect("marlin.gcode");
-    // The current settings are the reply's: no shaper at M204 P500.
-    assert_eq!(row(&md, "x", "current")[3..5], ["none", "500"], "{md}");
-    let events: Vec<_> = Reader::new(g.as_bytes(), ReaderOptions::new(Dialect::Marlin))
-        .collect::<Result<_, _>>()
-        .expect("settle reads its own export");
-    let mut accel = None;
-    let mut axes_seen = Vec::new();
-    for e in &events {
-        match &e.kind {
-            EventKind::Limits(LimitChange::FtMotion {
-                axes,
-                shaper: Some(shaper),
-                frequency_hz,
-                damping_ratio,
-                ..
-            }) => {
-                let letter = if axes.x { "x" } else { "y" };
-                let rec = row(&md, letter, "**recommended**");
-                let text = match shaper {
-                    FtShaper::None => "none".to_string(),
-                    s => {
-                        let i = (0..=8u32)
-                            .find(|c| FtShaper::from_code(*c) == Some(*s))
-                            .expect("a code") as usize;
-                        format!(
-                            "marlin:{} @ {:.1} Hz (zeta {})",
-                            MarlinShaper::ALL[i - 1].name(),
-                            frequency_hz.expect("A"),
-                            damping_ratio.expect("I")
-                        )
-                    }
-                };
-                assert_eq!(rec[3], text, "{letter}\n{g}\n{md}");
-                axes_seen.push(letter);
-            }
-            EventKind::Limits(LimitChange::Accel { .. }) => accel = Some(e.line),
-            _ => {}
-        }
-    }
-    assert_eq!(axes_seen, ["x", "y"], "{g}");
-    // One acceleration for both axes: the recommended one, above the reply's M201 X500
-    // Y500 (line 13) on the stand-in's modes.
-    let rec_accel = row(&md, "x", "**recommended**")[4];
-    assert_eq!(row(&md, "y", "**recommended**")[4], rec_accel);
-    let rec: f64 = rec_accel.parse().expect("a number");
-    assert!(rec > 500.0, "{md}");
-    assert!(accel.is_some(), "{g}");
-    let lines: Vec<&str> = g.lines().filter(|l| !l.starts_with(';')).collect();
-    let m201 = format!("M201 X{rec_accel} Y{rec_accel}");
-    let m204 = format!("M204 P{rec_accel} T{rec_accel}");
-    assert_eq!(
-        lines[lines.len() - 2..],
-        [m201.as_str(), m204.as_str()],
-        "{g}"
-    );
-    // The printer after the reply's settings and then these lines: Marlin's planner, as
-    // settle follows it (M201 and M204 both cap the move), runs at the recommendation.
-    // Without M201 it would stay at 500 mm/s^2.
-    let sent = dir.path().join("sent.txt");
-    let reply = std::fs::read_to_string(ender()).expect("reply");
-    std::fs::write(&sent, format!("{reply}{g}")).expect("writes");
+    (cut, md, g)
+}
+
+/// The acceleration Marlin runs printing moves at after `reply` and then `g` are sent
+/// (settle's Marlin reader: M204 P capped by M201 X and Y), mm/s^2, and the M593 shapers.
+fn after_sending(
+    dir: &Path,
+    reply: &Path,
+    g: &str,
+) -> (f64, [Option<settle_gcode::job::ShaperSetting>; 3]) {
+    let sent = dir.join("sent.txt");
+    let r = std::fs::read_to_string(reply).expect("reply");
+    std::fs::write(&sent, format!("{r}{g}")).expect("writes");
     let after = settle_gcode::config::MarlinSettings::read(&sent).expect("reads");
     let p = after.planner;
-    let effective_mm_s2 = p
+    let effective = p
         .print_accel_m_s2
         .min(p.max_accel_m_s2[0])
         .min(p.max_accel_m_s2[1])
         * 1e3;
+    (effective, after.shapers)
+}
+
+/// The recommended acceleration of both axes in tune.md (one for both).
+fn recommended_accel(md: &str) -> f64 {
+    let rec = row(md, "x", "**recommended**")[4];
+    assert_eq!(row(md, "y", "**recommended**")[4], rec, "{md}");
+    rec.parse().expect("a number")
+}
+
+/// The real reply (no M593, no M493) -> `settle import marlin` -> `settle tune --firmware
+/// marlin` -> marlin.gcode, from the command line as an owner runs it: the build's input
+/// shaper is Marlin's built-in ZV, so the export is `M593` lines (no `M493`, which this
+/// printer could not run); sent after the reply, settle's Marlin reader gives each axis
+/// the ZV tune.md recommends, and the recommended acceleration.
+#[test]
+fn the_real_reply_imports_tunes_and_exports_m593_lines() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (scenario, md, g) = import_and_tune(dir.path(), &ender(), None);
     assert!(
-        (effective_mm_s2 - rec).abs() < 1e-9,
-        "{effective_mm_s2}\n{g}"
+        scenario.contains("marlin_shaping = \"input_shaping\""),
+        "{scenario}"
     );
-    let without_m201 = g.replace(&format!("M201 X{rec_accel} Y{rec_accel}\n"), "");
-    std::fs::write(&sent, format!("{reply}{without_m201}")).expect("writes");
-    let capped = settle_gcode::config::MarlinSettings::read(&sent).expect("reads");
-    assert_eq!(capped.planner.max_accel_m_s2[0] * 1e3, 500.0);
+    // The current settings are the reply's: no shaper at M204 P500.
+    assert_eq!(row(&md, "x", "current")[3..5], ["none", "500"], "{md}");
+    let lines: Vec<&str> = g.lines().filter(|l| !l.starts_with(';')).collect();
+    assert!(!g.contains("M493"), "{g}");
+    assert_eq!(lines.len(), 4, "{g}");
+    assert!(
+        lines[0].starts_with("M593 X F") && lines[1].starts_with("M593 Y F"),
+        "{g}"
+    );
+    let rec = recommended_accel(&md);
+    assert!(rec > 500.0, "{md}");
+    assert_eq!(
+        lines[2..],
+        [format!("M201 X{rec} Y{rec}"), format!("M204 P{rec} T{rec}")],
+        "{g}"
+    );
+    let (effective, shapers) = after_sending(dir.path(), &ender(), &g);
+    assert_eq!(effective, rec, "{g}");
+    for (i, letter) in ["x", "y"].into_iter().enumerate() {
+        let s = shapers[i].as_ref().expect("shaped");
+        let text = format!(
+            "{} @ {:.1} Hz (zeta {})",
+            s.shaper_type.name(),
+            s.frequency_hz,
+            s.damping_ratio
+        );
+        assert_eq!(
+            row(&md, letter, "**recommended**")[3],
+            text,
+            "{letter}\n{g}\n{md}"
+        );
+        assert!(text.starts_with("zv @ "), "{text}");
+    }
+    assert!(
+        md.contains("Marlin (`marlin.gcode`; input shaping, M593)"),
+        "{md}"
+    );
+}
+
+/// A reply with M593 lines (the real reply with the block Marlin's M593_report prints):
+/// each axis's current ZV is the baseline, the scenario is for input shaping, and the
+/// export's M593 lines replace them.
+#[test]
+fn a_reply_with_m593_tunes_its_zv_shapers() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let reply = ender_with(
+        dir.path(),
+        "m593.txt",
+        "Recv: echo:; Input Shaping:\n\
+         Recv: echo:  M593 X F42.50 D0.15\n\
+         Recv: echo:  M593 Y F36.00 D0.08\n",
+    );
+    let i = import(&opts(reply.clone(), &dir.path().join("m593.toml"))).expect("imports");
+    let c = &i.current;
+    assert_eq!(c.axes[0].shaper, Some(("zv".into(), 42.5, 0.15)));
+    assert_eq!(c.axes[1].shaper, Some(("zv".into(), 36.0, 0.08)));
+    assert!(
+        !c.notes.iter().any(|n| n.contains("neither M593 nor M493")),
+        "{:?}",
+        c.notes
+    );
+    let (scenario, md, g) = import_and_tune(dir.path(), &reply, None);
+    assert!(
+        scenario.contains("marlin_shaping = \"input_shaping\""),
+        "{scenario}"
+    );
+    assert_eq!(
+        row(&md, "x", "current")[3..5],
+        ["zv @ 42.5 Hz (zeta 0.15)", "500"],
+        "{md}"
+    );
+    assert!(!g.contains("M493"), "{g}");
+    let (effective, shapers) = after_sending(dir.path(), &reply, &g);
+    assert_eq!(effective, recommended_accel(&md), "{g}");
+    for (i, letter) in ["x", "y"].into_iter().enumerate() {
+        let rec = row(&md, letter, "**recommended**")[3];
+        match shapers[i].as_ref() {
+            Some(s) => assert_eq!(
+                rec,
+                format!(
+                    "{} @ {:.1} Hz (zeta {})",
+                    s.shaper_type.name(),
+                    s.frequency_hz,
+                    s.damping_ratio
+                ),
+                "{letter}\n{g}"
+            ),
+            None => assert_eq!(rec, "none", "{letter}\n{g}"),
+        }
+    }
+}
+
+/// A reply with FT_MOTION's M493 (the real reply with an `M493` line): the scenario is for
+/// Fixed-Time Motion and marlin.gcode writes `M493` lines, read back by settle's G-code
+/// reader as the winner tune.md recommends per axis, and the acceleration.
+#[test]
+fn a_reply_with_m493_keeps_the_fixed_time_motion_export() {
+    use settle_gcode::{Dialect, EventKind, FtShaper, LimitChange, Reader, ReaderOptions};
+    use settle_planner::shaper::MarlinShaper;
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let reply = ender_with(
+        dir.path(),
+        "m493.txt",
+        "Recv: echo:; Fixed-Time Motion:\nRecv: echo:  M493 S1 P0 K0\n",
+    );
+    let (scenario, md, g) = import_and_tune(
+        dir.path(),
+        &reply,
+        Some("[\"none\", \"marlin:zv\", \"marlin:ei\"]"),
+    );
+    assert!(
+        scenario.contains("marlin_shaping = \"ft_motion\""),
+        "{scenario}"
+    );
+    assert!(!g.lines().any(|l| l.starts_with("M593")), "{g}");
+    let events: Vec<_> = Reader::new(g.as_bytes(), ReaderOptions::new(Dialect::Marlin))
+        .collect::<Result<_, _>>()
+        .expect("settle reads its own export");
+    let mut axes_seen = Vec::new();
+    for e in &events {
+        if let EventKind::Limits(LimitChange::FtMotion {
+            axes,
+            shaper: Some(shaper),
+            frequency_hz,
+            damping_ratio,
+            ..
+        }) = &e.kind
+        {
+            let letter = if axes.x { "x" } else { "y" };
+            let rec = row(&md, letter, "**recommended**");
+            let text = match shaper {
+                FtShaper::None => "none".to_string(),
+                s => {
+                    let i = (0..=8u32)
+                        .find(|c| FtShaper::from_code(*c) == Some(*s))
+                        .expect("a code") as usize;
+                    format!(
+                        "marlin:{} @ {:.1} Hz (zeta {})",
+                        MarlinShaper::ALL[i - 1].name(),
+                        frequency_hz.expect("A"),
+                        damping_ratio.expect("I")
+                    )
+                }
+            };
+            assert_eq!(rec[3], text, "{letter}\n{g}\n{md}");
+            axes_seen.push(letter);
+        }
+    }
+    assert_eq!(axes_seen, ["x", "y"], "{g}");
+    let rec = recommended_accel(&md);
+    assert!(rec > 500.0, "{md}");
+    let lines: Vec<&str> = g.lines().filter(|l| !l.starts_with(';')).collect();
+    assert_eq!(
+        lines[lines.len() - 2..],
+        [format!("M201 X{rec} Y{rec}"), format!("M204 P{rec} T{rec}")],
+        "{g}"
+    );
+    // Marlin's planner, as settle follows it (M201 and M204 both cap the move), runs at
+    // the recommendation; without M201 it would stay at the reply's 500 mm/s^2 (line 13).
+    let (effective, _) = after_sending(dir.path(), &reply, &g);
+    assert_eq!(effective, rec, "{g}");
+    let without_m201 = g.replace(&format!("M201 X{rec} Y{rec}\n"), "");
+    let (capped, _) = after_sending(dir.path(), &reply, &without_m201);
+    assert_eq!(capped, 500.0);
+}
+
+/// A `[tune] marlin_shaping` that is neither Marlin shaper: exit 2, naming the file, the
+/// key and the values allowed.
+#[test]
+fn an_unknown_marlin_shaping_is_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scenario = dir.path().join("ender.toml");
+    run_ok(
+        settle()
+            .args(["import", "marlin"])
+            .arg(ender())
+            .arg("--out")
+            .arg(&scenario),
+    );
+    let text = std::fs::read_to_string(&scenario).expect("reads");
+    let bad = text.replace(
+        "marlin_shaping = \"input_shaping\"",
+        "marlin_shaping = \"zv_shaping\"",
+    );
+    assert_ne!(bad, text);
+    std::fs::write(&scenario, bad).expect("writes");
+    let r = settle()
+        .arg("tune")
+        .arg(&scenario)
+        .args(["--firmware", "marlin", "--out"])
+        .arg(dir.path().join("tune"))
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    for want in [
+        "ender.toml",
+        "tune.marlin_shaping",
+        "unknown Marlin shaping `zv_shaping`; allowed: ft_motion, input_shaping",
+    ] {
+        assert!(err.contains(want), "{want}: {err}");
+    }
+    assert!(!dir.path().join("tune").exists());
 }

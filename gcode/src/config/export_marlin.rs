@@ -1,11 +1,20 @@
-//! Input shaping written as Marlin G-code for its Fixed-Time Motion (`FT_MOTION`, Marlin
-//! 2.1.3 and later), with `M493` as MarlinDocumentation's `_gcode/M493.md` documents it:
-//! `M493 S1` turns Fixed-Time Motion on, and one `M493 <axis> C<shaper> A<Hz> I<zeta>`
-//! line per axis (`Q<vtol>` for the EI family) sets that axis's shaper: Marlin shapes X
-//! and Y apart, and the page asks for both to be set. `M201 X Y` and `M204 P T` follow
-//! when accelerations are given (Marlin caps each move by both). The settings live in EEPROM (`M500` keeps them). Numbers are
-//! written shortest-exact, so settle's G-code reader reads back the same values bit for
-//! bit.
+//! Input shaping written as Marlin G-code, for either of Marlin's two input shapers (the
+//! build has one or the other):
+//!
+//! - [`MarlinExport`]: Fixed-Time Motion (`FT_MOTION`, Marlin 2.1.3 and later), with `M493`
+//!   as MarlinDocumentation's `_gcode/M493.md` documents it: `M493 S1` turns Fixed-Time
+//!   Motion on, and one `M493 <axis> C<shaper> A<Hz> I<zeta>` line per axis (`Q<vtol>` for
+//!   the EI family) sets that axis's shaper: Marlin shapes X and Y apart, and the page asks
+//!   for both to be set.
+//! - [`MarlinZvExport`]: the built-in ZV shaper (`INPUT_SHAPING_X`/`_Y`, Marlin 2.1.2 and
+//!   later), one `M593 <axis> F<Hz> D<zeta>` line per axis, `F0` for an axis left unshaped
+//!   (Marlin/src/gcode/feature/input_shaping/M593.cpp takes `D` from 0 to 1, and `F` 0 or
+//!   above a bound of its stepper timer).
+//!
+//! Both write `M201 X Y` and `M204 P T` after the shapers, the same lines, when
+//! accelerations are given (Marlin caps each move by both). The settings live in EEPROM
+//! (`M500` keeps them). Numbers are written shortest-exact, so settle's G-code reader
+//! reads back the same values bit for bit.
 
 use super::export_text::{Note, annotate, comment_text, m201_line, m204_line, refuse};
 use crate::FtShaper;
@@ -49,6 +58,28 @@ pub struct MarlinExport {
     pub travel_accel_mm_s2: Option<f64>,
 }
 
+/// Whether the note keyed `key` belongs above `line`: the same command, and for the
+/// per-axis shaper command `per_axis` (`M493`, `M593`) the same axis word.
+fn key_matches(per_axis: &str, line: &str, key: &str) -> bool {
+    let mut l = line.split_whitespace();
+    let mut k = key.split_whitespace();
+    match (k.next(), k.next()) {
+        (Some(c), Some(w)) if c == per_axis => l.next() == Some(c) && l.next() == Some(w),
+        (Some(c), _) => l.next() == Some(c),
+        _ => false,
+    }
+}
+
+/// The `M201 X Y` and `M204 P T` lines both exports end with (each only when given).
+fn accel_lines(
+    max_accel_xy_mm_s2: [Option<f64>; 2],
+    print_accel_mm_s2: Option<f64>,
+    travel_accel_mm_s2: Option<f64>,
+) -> Result<String, GcodeError> {
+    let [x, y] = max_accel_xy_mm_s2;
+    Ok(m201_line(x, y)? + &m204_line(print_accel_mm_s2, travel_accel_mm_s2)?)
+}
+
 impl MarlinExport {
     /// The lines with each note as a `;` comment above the line it names ([`Note::key`]:
     /// the command and its first word, e.g. `M493 X A`, `M204 P`), or an error naming the
@@ -56,13 +87,7 @@ impl MarlinExport {
     pub fn to_config_with_notes(&self, notes: &[Note]) -> Result<String, GcodeError> {
         let text = self.to_config()?;
         Ok(annotate(&text, notes, ";", |line, key| {
-            let mut l = line.split_whitespace();
-            let mut k = key.split_whitespace();
-            match (k.next(), k.next()) {
-                (Some(c), Some(w)) if c == "M493" => l.next() == Some(c) && l.next() == Some(w),
-                (Some(c), _) => l.next() == Some(c),
-                _ => false,
-            }
+            key_matches("M493", line, key)
         }))
     }
 
@@ -84,9 +109,11 @@ impl MarlinExport {
         for a in &self.axes {
             out.push_str(&self.axis_line(a)?);
         }
-        let [x, y] = self.max_accel_xy_mm_s2;
-        out.push_str(&m201_line(x, y)?);
-        out.push_str(&m204_line(self.print_accel_mm_s2, self.travel_accel_mm_s2)?);
+        out.push_str(&accel_lines(
+            self.max_accel_xy_mm_s2,
+            self.print_accel_mm_s2,
+            self.travel_accel_mm_s2,
+        )?);
         Ok(out)
     }
 
@@ -127,6 +154,104 @@ impl MarlinExport {
         }
         line.push('\n');
         Ok(line)
+    }
+}
+
+/// One axis's ZV shaper (`M593 <axis> F D`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ZvAxisShaper {
+    /// `X` or `Y` (the axes Marlin's `INPUT_SHAPING_X`/`_Y` shape).
+    pub axis: char,
+    /// `F`: frequency, Hz; 0 writes `F0` alone (no shaping on the axis).
+    pub frequency_hz: f64,
+    /// `D`: damping ratio zeta.
+    pub damping_ratio: f64,
+}
+
+/// What to write for Marlin's built-in ZV shaper.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MarlinZvExport {
+    /// What produced the values (a scenario, a command line); written as a comment.
+    pub produced_by: String,
+    /// The axes' shapers, in the order written.
+    pub axes: Vec<ZvAxisShaper>,
+    /// `M201 X`, `M201 Y`: as [`MarlinExport::max_accel_xy_mm_s2`].
+    pub max_accel_xy_mm_s2: [Option<f64>; 2],
+    /// `M204 P`: as [`MarlinExport::print_accel_mm_s2`].
+    pub print_accel_mm_s2: Option<f64>,
+    /// `M204 T`: as [`MarlinExport::travel_accel_mm_s2`].
+    pub travel_accel_mm_s2: Option<f64>,
+}
+
+impl MarlinZvExport {
+    /// The lines with each note as a `;` comment above the line it names ([`Note::key`]:
+    /// the command and its first word, e.g. `M593 X F`, `M204 P`), or an error naming the
+    /// first value the firmware would refuse.
+    pub fn to_config_with_notes(&self, notes: &[Note]) -> Result<String, GcodeError> {
+        let text = self.to_config()?;
+        Ok(annotate(&text, notes, ";", |line, key| {
+            key_matches("M593", line, key)
+        }))
+    }
+
+    /// The lines, or an error naming the first value the firmware would refuse.
+    pub fn to_config(&self) -> Result<String, GcodeError> {
+        let by = comment_text(&self.produced_by);
+        let mut out = format!(
+            "; Written by settle: {by}\n\
+             ; Marlin input shaping (ZV; INPUT_SHAPING_X/Y, Marlin 2.1.2 or later): send these\n\
+             ; lines, then M500 to keep them.\n"
+        );
+        let lowest = self
+            .axes
+            .iter()
+            .map(|a| a.frequency_hz)
+            .filter(|f| *f > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        if lowest.is_finite() {
+            // stepper.h sizes the echo buffer (ShapingQueue) for SHAPING_MIN_FREQ; below it
+            // stepper.cpp's shaping_isr releases echoes early when the buffer fills, so the
+            // shaper is not the one designed during fast moves.
+            out.push_str(&format!(
+                "; Needs SHAPING_MIN_FREQ at or below {lowest} Hz in the build (Configuration_adv.h;\n\
+                 ; by default the lower of SHAPING_FREQ_X and SHAPING_FREQ_Y): below it the echo\n\
+                 ; buffer is too small for fast moves and the shaping weakens.\n"
+            ));
+        }
+        for a in &self.axes {
+            out.push_str(&Self::axis_line(a)?);
+        }
+        out.push_str(&accel_lines(
+            self.max_accel_xy_mm_s2,
+            self.print_accel_mm_s2,
+            self.travel_accel_mm_s2,
+        )?);
+        Ok(out)
+    }
+
+    /// One axis's `M593` line.
+    fn axis_line(a: &ZvAxisShaper) -> Result<String, GcodeError> {
+        let axis = a.axis;
+        if !matches!(axis, 'X' | 'Y') {
+            return Err(refuse("M593 axis", axis, "X or Y"));
+        }
+        if a.frequency_hz == 0.0 {
+            return Ok(format!("M593 {axis} F0\n"));
+        }
+        if !(a.frequency_hz.is_finite() && a.frequency_hz > 0.0) {
+            return Err(refuse(
+                &format!("M593 {axis} F"),
+                a.frequency_hz,
+                "0 (off) or a frequency above 0 Hz",
+            ));
+        }
+        if !(0.0..=1.0).contains(&a.damping_ratio) {
+            return Err(refuse(&format!("M593 {axis} D"), a.damping_ratio, "0 to 1"));
+        }
+        Ok(format!(
+            "M593 {axis} F{} D{}\n",
+            a.frequency_hz, a.damping_ratio
+        ))
     }
 }
 
@@ -223,5 +348,74 @@ mod tests {
         assert!(refused(q, 1000).contains("M493 X Q"));
         let text = e(ei('X', 40.0), 2000).to_config().expect("valid");
         assert!(text.contains("FTM_FS = 2000 Hz"), "{text}");
+    }
+
+    #[test]
+    fn zv_lines_and_their_notes() {
+        let e = MarlinZvExport {
+            produced_by: "test".into(),
+            axes: vec![
+                ZvAxisShaper {
+                    axis: 'X',
+                    frequency_hz: 41.3,
+                    damping_ratio: 0.1,
+                },
+                ZvAxisShaper {
+                    axis: 'Y',
+                    frequency_hz: 0.0,
+                    damping_ratio: f64::NAN,
+                },
+            ],
+            max_accel_xy_mm_s2: [Some(4000.0), None],
+            print_accel_mm_s2: Some(4000.0),
+            travel_accel_mm_s2: Some(4000.0),
+        };
+        let notes = [
+            Note {
+                key: "M593 X D".into(),
+                text: "why D".into(),
+            },
+            Note {
+                key: "M593 Y F".into(),
+                text: "why Y".into(),
+            },
+        ];
+        let text = e.to_config_with_notes(&notes).expect("valid");
+        let lines: Vec<&str> = text
+            .lines()
+            .filter(|l| !l.starts_with("; Written"))
+            .collect();
+        assert_eq!(
+            lines,
+            [
+                "; Marlin input shaping (ZV; INPUT_SHAPING_X/Y, Marlin 2.1.2 or later): send these",
+                "; lines, then M500 to keep them.",
+                "; Needs SHAPING_MIN_FREQ at or below 41.3 Hz in the build (Configuration_adv.h;",
+                "; by default the lower of SHAPING_FREQ_X and SHAPING_FREQ_Y): below it the echo",
+                "; buffer is too small for fast moves and the shaping weakens.",
+                "; why D",
+                "M593 X F41.3 D0.1",
+                "; why Y",
+                "M593 Y F0",
+                "M201 X4000",
+                "M204 P4000 T4000",
+            ]
+        );
+        let refused = |axis, f, d| {
+            MarlinZvExport {
+                axes: vec![ZvAxisShaper {
+                    axis,
+                    frequency_hz: f,
+                    damping_ratio: d,
+                }],
+                ..e.clone()
+            }
+            .to_config()
+            .expect_err("refused")
+            .to_string()
+        };
+        assert!(refused('X', 40.0, 1.01).contains("M593 X D"));
+        assert!(refused('Y', -3.0, 0.1).contains("M593 Y F"));
+        assert!(refused('Z', 40.0, 0.1).contains("X or Y"));
     }
 }

@@ -14,6 +14,7 @@ use settle_gcode::config::Note;
 
 use super::Outcome;
 use super::cells::ms;
+use super::firmware::MarlinShaping;
 use super::search::Score;
 
 /// One changed setting.
@@ -319,10 +320,12 @@ pub fn rrf(
     out
 }
 
-/// The changes `marlin.gcode` makes: per tuned axis `x`/`y` its `M493` shaper, `M201
-/// X`/`Y` (`caps`, as for [`rrf`]) and `M204 P`/`T`.
+/// The changes `marlin.gcode` makes: per tuned axis `x`/`y` its shaper (Fixed-Time
+/// Motion's `M493 C A I`, or for the built-in input shaping `M593 F D`, whose only shaper
+/// is ZV and whose "off" is `F0`), `M201 X`/`Y` (`caps`, as for [`rrf`]) and `M204 P`/`T`.
 pub fn marlin(
     axes: &[(String, Outcome)],
+    shaping: MarlinShaping,
     caps: [(Option<f64>, Option<f64>); 2],
     accel: Option<f64>,
 ) -> Vec<Change> {
@@ -330,16 +333,18 @@ pub fn marlin(
     for letter in ["X", "Y"] {
         let lower = letter.to_ascii_lowercase();
         if let Some((axis, o)) = axes.iter().find(|(a, _)| a.split('+').any(|x| x == lower)) {
-            out.extend(shaper_changes(
-                axis,
-                o,
-                [
-                    &format!("M493 {letter} C"),
-                    &format!("M493 {letter} A"),
-                    &format!("M493 {letter} I"),
-                ],
-                ("none", f64::NAN, f64::NAN),
-            ));
+            let (keys, off) = match shaping {
+                MarlinShaping::FtMotion => (
+                    ["C", "A", "I"].map(|w| format!("M493 {letter} {w}")),
+                    ("none", f64::NAN, f64::NAN),
+                ),
+                // The shaper's type has no word in M593 (ZV only): keyed by the line.
+                MarlinShaping::InputShaping => (
+                    ["", " F", " D"].map(|w| format!("M593 {letter}{w}")),
+                    ("zv", 0.0, f64::NAN),
+                ),
+            };
+            out.extend(shaper_changes(axis, o, [&keys[0], &keys[1], &keys[2]], off));
         }
     }
     out.extend(m201_changes(

@@ -19,11 +19,13 @@
 //! Every value that differs from the current one carries a comment above it: what it was
 //! and why it changed ([`super::changes`]); a machine that is a built-in preset standing in
 //! for the user's printer is named in the header.
-//! - `marlin.gcode`: Marlin Fixed-Time Motion's `M493 S1` and one `M493 <axis> C A I [Q]`
-//!   line per tuned axis (Marlin shapes X and Y apart; settle-gcode's `MarlinExport`), and
-//!   `M204 P T` when the acceleration changes, with `M201` as in `rrf.g`; read back by
-//!   settle's G-code reader in
-//!   `tests/all/tune_firmware.rs`. An axis not tuned is left as it is, and said.
+//! - `marlin.gcode`: for the input shaper of the printer's build (`[tune] marlin_shaping`),
+//!   Fixed-Time Motion's `M493 S1` and one `M493 <axis> C A I [Q]` line per tuned axis
+//!   (settle-gcode's `MarlinExport`), or the built-in ZV shaper's one `M593 <axis> F D`
+//!   line per tuned axis, `F0` unshaped (settle-gcode's `MarlinZvExport`); Marlin shapes X
+//!   and Y apart. Then `M204 P T` when the acceleration changes, with `M201` as in
+//!   `rrf.g`. Read back by settle's G-code reader in `tests/all/tune_firmware.rs` and
+//!   `tests/all/import_marlin.rs`. An axis not tuned is left as it is, and said.
 //! - `tmc4361a.txt`: per axis, the TMC4361A ramp registers of the recommended move, from
 //!   the axis's own microsteps per mm; refused, with the reason, for what the chip cannot
 //!   run (a trapezoid's infinite bows, an input shaper, a value outside a register).
@@ -32,7 +34,8 @@ use std::fmt::Write as _;
 
 use settle_gcode::FtShaper;
 use settle_gcode::config::{
-    FtAxisShaper, KlipperExport, MarlinExport, Note, RrfExport, ShaperSetting as FirmwareShaper,
+    FtAxisShaper, KlipperExport, MarlinExport, MarlinZvExport, Note, RrfExport,
+    ShaperSetting as FirmwareShaper, ZvAxisShaper,
 };
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
@@ -41,6 +44,7 @@ use settle_planner::tmc::ramp::SRampParams;
 use settle_planner::tmc::registers::{TmcUnits, export};
 
 use super::Outcome;
+use super::firmware::{Candidates, MarlinShaping};
 use super::search::Score;
 use super::{changes, head, target};
 use crate::studies::corner::Corner;
@@ -95,7 +99,7 @@ fn header_notes(axes: &[(String, Outcome)]) -> Vec<Note> {
 fn klipper_axis(axes: &[(String, Outcome)], letter: &str) -> Result<FirmwareShaper, String> {
     if let Some(o) = winner_of(axes, letter) {
         let w = &o.scores[o.winner];
-        if let Err(why) = target::expressible(Firmware::Klipper, &w.candidate) {
+        if let Err(why) = target::expressible(Candidates::of(Firmware::Klipper), &w.candidate) {
             return Err(format!(
                 "the recommendation on {letter}, {}, is not something Klipper runs ({why}); tune with --firmware klipper",
                 w.candidate.label()
@@ -225,18 +229,19 @@ fn rrf_axis(axes: &[(String, Outcome)]) -> Option<(&str, &Score)> {
     shaped.first().copied()
 }
 
-/// Why the export for `fw` (named `who`) is not written, if it is not: a tuned axis's
+/// Why the export for `runs` (named `who`) is not written, if it is not: a tuned axis's
 /// recommendation that the firmware does not run.
-fn refusal(axes: &[(String, Outcome)], fw: Firmware, who: &str) -> Option<String> {
+fn refusal(axes: &[(String, Outcome)], runs: Candidates, who: &str) -> Option<String> {
     if axes.is_empty() {
         return Some("nothing was tuned".into());
     }
     axes.iter().find_map(|(a, o)| {
         let w = &o.scores[o.winner];
-        target::expressible(fw, &w.candidate).err().map(|why| {
+        target::expressible(runs, &w.candidate).err().map(|why| {
             format!(
-                "the recommendation on {a}, {}, is not something {who} runs ({why}); tune with --firmware {fw}",
-                w.candidate.label()
+                "the recommendation on {a}, {}, is not something {who} runs ({why}); tune with --firmware {}",
+                w.candidate.label(),
+                runs.name()
             )
         })
     })
@@ -244,7 +249,7 @@ fn refusal(axes: &[(String, Outcome)], fw: Firmware, who: &str) -> Option<String
 
 /// Why `rrf.g` is not written, if it is not.
 fn rrf_refusal(axes: &[(String, Outcome)]) -> Option<String> {
-    refusal(axes, Firmware::Rrf, "RepRapFirmware")
+    refusal(axes, Candidates::of(Firmware::Rrf), "RepRapFirmware")
 }
 
 /// `rrf.g`: the `M593` line (and `M204` when the acceleration changes), or comments saying
@@ -301,9 +306,18 @@ pub fn rrf_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
     Some(changes::rrf(axes, axis, m201(axes), a))
 }
 
+/// Marlin's input shaper the tune was for (`[tune] marlin_shaping`; Fixed-Time Motion
+/// unless the tune searched Marlin's built-in input shaping).
+fn marlin_shaping(axes: &[(String, Outcome)]) -> MarlinShaping {
+    axes.first().map_or(MarlinShaping::FtMotion, |(_, o)| {
+        o.plan.firmware.marlin_shaping()
+    })
+}
+
 /// Why `marlin.gcode` is not written, if it is not.
 fn marlin_refusal(axes: &[(String, Outcome)]) -> Option<String> {
-    refusal(axes, Firmware::Marlin, "Marlin")
+    let runs = Candidates::of(Firmware::Marlin).with_marlin_shaping(marlin_shaping(axes));
+    refusal(axes, runs, "Marlin")
 }
 
 /// Axis `letter`'s `M493` values from its tuned winner (`C0` unshaped), and the `FTM_FS`
@@ -342,11 +356,74 @@ fn marlin_axis(axes: &[(String, Outcome)], letter: &str) -> Option<(FtAxisShaper
     }
 }
 
-/// `marlin.gcode`: Marlin Fixed-Time Motion's `M493` lines per tuned axis (and `M204` when
-/// the acceleration changes), or comments saying why it is not written.
+/// Axis `letter`'s `M593` values from its tuned winner (`F0` unshaped); `None` when the
+/// axis was not tuned. The search ran only `zv` ([`super::firmware::Candidates`]).
+fn marlin_zv_axis(axes: &[(String, Outcome)], letter: &str) -> Option<ZvAxisShaper> {
+    let o = winner_of(axes, letter)?;
+    let w = &o.scores[o.winner];
+    let axis = letter.to_ascii_uppercase().chars().next()?;
+    Some(match w.candidate.shaper {
+        Some(sh) if sh.shaper_type == Some(ShaperType::Zv) => ZvAxisShaper {
+            axis,
+            frequency_hz: sh.frequency_hz,
+            damping_ratio: sh.damping_ratio,
+        },
+        _ => ZvAxisShaper {
+            axis,
+            frequency_hz: 0.0,
+            damping_ratio: f64::NAN,
+        },
+    })
+}
+
+/// `marlin.gcode` for Marlin's built-in input shaping: `M593` per tuned axis, then the
+/// same `M201`/`M204` as [`marlin`]'s Fixed-Time Motion lines.
+fn marlin_zv(axes: &[(String, Outcome)], produced_by: &str) -> String {
+    let mut shapers = Vec::new();
+    let mut untuned = String::new();
+    for letter in ["x", "y"] {
+        match marlin_zv_axis(axes, letter) {
+            Some(zv) => shapers.push(zv),
+            None => {
+                let _ = writeln!(
+                    untuned,
+                    "; axis {letter} was not tuned: its M593 {} settings stay as they are (Marlin shapes X and Y apart; set both)",
+                    letter.to_ascii_uppercase()
+                );
+            }
+        }
+    }
+    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    let caps = m201(axes);
+    let e = MarlinZvExport {
+        produced_by: produced_by.to_string(),
+        axes: shapers,
+        max_accel_xy_mm_s2: caps.map(|(w, _)| w),
+        print_accel_mm_s2: a,
+        travel_accel_mm_s2: a,
+    };
+    let mut notes = header_notes(axes);
+    notes.extend(
+        changes::marlin(axes, MarlinShaping::InputShaping, caps, a)
+            .iter()
+            .map(changes::Change::note),
+    );
+    match e.to_config_with_notes(&notes) {
+        Ok(text) => format!("{text}{untuned}"),
+        Err(err) => format!("; no Marlin configuration: {err}\n"),
+    }
+}
+
+/// `marlin.gcode`: Marlin Fixed-Time Motion's `M493` lines per tuned axis, or with
+/// `[tune] marlin_shaping = "input_shaping"` its built-in ZV shaper's `M593` lines
+/// (`marlin_zv`); `M201`/`M204` as the module documentation says; or comments saying why
+/// it is not written.
 pub fn marlin(axes: &[(String, Outcome)], produced_by: &str) -> String {
     if let Some(why) = marlin_refusal(axes) {
         return format!("; no Marlin configuration: {why}\n");
+    }
+    if marlin_shaping(axes) == MarlinShaping::InputShaping {
+        return marlin_zv(axes, produced_by);
     }
     let mut shapers = Vec::new();
     let mut untuned = String::new();
@@ -378,7 +455,7 @@ pub fn marlin(axes: &[(String, Outcome)], produced_by: &str) -> String {
     };
     let mut notes = header_notes(axes);
     notes.extend(
-        changes::marlin(axes, caps, a)
+        changes::marlin(axes, MarlinShaping::FtMotion, caps, a)
             .iter()
             .map(changes::Change::note),
     );
@@ -394,7 +471,7 @@ pub fn marlin_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>
         return None;
     }
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
-    Some(changes::marlin(axes, m201(axes), a))
+    Some(changes::marlin(axes, marlin_shaping(axes), m201(axes), a))
 }
 
 /// `tmc4361a.txt`: per axis, the register file of the recommended move (the first of the

@@ -8,6 +8,12 @@
 //! - The TMC4361A's ramp generator runs S-shaped ramps (BOW1..4: `scurve` and `fourjerk`)
 //!   and has no input shaper.
 //! - `any`: every profile kind and Klipper's shapers (settle's default set).
+//!
+//! Marlin has two input shapers, chosen when the firmware is built ([`MarlinShaping`],
+//! `[tune] marlin_shaping`): Fixed-Time Motion (`FT_MOTION`, Marlin 2.1.3+, `M493`, the
+//! eight shapers of `ShaperType::MARLIN`) and the built-in ZV shaper (`INPUT_SHAPING_X` /
+//! `INPUT_SHAPING_Y`, Marlin 2.1.2+, `M593`), whose one shaper is Klipper's `zv`
+//! (`ShaperType::Zv`: settle-gcode reads `M593` as it).
 
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
@@ -25,18 +31,64 @@ pub const TUNED: [Firmware; 4] = [
 /// Names `--firmware` takes.
 pub const ALLOWED: &str = "klipper, marlin, rrf, tmc4361a, any";
 
+/// Which of Marlin's input shapers the printer's build has (`[tune] marlin_shaping`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MarlinShaping {
+    /// Fixed-Time Motion (`FT_MOTION`, Marlin 2.1.3+): `M493`, eight shapers per axis.
+    #[default]
+    FtMotion,
+    /// The built-in ZV shaper (`INPUT_SHAPING_X`/`_Y`, Marlin 2.1.2+): `M593 F D` per
+    /// axis (Marlin/src/gcode/feature/input_shaping/M593.cpp).
+    InputShaping,
+}
+
+impl MarlinShaping {
+    /// Names `[tune] marlin_shaping` takes.
+    pub const ALLOWED: &'static str = "ft_motion, input_shaping";
+
+    /// Parse a name of [`MarlinShaping::ALLOWED`].
+    pub fn parse(name: &str) -> Result<Self, String> {
+        match name {
+            "ft_motion" => Ok(MarlinShaping::FtMotion),
+            "input_shaping" => Ok(MarlinShaping::InputShaping),
+            _ => Err(format!(
+                "unknown Marlin shaping `{name}`; allowed: {}",
+                Self::ALLOWED
+            )),
+        }
+    }
+
+    /// Its name as [`MarlinShaping::parse`] takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            MarlinShaping::FtMotion => "ft_motion",
+            MarlinShaping::InputShaping => "input_shaping",
+        }
+    }
+}
+
 /// The candidates `settle tune` restricts itself to: those a firmware of [`TUNED`] runs,
-/// or (`any`) every one.
+/// or (`any`) every one; for Marlin, with the input shaper of its build.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Candidates(Option<Firmware>);
+pub struct Candidates(Option<Firmware>, MarlinShaping);
 
 impl Candidates {
     /// No restriction.
-    pub const ANY: Candidates = Candidates(None);
+    pub const ANY: Candidates = Candidates(None, MarlinShaping::FtMotion);
 
-    /// What `firmware` runs.
+    /// What `firmware` runs (Marlin: with Fixed-Time Motion).
     pub fn of(firmware: Firmware) -> Self {
-        Candidates(Some(firmware))
+        Candidates(Some(firmware), MarlinShaping::FtMotion)
+    }
+
+    /// The same, with Marlin's input shaper `shaping` (it matters only for Marlin).
+    pub fn with_marlin_shaping(self, shaping: MarlinShaping) -> Self {
+        Candidates(self.0, shaping)
+    }
+
+    /// Marlin's input shaper these candidates are for.
+    pub fn marlin_shaping(self) -> MarlinShaping {
+        self.1
     }
 
     /// The firmware, `None` for any.
@@ -83,7 +135,11 @@ impl Candidates {
     pub fn shapers(self) -> Vec<ShaperType> {
         match self.0 {
             None | Some(Firmware::Klipper | Firmware::Settle) => ShaperType::KLIPPER.to_vec(),
-            Some(Firmware::Marlin) => ShaperType::MARLIN.to_vec(),
+            Some(Firmware::Marlin) => match self.1 {
+                MarlinShaping::FtMotion => ShaperType::MARLIN.to_vec(),
+                // M593's only shaper (its `T` type word is "not implemented yet" in M593.cpp).
+                MarlinShaping::InputShaping => vec![ShaperType::Zv],
+            },
             Some(Firmware::Rrf) => ShaperType::RRF.to_vec(),
             // GRBL has no input shaper.
             Some(Firmware::Tmc4361a | Firmware::Grbl) => Vec::new(),
@@ -115,12 +171,18 @@ impl Candidates {
         let ok = match self.0 {
             None => true,
             Some(Firmware::Tmc4361a) => false,
+            Some(Firmware::Marlin) if self.1 == MarlinShaping::InputShaping => k == ShaperType::Zv,
             Some(f) => k.firmware() == f,
         };
         if ok {
             Ok(())
         } else if self.0 == Some(Firmware::Tmc4361a) {
             Err("the TMC4361A has no input shaper: give shapers = [\"none\"]".into())
+        } else if self.0 == Some(Firmware::Marlin) && self.1 == MarlinShaping::InputShaping {
+            Err(format!(
+                "Marlin's built-in input shaping (M593, marlin_shaping = \"input_shaping\") runs only `zv`, not `{}`",
+                k.name()
+            ))
         } else {
             Err(format!(
                 "{} does not run {}'s shaper `{}`; it runs: {}",
@@ -161,6 +223,35 @@ mod tests {
         assert_eq!(
             Candidates::parse("linuxcnc"),
             Err("unknown firmware `linuxcnc`; allowed: klipper, marlin, rrf, tmc4361a, any".into())
+        );
+    }
+
+    #[test]
+    fn marlin_input_shaping_runs_only_zv() {
+        assert_eq!(
+            MarlinShaping::parse("input_shaping"),
+            Ok(MarlinShaping::InputShaping)
+        );
+        assert_eq!(
+            MarlinShaping::parse("M593"),
+            Err("unknown Marlin shaping `M593`; allowed: ft_motion, input_shaping".into())
+        );
+        let is = Candidates::of(Firmware::Marlin).with_marlin_shaping(MarlinShaping::InputShaping);
+        assert_eq!(is.shapers(), [ShaperType::Zv]);
+        assert_eq!(is.check_shaper(Some(ShaperType::Zv)), Ok(()));
+        let err = is
+            .check_shaper(Some(ShaperType::marlin(
+                settle_planner::shaper::MarlinShaper::Zv,
+            )))
+            .expect_err("FT_MOTION's zv is not M593's");
+        assert!(err.contains("runs only `zv`, not `marlin:zv`"), "{err}");
+        assert_eq!(
+            Candidates::of(Firmware::Marlin).shapers(),
+            ShaperType::MARLIN
+        );
+        assert_eq!(
+            Candidates::of(Firmware::Marlin).check_shaper(Some(ShaperType::Zv)),
+            Err("marlin does not run klipper's shaper `zv`; it runs: marlin:zv, marlin:zvd, marlin:zvdd, marlin:zvddd, marlin:ei, marlin:2hei, marlin:3hei, marlin:mzv".into())
         );
     }
 }

@@ -10,7 +10,7 @@ use crate::input::source::Source;
 use crate::spec::run_spec::RunSpec;
 use crate::studies::corner::Corner;
 use crate::studies::shaping::{DEFAULT_DAMPING_RATIO, ShaperSetting};
-use crate::workflows::tune::firmware::Candidates;
+use crate::workflows::tune::firmware::{Candidates, MarlinShaping};
 use crate::workflows::tune::search::{BandSource, Candidate, Plan};
 use crate::workflows::tune::target;
 use settle_planner::firmware::Firmware;
@@ -101,6 +101,12 @@ pub fn plan(
     let firmware = match &spec.firmware {
         None => Candidates::ANY,
         Some(f) => Candidates::parse(f).map_err(|m| src.error_at("tune.firmware", m))?,
+    };
+    let firmware = match &spec.marlin_shaping {
+        None => firmware,
+        Some(m) => firmware.with_marlin_shaping(
+            MarlinShaping::parse(m).map_err(|e| src.error_at("tune.marlin_shaping", e))?,
+        ),
     };
     if let Some(cur) = spec.axis.as_ref().and_then(|m| m.get(&base.axis)) {
         let current = current_shaper(cur, base.state::<ShaperSetting>())

@@ -358,9 +358,13 @@ pub fn tune_with(
         md.push('\n');
         figures.push(out.join(format!("{name}.svg")));
     }
+    let marlin_kind = match done[0].1.plan.firmware.marlin_shaping() {
+        firmware::MarlinShaping::FtMotion => "Fixed-Time Motion, M493",
+        firmware::MarlinShaping::InputShaping => "input shaping, M593",
+    };
     let _ = write!(
         md,
-        "## Export\n\nKlipper (`klipper.cfg`; paste at the end of printer.cfg, above any SAVE_CONFIG block):\n\n```ini\n{klipper}```\n\nRepRapFirmware (`rrf.g`; config.g lines):\n\n```\n{rrf}```\n\nMarlin (`marlin.gcode`; Fixed-Time Motion, M493):\n\n```\n{marlin}```\n\nTMC4361A ramp registers (`tmc4361a.txt`):\n\n```\n{tmc}```\n"
+        "## Export\n\nKlipper (`klipper.cfg`; paste at the end of printer.cfg, above any SAVE_CONFIG block):\n\n```ini\n{klipper}```\n\nRepRapFirmware (`rrf.g`; config.g lines):\n\n```\n{rrf}```\n\nMarlin (`marlin.gcode`; {marlin_kind}):\n\n```\n{marlin}```\n\nTMC4361A ramp registers (`tmc4361a.txt`):\n\n```\n{tmc}```\n"
     );
     let write = |name: &str, text: &str| write_atomic(&out.join(name), text.as_bytes());
     write("tune.md", &md)?;

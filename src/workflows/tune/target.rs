@@ -5,7 +5,9 @@
 //! - the damping ratio a shaper may be designed for ([`damping_range`]): Klipper's
 //!   `max_damping_ratio` per shaper (`klippy/extras/shaper_defs.py`: 0.99, `ei` 0.4,
 //!   `2hump_ei` 0.3, `3hump_ei` 0.2), Marlin's `M493 I` (0.01 to under 1), RepRapFirmware's
-//!   `M593 S` (0 to 0.99);
+//!   `M593 S` (0 to 0.99); Marlin's `M593 D` takes 0 to 1 (M593.cpp), and its ZV is
+//!   Klipper's `zv`, designed within Klipper's 0 to 0.99 (a damping ratio of 1 has no
+//!   damped period to shape);
 //! - the TMC4361A's register ranges ([`tmc_ranges`]): BOW1..4 and AMAX/DMAX are unsigned
 //!   24-bit registers, VMAX a signed 32-bit 24.8 fixed point (the chip's datasheet, the
 //!   table in `planner/src/tmc/registers.rs`), in the frequency mode the export writes;
@@ -108,11 +110,10 @@ pub fn tmc_ranges(usteps_per_mm: f64, f_clk_hz: u32) -> TmcRanges {
     }
 }
 
-/// `Ok` when `fw` can run candidate `c` as it was simulated (its profile kind and
-/// shaper), else why not. The jerk and register ranges of the TMC4361A are checked by
-/// the export, and kept inside them by the search.
-pub fn expressible(fw: Firmware, c: &Candidate) -> Result<(), String> {
-    let runs = Candidates::of(fw);
+/// `Ok` when `runs` (a firmware, and for Marlin its input shaper) can run candidate `c`
+/// as it was simulated (its profile kind and shaper), else why not. The jerk and register
+/// ranges of the TMC4361A are checked by the export, and kept inside them by the search.
+pub fn expressible(runs: Candidates, c: &Candidate) -> Result<(), String> {
     runs.check_kind(c.kind)?;
     runs.check_shaper(c.shaper.and_then(|s| s.shaper_type))?;
     if let Some(sh) = c.shaper.filter(|s| s.shaper_type.is_some())
@@ -120,7 +121,7 @@ pub fn expressible(fw: Firmware, c: &Candidate) -> Result<(), String> {
     {
         return Err(e.to_string());
     }
-    if fw == Firmware::Tmc4361a && c.kind == ProfileKind::Trapezoid {
+    if runs.firmware() == Some(Firmware::Tmc4361a) && c.kind == ProfileKind::Trapezoid {
         return Err("a trapezoid's bows are infinite".into());
     }
     Ok(())
