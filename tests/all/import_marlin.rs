@@ -229,14 +229,7 @@ fn a_reply_without_motion_settings_is_refused() {
 /// The cells of the Markdown table rows of `md` whose first two cells are `first`,
 /// `second`.
 fn row<'a>(md: &'a str, first: &str, second: &str) -> Vec<&'a str> {
-    md.lines()
-        .filter(|l| l.starts_with('|'))
-        .map(|l| {
-            l.trim_matches('|')
-                .split('|')
-                .map(str::trim)
-                .collect::<Vec<_>>()
-        })
+    crate::support::md_rows(md)
         .find(|c| c.len() > 4 && c[0] == first && c[1] == second)
         .unwrap_or_else(|| panic!("no row {first} {second} in\n{md}"))
 }

@@ -55,14 +55,7 @@ fn read(p: &Path) -> String {
 
 /// The cells of the Markdown table rows of `md` whose first cell is `first`.
 fn rows<'a>(md: &'a str, first: &str) -> Vec<Vec<&'a str>> {
-    md.lines()
-        .filter(|l| l.starts_with('|'))
-        .map(|l| {
-            l.trim_matches('|')
-                .split('|')
-                .map(str::trim)
-                .collect::<Vec<_>>()
-        })
+    crate::support::md_rows(md)
         .filter(|c| c[0] == first)
         .collect()
 }

@@ -65,20 +65,7 @@ pub(crate) fn annotate(
 /// The `M204` line (`P` printing, `T` travel acceleration, mm/s^2, each written only when
 /// given; empty when neither is), or an error for one that is not finite and above 0.
 pub(crate) fn m204_line(print: Option<f64>, travel: Option<f64>) -> Result<String, GcodeError> {
-    let mut m204 = String::new();
-    for (word, key, v) in [("P", "M204 P", print), ("T", "M204 T", travel)] {
-        if let Some(a) = v {
-            if !(a.is_finite() && a > 0.0) {
-                return Err(refuse(key, a, "a finite acceleration > 0 mm/s^2"));
-            }
-            m204.push_str(&format!(" {word}{a}"));
-        }
-    }
-    Ok(if m204.is_empty() {
-        m204
-    } else {
-        format!("M204{m204}\n")
-    })
+    accel_line("M204", [("P", print), ("T", travel)])
 }
 
 /// The `M201` line of X and Y (each axis's acceleration cap, mm/s^2, written only when
@@ -88,18 +75,25 @@ pub(crate) fn m204_line(print: Option<f64>, travel: Option<f64>) -> Result<Strin
 /// RepRapFirmware's `DDA::InitStandardMove` in `src/Movement/DDA.cpp`), so an `M204` above
 /// `M201` is not what the printer runs.
 pub(crate) fn m201_line(x: Option<f64>, y: Option<f64>) -> Result<String, GcodeError> {
-    let mut m201 = String::new();
-    for (word, key, v) in [("X", "M201 X", x), ("Y", "M201 Y", y)] {
+    accel_line("M201", [("X", x), ("Y", y)])
+}
+
+/// `command` with each given word's acceleration (mm/s^2; empty when none is given), or
+/// an error naming `command word` for one that is not finite and above 0.
+fn accel_line(command: &str, words: [(&str, Option<f64>); 2]) -> Result<String, GcodeError> {
+    let mut line = String::new();
+    for (word, v) in words {
         if let Some(a) = v {
             if !(a.is_finite() && a > 0.0) {
-                return Err(refuse(key, a, "a finite acceleration > 0 mm/s^2"));
+                let key = format!("{command} {word}");
+                return Err(refuse(&key, a, "a finite acceleration > 0 mm/s^2"));
             }
-            m201.push_str(&format!(" {word}{a}"));
+            line.push_str(&format!(" {word}{a}"));
         }
     }
-    Ok(if m201.is_empty() {
-        m201
+    Ok(if line.is_empty() {
+        line
     } else {
-        format!("M201{m201}\n")
+        format!("{command}{line}\n")
     })
 }

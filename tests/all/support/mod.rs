@@ -78,6 +78,13 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
+/// The cells of every Markdown table row of `md` (lines starting with `|`), trimmed.
+pub fn md_rows(md: &str) -> impl Iterator<Item = Vec<&str>> {
+    md.lines()
+        .filter(|l| l.starts_with('|'))
+        .map(|l| l.trim_matches('|').split('|').map(str::trim).collect())
+}
+
 /// The extra figure `name` of a study in `m`.
 pub fn extra(m: &settle::Metrics, name: &str) -> f64 {
     m.extra
