@@ -376,93 +376,83 @@ fn marlin_zv_axis(axes: &[(String, Outcome)], letter: &str) -> Option<ZvAxisShap
     })
 }
 
-/// `marlin.gcode` for Marlin's built-in input shaping: `M593` per tuned axis, then the
-/// same `M201`/`M204` as [`marlin`]'s Fixed-Time Motion lines.
-fn marlin_zv(axes: &[(String, Outcome)], produced_by: &str) -> String {
-    let mut shapers = Vec::new();
-    let mut untuned = String::new();
-    for letter in ["x", "y"] {
-        match marlin_zv_axis(axes, letter) {
-            Some(zv) => shapers.push(zv),
-            None => {
-                let _ = writeln!(
-                    untuned,
-                    "; axis {letter} was not tuned: its M593 {} settings stay as they are (Marlin shapes X and Y apart; set both)",
-                    letter.to_ascii_uppercase()
-                );
-            }
-        }
-    }
-    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
-    let caps = m201(axes);
-    let e = MarlinZvExport {
-        produced_by: produced_by.to_string(),
-        axes: shapers,
-        max_accel_xy_mm_s2: caps.map(|(w, _)| w),
-        print_accel_mm_s2: a,
-        travel_accel_mm_s2: a,
-    };
-    let mut notes = header_notes(axes);
-    notes.extend(
-        changes::marlin(axes, MarlinShaping::InputShaping, caps, a)
-            .iter()
-            .map(changes::Change::note),
-    );
-    match e.to_config_with_notes(&notes) {
-        Ok(text) => format!("{text}{untuned}"),
-        Err(err) => format!("; no Marlin configuration: {err}\n"),
-    }
-}
-
 /// `marlin.gcode`: Marlin Fixed-Time Motion's `M493` lines per tuned axis, or with
-/// `[tune] marlin_shaping = "input_shaping"` its built-in ZV shaper's `M593` lines
-/// (`marlin_zv`); `M201`/`M204` as the module documentation says; or comments saying why
-/// it is not written.
+/// `[tune] marlin_shaping = "input_shaping"` its built-in ZV shaper's `M593` lines;
+/// `M201`/`M204` as the module documentation says; or comments saying why it is not
+/// written.
 pub fn marlin(axes: &[(String, Outcome)], produced_by: &str) -> String {
     if let Some(why) = marlin_refusal(axes) {
         return format!("; no Marlin configuration: {why}\n");
     }
-    if marlin_shaping(axes) == MarlinShaping::InputShaping {
-        return marlin_zv(axes, produced_by);
-    }
-    let mut shapers = Vec::new();
-    let mut untuned = String::new();
-    let mut ftm_fs_hz = MARLIN_FTM_FS_HZ;
-    for letter in ["x", "y"] {
-        match marlin_axis(axes, letter) {
-            Some((ft, fs)) => {
-                shapers.push(ft);
-                ftm_fs_hz = fs.unwrap_or(ftm_fs_hz);
-            }
-            None => {
-                let _ = writeln!(
-                    untuned,
-                    "; axis {letter} was not tuned: its M493 {} settings stay as they are (Marlin shapes X and Y apart; set both)",
-                    letter.to_ascii_uppercase()
-                );
-            }
-        }
-    }
+    let shaping = marlin_shaping(axes);
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
     let caps = m201(axes);
-    let e = MarlinExport {
-        produced_by: produced_by.to_string(),
-        ftm_fs_hz,
-        axes: shapers,
-        max_accel_xy_mm_s2: caps.map(|(w, _)| w),
-        print_accel_mm_s2: a,
-        travel_accel_mm_s2: a,
-    };
+    let max_accel_xy_mm_s2 = caps.map(|(w, _)| w);
     let mut notes = header_notes(axes);
     notes.extend(
-        changes::marlin(axes, MarlinShaping::FtMotion, caps, a)
+        changes::marlin(axes, shaping, caps, a)
             .iter()
             .map(changes::Change::note),
     );
-    match e.to_config_with_notes(&notes) {
-        Ok(text) => format!("{text}{untuned}"),
+    let (text, command) = match shaping {
+        MarlinShaping::InputShaping => {
+            let (axes_written, untuned) = per_axis(|l| marlin_zv_axis(axes, l));
+            let e = MarlinZvExport {
+                produced_by: produced_by.to_string(),
+                axes: axes_written,
+                max_accel_xy_mm_s2,
+                print_accel_mm_s2: a,
+                travel_accel_mm_s2: a,
+            };
+            (e.to_config_with_notes(&notes), ("M593", untuned))
+        }
+        MarlinShaping::FtMotion => {
+            let (written, untuned) = per_axis(|l| marlin_axis(axes, l));
+            // The last tuned axis's sample rate where it sets one.
+            let ftm_fs_hz = written
+                .iter()
+                .rev()
+                .find_map(|(_, fs)| *fs)
+                .unwrap_or(MARLIN_FTM_FS_HZ);
+            let e = MarlinExport {
+                produced_by: produced_by.to_string(),
+                ftm_fs_hz,
+                axes: written.into_iter().map(|(ft, _)| ft).collect(),
+                max_accel_xy_mm_s2,
+                print_accel_mm_s2: a,
+                travel_accel_mm_s2: a,
+            };
+            (e.to_config_with_notes(&notes), ("M493", untuned))
+        }
+    };
+    let (command, untuned) = command;
+    match text {
+        Ok(text) => {
+            let mut out = text;
+            for letter in untuned {
+                let _ = writeln!(
+                    out,
+                    "; axis {letter} was not tuned: its {command} {} settings stay as they are (Marlin shapes X and Y apart; set both)",
+                    letter.to_ascii_uppercase()
+                );
+            }
+            out
+        }
         Err(err) => format!("; no Marlin configuration: {err}\n"),
     }
+}
+
+/// What `of` gives for axes `x` and `y`, and the letters of those it gives nothing for
+/// (not tuned).
+fn per_axis<T>(of: impl Fn(&str) -> Option<T>) -> (Vec<T>, Vec<&'static str>) {
+    let (mut given, mut not) = (Vec::new(), Vec::new());
+    for letter in ["x", "y"] {
+        match of(letter) {
+            Some(t) => given.push(t),
+            None => not.push(letter),
+        }
+    }
+    (given, not)
 }
 
 /// The changes `marlin.gcode` makes (`None` when it is not written).
