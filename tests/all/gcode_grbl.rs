@@ -81,6 +81,40 @@ fn a_scan_line_measures_the_closed_form_error_along_the_fly_axis() {
     assert!(o.worst_um < got, "contour {} vs fly {got}", o.worst_um);
 }
 
+/// A raster is lines along one axis; a vector job's straight lines run along both. A
+/// 30 x 31 mm rectangle cut with the laser on is not a raster, though more than half its
+/// length (62 of 122 mm) is lines along Y: its error along a side misplaces no pixel, and
+/// summary.md has no raster section. Ten scan lines along X with that rectangle around
+/// them (360 mm along X, 62 along Y: more than a tenth) are not one either; with a
+/// diagonal outline instead (no line along Y) they are, fly axis X.
+#[test]
+fn a_vector_cut_is_not_a_raster() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let machine = write(dir.path(), "one_mode.toml", ONE_MODE);
+    let rectangle = "G1 X30 F6000\nG1 Y31\nG1 X0\nG1 Y0\n";
+    let mut scan = String::new();
+    for k in 0..10 {
+        let x = if k % 2 == 0 { 30 } else { 0 };
+        scan.push_str(&format!("G0 Y{}\nG1 X{x} F6000\n", 1 + 2 * k));
+    }
+    let diamond = "G0 X15 Y0\nG1 X30 Y15 F6000\nG1 X15 Y30\nG1 X0 Y15\nG1 X15 Y0\n";
+    for (name, body, want) in [
+        ("rectangle", rectangle.to_string(), None),
+        (
+            "scan and rectangle",
+            format!("{scan}G0 X0 Y0\n{rectangle}"),
+            None,
+        ),
+        ("scan and diamond", format!("{scan}{diamond}"), Some(0)),
+    ] {
+        let file = write(dir.path(), "job.nc", &format!("G90\nM4 S500\n{body}M5\n"));
+        let o = measure(&grbl(file, machine.to_str().expect("utf-8"))).expect("runs");
+        assert_eq!(o.streamed.fly.raster(), want, "{name}");
+        let summary = settle::workflows::gcode::report::summary_md(&o, &[]);
+        assert_eq!(summary.contains("## Raster scan"), want.is_some(), "{name}");
+    }
+}
+
 #[test]
 fn a_file_without_a_working_move_is_refused() {
     let dir = tempfile::tempdir().expect("tempdir");

@@ -7,9 +7,12 @@
 //! Every laser move (working, [`settle_gcode::Tool::Laser`]) straight along X (or along Y)
 //! counts: its samples' along-axis error (toolhead minus the command the machine receives
 //! on that axis) goes to that axis's histogram. A laser job is a raster when more than
-//! half of its working length is such lines along one axis ([`FlyAxis::raster`]); that
-//! axis is its fly axis. Printers and mills draw contours, not rasters: their moves are
-//! not counted.
+//! half of its working length is such lines along one axis and its lines along the other
+//! axis are at most a tenth as long ([`FlyAxis::raster`]); that axis is its fly axis. A
+//! raster's scan lines all run one way (its step-overs are short, or run with the laser
+//! off); a vector job's straight lines run both ways, a rectangle's sides as long along X
+//! as along Y, and its along-line error misplaces no pixel. Printers and mills draw
+//! contours, not rasters: their moves are not counted.
 
 use super::stats::{Histogram, Split, Spot};
 use settle_gcode::job::{MoveGeometry, MoveInfo};
@@ -17,6 +20,10 @@ use settle_gcode::job::{MoveGeometry, MoveInfo};
 /// A line is along an axis when its other components are below this fraction of its
 /// length.
 const ALONG: f64 = 1e-6;
+
+/// A raster's lines along the other axis are at most this fraction of its lines along
+/// the fly axis (module doc).
+const ACROSS: f64 = 0.1;
 
 /// The along-line errors of the scan lines along X and along Y.
 #[derive(Debug, Clone, Default)]
@@ -84,9 +91,15 @@ impl FlyAxis {
         }
     }
 
-    /// The fly axis (0 X, 1 Y) when the job is a raster (module doc).
+    /// The fly axis (0 X, 1 Y) when the job is a raster (module doc): more than half of
+    /// the working length on lines along it, and at most a tenth of that along the other
+    /// axis.
     pub fn raster(&self) -> Option<usize> {
         let a = if self.length_mm[0] >= self.length_mm[1] { 0 } else { 1 };
-        (self.working_mm > 0.0 && self.length_mm[a] > 0.5 * self.working_mm).then_some(a)
+        let across = self.length_mm[1 - a];
+        (self.working_mm > 0.0
+            && self.length_mm[a] > 0.5 * self.working_mm
+            && across <= ACROSS * self.length_mm[a])
+            .then_some(a)
     }
 }
