@@ -278,3 +278,124 @@ fn a_cura_files_layers_are_at_the_z_they_print_at() {
     }
     assert_eq!(z.last(), Some(&max_z));
 }
+
+/// `GcodeOptions` for `file` on `printer_xy` under GRBL with the repository's laser
+/// settings (gcode/prints/laser_grbl_settings.txt).
+fn laser_settings(file: std::path::PathBuf) -> GcodeOptions {
+    let text = std::fs::read_to_string(
+        crate::support::root().join("gcode/prints/laser_grbl_settings.txt"),
+    )
+    .expect("settings");
+    let s = GrblSettings::parse(&text, "laser_grbl_settings.txt").expect("settings");
+    let mut o = GcodeOptions::new(file, "printer_xy", Firmware::Grbl).expect("options");
+    o.job = JobConfig::from_grbl(&s).expect("job");
+    o
+}
+
+/// A real Inkscape Lasertools fill (gcode/prints/laser/PROVENANCE.md) sets the power on
+/// lines of its own, `S90` before each line of its infill and `S1` after it. GRBL waits
+/// for the machine to stop at an `S` change on a line that does not move (grbl/gcode.c,
+/// `spindle_sync`), so every move of the infill runs from rest to rest: its time is the
+/// sum of one trapezoid per move, computed here from the file's words alone (targets
+/// rounded to whole steps, 80 steps/mm; the rate and acceleration along the move's
+/// direction, the smallest over its axes of `$110/|u|` and `$120/|u|`; a `G0` at the
+/// rapid rate, a `G1` at its `F`), and settle's planned time is that sum. The whole job
+/// (the outlines after the infill run as joined lines) is a raster along Y; the frame
+/// the plugin wrote for it and a real LaserWeb cut are not.
+#[test]
+fn real_laser_jobs_stop_where_grbl_stops_and_only_the_fill_is_a_raster() {
+    let dir = crate::support::root().join("gcode/prints/laser");
+    let job = dir.join("btc_laser_qr_unbt_0001.gcode");
+    let text = std::fs::read_to_string(&job).expect("print");
+    let settings = std::fs::read_to_string(
+        crate::support::root().join("gcode/prints/laser_grbl_settings.txt"),
+    )
+    .expect("settings");
+    for want in [
+        "$100=80.000",
+        "$101=80.000",
+        "$110=6000.000",
+        "$111=6000.000",
+    ] {
+        assert!(settings.contains(want), "{want}");
+    }
+    assert!(settings.contains("$120=1000.000") && settings.contains("$121=1000.000"));
+    let (steps, vmax, amax) = (80.0, 100.0, 1000.0);
+    // The infill: the lines before `;END infill`, then the laser off.
+    let end = text.find(";END infill").expect("infill");
+    let infill = format!("{}M05 S0\n", &text[..end]);
+    let (mut at, mut feed, mut g0) = ([0i64; 2], 0.0, true);
+    let mut by_hand = 0.0;
+    let mut moves = 0;
+    for line in infill.lines() {
+        let line = line.split(';').next().unwrap_or("");
+        let mut target = at;
+        let mut moved = false;
+        for w in line.split_whitespace() {
+            let (k, v) = w.split_at(1);
+            match k {
+                "G" => g0 = v.parse::<f64>().expect("G") == 0.0,
+                "F" => feed = v.parse::<f64>().expect("F") / 60.0,
+                "X" | "Y" => {
+                    let i = usize::from(k == "Y");
+                    target[i] = (v.parse::<f64>().expect("coordinate") * steps).round() as i64;
+                    moved = true;
+                }
+                _ => {}
+            }
+        }
+        if !moved || target == at {
+            continue;
+        }
+        let d = [
+            (target[0] - at[0]) as f64 / steps,
+            (target[1] - at[1]) as f64 / steps,
+        ];
+        let len = d[0].hypot(d[1]);
+        let along = |limit: f64| {
+            d.iter()
+                .filter(|c| **c != 0.0)
+                .map(|c| limit * len / c.abs())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let (rate, accel) = (along(vmax), along(amax));
+        let v = if g0 { rate } else { feed.min(rate) };
+        by_hand += if len <= v * v / accel {
+            2.0 * (len / accel).sqrt()
+        } else {
+            len / v + v / accel
+        };
+        moves += 1;
+        at = target;
+    }
+    assert_eq!(
+        moves, 7574,
+        "the infill's 3,787 G00 and 3,787 G01 that move"
+    );
+    let scratch = tempfile::tempdir().expect("tempdir");
+    let infill_file = write(scratch.path(), "infill.gcode", &infill);
+    let o = measure(&laser_settings(infill_file)).expect("the infill runs");
+    assert!(
+        (o.print_time_s - by_hand).abs() < 1e-6 * by_hand,
+        "settle {} s, by hand {by_hand} s",
+        o.print_time_s
+    );
+    let whole = measure(&laser_settings(job)).expect("the job runs");
+    assert!(whole.print_time_s > o.print_time_s);
+    assert_eq!(whole.streamed.fly.raster(), Some(1), "scan lines along Y");
+    for name in [
+        "btc_laser_qr_unbt_0001_bounding_box.gcode",
+        "escaleras_300-02.gcode",
+    ] {
+        let o = measure(&laser_settings(dir.join(name))).expect("the job runs");
+        assert_eq!(o.streamed.fly.raster(), None, "{name}");
+        if name.starts_with("escaleras") {
+            // Its 118,235.73 mm of cuts at the header's 1000 mm/min are a floor.
+            assert!(
+                o.print_time_s > 118_235.73 / (1000.0 / 60.0),
+                "{}",
+                o.print_time_s
+            );
+        }
+    }
+}

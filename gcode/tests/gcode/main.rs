@@ -18,6 +18,7 @@ mod job_prints;
 mod job_settle;
 mod job_times;
 mod job_util;
+mod laser;
 mod layer_bound;
 mod layers;
 mod roundtrip;
