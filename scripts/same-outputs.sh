@@ -15,8 +15,8 @@
 #     --versus and --config (Klipper's printer.cfg, RepRapFirmware's config.g), and a layer
 #     on rapier with the full driver model; GRBL's jobs on grbl with their $$ settings (the
 #     milled contour also with --layer-source markers); the
-#     real Fusion 360 (GRBL), Cura (Marlin) and Slic3r (Klipper) jobs in its cnc/, cura/
-#     and slic3r/ folders;
+#     real Fusion 360 (GRBL), LaserWeb and Inkscape Lasertools (GRBL, laser mode), Cura
+#     (Marlin) and Slic3r (Klipper) jobs in its cnc/, laser/, cura/ and slic3r/ folders;
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
 #     what identify wrote, `settle import` of the example configurations and of the real
 #     ones of gcode/tests/data/real/ (a Marlin M503 reply among them; two, and the reply,
@@ -119,6 +119,11 @@ cases() {
   # from Z) on Klipper: two of its 240 layers.
   for p in "$P"/cnc/*.nc; do
     echo "gcode-fusion-$(basename "$p" .nc) gcode $p --machine printer_xy --firmware grbl --config $P/shapeoko3_grbl_settings.txt --out {out}"
+  done
+  # The real laser jobs (a LaserWeb cut, an Inkscape Lasertools fill) with the laser's
+  # settings ($32=1).
+  for stem in escaleras_300-02 btc_laser_qr_unbt_0001; do
+    echo "gcode-laser-$stem gcode $P/laser/$stem.gcode --machine printer_xy --firmware grbl --config $P/laser_grbl_settings.txt --out {out}"
   done
   # The milled contour's layers from slicer markers only (it has none: one layer).
   echo "gcode-cnc_contour-markers gcode $P/cnc_contour.gcode --machine printer_xy --firmware grbl --config $P/shapeoko3_grbl_settings.txt --layer-source markers --out {out}"
