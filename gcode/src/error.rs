@@ -80,8 +80,9 @@ pub enum GcodeError {
         /// Where (column = first invalid byte).
         at: Location,
     },
-    /// A control character other than tab (or a trailing carriage return).
-    #[error("{at}: control character 0x{byte:02x} (binary data?); G-code is text")]
+    /// A control character other than tab (or a trailing carriage return); a carriage
+    /// return inside a line is named as such.
+    #[error("{at}: {}", control_words(*.byte))]
     ControlCharacter {
         /// Where.
         at: Location,
@@ -477,5 +478,20 @@ impl GcodeError {
     /// The 1-based line number of a line error.
     pub fn line(&self) -> Option<u64> {
         self.location().map(|l| l.line)
+    }
+}
+
+/// What a control character `byte` inside a line means: a carriage return there is most
+/// likely a line end (a file whose lines end in CR alone, as classic Mac OS wrote them;
+/// GRBL ends a line at CR as at LF, grbl/protocol.c), which the reader does not take as
+/// one; anything else is binary data.
+fn control_words(byte: u8) -> String {
+    if byte == b'\r' {
+        "carriage return (0x0d) inside the line: lines end at LF here (a CR before it is \
+         dropped), and this file seems to end its lines in CR alone, which GRBL also takes \
+         as a line end (grbl/protocol.c); convert them to LF (tr '\\r' '\\n')"
+            .to_owned()
+    } else {
+        format!("control character 0x{byte:02x} (binary data?); G-code is text")
     }
 }

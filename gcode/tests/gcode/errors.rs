@@ -47,6 +47,33 @@ fn binary_garbage() {
     assert!(matches!(s.first[2], GcodeError::Syntax { .. }));
 }
 
+/// Lines that end in CR alone (classic Mac OS) read as one line, which GRBL would have
+/// read as several (it ends a line at CR as at LF, grbl/protocol.c): refused at the
+/// first CR with what it most likely is, not as binary data. CR LF reads as LF.
+#[test]
+fn a_file_of_lines_ended_by_cr_alone_is_named_so() {
+    let crlf = "G90\r\nM4 S300\r\nG1 X10 F3000\r\nM5\r\n";
+    assert_eq!(crate::moves(crlf, Dialect::Grbl).len(), 1);
+    let e = error("G90\rM4 S300\rG1 X10 F3000\rM5\r", Dialect::Grbl);
+    let text = e.to_string();
+    assert!(
+        matches!(e, GcodeError::ControlCharacter { byte: b'\r', .. }),
+        "{e}"
+    );
+    assert!(
+        text.starts_with("<input>:1:4: carriage return (0x0d) inside the line"),
+        "{text}"
+    );
+    assert!(
+        text.contains("CR alone") && text.contains("convert them to LF"),
+        "{text}"
+    );
+    assert!(!text.contains("binary data"), "{text}");
+    // Any other control character is still binary data.
+    let e = error("G1 X1\x07\n", Dialect::Grbl).to_string();
+    assert!(e.contains("control character 0x07 (binary data?)"), "{e}");
+}
+
 #[test]
 fn a_ten_megabyte_line_is_an_error_and_is_skipped_unread() {
     let mut bytes = b"G1 X1\n".to_vec();
