@@ -190,3 +190,29 @@ fn lasertools_fill_lies_in_the_frame_the_plugin_wrote_for_it() {
         );
     }
 }
+
+/// Two forms the Lasertools fill writes, as GRBL reads them: a number ending in a bare
+/// point (`Y78.` is 78 mm), and an `F` on a `G0` line, which the rapid ignores but which
+/// stays the feed of the `G1` after it (grbl/gcode.c copies `F` into the modal state
+/// whatever the motion mode).
+#[test]
+fn a_bare_point_and_an_f_on_a_rapid_read_as_grbl_reads_them() {
+    let m = super::moves(
+        "G90\nM3 S90\nG01 F1200.0\nG00 X4.19 Y78. F3000.0\nG01 Y80.\nG00 X5. F600\nG1 Y78\n",
+        Dialect::Grbl,
+    );
+    assert_eq!(m.len(), 4);
+    assert_eq!((m[0].end.x_mm, m[0].end.y_mm), (4.19, 78.0));
+    assert!(m[0].rapid && !m[1].rapid);
+    assert_eq!(m[1].end.y_mm, 80.0);
+    assert!(
+        (m[1].feed_mm_s - 3000.0 / 60.0).abs() < 1e-12,
+        "{}",
+        m[1].feed_mm_s
+    );
+    assert!(
+        (m[3].feed_mm_s - 600.0 / 60.0).abs() < 1e-12,
+        "{}",
+        m[3].feed_mm_s
+    );
+}
