@@ -223,7 +223,7 @@ impl Simulation for Run<'_> {
         };
         let ran = ran.and_then(|()| {
             driver.sample(0, window, Some(&at_end), &mut sink)?;
-            driver.hold(&hold, 1..=n, window, &mut sink)
+            driver.hold(&hold, Some(1), n, window, &mut sink)
         });
         Ok(Ok(sink.finish(&mut driver, self.names, ran)))
     }

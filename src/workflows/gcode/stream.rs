@@ -639,8 +639,12 @@ struct JobChunks<'a, R> {
 }
 
 impl<R: BufRead> JobChunks<'_, R> {
-    /// The next chunk, its time 0 its start on the print clock.
+    /// The next chunk, its time 0 its start on the print clock. After the first one (once a
+    /// chunk has been simulated) the file is first told how far it has been read.
     fn next(&mut self, acc: &mut Account) -> Result<Option<Chunk<'static>>, Error> {
+        if let Some((tell, size)) = self.progress.filter(|_| !self.end.is_empty()) {
+            tell(self.job.reader().bytes_read(), size);
+        }
         let Some(chunk) = self
             .job
             .next_chunk()
@@ -694,17 +698,8 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
             let rate = acc.opts.sample_rate_hz;
             let d = Driver::new(plant, &names, &starts, rate, t_first, false).map_err(sim_err)?;
             let mut d = d.streamed();
-            // The file is told how far it has been read after each chunk is simulated.
-            let next = |acc: &mut Account| {
-                if let Some((tell, size)) = chunks.progress {
-                    tell(chunks.job.reader().bytes_read(), size);
-                }
-                chunks.next(acc)
-            };
-            let faulted = stopped(
-                d.follow_chunks(Some(first), next, true, &mut acc)?,
-                &mut acc,
-            )?;
+            let ran = d.follow_chunks(Some(first), |acc| chunks.next(acc), true, &mut acc)?;
+            let faulted = stopped(ran, &mut acc)?;
             // The print time simulated: to the last command (the tail is counted apart).
             let t_end = d.time_s();
             acc.out.simulated_s = t_end - t_first;
@@ -720,7 +715,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                     end_xy: [hold[ix].p, hold[iy].p],
                 });
                 let last_k = ((t_end + tail_s) / d.clock().dt_s).floor() as u64;
-                stopped(d.hold_on(&hold, last_k, &mut acc), &mut acc)?;
+                stopped(d.hold(&hold, None, last_k, d.clock(), &mut acc), &mut acc)?;
                 let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
                 tail.duration_s = d.time_s() - t_end;
                 acc.flush();
