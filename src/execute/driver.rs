@@ -6,8 +6,9 @@
 //! - The clock: sample `k` is at `k / sample_rate` s. A command ([`Driver::follow`]) is a
 //!   trajectory whose time 0 is `t0` on the clock; a motion's chunks follow one another
 //!   on one clock, the plant's state carried across them ([`Driver::follow_chunks`], the
-//!   one loop of a run and of a G-code job); [`Driver::hold`] holds a command on a clock
-//!   of its own (the observation window after a move).
+//!   one loop of a run and of a G-code job); [`Driver::hold`] holds a command, on a clock
+//!   of its own (the observation window after a move) or on the driver's from where it
+//!   stands (a G-code job's ringing after its last move).
 //! - Steps are split at every breakpoint of every axis, so each axis's commanded jerk is
 //!   constant within each step (the modal plant is then exact). A whole sample interval
 //!   is stepped as exactly `1 / sample_rate` s.
@@ -289,16 +290,13 @@ impl<'p, P: Plant> Driver<'p, P> {
                     walk.fill(m, |i| local(k0 - 1 + i as u64), &mut self.breaks);
                 }
                 let fail = |i: usize| clock.time(k0 - 1 + i as u64);
-                let Some(done) = self.batch(m, k0, clock, fail, across, sink)? else {
-                    // The plant steps these samples one by one: so does the rest of the
-                    // trajectory, from this sample on.
-                    inner = None;
-                    continue;
-                };
-                if done < m {
-                    // The walk went past steps not taken.
+                let done = self.batch(m, k0, clock, fail, across, sink)?;
+                // The plant steps these samples one by one (so does the rest of the
+                // trajectory, from this sample on), or the walk went past steps not taken.
+                if done.is_none_or(|done| done < m) {
                     inner = None;
                 }
+                let Some(done) = done else { continue };
                 self.k = k0 + done as u64 - 1;
                 tau = local(self.k);
             } else {
@@ -484,13 +482,11 @@ impl<'p, P: Plant> Driver<'p, P> {
         }
         let (plant, n) = (self.plant, self.cmd.len());
         let (cmd_p, toolhead) = (&mut self.cmd_p[..n], &mut self.toolhead[..n]);
+        let within = |(c, h): (&f64, &f64)| (h - c).abs() <= BLOWUP_M;
         let observed = self.record
             || sink.observes()
-            || !(plant.positions(&self.state, cmd_p, toolhead)
-                && cmd_p
-                    .iter()
-                    .zip(&*toolhead)
-                    .all(|(c, h)| (h - c).abs() <= BLOWUP_M));
+            || !plant.positions(&self.state, cmd_p, toolhead)
+            || !cmd_p.iter().zip(&*toolhead).all(within);
         if observed {
             // Every value finite and no blow-up is what `fault_in` checks; otherwise it
             // names the fault.

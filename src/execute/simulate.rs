@@ -301,7 +301,7 @@ impl Sink for RunSink<'_, '_> {
             .push_run(s.count, |i| s.time(i), s.commanded_m, s.toolhead_m);
         if let Some(st) = self.stream.as_deref_mut() {
             let clock = [s.clock.origin_s, s.clock.dt_s];
-            st.samples(clock, s.k0, &s.toolhead_m[..s.count * s.axes], s.axes);
+            st.samples(clock, s.k0, s.toolhead_m, s.axes);
         }
         if self.path.is_none() && self.record.is_none() {
             return ControlFlow::Continue(());
