@@ -407,20 +407,18 @@ impl<'p, P: Plant> Driver<'p, P> {
         let len = m * self.cmd.len();
         let (cmds, dt, state) = (&self.cmds[..len], self.clock.dt_s, &mut self.state);
         let (cmd_p, toolhead) = (&mut self.cmd_p[..len], &mut self.toolhead[..len]);
+        let p = self.plant;
         let result = if across {
             let breaks: Vec<&[InnerBreak]> = self.breaks.iter().map(Vec::as_slice).collect();
-            let p = self.plant;
             p.step_samples_across(state, cmds, &breaks, dt, BLOWUP_M, cmd_p, toolhead)
         } else {
-            self.plant
-                .step_samples(state, cmds, dt, BLOWUP_M, cmd_p, toolhead)
+            p.step_samples(state, cmds, dt, BLOWUP_M, cmd_p, toolhead)
         };
         let (count, outcome) = match result {
             Ok(Some(done)) if (1..=m).contains(&done) => (done - 1, Ok(Some(done))),
+            Ok(_) if across => return Ok(None),
             Ok(_) => {
-                if !across {
-                    self.min_batch = usize::MAX;
-                }
+                self.min_batch = usize::MAX;
                 return Ok(None);
             }
             Err((failed, error)) => {
