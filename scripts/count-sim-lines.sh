@@ -7,11 +7,11 @@
 #
 # The parts, each found by its function or impl boundaries:
 #   driver   src/execute/driver.rs, the whole file;
-#   run      src/execute/simulate.rs from `pub struct Run` to the end (a run on a plant:
-#            `Run`, `RunSink` and its `finish`);
+#   run      src/execute/simulate.rs from `pub struct Run` (its attributes with it) to
+#            the end: a run on a plant, `Run`, `RunSink` and its `finish`;
 #   job sink src/workflows/gcode/stream.rs, the block `impl Sink for Account`;
-#   job loop src/workflows/gcode/stream.rs from `pub fn simulate_job` to the end
-#            (`JobSim`, its chunks, what a stop means for a job).
+#   job loop src/workflows/gcode/stream.rs from `pub fn simulate_job` to the end: the
+#            job's chunks, what a stop means for a job, the job on a plant.
 # Prints each part's count, then their sum.
 set -euo pipefail
 cd "$(dirname "$0")/.."
