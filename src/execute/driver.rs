@@ -6,8 +6,9 @@
 //! - The clock: sample `k` is at `k / sample_rate` s. A command ([`Driver::follow`]) is a
 //!   trajectory whose time 0 is `t0` on the clock; a motion's chunks follow one another
 //!   on one clock, the plant's state carried across them ([`Driver::follow_chunks`], the
-//!   one loop of a run and of a G-code job); [`Driver::hold`] holds a command on a clock
-//!   of its own (the observation window after a move).
+//!   one loop of a run and of a G-code job); [`Driver::hold`] holds a command, on a clock
+//!   of its own (the observation window after a move) or on the driver's from where it
+//!   stands (a G-code job's ringing after its last move).
 //! - Steps are split at every breakpoint of every axis, so each axis's commanded jerk is
 //!   constant within each step (the modal plant is then exact). A whole sample interval
 //!   is stepped as exactly `1 / sample_rate` s.
@@ -21,7 +22,7 @@
 //!   in full and stops it with [`Stop::Interrupted`].
 
 use std::borrow::Cow;
-use std::ops::{ControlFlow, RangeInclusive};
+use std::ops::ControlFlow;
 
 use settle_planner::{Sample, State, Trajectory};
 use settle_sim::{InnerBreak, Observation, Plant, SimError};
@@ -137,10 +138,9 @@ pub struct Driver<'p, P: Plant> {
     t: f64,
     /// Every sample observed in full (a recording): no batches.
     record: bool,
-    /// Whole samples go to the plant in batches: not when recording, nor once the plant
-    /// has declined one ([`Plant::step_samples`] returned `None`).
-    batches: bool,
-    /// The fewest samples a batch takes (fewer are stepped one by one).
+    /// The fewest samples a batch takes (fewer are stepped one by one); `usize::MAX`: no
+    /// batches (when recording, or once the plant has declined one: [`Plant::step_samples`]
+    /// returned `None`).
     min_batch: usize,
     /// Batches go across breakpoints where the plant can ([`Driver::across_breakpoints`]).
     across: bool,
@@ -188,8 +188,7 @@ impl<'p, P: Plant> Driver<'p, P> {
             k: (t0_s / dt).ceil() as u64,
             t: 0.0,
             record,
-            batches: !record,
-            min_batch: 1,
+            min_batch: if record { usize::MAX } else { 1 },
             across: false,
             breaks: vec![Vec::new(); axes],
             obs: vec![Observation::default(); axes],
@@ -207,7 +206,7 @@ impl<'p, P: Plant> Driver<'p, P> {
     /// stepped it (a plant's batch may take longer internal steps than one sample, MuJoCo's
     /// does: the choice can change the last bits).
     pub fn streamed(mut self) -> Self {
-        self.min_batch = 2;
+        self.min_batch = self.min_batch.max(2);
         self.across_breakpoints()
     }
 
@@ -280,13 +279,9 @@ impl<'p, P: Plant> Driver<'p, P> {
             // breakpoints, up to the trajectory's end.
             let across = inner.is_some();
             let (k0, end) = (self.k, if across { t1 } else { bp });
-            let m = if self.batches && at_sample && takes(t_sample) && (across || whole) {
-                let more = (1..CHUNK as u64).map(|i| local(k0 + i));
-                1 + more.take_while(|&ts| ts <= end && takes(ts)).count()
-            } else {
-                0
-            };
-            let reached = if m >= self.min_batch {
+            let fits = |&ts: &f64| at_sample && self.min_batch <= CHUNK && ts <= end && takes(ts);
+            let m = (k0..k0 + CHUNK as u64).map(local).take_while(fits).count();
+            if m >= self.min_batch {
                 let n = self.cmd.len();
                 for (i, c) in self.cmds.chunks_exact_mut(n).take(m).enumerate() {
                     cursor.at(local(k0 - 1 + i as u64), c);
@@ -295,33 +290,29 @@ impl<'p, P: Plant> Driver<'p, P> {
                     walk.fill(m, |i| local(k0 - 1 + i as u64), &mut self.breaks);
                 }
                 let fail = |i: usize| clock.time(k0 - 1 + i as u64);
-                let Some(done) = self.batch(m, k0, clock, fail, across, sink)? else {
-                    // The plant steps these samples one by one: so does the rest of the
-                    // trajectory, from this sample on.
-                    inner = None;
-                    continue;
-                };
-                if done < m {
-                    // The walk went past steps not taken.
+                let done = self.batch(m, k0, clock, fail, across, sink)?;
+                // The plant steps these samples one by one (so does the rest of the
+                // trajectory, from this sample on), or the walk went past steps not taken.
+                if done.is_none_or(|done| done < m) {
                     inner = None;
                 }
+                let Some(done) = done else { continue };
                 self.k = k0 + done as u64 - 1;
                 tau = local(self.k);
-                true
             } else {
                 cursor.at(tau, &mut self.cmd);
                 self.step(if whole { dt } else { next - tau }, t0_s + tau)?;
                 tau = next;
                 self.t = t0_s + tau;
-                next == t_sample
-            };
-            if reached {
-                if takes(tau) {
-                    cursor.at(tau, &mut self.cmd);
-                    self.sample(self.k, clock, None, sink)?;
+                if next != t_sample {
+                    continue;
                 }
-                self.k += 1;
             }
+            if takes(tau) {
+                cursor.at(tau, &mut self.cmd);
+                self.sample(self.k, clock, None, sink)?;
+            }
+            self.k += 1;
         }
         Ok(())
     }
@@ -349,13 +340,15 @@ impl<'p, P: Plant> Driver<'p, P> {
         Ok(Ok(()))
     }
 
-    /// Hold `cmd` (one sample per axis, the driver's command from now on): a step of one
-    /// sample period to each sample `k` of `ks`, taken at `clock.time(k)`. The driver's own
-    /// clock is left alone.
+    /// Hold `cmd` (one sample per axis, the driver's command from now on) to every sample
+    /// `k` of `clock` from `first` to `last`, each after a step of one sample period taken
+    /// at `clock.time(k)`; without `first`, from the driver's next sample, the step to it
+    /// from where the driver stands (part of a period).
     pub fn hold(
         &mut self,
         cmd: &[Sample],
-        ks: RangeInclusive<u64>,
+        first: Option<u64>,
+        last: u64,
         clock: Clock,
         sink: &mut impl Sink,
     ) -> Result<(), Stop> {
@@ -363,36 +356,22 @@ impl<'p, P: Plant> Driver<'p, P> {
         for c in self.cmds.chunks_exact_mut(cmd.len()) {
             c.copy_from_slice(cmd);
         }
-        let (mut k, last, dt) = (*ks.start(), *ks.end(), self.clock.dt_s);
+        let (mut k, t, dt) = (first.unwrap_or(self.k), self.t, self.clock.dt_s);
+        if first.is_none() && k <= last {
+            self.step(clock.time(k) - t, t)?;
+            self.sample(k, clock, None, sink)?;
+            k += 1;
+        }
         while k <= last {
             let m = (last - k + 1).min(CHUNK as u64) as usize;
             let fail = |i: usize| clock.time(k + i as u64) - dt;
-            let batched = self.batches && m >= self.min_batch;
-            match batched.then(|| self.batch(m, k, clock, fail, false, sink)) {
+            match (m >= self.min_batch).then(|| self.batch(m, k, clock, fail, false, sink)) {
                 Some(Ok(Some(done))) => k += done as u64 - 1,
                 Some(Err(stop)) => return Err(stop),
                 _ => self.step(dt, clock.time(k) - dt)?,
             }
             self.sample(k, clock, None, sink)?;
             k += 1;
-        }
-        Ok(())
-    }
-
-    /// Hold `cmd` on the driver's own clock from where it stands: a step to the next
-    /// sample (part of a period), then every sample up to `last_k`.
-    pub fn hold_on(
-        &mut self,
-        cmd: &[Sample],
-        last_k: u64,
-        sink: &mut impl Sink,
-    ) -> Result<(), Stop> {
-        let (k, t, clock) = (self.k, self.t, self.clock);
-        if k <= last_k {
-            self.cmd.copy_from_slice(cmd);
-            self.step(clock.time(k) - t, t)?;
-            self.sample(k, clock, None, sink)?;
-            self.hold(cmd, k + 1..=last_k, clock, sink)?;
         }
         Ok(())
     }
@@ -425,21 +404,21 @@ impl<'p, P: Plant> Driver<'p, P> {
         across: bool,
         sink: &mut impl Sink,
     ) -> Result<Option<usize>, Stop> {
-        let (axes, len) = (self.cmd.len(), m * self.cmd.len());
+        let len = m * self.cmd.len();
         let (cmds, dt, state) = (&self.cmds[..len], self.clock.dt_s, &mut self.state);
         let (cmd_p, toolhead) = (&mut self.cmd_p[..len], &mut self.toolhead[..len]);
+        let p = self.plant;
         let result = if across {
             let breaks: Vec<&[InnerBreak]> = self.breaks.iter().map(Vec::as_slice).collect();
-            let p = self.plant;
             p.step_samples_across(state, cmds, &breaks, dt, BLOWUP_M, cmd_p, toolhead)
         } else {
-            self.plant
-                .step_samples(state, cmds, dt, BLOWUP_M, cmd_p, toolhead)
+            p.step_samples(state, cmds, dt, BLOWUP_M, cmd_p, toolhead)
         };
         let (count, outcome) = match result {
             Ok(Some(done)) if (1..=m).contains(&done) => (done - 1, Ok(Some(done))),
+            Ok(_) if across => return Ok(None),
             Ok(_) => {
-                self.batches &= across;
+                self.min_batch = usize::MAX;
                 return Ok(None);
             }
             Err((failed, error)) => {
@@ -447,28 +426,46 @@ impl<'p, P: Plant> Driver<'p, P> {
                 (failed.min(m), Err(Stop::Backend { t_s, error }))
             }
         };
+        if count > 0 {
+            self.hand(k0, count, clock, None, sink)?;
+        }
+        outcome
+    }
+
+    /// Hand the sink samples `k0 ..` (`count` of them) of `clock`, their positions in
+    /// [`Driver::cmd_p`] and [`Driver::toolhead`]: a batch's (`full` `None`), or a sample
+    /// evaluated in full (`Some(observed)`: with the driver's command, and its observations
+    /// when `observed`). The last sample the sink takes is the last thing done.
+    fn hand(
+        &mut self,
+        k0: u64,
+        count: usize,
+        clock: Clock,
+        full: Option<bool>,
+        sink: &mut impl Sink,
+    ) -> Result<(), Stop> {
+        let (axes, len) = (self.cmd.len(), count * self.cmd.len());
         let view = Samples {
             k0,
             count,
             clock,
             axes,
-            commanded_m: &self.cmd_p,
-            toolhead_m: &self.toolhead,
-            cmd: None,
-            observed: None,
+            commanded_m: &self.cmd_p[..len],
+            toolhead_m: &self.toolhead[..len],
+            cmd: full.map(|_| &self.cmd[..]),
+            observed: full.unwrap_or(false).then_some(&self.obs[..]),
         };
-        if count > 0 {
-            let stop = sink.samples(&view);
-            self.t = view.time(stop.break_value().unwrap_or(count - 1));
-            if stop.is_break() {
-                return Err(Stop::Sink);
-            }
+        let stop = sink.samples(&view);
+        self.t = view.time(stop.break_value().unwrap_or(count - 1));
+        match stop {
+            ControlFlow::Break(_) => Err(Stop::Sink),
+            ControlFlow::Continue(()) => Ok(()),
         }
-        outcome
     }
 
-    /// Evaluate the plant now in full as sample `k` of `clock` (command `cmd`, else the
-    /// driver's current one): checked, handed to the sink, and an interruption looked for.
+    /// Evaluate the plant now in full as sample `k` of `clock` (command `cmd` when given,
+    /// the driver's command from then on; else the driver's current one): checked, handed
+    /// to the sink, and an interruption looked for.
     pub fn sample(
         &mut self,
         k: u64,
@@ -478,15 +475,16 @@ impl<'p, P: Plant> Driver<'p, P> {
     ) -> Result<(), Stop> {
         let t = clock.time(k);
         self.t = t;
+        if let Some(cmd) = cmd {
+            self.cmd.copy_from_slice(cmd);
+        }
         let (plant, n) = (self.plant, self.cmd.len());
         let (cmd_p, toolhead) = (&mut self.cmd_p[..n], &mut self.toolhead[..n]);
+        let within = |(c, h): (&f64, &f64)| (h - c).abs() <= BLOWUP_M;
         let observed = self.record
             || sink.observes()
-            || !(plant.positions(&self.state, cmd_p, toolhead)
-                && cmd_p
-                    .iter()
-                    .zip(&*toolhead)
-                    .all(|(c, h)| (h - c).abs() <= BLOWUP_M));
+            || !plant.positions(&self.state, cmd_p, toolhead)
+            || !cmd_p.iter().zip(&*toolhead).all(within);
         if observed {
             // Every value finite and no blow-up is what `fault_in` checks; otherwise it
             // names the fault.
@@ -498,19 +496,7 @@ impl<'p, P: Plant> Driver<'p, P> {
                 return Err(Stop::Fault(reason));
             }
         }
-        let view = Samples {
-            k0: k,
-            count: 1,
-            clock,
-            axes: n,
-            commanded_m: cmd_p,
-            toolhead_m: toolhead,
-            cmd: Some(cmd.unwrap_or(&self.cmd)),
-            observed: observed.then_some(&self.obs[..]),
-        };
-        if sink.samples(&view).is_break() {
-            return Err(Stop::Sink);
-        }
+        self.hand(k, 1, clock, Some(observed), sink)?;
         self.polls += 1;
         if self.polls.is_multiple_of(INTERRUPT_POLL) && crate::execute::interrupt::requested() {
             return Err(Stop::Interrupted);
@@ -543,11 +529,10 @@ pub fn fault_in(t: f64, names: &[String], obs: &[Observation]) -> Option<String>
             ("carriage position", o.carriage_m),
             ("motor angle", o.motor_angle_rad),
         ];
-        let bad = values
-            .into_iter()
-            .find(|(_, v)| v.is_some_and(|v| !v.is_finite()));
-        if let Some((what, Some(v))) = bad {
-            return Some(format!("{what} of axis {axis} became {v} at t = {t:.6} s"));
+        for (what, v) in values {
+            if let Some(v) = v.filter(|v| !v.is_finite()) {
+                return Some(format!("{what} of axis {axis} became {v} at t = {t:.6} s"));
+            }
         }
         let err = o.toolhead_m - o.commanded_m;
         (err.abs() > BLOWUP_M).then(|| {

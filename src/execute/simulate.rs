@@ -223,7 +223,7 @@ impl Simulation for Run<'_> {
         };
         let ran = ran.and_then(|()| {
             driver.sample(0, window, Some(&at_end), &mut sink)?;
-            driver.hold(&hold, 1..=n, window, &mut sink)
+            driver.hold(&hold, Some(1), n, window, &mut sink)
         });
         Ok(Ok(sink.finish(&mut driver, self.names, ran)))
     }
@@ -301,7 +301,7 @@ impl Sink for RunSink<'_, '_> {
             .push_run(s.count, |i| s.time(i), s.commanded_m, s.toolhead_m);
         if let Some(st) = self.stream.as_deref_mut() {
             let clock = [s.clock.origin_s, s.clock.dt_s];
-            st.samples(clock, s.k0, &s.toolhead_m[..s.count * s.axes], s.axes);
+            st.samples(clock, s.k0, s.toolhead_m, s.axes);
         }
         if self.path.is_none() && self.record.is_none() {
             return ControlFlow::Continue(());

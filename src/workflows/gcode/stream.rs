@@ -568,18 +568,13 @@ impl Sink for Account {
         for i in 0..s.count {
             let ((c, h), t) = (s.positions(i), s.time(i));
             self.add_sample(s.k0 + i as u64, t, c, h);
-            if let Some(obs) = s.observed
-                && self.out.first_lost_step.is_none()
-            {
+            if let Some(obs) = s.observed.filter(|_| self.out.first_lost_step.is_none()) {
                 self.lost_step_check(t, obs);
             }
-            if let Some(r) = self.ringing.as_mut()
-                && r.stops(xy, t, h)
-            {
-                return ControlFlow::Break(i);
-            }
-            if self.rec.as_ref().is_some_and(|r| r.full().is_some()) {
-                // The recording is past its bound: the job ends here, in an error.
+            // The ringing after the last move has died down, or the recording is past its
+            // bound (the job ends here, in an error).
+            let settled = self.ringing.as_mut().is_some_and(|r| r.stops(xy, t, h));
+            if settled || self.rec.as_ref().is_some_and(|r| r.full().is_some()) {
                 return ControlFlow::Break(i);
             }
         }
@@ -602,27 +597,19 @@ pub fn simulate_job<R: BufRead>(
     let rate = opts.sample_rate_hz;
     let (file, progress) = file;
     let size = std::fs::metadata(file).map_or(0, |m| m.len());
-    let sim = JobSim {
-        chunks: JobChunks {
-            job,
-            file,
-            progress: progress.map(|p| (p, size)),
-            end: Vec::new(),
-            range_start: None,
-        },
-        acc: Account::new(opts, rec),
+    let chunks = JobChunks {
+        job,
+        file,
+        progress: progress.map(|p| (p, size)),
+        end: Vec::new(),
+        range_start: None,
     };
+    let sim = (chunks, Account::new(opts, rec));
     with_plant(backend, axes, options, rate, &[], sim).map_err(sim_err)?
 }
 
 fn sim_err(source: SimError) -> Error {
     Error::Sim { run: 0, source }
-}
-
-/// A job on a plant, as a [`Simulation`]: its chunks and the account of their samples.
-struct JobSim<'a, R> {
-    chunks: JobChunks<'a, R>,
-    acc: Account,
 }
 
 /// A job's chunks on the machine's axes and the print clock, each one's moves handed to the
@@ -639,27 +626,24 @@ struct JobChunks<'a, R> {
 }
 
 impl<R: BufRead> JobChunks<'_, R> {
-    /// The next chunk, its time 0 its start on the print clock.
+    /// The next chunk, its time 0 its start on the print clock. After the first one (once a
+    /// chunk has been simulated) the file is first told how far it has been read.
     fn next(&mut self, acc: &mut Account) -> Result<Option<Chunk<'static>>, Error> {
-        let Some(chunk) = self
-            .job
-            .next_chunk()
-            .map_err(super::gcode_error(self.file))?
-        else {
+        if let Some((tell, size)) = self.progress.filter(|_| !self.end.is_empty()) {
+            tell(self.job.reader().bytes_read(), size);
+        }
+        let read = self.job.next_chunk();
+        let Some(chunk) = read.map_err(super::gcode_error(self.file))? else {
             return Ok(None);
         };
         acc.active.add(&chunk.moves);
         let axes = acc.opts.job_axes.iter();
         let axes = axes.map(|&i| chunk.trajectory.axes()[i].clone()).collect();
         let sub = Trajectory::new(axes).map_err(|source| Error::Plan { run: 0, source })?;
-        if self.range_start.is_none()
-            && let Some((a, _)) = acc.opts.layers
-        {
-            self.range_start = chunk
-                .moves
-                .iter()
-                .find(|m| m.layer >= a && m.duration_s > 0.0)
-                .map(|m| m.start_time_s);
+        if let (None, Some((a, _))) = (self.range_start, acc.opts.layers) {
+            let mut moves = chunk.moves.iter();
+            let first = moves.find(|m| m.layer >= a && m.duration_s > 0.0);
+            self.range_start = first.map(|m| m.start_time_s);
         }
         self.end = sub.axes().iter().map(Profile::end).collect();
         acc.follow(chunk.start_time_s, &sub);
@@ -682,11 +666,12 @@ fn stopped(ran: Result<(), Stop>, acc: &mut Account) -> Result<bool, Error> {
     }
 }
 
-impl<R: BufRead> Simulation for JobSim<'_, R> {
+/// A job on a plant: its chunks and the account of their samples.
+impl<R: BufRead> Simulation for (JobChunks<'_, R>, Account) {
     type Output = Result<(Streamed, Option<Recorder>), Error>;
 
     fn run<P: Plant>(self, plant: &P) -> Self::Output {
-        let (mut chunks, mut acc) = (self.chunks, self.acc);
+        let (mut chunks, mut acc) = self;
         let names = acc.opts.names.clone();
         if let Some(first) = chunks.next(&mut acc)? {
             let t_first = first.0;
@@ -694,17 +679,8 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
             let rate = acc.opts.sample_rate_hz;
             let d = Driver::new(plant, &names, &starts, rate, t_first, false).map_err(sim_err)?;
             let mut d = d.streamed();
-            // The file is told how far it has been read after each chunk is simulated.
-            let next = |acc: &mut Account| {
-                if let Some((tell, size)) = chunks.progress {
-                    tell(chunks.job.reader().bytes_read(), size);
-                }
-                chunks.next(acc)
-            };
-            let faulted = stopped(
-                d.follow_chunks(Some(first), next, true, &mut acc)?,
-                &mut acc,
-            )?;
+            let ran = d.follow_chunks(Some(first), |acc| chunks.next(acc), true, &mut acc)?;
+            let faulted = stopped(ran, &mut acc)?;
             // The print time simulated: to the last command (the tail is counted apart).
             let t_end = d.time_s();
             acc.out.simulated_s = t_end - t_first;
@@ -720,7 +696,7 @@ impl<R: BufRead> Simulation for JobSim<'_, R> {
                     end_xy: [hold[ix].p, hold[iy].p],
                 });
                 let last_k = ((t_end + tail_s) / d.clock().dt_s).floor() as u64;
-                stopped(d.hold_on(&hold, last_k, &mut acc), &mut acc)?;
+                stopped(d.hold(&hold, None, last_k, d.clock(), &mut acc), &mut acc)?;
                 let mut tail = acc.ringing.take().map(|r| r.tail).unwrap_or_default();
                 tail.duration_s = d.time_s() - t_end;
                 acc.flush();
