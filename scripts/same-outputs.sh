@@ -16,7 +16,8 @@
 #     on rapier with the full driver model; GRBL's jobs on grbl with their $$ settings (the
 #     milled contour also with --layer-source markers); the
 #     real Fusion 360 (GRBL), LaserWeb and Inkscape Lasertools (GRBL, laser mode), Cura
-#     (Marlin) and Slic3r (Klipper) jobs in its cnc/, laser/, cura/ and slic3r/ folders;
+#     (Marlin), Slic3r and OrcaSlicer (Klipper) jobs in its cnc/, laser/, cura/, slic3r/
+#     and orca/ folders;
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
 #     what identify wrote, `settle import` of the example configurations and of the real
 #     ones of gcode/tests/data/real/ (a Marlin M503 reply among them; two, and the reply,
@@ -129,6 +130,9 @@ cases() {
   echo "gcode-cnc_contour-markers gcode $P/cnc_contour.gcode --machine printer_xy --firmware grbl --config $P/shapeoko3_grbl_settings.txt --layer-source markers --out {out}"
   echo "gcode-cura-kreistest gcode $P/cura/Kreistest.gcode --machine printer_xy --firmware marlin --shaper mzv@48 --out {out}"
   echo "gcode-slic3r-benchy-arcs gcode $P/slic3r/benchy_arcs.gcode --machine printer_xy --shaper mzv@48 --layers 120..121 --out {out}"
+  # OrcaSlicer's Klipper file (per-feature SET_VELOCITY_LIMIT, spiral lifts): two of its
+  # 190 layers, a solid bottom layer and a wall layer.
+  echo "gcode-orca-klipper gcode $P/orca/orca_slicer.gcode --machine printer_xy --firmware klipper --shaper mzv@48 --layers 8..9 --out {out}"
   echo "gcode-corner-modes gcode $S/gcode_corner.gcode --machine out/identify/machine.toml --firmware settle --out {out}"
   echo "machine-printer_xy machine printer_xy"
   echo "machine-leadscrew_stage machine leadscrew_stage"

@@ -43,6 +43,7 @@ pub(crate) const RRF_ABSOLUTE_MIN_SPEED_MM_S: f64 = 0.01;
 const MARLIN_J_OUT_OF_RANGE: &str = "J outside 0.01 to 0.3 mm is refused by Marlin, which keeps its junction deviation (\"?J out of range\", Marlin/src/gcode/config/M200-M205.cpp)";
 const MARLIN_JERK_IN_JD_BUILD: &str = "X Y Z E (classic jerk) are read only by a Marlin built with CLASSIC_JERK; this one uses junction deviation (Marlin/src/gcode/config/M200-M205.cpp)";
 const MARLIN_J_IN_CLASSIC_BUILD: &str = "J (junction deviation) is not read by a Marlin built with CLASSIC_JERK (Marlin/src/gcode/config/M200-M205.cpp)";
+const KLIPPER_ACCEL_TO_DECEL: &str = "ACCEL_TO_DECEL is not read: Klipper removed it on 2025-08-11 (docs/Config_Changes.md) and keeps its minimum_cruise_ratio; an older Klipper planned as with minimum_cruise_ratio = 1 - min(1, ACCEL_TO_DECEL / ACCEL) (give that as minimum_cruise_ratio in --config to plan as it did)";
 const MARLIN_XY_FREQUENCY: &str = "F and S (the XY frequency limit) are read only by a Marlin built with XY_FREQUENCY_LIMIT, off in its example configuration (Marlin/src/gcode/config/M200-M205.cpp); not modelled";
 const RRF_ACCEL_RAISED: &str = "an acceleration below 0.1 mm/s^2 runs at 0.1, RepRapFirmware's least (MinimumAcceleration, src/Config/Configuration.h; Platform::SetAcceleration, GCodes::ConfigureAccelerations)";
 const RRF_MIN_SPEED_RAISED: &str = "I below 0.01 mm/s runs at 0.01, RepRapFirmware's least (AbsoluteMinFeedrate, src/Config/Configuration.h; Platform::SetMinMovementSpeed)";
@@ -164,10 +165,13 @@ impl Driver {
                         && minimum_cruise_ratio.is_none()
                     {
                         return Ok(LimitOutcome::Ignored(if accel_to_decel_mm_s2.is_some() {
-                            "ACCEL_TO_DECEL was removed from Klipper (docs/Config_Changes.md)"
+                            KLIPPER_ACCEL_TO_DECEL
                         } else {
                             "nothing to change"
                         }));
+                    }
+                    if accel_to_decel_mm_s2.is_some() {
+                        notes.push(KLIPPER_ACCEL_TO_DECEL);
                     }
                     p.set_velocity_limit(
                         mm(velocity_mm_s),

@@ -24,6 +24,8 @@ pub struct CanonicalWriter<W> {
     dialect: Dialect,
     /// The next dwell came from a Klipper `G4 S..` already written with its note.
     skip_dwell: bool,
+    /// The `P` word of the next arc, from a Klipper note that it was passed over.
+    arc_word: Option<String>,
 }
 
 /// The number `d` near `guess` with `forward(d) == value` (so a reader that applies
@@ -67,6 +69,7 @@ impl<W: Write> CanonicalWriter<W> {
             out,
             dialect,
             skip_dwell: false,
+            arc_word: None,
         })
     }
 
@@ -118,6 +121,13 @@ impl<W: Write> CanonicalWriter<W> {
                 } else {
                     writeln!(self.out, "G28{}", flags(axes))
                 }
+            }
+            // A Klipper `G2`/`G3` with a `P` word: the word goes on the arc that follows.
+            EventKind::Note(Note::IgnoredByFirmware { command, .. })
+                if command.starts_with("G2 P") || command.starts_with("G3 P") =>
+            {
+                self.arc_word = Some(command[3..].to_string());
+                Ok(())
             }
             EventKind::Note(Note::IgnoredByFirmware { command, .. }) => {
                 // A Klipper `G4 S..` note is followed by its own (zero) dwell, which the
@@ -218,6 +228,9 @@ impl<W: Write> CanonicalWriter<W> {
                 match a.radius_word_mm {
                     Some(r) => write!(self.out, " R{r}")?,
                     None => write!(self.out, " {i}{} {j}{}", a.offset_i_mm, a.offset_j_mm)?,
+                }
+                if let Some(word) = self.arc_word.take() {
+                    write!(self.out, " {word}")?;
                 }
                 writeln!(self.out)?;
                 if a.plane != Plane::Xy {

@@ -12,6 +12,7 @@
 //! | G92 without axes | sets X Y Z E to 0 (`gcode_move.py` `cmd_G92`) | nothing (`Marlin/src/gcode/geometry/G92.cpp`) | nothing (`GCodes::SetPositions`, `src/GCodes/GCodes3.cpp`) |
 //! | G2/G3 R form | refused (`klippy/extras/gcode_arcs.py`) | yes | yes |
 //! | G2/G3 in G91 | refused (`gcode_arcs.py`) | yes | yes |
+//! | G2/G3 `P` (OrcaSlicer's spiral lift `P1`) | passed over, noted (`gcode_arcs.py` reads no P): an arc ending at its start is one turn | refused by this reader (Marlin reads extra turns only in an ARC_P_CIRCLES build) | refused by this reader |
 //! | M203 | not a command | mm/s | mm/min (mm/s with `S1`) |
 //! | jerk | `SQUARE_CORNER_VELOCITY` | M205 X/Y/Z/E mm/s, J junction deviation | M566 mm/min (limit), M205 mm/s (printing moves) |
 //! | M92 M350 M906 M208 M669 M98 M501 | not commands (`printer.cfg` holds these settings) | counted as ignored | [`crate::Setting`]s and macro-call notes (`config.g`) |

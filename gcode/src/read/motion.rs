@@ -263,6 +263,14 @@ impl Motion {
             // GRBL takes K (grbl/gcode.c reads I, J and K in every plane and uses the
             // plane's two).
             cmd.allow(p, b"XYZFIJKR", "X Y Z F I J K R")?;
+        } else if self.dialect == Dialect::Klipper {
+            // Klipper reads X Y Z E F I J (and K in G18/G19) and passes over any other
+            // word: OrcaSlicer's spiral lift writes `P1` (the caller notes it).
+            cmd.allow(
+                p,
+                b"XYZEFIJRP",
+                "X Y Z E F I J, and P, which Klipper passes over",
+            )?;
         } else {
             cmd.allow(p, b"XYZEFIJR", "X Y Z E F I J R")?;
         }

@@ -519,6 +519,21 @@ impl Interp {
             }
             (b'G', 2 | 3) => {
                 let mv = self.motion.arc(cmd, p, number == 2)?;
+                if self.opts.dialect == Dialect::Klipper && p.has(b'P') {
+                    // OrcaSlicer's spiral lift (`G3 Z.8 I.044 J-1.216 P1 F30000`): one
+                    // turn that ends where it starts, which Klipper traces as a full
+                    // circle whatever P says (Marlin's ARC_P_CIRCLES reads P as extra
+                    // turns).
+                    let at = p.at(b'P') + 1;
+                    let end = cmd.args[at..]
+                        .find([' ', '\t'])
+                        .map_or(cmd.args.len(), |k| at + k);
+                    let note = Note::IgnoredByFirmware {
+                        command: format!("G{number} P{}", &cmd.args[at..end]),
+                        reason: "Klipper's G2/G3 reads no P, the count of turns Marlin's ARC_P_CIRCLES reads; an arc that ends where it starts is one full turn (klippy/extras/gcode_arcs.py)",
+                    };
+                    self.push(line, EventKind::Note(note));
+                }
                 self.push_move(line, mv);
             }
             (b'G', 4) => {

@@ -57,6 +57,46 @@ fn full_circle_and_helix() {
     assert!(p.x_mm.abs() < 1e-12 && (p.y_mm - r).abs() < 1e-12 && (p.z_mm - 0.2).abs() < 1e-15);
 }
 
+/// OrcaSlicer's spiral lift (its `z_hop_types = Spiral Lift`), as it writes it before a
+/// travel: `G17`, then a helix that ends where it starts, with `P1`. Klipper reads no `P`
+/// (klippy/extras/gcode_arcs.py takes X Y Z E F I J and passes over other words) and
+/// traces an arc ending at its start as one full turn; the reader notes the `P` it passed
+/// over. Marlin reads `P` as extra turns only when built with ARC_P_CIRCLES, and
+/// RepRapFirmware not at all: those dialects refuse the word, naming what they take.
+#[test]
+fn orca_spiral_lift_is_one_full_turn_under_klipper() {
+    use settle_gcode::{EventKind, Note};
+    let text = "G1 X81.256 Y78.477 Z.4 F30000\nG17\nG3 Z.8 I.044 J-1.216 P1  F30000\n";
+    let ev = crate::events(text, Dialect::Klipper);
+    let notes: Vec<_> = ev
+        .iter()
+        .filter_map(|e| match &e.kind {
+            EventKind::Note(Note::IgnoredByFirmware { command, .. }) => Some(command.as_str()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(notes, ["G3 P1"]);
+    let mv = *moves(text, Dialect::Klipper).last().expect("a move");
+    let Path::Arc(a) = mv.path else {
+        panic!("not an arc")
+    };
+    assert!(a.is_full_circle() && !a.clockwise());
+    let r = 0.044f64.hypot(1.216);
+    assert!(close_rel(a.radius_mm, r, 1e-12));
+    assert!(close_rel(mv.length_mm(), (TAU * r).hypot(0.4), 1e-9));
+    assert_eq!(
+        (mv.end.x_mm, mv.end.y_mm, mv.end.z_mm),
+        (81.256, 78.477, 0.8)
+    );
+    assert!(!mv.is_working());
+    for d in [Dialect::Marlin, Dialect::Rrf] {
+        match error(text, d) {
+            GcodeError::UnknownParameter { param, .. } => assert_eq!(param, "P", "{d}"),
+            other => panic!("{d}: {other}"),
+        }
+    }
+}
+
 #[test]
 fn r_form_short_and_long_arcs() {
     // Chord 6 and radius 5: the short arc sweeps 2 asin(0.6), the long one the rest.

@@ -51,6 +51,29 @@ fn klipper_set_velocity_limit_and_m204() {
     );
     assert_rel("ignored", s.print_time_s, 2.0 * (l / v + v / 3000.0), 1e-9);
     assert_eq!(s.ignored.values().sum::<u64>(), 1, "{:?}", s.ignored);
+    // OrcaSlicer writes ACCEL_TO_DECEL beside ACCEL (`SET_VELOCITY_LIMIT ACCEL=1000
+    // ACCEL_TO_DECEL=1000`): ACCEL applies, ACCEL_TO_DECEL is listed as not followed
+    // (Klipper removed it on 2025-08-11), and the minimum cruise ratio stays.
+    let (_, s) = run(
+        "G1 X50 F6000\nSET_VELOCITY_LIMIT ACCEL=1000 ACCEL_TO_DECEL=1000\nG1 X0\n",
+        k(),
+    );
+    assert_rel(
+        "ACCEL beside ACCEL_TO_DECEL",
+        s.print_time_s,
+        l / v + v / 3000.0 + l / v + v / 1000.0,
+        1e-9,
+    );
+    assert_eq!(s.limit_changes, 1);
+    let listed: Vec<_> = s.ignored.iter().collect();
+    assert_eq!(listed.len(), 1, "{listed:?}");
+    assert!(
+        listed[0]
+            .0
+            .starts_with("SET_VELOCITY_LIMIT: ACCEL_TO_DECEL is not read")
+            && *listed[0].1 == 1,
+        "{listed:?}"
+    );
 }
 
 #[test]

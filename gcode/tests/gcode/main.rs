@@ -21,6 +21,7 @@ mod job_util;
 mod laser;
 mod layer_bound;
 mod layers;
+mod orca;
 mod roundtrip;
 mod segments;
 mod slic3r;
