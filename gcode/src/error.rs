@@ -43,6 +43,16 @@ pub enum GcodeError {
     /// reader).
     #[error(transparent)]
     File(Box<settle_files::FileError>),
+    /// A binary G-code file that cannot be decoded (gcode/src/read/bgcode.rs): truncated,
+    /// a bad checksum, an unknown block type, compression or encoding, or text past the
+    /// limit on a G-code file.
+    #[error("{source_name}: binary G-code, {source}")]
+    Bgcode {
+        /// The path.
+        source_name: Arc<str>,
+        /// The byte offset and what is wrong.
+        source: crate::read::bgcode::BgcodeError,
+    },
     /// A file an `[include]` (or RepRapFirmware `M98 P`) names cannot be read.
     #[error("{at}: {what}: {source}")]
     Include {
@@ -432,6 +442,15 @@ impl GcodeError {
             return settle_files::read::unwrap_io(std::path::Path::new(&**source_name), source)
                 .into();
         }
+        let source = match source.downcast::<crate::read::bgcode::BgcodeError>() {
+            Ok(b) => {
+                return GcodeError::Bgcode {
+                    source_name: source_name.clone(),
+                    source: b,
+                };
+            }
+            Err(source) => source,
+        };
         GcodeError::Io {
             source_name: source_name.clone(),
             source,
@@ -442,6 +461,7 @@ impl GcodeError {
     pub fn location(&self) -> Option<&Location> {
         match self {
             GcodeError::Io { .. }
+            | GcodeError::Bgcode { .. }
             | GcodeError::File(_)
             | GcodeError::ConfigMissing { .. }
             | GcodeError::ExportValue { .. }

@@ -95,6 +95,7 @@ pub use read::arc::{
     Arc, FULL_CIRCLE_TOLERANCE_MM, Plane, RADIUS_TOLERANCE_MAX_MM, RADIUS_TOLERANCE_MM,
     RADIUS_TOLERANCE_REL,
 };
+pub use read::bgcode::{Bgcode, BgcodeError};
 pub use read::canonical::CanonicalWriter;
 pub use read::dialect::Dialect;
 pub use read::event::{Event, EventKind, LayerChange, LayerSource, Note};

@@ -9,10 +9,12 @@
 //!   [`limits`] and [`limit_parse`] (motion-limit commands), [`setting`] and
 //!   [`setting_parse`] (RepRapFirmware's configuration commands);
 //! - [`reader`]: the reader itself, which names a file that holds G-code but is not
-//!   text ([`packaged`]: binary G-code, gzip, zip); [`summary`]: a file's statistics;
+//!   text ([`packaged`]: gzip, zip; binary G-code it decodes, [`bgcode`], when it opens
+//!   the file itself); [`summary`]: a file's statistics;
 //!   [`canonical`]: events written back as G-code.
 
 pub(crate) mod arc;
+pub(crate) mod bgcode;
 pub(crate) mod canonical;
 pub(crate) mod cmd;
 pub(crate) mod dialect;

@@ -1,6 +1,8 @@
 //! Files that hold G-code but are not G-code text, known by their first bytes: binary
 //! G-code, a gzip stream, a zip archive, a zstd frame, UTF-16 text. Each is named with the way to its text, rather
-//! than refused as "binary data" at its first odd byte.
+//! than refused as "binary data" at its first odd byte. Binary G-code is named only when
+//! it reaches the reader as bytes: a file the reader opens itself is decoded
+//! ([`crate::read::bgcode`]).
 
 use settle_files::packed::Packed;
 
@@ -11,7 +13,7 @@ pub(crate) fn packaged(first: &[u8]) -> Option<(&'static str, &'static str)> {
     if first.starts_with(b"GCDE") {
         return Some((
             "binary G-code (bgcode: the file starts with GCDE, as PrusaSlicer writes it for printers that take binary G-code)",
-            "convert it (PrusaSlicer: File > Convert > Convert binary G-code to ASCII), or export text G-code (Printer Settings > General: untick \"Supports binary G-code\")",
+            "give settle the file itself, which it decodes (settle gcode print.bgcode), or convert it (PrusaSlicer: File > Convert > Convert binary G-code to ASCII)",
         ));
     }
     match Packed::of(first)? {

@@ -120,17 +120,61 @@ struct Interp {
 }
 
 /// A G-code file open for reading (settle-files' reader: a regular file of at most
-/// [`settle_files::limit::GCODE`]).
-pub type FileInput = BufReader<settle_files::read::Input>;
+/// [`settle_files::limit::GCODE`]): its text, or, for a binary G-code file (it starts with
+/// `GCDE`), the text its G-code blocks decode to ([`crate::Bgcode`]).
+#[derive(Debug)]
+pub enum FileInput {
+    /// A text file.
+    Text(BufReader<settle_files::read::Input>),
+    /// A binary G-code file, decoded block by block.
+    Binary(super::bgcode::Bgcode<BufReader<settle_files::read::Input>>),
+}
+
+impl std::io::Read for FileInput {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        match self {
+            FileInput::Text(r) => r.read(buf),
+            FileInput::Binary(r) => r.read(buf),
+        }
+    }
+}
+
+impl BufRead for FileInput {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        match self {
+            FileInput::Text(r) => r.fill_buf(),
+            FileInput::Binary(r) => r.fill_buf(),
+        }
+    }
+
+    fn consume(&mut self, amt: usize) {
+        match self {
+            FileInput::Text(r) => r.consume(amt),
+            FileInput::Binary(r) => r.consume(amt),
+        }
+    }
+}
 
 impl Reader<FileInput> {
     /// Opens a file (a regular file, links followed, of at most
-    /// [`settle_files::limit::GCODE`]).
+    /// [`settle_files::limit::GCODE`]); a binary G-code file is read as its G-code text.
     pub fn open(path: impl AsRef<Path>, options: ReaderOptions) -> Result<Self, GcodeError> {
         let path = path.as_ref();
         let name: Arc<str> = Arc::from(path.display().to_string());
         let file = settle_files::read::open(path, settle_files::limit::GCODE)?;
-        Ok(Reader::new(BufReader::with_capacity(64 * 1024, file), options).with_name(name))
+        let mut buffered = BufReader::with_capacity(64 * 1024, file);
+        let binary = buffered
+            .fill_buf()
+            .map_err(|e| GcodeError::io(&name, e))?
+            .starts_with(b"GCDE");
+        let input = if binary {
+            FileInput::Binary(
+                super::bgcode::Bgcode::new(buffered).map_err(|e| GcodeError::io(&name, e))?,
+            )
+        } else {
+            FileInput::Text(buffered)
+        };
+        Ok(Reader::new(input, options).with_name(name))
     }
 }
 
