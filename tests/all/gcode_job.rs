@@ -177,7 +177,7 @@ fn bad_gcode_exits_2_with_file_and_line_and_writes_nothing() {
         (
             "benchy.bgcode",
             bgcode,
-            "benchy.bgcode:1:1: binary G-code (bgcode",
+            "benchy.bgcode: binary G-code, byte 18: truncated: the block's parameters needs 2 bytes, the file ends at byte 18",
         ),
         (
             "benchy.gcode.gz",

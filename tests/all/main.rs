@@ -9,6 +9,7 @@ mod adversarial;
 mod cli;
 mod corners;
 mod faults;
+mod gcode_bgcode;
 mod gcode_config;
 mod gcode_grbl;
 mod gcode_job;

@@ -533,6 +533,15 @@ pub fn gcode_error(file: &Path) -> impl Fn(GcodeError) -> Error + '_ {
                 source,
             } => return Error::read(PathBuf::from(&*source_name), source),
             GcodeError::File(f) => return (*f).into(),
+            GcodeError::Bgcode {
+                source_name,
+                source,
+            } => {
+                return Error::input(
+                    PathBuf::from(&*source_name),
+                    format!("binary G-code, {source}"),
+                );
+            }
             e => e,
         };
         if let Some(at) = e.location() {
