@@ -590,17 +590,17 @@ mod tests {
     #[test]
     fn heatshrink_literals_and_an_overlapping_back_reference() {
         let data = [0xb0, 0xd8, 0x82, 0x80];
-        assert_eq!(heatshrink(&data, 4, 3, 100).unwrap(), b"ababa");
+        assert_eq!(heatshrink(&data, 4, 3, 100).expect("decodes"), b"ababa");
         // The declared size is a bound.
         assert!(
             heatshrink(&data, 4, 3, 4)
-                .unwrap_err()
+                .expect_err("past the declared size")
                 .contains("past 4 bytes")
         );
         // A reference before the first byte: tag 0, index 0000, count 000 = 00000000.
         assert!(
             heatshrink(&[0x00], 4, 3, 100)
-                .unwrap_err()
+                .expect_err("a reference before the start")
                 .contains("back-reference")
         );
     }
@@ -617,14 +617,14 @@ mod tests {
         ];
         let mut out = Vec::new();
         MeatPack::default().decode(&data, &mut out);
-        assert_eq!(String::from_utf8(out).unwrap(), "G1 XM\nE11YMYok");
+        assert_eq!(String::from_utf8(out).expect("ASCII"), "G1 XM\nE11YMYok");
         // The state carries from one block to the next: a split signal, a split pair.
         let mut out = Vec::new();
         let mut mp = MeatPack::default();
         for chunk in data.chunks(2) {
             mp.decode(chunk, &mut out);
         }
-        assert_eq!(String::from_utf8(out).unwrap(), "G1 XM\nE11YMYok");
+        assert_eq!(String::from_utf8(out).expect("ASCII"), "G1 XM\nE11YMYok");
     }
 
     #[test]
