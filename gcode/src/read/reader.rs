@@ -568,12 +568,12 @@ impl Interp {
                     // turn that ends where it starts, which Klipper traces as a full
                     // circle whatever P says (Marlin's ARC_P_CIRCLES reads P as extra
                     // turns).
-                    let at = p.at(b'P') + 1;
-                    let end = cmd.args[at..]
-                        .find([' ', '\t'])
-                        .map_or(cmd.args.len(), |k| at + k);
+                    let turns = match p.get(b'P') {
+                        crate::read::params::Value::Num(v) => v.to_string(),
+                        _ => String::new(),
+                    };
                     let note = Note::IgnoredByFirmware {
-                        command: format!("G{number} P{}", &cmd.args[at..end]),
+                        command: format!("G{number} P{turns}"),
                         reason: "Klipper's G2/G3 reads no P, the count of turns Marlin's ARC_P_CIRCLES reads; an arc that ends where it starts is one full turn (klippy/extras/gcode_arcs.py)",
                     };
                     self.push(line, EventKind::Note(note));

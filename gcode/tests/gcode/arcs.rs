@@ -76,6 +76,16 @@ fn orca_spiral_lift_is_one_full_turn_under_klipper() {
         })
         .collect();
     assert_eq!(notes, ["G3 P1"]);
+    // Written without spaces, the note still names the P word alone.
+    let compact = "G1 X81.256 Y78.477 Z.4 F30000\nG17\nG3Z.8I.044J-1.216P1F30000\n";
+    let listed = crate::events(compact, Dialect::Klipper)
+        .iter()
+        .filter_map(|e| match &e.kind {
+            EventKind::Note(Note::IgnoredByFirmware { command, .. }) => Some(command.clone()),
+            _ => None,
+        })
+        .collect::<Vec<_>>();
+    assert_eq!(listed, ["G3 P1"]);
     let mv = *moves(text, Dialect::Klipper).last().expect("a move");
     let Path::Arc(a) = mv.path else {
         panic!("not an arc")
