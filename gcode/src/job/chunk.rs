@@ -112,6 +112,9 @@ pub struct LayerTime {
     /// moves), where it has any: one value in a planar layer; a spiral vase in a file that
     /// marks no layer is one layer from its bottom to its top.
     pub print_z_mm: Option<[f64; 2]>,
+    /// What opened it: a slicer's layer marker or a change of Z; `None` for the moves
+    /// before the first (a start G-code's).
+    pub opened_by: Option<crate::LayerSource>,
 }
 
 /// A limit the file raises above the configuration it started with.

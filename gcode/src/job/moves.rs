@@ -12,6 +12,7 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 
 use super::chunk::{LayerTime, MoveInfo};
+use crate::LayerSource;
 
 /// A move whose segments are still coming.
 #[derive(Debug)]
@@ -127,9 +128,9 @@ impl MoveTable {
         }
     }
 
-    /// The layer `z_mm` starts (from the file's layer markers).
-    pub(crate) fn layer_z(&mut self, layer: u32, z_mm: Option<f64>) {
-        self.account.z.push((layer, z_mm));
+    /// The layer `z_mm` starts (from the file's layer markers or a change of Z, `source`).
+    pub(crate) fn layer_z(&mut self, layer: u32, z_mm: Option<f64>, source: LayerSource) {
+        self.account.z.push((layer, z_mm, source));
         if self.account.z.len() > 64 {
             self.account.z.remove(0);
         }
@@ -151,8 +152,8 @@ impl MoveTable {
 struct Account {
     closed: Vec<LayerTime>,
     current: Option<LayerTime>,
-    /// Recent layer markers: (layer, Z).
-    z: Vec<(u32, Option<f64>)>,
+    /// Recent layer changes: (layer, Z, what found it).
+    z: Vec<(u32, Option<f64>, LayerSource)>,
 }
 
 impl Account {
@@ -167,12 +168,8 @@ impl Account {
                 }
                 None => 0.0,
             };
-            let z_mm = self
-                .z
-                .iter()
-                .rev()
-                .find(|(l, _)| *l == m.layer)
-                .and_then(|(_, z)| *z);
+            let change = self.z.iter().rev().find(|(l, _, _)| *l == m.layer);
+            let (z_mm, opened_by) = change.map_or((None, None), |&(_, z, s)| (z, Some(s)));
             self.current = Some(LayerTime {
                 layer: m.layer,
                 z_mm,
@@ -181,6 +178,7 @@ impl Account {
                 moves: 0,
                 working_s: 0.0,
                 print_z_mm: None,
+                opened_by,
             });
         }
         if let Some(c) = self.current.as_mut() {

@@ -298,6 +298,8 @@ pub struct LayerRow {
     /// The lowest and highest Z of its extruding moves (mm;
     /// [`settle_gcode::job::LayerTime::print_z_mm`]).
     pub print_z_mm: Option<[f64; 2]>,
+    /// What opened it ([`settle_gcode::job::LayerTime::opened_by`]).
+    pub opened_by: Option<settle_gcode::LayerSource>,
     /// Its contour-error account, when it was simulated.
     pub stats: Option<stats::LayerStats>,
 }
@@ -366,23 +368,41 @@ impl GcodeOutcome {
     }
 
     /// The layers whose extruding moves are not in one plane ([`NON_PLANAR_MM`]), in
-    /// words: a file that marks no layer and prints rising (a spiral vase, non-planar
-    /// moves) has its layers from Z, and one such layer holds all of that height, so its
-    /// numbers are not a layer's. `None` when every layer is planar.
+    /// words, by what the first such layer is: the moves before a slicer's first layer
+    /// marker (a start G-code's purge line that extrudes on its way down), a marked layer
+    /// with non-planar moves, or, in a file that marks no layer and prints rising (a
+    /// spiral vase, non-planar moves), a layer from Z that holds all of that height. Its
+    /// numbers are then not one layer's. `None` when every layer is planar.
     pub fn non_planar_words(&self) -> Option<String> {
-        let spans: Vec<(u32, [f64; 2])> = self
+        let spans: Vec<&LayerRow> = self
             .layers
             .iter()
-            .filter_map(|l| l.print_z_mm.map(|z| (l.layer, z)))
-            .filter(|(_, [lo, hi])| hi - lo > NON_PLANAR_MM)
+            .filter(|l| l.print_z_mm.is_some_and(|[lo, hi]| hi - lo > NON_PLANAR_MM))
             .collect();
-        let (layer, [lo, hi]) = *spans.first()?;
+        let first = *spans.first()?;
+        let (layer, [lo, hi]) = (first.layer, first.print_z_mm?);
         let more = match spans.len() {
             1 => String::new(),
             n => format!(" (and {} more such layers)", n - 1),
         };
+        let marked = |s: &settle_gcode::LayerSource| *s != settle_gcode::LayerSource::ZChange;
+        let file_marks = self
+            .layers
+            .iter()
+            .any(|l| l.opened_by.as_ref().is_some_and(marked));
+        let what = match first.opened_by {
+            None if file_marks => format!(
+                "layer {layer} (the moves before the file's first layer marker: its start G-code) extrudes between Z {lo:.2} and {hi:.2} mm{more}: not one plane (a purge line that extrudes on its way down, say)"
+            ),
+            Some(s) if marked(&s) => format!(
+                "layer {layer}'s extruding moves span Z {lo:.2} to {hi:.2} mm{more}: not one plane (non-planar moves within one layer the file marks)"
+            ),
+            _ => format!(
+                "layer {layer}'s extruding moves rise from Z {lo:.2} to {hi:.2} mm{more}: not one plane (a spiral vase, or non-planar moves, in a file that marks no layers)"
+            ),
+        };
         Some(format!(
-            "layer {layer}'s extruding moves rise from Z {lo:.2} to {hi:.2} mm{more}: not one plane (a spiral vase, or non-planar moves, in a file that marks no layers), so its per-layer numbers (Z, time, contour error) are over that whole height, not one layer's"
+            "{what}, so its per-layer numbers (Z, time, contour error) are over that whole height, not one layer's"
         ))
     }
 
@@ -836,6 +856,7 @@ fn simulate(
             duration_s: l.duration_s,
             moves: l.moves,
             print_z_mm: l.print_z_mm,
+            opened_by: l.opened_by,
             stats: by_layer.remove(&l.layer),
         })
         .collect();

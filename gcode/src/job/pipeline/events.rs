@@ -89,7 +89,7 @@ impl<R: BufRead> Job<R> {
                 self.drain(ev.line)
             }
             EventKind::Layer(c) => {
-                self.table.layer_z(ev.layer, c.z_mm);
+                self.table.layer_z(ev.layer, c.z_mm, c.source);
                 Ok(())
             }
             EventKind::Limits(c) => self.on_limits(ev.line, &c),
