@@ -128,8 +128,13 @@ pub struct LimitOverride {
     pub limit: &'static str,
     /// The configuration's value.
     pub configured: f64,
-    /// The file's.
+    /// The file's, the first time it raises the limit.
     pub file: f64,
+    /// The highest value the file sets it to.
+    pub highest: f64,
+    /// How many commands change it to a value above the configuration's (this one
+    /// counted).
+    pub raises: u64,
 }
 
 /// What a job did, for reports.

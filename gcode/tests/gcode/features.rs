@@ -81,6 +81,8 @@ fn klipper_refuses_a_move_out_of_range_with_its_own_words() {
         (o[0].line, o[0].configured, o[0].file),
         (1, 7000.0, 15000.0)
     );
+    // Raised twice, the second time higher.
+    assert_eq!((o[0].raises, o[0].highest), (2, 16000.0));
     assert_eq!(o[0].limit, "max_accel (mm/s^2)");
 }
 

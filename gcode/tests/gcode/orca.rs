@@ -186,6 +186,27 @@ fn an_orca_file_under_klipper_lists_what_it_does_not_follow_and_times_near_orca(
         text.lines().nth(1283),
         Some("SET_VELOCITY_LIMIT ACCEL=10000 ACCEL_TO_DECEL=10000")
     );
+    // How often and how high the file sets ACCEL above 3000, counted from its text: a
+    // `SET_VELOCITY_LIMIT ACCEL=` that changes the value to one above 3000.
+    let (mut accel, mut raises, mut highest) = (3000.0_f64, 0_u64, 0.0_f64);
+    for line in text.lines().filter(|l| l.starts_with("SET_VELOCITY_LIMIT")) {
+        let value = line
+            .split_whitespace()
+            .find_map(|w| w.strip_prefix("ACCEL="));
+        let Some(v) = value.map(|v| v.parse::<f64>().expect("a number")) else {
+            continue;
+        };
+        if v != accel && v > 3000.0 {
+            (raises, highest) = (raises + 1, highest.max(v));
+        }
+        accel = v;
+    }
+    assert!(raises > 1000, "{raises}");
+    let accel = s.overrides.iter().find(|o| o.limit == "max_accel (mm/s^2)");
+    let accel = accel.expect("raised");
+    assert_eq!((accel.raises, accel.highest), (raises, highest));
+    let scv = &s.overrides[0];
+    assert_eq!((scv.raises, scv.highest), (1, 20.0));
 
     // The print time against OrcaSlicer's estimate (5,563 s). Both plan the same moves
     // at the same feeds and the file's accelerations, but OrcaSlicer's estimator is a

@@ -522,13 +522,21 @@ impl GcodeOutcome {
 /// A limit the file raises, in words: `line 12: M204 raises max_accel (mm/s^2) from the
 /// configuration's 7000 to 15000; the firmware follows the file`.
 pub fn override_words(o: &settle_gcode::job::LimitOverride) -> String {
-    // Klipper reads M204 S as its SET_VELOCITY_LIMIT ACCEL.
+    // Klipper reads M204 S as its SET_VELOCITY_LIMIT ACCEL (klippy/toolhead.py
+    // `cmd_M204`); its other limits only SET_VELOCITY_LIMIT sets.
     let command = match o.command.as_str() {
-        "SET_VELOCITY_LIMIT" => "M204 (or SET_VELOCITY_LIMIT)",
+        "SET_VELOCITY_LIMIT" if o.limit.starts_with("max_accel ") => "M204 (or SET_VELOCITY_LIMIT)",
         c => c,
     };
+    let more = match o.raises {
+        0 | 1 => String::new(),
+        n => format!(
+            " ({n} commands set it above the configuration's, to {} at most)",
+            plot_num(o.highest)
+        ),
+    };
     format!(
-        "line {}: {} raises {} from the configuration's {} to {}; the firmware follows the file",
+        "line {}: {} raises {} from the configuration's {} to {}{more}; the firmware follows the file",
         o.line,
         command,
         o.limit,

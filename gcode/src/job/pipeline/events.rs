@@ -440,8 +440,8 @@ impl<R: BufRead> Job<R> {
         Ok(())
     }
 
-    /// Record the limits the file just raised above the configuration's (the first time
-    /// for each limit).
+    /// Record the limits the file just raised above the configuration's: where it first
+    /// does for each limit, how often and how high.
     fn note_overrides(
         &mut self,
         line: u64,
@@ -453,15 +453,23 @@ impl<R: BufRead> Job<R> {
             let Some(&(_, configured)) = self.start_limits.iter().find(|(n, _)| n == name) else {
                 continue;
             };
-            let seen = self.overrides.iter().any(|o| o.limit == *name);
-            if new != old && *new > configured * (1.0 + 1e-9) && !seen {
-                self.overrides.push(LimitOverride {
+            if new == old || *new <= configured * (1.0 + 1e-9) {
+                continue;
+            }
+            match self.overrides.iter_mut().find(|o| o.limit == *name) {
+                Some(o) => {
+                    o.highest = o.highest.max(*new);
+                    o.raises += 1;
+                }
+                None => self.overrides.push(LimitOverride {
                     line,
                     command: command.to_string(),
                     limit: name,
                     configured,
                     file: *new,
-                });
+                    highest: *new,
+                    raises: 1,
+                }),
             }
         }
     }
