@@ -17,7 +17,7 @@
 #     milled contour also with --layer-source markers); the
 #     real Fusion 360 (GRBL), LaserWeb and Inkscape Lasertools (GRBL, laser mode), Cura
 #     (Marlin), Slic3r and OrcaSlicer (Klipper) jobs in its cnc/, laser/, cura/, slic3r/
-#     and orca/ folders, and PrusaSlicer's binary G-code in bgcode/;
+#     and orca/ folders, and PrusaSlicer's binary G-code in bgcode/ (on marlin and on prusa);
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
 #     what identify wrote, `settle import` of the example configurations and of the real
 #     ones of gcode/tests/data/real/ (a Marlin M503 reply among them; two, and the reply,
@@ -136,6 +136,8 @@ cases() {
   # PrusaSlicer's binary G-code (heatshrink, MeatPack) for an MK4S, its end G-code's
   # Prusa-only M593 T skipped.
   echo "gcode-prusaslicer-bgcode gcode $P/bgcode/mini_cube_ps2.8.1.bgcode --machine printer_xy --firmware marlin --skip-bad-lines --out {out}"
+  # The same file as Prusa's firmware reads it, every line (its M593 T among them).
+  echo "gcode-prusaslicer-bgcode-prusa gcode $P/bgcode/mini_cube_ps2.8.1.bgcode --machine printer_xy --firmware prusa --out {out}"
   echo "gcode-corner-modes gcode $S/gcode_corner.gcode --machine out/identify/machine.toml --firmware settle --out {out}"
   echo "machine-printer_xy machine printer_xy"
   echo "machine-leadscrew_stage machine leadscrew_stage"

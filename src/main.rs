@@ -246,8 +246,9 @@ enum Command {
         /// The machine: a preset (printer_xy), a machine file, or a scenario file (its [machine]).
         #[arg(long)]
         machine: String,
-        /// The planner: klipper, marlin, rrf, grbl (GRBL and grblHAL: lasers and CNC) or
-        /// settle [default: klipper; with --config, rrf for a file ending in .g].
+        /// The planner: klipper, marlin, prusa (Prusa-Firmware-Buddy, also buddy), rrf, grbl
+        /// (GRBL and grblHAL: lasers and CNC) or settle [default: klipper; with --config,
+        /// rrf for a file ending in .g].
         #[arg(long, value_parser = parse_firmware)]
         firmware: Option<settle_planner::firmware::Firmware>,
         /// The firmware's configuration (Klipper printer.cfg with its includes,

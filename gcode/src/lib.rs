@@ -103,6 +103,6 @@ pub use read::geometry::{Bounds, Move, MoveKind, Path, Point, Tool};
 pub use read::layers::LayerMode;
 pub use read::limits::{AxisFlags, AxisValues, FtShaper, LimitChange};
 pub use read::reader::{FileInput, MAX_FEATURES, Reader, ReaderOptions, Skipped};
-pub use read::segments::{ArcSegmentation, GrblArcs, KlipperArcs, MarlinArcs, RrfArcs};
+pub use read::segments::{ArcSegmentation, GrblArcs, KlipperArcs, MarlinArcs, PrusaArcs, RrfArcs};
 pub use read::setting::Setting;
 pub use read::summary::{LimitSeen, Summary};

@@ -86,7 +86,8 @@ impl ShaperSetting {
     /// The name in the syntax of `settle_planner::shaper::ShaperType`: Klipper's text as is,
     /// `rrf:<type>` for RepRapFirmware, `marlin:<name>` for Marlin. `None` when the
     /// firmware does not shape with it ([`ShaperSetting::is_enabled`]) or it is
-    /// RepRapFirmware's `custom` shaper, known only by its impulses.
+    /// RepRapFirmware's `custom` shaper, known only by its impulses, or the firmware is one
+    /// whose configuration settle does not read (Prusa's, GRBL).
     pub fn type_name(&self, firmware: Dialect) -> Option<String> {
         if !self.is_enabled(firmware) {
             return None;
@@ -96,7 +97,7 @@ impl ShaperSetting {
             Dialect::Rrf if self.name == "custom" => None,
             Dialect::Rrf => Some(format!("rrf:{}", self.name)),
             Dialect::Marlin => Some(format!("marlin:{}", self.name)),
-            Dialect::Grbl => None,
+            Dialect::Prusa | Dialect::Grbl => None,
         }
     }
 }

@@ -17,7 +17,8 @@ use crate::config::GrblSettings;
 use crate::{ArcSegmentation, Dialect, GcodeError, GrblArcs, LayerMode, ReaderOptions};
 
 /// A firmware by name, for a G-code job: one of [`Firmware::GCODE`] (klipper, marlin,
-/// rrf, grbl, settle; `reprapfirmware` and `duet` are rrf, `grblhal` is grbl).
+/// prusa, rrf, grbl, settle; `buddy` is prusa, `reprapfirmware` and `duet` are rrf,
+/// `grblhal` is grbl).
 pub fn parse_firmware(name: &str) -> Result<Firmware, GcodeError> {
     Firmware::parse_among(name, &Firmware::GCODE, "a G-code planner").map_err(|reason| {
         GcodeError::JobSetting {
@@ -98,6 +99,9 @@ pub enum PlannerConfig {
     Klipper(KlipperConfig),
     /// Marlin's Configuration.h settings.
     Marlin(MarlinConfig),
+    /// Prusa-Firmware-Buddy's: Marlin's planner run by its precise stepping
+    /// ([`MarlinConfig::prusa_mk4`]).
+    Prusa(MarlinConfig),
     /// RepRapFirmware's config.g settings.
     Rrf(RrfConfig),
     /// GRBL's `$` settings (the planner's, the arc tolerance, the laser mode).
@@ -112,6 +116,7 @@ impl PlannerConfig {
         match self {
             PlannerConfig::Klipper(_) => Firmware::Klipper,
             PlannerConfig::Marlin(_) => Firmware::Marlin,
+            PlannerConfig::Prusa(_) => Firmware::Prusa,
             PlannerConfig::Rrf(_) => Firmware::Rrf,
             PlannerConfig::Grbl(_) => Firmware::Grbl,
             PlannerConfig::Settle(_) => Firmware::Settle,
@@ -151,12 +156,16 @@ pub struct JobConfig {
 }
 
 impl JobConfig {
-    /// The firmware's defaults (no input shaping: every firmware ships with it off):
+    /// The firmware's defaults (no input shaping, as every firmware but Prusa's ships):
     /// - Klipper: `max_velocity` 500 mm/s, `max_accel` 3000 mm/s^2, `max_z_velocity`
     ///   25 mm/s, `max_z_accel` 30 mm/s^2 (Klipper requires these in printer.cfg; these are
     ///   its config/example-cartesian.cfg) and Klipper's defaults for the rest
     ///   ([`KlipperConfig::new`]);
     /// - Marlin: [`MarlinConfig::new`] (its example configuration);
+    /// - Prusa: [`MarlinConfig::prusa_mk4`] and the MK4's shapers as Prusa ships them, MZV
+    ///   at 50.7 Hz on X and 40.6 Hz on Y (damping 0.1; input_shaper_config.hpp). A
+    ///   printer keeps its own in EEPROM (its calibration may have changed them);
+    ///   the file's `M593` lines change them;
     /// - RepRapFirmware: [`RrfConfig::new`] (Configuration.h);
     /// - GRBL: [`GrblSettings::new`] (grbl/defaults.h `DEFAULTS_GENERIC`);
     /// - settle: [`SettleConfig::new`].
@@ -170,6 +179,7 @@ impl JobConfig {
                 PlannerConfig::Klipper(c)
             }
             Firmware::Marlin => PlannerConfig::Marlin(MarlinConfig::new()),
+            Firmware::Prusa => PlannerConfig::Prusa(MarlinConfig::prusa_mk4()),
             Firmware::Rrf => PlannerConfig::Rrf(RrfConfig::new()),
             Firmware::Grbl => PlannerConfig::Grbl(GrblSettings::new()),
             Firmware::Settle => {
@@ -189,11 +199,15 @@ impl JobConfig {
             }
         };
         let dialect = Dialect::of(firmware);
+        let shapers = match firmware {
+            Firmware::Prusa => crate::job::shapers::prusa_mk4_shapers(),
+            _ => [None; 3],
+        };
         Ok(Self {
             planner,
             dialect,
             layer_mode: LayerMode::Auto,
-            shapers: [None; 3],
+            shapers,
             alignment: Alignment::Centred,
             arcs: ArcSegmentation::default_for(dialect),
             profiles: ProfileOptions::default(),

@@ -63,7 +63,9 @@ impl Driver {
     pub(crate) fn new(cfg: &PlannerConfig) -> Result<Option<Self>, PlanError> {
         Ok(Some(match cfg {
             PlannerConfig::Klipper(c) => Driver::Klipper(Box::new(KlipperPlanner::new(*c)?)),
-            PlannerConfig::Marlin(c) => Driver::Marlin(Box::new(MarlinPlanner::new(*c)?)),
+            PlannerConfig::Marlin(c) | PlannerConfig::Prusa(c) => {
+                Driver::Marlin(Box::new(MarlinPlanner::new(*c)?))
+            }
             PlannerConfig::Rrf(c) => Driver::Rrf(Box::new(RrfPlanner::new(*c)?)),
             PlannerConfig::Grbl(s) => Driver::Grbl(Box::new(GrblPlanner::new(s.planner())?)),
             PlannerConfig::Settle(_) => return Ok(None),
@@ -260,6 +262,13 @@ impl Driver {
                     }
                     LimitChange::MarlinInputShaping { .. } | LimitChange::FtMotion { .. } => {
                         return Ok(LimitOutcome::Applied);
+                    }
+                    LimitChange::PrusaInputShaping { save, .. } => {
+                        return Ok(LimitOutcome::Ignored(if *save {
+                            "W saves the input shaper to EEPROM; A and M, the weight adjustment M74 makes to Y's shaper, are not modelled"
+                        } else {
+                            "A and M (the weight adjustment M74 makes to Y's shaper) are not modelled"
+                        }));
                     }
                     LimitChange::FtSmoothing { .. } => {
                         return Ok(LimitOutcome::Ignored(

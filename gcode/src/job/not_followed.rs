@@ -46,6 +46,12 @@ pub(crate) fn reason(firmware: Firmware, name: &str) -> &'static str {
         (Some(b'M'), Some(564 | 211)) => {
             "software limits on or off: not followed; the configuration's travel applies"
         }
+        (Some(b'M'), Some(74)) if firmware == Firmware::Prusa => {
+            "the mass on the bed (PrusaSlicer writes it at each layer): Prusa's firmware waits for the motion to stop and moves Y's shaper frequency towards F + A at the mass limit M (M593 A, M; -20 Hz at 800 g on the MK4, M74.cpp); not simulated"
+        }
+        (Some(b'M'), Some(862 | 555)) if firmware == Firmware::Prusa => {
+            "a printer, nozzle or firmware check, or the print area for probing: no motion"
+        }
         (Some(b'T'), Some(_)) => {
             "a tool change: the tool's offsets and the firmware's tool-change moves are not simulated"
         }
@@ -90,6 +96,9 @@ mod tests {
         assert!(reason(k, "M900").contains("pressure or linear advance"));
         assert!(reason(k, "M999").contains("Unknown command"));
         assert!(reason(Firmware::Marlin, "M999").contains("this firmware"));
+        assert!(reason(Firmware::Marlin, "M74").contains("this firmware"));
+        assert!(reason(Firmware::Prusa, "M74").contains("shaper frequency"));
+        assert!(reason(Firmware::Prusa, "M862.3").contains("check"));
         assert!(reason(k, "PRINT_START").contains("macro"));
         assert!(reason(k, "SET_PRESSURE_ADVANCE").contains("extruder motion"));
     }

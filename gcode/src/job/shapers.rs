@@ -11,12 +11,19 @@
 //!   (`Marlin/src/gcode/feature/ft_motion/M493.cpp`): FT_MOTION on or off (`S`), and per
 //!   axis (X and Y unless named) the shaper `C` (0 none, 1..8 ZV..MZV), frequency `A`,
 //!   damping `I`, vibration tolerance `Q`.
+//! - Prusa-Firmware-Buddy `M593` (lib/Marlin/Marlin/src/gcode/feature/input_shaper/M593.cpp,
+//!   `M593_internal`): with any of `T`, `F`, `D`, `R`, each axis named (X, Y and Z when
+//!   none is) takes the values given over its own, or over the printer's defaults when
+//!   its shaper is off; `F0` turns it off; a frequency is clamped to 10..=100 Hz
+//!   (`clamp_frequency_to_safe_values`, input_shaper_config.cpp; the MK4's range, 150 Hz
+//!   on the MINI). `T` 0..5 is ZV, ZVD, MZV (Klipper's), EI, 2HUMP_EI, 3HUMP_EI
+//!   (`prusa:`), 6 no shaper; `R` the EI family's vibration reduction (tolerance `1/R`).
 //! - RepRapFirmware `M593` (`AxisShaper::Configure`, src/Movement/AxisShaper.cpp): one
 //!   shaper for the motion (here X and Y), type `P`, frequency `F` (default 40 Hz),
 //!   damping `S` (default 0.1); a frequency or damping given while the type is `none`
 //!   selects `zvd`. `custom` shapers (`H`, `T`) are not supported.
 
-use settle_planner::shaper::{MarlinShaper, RrfShaper, ShaperType};
+use settle_planner::shaper::{MarlinShaper, PrusaShaper, RrfShaper, ShaperType};
 
 use super::config::ShaperSetting;
 use crate::config::klipper_shaper;
@@ -30,6 +37,74 @@ struct Axis {
     shaper_type: Option<ShaperType>,
     frequency_hz: f64,
     damping_ratio: f64,
+    /// Prusa: the `M593 T` type (0..=6), which keeps its number while `R` changes;
+    /// [`NOT_PRUSA`] for a shaper the job started with that is none of Prusa's.
+    prusa_type: u32,
+    /// Prusa: the vibration reduction `M593 R` (the EI family's tolerance is `1/R`).
+    vibration_reduction: f64,
+}
+
+/// Prusa-Firmware-Buddy's `M593 T` of Klipper's `mzv`.
+const PRUSA_MZV: u32 = 2;
+/// Prusa-Firmware-Buddy's `M593 T` of no shaper (`Type::null`).
+const PRUSA_NULL: u32 = 6;
+/// The `prusa_type` of a shaper that is not one of Prusa's.
+const NOT_PRUSA: u32 = u32::MAX;
+/// Prusa-Firmware-Buddy's safe frequencies, Hz (`frequency_safe_min`, `frequency_safe_max`
+/// of the MK4, input_shaper_config.hpp).
+const PRUSA_SAFE_HZ: (f64, f64) = (10.0, 100.0);
+/// Prusa-Firmware-Buddy's default vibration reduction (`M593 R`).
+const PRUSA_VIBRATION_REDUCTION: f64 = 20.0;
+
+/// The MK4's (and MK4S's) shapers as Prusa-Firmware-Buddy ships them (`axis_x_default`,
+/// `axis_y_default`, `axis_z_default`, input_shaper_config.hpp): MZV at 50.7 Hz on X and
+/// 40.6 Hz on Y, damping 0.1, none on Z. What an axis whose shaper is off takes when an
+/// `M593` sets part of it.
+const PRUSA_MK4_DEFAULTS: [(u32, f64); 3] =
+    [(PRUSA_MZV, 50.7), (PRUSA_MZV, 40.6), (PRUSA_NULL, 0.0)];
+
+/// The shaper of Prusa's `M593 T<code>` with vibration reduction `r` (`None`: no shaper).
+fn prusa_kind(code: u32, r: f64) -> Option<ShaperType> {
+    let ei = |shaper| ShaperType::Prusa {
+        shaper,
+        v_tol: 1.0 / r,
+    };
+    match code {
+        0 => Some(ShaperType::Zv),
+        1 => Some(ShaperType::Zvd),
+        2 => Some(ShaperType::MZV),
+        3 => Some(ei(PrusaShaper::Ei)),
+        4 => Some(ei(PrusaShaper::TwoHumpEi)),
+        5 => Some(ei(PrusaShaper::ThreeHumpEi)),
+        _ => None,
+    }
+}
+
+/// The `M593 T` of a shaper setting's type, for the state a job starts with (`None`: not
+/// one of Prusa's).
+fn prusa_code(kind: ShaperType) -> Option<(u32, f64)> {
+    let r = PRUSA_VIBRATION_REDUCTION;
+    match kind {
+        ShaperType::Zv => Some((0, r)),
+        ShaperType::Zvd => Some((1, r)),
+        k if k == ShaperType::MZV => Some((PRUSA_MZV, r)),
+        ShaperType::Prusa { shaper, v_tol } => {
+            let code = PrusaShaper::ALL.iter().position(|s| *s == shaper)? as u32 + 3;
+            Some((code, 1.0 / v_tol))
+        }
+        _ => None,
+    }
+}
+
+/// The MK4's shaper defaults as job settings (X and Y; Z unshaped).
+pub(crate) fn prusa_mk4_shapers() -> [Option<ShaperSetting>; 3] {
+    PRUSA_MK4_DEFAULTS.map(|(code, f)| {
+        prusa_kind(code, PRUSA_VIBRATION_REDUCTION).map(|shaper_type| ShaperSetting {
+            shaper_type,
+            frequency_hz: f,
+            damping_ratio: 0.1,
+        })
+    })
 }
 
 impl Axis {
@@ -71,20 +146,30 @@ impl ShaperState {
         let (default_kind, default_f, default_z) = match firmware {
             Firmware::Rrf => (None, 40.0, 0.1),
             Firmware::Klipper => (Some(ShaperType::MZV), 0.0, 0.1),
-            Firmware::Marlin | Firmware::Grbl | Firmware::Settle | Firmware::Tmc4361a => {
-                (None, 0.0, 0.1)
-            }
+            Firmware::Marlin
+            | Firmware::Prusa
+            | Firmware::Grbl
+            | Firmware::Settle
+            | Firmware::Tmc4361a => (None, 0.0, 0.1),
         };
         let axes = initial.map(|s| match s {
-            Some(s) => Axis {
-                shaper_type: Some(s.shaper_type),
-                frequency_hz: s.frequency_hz,
-                damping_ratio: s.damping_ratio,
-            },
+            Some(s) => {
+                let (prusa_type, vibration_reduction) =
+                    prusa_code(s.shaper_type).unwrap_or((NOT_PRUSA, PRUSA_VIBRATION_REDUCTION));
+                Axis {
+                    shaper_type: Some(s.shaper_type),
+                    frequency_hz: s.frequency_hz,
+                    damping_ratio: s.damping_ratio,
+                    prusa_type,
+                    vibration_reduction,
+                }
+            }
             None => Axis {
                 shaper_type: default_kind,
                 frequency_hz: default_f,
                 damping_ratio: default_z,
+                prusa_type: PRUSA_NULL,
+                vibration_reduction: PRUSA_VIBRATION_REDUCTION,
             },
         });
         Self {
@@ -201,6 +286,67 @@ impl ShaperState {
                     || vibration_tolerance.is_some())
             }
             (
+                Firmware::Prusa,
+                LimitChange::PrusaInputShaping {
+                    axes,
+                    shaper_type,
+                    frequency_hz,
+                    damping_ratio,
+                    vibration_reduction,
+                    ..
+                },
+            ) => {
+                let any = shaper_type.is_some()
+                    || frequency_hz.is_some()
+                    || damping_ratio.is_some()
+                    || vibration_reduction.is_some();
+                if !any {
+                    return Ok(false);
+                }
+                let none = !(axes.x || axes.y || axes.z);
+                let pick = [axes.x || none, axes.y || none, axes.z || none];
+                for (i, a) in self.axes.iter_mut().enumerate() {
+                    if !pick[i] {
+                        continue;
+                    }
+                    if *frequency_hz == Some(0.0) {
+                        a.frequency_hz = 0.0;
+                        continue;
+                    }
+                    let mut retype = a.frequency_hz == 0.0;
+                    if retype {
+                        // Off: the printer's defaults are the base (`axis_defaults`).
+                        let (code, f) = PRUSA_MK4_DEFAULTS[i];
+                        (a.prusa_type, a.frequency_hz) = (code, f);
+                        a.damping_ratio = if code == PRUSA_NULL { 0.0 } else { 0.1 };
+                        a.vibration_reduction = if code == PRUSA_NULL {
+                            0.0
+                        } else {
+                            PRUSA_VIBRATION_REDUCTION
+                        };
+                    }
+                    if let Some(t) = shaper_type {
+                        a.prusa_type = *t;
+                        retype = true;
+                    }
+                    if let Some(f) = frequency_hz {
+                        a.frequency_hz = *f;
+                    }
+                    if let Some(z) = damping_ratio {
+                        a.damping_ratio = *z;
+                    }
+                    if let Some(r) = vibration_reduction {
+                        a.vibration_reduction = *r;
+                        retype |= a.prusa_type != NOT_PRUSA;
+                    }
+                    a.frequency_hz = a.frequency_hz.clamp(PRUSA_SAFE_HZ.0, PRUSA_SAFE_HZ.1);
+                    if retype {
+                        a.shaper_type = prusa_kind(a.prusa_type, a.vibration_reduction);
+                    }
+                }
+                Ok(true)
+            }
+            (
                 Firmware::Rrf,
                 LimitChange::RrfInputShaping {
                     shaper,
@@ -282,4 +428,84 @@ fn marlin_kind(s: FtShaper) -> Option<ShaperType> {
         FtShaper::Mzv => MarlinShaper::Mzv,
     };
     Some(ShaperType::marlin(family))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn m593(axes: &str, t: Option<u32>, f: Option<f64>, d: Option<f64>) -> LimitChange {
+        LimitChange::PrusaInputShaping {
+            axes: AxisFlags {
+                x: axes.contains('X'),
+                y: axes.contains('Y'),
+                z: axes.contains('Z'),
+                e: false,
+            },
+            shaper_type: t,
+            frequency_hz: f,
+            damping_ratio: d,
+            vibration_reduction: None,
+            weight_frequency_delta_hz: None,
+            weight_mass_limit_g: None,
+            save: false,
+        }
+    }
+
+    fn kinds(s: &ShaperState) -> [Option<(String, f64, f64)>; 3] {
+        s.settings()
+            .map(|a| a.map(|a| (a.shaper_type.name(), a.frequency_hz, a.damping_ratio)))
+    }
+
+    fn one(name: &str, f: f64, d: f64) -> Option<(String, f64, f64)> {
+        Some((name.to_string(), f, d))
+    }
+
+    #[test]
+    fn prusa_m593_follows_m593_internal() {
+        let mut s = ShaperState::new(Firmware::Prusa, &prusa_mk4_shapers());
+        assert_eq!(
+            kinds(&s),
+            [one("mzv", 50.7, 0.1), one("mzv", 40.6, 0.1), None]
+        );
+        // PrusaSlicer's end G-code: MZV, off.
+        assert_eq!(s.apply(&m593("X", Some(2), Some(0.0), None)), Ok(true));
+        assert_eq!(s.apply(&m593("Y", Some(2), Some(0.0), None)), Ok(true));
+        assert_eq!(kinds(&s), [None, None, None]);
+        // An axis that is off starts again from the MK4's default (50.7 Hz on X).
+        assert_eq!(s.apply(&m593("X", None, None, Some(0.2))), Ok(true));
+        assert_eq!(kinds(&s)[0], one("mzv", 50.7, 0.2));
+        // Types by number; frequencies clamped to 10..=100 Hz; no axis named: all three.
+        // Z starts from its default, no shaper with damping 0 and vibration reduction 0:
+        // an EI of tolerance 1/0, which the firmware computes as NaN and settle refuses.
+        assert_eq!(s.apply(&m593("", Some(3), Some(120.0), None)), Ok(true));
+        let k = kinds(&s);
+        assert_eq!(
+            k[..2],
+            [one("prusa:ei", 100.0, 0.2), one("prusa:ei", 100.0, 0.1)]
+        );
+        assert_eq!(k[2], one("prusa:ei(v_tol=inf)", 100.0, 0.0));
+        assert!(
+            s.settings()[2]
+                .map(|z| z.build())
+                .is_some_and(|b| b.is_err())
+        );
+        assert_eq!(s.apply(&m593("Z", Some(6), None, None)), Ok(true));
+        assert_eq!(kinds(&s)[2], None);
+        assert_eq!(s.apply(&m593("Y", Some(1), Some(4.0), None)), Ok(true));
+        assert_eq!(kinds(&s)[1], one("zvd", 10.0, 0.1));
+        // `R` changes the EI family's tolerance.
+        let mut r = m593("X", None, None, None);
+        if let LimitChange::PrusaInputShaping {
+            vibration_reduction,
+            ..
+        } = &mut r
+        {
+            *vibration_reduction = Some(10.0);
+        }
+        assert_eq!(s.apply(&r), Ok(true));
+        assert_eq!(kinds(&s)[0], one("prusa:ei(v_tol=0.1)", 100.0, 0.2));
+        // Only W (or the weight adjustment): no shaper change here.
+        assert_eq!(s.apply(&m593("", None, None, None)), Ok(false));
+    }
 }

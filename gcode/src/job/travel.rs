@@ -169,7 +169,7 @@ impl Travel {
                         };
                     }
                 }
-                Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => {}
+                Firmware::Marlin | Firmware::Prusa | Firmware::Settle | Firmware::Tmc4361a => {}
             }
         }
         TravelCheck::Inside

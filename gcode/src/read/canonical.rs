@@ -94,7 +94,7 @@ impl<W: Write> CanonicalWriter<W> {
                             inverse(*duration_s, duration_s * 1000.0, |d| d / 1000.0)
                         )
                     }
-                    Dialect::Marlin | Dialect::Rrf | Dialect::Grbl => {
+                    Dialect::Marlin | Dialect::Prusa | Dialect::Rrf | Dialect::Grbl => {
                         writeln!(self.out, "G4 S{duration_s}")
                     }
                 }
@@ -312,6 +312,27 @@ impl<W: Write> CanonicalWriter<W> {
                 write!(o, "M593{}", flags(a))?;
                 opt(o, " F", *frequency_hz)?;
                 opt(o, " D", *damping_ratio)?;
+            }
+            LimitChange::PrusaInputShaping {
+                axes: a,
+                shaper_type,
+                frequency_hz,
+                damping_ratio,
+                vibration_reduction,
+                weight_frequency_delta_hz,
+                weight_mass_limit_g,
+                save,
+            } => {
+                write!(o, "M593{}", flags(a))?;
+                opt(o, " T", shaper_type.map(f64::from))?;
+                opt(o, " F", *frequency_hz)?;
+                opt(o, " D", *damping_ratio)?;
+                opt(o, " R", *vibration_reduction)?;
+                opt(o, " A", *weight_frequency_delta_hz)?;
+                opt(o, " M", *weight_mass_limit_g)?;
+                if *save {
+                    write!(o, " W")?;
+                }
             }
             LimitChange::RrfInputShaping {
                 shaper,

@@ -18,6 +18,15 @@
 //! | M92 M350 M906 M208 M669 M98 M501 | not commands (`printer.cfg` holds these settings) | counted as ignored | [`crate::Setting`]s and macro-call notes (`config.g`) |
 //! | M220 / M221 | speed and extrusion factors (`klippy/extras/gcode_move.py`) | the same (`M220.cpp`, `M221.cpp`; whole percent) | the same (`GCodes2.cpp`) |
 //!
+//! Prusa-Firmware-Buddy (Prusa's MK4, MK4S, MINI, XL, CORE One) is Marlin 2.0 with Prusa's
+//! changes; its dialect is Marlin's in every row above, and its `M593` is its own
+//! (lib/Marlin/Marlin/src/gcode/feature/input_shaper/M593.cpp): `T` the shaper type
+//! (0 ZV, 1 ZVD, 2 MZV, 3 EI, 4 2HUMP_EI, 5 3HUMP_EI, 6 none), `F` the frequency (0 turns
+//! the axis's shaper off), `D` the damping ratio (0 to 1), `R` the vibration reduction
+//! (> 0) of the EI family, `X` `Y` `Z` the axes (none named: all three), `A` and `M` the
+//! weight adjustment `M74` applies, `W` saving to EEPROM. Mainline Marlin's `M593` has no
+//! `T`: under `marlin` a `T` is refused with a pointer to `prusa`.
+//!
 //! GRBL and grblHAL (the CNC and laser firmware) read another language, RS274/NGC as
 //! grbl/gcode.c `gc_execute_line` parses it; see [`crate::read::grbl`]: several commands
 //! on a line, modal motion (`X10 Y5` continues the last `G0`-`G3`), `F` in mm/min (or
@@ -35,6 +44,8 @@ pub enum Dialect {
     Klipper,
     /// Marlin 2.1.
     Marlin,
+    /// Prusa-Firmware-Buddy: Marlin's, with Prusa's `M593`.
+    Prusa,
     /// RepRapFirmware 3.5.
     Rrf,
     /// GRBL 1.1 (gnea/grbl) and grblHAL: CNC mills and lasers.
@@ -43,15 +54,21 @@ pub enum Dialect {
 
 impl Dialect {
     /// All dialects, in a fixed order.
-    pub const ALL: [Dialect; 4] = [
+    pub const ALL: [Dialect; 5] = [
         Dialect::Klipper,
         Dialect::Marlin,
+        Dialect::Prusa,
         Dialect::Rrf,
         Dialect::Grbl,
     ];
 
     /// The printer firmwares' dialects (an extruder `E`, slicer comments).
-    pub const PRINTERS: [Dialect; 3] = [Dialect::Klipper, Dialect::Marlin, Dialect::Rrf];
+    pub const PRINTERS: [Dialect; 4] = [
+        Dialect::Klipper,
+        Dialect::Marlin,
+        Dialect::Prusa,
+        Dialect::Rrf,
+    ];
 
     /// The dialect a file for `firmware`'s planner is read in: its own, and Marlin's for
     /// settle's planner (most slicers write Marlin-flavoured G-code) and for a firmware
@@ -61,6 +78,7 @@ impl Dialect {
             Firmware::Klipper => Dialect::Klipper,
             Firmware::Rrf => Dialect::Rrf,
             Firmware::Grbl => Dialect::Grbl,
+            Firmware::Prusa => Dialect::Prusa,
             Firmware::Marlin | Firmware::Settle | Firmware::Tmc4361a => Dialect::Marlin,
         }
     }
@@ -70,12 +88,13 @@ impl Dialect {
         match self {
             Dialect::Klipper => Firmware::Klipper,
             Dialect::Marlin => Firmware::Marlin,
+            Dialect::Prusa => Firmware::Prusa,
             Dialect::Rrf => Firmware::Rrf,
             Dialect::Grbl => Firmware::Grbl,
         }
     }
 
-    /// Its firmware's name (`klipper`, `marlin`, `rrf`, `grbl`).
+    /// Its firmware's name (`klipper`, `marlin`, `prusa`, `rrf`, `grbl`).
     pub fn name(self) -> &'static str {
         self.firmware().name()
     }
@@ -85,10 +104,15 @@ impl Dialect {
     /// error:22 in grbl/gcode.c).
     pub fn initial_feed_mm_s(self) -> f64 {
         match self {
-            Dialect::Klipper | Dialect::Marlin => 25.0,
+            Dialect::Klipper | Dialect::Marlin | Dialect::Prusa => 25.0,
             Dialect::Rrf => 50.0,
             Dialect::Grbl => 0.0,
         }
+    }
+
+    /// Whether it reads G-code as Marlin does (Marlin, and Prusa's derivative of it).
+    pub fn is_marlin(self) -> bool {
+        matches!(self, Dialect::Marlin | Dialect::Prusa)
     }
 }
 

@@ -25,6 +25,9 @@ pub(crate) enum Outcome {
 
 const PER_MIN: f64 = 1.0 / 60.0;
 
+/// Why Marlin's `M593` refuses a `T`: the shaper type is Prusa's firmware's word.
+const PRUSA_M593_T: &str = "T (the shaper type) is Prusa's firmware's (Prusa-Firmware-Buddy, on the MK4, MINI, XL and CORE One: 0 ZV, 1 ZVD, 2 MZV, 3 EI, 4 2HUMP_EI, 5 3HUMP_EI); Marlin's M593 shapes with ZV only and has no T: read a file sliced for a Prusa printer with --firmware prusa";
+
 /// Per-axis values of X Y Z E scaled by `scale`; E may be a list (first value).
 fn axes(cmd: &Cmd, p: &Params, check: Check, scale: f64) -> Result<AxisValues, GcodeError> {
     let get = |l| cmd.num(p, l, check).map(|v| v.map(|v| v * scale));
@@ -75,13 +78,13 @@ pub(crate) fn m_code(
     let limits = |c| Ok(Outcome::Limits(c));
     let known = matches!(
         (dialect, number),
-        (Marlin | Rrf, 201 | 203 | 204 | 205 | 593) | (Marlin, 493 | 494) | (Rrf, 566)
+        (Marlin | Prusa | Rrf, 201 | 203 | 204 | 205 | 593) | (Marlin, 493 | 494) | (Rrf, 566)
     );
     if known && p.is_empty() {
         return Ok(Outcome::Nothing); // a report of the current values
     }
     match (dialect, number) {
-        (Marlin, 201) => {
+        (Marlin | Prusa, 201) => {
             cmd.allow(
                 p,
                 b"XYZEFST",
@@ -101,7 +104,7 @@ pub(crate) fn m_code(
                 xy_frequency_min_speed_pct: None,
             })
         }
-        (Marlin, 203) => {
+        (Marlin | Prusa, 203) => {
             cmd.allow(p, b"XYZET", "X Y Z E (mm/s), T (extruder)")?;
             limits(LimitChange::MaxFeedrate {
                 per_axis_mm_s: axes(cmd, p, POSITIVE, 1.0)?,
@@ -143,17 +146,17 @@ pub(crate) fn m_code(
             };
             limits(velocity_limit(None, Some(accel)))
         }
-        (Marlin | Rrf, 204) => {
+        (Marlin | Prusa | Rrf, 204) => {
             cmd.allow(p, b"PRST", "P T S R (mm/s^2)")?;
             let s = cmd.num(p, b'S', POSITIVE)?;
             let retract = cmd.num(p, b'R', POSITIVE)?;
             limits(LimitChange::Accel {
                 print_mm_s2: cmd.num(p, b'P', POSITIVE)?.or(s),
                 travel_mm_s2: cmd.num(p, b'T', POSITIVE)?.or(s),
-                retract_mm_s2: if dialect == Marlin { retract } else { None },
+                retract_mm_s2: if dialect.is_marlin() { retract } else { None },
             })
         }
-        (Marlin, 205) => {
+        (Marlin | Prusa, 205) => {
             cmd.allow(p, b"BSTJXYZE", "B (us) S T (mm/s) J (mm) X Y Z E (mm/s)")?;
             limits(LimitChange::MarlinAdvanced {
                 junction_deviation_mm: cmd.num(p, b'J', POSITIVE)?,
@@ -186,11 +189,35 @@ pub(crate) fn m_code(
             })
         }
         (Marlin, 593) => {
+            if p.has(b'T') {
+                return Err(cmd.unsupported(PRUSA_M593_T));
+            }
             cmd.allow(p, b"XYZDF", "X Y Z (flags), D (damping ratio), F (Hz)")?;
             limits(LimitChange::MarlinInputShaping {
                 axes: flags(p),
                 frequency_hz: cmd.num(p, b'F', NON_NEGATIVE)?,
                 damping_ratio: cmd.num(p, b'D', FRACTION)?,
+            })
+        }
+        (Prusa, 593) => {
+            cmd.allow(
+                p,
+                b"XYZTFDRAMW",
+                "X Y Z (flags), T (0-6), F (Hz), D (damping ratio), R (> 0), A (Hz, < 0), M (g), W",
+            )?;
+            let below_zero = Check {
+                ok: |v| v < 0.0,
+                allowed: "below 0 (Hz)",
+            };
+            limits(LimitChange::PrusaInputShaping {
+                axes: flags(p),
+                shaper_type: small(cmd, p, b'T', 6, "0 to 6")?,
+                frequency_hz: cmd.num(p, b'F', NON_NEGATIVE)?,
+                damping_ratio: cmd.num(p, b'D', FRACTION)?,
+                vibration_reduction: cmd.num(p, b'R', POSITIVE)?,
+                weight_frequency_delta_hz: cmd.num(p, b'A', below_zero)?,
+                weight_mass_limit_g: cmd.num(p, b'M', NON_NEGATIVE)?,
+                save: p.has(b'W'),
             })
         }
         (Rrf, 593) => {

@@ -149,6 +149,27 @@ pub enum LimitChange {
         /// `D`: damping ratio zeta.
         damping_ratio: Option<f64>,
     },
+    /// Prusa-Firmware-Buddy `M593` (lib/Marlin/Marlin/src/gcode/feature/input_shaper/M593.cpp):
+    /// per axis (X, Y and Z when none is named) the shaper type, frequency, damping ratio
+    /// and vibration reduction; the weight adjustment `M74` applies to Y; saving to EEPROM.
+    PrusaInputShaping {
+        /// Axes named (X, Y, Z; E unused).
+        axes: AxisFlags,
+        /// `T`: 0 ZV, 1 ZVD, 2 MZV, 3 EI, 4 2HUMP_EI, 5 3HUMP_EI, 6 none.
+        shaper_type: Option<u32>,
+        /// `F`: frequency, Hz (0 turns the axis's shaper off).
+        frequency_hz: Option<f64>,
+        /// `D`: damping ratio zeta (0 ..= 1).
+        damping_ratio: Option<f64>,
+        /// `R`: vibration reduction of the EI family (> 0; its tolerance is `1 / R`).
+        vibration_reduction: Option<f64>,
+        /// `A`: the weight adjustment's frequency change at the mass limit, Hz (< 0).
+        weight_frequency_delta_hz: Option<f64>,
+        /// `M`: the weight adjustment's mass limit, g (0 turns it off).
+        weight_mass_limit_g: Option<f64>,
+        /// `W`: save the settings to EEPROM.
+        save: bool,
+    },
     /// RepRapFirmware `M593` (`AxisShaper::Configure`, `src/Movement/AxisShaper.cpp`).
     RrfInputShaping {
         /// `P"type"`: none, zvd, zvdd, zvddd, mzv, ei2, ei3, custom (lower case).
@@ -239,7 +260,9 @@ impl LimitChange {
                 ..
             } => "M205",
             LimitChange::RrfJerk { .. } => "M566",
-            LimitChange::MarlinInputShaping { .. } | LimitChange::RrfInputShaping { .. } => "M593",
+            LimitChange::MarlinInputShaping { .. }
+            | LimitChange::PrusaInputShaping { .. }
+            | LimitChange::RrfInputShaping { .. } => "M593",
             LimitChange::FtMotion { .. } => "M493",
             LimitChange::FtSmoothing { .. } => "M494",
             LimitChange::VelocityLimit { .. } => "SET_VELOCITY_LIMIT",

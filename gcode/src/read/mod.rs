@@ -28,6 +28,7 @@ pub(crate) mod limits;
 pub(crate) mod motion;
 pub(crate) mod packaged;
 pub(crate) mod params;
+pub(crate) mod prusa_arcs;
 pub(crate) mod reader;
 pub(crate) mod segments;
 pub(crate) mod setting;

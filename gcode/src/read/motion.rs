@@ -126,7 +126,7 @@ impl Motion {
     /// G90 (false) / G91 (true).
     pub(crate) fn set_relative(&mut self, relative: bool) {
         self.axes_relative = relative;
-        if self.dialect == Dialect::Marlin {
+        if self.dialect.is_marlin() {
             self.e_relative = relative;
         }
     }
@@ -379,7 +379,9 @@ impl Motion {
         let s = cmd.num(p, b'S', NON_NEGATIVE)?;
         Ok(match self.dialect {
             Dialect::Klipper => (ms.unwrap_or(0.0) / 1000.0, s.is_some()),
-            Dialect::Marlin | Dialect::Rrf => (s.unwrap_or(ms.unwrap_or(0.0) / 1000.0), false),
+            Dialect::Marlin | Dialect::Prusa | Dialect::Rrf => {
+                (s.unwrap_or(ms.unwrap_or(0.0) / 1000.0), false)
+            }
             // GRBL's P is in seconds (grbl/gcode.c `mc_dwell(gc_block.values.p)`).
             Dialect::Grbl => (ms.unwrap_or(0.0), false),
         })

@@ -607,7 +607,7 @@ impl Interp {
                             "Klipper refuses inch units (klippy/extras/gcode_move.py cmd_G20: \"Machine does not support G20\"); convert the file to millimetres",
                         ));
                     }
-                    Dialect::Marlin if number == 20 => {
+                    Dialect::Marlin | Dialect::Prusa if number == 20 => {
                         return Err(cmd.unsupported(
                             "Marlin reads G20 only when built with INCH_MODE_SUPPORT (off in its example configuration); convert the file to millimetres",
                         ));
@@ -751,7 +751,7 @@ fn factor(
     p: &Params,
 ) -> Result<Option<Note>, GcodeError> {
     let allowed: &[u8] = match dialect {
-        Dialect::Marlin => b"SBRT",
+        Dialect::Marlin | Dialect::Prusa => b"SBRT",
         Dialect::Rrf => b"SD",
         _ => b"S",
     };
@@ -761,7 +761,7 @@ fn factor(
         allowed: "a percentage above 0, up to 10000",
     };
     let percent = match (cmd.num(p, b'S', check)?, dialect) {
-        (Some(s), Dialect::Marlin) => s.trunc().max(1.0),
+        (Some(s), Dialect::Marlin | Dialect::Prusa) => s.trunc().max(1.0),
         // RepRapFirmware takes a factor of 0.01 or more: M220 answers "Invalid speed
         // factor", M221 keeps its factor without a word (src/GCodes/GCodes2.cpp cases 220
         // and 221).

@@ -21,6 +21,8 @@
 //!   `max(1, trunc(r sweep / length + 0.8))`, angles by incremental rotation with a full
 //!   sine/cosine every 9th segment, Z and E each step `(end - current) / segments left`.
 //!   Single precision like the firmware.
+//! - **Prusa-Firmware-Buddy** ([`crate::read::prusa_arcs`]): Marlin's `plan_arc` with a
+//!   segment length from a deviation of 0.02 mm and the feed rate.
 //! - **GRBL** ([`crate::read::grbl::arcs`]): segments from the arc tolerance `$12`.
 //!
 //! The returned points exclude the start and end at the move's end point (every firmware
@@ -33,6 +35,7 @@ use std::f64::consts::TAU;
 use crate::read::dialect::Dialect;
 use crate::read::geometry::{Move, Path, Point};
 pub use crate::read::grbl::arcs::GrblArcs;
+pub use crate::read::prusa_arcs::PrusaArcs;
 
 /// Klipper's `[gcode_arcs]` section.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,6 +111,8 @@ pub enum ArcSegmentation {
     Klipper(KlipperArcs),
     /// Marlin.
     Marlin(MarlinArcs),
+    /// Prusa-Firmware-Buddy.
+    Prusa(PrusaArcs),
     /// RepRapFirmware.
     Rrf(RrfArcs),
     /// GRBL.
@@ -120,6 +125,7 @@ impl ArcSegmentation {
         match dialect {
             Dialect::Klipper => ArcSegmentation::Klipper(KlipperArcs::default()),
             Dialect::Marlin => ArcSegmentation::Marlin(MarlinArcs::default()),
+            Dialect::Prusa => ArcSegmentation::Prusa(PrusaArcs::default()),
             Dialect::Rrf => ArcSegmentation::Rrf(RrfArcs::default()),
             Dialect::Grbl => ArcSegmentation::Grbl(GrblArcs::default()),
         }
@@ -142,6 +148,9 @@ impl Move {
             (Path::Line, _) => out.push(self.end),
             (Path::Arc(_), ArcSegmentation::Klipper(p)) => klipper(self, p, out),
             (Path::Arc(_), ArcSegmentation::Marlin(p)) => marlin(self, p, out),
+            (Path::Arc(_), ArcSegmentation::Prusa(p)) => {
+                crate::read::prusa_arcs::prusa(self, p, out)
+            }
             (Path::Arc(_), ArcSegmentation::Rrf(p)) => rrf(self, p, out),
             (Path::Arc(_), ArcSegmentation::Grbl(p)) => crate::read::grbl::arcs::grbl(self, p, out),
         }

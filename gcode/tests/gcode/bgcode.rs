@@ -5,7 +5,11 @@
 
 use std::io::Read;
 
-use settle_gcode::{Bgcode, Dialect, EventKind, GcodeError, Reader, ReaderOptions};
+use settle_gcode::job::{Job, JobConfig};
+use settle_gcode::{
+    AxisFlags, Bgcode, Dialect, EventKind, GcodeError, LimitChange, Reader, ReaderOptions,
+};
+use settle_planner::firmware::Firmware;
 
 fn decoded(name: &str) -> String {
     let file = std::fs::File::open(super::print_path(name)).expect("print");
@@ -221,4 +225,41 @@ fn a_block_past_the_bound_is_refused_before_reading_it() {
             .contains("a G-code block of 60 bytes would take the text past 100 bytes"),
         "{e}"
     );
+}
+
+/// The MK4S file read as Prusa's firmware reads it, without skipping a line: its only
+/// shaper lines are PrusaSlicer's end G-code, `M593 X T2 F0` and `M593 Y T2 F0` ("disable
+/// IS": type 2, MZV, frequency 0, off), so the print runs on the printer's own shapers and
+/// the job changes them twice, at its end.
+#[test]
+fn the_mk4s_file_turns_prusas_shapers_off_at_its_end() {
+    let path = super::print_path("bgcode/mini_cube_ps2.8.1.bgcode");
+    let changes: Vec<LimitChange> = Reader::open(&path, ReaderOptions::new(Dialect::Prusa))
+        .expect("opens")
+        .map(|e| e.expect("reads every line"))
+        .filter_map(|e| match e.kind {
+            EventKind::Limits(c @ LimitChange::PrusaInputShaping { .. }) => Some(c),
+            _ => None,
+        })
+        .collect();
+    let off = |x: bool, y: bool| LimitChange::PrusaInputShaping {
+        axes: AxisFlags {
+            x,
+            y,
+            z: false,
+            e: false,
+        },
+        shaper_type: Some(2),
+        frequency_hz: Some(0.0),
+        damping_ratio: None,
+        vibration_reduction: None,
+        weight_frequency_delta_hz: None,
+        weight_mass_limit_g: None,
+        save: false,
+    };
+    assert_eq!(changes, [off(true, false), off(false, true)]);
+    let cfg = JobConfig::defaults(Firmware::Prusa).expect("defaults");
+    let mut job = Job::open(&path, cfg).expect("job");
+    job.run_to_end().expect("plans");
+    assert_eq!(job.summary().shaper_changes, 2);
 }

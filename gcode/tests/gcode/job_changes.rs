@@ -306,6 +306,38 @@ fn marlin_and_rrf_shaper_commands_wait_for_a_standstill() {
 }
 
 #[test]
+fn prusa_m593_sets_one_axis_shaper_by_type() {
+    // The MK4's shapers as Prusa ships them, then `M593 X T3 F45 D0.05`: X runs Prusa's
+    // EI at 45 Hz from the standstill the firmware waits for; Y keeps its MZV.
+    let prusa = JobConfig::defaults(Firmware::Prusa).expect("defaults");
+    assert_eq!(
+        prusa.shapers,
+        [setting("mzv", 50.7, 0.1), setting("mzv", 40.6, 0.1), None]
+    );
+    check_switch(
+        "prusa M593",
+        prusa,
+        "G1 X50 F6000\nM593 X T3 F45 D0.05\nG1 X100 Y20\n",
+        "G1 X50 F6000\nM400\nG1 X100 Y20\n",
+        [
+            setting("prusa:ei", 45.0, 0.05),
+            setting("mzv", 40.6, 0.1),
+            None,
+        ],
+        0.0,
+    );
+}
+
+#[test]
+fn marlin_refuses_prusas_m593_t_and_names_prusa() {
+    let err = job_error(Firmware::Marlin, "G1 X10 F6000\nM593 X T2 F0\n");
+    assert!(
+        err.contains("Prusa") && err.contains("--firmware prusa"),
+        "{err}"
+    );
+}
+
+#[test]
 fn bad_shaper_commands_name_their_line() {
     let k = JobConfig::defaults(Firmware::Klipper).expect("defaults");
     let text = "G1 X10 F6000\nSET_INPUT_SHAPER SHAPER_TYPE=bogus SHAPER_FREQ_X=40\n";

@@ -227,7 +227,9 @@ fn arcs_plan_as_the_firmware_cuts_them() {
         assert!(moves.len() > 20, "{fw}: {} segments", moves.len());
         let mut p: Box<dyn FirmwarePlanner> = match &cfg.planner {
             PlannerConfig::Klipper(c) => Box::new(KlipperPlanner::new(*c).expect("c")),
-            PlannerConfig::Marlin(c) => Box::new(MarlinPlanner::new(*c).expect("c")),
+            PlannerConfig::Marlin(c) | PlannerConfig::Prusa(c) => {
+                Box::new(MarlinPlanner::new(*c).expect("c"))
+            }
             PlannerConfig::Rrf(c) => Box::new(RrfPlanner::new(*c).expect("c")),
             PlannerConfig::Grbl(_) | PlannerConfig::Settle(_) => {
                 unreachable!("printer firmwares only")

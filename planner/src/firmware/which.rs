@@ -6,6 +6,11 @@
 //!   [`crate::firmware::marlin`], [`crate::firmware::rrf`]) and shape with their own shaper
 //!   definitions ([`crate::shaper::ShaperType::firmware`]); `rrf` is also written
 //!   `reprapfirmware` or `duet` (RepRapFirmware runs on Duet boards).
+//! - Prusa (`prusa`, also `buddy`): Prusa-Firmware-Buddy, the Marlin derivative of Prusa's
+//!   MK4, MK4S, MINI, XL and CORE One. It plans as Marlin does (classic jerk, the same
+//!   look-ahead), runs each block as a trapezoid in continuous time (its precise stepping,
+//!   [`crate::firmware::marlin::MarlinStepper::PreciseStepping`]) and shapes X, Y and Z
+//!   with Klipper's shapers, chosen by `M593 T`.
 //! - GRBL (gnea/grbl 1.1, and grblHAL, which plans the same way) runs CNC mills and
 //!   lasers: its planner is [`crate::firmware::grbl`].
 //! - `settle` is settle's own jerk-limited look-ahead ([`crate::path`]): it plans G-code
@@ -23,6 +28,8 @@ pub enum Firmware {
     Klipper,
     /// Marlin.
     Marlin,
+    /// Prusa-Firmware-Buddy (Prusa's Marlin derivative).
+    Prusa,
     /// RepRapFirmware.
     Rrf,
     /// GRBL and grblHAL.
@@ -35,9 +42,10 @@ pub enum Firmware {
 
 impl Firmware {
     /// Every firmware, in a fixed order.
-    pub const ALL: [Firmware; 6] = [
+    pub const ALL: [Firmware; 7] = [
         Firmware::Klipper,
         Firmware::Marlin,
+        Firmware::Prusa,
         Firmware::Rrf,
         Firmware::Grbl,
         Firmware::Settle,
@@ -45,9 +53,10 @@ impl Firmware {
     ];
 
     /// Those that plan G-code jobs.
-    pub const GCODE: [Firmware; 5] = [
+    pub const GCODE: [Firmware; 6] = [
         Firmware::Klipper,
         Firmware::Marlin,
+        Firmware::Prusa,
         Firmware::Rrf,
         Firmware::Grbl,
         Firmware::Settle,
@@ -55,19 +64,21 @@ impl Firmware {
 
     /// Those that plan a printer's G-code (an extruder `E`, slicer files): all of
     /// [`Firmware::GCODE`] but GRBL.
-    pub const PRINTERS: [Firmware; 4] = [
+    pub const PRINTERS: [Firmware; 5] = [
         Firmware::Klipper,
         Firmware::Marlin,
+        Firmware::Prusa,
         Firmware::Rrf,
         Firmware::Settle,
     ];
 
     /// Its name, as [`Firmware::parse`] reads it and outputs write it (`klipper`,
-    /// `marlin`, `rrf`, `settle`, `tmc4361a`).
+    /// `marlin`, `prusa`, `rrf`, `settle`, `tmc4361a`).
     pub fn name(self) -> &'static str {
         match self {
             Firmware::Klipper => "klipper",
             Firmware::Marlin => "marlin",
+            Firmware::Prusa => "prusa",
             Firmware::Rrf => "rrf",
             Firmware::Grbl => "grbl",
             Firmware::Settle => "settle",
@@ -76,12 +87,13 @@ impl Firmware {
     }
 
     /// A firmware by name (any case): its [`Firmware::name`], or `reprapfirmware` or
-    /// `duet` for RepRapFirmware, `grblhal` for GRBL.
+    /// `duet` for RepRapFirmware, `grblhal` for GRBL, `buddy` for Prusa.
     pub fn parse(name: &str) -> Option<Self> {
         let lower = name.to_ascii_lowercase();
         match lower.as_str() {
             "reprapfirmware" | "duet" => Some(Firmware::Rrf),
             "grblhal" => Some(Firmware::Grbl),
+            "buddy" => Some(Firmware::Prusa),
             n => Self::ALL.into_iter().find(|f| f.name() == n),
         }
     }
@@ -131,6 +143,8 @@ mod tests {
         assert_eq!(Firmware::parse("duet"), Some(Firmware::Rrf));
         assert_eq!(Firmware::parse("RepRapFirmware"), Some(Firmware::Rrf));
         assert_eq!(Firmware::parse("grblHAL"), Some(Firmware::Grbl));
+        assert_eq!(Firmware::parse("Buddy"), Some(Firmware::Prusa));
+        assert_eq!(Firmware::parse("prusa"), Some(Firmware::Prusa));
         assert_eq!(Firmware::parse("linuxcnc"), None);
         let only = [Firmware::Klipper, Firmware::Rrf];
         assert_eq!(

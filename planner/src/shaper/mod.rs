@@ -13,7 +13,10 @@
 //! - `marlin:...` are Marlin FT_MOTION's (Marlin/src/module/ft_motion/shaping.cpp), with
 //!   impulse times rounded to its trajectory rate `FTM_FS`;
 //! - `rrf:...` are RepRapFirmware M593's (src/Movement/AxisShaper.cpp), with delays rounded
-//!   to the step clock.
+//!   to the step clock;
+//! - `prusa:...` are Prusa-Firmware-Buddy's EI family
+//!   (lib/Marlin/Marlin/src/feature/input_shaper/input_shaper.cpp), Klipper's earlier
+//!   closed forms; Buddy's ZV, ZVD and MZV are Klipper's own.
 //!
 //! The shaped profile is again a [`crate::Profile`]: between consecutive shifted breakpoints every
 //! copy has constant jerk, so the sum does too; acceleration jumps (trapezoids) stay jumps.
@@ -23,6 +26,7 @@ mod klipper;
 mod marlin;
 mod mzv_solve;
 mod name;
+mod prusa;
 mod response;
 mod rrf;
 mod shaper_type;
@@ -33,7 +37,7 @@ mod tests;
 pub use response::{remaining_vibration, smoothing_mm};
 pub use shaper_type::{
     KLIPPER_DEFAULT_DAMPING_RATIO, KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL, MarlinShaper,
-    RRF_STEP_CLOCK_HZ, RrfShaper, ShaperType,
+    PRUSA_V_TOL, PrusaShaper, RRF_STEP_CLOCK_HZ, RrfShaper, ShaperType,
 };
 
 use crate::PlanError;
@@ -78,6 +82,9 @@ impl Shaper {
     ///   `0.01..1` (M493 `I` allows 1.0, where the firmware divides by zero). Default 0.1.
     /// - RepRapFirmware: `frequency_hz` in `step_clock / 131070 ..= 1000` (M593 `F`; 5.72
     ///   Hz on Duet 3), `damping_ratio` in `0..=0.99` (M593 `S`). Default 0.05 (3.6 line).
+    /// - Prusa (its EI family): `damping_ratio` below 1 (`input_shaper::get` halts the
+    ///   printer otherwise), `v_tol` above 0 (M593 `R` > 0). Default damping 0.1. Its
+    ///   `M593 F` clamp to 10..=100 Hz (150 on the MINI) is the caller's.
     pub fn new(kind: ShaperType, frequency_hz: f64, damping_ratio: f64) -> Result<Self, PlanError> {
         if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
             return Err(PlanError::NonFinite {
@@ -114,6 +121,18 @@ impl Shaper {
                     return Err(out_of("v_tol (M493 Q)", 0.0, 1.0, v_tol));
                 }
                 marlin::impulses(shaper, frequency_hz, damping_ratio, v_tol, ftm_fs_hz)
+            }
+            ShaperType::Prusa { shaper, v_tol } => {
+                if damping_ratio >= 1.0 {
+                    return Err(invalid(
+                        kind,
+                        format!("damping_ratio must be below 1, got {damping_ratio}"),
+                    ));
+                }
+                if !(v_tol.is_finite() && v_tol > 0.0) {
+                    return Err(out_of("v_tol", 0.0, f64::INFINITY, v_tol));
+                }
+                prusa::impulses(shaper, frequency_hz, damping_ratio, v_tol)
             }
             ShaperType::Rrf {
                 shaper,

@@ -12,12 +12,14 @@
 //!   family only, M493 `Q`, 0..=1) and `ftm_fs` (the trajectory rate `FTM_FS`, Hz).
 //! - RepRapFirmware M593: `rrf:zvd`, `rrf:zvdd`, `rrf:zvddd`, `rrf:mzv`, `rrf:ei2`,
 //!   `rrf:ei3`; parameter `step_clock` (Hz).
+//! - Prusa-Firmware-Buddy M593 `T3`..`T5`: `prusa:ei`, `prusa:2hump_ei`, `prusa:3hump_ei`;
+//!   parameter `v_tol` (`1 / R`, > 0). Its `T0`..`T2` are Klipper's `zv`, `zvd`, `mzv`.
 //!
 //! Names are case-insensitive and spaces around parts are ignored.
 
 use super::shaper_type::{
-    KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL, MarlinShaper, RRF_STEP_CLOCK_HZ, RrfShaper,
-    ShaperType,
+    KLIPPER_V_TOL, MARLIN_FTM_FS_HZ, MARLIN_V_TOL, MarlinShaper, PRUSA_V_TOL, PrusaShaper,
+    RRF_STEP_CLOCK_HZ, RrfShaper, ShaperType,
 };
 use crate::PlanError;
 
@@ -170,6 +172,7 @@ impl ShaperType {
             None | Some("klipper") => klipper(name, family, &args),
             Some("marlin") => marlin(name, family, &args),
             Some("rrf") => rrf(name, family, &args),
+            Some("prusa") => prusa(name, family, &args),
             Some(_) => Err(unknown(name)),
         }
     }
@@ -271,4 +274,23 @@ fn rrf(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperType, PlanErr
         shaper,
         step_clock_hz,
     })
+}
+
+fn prusa(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperType, PlanError> {
+    let shaper = PrusaShaper::ALL
+        .into_iter()
+        .find(|s| s.name() == family)
+        .ok_or_else(|| unknown(name))?;
+    let v = assign(name, args, &["v_tol"])?;
+    let v_tol = v[0]
+        .map(|s| number(name, "v_tol", s))
+        .transpose()?
+        .unwrap_or(PRUSA_V_TOL);
+    if !(v_tol > 0.0) {
+        return Err(invalid(
+            name,
+            format!("`v_tol` must be > 0 (1 / M593 R), got {v_tol}"),
+        ));
+    }
+    Ok(ShaperType::Prusa { shaper, v_tol })
 }

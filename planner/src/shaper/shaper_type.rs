@@ -4,7 +4,8 @@
 //! shapers of Marlin's FT_MOTION and RepRapFirmware's M593 carry a `marlin:` or `rrf:`
 //! prefix, because the same name means different impulses there (Marlin's MZV decays by the
 //! ZV factor, RepRapFirmware's MZV puts its impulses in the opposite order, both EIs differ
-//! from Klipper's). See [`ShaperType::parse`] for the syntax; `Display` writes the same
+//! from Klipper's). Prusa-Firmware-Buddy's ZV, ZVD and MZV are Klipper's; its EI family
+//! (Klipper's earlier closed forms) carries a `prusa:` prefix. See [`ShaperType::parse`] for the syntax; `Display` writes the same
 //! syntax back, and a Klipper kind's text is what Klipper's `shaper_type` accepts.
 
 use std::fmt;
@@ -119,6 +120,40 @@ impl RrfShaper {
     }
 }
 
+/// Prusa-Firmware-Buddy's EI family (`input_shaper::Type`, `M593 T3`..`T5`,
+/// lib/Marlin/Marlin/src/feature/input_shaper/input_shaper_config.hpp).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PrusaShaper {
+    /// EI (`T3`).
+    Ei,
+    /// Two-hump EI (`T4`).
+    TwoHumpEi,
+    /// Three-hump EI (`T5`).
+    ThreeHumpEi,
+}
+
+impl PrusaShaper {
+    /// Every family, in `M593 T` order.
+    pub const ALL: [PrusaShaper; 3] = [
+        PrusaShaper::Ei,
+        PrusaShaper::TwoHumpEi,
+        PrusaShaper::ThreeHumpEi,
+    ];
+
+    /// The name after `prusa:`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PrusaShaper::Ei => "ei",
+            PrusaShaper::TwoHumpEi => "2hump_ei",
+            PrusaShaper::ThreeHumpEi => "3hump_ei",
+        }
+    }
+}
+
+/// Prusa-Firmware-Buddy's default vibration tolerance of its EI family: `1 / R` with the
+/// `M593 R` default 20 (`vibration_reduction`, input_shaper_config.hpp).
+pub const PRUSA_V_TOL: f64 = 1.0 / 20.0;
+
 /// Klipper's default damping ratio of a shaper (`DEFAULT_DAMPING_RATIO`).
 pub const KLIPPER_DEFAULT_DAMPING_RATIO: f64 = 0.1;
 /// Klipper's default vibration tolerance of `ei` (`1/SHAPER_VIBRATION_REDUCTION`, 5%).
@@ -164,6 +199,13 @@ pub enum ShaperType {
         v_tol: f64,
         /// Trajectory rate `FTM_FS` (Hz) that impulse times are rounded to.
         ftm_fs_hz: u32,
+    },
+    /// A Prusa-Firmware-Buddy EI shaper (`M593 T3`..`T5`).
+    Prusa {
+        /// The family.
+        shaper: PrusaShaper,
+        /// Vibration tolerance, `1 / R` (`M593 R`, default 20).
+        v_tol: f64,
     },
     /// A RepRapFirmware M593 shaper.
     Rrf {
@@ -218,7 +260,8 @@ impl ShaperType {
         klipper:NAME, mzv(n=N,t=T) or mzv(n=N,tau=TAU) with integer N >= 3, ei(v_tol=V)); \
         marlin:zv, marlin:zvd, marlin:zvdd, marlin:zvddd, marlin:ei, marlin:2hei, \
         marlin:3hei, marlin:mzv (parameters v_tol=V for the EI family, ftm_fs=HZ); \
-        rrf:zvd, rrf:zvdd, rrf:zvddd, rrf:mzv, rrf:ei2, rrf:ei3 (parameter step_clock=HZ)";
+        rrf:zvd, rrf:zvdd, rrf:zvddd, rrf:mzv, rrf:ei2, rrf:ei3 (parameter step_clock=HZ); \
+        prusa:ei, prusa:2hump_ei, prusa:3hump_ei (parameter v_tol=V)";
 
     /// A Marlin shaper with Marlin's defaults.
     pub const fn marlin(shaper: MarlinShaper) -> Self {
@@ -237,10 +280,19 @@ impl ShaperType {
         }
     }
 
-    /// The firmware whose definition this is (Klipper, Marlin or RepRapFirmware).
+    /// A Prusa-Firmware-Buddy EI shaper with its default tolerance.
+    pub const fn prusa(shaper: PrusaShaper) -> Self {
+        ShaperType::Prusa {
+            shaper,
+            v_tol: PRUSA_V_TOL,
+        }
+    }
+
+    /// The firmware whose definition this is (Klipper, Marlin, Prusa or RepRapFirmware).
     pub fn firmware(self) -> Firmware {
         match self {
             ShaperType::Marlin { .. } => Firmware::Marlin,
+            ShaperType::Prusa { .. } => Firmware::Prusa,
             ShaperType::Rrf { .. } => Firmware::Rrf,
             _ => Firmware::Klipper,
         }
@@ -256,7 +308,7 @@ impl ShaperType {
             ShaperType::Zvd | ShaperType::Ei { .. } => Some(29.0),
             ShaperType::TwoHumpEi => Some(39.0),
             ShaperType::ThreeHumpEi => Some(48.0),
-            ShaperType::Marlin { .. } | ShaperType::Rrf { .. } => None,
+            ShaperType::Marlin { .. } | ShaperType::Prusa { .. } | ShaperType::Rrf { .. } => None,
         }
     }
 
@@ -278,6 +330,11 @@ impl ShaperType {
                 MarlinShaper::TwoHei => "marlin:2hei",
                 MarlinShaper::ThreeHei => "marlin:3hei",
                 MarlinShaper::Mzv => "marlin:mzv",
+            },
+            ShaperType::Prusa { shaper, .. } => match shaper {
+                PrusaShaper::Ei => "prusa:ei",
+                PrusaShaper::TwoHumpEi => "prusa:2hump_ei",
+                PrusaShaper::ThreeHumpEi => "prusa:3hump_ei",
             },
             ShaperType::Rrf { shaper, .. } => match shaper {
                 RrfShaper::Zvd => "rrf:zvd",
@@ -322,6 +379,9 @@ impl fmt::Display for ShaperType {
                 if ftm_fs_hz != MARLIN_FTM_FS_HZ {
                     params.push(format!("ftm_fs={ftm_fs_hz}"));
                 }
+            }
+            ShaperType::Prusa { v_tol, .. } if v_tol != PRUSA_V_TOL => {
+                params.push(format!("v_tol={v_tol}"));
             }
             ShaperType::Rrf { step_clock_hz, .. } if step_clock_hz != RRF_STEP_CLOCK_HZ => {
                 params.push(format!("step_clock={step_clock_hz}"));

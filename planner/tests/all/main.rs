@@ -11,6 +11,7 @@ mod firmware_grbl;
 mod firmware_klipper;
 mod firmware_marlin;
 mod firmware_profiles;
+mod firmware_prusa;
 mod firmware_rrf;
 mod fourjerk;
 mod fourjerk_check;

@@ -199,7 +199,7 @@ pub fn job_config(run: &RunSpec, job: &GcodeJob, shaper: Option<ShaperSetting>) 
             c.max_velocity_m_s = v;
             c.max_accel_m_s2 = a;
         }
-        PlannerConfig::Marlin(c) => {
+        PlannerConfig::Marlin(c) | PlannerConfig::Prusa(c) => {
             for i in 0..3 {
                 c.max_feedrate_m_s[i] = v;
                 c.max_accel_m_s2[i] = a;

@@ -237,7 +237,7 @@ impl GcodeOptions {
                 let notes = c.notes.iter().map(ToString::to_string).collect();
                 (job, notes, c.files)
             }
-            Firmware::Settle | Firmware::Tmc4361a => {
+            Firmware::Prusa | Firmware::Settle | Firmware::Tmc4361a => {
                 return Err(Error::input_key(
                     &config,
                     "--config",
@@ -940,7 +940,7 @@ pub fn config_settings(job: &JobConfig) -> String {
             g.junction_deviation_mm,
             u8::from(g.laser_mode)
         ),
-        PlannerConfig::Marlin(c) => {
+        PlannerConfig::Marlin(c) | PlannerConfig::Prusa(c) => {
             use settle_planner::firmware::marlin::MarlinJerk;
             let corner = match c.jerk {
                 MarlinJerk::JunctionDeviation { deviation_m, .. } => {

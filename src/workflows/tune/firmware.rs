@@ -17,7 +17,7 @@
 
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
-use settle_planner::shaper::ShaperType;
+use settle_planner::shaper::{PrusaShaper, ShaperType};
 
 /// The firmwares `settle tune` searches for (and exports to): Klipper, Marlin,
 /// RepRapFirmware and the TMC4361A.
@@ -124,7 +124,13 @@ impl Candidates {
     pub fn kinds(self) -> Vec<ProfileKind> {
         match self.0 {
             None | Some(Firmware::Settle) => ProfileKind::ALL.to_vec(),
-            Some(Firmware::Klipper | Firmware::Marlin | Firmware::Rrf | Firmware::Grbl) => {
+            Some(
+                Firmware::Klipper
+                | Firmware::Marlin
+                | Firmware::Prusa
+                | Firmware::Rrf
+                | Firmware::Grbl,
+            ) => {
                 vec![ProfileKind::Trapezoid]
             }
             Some(Firmware::Tmc4361a) => vec![ProfileKind::SCurve, ProfileKind::FourJerk],
@@ -141,6 +147,12 @@ impl Candidates {
                 MarlinShaping::InputShaping => vec![ShaperType::Zv],
             },
             Some(Firmware::Rrf) => ShaperType::RRF.to_vec(),
+            // M593 T0..T5: Klipper's ZV, ZVD and MZV, and Prusa's EI family.
+            Some(Firmware::Prusa) => {
+                let mut all = vec![ShaperType::Zv, ShaperType::Zvd, ShaperType::MZV];
+                all.extend(PrusaShaper::ALL.map(ShaperType::prusa));
+                all
+            }
             // GRBL has no input shaper.
             Some(Firmware::Tmc4361a | Firmware::Grbl) => Vec::new(),
         }
@@ -172,6 +184,7 @@ impl Candidates {
             None => true,
             Some(Firmware::Tmc4361a) => false,
             Some(Firmware::Marlin) if self.1 == MarlinShaping::InputShaping => k == ShaperType::Zv,
+            Some(Firmware::Prusa) => self.shapers().contains(&k),
             Some(f) => k.firmware() == f,
         };
         if ok {

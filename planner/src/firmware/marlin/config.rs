@@ -35,6 +35,20 @@ pub enum JdSmallSegments {
     LookupTable,
 }
 
+/// What runs a planned block: how its entry, cruise and exit speeds become motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MarlinStepper {
+    /// Marlin's stepper (stepper.cpp): step rates fixed by `calculate_trapezoid_for_block`
+    /// (rounded, raised to `MINIMAL_STEP_RATE`), phases ended at step counts.
+    Stepper,
+    /// Prusa-Firmware-Buddy's precise stepping
+    /// (lib/Marlin/Marlin/src/feature/precise_stepping/precise_stepping.cpp,
+    /// `append_move_segments_to_queue`): the block's entry, nominal and exit speeds and
+    /// acceleration in mm, a trapezoid in continuous time, no step-rate rounding and no
+    /// minimal step rate.
+    PreciseStepping,
+}
+
 /// Marlin's motion settings (Configuration.h, changed by M92, M201, M203, M204, M205).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MarlinConfig {
@@ -74,6 +88,8 @@ pub struct MarlinConfig {
     pub minimal_step_rate_hz: f64,
     /// Blocks queued before the stepper takes the first one after an empty queue (3).
     pub first_block_after: usize,
+    /// What runs the planned blocks (Marlin's stepper).
+    pub stepper: MarlinStepper,
 }
 
 impl MarlinConfig {
@@ -104,6 +120,38 @@ impl MarlinConfig {
             minimum_planner_speed_m_s: 0.05e-3,
             minimal_step_rate_hz: 120.0,
             first_block_after: 3,
+            stepper: MarlinStepper::Stepper,
+        }
+    }
+
+    /// A Prusa MK4 / MK4S as Prusa-Firmware-Buddy ships it (include/marlin/Configuration_MK4.h
+    /// and Configuration_MK4_adv.h): 100/100/400/380 steps/mm planned in mini-steps of a
+    /// quarter step (`PLANNER_STEPS_MULTIPLIER` 4, lib/Marlin/Marlin/src/module/planner.h;
+    /// so 400/400/1600/1520 per mm, and `MIN_STEPS_PER_SEGMENT` 6 steps is 24), 300/300/40/50
+    /// mm/s (`DEFAULT_MAX_FEEDRATE` 400/400/40/50 capped by `HWLIMIT_NORMAL_MAX_FEEDRATE`
+    /// 300/300/40/100, `Planner::apply_settings`), 1250/1250/200/1500 mm/s^2,
+    /// print and travel 1250 mm/s^2, retract 800 mm/s^2, classic jerk 8/8/2/5 mm/s,
+    /// minimum feed rates 0, `M205 B` 20 ms, a 32-block buffer, `MINIMUM_PLANNER_SPEED`
+    /// 0.05 mm/s, trapezoids run by precise stepping. `SLOWDOWN` is off here: Buddy slows
+    /// short blocks only while its command queue holds 3 commands or fewer
+    /// (`Planner::_populate_block`), and printing from a file it holds more.
+    pub fn prusa_mk4() -> Self {
+        Self {
+            steps_per_m: [400e3, 400e3, 1600e3, 1520e3],
+            max_feedrate_m_s: [0.3, 0.3, 0.04, 0.05],
+            max_accel_m_s2: [1.25, 1.25, 0.2, 1.5],
+            print_accel_m_s2: 1.25,
+            retract_accel_m_s2: 0.8,
+            travel_accel_m_s2: 1.25,
+            slowdown: false,
+            jerk: MarlinJerk::Classic {
+                max_jerk_m_s: [8e-3, 8e-3, 2e-3, 5e-3],
+                travel_extra_xy_jerk_m_s: 0.0,
+            },
+            block_buffer_size: 32,
+            min_steps_per_segment: 24,
+            stepper: MarlinStepper::PreciseStepping,
+            ..Self::new()
         }
     }
 

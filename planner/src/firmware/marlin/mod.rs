@@ -41,5 +41,5 @@ mod config;
 mod planner;
 mod trapezoid;
 
-pub use config::{JdSmallSegments, MarlinConfig, MarlinJerk};
+pub use config::{JdSmallSegments, MarlinConfig, MarlinJerk, MarlinStepper};
 pub use planner::MarlinPlanner;

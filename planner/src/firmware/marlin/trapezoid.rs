@@ -9,7 +9,7 @@
 //! last step. Each phase here is that law in continuous time, ended at its step count.
 
 use super::block::Block;
-use super::config::MarlinConfig;
+use super::config::{MarlinConfig, MarlinStepper};
 use crate::firmware::{Phase, PlannedMove, RampShape};
 
 /// The trapezoid of `b` for entry and exit speeds `entry_speed`, `exit_speed` (m/s), as
@@ -20,6 +20,9 @@ pub(super) fn plan_block(
     exit_speed: f64,
     cfg: &MarlinConfig,
 ) -> PlannedMove {
+    if cfg.stepper == MarlinStepper::PreciseStepping {
+        return precise(b, entry_speed, exit_speed);
+    }
     let n = b.step_event_count;
     let rn = b.nominal_rate.max(1.0);
     let nomr = 1.0 / b.nominal_speed_sqr.sqrt();
@@ -79,6 +82,66 @@ pub(super) fn plan_block(
     p.cruise_t_s = cruise.duration_s;
     p.decel_t_s = dec.ramp.duration_s + dec.hold.duration_s;
     p.s_curve = cfg.s_curve;
+    p
+}
+
+/// Distances below this are none (`EPSILON_DISTANCE`, 1e-6 mm, precise_stepping.hpp), m.
+const EPSILON_DISTANCE_M: f64 = 1e-9;
+
+/// Prusa-Firmware-Buddy's precise stepping (`append_move_segments_to_queue`,
+/// lib/Marlin/Marlin/src/feature/precise_stepping/precise_stepping.cpp): the block's
+/// `initial_speed`, `nominal_speed`, `final_speed` and `acceleration` as they are, up
+/// to the nominal speed, on at it, down to the exit; a block too short to reach it
+/// turns where the two ramps meet. Distances under `EPSILON_DISTANCE` are none.
+fn precise(b: &Block, start_v: f64, end_v: f64) -> PlannedMove {
+    let (l, a) = (b.millimeters, b.acceleration);
+    let mut cruise_v = b.nominal_speed_sqr.sqrt();
+    let to_cruise = |from: f64, cruise: f64| {
+        let d = (cruise * cruise - from * from) / (2.0 * a);
+        if d < EPSILON_DISTANCE_M { 0.0 } else { d }
+    };
+    let mut accel_d = to_cruise(start_v, cruise_v);
+    let mut decel_d = to_cruise(end_v, cruise_v);
+    let mut cruise_d = l - accel_d - decel_d;
+    if cruise_d < EPSILON_DISTANCE_M {
+        let meet = (2.0 * l * a + end_v * end_v - start_v * start_v) / (4.0 * a);
+        accel_d = if meet <= EPSILON_DISTANCE_M {
+            0.0
+        } else if meet > l - EPSILON_DISTANCE_M {
+            l
+        } else {
+            meet
+        };
+        decel_d = (l - accel_d).max(0.0);
+        cruise_d = 0.0;
+        cruise_v = (2.0 * accel_d * a + start_v * start_v).sqrt();
+    }
+    let acc = if accel_d != 0.0 {
+        Phase::linear((cruise_v - start_v) / a, start_v, a)
+    } else {
+        Phase::constant(0.0, start_v)
+    };
+    let cruise = if cruise_d != 0.0 {
+        Phase::constant(cruise_d / cruise_v, cruise_v)
+    } else {
+        Phase::constant(0.0, cruise_v)
+    };
+    let dec = if decel_d != 0.0 {
+        Phase::linear((cruise_v - end_v) / a, cruise_v, -a)
+    } else {
+        Phase::constant(0.0, cruise_v)
+    };
+    let phases = [acc, cruise, dec];
+    let mut p = PlannedMove::new(b.seq, b.start_m, b.axes_r, l, &phases);
+    p.start_speed_m_s = start_v;
+    p.cruise_speed_m_s = cruise_v;
+    p.end_speed_m_s = if decel_d != 0.0 { end_v } else { cruise_v };
+    p.accel_m_s2 = a;
+    p.decel_m_s2 = a;
+    p.accel_t_s = acc.duration_s;
+    p.cruise_t_s = cruise.duration_s;
+    p.decel_t_s = dec.duration_s;
+    p.s_curve = false;
     p
 }
 
