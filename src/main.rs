@@ -445,8 +445,15 @@ struct OutputFlags {
 fn main() -> ExitCode {
     match dispatch(Cli::parse().command) {
         Ok(report) => {
-            print!("{}", report.stdout);
+            // A reader that stops early (`settle machine printer_xy | head -1`) closes the
+            // pipe: an I/O failure named once (exit 1, as `settle plan` has it), not a
+            // panic of `print!`.
+            let written = write_stdout(&report.stdout);
             eprint!("{}", report.stderr);
+            if let Err(e) = written {
+                eprintln!("error: cannot write stdout: {e}");
+                return ExitCode::from(1);
+            }
             ExitCode::from(match report.exit {
                 Exit::Ok | Exit::RunsFailed => 0,
                 Exit::Failed => 1,
@@ -458,6 +465,14 @@ fn main() -> ExitCode {
             ExitCode::from(if e.is_input_error() { 2 } else { 1 })
         }
     }
+}
+
+/// A report's standard output, written and flushed.
+fn write_stdout(text: &str) -> std::io::Result<()> {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())?;
+    out.flush()
 }
 
 /// A progress bar on stderr (drawn only when stderr is a terminal), fed by the workflows'

@@ -170,7 +170,9 @@ impl LinearResponse {
             bv[n + i] = minv[i] * (lin.bc[i] - cg[i]);
         }
         // Eigenvalues, then eigenvectors by inverse iteration on (A - lambda I).
-        let lambda: Vec<C> = a.complex_eigenvalues().iter().copied().collect();
+        let lambda: Vec<C> = crate::numerics::eigenvalues(&a).ok_or_else(|| {
+            unsupported("the eigenvalues of its linearised model do not converge (parts that differ by hundreds of orders of magnitude: check their units)")
+        })?;
         let ac: DMatrix<C> = a.map(C::from);
         let dim = 2 * n;
         let mut v = DMatrix::<C>::zeros(dim, dim);

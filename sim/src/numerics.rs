@@ -43,3 +43,18 @@ pub fn start_equilibrium(
         }
     }
 }
+
+/// Most QR iterations [`eigenvalues`] allows per row of the matrix: a well-posed axis
+/// converges in a few per eigenvalue.
+const SCHUR_ITERATIONS_PER_ROW: usize = 1000;
+
+/// The eigenvalues of `a` (nalgebra's real Schur form, as `complex_eigenvalues` computes
+/// them), or `None` when its QR iteration does not converge: nalgebra's
+/// `complex_eigenvalues` iterates without a bound and never returns on a model whose
+/// parts differ by hundreds of orders of magnitude (a mount stiffness of 1e308 N/m).
+pub fn eigenvalues(a: &nalgebra::DMatrix<f64>) -> Option<Vec<nalgebra::Complex<f64>>> {
+    let n = a.nrows();
+    let max_niter = SCHUR_ITERATIONS_PER_ROW * n.max(1);
+    nalgebra::linalg::Schur::try_new(a.clone(), f64::EPSILON, max_niter)
+        .map(|s| s.complex_eigenvalues().iter().copied().collect())
+}

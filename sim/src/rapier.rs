@@ -158,10 +158,14 @@ pub fn fastest_rate(axis: &AxisModel, start_m: f64) -> Result<f64, SimError> {
             a[(n + i, n + j)] = -lin.c[(i, j)] / lin.m[(i, i)];
         }
     }
-    Ok(a.complex_eigenvalues()
-        .iter()
-        .map(|l| l.norm())
-        .fold(0.0, f64::max))
+    let lambda = crate::numerics::eigenvalues(&a).ok_or_else(|| SimError::Unsupported {
+        backend: "rapier",
+        reason: format!(
+            "axis `{}`: the eigenvalues of its linearised model do not converge (parts that differ by hundreds of orders of magnitude: check their units)",
+            axis.name
+        ),
+    })?;
+    Ok(lambda.iter().map(|l| l.norm()).fold(0.0, f64::max))
 }
 
 /// Insert an axis's bodies into the world at coordinates `q` (m, rad), at rest.

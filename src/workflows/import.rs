@@ -477,7 +477,9 @@ pub fn tune_accels(current: f64, top: Option<f64>) -> Vec<f64> {
             ACCEL_SCALES_ABOVE
                 .iter()
                 .map(|k| (current * k / 100.0).floor() * 100.0)
-                .filter(|a| *a < top),
+                // Under 100 mm/s^2 (a max_accel given in m/s^2) a multiple rounds down
+                // to 0, which `settle tune` refuses.
+                .filter(|a| *a > 0.0 && *a < top),
         );
         v.push(top);
     }

@@ -12,12 +12,12 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use settle_planner::{Profile, State};
-use settle_sim::DriverMode;
 use settle_sim::closed_form::LinearResponse;
+use settle_sim::{AxisModel, DriverMode};
 
 use crate::error::Error;
 use crate::input::machine_form::MachineForm;
-use crate::input::modes::AxisModes;
+use crate::input::modes::{AxisModes, MAX_FREQUENCY_HZ};
 use crate::workflows::{Exit, Report};
 
 /// Modes below this frequency (Hz) are the rigid motion, not a vibration: not listed.
@@ -118,6 +118,7 @@ fn of_form(name: &str, source: &Path, form: MachineForm) -> Result<MachineModes,
             for axis in m.compile(DriverMode::Linear).map_err(sim_err)? {
                 let rest = Profile::empty(State::default());
                 let lr = LinearResponse::new(&axis, &rest).map_err(sim_err)?;
+                trustworthy(source, &axis, &lr)?;
                 let modes = lr
                     .weighted_modes()
                     .into_iter()
@@ -139,6 +140,49 @@ fn of_form(name: &str, source: &Path, form: MachineForm) -> Result<MachineModes,
         linearised,
         axes,
     })
+}
+
+/// Refuses modes settle cannot stand behind: a linearised axis with a natural frequency
+/// above any mode a machine may have ([`MAX_FREQUENCY_HZ`]; a sweep would need a sample
+/// rate past it), or a pole that grows (a negative damping ratio) or is not a number.
+/// Parts in the wrong unit (a rotor inertia in kg m^2, 1e7 times too small) make the model
+/// so stiff that its eigenvalues lose their digits: the slow modes come out with negative
+/// damping, and the fast one, overdamped, is not listed at all.
+fn trustworthy(source: &Path, axis: &AxisModel, lr: &LinearResponse) -> Result<(), Error> {
+    let sim_err = |e: settle_sim::SimError| Error::input(source, e.to_string());
+    let q = axis.lumped.equilibrium(0.0, None).map_err(sim_err)?;
+    let fastest_hz = axis
+        .lumped
+        .natural_frequencies_hz(&q)
+        .into_iter()
+        .fold(0.0, |a: f64, f| {
+            if a.is_nan() || f.is_nan() {
+                f64::NAN
+            } else {
+                a.max(f)
+            }
+        });
+    let grows = lr
+        .poles()
+        .iter()
+        .any(|l| !(l.re <= 0.0 && l.im.is_finite()));
+    if fastest_hz.is_nan() || fastest_hz > MAX_FREQUENCY_HZ || grows {
+        let what = if grows {
+            "a mode with a negative damping ratio".to_string()
+        } else {
+            format!(
+                "a mode at {fastest_hz:.4e} Hz, above the {MAX_FREQUENCY_HZ} Hz a machine's mode may have"
+            )
+        };
+        return Err(Error::input(
+            source,
+            format!(
+                "axis `{}`: the linearised model has {what}: settle cannot resolve its modes; check the units of its parts (motor.rotor_inertia_g_cm2 in g cm^2, 54 for a NEMA 17, not kg m^2; stiffnesses in N/m; masses in kg)",
+                axis.name
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn as_given(axes: &[AxisModes]) -> Vec<(String, Vec<ModeRow>)> {

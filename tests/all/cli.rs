@@ -426,3 +426,25 @@ fn without_the_feature_rerun_is_a_clear_error() {
     assert!(err.contains("--features rerun"), "{err}");
     assert!(!out.join("runs.csv").exists(), "nothing was run");
 }
+
+/// A reader that stops before the output ends (`settle machine printer_xy | head -1`)
+/// closes the pipe: the command names the failed write and exits 1, never a panic (101).
+#[test]
+fn a_closed_standard_output_is_an_io_failure_not_a_panic() {
+    let mut child = settle()
+        .args(["machine", "printer_xy"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("settle runs");
+    // No reader: every write to the pipe fails.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("settle ends");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("error: cannot write stdout: Broken pipe"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+}

@@ -337,3 +337,30 @@ fn real_configurations_import_with_their_owners_shapers() {
         );
     }
 }
+
+/// A configuration whose acceleration is under 100 mm/s^2 (`max_accel: 3`, written in
+/// m/s^2) gets a search `settle tune` takes: no acceleration above it rounds down to 0.
+#[test]
+fn a_tiny_acceleration_searches_no_zero() {
+    for current in [3.0, 60.0, 99.0] {
+        let v = settle::workflows::import::tune_accels(current, Some(10_800.0));
+        assert!(v.iter().all(|a| *a > 0.0), "{current}: {v:?}");
+        assert!(v.contains(&current), "{current}: {v:?}");
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cfg = dir.path().join("printer.cfg");
+    std::fs::write(
+        &cfg,
+        "[printer]\nkinematics: cartesian\nmax_velocity: 0.3\nmax_accel: 3\n",
+    )
+    .expect("write");
+    let out = dir.path().join("p.toml");
+    import(&opts(Firmware::Klipper, cfg, &out)).expect("imports");
+    let (sc, _) = settle::load_runs(&out).expect("loads");
+    let accels = sc
+        .tune
+        .as_ref()
+        .and_then(|t| t.accelerations_mm_s2.clone())
+        .expect("[tune] accelerations_mm_s2");
+    assert!(accels.iter().all(|a| *a > 0.0), "{accels:?}");
+}

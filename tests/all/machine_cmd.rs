@@ -123,3 +123,52 @@ fn the_modes_ranges_keep_what_settle_resolves_and_identify_writes() {
     // settle identify's resonance tests start at 1 Hz at the lowest.
     const { assert!(MIN_FREQUENCY_HZ < settle::workflows::identify::FREQ_MIN_HZ) };
 }
+
+/// A physical machine whose parts are in the wrong unit has no modes settle can stand
+/// behind: a rotor inertia in kg m^2 (5.4e-6 for 54 g cm^2) puts the rotor's mode near
+/// 1 MHz, which was dropped from the list while the others were printed as if sound; a
+/// mount stiffness of 1e308 N/m made the eigenvalue iteration run forever. Both exit 2,
+/// at once, naming the file and the units to check.
+#[test]
+fn parts_in_the_wrong_unit_are_refused_not_listed() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let preset = settle::input::machine_file::PRESETS[0].2;
+    for (name, from, to, says) in [
+        (
+            "kg_m2.toml",
+            "rotor_inertia_g_cm2 = 54.0",
+            "rotor_inertia_g_cm2 = 5.4e-6",
+            "above the 50000 Hz a machine's mode may have",
+        ),
+        (
+            "stiff.toml",
+            "stiffness_n_per_m = 5.0e5",
+            "stiffness_n_per_m = 1e308",
+            "the eigenvalues of its linearised model do not converge",
+        ),
+    ] {
+        assert!(preset.contains(from), "{from}");
+        let path = dir.path().join(name);
+        std::fs::write(&path, preset.replacen(from, to, 1)).expect("write");
+        let mut child = settle()
+            .arg("machine")
+            .arg(&path)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("settle runs");
+        let start = std::time::Instant::now();
+        while child.try_wait().expect("waits").is_none() {
+            if start.elapsed().as_secs() > 30 {
+                let _ = child.kill();
+                panic!("{name}: still running after 30 s");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let out = child.wait_with_output().expect("ends");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(name) && err.contains(says), "{name}: {err}");
+        assert!(err.contains("check"), "{name}: {err}");
+    }
+}

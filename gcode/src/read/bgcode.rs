@@ -42,6 +42,12 @@ use std::io::{self, BufRead, Read};
 /// The largest G-code text a binary file may decode to: the limit on a G-code file.
 pub const MAX_TEXT: u64 = settle_files::limit::GCODE.bytes;
 
+/// The largest G-code or file metadata block, stored or decompressed (64 MiB): a block is
+/// held in memory whole while it is decoded, so a small file whose block claims gigabytes
+/// (a decompression bomb) is refused before anything is allocated. PrusaSlicer's blocks
+/// hold tens of KiB (the two test files' largest, gcode/prints/bgcode: 38 KB).
+pub const MAX_BLOCK: u64 = 64 << 20;
+
 /// Why a binary G-code file cannot be read, at a byte offset of the file.
 #[derive(Debug)]
 pub struct BgcodeError {
@@ -245,6 +251,16 @@ impl<R: Read> Bgcode<R> {
                     self.max_text
                 ),
             ));
+        }
+        for (bytes, what) in [(size, "decompressed"), (stored, "stored")] {
+            if u64::from(bytes) > MAX_BLOCK {
+                return Err(bad(
+                    at + if what == "stored" { 8 } else { 4 },
+                    format!(
+                        "a block of {bytes} bytes {what}, past the {MAX_BLOCK} bytes (64 MiB) a block may hold"
+                    ),
+                ));
+            }
         }
         // The stored data, allocated as it is read (a short file cannot make it large).
         let mut data = Vec::new();

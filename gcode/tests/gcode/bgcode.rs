@@ -201,6 +201,32 @@ fn a_hand_made_file_reads_and_damage_is_refused_with_its_offset() {
     assert!(refused(&version).contains("byte 4: version 2 (allowed: 1)"));
 }
 
+/// A block is held whole while it is decoded: one that claims more than 64 MiB
+/// decompressed (a few MiB of deflate can hold gigabytes of G-code) or stored is refused
+/// before it is read, however much of the file's text bound is left.
+#[test]
+fn a_block_past_64_mib_is_refused_before_decompressing_it() {
+    let mut f = one_block(1, b"G1 X1\n");
+    f[14..18].copy_from_slice(&((64u32 << 20) + 1).to_le_bytes());
+    let e = refused(&f);
+    assert!(
+        e.contains("byte 14: a block of 67108865 bytes decompressed, past the 67108864 bytes (64 MiB) a block may hold"),
+        "{e}"
+    );
+    let mut f = one_block(1, b"G1 X1\n");
+    f[18..22].copy_from_slice(&((64u32 << 20) + 1).to_le_bytes());
+    let e = refused(&f);
+    assert!(
+        e.contains("byte 18: a block of 67108865 bytes stored, past the 67108864 bytes"),
+        "{e}"
+    );
+    // At the bound, the block is read (and here found short).
+    let mut f = one_block(0, b"G1 X1\n");
+    f[14..18].copy_from_slice(&(64u32 << 20).to_le_bytes());
+    let e = refused(&f);
+    assert!(e.contains("truncated"), "{e}");
+}
+
 /// A block's declared size is checked against the bound before anything is allocated:
 /// a block of 4 GiB - 1 in a file of 30 bytes.
 #[test]

@@ -1,7 +1,8 @@
 //! Klipper's suggested maximum acceleration (`find_shaper_max_accel`, `_bisect`): the
 //! largest acceleration whose smoothing stays within a target (Klipper's 0.12 mm,
 //! [`super::TARGET_SMOOTHING_MM`]), by doubling and bisection to 1e-8 mm/s^2, in the same
-//! steps as the Python.
+//! steps as the Python (and no further than two neighbouring doubles, where the Python
+//! would loop forever).
 
 use crate::shaper::smoothing_mm;
 
@@ -24,6 +25,12 @@ pub fn max_accel_mm_s2(amplitudes: &[f64], times_s: &[f64], scv_mm_s: f64, targe
     }
     while right - left > 1e-8 {
         let middle = (left + right) * 0.5;
+        // Past about 6e7 mm/s^2 (a shaper of a few kHz) no double lies between two
+        // neighbours 1e-8 apart: the interval cannot shrink further, and Klipper's
+        // tolerance would loop forever.
+        if middle <= left || middle >= right {
+            break;
+        }
         if ok(middle) {
             left = middle;
         } else {

@@ -275,3 +275,20 @@ fn a_spectrum_without_vibration_is_refused() {
     // A flat but positive spectrum is a spectrum: Klipper chooses on it.
     find_best_shaper(&[flat(1.0)], &opts).expect("a positive spectrum");
 }
+
+/// A shaper of a few kHz (a configuration's `shaper_freq_x: 4660`, the decimal point of
+/// 46.60 lost) allows an acceleration of about 1e9 mm/s^2, where doubles lie further
+/// apart than the bisection's 1e-8 mm/s^2: the search ends at two neighbouring doubles
+/// (it looped forever), and the answer still keeps the smoothing within the target.
+#[test]
+fn max_accel_of_a_khz_shaper_ends() {
+    use settle_planner::shaper::{Shaper, smoothing_mm};
+    use settle_planner::shaper_select::max_accel_mm_s2;
+    for f in [4660.0, 5e4] {
+        let sh = Shaper::new(kinds(&["mzv"])[0], f, 0.1).expect("shaper");
+        let a = max_accel_mm_s2(sh.amplitudes(), sh.times_s(), 5.0, 0.12);
+        assert!(a.is_finite() && a > 1e6, "{f} Hz: {a}");
+        let s = smoothing_mm(sh.amplitudes(), sh.times_s(), a, 5.0);
+        assert!(s <= 0.12, "{f} Hz: {s}");
+    }
+}

@@ -144,8 +144,10 @@ impl MujocoModel {
                 a[(n + i, n + j)] = -lin.c[(i, j)] / mi;
             }
         }
-        let lambda_max = a
-            .complex_eigenvalues()
+        let lambda_max = crate::numerics::eigenvalues(&a)
+            .ok_or_else(|| SimError::InvalidModel {
+                what: "the eigenvalues of the linearised model do not converge (parts that differ by hundreds of orders of magnitude: check their units)".into(),
+            })?
             .iter()
             .map(|l| l.norm())
             .fold(0.0f64, f64::max);
