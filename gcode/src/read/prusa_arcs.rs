@@ -13,6 +13,7 @@
 use std::f32::consts::TAU as TAU32;
 
 use crate::read::geometry::{Move, Path, Point};
+use crate::read::segments::ArcTurn;
 
 /// Prusa-Firmware-Buddy's arc constants (Configuration_MK4_adv.h; the same on its other
 /// printers' files).
@@ -91,20 +92,9 @@ pub(crate) fn prusa(mv: &Move, p: &PrusaArcs, out: &mut Vec<Point>) {
         let theta = angular / segments as f32;
         let (sin_t, cos_t) = theta.sin_cos();
         let (per_l, per_e) = (travel_l / segments as f32, travel_e / segments as f32);
-        let n_corr = p.n_arc_correction.max(1);
-        let mut recalc = n_corr;
+        let mut turn = ArcTurn::new(p.n_arc_correction, theta, (sin_t, cos_t), offset);
         for k in 1..segments {
-            recalc = recalc.saturating_sub(1);
-            if n_corr > 1 && recalc != 0 {
-                let r_new_y = rvec[0] * sin_t + rvec[1] * cos_t;
-                rvec[0] = rvec[0] * cos_t - rvec[1] * sin_t;
-                rvec[1] = r_new_y;
-            } else {
-                recalc = n_corr;
-                let (sin_k, cos_k) = (k as f32 * theta).sin_cos();
-                rvec[0] = -offset[0] * cos_k + offset[1] * sin_k;
-                rvec[1] = -offset[0] * sin_k - offset[1] * cos_k;
-            }
+            turn.next(k, &mut rvec);
             out.push(Point::new(
                 f64::from(center_p + rvec[0]),
                 f64::from(center_q + rvec[1]),

@@ -279,20 +279,9 @@ fn marlin(mv: &Move, p: &MarlinArcs, out: &mut Vec<Point>) {
         let cos_t = 1.0 - 0.5 * sq;
         let (per_l, per_e) = (travel_l / segments as f32, travel_e / segments as f32);
         let (mut raw_l, mut raw_e) = (f(s.z_mm), f(s.e_mm));
-        let n_corr = p.n_arc_correction.max(1);
-        let mut recalc = n_corr;
+        let mut turn = ArcTurn::new(p.n_arc_correction, theta, (sin_t, cos_t), offset);
         for k in 1..segments {
-            recalc = recalc.saturating_sub(1);
-            if n_corr > 1 && recalc != 0 {
-                let r_new_y = rvec[0] * sin_t + rvec[1] * cos_t;
-                rvec[0] = rvec[0] * cos_t - rvec[1] * sin_t;
-                rvec[1] = r_new_y;
-            } else {
-                recalc = n_corr;
-                let (sin_k, cos_k) = (k as f32 * theta).sin_cos();
-                rvec[0] = -offset[0] * cos_k + offset[1] * sin_k;
-                rvec[1] = -offset[0] * sin_k - offset[1] * cos_k;
-            }
+            turn.next(k, &mut rvec);
             raw_l += per_l;
             raw_e += per_e;
             out.push(Point::new(
@@ -304,6 +293,55 @@ fn marlin(mv: &Move, p: &MarlinArcs, out: &mut Vec<Point>) {
         }
     }
     out.push(t);
+}
+
+/// Marlin's turn of the arc's radius vector from one segment's end to the next (Marlin's
+/// `plan_arc`, which Prusa-Firmware-Buddy keeps): a rotation by the segment's angle
+/// (`sin_t`, `cos_t`), and every `N_ARC_CORRECTION` segments the vector computed afresh
+/// from the centre's offset (`-offset` turned by `k theta`), in single precision.
+pub(crate) struct ArcTurn {
+    n_corr: u32,
+    recalc: u32,
+    theta: f32,
+    sin_cos: (f32, f32),
+    offset: [f32; 2],
+}
+
+impl ArcTurn {
+    /// The turn of segments of angle `theta` (`sin_cos` its rotation), corrected every
+    /// `n_arc_correction` segments (at least 1: every one), about a centre at `offset`
+    /// from the start.
+    pub(crate) fn new(
+        n_arc_correction: u32,
+        theta: f32,
+        sin_cos: (f32, f32),
+        offset: [f32; 2],
+    ) -> Self {
+        let n_corr = n_arc_correction.max(1);
+        Self {
+            n_corr,
+            recalc: n_corr,
+            theta,
+            sin_cos,
+            offset,
+        }
+    }
+
+    /// Turn `rvec` to the end of segment `k` (from 1).
+    pub(crate) fn next(&mut self, k: u32, rvec: &mut [f32; 2]) {
+        let ((sin_t, cos_t), offset) = (self.sin_cos, self.offset);
+        self.recalc = self.recalc.saturating_sub(1);
+        if self.n_corr > 1 && self.recalc != 0 {
+            let r_new_y = rvec[0] * sin_t + rvec[1] * cos_t;
+            rvec[0] = rvec[0] * cos_t - rvec[1] * sin_t;
+            rvec[1] = r_new_y;
+        } else {
+            self.recalc = self.n_corr;
+            let (sin_k, cos_k) = (k as f32 * self.theta).sin_cos();
+            rvec[0] = -offset[0] * cos_k + offset[1] * sin_k;
+            rvec[1] = -offset[0] * sin_k - offset[1] * cos_k;
+        }
+    }
 }
 
 fn rrf(mv: &Move, p: &RrfArcs, out: &mut Vec<Point>) {
