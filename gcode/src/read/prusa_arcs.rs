@@ -10,10 +10,8 @@
 //! previous radius vector, recomputed from the start every `N_ARC_CORRECTION` (25)
 //! segments; Z and E at `start + i * travel / segments`. Single precision, as the firmware.
 
-use std::f32::consts::TAU as TAU32;
-
 use crate::read::geometry::{Move, Path, Point};
-use crate::read::segments::ArcTurn;
+use crate::read::segments::{ArcTurn, MarlinArc};
 
 /// Prusa-Firmware-Buddy's arc constants (Configuration_MK4_adv.h; the same on its other
 /// printers' files).
@@ -48,29 +46,20 @@ pub(crate) fn prusa(mv: &Move, p: &PrusaArcs, out: &mut Vec<Point>) {
         out.push(mv.end);
         return;
     };
-    let (i, j, clockwise) = (arc.offset_i_mm, arc.offset_j_mm, arc.clockwise());
     let (s, t) = (mv.start, mv.end);
     let f = |v: f64| v as f32;
-    let (cur_p, cur_q, cart_p, cart_q) = (f(s.x_mm), f(s.y_mm), f(t.x_mm), f(t.y_mm));
-    let offset = [f(i), f(j)];
-    let mut rvec = [-offset[0], -offset[1]];
-    let radius = (rvec[0] * rvec[0] + rvec[1] * rvec[1]).sqrt();
-    let (center_p, center_q) = (cur_p - rvec[0], cur_q - rvec[1]);
-    let (rt_x, rt_y) = (cart_p - center_p, cart_q - center_q);
-    let near = |a: f32, b: f32| (-0.000_001..=0.000_001).contains(&(a - b));
-    let (angular, abs_angular) = if near(cur_p, cart_p) && near(cur_q, cart_q) {
-        (if clockwise { -TAU32 } else { TAU32 }, TAU32)
-    } else {
-        let mut a = (rvec[0] * rt_y - rvec[1] * rt_x).atan2(rvec[0] * rt_x + rvec[1] * rt_y);
-        if a == 0.0 {
-            return; // "Angular travel too small to detect? Just return."
-        }
-        if a >= 0.0 && clockwise {
-            a -= TAU32;
-        } else if a < 0.0 && !clockwise {
-            a += TAU32;
-        }
-        (a, a.abs())
+    let (i, j, clockwise) = (arc.offset_i_mm, arc.offset_j_mm, arc.clockwise());
+    let Some(MarlinArc {
+        offset,
+        mut rvec,
+        radius,
+        center: [center_p, center_q],
+        angular,
+        abs_angular,
+        ..
+    }) = MarlinArc::new(mv, i, j, clockwise)
+    else {
+        return; // "Angular travel too small to detect? Just return."
     };
     let (start_l, start_e) = (f(s.z_mm), f(s.e_mm));
     let travel_l = f(t.z_mm) - start_l;

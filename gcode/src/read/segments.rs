@@ -221,35 +221,22 @@ fn marlin(mv: &Move, p: &MarlinArcs, out: &mut Vec<Point>) {
     let (i, j, clockwise) = arc_of(mv);
     let (s, t) = (mv.start, mv.end);
     let f = |v: f64| v as f32;
-    let (cur_p, cur_q, cart_p, cart_q) = (f(s.x_mm), f(s.y_mm), f(t.x_mm), f(t.y_mm));
-    let offset = [f(i), f(j)];
-    let mut rvec = [-offset[0], -offset[1]];
-    let radius = (rvec[0] * rvec[0] + rvec[1] * rvec[1]).sqrt();
-    let (center_p, center_q) = (cur_p - rvec[0], cur_q - rvec[1]);
-    let (rt_x, rt_y) = (cart_p - center_p, cart_q - center_q);
-    let near = |a: f32, b: f32| (-0.000_001..=0.000_001).contains(&(a - b));
-    let (angular, abs_angular, min_segments) = if near(cur_p, cart_p) && near(cur_q, cart_q) {
-        (
-            if clockwise { -TAU32 } else { TAU32 },
-            TAU32,
-            p.min_circle_segments as f32,
-        )
+    let Some(MarlinArc {
+        offset,
+        mut rvec,
+        radius,
+        center: [center_p, center_q],
+        angular,
+        abs_angular,
+        whole,
+    }) = MarlinArc::new(mv, i, j, clockwise)
+    else {
+        return;
+    };
+    let min_segments = if whole {
+        p.min_circle_segments as f32
     } else {
-        let mut a = (rvec[0] * rt_y - rvec[1] * rt_x).atan2(rvec[0] * rt_x + rvec[1] * rt_y);
-        if a == 0.0 {
-            return; // "Angular travel too small to detect? Just return."
-        }
-        if a >= 0.0 && clockwise {
-            a -= TAU32;
-        } else if a < 0.0 && !clockwise {
-            a += TAU32;
-        }
-        let abs = a.abs();
-        (
-            a,
-            abs,
-            (p.min_circle_segments as f32 * (abs / TAU32)).ceil(),
-        )
+        (p.min_circle_segments as f32 * (abs_angular / TAU32)).ceil()
     };
     let travel_l = f(t.z_mm) - f(s.z_mm);
     let travel_e = f(t.e_mm) - f(s.e_mm);
@@ -293,6 +280,64 @@ fn marlin(mv: &Move, p: &MarlinArcs, out: &mut Vec<Point>) {
         }
     }
     out.push(t);
+}
+
+/// An arc as Marlin's `plan_arc` sets it out (Prusa-Firmware-Buddy keeps it), in single
+/// precision: the radius vector from the centre to the start, and the angular travel,
+/// a whole turn when the end is within 1e-6 mm of the start.
+pub(crate) struct MarlinArc {
+    /// The centre's offset from the start (`I`, `J`).
+    pub offset: [f32; 2],
+    /// From the centre to the start.
+    pub rvec: [f32; 2],
+    pub radius: f32,
+    pub center: [f32; 2],
+    /// Signed (negative clockwise), and its size.
+    pub angular: f32,
+    pub abs_angular: f32,
+    /// A whole turn (the end at the start).
+    pub whole: bool,
+}
+
+impl MarlinArc {
+    /// The arc of `mv` about the offset `(i, j)`; `None` when the angular travel is too
+    /// small to detect (Marlin then returns without a move: "Angular travel too small to
+    /// detect? Just return.").
+    pub(crate) fn new(mv: &Move, i: f64, j: f64, clockwise: bool) -> Option<Self> {
+        let (s, t) = (mv.start, mv.end);
+        let f = |v: f64| v as f32;
+        let (cur_p, cur_q, cart_p, cart_q) = (f(s.x_mm), f(s.y_mm), f(t.x_mm), f(t.y_mm));
+        let offset = [f(i), f(j)];
+        let rvec = [-offset[0], -offset[1]];
+        let radius = (rvec[0] * rvec[0] + rvec[1] * rvec[1]).sqrt();
+        let (center_p, center_q) = (cur_p - rvec[0], cur_q - rvec[1]);
+        let (rt_x, rt_y) = (cart_p - center_p, cart_q - center_q);
+        let near = |a: f32, b: f32| (-0.000_001..=0.000_001).contains(&(a - b));
+        let whole = near(cur_p, cart_p) && near(cur_q, cart_q);
+        let angular = if whole {
+            if clockwise { -TAU32 } else { TAU32 }
+        } else {
+            let mut a = (rvec[0] * rt_y - rvec[1] * rt_x).atan2(rvec[0] * rt_x + rvec[1] * rt_y);
+            if a == 0.0 {
+                return None;
+            }
+            if a >= 0.0 && clockwise {
+                a -= TAU32;
+            } else if a < 0.0 && !clockwise {
+                a += TAU32;
+            }
+            a
+        };
+        Some(Self {
+            offset,
+            rvec,
+            radius,
+            center: [center_p, center_q],
+            angular,
+            abs_angular: angular.abs(),
+            whole,
+        })
+    }
 }
 
 /// Marlin's turn of the arc's radius vector from one segment's end to the next (Marlin's
