@@ -9,10 +9,11 @@ use settle_planner::firmware::rrf::RrfConfig;
 use settle_planner::firmware::{Firmware, Kinematics};
 use settle_planner::path::junction::Junction;
 use settle_planner::path::{CornerStrategy, PathOptions};
+use settle_planner::shaper::ShaperType;
 use settle_planner::shaper::stream::Alignment;
-use settle_planner::shaper::{Shaper, ShaperType};
 use settle_planner::{Limits, PlanError, ProfileKind};
 
+pub use super::shapers::ShaperSetting;
 use crate::config::GrblSettings;
 use crate::{ArcSegmentation, Dialect, GcodeError, GrblArcs, LayerMode, ReaderOptions};
 
@@ -26,35 +27,6 @@ pub fn parse_firmware(name: &str) -> Result<Firmware, GcodeError> {
             reason,
         }
     })
-}
-
-/// An input shaper on one axis: which, and the mode it is tuned to.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ShaperSetting {
-    /// The shaper (bare names are Klipper's, `marlin:` and `rrf:` the other firmwares').
-    pub shaper_type: ShaperType,
-    /// Frequency it is tuned to (Hz).
-    pub frequency_hz: f64,
-    /// Damping ratio it is tuned to.
-    pub damping_ratio: f64,
-}
-
-impl ShaperSetting {
-    /// The shaper's impulses (its firmware's checks apply, and settle's lowest frequency,
-    /// [`settle_planner::shaper::MIN_FREQUENCY_HZ`]).
-    pub fn build(&self) -> Result<Shaper, PlanError> {
-        let min = settle_planner::shaper::MIN_FREQUENCY_HZ;
-        if self.frequency_hz < min {
-            return Err(PlanError::InvalidShaper {
-                name: self.shaper_type.to_string(),
-                reason: format!(
-                    "frequency {} Hz is below {min} Hz, the lowest settle runs (a shaper lasts about one period)",
-                    self.frequency_hz
-                ),
-            });
-        }
-        Shaper::new(self.shaper_type, self.frequency_hz, self.damping_ratio)
-    }
 }
 
 /// settle's own planner: its limits, speed law, corner strategy and look-ahead window.

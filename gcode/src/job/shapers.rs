@@ -23,12 +23,41 @@
 //!   damping `S` (default 0.1); a frequency or damping given while the type is `none`
 //!   selects `zvd`. `custom` shapers (`H`, `T`) are not supported.
 
-use settle_planner::shaper::{MarlinShaper, PrusaShaper, RrfShaper, ShaperType};
+use settle_planner::PlanError;
+use settle_planner::shaper::{MarlinShaper, PrusaShaper, RrfShaper, Shaper, ShaperType};
 
-use super::config::ShaperSetting;
 use crate::config::klipper_shaper;
 use crate::read::limits::{AxisFlags, FtShaper, LimitChange};
 use settle_planner::firmware::Firmware;
+
+/// An input shaper on one axis: which, and the mode it is tuned to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShaperSetting {
+    /// The shaper (bare names are Klipper's, `marlin:` and `rrf:` the other firmwares').
+    pub shaper_type: ShaperType,
+    /// Frequency it is tuned to (Hz).
+    pub frequency_hz: f64,
+    /// Damping ratio it is tuned to.
+    pub damping_ratio: f64,
+}
+
+impl ShaperSetting {
+    /// The shaper's impulses (its firmware's checks apply, and settle's lowest frequency,
+    /// [`settle_planner::shaper::MIN_FREQUENCY_HZ`]).
+    pub fn build(&self) -> Result<Shaper, PlanError> {
+        let min = settle_planner::shaper::MIN_FREQUENCY_HZ;
+        if self.frequency_hz < min {
+            return Err(PlanError::InvalidShaper {
+                name: self.shaper_type.to_string(),
+                reason: format!(
+                    "frequency {} Hz is below {min} Hz, the lowest settle runs (a shaper lasts about one period)",
+                    self.frequency_hz
+                ),
+            });
+        }
+        Shaper::new(self.shaper_type, self.frequency_hz, self.damping_ratio)
+    }
+}
 
 /// One axis's shaper state as its firmware keeps it.
 #[derive(Debug, Clone, Copy, PartialEq)]
