@@ -25,6 +25,7 @@ pub(crate) mod layers;
 pub(crate) mod lex;
 pub(crate) mod limit_parse;
 pub(crate) mod limits;
+pub(crate) mod marlin_arc;
 pub(crate) mod motion;
 pub(crate) mod packaged;
 pub(crate) mod params;

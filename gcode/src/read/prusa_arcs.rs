@@ -11,7 +11,7 @@
 //! segments; Z and E at `start + i * travel / segments`. Single precision, as the firmware.
 
 use crate::read::geometry::{Move, Path, Point};
-use crate::read::segments::{ArcTurn, MarlinArc};
+use crate::read::marlin_arc::{ArcTurn, MarlinArc};
 
 /// Prusa-Firmware-Buddy's arc constants (Configuration_MK4_adv.h; the same on its other
 /// printers' files).
