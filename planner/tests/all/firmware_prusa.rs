@@ -195,3 +195,137 @@ fn precise_stepping_runs_the_blocks_trapezoid_in_mm() {
     assert_rel("peak", planned[0].cruise_speed_m_s, peak * MM, 1e-9);
     assert_rel("short time", t, 2.0 * (peak - v0) / a, 1e-9);
 }
+
+/// Each printer's settings as Prusa-Firmware-Buddy (commit 818d812f) ships them, typed
+/// from its include/marlin/Configuration_<printer>.h: `DEFAULT_AXIS_STEPS_PER_UNIT` (times
+/// the planner's 4 mini-steps, lib/Marlin/Marlin/src/module/planner.h),
+/// `DEFAULT_MAX_FEEDRATE` capped by `HWLIMIT_NORMAL_MAX_FEEDRATE`,
+/// `DEFAULT_MAX_ACCELERATION`, `DEFAULT_ACCELERATION`, `DEFAULT_RETRACT_ACCELERATION`,
+/// `DEFAULT_TRAVEL_ACCELERATION`, `DEFAULT_XJERK`..`DEFAULT_EJERK`, `COREXY`.
+#[test]
+fn each_prusa_printer_has_its_configuration_h() {
+    use settle_planner::firmware::Kinematics;
+    use settle_planner::firmware::marlin::{MarlinJerk, PrusaModel};
+    struct Want {
+        model: PrusaModel,
+        steps: [f64; 4],
+        feed: [f64; 4],
+        accel: [f64; 4],
+        print_retract_travel: [f64; 3],
+        e_jerk: f64,
+        corexy: bool,
+    }
+    let wants = [
+        Want {
+            // MINI: feed 180/180/12/80 under the caps 400/400/12/80.
+            model: PrusaModel::Mini,
+            steps: [100.0, 100.0, 400.0, 325.0],
+            feed: [180.0, 180.0, 12.0, 80.0],
+            accel: [1250.0, 1250.0, 400.0, 4000.0],
+            print_retract_travel: [1250.0, 1250.0, 1250.0],
+            e_jerk: 10.0,
+            corexy: false,
+        },
+        Want {
+            // MK3.5: feed 200/200/40/45 capped by 300/300/12/120 (Z 12); E 266 steps.
+            model: PrusaModel::Mk3_5,
+            steps: [100.0, 100.0, 400.0, 266.0],
+            feed: [200.0, 200.0, 12.0, 45.0],
+            accel: [1250.0, 1250.0, 400.0, 4000.0],
+            print_retract_travel: [1250.0, 1250.0, 1250.0],
+            e_jerk: 5.0,
+            corexy: false,
+        },
+        Want {
+            // MK4: feed 400/400/40/50 capped by 300/300/40/100.
+            model: PrusaModel::Mk4,
+            steps: [100.0, 100.0, 400.0, 380.0],
+            feed: [300.0, 300.0, 40.0, 50.0],
+            accel: [1250.0, 1250.0, 200.0, 1500.0],
+            print_retract_travel: [1250.0, 800.0, 1250.0],
+            e_jerk: 5.0,
+            corexy: false,
+        },
+        Want {
+            // XL: feed 550/550/12/45 capped by 460/460/20/100.
+            model: PrusaModel::Xl,
+            steps: [80.0, 80.0, 800.0, 380.0],
+            feed: [460.0, 460.0, 12.0, 45.0],
+            accel: [5000.0, 5000.0, 200.0, 1500.0],
+            print_retract_travel: [1800.0, 1200.0, 5000.0],
+            e_jerk: 5.0,
+            corexy: true,
+        },
+        Want {
+            // CORE One: feed 350/350/30/50 under the caps 350/350/35/100.
+            model: PrusaModel::CoreOne,
+            steps: [100.0, 100.0, 400.0, 380.0],
+            feed: [350.0, 350.0, 30.0, 50.0],
+            accel: [10000.0, 10000.0, 1000.0, 1500.0],
+            print_retract_travel: [1250.0, 1250.0, 1500.0],
+            e_jerk: 5.0,
+            corexy: true,
+        },
+    ];
+    for w in wants {
+        let c = w.model.config();
+        let what = w.model.name();
+        for i in 0..4 {
+            assert_rel(what, c.steps_per_m[i], w.steps[i] * 4.0 / MM, 1e-12);
+            assert_rel(what, c.max_feedrate_m_s[i], w.feed[i] * MM, 1e-12);
+            assert_rel(what, c.max_accel_m_s2[i], w.accel[i] * MM, 1e-12);
+        }
+        let [p, r, t] = w.print_retract_travel;
+        assert_rel(what, c.print_accel_m_s2, p * MM, 1e-12);
+        assert_rel(what, c.retract_accel_m_s2, r * MM, 1e-12);
+        assert_rel(what, c.travel_accel_m_s2, t * MM, 1e-12);
+        let MarlinJerk::Classic { max_jerk_m_s, .. } = c.jerk else {
+            panic!("{what}: Buddy plans with classic jerk");
+        };
+        for (got, want) in max_jerk_m_s.iter().zip([8.0, 8.0, 2.0, w.e_jerk]) {
+            assert_rel(what, *got, want * MM, 1e-12);
+        }
+        let kinematics = if w.corexy {
+            Kinematics::CoreXy
+        } else {
+            Kinematics::Cartesian
+        };
+        assert_eq!(c.kinematics, kinematics, "{what}");
+        assert_eq!(c.block_buffer_size, 32, "{what}");
+        assert_eq!(
+            c.min_steps_per_segment, 24,
+            "{what}: 6 steps of 4 mini-steps"
+        );
+        assert_eq!(c.stepper, MarlinStepper::PreciseStepping, "{what}");
+        assert!(!c.s_curve && !c.slowdown, "{what}");
+        assert_rel(what, c.minimum_planner_speed_m_s, 0.05 * MM, 1e-12);
+    }
+}
+
+#[test]
+fn a_long_travel_move_cruises_at_each_printers_limits() {
+    // 150 mm in X asked at 500 mm/s, faster than every printer's limit: each runs the
+    // trapezoid of its own travel acceleration and X speed limit, from and to
+    // MINIMUM_PLANNER_SPEED (0.05 mm/s). On the CoreXY printers (XL, CORE One) a move in X
+    // turns both motors by 150 mm, each within X's limits.
+    use settle_planner::firmware::marlin::PrusaModel;
+    let v0 = 0.05;
+    for (model, v, a) in [
+        (PrusaModel::Mini, 180.0, 1250.0),
+        (PrusaModel::Mk3_5, 200.0, 1250.0),
+        (PrusaModel::Mk4, 300.0, 1250.0),
+        (PrusaModel::Xl, 460.0, 5000.0),
+        (PrusaModel::CoreOne, 350.0, 1500.0),
+    ] {
+        let ramp_mm = (v * v - v0 * v0) / (2.0 * a);
+        let want = 2.0 * (v - v0) / a + (150.0 - 2.0 * ramp_mm) / v;
+        let (planned, t) = plan_with(
+            &mut MarlinPlanner::new(model.config()).expect("config"),
+            &[xy([0.0, 0.0], [150.0, 0.0], 500.0)],
+        );
+        assert_eq!(planned.len(), 1, "{model}");
+        assert_rel(model.name(), planned[0].cruise_speed_m_s, v * MM, 1e-9);
+        assert_rel(model.name(), planned[0].accel_m_s2, a * MM, 1e-9);
+        assert_rel(model.name(), t, want, 1e-9);
+    }
+}

@@ -39,7 +39,9 @@
 mod block;
 mod config;
 mod planner;
+mod prusa;
 mod trapezoid;
 
 pub use config::{JdSmallSegments, MarlinConfig, MarlinJerk, MarlinStepper};
 pub use planner::MarlinPlanner;
+pub use prusa::PrusaModel;
