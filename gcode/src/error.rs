@@ -373,6 +373,19 @@ pub enum GcodeError {
         /// How the layer change was found.
         from: crate::LayerSource,
     },
+    /// A Prusa job for a printer settle has no Prusa-Firmware-Buddy settings for
+    /// (`M862.3 P "MK3S"`): planning it with another printer's would be a guess.
+    #[error(
+        "{at}: `M862.3 P \"{name}\"`: settle has no Prusa-Firmware-Buddy settings for this printer, so --firmware prusa cannot plan the file as it would run (allowed: {known})"
+    )]
+    UnknownPrinter {
+        /// The `M862.3` line.
+        at: Location,
+        /// The printer's name as written.
+        name: String,
+        /// The names settle knows.
+        known: String,
+    },
     /// A job setting (not from the file) that cannot be used.
     #[error("job setting `{key}`: {reason}")]
     JobSetting {
@@ -491,7 +504,8 @@ impl GcodeError {
             | GcodeError::Plan { at, .. }
             | GcodeError::OutOfTravel { at, .. }
             | GcodeError::TooLong { at, .. }
-            | GcodeError::TooManyLayers { at, .. } => Some(at),
+            | GcodeError::TooManyLayers { at, .. }
+            | GcodeError::UnknownPrinter { at, .. } => Some(at),
         }
     }
 

@@ -3,7 +3,7 @@
 //! an imported printer.cfg / config.g).
 
 use settle_planner::firmware::klipper::KlipperConfig;
-use settle_planner::firmware::marlin::MarlinConfig;
+use settle_planner::firmware::marlin::{MarlinConfig, PrusaModel};
 use settle_planner::firmware::profiles::ProfileOptions;
 use settle_planner::firmware::rrf::RrfConfig;
 use settle_planner::firmware::{Firmware, Kinematics};
@@ -71,8 +71,8 @@ pub enum PlannerConfig {
     Klipper(KlipperConfig),
     /// Marlin's Configuration.h settings.
     Marlin(MarlinConfig),
-    /// Prusa-Firmware-Buddy's: Marlin's planner run by its precise stepping
-    /// ([`MarlinConfig::prusa_mk4`]).
+    /// Prusa-Firmware-Buddy's: Marlin's planner run by its precise stepping, with a
+    /// printer's settings ([`PrusaModel::config`]).
     Prusa(MarlinConfig),
     /// RepRapFirmware's config.g settings.
     Rrf(RrfConfig),
@@ -92,6 +92,42 @@ impl PlannerConfig {
             PlannerConfig::Rrf(_) => Firmware::Rrf,
             PlannerConfig::Grbl(_) => Firmware::Grbl,
             PlannerConfig::Settle(_) => Firmware::Settle,
+        }
+    }
+}
+
+/// Which Prusa printer's settings a `--firmware prusa` job runs with, and why: the
+/// printer the file names with its first `M862.3 P "<name>"` before its first move (every
+/// PrusaSlicer start G-code writes one), else the MK4 ([`crate::job::prusa_printer`] reads
+/// it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PrusaPrinter {
+    /// The printer family.
+    pub model: PrusaModel,
+    /// The line that named it and the name as written (`None`: the file names none, so
+    /// the MK4's settings, settle's default).
+    pub named_at: Option<(u64, String)>,
+}
+
+impl PrusaPrinter {
+    /// The MK4, for a file that names no printer.
+    pub fn unnamed() -> Self {
+        Self {
+            model: PrusaModel::Mk4,
+            named_at: None,
+        }
+    }
+}
+
+impl std::fmt::Display for PrusaPrinter {
+    /// `Prusa MINI settings (from line 136: M862.3 P "MINI")`, or the MK4's and why.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Prusa {} settings ", self.model)?;
+        match &self.named_at {
+            Some((line, name)) => write!(f, "(from line {line}: M862.3 P \"{name}\")"),
+            None => f.write_str(
+                "(the file names no printer: no M862.3 P before its first move; settle's default)",
+            ),
         }
     }
 }
@@ -125,6 +161,9 @@ pub struct JobConfig {
     /// extruder's `pressure_advance_smooth_time` when pressure advance is on (0.020 s for
     /// the default 0.040 s; off by default). It sets the pause a `SET_INPUT_SHAPER` makes.
     pub klipper_flush_delay_s: f64,
+    /// Prusa: the printer whose settings the planner and the shapers start with (`None`
+    /// for the other firmwares).
+    pub prusa: Option<PrusaPrinter>,
 }
 
 impl JobConfig {
@@ -134,10 +173,8 @@ impl JobConfig {
     ///   its config/example-cartesian.cfg) and Klipper's defaults for the rest
     ///   ([`KlipperConfig::new`]);
     /// - Marlin: [`MarlinConfig::new`] (its example configuration);
-    /// - Prusa: [`MarlinConfig::prusa_mk4`] and the MK4's shapers as Prusa ships them, MZV
-    ///   at 50.7 Hz on X and 40.6 Hz on Y (damping 0.1; input_shaper_config.hpp). A
-    ///   printer keeps its own in EEPROM (its calibration may have changed them);
-    ///   the file's `M593` lines change them;
+    /// - Prusa: the MK4's, [`JobConfig::prusa`] of [`PrusaPrinter::unnamed`] (a file that
+    ///   names its printer takes that printer's, [`crate::job::prusa_printer`]);
     /// - RepRapFirmware: [`RrfConfig::new`] (Configuration.h);
     /// - GRBL: [`GrblSettings::new`] (grbl/defaults.h `DEFAULTS_GENERIC`);
     /// - settle: [`SettleConfig::new`].
@@ -151,7 +188,7 @@ impl JobConfig {
                 PlannerConfig::Klipper(c)
             }
             Firmware::Marlin => PlannerConfig::Marlin(MarlinConfig::new()),
-            Firmware::Prusa => PlannerConfig::Prusa(MarlinConfig::prusa_mk4()),
+            Firmware::Prusa => PlannerConfig::Prusa(PrusaModel::Mk4.config()),
             Firmware::Rrf => PlannerConfig::Rrf(RrfConfig::new()),
             Firmware::Grbl => PlannerConfig::Grbl(GrblSettings::new()),
             Firmware::Settle => {
@@ -171,9 +208,10 @@ impl JobConfig {
             }
         };
         let dialect = Dialect::of(firmware);
-        let shapers = match firmware {
-            Firmware::Prusa => crate::job::shapers::prusa_mk4_shapers(),
-            _ => [None; 3],
+        let prusa = (firmware == Firmware::Prusa).then(PrusaPrinter::unnamed);
+        let shapers = match &prusa {
+            Some(p) => crate::job::shapers::prusa_shapers(p.model),
+            None => [None; 3],
         };
         Ok(Self {
             planner,
@@ -185,7 +223,23 @@ impl JobConfig {
             profiles: ProfileOptions::default(),
             travel_mm: [None; 3],
             klipper_flush_delay_s: 0.001,
+            prusa,
         })
+    }
+
+    /// What a Prusa printer starts a file with: its family's settings
+    /// ([`PrusaModel::config`]) and its shapers as Prusa ships them (MZV at 50.7 Hz on X
+    /// and 40.6 Hz on Y on the MK4 and MK3.5, 118.2 and 32.8 Hz on the MINI, 35.8 and
+    /// 35.4 Hz on the XL, EI at 60 and 50 Hz on the CORE One; damping 0.1,
+    /// lib/Marlin/Marlin/src/feature/input_shaper/input_shaper_config.hpp). A printer
+    /// keeps its own in EEPROM (its calibration may have changed them); the file's
+    /// `M593` lines change them.
+    pub fn prusa(printer: PrusaPrinter) -> Result<Self, GcodeError> {
+        let mut cfg = Self::defaults(Firmware::Prusa)?;
+        cfg.planner = PlannerConfig::Prusa(printer.model.config());
+        cfg.shapers = crate::job::shapers::prusa_shapers(printer.model);
+        cfg.prusa = Some(printer);
+        Ok(cfg)
     }
 
     /// Which firmware.

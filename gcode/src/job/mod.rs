@@ -67,11 +67,15 @@ mod input;
 mod moves;
 mod not_followed;
 mod pipeline;
+mod printer;
 mod settle;
 pub(crate) mod shapers;
 mod slice;
 mod travel;
 
 pub use chunk::{JobChunk, JobSummary, LayerTime, LimitOverride, MoveGeometry, MoveInfo};
-pub use config::{JobConfig, PlannerConfig, SettleConfig, ShaperSetting, parse_firmware};
+pub use config::{
+    JobConfig, PlannerConfig, PrusaPrinter, SettleConfig, ShaperSetting, parse_firmware,
+};
 pub use pipeline::Job;
+pub use printer::prusa_printer;

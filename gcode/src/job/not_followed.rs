@@ -49,6 +49,9 @@ pub(crate) fn reason(firmware: Firmware, name: &str) -> &'static str {
         (Some(b'M'), Some(74)) if firmware == Firmware::Prusa => {
             "the mass on the bed (PrusaSlicer writes it at each layer): Prusa's firmware waits for the motion to stop and moves Y's shaper frequency towards F + A at the mass limit M (M593 A, M; -20 Hz at 800 g on the MK4, M74.cpp); not simulated"
         }
+        (Some(b'M'), Some(862)) if firmware == Firmware::Prusa && name == "M862.3" => {
+            "the printer-model check: no motion (the first before the first move names the printer whose settings the job runs with)"
+        }
         (Some(b'M'), Some(862 | 555)) if firmware == Firmware::Prusa => {
             "a printer, nozzle or firmware check, or the print area for probing: no motion"
         }
@@ -98,7 +101,8 @@ mod tests {
         assert!(reason(Firmware::Marlin, "M999").contains("this firmware"));
         assert!(reason(Firmware::Marlin, "M74").contains("this firmware"));
         assert!(reason(Firmware::Prusa, "M74").contains("shaper frequency"));
-        assert!(reason(Firmware::Prusa, "M862.3").contains("check"));
+        assert!(reason(Firmware::Prusa, "M862.3").contains("printer-model check"));
+        assert!(reason(Firmware::Prusa, "M862.1").contains("nozzle"));
         assert!(reason(k, "PRINT_START").contains("macro"));
         assert!(reason(k, "SET_PRESSURE_ADVANCE").contains("extruder motion"));
     }

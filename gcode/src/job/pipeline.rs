@@ -136,7 +136,10 @@ impl<R: BufRead> Job<R> {
         Ok(Self {
             reader,
             source: Arc::from("<input>"),
-            shapers: ShaperState::new(cfg.firmware(), &cfg.shapers),
+            shapers: match &cfg.prusa {
+                Some(p) => ShaperState::new(cfg.firmware(), &cfg.shapers).with_prusa_model(p.model),
+                None => ShaperState::new(cfg.firmware(), &cfg.shapers),
+            },
             input: Input::new(cfg.alignment, initial, false),
             cfg,
             planner,

@@ -15,8 +15,8 @@
 //!   `M593_internal`): with any of `T`, `F`, `D`, `R`, each axis named (X, Y and Z when
 //!   none is) takes the values given over its own, or over the printer's defaults when
 //!   its shaper is off; `F0` turns it off; a frequency is clamped to 10..=100 Hz
-//!   (`clamp_frequency_to_safe_values`, input_shaper_config.cpp; the MK4's range, 150 Hz
-//!   on the MINI). `T` 0..5 is ZV, ZVD, MZV (Klipper's), EI, 2HUMP_EI, 3HUMP_EI
+//!   (`clamp_frequency_to_safe_values`, input_shaper_config.cpp; 10..=150 Hz on the
+//!   MINI, [`PrusaModel::shaper_max_hz`]). `T` 0..5 is ZV, ZVD, MZV (Klipper's), EI, 2HUMP_EI, 3HUMP_EI
 //!   (`prusa:`), 6 no shaper; `R` the EI family's vibration reduction (tolerance `1/R`).
 //! - RepRapFirmware `M593` (`AxisShaper::Configure`, src/Movement/AxisShaper.cpp): one
 //!   shaper for the motion (here X and Y), type `P`, frequency `F` (default 40 Hz),
@@ -29,6 +29,7 @@ use settle_planner::shaper::{MarlinShaper, PrusaShaper, RrfShaper, Shaper, Shape
 use crate::config::klipper_shaper;
 use crate::read::limits::{AxisFlags, FtShaper, LimitChange};
 use settle_planner::firmware::Firmware;
+use settle_planner::firmware::marlin::PrusaModel;
 
 /// An input shaper on one axis: which, and the mode it is tuned to.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,18 +80,30 @@ const PRUSA_MZV: u32 = 2;
 const PRUSA_NULL: u32 = 6;
 /// The `prusa_type` of a shaper that is not one of Prusa's.
 const NOT_PRUSA: u32 = u32::MAX;
-/// Prusa-Firmware-Buddy's safe frequencies, Hz (`frequency_safe_min`, `frequency_safe_max`
-/// of the MK4, input_shaper_config.hpp).
-const PRUSA_SAFE_HZ: (f64, f64) = (10.0, 100.0);
+/// Prusa-Firmware-Buddy's lowest safe frequency, Hz (`frequency_safe_min`,
+/// input_shaper_config.hpp; the highest is [`PrusaModel::shaper_max_hz`]).
+const PRUSA_SAFE_MIN_HZ: f64 = 10.0;
 /// Prusa-Firmware-Buddy's default vibration reduction (`M593 R`).
 const PRUSA_VIBRATION_REDUCTION: f64 = 20.0;
 
-/// The MK4's (and MK4S's) shapers as Prusa-Firmware-Buddy ships them (`axis_x_default`,
-/// `axis_y_default`, `axis_z_default`, input_shaper_config.hpp): MZV at 50.7 Hz on X and
-/// 40.6 Hz on Y, damping 0.1, none on Z. What an axis whose shaper is off takes when an
+/// Prusa-Firmware-Buddy's `M593 T` of its EI (`Type::ei`).
+const PRUSA_EI: u32 = 3;
+
+/// A printer's shapers as Prusa-Firmware-Buddy ships them (`axis_x_default`,
+/// `axis_y_default`, `axis_z_default`, input_shaper_config.hpp), as `M593 T` and
+/// frequency: MZV at 50.7 Hz on X and 40.6 Hz on Y (the MK4 and MK3.5 builds), 118.2 and
+/// 32.8 Hz (MINI), 35.8 and 35.4 Hz (XL), EI at 60 and 50 Hz (CORE One); damping 0.1,
+/// vibration reduction 20; none on Z. What an axis whose shaper is off takes when an
 /// `M593` sets part of it.
-const PRUSA_MK4_DEFAULTS: [(u32, f64); 3] =
-    [(PRUSA_MZV, 50.7), (PRUSA_MZV, 40.6), (PRUSA_NULL, 0.0)];
+fn prusa_defaults(model: PrusaModel) -> [(u32, f64); 3] {
+    let (code, x, y) = match model {
+        PrusaModel::Mini => (PRUSA_MZV, 118.2, 32.8),
+        PrusaModel::Xl => (PRUSA_MZV, 35.8, 35.4),
+        PrusaModel::CoreOne => (PRUSA_EI, 60.0, 50.0),
+        PrusaModel::Mk4 | PrusaModel::Mk3_5 => (PRUSA_MZV, 50.7, 40.6),
+    };
+    [(code, x), (code, y), (PRUSA_NULL, 0.0)]
+}
 
 /// The shaper of Prusa's `M593 T<code>` with vibration reduction `r` (`None`: no shaper).
 fn prusa_kind(code: u32, r: f64) -> Option<ShaperType> {
@@ -125,9 +138,9 @@ fn prusa_code(kind: ShaperType) -> Option<(u32, f64)> {
     }
 }
 
-/// The MK4's shaper defaults as job settings (X and Y; Z unshaped).
-pub(crate) fn prusa_mk4_shapers() -> [Option<ShaperSetting>; 3] {
-    PRUSA_MK4_DEFAULTS.map(|(code, f)| {
+/// A printer's shaper defaults as job settings (X and Y; Z unshaped).
+pub(crate) fn prusa_shapers(model: PrusaModel) -> [Option<ShaperSetting>; 3] {
+    prusa_defaults(model).map(|(code, f)| {
         prusa_kind(code, PRUSA_VIBRATION_REDUCTION).map(|shaper_type| ShaperSetting {
             shaper_type,
             frequency_hz: f,
@@ -167,6 +180,8 @@ pub(crate) struct ShaperState {
     axes: [Axis; 3],
     /// Marlin: FT_MOTION switched off by `M493 S0` (its shapers then do nothing).
     ft_off: bool,
+    /// Prusa: the printer (its shipped shapers and its highest frequency).
+    prusa_model: PrusaModel,
 }
 
 impl ShaperState {
@@ -205,7 +220,14 @@ impl ShaperState {
             firmware,
             axes,
             ft_off: false,
+            prusa_model: PrusaModel::Mk4,
         }
+    }
+
+    /// Prusa: `M593` as `model`'s firmware runs it (the MK4's otherwise).
+    pub(crate) fn with_prusa_model(mut self, model: PrusaModel) -> Self {
+        self.prusa_model = model;
+        self
     }
 
     /// The settings in force (X, Y, Z).
@@ -334,6 +356,8 @@ impl ShaperState {
                 }
                 let none = !(axes.x || axes.y || axes.z);
                 let pick = [axes.x || none, axes.y || none, axes.z || none];
+                let defaults = prusa_defaults(self.prusa_model);
+                let max_hz = self.prusa_model.shaper_max_hz();
                 for (i, a) in self.axes.iter_mut().enumerate() {
                     if !pick[i] {
                         continue;
@@ -345,7 +369,7 @@ impl ShaperState {
                     let mut retype = a.frequency_hz == 0.0;
                     if retype {
                         // Off: the printer's defaults are the base (`axis_defaults`).
-                        let (code, f) = PRUSA_MK4_DEFAULTS[i];
+                        let (code, f) = defaults[i];
                         (a.prusa_type, a.frequency_hz) = (code, f);
                         a.damping_ratio = if code == PRUSA_NULL { 0.0 } else { 0.1 };
                         a.vibration_reduction = if code == PRUSA_NULL {
@@ -368,7 +392,7 @@ impl ShaperState {
                         a.vibration_reduction = *r;
                         retype |= a.prusa_type != NOT_PRUSA;
                     }
-                    a.frequency_hz = a.frequency_hz.clamp(PRUSA_SAFE_HZ.0, PRUSA_SAFE_HZ.1);
+                    a.frequency_hz = a.frequency_hz.clamp(PRUSA_SAFE_MIN_HZ, max_hz);
                     if retype {
                         a.shaper_type = prusa_kind(a.prusa_type, a.vibration_reduction);
                     }
@@ -491,8 +515,37 @@ mod tests {
     }
 
     #[test]
+    fn prusa_m593_takes_the_printers_defaults_and_range() {
+        // The MINI: MZV at 118.2 / 32.8 Hz; frequencies up to 150 Hz.
+        let mini = PrusaModel::Mini;
+        let mut s = ShaperState::new(Firmware::Prusa, &prusa_shapers(mini)).with_prusa_model(mini);
+        assert_eq!(
+            kinds(&s),
+            [one("mzv", 118.2, 0.1), one("mzv", 32.8, 0.1), None]
+        );
+        assert_eq!(s.apply(&m593("X", None, Some(140.0), None)), Ok(true));
+        assert_eq!(s.apply(&m593("Y", None, Some(170.0), None)), Ok(true));
+        assert_eq!(
+            kinds(&s)[..2],
+            [one("mzv", 140.0, 0.1), one("mzv", 150.0, 0.1)]
+        );
+        // The CORE One: EI (vibration reduction 20) at 60 / 50 Hz, what an axis turned off
+        // starts again from.
+        let core = PrusaModel::CoreOne;
+        let mut s = ShaperState::new(Firmware::Prusa, &prusa_shapers(core)).with_prusa_model(core);
+        assert_eq!(
+            kinds(&s),
+            [one("prusa:ei", 60.0, 0.1), one("prusa:ei", 50.0, 0.1), None]
+        );
+        assert_eq!(s.apply(&m593("Y", None, Some(0.0), None)), Ok(true));
+        assert_eq!(kinds(&s)[1], None);
+        assert_eq!(s.apply(&m593("Y", None, None, Some(0.05))), Ok(true));
+        assert_eq!(kinds(&s)[1], one("prusa:ei", 50.0, 0.05));
+    }
+
+    #[test]
     fn prusa_m593_follows_m593_internal() {
-        let mut s = ShaperState::new(Firmware::Prusa, &prusa_mk4_shapers());
+        let mut s = ShaperState::new(Firmware::Prusa, &prusa_shapers(PrusaModel::Mk4));
         assert_eq!(
             kinds(&s),
             [one("mzv", 50.7, 0.1), one("mzv", 40.6, 0.1), None]

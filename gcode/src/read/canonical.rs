@@ -135,6 +135,9 @@ impl<W: Write> CanonicalWriter<W> {
                 self.skip_dwell = command.starts_with("G4");
                 writeln!(self.out, "{command}")
             }
+            EventKind::Note(Note::PrinterModel { name }) => {
+                writeln!(self.out, "M862.3 P\"{name}\"")
+            }
             EventKind::Note(Note::MacroCall { command, path }) => match *command {
                 "M501" => writeln!(self.out, "M501"),
                 _ => writeln!(self.out, "{command} P\"{}\"", path.replace('"', "\"\"")),

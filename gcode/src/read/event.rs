@@ -83,6 +83,14 @@ pub enum Note {
         /// What the firmware says.
         reason: &'static str,
     },
+    /// Prusa-Firmware-Buddy's printer-model check, `M862.3 P "MK4S"` (Prusa dialect):
+    /// the name as Buddy reads it (src/marlin_stubs/M862_2_3.cpp: after `P`, spaces and
+    /// quotes skipped, then letters, digits and dots). The command is also counted among
+    /// [`crate::Reader::ignored_commands`] (it moves nothing).
+    PrinterModel {
+        /// The printer's name (`MINI`, `MK4S`, `COREONE`).
+        name: String,
+    },
     /// RepRapFirmware runs another file here (`M98 P"file"`, or `M501`, which runs
     /// `config-override.g`); the reader does not open it
     /// ([`crate::config::RrfConfig`] does).

@@ -222,6 +222,11 @@ impl<R: BufRead> Reader<R> {
         self
     }
 
+    /// The input's name in error messages ([`Reader::with_name`]).
+    pub fn source_name(&self) -> &Arc<str> {
+        &self.source_name
+    }
+
     /// The options in use.
     pub fn options(&self) -> &ReaderOptions {
         &self.interp.opts
@@ -355,6 +360,19 @@ impl<R: BufRead> Iterator for Reader<R> {
             }
         }
     }
+}
+
+/// The printer `M862.3` names with `P`, as Prusa-Firmware-Buddy reads it
+/// (src/marlin_stubs/M862_2_3.cpp, `M862_3`): after the `P`, spaces and double quotes are
+/// skipped, then letters, digits and dots make the name (`P "MK4S"`, `P"MK4S"`, `P MK4S`).
+/// `None` without `P` (`M862.3 Q` asks the printer for its name).
+fn printer_model(args: &str) -> Option<String> {
+    let at = args.find('P')?;
+    let rest = args[at + 1..].trim_start_matches([' ', '"']);
+    let end = rest
+        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '.'))
+        .unwrap_or(rest.len());
+    Some(rest[..end].to_string())
 }
 
 /// RepRapFirmware's configuration commands ([`setting_parse`]).
@@ -547,6 +565,12 @@ impl Interp {
                 _ => false,
             };
         if !known {
+            if self.opts.dialect == Dialect::Prusa
+                && (letter, number, sub) == (b'M', 862, Some(3))
+                && let Some(name) = printer_model(cmd.args)
+            {
+                self.push(cmd.line, EventKind::Note(Note::PrinterModel { name }));
+            }
             self.ignore(cmd.name);
             return Ok(());
         }

@@ -23,6 +23,7 @@ mod laser;
 mod layer_bound;
 mod layers;
 mod orca;
+mod prusa_models;
 mod roundtrip;
 mod segments;
 mod slic3r;

@@ -99,6 +99,9 @@ impl<R: BufRead> Job<R> {
                 self.ignore(format!("{name}: {reason}"));
                 Ok(())
             }
+            // The model was chosen before the job started ([`crate::job::PrusaPrinter`]);
+            // the reader counts the command among the ones it passes over.
+            EventKind::Note(Note::PrinterModel { .. }) => Ok(()),
             EventKind::Note(Note::MacroCall { command, .. }) => {
                 self.ignore(format!(
                     "{command}: a macro file the job does not open (config.g's reader runs them)"
