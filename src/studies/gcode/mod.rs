@@ -189,10 +189,11 @@ pub fn parse_layers(s: &str) -> Result<(u32, u32), String> {
     Ok((a, b))
 }
 
-/// The job configuration of `run`: its firmware's defaults, the run's limits, `shaper`
-/// on X and Y, and the job's layer source.
+/// The job configuration of `run`: its firmware's defaults for the job's file (for Prusa,
+/// the printer the file names, [`JobConfig::for_file`]), the run's limits, `shaper` on X
+/// and Y, and the job's layer source.
 pub fn job_config(run: &RunSpec, job: &GcodeJob, shaper: Option<ShaperSetting>) -> Result<JobConfig, String> {
-    let mut cfg = JobConfig::defaults(job.firmware).map_err(|e| e.to_string())?;
+    let mut cfg = JobConfig::for_file(job.firmware, &job.file).map_err(|e| e.to_string())?;
     let (v, a) = (run.vmax_mm_s * 1e-3, run.amax_mm_s2 * 1e-3);
     match &mut cfg.planner {
         PlannerConfig::Klipper(c) => {

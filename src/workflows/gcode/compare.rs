@@ -40,7 +40,7 @@ pub fn versus(
 ) -> Result<GcodeOptions, Error> {
     let job = match &base.config {
         Some(c) if c.job.firmware() == firmware => c.job.clone(),
-        _ => JobConfig::defaults(firmware).map_err(super::gcode_error(&base.file))?,
+        _ => JobConfig::for_file(firmware, &base.file).map_err(super::gcode_error(&base.file))?,
     };
     let config = base.config.clone().filter(|c| c.job.firmware() == firmware);
     Ok(GcodeOptions {

@@ -168,8 +168,10 @@ pub fn parse_shapers(s: &str) -> Result<XyShapers, String> {
 impl GcodeOptions {
     /// `file` on `machine` with `firmware`'s defaults, the modal backend and the linear
     /// driver (what the modal backend solves exactly).
+    /// A Prusa job takes the settings of the printer the file names
+    /// ([`JobConfig::for_file`]).
     pub fn new(file: PathBuf, machine: &str, firmware: Firmware) -> Result<Self, Error> {
-        let job = JobConfig::defaults(firmware).map_err(gcode_error(&file))?;
+        let job = JobConfig::for_file(firmware, &file).map_err(gcode_error(&file))?;
         Ok(Self {
             file,
             machine: machine.to_string(),
@@ -887,16 +889,24 @@ fn simulate(
         versus: None,
         recording: None,
         linearised_at: point,
-        config: opts.config.as_ref().map(|c| {
-            (
-                format!(
-                    "settings from {}: {}",
-                    c.path.display(),
-                    config_settings(&opts.job)
-                ),
-                c.notes.clone(),
-            )
-        }),
+        config: opts
+            .config
+            .as_ref()
+            .map(|c| {
+                (
+                    format!(
+                        "settings from {}: {}",
+                        c.path.display(),
+                        config_settings(&opts.job)
+                    ),
+                    c.notes.clone(),
+                )
+            })
+            .or_else(|| {
+                // Which printer's settings a Prusa job runs with, and why.
+                let p = opts.job.prusa.as_ref()?;
+                Some((format!("{p}: {}", config_settings(&opts.job)), Vec::new()))
+            }),
         grbl_steps_per_mm: match &opts.job.planner {
             settle_gcode::job::PlannerConfig::Grbl(g) => {
                 Some([g.steps_per_mm[0], g.steps_per_mm[1]])
@@ -997,17 +1007,21 @@ fn shaper_words(shapers: &[Option<ShaperSetting>; 3]) -> String {
 }
 
 /// The planner and the X and Y shapers in words: `klipper + mzv@48 Hz`, `settle` when
-/// unshaped, both shapers when they differ.
+/// unshaped, both shapers when they differ; Prusa's with the printer whose settings it
+/// runs (`prusa MINI + X mzv@118.2 Hz, Y mzv@32.8 Hz`).
 pub fn setting_name(job: &JobConfig) -> String {
     let name = |s: &Option<ShaperSetting>| {
         s.map(|s| format!("{}@{} Hz", s.shaper_type.name(), s.frequency_hz))
     };
+    let firmware = match &job.prusa {
+        Some(p) => format!("{} {}", job.firmware(), p.model),
+        None => job.firmware().to_string(),
+    };
     match (name(&job.shapers[0]), name(&job.shapers[1])) {
-        (None, None) => job.firmware().to_string(),
-        (x, y) if x == y => format!("{} + {}", job.firmware(), x.unwrap_or_default()),
+        (None, None) => firmware,
+        (x, y) if x == y => format!("{firmware} + {}", x.unwrap_or_default()),
         (x, y) => format!(
-            "{} + X {}, Y {}",
-            job.firmware(),
+            "{firmware} + X {}, Y {}",
             x.unwrap_or_else(|| "none".into()),
             y.unwrap_or_else(|| "none".into())
         ),
