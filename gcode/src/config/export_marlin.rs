@@ -60,7 +60,7 @@ pub struct MarlinExport {
 
 /// Whether the note keyed `key` belongs above `line`: the same command, and for the
 /// per-axis shaper command `per_axis` (`M493`, `M593`) the same axis word.
-fn key_matches(per_axis: &str, line: &str, key: &str) -> bool {
+pub(super) fn key_matches(per_axis: &str, line: &str, key: &str) -> bool {
     let mut l = line.split_whitespace();
     let mut k = key.split_whitespace();
     match (k.next(), k.next()) {
@@ -71,7 +71,7 @@ fn key_matches(per_axis: &str, line: &str, key: &str) -> bool {
 }
 
 /// The `M201 X Y` and `M204 P T` lines both exports end with (each only when given).
-fn accel_lines(
+pub(super) fn accel_lines(
     max_accel_xy_mm_s2: [Option<f64>; 2],
     print_accel_mm_s2: Option<f64>,
     travel_accel_mm_s2: Option<f64>,

@@ -5,7 +5,8 @@
 //! would use,
 //! and input shaper settings written back in each firmware's own syntax, ready to paste
 //! ([`KlipperExport`], [`RrfExport`], and Marlin's Fixed-Time Motion `M493` lines,
-//! [`MarlinExport`], or its built-in ZV shaper's `M593` lines, [`MarlinZvExport`]).
+//! [`MarlinExport`], or its built-in ZV shaper's `M593` lines, [`MarlinZvExport`];
+//! Prusa-Firmware-Buddy's `M593 T F D` lines, [`PrusaExport`]).
 //!
 //! Both readers return per-axis [`AxisDrive`]s (microsteps per mm, microstepping, current,
 //! travel) and [`ShaperSetting`]s (shaper name, frequency, damping ratio; Klipper per axis,
@@ -53,6 +54,7 @@
 mod budget;
 mod export_klipper;
 mod export_marlin;
+mod export_prusa;
 mod export_rrf;
 mod export_text;
 mod glob;
@@ -70,6 +72,7 @@ mod rrf_script;
 pub use budget::{MAX_BYTES as MAX_CONFIG_BYTES, MAX_FILES as MAX_CONFIG_FILES};
 pub use export_klipper::KlipperExport;
 pub use export_marlin::{FtAxisShaper, MarlinExport, MarlinZvExport, ZvAxisShaper};
+pub use export_prusa::{PrusaAxisShaper, PrusaExport};
 
 pub use export_rrf::RrfExport;
 pub use export_text::Note;

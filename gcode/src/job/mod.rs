@@ -79,3 +79,4 @@ pub use config::{
 };
 pub use pipeline::Job;
 pub use printer::prusa_printer;
+pub use shapers::prusa_common_hz;

@@ -82,7 +82,14 @@ const PRUSA_NULL: u32 = 6;
 const NOT_PRUSA: u32 = u32::MAX;
 /// Prusa-Firmware-Buddy's lowest safe frequency, Hz (`frequency_safe_min`,
 /// input_shaper_config.hpp; the highest is [`PrusaModel::shaper_max_hz`]).
-const PRUSA_SAFE_MIN_HZ: f64 = 10.0;
+pub const PRUSA_SAFE_MIN_HZ: f64 = 10.0;
+/// The shaper frequencies every Prusa-Firmware-Buddy printer runs as designed, Hz: from
+/// [`PRUSA_SAFE_MIN_HZ`] to the lowest [`PrusaModel::shaper_max_hz`] (100 Hz; the MINI
+/// takes up to 150). What a configuration written for any of them may hold.
+pub fn prusa_common_hz() -> (f64, f64) {
+    let max = PrusaModel::ALL.map(PrusaModel::shaper_max_hz);
+    (PRUSA_SAFE_MIN_HZ, max.into_iter().fold(f64::INFINITY, f64::min))
+}
 /// Prusa-Firmware-Buddy's default vibration reduction (`M593 R`).
 const PRUSA_VIBRATION_REDUCTION: f64 = 20.0;
 
@@ -124,7 +131,7 @@ fn prusa_kind(code: u32, r: f64) -> Option<ShaperType> {
 
 /// The `M593 T` of a shaper setting's type, for the state a job starts with (`None`: not
 /// one of Prusa's).
-fn prusa_code(kind: ShaperType) -> Option<(u32, f64)> {
+pub(crate) fn prusa_code(kind: ShaperType) -> Option<(u32, f64)> {
     let r = PRUSA_VIBRATION_REDUCTION;
     match kind {
         ShaperType::Zv => Some((0, r)),
