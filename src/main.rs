@@ -169,7 +169,7 @@ enum Command {
         /// files of one axis, named like calibration_data_x_*.csv, are combined).
         #[arg(required = true, num_args = 1..)]
         scenario: Vec<PathBuf>,
-        /// Only candidates this firmware runs: klipper, marlin, rrf, tmc4361a, any
+        /// Only candidates this firmware runs: klipper, marlin, prusa, rrf, tmc4361a, any
         /// [default: the scenario's `[tune] firmware`, else any].
         #[arg(long)]
         firmware: Option<String>,

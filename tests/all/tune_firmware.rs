@@ -9,6 +9,7 @@ use settle::spec::backend::Backend;
 use settle::workflows::tune::{Options, tune_axis};
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
+use settle_planner::shaper::ShaperType;
 
 use crate::support::{root, write};
 
@@ -57,6 +58,7 @@ fn firmware_restricts_the_candidates() {
         ("klipper", Some(Firmware::Klipper)),
         ("marlin", Some(Firmware::Marlin)),
         ("rrf", Some(Firmware::Rrf)),
+        ("prusa", Some(Firmware::Prusa)),
         ("tmc4361a", None),
     ] {
         let o = run(
@@ -75,8 +77,12 @@ fn firmware_restricts_the_candidates() {
             match shaper_fw {
                 Some(f) => {
                     assert_eq!(c.kind, ProfileKind::Trapezoid, "{fw}: {}", c.label());
+                    // Buddy's M593 T0-T2 are Klipper's zv, zvd and mzv (input_shaper.cpp).
+                    let buddy = [ShaperType::Zv, ShaperType::Zvd, ShaperType::MZV];
                     assert!(
-                        kind.is_none_or(|k| k.firmware() == f),
+                        kind.is_none_or(
+                            |k| k.firmware() == f || (f == Firmware::Prusa && buddy.contains(&k))
+                        ),
                         "{fw}: {}",
                         c.label()
                     );
@@ -91,9 +97,10 @@ fn firmware_restricts_the_candidates() {
                 }
             }
         }
-        // Klipper: none + its six shapers at the one mode frequency.
-        if fw == "klipper" {
-            assert_eq!(grid.len(), 7);
+        // Klipper: none + its six shapers at the one mode frequency; Buddy: none + its six
+        // (M593 T0 to T5).
+        if fw == "klipper" || fw == "prusa" {
+            assert_eq!(grid.len(), 7, "{fw}");
         }
     }
     // A shaper the firmware does not run: the key is named.
@@ -667,6 +674,114 @@ fn marlin_export_reads_back_as_the_recommendation() {
             .ignored
             .keys()
             .all(|k| !k.contains("M493") && !k.contains("M204")),
+        "{:?}",
+        summary.ignored
+    );
+}
+
+/// `prusa.gcode` read back by settle's G-code reader (Prusa-Firmware-Buddy's dialect) as a
+/// job would read it: per tuned axis the winner's `M593 T` (Buddy's type code), `F`, `D`
+/// and, for the EI family, `R` (1 / the vibration tolerance), bit for bit, then `M593 W`;
+/// a Prusa job starting with the file shapes with them.
+#[test]
+fn prusa_export_reads_back_as_the_recommendation() {
+    use settle_gcode::{Dialect, EventKind, LimitChange, Reader, ReaderOptions};
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let text = std::fs::read_to_string(root().join("scenarios/tune_printer.toml"))
+        .expect("scenario")
+        .replace(
+            "frequency_scales = [0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.15]",
+            "frequency_scales = [1.0]\naxes = [\"x\", \"y\"]\nshapers = [\"none\", \"zvd\", \"prusa:ei\", \"mzv\"]",
+        )
+        .replace("distances_mm = [5.0, 20.0, 50.0]", "distances_mm = [20.0]")
+        .replace("jerk_steps = 5", "jerk_steps = 1");
+    let p = write(dir.path(), "prusa.toml", &text);
+    let opts = Options {
+        firmware: Some("prusa".into()),
+        ..modal()
+    };
+    let t = settle::workflows::tune::tune_with(
+        &p,
+        Some(dir.path().join("out")),
+        &opts,
+        &settle::execute::pool::quiet,
+    )
+    .expect("tunes");
+    let g = std::fs::read_to_string(t.out.join("prusa.gcode")).expect("prusa.gcode");
+    let events: Vec<_> = Reader::new(g.as_bytes(), ReaderOptions::new(Dialect::Prusa))
+        .collect::<Result<_, _>>()
+        .expect("settle reads its own export");
+    let m593: Vec<&LimitChange> = events
+        .iter()
+        .filter_map(|e| match &e.kind {
+            EventKind::Limits(l @ LimitChange::PrusaInputShaping { .. }) => Some(l),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(m593.len(), 3, "X, Y, then W\n{g}");
+    assert!(
+        matches!(m593[2], LimitChange::PrusaInputShaping { save: true, .. }),
+        "{g}"
+    );
+    let mut shaped = 0;
+    for (line, letter) in m593[..2].iter().zip(["x", "y"]) {
+        let o = &t.axes.iter().find(|(a, _)| a == letter).expect("tuned").1;
+        let w = &o.scores[o.winner].candidate;
+        let LimitChange::PrusaInputShaping {
+            axes,
+            shaper_type,
+            frequency_hz,
+            damping_ratio,
+            vibration_reduction,
+            save,
+            ..
+        } = line
+        else {
+            unreachable!()
+        };
+        assert_eq!(
+            (axes.x, axes.y, *save),
+            (letter == "x", letter == "y", false),
+            "{g}"
+        );
+        match w.shaper.and_then(|s| s.shaper_type.map(|k| (k, s))) {
+            Some((k, sh)) => {
+                shaped += 1;
+                // M593.cpp's T: 0 ZV, 1 ZVD, 2 MZV, 3 EI (Buddy's), 4 2HUMP_EI, 5 3HUMP_EI.
+                let (code, r) = match k {
+                    ShaperType::Zvd => (1, None),
+                    k if k == ShaperType::MZV => (2, None),
+                    ShaperType::Prusa { v_tol, .. } => (3, Some(1.0 / v_tol)),
+                    other => panic!("{letter}: not a shaper of the search: {other:?}"),
+                };
+                assert_eq!(*shaper_type, Some(code), "{g}");
+                assert_eq!(*frequency_hz, Some(sh.frequency_hz), "{g}");
+                assert_eq!(*damping_ratio, Some(sh.damping_ratio), "{g}");
+                assert_eq!(*vibration_reduction, r, "{g}");
+            }
+            None => assert_eq!(
+                (*shaper_type, *frequency_hz),
+                (None, Some(0.0)),
+                "F0 turns the axis's shaper off\n{g}"
+            ),
+        }
+    }
+    assert!(
+        shaped > 0,
+        "a shaper wins on printer_xy's 39 Hz Y mode\n{g}"
+    );
+    // A Prusa job that starts with the file runs with its shapers and ignores only the
+    // EEPROM write.
+    let job = format!("{g}G28\nG1 X10 Y10 F6000\nG1 X50 Y10 E1\nG1 X50 Y50 E2\n");
+    let cfg = settle_gcode::job::JobConfig::defaults(Firmware::Prusa).expect("defaults");
+    let reader = Reader::new(job.as_bytes(), ReaderOptions::new(Dialect::Prusa));
+    let mut j = settle_gcode::job::Job::new(reader, cfg).expect("job");
+    j.by_ref().collect::<Result<Vec<_>, _>>().expect("plans");
+    let summary = j.summary();
+    assert!(summary.shaper_changes >= 1, "{summary:?}");
+    assert!(
+        summary.ignored.keys().all(|k| k.starts_with("M593")),
         "{:?}",
         summary.ignored
     );

@@ -130,9 +130,11 @@ fn the_example_printer_gets_one_answer_everywhere_with_its_reasons() {
     assert!(!changes.is_empty());
     let table = &md[md.find("## What changes in klipper.cfg").expect("changes")..];
     let mut n = 0;
+    // Its rows: up to the next section (another export's changes, or the first axis).
     for r in table
         .lines()
-        .take_while(|l| !l.starts_with("## Axis"))
+        .skip(1)
+        .take_while(|l| !l.starts_with("## "))
         .filter(|l| l.starts_with("| ") && !l.starts_with("| setting") && !l.starts_with("|---"))
     {
         let c: Vec<&str> = r.trim_matches('|').split('|').map(str::trim).collect();

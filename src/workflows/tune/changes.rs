@@ -329,28 +329,57 @@ pub fn marlin(
     caps: [(Option<f64>, Option<f64>); 2],
     accel: Option<f64>,
 ) -> Vec<Change> {
+    let keys = |letter: &str| match shaping {
+        MarlinShaping::FtMotion => (
+            ["C", "A", "I"].map(|w| format!("M493 {letter} {w}")),
+            ("none", f64::NAN, f64::NAN),
+        ),
+        // The shaper's type has no word in M593 (ZV only): keyed by the line.
+        MarlinShaping::InputShaping => (
+            ["", " F", " D"].map(|w| format!("M593 {letter}{w}")),
+            ("zv", 0.0, f64::NAN),
+        ),
+    };
+    let who = "Marlin (Marlin/src/module/planner.cpp, Planner::_populate_block)";
+    per_axis_changes(axes, keys, who, caps, accel)
+}
+
+/// The changes `prusa.gcode` makes: per tuned axis `x`/`y` its `M593 T F D` (no shaping
+/// is `F0`), `M201 X`/`Y` (`caps`, as for [`rrf`]) and `M204 P`/`T`.
+pub fn prusa(
+    axes: &[(String, Outcome)],
+    caps: [(Option<f64>, Option<f64>); 2],
+    accel: Option<f64>,
+) -> Vec<Change> {
+    let keys = |letter: &str| {
+        (
+            ["T", "F", "D"].map(|w| format!("M593 {letter} {w}")),
+            ("none", 0.0, f64::NAN),
+        )
+    };
+    let who = "Prusa-Firmware-Buddy (Marlin's planner, lib/Marlin/Marlin/src/module/planner.cpp)";
+    per_axis_changes(axes, keys, who, caps, accel)
+}
+
+/// The changes of a firmware that shapes X and Y apart: per tuned axis its shaper under
+/// the keys `keys(letter)` gives (type, frequency, damping, and the values of "off"),
+/// then `M201 X`/`Y` (`caps`; `who` caps moves by it) and `M204 P`/`T`.
+fn per_axis_changes(
+    axes: &[(String, Outcome)],
+    keys: impl Fn(&str) -> ([String; 3], (&'static str, f64, f64)),
+    who: &str,
+    caps: [(Option<f64>, Option<f64>); 2],
+    accel: Option<f64>,
+) -> Vec<Change> {
     let mut out = Vec::new();
     for letter in ["X", "Y"] {
         let lower = letter.to_ascii_lowercase();
         if let Some((axis, o)) = axes.iter().find(|(a, _)| a.split('+').any(|x| x == lower)) {
-            let (keys, off) = match shaping {
-                MarlinShaping::FtMotion => (
-                    ["C", "A", "I"].map(|w| format!("M493 {letter} {w}")),
-                    ("none", f64::NAN, f64::NAN),
-                ),
-                // The shaper's type has no word in M593 (ZV only): keyed by the line.
-                MarlinShaping::InputShaping => (
-                    ["", " F", " D"].map(|w| format!("M593 {letter}{w}")),
-                    ("zv", 0.0, f64::NAN),
-                ),
-            };
+            let (keys, off) = keys(letter);
             out.extend(shaper_changes(axis, o, [&keys[0], &keys[1], &keys[2]], off));
         }
     }
-    out.extend(m201_changes(
-        caps,
-        "Marlin (Marlin/src/module/planner.cpp, Planner::_populate_block)",
-    ));
+    out.extend(m201_changes(caps, who));
     for key in ["M204 P", "M204 T"] {
         out.extend(accel_change(axes, key, accel));
     }

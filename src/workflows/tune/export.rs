@@ -26,6 +26,12 @@
 //!   and Y apart. Then `M204 P T` when the acceleration changes, with `M201` as in
 //!   `rrf.g`. Read back by settle's G-code reader in `tests/all/tune_firmware.rs` and
 //!   `tests/all/import_marlin.rs`. An axis not tuned is left as it is, and said.
+//! - `prusa.gcode`: Prusa-Firmware-Buddy's `M593 <axis> T F D [R]` line per tuned axis
+//!   (settle-gcode's `PrusaExport`; `F0` unshaped), `M593 W` to store them, then `M201`
+//!   and `M204` as in `marlin.gcode` (Buddy plans with Marlin's planner). Written when
+//!   every tuned axis's recommendation is one of Buddy's six shapers at 10 to 100 Hz
+//!   (`--firmware prusa`). Read back by settle's G-code reader in
+//!   `tests/all/tune_firmware.rs`. An axis not tuned is left as it is, and said.
 //! - `tmc4361a.txt`: per axis, the TMC4361A ramp registers of the recommended move, from
 //!   the axis's own microsteps per mm; refused, with the reason, for what the chip cannot
 //!   run (a trapezoid's infinite bows, an input shaper, a value outside a register).
@@ -34,8 +40,8 @@ use std::fmt::Write as _;
 
 use settle_gcode::FtShaper;
 use settle_gcode::config::{
-    FtAxisShaper, KlipperExport, MarlinExport, MarlinZvExport, Note, RrfExport,
-    ShaperSetting as FirmwareShaper, ZvAxisShaper,
+    FtAxisShaper, KlipperExport, MarlinExport, MarlinZvExport, Note, PrusaAxisShaper, PrusaExport,
+    RrfExport, ShaperSetting as FirmwareShaper, ZvAxisShaper,
 };
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
@@ -462,6 +468,75 @@ pub fn marlin_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>
     }
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
     Some(changes::marlin(axes, marlin_shaping(axes), m201(axes), a))
+}
+
+/// Why `prusa.gcode` is not written, if it is not.
+fn prusa_refusal(axes: &[(String, Outcome)]) -> Option<String> {
+    refusal(
+        axes,
+        Candidates::of(Firmware::Prusa),
+        "Prusa-Firmware-Buddy",
+    )
+}
+
+/// Axis `letter`'s `M593` values from its tuned winner (no shaper: `F0`); `None` when the
+/// axis was not tuned.
+fn prusa_axis(axes: &[(String, Outcome)], letter: &str) -> Option<PrusaAxisShaper> {
+    let o = winner_of(axes, letter)?;
+    let w = &o.scores[o.winner];
+    let axis = letter.to_ascii_uppercase().chars().next()?;
+    let shaper = w.candidate.shaper.and_then(|sh| {
+        sh.shaper_type
+            .map(|k| (k, sh.frequency_hz, sh.damping_ratio))
+    });
+    Some(PrusaAxisShaper { axis, shaper })
+}
+
+/// `prusa.gcode`: Prusa-Firmware-Buddy's `M593` lines per tuned axis and `M593 W`,
+/// `M201`/`M204` as the module documentation says; or comments saying why it is not
+/// written.
+pub fn prusa(axes: &[(String, Outcome)], produced_by: &str) -> String {
+    if let Some(why) = prusa_refusal(axes) {
+        return format!("; no Prusa-Firmware-Buddy configuration: {why}\n");
+    }
+    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    let caps = m201(axes);
+    let mut notes = header_notes(axes);
+    notes.extend(
+        changes::prusa(axes, caps, a)
+            .iter()
+            .map(changes::Change::note),
+    );
+    let (written, untuned) = per_axis(|l| prusa_axis(axes, l));
+    let e = PrusaExport {
+        produced_by: produced_by.to_string(),
+        axes: written,
+        max_accel_xy_mm_s2: caps.map(|(w, _)| w),
+        print_accel_mm_s2: a,
+        travel_accel_mm_s2: a,
+    };
+    match e.to_config_with_notes(&notes) {
+        Ok(mut out) => {
+            for letter in untuned {
+                let _ = writeln!(
+                    out,
+                    "; axis {letter} was not tuned: its M593 {} settings stay as they are (Buddy shapes X and Y apart)",
+                    letter.to_ascii_uppercase()
+                );
+            }
+            out
+        }
+        Err(err) => format!("; no Prusa-Firmware-Buddy configuration: {err}\n"),
+    }
+}
+
+/// The changes `prusa.gcode` makes (`None` when it is not written).
+pub fn prusa_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
+    if prusa_refusal(axes).is_some() {
+        return None;
+    }
+    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    Some(changes::prusa(axes, m201(axes), a))
 }
 
 /// `tmc4361a.txt`: per axis, the register file of the recommended move (the first of the

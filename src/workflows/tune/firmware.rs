@@ -20,16 +20,17 @@ use settle_planner::firmware::Firmware;
 use settle_planner::shaper::{PrusaShaper, ShaperType};
 
 /// The firmwares `settle tune` searches for (and exports to): Klipper, Marlin,
-/// RepRapFirmware and the TMC4361A.
-pub const TUNED: [Firmware; 4] = [
+/// Prusa-Firmware-Buddy, RepRapFirmware and the TMC4361A.
+pub const TUNED: [Firmware; 5] = [
     Firmware::Klipper,
     Firmware::Marlin,
+    Firmware::Prusa,
     Firmware::Rrf,
     Firmware::Tmc4361a,
 ];
 
 /// Names `--firmware` takes.
-pub const ALLOWED: &str = "klipper, marlin, rrf, tmc4361a, any";
+pub const ALLOWED: &str = "klipper, marlin, prusa, rrf, tmc4361a, any";
 
 /// Which of Marlin's input shapers the printer's build has (`[tune] marlin_shaping`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -229,13 +230,16 @@ mod tests {
                 "{err}"
             );
             assert!(
-                err.ends_with("allowed: klipper, marlin, rrf, tmc4361a, any"),
+                err.ends_with("allowed: klipper, marlin, prusa, rrf, tmc4361a, any"),
                 "{err}"
             );
         }
         assert_eq!(
             Candidates::parse("linuxcnc"),
-            Err("unknown firmware `linuxcnc`; allowed: klipper, marlin, rrf, tmc4361a, any".into())
+            Err(
+                "unknown firmware `linuxcnc`; allowed: klipper, marlin, prusa, rrf, tmc4361a, any"
+                    .into()
+            )
         );
     }
 

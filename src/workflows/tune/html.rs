@@ -21,7 +21,7 @@ pub struct Page<'a> {
     /// The Pareto figure (SVG file) of each axis, in the order of `axes`.
     pub figures: &'a [PathBuf],
     /// The exported files: name and text.
-    pub exports: [(&'a str, &'a str); 4],
+    pub exports: [(&'a str, &'a str); 5],
     /// Where the numbers come from.
     pub provenance: Provenance,
 }

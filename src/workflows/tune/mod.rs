@@ -277,12 +277,13 @@ pub fn tune_to(
 
 /// The files `settle tune` writes in its output folder (with `pareto-<axis>.svg/png`
 /// for several axes: [`PATTERNS`]).
-const FILES: [&str; 9] = [
+const FILES: [&str; 10] = [
     "tune.md",
     "candidates.csv",
     "klipper.cfg",
     "rrf.g",
     "marlin.gcode",
+    "prusa.gcode",
     "tmc4361a.txt",
     "pareto.svg",
     "pareto.png",
@@ -304,7 +305,7 @@ const PATTERNS: [(&str, &str); 2] = [("pareto-", ".svg"), ("pareto-", ".png")];
 /// recommended, what changes in each export, then one section per axis), `candidates.csv`
 /// (every candidate of every axis), the Pareto figure of each axis (`pareto.svg/png`, or
 /// `pareto-<axis>.svg/png` for several axes), `report.html`, and `klipper.cfg`, `rrf.g`,
-/// `marlin.gcode` and `tmc4361a.txt` (see [`export`]).
+/// `marlin.gcode`, `prusa.gcode` and `tmc4361a.txt` (see [`export`]).
 pub fn tune_with(
     path: &Path,
     out: Option<PathBuf>,
@@ -335,6 +336,7 @@ pub fn tune_with(
     let klipper = export::klipper(&done, &produced_by);
     let rrf = export::rrf(&done, &produced_by);
     let marlin = export::marlin(&done, &produced_by);
+    let prusa = export::prusa(&done, &produced_by);
     let tmc = export::tmc4361a(&done);
     let mut md = format!("# settle tune: {}\n\n", sc.name);
     md.push_str(&head::current_to_recommended(&done, shared.as_deref()));
@@ -346,6 +348,9 @@ pub fn tune_with(
     }
     if let Some(c) = export::marlin_changes(&done) {
         md.push_str(&changes::table("marlin.gcode", &c));
+    }
+    if let Some(c) = export::prusa_changes(&done) {
+        md.push_str(&changes::table("prusa.gcode", &c));
     }
     let mut figures = Vec::new();
     for (axis, o) in &done {
@@ -364,7 +369,7 @@ pub fn tune_with(
     };
     let _ = write!(
         md,
-        "## Export\n\nKlipper (`klipper.cfg`; paste at the end of printer.cfg, above any SAVE_CONFIG block):\n\n```ini\n{klipper}```\n\nRepRapFirmware (`rrf.g`; config.g lines):\n\n```\n{rrf}```\n\nMarlin (`marlin.gcode`; {marlin_kind}):\n\n```\n{marlin}```\n\nTMC4361A ramp registers (`tmc4361a.txt`):\n\n```\n{tmc}```\n"
+        "## Export\n\nKlipper (`klipper.cfg`; paste at the end of printer.cfg, above any SAVE_CONFIG block):\n\n```ini\n{klipper}```\n\nRepRapFirmware (`rrf.g`; config.g lines):\n\n```\n{rrf}```\n\nMarlin (`marlin.gcode`; {marlin_kind}):\n\n```\n{marlin}```\n\nPrusa-Firmware-Buddy (`prusa.gcode`; M593):\n\n```\n{prusa}```\n\nTMC4361A ramp registers (`tmc4361a.txt`):\n\n```\n{tmc}```\n"
     );
     let write = |name: &str, text: &str| write_atomic(&out.join(name), text.as_bytes());
     write("tune.md", &md)?;
@@ -372,6 +377,7 @@ pub fn tune_with(
     write("klipper.cfg", &klipper)?;
     write("rrf.g", &rrf)?;
     write("marlin.gcode", &marlin)?;
+    write("prusa.gcode", &prusa)?;
     write("tmc4361a.txt", &tmc)?;
     let text = crate::input::file::read_text(path, crate::input::file::limit::SETTINGS)?;
     let page = html::page(html::Page {
@@ -383,6 +389,7 @@ pub fn tune_with(
             ("klipper.cfg", klipper.as_str()),
             ("rrf.g", rrf.as_str()),
             ("marlin.gcode", marlin.as_str()),
+            ("prusa.gcode", prusa.as_str()),
             ("tmc4361a.txt", tmc.as_str()),
         ],
         provenance: crate::output::report::provenance(
