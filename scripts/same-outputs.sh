@@ -22,7 +22,8 @@
 #     what identify wrote, `settle import` of the example configurations and of the real
 #     ones of gcode/tests/data/real/ (a Marlin M503 reply among them; two, and the reply,
 #     also under the Benchy), `settle tune` on
-#     the tune scenarios, on the imported printers (Klipper, RepRapFirmware, Marlin) and
+#     the tune scenarios (one also for Prusa-Firmware-Buddy), on the imported printers
+#     (Klipper, RepRapFirmware, Marlin) and
 #     with `--criterion klipper`;
 #   - `settle validate --backend rapier`;
 #   - `settle identify` on every spectrum of identify/tests/corpus/ (and its refusals),
@@ -165,6 +166,7 @@ cases() {
   echo "tune-imported tune out/import-voron-identified/printer.toml --jobs 2 --out {out}"
   echo "tune-imported-rrf tune out/import-mini/printer.toml --firmware rrf --jobs 2 --out {out}"
   echo "tune-imported-marlin tune out/import-marlin-ender3v2neo/printer.toml --firmware marlin --jobs 2 --out {out}"
+  echo "tune-printer-prusa tune $S/tune_printer.toml --firmware prusa --jobs 2 --out {out}"
   echo "tune-klipper-criterion tune --criterion klipper $root/planner/tests/data/klipper_two_peaks.csv"
   echo "validate-rapier validate --backend rapier --out {out}/validate.md"
   # Real recordings: every corpus spectrum, one sensor column, a raw recording without its
