@@ -159,6 +159,21 @@ impl Candidates {
         }
     }
 
+    /// The shaper frequencies it runs as designed, Hz (`None`: any the shaper takes); only
+    /// Prusa-Firmware-Buddy has a range: it clamps `M593 F` to 10 to 100 Hz on every printer but the MINI
+    /// (`clamp_frequency_to_safe_values`, lib/Marlin/Marlin/src/feature/input_shaper/
+    /// input_shaper_config.hpp).
+    pub fn frequency_range(self) -> Option<(f64, f64)> {
+        (self.0 == Some(Firmware::Prusa)).then_some(settle_gcode::job::PRUSA_SAFE_HZ)
+    }
+
+    /// Whether it runs a shaper designed for `frequency_hz` as designed
+    /// ([`Candidates::frequency_range`]).
+    pub fn takes_frequency(self, frequency_hz: f64) -> bool {
+        self.frequency_range()
+            .is_none_or(|(lo, hi)| (lo..=hi).contains(&frequency_hz))
+    }
+
     /// `Ok` when it plans `kind`, else why not.
     pub fn check_kind(self, kind: ProfileKind) -> Result<(), String> {
         if self.kinds().contains(&kind) {

@@ -396,6 +396,8 @@ pub fn plan(
     }
     let (fixed_damping, damping_source) = design_damping_source(&spec, &base);
     let mut shaper_settings: Vec<Option<ShaperSetting>> = Vec::new();
+    // The frequencies left out: outside what the firmware runs.
+    let mut outside: Vec<f64> = Vec::new();
     for s in &shapers {
         match s {
             None => shaper_settings.push(None),
@@ -423,6 +425,11 @@ pub fn plan(
                             frequency_hz: (f * x * 10.0).round() / 10.0,
                             damping_ratio,
                         };
+                        // A frequency the firmware would clamp is not what it runs.
+                        if !firmware.takes_frequency(s.frequency_hz) {
+                            outside.push(s.frequency_hz);
+                            continue;
+                        }
                         if !shaper_settings.contains(&Some(s)) {
                             shaper_settings.push(Some(s));
                         }
@@ -430,6 +437,15 @@ pub fn plan(
                 }
             }
         }
+    }
+    if let (Some((lo, hi)), Some(min), Some(max)) = (
+        firmware.frequency_range(),
+        outside.iter().copied().reduce(f64::min),
+        outside.iter().copied().reduce(f64::max),
+    ) {
+        notes.push(format!(
+            "Prusa-Firmware-Buddy runs shapers of {lo} to {hi} Hz only (M593 F; it clamps others): shapers at {min} to {max} Hz left out."
+        ));
     }
     let per_shape = shaper_settings.len() * accels.len();
     let count: usize = 1 + kinds

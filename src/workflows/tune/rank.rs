@@ -134,9 +134,15 @@ pub fn refine(
     let mut winner = grid_winner;
     for _ in 0..rounds {
         let c = scores[winner].candidate;
+        // Never a frequency the firmware would clamp.
+        let takes = |n: &Candidate| {
+            n.shaper
+                .filter(|s| s.shaper_type.is_some())
+                .is_none_or(|s| plan.firmware.takes_frequency(s.frequency_hz))
+        };
         let next: Vec<Candidate> = neighbours(&c, df, jr, jmax)
             .into_iter()
-            .filter(|n| !scores.iter().any(|s| s.candidate == *n))
+            .filter(|n| takes(n) && !scores.iter().any(|s| s.candidate == *n))
             .collect();
         if !next.is_empty() {
             let found = evaluate(plan, &next, jobs, &quiet)?;

@@ -14,8 +14,8 @@
 //! - whether the firmware has one acceleration for every axis ([`one_acceleration`]):
 //!   Klipper's `[printer] max_accel`, RepRapFirmware's and Marlin's `M204 P`;
 //! - whether a recommendation can be written ([`expressible`]): for Prusa-Firmware-Buddy
-//!   also a shaper frequency within the 10 to 100 Hz its `M593` takes (it clamps others:
-//!   `clamp_frequency_to_safe_values`, input_shaper_config.hpp).
+//!   also a shaper frequency within the 10 to 100 Hz its `M593` takes
+//!   ([`Candidates::frequency_range`], which the search holds to).
 
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
@@ -123,13 +123,13 @@ pub fn expressible(runs: Candidates, c: &Candidate) -> Result<(), String> {
     {
         return Err(e.to_string());
     }
-    let (lo, hi) = settle_gcode::job::PRUSA_SAFE_HZ;
     if let Some(sh) = c.shaper.filter(|s| s.shaper_type.is_some())
-        && runs.firmware() == Some(Firmware::Prusa)
-        && !(lo..=hi).contains(&sh.frequency_hz)
+        && !runs.takes_frequency(sh.frequency_hz)
+        && let Some((lo, hi)) = runs.frequency_range()
     {
         return Err(format!(
-            "Prusa-Firmware-Buddy clamps M593 F to {lo} to {hi} Hz (150 Hz on the MINI)"
+            "Prusa-Firmware-Buddy clamps M593 F to {lo} to {hi} Hz (150 Hz on the MINI), not {} Hz",
+            sh.frequency_hz
         ));
     }
     if runs.firmware() == Some(Firmware::Tmc4361a) && c.kind == ProfileKind::Trapezoid {
