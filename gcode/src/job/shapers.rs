@@ -88,7 +88,10 @@ pub const PRUSA_SAFE_MIN_HZ: f64 = 10.0;
 /// takes up to 150). What a configuration written for any of them may hold.
 pub fn prusa_common_hz() -> (f64, f64) {
     let max = PrusaModel::ALL.map(PrusaModel::shaper_max_hz);
-    (PRUSA_SAFE_MIN_HZ, max.into_iter().fold(f64::INFINITY, f64::min))
+    (
+        PRUSA_SAFE_MIN_HZ,
+        max.into_iter().fold(f64::INFINITY, f64::min),
+    )
 }
 /// Prusa-Firmware-Buddy's default vibration reduction (`M593 R`).
 const PRUSA_VIBRATION_REDUCTION: f64 = 20.0;

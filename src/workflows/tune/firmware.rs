@@ -164,7 +164,7 @@ impl Candidates {
     /// (`clamp_frequency_to_safe_values`, lib/Marlin/Marlin/src/feature/input_shaper/
     /// input_shaper_config.hpp).
     pub fn frequency_range(self) -> Option<(f64, f64)> {
-        (self.0 == Some(Firmware::Prusa)).then_some(settle_gcode::job::PRUSA_SAFE_HZ)
+        (self.0 == Some(Firmware::Prusa)).then(settle_gcode::job::prusa_common_hz)
     }
 
     /// Whether it runs a shaper designed for `frequency_hz` as designed
