@@ -3,6 +3,7 @@
 //! the value was swept.
 
 use crate::error::Error;
+use crate::input::modes::MAX_FREQUENCY_HZ;
 use crate::input::source::Source;
 use crate::spec::MAX_POSITION_MM;
 use crate::spec::run_spec::{RunSpec, needs_jerk};
@@ -146,6 +147,16 @@ pub fn validate_sampling(
                 "{} s is shorter than half a period of the slowest mode ({slowest_hz:.4} Hz in {what}): the residual vibration is not seen; give at least {:.4} s (ten decay time constants, 1 / (zeta 2 pi f), is the usual choice)",
                 run.window_s,
                 0.5 / slowest_hz
+            ),
+        ));
+    }
+    if fastest_hz > MAX_FREQUENCY_HZ && run.machine.physical().is_some() {
+        // No sample rate can be asked for: the machine is implausible, not the rate.
+        return Err(src.error_at(
+            "machine",
+            format!(
+                "the linearised modes of the machine `{}` reach {fastest_hz:.4e} Hz, above the {MAX_FREQUENCY_HZ} Hz a machine's mode may have: the machine is implausible (no sample rate would do); check the units of its parts (motor.rotor_inertia_g_cm2 in g cm^2, 54 for a NEMA 17, not kg m^2; stiffnesses in N/m; masses in kg; `settle machine` prints the modes)",
+                run.machine.physical().map_or("", |m| m.name.as_str())
             ),
         ));
     }

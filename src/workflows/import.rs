@@ -34,6 +34,7 @@
 //! given (`--machine`, a machine file from `settle identify` or written by hand); without
 //! it the preset `printer_xy` stands in, and the report says so.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -115,6 +116,10 @@ pub struct Current {
     /// Marlin: the input shaper of the printer's build (`[tune] marlin_shaping`); `None`
     /// for the other firmwares.
     pub marlin_shaping: Option<MarlinShaping>,
+    /// Where the settings were read, by the firmware's key (`printer.max_accel`,
+    /// `input_shaper.shaper_freq_x`, `M201`, `M593`): the file and line an error about a
+    /// setting settle cannot run names. Empty where the reader keeps no lines.
+    pub set_at: BTreeMap<String, Location>,
 }
 
 impl Current {
@@ -208,6 +213,16 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
     }
 }
 
+/// A configuration reader's place as the harness's, with the firmware's `key`.
+fn harness_location(at: &settle_gcode::Location, key: &str) -> Location {
+    Location {
+        file: PathBuf::from(at.source_name.as_ref()),
+        line: usize::try_from(at.line).ok(),
+        column: None,
+        key: Some(key.to_string()),
+    }
+}
+
 fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)> {
     s.type_name(dialect)
         .map(|n| (n, s.frequency_hz, s.damping_ratio))
@@ -270,6 +285,11 @@ pub fn read_current_files(
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
                 marlin_shaping: None,
+                set_at: c
+                    .set_at
+                    .iter()
+                    .map(|(k, at)| (k.clone(), harness_location(at, k)))
+                    .collect(),
             };
             Ok((cur, files))
         }
@@ -297,6 +317,7 @@ pub fn read_current_files(
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
                 marlin_shaping: None,
+                set_at: BTreeMap::new(),
             };
             Ok((cur, files))
         }
@@ -350,6 +371,40 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
             .min(p.max_accel_m_s2[0])
             .min(p.max_accel_m_s2[1]),
     );
+    // A limit that rounds to nothing at a millionth of a millimetre ([`marlin_mm`]) is no
+    // speed or acceleration a move can have.
+    for (value, command, what) in [
+        (vmax, "M203", "the lower of X and Y max feedrates (mm/s)"),
+        (
+            amax,
+            if p.print_accel_m_s2 < p.max_accel_m_s2[0].min(p.max_accel_m_s2[1]) {
+                "M204"
+            } else {
+                "M201"
+            },
+            "the printing acceleration, the lowest of M204 P and M201 X and Y (mm/s^2)",
+        ),
+    ] {
+        if value <= 0.0 {
+            let line = c
+                .followed
+                .iter()
+                .rev()
+                .find(|(_, f)| *f == command)
+                .map(|(l, _)| usize::try_from(*l).unwrap_or(0));
+            return Err(Error::Input {
+                at: Location {
+                    file: path.to_path_buf(),
+                    line,
+                    column: None,
+                    key: Some(command.to_string()),
+                },
+                message: format!(
+                    "{what} rounds to 0 at the millionth of a millimetre settle reads: no move can have it; allowed: at least 0.000001"
+                ),
+            });
+        }
+    }
     let axes = ["x", "y"]
         .into_iter()
         .enumerate()
@@ -401,6 +456,20 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
         }
         MarlinShaping::InputShaping
     };
+    // The last line of each command (the one whose values hold).
+    let set_at = c
+        .followed
+        .iter()
+        .map(|(line, command)| {
+            let at = Location {
+                file: path.to_path_buf(),
+                line: usize::try_from(*line).ok(),
+                column: None,
+                key: Some((*command).to_string()),
+            };
+            ((*command).to_string(), at)
+        })
+        .collect();
     Ok(Current {
         firmware: Firmware::Marlin,
         vmax_mm_s: vmax,
@@ -408,6 +477,7 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
         axes,
         notes,
         marlin_shaping: Some(shaping),
+        set_at,
     })
 }
 
@@ -649,43 +719,82 @@ fn scenario_text(
 }
 
 /// A scenario made of the settings read that settle cannot run (`e`, against the probe
-/// scenario), said against the configuration and the firmware's own key.
-fn settings_error(config: &Path, firmware: Firmware, axis: &str, e: Error) -> Error {
+/// scenario), said against the configuration, the firmware's own key and, where the
+/// reader keeps it, the line that set it.
+fn settings_error(config: &Path, cur: &Current, axis: &str, e: Error) -> Error {
     let Error::Input { at, message } = e else {
         return e;
     };
     let key = at.key.unwrap_or_default();
     let key = key.strip_prefix("sweep.").unwrap_or(&key);
-    let klipper = firmware == Firmware::Klipper;
-    let firmware_key = match key {
+    let klipper = cur.firmware == Firmware::Klipper;
+    // The command whose acceleration is the baseline's: an axis's M201 when it is the
+    // lowest, else M204 P.
+    let accel_command = if cur
+        .axes
+        .iter()
+        .any(|a| a.max_accel_mm_s2 == Some(cur.amax_mm_s2))
+    {
+        "M201"
+    } else {
+        "M204"
+    };
+    let (firmware_key, line_of) = match key {
         k if k.starts_with("limits.amax") => {
             if klipper {
-                "printer.max_accel"
+                (
+                    "printer.max_accel".to_string(),
+                    "printer.max_accel".to_string(),
+                )
             } else {
-                "M201 / M204 P"
+                ("M201 / M204 P".to_string(), accel_command.to_string())
             }
         }
         k if k.starts_with("limits.vmax") => {
             if klipper {
-                "printer.max_velocity"
+                (
+                    "printer.max_velocity".to_string(),
+                    "printer.max_velocity".to_string(),
+                )
             } else {
-                "M203"
+                ("M203".to_string(), "M203".to_string())
             }
         }
         k if k.starts_with("shaper.") => {
             if klipper {
-                "input_shaper"
+                let option = match k {
+                    "shaper.frequency_hz" => format!("shaper_freq_{axis}"),
+                    "shaper.damping_ratio" => format!("damping_ratio_{axis}"),
+                    _ => format!("shaper_type_{axis}"),
+                };
+                let section_key = format!("input_shaper.{option}");
+                let line_of = if option.starts_with("shaper_type")
+                    && !cur.set_at.contains_key(&section_key)
+                {
+                    "input_shaper.shaper_type".to_string()
+                } else {
+                    section_key.clone()
+                };
+                (section_key, line_of)
             } else {
-                "M593"
+                ("M593".to_string(), "M593".to_string())
             }
         }
-        _ => "",
+        _ => (String::new(), String::new()),
     };
     let message = format!("axis {axis}: settle cannot run these settings: {message}");
     if firmware_key.is_empty() {
-        Error::input(config, message)
-    } else {
-        Error::input_key(config, firmware_key, message)
+        return Error::input(config, message);
+    }
+    match cur.set_at.get(&line_of) {
+        Some(set) => Error::Input {
+            at: Location {
+                key: Some(firmware_key),
+                ..set.clone()
+            },
+            message,
+        },
+        None => Error::input_key(config, firmware_key, message),
     }
 }
 
@@ -787,7 +896,7 @@ pub fn import(opts: &ImportOptions) -> Result<Imported, Error> {
         // The machine has the axis: a scenario that does not load is the settings' fault
         // (a limit the firmware accepts that settle cannot run), said as such.
         let (_, runs) = crate::expand::parse_runs(&text, &probe)
-            .map_err(|e| settings_error(&opts.config, cur.firmware, &a.name, e))?;
+            .map_err(|e| settings_error(&opts.config, &cur, &a.name, e))?;
         if let Some(run) = runs.first() {
             if centre_hz.is_none() {
                 centre_hz = tuning_modes(run)

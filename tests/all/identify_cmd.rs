@@ -126,6 +126,20 @@ fn bad_files_and_options_exit_2_naming_the_file_and_line() {
     let (code, _, err) = run(&["identify", path_str(&unnamed), "--axis", "w"]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("allowed: x, y, z"), "{err}");
+    // A processed spectrum (Klipper's calibrate_shaper CSV) whose last frequency is 1e308
+    // Hz: out of bounds at its line, not a puzzle about bin widths.
+    let mut spectrum = String::from("freq,psd_x,psd_y,psd_z,psd_xyz\n");
+    for k in 0..40 {
+        spectrum.push_str(&format!("{:.1},1,1,1,3\n", f64::from(k) * 1.6));
+    }
+    spectrum.push_str("1e308,1,1,1,3\n");
+    let far = write(dir.path(), "resonances_x_far.csv", &spectrum);
+    let (code, _, err) = run(&["identify", path_str(&far)]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("resonances_x_far.csv:42: frequency 1e308 Hz in column `freq`; expected a frequency from 0 to 50000 Hz"),
+        "{err}"
+    );
 }
 
 /// What a new user runs first, and what the firmwares write that cannot be trusted: each

@@ -364,3 +364,54 @@ fn a_tiny_acceleration_searches_no_zero() {
         .expect("[tune] accelerations_mm_s2");
     assert!(accels.iter().all(|a| *a > 0.0), "{accels:?}");
 }
+
+/// A value Klipper reads but settle cannot stand behind is refused at its file, line and
+/// option: a shaper frequency of 1e308 Hz (it came back as "key `input_shaper`: ... got
+/// inf", no line, once the sweep around it overflowed), and an acceleration no run can
+/// reach in a sane number of samples (named the option but not its line).
+#[test]
+fn implausible_values_are_refused_at_their_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cfg = dir.path().join("printer.cfg");
+    let out = dir.path().join("o.toml");
+    let printer = "[printer]\nkinematics: cartesian\nmax_velocity: 300\nmax_accel: 3000\n";
+    for (text, line, key, says) in [
+        (
+            format!("{printer}\n[input_shaper]\nshaper_freq_x: 1e308\nshaper_type_x: mzv\n"),
+            7,
+            "input_shaper.shaper_freq_x",
+            "a finite number >= 0 <= 1000",
+        ),
+        (
+            format!("{printer}\n[input_shaper]\nshaper_freq_y: 40\nshaper_freq_x: 1e9\n"),
+            8,
+            "input_shaper.shaper_freq_x",
+            "a finite number >= 0 <= 1000",
+        ),
+        (
+            printer.replace("max_accel: 3000", "max_accel: 0.0000001"),
+            4,
+            "printer.max_accel",
+            "settle cannot run these settings",
+        ),
+    ] {
+        std::fs::write(&cfg, &text).expect("write");
+        let e = import(&opts(Firmware::Klipper, cfg.clone(), &out)).expect_err(&text);
+        let Error::Input { at, message } = &e else {
+            panic!("{text}: {e}")
+        };
+        assert_eq!(at.file, cfg, "{text}: {e}");
+        assert_eq!(at.line, Some(line), "{text}: {e}");
+        assert_eq!(at.key.as_deref(), Some(key), "{text}: {e}");
+        assert!(message.contains(says), "{text}: {e}");
+        assert!(!out.exists(), "{text}");
+        let r = crate::support::settle()
+            .args(["import", "klipper"])
+            .arg(&cfg)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .expect("runs");
+        assert_eq!(r.status.code(), Some(2), "{text}: {r:?}");
+    }
+}

@@ -226,6 +226,48 @@ fn a_reply_without_motion_settings_is_refused() {
     }
 }
 
+/// Values the firmware takes that settle cannot stand behind: a shaper frequency of a
+/// GHz, and limits that round to nothing at the millionth of a millimetre settle keeps
+/// (they came back as "empty sweep axis" and "got 0", naming no line). Each is refused,
+/// exit 2, at its file, line and command.
+#[test]
+fn implausible_values_are_refused_at_their_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("o.toml");
+    let head = "M92 X80 Y80 Z400 E100\nM203 X500 Y500 Z10 E50\nM201 X500 Y500 Z100 E5000\nM204 P500 R500 T500\nM205 B20000 S0 T0 J0.08\n";
+    for (last, want) in [
+        (
+            "M593 X F999999999 D0.1",
+            "m.txt:6: key `M593.F`: [M593] F = `999999999`: not allowed (allowed: 0 (off) or 1 to 1000 Hz)",
+        ),
+        (
+            "M201 X0.0000001",
+            "m.txt:6: key `M201`: the printing acceleration",
+        ),
+        (
+            "M204 P0.0000001",
+            "m.txt:6: key `M204`: the printing acceleration",
+        ),
+        (
+            "M203 X0.0000001",
+            "m.txt:6: key `M203`: the lower of X and Y",
+        ),
+    ] {
+        let reply = write(dir.path(), "m.txt", &format!("{head}{last}\n"));
+        let r = settle()
+            .args(["import", "marlin"])
+            .arg(&reply)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{last}: {err}");
+        assert!(err.contains(want), "{last}: {err}");
+        assert!(!out.exists(), "{last}");
+    }
+}
+
 /// The cells of the Markdown table rows of `md` whose first two cells are `first`,
 /// `second`.
 fn row<'a>(md: &'a str, first: &str, second: &str) -> Vec<&'a str> {

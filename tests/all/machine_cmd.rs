@@ -127,8 +127,10 @@ fn the_modes_ranges_keep_what_settle_resolves_and_identify_writes() {
 /// A physical machine whose parts are in the wrong unit has no modes settle can stand
 /// behind: a rotor inertia in kg m^2 (5.4e-6 for 54 g cm^2) puts the rotor's mode near
 /// 1 MHz, which was dropped from the list while the others were printed as if sound; a
-/// mount stiffness of 1e308 N/m made the eigenvalue iteration run forever. Both exit 2,
-/// at once, naming the file and the units to check.
+/// mount stiffness of 1e308 N/m made the eigenvalue iteration run forever. Both are
+/// outside their key's plausible range (`settle_sim::machine::PART_RANGES`) and exit 2 at
+/// once, naming the file, line and key; parts each plausible whose mode is not (a 0.1 g
+/// toolhead on a 1e12 N/m mount, 16 MHz) exit 2 naming the units to check.
 #[test]
 fn parts_in_the_wrong_unit_are_refused_not_listed() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -138,18 +140,28 @@ fn parts_in_the_wrong_unit_are_refused_not_listed() {
             "kg_m2.toml",
             "rotor_inertia_g_cm2 = 54.0",
             "rotor_inertia_g_cm2 = 5.4e-6",
-            "above the 50000 Hz a machine's mode may have",
+            ":45:1: key `motor.rotor_inertia_g_cm2`: must be a number from 1e-3 to 1e7 (g cm^2: 54 for a NEMA 17, not kg m^2), got 0.0000054",
         ),
         (
             "stiff.toml",
             "stiffness_n_per_m = 5.0e5",
             "stiffness_n_per_m = 1e308",
-            "the eigenvalues of its linearised model do not converge",
+            ":69:1: key `axis.x.mount.stiffness_n_per_m`: must be a number from 1 to 1e15 (N/m), got 1e308",
+        ),
+        (
+            "light.toml",
+            "stiffness_n_per_m = 5.0e5\ndamping_ratio = 0.05\n\n[axis.y]",
+            "stiffness_n_per_m = 1e12\ndamping_ratio = 0.05\n\n[axis.y]",
+            "above the 50000 Hz a machine's mode may have: settle cannot resolve its modes; check the units",
         ),
     ] {
         assert!(preset.contains(from), "{from}");
+        let mut text = preset.replacen(from, to, 1);
+        if name == "light.toml" {
+            text = text.replacen("toolhead_kg = 0.6", "toolhead_kg = 1e-4", 1);
+        }
         let path = dir.path().join(name);
-        std::fs::write(&path, preset.replacen(from, to, 1)).expect("write");
+        std::fs::write(&path, text).expect("write");
         let mut child = settle()
             .arg("machine")
             .arg(&path)
@@ -169,6 +181,47 @@ fn parts_in_the_wrong_unit_are_refused_not_listed() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{name}: {err}");
         assert!(err.contains(name) && err.contains(says), "{name}: {err}");
-        assert!(err.contains("check"), "{name}: {err}");
+    }
+}
+
+/// Every part of a physical machine is bounded before work starts: `1e308` and `1e-300`
+/// for a torque, a belt's `ea_n` or a mass overflowed the model ("invalid lumped model:
+/// coupling `belt`: stiffness and damping must be finite", "eigenvector iteration
+/// failed"), naming neither key nor line. Each exits 2 at its line and key with the range.
+#[test]
+fn every_part_is_bounded_at_its_key() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let preset = settle::input::machine_file::PRESETS[0].2;
+    for (from, key) in [
+        ("holding_torque_n_m = 0.40", "motor.holding_torque_n_m"),
+        ("ea_n = 15000.0", "axis.x.belt.ea_n"),
+        ("carriage_kg = 0.15", "axis.x.carriage_kg"),
+        ("toolhead_kg = 0.6", "axis.x.toolhead_kg"),
+        ("mass_kg = 5.0", "axis.y.frame.mass_kg"),
+        ("span_mm = 350.0", "axis.x.belt.span_mm"),
+        ("run_current_a_rms = 0.8", "driver.run_current_a_rms"),
+        ("supply_v = 24.0", "driver.supply_v"),
+        ("inductance_mh = 2.8", "motor.inductance_mh"),
+    ] {
+        let line = preset
+            .lines()
+            .position(|l| l.starts_with(from))
+            .expect("the preset has the key")
+            + 1;
+        let name = from.split(' ').next().expect("key");
+        for value in ["1e308", "1e-300", "-1", "nan"] {
+            let path = dir.path().join("m.toml");
+            let text = preset.replacen(from, &format!("{name} = {value}"), 1);
+            std::fs::write(&path, text).expect("write");
+            let out = settle().arg("machine").arg(&path).output().expect("runs");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(2), "{key} = {value}: {err}");
+            assert!(
+                err.contains(&format!(
+                    "m.toml:{line}:1: key `{key}`: must be a number from "
+                )),
+                "{key} = {value}: {err}"
+            );
+        }
     }
 }

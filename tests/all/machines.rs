@@ -162,6 +162,25 @@ jmax_mm_s3 = 1e5
     assert!(msg.contains("unused"), "{msg}");
 }
 
+/// Parts each within its range whose mode is not (a 0.1 g toolhead on a 1e12 N/m mount,
+/// 16 MHz): the sweep asked for a sample rate of 3e7 Hz at `observe.sample_rate_hz`, as if
+/// the rate were the mistake. The error names the machine and the units to check instead.
+#[test]
+fn a_machine_with_an_implausible_mode_is_named_not_the_sample_rate() {
+    let msg = err(&format!(
+        "{PRINTER}[sweep]\n\"machine.axis.y.mount.stiffness_n_per_m\" = [1e12]\n\"machine.axis.y.toolhead_kg\" = [1e-4]\n"
+    ));
+    assert!(
+        msg.starts_with("bad.toml:2:1: key `machine`: the linearised modes of the machine `printer_xy` reach 1.59"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("the machine is implausible") && msg.contains("motor.rotor_inertia_g_cm2"),
+        "{msg}"
+    );
+    assert!(!msg.contains("give at least"), "{msg}");
+}
+
 #[test]
 fn machine_form_errors() {
     let msg = err(&PRINTER.replace(

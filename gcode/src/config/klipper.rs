@@ -4,6 +4,7 @@
 //! `[tmc2130|tmc2208|tmc2209|tmc2240|tmc2660|tmc5160 stepper_*]` drivers
 //! (`klippy/extras/tmc*.py`). Other sections and options are not read.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -43,6 +44,12 @@ pub const DEFAULT_SQUARE_CORNER_VELOCITY_MM_S: f64 = 5.0;
 pub const DEFAULT_DAMPING_RATIO: f64 = 0.1;
 /// Klipper's default `shaper_type` (`klippy/extras/input_shaper.py`).
 pub const DEFAULT_SHAPER_TYPE: &str = "mzv";
+/// The highest shaper frequency read, Hz (Klipper's `shaper_freq_<axis>`, Marlin's
+/// `M593 F`). Neither firmware sets an upper limit, but a shaper tuned above 1 kHz lasts
+/// under a millisecond and cancels nothing a printer's belts or frame carry (their modes
+/// are tens to a few hundred Hz); RepRapFirmware refuses `M593` above the same 1000 Hz
+/// (`gcode/src/config/rrf.rs`). A larger value is a slip, refused at its line.
+pub const MAX_SHAPER_FREQUENCY_HZ: f64 = 1000.0;
 /// Klipper's default `full_steps_per_rotation` (`klippy/stepper.py`): a 1.8 degree motor.
 pub const DEFAULT_FULL_STEPS_PER_ROTATION: u32 = 200;
 
@@ -96,6 +103,9 @@ pub struct KlipperConfig {
     pub files: Vec<PathBuf>,
     /// What was read in a way worth knowing (SAVE_CONFIG values overridden, old options).
     pub notes: Vec<ConfigNote>,
+    /// Where each option in effect was set, by `section.key` (lower case): the file and
+    /// line an error about a value read here names.
+    pub set_at: BTreeMap<String, Location>,
 }
 
 impl KlipperConfig {
@@ -131,12 +141,24 @@ impl KlipperConfig {
             y: stepper(v, "stepper_y", &mut notes).map_err(skipped)?,
             z: stepper(v, "stepper_z", &mut notes).map_err(skipped)?,
         };
+        let set_at = loaded
+            .store
+            .sections()
+            .iter()
+            .flat_map(|sec| {
+                sec.options.iter().filter_map(|o| {
+                    let at = &loaded.store.get(&sec.name, &o.key)?.at;
+                    Some((format!("{}.{}", sec.name, o.key), at.clone()))
+                })
+            })
+            .collect();
         Ok(KlipperConfig {
             printer,
             input_shaper,
             steppers,
             files: loaded.files,
             notes,
+            set_at,
         })
     }
 }
@@ -285,7 +307,11 @@ fn shaper(v: Values, axis: &str) -> Result<ShaperSetting, GcodeError> {
         )?
         .unwrap_or(DEFAULT_DAMPING_RATIO);
     let frequency_hz = v
-        .float(S, &format!("shaper_freq_{axis}"), Range::min(0.0))?
+        .float(
+            S,
+            &format!("shaper_freq_{axis}"),
+            Range::min(0.0).max(MAX_SHAPER_FREQUENCY_HZ),
+        )?
         .unwrap_or(0.0);
     Ok(ShaperSetting {
         name,

@@ -28,6 +28,7 @@ use std::sync::Arc;
 use settle_planner::firmware::marlin::{MarlinConfig, MarlinJerk};
 
 use super::budget::Budget;
+use super::klipper::MAX_SHAPER_FREQUENCY_HZ;
 use super::machine::ConfigNote;
 use crate::error::{GcodeError, Location};
 use crate::job::driver::{Driver, LimitOutcome};
@@ -336,6 +337,20 @@ impl MarlinSettings {
             };
             let command = change.command_name();
             followed.push((at.line, command));
+            if let LimitChange::MarlinInputShaping {
+                frequency_hz: Some(f),
+                ..
+            } = change
+                && f > MAX_SHAPER_FREQUENCY_HZ
+            {
+                return Err(GcodeError::ConfigValue {
+                    at,
+                    section: "M593".into(),
+                    key: "F".into(),
+                    value: f.to_string().into(),
+                    allowed: format!("0 (off) or 1 to {MAX_SHAPER_FREQUENCY_HZ} Hz").into(),
+                });
+            }
             if matches!(change, LimitChange::MarlinInputShaping { .. }) {
                 shapers
                     .apply(&change)

@@ -12,6 +12,11 @@ use nalgebra::{Complex, DMatrix, DVector};
 
 type C = Complex<f64>;
 
+/// The largest `|ln |z||` of a pole (its decay or growth per sample, in nepers) the fit
+/// reports: e^700 is 1e304, the edge of `f64`; a pole beyond it is an eigenvalue without
+/// bound, not a mode.
+const MAX_LOG_STEP: f64 = 700.0;
+
 /// One measured mode.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeasuredMode {
@@ -26,7 +31,10 @@ pub struct MeasuredMode {
 /// Fit `order` damped exponentials to `y` (sampled every `dt_s`) and return the modes,
 /// strongest first (conjugate pairs merged). `y` should hold a few hundred samples at
 /// least 4 per period of the fastest mode; `order` is the number of poles (2 per
-/// oscillatory mode). `None` if the fit fails (too few samples, NaN).
+/// oscillatory mode). `None` if the fit fails (too few samples, NaN) or does not converge
+/// to a physical answer: a pole at zero or not finite (an unbounded eigenvalue: a decay
+/// rate or frequency without limit), or a mode whose frequency, damping ratio or
+/// amplitude is not a finite number.
 pub fn fit(y: &[f64], dt_s: f64, order: usize) -> Option<Vec<MeasuredMode>> {
     let n = y.len();
     if order == 0 || n < 3 * order + 3 || y.iter().any(|v| !v.is_finite()) {
@@ -48,6 +56,15 @@ pub fn fit(y: &[f64], dt_s: f64, order: usize) -> Option<Vec<MeasuredMode>> {
     // Least squares: v1 X = v2.
     let x = (v1.transpose() * &v1).lu().solve(&(v1.transpose() * &v2))?;
     let z: Vec<C> = x.complex_eigenvalues().iter().copied().collect();
+    // `ln z` is unbounded at zero and undefined off the finite plane, and a pole that
+    // decays or grows by more than e^700 (1e304) in one sample has left the range of the
+    // arithmetic: no mode to report.
+    if z.iter().any(|z| {
+        let r = z.norm();
+        !(z.re.is_finite() && z.im.is_finite() && r > 0.0 && r.ln().abs() <= MAX_LOG_STEP)
+    }) {
+        return None;
+    }
     // Amplitudes: y[k] = sum a_j z_j^k, complex least squares (QR).
     let vand = DMatrix::from_fn(n, m, |k, j| z[j].powu(k as u32));
     let yc = DVector::from_iterator(n, y.iter().map(|&v| C::new(v, 0.0)));
@@ -68,6 +85,11 @@ pub fn fit(y: &[f64], dt_s: f64, order: usize) -> Option<Vec<MeasuredMode>> {
             }
         })
         .collect();
+    if out.iter().any(|m| {
+        !(m.frequency_hz.is_finite() && m.damping_ratio.is_finite() && m.amplitude.is_finite())
+    }) {
+        return None;
+    }
     out.sort_by(|p, q| q.amplitude.total_cmp(&p.amplitude));
     Some(out)
 }
@@ -100,5 +122,19 @@ mod tests {
             assert!((m.damping_ratio - z).abs() < 1e-8, "{m:?}");
             assert!((m.amplitude - a).abs() < 1e-7 * a, "{m:?}");
         }
+    }
+
+    /// A lone impulse (one sample, then silence) is a decay infinitely fast: the pencil's
+    /// eigenvalue is exactly zero, whose logarithm has no bound. The fit is refused rather
+    /// than reported as a mode of infinite frequency and undefined damping.
+    #[test]
+    fn an_unbounded_eigenvalue_is_refused() {
+        let mut y = vec![0.0; 64];
+        y[0] = 1.0;
+        assert_eq!(fit(&y, 1e-3, 1), None);
+        // A decay by 1e-305 in one sample: a finite pole, but no mode.
+        let mut fast = y.clone();
+        fast[1] = 1e-305;
+        assert_eq!(fit(&fast, 1e-3, 1), None, "{:?}", fit(&fast, 1e-3, 1));
     }
 }

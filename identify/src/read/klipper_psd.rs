@@ -16,8 +16,12 @@
 //! `exp(1 - (10 / (f + 0.1))^2)`. The reader tells these apart by the bins between 0 and
 //! 5 Hz: all exactly zero means the older rule.
 
-use super::{MAX_PSD, MAX_SPECTRUM_ROWS, parse_number, truncate};
+use super::{MAX_PSD, MAX_RATE_HZ, MAX_SPECTRUM_ROWS, parse_number, truncate};
 use crate::IdentifyError;
+
+/// Highest frequency a row may have (Hz): the Nyquist frequency of the fastest
+/// recording a reader accepts ([`MAX_RATE_HZ`]).
+pub const MAX_FREQ_HZ: f64 = MAX_RATE_HZ / 2.0;
 
 /// Fewest frequency rows accepted.
 pub const MIN_ROWS: usize = 16;
@@ -155,6 +159,19 @@ pub fn parse(file: &str, text: &str) -> Result<ProcessedPsd, IdentifyError> {
             ));
         }
         let f = parse_number(file, n, "freq", fields[0])?;
+        if !(0.0..=MAX_FREQ_HZ).contains(&f) {
+            return Err(IdentifyError::format(
+                file,
+                n,
+                format!(
+                    "frequency {} Hz in column `freq`",
+                    truncate(fields[0].trim())
+                ),
+                format!(
+                    "a frequency from 0 to {MAX_FREQ_HZ} Hz (half the fastest sample rate settle reads, {MAX_RATE_HZ} Hz: no spectrum of a recording goes higher)"
+                ),
+            ));
+        }
         if freq_hz.last().is_some_and(|&p| f <= p) {
             return Err(IdentifyError::format(
                 file,

@@ -101,7 +101,7 @@ fn recordings_and_spectra_beyond_the_limits_are_refused() {
     assert_refused(&e, "m.csv", &too_many);
     let mut psd = String::from("freq,psd_x,psd_y,psd_z,psd_xyz\n");
     for k in 0..=MAX_SPECTRUM_ROWS {
-        writeln!(psd, "{k},1,1,1,3").expect("a string");
+        writeln!(psd, "{:.1},1,1,1,3", k as f64 * 0.1).expect("a string");
     }
     let e = klipper_psd::parse("p.csv", &psd).expect_err("too many rows");
     assert_refused(
@@ -122,5 +122,33 @@ fn recordings_and_spectra_beyond_the_limits_are_refused() {
         &e,
         "s.stdata",
         &format!("more than {MAX_FILE_BYTES} bytes of text"),
+    );
+}
+
+/// A processed spectrum's frequency beyond the Nyquist frequency of any recording settle
+/// reads (a last row of `1e308` Hz) is refused at its line as out of bounds; it was told
+/// "which no bin width fitting the rows before it rounds to", a puzzle rather than a bound.
+#[test]
+fn a_spectrum_frequency_beyond_any_recording_is_refused_at_its_line() {
+    let mut psd = String::from("freq,psd_x,psd_y,psd_z,psd_xyz\n");
+    for k in 0..20 {
+        writeln!(psd, "{:.1},1,1,1,3", k as f64 * 1.6).expect("a string");
+    }
+    for (last, found) in [
+        ("1e308", "frequency 1e308 Hz in column `freq`"),
+        ("50000.1", "frequency 50000.1 Hz in column `freq`"),
+    ] {
+        let text = format!("{psd}{last},1,1,1,3\n");
+        let e = klipper_psd::parse("p.csv", &text).expect_err(last);
+        let text = e.to_string();
+        assert!(text.starts_with("p.csv:22: "), "{text}");
+        assert!(text.contains(found), "{text}");
+        assert!(text.contains("a frequency from 0 to 50000 Hz"), "{text}");
+    }
+    let e =
+        klipper_psd::parse("p.csv", &psd.replacen("\n0.0,", "\n-1.0,", 1)).expect_err("negative");
+    assert!(
+        e.to_string().starts_with("p.csv:2: frequency -1.0 Hz"),
+        "{e}"
     );
 }

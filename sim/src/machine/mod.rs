@@ -214,6 +214,64 @@ impl Machine {
     }
 }
 
+/// The plausible range of each part's value (machine-file key inside the axis, lowest,
+/// highest, unit): wide enough for a desktop printer's micro motors and a machine tool's
+/// heavy gantry, narrow enough that a value in the wrong unit or a slip (`1e308`, a rotor
+/// inertia of 5.4e-6 typed in kg m^2 for 54 g cm^2) is refused at its key rather than
+/// overflowing the model or giving it modes of MHz. The values of
+/// `scenarios/machines/*.toml` lie well inside; the stiffnesses go to the rigid limit the
+/// model is checked against (sim/tests/all/machine.rs).
+pub const PART_RANGES: [(&str, f64, f64, &str); 19] = [
+    ("carriage_kg", 1e-4, 1e4, "kg"),
+    ("toolhead_kg", 1e-4, 1e4, "kg"),
+    ("beam_kg", 1e-4, 1e4, "kg; 0 for none"),
+    ("belt.ea_n", 1.0, 1e13, "N"),
+    ("belt.span_mm", 11.0, 1e5, "mm"),
+    ("belt.pitch_mm", 0.1, 100.0, "mm"),
+    ("screw.lead_mm", 0.01, 1e3, "mm"),
+    ("screw.stiffness_n_per_m", 1.0, 1e15, "N/m"),
+    ("mount.stiffness_n_per_m", 1.0, 1e15, "N/m"),
+    ("frame.mass_kg", 1e-4, 1e6, "kg"),
+    ("frame.stiffness_n_per_m", 1.0, 1e15, "N/m"),
+    ("motor.holding_torque_n_m", 1e-4, 1e3, "N m"),
+    ("motor.rated_current_a", 1e-3, 1e3, "A"),
+    ("motor.resistance_ohm", 1e-4, 1e4, "ohm"),
+    ("motor.inductance_mh", 1e-3, 1e4, "mH"),
+    (
+        "motor.rotor_inertia_g_cm2",
+        1e-3,
+        1e7,
+        "g cm^2: 54 for a NEMA 17, not kg m^2",
+    ),
+    ("driver.run_current_a_rms", 1e-3, 1e3, "A rms"),
+    ("driver.supply_v", 0.1, 1e4, "V"),
+    ("driver.current_loop_bandwidth_hz", 0.0, 1e7, "Hz"),
+];
+
+/// The most teeth a drive pulley may have (a 1000-tooth GT2 pulley is 64 cm across).
+pub const MAX_PULLEY_TEETH: u32 = 1000;
+
+/// The most rotor teeth a motor may have (50 for 1.8 degree steppers, 100 for 0.9).
+pub const MAX_ROTOR_TEETH: u32 = 1000;
+
+/// `x` as a person writes it: `0.1`, `1000`, `1e-4`, `1e9`.
+fn short(x: f64) -> String {
+    if x == 0.0 || (0.01..=1e4).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// `(lowest, highest, unit)` of `field` in [`PART_RANGES`].
+fn part_range(field: &str) -> (f64, f64, &'static str) {
+    PART_RANGES
+        .iter()
+        .find(|(f, ..)| *f == field)
+        .map(|&(_, lo, hi, unit)| (lo, hi, unit))
+        .unwrap_or((f64::MIN_POSITIVE, f64::MAX, ""))
+}
+
 impl AxisMachine {
     /// Check every parameter; errors name the field as a key path inside the axis.
     pub fn validate(&self) -> Result<(), SimError> {
@@ -225,37 +283,38 @@ impl AxisMachine {
                 allowed: allowed.to_string(),
             })
         };
-        let pos = |x: f64| x.is_finite() && x > 0.0;
         let ratio = |x: f64| (0.0..1.0).contains(&x);
-        const POS: &str = "a finite number > 0";
         const RATIO: &str = "0 <= damping_ratio < 1";
-        for (f, v) in [
-            ("carriage_kg", self.carriage_kg),
-            ("toolhead_kg", self.toolhead_kg),
-        ] {
-            if !pos(v) {
-                return bad(f, v, POS);
+        // Each value within its plausible range ([`PART_RANGES`]): a value outside is a
+        // slip or a wrong unit, and its products (stiffnesses of 1e308 N/m, torques of
+        // 1e308 N m) overflow or leave the linearised model without digits.
+        let check = |field: &str, v: f64| {
+            let (lo, hi, unit) = part_range(field);
+            if v.is_finite() && v >= lo && v <= hi {
+                Ok(())
+            } else {
+                bad(
+                    field,
+                    v,
+                    &format!("a number from {} to {} ({unit})", short(lo), short(hi)),
+                )
             }
-        }
-        if !(self.beam_kg.is_finite() && self.beam_kg >= 0.0) {
-            return bad("beam_kg", self.beam_kg, "a finite number >= 0");
+        };
+        check("carriage_kg", self.carriage_kg)?;
+        check("toolhead_kg", self.toolhead_kg)?;
+        if self.beam_kg != 0.0 {
+            check("beam_kg", self.beam_kg)?;
         }
         match &self.transmission {
             Transmission::Belt(b) => {
-                for (f, v) in [
-                    ("belt.ea_n", b.ea_n),
-                    ("belt.span_mm", b.span_mm),
-                    ("belt.pitch_mm", b.pitch_mm),
-                ] {
-                    if !pos(v) {
-                        return bad(f, v, POS);
-                    }
-                }
-                if b.pulley_teeth < 8 {
+                check("belt.ea_n", b.ea_n)?;
+                check("belt.span_mm", b.span_mm)?;
+                check("belt.pitch_mm", b.pitch_mm)?;
+                if !(8..=MAX_PULLEY_TEETH).contains(&b.pulley_teeth) {
                     return bad(
                         "belt.pulley_teeth",
                         f64::from(b.pulley_teeth),
-                        "an integer >= 8",
+                        &format!("an integer from 8 to {MAX_PULLEY_TEETH}"),
                     );
                 }
                 let min = crate::lumped::MIN_SPAN_M * 1e3;
@@ -271,34 +330,20 @@ impl AxisMachine {
                 }
             }
             Transmission::Screw(s) => {
-                for (f, v) in [
-                    ("screw.lead_mm", s.lead_mm),
-                    ("screw.stiffness_n_per_m", s.stiffness_n_per_m),
-                ] {
-                    if !pos(v) {
-                        return bad(f, v, POS);
-                    }
-                }
+                check("screw.lead_mm", s.lead_mm)?;
+                check("screw.stiffness_n_per_m", s.stiffness_n_per_m)?;
                 if !ratio(s.damping_ratio) {
                     return bad("screw.damping_ratio", s.damping_ratio, RATIO);
                 }
             }
         }
-        if !pos(self.mount.stiffness_n_per_m) {
-            return bad("mount.stiffness_n_per_m", self.mount.stiffness_n_per_m, POS);
-        }
+        check("mount.stiffness_n_per_m", self.mount.stiffness_n_per_m)?;
         if !ratio(self.mount.damping_ratio) {
             return bad("mount.damping_ratio", self.mount.damping_ratio, RATIO);
         }
         if let Some(f) = &self.frame {
-            for (k, v) in [
-                ("frame.mass_kg", f.mass_kg),
-                ("frame.stiffness_n_per_m", f.stiffness_n_per_m),
-            ] {
-                if !pos(v) {
-                    return bad(k, v, POS);
-                }
-            }
+            check("frame.mass_kg", f.mass_kg)?;
+            check("frame.stiffness_n_per_m", f.stiffness_n_per_m)?;
             if !ratio(f.damping_ratio) {
                 return bad("frame.damping_ratio", f.damping_ratio, RATIO);
             }
@@ -311,15 +356,13 @@ impl AxisMachine {
             ("motor.inductance_mh", m.inductance_mh),
             ("motor.rotor_inertia_g_cm2", m.rotor_inertia_g_cm2),
         ] {
-            if !pos(v) {
-                return bad(f, v, POS);
-            }
+            check(f, v)?;
         }
-        if m.rotor_teeth == 0 {
+        if m.rotor_teeth == 0 || m.rotor_teeth > MAX_ROTOR_TEETH {
             return bad(
                 "motor.rotor_teeth",
-                0.0,
-                "an integer >= 1 (50 for 1.8 degree motors)",
+                f64::from(m.rotor_teeth),
+                &format!("an integer from 1 to {MAX_ROTOR_TEETH} (50 for 1.8 degree motors)"),
             );
         }
         if !(m.detent_torque_n_m.is_finite()
@@ -343,20 +386,21 @@ impl AxisMachine {
                 "a power of two from 1 to 256",
             );
         }
-        for (f, v) in [
-            ("driver.run_current_a_rms", d.run_current_a_rms),
-            ("driver.supply_v", d.supply_v),
-        ] {
-            if !pos(v) {
-                return bad(f, v, POS);
-            }
-        }
+        check("driver.run_current_a_rms", d.run_current_a_rms)?;
+        check("driver.supply_v", d.supply_v)?;
         let min_bw = m.resistance_ohm / (std::f64::consts::TAU * m.inductance_mh * 1e-3);
-        if !(d.current_loop_bandwidth_hz.is_finite() && d.current_loop_bandwidth_hz > min_bw) {
+        let max_bw = part_range("driver.current_loop_bandwidth_hz").1;
+        if !(d.current_loop_bandwidth_hz.is_finite()
+            && d.current_loop_bandwidth_hz > min_bw
+            && d.current_loop_bandwidth_hz <= max_bw)
+        {
             return bad(
                 "driver.current_loop_bandwidth_hz",
                 d.current_loop_bandwidth_hz,
-                &format!("a finite number > R / (2 pi L) = {min_bw:.1} Hz"),
+                &format!(
+                    "a finite number > R / (2 pi L) = {min_bw:.1} Hz and <= {} Hz",
+                    short(max_bw)
+                ),
             );
         }
         Ok(())
