@@ -82,9 +82,9 @@ const PRUSA_NULL: u32 = 6;
 const NOT_PRUSA: u32 = u32::MAX;
 /// Prusa-Firmware-Buddy's lowest safe frequency, Hz (`frequency_safe_min`,
 /// input_shaper_config.hpp; the highest is [`PrusaModel::shaper_max_hz`]).
-pub const PRUSA_SAFE_MIN_HZ: f64 = 10.0;
+const PRUSA_SAFE_MIN_HZ: f64 = 10.0;
 /// The shaper frequencies every Prusa-Firmware-Buddy printer runs as designed, Hz: from
-/// [`PRUSA_SAFE_MIN_HZ`] to the lowest [`PrusaModel::shaper_max_hz`] (100 Hz; the MINI
+/// `frequency_safe_min` (10 Hz) to the lowest [`PrusaModel::shaper_max_hz`] (100 Hz; the MINI
 /// takes up to 150). What a configuration written for any of them may hold.
 pub fn prusa_common_hz() -> (f64, f64) {
     let max = PrusaModel::ALL.map(PrusaModel::shaper_max_hz);
