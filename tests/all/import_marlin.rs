@@ -211,18 +211,7 @@ fn a_reply_without_motion_settings_is_refused() {
         ),
     ];
     for (text, want) in cases {
-        let reply = write(dir.path(), "none.txt", text);
-        let r = settle()
-            .args(["import", "marlin"])
-            .arg(&reply)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .expect("runs");
-        let err = String::from_utf8_lossy(&r.stderr);
-        assert_eq!(r.status.code(), Some(2), "{text}: {err}");
-        assert!(err.contains(want), "{text}: {err}");
-        assert!(!out.exists(), "{text}");
+        refused(&write(dir.path(), "none.txt", text), &out, want);
     }
 }
 
@@ -253,18 +242,11 @@ fn implausible_values_are_refused_at_their_line() {
             "m.txt:6: key `M203`: the lower of X and Y",
         ),
     ] {
-        let reply = write(dir.path(), "m.txt", &format!("{head}{last}\n"));
-        let r = settle()
-            .args(["import", "marlin"])
-            .arg(&reply)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .expect("runs");
-        let err = String::from_utf8_lossy(&r.stderr);
-        assert_eq!(r.status.code(), Some(2), "{last}: {err}");
-        assert!(err.contains(want), "{last}: {err}");
-        assert!(!out.exists(), "{last}");
+        refused(
+            &write(dir.path(), "m.txt", &format!("{head}{last}\n")),
+            &out,
+            want,
+        );
     }
 }
 
@@ -571,4 +553,21 @@ fn an_unknown_marlin_shaping_is_refused() {
         assert!(err.contains(want), "{want}: {err}");
     }
     assert!(!dir.path().join("tune").exists());
+}
+
+/// `settle import marlin REPLY --out OUT` exits 2 with `want` in its error and writes
+/// nothing.
+fn refused(reply: &std::path::Path, out: &std::path::Path, want: &str) {
+    let r = settle()
+        .args(["import", "marlin"])
+        .arg(reply)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&r.stderr);
+    let what = reply.display();
+    assert_eq!(r.status.code(), Some(2), "{what}: {err}");
+    assert!(err.contains(want), "{what}: {err}");
+    assert!(!out.exists(), "{what}");
 }

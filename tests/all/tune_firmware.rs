@@ -568,6 +568,31 @@ fn the_search_holds_only_what_the_target_can_take() {
     );
 }
 
+/// `scenarios/tune_printer.toml` tuned on X and Y for `firmware` with the `shapers` (a TOML
+/// list's items) at the modes' own frequencies, one 20 mm move, written under `dir/out`.
+fn tune_printer_xy(dir: &Path, shapers: &str, firmware: &str) -> settle::workflows::tune::Tuned {
+    let text = std::fs::read_to_string(root().join("scenarios/tune_printer.toml"))
+        .expect("scenario")
+        .replace(
+            "frequency_scales = [0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.15]",
+            &format!("frequency_scales = [1.0]\naxes = [\"x\", \"y\"]\nshapers = [{shapers}]"),
+        )
+        .replace("distances_mm = [5.0, 20.0, 50.0]", "distances_mm = [20.0]")
+        .replace("jerk_steps = 5", "jerk_steps = 1");
+    let p = write(dir, &format!("{firmware}.toml"), &text);
+    let opts = Options {
+        firmware: Some(firmware.into()),
+        ..modal()
+    };
+    settle::workflows::tune::tune_with(
+        &p,
+        Some(dir.join("out")),
+        &opts,
+        &settle::execute::pool::quiet,
+    )
+    .expect("tunes")
+}
+
 /// `marlin.gcode` read back by settle's G-code reader (Marlin dialect) as a job would read
 /// it: Fixed-Time Motion on, and per tuned axis the winner's shaper (`M493 C`), frequency
 /// (`A`), damping (`I`) and, for the EI family, vibration tolerance (`Q`), bit for bit;
@@ -578,26 +603,8 @@ fn marlin_export_reads_back_as_the_recommendation() {
     use settle_planner::shaper::{MarlinShaper, ShaperType};
 
     let dir = tempfile::tempdir().expect("tempdir");
-    let text = std::fs::read_to_string(root().join("scenarios/tune_printer.toml"))
-        .expect("scenario")
-        .replace(
-            "frequency_scales = [0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.15]",
-            "frequency_scales = [1.0]\naxes = [\"x\", \"y\"]\nshapers = [\"none\", \"marlin:zvd\", \"marlin:ei\", \"marlin:mzv\"]",
-        )
-        .replace("distances_mm = [5.0, 20.0, 50.0]", "distances_mm = [20.0]")
-        .replace("jerk_steps = 5", "jerk_steps = 1");
-    let p = write(dir.path(), "marlin.toml", &text);
-    let opts = Options {
-        firmware: Some("marlin".into()),
-        ..modal()
-    };
-    let t = settle::workflows::tune::tune_with(
-        &p,
-        Some(dir.path().join("out")),
-        &opts,
-        &settle::execute::pool::quiet,
-    )
-    .expect("tunes");
+    let shapers = r#""none", "marlin:zvd", "marlin:ei", "marlin:mzv""#;
+    let t = tune_printer_xy(dir.path(), shapers, "marlin");
     let g = std::fs::read_to_string(t.out.join("marlin.gcode")).expect("marlin.gcode");
     let events: Vec<_> = Reader::new(g.as_bytes(), ReaderOptions::new(Dialect::Marlin))
         .collect::<Result<_, _>>()
@@ -688,26 +695,7 @@ fn prusa_export_reads_back_as_the_recommendation() {
     use settle_gcode::{Dialect, EventKind, LimitChange, Reader, ReaderOptions};
 
     let dir = tempfile::tempdir().expect("tempdir");
-    let text = std::fs::read_to_string(root().join("scenarios/tune_printer.toml"))
-        .expect("scenario")
-        .replace(
-            "frequency_scales = [0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.15]",
-            "frequency_scales = [1.0]\naxes = [\"x\", \"y\"]\nshapers = [\"none\", \"zvd\", \"prusa:ei\", \"mzv\"]",
-        )
-        .replace("distances_mm = [5.0, 20.0, 50.0]", "distances_mm = [20.0]")
-        .replace("jerk_steps = 5", "jerk_steps = 1");
-    let p = write(dir.path(), "prusa.toml", &text);
-    let opts = Options {
-        firmware: Some("prusa".into()),
-        ..modal()
-    };
-    let t = settle::workflows::tune::tune_with(
-        &p,
-        Some(dir.path().join("out")),
-        &opts,
-        &settle::execute::pool::quiet,
-    )
-    .expect("tunes");
+    let t = tune_printer_xy(dir.path(), r#""none", "zvd", "prusa:ei", "mzv""#, "prusa");
     let g = std::fs::read_to_string(t.out.join("prusa.gcode")).expect("prusa.gcode");
     let events: Vec<_> = Reader::new(g.as_bytes(), ReaderOptions::new(Dialect::Prusa))
         .collect::<Result<_, _>>()
