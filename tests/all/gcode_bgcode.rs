@@ -82,7 +82,7 @@ fn a_mini_file_runs_with_the_minis_settings_and_an_unknown_printer_is_refused() 
     let mini = root().join("gcode/prints/bgcode/mini_cube_b_ref.gcode");
     let out = run_ok(&mut prusa(&mini, "mini"));
     let stdout = String::from_utf8_lossy(&out.stdout);
-    let said = "Prusa MINI settings (from line 136: M862.3 P \"MINI\"): prusa: M203 X180 Y180 mm/s, M201 X1250 Y1250 mm/s^2, M204 P1250 T1250 mm/s^2, M205 X8 Y8 mm/s (classic jerk), M92 X400 Y400 steps/mm; shaper X mzv@118.2 Hz, Y mzv@32.8 Hz";
+    let said = "Prusa MINI settings (from line 136: M862.3 P \"MINI\"): prusa: M203 X180 Y180 mm/s, M201 X1250 Y1250 mm/s^2, M204 P1250 T1250 mm/s^2, M205 X8 Y8 mm/s (classic jerk), M92 X100 Y100 steps/mm (planned in quarter steps); shaper X mzv@118.2 Hz, Y mzv@32.8 Hz";
     assert!(
         stdout.contains(said) || String::from_utf8_lossy(&out.stderr).contains(said),
         "{stdout}"

@@ -962,10 +962,18 @@ pub fn config_settings(job: &JobConfig) -> String {
                     mm(max_jerk_m_s[1])
                 ),
             };
+            // Buddy's planner counts quarter steps: its M92 is a quarter of the planner's.
+            let (per_step, quarter) = match &job.planner {
+                PlannerConfig::Prusa(_) => (
+                    settle_planner::firmware::marlin::PLANNER_STEPS_MULTIPLIER,
+                    " (planned in quarter steps)",
+                ),
+                _ => (1.0, ""),
+            };
             // Steps per m as steps per mm, rounded to 1e-6 (`80`, not `80.00000000000001`).
-            let per_mm = |v: f64| format!("{}", (v * 1e3).round() / 1e6);
+            let per_mm = |v: f64| format!("{}", (v / per_step * 1e3).round() / 1e6);
             format!(
-                "M203 X{} Y{} mm/s, M201 X{} Y{} mm/s^2, M204 P{} T{} mm/s^2, {corner}, M92 X{} Y{} steps/mm",
+                "M203 X{} Y{} mm/s, M201 X{} Y{} mm/s^2, M204 P{} T{} mm/s^2, {corner}, M92 X{} Y{} steps/mm{quarter}",
                 mm(c.max_feedrate_m_s[0]),
                 mm(c.max_feedrate_m_s[1]),
                 mm(c.max_accel_m_s2[0]),

@@ -44,4 +44,4 @@ mod trapezoid;
 
 pub use config::{JdSmallSegments, MarlinConfig, MarlinJerk, MarlinStepper};
 pub use planner::MarlinPlanner;
-pub use prusa::PrusaModel;
+pub use prusa::{PLANNER_STEPS_MULTIPLIER, PrusaModel};

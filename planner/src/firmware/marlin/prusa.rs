@@ -174,7 +174,7 @@ impl PrusaModel {
 
 /// Buddy's planner counts quarter steps (`PLANNER_STEPS_MULTIPLIER`,
 /// lib/Marlin/Marlin/src/module/planner.h).
-const PLANNER_STEPS_MULTIPLIER: f64 = 4.0;
+pub const PLANNER_STEPS_MULTIPLIER: f64 = 4.0;
 
 impl std::fmt::Display for PrusaModel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
