@@ -774,3 +774,71 @@ fn prusa_export_reads_back_as_the_recommendation() {
         summary.ignored
     );
 }
+
+/// Prusa-Firmware-Buddy clamps `M593 F` to 10-100 Hz on its printers (the MINI's 150 Hz is
+/// not assumed): the search for it holds no shaper outside that range, in the grid nor in
+/// the refinement, and says which it left out. The one mode is at 47.2 Hz: scales of 1 and
+/// 2.5 put shapers at 47.2 and 118 Hz.
+#[test]
+fn prusa_search_holds_only_the_frequencies_buddy_runs() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = run(
+        dir.path(),
+        "frequency_scales = [1.0, 2.5]\nshapers = [\"none\", \"mzv\"]\nrefine_rounds = 3\n",
+        &Options {
+            firmware: Some("prusa".into()),
+            ..modal()
+        },
+    );
+    let shaped: Vec<f64> = o.scores[1..]
+        .iter()
+        .filter_map(|s| s.candidate.shaper.filter(|sh| sh.shaper_type.is_some()))
+        .map(|sh| sh.frequency_hz)
+        .collect();
+    assert!(shaped.contains(&47.2), "{shaped:?}");
+    assert!(
+        shaped.iter().all(|f| (10.0..=100.0).contains(f)),
+        "{shaped:?}"
+    );
+    assert!(
+        o.plan.notes.iter().any(|n| n.contains(
+            "Prusa-Firmware-Buddy runs shapers of 10 to 100 Hz only (M593 F; it clamps others): shapers at 118 to 118 Hz left out."
+        )),
+        "{:?}",
+        o.plan.notes
+    );
+    // Shapers near the top (99.1 Hz, 2.1 x the mode): the refinement's steps above 100 Hz
+    // are not taken for Buddy, and are without a firmware.
+    let refined = |firmware: Option<&str>| -> Vec<f64> {
+        let o = run(
+            dir.path(),
+            "frequency_scales = [2.1]\nshapers = [\"mzv\"]\nrefine_rounds = 2\n",
+            &Options {
+                firmware: firmware.map(Into::into),
+                ..modal()
+            },
+        );
+        o.scores[o.plan.candidates.len()..]
+            .iter()
+            .filter_map(|s| s.candidate.shaper.map(|sh| sh.frequency_hz))
+            .collect()
+    };
+    let buddy = refined(Some("prusa"));
+    assert!(!buddy.is_empty(), "refined");
+    assert!(buddy.iter().all(|f| *f <= 100.0), "{buddy:?}");
+    let free = refined(None);
+    assert!(free.iter().any(|f| *f > 100.0), "{free:?}");
+    // Without the firmware the same search takes the 118 Hz shaper.
+    let any = run(
+        dir.path(),
+        "frequency_scales = [1.0, 2.5]\nshapers = [\"none\", \"mzv\"]\nrefine_rounds = 0\n",
+        &modal(),
+    );
+    assert!(
+        any.scores.iter().any(|s| s
+            .candidate
+            .shaper
+            .is_some_and(|sh| sh.frequency_hz == 118.0)),
+        "the scales reach 118 Hz"
+    );
+}
