@@ -213,16 +213,16 @@ enum Command {
         max_smoothing: Option<f64>,
     },
     /// Read a firmware configuration (Klipper printer.cfg, RepRapFirmware config.g,
-    /// Marlin's reply to M503) into a scenario with your current settings as its baseline
+    /// Marlin's reply to M503, a Prusa's replies to M115, M503 and M593) into a scenario with your current settings as its baseline
     /// and a search around them.
     #[command(
-        after_help = "Example:\n  settle import klipper printer.cfg --machine machine.toml --out printer.toml\n  settle tune printer.toml\n  (klipper.cfg in results/printer_import-tune/ holds the recommendation)\n  settle import marlin m503.txt --out printer.toml\n  settle tune printer.toml --firmware marlin\n  (marlin.gcode holds Marlin's lines)"
+        after_help = "Example:\n  settle import klipper printer.cfg --machine machine.toml --out printer.toml\n  settle tune printer.toml\n  (klipper.cfg in results/printer_import-tune/ holds the recommendation)\n  settle import marlin m503.txt --out printer.toml\n  settle tune printer.toml --firmware marlin\n  (marlin.gcode holds Marlin's lines)\n  settle import prusa terminal.txt --out printer.toml\n  settle tune printer.toml\n  (prusa.gcode holds Prusa-Firmware-Buddy's lines)"
     )]
     Import {
-        /// The firmware: klipper, marlin or rrf (also written reprapfirmware or duet).
+        /// The firmware: klipper, marlin, prusa or rrf (also written reprapfirmware or duet).
         firmware: String,
-        /// printer.cfg (with its includes), config.g, or Marlin's reply to M503 as a
-        /// terminal saves it.
+        /// printer.cfg (with its includes), config.g, Marlin's reply to M503, or a
+        /// Prusa's replies to M115, M503 and M593, as a terminal saves them.
         config: PathBuf,
         /// The machine file (from `settle identify`, or written by hand) [default: the
         /// preset printer_xy stands in, with a note].

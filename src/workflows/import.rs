@@ -230,7 +230,12 @@ fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)
 
 /// The firmwares whose configurations `settle import` reads: Klipper (printer.cfg),
 /// Marlin (its reply to `M503`) and RepRapFirmware (config.g).
-pub const READ: [Firmware; 3] = [Firmware::Klipper, Firmware::Marlin, Firmware::Rrf];
+pub const READ: [Firmware; 4] = [
+    Firmware::Klipper,
+    Firmware::Marlin,
+    Firmware::Prusa,
+    Firmware::Rrf,
+];
 
 /// A firmware of [`READ`] by name ([`Firmware::parse`]'s names); GRBL is refused with its
 /// reason (its `$$` settings feed `settle gcode`, not a tune: GRBL has no input shaper).
@@ -321,8 +326,13 @@ pub fn read_current_files(
             };
             Ok((cur, files))
         }
-        Firmware::Marlin => {
-            let c = MarlinSettings::read(path).map_err(|e| config_error(path, e))?;
+        Firmware::Marlin | Firmware::Prusa => {
+            let c = if firmware == Firmware::Prusa {
+                MarlinSettings::read_prusa(path)
+            } else {
+                MarlinSettings::read(path)
+            };
+            let c = c.map_err(|e| config_error(path, e))?;
             c.job_config().map_err(|e| config_error(path, e))?;
             Ok((marlin_current(&c, path)?, c.files.clone()))
         }
@@ -330,7 +340,7 @@ pub fn read_current_files(
             path,
             "firmware",
             format!(
-                "settle import reads klipper (printer.cfg), marlin (M503 reply) and rrf (config.g), not {}",
+                "settle import reads klipper (printer.cfg), marlin (M503 reply), prusa (M115, M503 and M593 replies) and rrf (config.g), not {}",
                 other.name()
             ),
         )),
@@ -344,9 +354,10 @@ fn marlin_mm(v_m: f64) -> f64 {
     (v_m * 1e9).round() / 1e6
 }
 
-/// The current settings of a Marlin `M503` reply (read by settle-gcode's
-/// [`MarlinSettings`]).
+/// The current settings of a Marlin `M503` reply, or of a Prusa-Firmware-Buddy log (read
+/// by settle-gcode's [`MarlinSettings`]).
 fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
+    let firmware = c.firmware();
     // The baseline is the reply's: without these the speed or acceleration would be
     // Marlin's example configuration's (MarlinSettings starts from it), not the printer's.
     for (command, what) in [
@@ -412,8 +423,10 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
             name: name.into(),
             // M593 is Marlin's ZV (settle-gcode reads it as `zv`); `F0` is no shaper.
             shaper: c.shapers[i].map(|s| (s.shaper_type.name(), s.frequency_hz, s.damping_ratio)),
-            // Marlin's steps per mm count microsteps.
-            usteps_per_mm: c.steps_per_mm[i],
+            // Marlin's steps per mm count microsteps; Buddy's `M92` counts its planner's
+            // steps (quarter steps of it are planned, PLANNER_STEPS_MULTIPLIER), not the
+            // driver's microsteps: none is given.
+            usteps_per_mm: c.steps_per_mm[i].filter(|_| firmware != Firmware::Prusa),
             // M201, which the reply has (checked above).
             max_accel_mm_s2: Some(marlin_mm(p.max_accel_m_s2[i])),
         })
@@ -430,8 +443,20 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
         ),
     };
     notes.push(format!(
-        "{corner} read, not in the scenario: it sets the speed through corners, and the scenario's moves start and end at rest (settle gcode --firmware marlin --config follows it)"
+        "{corner} read, not in the scenario: it sets the speed through corners, and the scenario's moves start and end at rest ({})",
+        if firmware == Firmware::Prusa {
+            "settle gcode --firmware prusa plans a job with the classic jerk of the printer the file names"
+        } else {
+            "settle gcode --firmware marlin --config follows it"
+        }
     ));
+    if let Some((line, name)) = c.prusa.as_ref().and_then(|p| p.named_at.as_ref()) {
+        notes.push(format!(
+            "{}:{line}: the printer is a Prusa {name} (M115's MACHINE_TYPE): the {}'s settings stand for what the replies do not give",
+            path.display(),
+            c.prusa.as_ref().map_or("MK4", |p| p.model.name())
+        ));
+    }
     let has_m493 = c.notes.iter().any(|n| n.text.starts_with("M493"));
     let has_m593 = c.followed.iter().any(|(_, f)| *f == "M593");
     if has_m493 {
@@ -446,15 +471,17 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
     // and settle tunes for the built-in ZV shaper (INPUT_SHAPING_X/Y in
     // Configuration_adv.h), the shaper of the older release (Marlin 2.1.2; FT_MOTION
     // needs 2.1.3).
-    let shaping = if has_m493 {
-        MarlinShaping::FtMotion
+    let shaping = if firmware == Firmware::Prusa {
+        None
+    } else if has_m493 {
+        Some(MarlinShaping::FtMotion)
     } else {
         if !has_m593 {
             notes.push(
                 "the reply has neither M593 nor M493: this build has no input shaper; the scenario tunes Marlin's built-in ZV shaper (marlin_shaping = \"input_shaping\", M593: INPUT_SHAPING_X and INPUT_SHAPING_Y in Configuration_adv.h, Marlin 2.1.2 or later); set marlin_shaping = \"ft_motion\" for a Fixed-Time Motion build (M493)".into(),
             );
         }
-        MarlinShaping::InputShaping
+        Some(MarlinShaping::InputShaping)
     };
     // The last line of each command (the one whose values hold).
     let set_at = c
@@ -471,12 +498,12 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
         })
         .collect();
     Ok(Current {
-        firmware: Firmware::Marlin,
+        firmware,
         vmax_mm_s: vmax,
         amax_mm_s2: amax,
         axes,
         notes,
-        marlin_shaping: Some(shaping),
+        marlin_shaping: shaping,
         set_at,
     })
 }
@@ -599,6 +626,7 @@ fn scenario_text(
         match cur.marlin_shaping {
             Some(MarlinShaping::FtMotion) => "marlin.gcode (FT_MOTION's M493)",
             Some(MarlinShaping::InputShaping) => "marlin.gcode (input shaping's M593)",
+            None if fw == Firmware::Prusa => "prusa.gcode (Buddy's M593)",
             None => "klipper.cfg / rrf.g",
         },
     );
@@ -710,7 +738,7 @@ fn scenario_text(
         if let Some(m) = a.max_accel_mm_s2 {
             let _ = writeln!(
                 t,
-                "max_accel_mm_s2 = {m:?}   # M201 {}: marlin.gcode / rrf.g raise it where it is below the recommended acceleration",
+                "max_accel_mm_s2 = {m:?}   # M201 {}: marlin.gcode / prusa.gcode / rrf.g raise it where it is below the recommended acceleration",
                 a.name.to_ascii_uppercase()
             );
         }

@@ -114,6 +114,38 @@ fn a_mini_file_runs_with_the_minis_settings_and_an_unknown_printer_is_refused() 
     );
 }
 
+/// `--config` of a Prusa's terminal log (gcode/tests/data/prusa/README.md): the job plans
+/// with the printer's own limits and shapers as the replies give them, and a file sliced
+/// for another printer is said.
+#[test]
+fn a_prusa_job_follows_the_printers_own_replies_under_config() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let log = root().join("gcode/tests/data/prusa/mk4s_m115_m503_m593.txt");
+    let mini = root().join("gcode/prints/bgcode/mini_cube_b_ref.gcode");
+    let out = run_ok(
+        settle()
+            .args(["gcode", "--machine", "printer_xy", "--firmware", "prusa"])
+            .arg(&mini)
+            .args(["--layers", "1..1", "--config"])
+            .arg(&log)
+            .arg("--out")
+            .arg(dir.path().join("mk4s")),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    let summary = std::fs::read_to_string(dir.path().join("mk4s/summary.md")).expect("summary");
+    // The log's M203, M201, M204, M205, M92 and M593 replies, by hand.
+    let said = "prusa: M203 X300 Y300 mm/s, M201 X4000 Y4000 mm/s^2, M204 P4000 T4000 mm/s^2, M205 X8 Y8 mm/s (classic jerk), M92 X100 Y100 steps/mm (planned in quarter steps); shaper X mzv@50.700001 Hz, Y mzv@40.599998 Hz";
+    assert!(summary.contains(said), "{summary}");
+    assert!(
+        summary.contains("prusa MK4 + X mzv@50.700001 Hz, Y mzv@40.599998 Hz"),
+        "{summary}"
+    );
+    assert!(
+        err.contains("mini_cube_b_ref.gcode:136: the file was sliced for a Prusa MINI (M862.3 P), not the configuration's MK4"),
+        "{err}"
+    );
+}
+
 /// A CSV's rows without its columns of line numbers (`worst_line`).
 fn without_lines(csv: &str) -> Vec<Vec<String>> {
     let mut rows = csv

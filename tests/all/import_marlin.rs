@@ -571,3 +571,62 @@ fn refused(reply: &std::path::Path, out: &std::path::Path, want: &str) {
     assert!(err.contains(want), "{what}: {err}");
     assert!(!out.exists(), "{what}");
 }
+
+/// `settle import prusa`: a Prusa-Firmware-Buddy log (`M115`, `M503`, `M593`; the file
+/// written in Buddy's formats, gcode/tests/data/prusa/README.md) becomes a scenario whose
+/// baseline is the printer's own shapers and limits, tuned for `prusa.gcode`.
+#[test]
+fn a_prusa_log_imports_its_shapers_as_the_baseline() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let log = root().join("gcode/tests/data/prusa/mk4s_m115_m503_m593.txt");
+    let out = dir.path().join("mk4s.toml");
+    let r = run_ok(
+        settle()
+            .args(["import", "prusa"])
+            .arg(&log)
+            .arg("--out")
+            .arg(&out),
+    );
+    let r = String::from_utf8_lossy(&r.stdout).to_string();
+    assert!(
+        r.contains("current x: mzv @ 50.700001 Hz (zeta 0.1), 4000 mm/s^2, 300 mm/s"),
+        "{r}"
+    );
+    assert!(
+        r.contains("current y: mzv @ 40.599998 Hz (zeta 0.1), 4000 mm/s^2, 300 mm/s"),
+        "{r}"
+    );
+    let toml = std::fs::read_to_string(&out).expect("scenario");
+    for want in [
+        "[tune]\nfirmware = \"prusa\"\n",
+        "[tune.axis.x]\nshaper = \"mzv\"\nfrequency_hz = 50.700001\ndamping_ratio = 0.1\nmax_accel_mm_s2 = 4000.0",
+        "[tune.axis.y]\nshaper = \"mzv\"\nfrequency_hz = 40.599998\n",
+        "the printer is a Prusa MK4S (M115's MACHINE_TYPE)",
+        "with prusa.gcode",
+    ] {
+        assert!(toml.contains(want), "{want}\n{toml}");
+    }
+    // Buddy's M503 does not report its shapers: a log without the M593 reply is refused.
+    let text = std::fs::read_to_string(&log).expect("log");
+    let bare: String = text
+        .lines()
+        .filter(|l| !l.contains("axis"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let no_m593 = write(dir.path(), "no_m593.txt", &bare);
+    let refused_out = dir.path().join("refused.toml");
+    let r = settle()
+        .args(["import", "prusa"])
+        .arg(&no_m593)
+        .arg("--out")
+        .arg(&refused_out)
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("no_m593.txt:1: no M593 reply for X and Y"),
+        "{err}"
+    );
+    assert!(!refused_out.exists());
+}

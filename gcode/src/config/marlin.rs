@@ -20,12 +20,18 @@
 //! whose `M205` has jerks and no `J` comes from a classic-jerk build, and the planner
 //! follows classic jerk. Every other command of the reply is listed once as read and not
 //! used; a value the job's own commands would have refused is an error naming the line.
+//!
+//! A Prusa-Firmware-Buddy printer (a Marlin derivative) is read from its replies to
+//! `M115`, `M503` and `M593` in one log ([`MarlinSettings::parse_prusa`]); such a log
+//! read as Marlin's is refused at its first Buddy line.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use settle_planner::firmware::marlin::{MarlinConfig, MarlinJerk};
+use settle_planner::firmware::marlin::{
+    MarlinConfig, MarlinJerk, PLANNER_STEPS_MULTIPLIER, PrusaModel,
+};
 
 use super::budget::Budget;
 use super::klipper::MAX_SHAPER_FREQUENCY_HZ;
@@ -33,7 +39,7 @@ use super::machine::ConfigNote;
 use crate::error::{GcodeError, Location};
 use crate::job::driver::{Driver, LimitOutcome};
 use crate::job::shapers::ShaperState;
-use crate::job::{JobConfig, PlannerConfig, ShaperSetting};
+use crate::job::{JobConfig, PlannerConfig, PrusaPrinter, ShaperSetting};
 use crate::read::dialect::Dialect;
 use crate::read::event::{EventKind, Note};
 use crate::read::limits::LimitChange;
@@ -58,6 +64,9 @@ pub struct MarlinSettings {
     pub files: Vec<PathBuf>,
     /// What the reader noted: commands read and not used, values Marlin keeps.
     pub notes: Vec<ConfigNote>,
+    /// Prusa-Firmware-Buddy ([`MarlinSettings::read_prusa`]): the printer, from the
+    /// `M115` reply's `MACHINE_TYPE` (its line) or the MK4 when the log has none.
+    pub prusa: Option<PrusaPrinter>,
 }
 
 impl MarlinSettings {
@@ -65,16 +74,31 @@ impl MarlinSettings {
     /// `M203`, `M201`, `M204` and `M205` settings and the `M593` shapers. Everything else
     /// is [`JobConfig::defaults`]'.
     pub fn job_config(&self) -> Result<JobConfig, GcodeError> {
-        let mut cfg = JobConfig::defaults(Firmware::Marlin)?;
         self.planner
             .validate()
             .map_err(|e| GcodeError::JobSetting {
                 key: "M503 settings",
                 reason: e.to_string(),
             })?;
-        cfg.planner = PlannerConfig::Marlin(self.planner);
+        let mut cfg = match &self.prusa {
+            Some(printer) => JobConfig::prusa(printer.clone())?,
+            None => JobConfig::defaults(Firmware::Marlin)?,
+        };
+        cfg.planner = match self.prusa {
+            Some(_) => PlannerConfig::Prusa(self.planner),
+            None => PlannerConfig::Marlin(self.planner),
+        };
         cfg.shapers = self.shapers;
         Ok(cfg)
+    }
+
+    /// The firmware the settings are for: Marlin, or Prusa-Firmware-Buddy.
+    pub fn firmware(&self) -> Firmware {
+        if self.prusa.is_some() {
+            Firmware::Prusa
+        } else {
+            Firmware::Marlin
+        }
     }
 }
 
@@ -233,7 +257,32 @@ impl MarlinSettings {
 
     /// Reads `text` as the `M503` reply at `path` (which names it in errors).
     pub fn parse(text: &str, path: impl AsRef<Path>) -> Result<Self, GcodeError> {
+        Self::parse_for(text, path.as_ref(), false)
+    }
+
+    /// Reads the terminal log of a Prusa-Firmware-Buddy printer at `path`
+    /// ([`MarlinSettings::parse_prusa`]).
+    pub fn read_prusa(path: impl AsRef<Path>) -> Result<Self, GcodeError> {
         let path = path.as_ref();
+        let text = Budget::new().main(path)?;
+        Self::parse_prusa(&text, path)
+    }
+
+    /// Reads `text` as a Prusa-Firmware-Buddy printer's replies to `M115`, `M503` and
+    /// `M593` (the module doc's terminal rules): the printer from `M115`'s
+    /// `MACHINE_TYPE:Prusa-<name>` (src/marlin_stubs/host/M115.cpp; the MK4 without it,
+    /// noted), `M503` as Marlin's over that printer's settings (Buddy's `M92` is in its
+    /// planner's quarter steps, `PLANNER_STEPS_MULTIPLIER`), and the shapers from the `M593`
+    /// reply, which `M503` does not print (lib/Marlin/Marlin/src/gcode/feature/input_shaper/
+    /// M593.cpp, `dump_current_config`): `axis X type=MZV freq=50.700001 damp=0.100000
+    /// vr=20.000000` is followed as `M593 X T2 F50.700001 D0.100000 R20.000000`, `axis Z
+    /// disabled` as `M593 Z F0`. A log without the `M593` reply of X and Y is refused: the
+    /// printer's shapers live in its EEPROM and nothing else reports them.
+    pub fn parse_prusa(text: &str, path: impl AsRef<Path>) -> Result<Self, GcodeError> {
+        Self::parse_for(text, path.as_ref(), true)
+    }
+
+    fn parse_for(text: &str, path: &Path, prusa: bool) -> Result<Self, GcodeError> {
         let source: Arc<str> = Arc::from(path.display().to_string());
         let at = |line: u64| Location {
             source_name: source.clone(),
@@ -246,9 +295,42 @@ impl MarlinSettings {
         let mut classic_jerk = false;
         let mut any = false;
         // The planner's lines, each on its own line number; the rest blank.
-        let mut kept = Vec::new();
+        let mut kept: Vec<std::borrow::Cow<'_, str>> = Vec::new();
+        let mut printer: Option<PrusaPrinter> = None;
+        let mut prusa_axes = [false; 3];
+        let mut prusa_off = [None; 3];
         for (i, raw) in text.lines().enumerate() {
             let line = i as u64 + 1;
+            if prusa && let Some(t) = reply_text(raw) {
+                match prusa_reply(t, &at(line))? {
+                    PrusaReply::Printer(p) => {
+                        printer.get_or_insert(p);
+                        kept.push("".into());
+                        continue;
+                    }
+                    PrusaReply::Axis(axis, m593) => {
+                        any = true;
+                        prusa_axes[axis] = true;
+                        prusa_off[axis] = m593.ends_with(" F0").then_some(line);
+                        kept.push(m593.into());
+                        continue;
+                    }
+                    PrusaReply::Note(text) => {
+                        notes.push(ConfigNote::at(at(line), text));
+                        kept.push("".into());
+                        continue;
+                    }
+                    PrusaReply::Other => {}
+                }
+            } else if let Some(t) = reply_text(raw)
+                && (t.contains("FIRMWARE_NAME:Prusa-Firmware-Buddy")
+                    || (t.starts_with("axis ") && t.contains(" type=")))
+            {
+                return Err(GcodeError::ConfigSyntax {
+                    at: at(line),
+                    what: "a Prusa-Firmware-Buddy reply (M115's or M593's): read it as a Prusa's (settle import prusa, settle gcode --firmware prusa --config), whose M593 Marlin's does not share".into(),
+                });
+            }
             let keep = match reply_text(raw) {
                 Some(t) if !t.starts_with(';') && !t.starts_with("//") => match command_of(t) {
                     Some(c) if PLANNER_COMMANDS.contains(&c.as_str()) => {
@@ -291,7 +373,19 @@ impl MarlinSettings {
                 },
                 _ => "",
             };
-            kept.push(keep);
+            kept.push(keep.into());
+        }
+        if prusa && !(prusa_axes[0] && prusa_axes[1]) {
+            return Err(GcodeError::ConfigSyntax {
+                at: at(1),
+                what: "no M593 reply for X and Y (`axis X type=... freq=...`): Prusa-Firmware-Buddy keeps its input shapers in EEPROM and its M503 does not report them; send M593 with no arguments too and save its reply with M503's".into(),
+            });
+        }
+        if let [Some(line), Some(_), _] = prusa_off {
+            notes.push(ConfigNote::at(
+                at(line),
+                "M593: the shapers of X and Y are off. PrusaSlicer's end G-code turns them off after every job (`M593 X T2 F0`, resources/profiles/PrusaResearch.ini) without saving that: a reply sent after a print shows them off. If they were on, restart the printer and send M593 again".to_string(),
+            ));
         }
         if !any {
             return Err(GcodeError::ConfigSyntax {
@@ -299,13 +393,25 @@ impl MarlinSettings {
                 what: "not an M503 report: no M92, M201, M203, M204, M205 or M593 line (send M503 to the printer and save its reply)".into(),
             });
         }
-        let mut planner = MarlinConfig::new();
+        let printer = prusa.then(|| {
+            printer.unwrap_or_else(|| {
+                notes.push(ConfigNote::at(
+                    at(1),
+                    "no M115 reply (`MACHINE_TYPE:Prusa-<printer>`): the MK4's settings stand for what the replies do not give; send M115 too and save its reply to read the printer's own".to_string(),
+                ));
+                PrusaPrinter::unnamed()
+            })
+        });
+        let (mut planner, steps_scale) = match &printer {
+            Some(p) => (p.model.config(), PLANNER_STEPS_MULTIPLIER),
+            None => (MarlinConfig::new(), 1.0),
+        };
         for (i, s) in steps.iter().enumerate() {
             if let Some(s) = s {
-                planner.steps_per_m[i] = s * 1e3;
+                planner.steps_per_m[i] = s * steps_scale * 1e3;
             }
         }
-        if classic_jerk {
+        if classic_jerk && printer.is_none() {
             // Marlin's Configuration.h defaults (DEFAULT_XJERK ... DEFAULT_EJERK), the
             // reply's own values set below.
             planner.jerk = MarlinJerk::Classic {
@@ -319,13 +425,28 @@ impl MarlinSettings {
                 command: command.to_string(),
                 source: Box::new(e),
             };
-        let mut driver = Driver::new(&crate::job::PlannerConfig::Marlin(planner))
+        let (config, firmware, dialect) = match &printer {
+            Some(_) => (
+                PlannerConfig::Prusa(planner),
+                Firmware::Prusa,
+                Dialect::Prusa,
+            ),
+            None => (
+                PlannerConfig::Marlin(planner),
+                Firmware::Marlin,
+                Dialect::Marlin,
+            ),
+        };
+        let mut driver = Driver::new(&config)
             .map_err(|e| plan_error(1, "M92", e))?
             .expect("Marlin's planner is a firmware's");
-        let mut shapers = ShaperState::new(Firmware::Marlin, &[None; 3]);
+        let mut shapers = ShaperState::new(firmware, &[None; 3]);
+        if let Some(p) = &printer {
+            shapers = shapers.with_prusa_model(p.model);
+        }
         let mut followed = Vec::new();
         let text = kept.join("\n");
-        for event in super::located_events(&text, Dialect::Marlin, &source) {
+        for event in super::located_events(&text, dialect, &source) {
             let (at, kind) = event?;
             let change = match kind {
                 EventKind::Limits(c) => c,
@@ -351,7 +472,33 @@ impl MarlinSettings {
                     allowed: format!("0 (off) or 1 to {MAX_SHAPER_FREQUENCY_HZ} Hz").into(),
                 });
             }
-            if matches!(change, LimitChange::MarlinInputShaping { .. }) {
+            if let (
+                Some(p),
+                LimitChange::PrusaInputShaping {
+                    frequency_hz: Some(f),
+                    ..
+                },
+            ) = (&printer, &change)
+            {
+                let max = p.model.shaper_max_hz();
+                if *f != 0.0 && !(10.0..=max).contains(f) {
+                    return Err(GcodeError::ConfigValue {
+                        at,
+                        section: "M593".into(),
+                        key: "freq".into(),
+                        value: f.to_string().into(),
+                        allowed: format!(
+                            "10 to {max} Hz, what the {} runs (clamp_frequency_to_safe_values): a reply of another printer? Save M115's reply with it",
+                            p.model.name()
+                        )
+                        .into(),
+                    });
+                }
+            }
+            if matches!(
+                change,
+                LimitChange::MarlinInputShaping { .. } | LimitChange::PrusaInputShaping { .. }
+            ) {
                 shapers
                     .apply(&change)
                     .map_err(|_| GcodeError::ConfigSyntax {
@@ -387,8 +534,110 @@ impl MarlinSettings {
             followed,
             files: vec![path.to_path_buf()],
             notes,
+            prusa: printer,
         })
     }
+}
+
+/// What a line of a Prusa-Firmware-Buddy log holds besides Marlin's `M503` reply.
+enum PrusaReply {
+    /// `M115`'s `MACHINE_TYPE:Prusa-<name>`: the printer.
+    Printer(PrusaPrinter),
+    /// An `M593` reply line of axis 0, 1 or 2 (X, Y, Z), as the `M593` that sets it.
+    Axis(usize, String),
+    /// A line read and not used, with why.
+    Note(String),
+    /// Anything else (Marlin's rules apply).
+    Other,
+}
+
+/// The Prusa-Firmware-Buddy shaper names of `M593 T0`-`T6` (`filter_names`,
+/// lib/Marlin/Marlin/src/feature/input_shaper/input_shaper_config.hpp).
+const PRUSA_TYPES: [&str; 7] = ["ZV", "ZVD", "MZV", "EI", "EI_2HUMP", "EI_3HUMP", "Null"];
+
+/// A reply line `text` (terminal prefixes gone) of a Prusa-Firmware-Buddy log at `at`
+/// ([`MarlinSettings::parse_prusa`]).
+fn prusa_reply(text: &str, at: &Location) -> Result<PrusaReply, GcodeError> {
+    let bad = |key: &str, value: &str, allowed: String| GcodeError::ConfigValue {
+        at: at.clone(),
+        section: "M593".into(),
+        key: key.to_string(),
+        value: value.to_string().into(),
+        allowed: allowed.into(),
+    };
+    if let Some(i) = text.find("MACHINE_TYPE:Prusa-") {
+        let name = text[i + "MACHINE_TYPE:Prusa-".len()..]
+            .split_whitespace()
+            .next()
+            .unwrap_or("");
+        return match PrusaModel::from_printer_name(name) {
+            Some(model) => Ok(PrusaReply::Printer(PrusaPrinter {
+                model,
+                named_at: Some((at.line, name.to_string())),
+            })),
+            None => Err(GcodeError::ConfigValue {
+                at: at.clone(),
+                section: "M115".into(),
+                key: "MACHINE_TYPE".into(),
+                value: format!("Prusa-{name}").into(),
+                allowed: format!(
+                    "a printer settle has Prusa-Firmware-Buddy settings for: {}",
+                    PrusaModel::printer_names()
+                )
+                .into(),
+            }),
+        };
+    }
+    if text.starts_with("weight_adjust y") || text == "weight adjust y disabled" {
+        return Ok(PrusaReply::Note(format!(
+            "M593 `{text}`: read, not used (Buddy lowers Y's shaper frequency as the bed's load set by M74 grows; settle plans the unloaded bed)"
+        )));
+    }
+    let mut words = text.split_whitespace();
+    let (Some("axis"), Some(letter)) = (words.next(), words.next()) else {
+        return Ok(PrusaReply::Other);
+    };
+    let Some(axis) = ["X", "Y", "Z"].iter().position(|a| *a == letter) else {
+        return Err(bad("axis", letter, "X, Y or Z".into()));
+    };
+    let rest: Vec<&str> = words.collect();
+    if rest == ["disabled"] {
+        return Ok(PrusaReply::Axis(axis, format!("M593 {letter} F0")));
+    }
+    let mut values = [None; 4];
+    for w in &rest {
+        let (key, value) = w.split_once('=').unwrap_or((w, ""));
+        let slot = ["type", "freq", "damp", "vr"]
+            .iter()
+            .position(|k| *k == key);
+        let Some(slot) = slot else {
+            return Err(bad(
+                key,
+                value,
+                "type, freq, damp, vr (M593's reply)".into(),
+            ));
+        };
+        values[slot] = Some(value);
+    }
+    let [Some(kind), Some(freq), Some(damp), Some(vr)] = values else {
+        return Err(bad(
+            "axis",
+            text,
+            "`axis <X|Y|Z> type=<T> freq=<Hz> damp=<ratio> vr=<reduction>` or `axis <X|Y|Z> disabled`".into(),
+        ));
+    };
+    let Some(code) = PRUSA_TYPES.iter().position(|t| *t == kind) else {
+        return Err(bad("type", kind, PRUSA_TYPES.join(", ")));
+    };
+    for (key, v) in [("freq", freq), ("damp", damp), ("vr", vr)] {
+        if !v.parse::<f64>().is_ok_and(f64::is_finite) {
+            return Err(bad(key, v, "a finite number".into()));
+        }
+    }
+    Ok(PrusaReply::Axis(
+        axis,
+        format!("M593 {letter} T{code} F{freq} D{damp} R{vr}"),
+    ))
 }
 
 /// The line of the last `command` followed (1 when none).
@@ -578,6 +827,148 @@ mod tests {
             s.notes[0]
                 .to_string()
                 .starts_with("m.txt:2: M9999: not a command")
+        );
+    }
+
+    /// A Prusa-Firmware-Buddy terminal log (gcode/tests/data/prusa/README.md).
+    const PRUSA_LOG: &str = include_str!("../../tests/data/prusa/mk4s_m115_m503_m593.txt");
+
+    #[test]
+    fn a_prusa_log_gives_the_printer_its_limits_and_its_shapers() {
+        let s = MarlinSettings::parse_prusa(PRUSA_LOG, "p.txt").expect("a Buddy log");
+        let printer = s.prusa.clone().expect("a Prusa printer");
+        assert_eq!(printer.model, PrusaModel::Mk4);
+        assert_eq!(printer.named_at, Some((2, "MK4S".to_string())));
+        assert_eq!(s.firmware(), Firmware::Prusa);
+        let p = &s.planner;
+        // Buddy's M92 in its planner's quarter steps: 100 steps/mm are 400 per mm planned.
+        assert_eq!(p.steps_per_m, [400e3, 400e3, 1600e3, 1520e3]);
+        assert_eq!(p.max_feedrate_m_s, [0.3, 0.3, 0.04, 0.1]);
+        assert_eq!(p.max_accel_m_s2, [4.0, 4.0, 0.2, 2.5]);
+        assert_eq!(
+            (
+                p.print_accel_m_s2,
+                p.retract_accel_m_s2,
+                p.travel_accel_m_s2
+            ),
+            (4.0, 2.5, 4.0)
+        );
+        assert!(matches!(
+            p.jerk,
+            MarlinJerk::Classic { max_jerk_m_s, .. } if max_jerk_m_s == [8e-3, 8e-3, 2e-3, 10e-3]
+        ));
+        let [x, y, z] = s.shapers;
+        let (x, y) = (x.expect("X shaped"), y.expect("Y shaped"));
+        assert_eq!(
+            (x.shaper_type, x.frequency_hz, x.damping_ratio),
+            (ShaperType::MZV, 50.700001, 0.1)
+        );
+        assert_eq!(
+            (y.shaper_type, y.frequency_hz),
+            (ShaperType::MZV, 40.599998)
+        );
+        assert_eq!(z, None);
+        let weight = s
+            .notes
+            .iter()
+            .find(|n| n.to_string().contains("weight_adjust"));
+        assert!(
+            weight
+                .expect("the weight line noted")
+                .to_string()
+                .starts_with("p.txt:21:")
+        );
+        // The job starts with them: the printer's planner and shapers, not the shipped ones.
+        let job = s.job_config().expect("a job configuration");
+        assert_eq!(job.firmware(), Firmware::Prusa);
+        assert_eq!(job.shapers, s.shapers);
+    }
+
+    #[test]
+    fn a_prusa_log_reads_each_printers_shapers_and_refuses_what_buddy_would_not_print() {
+        let with = |machine: &str, axes: &str| {
+            let log = PRUSA_LOG
+                .replace(
+                    "MACHINE_TYPE:Prusa-MK4S",
+                    &format!("MACHINE_TYPE:Prusa-{machine}"),
+                )
+                .replace(
+                    "Recv: echo:axis X type=MZV freq=50.700001 damp=0.100000 vr=20.000000\n",
+                    axes,
+                );
+            MarlinSettings::parse_prusa(&log, "p.txt")
+        };
+        // The CORE One's EI (M593 T3) with vibration reduction 20: tolerance 1/20; CoreXY.
+        let core = with(
+            "COREONE",
+            "echo:axis X type=EI freq=60.000000 damp=0.100000 vr=20.000000\n",
+        )
+        .expect("a CORE One log");
+        let x = core.shapers[0].expect("X shaped");
+        assert_eq!(
+            x.shaper_type,
+            ShaperType::Prusa {
+                shaper: settle_planner::shaper::PrusaShaper::Ei,
+                v_tol: 1.0 / 20.0
+            }
+        );
+        assert_eq!(x.frequency_hz, 60.0);
+        assert_eq!(
+            core.planner.kinematics,
+            settle_planner::firmware::Kinematics::CoreXy
+        );
+        // 118.2 Hz is the MINI's shipped X shaper, above the MK4's 100 Hz.
+        let mini_x = "echo:axis X type=MZV freq=118.199997 damp=0.100000 vr=20.000000\n";
+        assert_eq!(
+            with("MINI", mini_x).expect("a MINI log").shapers[0].map(|s| s.frequency_hz),
+            Some(118.199997)
+        );
+        let errors = [
+            (with("MK4", mini_x), "p.txt:18: [M593] freq"),
+            (
+                with("MK4", "echo:axis X type=ZVDD freq=50 damp=0.1 vr=20\n"),
+                "p.txt:18: [M593] type",
+            ),
+            (
+                with("MK4", "echo:axis X type=MZV freq=nan damp=0.1 vr=20\n"),
+                "p.txt:18: [M593] freq",
+            ),
+            (with("MK3S", mini_x), "p.txt:2: [M115] MACHINE_TYPE"),
+            (with("MK4", ""), "p.txt:1: no M593 reply for X and Y"),
+        ];
+        for (result, want) in errors {
+            let e = result.expect_err(want).to_string();
+            assert!(e.starts_with(want), "{e}");
+        }
+        // Both off (as after a PrusaSlicer job's end G-code): unshaped, and said.
+        let off = PRUSA_LOG
+            .replace(
+                "axis X type=MZV freq=50.700001 damp=0.100000 vr=20.000000",
+                "axis X disabled",
+            )
+            .replace(
+                "axis Y type=MZV freq=40.599998 damp=0.100000 vr=20.000000",
+                "axis Y disabled",
+            );
+        let s = MarlinSettings::parse_prusa(&off, "p.txt").expect("shapers off");
+        assert_eq!(s.shapers, [None; 3]);
+        let note = s.notes.iter().find(|n| n.to_string().contains("are off"));
+        assert!(note.expect("said").to_string().starts_with("p.txt:18:"));
+        // Read as mainline Marlin's, the log is refused at its first Buddy line.
+        let e = MarlinSettings::parse(PRUSA_LOG, "p.txt").expect_err("not Marlin's");
+        assert!(e.to_string().starts_with("p.txt:2: "), "{e}");
+        assert!(e.to_string().contains("settle import prusa"), "{e}");
+        // Without M115's reply: the MK4's settings, said.
+        let bare = PRUSA_LOG.replace("MACHINE_TYPE:Prusa-MK4S", "");
+        let s = MarlinSettings::parse_prusa(&bare, "p.txt").expect("a log without M115");
+        assert_eq!(
+            s.prusa.map(|p| (p.model, p.named_at)),
+            Some((PrusaModel::Mk4, None))
+        );
+        assert!(
+            s.notes
+                .iter()
+                .any(|n| n.to_string().contains("no M115 reply"))
         );
     }
 }

@@ -239,12 +239,20 @@ impl GcodeOptions {
                 let notes = c.notes.iter().map(ToString::to_string).collect();
                 (job, notes, c.files)
             }
-            Firmware::Prusa | Firmware::Settle | Firmware::Tmc4361a => {
+            Firmware::Prusa => {
+                let c = settle_gcode::config::MarlinSettings::read_prusa(&config)
+                    .map_err(|e| crate::workflows::import::config_error(&config, e))?;
+                let job = c.job_config().map_err(gcode_error(&config))?;
+                let mut notes: Vec<String> = c.notes.iter().map(ToString::to_string).collect();
+                notes.extend(prusa_printers(&file, &config, job.prusa.as_ref())?);
+                (job, notes, c.files)
+            }
+            Firmware::Settle | Firmware::Tmc4361a => {
                 return Err(Error::input_key(
                     &config,
                     "--config",
                     format!(
-                        "--config reads a Klipper printer.cfg (--firmware klipper), a RepRapFirmware config.g (--firmware rrf), GRBL's $$ settings (--firmware grbl) or Marlin's M503 reply (--firmware marlin), not {firmware}'s settings"
+                        "--config reads a Klipper printer.cfg (--firmware klipper), a RepRapFirmware config.g (--firmware rrf), GRBL's $$ settings (--firmware grbl), Marlin's M503 reply (--firmware marlin) or a Prusa's replies to M115, M503 and M593 (--firmware prusa), not {firmware}'s settings"
                     ),
                 ));
             }
@@ -915,6 +923,41 @@ fn simulate(
         },
     };
     Ok((outcome, rec))
+}
+
+/// Which printer a Prusa job runs as under `--config`: the configuration's (`from`, read
+/// from `config`), said; a file sliced for another family (its `M862.3 P`) is said too,
+/// as Buddy warns of it before printing.
+fn prusa_printers(
+    file: &Path,
+    config: &Path,
+    from: Option<&settle_gcode::job::PrusaPrinter>,
+) -> Result<Vec<String>, Error> {
+    let Some(printer) = from else {
+        return Ok(Vec::new());
+    };
+    let mut notes = vec![match &printer.named_at {
+        Some((line, name)) => format!(
+            "{}:{line}: planned as the printer the configuration names, a Prusa {name} (M115's MACHINE_TYPE; the {}'s settings stand for what the replies do not give)",
+            config.display(),
+            printer.model
+        ),
+        None => format!(
+            "{}: planned with the replies over the MK4's settings (no M115 reply names the printer)",
+            config.display()
+        ),
+    }];
+    let job = JobConfig::for_file(Firmware::Prusa, file).map_err(gcode_error(file))?;
+    if let Some(sliced) = job.prusa.filter(|p| p.model != printer.model)
+        && let Some((line, name)) = &sliced.named_at
+    {
+        notes.push(format!(
+                "{}:{line}: the file was sliced for a Prusa {name} (M862.3 P), not the configuration's {}: planned as the configuration's printer",
+                file.display(),
+                printer.model
+            ));
+    }
+    Ok(notes)
 }
 
 /// The planner's limits and the shapers of `job` in words, in the firmware's terms
