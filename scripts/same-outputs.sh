@@ -21,7 +21,8 @@
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
 #     what identify wrote, `settle import` of the example configurations and of the real
 #     ones of gcode/tests/data/real/ (a Marlin M503 reply among them; two, and the reply,
-#     also under the Benchy), `settle tune` on
+#     also under the Benchy) and a Prusa's M115/M503/M593 log (also under a job),
+#     `settle tune` on
 #     the tune scenarios (one also for Prusa-Firmware-Buddy), on the imported printers
 #     (Klipper, RepRapFirmware, Marlin) and
 #     with `--criterion klipper`;
@@ -155,6 +156,10 @@ cases() {
   echo "import-real-railcore import rrf $REAL/railcore/sys/config.g --out {out}/printer.toml"
   # A Marlin owner's M503 reply (gcode/tests/data/real/marlin/PROVENANCE.md), imported.
   echo "import-marlin-ender3v2neo import marlin $REAL/marlin/ender3v2neo/m503_20241028.gcode --out {out}/printer.toml"
+  # A Prusa's replies to M115, M503 and M593 (written in Buddy's formats,
+  # gcode/tests/data/prusa/README.md), imported and driving a job.
+  echo "import-prusa-mk4s import prusa $root/gcode/tests/data/prusa/mk4s_m115_m503_m593.txt --out {out}/printer.toml"
+  echo "gcode-mini-prusa-config gcode $P/bgcode/mini_cube_b_ref.gcode --machine printer_xy --firmware prusa --config $root/gcode/tests/data/prusa/mk4s_m115_m503_m593.txt --out {out}"
   echo "gcode-benchy-real-vt627 gcode $P/benchy/3DBenchy.gcode --machine printer_xy --config $REAL/vt627/printer.cfg --out {out}"
   echo "gcode-benchy-real-railcore gcode $P/benchy/3DBenchy.gcode --machine printer_xy --config $REAL/railcore/sys/config.g --out {out}"
   # A Marlin owner's M503 reply (gcode/tests/data/real/marlin/PROVENANCE.md).
@@ -167,6 +172,7 @@ cases() {
   echo "tune-imported-rrf tune out/import-mini/printer.toml --firmware rrf --jobs 2 --out {out}"
   echo "tune-imported-marlin tune out/import-marlin-ender3v2neo/printer.toml --firmware marlin --jobs 2 --out {out}"
   echo "tune-printer-prusa tune $S/tune_printer.toml --firmware prusa --jobs 2 --out {out}"
+  echo "tune-imported-prusa tune out/import-prusa-mk4s/printer.toml --jobs 2 --out {out}"
   echo "tune-klipper-criterion tune --criterion klipper $root/planner/tests/data/klipper_two_peaks.csv"
   echo "validate-rapier validate --backend rapier --out {out}/validate.md"
   # Real recordings: every corpus spectrum, one sensor column, a raw recording without its
