@@ -229,7 +229,8 @@ fn shaper_now(s: &FirmwareShaper, dialect: Dialect) -> Option<(String, f64, f64)
 }
 
 /// The firmwares whose configurations `settle import` reads: Klipper (printer.cfg),
-/// Marlin (its reply to `M503`) and RepRapFirmware (config.g).
+/// Marlin (its reply to `M503`), Prusa-Firmware-Buddy (its replies to `M115`, `M503` and
+/// `M593`) and RepRapFirmware (config.g).
 pub const READ: [Firmware; 4] = [
     Firmware::Klipper,
     Firmware::Marlin,
@@ -443,12 +444,7 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
         ),
     };
     notes.push(format!(
-        "{corner} read, not in the scenario: it sets the speed through corners, and the scenario's moves start and end at rest ({})",
-        if firmware == Firmware::Prusa {
-            "settle gcode --firmware prusa plans a job with the classic jerk of the printer the file names"
-        } else {
-            "settle gcode --firmware marlin --config follows it"
-        }
+        "{corner} read, not in the scenario: it sets the speed through corners, and the scenario's moves start and end at rest (settle gcode --firmware {firmware} --config follows it)"
     ));
     if let Some((line, name)) = c.prusa.as_ref().and_then(|p| p.named_at.as_ref()) {
         notes.push(format!(
