@@ -734,8 +734,13 @@ fn scenario_text(
         if let Some(m) = a.max_accel_mm_s2 {
             let _ = writeln!(
                 t,
-                "max_accel_mm_s2 = {m:?}   # M201 {}: marlin.gcode / prusa.gcode / rrf.g raise it where it is below the recommended acceleration",
-                a.name.to_ascii_uppercase()
+                "max_accel_mm_s2 = {m:?}   # M201 {}: {} where it is below the recommended acceleration",
+                a.name.to_ascii_uppercase(),
+                if cur.firmware == Firmware::Prusa {
+                    "prusa.gcode raises it"
+                } else {
+                    "marlin.gcode / rrf.g raise it"
+                }
             );
         }
     }
