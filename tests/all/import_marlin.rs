@@ -227,7 +227,7 @@ fn implausible_values_are_refused_at_their_line() {
     for (last, want) in [
         (
             "M593 X F999999999 D0.1",
-            "m.txt:6: key `M593.F`: [M593] F = `999999999`: not allowed (allowed: 0 (off) or 1 to 1000 Hz)",
+            "m.txt:6: key `M593.F`: [M593] F = `999999999`: not allowed (allowed: 0 (off) or 1 to 1000 Hz: below 1 Hz",
         ),
         (
             "M201 X0.0000001",

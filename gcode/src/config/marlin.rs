@@ -28,7 +28,6 @@ use std::sync::Arc;
 use settle_planner::firmware::marlin::{MarlinConfig, MarlinJerk};
 
 use super::budget::Budget;
-use super::klipper::MAX_SHAPER_FREQUENCY_HZ;
 use super::machine::ConfigNote;
 use crate::error::{GcodeError, Location};
 use crate::job::driver::{Driver, LimitOutcome};
@@ -358,7 +357,23 @@ impl MarlinSettings {
         let mut followed = Vec::new();
         let text = kept.join("\n");
         for event in super::located_events(&text, Dialect::Marlin, &source) {
-            let (at, kind) = event?;
+            // A word the job's command refuses, named as the reply's setting.
+            let (at, kind) = event.map_err(|e| match e {
+                GcodeError::OutOfRange {
+                    at,
+                    command,
+                    param,
+                    value,
+                    allowed,
+                } => GcodeError::ConfigValue {
+                    at: Location { column: None, ..at },
+                    section: command,
+                    key: param,
+                    value: value.to_string().into(),
+                    allowed: allowed.into(),
+                },
+                e => e,
+            })?;
             let change = match kind {
                 EventKind::Limits(c) => c,
                 EventKind::Note(Note::IgnoredByFirmware { command, reason }) => {
@@ -369,20 +384,6 @@ impl MarlinSettings {
             };
             let command = change.command_name();
             followed.push((at.line, command));
-            if let LimitChange::MarlinInputShaping {
-                frequency_hz: Some(f),
-                ..
-            } = change
-                && f > MAX_SHAPER_FREQUENCY_HZ
-            {
-                return Err(GcodeError::ConfigValue {
-                    at,
-                    section: "M593".into(),
-                    key: "F".into(),
-                    value: f.to_string().into(),
-                    allowed: format!("0 (off) or 1 to {MAX_SHAPER_FREQUENCY_HZ} Hz").into(),
-                });
-            }
             if matches!(change, LimitChange::MarlinInputShaping { .. }) {
                 shapers
                     .apply(&change)

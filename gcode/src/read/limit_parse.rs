@@ -42,6 +42,15 @@ pub(crate) const FT_DAMPING: Check = Check {
     allowed: "0.01 to below 1: Marlin's M493 refuses a damping ratio outside 0.01 to 1 (Marlin/src/gcode/feature/ft_motion/M493.cpp), and at 1 its shapers divide by sqrt(1 - zeta^2) = 0",
 };
 
+/// A shaper frequency in a job (Marlin's `M593 F`, Klipper's `SET_INPUT_SHAPER
+/// SHAPER_FREQ_*`): 0 (off), or 1 Hz (settle's lowest,
+/// `settle_planner::shaper::MIN_FREQUENCY_HZ`) to [`crate::config::MAX_SHAPER_FREQUENCY_HZ`],
+/// as where printer.cfg and an `M503` reply set it.
+pub(crate) const SHAPER_FREQUENCY: Check = Check {
+    ok: |v| v == 0.0 || (1.0..=crate::config::MAX_SHAPER_FREQUENCY_HZ).contains(&v),
+    allowed: "0 (off) or 1 to 1000 Hz: below 1 Hz a shaper lasts a second or more, and a shaper tuned above 1 kHz lasts under a millisecond and cancels nothing a printer's belts or frame carry (their modes are tens to a few hundred Hz); RepRapFirmware refuses M593 above 1000 Hz, and printer.cfg's shaper_freq_* and an M503 reply's M593 F are held to the same",
+};
+
 /// Why `M493 D1`/`D2` is refused.
 const FT_DYNAMIC_FREQUENCY: &str = "D1 (Z-based) and D2 (mass-based) make Marlin change the shaper frequency as the print goes, by F per mm of Z (D1) or of filament extruded (D2) (Marlin/src/module/ft_motion.cpp); settle shapes at the fixed frequency A only: remove D, or give D0";
 
@@ -245,7 +254,7 @@ pub(crate) fn m_code(
             cmd.allow(p, b"XYZDF", "X Y Z (flags), D (damping ratio), F (Hz)")?;
             limits(LimitChange::MarlinInputShaping {
                 axes: flags(p),
-                frequency_hz: cmd.num(p, b'F', NON_NEGATIVE)?,
+                frequency_hz: cmd.num(p, b'F', SHAPER_FREQUENCY)?,
                 damping_ratio: cmd.num(p, b'D', FRACTION)?,
             })
         }
@@ -419,9 +428,9 @@ pub(crate) fn named(
             shaper_type,
             shaper_type_xyz: per_axis,
             frequency_hz_xyz: [
-                num("SHAPER_FREQ_X", NON_NEGATIVE)?,
-                num("SHAPER_FREQ_Y", NON_NEGATIVE)?,
-                num("SHAPER_FREQ_Z", NON_NEGATIVE)?,
+                num("SHAPER_FREQ_X", SHAPER_FREQUENCY)?,
+                num("SHAPER_FREQ_Y", SHAPER_FREQUENCY)?,
+                num("SHAPER_FREQ_Z", SHAPER_FREQUENCY)?,
             ],
             damping_ratio_xyz: [
                 num("DAMPING_RATIO_X", FRACTION)?,

@@ -468,3 +468,46 @@ fn marlin_m493_values_are_bounded_at_their_line() {
     let text = "M493 S1 X C1 A10 I0.01 D0\nM493 Y C8 A500 I0.99 Q1\n";
     assert_eq!(crate::limits(text, Dialect::Marlin).len(), 2);
 }
+
+/// A shaper frequency in a job is held to what printer.cfg's `shaper_freq_*` and an
+/// `M503` reply's `M593 F` are held to: 0 (off), or 1 to 1000 Hz. The old reader took
+/// Marlin's `M593 X F1000000000` and Klipper's `SHAPER_FREQ_X=1e9` and replayed the job
+/// as if unshaped, where the same value in the configuration was refused.
+#[test]
+fn a_jobs_shaper_frequency_is_held_to_the_configurations_range() {
+    for (text, dialect, word, value) in [
+        ("G90\nM593 X F1000000000", Dialect::Marlin, "F", 1e9),
+        ("G90\nM593 Y F1000.5 D0.1", Dialect::Marlin, "F", 1000.5),
+        ("G90\nM593 F0.5", Dialect::Marlin, "F", 0.5),
+        (
+            "G90\nSET_INPUT_SHAPER SHAPER_TYPE=mzv SHAPER_FREQ_X=1e9",
+            Dialect::Klipper,
+            "SHAPER_FREQ_X",
+            1e9,
+        ),
+        (
+            "G90\nSET_INPUT_SHAPER SHAPER_FREQ_Y=0.2",
+            Dialect::Klipper,
+            "SHAPER_FREQ_Y",
+            0.2,
+        ),
+    ] {
+        match error(text, dialect) {
+            GcodeError::OutOfRange {
+                at,
+                param,
+                value: v,
+                allowed,
+                ..
+            } => {
+                assert_eq!((at.line, param.as_str(), v), (2, word, value), "{text}");
+                assert!(allowed.starts_with("0 (off) or 1 to 1000 Hz"), "{allowed}");
+            }
+            e => panic!("{text}: {e}"),
+        }
+    }
+    let ok = "M593 X F0\nM593 Y F1 D0.1\nM593 X F1000\n";
+    assert_eq!(crate::limits(ok, Dialect::Marlin).len(), 3);
+    let ok = "SET_INPUT_SHAPER SHAPER_FREQ_X=0 SHAPER_FREQ_Y=1000\n";
+    assert_eq!(crate::limits(ok, Dialect::Klipper).len(), 1);
+}
