@@ -386,6 +386,17 @@ pub enum GcodeError {
         /// The names settle knows.
         known: String,
     },
+    /// A setting of a configuration file that the job cannot use, at the line that set
+    /// it (a shaper settle refuses, limits the planner refuses).
+    #[error("{at}: key `{key}`: {reason}")]
+    ConfigSetting {
+        /// The line that set it (the last one, where several did).
+        at: Location,
+        /// The setting as its firmware names it (`M593`, `input_shaper.shaper_freq_x`).
+        key: String,
+        /// What is wrong and what is allowed.
+        reason: String,
+    },
     /// A job setting (not from the file) that cannot be used.
     #[error("job setting `{key}`: {reason}")]
     JobSetting {
@@ -499,6 +510,7 @@ impl GcodeError {
             | GcodeError::ArcTooManySegments { at, .. }
             | GcodeError::ConfigSyntax { at, .. }
             | GcodeError::ConfigValue { at, .. }
+            | GcodeError::ConfigSetting { at, .. }
             | GcodeError::IncludeCycle { at, .. }
             | GcodeError::Include { at, .. }
             | GcodeError::Plan { at, .. }

@@ -48,6 +48,31 @@ pub fn min_move_time_s(distance_mm: f64, vmax_mm_s: f64, amax_mm_s2: f64) -> f64
     }
 }
 
+/// The key at fault for a run whose move takes too long ([`validate_duration`]): of the
+/// two values the move's time rests on (the distance and vmax when the move cruises, its
+/// time then mostly `d / vmax`; the distance and amax when it never reaches vmax,
+/// `2 sqrt(d / amax)`), the one swept, else the one further from a 100 mm move at
+/// 100 mm/s and 1000 mm/s^2 (the time grows with the distance and falls with the
+/// limit). A limit that takes no part is never named, whatever is swept.
+fn duration_key(run: &RunSpec) -> String {
+    const DISTANCE: &str = "move.distance_mm";
+    let (d, v, a) = (run.distance_mm.abs(), run.vmax_mm_s, run.amax_mm_s2);
+    // Each value with how far it is from the reference, in the direction that lengthens.
+    let (first, second) = if d * a <= v * v {
+        ((DISTANCE, d / 100.0), ("limits.amax_mm_s2", 1000.0 / a))
+    } else {
+        ((DISTANCE, d / 100.0), ("limits.vmax_mm_s", 100.0 / v))
+    };
+    let swept = |k: &str| run.blame(k).starts_with("sweep.");
+    let key = match (swept(first.0), swept(second.0)) {
+        (true, false) => first.0,
+        (false, true) => second.0,
+        _ if second.1 > first.1 => second.0,
+        _ => first.0,
+    };
+    run.blame(key)
+}
+
 /// Check that a run's simulated time (its move at the fastest the limits allow, plus the
 /// observation window) stays within [`MAX_SAMPLES_PER_RUN`] samples, before any work.
 fn validate_duration(run: &RunSpec, src: &Source) -> Result<(), Error> {
@@ -68,11 +93,7 @@ fn validate_duration(run: &RunSpec, src: &Source) -> Result<(), Error> {
     if samples.is_finite() && samples <= MAX_SAMPLES_PER_RUN {
         return Ok(());
     }
-    let key = ["move.distance_mm", "limits.vmax_mm_s", "limits.amax_mm_s2"]
-        .into_iter()
-        .map(|k| run.blame(k))
-        .find(|k| k.starts_with("sweep."))
-        .unwrap_or_else(|| "move.distance_mm".to_string());
+    let key = duration_key(run);
     Err(src.error_at(
         &key,
         format!(

@@ -192,6 +192,7 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
                 settle_gcode::GcodeError::ConfigValue { section, key, .. } => {
                     Some(format!("{section}.{key}"))
                 }
+                settle_gcode::GcodeError::ConfigSetting { key, .. } => Some(key.clone()),
                 _ => None,
             };
             Error::Input {
@@ -201,7 +202,10 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
                     column: at.column,
                     key,
                 },
-                message: text.strip_prefix(&prefix).unwrap_or(&text).to_string(),
+                message: match &e {
+                    settle_gcode::GcodeError::ConfigSetting { reason, .. } => reason.clone(),
+                    _ => text.strip_prefix(&prefix).unwrap_or(&text).to_string(),
+                },
             }
         }
         None => match e {
@@ -323,7 +327,11 @@ pub fn read_current_files(
                 axes,
                 notes: c.notes.iter().map(ToString::to_string).collect(),
                 marlin_shaping: None,
-                set_at: BTreeMap::new(),
+                set_at: c
+                    .set_at
+                    .iter()
+                    .map(|(k, at)| (k.clone(), harness_location(at, k)))
+                    .collect(),
             };
             Ok((cur, files))
         }

@@ -150,6 +150,96 @@ fn a_configuration_settle_cannot_follow_exits_2_and_writes_nothing() {
     }
 }
 
+/// A setting the job cannot use is named at the line of the configuration that set it,
+/// with its key and what is allowed, exit 2, nothing written: the old binary named a
+/// config.g's `M593` and `M669`, and a printer.cfg's shaper frequency, without a line
+/// (`c.g: key M593: ...`), and took Marlin's `M92 X0.0000001` and `M493 A1e308` and
+/// GRBL's `$100=0.0000001` (at 1e-7 steps/mm a move is no whole step: it reported 60 mm
+/// of error as measured).
+#[test]
+fn a_configurations_bad_setting_is_named_at_its_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let gcode = write(d, "m.gcode", "G90\nM83\nG1 X10 F6000\nG1 X20 E1\n");
+    let cases: [(&str, &str, &str, &str, &str); 7] = [
+        (
+            "c.g",
+            "M92 X80 Y80\n; RepRapFirmware allows S up to 0.99\nM593 P\"ei3\" F40 S0.5\n",
+            "rrf",
+            "c.g:3: key `M593`",
+            "impulse times",
+        ),
+        (
+            "k.g",
+            "M92 X80\nM669 K3\n",
+            "rrf",
+            "k.g:2: key `M669 K`",
+            "cartesian and corexy",
+        ),
+        (
+            "s.cfg",
+            "[printer]\nkinematics: cartesian\nmax_velocity: 300\nmax_accel: 3000\n[input_shaper]\nshaper_type: mzv\nshaper_freq_x: 0.001\nshaper_freq_y: 40\n",
+            "klipper",
+            "s.cfg:7: key `input_shaper.shaper_freq_x`",
+            "below 1 Hz",
+        ),
+        (
+            "steps.txt",
+            "echo:  M203 X500 Y500\necho:  M92 X0.0000001 Y80\n",
+            "marlin",
+            "steps.txt:2: key `M92.X`",
+            "1 to 1e6 steps/mm",
+        ),
+        (
+            "ft.txt",
+            "echo:  M203 X500 Y500\necho:; Fixed-Time Motion:\necho:  M493 S1 A1e308\n",
+            "marlin",
+            "ft.txt:3: key `M493.A`",
+            "10 to 500 Hz",
+        ),
+        (
+            "zeta.txt",
+            "echo:  M203 X500 Y500\necho:  M493 X C1 A40 I1\n",
+            "marlin",
+            "zeta.txt:2: key `M493.I`",
+            "0.01 to below 1",
+        ),
+        (
+            "grbl.txt",
+            "$110=6000\n$100=0.0000001\n",
+            "grbl",
+            "grbl.txt:2: key `$100`",
+            "1 to 1e6 steps/mm",
+        ),
+    ];
+    for (name, text, firmware, at, allowed) in cases {
+        let config = write(d, name, text);
+        let out_dir = d.join("out");
+        let out = settle()
+            .arg("gcode")
+            .arg(&gcode)
+            .args([
+                "--machine",
+                "printer_xy",
+                "--firmware",
+                firmware,
+                "--config",
+            ])
+            .arg(&config)
+            .arg("--out")
+            .arg(&out_dir)
+            .output()
+            .expect("settle runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {stderr}");
+        assert!(
+            stderr.contains(at) && stderr.contains(allowed),
+            "{name}: {stderr}"
+        );
+        assert!(!out_dir.exists(), "{name} wrote {out_dir:?}");
+    }
+}
+
 /// summary.md and report.html say what `--config` set and where the modal backend
 /// linearised the machine: the cube layer is printed at X and Y 100 to 120 mm, so at X and
 /// Y 110 mm.

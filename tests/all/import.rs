@@ -394,6 +394,14 @@ fn implausible_values_are_refused_at_their_line() {
             "printer.max_accel",
             "settle cannot run these settings",
         ),
+        // A speed at which the search's 20 mm move outlasts a run: the speed is named,
+        // not the acceleration the search sweeps (the old error named max_accel).
+        (
+            printer.replace("max_velocity: 300", "max_velocity: 0.001"),
+            3,
+            "printer.max_velocity",
+            "a move of 20 mm at vmax_mm_s = 0.001",
+        ),
     ] {
         std::fs::write(&cfg, &text).expect("write");
         let e = import(&opts(Firmware::Klipper, cfg.clone(), &out)).expect_err(&text);
@@ -413,5 +421,42 @@ fn implausible_values_are_refused_at_their_line() {
             .output()
             .expect("runs");
         assert_eq!(r.status.code(), Some(2), "{text}: {r:?}");
+    }
+}
+
+/// A config.g value settle cannot run is named at its line: the old reader recorded no
+/// line for config.g (`c.g: key M203: ...`), and named the acceleration for a speed too
+/// low to run.
+#[test]
+fn a_config_g_value_is_refused_at_its_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cfg = dir.path().join("config.g");
+    let out = dir.path().join("o.toml");
+    for (text, line, key, says) in [
+        (
+            "M92 X80 Y80\nM201 X1000 Y1000\nM203 X0.06 Y0.06\nM204 P1000 T1000\n",
+            3,
+            "M203",
+            "a move of 20 mm at vmax_mm_s = 0.001",
+        ),
+        (
+            "M92 X80 Y80\nM593 P\"ei3\" F40 S0.5\nM201 X1000 Y1000\n",
+            2,
+            "M593",
+            "impulse times",
+        ),
+    ] {
+        std::fs::write(&cfg, text).expect("write");
+        let e = import(&opts(Firmware::Rrf, cfg.clone(), &out)).expect_err(text);
+        let Error::Input { at, message } = &e else {
+            panic!("{text}: {e}")
+        };
+        assert_eq!(
+            (&at.file, at.line, at.key.as_deref()),
+            (&cfg, Some(line), Some(key)),
+            "{text}: {e}"
+        );
+        assert!(message.contains(says), "{text}: {e}");
+        assert!(!out.exists(), "{text}");
     }
 }

@@ -227,7 +227,7 @@ fn implausible_values_are_refused_at_their_line() {
     for (last, want) in [
         (
             "M593 X F999999999 D0.1",
-            "m.txt:6: key `M593.F`: [M593] F = `999999999`: not allowed (allowed: 0 (off) or 1 to 1000 Hz)",
+            "m.txt:6: key `M593.F`: [M593] F = `999999999`: not allowed (allowed: 0 (off) or 1 to 1000 Hz: below 1 Hz",
         ),
         (
             "M201 X0.0000001",
@@ -240,6 +240,13 @@ fn implausible_values_are_refused_at_their_line() {
         (
             "M203 X0.0000001",
             "m.txt:6: key `M203`: the lower of X and Y",
+        ),
+        // Slow enough that a move of the search outlasts a run: the speed is at fault,
+        // not the acceleration the search sweeps (the old error named `M201 / M204 P`
+        // at line 4).
+        (
+            "M203 X0.001",
+            "m.txt:6: key `M203`: axis x: settle cannot run these settings: run 0: a move of 20 mm at vmax_mm_s = 0.001",
         ),
     ] {
         refused(

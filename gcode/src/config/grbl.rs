@@ -115,7 +115,13 @@ impl GrblSettings {
             }
         };
         match number {
-            100..=102 => self.steps_per_mm[axis] = positive(value)?,
+            100..=102 => {
+                let steps = crate::read::limit_parse::STEPS_PER_MM;
+                if !(steps.ok)(value) {
+                    return Err(steps.allowed);
+                }
+                self.steps_per_mm[axis] = value;
+            }
             110..=112 => self.max_rate_mm_min[axis] = positive(value)?,
             120..=122 => self.accel_mm_s2[axis] = positive(value)?,
             130..=132 => self.max_travel_mm[axis] = value,
@@ -271,5 +277,27 @@ mod tests {
         }
         let bad = GrblSettings::parse("Grbl 1.1h\n$110=0\n", "g.txt").expect_err("refused");
         assert!(bad.to_string().contains("g.txt:2"), "{bad}");
+    }
+
+    /// Steps per mm no machine has are refused at their line with the range (the old
+    /// reader took any value above 1e-9: at `$100=0.0000001` a 10 mm move is no whole
+    /// step, and the replay reported 10 mm of error); 1 and 1e6 are read.
+    #[test]
+    fn steps_per_mm_are_bounded() {
+        for (text, line) in [
+            ("$100=0.0000001\n", "g.txt:1"),
+            ("$110=500\n$102=0.5\n", "g.txt:2"),
+            ("$101=1000001\n", "g.txt:1"),
+        ] {
+            let e = GrblSettings::parse(text, "g.txt")
+                .expect_err(text)
+                .to_string();
+            assert!(
+                e.contains(line) && e.contains("1 to 1e6 steps/mm"),
+                "{text}: {e}"
+            );
+        }
+        let s = GrblSettings::parse("$100=1\n$101=1000000\n", "g.txt").expect("read");
+        assert_eq!(s.steps_per_mm, [1.0, 1e6, 250.0]);
     }
 }

@@ -34,7 +34,6 @@ use settle_planner::firmware::marlin::{
 };
 
 use super::budget::Budget;
-use super::klipper::MAX_SHAPER_FREQUENCY_HZ;
 use super::machine::ConfigNote;
 use crate::error::{GcodeError, Location};
 use crate::job::driver::{Driver, LimitOutcome};
@@ -42,6 +41,7 @@ use crate::job::shapers::ShaperState;
 use crate::job::{JobConfig, PlannerConfig, PrusaPrinter, ShaperSetting};
 use crate::read::dialect::Dialect;
 use crate::read::event::{EventKind, Note};
+use crate::read::limit_parse::{FT_DAMPING, FT_FREQUENCY, STEPS_PER_MM};
 use crate::read::limits::LimitChange;
 use settle_planner::firmware::Firmware;
 
@@ -200,7 +200,7 @@ fn command_of(text: &str) -> Option<String> {
     Some(format!("{}{number}", letter as char))
 }
 
-/// `M92`'s values (X, Y, Z, E): positive steps per mm; `T` (an extruder of a
+/// `M92`'s values (X, Y, Z, E): steps per mm within [`STEPS_PER_MM`], as a job's `M92`; `T` (an extruder of a
 /// `DISTINCT_E_FACTORS` build) is read, and only the first extruder's `E` kept.
 fn steps_words(text: &str, at: &Location, steps: &mut [Option<f64>; 4]) -> Result<(), GcodeError> {
     let code = text.split(';').next().unwrap_or("");
@@ -225,8 +225,8 @@ fn steps_words(text: &str, at: &Location, steps: &mut [Option<f64>; 4]) -> Resul
         match letter.to_ascii_uppercase().as_str() {
             "T" => extruder = v,
             l @ ("X" | "Y" | "Z" | "E") => {
-                if !(v > 0.0 && v <= 1e9) {
-                    return Err(bad("steps per mm above 0"));
+                if !(STEPS_PER_MM.ok)(v) {
+                    return Err(bad(STEPS_PER_MM.allowed));
                 }
                 values.push((l.as_bytes()[0], v));
             }
@@ -242,6 +242,34 @@ fn steps_words(text: &str, at: &Location, steps: &mut [Option<f64>; 4]) -> Resul
             _ => continue,
         };
         steps[i] = Some(v);
+    }
+    Ok(())
+}
+
+/// An `M493` line of the reply: not followed (FT_MOTION's settings are the job's own
+/// `M493`), but its frequency `A`, damping `I` and tolerance `Q` are held to what the
+/// job's `M493` takes ([`FT_FREQUENCY`], [`FT_DAMPING`], 0 to 1), so a value Marlin
+/// would refuse is named at its line. The other words differ between Marlin's versions
+/// (2.1.2 reported `M493 S<mode> P K`) and are not read.
+fn ft_words(text: &str, at: &Location) -> Result<(), GcodeError> {
+    let code = text.split(';').next().unwrap_or("");
+    for w in code.split_whitespace().skip(1) {
+        let (letter, value) = w.split_at(w.chars().next().map_or(0, char::len_utf8));
+        let check = match letter.to_ascii_uppercase().as_str() {
+            "A" => FT_FREQUENCY,
+            "I" => FT_DAMPING,
+            "Q" => crate::read::cmd::FRACTION,
+            _ => continue,
+        };
+        if !value.parse::<f64>().is_ok_and(|v| (check.ok)(v)) {
+            return Err(GcodeError::ConfigValue {
+                at: at.clone(),
+                section: "M493".into(),
+                key: letter.to_string(),
+                value: value.into(),
+                allowed: check.allowed.into(),
+            });
+        }
     }
     Ok(())
 }
@@ -356,6 +384,9 @@ impl MarlinSettings {
                             });
                     }
                     Some(c) => {
+                        if c == "M493" {
+                            ft_words(t, &at(line))?;
+                        }
                         if unused.insert(c.clone()) {
                             let text = match unused_reason(&c) {
                                 Some(what) => {
@@ -447,7 +478,23 @@ impl MarlinSettings {
         let mut followed = Vec::new();
         let text = kept.join("\n");
         for event in super::located_events(&text, dialect, &source) {
-            let (at, kind) = event?;
+            // A word the job's command refuses, named as the reply's setting.
+            let (at, kind) = event.map_err(|e| match e {
+                GcodeError::OutOfRange {
+                    at,
+                    command,
+                    param,
+                    value,
+                    allowed,
+                } => GcodeError::ConfigValue {
+                    at: Location { column: None, ..at },
+                    section: command,
+                    key: param,
+                    value: value.to_string().into(),
+                    allowed: allowed.into(),
+                },
+                e => e,
+            })?;
             let change = match kind {
                 EventKind::Limits(c) => c,
                 EventKind::Note(Note::IgnoredByFirmware { command, reason }) => {
@@ -458,20 +505,6 @@ impl MarlinSettings {
             };
             let command = change.command_name();
             followed.push((at.line, command));
-            if let LimitChange::MarlinInputShaping {
-                frequency_hz: Some(f),
-                ..
-            } = change
-                && f > MAX_SHAPER_FREQUENCY_HZ
-            {
-                return Err(GcodeError::ConfigValue {
-                    at,
-                    section: "M593".into(),
-                    key: "F".into(),
-                    value: f.to_string().into(),
-                    allowed: format!("0 (off) or 1 to {MAX_SHAPER_FREQUENCY_HZ} Hz").into(),
-                });
-            }
             if let (
                 Some(p),
                 LimitChange::PrusaInputShaping {
@@ -801,6 +834,42 @@ mod tests {
                 "M201",
             ),
             ("M203 X300\nM92 X0 Y80\n", "m503.txt:2", "M92"),
+            // Steps per mm no machine has (the old reader took any above 0: at 1e-7 a
+            // 50 mm move is no whole step, and the replay reported 60 mm of error).
+            (
+                "M203 X300\nM92 X1e-7 Y80\n",
+                "m503.txt:2",
+                "1 to 1e6 steps/mm",
+            ),
+            ("M92 X80 Y80 Z400 E0.5\n", "m503.txt:1", "1 to 1e6 steps/mm"),
+            ("M92 X80 Y80 Z2e6\n", "m503.txt:1", "1 to 1e6 steps/mm"),
+            // FT_MOTION's M493 is not followed, but values Marlin's M493 refuses are
+            // named at their line (the old reader only noted the command).
+            (
+                "M203 X300\necho:  M493 S1 A1e308\n",
+                "m503.txt:2",
+                "10 to 500 Hz",
+            ),
+            (
+                "M203 X300\necho:  M493 X C1 A5 I0.1\n",
+                "m503.txt:2",
+                "10 to 500 Hz",
+            ),
+            (
+                "M203 X300\necho:  M493 X C1 A40 I1\n",
+                "m503.txt:2",
+                "0.01 to below 1",
+            ),
+            (
+                "M203 X300\necho:  M493 X C5 A40 I0.1 Q2\n",
+                "m503.txt:2",
+                "0 to 1",
+            ),
+            (
+                "M203 X300\necho:  M493 X C5 A40 I0.1 Qnan\n",
+                "m503.txt:2",
+                "0 to 1",
+            ),
             ("M203 X300\nM593 X F40 D1.5\n", "m503.txt:2", "M593"),
             ("echo:  G20 ; (in)\nM203 X10\n", "m503.txt:1", "G20"),
             (
@@ -816,6 +885,24 @@ mod tests {
                 .to_string();
             assert!(e.contains(at) && e.contains(what), "{text:?}: {e}");
         }
+    }
+
+    /// The ends of the ranges are read; an M493 of Marlin 2.1.2's report (`S` a mode
+    /// number, `P`, `K`) is only noted.
+    #[test]
+    fn values_at_the_ends_of_their_ranges_are_read() {
+        let text = "M92 X1 Y1000000 Z400 E93\nM493 S1 P0 K0\nM493 X C1 A10 I0.01 Q0\nM493 Y C1 A500 I0.99 Q1\nM493 S10\n";
+        let s = MarlinSettings::parse(text, "m503.txt").expect("read");
+        assert_eq!(
+            s.steps_per_mm,
+            [Some(1.0), Some(1e6), Some(400.0), Some(93.0)]
+        );
+        assert_eq!(s.notes.len(), 1, "{:?}", s.notes);
+        assert!(
+            s.notes[0].text.starts_with("M493 (FT_MOTION"),
+            "{:?}",
+            s.notes
+        );
     }
 
     /// A command settle does not know is a note, once.

@@ -80,7 +80,7 @@ pub use grbl::GrblSettings;
 pub use klipper::{
     DEFAULT_DAMPING_RATIO, DEFAULT_FULL_STEPS_PER_ROTATION, DEFAULT_MINIMUM_CRUISE_RATIO,
     DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,
-    KlipperStepper,
+    KlipperStepper, MAX_SHAPER_FREQUENCY_HZ,
 };
 pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
 pub use marlin::MarlinSettings;

@@ -16,6 +16,7 @@
 //! - Meta-commands and `{expressions}` that name anything are not evaluated (see the
 //!   notes); an expression of numbers alone is worked out (`rrf_script`).
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -112,6 +113,10 @@ pub struct RrfConfig {
     pub files: Vec<PathBuf>,
     /// What was not read (conditional blocks, expressions, missing macros).
     pub notes: Vec<ConfigNote>,
+    /// Where each command in effect was last given, by its name (`M593`, `M203`, and
+    /// `M593 F` for the last `M593` with a frequency): the file and line an error about a
+    /// value read here names.
+    pub set_at: BTreeMap<String, Location>,
 }
 
 /// Where macros are looked up, and the files being read (absolute, outermost first).
@@ -167,6 +172,7 @@ impl RrfConfig {
             idle_current_percent: 30.0,
             files: Vec::new(),
             notes: Vec::new(),
+            set_at: BTreeMap::new(),
         }
     }
 
@@ -204,8 +210,23 @@ impl RrfConfig {
         for event in super::located_events(&script.text, Dialect::Rrf, &source) {
             let (at, kind) = event?;
             match kind {
-                EventKind::Setting(s) => self.setting(&s, &at)?,
-                EventKind::Limits(l) => self.limits(&l, &at)?,
+                EventKind::Setting(s) => {
+                    if let Setting::Kinematics { .. } = s {
+                        self.set_at.insert("M669 K".into(), at.clone());
+                    }
+                    self.setting(&s, &at)?;
+                }
+                EventKind::Limits(l) => {
+                    self.set_at.insert(l.command_name().into(), at.clone());
+                    if let LimitChange::RrfInputShaping {
+                        frequency_hz: Some(_),
+                        ..
+                    } = l
+                    {
+                        self.set_at.insert("M593 F".into(), at.clone());
+                    }
+                    self.limits(&l, &at)?;
+                }
                 EventKind::Note(Note::MacroCall { path: name, .. }) => {
                     self.macro_call(&name, at, files)?;
                 }

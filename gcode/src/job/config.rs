@@ -15,6 +15,7 @@ use settle_planner::{Limits, PlanError, ProfileKind};
 
 pub use super::shapers::ShaperSetting;
 use crate::config::GrblSettings;
+use crate::error::Location;
 use crate::{ArcSegmentation, Dialect, GcodeError, GrblArcs, LayerMode, ReaderOptions};
 
 /// A firmware by name, for a G-code job: one of [`Firmware::GCODE`] (klipper, marlin,
@@ -290,17 +291,36 @@ fn planner_kinematics(name: &str, key: &'static str) -> Result<Kinematics, Gcode
     }
 }
 
+/// A job setting's error at the configuration line `at` that set it, where known.
+fn located(e: GcodeError, at: Option<&Location>) -> GcodeError {
+    match (e, at) {
+        (GcodeError::JobSetting { key, reason }, Some(at)) => GcodeError::ConfigSetting {
+            at: at.clone(),
+            key: key.to_string(),
+            reason,
+        },
+        (e, _) => e,
+    }
+}
+
 /// An axis's shaper as a configuration file sets it, as a job setting (`None`: the
 /// firmware does not shape the axis). An error names `keys`' first (the shaper's type),
-/// or its second for a frequency below settle's lowest.
+/// or its second for a frequency below settle's lowest, at the line `line_of` gives for
+/// that key (the key alone where it gives none).
 fn config_shaper(
     s: &crate::config::ShaperSetting,
     dialect: Dialect,
     keys: [&'static str; 2],
+    line_of: &dyn Fn(&str) -> Option<Location>,
 ) -> Result<Option<ShaperSetting>, GcodeError> {
     let min = settle_planner::shaper::MIN_FREQUENCY_HZ;
     let key = keys[usize::from(s.frequency_hz < min && s.type_name(dialect).is_some())];
-    let bad = |reason: String| GcodeError::JobSetting { key, reason };
+    let bad = |reason: String| {
+        located(
+            GcodeError::JobSetting { key, reason },
+            line_of(key).as_ref(),
+        )
+    };
     let Some(name) = s.type_name(dialect) else {
         if s.is_enabled(dialect) {
             return Err(bad(format!(
@@ -336,7 +356,8 @@ impl JobConfig {
         k.square_corner_velocity_m_s = p.square_corner_velocity_mm_s * 1e-3;
         k.max_z_velocity_m_s = p.max_z_velocity_mm_s * 1e-3;
         k.max_z_accel_m_s2 = p.max_z_accel_mm_s2 * 1e-3;
-        k.kinematics = planner_kinematics(&p.kinematics, "printer.kinematics")?;
+        k.kinematics = planner_kinematics(&p.kinematics, "printer.kinematics")
+            .map_err(|e| located(e, c.set_at.get("printer.kinematics")))?;
         k.validate().map_err(|e| GcodeError::JobSetting {
             key: "printer",
             reason: e.to_string(),
@@ -353,8 +374,13 @@ impl JobConfig {
                 ["input_shaper.shaper_type_y", "input_shaper.shaper_freq_y"],
                 ["input_shaper.shaper_type_z", "input_shaper.shaper_freq_z"],
             ];
+            // The axis's own option, else the one of every axis (`shaper_type`).
+            let line_of = |key: &str| {
+                let common = key.trim_end_matches(['x', 'y', 'z']).trim_end_matches('_');
+                c.set_at.get(key).or_else(|| c.set_at.get(common)).cloned()
+            };
             for (i, ((_, axis), key)) in s.iter().zip(keys).enumerate() {
-                cfg.shapers[i] = config_shaper(axis, Dialect::Klipper, key)?;
+                cfg.shapers[i] = config_shaper(axis, Dialect::Klipper, key, &line_of)?;
             }
         }
         Ok(cfg)
@@ -375,7 +401,8 @@ impl JobConfig {
         }
         r.print_accel_m_s2 = c.print_accel_mm_s2 * 1e-3;
         r.travel_accel_m_s2 = c.travel_accel_mm_s2 * 1e-3;
-        r.kinematics = planner_kinematics(&c.kinematics, "M669 K")?;
+        r.kinematics = planner_kinematics(&c.kinematics, "M669 K")
+            .map_err(|e| located(e, c.set_at.get("M669 K")))?;
         r.validate().map_err(|e| GcodeError::JobSetting {
             key: "config.g limits",
             reason: e.to_string(),
@@ -387,7 +414,8 @@ impl JobConfig {
                 .position_max_mm
                 .map(|hi| (a.drive.position_min_mm, hi));
         }
-        let shaper = config_shaper(&c.input_shaper, Dialect::Rrf, ["M593", "M593 F"])?;
+        let line_of = |key: &str| c.set_at.get(key).cloned();
+        let shaper = config_shaper(&c.input_shaper, Dialect::Rrf, ["M593", "M593 F"], &line_of)?;
         cfg.shapers[0] = shaper;
         cfg.shapers[1] = shaper;
         Ok(cfg)

@@ -25,6 +25,65 @@ pub(crate) enum Outcome {
 
 const PER_MIN: f64 = 1.0 / 60.0;
 
+/// Marlin's `M493 A`, Hz: what `M493` takes (Marlin/src/gcode/feature/ft_motion/M493.cpp,
+/// `WITHIN(baseFreqVal, FTM_MIN_SHAPE_FREQ, (FTM_FS) / 2)`; it answers `?Invalid` and keeps
+/// the old frequency otherwise), with the lowest `FTM_MIN_SHAPE_FREQ` a Marlin release
+/// configures (10 Hz; later Configuration_adv.h files have 20) and the default `FTM_FS`
+/// (1000 Hz).
+pub(crate) const FT_FREQUENCY: Check = Check {
+    ok: |v| (10.0..=500.0).contains(&v),
+    allowed: "10 to 500 Hz: Marlin's M493 refuses a frequency below FTM_MIN_SHAPE_FREQ (10 Hz at the least, 20 in later Configuration_adv.h files) or above FTM_FS / 2 (FTM_FS 1000 Hz), and keeps the old one (Marlin/src/gcode/feature/ft_motion/M493.cpp)",
+};
+
+/// Marlin's `M493 I`, the damping ratio: `M493` takes 0.01 to 1 (M493.cpp); at 1 the
+/// shapers divide by zero (`sqrt(1 - zeta^2)` in ft_motion.cpp), so 1 is refused too.
+pub(crate) const FT_DAMPING: Check = Check {
+    ok: |v| (0.01..1.0).contains(&v),
+    allowed: "0.01 to below 1: Marlin's M493 refuses a damping ratio outside 0.01 to 1 (Marlin/src/gcode/feature/ft_motion/M493.cpp), and at 1 its shapers divide by sqrt(1 - zeta^2) = 0",
+};
+
+/// A shaper frequency in a job (Marlin's `M593 F`, Klipper's `SET_INPUT_SHAPER
+/// SHAPER_FREQ_*`): 0 (off), or 1 Hz (settle's lowest,
+/// `settle_planner::shaper::MIN_FREQUENCY_HZ`) to [`crate::config::MAX_SHAPER_FREQUENCY_HZ`],
+/// as where printer.cfg and an `M503` reply set it.
+pub(crate) const SHAPER_FREQUENCY: Check = Check {
+    ok: |v| v == 0.0 || (1.0..=crate::config::MAX_SHAPER_FREQUENCY_HZ).contains(&v),
+    allowed: "0 (off) or 1 to 1000 Hz: below 1 Hz a shaper lasts a second or more, and a shaper tuned above 1 kHz lasts under a millisecond and cancels nothing a printer's belts or frame carry (their modes are tens to a few hundred Hz); RepRapFirmware refuses M593 above 1000 Hz, and printer.cfg's shaper_freq_* and an M503 reply's M593 F are held to the same",
+};
+
+/// Why `M493 D1`/`D2` is refused.
+const FT_DYNAMIC_FREQUENCY: &str = "D1 (Z-based) and D2 (mass-based) make Marlin change the shaper frequency as the print goes, by F per mm of Z (D1) or of filament extruded (D2) (Marlin/src/module/ft_motion.cpp); settle shapes at the fixed frequency A only: remove D, or give D0";
+
+/// The steps per mm settle plans with (Marlin's `M92` in a job and in an `M503` reply,
+/// GRBL's `$100`-`$102`): 1 to 1e6.
+pub(crate) const STEPS_PER_MM: Check = Check {
+    ok: |v| (1.0..=1e6).contains(&v),
+    allowed: STEPS_PER_MM_ALLOWED,
+};
+
+/// What [`STEPS_PER_MM`] allows, and why.
+pub(crate) const STEPS_PER_MM_ALLOWED: &str = "1 to 1e6 steps/mm: the planner counts position in whole steps, so below 1 step/mm a step is longer than a millimetre (a 200-step motor at full step on a 40-tooth GT2 pulley, 80 mm a turn, makes 2.5), and above 1e6 the firmware's 32-bit step count overflows within 2.1 m of travel (Marlin's `xyze_long_t position` in Marlin/src/module/planner.h, GRBL's `int32_t sys_position` in grbl/main.c)";
+
+/// Marlin's `M92` in a job: each of X, Y, Z, E given a number is checked against
+/// [`STEPS_PER_MM`] (settle's reader does not follow it: the job's planner keeps the
+/// configuration's steps). Other words (`T`, `MAGIC_NUMBERS_GCODE`'s `H` and `L`) are
+/// not read.
+pub(crate) fn marlin_steps(cmd: &Cmd, p: &Params) -> Result<(), GcodeError> {
+    for letter in *b"XYZE" {
+        if let crate::read::params::Value::Num(v) = p.get(letter)
+            && !(STEPS_PER_MM.ok)(v)
+        {
+            return Err(cmd.out_of_range(
+                Some(p.at(letter)),
+                &char::from(letter).to_string(),
+                v,
+                STEPS_PER_MM.allowed,
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Why Marlin's `M593` refuses a `T`: the shaper type is Prusa's firmware's word.
 const PRUSA_M593_T: &str = "T (the shaper type) is Prusa's firmware's (Prusa-Firmware-Buddy, on the MK4, MINI, XL and CORE One: 0 ZV, 1 ZVD, 2 MZV, 3 EI, 4 2HUMP_EI, 5 3HUMP_EI); Marlin's M593 shapes with ZV only and has no T: read a file sliced for a Prusa printer with --firmware prusa";
 
@@ -195,7 +254,7 @@ pub(crate) fn m_code(
             cmd.allow(p, b"XYZDF", "X Y Z (flags), D (damping ratio), F (Hz)")?;
             limits(LimitChange::MarlinInputShaping {
                 axes: flags(p),
-                frequency_hz: cmd.num(p, b'F', NON_NEGATIVE)?,
+                frequency_hz: cmd.num(p, b'F', SHAPER_FREQUENCY)?,
                 damping_ratio: cmd.num(p, b'D', FRACTION)?,
             })
         }
@@ -246,15 +305,19 @@ pub(crate) fn m_code(
                 "S H (0/1) C (0-8) D (0-2) A (Hz) F I Q, X Y Z E (flags)",
             )?;
             let shaper = small(cmd, p, b'C', 8, "0 to 8")?.and_then(FtShaper::from_code);
+            let dynamic_mode = small(cmd, p, b'D', 2, "0 to 2")?;
+            if dynamic_mode.is_some_and(|d| d > 0) {
+                return Err(cmd.unsupported(FT_DYNAMIC_FREQUENCY));
+            }
             limits(LimitChange::FtMotion {
                 enabled: cmd.num(p, b'S', BOOL)?.map(|v| v == 1.0),
                 axis_sync: cmd.num(p, b'H', BOOL)?.map(|v| v == 1.0),
                 axes: flags(p),
                 shaper,
-                dynamic_mode: small(cmd, p, b'D', 2, "0 to 2")?,
-                frequency_hz: cmd.num(p, b'A', NON_NEGATIVE)?,
+                dynamic_mode,
+                frequency_hz: cmd.num(p, b'A', FT_FREQUENCY)?,
                 frequency_scaling: cmd.num(p, b'F', FINITE)?,
-                damping_ratio: cmd.num(p, b'I', FRACTION)?,
+                damping_ratio: cmd.num(p, b'I', FT_DAMPING)?,
                 vibration_tolerance: cmd.num(p, b'Q', FRACTION)?,
             })
         }
@@ -365,9 +428,9 @@ pub(crate) fn named(
             shaper_type,
             shaper_type_xyz: per_axis,
             frequency_hz_xyz: [
-                num("SHAPER_FREQ_X", NON_NEGATIVE)?,
-                num("SHAPER_FREQ_Y", NON_NEGATIVE)?,
-                num("SHAPER_FREQ_Z", NON_NEGATIVE)?,
+                num("SHAPER_FREQ_X", SHAPER_FREQUENCY)?,
+                num("SHAPER_FREQ_Y", SHAPER_FREQUENCY)?,
+                num("SHAPER_FREQ_Z", SHAPER_FREQUENCY)?,
             ],
             damping_ratio_xyz: [
                 num("DAMPING_RATIO_X", FRACTION)?,

@@ -561,6 +561,7 @@ impl Interp {
                         number,
                         82 | 83 | 400 | 201 | 203 | 204 | 205 | 566 | 593 | 493 | 494 | 220 | 221
                     ) || (self.opts.dialect == Dialect::Rrf && is_rrf_setting(number))
+                        || (self.opts.dialect.is_marlin() && number == 92)
                 }
                 _ => false,
             };
@@ -657,6 +658,11 @@ impl Interp {
                 if let Some(note) = factor(&mut self.motion, self.opts.dialect, cmd, number, p)? {
                     self.push(line, EventKind::Note(note));
                 }
+            }
+            // Marlin's steps per mm: checked, not followed (the configuration's hold).
+            (b'M', 92) if self.opts.dialect.is_marlin() => {
+                limit_parse::marlin_steps(cmd, p)?;
+                self.ignore(cmd.name);
             }
             (b'M', n) if is_rrf_setting(n) => {
                 match setting_parse::m_code(self.opts.dialect, cmd, number, p)? {

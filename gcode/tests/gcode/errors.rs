@@ -381,3 +381,133 @@ fn packaged_gcode_is_named_and_never_skipped() {
         .count();
     assert_eq!(moves, 1);
 }
+
+/// Marlin's `M92` in a job is not followed (the configuration's steps hold), but a value
+/// no machine has is refused at its line, with the range and why: at 1e-7 steps/mm a
+/// 50 mm move is not one whole step (the old reader listed it as not followed and the
+/// job replayed as if it were not there), at 2e6 a 32-bit step count overflows within
+/// 1.07 m (2^31 / 2e6 mm). 1 and 1e6 themselves, and a real printer's values, are read.
+#[test]
+fn marlin_m92_steps_per_mm_are_bounded_at_their_line() {
+    for (text, dialect, word, value) in [
+        ("G90\nM92 X0.0000001", Dialect::Marlin, "X", 1e-7),
+        ("G90\nM92 X80 Y80 Z400 E0.5", Dialect::Marlin, "E", 0.5),
+        ("G90\nM92 Z2000000", Dialect::Prusa, "Z", 2e6),
+    ] {
+        match error(text, dialect) {
+            GcodeError::OutOfRange {
+                at,
+                command,
+                param,
+                value: v,
+                allowed,
+            } => {
+                assert_eq!(
+                    (at.line, command.as_str(), param.as_str(), v),
+                    (2, "M92", word, value),
+                    "{text}"
+                );
+                assert!(allowed.starts_with("1 to 1e6 steps/mm"), "{allowed}");
+                assert!(allowed.contains("32-bit step count"), "{allowed}");
+            }
+            e => panic!("{text}: {e}"),
+        }
+    }
+    for dialect in [Dialect::Marlin, Dialect::Prusa] {
+        let text = "M92 X80.29 Y80.29 Z399.21 E425.35\nM92 X1 E1000000\nM92\n";
+        assert_eq!(crate::ignored(text, dialect), ["M92 x3"]);
+        assert_eq!(
+            crate::moves(&format!("{text}G1 X10 F600\n"), dialect).len(),
+            1
+        );
+    }
+}
+
+/// Marlin's `M493` (FT_MOTION): a frequency `A` outside 10 to 500 Hz and a damping `I`
+/// outside 0.01 to below 1 are refused at their word, as Marlin's M493.cpp refuses them
+/// (`WITHIN(baseFreqVal, FTM_MIN_SHAPE_FREQ, FTM_FS / 2)`, `WITHIN(zetaVal, 0.01, 1)`); the
+/// old reader shaped at 5 Hz, which Marlin never runs. `D1`/`D2` (a frequency that moves
+/// with Z or the extruded filament) is refused: settle shapes at a fixed frequency.
+#[test]
+fn marlin_m493_values_are_bounded_at_their_line() {
+    for (text, word, value, allowed) in [
+        ("M493 S1 X C1 A5", "A", 5.0, "10 to 500 Hz"),
+        ("M493 S1 X C1 A9.99", "A", 9.99, "10 to 500 Hz"),
+        ("M493 S1 X C1 A500.5", "A", 500.5, "10 to 500 Hz"),
+        ("M493 S1 X C1 A40 I0.001", "I", 0.001, "0.01 to below 1"),
+        ("M493 S1 X C1 A40 I1", "I", 1.0, "0.01 to below 1"),
+    ] {
+        match error(text, Dialect::Marlin) {
+            GcodeError::OutOfRange {
+                at,
+                param,
+                value: v,
+                allowed: a,
+                ..
+            } => {
+                assert_eq!((at.line, param.as_str(), v), (1, word, value), "{text}");
+                assert!(
+                    a.starts_with(allowed) && a.contains("M493.cpp"),
+                    "{text}: {a}"
+                );
+            }
+            e => panic!("{text}: {e}"),
+        }
+    }
+    for d in ["D1", "D2"] {
+        let text = format!("M493 S1 X C1 A40 {d} F0.5");
+        match error(&text, Dialect::Marlin) {
+            GcodeError::Unsupported { at, why, .. } => {
+                assert_eq!(at.line, 1);
+                assert!(why.contains("fixed frequency"), "{why}");
+            }
+            e => panic!("{text}: {e}"),
+        }
+    }
+    // The ends of the ranges, and D0, are read.
+    let text = "M493 S1 X C1 A10 I0.01 D0\nM493 Y C8 A500 I0.99 Q1\n";
+    assert_eq!(crate::limits(text, Dialect::Marlin).len(), 2);
+}
+
+/// A shaper frequency in a job is held to what printer.cfg's `shaper_freq_*` and an
+/// `M503` reply's `M593 F` are held to: 0 (off), or 1 to 1000 Hz. The old reader took
+/// Marlin's `M593 X F1000000000` and Klipper's `SHAPER_FREQ_X=1e9` and replayed the job
+/// as if unshaped, where the same value in the configuration was refused.
+#[test]
+fn a_jobs_shaper_frequency_is_held_to_the_configurations_range() {
+    for (text, dialect, word, value) in [
+        ("G90\nM593 X F1000000000", Dialect::Marlin, "F", 1e9),
+        ("G90\nM593 Y F1000.5 D0.1", Dialect::Marlin, "F", 1000.5),
+        ("G90\nM593 F0.5", Dialect::Marlin, "F", 0.5),
+        (
+            "G90\nSET_INPUT_SHAPER SHAPER_TYPE=mzv SHAPER_FREQ_X=1e9",
+            Dialect::Klipper,
+            "SHAPER_FREQ_X",
+            1e9,
+        ),
+        (
+            "G90\nSET_INPUT_SHAPER SHAPER_FREQ_Y=0.2",
+            Dialect::Klipper,
+            "SHAPER_FREQ_Y",
+            0.2,
+        ),
+    ] {
+        match error(text, dialect) {
+            GcodeError::OutOfRange {
+                at,
+                param,
+                value: v,
+                allowed,
+                ..
+            } => {
+                assert_eq!((at.line, param.as_str(), v), (2, word, value), "{text}");
+                assert!(allowed.starts_with("0 (off) or 1 to 1000 Hz"), "{allowed}");
+            }
+            e => panic!("{text}: {e}"),
+        }
+    }
+    let ok = "M593 X F0\nM593 Y F1 D0.1\nM593 X F1000\n";
+    assert_eq!(crate::limits(ok, Dialect::Marlin).len(), 3);
+    let ok = "SET_INPUT_SHAPER SHAPER_FREQ_X=0 SHAPER_FREQ_Y=1000\n";
+    assert_eq!(crate::limits(ok, Dialect::Klipper).len(), 1);
+}

@@ -585,11 +585,20 @@ pub fn gcode_error(file: &Path) -> impl Fn(GcodeError) -> Error + '_ {
         if let Some(at) = e.location() {
             let prefix = format!("{at}: ");
             let text = e.to_string();
-            let message = text.strip_prefix(&prefix).unwrap_or(&text).to_string();
+            let (key, message) = match &e {
+                GcodeError::ConfigSetting { key, reason, .. } => {
+                    (Some(key.clone()), reason.clone())
+                }
+                _ => (
+                    None,
+                    text.strip_prefix(&prefix).unwrap_or(&text).to_string(),
+                ),
+            };
             return Error::Input {
                 at: Location {
                     line: usize::try_from(at.line).ok(),
                     column: at.column,
+                    key,
                     ..Location::file(PathBuf::from(&*at.source_name))
                 },
                 message,
