@@ -176,7 +176,7 @@ fn command_of(text: &str) -> Option<String> {
     Some(format!("{}{number}", letter as char))
 }
 
-/// `M92`'s values (X, Y, Z, E): positive steps per mm; `T` (an extruder of a
+/// `M92`'s values (X, Y, Z, E): steps per mm within [`super::MICROSTEPS_PER_MM`]; `T` (an extruder of a
 /// `DISTINCT_E_FACTORS` build) is read, and only the first extruder's `E` kept.
 fn steps_words(text: &str, at: &Location, steps: &mut [Option<f64>; 4]) -> Result<(), GcodeError> {
     let code = text.split(';').next().unwrap_or("");
@@ -201,8 +201,9 @@ fn steps_words(text: &str, at: &Location, steps: &mut [Option<f64>; 4]) -> Resul
         match letter.to_ascii_uppercase().as_str() {
             "T" => extruder = v,
             l @ ("X" | "Y" | "Z" | "E") => {
-                if !(v > 0.0 && v <= 1e9) {
-                    return Err(bad("steps per mm above 0"));
+                let (lo, hi) = super::MICROSTEPS_PER_MM;
+                if !(lo..=hi).contains(&v) {
+                    return Err(bad(&format!("steps per mm from {lo} to {hi:e}")));
                 }
                 values.push((l.as_bytes()[0], v));
             }
@@ -552,6 +553,12 @@ mod tests {
                 "M201",
             ),
             ("M203 X300\nM92 X0 Y80\n", "m503.txt:2", "M92"),
+            (
+                "M203 X300\nM92 X80 Y1e10\n",
+                "m503.txt:2",
+                "(allowed: steps per mm from 1 to 1e9)",
+            ),
+            ("M203 X300\nM92 X0.5 Y80\n", "m503.txt:2", "from 1 to 1e9"),
             ("M203 X300\nM593 X F40 D1.5\n", "m503.txt:2", "M593"),
             ("echo:  G20 ; (in)\nM203 X10\n", "m503.txt:1", "G20"),
             (
