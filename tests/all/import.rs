@@ -208,7 +208,10 @@ fn import_refuses_grbl_with_its_reason() {
         err.contains("grbl is not a firmware whose configuration settle import reads: GRBL has no input shaper"),
         "{err}"
     );
-    assert!(err.contains("allowed: klipper, marlin, prusa, rrf"), "{err}");
+    assert!(
+        err.contains("allowed: klipper, marlin, prusa, rrf"),
+        "{err}"
+    );
     assert_eq!(
         settle::workflows::import::parse_firmware("duet"),
         Ok(Firmware::Rrf)

@@ -697,6 +697,17 @@ fn prusa_export_reads_back_as_the_recommendation() {
     let dir = tempfile::tempdir().expect("tempdir");
     let t = tune_printer_xy(dir.path(), r#""none", "zvd", "prusa:ei", "mzv""#, "prusa");
     let g = std::fs::read_to_string(t.out.join("prusa.gcode")).expect("prusa.gcode");
+    // The damping ratio 0.1 is Buddy's own default (`damping_ratio = 0.1f` of
+    // axis_x_default and axis_y_default in lib/Marlin/Marlin/src/feature/input_shaper/
+    // input_shaper_config.hpp), and the file says so rather than citing Klipper alone.
+    let d_line = g
+        .lines()
+        .find(|l| l.starts_with("; M593 ") && l.contains(" D: "))
+        .expect("the damping's change line");
+    assert!(
+        d_line.contains("-> 0.1: Buddy's default (damping_ratio 0.1 of axis_x_default"),
+        "{d_line}"
+    );
     let events: Vec<_> = Reader::new(g.as_bytes(), ReaderOptions::new(Dialect::Prusa))
         .collect::<Result<_, _>>()
         .expect("settle reads its own export");

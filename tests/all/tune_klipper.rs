@@ -156,3 +156,66 @@ fn a_files_axis_is_read_as_identify_reads_it() {
         "{e}"
     );
 }
+
+/// Klipper's fit names a shaper and a frequency for any spectrum; `--criterion klipper`
+/// answers only for one that shows a resonance: its largest PSD (as measured, before the
+/// normalisation to the frequencies) at least 10 times its noise floor (the 5th
+/// percentile) between 10 and 135 Hz. A flat spectrum (every PSD 100, ratio exactly 1)
+/// and 5 s of white noise (uniform, +-500 mm/s^2) recorded at 3,200 Hz (Welch's estimate of a flat spectrum,
+/// within a factor of about 3) are refused naming the file, and so is a recording of a
+/// sensor that read one value throughout (a spectrum of zeros: no vibration); the corpus's resonance tests
+/// reach 71 and more (zippy's X: 101).
+#[test]
+fn a_spectrum_without_a_resonance_names_no_shaper() {
+    use rand::{Rng as _, SeedableRng as _};
+    let dir = tempfile::tempdir().expect("tempdir");
+    let flat = dir.path().join("calibration_data_x_flat.csv");
+    let mut text = String::from("freq,psd_x,psd_y,psd_z,psd_xyz\n");
+    for k in 0..128 {
+        text.push_str(&format!(
+            "{:.1},1.000e+02,1.000e+02,1.000e+02,3.000e+02\n",
+            k as f64 * 1.5625
+        ));
+    }
+    std::fs::write(&flat, text).expect("write");
+    let e = load(&flat).expect_err("flat").to_string();
+    assert!(
+        e.contains("calibration_data_x_flat.csv")
+            && e.contains("no resonance peak above the noise between 10 and 135 Hz (largest PSD / noise floor is 1.00; at least 10 is needed)"),
+        "{e}"
+    );
+    let noise = dir.path().join("raw_data_x_noise.csv");
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    let mut text = String::from("#time,accel_x,accel_y,accel_z\n");
+    for i in 0..16_000 {
+        let mut g = || rng.random_range(-500.0..500.0_f64);
+        let (x, y, z) = (g(), g(), g());
+        text.push_str(&format!(
+            "{:.6},{x:.6},{y:.6},{z:.6}\n",
+            100.0 + i as f64 / 3200.0
+        ));
+    }
+    std::fs::write(&noise, text).expect("write");
+    let e = load(&noise).expect_err("noise").to_string();
+    assert!(
+        e.contains("raw_data_x_noise.csv") && e.contains("no resonance peak above the noise"),
+        "{e}"
+    );
+    // A sensor that read one value throughout: a spectrum of zeros (or rounding).
+    let still = dir.path().join("raw_data_x_still.csv");
+    let mut text = String::from("#time,accel_x,accel_y,accel_z\n");
+    for i in 0..16_000 {
+        text.push_str(&format!(
+            "{:.6},100.0,200.0,9806.65\n",
+            100.0 + i as f64 / 3200.0
+        ));
+    }
+    std::fs::write(&still, text).expect("write");
+    let e = load(&still).expect_err("still").to_string();
+    assert!(
+        e.contains("raw_data_x_still.csv") && e.contains("no vibration between 10 and 135 Hz"),
+        "{e}"
+    );
+    let zippy = root().join("identify/tests/corpus/zippy_resonances_x_20220317_143228.csv");
+    load(&zippy).expect("a resonance test");
+}

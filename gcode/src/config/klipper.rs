@@ -447,12 +447,24 @@ fn stepper(
     }
     let full_steps_per_rotation = full_steps as u32;
     let microsteps = microsteps as u32;
+    let microsteps_per_mm = f64::from(full_steps_per_rotation) * f64::from(microsteps) * gear_ratio
+        / rotation_distance_mm;
+    let (lo, hi) = super::MICROSTEPS_PER_MM;
+    if !(lo..=hi).contains(&microsteps_per_mm)
+        && let Some((opt, text)) = v.text(name, "rotation_distance")
+    {
+        return Err(invalid(
+            opt,
+            name,
+            &text,
+            format!(
+                "a rotation_distance (mm) that gives {lo} to {hi:e} microsteps per mm ({full_steps_per_rotation} full steps x {microsteps} microsteps x gear ratio {gear_ratio} / {text} mm is {microsteps_per_mm:e})"
+            ),
+        ));
+    }
     Ok(Some(KlipperStepper {
         drive: AxisDrive {
-            microsteps_per_mm: f64::from(full_steps_per_rotation)
-                * f64::from(microsteps)
-                * gear_ratio
-                / rotation_distance_mm,
+            microsteps_per_mm,
             microsteps,
             interpolate,
             run_current_a_rms,

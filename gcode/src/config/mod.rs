@@ -82,7 +82,7 @@ pub use klipper::{
     DEFAULT_SHAPER_TYPE, DEFAULT_SQUARE_CORNER_VELOCITY_MM_S, KlipperConfig, KlipperPrinter,
     KlipperStepper, MAX_SHAPER_FREQUENCY_HZ,
 };
-pub use machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
+pub use machine::{AxisDrive, ConfigNote, MICROSTEPS_PER_MM, ShaperSetting, Xyz};
 pub use marlin::MarlinSettings;
 pub use rrf::{
     RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RRF_MINIMUM_ACCEL_MM_S2, RRF_MINIMUM_JERK_MM_S,

@@ -280,6 +280,20 @@ fn malformed_values_name_file_line_and_key() {
             "full_steps_per_rotation",
             "divisible by 4",
         ),
+        // 200 x 16 / 1e-12 mm = 3.2e15 and 200 x 1 / 5000 mm = 0.04 microsteps per mm,
+        // outside 1 to 1e9 (settle_gcode::config::MICROSTEPS_PER_MM).
+        (
+            "[stepper_z]\nrotation_distance: 1e-12\nmicrosteps: 16\n",
+            6,
+            "rotation_distance",
+            "gives 1 to 1e9 microsteps per mm (200 full steps x 16 microsteps x gear ratio 1 / 1e-12 mm is 3.2e15)",
+        ),
+        (
+            "[stepper_z]\nrotation_distance: 5000\nmicrosteps: 1\n",
+            6,
+            "rotation_distance",
+            "(200 full steps x 1 microsteps x gear ratio 1 / 5000 mm is 4e-2)",
+        ),
         (
             "[stepper_z]\nrotation_distance: 40\nmicrosteps: 16.5\n",
             7,

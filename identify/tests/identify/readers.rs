@@ -179,3 +179,45 @@ fn shaketune_stdata_reads_and_rejects() {
     let edge = line(100, false).replace("[0.5, 1.0, 2.0", "[0.5, 1.0, -1e9");
     stdata::parse("s.stdata", &pack(&edge)).expect("1e9 mm/s^2 is within the bound");
 }
+
+/// Raw samples at `first_ms` apart up to sample 600, then `then_ms` apart, 1,000 in all.
+fn raw_two_rates(first_ms: f64, then_ms: f64) -> String {
+    let mut s = String::from("#time,accel_x,accel_y,accel_z\n");
+    for i in 0..1000 {
+        let t = if i <= 600 {
+            i as f64 * first_ms
+        } else {
+            600.0 * first_ms + (i - 600) as f64 * then_ms
+        };
+        s.push_str(&format!(
+            "{:.6},1.0,{}.0,9806.65\n",
+            1.0 + t / 1000.0,
+            i % 7
+        ));
+    }
+    s
+}
+
+/// A recording whose sample rate changes is refused: every sample is read at the mean
+/// rate, so a stretch at another rate shows its frequencies moved. 1 ms apart, then 2 ms
+/// apart after sample 600: 999 intervals over 1.398 s, a mean rate of 714.59 Hz, and the
+/// first of the nine stretches of 111 intervals runs at 1000 Hz, 39.9 % above it. A rate
+/// that moves by 0.5 % (1 ms, then 1.005 ms) stays within the 1 % allowed.
+#[test]
+fn klipper_raw_refuses_a_rate_that_changes() {
+    let e = klipper_raw::parse("a.csv", &raw_two_rates(1.0, 2.0)).expect_err("two rates");
+    assert_eq!(line_of(&e), ("a.csv".to_string(), 2), "{e}");
+    let text = e.to_string();
+    assert!(
+        text.contains(
+            "samples 0 to 111 (1.000000 to 1.111000 s) at 1000.00 Hz, +39.9 % off the recording's mean rate of 714.59 Hz"
+        ),
+        "{text}"
+    );
+    assert!(
+        text.contains("every stretch within 1 % of the mean rate"),
+        "{text}"
+    );
+    let rec = klipper_raw::parse("a.csv", &raw_two_rates(1.0, 1.005)).expect("0.5 % apart");
+    assert_eq!(rec.len(), 1000);
+}

@@ -76,6 +76,14 @@ fn nearest_mode(o: &Outcome, f: f64) -> Option<(f64, f64)> {
         .min_by(|a, b| (f / a.0 - 1.0).abs().total_cmp(&(f / b.0 - 1.0).abs()))
 }
 
+/// The default damping ratio shapers are designed for, as Klipper knows it
+/// (`shaper_defs.DEFAULT_DAMPING_RATIO`, 0.1).
+const KLIPPER_DEFAULT: &str = "Klipper's default";
+
+/// The same 0.1 as Prusa-Firmware-Buddy knows it: the `damping_ratio` of its
+/// `axis_x_default` and `axis_y_default` (every printer it builds for).
+const BUDDY_DEFAULT: &str = "Buddy's default (damping_ratio 0.1 of axis_x_default and axis_y_default, lib/Marlin/Marlin/src/feature/input_shaper/input_shaper_config.hpp; Klipper's is the same)";
+
 /// Why the shaper is tuned to `f`: the mode it is nearest to as a multiple.
 fn frequency_why(axis: &str, o: &Outcome, f: f64) -> String {
     match nearest_mode(o, f) {
@@ -88,8 +96,9 @@ fn frequency_why(axis: &str, o: &Outcome, f: f64) -> String {
     }
 }
 
-/// Why the damping ratio is `z`.
-fn damping_why(axis: &str, o: &Outcome, f: f64, z: f64) -> String {
+/// Why the damping ratio is `z`; `default` names the default damping ratio shapers are
+/// designed for on a physical machine, as the firmware the export is for knows it.
+fn damping_why(axis: &str, o: &Outcome, f: f64, z: f64, default: &str) -> String {
     let spec = &o.plan.spec;
     match (o.plan.shaper_damping, spec.shaper_damping_ratio) {
         (Some(d), Some(_)) if (d - z).abs() < 5e-4 => {
@@ -98,7 +107,7 @@ fn damping_why(axis: &str, o: &Outcome, f: f64, z: f64) -> String {
         }
         (Some(d), None) if (d - z).abs() < 5e-4 => {
             return format!(
-                "Klipper's default: the damping of the modes of a physical machine ({}) is an estimate from its parts, not a measurement",
+                "{default}: the damping of the modes of a physical machine ({}) is an estimate from its parts, not a measurement",
                 o.plan.modes_source
             );
         }
@@ -117,8 +126,15 @@ fn damping_why(axis: &str, o: &Outcome, f: f64, z: f64) -> String {
 }
 
 /// The changes of one axis's shaper, keyed `{type_key}`, `{freq_key}`, `{damping_key}`;
-/// `off` is how the export writes "no shaping" (type, frequency, damping).
-fn shaper_changes(axis: &str, o: &Outcome, keys: [&str; 3], off: (&str, f64, f64)) -> Vec<Change> {
+/// `off` is how the export writes "no shaping" (type, frequency, damping); `default` names
+/// the default damping ratio (see [`damping_why`]).
+fn shaper_changes(
+    axis: &str,
+    o: &Outcome,
+    keys: [&str; 3],
+    off: (&str, f64, f64),
+    default: &str,
+) -> Vec<Change> {
     let (d, w) = (&o.scores[0], &o.scores[o.winner]);
     let as_written = |s: &Score| shaper_values(s).unwrap_or((off.0.to_string(), off.1, off.2));
     let (was, now) = (as_written(d), as_written(w));
@@ -158,7 +174,7 @@ fn shaper_changes(axis: &str, o: &Outcome, keys: [&str; 3], off: (&str, f64, f64
     }
     if text(was.2) != text(now.2) {
         let why = if shaper_values(w).is_some() {
-            damping_why(axis, o, now.1, now.2)
+            damping_why(axis, o, now.1, now.2, default)
         } else {
             "shaping off".into()
         };
@@ -255,6 +271,7 @@ pub fn klipper(axes: &[(String, Outcome)], accel: Option<f64>) -> Vec<Change> {
                     &format!("damping_ratio_{letter}"),
                 ],
                 ("mzv", 0.0, super::target::KLIPPER_OFF_DAMPING),
+                KLIPPER_DEFAULT,
             ));
         }
     }
@@ -308,6 +325,7 @@ pub fn rrf(
             o,
             ["M593 P", "M593 F", "M593 S"],
             ("none", f64::NAN, f64::NAN),
+            KLIPPER_DEFAULT,
         ));
     }
     out.extend(m201_changes(
@@ -341,7 +359,7 @@ pub fn marlin(
         ),
     };
     let who = "Marlin (Marlin/src/module/planner.cpp, Planner::_populate_block)";
-    per_axis_changes(axes, keys, who, caps, accel)
+    per_axis_changes(axes, keys, who, KLIPPER_DEFAULT, caps, accel)
 }
 
 /// The changes `prusa.gcode` makes: per tuned axis `x`/`y` its `M593 T F D` (no shaping
@@ -358,16 +376,18 @@ pub fn prusa(
         )
     };
     let who = "Prusa-Firmware-Buddy (Marlin's planner, lib/Marlin/Marlin/src/module/planner.cpp)";
-    per_axis_changes(axes, keys, who, caps, accel)
+    per_axis_changes(axes, keys, who, BUDDY_DEFAULT, caps, accel)
 }
 
 /// The changes of a firmware that shapes X and Y apart: per tuned axis its shaper under
 /// the keys `keys(letter)` gives (type, frequency, damping, and the values of "off"),
-/// then `M201 X`/`Y` (`caps`; `who` caps moves by it) and `M204 P`/`T`.
+/// then `M201 X`/`Y` (`caps`; `who` caps moves by it) and `M204 P`/`T`; `default` names
+/// the default damping ratio (see [`damping_why`]).
 fn per_axis_changes(
     axes: &[(String, Outcome)],
     keys: impl Fn(&str) -> ([String; 3], (&'static str, f64, f64)),
     who: &str,
+    default: &str,
     caps: [(Option<f64>, Option<f64>); 2],
     accel: Option<f64>,
 ) -> Vec<Change> {
@@ -376,7 +396,13 @@ fn per_axis_changes(
         let lower = letter.to_ascii_lowercase();
         if let Some((axis, o)) = axes.iter().find(|(a, _)| a.split('+').any(|x| x == lower)) {
             let (keys, off) = keys(letter);
-            out.extend(shaper_changes(axis, o, [&keys[0], &keys[1], &keys[2]], off));
+            out.extend(shaper_changes(
+                axis,
+                o,
+                [&keys[0], &keys[1], &keys[2]],
+                off,
+                default,
+            ));
         }
     }
     out.extend(m201_changes(caps, who));

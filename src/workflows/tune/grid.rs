@@ -288,6 +288,7 @@ pub fn plan(
             format!("{hz} Hz: the TMC4361A takes a clock of 4 to 32 MHz (4000000 to 32000000)"),
         ));
     }
+    check_usteps(&spec, src)?;
     let mut notes: Vec<String> = Vec::new();
     let tmc = match firmware.firmware() {
         Some(Firmware::Tmc4361a) => {
@@ -733,4 +734,34 @@ pub fn tuning_modes(base: &RunSpec) -> Vec<(f64, f64)> {
         }
     }
     out
+}
+
+/// Fewest and most microsteps per mm `[tune] usteps_per_mm` and `[tune.axis.<name>]
+/// usteps_per_mm` may give: settle-gcode's [`settle_gcode::config::MICROSTEPS_PER_MM`], 1
+/// to 1e9, the range a firmware configuration is read with. The TMC4361A's registers
+/// count microsteps, so every range of the search and every register of the export
+/// scales with it: 0 or NaN gave a whole search and then no register file, -100 a
+/// negative AMAX blamed on `limits.amax_mm_s2`, and 1e-6 a VMAX that rounds to 0.
+pub const USTEPS_PER_MM: (f64, f64) = settle_gcode::config::MICROSTEPS_PER_MM;
+
+/// Refuse a `usteps_per_mm` of `spec` outside [`USTEPS_PER_MM`], naming its key, before
+/// any work.
+fn check_usteps(spec: &crate::input::tune_spec::TuneSpec, src: &Source) -> Result<(), Error> {
+    let (lo, hi) = USTEPS_PER_MM;
+    let axes = spec.axis.iter().flatten();
+    let given = std::iter::once(("tune.usteps_per_mm".to_string(), spec.usteps_per_mm))
+        .chain(axes.map(|(name, a)| (format!("tune.axis.{name}.usteps_per_mm"), a.usteps_per_mm)));
+    for (key, v) in given {
+        if let Some(v) = v
+            && !(lo..=hi).contains(&v)
+        {
+            return Err(src.error_at(
+                &key,
+                format!(
+                    "{v} microsteps per mm: allowed {lo} to {hi:e} (the axis's full steps per mm times its microstepping)"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }

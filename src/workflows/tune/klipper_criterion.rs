@@ -174,7 +174,11 @@ pub fn load(path: &Path) -> Result<Vec<CalibrationData>, Error> {
     match settle_identify::read_file(path)? {
         FileData::Spectrum(psd) => {
             spectrum_sees_the_test(path, psd.freq_hz.last().copied())?;
-            Ok(processed(&psd))
+            let sets = processed(&psd);
+            for d in &sets {
+                holds_a_resonance(path, d)?;
+            }
+            Ok(sets)
         }
         FileData::Recordings(recs) => recs
             .iter()
@@ -195,6 +199,7 @@ pub fn load(path: &Path) -> Result<Vec<CalibrationData>, Error> {
                     psd_z: Some(z),
                 };
                 d.normalize_to_frequencies();
+                holds_a_resonance(path, &d)?;
                 Ok(d)
             })
             .collect(),
@@ -238,6 +243,58 @@ fn spectrum_sees_the_test(path: &Path, last_hz: Option<f64>) -> Result<(), Error
             ),
         )),
     }
+}
+
+/// The band in which a spectrum must show a resonance (Hz): from twice Klipper's lowest
+/// frequency (`MIN_FREQ` 5 Hz; below 10 Hz calibrate_shaper.py's normalisation also rolls
+/// the spectrum off) to the top of Klipper's resonance test ([`SweepTest::klipper`]).
+const RESONANCE_BAND_LO_HZ: f64 = 10.0;
+
+/// A data set `d` (as calibrate_shaper.py fits it: normalised to the frequencies,
+/// `psd / (f + 0.1)`) must show a resonance: in the test's band, its largest PSD as
+/// measured (the normalisation undone) at least
+/// [`settle_identify::fit::sweep::MIN_PEAK_TO_FLOOR`] (10) times its noise floor (the 5th
+/// percentile), the rule of `settle identify`'s sweep fit, and at least
+/// [`settle_identify::read::MIN_PEAK_PSD`] (a spectrum of zeros or of rounding is no
+/// vibration). A recording of noise, of a still machine or of a constant holds none (its
+/// ratio is about 1; the resonance tests of the corpus, identify/tests/corpus, reach 71 to
+/// 939): Klipper's fit would still name a shaper and a frequency for it, which answer for
+/// nothing. Refused, with the ratio.
+/// (A processed file with the `shapers:` column comes normalised as the script wrote it;
+/// the others are normalised when read, as the script does.)
+fn holds_a_resonance(path: &Path, d: &CalibrationData) -> Result<(), Error> {
+    let top_hz = SweepTest::klipper().freq_end_hz;
+    let mut sorted: Vec<f64> = d
+        .freq_hz
+        .iter()
+        .zip(&d.psd_sum)
+        .filter(|(f, _)| (RESONANCE_BAND_LO_HZ..=top_hz).contains(*f))
+        .map(|(f, p)| p * (f + 0.1))
+        .collect();
+    sorted.sort_by(f64::total_cmp);
+    let (peak, floor) = match sorted.as_slice() {
+        [] => (0.0, 0.0),
+        s => (
+            s[s.len() - 1],
+            s[((s.len() - 1) as f64 * 0.05).round() as usize],
+        ),
+    };
+    let needed = settle_identify::fit::sweep::MIN_PEAK_TO_FLOOR;
+    let least = settle_identify::read::MIN_PEAK_PSD;
+    if peak >= least && peak >= needed * floor {
+        return Ok(());
+    }
+    let why = if peak >= least {
+        format!(
+            "no resonance peak above the noise between {RESONANCE_BAND_LO_HZ:.0} and {top_hz:.0} Hz (largest PSD / noise floor is {:.2}; at least {needed:.0} is needed): a recording of noise or of a machine at rest, for which a shaper and its frequency would answer for nothing; record a resonance test (TEST_RESONANCES)",
+            peak / floor
+        )
+    } else {
+        format!(
+            "no vibration between {RESONANCE_BAND_LO_HZ:.0} and {top_hz:.0} Hz: the largest PSD is {peak:.3e} (mm/s^2)^2/Hz, below the {least:.0e} of a vibration at the resolution Klipper writes (a sensor that read one value, a file of zeros); record a resonance test (TEST_RESONANCES)"
+        )
+    };
+    Err(Error::input(path, why))
 }
 
 /// A processed file's data sets: `psd_xyz` (with the axes) of the per-axis layout, else

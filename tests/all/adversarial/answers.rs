@@ -147,6 +147,28 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         })
         .collect();
     sb.write("still_x.csv", &(still.join("\n") + "\n"));
+    // The example recording (800 Hz) with its time stamps 2.5 ms apart from its 2,600th
+    // sample on (400 Hz): one file at two rates, each read at the mean rate.
+    let mut k = 0usize;
+    let mut t_s = 0.0_f64;
+    let two_rates: Vec<String> = rec
+        .lines()
+        .map(|l| match l.split_once(',') {
+            Some((t, rest)) if !l.starts_with('#') => {
+                let t: f64 = t.parse().expect("time");
+                if k == 0 {
+                    t_s = t;
+                }
+                k += 1;
+                if k > 1 {
+                    t_s += if k <= 2600 { 1.0 / 800.0 } else { 1.0 / 400.0 };
+                }
+                format!("{t_s:.6},{rest}")
+            }
+            _ => l.to_string(),
+        })
+        .collect();
+    sb.write("two_rates_x.csv", &(two_rates.join("\n") + "\n"));
     // A processed spectrum of the corpus (rows to 199.9 Hz) cut after its 90 Hz row.
     let corpus = concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -289,8 +311,17 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "tune --criterion klipper still_x.csv --out o_still",
             &[
                 "still_x.csv",
-                "the spectrum holds no vibration to shape",
-                "nothing was measured",
+                "no vibration between 10 and 135 Hz",
+                "a file of zeros",
+            ],
+        ),
+        refused(
+            "identify a recording whose sample rate halves halfway",
+            "identify two_rates_x.csv --freq-start 30 --freq-end 90 --hz-per-sec 10 --out o/m.toml",
+            &[
+                "two_rates_x.csv:2:",
+                "% off the recording's mean rate of 533.",
+                "split the file where its rate changes",
             ],
         ),
         refused(

@@ -3,7 +3,8 @@
 //! Hz, an integration step of 1e-300 s, scans of 1e9 and 2^63 lines, 100,000 modes, a
 //! search of a thousand frequencies, a figure count of a million; modes of 1e300 Hz and
 //! 1e-300 Hz, a weight of 1e300 and a frequency standard deviation of 1e300 Hz (in a
-//! machine file each command reads, inline and swept); and memory that would grow with
+//! machine file each command reads, inline and swept); microsteps per mm of 0 and -100
+//! for the TMC4361A's registers; and memory that would grow with
 //! the job (the ringing map of a layer of 3,200 long lines, which must stay
 //! under the suite's 1 GiB like every case).
 
@@ -60,6 +61,20 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         &(scenario_with("[sweep]\nprofile = [\"trapezoid\", \"scurve\"]\n", "")
             + &format!("[tune]\nfrequency_scales = [{}]\n", scales.join(", "))),
     );
+    // Microsteps per mm the TMC4361A's registers scale with: 0 (a whole search, then no
+    // register file) and -100 on one axis (a negative AMAX, blamed on another key).
+    for (name, table) in [
+        ("tune_usteps0.toml", "[tune]\nusteps_per_mm = 0.0\n"),
+        (
+            "tune_usteps_axis.toml",
+            "[tune]\nusteps_per_mm = 80.0\n[tune.axis.x]\nusteps_per_mm = -100.0\n",
+        ),
+    ] {
+        sb.write(
+            name,
+            &(scenario_with("[sweep]\nprofile = [\"trapezoid\", \"scurve\"]\n", "") + table),
+        );
+    }
     // One layer of 3,200 lines of 190 mm (1.9 s each): the ringing map of a layer of
     // 6,080 s of printing.
     let mut layer = String::from("G28\nM83\nG1 Z0.2 F3000\n");
@@ -170,6 +185,19 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "tune over 1,000 frequency scales",
             "tune tune_many.toml --out o",
             &["tune.frequency_scales", "at most 64"],
+        ),
+        refused(
+            "tune --firmware tmc4361a at 0 microsteps per mm",
+            "tune tune_usteps0.toml --firmware tmc4361a --out o",
+            &[
+                "tune_usteps0.toml:",
+                "key `tune.usteps_per_mm`: 0 microsteps per mm: allowed 1 to 1e9",
+            ],
+        ),
+        refused(
+            "tune at -100 microsteps per mm on axis x",
+            "tune tune_usteps_axis.toml --firmware tmc4361a --out o",
+            &["key `tune.axis.x.usteps_per_mm`: -100 microsteps per mm: allowed 1 to 1e9"],
         ),
         refused(
             "identify --hz-per-sec 1e-9",
