@@ -123,6 +123,45 @@ pub fn create_tmp(path: &Path) -> Result<(PathBuf, File), FileError> {
     Ok((tmp, file))
 }
 
+/// A file written in place at `path` (a log that grows as the work goes, such as a
+/// sweep's journal, which a rename cannot produce), emptied, after [`check_target`] of
+/// `path`; the open itself follows no link and does not wait on a FIFO put at `path`
+/// since the check, and what it opened must be a regular file.
+pub fn create_in_place(path: &Path) -> Result<File, FileError> {
+    check_target(path)?;
+    open_in_place(path)
+}
+
+/// [`create_in_place`]'s open, without the check before it.
+fn open_in_place(path: &Path) -> Result<File, FileError> {
+    let mut options = File::options();
+    options.write(true).create(true).truncate(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt as _;
+        options.custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+    }
+    // A refused open (a link: O_NOFOLLOW; a FIFO without a reader: O_NONBLOCK) is
+    // named as the check names it.
+    let file = options
+        .open(path)
+        .map_err(|source| match check_target(path) {
+            Err(refused) => refused,
+            Ok(()) => write_err(path)(source),
+        })?;
+    let meta = file.metadata().map_err(write_err(path))?;
+    if !meta.is_file() {
+        return Err(FileError::Refused {
+            path: path.to_path_buf(),
+            why: format!(
+                "it is {}; settle writes regular files or new paths only: write elsewhere",
+                what_is(&meta)
+            ),
+        });
+    }
+    Ok(file)
+}
+
 /// Move the finished temporary file `tmp` to `path` (checked again: nothing may have taken
 /// its place meanwhile), removing `tmp` on failure.
 pub fn commit(tmp: &Path, path: &Path) -> Result<(), FileError> {
@@ -253,6 +292,35 @@ impl Inputs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The open of a file written in place holds the rule by itself, for what takes a
+    /// path's place after [`check_target`] looked: a link is not followed (its target
+    /// keeps its bytes), a FIFO is refused without waiting for a reader, a regular file
+    /// is emptied.
+    #[cfg(unix)]
+    #[test]
+    fn a_file_written_in_place_is_opened_without_following_or_waiting() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let target = dir.path().join("elsewhere.txt");
+        std::fs::write(&target, b"keep").expect("target");
+        let link = dir.path().join("journal.csv");
+        std::os::unix::fs::symlink(&target, &link).expect("link");
+        let e = open_in_place(&link).expect_err("a link").to_string();
+        assert!(e.contains("it is a link"), "{e}");
+        assert_eq!(std::fs::read(&target).expect("read"), b"keep");
+        let fifo = dir.path().join("fifo");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("mkfifo runs");
+        assert!(made.success());
+        let e = open_in_place(&fifo).expect_err("a FIFO").to_string();
+        assert!(e.contains("it is a FIFO"), "{e}");
+        let file = dir.path().join("file.csv");
+        std::fs::write(&file, b"old").expect("file");
+        drop(create_in_place(&file).expect("a regular file"));
+        assert_eq!(std::fs::read(&file).expect("read"), b"");
+    }
 
     #[test]
     fn writes_new_paths_and_regular_files_whole() {

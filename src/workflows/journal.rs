@@ -96,8 +96,7 @@ impl Journal {
             path: path.clone(),
             source,
         };
-        settle_files::write::check_target(&path)?;
-        let mut file = File::create(&path).map_err(write_err)?;
+        let mut file = settle_files::write::create_in_place(&path)?;
         file.write_all(format!("{key_line}\n{header}").as_bytes())
             .map_err(write_err)?;
         Ok(Self {
