@@ -1025,7 +1025,7 @@ mod tests {
             weight
                 .expect("the weight line noted")
                 .to_string()
-                .starts_with("p.txt:21:")
+                .starts_with("p.txt:29:")
         );
         // The job starts with them: the printer's planner and shapers, not the shipped ones.
         let job = s.job_config().expect("a job configuration");
@@ -1073,14 +1073,14 @@ mod tests {
             Some(118.199997)
         );
         let errors = [
-            (with("MK4", mini_x), "p.txt:18: [M593] freq"),
+            (with("MK4", mini_x), "p.txt:26: [M593] freq"),
             (
                 with("MK4", "echo:axis X type=ZVDD freq=50 damp=0.1 vr=20\n"),
-                "p.txt:18: [M593] type",
+                "p.txt:26: [M593] type",
             ),
             (
                 with("MK4", "echo:axis X type=MZV freq=nan damp=0.1 vr=20\n"),
-                "p.txt:18: [M593] freq",
+                "p.txt:26: [M593] freq",
             ),
             (with("MK3S", mini_x), "p.txt:2: [M115] MACHINE_TYPE"),
             (with("MK4", ""), "p.txt:1: no M593 reply for X and Y"),
@@ -1102,7 +1102,7 @@ mod tests {
         let s = MarlinSettings::parse_prusa(&off, "p.txt").expect("shapers off");
         assert_eq!(s.shapers, [None; 3]);
         let note = s.notes.iter().find(|n| n.to_string().contains("are off"));
-        assert!(note.expect("said").to_string().starts_with("p.txt:18:"));
+        assert!(note.expect("said").to_string().starts_with("p.txt:26:"));
         // Buddy reloads its EEPROM shapers at every print's end (`finalize_print` calls
         // `input_shaper::init`, src/common/marlin_server.cpp): off between jobs is the
         // saved state, not what PrusaSlicer's end G-code left.
@@ -1150,12 +1150,12 @@ mod tests {
         let e = z("axis Z type=EI freq=40.000000 damp=0.000000 vr=0.000000")
             .expect_err("EI with vr 0")
             .to_string();
-        assert!(e.starts_with("p.txt:20: [M593] vr"), "{e}");
+        assert!(e.starts_with("p.txt:28: [M593] vr"), "{e}");
         // input_shaper::get halts the printer at damping 1 (input_shaper.cpp `bsod`).
         let e = z("axis Z type=ZV freq=40.000000 damp=1.000000 vr=20.000000")
             .expect_err("damping 1")
             .to_string();
-        assert!(e.starts_with("p.txt:20: [M593] damp"), "{e}");
+        assert!(e.starts_with("p.txt:28: [M593] damp"), "{e}");
     }
 
     #[test]
@@ -1166,7 +1166,7 @@ mod tests {
         let e = MarlinSettings::parse_prusa(&format!("{PRUSA_LOG}{mini}"), "p.txt")
             .expect_err("two printers")
             .to_string();
-        assert!(e.starts_with("p.txt:23: [M115] MACHINE_TYPE"), "{e}");
+        assert!(e.starts_with("p.txt:31: [M115] MACHINE_TYPE"), "{e}");
         assert!(e.contains("Prusa-MK4S"), "{e}");
         // The same printer's M115 twice is one printer.
         let again = PRUSA_LOG.lines().nth(1).expect("M115's reply");
