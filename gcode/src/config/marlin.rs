@@ -1174,4 +1174,37 @@ mod tests {
             .expect("one printer");
         assert_eq!(s.prusa.expect("named").named_at, Some((2, "MK4S".into())));
     }
+
+    #[test]
+    fn a_bare_prusa_log_with_crlf_reads_as_the_terminals() {
+        // The replies as the printer sends them (M115.cpp, M503's report, M593.cpp's
+        // `dump_current_config`), without OctoPrint's `Recv: `, `echo:` or `Send:` lines,
+        // ended by CRLF: the same printer, limits and shapers.
+        let bare: String = PRUSA_LOG
+            .lines()
+            .filter(|l| !l.starts_with("Send:"))
+            .map(|l| {
+                let l = l.strip_prefix("Recv: ").unwrap_or(l);
+                format!("{}\r\n", l.strip_prefix("echo:").unwrap_or(l))
+            })
+            .collect();
+        let a = MarlinSettings::parse_prusa(PRUSA_LOG, "p.txt").expect("the terminal's");
+        let b = MarlinSettings::parse_prusa(&bare, "p.txt").expect("the bare replies");
+        assert_eq!(b.prusa.map(|p| p.model), a.prusa.map(|p| p.model));
+        assert_eq!(b.planner, a.planner);
+        assert_eq!(b.shapers, a.shapers);
+        assert_eq!(b.shapers[0].map(|s| s.frequency_hz), Some(50.700001));
+    }
+
+    #[test]
+    fn a_second_m593_reply_is_the_printers_later_state() {
+        // Each M593 reply prints all three axes (M593.cpp `dump_current_config`): the later
+        // one holds, as the later of two M503 replies does.
+        let later = "Recv: echo:axis X type=ZVD freq=45.000000 damp=0.100000 vr=20.000000\nRecv: echo:axis Y disabled\nRecv: echo:axis Z disabled\n";
+        let s = MarlinSettings::parse_prusa(&format!("{PRUSA_LOG}{later}"), "p.txt")
+            .expect("two M593 replies");
+        let x = s.shapers[0].expect("X shaped");
+        assert_eq!((x.shaper_type, x.frequency_hz), (ShaperType::Zvd, 45.0));
+        assert_eq!(s.shapers[1], None);
+    }
 }
