@@ -299,8 +299,10 @@ impl MarlinSettings {
     /// Reads `text` as a Prusa-Firmware-Buddy printer's replies to `M115`, `M503` and
     /// `M593` (the module doc's terminal rules): the printer from `M115`'s
     /// `MACHINE_TYPE:Prusa-<name>` (src/marlin_stubs/host/M115.cpp; the MK4 without it,
-    /// noted), `M503` as Marlin's over that printer's settings (Buddy's `M92` is in its
-    /// planner's quarter steps, `PLANNER_STEPS_MULTIPLIER`), and the shapers from the `M593`
+    /// noted), `M503` as Marlin's over that printer's settings (Buddy's `M92` reports
+    /// steps per mm, `axis_steps_per_mm` (lib/Marlin/Marlin/src/gcode/config/M92.cpp), and
+    /// its planner counts quarter steps, `axis_msteps_per_mm`, `PLANNER_STEPS_MULTIPLIER`
+    /// times as many (lib/Marlin/Marlin/src/module/planner.h): settle plans the latter), and the shapers from the `M593`
     /// reply, which `M503` does not print (lib/Marlin/Marlin/src/gcode/feature/input_shaper/
     /// M593.cpp, `dump_current_config`): `axis X type=MZV freq=50.700001 damp=0.100000
     /// vr=20.000000` is followed as `M593 X T2 F50.700001 D0.100000 R20.000000`, `axis Z
@@ -332,6 +334,28 @@ impl MarlinSettings {
             if prusa && let Some(t) = reply_text(raw) {
                 match prusa_reply(t, &at(line))? {
                     PrusaReply::Printer(p) => {
+                        // Two M115 replies naming different printers: not one printer's log.
+                        if let Some(first) = &printer
+                            && first.named_at.as_ref().map(|(_, n)| n)
+                                != p.named_at.as_ref().map(|(_, n)| n)
+                        {
+                            let (first_line, first_name) =
+                                first.named_at.clone().unwrap_or_default();
+                            return Err(GcodeError::ConfigValue {
+                                at: at(line),
+                                section: "M115".into(),
+                                key: "MACHINE_TYPE".into(),
+                                value: format!(
+                                    "Prusa-{}",
+                                    p.named_at.map(|(_, n)| n).unwrap_or_default()
+                                )
+                                .into(),
+                                allowed: format!(
+                                    "Prusa-{first_name}, the printer line {first_line} names: one printer's replies per log"
+                                )
+                                .into(),
+                            });
+                        }
                         printer.get_or_insert(p);
                         kept.push("".into());
                         continue;
@@ -413,9 +437,12 @@ impl MarlinSettings {
             });
         }
         if let [Some(line), Some(_), _] = prusa_off {
+            // Buddy reloads the saved shapers at every print's end (`finalize_print` calls
+            // `input_shaper::init`, src/common/marlin_server.cpp) and at boot: off in a reply
+            // sent between jobs is the printer's saved state.
             notes.push(ConfigNote::at(
                 at(line),
-                "M593: the shapers of X and Y are off. PrusaSlicer's end G-code turns them off after every job (`M593 X T2 F0`, resources/profiles/PrusaResearch.ini) without saving that: a reply sent after a print shows them off. If they were on, restart the printer and send M593 again".to_string(),
+                "M593: the shapers of X and Y are off. Buddy reloads its saved shapers at every print's end (finalize_print, src/common/marlin_server.cpp) and at boot, so between jobs this is the printer's saved setting; a reply sent during a job shows what that job's G-code set (PrusaSlicer's MK4, MK4S, MK3.9 and MK3.5 end G-code turns them off with `M593 X T2 F0`)".to_string(),
             ));
         }
         if !any {
@@ -623,7 +650,7 @@ fn prusa_reply(text: &str, at: &Location) -> Result<PrusaReply, GcodeError> {
     }
     if text.starts_with("weight_adjust y") || text == "weight adjust y disabled" {
         return Ok(PrusaReply::Note(format!(
-            "M593 `{text}`: read, not used (Buddy lowers Y's shaper frequency as the bed's load set by M74 grows; settle plans the unloaded bed)"
+            "M593 `{text}`: read, not used (Buddy lowers Y's shaper frequency as the bed's load set by M74 grows; settle plans the unloaded bed, and a reply sent during a job after its M74 shows Y's frequency already lowered)"
         )));
     }
     let mut words = text.split_whitespace();
@@ -662,14 +689,48 @@ fn prusa_reply(text: &str, at: &Location) -> Result<PrusaReply, GcodeError> {
     let Some(code) = PRUSA_TYPES.iter().position(|t| *t == kind) else {
         return Err(bad("type", kind, PRUSA_TYPES.join(", ")));
     };
-    for (key, v) in [("freq", freq), ("damp", damp), ("vr", vr)] {
-        if !v.parse::<f64>().is_ok_and(f64::is_finite) {
-            return Err(bad(key, v, "a finite number".into()));
-        }
+    let mut numbers = [0.0; 3];
+    for (i, (key, v)) in [("freq", freq), ("damp", damp), ("vr", vr)]
+        .into_iter()
+        .enumerate()
+    {
+        numbers[i] = v
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| bad(key, v, "a finite number".into()))?;
     }
+    let [_, damping, reduction] = numbers;
+    let null = PRUSA_TYPES[code] == "Null";
+    // input_shaper::get halts the printer on a damping ratio of 1 or more for every type
+    // but Null (lib/Marlin/Marlin/src/feature/input_shaper/input_shaper.cpp), so no running
+    // printer reports one.
+    if !null && !(0.0..1.0).contains(&damping) {
+        return Err(bad(
+            "damp",
+            damp,
+            "0 to below 1 (Buddy halts at 1 or more, input_shaper::get)".into(),
+        ));
+    }
+    // The EI family's tolerance is 1/vr (input_shaper.cpp); the other types do not read
+    // vr, whose 0 an axis shows when `M593 Z F<Hz>` started it from `axis_z_default`
+    // (input_shaper_config.hpp, M593.cpp `M593_set_axis_config`).
+    let ei = (3..=5).contains(&code);
+    if ei && reduction <= 0.0 {
+        return Err(bad(
+            "vr",
+            vr,
+            "above 0 for EI, EI_2HUMP and EI_3HUMP (their tolerance is 1/vr)".into(),
+        ));
+    }
+    let r = if reduction > 0.0 {
+        format!(" R{vr}")
+    } else {
+        String::new()
+    };
     Ok(PrusaReply::Axis(
         axis,
-        format!("M593 {letter} T{code} F{freq} D{damp} R{vr}"),
+        format!("M593 {letter} T{code} F{freq} D{damp}{r}"),
     ))
 }
 
@@ -928,7 +989,8 @@ mod tests {
         assert_eq!(printer.named_at, Some((2, "MK4S".to_string())));
         assert_eq!(s.firmware(), Firmware::Prusa);
         let p = &s.planner;
-        // Buddy's M92 in its planner's quarter steps: 100 steps/mm are 400 per mm planned.
+        // Buddy's M92 reports `axis_steps_per_mm` (M92.cpp); its planner counts
+        // `axis_msteps_per_mm`, 4 times as many (planner.h): 100 steps/mm are 400 planned.
         assert_eq!(p.steps_per_m, [400e3, 400e3, 1600e3, 1520e3]);
         assert_eq!(p.max_feedrate_m_s, [0.3, 0.3, 0.04, 0.1]);
         assert_eq!(p.max_accel_m_s2, [4.0, 4.0, 0.2, 2.5]);
@@ -963,7 +1025,7 @@ mod tests {
             weight
                 .expect("the weight line noted")
                 .to_string()
-                .starts_with("p.txt:21:")
+                .starts_with("p.txt:29:")
         );
         // The job starts with them: the printer's planner and shapers, not the shipped ones.
         let job = s.job_config().expect("a job configuration");
@@ -1011,14 +1073,14 @@ mod tests {
             Some(118.199997)
         );
         let errors = [
-            (with("MK4", mini_x), "p.txt:18: [M593] freq"),
+            (with("MK4", mini_x), "p.txt:26: [M593] freq"),
             (
                 with("MK4", "echo:axis X type=ZVDD freq=50 damp=0.1 vr=20\n"),
-                "p.txt:18: [M593] type",
+                "p.txt:26: [M593] type",
             ),
             (
                 with("MK4", "echo:axis X type=MZV freq=nan damp=0.1 vr=20\n"),
-                "p.txt:18: [M593] freq",
+                "p.txt:26: [M593] freq",
             ),
             (with("MK3S", mini_x), "p.txt:2: [M115] MACHINE_TYPE"),
             (with("MK4", ""), "p.txt:1: no M593 reply for X and Y"),
@@ -1040,7 +1102,13 @@ mod tests {
         let s = MarlinSettings::parse_prusa(&off, "p.txt").expect("shapers off");
         assert_eq!(s.shapers, [None; 3]);
         let note = s.notes.iter().find(|n| n.to_string().contains("are off"));
-        assert!(note.expect("said").to_string().starts_with("p.txt:18:"));
+        assert!(note.expect("said").to_string().starts_with("p.txt:26:"));
+        // Buddy reloads its EEPROM shapers at every print's end (`finalize_print` calls
+        // `input_shaper::init`, src/common/marlin_server.cpp): off between jobs is the
+        // saved state, not what PrusaSlicer's end G-code left.
+        let said = note.expect("said").to_string();
+        assert!(said.contains("at every print's end"), "{said}");
+        assert!(!said.contains("after every job"), "{said}");
         // Read as mainline Marlin's, the log is refused at its first Buddy line.
         let e = MarlinSettings::parse(PRUSA_LOG, "p.txt").expect_err("not Marlin's");
         assert!(e.to_string().starts_with("p.txt:2: "), "{e}");
@@ -1057,5 +1125,86 @@ mod tests {
                 .iter()
                 .any(|n| n.to_string().contains("no M115 reply"))
         );
+    }
+
+    #[test]
+    fn a_prusa_reply_with_vr_0_is_read_where_buddy_does_not_use_vr() {
+        // `M593 Z F40` starts Z from `axis_z_default` (type Null, damping 0, vr 0;
+        // lib/Marlin/Marlin/src/feature/input_shaper/input_shaper_config.hpp) and M593.cpp's
+        // `dump_axis_config` prints it as is: vr 0 is a real reply for the types that do not
+        // read it (input_shaper.cpp reads vr only for EI, EI_2HUMP, EI_3HUMP).
+        let z = |line: &str| {
+            MarlinSettings::parse_prusa(&PRUSA_LOG.replace("axis Z disabled", line), "p.txt")
+        };
+        let null =
+            z("axis Z type=Null freq=40.000000 damp=0.000000 vr=0.000000").expect("a Null Z");
+        assert_eq!(null.shapers[2], None);
+        let mzv = z("axis Z type=MZV freq=40.000000 damp=0.000000 vr=0.000000")
+            .expect("an MZV Z started from axis_z_default");
+        let s = mzv.shapers[2].expect("Z shaped");
+        assert_eq!(
+            (s.shaper_type, s.frequency_hz, s.damping_ratio),
+            (ShaperType::MZV, 40.0, 0.0)
+        );
+        // EI's tolerance is 1/vr (input_shaper.cpp): vr 0 is refused, not a guess.
+        let e = z("axis Z type=EI freq=40.000000 damp=0.000000 vr=0.000000")
+            .expect_err("EI with vr 0")
+            .to_string();
+        assert!(e.starts_with("p.txt:28: [M593] vr"), "{e}");
+        // input_shaper::get halts the printer at damping 1 (input_shaper.cpp `bsod`).
+        let e = z("axis Z type=ZV freq=40.000000 damp=1.000000 vr=20.000000")
+            .expect_err("damping 1")
+            .to_string();
+        assert!(e.starts_with("p.txt:28: [M593] damp"), "{e}");
+    }
+
+    #[test]
+    fn a_prusa_log_naming_two_printers_is_refused() {
+        // M115.cpp prints one `MACHINE_TYPE:Prusa-<id_str>` per reply: two different names
+        // are two printers' replies in one log.
+        let mini = "Recv: FIRMWARE_NAME:Prusa-Firmware-Buddy 6.2.0+8899 (Github) MACHINE_TYPE:Prusa-MINI EXTRUDER_COUNT:1\n";
+        let e = MarlinSettings::parse_prusa(&format!("{PRUSA_LOG}{mini}"), "p.txt")
+            .expect_err("two printers")
+            .to_string();
+        assert!(e.starts_with("p.txt:31: [M115] MACHINE_TYPE"), "{e}");
+        assert!(e.contains("Prusa-MK4S"), "{e}");
+        // The same printer's M115 twice is one printer.
+        let again = PRUSA_LOG.lines().nth(1).expect("M115's reply");
+        let s = MarlinSettings::parse_prusa(&format!("{PRUSA_LOG}{again}\n"), "p.txt")
+            .expect("one printer");
+        assert_eq!(s.prusa.expect("named").named_at, Some((2, "MK4S".into())));
+    }
+
+    #[test]
+    fn a_bare_prusa_log_with_crlf_reads_as_the_terminals() {
+        // The replies as the printer sends them (M115.cpp, M503's report, M593.cpp's
+        // `dump_current_config`), without OctoPrint's `Recv: `, `echo:` or `Send:` lines,
+        // ended by CRLF: the same printer, limits and shapers.
+        let bare: String = PRUSA_LOG
+            .lines()
+            .filter(|l| !l.starts_with("Send:"))
+            .map(|l| {
+                let l = l.strip_prefix("Recv: ").unwrap_or(l);
+                format!("{}\r\n", l.strip_prefix("echo:").unwrap_or(l))
+            })
+            .collect();
+        let a = MarlinSettings::parse_prusa(PRUSA_LOG, "p.txt").expect("the terminal's");
+        let b = MarlinSettings::parse_prusa(&bare, "p.txt").expect("the bare replies");
+        assert_eq!(b.prusa.map(|p| p.model), a.prusa.map(|p| p.model));
+        assert_eq!(b.planner, a.planner);
+        assert_eq!(b.shapers, a.shapers);
+        assert_eq!(b.shapers[0].map(|s| s.frequency_hz), Some(50.700001));
+    }
+
+    #[test]
+    fn a_second_m593_reply_is_the_printers_later_state() {
+        // Each M593 reply prints all three axes (M593.cpp `dump_current_config`): the later
+        // one holds, as the later of two M503 replies does.
+        let later = "Recv: echo:axis X type=ZVD freq=45.000000 damp=0.100000 vr=20.000000\nRecv: echo:axis Y disabled\nRecv: echo:axis Z disabled\n";
+        let s = MarlinSettings::parse_prusa(&format!("{PRUSA_LOG}{later}"), "p.txt")
+            .expect("two M593 replies");
+        let x = s.shapers[0].expect("X shaped");
+        assert_eq!((x.shaper_type, x.frequency_hz), (ShaperType::Zvd, 45.0));
+        assert_eq!(s.shapers[1], None);
     }
 }
