@@ -34,7 +34,7 @@ impl<T> Xyz<T> {
 }
 
 /// Fewest and most microsteps per mm of an axis a configuration may give (Klipper's
-/// `[stepper_x]` resolution, Marlin's `M92`): 1 (a microstep of 1 mm; a 1.8 degree
+/// `[stepper_x]` resolution, Marlin's `M92`, config.g's `M92` and `M350`): 1 (a microstep of 1 mm; a 1.8 degree
 /// motor's full step on a 40 mm belt pulley is 0.2 mm) to 1e9 (a femtometre-scale step,
 /// the bound `M92` always had here). Outside it a configuration is a typing or unit
 /// mistake (`rotation_distance: 1e-12` gives 3.2e15), and `settle tune` refuses a

@@ -22,7 +22,7 @@ use std::sync::Arc;
 
 use super::budget::Budget;
 use super::klipper_files::absolute;
-use super::machine::{AxisDrive, ConfigNote, ShaperSetting, Xyz};
+use super::machine::{AxisDrive, ConfigNote, MICROSTEPS_PER_MM, ShaperSetting, Xyz};
 use super::rrf_script::unconditional;
 use crate::error::{GcodeError, Location};
 use crate::read::dialect::Dialect;
@@ -125,6 +125,9 @@ struct Files {
     sys: PathBuf,
     stack: Vec<PathBuf>,
     budget: Budget,
+    /// Per axis (X, Y, Z), the command that last changed its steps per mm, where, and the
+    /// value it gave there (steps per mm for `M92`, microstepping for `M350`).
+    steps_set: [Option<(Location, &'static str, f64)>; 3],
 }
 
 /// Per-axis state while reading, in the firmware's units where they differ.
@@ -196,9 +199,40 @@ impl RrfConfig {
             sys: path.parent().unwrap_or(Path::new("")).to_path_buf(),
             stack: Vec::new(),
             budget,
+            steps_set: [None, None, None],
         };
         c.run(text, path, &mut files)?;
+        c.check_steps_per_mm(&files)?;
         Ok(c)
+    }
+
+    /// Refuse an axis left with steps per mm outside [`MICROSTEPS_PER_MM`], at the `M92`
+    /// or `M350` that set it. RepRapFirmware takes any positive `M92` and raises one below
+    /// 0.01 to 0.01 (`MinimumStepsPerMm`); settle reads it so, but an axis under one
+    /// microstep per mm (a step longer than a millimetre) or over 1e9 is a typing or unit
+    /// mistake, and `settle tune` refuses such a `usteps_per_mm`: refused here, where the
+    /// value was written, rather than imported into a scenario tune then refuses.
+    fn check_steps_per_mm(&self, files: &Files) -> Result<(), GcodeError> {
+        let (lo, hi) = MICROSTEPS_PER_MM;
+        let axes = [&self.axes.x, &self.axes.y, &self.axes.z];
+        for ((axis, letter), set) in axes.into_iter().zip(["X", "Y", "Z"]).zip(&files.steps_set) {
+            let v = axis.drive.microsteps_per_mm;
+            if let Some((at, command, given)) = set
+                && !(lo..=hi).contains(&v)
+            {
+                return Err(GcodeError::ConfigValue {
+                    at: at.clone(),
+                    section: (*command).to_string(),
+                    key: letter.to_string(),
+                    value: given.to_string().into(),
+                    allowed: format!(
+                        "a value that leaves axis {letter} {lo} to {hi:e} microsteps per mm (this leaves {v}, after RepRapFirmware's floor of {MINIMUM_STEPS_PER_MM} steps/mm, `MinimumStepsPerMm` in src/Config/Configuration.h): below one a microstep is longer than a millimetre, and settle tune takes 1 to 1e9"
+                    )
+                    .into(),
+                });
+            }
+        }
+        Ok(())
     }
 
     fn run(&mut self, text: &str, path: &Path, files: &mut Files) -> Result<(), GcodeError> {
@@ -214,7 +248,23 @@ impl RrfConfig {
                     if let Setting::Kinematics { .. } = s {
                         self.set_at.insert("M669 K".into(), at.clone());
                     }
+                    let before = self.state().map(|a| a.steps_per_mm);
                     self.setting(&s, &at)?;
+                    let given = match &s {
+                        Setting::StepsPerMm { per_axis, .. } => Some(("M92", xyz(per_axis))),
+                        Setting::Microstepping { per_axis, .. } => Some(("M350", xyz(per_axis))),
+                        _ => None,
+                    };
+                    if let Some((command, values)) = given {
+                        let after = self.state().map(|a| a.steps_per_mm);
+                        for i in 0..3 {
+                            if let Some(v) = values[i]
+                                && after[i] != before[i]
+                            {
+                                files.steps_set[i] = Some((at.clone(), command, v));
+                            }
+                        }
+                    }
                 }
                 EventKind::Limits(l) => {
                     self.set_at.insert(l.command_name().into(), at.clone());

@@ -320,3 +320,54 @@ fn other_dialects_ignore_configuration_commands() {
         ["M208 x1", "M92 x1"]
     );
 }
+
+#[test]
+fn steps_per_mm_outside_what_tune_takes_are_refused_where_written() {
+    // RepRapFirmware takes any positive `M92` and raises a value below 0.01 to 0.01
+    // (`MinimumStepsPerMm`, src/Config/Configuration.h); settle tune takes 1 to 1e9
+    // microsteps per mm. The axis's final value is checked, at the line that set it:
+    // M350 X16, M92 X10, then M350 X1 leaves 10 * 1 / 16 = 0.625; M92 Z1e9 (the most the
+    // word takes) at the default x16, then M350 Z256, 1e9 * 256 / 16.
+    for (text, line, command, key, leaves) in [
+        ("M92 X80 Y0.5\n", 1, "M92", "Y", "leaves 0.5,"),
+        ("G90\nM92 X0.001\n", 2, "M92", "X", "leaves 0.01,"),
+        (
+            "M350 X16\nM92 X10\nM350 X1\n",
+            3,
+            "M350",
+            "X",
+            "leaves 0.625,",
+        ),
+        (
+            "M92 Z1e9\nM350 Z256\n",
+            2,
+            "M350",
+            "Z",
+            "leaves 16000000000,",
+        ),
+    ] {
+        match parse_err(text) {
+            GcodeError::ConfigValue {
+                at,
+                section,
+                key: k,
+                allowed,
+                ..
+            } => {
+                assert_eq!(
+                    (at.line, section.as_str(), k.as_str()),
+                    (line, command, key),
+                    "{text}"
+                );
+                assert!(allowed.contains(leaves), "{text}: {allowed}");
+            }
+            e => panic!("{text}: {e:?}"),
+        }
+    }
+    // What a later line sets is what the firmware runs with: read, not refused.
+    assert_eq!(
+        parse("M92 X0.5\nM92 X80\n").axes.x.drive.microsteps_per_mm,
+        80.0
+    );
+    assert_eq!(parse("M92 X1 Y1e9\n").axes.y.drive.microsteps_per_mm, 1e9);
+}

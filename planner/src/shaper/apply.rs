@@ -8,8 +8,9 @@ impl Shaper {
     /// extended by its start state before `t = 0` and its end state after its end, moving on
     /// at constant velocity (so a move that starts and ends at rest is shaped into one that
     /// does too, `duration_s()` longer). The start and end accelerations must be zero (a
-    /// move, not a fragment). Since the weights are positive and sum to 1, the shaped
-    /// velocity, acceleration and jerk stay within the original's bounds.
+    /// move, not a fragment). The weights sum to 1; where they are all positive the shaped
+    /// velocity, acceleration and jerk stay within the original's bounds (a negative one,
+    /// as RepRapFirmware's `ei2`/`ei3` have at high damping, can take them beyond).
     ///
     /// "Zero" is zero to round-off: within [`END_ACCEL_ROUND_OFF`] of the profile's peak
     /// acceleration (a PVT step's knots sum its segments' jerks to about 1e-16 m/s^2, not

@@ -56,7 +56,8 @@ pub const END_ACCEL_ROUND_OFF: f64 = 1e-9;
 pub const VIBRATION_TOLERANCE: f64 = KLIPPER_V_TOL;
 
 /// A shaper: impulse amplitudes (as its firmware computes them; Klipper's do not sum to
-/// 1, Marlin's and RepRapFirmware's do) and times (s), the first 0.
+/// 1, Marlin's and RepRapFirmware's do; RepRapFirmware's `ei3` above damping 0.3 and `ei2`
+/// above 0.41 have negative ones) and times (s), increasing, the first 0.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Shaper {
     shaper_type: ShaperType,
@@ -168,8 +169,9 @@ impl Shaper {
                 }
             }
         };
-        // Klipper's step generation refuses impulses out of time order (kin_shaper.c); the
-        // others cannot produce them.
+        // Klipper's step generation refuses impulses out of time order (kin_shaper.c);
+        // RepRapFirmware runs its ei2/ei3 delays in any order and `rrf::impulses` puts
+        // them in time order; the others cannot produce them.
         if times_s.windows(2).any(|w| w[0] >= w[1]) {
             return Err(invalid(
                 kind,

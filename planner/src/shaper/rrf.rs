@@ -1,6 +1,7 @@
 //! RepRapFirmware's M593 shapers as src/Movement/AxisShaper.cpp (`AxisShaper::Configure`,
-//! 3.6 line) computes them: amplitudes that sum to one (the last is `1 - sum` of the
-//! others) and delays in whole step-clock ticks.
+//! 3.6 line: 3.6-dev at 8875b7ec447dd29399433711d6b686d4ad587318) computes them:
+//! amplitudes that sum to one (the last is `1 - sum` of the others) and delays in whole
+//! step-clock ticks.
 //!
 //! With `s = sqrt(1 - zeta^2)`, `k = expf(-zeta pi / s)` and the damped period in ticks
 //! `P = lrintf(step_clock / (f s))`:
@@ -13,7 +14,17 @@
 //!   first, so unlike Klipper's MZV it does not cancel the mode it is tuned to exactly;
 //! - `ei2`, `ei3`: the same damping cubics as Klipper's `2hump_ei`/`3hump_ei`, but the
 //!   times are fractions of the damped period `P` (Klipper: of `1/f`) and the last
-//!   amplitude is `1 - sum` of the others (Klipper normalises by the sum).
+//!   amplitude is `1 - sum` of the others (Klipper normalises by the sum). Klipper stops
+//!   these cubics at damping 0.3 and 0.2 (`max_damping_ratio`); M593 takes `S` to 0.99
+//!   and evaluates them there too. From about 0.41 (`ei3`) and 0.47 (`ei2`) their delays
+//!   are no longer increasing (`M593 P"ei3" F40 S0.5`: 0, 49566, 75373, 68758, 58195
+//!   ticks), and amplitudes turn negative (there: 1.138, 0.505, -0.314, -0.272, -0.056).
+//!   The firmware runs them as they are: `Move::AddLinearSegments` (src/Movement/Move.cpp)
+//!   adds each impulse's scaled copy of a move at its own delay through
+//!   `Move::AddSegment`, which merges the copy into the time-ordered segment list wherever
+//!   it starts, so the motion is the sum of the copies in whatever order the delays come.
+//!   This file gives the same sum in time order: the impulses sorted by delay, and those
+//!   at the same tick (they occur, e.g. `ei3` at 100 Hz and S0.5629) added into one.
 //!
 //! Single precision where the firmware uses `float`, so `P` and the delays round as on the
 //! board; `lrintf` rounds half to even.
@@ -123,5 +134,22 @@ pub(super) fn impulses(shaper: RrfShaper, f_hz: f64, zeta: f64, step_clock_hz: u
     let sum: f64 = a.iter().sum();
     a.push(1.0 - sum);
     let clock = f64::from(step_clock_hz);
+    let (a, delays) = in_time_order(a, delays);
     (a, delays.into_iter().map(|d| d as f64 / clock).collect())
+}
+
+/// The impulses `(amplitudes, delays)` sorted by delay (a stable sort: increasing delays
+/// are left as they are), those at the same delay added into one: the train the firmware's
+/// sum of delayed copies amounts to (module doc).
+fn in_time_order(amplitudes: Vec<f64>, delays: Vec<i64>) -> (Vec<f64>, Vec<i64>) {
+    let mut train: Vec<(i64, f64)> = delays.into_iter().zip(amplitudes).collect();
+    train.sort_by_key(|&(d, _)| d);
+    let mut merged: Vec<(i64, f64)> = Vec::with_capacity(train.len());
+    for (d, a) in train {
+        match merged.last_mut() {
+            Some((d0, a0)) if *d0 == d => *a0 += a,
+            _ => merged.push((d, a)),
+        }
+    }
+    merged.into_iter().map(|(d, a)| (a, d)).unzip()
 }

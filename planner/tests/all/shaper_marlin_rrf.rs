@@ -239,3 +239,105 @@ fn rrf_hand_computed_zvd_and_mzv_order() {
     assert!(Shaper::new(k, 1000.0, 0.1).is_ok() && Shaper::new(k, 1000.5, 0.1).is_err());
     assert!(Shaper::new(k, 40.0, 0.99).is_ok() && Shaper::new(k, 40.0, 0.995).is_err());
 }
+
+#[test]
+fn rrf_ei_past_the_fit_run_as_the_firmware_sums_them() {
+    // RepRapFirmware src/Movement/AxisShaper.cpp at 8875b7ec447dd29399433711d6b686d4ad587318
+    // (3.6-dev), `AxisShaper::Configure`, worked by hand at 40 Hz on the 750 kHz step
+    // clock: damped period P = lrintf(750000 / (40 sqrt(1 - S^2))) (19137 ticks at S0.2,
+    // 21651 at S0.5, 43015 at S0.9, 132915 at S0.99), amplitudes the damping cubics (the
+    // last 1 - the others), delays lrintf(cubic * P). M593 takes S up to 0.99; from about
+    // S0.41 (ei3) and S0.47 (ei2) the delays come out of order. At S0.5 the firmware's
+    // `ei3` is amplitudes 1.1383350, 0.5047000, -0.3144500, -0.2723350, -0.0562499 at
+    // delays 0, 49566, 75373, 68758, 58195 ticks (e.g. the second: 0.49974 + 0.23834/2 +
+    // 0.44559/4 + 12.4720/8 = 2.28932 periods, 49566 ticks), and its `ei2` 0.9569975,
+    // 0.1363775, -0.0858613, -0.0075138 at 0, 26302, 37134, 34945. The firmware adds
+    // each impulse's copy of a move at its own delay into one time-ordered list
+    // (`Move::AddLinearSegments` and `Move::AddSegment`, src/Movement/Move.cpp), so the
+    // motion is the same train in time order, written here sorted by delay. S0.2 is in
+    // the fit's range and already in order.
+    let clock = 750_000.0f64;
+    let cases: [(RrfShaper, f64, &[f64], &[i64]); 8] = [
+        (
+            RrfShaper::Ei2,
+            0.2,
+            &[0.3947420, 0.3399320, 0.1936989, 0.0716271],
+            &[0, 10698, 19832, 28402],
+        ),
+        (
+            RrfShaper::Ei2,
+            0.5,
+            &[0.9569975, 0.1363775, -0.0075138, -0.0858613],
+            &[0, 26302, 34945, 37134],
+        ),
+        (
+            RrfShaper::Ei2,
+            0.9,
+            &[1.7911195, -0.2495983, -0.0797005, -0.4618208],
+            &[0, 109250, 202074, 251110],
+        ),
+        (
+            RrfShaper::Ei2,
+            0.99,
+            &[1.9493326, -0.3580322, -0.0591059, -0.5321944],
+            &[0, 389622, 811704, 1004407],
+        ),
+        (
+            RrfShaper::Ei3,
+            0.2,
+            &[0.3861276, 0.2949856, 0.1772315, 0.0932180, 0.0484372],
+            &[0, 12726, 22021, 30141, 38484],
+        ),
+        (
+            RrfShaper::Ei3,
+            0.5,
+            &[1.1383350, 0.5047000, -0.0562499, -0.2723350, -0.3144500],
+            &[0, 49566, 58195, 68758, 75373],
+        ),
+        (
+            RrfShaper::Ei3,
+            0.9,
+            &[2.4161036, -0.5797954, 2.2361245, -1.5632129, -1.5092201],
+            &[0, 265998, 437345, 532376, 705846],
+        ),
+        (
+            RrfShaper::Ei3,
+            0.99,
+            &[2.6965864, -0.8089089, 3.0234008, -2.0528994, -1.8581785],
+            &[0, 1005796, 1764312, 2146981, 2881607],
+        ),
+    ];
+    for (shaper, z, a, d) in cases {
+        let kind = ShaperType::rrf(shaper);
+        let s = Shaper::new(kind, 40.0, z).unwrap_or_else(|e| panic!("{kind} S{z}: {e}"));
+        let t: Vec<f64> = d.iter().map(|&d| d as f64 / clock).collect();
+        assert_train(&s, a, &t, &format!("{kind} 40 Hz S{z}"));
+    }
+    // What these trains leave of the 40 Hz mode of their own damping (Klipper's estimate
+    // `|sum A_i e^(-zeta w (T_N - T_i)) e^(i w_d T_i)| / sum A_i` over the impulses above,
+    // worked apart in double precision): 11.3% for ei2 at S0.5, 29.2% for ei3 at S0.5 and
+    // 150.9% for ei3 at S0.9, more than no shaping leaves.
+    for (shaper, z, left) in [
+        (RrfShaper::Ei2, 0.5, 0.11278),
+        (RrfShaper::Ei3, 0.5, 0.29203),
+        (RrfShaper::Ei3, 0.9, 1.50922),
+    ] {
+        let s = Shaper::new(ShaperType::rrf(shaper), 40.0, z).expect("rrf shaper");
+        let got = s.remaining_vibration(40.0, z);
+        assert!(
+            (got - left).abs() < 1e-4,
+            "{shaper:?} S{z}: {got} vs {left}"
+        );
+    }
+    // Two delays on the same tick are one impulse: `ei3` at 100 Hz, S0.5629 (P 9074) has
+    // amplitudes 1.3295622, 0.6296889, -0.4625535, -0.3984257, -0.0982720 at delays 0,
+    // 27218, 41654, 35900, 27218: the second and the last add up to 0.5314169.
+    let s = Shaper::new(ShaperType::rrf(RrfShaper::Ei3), 100.0, 0.5629).expect("ei3");
+    let t: Vec<f64> = [0, 27218, 35900, 41654].map(|d| d as f64 / clock).to_vec();
+    assert_train(
+        &s,
+        &[1.3295622, 0.5314169, -0.3984257, -0.4625535],
+        &t,
+        "ei3 100 Hz S0.5629",
+    );
+}
