@@ -164,10 +164,10 @@ fn a_configurations_bad_setting_is_named_at_its_line() {
     let cases: [(&str, &str, &str, &str, &str); 7] = [
         (
             "c.g",
-            "M92 X80 Y80\n; RepRapFirmware allows S up to 0.99\nM593 P\"ei3\" F40 S0.5\n",
+            "M92 X80 Y80\n; RepRapFirmware's M593 takes F from 5.722 to 1000 Hz\nM593 P\"ei3\" F2000 S0.1\n",
             "rrf",
-            "c.g:3: key `M593`",
-            "impulse times",
+            "c.g:3: key `M593.F`",
+            "5.722 to 1000 Hz",
         ),
         (
             "k.g",

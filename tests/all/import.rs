@@ -443,10 +443,10 @@ fn a_config_g_value_is_refused_at_its_line() {
             "a move of 20 mm at vmax_mm_s = 0.001",
         ),
         (
-            "M92 X80 Y80\nM593 P\"ei3\" F40 S0.5\nM201 X1000 Y1000\n",
+            "M92 X80 Y80\nM593 P\"ei3\" F2000 S0.1\nM201 X1000 Y1000\n",
             2,
-            "M593",
-            "impulse times",
+            "M593.F",
+            "5.722 to 1000 Hz",
         ),
     ] {
         std::fs::write(&cfg, text).expect("write");
