@@ -128,25 +128,12 @@ fn a_configuration_settle_cannot_follow_exits_2_and_writes_nothing() {
         (&[], &dir.path().join("missing.cfg"), "missing.cfg"),
     ];
     for (extra, config, key) in cases {
-        let out_dir = dir.path().join("out");
-        let out = settle()
-            .arg("gcode")
-            .arg(&gcode)
-            .args(["--machine", "printer_xy", "--config"])
-            .arg(config)
-            .args(extra)
-            .arg("--out")
-            .arg(&out_dir)
-            .output()
-            .expect("settle runs");
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{config:?}: {stderr}");
+        let stderr = refused_config(&gcode, config, extra, &dir.path().join("out"));
         assert!(
             stderr.contains(&*config.file_name().expect("a name").to_string_lossy())
                 && stderr.contains(key),
             "{config:?}: {stderr}"
         );
-        assert!(!out_dir.exists(), "{config:?} wrote {out_dir:?}");
     }
 }
 
@@ -214,30 +201,31 @@ fn a_configurations_bad_setting_is_named_at_its_line() {
     ];
     for (name, text, firmware, at, allowed) in cases {
         let config = write(d, name, text);
-        let out_dir = d.join("out");
-        let out = settle()
-            .arg("gcode")
-            .arg(&gcode)
-            .args([
-                "--machine",
-                "printer_xy",
-                "--firmware",
-                firmware,
-                "--config",
-            ])
-            .arg(&config)
-            .arg("--out")
-            .arg(&out_dir)
-            .output()
-            .expect("settle runs");
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{name}: {stderr}");
+        let stderr = refused_config(&gcode, &config, &["--firmware", firmware], &d.join("out"));
         assert!(
             stderr.contains(at) && stderr.contains(allowed),
             "{name}: {stderr}"
         );
-        assert!(!out_dir.exists(), "{name} wrote {out_dir:?}");
     }
+}
+
+/// `settle gcode GCODE --machine printer_xy --config CONFIG EXTRA --out OUT`: exit 2 and
+/// nothing written at `out`; its standard error.
+fn refused_config(gcode: &Path, config: &Path, extra: &[&str], out: &Path) -> String {
+    let run = settle()
+        .arg("gcode")
+        .arg(gcode)
+        .args(["--machine", "printer_xy", "--config"])
+        .arg(config)
+        .args(extra)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .expect("settle runs");
+    let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+    assert_eq!(run.status.code(), Some(2), "{config:?}: {stderr}");
+    assert!(!out.exists(), "{config:?} wrote {out:?}");
+    stderr
 }
 
 /// summary.md and report.html say what `--config` set and where the modal backend
