@@ -210,7 +210,7 @@ impl GcodeOptions {
         } else {
             Firmware::Klipper
         });
-        let (job, notes, files) = match firmware {
+        let (job, mut notes, files): (JobConfig, Vec<String>, _) = match firmware {
             Firmware::Klipper => {
                 let c = settle_gcode::config::KlipperConfig::read(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
@@ -243,8 +243,7 @@ impl GcodeOptions {
                 let c = settle_gcode::config::MarlinSettings::read_prusa(&config)
                     .map_err(|e| crate::workflows::import::config_error(&config, e))?;
                 let job = c.job_config().map_err(gcode_error(&config))?;
-                let mut notes: Vec<String> = c.notes.iter().map(ToString::to_string).collect();
-                notes.extend(prusa_printers(&file, &config, job.prusa.as_ref())?);
+                let notes = c.notes.iter().map(ToString::to_string).collect();
                 (job, notes, c.files)
             }
             Firmware::Settle | Firmware::Tmc4361a => {
@@ -258,6 +257,14 @@ impl GcodeOptions {
             }
         };
         let mut opts = Self::new(file, machine, firmware)?;
+        // A Prusa job: which printer it runs as, against the one the file names (read by
+        // `Self::new`).
+        notes.extend(prusa_printers(
+            &opts.file,
+            &config,
+            job.prusa.as_ref(),
+            &opts.job,
+        ));
         opts.job = job.clone();
         opts.config = Some(ConfigSource {
             path: config,
@@ -935,15 +942,16 @@ fn simulate(
 }
 
 /// Which printer a Prusa job runs as under `--config`: the configuration's (`from`, read
-/// from `config`), said; a file sliced for another family (its `M862.3 P`) is said too,
-/// as Buddy warns of it before printing.
+/// from `config`), said; a file sliced for another family (its `M862.3 P`, in `job`, the
+/// settings the file alone gives) is said too, as Buddy warns of it before printing.
 fn prusa_printers(
     file: &Path,
     config: &Path,
     from: Option<&settle_gcode::job::PrusaPrinter>,
-) -> Result<Vec<String>, Error> {
+    job: &JobConfig,
+) -> Vec<String> {
     let Some(printer) = from else {
-        return Ok(Vec::new());
+        return Vec::new();
     };
     let mut notes = vec![match &printer.named_at {
         Some((line, name)) => format!(
@@ -956,8 +964,7 @@ fn prusa_printers(
             config.display()
         ),
     }];
-    let job = JobConfig::for_file(Firmware::Prusa, file).map_err(gcode_error(file))?;
-    if let Some(sliced) = job.prusa.filter(|p| p.model != printer.model)
+    if let Some(sliced) = job.prusa.as_ref().filter(|p| p.model != printer.model)
         && let Some((line, name)) = &sliced.named_at
     {
         notes.push(format!(
@@ -966,7 +973,7 @@ fn prusa_printers(
                 printer.model
             ));
     }
-    Ok(notes)
+    notes
 }
 
 /// The planner's limits and the shapers of `job` in words, in the firmware's terms
