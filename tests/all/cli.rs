@@ -431,15 +431,16 @@ fn without_the_feature_rerun_is_a_clear_error() {
 /// closes the pipe: the command names the failed write and exits 1, never a panic (101).
 #[test]
 fn a_closed_standard_output_is_an_io_failure_not_a_panic() {
-    let mut child = settle()
+    // A pipe whose reader is closed before the command starts: every write to it fails.
+    // (Closing the reader after the start races the command: its whole output fits in
+    // the pipe's buffer when it writes first.)
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    let out = settle()
         .args(["machine", "printer_xy"])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
+        .stdout(writer)
+        .output()
         .expect("settle runs");
-    // No reader: every write to the pipe fails.
-    drop(child.stdout.take());
-    let out = child.wait_with_output().expect("settle ends");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
