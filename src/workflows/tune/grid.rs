@@ -97,6 +97,10 @@ pub fn plan(
         .ok_or_else(|| src.error_at("name", "the scenario has no run"))?;
     if let Some(a) = axis {
         base.axis = a.to_string();
+        // The scenario's sampling was checked against the move's axis: this one's modes
+        // must be seen too.
+        let range = crate::expand::validate::mode_range_hz(&base);
+        crate::expand::validate::validate_sampling(&base, range, src)?;
     }
     let firmware = match &spec.firmware {
         None => Candidates::ANY,
