@@ -113,17 +113,16 @@ fn validate_duration(run: &RunSpec, src: &Source) -> Result<(), Error> {
 /// rotations at 0 Hz left out). `None` when there are none or the machine cannot be
 /// linearised (its own checks report why).
 pub fn mode_range_hz(run: &RunSpec) -> Option<(f64, f64)> {
+    let moved = studies::moved_axes(run);
     let freqs: Vec<f64> = match run.machine.physical() {
-        None => run
-            .axis
-            .split('+')
+        None => moved
+            .iter()
             .flat_map(|a| run.machine.modes_of(a).iter().map(|m| m.frequency_hz))
             .collect(),
         Some(machine) => {
             let axes = machine.compile(settle_sim::DriverMode::Linear).ok()?;
-            let moved: Vec<&str> = run.axis.split('+').collect();
             let mut out = Vec::new();
-            for a in axes.iter().filter(|a| moved.contains(&a.name.as_str())) {
+            for a in axes.iter().filter(|a| moved.contains(&a.name)) {
                 let q = a.lumped.equilibrium(run.start_mm * 1e-3, None).ok()?;
                 out.extend(a.lumped.natural_frequencies_hz(&q));
             }
@@ -156,11 +155,15 @@ pub fn validate_sampling(
     let Some((slowest_hz, fastest_hz)) = range else {
         return Ok(());
     };
-    let what = if run.machine.physical().is_some() {
-        "the machine's linearised modes"
-    } else {
-        "machine.modes"
-    };
+    let what = format!(
+        "{} of the axes the run moves: {}",
+        if run.machine.physical().is_some() {
+            "the machine's linearised modes"
+        } else {
+            "machine.modes"
+        },
+        studies::moved_axes(run).join(", ")
+    );
     if run.window_s < 0.5 / slowest_hz {
         return Err(src.error_at(
             "observe.window_s",

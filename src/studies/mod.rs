@@ -303,6 +303,12 @@ pub trait Study: std::fmt::Debug + Sync {
         Ok(None)
     }
 
+    /// The machine axes a motion study's run moves, whose vibration its samples must
+    /// resolve (see [`moved_axes`]): by default the move's axis, or a path's two (`x+y`).
+    fn moved_axes(&self, run: &RunSpec) -> Vec<String> {
+        run.axis.split('+').map(str::to_string).collect()
+    }
+
     /// Plan the run's motion (motion studies: [`Role::Move`], [`Role::Path`]).
     fn plan(&self, run: &RunSpec, ctx: &PlanContext) -> Result<Planned, PlanError> {
         let _ = (run, ctx);
@@ -426,6 +432,12 @@ pub fn shaper(run: &RunSpec) -> Result<Option<Shaper>, PlanError> {
         }
     }
     Ok(shaper)
+}
+
+/// The machine axes `run`'s motion moves (its motion study's [`Study::moved_axes`]): the
+/// axes whose modes its sample rate must resolve and its window must show.
+pub fn moved_axes(run: &RunSpec) -> Vec<String> {
+    motion(run).moved_axes(run)
 }
 
 /// Plan `run` on a machine with axes `axes`: its motion study, with its modifiers' shaper.

@@ -123,6 +123,16 @@ impl ShaperSetting {
                 ),
             ));
         }
+        let max = crate::input::modes::MAX_FREQUENCY_HZ;
+        if self.shaper_type.is_some() && self.frequency_hz > max {
+            return Err((
+                "shaper.frequency_hz",
+                format!(
+                    "{} Hz is above {max} Hz, the fastest mode a machine may have (a shaper is tuned to a mode; one far above every mode shapes nothing)",
+                    self.frequency_hz
+                ),
+            ));
+        }
         if !(0.0..1.0).contains(&self.damping_ratio) {
             return Err((
                 "shaper.damping_ratio",

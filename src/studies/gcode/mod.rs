@@ -362,6 +362,11 @@ impl Study for GcodeRun {
         Role::Path
     }
 
+    /// Every axis of the machine: a job moves x and y, and z between layers.
+    fn moved_axes(&self, run: &RunSpec) -> Vec<String> {
+        run.axis_names()
+    }
+
     fn sweepable(&self) -> &'static str {
         "gcode.firmware"
     }

@@ -149,6 +149,19 @@ impl Study for ScanStep {
         Role::Move
     }
 
+    /// The step axis and, when the machine has it, the fly axis (simulated: its modes
+    /// ring after every turnaround and are reported per axis).
+    fn moved_axes(&self, run: &RunSpec) -> Vec<String> {
+        let mut axes: Vec<String> = run.axis.split('+').map(str::to_string).collect();
+        if let Some(scan) = run.state::<ScanSpec>()
+            && run.axis_names().contains(&scan.fly_axis)
+            && !axes.contains(&scan.fly_axis)
+        {
+            axes.push(scan.fly_axis.clone());
+        }
+        axes
+    }
+
     fn sweepable(&self) -> &'static str {
         SWEEPABLE
     }

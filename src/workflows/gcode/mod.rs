@@ -1298,6 +1298,13 @@ pub fn parse_shaper(s: &str) -> Result<ShaperSetting, String> {
         None => (rest, 0.1),
     };
     let frequency_hz = f.parse::<f64>().map_err(|_| bad())?;
+    // As the job's own files set it (printer.cfg's shaper_freq_*, M593 F): at most 1 kHz.
+    let max = settle_gcode::config::MAX_SHAPER_FREQUENCY_HZ;
+    if frequency_hz > max {
+        return Err(format!(
+            "`{s}`: {f} Hz is above {max} Hz, the highest shaper frequency a G-code replay takes (as printer.cfg's shaper_freq_* and M593 F): a shaper tuned above 1 kHz cancels nothing a printer's belts or frame carry"
+        ));
+    }
     let kind = settle_planner::shaper::ShaperType::parse(kind).map_err(|e| e.to_string())?;
     let setting = ShaperSetting {
         shaper_type: kind,

@@ -97,6 +97,10 @@ pub fn plan(
         .ok_or_else(|| src.error_at("name", "the scenario has no run"))?;
     if let Some(a) = axis {
         base.axis = a.to_string();
+        // The scenario's sampling was checked against the move's axis: this one's modes
+        // must be seen too.
+        let range = crate::expand::validate::mode_range_hz(&base);
+        crate::expand::validate::validate_sampling(&base, range, src)?;
     }
     let firmware = match &spec.firmware {
         None => Candidates::ANY,
@@ -426,6 +430,16 @@ pub fn plan(
                             frequency_hz: (f * x * 10.0).round() / 10.0,
                             damping_ratio,
                         };
+                        let max = crate::input::modes::MAX_FREQUENCY_HZ;
+                        if s.frequency_hz > max {
+                            return Err(src.error_at(
+                                "tune.frequency_scales",
+                                format!(
+                                    "{x} times the {f:.1} Hz mode is a shaper of {} Hz, above {max} Hz, the fastest mode a machine may have: give multiples that keep every shaper at or below it (the default is 0.8 to 1.2)",
+                                    s.frequency_hz
+                                ),
+                            ));
+                        }
                         // A frequency the firmware would clamp is not what it runs.
                         if !firmware.takes_frequency(s.frequency_hz) {
                             outside.push(s.frequency_hz);

@@ -1,7 +1,8 @@
 //! Answers settle cannot stand behind, refused (exit 2) or said: a G-code file without a
 //! move (prose, a system file as a scenario's `[gcode] file`) or a layer range without
 //! a working one, a move or dwell of more than an hour, a sample rate under Nyquist (a
-//! replay's; a recording's for Klipper's shaper choice), a ring-down fit of a record that
+//! replay's; a scan's fly axis; a `[gcode]` job's z axis; an axis `[tune] axes` adds; a recording's for Klipper's
+//! shaper choice), a ring-down fit of a record that
 //! holds no free decay, a move, corner or scan where f64 cannot resolve it, a shaper
 //! Klipper refuses in an imported configuration, a mode too slow for the window,
 //! two-value keys given three, a fly axis that is none, a clock of 0 Hz, a plan without
@@ -214,10 +215,89 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         "crawl.cfg",
         "[printer]\nkinematics: cartesian\nmax_velocity: 0.0001\nmax_accel: 3000\n",
     );
+    // A scan whose fly axis (y, simulated: the machine has it) rings at 1,500 Hz, and a
+    // G-code job whose z axis rings at 3,000 Hz, sampled at 2,000 Hz: Nyquist is 1,000 Hz.
+    sb.write(
+        "scan_fly_fast.toml",
+        &scenario_with(
+            "modes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]",
+            "[machine.axis.x]\nmodes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]\n[machine.axis.y]\nmodes = [{ frequency_hz = 1500.0, damping_ratio = 0.05 }]",
+        )
+        .replace("distance_mm = 5.0", "distance_mm = 0.5")
+        .replace(
+            "[observe]",
+            "[scan]\nv_scan_mm_s = 100.0\nfly_amax_mm_s2 = 10000.0\nwidth_mm = 10.0\n[observe]",
+        ),
+    );
+    sb.write(
+        "scan_fly_seen.toml",
+        &std::fs::read_to_string(sb.root().join("scan_fly_fast.toml"))
+            .expect("scan")
+            .replace("sample_rate_hz = 2000", "sample_rate_hz = 3000"),
+    );
+    sb.write(
+        "gcode_z_fast.toml",
+        &GCODE_SECRET
+            .replace("gcode_secret", "gcode_z_fast")
+            .replace("file = \"secret.txt\"", "file = \"print.gcode\"")
+            .replace(
+                "preset = \"printer_xy\"\ndriver_model = \"linear\"",
+                "[machine.axis.x]\nmodes = [{ frequency_hz = 40.0, damping_ratio = 0.05 }]\n[machine.axis.y]\nmodes = [{ frequency_hz = 50.0, damping_ratio = 0.05 }]\n[machine.axis.z]\nmodes = [{ frequency_hz = 3000.0, damping_ratio = 0.05 }]",
+            )
+            .replace("sample_rate_hz = 10000", "sample_rate_hz = 2000"),
+    );
+    // `[tune] axes` tunes y too, whose 1,500 Hz mode the 2,000 Hz sample rate cannot see.
+    sb.write(
+        "tune_y_fast.toml",
+        &(std::fs::read_to_string(sb.root().join("scan_fly_fast.toml"))
+            .expect("scan")
+            .replace("[sweep]\nprofile = [\"trapezoid\", \"scurve\"]\n", "")
+            .replace(
+                "[scan]\nv_scan_mm_s = 100.0\nfly_amax_mm_s2 = 10000.0\nwidth_mm = 10.0\n",
+                "",
+            )
+            + "[tune]\naxes = [\"x\", \"y\"]\ndistances_mm = [0.5]\njerk_steps = 2\n"),
+    );
     let refused = |what: &str, line: &str, parts: &[&str]| {
         Case::line(what, line, &[], Expect::refused(parts))
     };
     vec![
+        refused(
+            "tune of an axis whose mode is above Nyquist",
+            "tune tune_y_fast.toml --out o",
+            &[
+                "tune_y_fast.toml:",
+                "key `observe.sample_rate_hz`",
+                "(1500.0000 Hz in machine.modes of the axes the run moves: y)",
+                "at least 3000.0000 Hz",
+            ],
+        ),
+        refused(
+            "a scan sampled under Nyquist of its fly axis's mode",
+            "run scan_fly_fast.toml --case 0 --backend modal --out o/t.csv",
+            &[
+                "scan_fly_fast.toml:",
+                "key `observe.sample_rate_hz`",
+                "2000 Hz gives fewer than two samples per period of the fastest mode (1500.0000 Hz in machine.modes of the axes the run moves: x, y)",
+                "at least 3000.0000 Hz",
+            ],
+        ),
+        Case::line(
+            "the same scan at 3000 Hz",
+            "run scan_fly_seen.toml --case 0 --backend modal --out o_seen/t.csv",
+            &["o_seen"],
+            Expect::answered(&["axis y: residual_peak_um"]),
+        ),
+        refused(
+            "[gcode] on a machine whose z mode is above Nyquist",
+            "sweep gcode_z_fast.toml --backend modal --out o",
+            &[
+                "gcode_z_fast.toml:",
+                "key `observe.sample_rate_hz`",
+                "(3000.0000 Hz in machine.modes of the axes the run moves: x, y, z)",
+                "at least 6000.0000 Hz",
+            ],
+        ),
         refused(
             "gcode on prose",
             "gcode prose.gcode --machine printer_xy --out o",

@@ -6,7 +6,9 @@
 //! machine file each command reads, inline and swept); microsteps per mm of 0 and -100
 //! for the TMC4361A's registers; and memory that would grow with
 //! the job (the ringing map of a layer of 3,200 long lines, which must stay
-//! under the suite's 1 GiB like every case).
+//! under the suite's 1 GiB like every case); shapers above the fastest mode a machine may
+//! have (50 kHz: `[shaper]`, `[tune.axis.x]`, `tune.frequency_scales`) or above the 1 kHz
+//! a G-code replay takes (`settle gcode --shaper`).
 
 use super::sandbox::SCENARIO;
 use super::{Case, Expect, Sandbox, check_all};
@@ -129,6 +131,30 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "\"machine.modes.0.frequency_hz\" = [40.0, 1e6]",
         ),
     );
+    // Shapers far above every mode a machine may have (50 kHz): in `[shaper]`, as a
+    // `[tune.axis.x]` current setting, and as a multiple of the 40 Hz mode.
+    sb.write(
+        "shaper_fast.toml",
+        &(SCENARIO.to_string() + "[shaper]\ntype = \"mzv\"\nfrequency_hz = 1e300\n"),
+    );
+    let tune = |table: &str| {
+        scenario_with("[sweep]\nprofile = [\"trapezoid\", \"scurve\"]\n", "")
+            + "[tune]\ndistances_mm = [5.0]\njerk_steps = 2\nkinds = [\"scurve\"]\nshapers = [\"mzv\"]\n"
+            + table
+    };
+    sb.write(
+        "tune_current_fast.toml",
+        &tune("[tune.axis.x]\nshaper = \"mzv\"\nfrequency_hz = 1e300\n"),
+    );
+    sb.write(
+        "tune_scale_fast.toml",
+        &tune("frequency_scales = [1.0, 1e300]\n"),
+    );
+    // 1250 x 40 Hz = 50 kHz, the bound itself: searched (the shaper shapes nothing).
+    sb.write(
+        "tune_scale_edge.toml",
+        &tune("frequency_scales = [1250.0]\n"),
+    );
     let gcode = |what: &str, more: &[&str], parts: &[&str]| {
         let mut a = vec![
             "gcode",
@@ -161,6 +187,45 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             &["--sample-rate-hz", "above the limit of 100000 Hz"],
         ),
         gcode("--maps 1000000", &["--maps", "1000000"], &["--maps"]),
+        gcode(
+            "--shaper mzv@1e300",
+            &["--shaper", "mzv@1e300"],
+            &["--shaper", "`mzv@1e300`", "above 1000 Hz"],
+        ),
+        gcode(
+            "--shaper x=mzv@48,y=ei@1001",
+            &["--shaper", "x=mzv@48,y=ei@1001"],
+            &["--shaper", "`ei@1001`: 1001 Hz is above 1000 Hz"],
+        ),
+        refused(
+            "shaper.frequency_hz = 1e300",
+            "sweep shaper_fast.toml --backend modal --out o",
+            &[
+                "shaper_fast.toml:",
+                "key `shaper.frequency_hz`",
+                "1e300 Hz is above 50000 Hz",
+            ],
+        ),
+        refused(
+            "tune with a current shaper of 1e300 Hz",
+            "tune tune_current_fast.toml --out o",
+            &["key `tune.axis.x.shaper`", "1e300 Hz is above 50000 Hz"],
+        ),
+        refused(
+            "tune.frequency_scales = [1, 1e300]",
+            "tune tune_scale_fast.toml --out o",
+            &[
+                "key `tune.frequency_scales`",
+                "1e300 times the 40.0 Hz mode",
+                "above 50000 Hz",
+            ],
+        ),
+        Case::line(
+            "tune.frequency_scales = [1250] (a 50 kHz shaper, the bound)",
+            "tune tune_scale_edge.toml --out o_edge",
+            &["o_edge"],
+            Expect::answered(&["+mzv@50000.0Hz"]),
+        ),
         refused(
             "sim.max_step_s = 1e-300",
             "sweep step.toml --backend rapier --out o",
