@@ -22,7 +22,9 @@ use settle_identify::SweepTest;
 use settle_identify::read::{FileData, klipper_psd};
 use settle_identify::welch::klipper_response;
 use settle_planner::shaper::ShaperType;
-use settle_planner::shaper_select::{CalibrationData, SelectOptions, Selection, find_best_shaper};
+use settle_planner::shaper_select::{
+    CalibrationData, MAX_SHAPER_FREQ_HZ, SelectOptions, Selection, find_best_shaper,
+};
 
 use crate::error::Error;
 use crate::output::atomic::{create_dir, write_atomic};
@@ -206,13 +208,23 @@ pub fn load(path: &Path) -> Result<Vec<CalibrationData>, Error> {
     }
 }
 
+/// The highest frequency a recording's spectrum must show for Klipper's fit (Hz): the top
+/// of Klipper's resonance test (`max_freq` of `[resonance_tester]`, 135 Hz,
+/// [`SweepTest::klipper`]) and of the shaper frequencies the fit tries
+/// (`MAX_SHAPER_FREQ` of shaper_calibrate.py, 150 Hz, [`MAX_SHAPER_FREQ_HZ`]), whichever
+/// is higher. Below the first the spectrum cannot show the resonances the test excites;
+/// below the second the fit can place a shaper at a frequency the recording does not
+/// resolve (a 125 Hz resonance sampled at 280 Hz had its `ei`, `2hump_ei` and `3hump_ei`
+/// fitted at 149.8, 145.8 and 149.8 Hz, above the recording's 140 Hz Nyquist frequency).
+fn fit_top_hz() -> f64 {
+    SweepTest::klipper().freq_end_hz.max(MAX_SHAPER_FREQ_HZ)
+}
+
 /// A raw recording sampled at `sample_rate_hz` resolves frequencies up to its Nyquist
-/// frequency only: below the top of Klipper's resonance test (`max_freq` of
-/// `[resonance_tester]`, [`SweepTest::klipper`]), it cannot show the resonances the test
-/// excites, and a shaper fitted to its spectrum (Klipper's fit scores shapers up to
-/// 200 Hz) answers for what it never saw. Refused, with the rate that would do.
+/// frequency only: at or below [`fit_top_hz`], a shaper fitted to its spectrum answers
+/// for what it never saw. Refused, with the rate that would do.
 fn sees_the_test(path: &Path, sample_rate_hz: f64) -> Result<(), Error> {
-    let top_hz = SweepTest::klipper().freq_end_hz;
+    let top_hz = fit_top_hz();
     let nyquist_hz = sample_rate_hz / 2.0;
     if nyquist_hz > top_hz {
         return Ok(());
@@ -220,7 +232,8 @@ fn sees_the_test(path: &Path, sample_rate_hz: f64) -> Result<(), Error> {
     Err(Error::input(
         path,
         format!(
-            "sampled at {sample_rate_hz:.1} Hz, it resolves frequencies up to {nyquist_hz:.1} Hz (Nyquist), not the {top_hz:.0} Hz at the top of Klipper's resonance test: a shaper fitted to it would answer for resonances it cannot show; record at more than {:.0} Hz (an ADXL345 records at 3,200 Hz)",
+            "sampled at {sample_rate_hz:.1} Hz, it resolves frequencies up to {nyquist_hz:.1} Hz (Nyquist), not the {top_hz:.0} Hz up to which Klipper's fit places shapers (its resonance test stops at {:.0} Hz): a shaper fitted to it would answer for frequencies it cannot show; record at more than {:.0} Hz (an ADXL345 records at 3,200 Hz)",
+            SweepTest::klipper().freq_end_hz,
             2.0 * top_hz
         ),
     ))
@@ -228,18 +241,19 @@ fn sees_the_test(path: &Path, sample_rate_hz: f64) -> Result<(), Error> {
 
 /// A processed spectrum (a PSD CSV) whose rows end at `last_hz`: [`sees_the_test`] for
 /// spectra. calibrate_shaper.py writes its rows up to 200 Hz (every file of the corpus
-/// ends at 198.5-199.9 Hz); one that ends below the top of Klipper's resonance test
-/// (a cut copy) holds nothing of the resonances above its end, and a shaper fitted to it
-/// answers for them. Refused, with the range that would do.
+/// ends at 198.5-199.9 Hz); one that ends below [`fit_top_hz`] (a cut copy) holds nothing
+/// of the resonances above its end, and a shaper fitted to it answers for them. Refused,
+/// with the range that would do.
 fn spectrum_sees_the_test(path: &Path, last_hz: Option<f64>) -> Result<(), Error> {
-    let top_hz = SweepTest::klipper().freq_end_hz;
+    let top_hz = fit_top_hz();
     match last_hz {
         Some(last) if last >= top_hz => Ok(()),
         _ => Err(Error::input(
             path,
             format!(
-                "its spectrum ends at {:.1} Hz, below the {top_hz:.0} Hz at the top of Klipper's resonance test: a shaper fitted to it would answer for resonances it does not show; give the whole file (calibrate_shaper.py writes its rows up to 200 Hz)",
-                last_hz.unwrap_or(0.0)
+                "its spectrum ends at {:.1} Hz, below the {top_hz:.0} Hz up to which Klipper's fit places shapers (its resonance test stops at {:.0} Hz): a shaper fitted to it would answer for frequencies it does not show; give the whole file (calibrate_shaper.py writes its rows up to 200 Hz)",
+                last_hz.unwrap_or(0.0),
+                SweepTest::klipper().freq_end_hz
             ),
         )),
     }

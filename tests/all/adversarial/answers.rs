@@ -138,6 +138,18 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         .map(|(_, l)| l)
         .collect();
     sb.write("slow_x.csv", &(slow.join("\n") + "\n"));
+    // The example recording at about 280 Hz (sample round(k * 800 / 280) kept): Nyquist
+    // 140 Hz, above the 135 Hz top of Klipper's resonance test but below the 150 Hz up to
+    // which its fit places shapers.
+    let data: Vec<&str> = rec.lines().filter(|l| !l.starts_with('#')).collect();
+    let mut edge: Vec<&str> = rec.lines().filter(|l| l.starts_with('#')).collect();
+    edge.extend(
+        (0..)
+            .map(|k: usize| (k as f64 * 800.0 / 280.0).round() as usize)
+            .take_while(|&j| j < data.len())
+            .map(|j| data[j]),
+    );
+    sb.write("edge_x.csv", &(edge.join("\n") + "\n"));
     // The example recording with every acceleration held at one value: a machine that
     // never moved (or a sensor that read a constant).
     let still: Vec<String> = rec
@@ -382,7 +394,18 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
                 "slow_x.csv",
                 "sampled at 50.",
                 "Nyquist",
-                "more than 270 Hz",
+                "more than 300 Hz",
+            ],
+        ),
+        refused(
+            "tune --criterion klipper on a recording sampled at 280 Hz",
+            "tune --criterion klipper edge_x.csv",
+            &[
+                "edge_x.csv",
+                "sampled at 280.",
+                "140.1 Hz (Nyquist)",
+                "150 Hz up to which Klipper's fit places shapers",
+                "more than 300 Hz",
             ],
         ),
         // Klipper's remaining vibration is 0 / 0 there: no "0 %" and no input_shaper.cfg.
@@ -407,7 +430,7 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
         refused(
             "tune --criterion klipper on a spectrum that ends at 90 Hz",
             "tune --criterion klipper cut_x.csv",
-            &["cut_x.csv", "ends at 89.9 Hz", "below the 135 Hz", "200 Hz"],
+            &["cut_x.csv", "ends at 89.9 Hz", "below the 150 Hz", "200 Hz"],
         ),
         refused(
             "identify a resonance sweep without its test's options",
