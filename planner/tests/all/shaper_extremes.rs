@@ -126,6 +126,30 @@ fn marlin_ft_motion_at_damping_0_9() {
     };
     assert_train(&marlin(MarlinShaper::Zv), &zv, &n(2, 29.0), 1e-12);
     assert_train(&marlin(MarlinShaper::Zvd), &zvd, &n(3, 29.0), 1e-12);
+    // ZVDD [1, 3K, 3K^2, K^3] and ZVDDD [1, 4K, 6K^2, 4K^3, K^4].
+    assert_train(
+        &marlin(MarlinShaper::Zvdd),
+        &[
+            9.954426282e-01,
+            4.550434496e-03,
+            6.933751050e-06,
+            3.521781173e-09,
+        ],
+        &n(4, 29.0),
+        1e-12,
+    );
+    assert_train(
+        &marlin(MarlinShaper::Zvddd),
+        &[
+            9.939281245e-01,
+            6.058015059e-03,
+            1.384640356e-05,
+            1.406569201e-08,
+            5.358170019e-12,
+        ],
+        &n(5, 29.0),
+        1e-12,
+    );
     // MZV: [1, sqrt2 K, K^2] with ZV's K.
     assert_train(
         &marlin(MarlinShaper::Mzv),
