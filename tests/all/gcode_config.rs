@@ -140,15 +140,16 @@ fn a_configuration_settle_cannot_follow_exits_2_and_writes_nothing() {
 /// A setting the job cannot use is named at the line of the configuration that set it,
 /// with its key and what is allowed, exit 2, nothing written: the old binary named a
 /// config.g's `M593` and `M669`, and a printer.cfg's shaper frequency, without a line
-/// (`c.g: key M593: ...`), and took Marlin's `M92 X0.0000001` and `M493 A1e308` and
-/// GRBL's `$100=0.0000001` (at 1e-7 steps/mm a move is no whole step: it reported 60 mm
-/// of error as measured).
+/// (`c.g: key M593: ...`), and took Marlin's `M92 X0.0000001`, `M493 A1e308`, `M494
+/// X0.5` (Marlin's M494 takes 0 to 0.1 s) and `M205 B5000000` (a block stretched to 5 s)
+/// and GRBL's `$100=0.0000001` (at 1e-7 steps/mm a move is no whole step: it reported
+/// 60 mm of error as measured).
 #[test]
 fn a_configurations_bad_setting_is_named_at_its_line() {
     let dir = tempfile::tempdir().expect("tempdir");
     let d = dir.path();
     let gcode = write(d, "m.gcode", "G90\nM83\nG1 X10 F6000\nG1 X20 E1\n");
-    let cases: [(&str, &str, &str, &str, &str); 7] = [
+    let cases: [(&str, &str, &str, &str, &str); 9] = [
         (
             "c.g",
             "M92 X80 Y80\n; RepRapFirmware's M593 takes F from 5.722 to 1000 Hz\nM593 P\"ei3\" F2000 S0.1\n",
@@ -190,6 +191,20 @@ fn a_configurations_bad_setting_is_named_at_its_line() {
             "marlin",
             "zeta.txt:2: key `M493.I`",
             "0.01 to below 1",
+        ),
+        (
+            "smooth.txt",
+            "echo:  M203 X500 Y500\necho:; FT Motion:\necho:  M494 T0 X0.5 Y0 Z0 E0.02\n",
+            "marlin",
+            "smooth.txt:3: key `M494.X`",
+            "0 to 0.1 s",
+        ),
+        (
+            "segment.txt",
+            "echo:  M203 X500 Y500\necho:  M205 B5000000.00 S0.00 T0.00 J0.08\n",
+            "marlin",
+            "segment.txt:2: key `M205.B`",
+            "0 to 1000000 us",
         ),
         (
             "grbl.txt",

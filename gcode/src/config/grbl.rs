@@ -77,6 +77,10 @@ impl Default for GrblSettings {
     }
 }
 
+/// Why `$30` at or below `$31` is refused: GRBL then has no PWM range, and the two GRBLs
+/// disagree on whether `S0` works the material.
+const NO_PWM_RANGE: &str = "$30 above $31 (set $31 first when lowering both): with $30 at or below $31 GRBL has no PWM range and runs the spindle or laser at full power for every S, S0 included (spindle_compute_pwm_value, gnea/grbl grbl/spindle_control.c), where grblHAL turns it off at S0 (spindle_set_rpm, spindle_control.c): which moves work is not known";
+
 impl GrblSettings {
     /// GRBL's `DEFAULTS_GENERIC` (grbl/defaults.h): 250 steps/mm, 500 mm/min,
     /// 10 mm/s^2, 200 mm of travel on every axis, junction deviation 0.01 mm, arc
@@ -129,6 +133,8 @@ impl GrblSettings {
             12 => self.arc_tolerance_mm = positive(value)?,
             20 => self.soft_limits = value.trunc() != 0.0,
             22 => self.homing = value.trunc() != 0.0,
+            30 if value <= self.spindle_min => return Err(NO_PWM_RANGE),
+            31 if value >= self.spindle_max => return Err(NO_PWM_RANGE),
             30 => self.spindle_max = value,
             31 => self.spindle_min = value,
             32 => self.laser_mode = value.trunc() == 1.0,
@@ -232,6 +238,28 @@ impl GrblSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `$30` at or below `$31` leaves GRBL no PWM range (gnea/grbl
+    /// `spindle_compute_pwm_value` fires at full power even at S0; grblHAL's
+    /// `spindle_set_rpm` turns S0 off): refused at its line. The old reader took `$30=0`.
+    #[test]
+    fn a_spindle_range_without_width_is_refused_at_its_line() {
+        for (text, line) in [
+            ("$30=0\n$31=0\n", 1),
+            ("$30=1000\n$31=1000\n", 2),
+            ("$31=200\n$30=100\n", 2),
+        ] {
+            let e = GrblSettings::parse(text, "g.txt")
+                .expect_err(text)
+                .to_string();
+            assert!(
+                e.contains(&format!("g.txt:{line}")) && e.contains("no PWM range"),
+                "{text}: {e}"
+            );
+        }
+        let s = GrblSettings::parse("$31=100\n$30=24000\n", "g.txt").expect("a range");
+        assert_eq!((s.spindle_min, s.spindle_max), (100.0, 24000.0));
+    }
 
     #[test]
     fn a_settings_dump_sets_the_planner() {

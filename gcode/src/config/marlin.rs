@@ -39,9 +39,12 @@ use crate::error::{GcodeError, Location};
 use crate::job::driver::{Driver, LimitOutcome};
 use crate::job::shapers::ShaperState;
 use crate::job::{JobConfig, PlannerConfig, PrusaPrinter, ShaperSetting};
+use crate::read::cmd::Check;
 use crate::read::dialect::Dialect;
 use crate::read::event::{EventKind, Note};
-use crate::read::limit_parse::{FT_DAMPING, FT_FREQUENCY, STEPS_PER_MM};
+use crate::read::limit_parse::{
+    FT_DAMPING, FT_FREQUENCY, FT_OVERSHOOT, FT_SMOOTHING_S, STEPS_PER_MM,
+};
 use crate::read::limits::LimitChange;
 use settle_planner::firmware::Firmware;
 
@@ -246,25 +249,34 @@ fn steps_words(text: &str, at: &Location, steps: &mut [Option<f64>; 4]) -> Resul
     Ok(())
 }
 
-/// An `M493` line of the reply: not followed (FT_MOTION's settings are the job's own
-/// `M493`), but its frequency `A`, damping `I` and tolerance `Q` are held to what the
-/// job's `M493` takes ([`FT_FREQUENCY`], [`FT_DAMPING`], 0 to 1), so a value Marlin
-/// would refuse is named at its line. The other words differ between Marlin's versions
-/// (2.1.2 reported `M493 S<mode> P K`) and are not read.
-fn ft_words(text: &str, at: &Location) -> Result<(), GcodeError> {
+/// An `M493` or `M494` line of the reply: not followed (FT_MOTION's settings are the
+/// job's own `M493`/`M494`), but the words Marlin's commands bound are held to what the
+/// job's take, so a value Marlin would refuse is named at its line: `M493`'s frequency
+/// `A`, damping `I` and tolerance `Q` ([`FT_FREQUENCY`], [`FT_DAMPING`], 0 to 1), `M494`'s
+/// trajectory `T` (0 to 2), overshoot `O` ([`FT_OVERSHOOT`]) and smoothing times `X Y Z E`
+/// ([`FT_SMOOTHING_S`]). The other words differ between Marlin's versions (2.1.2
+/// reported `M493 S<mode> P K`) and are not read.
+fn ft_words(command: &str, text: &str, at: &Location) -> Result<(), GcodeError> {
+    const TRAJECTORY: Check = Check {
+        ok: |v| v == 0.0 || v == 1.0 || v == 2.0,
+        allowed: "0, 1 or 2 (TRAPEZOIDAL, POLY5, POLY6): Marlin's M494 refuses another trajectory type (Marlin/src/gcode/feature/ft_motion/M494.cpp)",
+    };
     let code = text.split(';').next().unwrap_or("");
     for w in code.split_whitespace().skip(1) {
         let (letter, value) = w.split_at(w.chars().next().map_or(0, char::len_utf8));
-        let check = match letter.to_ascii_uppercase().as_str() {
-            "A" => FT_FREQUENCY,
-            "I" => FT_DAMPING,
-            "Q" => crate::read::cmd::FRACTION,
+        let check = match (command, letter.to_ascii_uppercase().as_str()) {
+            ("M493", "A") => FT_FREQUENCY,
+            ("M493", "I") => FT_DAMPING,
+            ("M493", "Q") => crate::read::cmd::FRACTION,
+            ("M494", "T") => TRAJECTORY,
+            ("M494", "O") => FT_OVERSHOOT,
+            ("M494", "X" | "Y" | "Z" | "E") => FT_SMOOTHING_S,
             _ => continue,
         };
         if !value.parse::<f64>().is_ok_and(|v| (check.ok)(v)) {
             return Err(GcodeError::ConfigValue {
                 at: at.clone(),
-                section: "M493".into(),
+                section: command.into(),
                 key: letter.to_string(),
                 value: value.into(),
                 allowed: check.allowed.into(),
@@ -408,8 +420,8 @@ impl MarlinSettings {
                             });
                     }
                     Some(c) => {
-                        if c == "M493" {
-                            ft_words(t, &at(line))?;
+                        if c == "M493" || c == "M494" {
+                            ft_words(&c, t, &at(line))?;
                         }
                         if unused.insert(c.clone()) {
                             let text = match unused_reason(&c) {
@@ -931,6 +943,23 @@ mod tests {
                 "m503.txt:2",
                 "0 to 1",
             ),
+            // M494 likewise (the old reader only noted it), and M205 B, which is followed.
+            (
+                "M203 X300\necho:  M494 T2 X0 Y0 Z0 E0.02 O2\n",
+                "m503.txt:2",
+                "1.25 to 1.875",
+            ),
+            ("M203 X300\necho:  M494 T3\n", "m503.txt:2", "0, 1 or 2"),
+            (
+                "M203 X300\necho:  M494 X0.2 Y0 Z0 E0.02\n",
+                "m503.txt:2",
+                "0 to 0.1 s",
+            ),
+            (
+                "M203 X300\necho:  M205 B2000000.00 S0.00 T0.00 J0.08\n",
+                "m503.txt:2",
+                "0 to 1000000 us",
+            ),
             ("M203 X300\nM593 X F40 D1.5\n", "m503.txt:2", "M593"),
             ("echo:  G20 ; (in)\nM203 X10\n", "m503.txt:1", "G20"),
             (
@@ -952,15 +981,20 @@ mod tests {
     /// number, `P`, `K`) is only noted.
     #[test]
     fn values_at_the_ends_of_their_ranges_are_read() {
-        let text = "M92 X1 Y1000000 Z400 E93\nM493 S1 P0 K0\nM493 X C1 A10 I0.01 Q0\nM493 Y C1 A500 I0.99 Q1\nM493 S10\n";
+        let text = "M92 X1 Y1000000 Z400 E93\nM493 S1 P0 K0\nM493 X C1 A10 I0.01 Q0\nM493 Y C1 A500 I0.99 Q1\nM493 S10\nM494 T2 X0 Y0.1 Z0 E0.02 O1.875\nM494 X0.1 Y0 Z0 E0\n";
         let s = MarlinSettings::parse(text, "m503.txt").expect("read");
         assert_eq!(
             s.steps_per_mm,
             [Some(1.0), Some(1e6), Some(400.0), Some(93.0)]
         );
-        assert_eq!(s.notes.len(), 1, "{:?}", s.notes);
+        assert_eq!(s.notes.len(), 2, "{:?}", s.notes);
         assert!(
             s.notes[0].text.starts_with("M493 (FT_MOTION"),
+            "{:?}",
+            s.notes
+        );
+        assert!(
+            s.notes[1].text.starts_with("M494 (FT_MOTION"),
             "{:?}",
             s.notes
         );

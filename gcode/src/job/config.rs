@@ -255,6 +255,7 @@ impl JobConfig {
         o.layers = self.layer_mode;
         if let PlannerConfig::Grbl(g) = &self.planner {
             o.laser_mode = g.laser_mode;
+            o.spindle_range = [g.spindle_min, g.spindle_max];
         }
         o
     }

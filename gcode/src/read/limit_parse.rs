@@ -42,6 +42,38 @@ pub(crate) const FT_DAMPING: Check = Check {
     allowed: "0.01 to below 1: Marlin's M493 refuses a damping ratio outside 0.01 to 1 (Marlin/src/gcode/feature/ft_motion/M493.cpp), and at 1 its shapers divide by sqrt(1 - zeta^2) = 0",
 };
 
+/// Marlin's `M494 O`, the POLY6 trajectory's acceleration overshoot: `M494` takes 1.25 to
+/// 1.875 and answers `?Invalid` and keeps the old value otherwise
+/// (Marlin/src/gcode/feature/ft_motion/M494.cpp, `GcodeSuite::M494`).
+pub(crate) const FT_OVERSHOOT: Check = Check {
+    ok: |v| (1.25..=1.875).contains(&v),
+    allowed: "1.25 to 1.875: Marlin's M494 refuses another POLY6 acceleration overshoot and keeps the old one (Marlin/src/gcode/feature/ft_motion/M494.cpp)",
+};
+
+/// Marlin's `M494 X Y Z E`, the FT_MOTION smoothing time per axis, s: `M494` takes 0 to
+/// `FTM_MAX_SMOOTHING_TIME` and answers `?Invalid` and keeps the old time otherwise
+/// (M494.cpp; `FTMotion::set_smoothing_time` in Marlin/src/module/ft_motion.cpp), and
+/// every Configuration_adv.h Marlin ships sets `FTM_MAX_SMOOTHING_TIME` to 0.10 s (a
+/// longer one costs `FTM_FS` samples of RAM a second, ft_motion.h `ftm_smooth_max_i`).
+pub(crate) const FT_SMOOTHING_S: Check = Check {
+    ok: |v| (0.0..=0.1).contains(&v),
+    allowed: "0 to 0.1 s: Marlin's M494 refuses a smoothing time above FTM_MAX_SMOOTHING_TIME (0.10 s in Marlin's Configuration_adv.h) and keeps the old one (Marlin/src/gcode/feature/ft_motion/M494.cpp)",
+};
+
+/// Marlin's `M205 B`, the minimum segment time, µs. Marlin stores it in a `uint32_t`
+/// without a bound (`GcodeSuite::M205`, Marlin/src/gcode/config/M200-M205.cpp), and
+/// `SLOWDOWN` (`Planner::_populate_block`, Marlin/src/module/planner.cpp) stretches a block
+/// shorter than it, while 2 to `BLOCK_BUFFER_SIZE / 2 - 1` blocks are queued, to
+/// `segment + 2 (B - segment) / queued`: with 2 queued, to B itself. Its int32 arithmetic
+/// (`2 * time_diff`) overflows from 2^30 µs (18 minutes). Settle takes up to 1 s, 50 times
+/// `DEFAULT_MINSEGMENTTIME` (20000 µs in every Configuration.h Marlin and
+/// Prusa-Firmware-Buddy ship): a second per short block is a printer stopping at every
+/// segment of a curve, no setting a printer runs with.
+pub(crate) const MIN_SEGMENT_TIME_US: Check = Check {
+    ok: |v| (0.0..=1e6).contains(&v),
+    allowed: "0 to 1000000 us (1 s): Marlin's default is 20000 us (DEFAULT_MINSEGMENTTIME); SLOWDOWN stretches a short block to as long as B while the queue drains (Planner::_populate_block), so a B of more than a second would make the printer crawl a second per segment of every curve, and from 2^30 us Marlin's own arithmetic overflows",
+};
+
 /// A shaper frequency in a job (Marlin's `M593 F`, Klipper's `SET_INPUT_SHAPER
 /// SHAPER_FREQ_*`): 0 (off), or 1 Hz (settle's lowest,
 /// `settle_planner::shaper::MIN_FREQUENCY_HZ`) to [`crate::config::MAX_SHAPER_FREQUENCY_HZ`],
@@ -222,7 +254,7 @@ pub(crate) fn m_code(
                 jerk_mm_s: axes(cmd, p, NON_NEGATIVE, 1.0)?,
                 min_feedrate_mm_s: cmd.num(p, b'S', NON_NEGATIVE)?,
                 min_travel_feedrate_mm_s: cmd.num(p, b'T', NON_NEGATIVE)?,
-                min_segment_time_s: cmd.num(p, b'B', NON_NEGATIVE)?.map(|us| us * 1e-6),
+                min_segment_time_s: cmd.num(p, b'B', MIN_SEGMENT_TIME_US)?.map(|us| us * 1e-6),
             })
         }
         (Rrf, 205 | 566) => {
@@ -325,8 +357,8 @@ pub(crate) fn m_code(
             cmd.allow(p, b"TOXYZE", "T (0-2) O (overshoot) X Y Z E (s)")?;
             limits(LimitChange::FtSmoothing {
                 trajectory: small(cmd, p, b'T', 2, "0 to 2")?,
-                overshoot: cmd.num(p, b'O', POSITIVE)?,
-                smoothing_s: axes(cmd, p, NON_NEGATIVE, 1.0)?,
+                overshoot: cmd.num(p, b'O', FT_OVERSHOOT)?,
+                smoothing_s: axes(cmd, p, FT_SMOOTHING_S, 1.0)?,
             })
         }
         _ => Ok(Outcome::Unknown),

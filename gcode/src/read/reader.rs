@@ -45,6 +45,11 @@ pub struct ReaderOptions {
     /// GRBL: the laser mode (`$32=1`) at the start of the file (off by default, as GRBL
     /// ships; the file's own `$32` lines change it).
     pub laser_mode: bool,
+    /// GRBL: `$31` and `$30`, the `S` of the least and of full spindle speed or laser
+    /// power, at the start of the file (0 and 1000, GRBL's defaults.h; the file's own
+    /// `$30`/`$31` lines change them). An `S` outside them is noted: GRBL runs it at the
+    /// nearer end.
+    pub spindle_range: [f64; 2],
 }
 
 impl ReaderOptions {
@@ -59,6 +64,7 @@ impl ReaderOptions {
             max_extruder_mm: 1e9,
             kept_errors: 20,
             laser_mode: false,
+            spindle_range: [0.0, 1000.0],
         }
     }
 }
@@ -199,7 +205,7 @@ impl<R: BufRead> Reader<R> {
             ignored: BTreeMap::new(),
             name_buf: String::new(),
             skipped: Skipped::default(),
-            grbl: GrblState::new(options.laser_mode),
+            grbl: GrblState::new(options.laser_mode, options.spindle_range),
             words_buf: String::new(),
             block_out: Vec::new(),
             features: vec![String::new()],

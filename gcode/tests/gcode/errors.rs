@@ -469,6 +469,86 @@ fn marlin_m493_values_are_bounded_at_their_line() {
     assert_eq!(crate::limits(text, Dialect::Marlin).len(), 2);
 }
 
+/// Marlin's `M494` (FT_MOTION's trajectory and smoothing): an overshoot `O` outside 1.25
+/// to 1.875 and a smoothing time `X Y Z E` outside 0 to 0.1 s (`FTM_MAX_SMOOTHING_TIME`)
+/// are refused at their word, as Marlin's M494.cpp refuses them (`WITHIN(val, 1.25f,
+/// 1.875f)`, `WITHIN(val, 0.0f, FTM_MAX_SMOOTHING_TIME)`); the old reader took any
+/// positive overshoot and any smoothing time up to 1e9 s.
+#[test]
+fn marlin_m494_values_are_bounded_at_their_line() {
+    for (text, word, value, allowed) in [
+        ("M494 T2 O1.2", "O", 1.2, "1.25 to 1.875"),
+        ("M494 T2 O1.876", "O", 1.876, "1.25 to 1.875"),
+        ("M494 O1000000000", "O", 1e9, "1.25 to 1.875"),
+        ("M494 X0.11", "X", 0.11, "0 to 0.1 s"),
+        ("M494 Y1000000", "Y", 1e6, "0 to 0.1 s"),
+        ("M494 Z0.2", "Z", 0.2, "0 to 0.1 s"),
+        ("M494 X0.01 E0.5", "E", 0.5, "0 to 0.1 s"),
+    ] {
+        match error(text, Dialect::Marlin) {
+            GcodeError::OutOfRange {
+                at,
+                param,
+                value: v,
+                allowed: a,
+                ..
+            } => {
+                assert_eq!((at.line, param.as_str(), v), (1, word, value), "{text}");
+                assert!(
+                    a.starts_with(allowed) && a.contains("M494.cpp"),
+                    "{text}: {a}"
+                );
+            }
+            e => panic!("{text}: {e}"),
+        }
+    }
+    // A negative time and a trajectory type above 2 were refused before and still are.
+    for text in ["M494 X-0.01", "M494 T3"] {
+        assert!(matches!(
+            error(text, Dialect::Marlin),
+            GcodeError::OutOfRange { .. }
+        ));
+    }
+    // The ends of the ranges are read.
+    let text = "M494 T2 O1.25 X0 Y0.1\nM494 O1.875 Z0.1 E0\n";
+    assert_eq!(crate::limits(text, Dialect::Marlin).len(), 2);
+}
+
+/// Marlin's `M205 B` (minimum segment time, µs) in a job: 0 to 1000000 µs. Marlin keeps
+/// any whole number in a `uint32_t` (`GcodeSuite::M205`) and SLOWDOWN stretches a short
+/// block to as long as B (`Planner::_populate_block`); the old reader took up to 1e9 µs
+/// and planned blocks of 1000 s.
+#[test]
+fn marlin_m205_b_is_bounded_at_its_line() {
+    for dialect in [Dialect::Marlin, Dialect::Prusa] {
+        for (text, value) in [
+            ("M205 B1000001", 1_000_001.0),
+            ("M205 B1000000000 S0", 1e9),
+            ("M205 B-1", -1.0),
+        ] {
+            match error(text, dialect) {
+                GcodeError::OutOfRange {
+                    at,
+                    command,
+                    param,
+                    value: v,
+                    allowed,
+                } => {
+                    assert_eq!(
+                        (at.line, command.as_str(), param.as_str(), v),
+                        (1, "M205", "B", value),
+                        "{text}"
+                    );
+                    assert!(allowed.starts_with("0 to 1000000 us"), "{allowed}");
+                }
+                e => panic!("{text}: {e}"),
+            }
+        }
+        let text = "M205 B0\nM205 B1000000 S0\nM205 B20000.00 S0.00 T0.00 J0.08\n";
+        assert_eq!(crate::limits(text, dialect).len(), 3);
+    }
+}
+
 /// A shaper frequency in a job is held to what printer.cfg's `shaper_freq_*` and an
 /// `M503` reply's `M593 F` are held to: 0 (off), or 1 to 1000 Hz. The old reader took
 /// Marlin's `M593 X F1000000000` and Klipper's `SHAPER_FREQ_X=1e9` and replayed the job

@@ -325,3 +325,56 @@ fn a_setting_value_grbl_cannot_read_or_above_1e9_is_refused() {
         .expect("plain decimals");
     assert_eq!((s.accel_mm_s2[0], s.max_rate_mm_min[0]), (1e9, 6000.0));
 }
+
+/// The `S` notes of `text` read with `$31`, `$30` = `range`: (line, reason).
+fn s_notes(text: &str, range: [f64; 2]) -> Vec<(u64, &'static str)> {
+    let opts = ReaderOptions {
+        laser_mode: true,
+        spindle_range: range,
+        ..ReaderOptions::new(Dialect::Grbl)
+    };
+    Reader::new(text.as_bytes(), opts)
+        .map(|e| e.expect("valid"))
+        .filter_map(|e| match e.kind {
+            EventKind::Note(settle_gcode::Note::IgnoredByFirmware { command, reason })
+                if command == "S" =>
+            {
+                Some((e.line, reason))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// GRBL runs an `S` outside `$31..$30` at the nearer end (gnea/grbl
+/// grbl/spindle_control.c `spindle_compute_pwm_value`: `rpm >= rpm_max` gives
+/// `rpm_max`, `0 < rpm <= rpm_min` gives `rpm_min`, `S0` off; grblHAL's
+/// `spindle_set_rpm` the same): which moves work is unchanged, and the file's power is
+/// noted where it is not what runs. The old reader passed `S5000` on a `$30=1000` laser
+/// without a word; negative `S` stays refused (error:4), and GRBL's `read_float`
+/// (grbl/nuts_bolts.c) reads no exponent, so `S1e9` is `S1` followed by a word `E`
+/// GRBL does not have.
+#[test]
+fn s_outside_the_spindle_range_runs_at_its_end_and_is_noted() {
+    let text = "G90\nM4 S5000\nG1 X10 F600\nX20 S1000\nX30 S50\nX40 S0\nM5\n";
+    let notes = s_notes(text, [100.0, 1000.0]);
+    assert_eq!(notes.len(), 2, "{notes:?}");
+    assert_eq!(notes[0].0, 2);
+    assert!(notes[0].1.starts_with("above $30"), "{notes:?}");
+    assert_eq!(notes[1].0, 5);
+    assert!(notes[1].1.contains("below $31"), "{notes:?}");
+    // Which moves work: every feed move with S above 0 (the clamp keeps it above 0).
+    let working: Vec<bool> = laser(text)
+        .into_iter()
+        .filter_map(|k| match k {
+            EventKind::Move(m) => Some(m.is_working()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(working, [true, true, true, false]);
+    // The file's own $30 moves the end: S5000 is within $30=8000.
+    assert!(s_notes("$30=8000\nM4 S5000\nG1 X10 F600\n", [0.0, 1000.0]).is_empty());
+    assert!(err("M3 S-1\n").contains("error:4"));
+    let e = err("M3 S1e9\n");
+    assert!(e.contains("no extruder"), "{e}");
+}

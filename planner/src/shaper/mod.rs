@@ -80,12 +80,18 @@ impl Shaper {
     /// - Klipper: `frequency_hz > 0`; `damping_ratio` in `0..=0.99` (`ei` 0.4, `2hump_ei`
     ///   0.3, `3hump_ei` 0.2: `max_damping_ratio` in shaper_defs.py). Default damping 0.1.
     /// - Marlin: `frequency_hz` in `(0, FTM_FS/2]` (M493 `A`), `damping_ratio` in
-    ///   `0.01..1` (M493 `I` allows 1.0, where the firmware divides by zero). Default 0.1.
+    ///   `0.01..1` (M493 `I` allows 1.0, where the firmware divides by zero), `v_tol` in
+    ///   `0..=1` (M493 `Q`), above 0 for 2HEI (whose first amplitude is 0 / 0 at 0).
+    ///   Default 0.1.
     /// - RepRapFirmware: `frequency_hz` in `step_clock / 131070 ..= 1000` (M593 `F`; 5.72
     ///   Hz on Duet 3), `damping_ratio` in `0..=0.99` (M593 `S`). Default 0.05 (3.6 line).
     /// - Prusa (its EI family): `damping_ratio` below 1 (`input_shaper::get` halts the
-    ///   printer otherwise), `v_tol` above 0 (M593 `R` > 0). Default damping 0.1. Its
+    ///   printer otherwise), `v_tol` above 0 (M593 `R` > 0), at most 1 for 2HUMP_EI
+    ///   (`sqrt(1 - v^2)`). Default damping 0.1. Its
     ///   `M593 F` clamp to 10..=100 Hz (150 on the MINI) is the caller's.
+    ///
+    /// Whatever the firmware, amplitudes that are not all numbers, or whose sum is not
+    /// above 0, are refused: every firmware divides by their sum.
     pub fn new(kind: ShaperType, frequency_hz: f64, damping_ratio: f64) -> Result<Self, PlanError> {
         if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
             return Err(PlanError::NonFinite {
@@ -121,6 +127,12 @@ impl Shaper {
                 if !(0.0..=1.0).contains(&v_tol) {
                     return Err(out_of("v_tol (M493 Q)", 0.0, 1.0, v_tol));
                 }
+                if shaper == MarlinShaper::TwoHei && v_tol as f32 == 0.0 {
+                    return Err(invalid(
+                        kind,
+                        "v_tol (M493 Q) 0: Marlin's 2HEI amplitude (3X^2 + 2X + 3v^2) / (16X) has X = (v^2 (sqrt(1 - v^2) + 1))^(1/3) = 0 and divides 0 by 0 (AxisShaping::set_axis_shaping_A, Marlin/src/module/ft_motion/shaping.cpp); M493 takes Q0 and shapes with NaN: give Q above 0".into(),
+                    ));
+                }
                 marlin::impulses(shaper, frequency_hz, damping_ratio, v_tol, ftm_fs_hz)
             }
             ShaperType::Prusa { shaper, v_tol } => {
@@ -132,6 +144,14 @@ impl Shaper {
                 }
                 if !(v_tol.is_finite() && v_tol > 0.0) {
                     return Err(out_of("v_tol", 0.0, f64::INFINITY, v_tol));
+                }
+                if shaper == PrusaShaper::TwoHumpEi && v_tol as f32 > 1.0 {
+                    return Err(invalid(
+                        kind,
+                        format!(
+                            "v_tol {v_tol} (1 / M593 R) above 1: Buddy's 2HUMP_EI takes sqrt(1 - v^2) of it (input_shaper::get, lib/Marlin/Marlin/src/feature/input_shaper/input_shaper.cpp), which is no number; M593 takes any R above 0 and shapes with NaN: give R of 1 or more"
+                        ),
+                    ));
                 }
                 prusa::impulses(shaper, frequency_hz, damping_ratio, v_tol)
             }
@@ -169,6 +189,18 @@ impl Shaper {
                 }
             }
         };
+        // Every amplitude a number and their sum positive: the firmwares divide by the sum
+        // (Klipper's C side, Marlin's `adj`, Buddy's `inv_sum_a`), so a train that is not
+        // is no motion any of them runs.
+        let sum: f64 = amplitudes.iter().sum();
+        if amplitudes.iter().any(|a| !a.is_finite()) || !(sum.is_finite() && sum > 0.0) {
+            return Err(invalid(
+                kind,
+                format!(
+                    "the firmware's impulse amplitudes at {frequency_hz} Hz and damping {damping_ratio} are not numbers summing above 0: {amplitudes:?}"
+                ),
+            ));
+        }
         // Klipper's step generation refuses impulses out of time order (kin_shaper.c);
         // RepRapFirmware runs its ei2/ei3 delays in any order and `rrf::impulses` puts
         // them in time order; the others cannot produce them.

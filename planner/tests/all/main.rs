@@ -25,6 +25,7 @@ mod paths;
 mod pvt;
 mod raster;
 mod rest_to_rest;
+mod shaper_extremes;
 mod shaper_klipper;
 mod shaper_marlin_rrf;
 mod shaper_names;

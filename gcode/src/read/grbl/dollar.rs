@@ -136,9 +136,12 @@ pub(crate) fn line(
     if state.moving {
         return busy(format!("${number}={v}"), out);
     }
-    if number == 32 {
+    match number {
         // grbl/settings.c: any non-zero value; grblHAL's $32 is a mode (1 laser, 2 lathe).
-        state.laser_mode = value.trunc() == 1.0;
+        32 => state.laser_mode = value.trunc() == 1.0,
+        30 => state.spindle_range[1] = value,
+        31 => state.spindle_range[0] = value,
+        _ => {}
     }
     out.push(EventKind::Setting(Setting::Grbl { number, value }));
     Ok(Dollar::Events)

@@ -48,6 +48,8 @@ use words::{Flow, MotionMode, NonModal, Spindle, Words};
 pub(crate) struct GrblState {
     /// `$32`: laser mode.
     pub(crate) laser_mode: bool,
+    /// `$31` and `$30`: the `S` of the least and of full speed or power.
+    pub(crate) spindle_range: [f64; 2],
     motion: MotionMode,
     spindle: Spindle,
     /// The spindle speed / laser power `S`.
@@ -70,10 +72,12 @@ pub(crate) struct GrblState {
 }
 
 impl GrblState {
-    /// GRBL's power-up state; `laser_mode` from the configuration (`$32`).
-    pub(crate) fn new(laser_mode: bool) -> Self {
+    /// GRBL's power-up state; `laser_mode` (`$32`) and `spindle_range` (`$31`, `$30`)
+    /// from the configuration.
+    pub(crate) fn new(laser_mode: bool, spindle_range: [f64; 2]) -> Self {
         Self {
             laser_mode,
+            spindle_range,
             motion: MotionMode::Seek,
             spindle: Spindle::Off,
             s: 0.0,
@@ -183,6 +187,23 @@ impl GrblState {
             && !laser_is_motion
             && self.spindle == Spindle::Cw
             && (self.motion.is_feed() == laser_disable);
+        if let Some(s) = w.s {
+            // GRBL runs an S outside $31..$30 at the nearer end (grbl/spindle_control.c
+            // `spindle_compute_pwm_value`; grblHAL's `spindle_set_rpm` clamps the same),
+            // S0 off: whether the move works is the same, its power is not the file's.
+            let [min, max] = self.spindle_range;
+            if s > max {
+                out.push(EventKind::Note(Note::IgnoredByFirmware {
+                    command: "S".into(),
+                    reason: "above $30: GRBL runs the spindle or laser at $30, full speed or power (spindle_compute_pwm_value, grbl/spindle_control.c); the move works as it would at $30",
+                }));
+            } else if s > 0.0 && s < min {
+                out.push(EventKind::Note(Note::IgnoredByFirmware {
+                    command: "S".into(),
+                    reason: "above 0 and below $31: GRBL runs the spindle or laser at $31, its least speed or power (spindle_compute_pwm_value, grbl/spindle_control.c); the move works as it would at $31",
+                }));
+            }
+        }
         let s = w.s.unwrap_or(self.s);
         if s != self.s || force_sync {
             if self.spindle != Spindle::Off && !laser_is_motion {
