@@ -27,7 +27,10 @@ fn damping_0_1_floors_the_cubic_to_54_of_128() {
     // floor 54: the echo 54/128 = 0.421875, the step 74/128 = 0.578125 (Klipper's
     // K / (1 + K) is 0.4217). The delay 1 / (2 * 50) = 0.01 s, where Klipper's zv waits
     // 0.01 / sqrt(1 - 0.01) = 0.0100504 s, 0.5 % longer.
-    assert_eq!(train(50.0, 0.1), (vec![0.578125, 0.421875], vec![0.0, 0.01]));
+    assert_eq!(
+        train(50.0, 0.1),
+        (vec![0.578125, 0.421875], vec![0.0, 0.01])
+    );
     let klipper = Shaper::new(ShaperType::Zv, 50.0, 0.1).expect("zv");
     assert!((klipper.duration_s() / 0.01 - 1.0 / (1.0f64 - 0.01).sqrt()).abs() < 1e-12);
 }
@@ -54,7 +57,10 @@ fn from_damping_0_8646_the_echo_floors_to_nothing() {
     assert_eq!(train(40.0, 0.95), (vec![1.0], vec![0.0]));
     // The cubic crosses 1 between 0.864 (64.44056192 - 85.5533563 - 5.6591525 +
     // 27.7810417 = 1.00909...) and 0.865 (0.99354...); at 1 it is 0 by definition.
-    assert_eq!(train(40.0, 0.864), (vec![127.0 / 128.0, 1.0 / 128.0], vec![0.0, 0.0125]));
+    assert_eq!(
+        train(40.0, 0.864),
+        (vec![127.0 / 128.0, 1.0 / 128.0], vec![0.0, 0.0125])
+    );
     assert_eq!(train(40.0, 0.865), (vec![1.0], vec![0.0]));
     assert_eq!(train(40.0, 1.0), (vec![1.0], vec![0.0]));
     // M593 refuses D outside 0..=1 ("Zeta (D) value out of range").
