@@ -430,7 +430,8 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
         .enumerate()
         .map(|(i, name)| AxisNow {
             name: name.into(),
-            // M593 is Marlin's ZV (settle-gcode reads it as `zv`); `F0` is no shaper.
+            // M593 is Marlin's stepper ZV (settle-gcode reads it as `marlin:m593`); `F0` is
+            // no shaper.
             shaper: c.shapers[i].map(|s| (s.shaper_type.name(), s.frequency_hz, s.damping_ratio)),
             // Marlin's steps per mm count microsteps; Buddy's `M92` counts its planner's
             // steps (quarter steps of it are planned, PLANNER_STEPS_MULTIPLIER), not the

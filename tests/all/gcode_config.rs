@@ -347,12 +347,15 @@ fn a_marlin_m503_reply_plans_as_its_commands_at_the_files_top() {
     );
     assert_eq!(from_reply.worst_um.to_bits(), written.worst_um.to_bits());
     assert_eq!(from_reply.p95_um.to_bits(), written.p95_um.to_bits());
-    assert_eq!(from_reply.setting, "marlin + X zv@40 Hz, Y zv@35.5 Hz");
+    assert_eq!(
+        from_reply.setting,
+        "marlin + X marlin:m593@40 Hz, Y marlin:m593@35.5 Hz"
+    );
     let (settings, notes) = from_reply.config.as_ref().expect("read");
     assert!(
         settings.ends_with(
             "marlin: M203 X200 Y200 mm/s, M201 X2000 Y2000 mm/s^2, M204 P1200 T1800 mm/s^2, \
-             M205 J0.05 mm, M92 X100 Y100 steps/mm; shaper X zv@40 Hz, Y zv@35.5 Hz"
+             M205 J0.05 mm, M92 X100 Y100 steps/mm; shaper X marlin:m593@40 Hz, Y marlin:m593@35.5 Hz"
         ),
         "{settings}"
     );

@@ -137,7 +137,7 @@ fn junction_deviation_and_classic_jerk_replies_map_onto_the_baseline() {
     let i = import(&opts(jd, &dir.path().join("jd.toml"))).expect("imports");
     let c = &i.current;
     assert_eq!((c.vmax_mm_s, c.amax_mm_s2), (350.0, 2000.0));
-    assert_eq!(c.axes[0].shaper, Some(("zv".into(), 40.5, 0.12)));
+    assert_eq!(c.axes[0].shaper, Some(("marlin:m593".into(), 40.5, 0.12)));
     assert_eq!(c.axes[1].shaper, None, "F0: off");
     assert_eq!(
         (c.axes[0].usteps_per_mm, c.axes[1].usteps_per_mm),
@@ -153,7 +153,7 @@ fn junction_deviation_and_classic_jerk_replies_map_onto_the_baseline() {
     let (sc, _) = settle::load_runs(&dir.path().join("jd.toml")).expect("loads");
     assert_eq!(
         sc.current.get("shaper.type").and_then(|v| v.as_str()),
-        Some("zv")
+        Some("marlin:m593")
     );
     assert_eq!(
         sc.current
@@ -387,7 +387,7 @@ fn the_real_reply_imports_tunes_and_exports_m593_lines() {
             text,
             "{letter}\n{g}\n{md}"
         );
-        assert!(text.starts_with("zv @ "), "{text}");
+        assert!(text.starts_with("marlin:m593 @ "), "{text}");
     }
     assert!(
         md.contains("Marlin (`marlin.gcode`; input shaping, M593)"),
@@ -410,8 +410,8 @@ fn a_reply_with_m593_tunes_its_zv_shapers() {
     );
     let i = import(&opts(reply.clone(), &dir.path().join("m593.toml"))).expect("imports");
     let c = &i.current;
-    assert_eq!(c.axes[0].shaper, Some(("zv".into(), 42.5, 0.15)));
-    assert_eq!(c.axes[1].shaper, Some(("zv".into(), 36.0, 0.08)));
+    assert_eq!(c.axes[0].shaper, Some(("marlin:m593".into(), 42.5, 0.15)));
+    assert_eq!(c.axes[1].shaper, Some(("marlin:m593".into(), 36.0, 0.08)));
     assert!(
         !c.notes.iter().any(|n| n.contains("neither M593 nor M493")),
         "{:?}",
@@ -424,7 +424,7 @@ fn a_reply_with_m593_tunes_its_zv_shapers() {
     );
     assert_eq!(
         row(&md, "x", "current")[3..5],
-        ["zv @ 42.5 Hz (zeta 0.15)", "500"],
+        ["marlin:m593 @ 42.5 Hz (zeta 0.15)", "500"],
         "{md}"
     );
     assert!(!g.contains("M493"), "{g}");

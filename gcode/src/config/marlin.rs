@@ -13,7 +13,7 @@
 //!
 //! The commands the planner uses are followed exactly as the same commands in a G-code
 //! file are ([`crate::job`]'s Marlin rules, the same reader and the same driver): `M203`,
-//! `M201`, `M204`, `M205` and `M593` (Marlin's ZV shaper per axis). `M92` (steps per mm)
+//! `M201`, `M204`, `M205` and `M593` (Marlin's stepper ZV per axis, `marlin:m593`). `M92` (steps per mm)
 //! sets the planner's step counts of X, Y, Z, E, which a G-code file's `M92` does not
 //! (settle's G-code reader does not follow it). `M205` prints `J` in a build with
 //! junction deviation and `X Y Z E` in one with `CLASSIC_JERK` (M205_report): a reply
@@ -815,7 +815,7 @@ mod tests {
         let y = s.shapers[1].expect("Y shaped");
         assert_eq!(
             (x.shaper_type, x.frequency_hz, x.damping_ratio),
-            (ShaperType::Zv, 40.0, 0.15),
+            (ShaperType::MarlinM593, 40.0, 0.15),
             "{what}"
         );
         assert_eq!((y.frequency_hz, y.damping_ratio), (35.5, 0.1), "{what}");

@@ -7,7 +7,8 @@
 //!   `shaper_defs.py` does not know (settle's `marlin:`/`rrf:` names among them) is an
 //!   error, as in `printer.cfg` ([`crate::config`]'s check).
 //! - Marlin `M593` (`Marlin/src/gcode/feature/input_shaping/M593.cpp`): the stepper's ZV
-//!   shaper on X and Y (or the axes named), `F` (0 off) and `D` (0..=1). `M493`
+//!   shaper on X and Y (or the axes named), `F` (0 off) and `D` (0..=1), run as
+//!   Marlin/src/module/stepper.cpp computes it (`marlin:m593`: not Klipper's `zv`). `M493`
 //!   (`Marlin/src/gcode/feature/ft_motion/M493.cpp`): FT_MOTION on or off (`S`), and per
 //!   axis (X and Y unless named) the shaper `C` (0 none, 1..8 ZV..MZV), frequency `A`,
 //!   damping `I`, vibration tolerance `Q`.
@@ -303,7 +304,7 @@ impl ShaperState {
                         a.damping_ratio = z;
                     }
                     if let Some(f) = frequency_hz {
-                        a.shaper_type = Some(ShaperType::Zv);
+                        a.shaper_type = Some(ShaperType::MarlinM593);
                         a.frequency_hz = *f;
                     }
                 }

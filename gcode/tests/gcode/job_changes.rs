@@ -150,19 +150,35 @@ fn expected(
     let taus = |s: &Option<Shaper>| -> Vec<(f64, f64)> {
         match s {
             None => vec![(1.0, 0.0)],
-            Some(s) => {
-                let c: f64 = s.weights().zip(s.times_s()).map(|(w, t)| w * t).sum();
-                s.weights()
-                    .zip(s.times_s())
-                    .map(|(w, t)| (w, t - c))
-                    .collect()
-            }
+            Some(s) => centred(
+                &s.weights()
+                    .zip(s.times_s().iter().copied())
+                    .collect::<Vec<_>>(),
+            ),
         }
     };
+    expected_taus(u, i, t, switch_s, &taus(old), &taus(new))
+}
+
+/// Impulses `(w, T)` as `(w, T - c)`, `c = sum w T` their centroid.
+fn centred(impulses: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let c: f64 = impulses.iter().map(|(w, t)| w * t).sum();
+    impulses.iter().map(|&(w, t)| (w, t - c)).collect()
+}
+
+/// [`expected`] with the old and new shapers as centred impulses `(w, tau)`.
+fn expected_taus(
+    u: &[JobChunk],
+    i: usize,
+    t: f64,
+    switch_s: f64,
+    old: &[(f64, f64)],
+    new: &[(f64, f64)],
+) -> f64 {
     let at_switch = at(u, switch_s)[i];
     let line = |s: f64| at_switch.p + at_switch.v * (s - switch_s);
     let p = |s: f64| at(u, s)[i].p;
-    let a: f64 = taus(old)
+    let a: f64 = old
         .iter()
         .map(|(w, tau)| {
             w * if t - tau <= switch_s {
@@ -172,7 +188,7 @@ fn expected(
             }
         })
         .sum();
-    let b: f64 = taus(new)
+    let b: f64 = new
         .iter()
         .map(|(w, tau)| {
             w * if t - tau >= switch_s {
@@ -270,7 +286,7 @@ fn marlin_and_rrf_shaper_commands_wait_for_a_standstill() {
         marlin.clone(),
         "G1 X50 F6000\nM593 X F40 D0.1\nG1 X100 Y20\n",
         "G1 X50 F6000\nM400\nG1 X100 Y20\n",
-        [setting("zv", 40.0, 0.1), None, None],
+        [setting("marlin:m593", 40.0, 0.1), None, None],
         0.0,
     );
     let mut ft = marlin;
@@ -455,4 +471,43 @@ fn values_a_firmware_refuses_or_raises_are_dropped_or_raised_and_listed() {
     let (_, s) = run(&format!("M220 S0.5\n{base}"), rrf());
     assert_eq!(s.print_time_s, plain.print_time_s);
     not_followed(&s, "M220", "below 1 %");
+}
+
+#[test]
+fn marlin_m593_runs_the_steppers_zv_not_klippers() {
+    // `M593 X F40 D0.5` as Marlin/src/module/stepper.cpp runs it: the echo's share
+    // FLOOR(64.44056192 - 99.02008832 * 0.5 - 7.58095488 * 0.25 + 43.073216 * 0.125) =
+    // FLOOR(18.419) = 18 of 128 (`set_shaping_damping_ratio`), the step keeps 110; the
+    // echo 2 MHz / 2 / 40 = 25000 ticks = 1 / (2 * 40) = 12.5 ms late
+    // (`set_shaping_frequency`). Klipper's zv would wait 12.5 ms / sqrt(1 - 0.25) =
+    // 14.434 ms with K = exp(-0.5 pi / sqrt(0.75)) = 0.16303: [0.85983, 0.14017].
+    let marlin = job(PlannerConfig::Marlin(MarlinConfig::new()));
+    let text = "G1 X50 F6000\nM593 X F40 D0.5\nG1 X100 Y20\n";
+    let (chunks, s) = run(text, marlin.clone());
+    assert_contiguous(&chunks);
+    assert_eq!(s.shaper_changes, 1);
+    let mut plain = marlin;
+    plain.shapers = [None; 3];
+    let (u, su) = run("G1 X50 F6000\nM400\nG1 X100 Y20\n", plain);
+    assert_rel("print time", s.print_time_s, su.print_time_s, 1e-12);
+    let switch_s = u[0].moves[0].end_time_s();
+    let hand = centred(&[(110.0 / 128.0, 0.0), (18.0 / 128.0, 0.0125)]);
+    let k = (-0.5 * std::f64::consts::PI / 0.75f64.sqrt()).exp();
+    let klipper = centred(&[
+        (1.0 / (1.0 + k), 0.0),
+        (k / (1.0 + k), 0.0125 / 0.75f64.sqrt()),
+    ]);
+    let end = chunks.last().map(JobChunk::end_time_s).expect("chunks");
+    let mut apart = 0.0f64;
+    for n in 0..=3000 {
+        let t = chunks[0].start_time_s + (end - chunks[0].start_time_s) * n as f64 / 3000.0;
+        let got = at(&chunks, t)[0].p;
+        let want = expected_taus(&u, 0, t, switch_s, &[(1.0, 0.0)], &hand);
+        assert!((got - want).abs() < 1e-12, "t {t}: {got} vs {want}");
+        let zv = expected_taus(&u, 0, t, switch_s, &[(1.0, 0.0)], &klipper);
+        apart = apart.max((got - zv).abs());
+    }
+    // Klipper's zv would put X up to 1.0e-5 mm elsewhere (its later, smaller echo), ten
+    // million times the agreement above: the job does not run it.
+    assert!(apart > 5e-6, "{apart}");
 }

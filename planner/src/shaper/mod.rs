@@ -11,7 +11,9 @@
 //! - bare names are Klipper's current definitions (klippy/extras/shaper_defs.py): `zv`, `mzv(n,t)`, `zvd`, `ei(v_tol)`, `2hump_ei`,
 //!   `3hump_ei`;
 //! - `marlin:...` are Marlin FT_MOTION's (Marlin/src/module/ft_motion/shaping.cpp), with
-//!   impulse times rounded to its trajectory rate `FTM_FS`;
+//!   impulse times rounded to its trajectory rate `FTM_FS`; `marlin:m593` is the stepper's
+//!   ZV of `M593` (Marlin/src/module/stepper.cpp), amplitudes in 128ths from a cubic in the
+//!   damping ratio, the echo half the undamped period late;
 //! - `rrf:...` are RepRapFirmware M593's (src/Movement/AxisShaper.cpp), with delays rounded
 //!   to the step clock;
 //! - `prusa:...` are Prusa-Firmware-Buddy's EI family
@@ -24,6 +26,7 @@
 mod apply;
 mod klipper;
 mod marlin;
+mod marlin_m593;
 mod mzv_solve;
 mod name;
 mod prusa;
@@ -83,6 +86,8 @@ impl Shaper {
     ///   `0.01..1` (M493 `I` allows 1.0, where the firmware divides by zero), `v_tol` in
     ///   `0..=1` (M493 `Q`), above 0 for 2HEI (whose first amplitude is 0 / 0 at 0).
     ///   Default 0.1.
+    /// - Marlin's stepper ZV (`marlin:m593`): `damping_ratio` in `0..=1` (M593 `D`; from
+    ///   0.8646 its echo is 0 and nothing is shaped). M593 `F` takes any frequency above 0.
     /// - RepRapFirmware: `frequency_hz` in `step_clock / 131070 ..= 1000` (M593 `F`; 5.72
     ///   Hz on Duet 3), `damping_ratio` in `0..=0.99` (M593 `S`). Default 0.05 (3.6 line).
     /// - Prusa (its EI family): `damping_ratio` below 1 (`input_shaper::get` halts the
@@ -134,6 +139,12 @@ impl Shaper {
                     ));
                 }
                 marlin::impulses(shaper, frequency_hz, damping_ratio, v_tol, ftm_fs_hz)
+            }
+            ShaperType::MarlinM593 => {
+                if damping_ratio > 1.0 {
+                    return Err(out_of("damping_ratio (M593 D)", 0.0, 1.0, damping_ratio));
+                }
+                marlin_m593::impulses(frequency_hz, damping_ratio)
             }
             ShaperType::Prusa { shaper, v_tol } => {
                 if damping_ratio >= 1.0 {

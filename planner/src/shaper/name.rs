@@ -10,6 +10,7 @@
 //! - Marlin FT_MOTION: `marlin:zv`, `marlin:zvd`, `marlin:zvdd`, `marlin:zvddd`,
 //!   `marlin:ei`, `marlin:2hei`, `marlin:3hei`, `marlin:mzv`; parameters `v_tol` (the EI
 //!   family only, M493 `Q`, 0..=1) and `ftm_fs` (the trajectory rate `FTM_FS`, Hz).
+//! - Marlin's stepper ZV (`M593 F D`, `INPUT_SHAPING_X`/`_Y`): `marlin:m593`, no parameters.
 //! - RepRapFirmware M593: `rrf:zvd`, `rrf:zvdd`, `rrf:zvddd`, `rrf:mzv`, `rrf:ei2`,
 //!   `rrf:ei3`; parameter `step_clock` (Hz).
 //! - Prusa-Firmware-Buddy M593 `T3`..`T5`: `prusa:ei`, `prusa:2hump_ei`, `prusa:3hump_ei`;
@@ -218,6 +219,10 @@ fn klipper(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperType, Pla
 }
 
 fn marlin(name: &str, family: &str, args: &[Arg<'_>]) -> Result<ShaperType, PlanError> {
+    if family == "m593" {
+        assign(name, args, &[])?;
+        return Ok(ShaperType::MarlinM593);
+    }
     let shaper = MarlinShaper::ALL
         .into_iter()
         .find(|s| s.name() == family)

@@ -2,7 +2,7 @@
 //!
 //! Bare names mean Klipper's current definitions (klippy/extras/shaper_defs.py); the
 //! shapers of Marlin's FT_MOTION and RepRapFirmware's M593 carry a `marlin:` or `rrf:`
-//! prefix, because the same name means different impulses there (Marlin's MZV decays by the
+//! prefix (Marlin's stepper ZV of `M593` is `marlin:m593`), because the same name means different impulses there (Marlin's MZV decays by the
 //! ZV factor, RepRapFirmware's MZV puts its impulses in the opposite order, both EIs differ
 //! from Klipper's). Prusa-Firmware-Buddy's ZV, ZVD and MZV are Klipper's; its EI family
 //! (Klipper's earlier closed forms) carries a `prusa:` prefix. See [`ShaperType::parse`] for the syntax; `Display` writes the same
@@ -191,6 +191,10 @@ pub enum ShaperType {
     TwoHumpEi,
     /// Klipper `3hump_ei`.
     ThreeHumpEi,
+    /// Marlin's stepper ZV (`INPUT_SHAPING_X`/`_Y`, `M593 F D`): amplitudes in 128ths from
+    /// a cubic in the damping ratio, the echo half the undamped period late
+    /// (Marlin/src/module/stepper.cpp; `marlin:m593`).
+    MarlinM593,
     /// A Marlin FT_MOTION shaper.
     Marlin {
         /// The family.
@@ -259,7 +263,8 @@ impl ShaperType {
     pub const ALLOWED: &'static str = "zv, mzv, zvd, ei, 2hump_ei, 3hump_ei (Klipper; also \
         klipper:NAME, mzv(n=N,t=T) or mzv(n=N,tau=TAU) with integer N >= 3, ei(v_tol=V)); \
         marlin:zv, marlin:zvd, marlin:zvdd, marlin:zvddd, marlin:ei, marlin:2hei, \
-        marlin:3hei, marlin:mzv (parameters v_tol=V for the EI family, ftm_fs=HZ); \
+        marlin:3hei, marlin:mzv (FT_MOTION's M493; parameters v_tol=V for the EI family, \
+        ftm_fs=HZ); marlin:m593 (the stepper's ZV of M593); \
         rrf:zvd, rrf:zvdd, rrf:zvddd, rrf:mzv, rrf:ei2, rrf:ei3 (parameter step_clock=HZ); \
         prusa:ei, prusa:2hump_ei, prusa:3hump_ei (parameter v_tol=V)";
 
@@ -291,7 +296,7 @@ impl ShaperType {
     /// The firmware whose definition this is (Klipper, Marlin, Prusa or RepRapFirmware).
     pub fn firmware(self) -> Firmware {
         match self {
-            ShaperType::Marlin { .. } => Firmware::Marlin,
+            ShaperType::Marlin { .. } | ShaperType::MarlinM593 => Firmware::Marlin,
             ShaperType::Prusa { .. } => Firmware::Prusa,
             ShaperType::Rrf { .. } => Firmware::Rrf,
             _ => Firmware::Klipper,
@@ -308,7 +313,10 @@ impl ShaperType {
             ShaperType::Zvd | ShaperType::Ei { .. } => Some(29.0),
             ShaperType::TwoHumpEi => Some(39.0),
             ShaperType::ThreeHumpEi => Some(48.0),
-            ShaperType::Marlin { .. } | ShaperType::Prusa { .. } | ShaperType::Rrf { .. } => None,
+            ShaperType::Marlin { .. }
+            | ShaperType::MarlinM593
+            | ShaperType::Prusa { .. }
+            | ShaperType::Rrf { .. } => None,
         }
     }
 
@@ -321,6 +329,7 @@ impl ShaperType {
             ShaperType::Ei { .. } => "ei",
             ShaperType::TwoHumpEi => "2hump_ei",
             ShaperType::ThreeHumpEi => "3hump_ei",
+            ShaperType::MarlinM593 => "marlin:m593",
             ShaperType::Marlin { shaper, .. } => match shaper {
                 MarlinShaper::Zv => "marlin:zv",
                 MarlinShaper::Zvd => "marlin:zvd",

@@ -27,6 +27,7 @@ mod raster;
 mod rest_to_rest;
 mod shaper_extremes;
 mod shaper_klipper;
+mod shaper_marlin_m593;
 mod shaper_marlin_rrf;
 mod shaper_names;
 mod shaper_select;

@@ -22,6 +22,7 @@ fn display_round_trips_for_every_family_and_parameters() {
         },
         ShaperType::Mzv { n: 4, t: 1.0 },
         ShaperType::Ei { v_tol: 0.03 },
+        ShaperType::MarlinM593,
         ShaperType::Marlin {
             shaper: MarlinShaper::TwoHei,
             v_tol: 0.1,

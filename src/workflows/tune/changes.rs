@@ -352,10 +352,10 @@ pub fn marlin(
             ["C", "A", "I"].map(|w| format!("M493 {letter} {w}")),
             ("none", f64::NAN, f64::NAN),
         ),
-        // The shaper's type has no word in M593 (ZV only): keyed by the line.
+        // The shaper's type has no word in M593 (its stepper ZV only): keyed by the line.
         MarlinShaping::InputShaping => (
             ["", " F", " D"].map(|w| format!("M593 {letter}{w}")),
-            ("zv", 0.0, f64::NAN),
+            ("marlin:m593", 0.0, f64::NAN),
         ),
     };
     let who = "Marlin (Marlin/src/module/planner.cpp, Planner::_populate_block)";

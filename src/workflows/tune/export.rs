@@ -363,13 +363,14 @@ fn marlin_axis(axes: &[(String, Outcome)], letter: &str) -> Option<(FtAxisShaper
 }
 
 /// Axis `letter`'s `M593` values from its tuned winner (`F0` unshaped); `None` when the
-/// axis was not tuned. The search ran only `zv` ([`super::firmware::Candidates`]).
+/// axis was not tuned. The search ran only `marlin:m593` ([`super::firmware::Candidates`]),
+/// whose F and D are the `M593` ones: Marlin computes the shaper from them as it did.
 fn marlin_zv_axis(axes: &[(String, Outcome)], letter: &str) -> Option<ZvAxisShaper> {
     let o = winner_of(axes, letter)?;
     let w = &o.scores[o.winner];
     let axis = letter.to_ascii_uppercase().chars().next()?;
     Some(match w.candidate.shaper {
-        Some(sh) if sh.shaper_type == Some(ShaperType::Zv) => ZvAxisShaper {
+        Some(sh) if sh.shaper_type == Some(ShaperType::MarlinM593) => ZvAxisShaper {
             axis,
             frequency_hz: sh.frequency_hz,
             damping_ratio: sh.damping_ratio,

@@ -12,8 +12,9 @@
 //! Marlin has two input shapers, chosen when the firmware is built ([`MarlinShaping`],
 //! `[tune] marlin_shaping`): Fixed-Time Motion (`FT_MOTION`, Marlin 2.1.3+, `M493`, the
 //! eight shapers of `ShaperType::MARLIN`) and the built-in ZV shaper (`INPUT_SHAPING_X` /
-//! `INPUT_SHAPING_Y`, Marlin 2.1.2+, `M593`), whose one shaper is Klipper's `zv`
-//! (`ShaperType::Zv`: settle-gcode reads `M593` as it).
+//! `INPUT_SHAPING_Y`, Marlin 2.1.2+, `M593`), whose one shaper is `marlin:m593`
+//! (`ShaperType::MarlinM593`, the ZV of Marlin/src/module/stepper.cpp, as settle-gcode
+//! reads `M593`).
 
 use settle_planner::ProfileKind;
 use settle_planner::firmware::Firmware;
@@ -145,7 +146,7 @@ impl Candidates {
             Some(Firmware::Marlin) => match self.1 {
                 MarlinShaping::FtMotion => ShaperType::MARLIN.to_vec(),
                 // M593's only shaper (its `T` type word is "not implemented yet" in M593.cpp).
-                MarlinShaping::InputShaping => vec![ShaperType::Zv],
+                MarlinShaping::InputShaping => vec![ShaperType::MarlinM593],
             },
             Some(Firmware::Rrf) => ShaperType::RRF.to_vec(),
             // M593 T0..T5: Klipper's ZV, ZVD and MZV, and Prusa's EI family.
@@ -199,7 +200,9 @@ impl Candidates {
         let ok = match self.0 {
             None => true,
             Some(Firmware::Tmc4361a) => false,
-            Some(Firmware::Marlin) if self.1 == MarlinShaping::InputShaping => k == ShaperType::Zv,
+            Some(Firmware::Marlin) if self.1 == MarlinShaping::InputShaping => {
+                k == ShaperType::MarlinM593
+            }
             Some(Firmware::Prusa) => self.shapers().contains(&k),
             Some(f) => k.firmware() == f,
         };
@@ -209,7 +212,7 @@ impl Candidates {
             Err("the TMC4361A has no input shaper: give shapers = [\"none\"]".into())
         } else if self.0 == Some(Firmware::Marlin) && self.1 == MarlinShaping::InputShaping {
             Err(format!(
-                "Marlin's built-in input shaping (M593, marlin_shaping = \"input_shaping\") runs only `zv`, not `{}`",
+                "Marlin's built-in input shaping (M593, marlin_shaping = \"input_shaping\") runs only `marlin:m593`, not `{}`",
                 k.name()
             ))
         } else {
@@ -259,7 +262,7 @@ mod tests {
     }
 
     #[test]
-    fn marlin_input_shaping_runs_only_zv() {
+    fn marlin_input_shaping_runs_only_its_stepper_zv() {
         assert_eq!(
             MarlinShaping::parse("input_shaping"),
             Ok(MarlinShaping::InputShaping)
@@ -269,14 +272,21 @@ mod tests {
             Err("unknown Marlin shaping `M593`; allowed: ft_motion, input_shaping".into())
         );
         let is = Candidates::of(Firmware::Marlin).with_marlin_shaping(MarlinShaping::InputShaping);
-        assert_eq!(is.shapers(), [ShaperType::Zv]);
-        assert_eq!(is.check_shaper(Some(ShaperType::Zv)), Ok(()));
+        assert_eq!(is.shapers(), [ShaperType::MarlinM593]);
+        assert_eq!(is.check_shaper(Some(ShaperType::MarlinM593)), Ok(()));
+        let err = is
+            .check_shaper(Some(ShaperType::Zv))
+            .expect_err("Klipper's zv is not M593's");
+        assert!(err.contains("runs only `marlin:m593`, not `zv`"), "{err}");
         let err = is
             .check_shaper(Some(ShaperType::marlin(
                 settle_planner::shaper::MarlinShaper::Zv,
             )))
             .expect_err("FT_MOTION's zv is not M593's");
-        assert!(err.contains("runs only `zv`, not `marlin:zv`"), "{err}");
+        assert!(
+            err.contains("runs only `marlin:m593`, not `marlin:zv`"),
+            "{err}"
+        );
         assert_eq!(
             Candidates::of(Firmware::Marlin).shapers(),
             ShaperType::MARLIN
