@@ -264,29 +264,34 @@ pub fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
 /// move beyond [`MAX_SAMPLES_PER_RUN`] is a mistake in the file even when every run takes
 /// a swept value instead. A path study's move is checked per run (its length is its path's).
 pub fn validate_base(base: &RunSpec, src: &Source) -> Result<(), Error> {
-    for (key, value) in [
-        ("move.distance_mm", base.distance_mm),
-        ("move.start_mm", base.start_mm),
-    ] {
-        if !value.is_finite() {
-            return Err(src.error_at(key, format!("must be finite, got {value}")));
-        }
-    }
-
-    for (key, value, unit) in [
-        ("limits.vmax_mm_s", Some(base.vmax_mm_s), "mm/s"),
-        ("limits.amax_mm_s2", Some(base.amax_mm_s2), "mm/s^2"),
-        ("limits.jmax_mm_s3", base.jmax_mm_s3, "mm/s^3"),
-    ] {
-        if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
-            return Err(src.error_at(
-                key,
-                format!("must be a finite number > 0 ({unit}), got {v}"),
-            ));
-        }
-    }
+    validate_move(base, src, |k| k.to_string())?;
     validate_duration(base, src)?;
     validate_positions(base, src, |k| k.to_string())
+}
+
+/// Check the move's distance and start and the limits (`blame` names the key): each finite,
+/// the distance 0 or at least [`crate::spec::MIN_LENGTH_MM`], each limit within the range
+/// of its quantity ([`crate::spec::check_limit`]).
+fn validate_move(run: &RunSpec, src: &Source, blame: impl Fn(&str) -> String) -> Result<(), Error> {
+    if let Err(m) = crate::spec::check_length(run.distance_mm, true) {
+        return Err(src.error_at(&blame("move.distance_mm"), m));
+    }
+    if !run.start_mm.is_finite() {
+        return Err(src.error_at(
+            &blame("move.start_mm"),
+            format!("must be finite, got {}", run.start_mm),
+        ));
+    }
+    for (key, value, unit) in [
+        ("limits.vmax_mm_s", Some(run.vmax_mm_s), "mm/s"),
+        ("limits.amax_mm_s2", Some(run.amax_mm_s2), "mm/s^2"),
+        ("limits.jmax_mm_s3", run.jmax_mm_s3, "mm/s^3"),
+    ] {
+        if let Some(Err(m)) = value.map(|v| crate::spec::check_limit(v, unit)) {
+            return Err(src.error_at(&blame(key), m));
+        }
+    }
+    Ok(())
 }
 
 /// Check that the move starts and ends within [`MAX_POSITION_MM`] (`blame` names the key).
@@ -326,28 +331,7 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
         Ok::<(), Error>(())
     };
     kind_check(true)?;
-    for (name, value) in [
-        ("move.distance_mm", run.distance_mm),
-        ("move.start_mm", run.start_mm),
-    ] {
-        if !value.is_finite() {
-            return Err(src.error_at(&run.blame(name), format!("must be finite, got {value}")));
-        }
-    }
-
-    let limits = [
-        ("limits.vmax_mm_s", Some(run.vmax_mm_s), "mm/s"),
-        ("limits.amax_mm_s2", Some(run.amax_mm_s2), "mm/s^2"),
-        ("limits.jmax_mm_s3", run.jmax_mm_s3, "mm/s^3"),
-    ];
-    for (key, value, unit) in limits {
-        if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
-            return Err(src.error_at(
-                &run.blame(key),
-                format!("must be a finite number > 0 ({unit}), got {v}"),
-            ));
-        }
-    }
+    validate_move(run, src, |k| run.blame(k))?;
     if needs_jerk(run.profile) && run.jmax_mm_s3.is_none() {
         return Err(src.error_at(
             "limits",

@@ -15,6 +15,72 @@ pub mod value;
 /// move is not resolved at all.
 pub const MAX_POSITION_MM: f64 = 1e5;
 
+/// The shortest length a move (other than a zero one), a corner path's leg or a scan's width
+/// may have (mm): 1 nm, the smallest step a wafer stage makes. A corner path's points are
+/// told apart to 1e-12 of their distance from the origin (settle-planner's `Path`), 1e-7 mm
+/// at [`MAX_POSITION_MM`]; a move's profile misses its target below about 1e-35 mm.
+pub const MIN_LENGTH_MM: f64 = 1e-6;
+
+/// The speeds a move's and a scan's limits may take (mm/s): a galvo's 1e4 with a hundred
+/// times to spare above, 1 um/s below. A scan's lines break below 1e-6 mm/s (their knot
+/// times no longer increase) and above 1e9 mm/s.
+pub const SPEED_RANGE_MM_S: (f64, f64) = (1e-3, 1e6);
+
+/// The accelerations a move's and a scan's limits may take (mm/s^2): a galvo's or a wafer
+/// stage's 1e7 with a hundred times to spare. A scan's turnarounds break above 1e17 mm/s^2
+/// and a move's profile above 1e100.
+pub const ACCELERATION_RANGE_MM_S2: (f64, f64) = (1e-3, 1e9);
+
+/// The jerks a move's and a scan's limits may take (mm/s^3): a galvo's 1e12 with a thousand
+/// times to spare. A move's profile breaks above 1e100 mm/s^3; at 1e-9 a 10 mm move lasts
+/// two hours.
+pub const JERK_RANGE_MM_S3: (f64, f64) = (1e-3, 1e15);
+
+/// The longest a scan may wait at a line's end (`scan.settle_margin_s`, s): a hundred
+/// seconds, against a real margin's milliseconds. A scan's trace is kept in memory
+/// (`crate::expand::validate::MAX_RECORDED_VALUES`): a 100 s margin at 10 kHz is 8e6 of a
+/// one-axis scan's values, half the limit; 1e4 s broke the 1e8 samples of a run.
+pub const MAX_MARGIN_S: f64 = 1e2;
+
+/// Check a motion limit against the range of its quantity, named by `unit` (`mm/s`,
+/// `mm/s^2` or `mm/s^3`): the message for a value outside it.
+pub fn check_limit(value: f64, unit: &str) -> Result<(), String> {
+    let (lo, hi) = match unit {
+        "mm/s" => SPEED_RANGE_MM_S,
+        "mm/s^2" => ACCELERATION_RANGE_MM_S2,
+        "mm/s^3" => JERK_RANGE_MM_S3,
+        _ => unreachable!("a motion limit in {unit}"),
+    };
+    if value.is_finite() && (lo..=hi).contains(&value) {
+        Ok(())
+    } else {
+        Err(format!(
+            "must be a finite number from {lo:e} to {hi:e} ({unit}), got {value}"
+        ))
+    }
+}
+
+/// Check a length (a leg, a width) or, with `zero_ok`, a move's distance (either sign)
+/// against [`MIN_LENGTH_MM`]: the message for a value outside it. The largest is bounded
+/// by the positions it reaches ([`MAX_POSITION_MM`]).
+pub fn check_length(value: f64, zero_ok: bool) -> Result<(), String> {
+    let ok = if zero_ok {
+        value == 0.0 || value.abs() >= MIN_LENGTH_MM
+    } else {
+        value >= MIN_LENGTH_MM
+    };
+    if value.is_finite() && ok {
+        return Ok(());
+    }
+    Err(if zero_ok {
+        format!(
+            "must be 0 or a finite number at least {MIN_LENGTH_MM:e} in magnitude (mm), got {value}"
+        )
+    } else {
+        format!("must be a finite number of at least {MIN_LENGTH_MM:e} (mm), got {value}")
+    })
+}
+
 /// Why a position past [`MAX_POSITION_MM`] is refused: `what` (`the move starts`) at `x` mm.
 pub fn beyond_positions(what: &str, x: f64) -> String {
     format!(

@@ -112,7 +112,7 @@ fn base_values_are_checked_even_when_a_sweep_overrides_them() {
             "distance_mm = 10.0",
             "distance_mm = nan",
             "move.distance_mm",
-            "must be finite, got NaN",
+            "must be 0 or a finite number at least 1e-6 in magnitude (mm), got NaN",
         ),
         (
             "distance_mm = 10.0",
@@ -124,7 +124,7 @@ fn base_values_are_checked_even_when_a_sweep_overrides_them() {
             "vmax_mm_s = 300.0",
             "vmax_mm_s = inf",
             "limits.vmax_mm_s",
-            "must be a finite number > 0 (mm/s), got inf",
+            "must be a finite number from 1e-3 to 1e6 (mm/s), got inf",
         ),
     ] {
         let mut text = quickstart_with(from, to);

@@ -31,7 +31,9 @@ pub fn quickstart_with(from: &str, to: &str) -> String {
 #[test]
 fn a_move_that_would_never_end_is_refused_with_its_key() {
     // The key blamed is the swept one of distance and limits, else the distance; the
-    // message gives all three.
+    // message gives all three. The limits are the slowest their ranges take (1e-3): a
+    // 100 mm move at 1e-3 mm/s lasts 1e5 s; at 1e-3 mm/s^2 it takes a 1e5 mm move
+    // (2e4 s) to go over.
     for (from, to, key) in [
         (
             "distance_mm = 10.0",
@@ -45,16 +47,19 @@ fn a_move_that_would_never_end_is_refused_with_its_key() {
         ),
         (
             "vmax_mm_s = 300.0",
-            "vmax_mm_s = 1e-9",
+            "vmax_mm_s = 1e-3",
             "sweep.move.distance_mm",
         ),
         (
             "amax_mm_s2 = 3000.0",
-            "amax_mm_s2 = 1e-9",
+            "amax_mm_s2 = 1e-3",
             "sweep.move.distance_mm",
         ),
     ] {
         let mut text = quickstart_with(from, to);
+        if to.contains("amax") {
+            text = text.replacen("50, 100]", "50, 1e5]", 1);
+        }
         if to.contains("distance") {
             text = text.replace(
                 "\"move.distance_mm\" = [0.5, 1, 2, 5, 10, 20, 50, 100]\n",

@@ -88,7 +88,10 @@ fn invalid_limits_name_the_key_and_what_is_allowed() {
         msg.starts_with("bad.toml:8:1: key `limits.amax_mm_s2`"),
         "{msg}"
     );
-    assert!(msg.contains("> 0"), "{msg}");
+    assert!(
+        msg.contains("from 1e-3 to 1e9 (mm/s^2), got -3000"),
+        "{msg}"
+    );
     // A swept value is blamed on the sweep line.
     let msg = parse_err(&GOOD.replace(
         "profile = [",

@@ -253,9 +253,10 @@ impl Corner {
                 ),
             ));
         }
+        for (p, x) in [("leg_in_mm", self.leg_in_mm), ("leg_out_mm", self.leg_out_mm)] {
+            crate::spec::check_length(x, false).map_err(|m| (key(p), m))?;
+        }
         for (p, x, unit) in [
-            ("leg_in_mm", self.leg_in_mm, "mm"),
-            ("leg_out_mm", self.leg_out_mm, "mm"),
             ("junction_deviation_mm", self.junction_deviation_mm, "mm"),
             (
                 "square_corner_velocity_mm_s",

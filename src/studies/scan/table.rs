@@ -75,25 +75,25 @@ impl ScanSpec {
 
     /// Check the values: `(key inside [scan], message)` for the first bad one.
     pub fn validate(&self) -> Result<(), (&'static str, String)> {
-        let positive = [
+        let limits = [
             ("v_scan_mm_s", Some(self.v_scan_mm_s), "mm/s"),
             ("fly_amax_mm_s2", Some(self.fly_amax_mm_s2), "mm/s^2"),
             ("fly_jmax_mm_s3", self.fly_jmax_mm_s3, "mm/s^3"),
-            ("width_mm", Some(self.width_mm), "mm"),
         ];
-        for (key, v, unit) in positive {
-            if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0)) {
-                return Err((
-                    key,
-                    format!("must be a finite number > 0 ({unit}), got {v}"),
-                ));
+        for (key, v, unit) in limits {
+            if let Some(Err(m)) = v.map(|v| crate::spec::check_limit(v, unit)) {
+                return Err((key, m));
             }
         }
-        if !(self.settle_margin_s.is_finite() && self.settle_margin_s >= 0.0) {
+        crate::spec::check_length(self.width_mm, false).map_err(|m| ("width_mm", m))?;
+        if !(self.settle_margin_s.is_finite()
+            && (0.0..=crate::spec::MAX_MARGIN_S).contains(&self.settle_margin_s))
+        {
             return Err((
                 "settle_margin_s",
                 format!(
-                    "must be a finite number >= 0 (s), got {}",
+                    "must be a finite number from 0 to {:e} (s), got {}",
+                    crate::spec::MAX_MARGIN_S,
                     self.settle_margin_s
                 ),
             ));

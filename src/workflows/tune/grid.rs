@@ -135,11 +135,20 @@ pub fn plan(
         .distances_mm
         .clone()
         .unwrap_or_else(|| vec![base.distance_mm]);
-    if distances_mm.is_empty() || distances_mm.iter().any(|d| !(d.is_finite() && *d != 0.0)) {
+    if distances_mm.is_empty() {
         return Err(src.error_at(
             "tune.distances_mm",
             "give one or more finite, non-zero move lengths (mm)",
         ));
+    }
+    for d in &distances_mm {
+        // Either sign; a zero move is a sweep's baseline, not a move to tune.
+        crate::spec::check_length(d.abs(), false).map_err(|m| {
+            src.error_at(
+                "tune.distances_mm",
+                format!("each length's magnitude {m} (from {d})"),
+            )
+        })?;
     }
     let angles_deg = match base.state::<Corner>() {
         None if spec.angles_deg.is_some() => {
@@ -247,11 +256,16 @@ pub fn plan(
     let accels: Vec<Option<f64>> = match &spec.accelerations_mm_s2 {
         None => vec![None],
         Some(list) => {
-            if list.is_empty() || list.iter().any(|a| !(a.is_finite() && *a > 0.0)) {
+            if list.is_empty() {
                 return Err(src.error_at(
                     "tune.accelerations_mm_s2",
                     "give one or more finite accelerations > 0 (mm/s^2)",
                 ));
+            }
+            for a in list {
+                crate::spec::check_limit(*a, "mm/s^2").map_err(|m| {
+                    src.error_at("tune.accelerations_mm_s2", format!("each acceleration {m}"))
+                })?;
             }
             list.iter().copied().map(Some).collect()
         }
@@ -384,6 +398,16 @@ pub fn plan(
         })
         .collect();
     jerks.dedup();
+    // The jerks searched are the scenario's limit divided by up to jerk_span: each within
+    // the range of a jerk, as the limit is (a TMC4361A's lowest BOW register is within it).
+    if let Some(j) = jerks.iter().find(|j| **j > 0.0) {
+        crate::spec::check_limit(*j, "mm/s^3").map_err(|m| {
+            src.error_at(
+                "tune.jerk_span",
+                format!("the lowest jerk searched, jmax_mm_s3 / jerk_span = {j:e} mm/s^3, {m}"),
+            )
+        })?;
+    }
     let modes = tuning_modes(&base);
     if modes.is_empty() && shapers.iter().any(Option::is_some) {
         return Err(src.error_at(

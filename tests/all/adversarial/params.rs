@@ -8,7 +8,9 @@
 //! the job (the ringing map of a layer of 3,200 long lines, which must stay
 //! under the suite's 1 GiB like every case); shapers above the fastest mode a machine may
 //! have (50 kHz: `[shaper]`, `[tune.axis.x]`, `tune.frequency_scales`) or above the 1 kHz
-//! a G-code replay takes (`settle gcode --shaper`).
+//! a G-code replay takes (`settle gcode --shaper`); the motion keys of a move, a corner
+//! path, a scan and `settle tune`'s lists just outside their ranges (src/spec/mod.rs),
+//! and run at their edges.
 
 use super::sandbox::SCENARIO;
 use super::{Case, Expect, Sandbox, check_all};
@@ -170,7 +172,8 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
     let refused = |what: &str, line: &str, parts: &[&str]| {
         Case::line(what, line, &[], Expect::refused(parts))
     };
-    vec![
+    let mut cases = motion_cases(sb);
+    cases.extend(vec![
         gcode(
             "--shaper mzv@1e-6",
             &["--shaper", "mzv@1e-6"],
@@ -333,7 +336,249 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "identify rec_x.csv --sweeping-period 1e-9",
             &["--sweeping-period"],
         ),
-    ]
+    ]);
+    cases
+}
+
+/// A corner path of the printer preset (linear driver, so the modal backend runs it):
+/// `legs` (`leg_in_mm = ..\nleg_out_mm = ..`) at 90 degrees.
+fn corner(legs: &str) -> String {
+    format!(
+        "name = \"adv_corner\"\n[machine]\npreset = \"printer_xy\"\ndriver_model = \"linear\"\n[corner]\nangle_deg = 90.0\n{legs}\nprofile = \"scurve\"\n[limits]\nvmax_mm_s = 200.0\namax_mm_s2 = 3000.0\njmax_mm_s3 = 100000.0\n[observe]\nwindow_s = 0.2\nsample_rate_hz = 10000\nbands_um = [10.0]\n"
+    )
+}
+
+/// The motion keys at the edges of their ranges (src/spec/mod.rs: lengths from 1e-6 mm,
+/// speeds 1e-3 to 1e6 mm/s, accelerations 1e-3 to 1e9 mm/s^2, jerks 1e-3 to 1e15 mm/s^3,
+/// a scan's margin 0 to 100 s): just outside, refused naming the key (the sweep's when
+/// swept) and the range, nothing written; just inside, run and measured.
+fn motion_cases(sb: &Sandbox) -> Vec<Case> {
+    let mut cases = Vec::new();
+    let mut refused = |file: &str, text: String, key: &str, range: &str| {
+        sb.write(file, &text);
+        cases.push(Case::line(
+            &format!("{file}: {key} outside {range}"),
+            &format!("sweep {file} --backend modal --out o"),
+            &[],
+            Expect::refused(&[&format!("{file}:"), &format!("key `{key}`"), range]),
+        ));
+    };
+    let speed = "from 1e-3 to 1e6 (mm/s)";
+    let accel = "from 1e-3 to 1e9 (mm/s^2)";
+    let jerk = "from 1e-3 to 1e15 (mm/s^3)";
+    let length = "at least 1e-6";
+    for (line, value, range) in [
+        ("vmax_mm_s = 300.0", "vmax_mm_s = 1.1e6", speed),
+        ("vmax_mm_s = 300.0", "vmax_mm_s = 9e-4", speed),
+        ("amax_mm_s2 = 3000.0", "amax_mm_s2 = 1.1e9", accel),
+        ("amax_mm_s2 = 3000.0", "amax_mm_s2 = 9e-4", accel),
+        ("jmax_mm_s3 = 100000.0", "jmax_mm_s3 = 1.1e15", jerk),
+        ("jmax_mm_s3 = 100000.0", "jmax_mm_s3 = 9e-4", jerk),
+        ("distance_mm = 5.0", "distance_mm = 9e-7", length),
+        ("distance_mm = 5.0", "distance_mm = -9e-7", length),
+    ] {
+        let key = value.split(' ').next().unwrap_or_default();
+        let table = if key == "distance_mm" {
+            "move"
+        } else {
+            "limits"
+        };
+        let file = format!("mo_{}.toml", value.replace([' ', '='], ""));
+        refused(
+            &file,
+            scenario_with(line, value),
+            &format!("{table}.{key}"),
+            range,
+        );
+    }
+    for (sweep, key, range) in [
+        (
+            "\"limits.amax_mm_s2\" = [3000.0, 1.1e9]",
+            "limits.amax_mm_s2",
+            accel,
+        ),
+        (
+            "\"limits.jmax_mm_s3\" = [1e5, 9e-4]",
+            "limits.jmax_mm_s3",
+            jerk,
+        ),
+        (
+            "\"move.distance_mm\" = [5.0, 9e-7]",
+            "move.distance_mm",
+            length,
+        ),
+    ] {
+        refused(
+            &format!("mo_swept_{key}.toml"),
+            scenario_with("profile = [\"trapezoid\", \"scurve\"]", sweep),
+            &format!("sweep.{key}"),
+            range,
+        );
+    }
+    let scan = |more: &str| {
+        scenario_with(
+            "[observe]",
+            &format!("[scan]\nv_scan_mm_s = 100.0\nfly_amax_mm_s2 = 10000.0\nfly_jmax_mm_s3 = 1e6\nwidth_mm = 10.0\nlines = 2\n{more}[observe]"),
+        )
+        .replace("distance_mm = 5.0", "distance_mm = 0.5")
+    };
+    let margin = "from 0 to 1e2 (s)";
+    for (from, to, range) in [
+        ("v_scan_mm_s = 100.0", "v_scan_mm_s = 1.1e6", speed),
+        ("v_scan_mm_s = 100.0", "v_scan_mm_s = 9e-4", speed),
+        ("fly_amax_mm_s2 = 10000.0", "fly_amax_mm_s2 = 1.1e9", accel),
+        ("fly_amax_mm_s2 = 10000.0", "fly_amax_mm_s2 = 9e-4", accel),
+        ("fly_jmax_mm_s3 = 1e6", "fly_jmax_mm_s3 = 1.1e15", jerk),
+        ("fly_jmax_mm_s3 = 1e6", "fly_jmax_mm_s3 = 9e-4", jerk),
+        ("width_mm = 10.0", "width_mm = 9e-7", length),
+        ("lines = 2", "lines = 2\nsettle_margin_s = 100.1", margin),
+    ] {
+        let key = if to.contains("settle_margin_s") {
+            "settle_margin_s"
+        } else {
+            to.split(' ').next().unwrap_or_default()
+        };
+        refused(
+            &format!("mo_scan_{}.toml", to.replace([' ', '=', '\n'], "")),
+            scan("").replacen(from, to, 1),
+            &format!("scan.{key}"),
+            range,
+        );
+    }
+    refused(
+        "mo_scan_swept.toml",
+        scan("").replacen(
+            "profile = [\"trapezoid\", \"scurve\"]",
+            "\"scan.v_scan_mm_s\" = [100.0, 1.1e6]",
+            1,
+        ),
+        "sweep.scan.v_scan_mm_s",
+        speed,
+    );
+    for legs in [
+        "leg_in_mm = 9e-7\nleg_out_mm = 20.0",
+        "leg_in_mm = 20.0\nleg_out_mm = 9e-7",
+    ] {
+        let key = if legs.starts_with("leg_in_mm = 9") {
+            "leg_in_mm"
+        } else {
+            "leg_out_mm"
+        };
+        refused(
+            &format!("mo_corner_{key}.toml"),
+            corner(legs),
+            &format!("corner.{key}"),
+            length,
+        );
+    }
+    // settle tune's lists and the jerks it searches (jmax / jerk_span), through the same
+    // ranges.
+    let tune = |table: &str| {
+        scenario_with("[sweep]\nprofile = [\"trapezoid\", \"scurve\"]\n", "")
+            + "[tune]\njerk_steps = 2\nkinds = [\"scurve\"]\n"
+            + table
+    };
+    for (file, table, key, range) in [
+        (
+            "mo_tune_accel.toml",
+            "distances_mm = [5.0]\naccelerations_mm_s2 = [3000.0, 1.1e9]\n",
+            "tune.accelerations_mm_s2",
+            accel,
+        ),
+        (
+            "mo_tune_distance.toml",
+            "distances_mm = [5.0, 9e-7]\n",
+            "tune.distances_mm",
+            length,
+        ),
+        (
+            "mo_tune_span.toml",
+            "distances_mm = [5.0]\njerk_span = 1e9\n",
+            "tune.jerk_span",
+            jerk,
+        ),
+    ] {
+        sb.write(file, &tune(table));
+        cases.push(Case::line(
+            &format!("{file}: {key} outside {range}"),
+            &format!("tune {file} --out o"),
+            &[],
+            Expect::refused(&[&format!("{file}:"), &format!("key `{key}`"), range]),
+        ));
+    }
+    // Just inside: each edge runs and prints its measurement.
+    let mut answered = |file: &str, case: u32, text: String, parts: &[&str]| {
+        sb.write(file, &text);
+        let out = format!("o_{}", file.trim_end_matches(".toml"));
+        cases.push(Case::line(
+            &format!("{file}: the edges of the ranges run"),
+            &format!("run {file} --case {case} --backend modal --out {out}/t.csv"),
+            &[&out],
+            Expect::answered(parts),
+        ));
+    };
+    // 5 mm at the fastest limits: 2 sqrt(d / amax) = 0.141 ms and the jerk phases of 1 us;
+    // the 40 Hz mode rings with nearly the whole step.
+    answered(
+        "mi_fast.toml",
+        1,
+        scenario_with("vmax_mm_s = 300.0", "vmax_mm_s = 1e6")
+            .replace("amax_mm_s2 = 3000.0", "amax_mm_s2 = 1e9")
+            .replace("jmax_mm_s3 = 100000.0", "jmax_mm_s3 = 1e15"),
+        &[
+            "run 1: scurve 5 mm",
+            "move_time_s            0.000142",
+            "residual_peak_um       4990.1295",
+        ],
+    );
+    // A nanometre step at the slowest limits: (32 d / jmax)^(1/3) = 0.317 s of S-curve.
+    answered(
+        "mi_slow.toml",
+        1,
+        scenario_with("distance_mm = 5.0", "distance_mm = -1e-6")
+            .replace("vmax_mm_s = 300.0", "vmax_mm_s = 1e-3")
+            .replace("amax_mm_s2 = 3000.0", "amax_mm_s2 = 1e-3")
+            .replace("jmax_mm_s3 = 100000.0", "jmax_mm_s3 = 1e-3"),
+        &[
+            "run 1: scurve -0.000001 mm",
+            "move_time_s            0.317480",
+        ],
+    );
+    // A scan at the fastest limits; the slowest, with a 1 nm line and a 100 s margin.
+    answered(
+        "mi_scan_fast.toml",
+        1,
+        scan("")
+            .replace("v_scan_mm_s = 100.0", "v_scan_mm_s = 1e6")
+            .replace("fly_amax_mm_s2 = 10000.0", "fly_amax_mm_s2 = 1e9")
+            .replace("fly_jmax_mm_s3 = 1e6", "fly_jmax_mm_s3 = 1e15"),
+        &["move_time_s            0.059965", "(re-entry) 6.3322 um"],
+    );
+    answered(
+        "mi_scan_slow.toml",
+        1,
+        scan("settle_margin_s = 100.0\n")
+            .replace("v_scan_mm_s = 100.0", "v_scan_mm_s = 1e-3")
+            .replace("fly_amax_mm_s2 = 10000.0", "fly_amax_mm_s2 = 1e-3")
+            .replace("fly_jmax_mm_s3 = 1e6", "fly_jmax_mm_s3 = 1e-3")
+            .replace("width_mm = 10.0", "width_mm = 1e-6"),
+        &[
+            "move_time_s            105.713143",
+            "scan_window_s          100.0542883523319",
+        ],
+    );
+    // Two legs of 1 nm: the corner path is resolved at them.
+    answered(
+        "mi_corner.toml",
+        0,
+        corner("leg_in_mm = 1e-6\nleg_out_mm = 1e-6"),
+        &[
+            "run 0: scurve 0.000002 mm",
+            "move_time_s            0.001368",
+            "residual_peak_um       0.0014",
+        ],
+    );
+    cases
 }
 
 #[test]
