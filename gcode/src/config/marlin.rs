@@ -1241,4 +1241,23 @@ mod tests {
         assert_eq!((x.shaper_type, x.frequency_hz), (ShaperType::Zvd, 45.0));
         assert_eq!(s.shapers[1], None);
     }
+
+    /// `M205 B` is `parser.value_ulong()` (`GcodeSuite::M205`,
+    /// Marlin/src/gcode/config/M200-M205.cpp), `strtoul(value_ptr, NULL, 10)`
+    /// (Marlin/src/gcode/parser.h), which stops at the `.`: `B20000.7` and `B20000.99` are
+    /// 20000 us, as `B20000.00` is, and `B19999.99` is 19999 us (rounding would give 20001,
+    /// 20001 and 20000).
+    #[test]
+    fn m205_b_is_truncated_as_strtoul_reads_it() {
+        let b = |v: &str| {
+            let reply = REPLY.replace("M205 B20000.00", &format!("M205 B{v}"));
+            MarlinSettings::parse(&reply, "r.txt")
+                .expect("an M503 reply")
+                .planner
+                .min_segment_time_s
+        };
+        assert_eq!(b("20000.7"), b("20000.00"));
+        assert_eq!(b("20000.99"), 20000.0 * 1e-6);
+        assert_eq!(b("19999.99"), 19999.0 * 1e-6);
+    }
 }
