@@ -1260,4 +1260,29 @@ mod tests {
         assert_eq!(b("20000.99"), 20000.0 * 1e-6);
         assert_eq!(b("19999.99"), 19999.0 * 1e-6);
     }
+
+    /// The reply's `M593` is the stepper's ZV (`M593_report`); FT_MOTION switched on by
+    /// the job (`M493 S1`) stops it, as `Stepper::isr` (Marlin/src/module/stepper.cpp)
+    /// skips `shaping_isr()` while `ftMotion.cfg.active`.
+    #[test]
+    fn a_replys_m593_is_bypassed_by_a_jobs_m493_s1() {
+        use crate::read::limits::{AxisFlags, LimitChange};
+        let s = MarlinSettings::parse(REPLY, "r.txt").expect("an M503 reply");
+        let mut state = ShaperState::new(Firmware::Marlin, &s.shapers);
+        assert_eq!(state.settings(), s.shapers);
+        assert!(s.shapers[0].is_some() && s.shapers[1].is_some());
+        let on = LimitChange::FtMotion {
+            enabled: Some(true),
+            axis_sync: None,
+            axes: AxisFlags::default(),
+            shaper: None,
+            dynamic_mode: None,
+            frequency_hz: None,
+            frequency_scaling: None,
+            damping_ratio: None,
+            vibration_tolerance: None,
+        };
+        assert_eq!(state.apply(&on), Ok(true));
+        assert_eq!(state.settings(), [None; 3]);
+    }
 }
