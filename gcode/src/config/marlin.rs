@@ -1241,4 +1241,48 @@ mod tests {
         assert_eq!((x.shaper_type, x.frequency_hz), (ShaperType::Zvd, 45.0));
         assert_eq!(s.shapers[1], None);
     }
+
+    /// `M205 B` is `parser.value_ulong()` (`GcodeSuite::M205`,
+    /// Marlin/src/gcode/config/M200-M205.cpp), `strtoul(value_ptr, NULL, 10)`
+    /// (Marlin/src/gcode/parser.h), which stops at the `.`: `B20000.7` and `B20000.99` are
+    /// 20000 us, as `B20000.00` is, and `B19999.99` is 19999 us (rounding would give 20001,
+    /// 20001 and 20000).
+    #[test]
+    fn m205_b_is_truncated_as_strtoul_reads_it() {
+        let b = |v: &str| {
+            let reply = REPLY.replace("M205 B20000.00", &format!("M205 B{v}"));
+            MarlinSettings::parse(&reply, "r.txt")
+                .expect("an M503 reply")
+                .planner
+                .min_segment_time_s
+        };
+        assert_eq!(b("20000.7"), b("20000.00"));
+        assert_eq!(b("20000.99"), 20000.0 * 1e-6);
+        assert_eq!(b("19999.99"), 19999.0 * 1e-6);
+    }
+
+    /// The reply's `M593` is the stepper's ZV (`M593_report`); FT_MOTION switched on by
+    /// the job (`M493 S1`) stops it, as `Stepper::isr` (Marlin/src/module/stepper.cpp)
+    /// skips `shaping_isr()` while `ftMotion.cfg.active`.
+    #[test]
+    fn a_replys_m593_is_bypassed_by_a_jobs_m493_s1() {
+        use crate::read::limits::{AxisFlags, LimitChange};
+        let s = MarlinSettings::parse(REPLY, "r.txt").expect("an M503 reply");
+        let mut state = ShaperState::new(Firmware::Marlin, &s.shapers);
+        assert_eq!(state.settings(), s.shapers);
+        assert!(s.shapers[0].is_some() && s.shapers[1].is_some());
+        let on = LimitChange::FtMotion {
+            enabled: Some(true),
+            axis_sync: None,
+            axes: AxisFlags::default(),
+            shaper: None,
+            dynamic_mode: None,
+            frequency_hz: None,
+            frequency_scaling: None,
+            damping_ratio: None,
+            vibration_tolerance: None,
+        };
+        assert_eq!(state.apply(&on), Ok(true));
+        assert_eq!(state.settings(), [None; 3]);
+    }
 }

@@ -11,7 +11,9 @@
 //!   Marlin/src/module/stepper.cpp computes it (`marlin:m593`: not Klipper's `zv`). `M493`
 //!   (`Marlin/src/gcode/feature/ft_motion/M493.cpp`): FT_MOTION on or off (`S`), and per
 //!   axis (X and Y unless named) the shaper `C` (0 none, 1..8 ZV..MZV), frequency `A`,
-//!   damping `I`, vibration tolerance `Q`.
+//!   damping `I`, vibration tolerance `Q`. The two are kept apart; under `M493 S1`
+//!   `Stepper::isr` skips `shaping_isr()`, so only FT_MOTION's shaper runs, and after
+//!   `M493 S0` only `M593`'s ([`ShaperState::settings`]).
 //! - Prusa-Firmware-Buddy `M593` (lib/Marlin/Marlin/src/gcode/feature/input_shaper/M593.cpp,
 //!   `M593_internal`): with any of `T`, `F`, `D`, `R`, each axis named (X, Y and Z when
 //!   none is) takes the values given over its own, or over the printer's defaults when
@@ -189,8 +191,16 @@ const RRF_ALLOWED: &str =
 pub(crate) struct ShaperState {
     firmware: Firmware,
     axes: [Axis; 3],
-    /// Marlin: FT_MOTION switched off by `M493 S0` (its shapers then do nothing).
-    ft_off: bool,
+    /// Marlin: the stepper's own ZV of `M593` (`Stepper::set_shaping_frequency`), kept
+    /// apart from FT_MOTION's `M493` shapers in `axes`, as Marlin keeps them apart. A build
+    /// may have both: SanityCheck.h's "Input Shaping requirements" and "Fixed-Time Motion
+    /// limitations" do not forbid INPUT_SHAPING_X/Y with FT_MOTION.
+    stepper: [Axis; 3],
+    /// Marlin: FT_MOTION as `M493 S` last switched it (`None`: the job has not said).
+    /// While it is on, `Stepper::isr` (Marlin/src/module/stepper.cpp) runs
+    /// `ftMotion_stepper()` and skips `shaping_isr()` with the block and pulse phases, so
+    /// `M593`'s shaping does nothing; while it is off, FT_MOTION's shapers do nothing.
+    ft_on: Option<bool>,
     /// Prusa: the printer (its shipped shapers and its highest frequency).
     prusa_model: PrusaModel,
 }
@@ -207,7 +217,32 @@ impl ShaperState {
             | Firmware::Settle
             | Firmware::Tmc4361a => (None, 0.0, 0.1),
         };
+        let none = Axis {
+            shaper_type: default_kind,
+            frequency_hz: default_f,
+            damping_ratio: default_z,
+            prusa_type: PRUSA_NULL,
+            vibration_reduction: PRUSA_VIBRATION_REDUCTION,
+        };
+        // Marlin: a starting `marlin:m593` is the stepper's, any other FT_MOTION's.
+        let is_m593 = |s: &Option<ShaperSetting>| {
+            firmware == Firmware::Marlin
+                && s.is_some_and(|s| s.shaper_type == ShaperType::MarlinM593)
+        };
+        let stepper = std::array::from_fn(|i| {
+            let s = &initial[i];
+            match s {
+                Some(s) if is_m593(&initial[i]) => Axis {
+                    shaper_type: Some(s.shaper_type),
+                    frequency_hz: s.frequency_hz,
+                    damping_ratio: s.damping_ratio,
+                    ..none
+                },
+                _ => none,
+            }
+        });
         let axes = initial.map(|s| match s {
+            Some(_) if is_m593(&s) => none,
             Some(s) => {
                 let (prusa_type, vibration_reduction) =
                     prusa_code(s.shaper_type).unwrap_or((NOT_PRUSA, PRUSA_VIBRATION_REDUCTION));
@@ -219,18 +254,13 @@ impl ShaperState {
                     vibration_reduction,
                 }
             }
-            None => Axis {
-                shaper_type: default_kind,
-                frequency_hz: default_f,
-                damping_ratio: default_z,
-                prusa_type: PRUSA_NULL,
-                vibration_reduction: PRUSA_VIBRATION_REDUCTION,
-            },
+            None => none,
         });
         Self {
             firmware,
             axes,
-            ft_off: false,
+            stepper,
+            ft_on: None,
             prusa_model: PrusaModel::Mk4,
         }
     }
@@ -241,13 +271,19 @@ impl ShaperState {
         self
     }
 
-    /// The settings in force (X, Y, Z).
+    /// The settings in force (X, Y, Z). Marlin: FT_MOTION's shaper while `M493 S1` has
+    /// it on, `M593`'s after `M493 S0`; before any `M493 S`, FT_MOTION's where one is
+    /// selected, else `M593`'s.
     pub(crate) fn settings(&self) -> [Option<ShaperSetting>; 3] {
         std::array::from_fn(|i| {
-            let a = &self.axes[i];
-            match a.shaper_type {
-                Some(ShaperType::Marlin { .. }) if self.ft_off => None,
-                _ => a.setting(),
+            let (ft, stepper) = (&self.axes[i], &self.stepper[i]);
+            if self.firmware != Firmware::Marlin {
+                return ft.setting();
+            }
+            match self.ft_on {
+                Some(true) => ft.setting(),
+                Some(false) => stepper.setting(),
+                None => ft.setting().or_else(|| stepper.setting()),
             }
         })
     }
@@ -299,7 +335,7 @@ impl ShaperState {
                     damping_ratio,
                 },
             ) => {
-                for a in self.marlin_axes(axes) {
+                for a in marlin_axes(&mut self.stepper, axes) {
                     if let Some(z) = damping_ratio.filter(|z| (0.0..=1.0).contains(z)) {
                         a.damping_ratio = z;
                     }
@@ -323,9 +359,9 @@ impl ShaperState {
                 },
             ) => {
                 if let Some(on) = enabled {
-                    self.ft_off = !on;
+                    self.ft_on = Some(*on);
                 }
-                for a in self.marlin_axes(axes) {
+                for a in marlin_axes(&mut self.axes, axes) {
                     if let Some(s) = shaper {
                         a.shaper_type = marlin_kind(*s);
                     }
@@ -466,16 +502,19 @@ impl ShaperState {
             _ => Ok(false),
         }
     }
+}
 
-    /// The axes a Marlin `M593`/`M493` applies to: those named, else X and Y.
-    fn marlin_axes(&mut self, named: &AxisFlags) -> impl Iterator<Item = &mut Axis> {
-        let none = !(named.x || named.y || named.z);
-        let pick = [named.x || none, named.y || none, named.z];
-        self.axes
-            .iter_mut()
-            .zip(pick)
-            .filter_map(|(a, p)| p.then_some(a))
-    }
+/// The axes of `state` a Marlin `M593`/`M493` applies to: those named, else X and Y.
+fn marlin_axes<'a>(
+    state: &'a mut [Axis; 3],
+    named: &AxisFlags,
+) -> impl Iterator<Item = &'a mut Axis> {
+    let none = !(named.x || named.y || named.z);
+    let pick = [named.x || none, named.y || none, named.z];
+    state
+        .iter_mut()
+        .zip(pick)
+        .filter_map(|(a, p)| p.then_some(a))
 }
 
 /// The shaper of `M493 C`.
@@ -600,5 +639,78 @@ mod tests {
         assert_eq!(kinds(&s)[0], one("prusa:ei(v_tol=0.1)", 100.0, 0.2));
         // Only W (or the weight adjustment): no shaper change here.
         assert_eq!(s.apply(&m593("", None, None, None)), Ok(false));
+    }
+
+    fn marlin_m593(axes: &str, f: Option<f64>, d: Option<f64>) -> LimitChange {
+        LimitChange::MarlinInputShaping {
+            axes: AxisFlags {
+                x: axes.contains('X'),
+                y: axes.contains('Y'),
+                z: false,
+                e: false,
+            },
+            frequency_hz: f,
+            damping_ratio: d,
+        }
+    }
+
+    fn m493(on: Option<bool>, axes: &str, c: Option<FtShaper>, a: Option<f64>) -> LimitChange {
+        LimitChange::FtMotion {
+            enabled: on,
+            axis_sync: None,
+            axes: AxisFlags {
+                x: axes.contains('X'),
+                y: axes.contains('Y'),
+                z: false,
+                e: false,
+            },
+            shaper: c,
+            dynamic_mode: None,
+            frequency_hz: a,
+            frequency_scaling: None,
+            damping_ratio: None,
+            vibration_tolerance: None,
+        }
+    }
+
+    /// `Stepper::isr` (Marlin/src/module/stepper.cpp) runs `ftMotion_stepper()` while
+    /// `ftMotion.cfg.active` and `shaping_isr()` only when it is not: `M593`'s ZV is kept
+    /// (`Stepper::set_shaping_frequency`) but does nothing under `M493 S1`, and is back
+    /// after `M493 S0`; FT_MOTION's `M493 C`/`A` shaper is its own, not laid on `M593`'s.
+    #[test]
+    fn marlin_m593_does_nothing_while_ft_motion_is_on() {
+        let mut s = ShaperState::new(Firmware::Marlin, &[None; 3]);
+        assert_eq!(s.apply(&marlin_m593("", Some(40.0), Some(0.1))), Ok(true));
+        let m593 = one("marlin:m593", 40.0, 0.1);
+        assert_eq!(kinds(&s), [m593.clone(), m593.clone(), None]);
+        assert_eq!(s.apply(&m493(Some(true), "", None, None)), Ok(true));
+        assert_eq!(kinds(&s), [None, None, None]);
+        // FT_MOTION's ZV on X at 50 Hz (damping Marlin's, 0.1 here as settle starts it).
+        let x_zv = m493(None, "X", Some(FtShaper::Zv), Some(50.0));
+        assert_eq!(s.apply(&x_zv), Ok(true));
+        assert_eq!(kinds(&s), [one("marlin:zv", 50.0, 0.1), None, None]);
+        // M593 under FT_MOTION is stored, not run.
+        assert_eq!(s.apply(&marlin_m593("Y", Some(30.0), None)), Ok(true));
+        assert_eq!(kinds(&s), [one("marlin:zv", 50.0, 0.1), None, None]);
+        assert_eq!(s.apply(&m493(Some(false), "", None, None)), Ok(true));
+        assert_eq!(
+            kinds(&s),
+            [m593, one("marlin:m593", 30.0, 0.1), None],
+            "M493 S0: the stepper's shaping again"
+        );
+    }
+
+    /// A job that starts with `M593`'s shaper (an `M503` reply's) loses it at `M493 S1`.
+    #[test]
+    fn a_starting_m593_shaper_is_bypassed_by_m493_s1() {
+        let m593 = ShaperSetting {
+            shaper_type: ShaperType::MarlinM593,
+            frequency_hz: 40.0,
+            damping_ratio: 0.15,
+        };
+        let mut s = ShaperState::new(Firmware::Marlin, &[Some(m593), Some(m593), None]);
+        assert_eq!(s.settings(), [Some(m593), Some(m593), None]);
+        assert_eq!(s.apply(&m493(Some(true), "", None, None)), Ok(true));
+        assert_eq!(s.settings(), [None; 3]);
     }
 }

@@ -254,7 +254,12 @@ pub(crate) fn m_code(
                 jerk_mm_s: axes(cmd, p, NON_NEGATIVE, 1.0)?,
                 min_feedrate_mm_s: cmd.num(p, b'S', NON_NEGATIVE)?,
                 min_travel_feedrate_mm_s: cmd.num(p, b'T', NON_NEGATIVE)?,
-                min_segment_time_s: cmd.num(p, b'B', MIN_SEGMENT_TIME_US)?.map(|us| us * 1e-6),
+                // `parser.value_ulong()` is `strtoul(value_ptr, NULL, 10)` (Marlin's
+                // Marlin/src/gcode/parser.h): the digits before a `.`, so `B20000.7` is
+                // 20000 us, truncated, not rounded.
+                min_segment_time_s: cmd
+                    .num(p, b'B', MIN_SEGMENT_TIME_US)?
+                    .map(|us| us.trunc() * 1e-6),
             })
         }
         (Rrf, 205 | 566) => {

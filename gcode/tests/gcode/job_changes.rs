@@ -321,6 +321,51 @@ fn marlin_and_rrf_shaper_commands_wait_for_a_standstill() {
     );
 }
 
+/// A Marlin build may have INPUT_SHAPING_X/Y and FT_MOTION both (Marlin/src/inc/SanityCheck.h
+/// forbids neither with the other); while `M493 S1` has FT_MOTION on, `Stepper::isr`
+/// (Marlin/src/module/stepper.cpp) skips `shaping_isr()`, so `M593`'s ZV (here an `M503`
+/// reply's, the job's start) stops at `M493 S1` and is back at `M493 S0`.
+#[test]
+fn marlin_m493_s1_bypasses_m593s_shaping() {
+    let mut cfg = job(PlannerConfig::Marlin(MarlinConfig::new()));
+    let m593 = setting("marlin:m593", 40.0, 0.15);
+    cfg.shapers = [m593, m593, None];
+    check_switch(
+        "M493 S1",
+        cfg.clone(),
+        "G1 X50 F6000\nM493 S1\nG1 X100 Y20\n",
+        "G1 X50 F6000\nM400\nG1 X100 Y20\n",
+        [None; 3],
+        0.0,
+    );
+    // An M593 under FT_MOTION is kept and runs from M493 S0: the motion of an M593 there.
+    cfg.shapers = [None; 3];
+    let (kept, _) = run(
+        "M493 S1\nM593 F40 D0.15\nG1 X50 F6000\nM493 S0\nG1 X100 Y20\n",
+        cfg.clone(),
+    );
+    let (there, _) = run("G1 X50 F6000\nM593 F40 D0.15\nG1 X100 Y20\n", cfg.clone());
+    let (plain, _) = run("G1 X50 F6000\nM400\nG1 X100 Y20\n", cfg.clone());
+    let last = |c: &[JobChunk]| c.last().map(JobChunk::end_time_s).expect("chunks");
+    let end = last(&there);
+    assert_rel("end", last(&kept), end, 1e-12);
+    let mut shaped = 0.0f64;
+    for n in 0..=3000 {
+        let t = end * n as f64 / 3000.0;
+        for i in 0..2 {
+            let (got, want) = (at(&kept, t)[i].p, at(&there, t)[i].p);
+            assert!(
+                (got - want).abs() < 1e-12,
+                "axis {i} t {t}: {got} vs {want}"
+            );
+            shaped = shaped.max((got - at(&plain, t)[i].p).abs());
+        }
+    }
+    // The ZV's echo moves the axes off the unshaped path (by 5.8e-5 mm at most, sampled),
+    // ten million times the agreement above: the comparison is not vacuous.
+    assert!(shaped > 1e-5, "{shaped}");
+}
+
 #[test]
 fn prusa_m593_sets_one_axis_shaper_by_type() {
     // The MK4's shapers as Prusa ships them, then `M593 X T3 F45 D0.05`: X runs Prusa's
