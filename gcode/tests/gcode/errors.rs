@@ -423,6 +423,24 @@ fn marlin_m92_steps_per_mm_are_bounded_at_their_line() {
     }
 }
 
+/// Marlin's `text` (one line) is refused at its word `word` of value `value`, the range
+/// given starting with `allowed` and citing `source`.
+fn refused_at_word(text: &str, word: &str, value: f64, allowed: &str, source: &str) {
+    match error(text, Dialect::Marlin) {
+        GcodeError::OutOfRange {
+            at,
+            param,
+            value: v,
+            allowed: a,
+            ..
+        } => {
+            assert_eq!((at.line, param.as_str(), v), (1, word, value), "{text}");
+            assert!(a.starts_with(allowed) && a.contains(source), "{text}: {a}");
+        }
+        e => panic!("{text}: {e}"),
+    }
+}
+
 /// Marlin's `M493` (FT_MOTION): a frequency `A` outside 10 to 500 Hz and a damping `I`
 /// outside 0.01 to below 1 are refused at their word, as Marlin's M493.cpp refuses them
 /// (`WITHIN(baseFreqVal, FTM_MIN_SHAPE_FREQ, FTM_FS / 2)`, `WITHIN(zetaVal, 0.01, 1)`); the
@@ -437,22 +455,7 @@ fn marlin_m493_values_are_bounded_at_their_line() {
         ("M493 S1 X C1 A40 I0.001", "I", 0.001, "0.01 to below 1"),
         ("M493 S1 X C1 A40 I1", "I", 1.0, "0.01 to below 1"),
     ] {
-        match error(text, Dialect::Marlin) {
-            GcodeError::OutOfRange {
-                at,
-                param,
-                value: v,
-                allowed: a,
-                ..
-            } => {
-                assert_eq!((at.line, param.as_str(), v), (1, word, value), "{text}");
-                assert!(
-                    a.starts_with(allowed) && a.contains("M493.cpp"),
-                    "{text}: {a}"
-                );
-            }
-            e => panic!("{text}: {e}"),
-        }
+        refused_at_word(text, word, value, allowed, "M493.cpp");
     }
     for d in ["D1", "D2"] {
         let text = format!("M493 S1 X C1 A40 {d} F0.5");
@@ -485,22 +488,7 @@ fn marlin_m494_values_are_bounded_at_their_line() {
         ("M494 Z0.2", "Z", 0.2, "0 to 0.1 s"),
         ("M494 X0.01 E0.5", "E", 0.5, "0 to 0.1 s"),
     ] {
-        match error(text, Dialect::Marlin) {
-            GcodeError::OutOfRange {
-                at,
-                param,
-                value: v,
-                allowed: a,
-                ..
-            } => {
-                assert_eq!((at.line, param.as_str(), v), (1, word, value), "{text}");
-                assert!(
-                    a.starts_with(allowed) && a.contains("M494.cpp"),
-                    "{text}: {a}"
-                );
-            }
-            e => panic!("{text}: {e}"),
-        }
+        refused_at_word(text, word, value, allowed, "M494.cpp");
     }
     // A negative time and a trajectory type above 2 were refused before and still are.
     for text in ["M494 X-0.01", "M494 T3"] {
