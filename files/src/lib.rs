@@ -28,5 +28,16 @@ pub mod read;
 pub mod write;
 
 pub use error::FileError;
+
+/// A FIFO (named pipe) made at `path` with the system's `mkfifo`, for the readers' and
+/// writers' tests that refuse one without waiting on it.
+#[cfg(all(test, unix))]
+pub(crate) fn make_fifo(path: &std::path::Path) {
+    let made = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+}
 pub use identity::FileId;
 pub use limit::Limit;

@@ -327,11 +327,7 @@ mod tests {
             "{e}"
         );
         let fifo = dir.path().join("fifo");
-        let made = std::process::Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .expect("mkfifo runs");
-        assert!(made.success());
+        crate::make_fifo(&fifo);
         let e = read_bytes(&fifo, SMALL).expect_err("fifo").to_string();
         assert!(e.contains("a FIFO (named pipe), not a regular file"), "{e}");
     }

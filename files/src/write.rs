@@ -309,11 +309,7 @@ mod tests {
         assert!(e.contains("it is a link"), "{e}");
         assert_eq!(std::fs::read(&target).expect("read"), b"keep");
         let fifo = dir.path().join("fifo");
-        let made = std::process::Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .expect("mkfifo runs");
-        assert!(made.success());
+        crate::make_fifo(&fifo);
         let e = open_in_place(&fifo).expect_err("a FIFO").to_string();
         assert!(e.contains("it is a FIFO"), "{e}");
         let file = dir.path().join("file.csv");
