@@ -189,6 +189,19 @@ fn planned_key(run: &RunSpec, duration_s: f64) -> String {
 /// its row saying why; a G-code job is planned as it streams and bounded by its own checks
 /// (`settle_gcode::MAX_STEP_DURATION_S`).
 fn validate_planned(run: &RunSpec, src: &Source) -> Result<(), Error> {
+    check_planned(run, src, false)
+}
+
+/// Check a run whose trace is recorded (`settle sweep --mcap`, `--rerun`: every run's trace
+/// is kept) as [`validate_planned`] checks one whose study keeps it: the sweep calls this
+/// for each of its runs before any starts.
+pub fn validate_recorded(run: &RunSpec, src: &Source) -> Result<(), Error> {
+    check_planned(run, src, true)
+}
+
+/// [`validate_planned`], the trace counted as kept when `recorded` or when the run's study
+/// measures it whole.
+fn check_planned(run: &RunSpec, src: &Source, recorded: bool) -> Result<(), Error> {
     if studies::motion(run).table() == Some("gcode") {
         return Ok(());
     }
@@ -201,7 +214,8 @@ fn validate_planned(run: &RunSpec, src: &Source) -> Result<(), Error> {
     };
     let duration_s = planned.motion.duration_s();
     let per_sample = crate::measure::channels::channels(&axes).len() + 1;
-    check_run_size(run, duration_s, per_sample, planned.probe.is_some()).map_err(|m| {
+    let kept = recorded || planned.probe.is_some();
+    check_run_size(run, duration_s, per_sample, kept).map_err(|m| {
         let what = if run.swept.is_empty() && run.id == 0 {
             "the run as written".to_string()
         } else {

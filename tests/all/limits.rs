@@ -332,3 +332,78 @@ fn a_scan_sweep_too_long_for_memory_is_refused_before_any_run() {
         "{e}"
     );
 }
+
+/// Two trapezoid moves of 1 and 300 mm at 1 mm/s and 1000 mm/s^2 on one 40 Hz mode,
+/// observed 0.5 s at `rate` Hz.
+fn slow_moves(rate: f64) -> String {
+    format!(
+        r#"name = "slow"
+[machine]
+modes = [{{ frequency_hz = 40.0, damping_ratio = 0.05 }}]
+[move]
+distance_mm = 1.0
+profile = "trapezoid"
+[limits]
+vmax_mm_s = 1.0
+amax_mm_s2 = 1000.0
+[observe]
+window_s = 0.5
+sample_rate_hz = {rate}
+bands_um = [10.0]
+[sweep]
+"move.distance_mm" = [1, 300]
+"#
+    )
+}
+
+#[test]
+fn a_recorded_sweep_checks_every_runs_trace_before_any_run() {
+    // The 300 mm move lasts d / v + v / a = 300.001 s; with the 0.5 s window its samples
+    // are 300.501 rate, each of 8 values when recorded (one axis: 6 channels, the path
+    // error, the time stamp). `--mcap` and `--rerun` keep every run's trace, at most 1.6e7
+    // values: the last rate within is taken, the next refused, blaming the swept distance.
+    let t: f64 = 300.0 / 1.0 + 1.0 / 1000.0 + 0.5;
+    let ok = (1.6e7 / (8.0 * t)).floor();
+    assert!(1.6e7 - 8.0 * t * ok > 100.0 && 8.0 * t * (ok + 1.0) > 1.6e7 + 100.0);
+    let check = |rate: f64| {
+        let text = slow_moves(rate);
+        let (sc, src) = settle::expand::parse(&text, Path::new("s.toml")).expect("parses");
+        let runs = settle::expand::expand(&sc, &src).expect("not recorded, every run is taken");
+        runs.iter()
+            .map(|r| settle::expand::validate::validate_recorded(r, &src))
+            .collect::<Result<Vec<()>, _>>()
+    };
+    check(ok).unwrap_or_else(|e| panic!("{ok} Hz: {e}"));
+    let e = check(ok + 1.0).expect_err("refused").to_string();
+    assert!(
+        e.starts_with("s.toml:15:") && e.contains("key `sweep.move.distance_mm`"),
+        "{e}"
+    );
+    assert!(
+        e.contains("run 1: its trace is kept in memory") && e.contains("of 8 values each"),
+        "{e}"
+    );
+    // Through the command: exit 2 before any run, nothing written.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scenario = write(dir.path(), "s.toml", &slow_moves(ok + 1.0));
+    let out = settle()
+        .args([
+            "sweep",
+            "s.toml",
+            "--mcap",
+            "--backend",
+            "modal",
+            "--out",
+            "o",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .expect("runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("key `sweep.move.distance_mm`"), "{stderr}");
+    assert!(
+        scenario.exists() && !dir.path().join("o").exists(),
+        "nothing written"
+    );
+}
