@@ -81,35 +81,14 @@ pub fn execute(spec: &RunSpec, record: Option<&mut Series>) -> Result<Metrics, E
         ..sim_options(spec)
     };
     let observe = observe_of(spec);
-    let duration_s = planned.motion.duration_s();
-    let samples = (duration_s + spec.window_s) * spec.sample_rate_hz;
-    if !(samples.is_finite() && samples <= crate::expand::validate::MAX_SAMPLES_PER_RUN) {
-        return Ok(Metrics::failed(
-            &spec.bands_um,
-            format!(
-                "the planned move takes {:.3e} s: with the {} s window at {} Hz that is {samples:.3e} samples, over the limit of {:e} per run",
-                duration_s,
-                spec.window_s,
-                spec.sample_rate_hz,
-                crate::expand::validate::MAX_SAMPLES_PER_RUN
-            ),
-        ));
-    }
-    // A trace kept in memory (recorded, or measured whole by the run's kind) is bounded.
+    // A trace kept in memory (recorded, or measured whole by the run's kind) is bounded;
+    // the sweep checked the same before any run ([`crate::expand::validate`]).
     let kept = record.is_some() || planned.probe.is_some();
     let per_sample = simulate::channels(&axes).len() + 1;
-    let values = samples * per_sample as f64;
-    if kept && values > crate::expand::validate::MAX_RECORDED_VALUES {
-        return Ok(Metrics::failed(
-            &spec.bands_um,
-            format!(
-                "its trace is kept in memory: {samples:.3e} samples (the {:.3e} s move and the {} s window at {} Hz) of {per_sample} values each are {values:.3e} values, over the limit of {:e}: shorten the move or the window, or lower observe.sample_rate_hz",
-                duration_s,
-                spec.window_s,
-                spec.sample_rate_hz,
-                crate::expand::validate::MAX_RECORDED_VALUES
-            ),
-        ));
+    if let Err(m) =
+        crate::expand::validate::check_run_size(spec, planned.motion.duration_s(), per_sample, kept)
+    {
+        return Ok(Metrics::failed(&spec.bands_um, m));
     }
     // A study that measures more than the common metrics gets the series recorded.
     let mut local = Series::default();

@@ -5,96 +5,19 @@
 use std::borrow::Cow;
 use std::ops::ControlFlow;
 
-use settle_planner::{PlanError, Profile, Sample, State};
-use settle_sim::{AxisModel, DriverMode, Observation, Plant, SimError};
+use settle_planner::{PlanError, Profile, State};
+use settle_sim::{AxisModel, Plant, SimError};
 
 use crate::execute::Observe;
 use crate::execute::driver::{Chunk, Clock, Driver, Samples, Sink, Stop, standing_at};
 use crate::execute::plant::{SimOptions, Simulation, with_plant};
 use crate::measure::accumulator::Accumulator;
+pub use crate::measure::channels::{AxisMeta, channels};
 use crate::measure::metrics::{Metrics, Status};
 use crate::measure::path_metrics::PathAccumulator;
 use crate::measure::series::Series;
 use crate::spec::backend::Backend;
 use crate::studies::{Motion, MotionStream};
-
-/// A per-axis channel of a recording: its name (the axis's is appended: `cmd_p_x`), its
-/// unit, and its value from the command and the observation of the axis.
-type Column = (&'static str, &'static str, fn(&Sample, &Observation) -> f64);
-
-/// The channels every axis records: the command, the toolhead and its error (toolhead -
-/// command).
-const COMMON: [Column; 6] = [
-    ("cmd_p", "m", |c, _| c.p),
-    ("cmd_v", "m_s", |c, _| c.v),
-    ("cmd_a", "m_s2", |c, _| c.a),
-    ("cmd_j", "m_s3", |c, _| c.j),
-    ("toolhead", "m", |_, o| o.toolhead_m),
-    ("error", "m", |_, o| o.toolhead_m - o.commanded_m),
-];
-
-/// The carriage's channel (m), where the model has a carriage.
-const CARRIAGE: Column = ("carriage", "m", |_, o| o.carriage_m.unwrap_or(f64::NAN));
-
-/// The motor's channels (rad; the load angle in electrical rad), where it has a stepper.
-const MOTOR: [Column; 2] = [
-    ("motor_angle", "rad", |_, o| {
-        o.motor_angle_rad.unwrap_or(f64::NAN)
-    }),
-    ("load_angle", "rad", |_, o| {
-        o.load_angle_rad.unwrap_or(f64::NAN)
-    }),
-];
-
-/// The phase currents (A), for the full driver model.
-const CURRENTS: [Column; 2] = [
-    ("current_a", "A", |_, o| {
-        o.currents_a.map_or(f64::NAN, |c| c[0])
-    }),
-    ("current_b", "A", |_, o| {
-        o.currents_a.map_or(f64::NAN, |c| c[1])
-    }),
-];
-
-/// The channels [`crate::execute::execute`] records for these axes: per axis `cmd_p_<axis>` (m),
-/// `cmd_v_<axis>` (m/s), `cmd_a_<axis>` (m/s^2), `cmd_j_<axis>` (m/s^3), `toolhead_<axis>`
-/// (m), `error_<axis>` (toolhead - command, m) and, where the model has them,
-/// `carriage_<axis>` (m), `motor_angle_<axis>` (rad), `load_angle_<axis>` (electrical
-/// rad), `current_a_<axis>`, `current_b_<axis>` (A, full driver); then `error` (length of
-/// the toolhead-minus-command vector, m).
-pub fn channels(axes: &[AxisModel]) -> Vec<(String, String)> {
-    let mut ch = Vec::new();
-    for a in axes {
-        for (c, u, _) in AxisMeta::of(a).columns {
-            ch.push((format!("{c}_{}", a.name), u.to_string()));
-        }
-    }
-    ch.push(("error".into(), "m".into()));
-    ch
-}
-
-/// The channels an axis records, in order ([`channels`]).
-#[derive(Debug, Clone)]
-pub struct AxisMeta {
-    columns: Vec<Column>,
-}
-
-impl AxisMeta {
-    /// What `axis` has.
-    pub fn of(axis: &AxisModel) -> Self {
-        let mut columns = COMMON.to_vec();
-        if axis.carriage.is_some() {
-            columns.push(CARRIAGE);
-        }
-        if axis.stepper.is_some() {
-            columns.extend(MOTOR);
-        }
-        if axis.mode == DriverMode::Full {
-            columns.extend(CURRENTS);
-        }
-        Self { columns }
-    }
-}
 
 /// Simulate `motion` (one profile per axis of `axes`, in their order; planned whole or
 /// streamed) on `backend` and measure it against its end point ([`Run`]). When

@@ -108,6 +108,126 @@ fn validate_duration(run: &RunSpec, src: &Source) -> Result<(), Error> {
     ))
 }
 
+/// Check the size of a run whose motion lasts `duration_s` (s): its samples, move and
+/// window together, within [`MAX_SAMPLES_PER_RUN`], and, when its trace is `kept` in
+/// memory, its values (`per_sample` each, the time stamp included) within
+/// [`MAX_RECORDED_VALUES`]. The message for a run over a limit. `crate::execute::execute`
+/// checks this before it simulates; [`validate_run`] before any run, on the planned
+/// motion.
+pub fn check_run_size(
+    run: &RunSpec,
+    duration_s: f64,
+    per_sample: usize,
+    kept: bool,
+) -> Result<(), String> {
+    let samples = (duration_s + run.window_s) * run.sample_rate_hz;
+    if !(samples.is_finite() && samples <= MAX_SAMPLES_PER_RUN) {
+        return Err(format!(
+            "the planned move takes {duration_s:.3e} s: with the {} s window at {} Hz that is {samples:.3e} samples, over the limit of {MAX_SAMPLES_PER_RUN:e} per run",
+            run.window_s, run.sample_rate_hz,
+        ));
+    }
+    let values = samples * per_sample as f64;
+    if kept && values > MAX_RECORDED_VALUES {
+        return Err(format!(
+            "its trace is kept in memory: {samples:.3e} samples (the {duration_s:.3e} s move and the {} s window at {} Hz) of {per_sample} values each are {values:.3e} values, over the limit of {MAX_RECORDED_VALUES:e}: shorten the move or the window, or lower observe.sample_rate_hz",
+            run.window_s, run.sample_rate_hz,
+        ));
+    }
+    Ok(())
+}
+
+/// The key at fault for a run whose planned motion is too long ([`validate_planned`]): a
+/// swept key the motion's time rests on, else for a scan the line's speed or its settle
+/// margin (whichever adds more to each line), for a move the jerk limit when the planned
+/// move takes more than twice its trapezoid's time (the jerk phases set it), else the key
+/// [`duration_key`] names.
+fn planned_key(run: &RunSpec, duration_s: f64) -> String {
+    use crate::studies::scan::ScanSpec;
+    const SCAN: [&str; 6] = [
+        "scan.v_scan_mm_s",
+        "scan.width_mm",
+        "scan.lines",
+        "scan.settle_margin_s",
+        "scan.fly_amax_mm_s2",
+        "scan.fly_jmax_mm_s3",
+    ];
+    const MOVE: [&str; 4] = [
+        "move.distance_mm",
+        "limits.vmax_mm_s",
+        "limits.amax_mm_s2",
+        "limits.jmax_mm_s3",
+    ];
+    let scan = run.state::<ScanSpec>();
+    let candidates = SCAN.iter().filter(|_| scan.is_some()).chain(MOVE.iter());
+    if let Some(k) = candidates
+        .map(|k| run.blame(k))
+        .find(|k| k.starts_with("sweep."))
+    {
+        return k;
+    }
+    if let Some(s) = scan {
+        let key = if s.settle_margin_s > s.width_mm / s.v_scan_mm_s {
+            "scan.settle_margin_s"
+        } else {
+            "scan.v_scan_mm_s"
+        };
+        return run.blame(key);
+    }
+    let trapezoid_s = min_move_time_s(run.distance_mm, run.vmax_mm_s, run.amax_mm_s2);
+    if run.jmax_mm_s3.is_some() && duration_s > 2.0 * trapezoid_s {
+        return run.blame("limits.jmax_mm_s3");
+    }
+    duration_key(run)
+}
+
+/// Check a run's planned motion against [`check_run_size`] before any run: the planner's
+/// own duration, so a jerk limit that stretches a move (a 1e-3 mm/s^3 jerk makes a 1e5 mm
+/// move last 1474 s, far beyond its 0.1 s at 1e6 mm/s) and a scan's lines (each crossed at
+/// `v_scan_mm_s`) count. The trace counted as kept is the one the run's study measures
+/// whole (a scan's, a shaped step's). A run that does not plan is left to fail as a run,
+/// its row saying why; a G-code job is planned as it streams and bounded by its own checks
+/// (`settle_gcode::MAX_STEP_DURATION_S`).
+fn validate_planned(run: &RunSpec, src: &Source) -> Result<(), Error> {
+    check_planned(run, src, false)
+}
+
+/// Check a run whose trace is recorded (`settle sweep --mcap`, `--rerun`: every run's trace
+/// is kept) as [`validate_planned`] checks one whose study keeps it: the sweep calls this
+/// for each of its runs before any starts.
+pub fn validate_recorded(run: &RunSpec, src: &Source) -> Result<(), Error> {
+    check_planned(run, src, true)
+}
+
+/// [`validate_planned`], the trace counted as kept when `recorded` or when the run's study
+/// measures it whole.
+fn check_planned(run: &RunSpec, src: &Source, recorded: bool) -> Result<(), Error> {
+    if studies::motion(run).table() == Some("gcode") {
+        return Ok(());
+    }
+    let Ok(axes) = run.machine.axes(run.driver) else {
+        return Ok(());
+    };
+    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+    let Ok(planned) = studies::plan(run, &names) else {
+        return Ok(());
+    };
+    let duration_s = planned.motion.duration_s();
+    let per_sample = crate::measure::channels::channels(&axes).len() + 1;
+    let kept = recorded || planned.probe.is_some();
+    check_run_size(run, duration_s, per_sample, kept).map_err(|m| {
+        let what = if run.swept.is_empty() && run.id == 0 {
+            "the run as written".to_string()
+        } else {
+            format!("run {}", run.id)
+        };
+        src.error_at(
+            &planned_key(run, duration_s),
+            format!("{what}: {m}; checked before any run starts"),
+        )
+    })
+}
+
 /// The slowest and fastest vibration modes (Hz) a run's axes have: the modes given, or a
 /// physical machine's undamped natural frequencies linearised at the move's start (rigid
 /// rotations at 0 Hz left out). `None` when there are none or the machine cannot be
@@ -395,5 +515,6 @@ pub fn validate_run(run: &RunSpec, src: &Source) -> Result<(), Error> {
         }
     }
     validate_duration(run, src)?;
-    validate_positions(run, src, |k| run.blame(k))
+    validate_positions(run, src, |k| run.blame(k))?;
+    validate_planned(run, src)
 }

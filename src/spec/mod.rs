@@ -36,6 +36,17 @@ pub const ACCELERATION_RANGE_MM_S2: (f64, f64) = (1e-3, 1e9);
 /// two hours.
 pub const JERK_RANGE_MM_S3: (f64, f64) = (1e-3, 1e15);
 
+/// The deviations a corner may take from its sharp point (mm): `corner.junction_deviation_mm`
+/// (GRBL's junction deviation) and `corner.blend_deviation_mm` (the blend's tolerance), from
+/// [`MIN_LENGTH_MM`] (1 nm, the smallest step a wafer stage makes) to [`MAX_POSITION_MM`]
+/// (100 m, beyond any machine). Firmware that owns such a key takes less or does not bound
+/// it: Marlin's `M205 J` takes 0.01 to 0.3 mm (`GcodeSuite::M205`,
+/// Marlin/src/gcode/config/M200-M205.cpp), GRBL's `$11` any number
+/// (`settings_store_global_setting`, grbl/settings.c). Beyond 100 m a deviation no longer
+/// describes a corner of a machine: `corner.junction_deviation_mm = 1e300` planned the
+/// corner at full speed and lost steps.
+pub const DEVIATION_RANGE_MM: (f64, f64) = (MIN_LENGTH_MM, MAX_POSITION_MM);
+
 /// The longest a scan may wait at a line's end (`scan.settle_margin_s`, s): a hundred
 /// seconds, against a real margin's milliseconds. A scan's trace is kept in memory
 /// (`crate::expand::validate::MAX_RECORDED_VALUES`): a 100 s margin at 10 kHz is 8e6 of a
@@ -43,9 +54,11 @@ pub const JERK_RANGE_MM_S3: (f64, f64) = (1e-3, 1e15);
 pub const MAX_MARGIN_S: f64 = 1e2;
 
 /// Check a motion limit against the range of its quantity, named by `unit` (`mm/s`,
-/// `mm/s^2` or `mm/s^3`): the message for a value outside it.
+/// `mm/s^2` or `mm/s^3`; `mm` for a corner's deviation, [`DEVIATION_RANGE_MM`]): the
+/// message for a value outside it.
 pub fn check_limit(value: f64, unit: &str) -> Result<(), String> {
     let (lo, hi) = match unit {
+        "mm" => DEVIATION_RANGE_MM,
         "mm/s" => SPEED_RANGE_MM_S,
         "mm/s^2" => ACCELERATION_RANGE_MM_S2,
         "mm/s^3" => JERK_RANGE_MM_S3,

@@ -7,6 +7,11 @@
 //! `{"duration":1.7,"axes":[{"p0":0,"v0":0,"a0":0,"segments":[[0.2,10.0],...]}]}` where each
 //! segment is `[duration, jerk]`, or `[duration, 0, accel]` for a constant-acceleration
 //! segment whose acceleration jumps to `accel` (trapezoids); or `{"error":"..."}`.
+//!
+//! Every line is bounded before it is planned: its length ([`settle_files::limit::PLAN_LINE`],
+//! read no further), its axes ([`MAX_AXES`]) and each value ([`MAX_MAGNITUDE`],
+//! [`MIN_LIMIT`]); a line outside them is answered with an error naming the field, the
+//! axis and the range.
 
 use serde::Deserialize;
 use serde_json::{Value, json};
@@ -45,6 +50,62 @@ struct Problem {
     interface: String,
 }
 
+/// The most axes one problem may have: 30, the most movement axes a firmware here drives
+/// (RepRapFirmware on a Duet 3 MB6HC: `MaxAxes`, src/Config/Pins_Duet3_MB6HC.h). Each axis
+/// is planned and answered with its own profile, so the axes bound a line's work and its
+/// answer as the line's length bounds its reading.
+pub const MAX_AXES: usize = 30;
+
+/// The largest magnitude of a value of a problem (a position, velocity, acceleration or
+/// jerk, in the problem's own units): 1e15. The planner is unit-free and answers only what
+/// f64 resolves: it checks each profile's end against the target to 1e-8 of the move's
+/// largest position and refuses one that misses (`verify`, planner/src/position.rs,
+/// "inputs beyond what f64 arithmetic resolves"). Inside 1e15 and [`MIN_LIMIT`] lie the
+/// problems of every machine in mm or m (`settle::spec`: positions to 1e5 mm, jerks to
+/// 1e15 mm/s^3) and the slowest answer (a 1e15 move at 1e-9 per second lasts 1e24 s) and
+/// the positions it passes stay far inside f64's range, where that check decides; beyond,
+/// the numbers stop meaning a motion (a 1e300 move at 1 per second was answered as lasting
+/// 1e300 s, its jerk phases of 1 s lost in the sum of its segments).
+pub const MAX_MAGNITUDE: f64 = 1e15;
+
+/// The smallest limit (`vmax`, `amax`, `jmax`, and the magnitude of `vmin`, `amin`): 1e-9,
+/// the least motion setting a G-code file may set (`settle_gcode::MIN_LIMIT_VALUE`: below
+/// it the planners' arithmetic leaves the range of f64). settle's slowest limits, 1e-3 mm/s
+/// (1e-6 m/s) and the like, lie above it.
+pub const MIN_LIMIT: f64 = 1e-9;
+
+/// Check every value of `pr` against [`MAX_MAGNITUDE`] and the limits against
+/// [`MIN_LIMIT`]: the message for the first value outside, naming its field and axis.
+fn check_values(pr: &Problem) -> Result<(), String> {
+    let (lo, hi) = (MIN_LIMIT, MAX_MAGNITUDE);
+    // (field, values, allowed range)
+    let fields: [(&str, &[f64], (f64, f64)); 11] = [
+        ("p0", &pr.p0, (-hi, hi)),
+        ("v0", &pr.v0, (-hi, hi)),
+        ("a0", &pr.a0, (-hi, hi)),
+        ("pf", &pr.pf, (-hi, hi)),
+        ("vf", &pr.vf, (-hi, hi)),
+        ("af", &pr.af, (-hi, hi)),
+        ("vmax", &pr.vmax, (lo, hi)),
+        ("amax", &pr.amax, (lo, hi)),
+        ("jmax", &pr.jmax, (lo, hi)),
+        ("vmin", &pr.vmin, (-hi, -lo)),
+        ("amin", &pr.amin, (-hi, -lo)),
+    ];
+    for (name, values, (min, max)) in fields {
+        if let Some((i, x)) = values
+            .iter()
+            .enumerate()
+            .find(|(_, x)| !(x.is_finite() && (min..=max).contains(*x)))
+        {
+            return Err(format!(
+                "`{name}` of axis {i} must be a number from {min:e} to {max:e}, got {x}: the planner answers values within {MAX_MAGNITUDE:e} in magnitude and limits of at least {MIN_LIMIT:e}, in the problem's own units"
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn default_sync() -> String {
     "time".into()
 }
@@ -71,6 +132,12 @@ fn solve(line: &str) -> Result<Value, String> {
     if n == 0 {
         return Err("`vmax` must list one value per axis".into());
     }
+    if n > MAX_AXES {
+        return Err(format!(
+            "`vmax` lists {n} axes; a problem has 1 to {MAX_AXES} (one value per axis)"
+        ));
+    }
+    check_values(&pr)?;
     let shape = match pr.kind.as_str() {
         "scurve" => Shape::JerkLimited,
         "trapezoid" => Shape::Trapezoid,
@@ -183,6 +250,11 @@ pub fn answer_bytes(number: u64, line: &[u8]) -> String {
 /// Lines answered together, in parallel, at most.
 pub const BATCH: usize = 8192;
 
+/// The most bytes of lines a batch holds: 64 MiB. A batch ends at [`BATCH`] lines or at
+/// this many bytes, whichever comes first: [`BATCH`] lines of the longest a line may be
+/// ([`settle_files::limit::PLAN_LINE`], 1 MiB) would hold 8 GiB.
+pub const BATCH_BYTES: usize = 64 << 20;
+
 /// Answer the JSON lines of `input` on `output`, in order, in parallel batches on `jobs`
 /// threads (all cores when `None`).
 ///
@@ -191,7 +263,7 @@ pub const BATCH: usize = 8192;
 /// error and the stream goes on. A batch holds up to [`BATCH`] lines
 /// (`max_batch` lower, e.g. 1 for a terminal), but never waits for input: it ends as soon
 /// as the lines read so far are all that `input` has delivered (no complete line left in
-/// the read buffer), then its answers are written and flushed. So a client that writes one
+/// the read buffer) or holds [`BATCH_BYTES`], then its answers are written and flushed. So a client that writes one
 /// line and waits for its answer gets it, and a file is still answered in large batches.
 pub fn plan_stream(
     input: impl std::io::Read,
@@ -216,7 +288,8 @@ pub fn plan_stream(
     loop {
         batch.clear();
         let mut eof = false;
-        while batch.len() < max_batch {
+        let mut held = 0;
+        while batch.len() < max_batch && held < BATCH_BYTES {
             // Reading on would wait for input: answer what is here first.
             if !batch.is_empty() && !input.get_ref().buffer().contains(&b'\n') {
                 break;
@@ -229,6 +302,7 @@ pub fn plan_stream(
                 LineStatus::Complete => Some(input.bytes().to_vec()),
                 LineStatus::TooLong => None,
             };
+            held += line.as_ref().map_or(0, Vec::len);
             batch.push((input.line_no(), line));
         }
         let too_long = |n: u64| {

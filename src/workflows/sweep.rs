@@ -164,6 +164,12 @@ pub fn sweep(
         Some(s) => all_runs.every(s.k - 1, s.n),
         None => all_runs,
     };
+    // A recorded run keeps its whole trace: each is checked for it before any starts.
+    if rec.is_some() {
+        for i in 0..runs.len() {
+            crate::expand::validate::validate_recorded(&(&runs as &dyn RunList).at(i), &src)?;
+        }
+    }
     // Never onto the scenario or a file it reads, nor through a link out of the folder.
     let read = crate::expand::machine::input_files(&sc, &src);
     crate::output::folder::check(&out, &NO_RESULTS, true, &read, writes)?;

@@ -376,3 +376,77 @@ fn bad_corner_input_names_file_line_and_key() {
         "{msg}"
     );
 }
+
+/// The next f64 above (`up`) or below `x > 0`.
+fn next(x: f64, up: bool) -> f64 {
+    f64::from_bits(if up { x.to_bits() + 1 } else { x.to_bits() - 1 })
+}
+
+#[test]
+fn corner_deviations_and_square_corner_velocity_are_bounded_as_written_and_swept() {
+    // Each key's range (crate::spec::DEVIATION_RANGE_MM for the deviations: 1 nm to 100 m;
+    // SPEED_RANGE_MM_S for the square corner velocity): its ends are taken, the next f64
+    // beyond either end is refused with the key, its line, the range and the value; a
+    // swept value is checked the same way and blames the sweep key.
+    let good = scenario();
+    let line_of = |text: &str, key: &str| {
+        1 + text
+            .lines()
+            .position(|l| l.starts_with(key))
+            .expect("key in text")
+    };
+    for (key, written, lo, hi, range) in [
+        (
+            "junction_deviation_mm",
+            JD,
+            1e-6,
+            1e5,
+            "from 1e-6 to 1e5 (mm)",
+        ),
+        (
+            "square_corner_velocity_mm_s",
+            SCV,
+            1e-3,
+            1e6,
+            "from 1e-3 to 1e6 (mm/s)",
+        ),
+        (
+            "blend_deviation_mm",
+            BLEND,
+            1e-6,
+            1e5,
+            "from 1e-6 to 1e5 (mm)",
+        ),
+    ] {
+        let at = |x: f64| good.replace(&format!("{key} = {written}\n"), &format!("{key} = {x}\n"));
+        for x in [lo, hi] {
+            let text = at(x);
+            assert_ne!(text, good);
+            settle::expand::parse_runs(&text, Path::new("bad.toml"))
+                .unwrap_or_else(|e| panic!("{key} = {x}: {e}"));
+        }
+        for x in [next(lo, false), next(hi, true), 0.0, f64::INFINITY] {
+            let text = at(x);
+            let msg = corner_err(&text);
+            let line = line_of(&text, key);
+            assert!(msg.starts_with(&format!("bad.toml:{line}:")), "{msg}");
+            assert!(msg.contains(&format!("key `corner.{key}`")), "{msg}");
+            assert!(
+                msg.contains(range) && msg.contains(&format!("got {x}")),
+                "{msg}"
+            );
+        }
+        // Swept: each value is checked; the bad one blames the sweep key and its line.
+        let text = format!("{good}\"corner.{key}\" = [{lo}, {}]\n", next(hi, true));
+        let msg = corner_err(&text);
+        let line = line_of(&text, &format!("\"corner.{key}\""));
+        assert!(msg.starts_with(&format!("bad.toml:{line}:")), "{msg}");
+        assert!(msg.contains(&format!("key `sweep.corner.{key}`")), "{msg}");
+        assert!(msg.contains(range), "{msg}");
+        let text = format!("{good}\"corner.{key}\" = [{lo}, {hi}]\n");
+        let runs = settle::expand::parse_runs(&text, Path::new("bad.toml"))
+            .unwrap_or_else(|e| panic!("{key} swept over its range: {e}"))
+            .1;
+        assert_eq!(runs.len(), 64);
+    }
+}

@@ -407,3 +407,43 @@ fn a_marked_file_says_which_layer_is_not_one_plane_and_why() {
         "{words}"
     );
 }
+
+#[test]
+fn the_jobs_square_corner_velocity_is_0_or_a_speed_in_range() {
+    // 0 stops at every corner; otherwise the range of a speed limit
+    // (settle::spec::SPEED_RANGE_MM_S, 1e-3 to 1e6 mm/s): its ends are taken, the next
+    // f64 beyond either end refused with the key and its line, as is a negative value.
+    let path = root().join("scenarios/gcode_corner.toml");
+    let good = std::fs::read_to_string(&path).expect("scenario");
+    let at = |x: f64| {
+        let t = good.replace(
+            "square_corner_velocity_mm_s = 5.0\n",
+            &format!("square_corner_velocity_mm_s = {x}\n"),
+        );
+        assert_ne!(t, good);
+        t
+    };
+    let line = 1 + good
+        .lines()
+        .position(|l| l.starts_with("square_corner_velocity_mm_s"))
+        .expect("key");
+    for x in [0.0, 1e-3, 1e6] {
+        settle::expand::parse_runs(&at(x), &path).unwrap_or_else(|e| panic!("{x}: {e}"));
+    }
+    let below = f64::from_bits(1e-3f64.to_bits() - 1);
+    let above = f64::from_bits(1e6f64.to_bits() + 1);
+    for x in [below, above, -5.0, f64::NEG_INFINITY] {
+        let e = settle::expand::parse_runs(&at(x), &path).expect_err("refused");
+        assert!(e.is_input_error(), "{e}");
+        let msg = e.to_string();
+        assert!(
+            msg.contains(&format!("gcode_corner.toml:{line}:"))
+                && msg.contains("key `gcode.square_corner_velocity_mm_s`")
+                && msg.contains(
+                    "0 (stop at every corner) or a finite number from 1e-3 to 1e6 (mm/s)"
+                )
+                && msg.contains(&format!("got {x}")),
+            "{msg}"
+        );
+    }
+}

@@ -230,3 +230,180 @@ fn a_bad_name_writes_nothing_and_names_the_key() {
         "nothing created"
     );
 }
+
+/// A point move whose time the jerk limit sets: 1e5 mm at 1e-3 mm/s^3 with limits it
+/// never reaches (1e6 mm/s, 1e9 mm/s^2), on one 40 Hz mode, observed 0.02 s at `rate` Hz.
+fn jerk_bound_move(rate: u64) -> String {
+    format!(
+        r#"name = "jerk_bound"
+[machine]
+modes = [{{ frequency_hz = 40.0, damping_ratio = 0.05 }}]
+[move]
+distance_mm = 1e5
+profile = "scurve"
+[limits]
+vmax_mm_s = 1e6
+amax_mm_s2 = 1e9
+jmax_mm_s3 = 1e-3
+[observe]
+window_s = 0.02
+sample_rate_hz = {rate}
+bands_um = [10.0]
+"#
+    )
+}
+
+#[test]
+fn a_move_stretched_by_its_jerk_limit_is_refused_on_its_planned_time() {
+    // The S-curve that reaches neither limit has three jerk phases of tau, 2 tau and tau
+    // and covers 2 j tau^3: tau = cbrt(d / (2 j)), the move lasts 4 tau = 1473.6 s, not
+    // the 0.101 s of its trapezoid (d / v + v / a). Its samples with the window:
+    // (4 tau + 0.02) rate. The last rate within 1e8 samples is taken, the next refused
+    // before any run, blaming the jerk limit with the planned time.
+    let (d, j, w) = (1e5_f64, 1e-3_f64, 0.02);
+    let move_s = 4.0 * (d / (2.0 * j)).cbrt();
+    assert!((move_s - 1473.6).abs() < 0.1, "{move_s}");
+    let ok = (1e8 / (move_s + w)).floor() as u64;
+    // Far from an integer: rounding cannot move the boundary.
+    assert!(1e8 - ok as f64 * (move_s + w) > 100.0);
+    assert!((ok + 1) as f64 * (move_s + w) > 1e8 + 100.0);
+    settle::expand::parse_runs(&jerk_bound_move(ok), Path::new("s.toml"))
+        .unwrap_or_else(|e| panic!("{ok} Hz: {e}"));
+    let e = expand_err(&jerk_bound_move(ok + 1));
+    assert!(e.starts_with("s.toml:10:"), "{e}");
+    assert!(e.contains("key `limits.jmax_mm_s3`"), "{e}");
+    assert!(
+        e.contains(&format!("the planned move takes {move_s:.3e} s"))
+            && e.contains("over the limit of 1e8 per run"),
+        "{e}"
+    );
+}
+
+/// `scenarios/ci_scan.toml` with `lines` extra lines appended to its `[sweep]` and its
+/// sample rate `rate`.
+fn ci_scan_with(sweep: &str, rate: f64) -> String {
+    let text = std::fs::read_to_string(crate::support::root().join("scenarios/ci_scan.toml"))
+        .expect("ci_scan");
+    let text = text.replace(
+        "sample_rate_hz = 10000\n",
+        &format!("sample_rate_hz = {rate}\n"),
+    );
+    format!("{text}{sweep}")
+}
+
+#[test]
+fn a_scan_sweep_too_long_for_memory_is_refused_before_any_run() {
+    // One swept scan speed of 1e-2 mm/s: each of the 2 lines of 10 mm takes 1000 s, 2000 s
+    // of raster that ci_scan keeps whole (1 axis simulated: 6 channels, the path error and
+    // the time stamp, 8 values a sample) at 10 kHz: 1.6e8 values, over 1.6e7. The sweep is
+    // refused before any of its 12 runs starts, blaming the swept key.
+    let e = expand_err(&ci_scan_with("\"scan.v_scan_mm_s\" = [100, 1e-2]\n", 1e4));
+    assert!(e.contains("key `sweep.scan.v_scan_mm_s`"), "{e}");
+    assert!(
+        e.contains("run 1:") && e.contains("the 2.000e3 s move") && e.contains("of 8 values each"),
+        "{e}"
+    );
+    assert!(e.contains("over the limit of 1.6e7"), "{e}");
+    // The boundary on the planned raster at 1 mm/s: its duration is the planner's (at
+    // least the 20 s the fly axis takes over the lines, and the turnaround and run-out add
+    // well under a second), the last rate within 1.6e7 values taken, the next refused.
+    let text = ci_scan_with("\"scan.v_scan_mm_s\" = [1]\n", 1e4);
+    let (_, runs) = settle::expand::parse_runs(&text, Path::new("s.toml")).expect("runs");
+    let names = runs[0].axis_names();
+    let raster_s = runs
+        .iter()
+        .map(|r| {
+            settle::studies::plan(r, &names)
+                .expect("plans")
+                .motion
+                .duration_s()
+        })
+        .fold(0.0, f64::max);
+    assert!((20.0..21.0).contains(&raster_s), "{raster_s}");
+    let ok = (1.6e7 / (8.0 * (raster_s + 0.02))).floor();
+    settle::expand::parse_runs(
+        &ci_scan_with("\"scan.v_scan_mm_s\" = [1]\n", ok),
+        Path::new("s.toml"),
+    )
+    .unwrap_or_else(|e| panic!("{ok} Hz: {e}"));
+    let e = expand_err(&ci_scan_with("\"scan.v_scan_mm_s\" = [1]\n", ok + 1.0));
+    assert!(
+        e.contains("key `sweep.scan.v_scan_mm_s`") && e.contains("its trace is kept in memory"),
+        "{e}"
+    );
+}
+
+/// Two trapezoid moves of 1 and 300 mm at 1 mm/s and 1000 mm/s^2 on one 40 Hz mode,
+/// observed 0.5 s at `rate` Hz.
+fn slow_moves(rate: f64) -> String {
+    format!(
+        r#"name = "slow"
+[machine]
+modes = [{{ frequency_hz = 40.0, damping_ratio = 0.05 }}]
+[move]
+distance_mm = 1.0
+profile = "trapezoid"
+[limits]
+vmax_mm_s = 1.0
+amax_mm_s2 = 1000.0
+[observe]
+window_s = 0.5
+sample_rate_hz = {rate}
+bands_um = [10.0]
+[sweep]
+"move.distance_mm" = [1, 300]
+"#
+    )
+}
+
+#[test]
+fn a_recorded_sweep_checks_every_runs_trace_before_any_run() {
+    // The 300 mm move lasts d / v + v / a = 300.001 s; with the 0.5 s window its samples
+    // are 300.501 rate, each of 8 values when recorded (one axis: 6 channels, the path
+    // error, the time stamp). `--mcap` and `--rerun` keep every run's trace, at most 1.6e7
+    // values: the last rate within is taken, the next refused, blaming the swept distance.
+    let t: f64 = 300.0 / 1.0 + 1.0 / 1000.0 + 0.5;
+    let ok = (1.6e7 / (8.0 * t)).floor();
+    assert!(1.6e7 - 8.0 * t * ok > 100.0 && 8.0 * t * (ok + 1.0) > 1.6e7 + 100.0);
+    let check = |rate: f64| {
+        let text = slow_moves(rate);
+        let (sc, src) = settle::expand::parse(&text, Path::new("s.toml")).expect("parses");
+        let runs = settle::expand::expand(&sc, &src).expect("not recorded, every run is taken");
+        runs.iter()
+            .map(|r| settle::expand::validate::validate_recorded(r, &src))
+            .collect::<Result<Vec<()>, _>>()
+    };
+    check(ok).unwrap_or_else(|e| panic!("{ok} Hz: {e}"));
+    let e = check(ok + 1.0).expect_err("refused").to_string();
+    assert!(
+        e.starts_with("s.toml:15:") && e.contains("key `sweep.move.distance_mm`"),
+        "{e}"
+    );
+    assert!(
+        e.contains("run 1: its trace is kept in memory") && e.contains("of 8 values each"),
+        "{e}"
+    );
+    // Through the command: exit 2 before any run, nothing written.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scenario = write(dir.path(), "s.toml", &slow_moves(ok + 1.0));
+    let out = settle()
+        .args([
+            "sweep",
+            "s.toml",
+            "--mcap",
+            "--backend",
+            "modal",
+            "--out",
+            "o",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .expect("runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("key `sweep.move.distance_mm`"), "{stderr}");
+    assert!(
+        scenario.exists() && !dir.path().join("o").exists(),
+        "nothing written"
+    );
+}

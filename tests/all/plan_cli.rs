@@ -290,3 +290,125 @@ fn an_axis_already_at_its_target_is_answered() {
     assert_eq!(out[7]["duration"].as_f64(), Some(0.0), "{}", out[7]);
     assert_eq!(out[7]["axes"][0]["segments"], serde_json::json!([]));
 }
+
+/// The next f64 away from zero (`out`) or towards it.
+fn next(x: f64, out: bool) -> f64 {
+    f64::from_bits(if out {
+        x.to_bits() + 1
+    } else {
+        x.to_bits() - 1
+    })
+}
+
+/// The first value past `bound` (away from zero with `out`) as the JSON reader reads it:
+/// serde_json's default parsing may round a long decimal to a neighbour of its f64, so the
+/// next f64 or the one after is the first that reads past the bound.
+fn beyond(bound: f64, out: bool) -> f64 {
+    let mut x = bound;
+    for _ in 0..2 {
+        x = next(x, out);
+        let read: f64 = serde_json::from_str(&serde_json::json!(x).to_string()).expect("reads");
+        if read != bound {
+            return read;
+        }
+    }
+    panic!("no value within 2 ulps of {bound} reads past it");
+}
+
+#[test]
+fn each_value_and_the_axes_are_bounded_before_planning() {
+    // The bounds (settle::workflows::plan): values within 1e15 in magnitude, limits at
+    // least 1e-9 (vmin, amin at most -1e-9), at most 30 axes. At each bound the line is
+    // planned (each axis on its own: fitting the unit move of axis 0 to the 1e15 s of
+    // axis 1 is beyond what f64 resolves, and the planner says so); the next f64 beyond is answered with an error naming the field, the axis
+    // and the range, and the stream goes on.
+    let line = |field: &str, x: f64| {
+        let mut v = serde_json::json!({
+            "p0": [0, 0], "pf": [1, 1], "v0": [0, 0], "af": [0, 0],
+            "vmax": [1, 1], "vmin": [-1, -1], "amax": [1, 1], "amin": [-1, -1], "jmax": [1, 1],
+            "sync": "none"
+        });
+        v[field][1] = serde_json::json!(x);
+        v.to_string()
+    };
+    let mut input = String::new();
+    let mut cases = Vec::new();
+    for (field, bounds, range) in [
+        ("p0", [-1e15, 1e15], "from -1e15 to 1e15"),
+        ("pf", [-1e15, 1e15], "from -1e15 to 1e15"),
+        ("v0", [-1e15, 1e15], "from -1e15 to 1e15"),
+        ("af", [-1e15, 1e15], "from -1e15 to 1e15"),
+        ("vmax", [1e-9, 1e15], "from 1e-9 to 1e15"),
+        ("amax", [1e-9, 1e15], "from 1e-9 to 1e15"),
+        ("jmax", [1e-9, 1e15], "from 1e-9 to 1e15"),
+        ("vmin", [-1e15, -1e-9], "from -1e15 to -1e-9"),
+        ("amin", [-1e15, -1e-9], "from -1e15 to -1e-9"),
+    ] {
+        let [lo, hi] = bounds;
+        // Away from zero beyond the larger end, towards it beyond the smaller one.
+        let (beyond_lo, beyond_hi) = if lo < 0.0 && hi < 0.0 {
+            (beyond(lo, true), beyond(hi, false))
+        } else if lo < 0.0 {
+            (beyond(lo, true), beyond(hi, true))
+        } else {
+            (beyond(lo, false), beyond(hi, true))
+        };
+        for (x, ok) in [
+            (lo, true),
+            (hi, true),
+            (beyond_lo, false),
+            (beyond_hi, false),
+        ] {
+            input.push_str(&line(field, x));
+            input.push('\n');
+            cases.push((field, x, ok, range));
+        }
+    }
+    // The largest and the smallest: a move of 1e15 at 1 (d / v + v / a + a / j), one of 1
+    // at 1e-9 per second (the same formula, v / a and a / j under 1 s of it).
+    input.push_str("{\"p0\":[-1e15],\"pf\":[1e15],\"vmax\":[1],\"amax\":[1],\"jmax\":[1]}\n");
+    let axes = |n: usize| {
+        let v = |x: f64| serde_json::json!(vec![x; n]);
+        serde_json::json!({"p0": v(0.0), "pf": v(1.0), "vmax": v(1.0), "amax": v(1.0), "jmax": v(1.0)})
+            .to_string()
+    };
+    input.push_str(&format!("{}\n{}\n", axes(30), axes(31)));
+    input.push_str("{\"p0\":[0],\"pf\":[1e300],\"vmax\":[1],\"amax\":[1],\"jmax\":[1]}\n");
+    let out = plan(&input);
+    assert_eq!(out.len(), cases.len() + 4);
+    for ((field, x, ok, range), a) in cases.iter().zip(&out) {
+        if *ok && matches!(*field, "v0" | "af") {
+            // Taken: a start or target far beyond the limits is the planner's to answer
+            // (it may find no profile), not refused as out of range.
+            let e = a["error"].as_str().unwrap_or("");
+            assert!(!e.contains("must be a number"), "{field} = {x}: {a}");
+        } else if *ok {
+            assert!(a.get("error").is_none(), "{field} = {x}: {a}");
+            assert!(a["duration"].as_f64().is_some_and(f64::is_finite), "{a}");
+        } else {
+            let e = a["error"]
+                .as_str()
+                .unwrap_or_else(|| panic!("{field} = {x}: {a}"));
+            assert!(
+                // A number of more digits than a message prints whole is shortened.
+                e.starts_with(&settle::error::shorten_numbers(&format!(
+                    "`{field}` of axis 1 must be a number {range}, got {x}"
+                ))),
+                "{field} = {x}: {e}"
+            );
+        }
+    }
+    let n = cases.len();
+    let d = out[n]["duration"].as_f64().expect("duration");
+    assert!((d - (2e15 + 2.0)).abs() <= 2e15 * 1e-12, "{}", out[n]);
+    assert_eq!(out[n + 1]["axes"].as_array().map(Vec::len), Some(30));
+    assert_eq!(
+        out[n + 2]["error"],
+        "`vmax` lists 31 axes; a problem has 1 to 30 (one value per axis)"
+    );
+    let e = out[n + 3]["error"].as_str().expect("error");
+    assert!(
+        e.starts_with("`pf` of axis 0 must be a number from -1e15 to 1e15, got 1e300"),
+        "{e}"
+    );
+}

@@ -256,6 +256,9 @@ impl Corner {
         for (p, x) in [("leg_in_mm", self.leg_in_mm), ("leg_out_mm", self.leg_out_mm)] {
             crate::spec::check_length(x, false).map_err(|m| (key(p), m))?;
         }
+        // The deviations within [`crate::spec::DEVIATION_RANGE_MM`]; the square corner
+        // velocity is a speed like the limits (Klipper's `square_corner_velocity` takes any
+        // value >= 0, `ToolHead.__init__`, klippy/toolhead.py; 0 is `exact_stop` here).
         for (p, x, unit) in [
             ("junction_deviation_mm", self.junction_deviation_mm, "mm"),
             (
@@ -265,12 +268,7 @@ impl Corner {
             ),
             ("blend_deviation_mm", self.blend_deviation_mm, "mm"),
         ] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err((
-                    key(p),
-                    format!("must be a finite number > 0 ({unit}), got {x}"),
-                ));
-            }
+            crate::spec::check_limit(x, unit).map_err(|m| (key(p), m))?;
         }
         if self.corner_mm.iter().any(|x| !x.is_finite()) {
             return Err((key("corner_mm"), "coordinates must be finite (mm)".into()));

@@ -377,6 +377,18 @@ impl Study for GcodeRun {
         };
         let firmware = parse_firmware(&spec.firmware)
             .map_err(|e| src.error_at("gcode.firmware", e.to_string()))?;
+        // 0 (stop at every corner) or a speed like the limits: Klipper takes any
+        // `square_corner_velocity` >= 0 (`ToolHead.__init__`, klippy/toolhead.py).
+        let scv = spec.square_corner_velocity_mm_s;
+        if scv != 0.0 && crate::spec::check_limit(scv, "mm/s").is_err() {
+            let (lo, hi) = crate::spec::SPEED_RANGE_MM_S;
+            return Err(src.error_at(
+                "gcode.square_corner_velocity_mm_s",
+                format!(
+                    "must be 0 (stop at every corner) or a finite number from {lo:e} to {hi:e} (mm/s), got {scv}"
+                ),
+            ));
+        }
         let layers = spec
             .layers
             .as_deref()
