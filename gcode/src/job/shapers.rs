@@ -288,6 +288,14 @@ impl ShaperState {
         })
     }
 
+    /// Marlin, once `M493 S` has switched FT_MOTION: whether it is on, and the shapers set
+    /// that do not run (`M593`'s while it is on, FT_MOTION's while it is off).
+    pub(crate) fn marlin_idle(&self) -> Option<(bool, [Option<ShaperSetting>; 3])> {
+        let on = self.ft_on.filter(|_| self.firmware == Firmware::Marlin)?;
+        let idle = if on { &self.stepper } else { &self.axes };
+        Some((on, std::array::from_fn(|i| idle[i].setting())))
+    }
+
     /// Apply `change` if it is a shaper command of this firmware; `Ok(true)` when it is
     /// one (the firmware then waits for a standstill and shapes what follows with the
     /// new settings), `Ok(false)` when `change` is not about shaping here.
@@ -505,11 +513,14 @@ impl ShaperState {
 }
 
 /// The axes of `state` a Marlin `M593`/`M493` applies to: those named, else X and Y.
+/// `M493 E` names the extruder alone (`apply_xy = !parser.seen("XYZE")`,
+/// `GcodeSuite::M493` in Marlin/src/gcode/feature/ft_motion/M493.cpp), whose shaper
+/// settle does not plan: no axis of `state`.
 fn marlin_axes<'a>(
     state: &'a mut [Axis; 3],
     named: &AxisFlags,
 ) -> impl Iterator<Item = &'a mut Axis> {
-    let none = !(named.x || named.y || named.z);
+    let none = !(named.x || named.y || named.z || named.e);
     let pick = [named.x || none, named.y || none, named.z];
     state
         .iter_mut()
@@ -662,7 +673,7 @@ mod tests {
                 x: axes.contains('X'),
                 y: axes.contains('Y'),
                 z: false,
-                e: false,
+                e: axes.contains('E'),
             },
             shaper: c,
             dynamic_mode: None,
@@ -712,5 +723,21 @@ mod tests {
         assert_eq!(s.settings(), [Some(m593), Some(m593), None]);
         assert_eq!(s.apply(&m493(Some(true), "", None, None)), Ok(true));
         assert_eq!(s.settings(), [None; 3]);
+    }
+
+    /// `M493 E C1 A40` sets the extruder's shaper only: Marlin applies `C`, `A`, `I`, `Q`
+    /// to X and Y only when no axis of X, Y, Z, E is named (`apply_xy =
+    /// !parser.seen("XYZE")`, `GcodeSuite::M493`, Marlin/src/gcode/feature/ft_motion/
+    /// M493.cpp). The old rule took an `E` alone as no axis named and set X and Y.
+    #[test]
+    fn marlin_m493_e_leaves_x_and_y_alone() {
+        let mut s = ShaperState::new(Firmware::Marlin, &[None; 3]);
+        let xy = m493(Some(true), "", Some(FtShaper::Zvd), Some(40.0));
+        assert_eq!(s.apply(&xy), Ok(true));
+        let zvd = one("marlin:zvd", 40.0, 0.1);
+        assert_eq!(kinds(&s), [zvd.clone(), zvd.clone(), None]);
+        let e = m493(None, "E", Some(FtShaper::Zv), Some(55.0));
+        assert_eq!(s.apply(&e), Ok(true));
+        assert_eq!(kinds(&s), [zvd.clone(), zvd, None]);
     }
 }
