@@ -479,7 +479,7 @@ impl MarlinSettings {
                                 what: "G20: the report's values are in inches (a Marlin built with INCH_MODE_SUPPORT); send G21, then M503, and save that reply".into(),
                             });
                     }
-                    Some(c) if c == "M493" && ft_report_is_current(t, &at(line))? => t,
+                    Some(c) if !prusa && c == "M493" && ft_report_is_current(t, &at(line))? => t,
                     Some(c) => {
                         if c == "M493" || c == "M494" {
                             ft_words(&c, t, &at(line))?;
@@ -1486,5 +1486,25 @@ mod tests {
             }
             assert_eq!(state.settings(), want, "S{on}");
         }
+    }
+
+    /// Prusa-Firmware-Buddy has no FT_MOTION: an `M493` line in its log is noted, as
+    /// before, and leaves the shapers of its `M593` reply.
+    #[test]
+    fn a_prusa_logs_m493_is_only_noted() {
+        let plain = MarlinSettings::parse_prusa(PRUSA_LOG, "p.txt").expect("a log");
+        let with = MarlinSettings::parse_prusa(
+            &format!("{PRUSA_LOG}Recv: echo:  M493 S1 D0 H0\n"),
+            "p.txt",
+        )
+        .expect("a log with M493");
+        assert_eq!(with.shapers, plain.shapers);
+        assert!(
+            with.notes
+                .iter()
+                .any(|n| n.text.starts_with("M493 (FT_MOTION")),
+            "{:?}",
+            with.notes
+        );
     }
 }
