@@ -66,10 +66,11 @@ const SHAPERS: [&str; 8] = [
     "custom", "ei2", "ei3", "mzv", "none", "zvd", "zvdd", "zvddd",
 ];
 
-/// `M593 F` limits, Hz (`AxisShaper::Configure`): above `StepClockRate / (2 * 65535)` with
-/// Duet 3's 750 kHz step clock (`src/RepRapFirmware.h`), at most 1000.
-pub(crate) const MIN_SHAPER_FREQUENCY_HZ: f64 = 750_000.0 / (2.0 * 65535.0);
-pub(crate) const MAX_SHAPER_FREQUENCY_HZ: f64 = 1000.0;
+/// `M593 F` limits, Hz: the reader's `M593` holds `F` to them (crate::read::limit_parse).
+pub(crate) use crate::read::limit_parse::{
+    RRF_MAX_SHAPER_FREQUENCY_HZ as MAX_SHAPER_FREQUENCY_HZ,
+    RRF_MIN_SHAPER_FREQUENCY_HZ as MIN_SHAPER_FREQUENCY_HZ,
+};
 
 /// An `M593 P` type as `GcodeBuffer::GetReducedString` (src/GCodes/GCodeBuffer/
 /// GCodeBuffer.cpp) gives it to `InputShaperType`: lower case, without `-`, `_` and
