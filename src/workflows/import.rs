@@ -462,9 +462,16 @@ fn marlin_current(c: &MarlinSettings, path: &Path) -> Result<Current, Error> {
             c.prusa.as_ref().map_or("MK4", |p| p.model.name())
         ));
     }
-    let has_m493 = c.notes.iter().any(|n| n.text.starts_with("M493"));
+    // An older report's `M493` with FT_MOTION off is noted; the current report's lines
+    // are followed (settle-gcode's `MarlinSettings`), their shapers in the baseline when
+    // FT_MOTION is on.
+    let m493_noted = c
+        .notes
+        .iter()
+        .any(|n| n.text.starts_with("M493 (FT_MOTION"));
+    let has_m493 = m493_noted || c.followed.iter().any(|(_, f)| *f == "M493");
     let has_m593 = c.followed.iter().any(|(_, f)| *f == "M593");
-    if has_m493 {
+    if m493_noted {
         notes.push(
             "the reply has FT_MOTION's M493: the current shaper is read from M593 only (none here if the reply has no M593); FT_MOTION's shaper is not part of the baseline".into(),
         );

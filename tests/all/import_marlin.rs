@@ -448,19 +448,55 @@ fn a_reply_with_m593_tunes_its_zv_shapers() {
     }
 }
 
-/// A reply with FT_MOTION's M493 (the real reply with an `M493` line): the scenario is for
-/// Fixed-Time Motion and marlin.gcode writes `M493` lines, read back by settle's G-code
-/// reader as the winner tune.md recommends per axis, and the acceleration.
+/// A reply with FT_MOTION on (the real reply with M593's block and FT_MOTION's as
+/// Marlin's `M593_report` and `M493_report` print them, Marlin/src/gcode/feature/
+/// input_shaping/M593.cpp and ft_motion/M493.cpp): the current shapers are FT_MOTION's
+/// (ZVD at 37.5 Hz on X, MZV at 44 Hz on Y), not M593's, which `Stepper::isr`
+/// (Marlin/src/module/stepper.cpp) does not run while FT_MOTION is on (the old import
+/// took M593's 42.5 and 36 Hz ZV); the scenario is for Fixed-Time Motion and
+/// marlin.gcode writes `M493` lines, read back by settle's G-code reader as the winner
+/// tune.md recommends per axis, and the acceleration.
 #[test]
 fn a_reply_with_m493_keeps_the_fixed_time_motion_export() {
     use settle_gcode::{Dialect, EventKind, FtShaper, LimitChange, Reader, ReaderOptions};
     use settle_planner::shaper::MarlinShaper;
 
     let dir = tempfile::tempdir().expect("tempdir");
+    let m593 = "Recv: echo:; Input Shaping:\n\
+                Recv: echo:  M593 X F42.50 D0.15\n\
+                Recv: echo:  M593 Y F36.00 D0.08\n\
+                Recv: echo:; Fixed-Time Motion:\n";
     let reply = ender_with(
         dir.path(),
         "m493.txt",
-        "Recv: echo:; Fixed-Time Motion:\nRecv: echo:  M493 S1 P0 K0\n",
+        &format!(
+            "{m593}Recv: echo:  M493 S1 D0 H0\n\
+             Recv: echo:  M493 X C2 A37.50 F0.00 I0.10 Q0.05\n\
+             Recv: echo:  M493 Y C8 A44.00 F0.00 I0.12 Q0.05\n"
+        ),
+    );
+    let i = import(&opts(reply.clone(), &dir.path().join("m493.toml"))).expect("imports");
+    let c = &i.current;
+    assert_eq!(c.axes[0].shaper, Some(("marlin:zvd".into(), 37.5, 0.1)));
+    assert_eq!(c.axes[1].shaper, Some(("marlin:mzv".into(), 44.0, 0.12)));
+    assert!(
+        c.notes
+            .iter()
+            .any(|n| n.contains("m493.txt:68: M593: not in force, FT_MOTION is on")),
+        "{:?}",
+        c.notes
+    );
+    // An older report's single M493 line with FT_MOTION on does not say which shaper
+    // runs: refused at its line, nothing written.
+    let older = ender_with(
+        dir.path(),
+        "older.txt",
+        &format!("{m593}Recv: echo:  M493 S1 A37.00 B37.00 D0 F0.00 H0.00 P0 K0.00\n"),
+    );
+    refused(
+        &older,
+        &dir.path().join("older.toml"),
+        "older.txt:70: key `M493.S`",
     );
     let (scenario, md, g) = import_and_tune(
         dir.path(),
@@ -470,6 +506,16 @@ fn a_reply_with_m493_keeps_the_fixed_time_motion_export() {
     assert!(
         scenario.contains("marlin_shaping = \"ft_motion\""),
         "{scenario}"
+    );
+    assert_eq!(
+        row(&md, "x", "current")[3..5],
+        ["marlin:zvd @ 37.5 Hz (zeta 0.1)", "500"],
+        "{md}"
+    );
+    assert_eq!(
+        row(&md, "y", "current")[3],
+        "marlin:mzv @ 44.0 Hz (zeta 0.12)",
+        "{md}"
     );
     assert!(!g.lines().any(|l| l.starts_with("M593")), "{g}");
     let events: Vec<_> = Reader::new(g.as_bytes(), ReaderOptions::new(Dialect::Marlin))

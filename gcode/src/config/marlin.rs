@@ -13,7 +13,9 @@
 //!
 //! The commands the planner uses are followed exactly as the same commands in a G-code
 //! file are ([`crate::job`]'s Marlin rules, the same reader and the same driver): `M203`,
-//! `M201`, `M204`, `M205` and `M593` (Marlin's stepper ZV per axis, `marlin:m593`). `M92` (steps per mm)
+//! `M201`, `M204`, `M205`, `M593` (Marlin's stepper ZV per axis, `marlin:m593`) and `M493`
+//! of Marlin's current report (FT_MOTION on or off and its shapers,
+//! [`ft_report_is_current`]). `M92` (steps per mm)
 //! sets the planner's step counts of X, Y, Z, E, which a G-code file's `M92` does not
 //! (settle's G-code reader does not follow it). `M205` prints `J` in a build with
 //! junction deviation and `X Y Z E` in one with `CLASSIC_JERK` (M205_report): a reply
@@ -47,6 +49,7 @@ use crate::read::limit_parse::{
 };
 use crate::read::limits::LimitChange;
 use settle_planner::firmware::Firmware;
+use settle_planner::shaper::ShaperType;
 
 /// Marlin's settings from an `M503` reply: the planner's starting configuration and
 /// shapers.
@@ -249,8 +252,8 @@ fn steps_words(text: &str, at: &Location, steps: &mut [Option<f64>; 4]) -> Resul
     Ok(())
 }
 
-/// An `M493` or `M494` line of the reply: not followed (FT_MOTION's settings are the
-/// job's own `M493`/`M494`), but the words Marlin's commands bound are held to what the
+/// An `M494` line of the reply, or an `M493` of an older report with FT_MOTION off: not
+/// followed ([`ft_report_is_current`]), but the words Marlin's commands bound are held to what the
 /// job's take, so a value Marlin would refuse is named at its line: `M493`'s frequency
 /// `A`, damping `I` and tolerance `Q` ([`FT_FREQUENCY`], [`FT_DAMPING`], 0 to 1), `M494`'s
 /// trajectory `T` (0 to 2), overshoot `O` ([`FT_OVERSHOOT`]) and smoothing times `X Y Z E`
@@ -284,6 +287,63 @@ fn ft_words(command: &str, text: &str, at: &Location) -> Result<(), GcodeError> 
         }
     }
     Ok(())
+}
+
+/// Whether the reply's `M493` line `text` at `at` is one of Marlin's current report
+/// (`GcodeSuite::M493_report`, Marlin/src/gcode/feature/ft_motion/M493.cpp:
+/// `M493 S<on> [D<mode>] H<sync>`, then per shaped axis `M493 X C<shaper> A<Hz> [F<k>]
+/// I<zeta> [Q<vtol>]`), which is followed as the same line of a job is (FT_MOTION on or
+/// off, and each axis's shaper). Earlier releases printed one line, `M493 S<mode> A<x Hz>
+/// B<y Hz> ... P<0|1> K<gain>` (2.1.3 also `G`, `L`, `O`), which does not say which
+/// shaper FT_MOTION runs on each axis: with `S0` (FT_MOTION off, the stepper's `M593`
+/// shaping runs) it is noted (`Ok(false)`); with FT_MOTION on it is refused, naming the
+/// line.
+fn ft_report_is_current(text: &str, at: &Location) -> Result<bool, GcodeError> {
+    let code = text.split(';').next().unwrap_or("");
+    let words: Vec<&str> = code.split_whitespace().skip(1).collect();
+    let letter = |w: &str| w.chars().next().map(|c| c.to_ascii_uppercase());
+    let older = words
+        .iter()
+        .any(|w| letter(w).is_some_and(|l| "BGKLOP".contains(l)));
+    if !older {
+        return Ok(true);
+    }
+    let mode = words
+        .iter()
+        .find(|w| letter(w) == Some('S'))
+        .map(|w| &w[1..]);
+    if mode.and_then(|m| m.parse::<f64>().ok()) == Some(0.0) {
+        return Ok(false);
+    }
+    Err(GcodeError::ConfigValue {
+        at: at.clone(),
+        section: "M493".into(),
+        key: "S".into(),
+        value: mode.unwrap_or("").to_string().into(),
+        allowed: "0 in this older report (`M493 S<mode> A B ... P K`), which does not say which shaper FT_MOTION runs on each axis: with FT_MOTION on, Marlin's stepper shaping (M593) does not run (`Stepper::isr`, Marlin/src/module/stepper.cpp) and settle cannot tell what does; send `M493` with no parameters and write its shapers as `M493 X C<shaper> A<Hz> I<zeta>` lines (Marlin's current M503 report) in place of this one".into(),
+    })
+}
+
+/// The note for the shapers a reply sets that do not run: `M593`'s while FT_MOTION is on
+/// (`Stepper::isr`, Marlin/src/module/stepper.cpp, skips `shaping_isr()` while
+/// `ftMotion.cfg.active`), FT_MOTION's while it is off; with the line of the command
+/// that set them.
+fn bypassed_note(shapers: &ShaperState, followed: &[(u64, &'static str)]) -> Option<(u64, String)> {
+    let (on, idle) = shapers.marlin_idle()?;
+    if idle.iter().all(Option::is_none) {
+        return None;
+    }
+    Some(if on {
+        (
+            followed_line(followed, "M593"),
+            "M593: not in force, FT_MOTION is on (M493 S1) and Marlin's stepper does not run its input shaping then (`Stepper::isr` skips `shaping_isr()`, Marlin/src/module/stepper.cpp); the shapers read are FT_MOTION's. settle carries only the shapers in force: a job that turns FT_MOTION off (M493 S0) runs unshaped here, where Marlin would run this M593 again".to_string(),
+        )
+    } else {
+        (
+            followed_line(followed, "M493"),
+            "M493: FT_MOTION is off (M493 S0), so its shapers do not run; the shapers read are M593's. settle carries only the shapers in force: a job that turns FT_MOTION on (M493 S1) runs without these FT_MOTION shapers here, where Marlin would run them".to_string(),
+        )
+    })
 }
 
 impl MarlinSettings {
@@ -419,6 +479,7 @@ impl MarlinSettings {
                                 what: "G20: the report's values are in inches (a Marlin built with INCH_MODE_SUPPORT); send G21, then M503, and save that reply".into(),
                             });
                     }
+                    Some(c) if !prusa && c == "M493" && ft_report_is_current(t, &at(line))? => t,
                     Some(c) => {
                         if c == "M493" || c == "M494" {
                             ft_words(&c, t, &at(line))?;
@@ -569,13 +630,15 @@ impl MarlinSettings {
             }
             if matches!(
                 change,
-                LimitChange::MarlinInputShaping { .. } | LimitChange::PrusaInputShaping { .. }
+                LimitChange::MarlinInputShaping { .. }
+                    | LimitChange::PrusaInputShaping { .. }
+                    | LimitChange::FtMotion { .. }
             ) {
                 shapers
                     .apply(&change)
                     .map_err(|_| GcodeError::ConfigSyntax {
                         at: at.clone(),
-                        what: "M593: not followed".into(),
+                        what: format!("{command}: not followed"),
                     })?;
                 continue;
             }
@@ -595,8 +658,17 @@ impl MarlinSettings {
         };
         let settings = shapers.settings();
         for s in settings.iter().flatten() {
+            // The shaper in force is `M593`'s stepper ZV or FT_MOTION's `M493` one.
+            let command = if s.shaper_type == ShaperType::MarlinM593 {
+                "M593"
+            } else {
+                "M493"
+            };
             s.build()
-                .map_err(|e| plan_error(followed_line(&followed, "M593"), "M593", e))?;
+                .map_err(|e| plan_error(followed_line(&followed, command), command, e))?;
+        }
+        if let Some(note) = bypassed_note(&shapers, &followed) {
+            notes.push(ConfigNote::at(at(note.0), note.1));
         }
         Ok(Self {
             planner: *p.config(),
@@ -758,7 +830,6 @@ fn followed_line(followed: &[(u64, &'static str)], command: &str) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use settle_planner::shaper::ShaperType;
 
     /// The reply of a Marlin 2.1 build with junction deviation and input shaping, as
     /// M503 prints it (settings.cpp, M200-M205.cpp, M92.cpp, M593.cpp).
@@ -916,8 +987,8 @@ mod tests {
             ),
             ("M92 X80 Y80 Z400 E0.5\n", "m503.txt:1", "1 to 1e6 steps/mm"),
             ("M92 X80 Y80 Z2e6\n", "m503.txt:1", "1 to 1e6 steps/mm"),
-            // FT_MOTION's M493 is not followed, but values Marlin's M493 refuses are
-            // named at their line (the old reader only noted the command).
+            // FT_MOTION's M493 is followed as a job's: values Marlin's M493 refuses are
+            // named at their line.
             (
                 "M203 X300\necho:  M493 S1 A1e308\n",
                 "m503.txt:2",
@@ -941,7 +1012,7 @@ mod tests {
             (
                 "M203 X300\necho:  M493 X C5 A40 I0.1 Qnan\n",
                 "m503.txt:2",
-                "0 to 1",
+                "`nan` is not a number",
             ),
             // M494 likewise (the old reader only noted it), and M205 B, which is followed.
             (
@@ -950,6 +1021,24 @@ mod tests {
                 "1.25 to 1.875",
             ),
             ("M203 X300\necho:  M494 T3\n", "m503.txt:2", "0, 1 or 2"),
+            // An older report's M493 with FT_MOTION on (2.1.2's mode 1, or 10 for its ZV)
+            // does not say what shapes each axis; the current report's D1 shapes at a
+            // frequency that changes as the print goes.
+            (
+                "M203 X300\necho:  M493 S1 A37.00 B37.00 D0 F0.00 H0.00 P0 K0.00\n",
+                "m503.txt:2",
+                "0 in this older report",
+            ),
+            (
+                "M203 X300\necho:  M493 S10 A37.00 B37.00 P0 K0.00\n",
+                "m503.txt:2",
+                "does not say which shaper FT_MOTION runs",
+            ),
+            (
+                "M203 X300\necho:  M493 S1 D1 H0\n",
+                "m503.txt:2",
+                "settle shapes at the fixed frequency A only",
+            ),
             (
                 "M203 X300\necho:  M494 X0.2 Y0 Z0 E0.02\n",
                 "m503.txt:2",
@@ -977,16 +1066,31 @@ mod tests {
         }
     }
 
-    /// The ends of the ranges are read; an M493 of Marlin 2.1.2's report (`S` a mode
-    /// number, `P`, `K`) is only noted.
+    /// The ends of the ranges are read; an M493 of an older report (`S` a mode number,
+    /// `P`, `K`) with FT_MOTION off is only noted, the current report's per-axis lines
+    /// are followed.
     #[test]
     fn values_at_the_ends_of_their_ranges_are_read() {
-        let text = "M92 X1 Y1000000 Z400 E93\nM493 S1 P0 K0\nM493 X C1 A10 I0.01 Q0\nM493 Y C1 A500 I0.99 Q1\nM493 S10\nM494 T2 X0 Y0.1 Z0 E0.02 O1.875\nM494 X0.1 Y0 Z0 E0\n";
+        let text = "M92 X1 Y1000000 Z400 E93\nM493 S0 P0 K0\nM493 X C1 A10 I0.01 Q0\nM493 Y C1 A500 I0.99 Q1\nM494 T2 X0 Y0.1 Z0 E0.02 O1.875\nM494 X0.1 Y0 Z0 E0\n";
         let s = MarlinSettings::parse(text, "m503.txt").expect("read");
         assert_eq!(
             s.steps_per_mm,
             [Some(1.0), Some(1e6), Some(400.0), Some(93.0)]
         );
+        let zv = |f: f64, z: f64| ShaperSetting {
+            shaper_type: ShaperType::Marlin {
+                shaper: settle_planner::shaper::MarlinShaper::Zv,
+                v_tol: 0.0,
+                ftm_fs_hz: settle_planner::shaper::MARLIN_FTM_FS_HZ,
+            },
+            frequency_hz: f,
+            damping_ratio: z,
+        };
+        let mut y = zv(500.0, 0.99);
+        if let ShaperType::Marlin { v_tol, .. } = &mut y.shaper_type {
+            *v_tol = 1.0;
+        }
+        assert_eq!(s.shapers, [Some(zv(10.0, 0.01)), Some(y), None]);
         assert_eq!(s.notes.len(), 2, "{:?}", s.notes);
         assert!(
             s.notes[0].text.starts_with("M493 (FT_MOTION"),
@@ -1284,5 +1388,123 @@ mod tests {
         };
         assert_eq!(state.apply(&on), Ok(true));
         assert_eq!(state.settings(), [None; 3]);
+    }
+
+    /// FT_MOTION's block of Marlin's current M503 report (`GcodeSuite::M493_report`,
+    /// Marlin/src/gcode/feature/ft_motion/M493.cpp: the `report_heading_etc` heading, then
+    /// `M493 S<active> D<dynFreqMode> H<axis_sync>` and one `M493 <axis> C<shaper>
+    /// A<baseFreq> F<dynFreqK> I<zeta> Q<vtol>` per shaped axis, floats with Marlin's two
+    /// decimals) with FT_MOTION `on` (1) or off (0): X ZVD (C2) at 37.5 Hz, Y EI (C5) at
+    /// 41.2 Hz with a tolerance of 0.08.
+    fn ft_block(on: u8) -> String {
+        format!(
+            "echo:; Fixed-Time Motion:\n\
+             echo:  M493 S{on} D0 H0\n\
+             echo:  M493 X C2 A37.50 F0.00 I0.10 Q0.05\n\
+             echo:  M493 Y C5 A41.20 F0.00 I0.15 Q0.08\n"
+        )
+    }
+
+    /// A reply with FT_MOTION on runs FT_MOTION's shapers and not M593's (`Stepper::isr`,
+    /// Marlin/src/module/stepper.cpp, runs `ftMotion_stepper()` and skips `shaping_isr()`
+    /// while `ftMotion.cfg.active`): the same lines in a job do the same. With FT_MOTION
+    /// off the reply's M593 runs. The old reader noted the M493 lines and kept M593's ZV
+    /// in both.
+    #[test]
+    fn a_replys_ft_motion_takes_effect_as_in_a_job() {
+        use settle_planner::shaper::{MARLIN_FTM_FS_HZ, MarlinShaper};
+        let ft = |shaper, v_tol, f, z| {
+            Some(ShaperSetting {
+                shaper_type: ShaperType::Marlin {
+                    shaper,
+                    v_tol,
+                    ftm_fs_hz: MARLIN_FTM_FS_HZ,
+                },
+                frequency_hz: f,
+                damping_ratio: z,
+            })
+        };
+        let x = ft(MarlinShaper::Zvd, 0.05, 37.5, 0.1);
+        let y = ft(MarlinShaper::Ei, 0.08, 41.2, 0.15);
+        let m593 = |f, z| {
+            Some(ShaperSetting {
+                shaper_type: ShaperType::MarlinM593,
+                frequency_hz: f,
+                damping_ratio: z,
+            })
+        };
+        // REPLY's M593 lines are 16 and 17; the FT block follows at 21 to 24.
+        let on = MarlinSettings::parse(&format!("{REPLY}{}", ft_block(1)), "r.txt")
+            .expect("a reply with FT_MOTION on");
+        assert_eq!(on.shapers, [x, y, None]);
+        assert_eq!(
+            on.followed
+                .iter()
+                .filter(|(_, c)| *c == "M493")
+                .map(|(l, _)| *l)
+                .collect::<Vec<_>>(),
+            [22, 23, 24]
+        );
+        let said = on.notes.iter().map(ToString::to_string).collect::<Vec<_>>();
+        assert!(
+            said.iter()
+                .any(|n| n.starts_with("r.txt:17: M593: not in force, FT_MOTION is on")),
+            "{said:?}"
+        );
+        assert!(
+            !said.iter().any(|n| n.contains("M493 (FT_MOTION")),
+            "{said:?}"
+        );
+        let off = MarlinSettings::parse(&format!("{REPLY}{}", ft_block(0)), "r.txt")
+            .expect("a reply with FT_MOTION off");
+        assert_eq!(off.shapers, [m593(40.0, 0.15), m593(35.5, 0.1), None]);
+        let said = off
+            .notes
+            .iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>();
+        assert!(
+            said.iter()
+                .any(|n| n.starts_with("r.txt:24: M493: FT_MOTION is off")),
+            "{said:?}"
+        );
+        // The same lines as a job's start, after M593's: the same shapers.
+        for (on, want) in [
+            (1, [x, y, None]),
+            (0, [m593(40.0, 0.15), m593(35.5, 0.1), None]),
+        ] {
+            let mut state = ShaperState::new(Firmware::Marlin, &[None; 3]);
+            let job = format!(
+                "M593 X F40.00 D0.15\nM593 Y F35.50 D0.10\n{}",
+                ft_block(on).replace("echo:", "")
+            );
+            let source: Arc<str> = Arc::from("job.gcode");
+            for e in super::super::located_events(&job, Dialect::Marlin, &source) {
+                if let (_, EventKind::Limits(c)) = e.expect("a job's lines") {
+                    state.apply(&c).expect("followed");
+                }
+            }
+            assert_eq!(state.settings(), want, "S{on}");
+        }
+    }
+
+    /// Prusa-Firmware-Buddy has no FT_MOTION: an `M493` line in its log is noted, as
+    /// before, and leaves the shapers of its `M593` reply.
+    #[test]
+    fn a_prusa_logs_m493_is_only_noted() {
+        let plain = MarlinSettings::parse_prusa(PRUSA_LOG, "p.txt").expect("a log");
+        let with = MarlinSettings::parse_prusa(
+            &format!("{PRUSA_LOG}Recv: echo:  M493 S1 D0 H0\n"),
+            "p.txt",
+        )
+        .expect("a log with M493");
+        assert_eq!(with.shapers, plain.shapers);
+        assert!(
+            with.notes
+                .iter()
+                .any(|n| n.text.starts_with("M493 (FT_MOTION")),
+            "{:?}",
+            with.notes
+        );
     }
 }

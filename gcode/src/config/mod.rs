@@ -84,6 +84,7 @@ pub use klipper::{
 };
 pub use machine::{AxisDrive, ConfigNote, MICROSTEPS_PER_MM, ShaperSetting, Xyz};
 pub use marlin::MarlinSettings;
+pub(crate) use rrf::rrf_shaper_name;
 pub use rrf::{
     RRF_DEFAULT_M204_MM_S2, RRF_DEFAULT_SHAPER, RRF_MINIMUM_ACCEL_MM_S2, RRF_MINIMUM_JERK_MM_S,
     RrfAxis, RrfConfig,

@@ -66,10 +66,22 @@ const SHAPERS: [&str; 8] = [
     "custom", "ei2", "ei3", "mzv", "none", "zvd", "zvdd", "zvddd",
 ];
 
-/// `M593 F` limits, Hz (`AxisShaper::Configure`): above `StepClockRate / (2 * 65535)` with
-/// Duet 3's 750 kHz step clock (`src/RepRapFirmware.h`), at most 1000.
-pub(crate) const MIN_SHAPER_FREQUENCY_HZ: f64 = 750_000.0 / (2.0 * 65535.0);
-pub(crate) const MAX_SHAPER_FREQUENCY_HZ: f64 = 1000.0;
+/// `M593 F` limits, Hz: the reader's `M593` holds `F` to them (crate::read::limit_parse).
+pub(crate) use crate::read::limit_parse::{
+    RRF_MAX_SHAPER_FREQUENCY_HZ as MAX_SHAPER_FREQUENCY_HZ,
+    RRF_MIN_SHAPER_FREQUENCY_HZ as MIN_SHAPER_FREQUENCY_HZ,
+};
+
+/// An `M593 P` type as `GcodeBuffer::GetReducedString` (src/GCodes/GCodeBuffer/
+/// GCodeBuffer.cpp) gives it to `InputShaperType`: lower case, without `-`, `_` and
+/// spaces (`"EI-2"` is `ei2`).
+pub(crate) fn rrf_shaper_name(written: &str) -> String {
+    written
+        .chars()
+        .filter(|c| !matches!(c, '-' | '_' | ' '))
+        .flat_map(char::to_lowercase)
+        .collect()
+}
 
 /// RepRapFirmware's input shaper before any `M593` (`AxisShaper::AxisShaper`): off, with
 /// 40 Hz and damping 0.05 waiting for a type.
@@ -242,7 +254,23 @@ impl RrfConfig {
         let script = unconditional(text, &source);
         self.notes.extend(script.notes);
         for event in super::located_events(&script.text, Dialect::Rrf, &source) {
-            let (at, kind) = event?;
+            // `M593`'s words are the configuration's shaper: named as its setting.
+            let (at, kind) = event.map_err(|e| match e {
+                GcodeError::OutOfRange {
+                    at,
+                    command,
+                    param,
+                    value,
+                    allowed,
+                } if command == "M593" => GcodeError::ConfigValue {
+                    at: Location { column: None, ..at },
+                    section: command,
+                    key: param,
+                    value: value.to_string().into(),
+                    allowed: allowed.into(),
+                },
+                e => e,
+            })?;
             match kind {
                 EventKind::Setting(s) => {
                     if let Setting::Kinematics { .. } = s {
@@ -526,14 +554,9 @@ impl RrfConfig {
             value: value.into(),
             allowed: allowed.into(),
         };
+        // `F` is within MIN_SHAPER_FREQUENCY_HZ..=MAX_SHAPER_FREQUENCY_HZ: the reader's
+        // `M593` refuses another (`RRF_SHAPER_FREQUENCY`, crate::read::limit_parse).
         if let Some(f) = frequency_hz {
-            if !(MIN_SHAPER_FREQUENCY_HZ..=MAX_SHAPER_FREQUENCY_HZ).contains(&f) {
-                return Err(bad(
-                    "F",
-                    f.to_string(),
-                    format!("{MIN_SHAPER_FREQUENCY_HZ:.3} to {MAX_SHAPER_FREQUENCY_HZ} Hz"),
-                ));
-            }
             self.input_shaper.frequency_hz = f;
         }
         if let Some(z) = damping_ratio {
@@ -541,12 +564,7 @@ impl RrfConfig {
         }
         match kind {
             Some(k) => {
-                // `GetReducedString`: lower case, without `-`, `_` and spaces.
-                let reduced: String = k
-                    .chars()
-                    .filter(|c| !matches!(c, '-' | '_' | ' '))
-                    .flat_map(char::to_lowercase)
-                    .collect();
+                let reduced = rrf_shaper_name(k);
                 if !SHAPERS.contains(&reduced.as_str()) {
                     return Err(bad("P", k.to_string(), SHAPERS.join(", ")));
                 }

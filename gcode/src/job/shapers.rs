@@ -21,15 +21,18 @@
 //!   (`clamp_frequency_to_safe_values`, input_shaper_config.cpp; 10..=150 Hz on the
 //!   MINI, [`PrusaModel::shaper_max_hz`]). `T` 0..5 is ZV, ZVD, MZV (Klipper's), EI, 2HUMP_EI, 3HUMP_EI
 //!   (`prusa:`), 6 no shaper; `R` the EI family's vibration reduction (tolerance `1/R`).
-//! - RepRapFirmware `M593` (`AxisShaper::Configure`, src/Movement/AxisShaper.cpp): one
-//!   shaper for the motion (here X and Y), type `P`, frequency `F` (default 40 Hz),
-//!   damping `S` (default 0.1); a frequency or damping given while the type is `none`
-//!   selects `zvd`. `custom` shapers (`H`, `T`) are not supported.
+//! - RepRapFirmware `M593` (`AxisShaper::Configure`, src/Movement/AxisShaper.cpp, 3.6):
+//!   one shaper for the motion (here X and Y), type `P` (reduced as `GetReducedString`
+//!   reduces it: `"EI-2"` is `ei2`), frequency `F` (default 40 Hz; 5.722 to 1000 Hz, the
+//!   reader's check), damping `S` (default 0.05, `DefaultDamping` in AxisShaper.h); a
+//!   frequency or damping given while the type is `none` selects `zvd`; `L` (3.5's
+//!   reduction limit) is not read. A `custom` shaper is refused (settle does not model
+//!   it); `H` and `T`, read for `custom` only, are ignored with another type.
 
 use settle_planner::PlanError;
 use settle_planner::shaper::{MarlinShaper, PrusaShaper, RrfShaper, Shaper, ShaperType};
 
-use crate::config::klipper_shaper;
+use crate::config::{RRF_DEFAULT_SHAPER, klipper_shaper, rrf_shaper_name};
 use crate::read::limits::{AxisFlags, FtShaper, LimitChange};
 use settle_planner::firmware::Firmware;
 use settle_planner::firmware::marlin::PrusaModel;
@@ -209,7 +212,9 @@ impl ShaperState {
     /// The state at the start of the file, from the job's settings.
     pub(crate) fn new(firmware: Firmware, initial: &[Option<ShaperSetting>; 3]) -> Self {
         let (default_kind, default_f, default_z) = match firmware {
-            Firmware::Rrf => (None, 40.0, 0.1),
+            // `AxisShaper::AxisShaper`: off, 40 Hz and damping 0.05 waiting for a type
+            // (`DefaultDamping` 0.05 in 3.6's src/Movement/AxisShaper.h; 3.5's was 0.1).
+            Firmware::Rrf => (None, RRF_DEFAULT_SHAPER.1, RRF_DEFAULT_SHAPER.2),
             Firmware::Klipper => (Some(ShaperType::MZV), 0.0, 0.1),
             Firmware::Marlin
             | Firmware::Prusa
@@ -286,6 +291,14 @@ impl ShaperState {
                 None => ft.setting().or_else(|| stepper.setting()),
             }
         })
+    }
+
+    /// Marlin, once `M493 S` has switched FT_MOTION: whether it is on, and the shapers set
+    /// that do not run (`M593`'s while it is on, FT_MOTION's while it is off).
+    pub(crate) fn marlin_idle(&self) -> Option<(bool, [Option<ShaperSetting>; 3])> {
+        let on = self.ft_on.filter(|_| self.firmware == Firmware::Marlin)?;
+        let idle = if on { &self.stepper } else { &self.axes };
+        Some((on, std::array::from_fn(|i| idle[i].setting())))
     }
 
     /// Apply `change` if it is a shaper command of this firmware; `Ok(true)` when it is
@@ -457,12 +470,11 @@ impl ShaperState {
                     durations_s,
                 },
             ) => {
-                if !amplitudes.is_empty() || !durations_s.is_empty() {
-                    return Err(ShaperProblem::Unsupported(
-                        "RepRapFirmware custom shapers (M593 H/T) are not modelled",
-                    ));
-                }
-                let kind = match shaper.as_deref() {
+                // `H` and `T` are read for a `custom` shaper only, which settle does not
+                // model: for another type RepRapFirmware does not read them.
+                let _ = (amplitudes, durations_s);
+                let name = shaper.as_deref().map(rrf_shaper_name);
+                let kind = match name.as_deref() {
                     None => None,
                     Some("none") => Some(None),
                     Some("custom") => {
@@ -480,8 +492,9 @@ impl ShaperState {
                         Some(Some(ShaperType::rrf(family)))
                     }
                 };
-                let seen =
-                    frequency_hz.is_some() || damping_ratio.is_some() || reduction_limit.is_some();
+                // `L` (3.5's reduction limit) is read no more in 3.6 and selects nothing.
+                let _ = reduction_limit;
+                let seen = frequency_hz.is_some() || damping_ratio.is_some();
                 for a in &mut self.axes[..2] {
                     if let Some(f) = frequency_hz {
                         a.frequency_hz = *f;
@@ -505,11 +518,14 @@ impl ShaperState {
 }
 
 /// The axes of `state` a Marlin `M593`/`M493` applies to: those named, else X and Y.
+/// `M493 E` names the extruder alone (`apply_xy = !parser.seen("XYZE")`,
+/// `GcodeSuite::M493` in Marlin/src/gcode/feature/ft_motion/M493.cpp), whose shaper
+/// settle does not plan: no axis of `state`.
 fn marlin_axes<'a>(
     state: &'a mut [Axis; 3],
     named: &AxisFlags,
 ) -> impl Iterator<Item = &'a mut Axis> {
-    let none = !(named.x || named.y || named.z);
+    let none = !(named.x || named.y || named.z || named.e);
     let pick = [named.x || none, named.y || none, named.z];
     state
         .iter_mut()
@@ -662,7 +678,7 @@ mod tests {
                 x: axes.contains('X'),
                 y: axes.contains('Y'),
                 z: false,
-                e: false,
+                e: axes.contains('E'),
             },
             shaper: c,
             dynamic_mode: None,
@@ -712,5 +728,76 @@ mod tests {
         assert_eq!(s.settings(), [Some(m593), Some(m593), None]);
         assert_eq!(s.apply(&m493(Some(true), "", None, None)), Ok(true));
         assert_eq!(s.settings(), [None; 3]);
+    }
+
+    /// `M493 E C1 A40` sets the extruder's shaper only: Marlin applies `C`, `A`, `I`, `Q`
+    /// to X and Y only when no axis of X, Y, Z, E is named (`apply_xy =
+    /// !parser.seen("XYZE")`, `GcodeSuite::M493`, Marlin/src/gcode/feature/ft_motion/
+    /// M493.cpp). The old rule took an `E` alone as no axis named and set X and Y.
+    #[test]
+    fn marlin_m493_e_leaves_x_and_y_alone() {
+        let mut s = ShaperState::new(Firmware::Marlin, &[None; 3]);
+        let xy = m493(Some(true), "", Some(FtShaper::Zvd), Some(40.0));
+        assert_eq!(s.apply(&xy), Ok(true));
+        let zvd = one("marlin:zvd", 40.0, 0.1);
+        assert_eq!(kinds(&s), [zvd.clone(), zvd.clone(), None]);
+        let e = m493(None, "E", Some(FtShaper::Zv), Some(55.0));
+        assert_eq!(s.apply(&e), Ok(true));
+        assert_eq!(kinds(&s), [zvd.clone(), zvd, None]);
+    }
+
+    fn rrf_m593(p: Option<&str>, f: Option<f64>, z: Option<f64>, l: Option<f64>) -> LimitChange {
+        LimitChange::RrfInputShaping {
+            shaper: p.map(str::to_string),
+            frequency_hz: f,
+            damping_ratio: z,
+            reduction_limit: l,
+            amplitudes: Vec::new(),
+            durations_s: Vec::new(),
+        }
+    }
+
+    /// RepRapFirmware 3.6's `M593` as `AxisShaper::Configure` (src/Movement/AxisShaper.cpp)
+    /// reads it: the damping before any `S` is `DefaultDamping`, 0.05 (AxisShaper.h; the
+    /// old rule kept 3.5's 0.1); `P` is reduced by `GetReducedString`, so `"EI-2"` is
+    /// `ei2` (the old rule refused it); `L` is no longer read, so `M593 L0.2` does not
+    /// select `zvd` (the old rule turned shaping on); `H` and `T` are read for `custom`
+    /// only (the old rule refused `M593 P"zvd" ... H...`); `custom` is refused.
+    #[test]
+    fn rrf_m593_follows_axis_shaper_configure() {
+        let mut s = ShaperState::new(Firmware::Rrf, &[None; 3]);
+        assert_eq!(s.apply(&rrf_m593(None, None, None, Some(0.2))), Ok(false));
+        assert_eq!(kinds(&s), [None, None, None]);
+        assert_eq!(s.apply(&rrf_m593(Some("zvd"), None, None, None)), Ok(true));
+        let zvd = one("rrf:zvd", 40.0, 0.05);
+        assert_eq!(kinds(&s), [zvd.clone(), zvd, None]);
+        assert_eq!(
+            s.apply(&rrf_m593(Some("ei-2"), Some(45.0), None, None)),
+            Ok(true)
+        );
+        let ei2 = one("rrf:ei2", 45.0, 0.05);
+        assert_eq!(kinds(&s), [ei2.clone(), ei2, None]);
+        let mut with_lists = rrf_m593(Some("zv_dd"), None, Some(0.1), None);
+        if let LimitChange::RrfInputShaping {
+            amplitudes,
+            durations_s,
+            ..
+        } = &mut with_lists
+        {
+            *amplitudes = vec![0.4, 0.7];
+            *durations_s = vec![0.01, 0.01];
+        }
+        assert_eq!(s.apply(&with_lists), Ok(true));
+        let zvdd = one("rrf:zvdd", 45.0, 0.1);
+        assert_eq!(kinds(&s), [zvdd.clone(), zvdd, None]);
+        assert!(matches!(
+            s.apply(&rrf_m593(Some("custom"), None, None, None)),
+            Err(ShaperProblem::Unsupported(_))
+        ));
+        // Off, then a frequency alone selects zvd again.
+        let mut s = ShaperState::new(Firmware::Rrf, &[None; 3]);
+        assert_eq!(s.apply(&rrf_m593(None, Some(52.0), None, None)), Ok(true));
+        let zvd = one("rrf:zvd", 52.0, 0.05);
+        assert_eq!(kinds(&s), [zvd.clone(), zvd, None]);
     }
 }

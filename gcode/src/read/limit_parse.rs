@@ -83,6 +83,28 @@ pub(crate) const SHAPER_FREQUENCY: Check = Check {
     allowed: "0 (off) or 1 to 1000 Hz: below 1 Hz a shaper lasts a second or more, and a shaper tuned above 1 kHz lasts under a millisecond and cancels nothing a printer's belts or frame carry (their modes are tens to a few hundred Hz); RepRapFirmware refuses M593 above 1000 Hz, and printer.cfg's shaper_freq_* and an M503 reply's M593 F are held to the same",
 };
 
+/// RepRapFirmware's `M593 F` limits, Hz (`AxisShaper::Configure`,
+/// src/Movement/AxisShaper.cpp): at least `StepClockRate / (2 * 65535)` with Duet 3's
+/// 750 kHz step clock (`src/RepRapFirmware.h`), at most 1000.
+pub(crate) const RRF_MIN_SHAPER_FREQUENCY_HZ: f64 = 750_000.0 / (2.0 * 65535.0);
+/// See [`RRF_MIN_SHAPER_FREQUENCY_HZ`].
+pub(crate) const RRF_MAX_SHAPER_FREQUENCY_HZ: f64 = 1000.0;
+
+/// RepRapFirmware's `M593 F`, Hz: `AxisShaper::Configure` (src/Movement/AxisShaper.cpp)
+/// reads it with `TryGetLimitedFValue('F', ..., MinimumInputShapingFrequency,
+/// MaximumInputShapingFrequency)`, whose `GetLimitedFValue`
+/// (src/GCodes/GCodeBuffer/GCodeBuffer.cpp) throws "parameter 'F' too low" or "too high"
+/// outside `StepClockRate / (2 * 65535)` (5.722 Hz on Duet 3's 750 kHz step clock) to
+/// 1000, compared in single precision, before the type is looked at: `M593 P"none" F3`
+/// is refused too.
+pub(crate) const RRF_SHAPER_FREQUENCY: Check = Check {
+    ok: |v| {
+        let f = v as f32;
+        f >= RRF_MIN_SHAPER_FREQUENCY_HZ as f32 && f <= RRF_MAX_SHAPER_FREQUENCY_HZ as f32
+    },
+    allowed: "5.722 to 1000 Hz: RepRapFirmware's M593 answers \"parameter 'F' too low\" (or \"too high\") and changes nothing (AxisShaper::Configure, src/Movement/AxisShaper.cpp; the least is StepClockRate / (2 x 65535) on Duet 3's 750 kHz step clock)",
+};
+
 /// Why `M493 D1`/`D2` is refused.
 const FT_DYNAMIC_FREQUENCY: &str = "D1 (Z-based) and D2 (mass-based) make Marlin change the shaper frequency as the print goes, by F per mm of Z (D1) or of filament extruded (D2) (Marlin/src/module/ft_motion.cpp); settle shapes at the fixed frequency A only: remove D, or give D0";
 
@@ -328,7 +350,7 @@ pub(crate) fn m_code(
             };
             limits(LimitChange::RrfInputShaping {
                 shaper: cmd.string(p, b'P')?.map(|s| s.to_ascii_lowercase()),
-                frequency_hz: cmd.num(p, b'F', POSITIVE)?,
+                frequency_hz: cmd.num(p, b'F', RRF_SHAPER_FREQUENCY)?,
                 damping_ratio: cmd.num(p, b'S', damping)?,
                 reduction_limit: cmd.num(p, b'L', FRACTION)?,
                 amplitudes: cmd.list(p, b'H', FINITE)?,

@@ -243,6 +243,7 @@ fn bad_values_name_file_line_and_parameter() {
     for (text, line, param) in [
         ("M593 F2000\n", 1, "F"),
         ("G90\nM593 F3\n", 2, "F"),
+        ("M593 P\"none\" F3\n", 1, "F"),
         ("M208 S1 X300\n", 1, "X"),
     ] {
         match parse_err(text) {

@@ -472,6 +472,40 @@ fn marlin_m493_values_are_bounded_at_their_line() {
     assert_eq!(crate::limits(text, Dialect::Marlin).len(), 2);
 }
 
+/// RepRapFirmware's `M593 F` outside `StepClockRate / (2 * 65535)` = 750000 / 131070 =
+/// 5.72213 Hz (Duet 3) to 1000 Hz is refused at its word whatever the type, as
+/// `AxisShaper::Configure` (src/Movement/AxisShaper.cpp) throws "parameter 'F' too low"
+/// from `GetLimitedFValue` before it looks at `P`. The old reader took any positive `F`
+/// and refused it only when it built a shaper, so `M593 P"none" F3` was read.
+#[test]
+fn rrf_m593_frequency_is_bounded_at_its_word() {
+    for (text, value) in [
+        ("M593 P\"none\" F3", 3.0),
+        ("M593 P\"zvd\" F5.722", 5.722),
+        ("M593 F1000.01", 1000.01),
+    ] {
+        match error(text, Dialect::Rrf) {
+            GcodeError::OutOfRange {
+                at,
+                param,
+                value: v,
+                allowed,
+                ..
+            } => {
+                assert_eq!((at.line, param.as_str(), v), (1, "F", value), "{text}");
+                assert!(
+                    allowed.starts_with("5.722 to 1000 Hz") && allowed.contains("AxisShaper.cpp"),
+                    "{text}: {allowed}"
+                );
+            }
+            e => panic!("{text}: {e}"),
+        }
+    }
+    // 5.7222 is above 5.72213, and 1000 is the top.
+    let text = "M593 P\"zvd\" F5.7222\nM593 F1000\n";
+    assert_eq!(crate::limits(text, Dialect::Rrf).len(), 2);
+}
+
 /// Marlin's `M494` (FT_MOTION's trajectory and smoothing): an overshoot `O` outside 1.25
 /// to 1.875 and a smoothing time `X Y Z E` outside 0 to 0.1 s (`FTM_MAX_SMOOTHING_TIME`)
 /// are refused at their word, as Marlin's M494.cpp refuses them (`WITHIN(val, 1.25f,
