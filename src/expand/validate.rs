@@ -193,7 +193,7 @@ fn validate_planned(run: &RunSpec, src: &Source) -> Result<(), Error> {
 }
 
 /// Check a run whose trace is recorded (`settle sweep --mcap`, `--rerun`: every run's trace
-/// is kept) as [`validate_planned`] checks one whose study keeps it: the sweep calls this
+/// is kept) as `validate_planned` checks one whose study keeps it: the sweep calls this
 /// for each of its runs before any starts.
 pub fn validate_recorded(run: &RunSpec, src: &Source) -> Result<(), Error> {
     check_planned(run, src, true)
