@@ -407,3 +407,87 @@ fn a_recorded_sweep_checks_every_runs_trace_before_any_run() {
         "nothing written"
     );
 }
+
+/// `scenarios/quickstart.toml` with its `[observe]` values replaced: `window_s`,
+/// `sample_rate_hz`, `bands_um` as written here.
+fn quickstart_observing(window: &str, rate: &str, bands: &str) -> String {
+    quickstart_with("window_s = 0.5", &format!("window_s = {window}"))
+        .replace(
+            "sample_rate_hz = 10000",
+            &format!("sample_rate_hz = {rate}"),
+        )
+        .replace("bands_um = [10.0, 50.0]", &format!("bands_um = [{bands}]"))
+}
+
+/// The line (1-based) of `text` that starts with `key`.
+fn line_of(text: &str, key: &str) -> usize {
+    1 + text
+        .lines()
+        .position(|l| l.starts_with(key))
+        .expect("the key is written")
+}
+
+#[test]
+fn the_observe_keys_are_bounded_at_their_limits() {
+    // Each limit is taken, the next f64 above it refused with the key's line, the range
+    // and the value. Window: at most 1e4 s (at 100 Hz, over the 80 Hz Nyquist of the
+    // 40 Hz mode: 1e6 samples, within the 1e8 of a run). Rate: at most 1e6 Hz. Bands:
+    // each below 0.1 m, the blow-up limit, 1e5 um; at most 16.
+    let above = |x: f64| f64::from_bits(x.to_bits() + 1);
+    let below = |x: f64| f64::from_bits(x.to_bits() - 1);
+    let accepted = |text: &str| {
+        settle::expand::parse_runs(text, Path::new("s.toml")).unwrap_or_else(|e| panic!("{e}"));
+    };
+    let refused = |text: &str, key: &str, what: &str| {
+        let e = expand_err(text);
+        let line = line_of(text, key.strip_prefix("observe.").expect("observe"));
+        assert!(
+            e.starts_with(&format!("s.toml:{line}:1: key `{key}`: {what}")),
+            "{e}"
+        );
+    };
+    accepted(&quickstart_observing("1e4", "100", "10.0"));
+    let w = above(1e4);
+    refused(
+        &quickstart_observing(&format!("{w:?}"), "100", "10.0"),
+        "observe.window_s",
+        &format!("must be a finite number > 0 and at most 1e4 (s), got {w}"),
+    );
+    assert_eq!(format!("{w}"), "10000.000000000002");
+    accepted(&quickstart_observing("0.5", "1e6", "10.0"));
+    let r = above(1e6);
+    refused(
+        &quickstart_observing("0.5", &format!("{r:?}"), "10.0"),
+        "observe.sample_rate_hz",
+        &format!("must be a finite number > 0 and at most 1e6 (Hz), got {r}"),
+    );
+    refused(
+        &quickstart_observing("0.5", "nan", "10.0"),
+        "observe.sample_rate_hz",
+        "must be a finite number > 0 and at most 1e6 (Hz), got NaN",
+    );
+    let b = below(1e5);
+    assert_eq!(format!("{b:?}"), "99999.99999999999");
+    accepted(&quickstart_observing(
+        "0.5",
+        "10000",
+        &format!("10.0, {b:?}"),
+    ));
+    refused(
+        &quickstart_observing("0.5", "10000", "10.0, 1e5"),
+        "observe.bands_um",
+        "band 1 must be a finite number > 0 and below 1e5 (um), got 100000: an error past 0.1 m stops the run as a fault",
+    );
+    let bands = |n: usize| {
+        (1..=n)
+            .map(|b| format!("{b}.0"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    accepted(&quickstart_observing("0.5", "10000", &bands(16)));
+    refused(
+        &quickstart_observing("0.5", "10000", &bands(17)),
+        "observe.bands_um",
+        "17 bands; at most 16",
+    );
+}
