@@ -160,8 +160,10 @@ pub fn check_run_size(
     Ok(())
 }
 
-/// The key at fault for a run whose planned motion is too long ([`validate_planned`]): a
-/// swept key the motion's time rests on, else for a scan the line's speed or its settle
+/// The key at fault for a run whose planned motion is too long ([`validate_planned`]):
+/// `observe.window_s` when the window is at least as long as the motion (it holds most of
+/// the samples; the `[observe]` keys are never swept), else a swept key the motion's time
+/// rests on, else for a scan the line's speed or its settle
 /// margin (whichever adds more to each line), for a move the jerk limit when the planned
 /// move takes more than twice its trapezoid's time (the jerk phases set it), else the key
 /// [`duration_key`] names.
@@ -181,6 +183,9 @@ fn planned_key(run: &RunSpec, duration_s: f64) -> String {
         "limits.amax_mm_s2",
         "limits.jmax_mm_s3",
     ];
+    if run.window_s >= duration_s {
+        return "observe.window_s".to_string();
+    }
     let scan = run.state::<ScanSpec>();
     let candidates = SCAN.iter().filter(|_| scan.is_some()).chain(MOVE.iter());
     if let Some(k) = candidates
@@ -216,8 +221,9 @@ fn validate_planned(run: &RunSpec, src: &Source) -> Result<(), Error> {
 }
 
 /// Check a run whose trace is recorded (`settle sweep --mcap`, `--rerun`: every run's trace
-/// is kept) as `validate_planned` checks one whose study keeps it: the sweep calls this
-/// for each of its runs before any starts.
+/// is kept; `settle run`'s one run, its trace written whole) as `validate_planned` checks
+/// one whose study keeps it: the sweep calls this for each of its runs before any starts,
+/// `settle run` for its run before it writes anything.
 pub fn validate_recorded(run: &RunSpec, src: &Source) -> Result<(), Error> {
     check_planned(run, src, true)
 }

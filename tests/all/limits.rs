@@ -406,6 +406,35 @@ fn a_recorded_sweep_checks_every_runs_trace_before_any_run() {
         scenario.exists() && !dir.path().join("o").exists(),
         "nothing written"
     );
+    // `settle run` keeps its one run's trace whole: run 1 at the refused rate is refused
+    // before it starts with the sweep's message, exit 2, no folder made; run 0 (the 1 mm
+    // move, 1.501 s of samples) is within and runs.
+    let run = |case: &str| {
+        settle()
+            .args(["run", "s.toml", "--case", case, "--backend", "modal"])
+            .args(["--out", "o/t.csv"])
+            .current_dir(dir.path())
+            .output()
+            .expect("runs")
+    };
+    let out = run("1");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "s.toml:{}",
+            e.strip_prefix("s.toml:").expect("file")
+        )),
+        "the sweep's message {e}, got {stderr}"
+    );
+    assert!(!dir.path().join("o").exists(), "nothing written");
+    let out = run("0");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.path().join("o/t.csv").is_file());
 }
 
 /// `scenarios/quickstart.toml` with its `[observe]` values replaced: `window_s`,
