@@ -5,6 +5,7 @@
 use crate::error::Error;
 use crate::input::modes::MAX_FREQUENCY_HZ;
 use crate::input::source::Source;
+use crate::measure::metrics::BLOWUP_M;
 use crate::spec::MAX_POSITION_MM;
 use crate::spec::run_spec::{RunSpec, needs_jerk};
 use crate::studies::{self, Role};
@@ -32,6 +33,28 @@ pub const MIN_STEP_S: f64 = 1e-6;
 /// of every figure, and a handful (a tolerance and a few looser or tighter ones) answers
 /// every settling question.
 pub const MAX_BANDS: usize = 16;
+
+/// The longest observation window `observe.window_s` may give (s): 1e4 s, the whole
+/// [`MAX_SAMPLES_PER_RUN`] at the default 10 kHz, and a hundred periods of the slowest mode
+/// a machine may have ([`crate::input::modes::MIN_FREQUENCY_HZ`], a period of 100 s). A settling question is
+/// answered in seconds (ten decay time constants of a 40 Hz, zeta 0.05 mode are 0.8 s); a
+/// window of hours is a unit mistake (milliseconds written as seconds). The samples limit
+/// alone does not bound it: at 0.02 Hz, two samples per period of that slowest mode, it
+/// would let a window reach 5e9 s.
+pub const MAX_WINDOW_S: f64 = 1e4;
+
+/// The highest sample rate `observe.sample_rate_hz` may give (Hz): 1 MHz, twenty samples
+/// per period of the fastest mode a machine may have ([`MAX_FREQUENCY_HZ`], 50 kHz; twenty
+/// or more give settling times to a few percent, as [`validate_sampling`] advises), one
+/// sample per [`MIN_STEP_S`], the finest integration step `sim.max_step_s` may force. A
+/// faster rate resolves nothing a machine's modes hold and only spends samples.
+pub const MAX_SAMPLE_RATE_HZ: f64 = 1e6;
+
+/// The widest settling band `observe.bands_um` may give is below this (um): the blow-up
+/// limit [`BLOWUP_M`] (0.1 m) in um. An error past it stops the run as a fault, so every run
+/// that completes stays within it: a band as wide would be entered at the move's end by
+/// every run, a settling time of 0 that says nothing.
+pub const BAND_LIMIT_UM: f64 = BLOWUP_M * 1e6;
 
 /// The most sweep axes a scenario may give: a figure draws one line per combination of
 /// the axes other than its x axis, and a report compares the axes side by side.
@@ -137,8 +160,10 @@ pub fn check_run_size(
     Ok(())
 }
 
-/// The key at fault for a run whose planned motion is too long ([`validate_planned`]): a
-/// swept key the motion's time rests on, else for a scan the line's speed or its settle
+/// The key at fault for a run whose planned motion is too long ([`validate_planned`]):
+/// `observe.window_s` when the window is at least as long as the motion (it holds most of
+/// the samples; the `[observe]` keys are never swept), else a swept key the motion's time
+/// rests on, else for a scan the line's speed or its settle
 /// margin (whichever adds more to each line), for a move the jerk limit when the planned
 /// move takes more than twice its trapezoid's time (the jerk phases set it), else the key
 /// [`duration_key`] names.
@@ -158,6 +183,9 @@ fn planned_key(run: &RunSpec, duration_s: f64) -> String {
         "limits.amax_mm_s2",
         "limits.jmax_mm_s3",
     ];
+    if run.window_s >= duration_s {
+        return "observe.window_s".to_string();
+    }
     let scan = run.state::<ScanSpec>();
     let candidates = SCAN.iter().filter(|_| scan.is_some()).chain(MOVE.iter());
     if let Some(k) = candidates
@@ -193,8 +221,9 @@ fn validate_planned(run: &RunSpec, src: &Source) -> Result<(), Error> {
 }
 
 /// Check a run whose trace is recorded (`settle sweep --mcap`, `--rerun`: every run's trace
-/// is kept) as `validate_planned` checks one whose study keeps it: the sweep calls this
-/// for each of its runs before any starts.
+/// is kept; `settle run`'s one run, its trace written whole) as `validate_planned` checks
+/// one whose study keeps it: the sweep calls this for each of its runs before any starts,
+/// `settle run` for its run before it writes anything.
 pub fn validate_recorded(run: &RunSpec, src: &Source) -> Result<(), Error> {
     check_planned(run, src, true)
 }
@@ -317,23 +346,29 @@ pub fn validate_sampling(
     Ok(())
 }
 
-/// Check the observation and simulation settings of the base run.
+/// Check a positive observation setting against its largest value `max` (in `unit`): the
+/// message for a value outside (0, `max`].
+fn check_up_to(value: f64, max: f64, unit: &str) -> Result<(), String> {
+    if value.is_finite() && value > 0.0 && value <= max {
+        Ok(())
+    } else {
+        Err(format!(
+            "must be a finite number > 0 and at most {max:e} ({unit}), got {value}"
+        ))
+    }
+}
+
+/// Check the observation and simulation settings of the base run: `observe.window_s` up to
+/// [`MAX_WINDOW_S`], `observe.sample_rate_hz` up to [`MAX_SAMPLE_RATE_HZ`], their product
+/// within [`MAX_SAMPLES_PER_RUN`], `sim.max_step_s` at least [`MIN_STEP_S`], and one to
+/// [`MAX_BANDS`] distinct `observe.bands_um`, each > 0 and below [`BAND_LIMIT_UM`]. The
+/// `[observe]` keys cannot be swept (`crate::spec::run_spec::RunSpec::set`): every run
+/// takes the values checked here.
 pub fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
-    if !(run.window_s.is_finite() && run.window_s > 0.0) {
-        return Err(src.error_at(
-            "observe.window_s",
-            format!("must be a finite number > 0 (s), got {}", run.window_s),
-        ));
-    }
-    if !(run.sample_rate_hz.is_finite() && run.sample_rate_hz > 0.0) {
-        return Err(src.error_at(
-            "observe.sample_rate_hz",
-            format!(
-                "must be a finite number > 0 (Hz), got {}",
-                run.sample_rate_hz
-            ),
-        ));
-    }
+    check_up_to(run.window_s, MAX_WINDOW_S, "s")
+        .map_err(|m| src.error_at("observe.window_s", m))?;
+    check_up_to(run.sample_rate_hz, MAX_SAMPLE_RATE_HZ, "Hz")
+        .map_err(|m| src.error_at("observe.sample_rate_hz", m))?;
     if run.window_s * run.sample_rate_hz > MAX_SAMPLES_PER_RUN {
         return Err(src.error_at(
             "observe.sample_rate_hz",
@@ -350,10 +385,25 @@ pub fn validate_observe(run: &RunSpec, src: &Source) -> Result<(), Error> {
             format!("must be a finite number > 0 and at least {MIN_STEP_S:e} (s), got {h}"),
         ));
     }
-    if run.bands_um.is_empty() || run.bands_um.iter().any(|b| !(b.is_finite() && *b > 0.0)) {
+    if run.bands_um.is_empty() {
         return Err(src.error_at(
             "observe.bands_um",
-            "give one or more bands, each a finite number > 0 (um)",
+            format!(
+                "give one or more bands, each a finite number > 0 and below {BAND_LIMIT_UM:e} (um)"
+            ),
+        ));
+    }
+    if let Some((i, b)) = run
+        .bands_um
+        .iter()
+        .enumerate()
+        .find(|(_, b)| !(b.is_finite() && **b > 0.0 && **b < BAND_LIMIT_UM))
+    {
+        return Err(src.error_at(
+            "observe.bands_um",
+            format!(
+                "band {i} must be a finite number > 0 and below {BAND_LIMIT_UM:e} (um), got {b}: an error past {BLOWUP_M} m stops the run as a fault, so no run that completes leaves a band as wide"
+            ),
         ));
     }
     let mut sorted = run.bands_um.clone();

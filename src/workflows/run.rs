@@ -4,7 +4,10 @@
 //! A run that fails (lost steps, a simulation fault, a planner or backend error) is a
 //! result as in `settle sweep`: its status and reason are printed instead of its metrics
 //! (runs.csv leaves them empty too), its trace up to where it stopped is written, and the
-//! report ends with [`Exit::RunsFailed`].
+//! report ends with [`Exit::RunsFailed`]. A run whose trace would be too long to keep is
+//! not started: it is refused (exit 2, the key at fault and the numbers) before anything
+//! is written, as a recorded sweep refuses it
+//! ([`crate::expand::validate::validate_recorded`]).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -81,6 +84,9 @@ pub fn run(opts: &RunOptions) -> Result<RunOutcome, Error> {
             ),
         ));
     };
+    // Its trace is kept whole: too long a one is refused before anything is written, as
+    // a recorded sweep refuses it.
+    crate::expand::validate::validate_recorded(spec, &src)?;
     let out = opts.out.clone().unwrap_or_else(|| {
         PathBuf::from("results")
             .join(&sc.name)

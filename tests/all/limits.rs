@@ -406,4 +406,117 @@ fn a_recorded_sweep_checks_every_runs_trace_before_any_run() {
         scenario.exists() && !dir.path().join("o").exists(),
         "nothing written"
     );
+    // `settle run` keeps its one run's trace whole: run 1 at the refused rate is refused
+    // before it starts with the sweep's message, exit 2, no folder made; run 0 (the 1 mm
+    // move, 1.501 s of samples) is within and runs.
+    let run = |case: &str| {
+        settle()
+            .args(["run", "s.toml", "--case", case, "--backend", "modal"])
+            .args(["--out", "o/t.csv"])
+            .current_dir(dir.path())
+            .output()
+            .expect("runs")
+    };
+    let out = run("1");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "s.toml:{}",
+            e.strip_prefix("s.toml:").expect("file")
+        )),
+        "the sweep's message {e}, got {stderr}"
+    );
+    assert!(!dir.path().join("o").exists(), "nothing written");
+    let out = run("0");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.path().join("o/t.csv").is_file());
+}
+
+/// `scenarios/quickstart.toml` with its `[observe]` values replaced: `window_s`,
+/// `sample_rate_hz`, `bands_um` as written here.
+fn quickstart_observing(window: &str, rate: &str, bands: &str) -> String {
+    quickstart_with("window_s = 0.5", &format!("window_s = {window}"))
+        .replace(
+            "sample_rate_hz = 10000",
+            &format!("sample_rate_hz = {rate}"),
+        )
+        .replace("bands_um = [10.0, 50.0]", &format!("bands_um = [{bands}]"))
+}
+
+/// The line (1-based) of `text` that starts with `key`.
+fn line_of(text: &str, key: &str) -> usize {
+    1 + text
+        .lines()
+        .position(|l| l.starts_with(key))
+        .expect("the key is written")
+}
+
+#[test]
+fn the_observe_keys_are_bounded_at_their_limits() {
+    // Each limit is taken, the next f64 above it refused with the key's line, the range
+    // and the value. Window: at most 1e4 s (at 100 Hz, over the 80 Hz Nyquist of the
+    // 40 Hz mode: 1e6 samples, within the 1e8 of a run). Rate: at most 1e6 Hz. Bands:
+    // each below 0.1 m, the blow-up limit, 1e5 um; at most 16.
+    let above = |x: f64| f64::from_bits(x.to_bits() + 1);
+    let below = |x: f64| f64::from_bits(x.to_bits() - 1);
+    let accepted = |text: &str| {
+        settle::expand::parse_runs(text, Path::new("s.toml")).unwrap_or_else(|e| panic!("{e}"));
+    };
+    let refused = |text: &str, key: &str, what: &str| {
+        let e = expand_err(text);
+        let line = line_of(text, key.strip_prefix("observe.").expect("observe"));
+        assert!(
+            e.starts_with(&format!("s.toml:{line}:1: key `{key}`: {what}")),
+            "{e}"
+        );
+    };
+    accepted(&quickstart_observing("1e4", "100", "10.0"));
+    let w = above(1e4);
+    refused(
+        &quickstart_observing(&format!("{w:?}"), "100", "10.0"),
+        "observe.window_s",
+        &format!("must be a finite number > 0 and at most 1e4 (s), got {w}"),
+    );
+    assert_eq!(format!("{w}"), "10000.000000000002");
+    accepted(&quickstart_observing("0.5", "1e6", "10.0"));
+    let r = above(1e6);
+    refused(
+        &quickstart_observing("0.5", &format!("{r:?}"), "10.0"),
+        "observe.sample_rate_hz",
+        &format!("must be a finite number > 0 and at most 1e6 (Hz), got {r}"),
+    );
+    refused(
+        &quickstart_observing("0.5", "nan", "10.0"),
+        "observe.sample_rate_hz",
+        "must be a finite number > 0 and at most 1e6 (Hz), got NaN",
+    );
+    let b = below(1e5);
+    assert_eq!(format!("{b:?}"), "99999.99999999999");
+    accepted(&quickstart_observing(
+        "0.5",
+        "10000",
+        &format!("10.0, {b:?}"),
+    ));
+    refused(
+        &quickstart_observing("0.5", "10000", "10.0, 1e5"),
+        "observe.bands_um",
+        "band 1 must be a finite number > 0 and below 1e5 (um), got 100000: an error past 0.1 m stops the run as a fault",
+    );
+    let bands = |n: usize| {
+        (1..=n)
+            .map(|b| format!("{b}.0"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    accepted(&quickstart_observing("0.5", "10000", &bands(16)));
+    refused(
+        &quickstart_observing("0.5", "10000", &bands(17)),
+        "observe.bands_um",
+        "17 bands; at most 16",
+    );
 }

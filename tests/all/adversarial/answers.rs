@@ -437,14 +437,18 @@ pub fn cases(sb: &Sandbox) -> Vec<Case> {
             "identify rec_x.csv --out o/m.toml",
             &["rec_x.csv", "no clean decay", "--hz-per-sec"],
         ),
-        Case::line(
-            "run of a trace too long to keep: failed, with its reason",
+        // 1.579e7 samples (the 0.08165 s move and the 7894 s window at 2000 Hz) of 8
+        // values: 1.263e8, over 1.6e7, refused before the run starts, nothing written.
+        refused(
+            "run of a trace too long to keep",
             "run long_window.toml --case 0 --backend modal --out o_long/t.csv --fail-on-failed-runs",
-            &["o_long"],
-            Expect::failed(&[
-                "FAILED (fault): its trace is kept in memory",
-                "over the limit of 1.6e7",
-            ]),
+            &[
+                "long_window.toml:12:1: key `observe.window_s`",
+                "its trace is kept in memory",
+                "the 7894 s window at 2000 Hz",
+                "1.263e8 values, over the limit of 1.6e7",
+                "checked before any run starts",
+            ],
         ),
         refused(
             "a corner at 1e15 mm",
