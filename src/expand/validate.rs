@@ -452,12 +452,13 @@ fn validate_move(run: &RunSpec, src: &Source, blame: impl Fn(&str) -> String) ->
             format!("must be finite, got {}", run.start_mm),
         ));
     }
-    for (key, value, unit) in [
-        ("limits.vmax_mm_s", Some(run.vmax_mm_s), "mm/s"),
-        ("limits.amax_mm_s2", Some(run.amax_mm_s2), "mm/s^2"),
-        ("limits.jmax_mm_s3", run.jmax_mm_s3, "mm/s^3"),
+    use crate::spec::Quantity::{Acceleration, Jerk, Speed};
+    for (key, value, quantity) in [
+        ("limits.vmax_mm_s", Some(run.vmax_mm_s), Speed),
+        ("limits.amax_mm_s2", Some(run.amax_mm_s2), Acceleration),
+        ("limits.jmax_mm_s3", run.jmax_mm_s3, Jerk),
     ] {
-        if let Some(Err(m)) = value.map(|v| crate::spec::check_limit(v, unit)) {
+        if let Some(Err(m)) = value.map(|v| crate::spec::check_limit(v, quantity)) {
             return Err(src.error_at(&blame(key), m));
         }
     }

@@ -53,17 +53,45 @@ pub const DEVIATION_RANGE_MM: (f64, f64) = (MIN_LENGTH_MM, MAX_POSITION_MM);
 /// one-axis scan's values, half the limit; 1e4 s broke the 1e8 samples of a run.
 pub const MAX_MARGIN_S: f64 = 1e2;
 
-/// Check a motion limit against the range of its quantity, named by `unit` (`mm/s`,
-/// `mm/s^2` or `mm/s^3`; `mm` for a corner's deviation, [`DEVIATION_RANGE_MM`]): the
-/// message for a value outside it.
-pub fn check_limit(value: f64, unit: &str) -> Result<(), String> {
-    let (lo, hi) = match unit {
-        "mm" => DEVIATION_RANGE_MM,
-        "mm/s" => SPEED_RANGE_MM_S,
-        "mm/s^2" => ACCELERATION_RANGE_MM_S2,
-        "mm/s^3" => JERK_RANGE_MM_S3,
-        _ => unreachable!("a motion limit in {unit}"),
-    };
+/// A quantity whose values a scenario bounds ([`check_limit`]): its range and its unit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quantity {
+    /// A corner's deviation from its sharp point ([`DEVIATION_RANGE_MM`], mm).
+    Deviation,
+    /// A speed ([`SPEED_RANGE_MM_S`], mm/s).
+    Speed,
+    /// An acceleration ([`ACCELERATION_RANGE_MM_S2`], mm/s^2).
+    Acceleration,
+    /// A jerk ([`JERK_RANGE_MM_S3`], mm/s^3).
+    Jerk,
+}
+
+impl Quantity {
+    /// The values taken (both ends included).
+    pub fn range(self) -> (f64, f64) {
+        match self {
+            Self::Deviation => DEVIATION_RANGE_MM,
+            Self::Speed => SPEED_RANGE_MM_S,
+            Self::Acceleration => ACCELERATION_RANGE_MM_S2,
+            Self::Jerk => JERK_RANGE_MM_S3,
+        }
+    }
+
+    /// The unit the values are in.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Self::Deviation => "mm",
+            Self::Speed => "mm/s",
+            Self::Acceleration => "mm/s^2",
+            Self::Jerk => "mm/s^3",
+        }
+    }
+}
+
+/// Check a motion limit against the range of its quantity: the message for a value
+/// outside it.
+pub fn check_limit(value: f64, quantity: Quantity) -> Result<(), String> {
+    let ((lo, hi), unit) = (quantity.range(), quantity.unit());
     if value.is_finite() && (lo..=hi).contains(&value) {
         Ok(())
     } else {

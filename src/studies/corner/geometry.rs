@@ -259,16 +259,17 @@ impl Corner {
         // The deviations within [`crate::spec::DEVIATION_RANGE_MM`]; the square corner
         // velocity is a speed like the limits (Klipper's `square_corner_velocity` takes any
         // value >= 0, `ToolHead.__init__`, klippy/toolhead.py; 0 is `exact_stop` here).
-        for (p, x, unit) in [
-            ("junction_deviation_mm", self.junction_deviation_mm, "mm"),
+        use crate::spec::Quantity::{Deviation, Speed};
+        for (p, x, quantity) in [
+            ("junction_deviation_mm", self.junction_deviation_mm, Deviation),
             (
                 "square_corner_velocity_mm_s",
                 self.square_corner_velocity_mm_s,
-                "mm/s",
+                Speed,
             ),
-            ("blend_deviation_mm", self.blend_deviation_mm, "mm"),
+            ("blend_deviation_mm", self.blend_deviation_mm, Deviation),
         ] {
-            crate::spec::check_limit(x, unit).map_err(|m| (key(p), m))?;
+            crate::spec::check_limit(x, quantity).map_err(|m| (key(p), m))?;
         }
         if self.corner_mm.iter().any(|x| !x.is_finite()) {
             return Err((key("corner_mm"), "coordinates must be finite (mm)".into()));

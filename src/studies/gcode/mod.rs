@@ -380,7 +380,7 @@ impl Study for GcodeRun {
         // 0 (stop at every corner) or a speed like the limits: Klipper takes any
         // `square_corner_velocity` >= 0 (`ToolHead.__init__`, klippy/toolhead.py).
         let scv = spec.square_corner_velocity_mm_s;
-        if scv != 0.0 && crate::spec::check_limit(scv, "mm/s").is_err() {
+        if scv != 0.0 && crate::spec::check_limit(scv, crate::spec::Quantity::Speed).is_err() {
             let (lo, hi) = crate::spec::SPEED_RANGE_MM_S;
             return Err(src.error_at(
                 "gcode.square_corner_velocity_mm_s",

@@ -75,13 +75,14 @@ impl ScanSpec {
 
     /// Check the values: `(key inside [scan], message)` for the first bad one.
     pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        use crate::spec::Quantity::{Acceleration, Jerk, Speed};
         let limits = [
-            ("v_scan_mm_s", Some(self.v_scan_mm_s), "mm/s"),
-            ("fly_amax_mm_s2", Some(self.fly_amax_mm_s2), "mm/s^2"),
-            ("fly_jmax_mm_s3", self.fly_jmax_mm_s3, "mm/s^3"),
+            ("v_scan_mm_s", Some(self.v_scan_mm_s), Speed),
+            ("fly_amax_mm_s2", Some(self.fly_amax_mm_s2), Acceleration),
+            ("fly_jmax_mm_s3", self.fly_jmax_mm_s3, Jerk),
         ];
-        for (key, v, unit) in limits {
-            if let Some(Err(m)) = v.map(|v| crate::spec::check_limit(v, unit)) {
+        for (key, v, quantity) in limits {
+            if let Some(Err(m)) = v.map(|v| crate::spec::check_limit(v, quantity)) {
                 return Err((key, m));
             }
         }

@@ -263,7 +263,7 @@ pub fn plan(
                 ));
             }
             for a in list {
-                crate::spec::check_limit(*a, "mm/s^2").map_err(|m| {
+                crate::spec::check_limit(*a, crate::spec::Quantity::Acceleration).map_err(|m| {
                     src.error_at("tune.accelerations_mm_s2", format!("each acceleration {m}"))
                 })?;
             }
@@ -401,7 +401,7 @@ pub fn plan(
     // The jerks searched are the scenario's limit divided by up to jerk_span: each within
     // the range of a jerk, as the limit is (a TMC4361A's lowest BOW register is within it).
     if let Some(j) = jerks.iter().find(|j| **j > 0.0) {
-        crate::spec::check_limit(*j, "mm/s^3").map_err(|m| {
+        crate::spec::check_limit(*j, crate::spec::Quantity::Jerk).map_err(|m| {
             src.error_at(
                 "tune.jerk_span",
                 format!("the lowest jerk searched, jmax_mm_s3 / jerk_span = {j:e} mm/s^3, {m}"),
