@@ -579,22 +579,7 @@ impl MarlinSettings {
         let text = kept.join("\n");
         for event in super::located_events(&text, dialect, &source) {
             // A word the job's command refuses, named as the reply's setting.
-            let (at, kind) = event.map_err(|e| match e {
-                GcodeError::OutOfRange {
-                    at,
-                    command,
-                    param,
-                    value,
-                    allowed,
-                } => GcodeError::ConfigValue {
-                    at: Location { column: None, ..at },
-                    section: command,
-                    key: param,
-                    value: value.to_string().into(),
-                    allowed: allowed.into(),
-                },
-                e => e,
-            })?;
+            let (at, kind) = event.map_err(super::out_of_range_as_setting)?;
             let change = match kind {
                 EventKind::Limits(c) => c,
                 EventKind::Note(Note::IgnoredByFirmware { command, reason }) => {

@@ -97,6 +97,28 @@ use crate::read::dialect::Dialect;
 use crate::read::event::EventKind;
 use crate::read::reader::{Reader, ReaderOptions};
 
+/// A word a job's command refuses ([`GcodeError::OutOfRange`]) named as the
+/// configuration's setting: the command its section, the word its key, the line without a
+/// column; any other error as it is.
+pub(crate) fn out_of_range_as_setting(e: GcodeError) -> GcodeError {
+    match e {
+        GcodeError::OutOfRange {
+            at,
+            command,
+            param,
+            value,
+            allowed,
+        } => GcodeError::ConfigValue {
+            at: Location { column: None, ..at },
+            section: command,
+            key: param,
+            value: value.to_string().into(),
+            allowed: allowed.into(),
+        },
+        e => e,
+    }
+}
+
 /// The events of a configuration file's `text` read in `dialect`, each with its line in
 /// `source` (what config.g's and GRBL's settings readers walk).
 pub(crate) fn located_events<'a>(

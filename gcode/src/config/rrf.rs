@@ -256,19 +256,9 @@ impl RrfConfig {
         for event in super::located_events(&script.text, Dialect::Rrf, &source) {
             // `M593`'s words are the configuration's shaper: named as its setting.
             let (at, kind) = event.map_err(|e| match e {
-                GcodeError::OutOfRange {
-                    at,
-                    command,
-                    param,
-                    value,
-                    allowed,
-                } if command == "M593" => GcodeError::ConfigValue {
-                    at: Location { column: None, ..at },
-                    section: command,
-                    key: param,
-                    value: value.to_string().into(),
-                    allowed: allowed.into(),
-                },
+                GcodeError::OutOfRange { ref command, .. } if command == "M593" => {
+                    super::out_of_range_as_setting(e)
+                }
                 e => e,
             })?;
             match kind {
