@@ -289,15 +289,17 @@ fn corner_err(text: &str) -> String {
     }
 }
 
+/// The 1-based line of `text` that starts with `key`.
+fn line_of(text: &str, key: &str) -> usize {
+    1 + text
+        .lines()
+        .position(|l| l.starts_with(key))
+        .expect("key in text")
+}
+
 #[test]
 fn bad_corner_input_names_file_line_and_key() {
     let good = scenario();
-    let line_of = |text: &str, key: &str| {
-        1 + text
-            .lines()
-            .position(|l| l.starts_with(key))
-            .expect("key in text")
-    };
     // Unknown key in [corner]: its line, and the allowed keys.
     let text = good.replace("leg_out_mm =", "leg_ot_mm = 1\nleg_out_mm =");
     let msg = corner_err(&text);
@@ -389,12 +391,6 @@ fn corner_deviations_and_square_corner_velocity_are_bounded_as_written_and_swept
     // beyond either end is refused with the key, its line, the range and the value; a
     // swept value is checked the same way and blames the sweep key.
     let good = scenario();
-    let line_of = |text: &str, key: &str| {
-        1 + text
-            .lines()
-            .position(|l| l.starts_with(key))
-            .expect("key in text")
-    };
     for (key, written, lo, hi, range) in [
         (
             "junction_deviation_mm",
