@@ -72,7 +72,7 @@ pub const MAX_MAGNITUDE: f64 = 1e15;
 /// the least motion setting a G-code file may set (`settle_gcode::MIN_LIMIT_VALUE`: below
 /// it the planners' arithmetic leaves the range of f64). settle's slowest limits, 1e-3 mm/s
 /// (1e-6 m/s) and the like, lie above it.
-pub const MIN_LIMIT: f64 = 1e-9;
+pub const MIN_LIMIT: f64 = settle_gcode::MIN_LIMIT_VALUE;
 
 /// Check every value of `pr` against [`MAX_MAGNITUDE`] and the limits against
 /// [`MIN_LIMIT`]: the message for the first value outside, naming its field and axis.

@@ -9,8 +9,8 @@
 
 use super::export_text::{Note, annotate, comment_text, m201_line, m204_line, refuse};
 use super::machine::ShaperSetting;
-use super::rrf::{MAX_SHAPER_FREQUENCY_HZ, MIN_SHAPER_FREQUENCY_HZ};
 use crate::error::GcodeError;
+use crate::read::limit_parse::{RRF_MAX_SHAPER_FREQUENCY_HZ, RRF_MIN_SHAPER_FREQUENCY_HZ};
 
 /// The `M593 P` types written (`custom` needs its impulses and is not).
 const TYPES: [&str; 7] = ["none", "zvd", "zvdd", "zvddd", "mzv", "ei2", "ei3"];
@@ -74,11 +74,11 @@ impl RrfExport {
     /// The `M593` line of a shaper that is on.
     fn shaper_line(&self, name: &str) -> Result<String, GcodeError> {
         let s = &self.shaper;
-        if !(MIN_SHAPER_FREQUENCY_HZ..=MAX_SHAPER_FREQUENCY_HZ).contains(&s.frequency_hz) {
+        if !(RRF_MIN_SHAPER_FREQUENCY_HZ..=RRF_MAX_SHAPER_FREQUENCY_HZ).contains(&s.frequency_hz) {
             return Err(refuse(
                 "M593 F",
                 s.frequency_hz,
-                format!("{MIN_SHAPER_FREQUENCY_HZ:.3} to {MAX_SHAPER_FREQUENCY_HZ} Hz"),
+                format!("{RRF_MIN_SHAPER_FREQUENCY_HZ:.3} to {RRF_MAX_SHAPER_FREQUENCY_HZ} Hz"),
             ));
         }
         if !(0.0..=0.99).contains(&s.damping_ratio) {

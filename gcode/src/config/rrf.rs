@@ -66,12 +66,6 @@ const SHAPERS: [&str; 8] = [
     "custom", "ei2", "ei3", "mzv", "none", "zvd", "zvdd", "zvddd",
 ];
 
-/// `M593 F` limits, Hz: the reader's `M593` holds `F` to them (crate::read::limit_parse).
-pub(crate) use crate::read::limit_parse::{
-    RRF_MAX_SHAPER_FREQUENCY_HZ as MAX_SHAPER_FREQUENCY_HZ,
-    RRF_MIN_SHAPER_FREQUENCY_HZ as MIN_SHAPER_FREQUENCY_HZ,
-};
-
 /// An `M593 P` type as `GcodeBuffer::GetReducedString` (src/GCodes/GCodeBuffer/
 /// GCodeBuffer.cpp) gives it to `InputShaperType`: lower case, without `-`, `_` and
 /// spaces (`"EI-2"` is `ei2`).
@@ -544,7 +538,7 @@ impl RrfConfig {
             value: value.into(),
             allowed: allowed.into(),
         };
-        // `F` is within MIN_SHAPER_FREQUENCY_HZ..=MAX_SHAPER_FREQUENCY_HZ: the reader's
+        // `F` is within RRF_MIN_SHAPER_FREQUENCY_HZ..=RRF_MAX_SHAPER_FREQUENCY_HZ: the reader's
         // `M593` refuses another (`RRF_SHAPER_FREQUENCY`, crate::read::limit_parse).
         if let Some(f) = frequency_hz {
             self.input_shaper.frequency_hz = f;
