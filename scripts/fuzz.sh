@@ -5,11 +5,17 @@
 # the run and leaves the input in fuzz/artifacts/<target>/.
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]    (default: 60 s, all targets)
+#   scripts/fuzz.sh --build-only                         (build every target, run none)
 #
 # The corpus grows in fuzz/corpus/<target>/ (the seeds there are committed; found inputs
 # are ignored by git). Long runs: scripts/fuzz.sh 3600
 set -euo pipefail
 cd "$(dirname "$0")/../fuzz"
+build_only=0
+if [[ "${1:-}" == --build-only ]]; then
+  build_only=1
+  shift
+fi
 secs="${1:-60}"
 shift || true
 targets=("$@")
@@ -33,6 +39,7 @@ echo "== fuzz build (${targets[*]})"
 bins=()
 for t in "${targets[@]}"; do bins+=(--bin "$t"); done
 cargo build --profile fuzz "${bins[@]}"
+[[ $build_only == 0 ]] || exit 0
 for t in "${targets[@]}"; do
   echo "== fuzz $t for ${secs}s"
   mkdir -p "corpus/$t"

@@ -27,6 +27,8 @@
 #   - scripts/fuzz.sh: in "$CARGO_TARGET_DIR-fuzz", settle's crates libFuzzer-instrumented
 #     at optimisation level 1, every other crate plain at level 0 (7.7 and 9.9 CPU-minutes
 #     cold instead of 12.1 and 13.5 with everything instrumented at level 1).
+#   The fuzz build and the rerun build start in the background, at the lowest priority,
+#   when the test build is done (see there).
 # Headless Chromium's apt-get install runs in the background from the start and is waited
 # for before the test run (it waits on the network and the disk while the builds use the
 # CPU).
@@ -77,9 +79,42 @@ phase() {
 }
 report() {
   local status=$?
+  stop_background
   phase ""
   echo "== phase times (m:ss), total $(mmss $(($(date +%s) - start_s)))$([[ $status -ne 0 ]] && echo ", FAILED in the last phase")"
   printf '%s\n' "${timings[@]}"
+}
+# Builds started in the background (below), each in a session of its own: stopped with
+# all their compilers when the script ends before their phase has waited for them.
+background_pids=()
+stop_background() {
+  local pid
+  for pid in "${background_pids[@]}"; do
+    kill -- "-$pid" 2>/dev/null || true
+  done
+}
+# `background LOG CMD...`: CMD at the lowest CPU priority, its output in LOG; its pid in $!.
+background() {
+  local log=$1
+  shift
+  setsid nice -n 19 "$@" >"$log" 2>&1 &
+  background_pids+=($!)
+}
+# `await PID LOG WHAT`: wait for a background build, show its output, fail if it failed.
+await() {
+  local status=0
+  wait "$1" || status=$?
+  local pid rest=()
+  for pid in "${background_pids[@]}"; do
+    [[ $pid == "$1" ]] || rest+=("$pid")
+  done
+  background_pids=("${rest[@]}")
+  cat "$2"
+  rm -f "$2"
+  if [[ $status -ne 0 ]]; then
+    echo "$3 failed (exit $status)" >&2
+    exit 1
+  fi
 }
 trap report EXIT
 
@@ -120,6 +155,28 @@ scripts/check-docs.sh
 
 phase "cargo test: build (profile ci)"
 cargo test --workspace --profile ci --locked "${features[@]}" --no-run
+
+# The fuzz targets' build (scripts/fuzz.sh, a target dir of its own) and the rerun
+# feature's (profile ci-rerun) need nothing the phases in between make: they start now,
+# in the background at the lowest CPU priority, and take what the test run, the gate,
+# the book's commands and Slurm leave of the two cores (a test binary's last long tests,
+# the daemons' start); their phases wait for them. The rerun sink's tests are in the
+# harness's one test binary, tests/all, or in tests/outputs_rerun.rs: whichever this tree has.
+if [[ -f tests/all/main.rs ]]; then
+  rerun_binary=(--test all)
+  rerun_filter=(-- rerun)
+else
+  rerun_binary=(--test outputs_rerun)
+  rerun_filter=()
+fi
+fuzz_log=$(mktemp)
+background "$fuzz_log" scripts/fuzz.sh --build-only
+fuzz_pid=$!
+if [[ "${SETTLE_SKIP_RERUN:-0}" != 1 ]]; then
+  rerun_log=$(mktemp)
+  background "$rerun_log" cargo test --profile ci-rerun --locked --features rerun "${rerun_binary[@]}" --no-run
+  rerun_pid=$!
+fi
 
 if [[ -n $browser_pid ]]; then
   phase "headless Chromium for the report's browser tests (waits for the install started first)"
@@ -172,17 +229,13 @@ SETTLE_BIN="$settle_bin" scripts/slurm-recipes.sh
 # --- end of the Slurm phase ---------------------------------------------------------------
 
 phase "fuzz smoke (scenario parser, settle plan input; scripts/fuzz.sh SECONDS for longer runs)"
+await "$fuzz_pid" "$fuzz_log" "the fuzz build (scripts/fuzz.sh --build-only)"
 scripts/fuzz.sh "${SETTLE_FUZZ_SECONDS:-15}"
 
 # The rerun sink is behind a cargo feature (the SDK's build is the largest of all): built
-# once here, unoptimised, and its tests run (the harness's tests in one binary, tests/all,
-# or in tests/outputs_rerun.rs: whichever this tree has).
+# once, unoptimised, in the background since the test build, and its tests run.
 if [[ "${SETTLE_SKIP_RERUN:-0}" != 1 ]]; then
   phase "rerun feature: build (profile ci-rerun) and test the .rrd sink"
-  if [[ -f tests/all/main.rs ]]; then
-    rerun_tests=(--test all -- rerun)
-  else
-    rerun_tests=(--test outputs_rerun)
-  fi
-  cargo test --profile ci-rerun --locked --features rerun "${rerun_tests[@]}"
+  await "$rerun_pid" "$rerun_log" "the rerun feature's build"
+  cargo test --profile ci-rerun --locked --features rerun "${rerun_binary[@]}" "${rerun_filter[@]}"
 fi
