@@ -2,8 +2,9 @@
 //! recording (`examples/data/raw_data_x_example.csv`, quantised at an ADXL345's x/y count
 //! as Klipper scales it, `SCALE_XY` = 0.003774 g in `klippy/extras/adxl345.py`) made ten
 //! times stronger and clipped at the ADXL345's 13-bit counts (-4096 to 4095), as the chip
-//! saturates. It is refused (exit 2) with the file, line, axis and what was seen, and
-//! nothing is written; the recording as it is still gives its modes.
+//! saturates; the same recording with one axis zeroed or divided far below any sensor's
+//! count. Each is refused (exit 2) with the file, line, axis and what was seen, and nothing
+//! is written; the recording as it is still gives its modes.
 
 use std::path::Path;
 
@@ -172,6 +173,53 @@ fn a_hand_made_clipped_sine_names_line_12() {
         .count();
     assert!(
         err.contains(&format!("({at_full_scale} samples, the first here)")),
+        "{err}"
+    );
+}
+
+/// A recording without a measured vibration: the example divided by 100,000 (its largest
+/// deviation, 23,946 mm/s^2, becomes 0.24, a tenth of an MPU-9250's count of 1/4096 g =
+/// 2.394 mm/s^2, the finest Klipper reads) gave the example's modes to four digits; an
+/// axis zeroed (a sensor axis that does not measure) gave modes from the other two.
+#[test]
+fn no_measured_vibration_and_a_dead_axis_are_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut tiny = String::new();
+    let mut dead = String::new();
+    for l in example().lines() {
+        if l.starts_with('#') {
+            tiny.push_str(&format!("{l}\n"));
+            dead.push_str(&format!("{l}\n"));
+            continue;
+        }
+        let f: Vec<&str> = l.split(',').collect();
+        let v: Vec<f64> = f[1..].iter().map(|v| v.parse().expect("number")).collect();
+        tiny.push_str(&format!(
+            "{},{:.6},{:.6},{:.6}\n",
+            f[0],
+            v[0] * 1e-5,
+            v[1] * 1e-5,
+            v[2] * 1e-5
+        ));
+        dead.push_str(&format!("{},0.000000,{},{}\n", f[0], f[2], f[3]));
+    }
+    let file = write(dir.path(), "raw_data_x_tiny.csv", &tiny);
+    let (code, out, err) = identify(&file, &dir.path().join("f0"));
+    assert_eq!(code, Some(2), "{out}{err}");
+    assert!(
+        err.contains("raw_data_x_tiny.csv: no vibration to identify")
+            && err.contains("varies by at least 2.394 mm/s^2")
+            && err.contains("MPU-9250's 1/4096 g"),
+        "{err}"
+    );
+    let file = write(dir.path(), "raw_data_x_dead.csv", &dead);
+    let (code, out, err) = identify(&file, &dir.path().join("f1"));
+    assert_eq!(code, Some(2), "{out}{err}");
+    let samples = example().lines().filter(|l| !l.starts_with('#')).count();
+    assert!(
+        err.contains(&format!(
+            "raw_data_x_dead.csv: a sensor axis that does not measure: sensor axis x reads 0 mm/s^2 in all {samples} samples"
+        )),
         "{err}"
     );
 }

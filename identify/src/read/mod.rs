@@ -279,10 +279,18 @@ pub(crate) fn klipper_clip_axis(column: String, values: &[f64]) -> ClipAxis<'_> 
 /// What to do about a recording Klipper's sensor clipped.
 pub(crate) const KLIPPER_CLIP_REMEDY: &str = "record again with less acceleration (a lower `accel_per_hz` in [resonance_tester] or TEST_RESONANCES, a gentler move), or mount the sensor where it moves less";
 
-/// Smallest vibration a recording may hold (mm/s^2): the largest deviation of a sensor
-/// axis from its mean must reach 1e-6 mm/s^2, the resolution Klipper writes (`%.6f`);
-/// no accelerometer resolves less (an ADXL345 step is 38 mm/s^2).
-pub const MIN_VIBRATION_MM_S2: f64 = 1e-6;
+/// Smallest vibration a Klipper or Shake&Tune recording may hold (mm/s^2): the largest
+/// deviation of a sensor axis from its mean must reach one count of the finest sensor
+/// Klipper reads, an MPU-9250's 1/4096 g (2.39 mm/s^2; [`KLIPPER_FULL_SCALES`]: an
+/// ICM-20948's or BMI160's is 4.79, an LIS2DW's 19.1, an ADXL345's 37 to 38). A sensor
+/// resolves nothing finer: a recording that varies by less holds no measured vibration
+/// (a sensor read while the machine stood still, values divided by a unit mistake).
+pub const MIN_VIBRATION_MM_S2: f64 = 0.000244140625 * KLIPPER_G;
+
+/// Smallest vibration an M956 recording may hold (mm/s^2): one count of the finest
+/// resolution RepRapFirmware reads, 16 bits at +-2 g (1/16384 g, 0.599 mm/s^2; see
+/// [`M956_FULL_SCALE_G`]).
+pub const MIN_VIBRATION_M956_MM_S2: f64 = STANDARD_GRAVITY_MM_S2 / 16384.0;
 
 /// Largest power spectral density a processed spectrum may hold ((mm/s^2)^2/Hz): 1e20,
 /// above the PSD of accelerations within [`MAX_ACCEL_MM_S2`] (`1e18 x` Klipper's 0.5 s
@@ -290,7 +298,8 @@ pub const MIN_VIBRATION_MM_S2: f64 = 1e-6;
 pub const MAX_PSD: f64 = 1e20;
 
 /// Smallest peak a processed spectrum may hold ((mm/s^2)^2/Hz): 1e-12, about the PSD of a
-/// vibration at [`MIN_VIBRATION_MM_S2`] over Klipper's 0.5 s window.
+/// vibration of 1e-6 mm/s^2 (the resolution Klipper writes, `%.6f`) over Klipper's 0.5 s
+/// window.
 pub const MIN_PEAK_PSD: f64 = 1e-12;
 
 /// `value_mm_s2` (read as `text` in column `column` at `line`) as an acceleration within
