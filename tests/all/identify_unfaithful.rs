@@ -223,3 +223,43 @@ fn no_measured_vibration_and_a_dead_axis_are_refused() {
         "{err}"
     );
 }
+
+/// A time column not in seconds: the example's times in milliseconds (its 5,200 samples
+/// over 6.49875 s are 5,199 / 6.49875 = 800 samples per second), and sample numbers.
+/// Both were refused with the rate they give; the message now says what the times read as.
+#[test]
+fn a_time_column_not_in_seconds_says_what_it_reads_as() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut ms = String::new();
+    let mut numbers = String::new();
+    let mut i = 0;
+    for l in example().lines() {
+        if l.starts_with('#') {
+            ms.push_str(&format!("{l}\n"));
+            numbers.push_str(&format!("{l}\n"));
+            continue;
+        }
+        let (t, rest) = l.split_once(',').expect("fields");
+        let t: f64 = t.parse().expect("time");
+        ms.push_str(&format!("{:.6},{rest}\n", t * 1000.0));
+        numbers.push_str(&format!("{i},{rest}\n"));
+        i += 1;
+    }
+    let last = i + 1;
+    let file = write(dir.path(), "raw_data_x_ms.csv", &ms);
+    let (code, out, err) = identify(&file, &dir.path().join("f0"));
+    assert_eq!(code, Some(2), "{out}{err}");
+    assert!(
+        err.contains(&format!(
+            "raw_data_x_ms.csv:{last}: time stamps 0.000000 to 6498.750000 for {i} samples, a sample rate of 0.8000 Hz (read as milliseconds, the times give 800.0 Hz); expected times in seconds"
+        )),
+        "{err}"
+    );
+    let file = write(dir.path(), "raw_data_x_numbers.csv", &numbers);
+    let (code, out, err) = identify(&file, &dir.path().join("f1"));
+    assert_eq!(code, Some(2), "{out}{err}");
+    assert!(
+        err.contains("a sample rate of 1.0000 Hz (the times count one a sample: sample numbers, or milliseconds at 1000.0 Hz); expected times in seconds"),
+        "{err}"
+    );
+}

@@ -542,9 +542,10 @@ pub(crate) fn check_times(
             file,
             line_of(n - 1),
             format!(
-                "time stamps {:.6} to {:.6} for {n} samples, a sample rate of {rate:.4} Hz",
+                "time stamps {:.6} to {:.6} for {n} samples, a sample rate of {rate:.4} Hz{}",
                 time_s[0],
-                time_s[n - 1]
+                time_s[n - 1],
+                unit_hint(time_s, rate)
             ),
             format!(
                 "times in seconds (Klipper writes `%.6f` s) at {MIN_RATE_HZ} to {MAX_RATE_HZ} samples per second"
@@ -596,6 +597,28 @@ pub(crate) fn check_times(
         }
     }
     Ok(())
+}
+
+/// What a time column that gives a rate outside [`MIN_RATE_HZ`] to [`MAX_RATE_HZ`] may be
+/// instead of seconds: sample numbers (every step 1), or milliseconds or microseconds
+/// when read so they give a rate within it; empty when neither.
+fn unit_hint(time_s: &[f64], rate: f64) -> String {
+    let numbers = time_s.windows(2).all(|w| w[1] - w[0] == 1.0);
+    let within = |r: f64| (MIN_RATE_HZ..=MAX_RATE_HZ).contains(&r);
+    let unit = [(1e3, "milliseconds"), (1e6, "microseconds")]
+        .into_iter()
+        .find(|(k, _)| within(rate * k));
+    match (numbers, unit) {
+        (true, Some((k, unit))) => format!(
+            " (the times count one a sample: sample numbers, or {unit} at {:.1} Hz)",
+            rate * k
+        ),
+        (true, None) => " (the times count one a sample: sample numbers)".to_string(),
+        (false, Some((k, unit))) => {
+            format!(" (read as {unit}, the times give {:.1} Hz)", rate * k)
+        }
+        (false, None) => String::new(),
+    }
 }
 
 /// At most 60 characters of `s`, for messages.
