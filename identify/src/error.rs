@@ -112,6 +112,15 @@ pub enum IdentifyError {
         /// What the recording holds, and what is needed.
         reason: String,
     },
+    /// A sensor axis the recording holds reads one value throughout while another varies:
+    /// the axis was not measured.
+    #[error("{file}: a sensor axis that does not measure: {reason}")]
+    AxisNotMeasured {
+        /// The file.
+        file: String,
+        /// Which axis, what it reads, and what to check.
+        reason: String,
+    },
     /// No free decay (ring-down) could be found in the recording.
     #[error("{file}: {reason}")]
     NoRingDown {

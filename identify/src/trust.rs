@@ -4,7 +4,9 @@
 
 use crate::IdentifyError;
 use crate::excitation::SweepTest;
-use crate::read::{MIN_PEAK_PSD, MIN_VIBRATION_MM_S2, Recording, RecordingFormat};
+use crate::read::{
+    MIN_PEAK_PSD, MIN_VIBRATION_M956_MM_S2, MIN_VIBRATION_MM_S2, Recording, RecordingFormat,
+};
 use crate::result::{Diagnostics, IdentifiedMode};
 
 /// How much longer than the test a sweep recording may last (factor, plus seconds): Klipper
@@ -25,20 +27,44 @@ pub(crate) fn free_recording(rec: &Recording, duration_s: f64, test: &SweepTest)
 }
 
 /// A recording must hold a vibration: some sensor axis must deviate from its mean by at
-/// least [`MIN_VIBRATION_MM_S2`]. Without one (a sensor that read a constant, a file of
-/// zeros) there is nothing to identify, and every spectrum of it is zero or rounding.
+/// least one count of the finest sensor its firmware reads ([`MIN_VIBRATION_MM_S2`] for
+/// Klipper's and Shake&Tune's files, [`MIN_VIBRATION_M956_MM_S2`] for M956's). Without one
+/// (a sensor that read a constant, a file of zeros, values far below any sensor's
+/// resolution) there is nothing to identify, and every spectrum of it is zero or rounding.
+/// Every axis the file holds must vary too: a live sensor's axes all carry noise of a
+/// count or more, so an axis that reads one value throughout while another varies was not
+/// measured (a broken or unconnected axis, a column overwritten), and the direction of the
+/// motion, found from all of them, would be found without it.
 pub(crate) fn check_vibration(source: &str, rec: &Recording) -> Result<(), IdentifyError> {
     const NAMES: [&str; 3] = ["x", "y", "z"];
+    let resolution = if rec.format == RecordingFormat::RrfM956 {
+        MIN_VIBRATION_M956_MM_S2
+    } else {
+        MIN_VIBRATION_MM_S2
+    };
     let mut largest = 0.0_f64;
     let mut means = Vec::new();
+    let mut constant = Vec::new();
     for (k, c) in rec.accel_mm_s2.iter().enumerate() {
         let Some(c) = c else { continue };
         let mean = c.iter().sum::<f64>() / c.len() as f64;
         let dev = c.iter().fold(0.0_f64, |m, v| m.max((v - mean).abs()));
         largest = largest.max(dev);
         means.push(format!("{} {mean}", NAMES[k]));
+        if c.iter().all(|v| *v == c[0]) {
+            constant.push((NAMES[k], c[0]));
+        }
     }
-    if largest >= MIN_VIBRATION_MM_S2 {
+    if largest >= resolution {
+        if let Some((name, value)) = constant.first() {
+            return Err(IdentifyError::AxisNotMeasured {
+                file: source.to_string(),
+                reason: format!(
+                    "sensor axis {name} reads {value} mm/s^2 in all {} samples while another axis varies by up to {largest:.3e} mm/s^2; a sensor's every axis carries noise of a count or more: check the sensor's wiring and `axes_map`, and that the file's columns are the sensor's",
+                    rec.len()
+                ),
+            });
+        }
         return Ok(());
     }
     let what = if largest == 0.0 {
@@ -52,10 +78,15 @@ pub(crate) fn check_vibration(source: &str, rec: &Recording) -> Result<(), Ident
             means.join(", ")
         )
     };
+    let finest = if rec.format == RecordingFormat::RrfM956 {
+        "one count of the finest resolution RepRapFirmware reads, 1/16384 g"
+    } else {
+        "one count of the finest sensor Klipper reads, an MPU-9250's 1/4096 g"
+    };
     Err(IdentifyError::NoVibration {
         file: source.to_string(),
         reason: format!(
-            "{what}; a recording of a moving machine varies by at least {MIN_VIBRATION_MM_S2:.0e} mm/s^2 (the resolution Klipper writes; an accelerometer's is far coarser): check the file's unit, and that the sensor was read while the machine moved"
+            "{what}; a recording of a moving machine varies by at least {resolution:.3} mm/s^2 ({finest}; no sensor resolves less): check the file's unit, and that the sensor was read while the machine moved"
         ),
     })
 }

@@ -21,6 +21,7 @@ mod gcode_stream;
 mod hardening_input;
 mod html_report;
 mod identify_cmd;
+mod identify_unfaithful;
 mod import;
 mod import_marlin;
 mod import_roundtrip;

@@ -8,8 +8,8 @@
 //! comments='#')`) skips every line starting with `#`; so does this one.
 
 use super::{
-    MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_accel, check_times, parse_number,
-    too_many_samples, truncate,
+    KLIPPER_CLIP_REMEDY, MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_accel,
+    check_clipping, check_times, klipper_clip_axis, parse_number, too_many_samples, truncate,
 };
 use crate::IdentifyError;
 
@@ -95,6 +95,19 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
         });
     }
     check_times(file, &time_s, |i| line_numbers[i])?;
+    let clip: Vec<_> = axes
+        .iter()
+        .zip(&COLUMNS[1..])
+        .map(|(a, c)| klipper_clip_axis(c.to_string(), a))
+        .collect();
+    check_clipping(
+        file,
+        &clip,
+        |i| line_numbers[i],
+        |i| time_s[i],
+        |c, _| c.to_string(),
+        KLIPPER_CLIP_REMEDY,
+    )?;
     let span = time_s[time_s.len() - 1] - time_s[0];
     let [x, y, z] = axes;
     Ok(Recording {

@@ -50,10 +50,247 @@ pub const STANDARD_GRAVITY_MM_S2: f64 = 9_806.65;
 /// beyond it (from about 1e70) the spectrum's squares overflow.
 pub const MAX_ACCEL_MM_S2: f64 = 1e9;
 
-/// Smallest vibration a recording may hold (mm/s^2): the largest deviation of a sensor
-/// axis from its mean must reach 1e-6 mm/s^2, the resolution Klipper writes (`%.6f`);
-/// no accelerometer resolves less (an ADXL345 step is 38 mm/s^2).
-pub const MIN_VIBRATION_MM_S2: f64 = 1e-6;
+/// An accelerometer's full scale as a firmware reads it: the file holds `count x
+/// count_mm_s2` for counts from `-min_count` to `max_count`. A sensor whose acceleration
+/// passes its range reads the extreme count (it saturates), so a signal that reached it is
+/// flat there and its spectrum holds harmonics that are not modes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FullScale {
+    /// The sensor (and its axes), as messages name it.
+    pub sensor: &'static str,
+    /// One count of the value the firmware scales (mm/s^2).
+    pub count_mm_s2: f64,
+    /// The largest positive count.
+    pub max_count: u32,
+    /// The magnitude of the most negative count.
+    pub min_count: u32,
+}
+
+impl FullScale {
+    /// The magnitudes (mm/s^2) of the sensor's full scale: from its largest positive count
+    /// to the magnitude of its most negative one (one count apart for a right-justified
+    /// count; Klipper's `axes_map` may negate an axis, so either sign reaches both).
+    pub fn magnitudes_mm_s2(&self) -> (f64, f64) {
+        (
+            f64::from(self.max_count) * self.count_mm_s2,
+            f64::from(self.min_count) * self.count_mm_s2,
+        )
+    }
+}
+
+/// Klipper's `FREEFALL_ACCEL` (`klippy/extras/adxl345.py`), the g its drivers scale by.
+const KLIPPER_G: f64 = 9.80665 * 1000.;
+
+/// The full scales Klipper reads its accelerometers at (`klippy/extras/*.py` of Klipper,
+/// the range register each driver writes and the scale it multiplies counts by; every
+/// value is then rounded to 6 decimals):
+/// - `adxl345.py`: `REG_DATA_FORMAT` 0x0B (full resolution, +-16 g), 13-bit counts
+///   (-4096 to 4095, as `_convert_samples` sign-extends them) times `SCALE_XY` (0.003774 g)
+///   or `SCALE_Z` (0.003906 g); before October 2022 one `SCALE` of 0.0039 g;
+/// - `lis2dw.py`, LIS2DW: `CTRL_REG6` 0x34 (+-16 g), 14-bit counts left-justified in 16
+///   bits (-32768 to 32764) times `1.952 / 4` mg;
+/// - `lis2dw.py`, LIS3DH: `CTRL_REG4` 0x38 (+-16 g, high resolution), 12-bit counts
+///   left-justified (-32768 to 32752) times `11.718 / 16` mg;
+/// - `mpu9250.py` (MPU-9250, MPU-6050 and kin): `ACCEL_CONFIG` 0x10 (+-8 g), 16-bit counts
+///   times 1/4096 g;
+/// - `icm20948.py` (`ACCEL_CONFIG` 0x06) and `bmi160.py` (`ACC_RANGE` 0x0C): +-16 g,
+///   16-bit counts times 1/2048 g.
+pub const KLIPPER_FULL_SCALES: [FullScale; 7] = [
+    FullScale {
+        sensor: "an ADXL345's x or y axis (+-16 g, 13-bit counts of 3.774 mg)",
+        count_mm_s2: 0.003774 * KLIPPER_G,
+        max_count: 4095,
+        min_count: 4096,
+    },
+    FullScale {
+        sensor: "an ADXL345's z axis (+-16 g, 13-bit counts of 3.906 mg)",
+        count_mm_s2: 0.003906 * KLIPPER_G,
+        max_count: 4095,
+        min_count: 4096,
+    },
+    FullScale {
+        sensor: "an ADXL345 as Klipper read it before October 2022 (+-16 g, 13-bit counts of 3.9 mg)",
+        count_mm_s2: 0.0039 * KLIPPER_G,
+        max_count: 4095,
+        min_count: 4096,
+    },
+    FullScale {
+        sensor: "an LIS2DW (+-16 g, 14-bit counts of 1.952 mg)",
+        count_mm_s2: 9.80665 * 1.952 / 4.,
+        max_count: 32764,
+        min_count: 32768,
+    },
+    FullScale {
+        sensor: "an LIS3DH (+-16 g, 12-bit counts of 11.718 mg)",
+        count_mm_s2: 9.80665 * 11.718 / 16.,
+        max_count: 32752,
+        min_count: 32768,
+    },
+    FullScale {
+        sensor: "an MPU-9250 or MPU-6050 (+-8 g, 16-bit counts of 1/4096 g)",
+        count_mm_s2: 0.000244140625 * KLIPPER_G,
+        max_count: 32767,
+        min_count: 32768,
+    },
+    FullScale {
+        sensor: "an ICM-20948 or BMI160 (+-16 g, 16-bit counts of 1/2048 g)",
+        count_mm_s2: KLIPPER_G / 2048.,
+        max_count: 32767,
+        min_count: 32768,
+    },
+];
+
+/// How far a value Klipper wrote may lie from the full scale it reads (mm/s^2): its last
+/// decimal (`round(..., 6)` and `%.6f` move a value by at most half of it).
+pub const KLIPPER_FULL_SCALE_TOLERANCE_MM_S2: f64 = 1e-6;
+
+/// The full scale RepRapFirmware reads every accelerometer at (g): +-2 g.
+/// `LISAccelerometer::Configure` (`src/Accelerometers/LISAccelerometer.cpp`) leaves the
+/// range bits of the LIS3DH, LIS3DSH and LIS2DW at +-2 g, and `Accelerometers.cpp` writes
+/// each value as `count / 2^(bits - 2)` g (`GetBitsAfterPoint`: "assumes the range is +/-
+/// 2g") with `GetDecimalPlaces` decimals: 2 for 8-bit counts, 3 for 10 and 12, 4 for 14
+/// and 16 (`Configure` sets 8, 10 or 12 bits for an LIS3DH, 14 for an LIS2DW, 16 for an
+/// LIS3DSH). Every value M956 writes lies from -2 to one count below 2 g.
+pub const M956_FULL_SCALE_G: f64 = 2.0;
+
+/// The count (g) of the coarsest resolution M956 writes with `decimals` decimals
+/// (`GetDecimalPlaces` in RepRapFirmware's `Accelerometers.cpp`): 1/64 g (8 bits) for 2,
+/// 1/256 g (10 bits) for 3, 1/4096 g (14 bits) for 4; the coarsest, 1/64 g, for any
+/// other count of decimals (M956 writes none).
+pub fn m956_count_g(decimals: usize) -> f64 {
+    match decimals {
+        3 => 1.0 / 256.0,
+        4 => 1.0 / 4096.0,
+        _ => 1.0 / 64.0,
+    }
+}
+
+/// The magnitudes (mm/s^2) from which a value M956 wrote with `decimals` decimals is at its
+/// full scale, and above which it is not M956's (a value beyond +-2 g): from one count of
+/// [`m956_count_g`] below 2 g (the largest positive count; RepRapFirmware's axis inversion
+/// turns the most negative count into it), less half the last decimal, to 2 g plus half
+/// the last decimal. With 3 or 4 decimals the file's resolution may be finer than the
+/// count taken (12 or 16 bits): the window then holds its last few counts too (within
+/// 0.2 % of the full scale).
+pub fn m956_full_scale_mm_s2(decimals: usize) -> (f64, f64) {
+    let half = 0.5 * 10f64.powi(-(decimals.min(9) as i32));
+    (
+        (M956_FULL_SCALE_G - m956_count_g(decimals) - half) * STANDARD_GRAVITY_MM_S2,
+        (M956_FULL_SCALE_G + half) * STANDARD_GRAVITY_MM_S2,
+    )
+}
+
+/// One axis of a recording, for [`check_clipping`]: its column's name, its samples, and the
+/// full scales (window of magnitudes, sensor named) it may have been read at.
+pub(crate) struct ClipAxis<'a> {
+    /// The column's name in the file (`accel_x`, `X`; `x` of a `.stdata` sample).
+    pub column: String,
+    /// The samples (mm/s^2).
+    pub values: &'a [f64],
+    /// Each full scale: the window of magnitudes `(low, high)` (mm/s^2) and the sensor.
+    pub scales: Vec<((f64, f64), String)>,
+}
+
+/// Refuse a recording the sensor clipped: an axis with a sample whose magnitude lies in a
+/// full scale's window while no sample of the axis lies above it (a sensor never reads
+/// beyond its full scale; an axis that does was read at another range, and its values
+/// near this one are measurements: the corpus's LIS2DW recordings, written at the
+/// ADXL345's scale, pass it 14 times and reach 3.7 times it). The message names the axis
+/// whose first clipped sample comes first: its line (`line_of`), its time (`time_of`, s),
+/// its column (`name_of` the axis's column and the sample's index), its value and how many
+/// samples of the axis are at the full scale.
+///
+/// A single sample at the full scale is refused too: whether the acceleration passed the
+/// range or the read was corrupt, that sample is not a measurement, and nothing in the
+/// file tells the two apart. (Klipper's `adxl_query` in `src/sensor_adxl345.c` already
+/// drops reads it finds corrupt.)
+pub(crate) fn check_clipping(
+    file: &str,
+    axes: &[ClipAxis],
+    line_of: impl Fn(usize) -> usize,
+    time_of: impl Fn(usize) -> f64,
+    name_of: impl Fn(&str, usize) -> String,
+    remedy: &str,
+) -> Result<(), IdentifyError> {
+    // (first index, count, axis, scale)
+    let mut first: Option<(usize, usize, usize, usize)> = None;
+    for (a, axis) in axes.iter().enumerate() {
+        let peak = axis.values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for (s, ((low, high), _)) in axis.scales.iter().enumerate() {
+            if peak < *low || peak > *high {
+                continue;
+            }
+            let at = |v: &&f64| v.abs() >= *low;
+            let count = axis.values.iter().filter(at).count();
+            let i = axis.values.iter().position(|v| v.abs() >= *low);
+            if let Some(i) = i
+                && first.is_none_or(|(j, ..)| i < j)
+            {
+                first = Some((i, count, a, s));
+            }
+        }
+    }
+    let Some((i, count, a, s)) = first else {
+        return Ok(());
+    };
+    let axis = &axes[a];
+    let v = axis.values[i];
+    let column = name_of(&axis.column, i);
+    let samples = if count == 1 {
+        "1 sample, this one".to_string()
+    } else {
+        format!("{count} samples, the first here")
+    };
+    Err(IdentifyError::format(
+        file,
+        line_of(i),
+        format!(
+            "`{column}` reads {v:.6} mm/s^2 ({:.4} g) at {:.6} s, the full scale of {} (no sample of `{}` reads more): the sensor clipped ({samples})",
+            v / STANDARD_GRAVITY_MM_S2,
+            time_of(i),
+            axis.scales[s].1,
+            axis.column
+        ),
+        format!(
+            "a recording within the sensor's range (a clipped signal is flat at the full scale, and its spectrum holds harmonics that are not modes): {remedy}"
+        ),
+    ))
+}
+
+/// The full scales of [`KLIPPER_FULL_SCALES`] as [`check_clipping`]'s windows, for the
+/// samples `values` of column `column` of a file Klipper (or Shake&Tune, through Klipper)
+/// wrote.
+pub(crate) fn klipper_clip_axis(column: String, values: &[f64]) -> ClipAxis<'_> {
+    let tol = KLIPPER_FULL_SCALE_TOLERANCE_MM_S2;
+    let scales = KLIPPER_FULL_SCALES
+        .iter()
+        .map(|f| {
+            let (low, high) = f.magnitudes_mm_s2();
+            ((low - tol, high + tol), f.sensor.to_string())
+        })
+        .collect();
+    ClipAxis {
+        column,
+        values,
+        scales,
+    }
+}
+
+/// What to do about a recording Klipper's sensor clipped.
+pub(crate) const KLIPPER_CLIP_REMEDY: &str = "record again with less acceleration (a lower `accel_per_hz` in [resonance_tester] or TEST_RESONANCES, a gentler move), or mount the sensor where it moves less";
+
+/// Smallest vibration a Klipper or Shake&Tune recording may hold (mm/s^2): the largest
+/// deviation of a sensor axis from its mean must reach one count of the finest sensor
+/// Klipper reads, an MPU-9250's 1/4096 g (2.39 mm/s^2; [`KLIPPER_FULL_SCALES`]: an
+/// ICM-20948's or BMI160's is 4.79, an LIS2DW's 19.1, an ADXL345's 37 to 38). A sensor
+/// resolves nothing finer: a recording that varies by less holds no measured vibration
+/// (a sensor read while the machine stood still, values divided by a unit mistake).
+pub const MIN_VIBRATION_MM_S2: f64 = 0.000244140625 * KLIPPER_G;
+
+/// Smallest vibration an M956 recording may hold (mm/s^2): one count of the finest
+/// resolution RepRapFirmware reads, 16 bits at +-2 g (1/16384 g, 0.599 mm/s^2; see
+/// [`M956_FULL_SCALE_G`]).
+pub const MIN_VIBRATION_M956_MM_S2: f64 = STANDARD_GRAVITY_MM_S2 / 16384.0;
 
 /// Largest power spectral density a processed spectrum may hold ((mm/s^2)^2/Hz): 1e20,
 /// above the PSD of accelerations within [`MAX_ACCEL_MM_S2`] (`1e18 x` Klipper's 0.5 s
@@ -61,7 +298,8 @@ pub const MIN_VIBRATION_MM_S2: f64 = 1e-6;
 pub const MAX_PSD: f64 = 1e20;
 
 /// Smallest peak a processed spectrum may hold ((mm/s^2)^2/Hz): 1e-12, about the PSD of a
-/// vibration at [`MIN_VIBRATION_MM_S2`] over Klipper's 0.5 s window.
+/// vibration of 1e-6 mm/s^2 (the resolution Klipper writes, `%.6f`) over Klipper's 0.5 s
+/// window.
 pub const MIN_PEAK_PSD: f64 = 1e-12;
 
 /// `value_mm_s2` (read as `text` in column `column` at `line`) as an acceleration within
@@ -304,9 +542,10 @@ pub(crate) fn check_times(
             file,
             line_of(n - 1),
             format!(
-                "time stamps {:.6} to {:.6} for {n} samples, a sample rate of {rate:.4} Hz",
+                "time stamps {:.6} to {:.6} for {n} samples, a sample rate of {rate:.4} Hz{}",
                 time_s[0],
-                time_s[n - 1]
+                time_s[n - 1],
+                unit_hint(time_s, rate)
             ),
             format!(
                 "times in seconds (Klipper writes `%.6f` s) at {MIN_RATE_HZ} to {MAX_RATE_HZ} samples per second"
@@ -358,6 +597,28 @@ pub(crate) fn check_times(
         }
     }
     Ok(())
+}
+
+/// What a time column that gives a rate outside [`MIN_RATE_HZ`] to [`MAX_RATE_HZ`] may be
+/// instead of seconds: sample numbers (every step 1), or milliseconds or microseconds
+/// when read so they give a rate within it; empty when neither.
+fn unit_hint(time_s: &[f64], rate: f64) -> String {
+    let numbers = time_s.windows(2).all(|w| w[1] - w[0] == 1.0);
+    let within = |r: f64| (MIN_RATE_HZ..=MAX_RATE_HZ).contains(&r);
+    let unit = [(1e3, "milliseconds"), (1e6, "microseconds")]
+        .into_iter()
+        .find(|(k, _)| within(rate * k));
+    match (numbers, unit) {
+        (true, Some((k, unit))) => format!(
+            " (the times count one a sample: sample numbers, or {unit} at {:.1} Hz)",
+            rate * k
+        ),
+        (true, None) => " (the times count one a sample: sample numbers)".to_string(),
+        (false, Some((k, unit))) => {
+            format!(" (read as {unit}, the times give {:.1} Hz)", rate * k)
+        }
+        (false, None) => String::new(),
+    }
 }
 
 /// At most 60 characters of `s`, for messages.

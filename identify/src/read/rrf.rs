@@ -9,8 +9,9 @@
 //! data from accelerometer` or `Received bad data` instead.
 
 use super::{
-    MAX_RATE_HZ, MAX_SAMPLES, MIN_RATE_HZ, MIN_SAMPLES, Recording, RecordingFormat,
-    STANDARD_GRAVITY_MM_S2, check_accel, parse_number, too_many_samples, truncate,
+    ClipAxis, MAX_RATE_HZ, MAX_SAMPLES, MIN_RATE_HZ, MIN_SAMPLES, Recording, RecordingFormat,
+    STANDARD_GRAVITY_MM_S2, check_accel, check_clipping, m956_full_scale_mm_s2, parse_number,
+    too_many_samples, truncate,
 };
 use crate::IdentifyError;
 
@@ -61,6 +62,10 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
         ));
     }
     let mut columns: Vec<Vec<f64>> = vec![Vec::new(); axis_of_column.len()];
+    // The fewest decimals a column's values are written with: M956 writes them all with
+    // as many as its resolution gives (`GetDecimalPlaces`), which says its count.
+    let mut decimals = vec![usize::MAX; axis_of_column.len()];
+    let mut line_numbers = Vec::new();
     let mut rate_hz = None;
     let mut last_line = hn;
     for (n, l) in lines {
@@ -108,6 +113,7 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
             };
             let g = parse_number(file, n, name, v)?;
             col.push(check_accel(file, n, name, v, g * STANDARD_GRAVITY_MM_S2)?);
+            decimals[k] = decimals[k].min(decimals_of(v));
         }
         if fields.next().is_some() {
             return Err(IdentifyError::format(
@@ -120,6 +126,7 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
                 ),
             ));
         }
+        line_numbers.push(n);
         last_line = n;
     }
     let Some(rate_hz) = rate_hz else {
@@ -140,6 +147,30 @@ pub fn parse(file: &str, text: &str) -> Result<Recording, IdentifyError> {
             needed: MIN_SAMPLES,
         });
     }
+    let clip: Vec<_> = columns
+        .iter()
+        .zip(&names[1..])
+        .zip(&decimals)
+        .map(|((values, name), &d)| ClipAxis {
+            column: name.to_string(),
+            values,
+            scales: vec![(
+                m956_full_scale_mm_s2(d),
+                format!(
+                    "RepRapFirmware's accelerometers (+-2 g; {d} decimals: counts of 1/{:.0} g or finer)",
+                    1.0 / super::m956_count_g(d)
+                ),
+            )],
+        })
+        .collect();
+    check_clipping(
+        file,
+        &clip,
+        |i| line_numbers[i],
+        |i| i as f64 / rate_hz,
+        |c, _| c.to_string(),
+        "record again with less acceleration (a gentler move), or mount the sensor where it moves less (RepRapFirmware reads every accelerometer at +-2 g; an axis along gravity reads 1 g at rest)",
+    )?;
     let named_axis = (axis_of_column.len() == 1).then(|| axis_of_column[0]);
     let mut accel: [Option<Vec<f64>>; 3] = [None, None, None];
     for (axis, col) in axis_of_column.into_iter().zip(columns) {
@@ -188,4 +219,11 @@ fn parse_rate_line(file: &str, line: usize, rest: &str) -> Result<f64, IdentifyE
         ));
     }
     Ok(rate)
+}
+
+/// How many decimals the number `text` is written with (digits after its point).
+fn decimals_of(text: &str) -> usize {
+    text.trim().split_once('.').map_or(0, |(_, f)| {
+        f.chars().take_while(char::is_ascii_digit).count()
+    })
 }

@@ -9,8 +9,8 @@
 use serde::Deserialize;
 
 use super::{
-    MAX_ACCEL_MM_S2, MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat, check_accel,
-    check_times, too_many_samples,
+    KLIPPER_CLIP_REMEDY, MAX_ACCEL_MM_S2, MAX_SAMPLES, MIN_SAMPLES, Recording, RecordingFormat,
+    check_accel, check_clipping, check_times, klipper_clip_axis, too_many_samples,
 };
 use crate::IdentifyError;
 
@@ -82,14 +82,32 @@ pub fn parse(file: &str, bytes: &[u8]) -> Result<Vec<Recording>, IdentifyError> 
                 check_accel(file, n, &column, &v.to_string(), v)?;
             }
         }
-        let axis = |k: usize| Some(m.samples.iter().map(|s| s[k]).collect::<Vec<f64>>());
+        let axes: [Vec<f64>; 3] =
+            std::array::from_fn(|k| m.samples.iter().map(|s| s[k + 1]).collect());
+        let clip: Vec<_> = axes
+            .iter()
+            .zip(["x", "y", "z"])
+            .map(|(a, name)| klipper_clip_axis(name.to_string(), a))
+            .collect();
+        // A sample is named by its index in the measurement's `samples` (the line holds
+        // them all), as `check_accel` names it.
+        let name_of = |c: &str, i: usize| format!("samples[{i}] {c}");
+        check_clipping(
+            file,
+            &clip,
+            |_| n,
+            |i| time_s[i],
+            name_of,
+            KLIPPER_CLIP_REMEDY,
+        )?;
         let span = time_s[time_s.len() - 1] - time_s[0];
+        let [x, y, z] = axes;
         out.push(Recording {
             source: file.to_string(),
             format: RecordingFormat::ShakeTune,
             name: Some(m.name.clone()),
             sample_rate_hz: time_s.len() as f64 / span,
-            accel_mm_s2: [axis(1), axis(2), axis(3)],
+            accel_mm_s2: [Some(x), Some(y), Some(z)],
             time_s,
             named_axis: None,
             last_line: n,

@@ -2,6 +2,7 @@
 //! recordings of settle's own plant in every file format.
 
 mod bounds;
+mod clipping;
 mod common;
 mod corpus;
 mod damping_shaketune;

@@ -99,7 +99,7 @@ fn the_book_lists_every_limit_as_the_code_has_it() {
     ));
     use settle_identify::read::{MAX_ACCEL_MM_S2, MAX_PSD, MIN_PEAK_PSD, MIN_VIBRATION_MM_S2};
     has(format!("within +-{MAX_ACCEL_MM_S2:.0e} mm/s^2"));
-    has(format!("at least {MIN_VIBRATION_MM_S2:.0e} mm/s^2"));
+    has(format!("at least {MIN_VIBRATION_MM_S2:.3} mm/s^2"));
     has(format!("at most {MAX_PSD:.0e} (mm/s^2)^2/Hz"));
     has(format!("a peak of at least {MIN_PEAK_PSD:.0e}"));
     assert!(
