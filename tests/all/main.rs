@@ -57,3 +57,4 @@ mod tune_scan;
 mod tune_trust;
 mod validate;
 mod workflows;
+mod wrong_kind;
