@@ -8,7 +8,9 @@
 //!   the limit while reading (a file that grows). [`read::read_capped`] bounds what a
 //!   decompressor may produce. [`lines::BoundedLines`] splits a stream into lines of
 //!   bounded length without holding an over-long line. [`packed::Packed`] names an input
-//!   that is an archive or a compressed stream by its first bytes.
+//!   that is an archive or a compressed stream by its first bytes; [`looks::Looks`] names
+//!   the kind of a file a command was handed by mistake (a G-code job, a printer.cfg, an
+//!   STL model) with the command that reads it.
 //! - Outputs ([`mod@write`]): a file is written only where nothing is or where a regular file
 //!   is (never onto a link, a folder, a device or a FIFO), through a temporary file and a
 //!   rename; a folder settle makes inside its output folder is never a link out of it; and
@@ -23,6 +25,7 @@ pub mod error;
 pub mod identity;
 pub mod limit;
 pub mod lines;
+pub mod looks;
 pub mod packed;
 pub mod read;
 pub mod write;

@@ -60,17 +60,41 @@ pub fn named(
         });
     }
     let looks_like_path = value.contains('/') || value.ends_with(".toml");
-    if !looks_like_path {
-        let names: Vec<&str> = PRESETS.iter().map(|(n, _, _)| *n).collect();
-        return Err(err(format!(
-            "unknown preset `{value}`; built in: {}, or give a path to a machine file (ending in .toml){}",
+    let names: Vec<&str> = PRESETS.iter().map(|(n, _, _)| *n).collect();
+    let or_scenario = if scenarios { " or a scenario" } else { "" };
+    // A file of another kind (a printer.cfg, a G-code job, a model) named where a machine
+    // goes: named as what it is, with the command that reads it.
+    let foreign = |file: &Path| -> Option<Error> {
+        use settle_files::looks::Looks;
+        let l = settle_files::looks::file(file, crate::input::file::limit::SETTINGS)?;
+        if matches!(l, Looks::MachineFile | Looks::Packed(_)) || (scenarios && l == Looks::Scenario)
+        {
+            return None;
+        }
+        Some(err(format!(
+            "{} is {}, not a machine: {}; a machine is a preset ({}), a machine file (ending in .toml){or_scenario}",
+            file.display(),
+            l.what(),
+            l.then(),
             names.join(", "),
-            if scenarios { " or a scenario" } else { "" }
+        )))
+    };
+    if !looks_like_path {
+        let file = base.join(value);
+        if let Some(e) = file.is_file().then(|| foreign(&file)).flatten() {
+            return Err(e);
+        }
+        return Err(err(format!(
+            "unknown preset `{value}`; built in: {}, or give a path to a machine file (ending in .toml){or_scenario}",
+            names.join(", "),
         )));
     }
     let source = base.join(value);
     let text = crate::input::file::read_text(&source, crate::input::file::limit::SETTINGS)
         .map_err(|e| {
+            if let Some(named) = foreign(&source) {
+                return named;
+            }
             let why = match e {
                 Error::Read { source, .. } => source.to_string(),
                 Error::Input { message, .. } => message,
@@ -81,12 +105,13 @@ pub fn named(
                 source.display()
             ))
         })?;
+    let named = |e: Error| foreign(&source).unwrap_or(e);
     if scenarios
         && text
             .parse::<toml::Table>()
             .is_ok_and(|t| t.contains_key("machine"))
     {
-        let (sc, src) = crate::expand::parse(&text, &source)?;
+        let (sc, src) = crate::expand::parse(&text, &source).map_err(named)?;
         let r = resolve_machine(&sc, &src)?;
         return Ok(Named {
             name: r.name,
@@ -95,7 +120,7 @@ pub fn named(
             source,
         });
     }
-    let d = parse_any(&text, &source)?;
+    let d = parse_any(&text, &source).map_err(named)?;
     Ok(Named {
         name: d.name,
         description: d.description,

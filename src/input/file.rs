@@ -33,6 +33,36 @@ pub fn stream_error(path: &Path, e: std::io::Error) -> Error {
     settle_files::read::unwrap_io(path, e).into()
 }
 
+/// `e`, a command's refusal of the file at `path` (read as a file of the kind `limit`
+/// describes), or, when the file is another kind of file settle knows
+/// ([`settle_files::looks`]: a G-code job, a printer.cfg, an STL model), that kind at its
+/// line 1, named with the command that reads it: `a G-code job (...), not {expected}:
+/// replay it with ...`. Kinds in `own` (what the command reads) and errors that are not
+/// bad input keep `e`; a file that cannot be read keeps its error.
+pub fn name_foreign(
+    path: &Path,
+    e: Error,
+    limit: Limit,
+    expected: &str,
+    own: &[settle_files::looks::Looks],
+) -> Error {
+    if !e.is_input_error() {
+        return e;
+    }
+    match settle_files::looks::file(path, limit) {
+        // Archives, compressed and UTF-16 files are named by the readers already.
+        Some(settle_files::looks::Looks::Packed(_)) => e,
+        Some(l) if !own.contains(&l) => Error::Input {
+            at: crate::error::Location {
+                line: Some(1),
+                ..crate::error::Location::file(path)
+            },
+            message: format!("{}, not {expected}: {}", l.what(), l.then()),
+        },
+        _ => e,
+    }
+}
+
 /// FNV-1a, 64 bit, over `parts` (each followed by a 0xff byte, which no UTF-8 text holds):
 /// a stable digest (std's hasher may change between releases) for the identity of inputs
 /// and the checksums of journal rows.

@@ -170,9 +170,23 @@ impl Default for ObserveSpec {
 /// Read and parse a scenario file; `claimed` are the top-level tables others read (the
 /// studies' tables: `crate::studies::tables`), left out of the strict parse.
 pub fn load(path: &Path, claimed: &[&str]) -> Result<(Scenario, Source), Error> {
-    let source = Source::load(path)?;
-    let scenario = parse_source(&source, claimed)?;
-    Ok((scenario, source))
+    let read = || {
+        let source = Source::load(path)?;
+        let scenario = parse_source(&source, claimed)?;
+        Ok((scenario, source))
+    };
+    // A G-code job, a printer.cfg or a machine file given in a scenario's place is named,
+    // with the command that reads it.
+    read().map_err(|e| {
+        use settle_files::looks::Looks;
+        crate::input::file::name_foreign(
+            path,
+            e,
+            crate::input::file::limit::SETTINGS,
+            "a scenario (TOML)",
+            &[Looks::Scenario],
+        )
+    })
 }
 
 /// Parse scenario text (see [`load`]); `path` is used in error messages.

@@ -270,6 +270,7 @@ pub fn read_current_files(
     firmware: Firmware,
     path: &Path,
 ) -> Result<(Current, Vec<PathBuf>), Error> {
+    not_a_config(path)?;
     match firmware {
         Firmware::Klipper => {
             let c = KlipperConfig::read(path).map_err(|e| config_error(path, e))?;
@@ -353,6 +354,43 @@ pub fn read_current_files(
                 other.name()
             ),
         )),
+    }
+}
+
+/// Refuses a file that is no firmware configuration at all, before a reader takes it for
+/// one: a G-code job (a slicer writes M201, M203 and M204 into every job, and
+/// RepRapFirmware's defaults stand in for what a config.g does not set), a scenario, a
+/// machine file, a recording or a model ([`settle_files::looks`]), named with the command
+/// that reads it. (A zero byte alone is left to the reader: a terminal's log of a serial
+/// line may hold one from a reset.)
+fn not_a_config(path: &Path) -> Result<(), Error> {
+    use settle_files::looks::Looks;
+    let limit = crate::input::file::limit::FIRMWARE_CONFIG;
+    match settle_files::looks::file(path, limit) {
+        Some(
+            l @ (Looks::GcodeJob
+            | Looks::Bgcode
+            | Looks::SlicedThreeMf
+            | Looks::ThreeMf
+            | Looks::Ufp
+            | Looks::StlBinary
+            | Looks::StlAscii
+            | Looks::Scenario
+            | Looks::MachineFile
+            | Looks::Recording
+            | Looks::Json),
+        ) => Err(Error::Input {
+            at: Location {
+                line: Some(1),
+                ..Location::file(path)
+            },
+            message: format!(
+                "{}, not a firmware configuration: {}; settle import reads a printer.cfg (klipper), a config.g (rrf), the reply to M503 (marlin) or the replies to M115, M503 and M593 (prusa)",
+                l.what(),
+                l.then()
+            ),
+        }),
+        _ => Ok(()),
     }
 }
 

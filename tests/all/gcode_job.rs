@@ -187,7 +187,7 @@ fn bad_gcode_exits_2_with_file_and_line_and_writes_nothing() {
         (
             "benchy.gcode.3mf",
             b"PK\x03\x04\x14\x00\x00\x00\x08\x00".to_vec(),
-            "benchy.gcode.3mf:1:1: a zip archive",
+            "benchy.gcode.3mf:1:1: a sliced 3MF (.gcode.3mf, as Bambu Studio and OrcaSlicer export a plate: a zip archive whose G-code is Metadata/plate_<n>.gcode)",
         ),
         (
             "garbage.gcode",

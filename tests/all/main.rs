@@ -58,3 +58,4 @@ mod tune_scan;
 mod tune_trust;
 mod validate;
 mod workflows;
+mod wrong_kind;

@@ -10,7 +10,9 @@
 //!   [`setting_parse`] (RepRapFirmware's configuration commands);
 //! - [`reader`]: the reader itself, which names a file that holds G-code but is not
 //!   text ([`packaged`]: gzip, zip; binary G-code it decodes, [`bgcode`], when it opens
-//!   the file itself); [`summary`]: a file's statistics;
+//!   the file itself) and, when it opens the file, one that is no G-code job at all (an
+//!   STL model, a 3MF project, a printer.cfg: `settle_files::looks`); [`summary`]: a
+//!   file's statistics;
 //!   [`canonical`]: events written back as G-code.
 
 pub(crate) mod arc;

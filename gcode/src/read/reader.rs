@@ -22,6 +22,7 @@ use crate::read::motion::Motion;
 use crate::read::params::{KeyValues, Params};
 use crate::read::setting_parse;
 use settle_files::lines::{BoundedLines as Lines, LineStatus};
+use settle_files::looks::Looks;
 
 /// How the reader reads.
 #[derive(Debug, Clone, PartialEq)]
@@ -99,6 +100,10 @@ pub struct Reader<R> {
     interp: Interp,
     error: Option<GcodeError>,
     finished: bool,
+    /// What the file looks like when it is text of another kind than G-code (a
+    /// printer.cfg, a scenario: [`Looks`]), as [`Reader::open`] found: its first error is
+    /// reported as that.
+    foreign: Option<Looks>,
 }
 
 #[derive(Debug)]
@@ -168,11 +173,35 @@ impl Reader<FileInput> {
         let path = path.as_ref();
         let name: Arc<str> = Arc::from(path.display().to_string());
         let file = settle_files::read::open(path, settle_files::limit::GCODE)?;
-        let mut buffered = BufReader::with_capacity(64 * 1024, file);
-        let binary = buffered
-            .fill_buf()
-            .map_err(|e| GcodeError::io(&name, e))?
-            .starts_with(b"GCDE");
+        let len = file.len();
+        let mut buffered = BufReader::with_capacity(settle_files::looks::HEAD, file);
+        let head = buffered.fill_buf().map_err(|e| GcodeError::io(&name, e))?;
+        let binary = head.starts_with(b"GCDE");
+        // A model, a slicer's package or binary data is no G-code at all; text of another
+        // kind (a printer.cfg, a scenario) is named if the reader refuses it.
+        let foreign = match Looks::of(head, &name, len) {
+            Some(
+                l @ (Looks::SlicedThreeMf
+                | Looks::ThreeMf
+                | Looks::Ufp
+                | Looks::StlBinary
+                | Looks::StlAscii
+                | Looks::Binary),
+            ) => {
+                return Err(GcodeError::Packaged {
+                    at: Location {
+                        source_name: name,
+                        line: 1,
+                        column: Some(1),
+                    },
+                    what: l.what(),
+                    instead: l.then(),
+                });
+            }
+            // G-code, and what the first line names (gzip, zip, UTF-16: `packaged`).
+            Some(Looks::GcodeJob | Looks::Bgcode | Looks::Packed(_)) | None => None,
+            other => other,
+        };
         let input = if binary {
             FileInput::Binary(
                 super::bgcode::Bgcode::new(buffered).map_err(|e| GcodeError::io(&name, e))?,
@@ -180,7 +209,9 @@ impl Reader<FileInput> {
         } else {
             FileInput::Text(buffered)
         };
-        Ok(Reader::new(input, options).with_name(name))
+        let mut reader = Reader::new(input, options).with_name(name);
+        reader.foreign = foreign;
+        Ok(reader)
     }
 }
 
@@ -219,6 +250,7 @@ impl<R: BufRead> Reader<R> {
             interp,
             error: None,
             finished: false,
+            foreign: None,
         }
     }
 
@@ -290,7 +322,26 @@ impl<R: BufRead> Reader<R> {
         }
     }
 
+    /// What [`Reader::open`] found the file to be when it is text of another kind than
+    /// G-code (a printer.cfg, a scenario, a recording), with the command that reads it.
+    pub fn looks(&self) -> Option<Looks> {
+        self.foreign
+    }
+
     fn fail(&mut self, e: GcodeError) {
+        if let Some(l) = self.foreign {
+            // Not a bad line of a job: no line of it is G-code, skipped or not.
+            self.error = Some(GcodeError::Packaged {
+                at: Location {
+                    source_name: self.source_name.clone(),
+                    line: 1,
+                    column: Some(1),
+                },
+                what: l.what(),
+                instead: l.then(),
+            });
+            return;
+        }
         if self.interp.opts.skip_bad_lines {
             let s = &mut self.interp.skipped;
             s.count += 1;

@@ -438,6 +438,7 @@ pub enum FileData {
 /// Read any supported file, choosing the reader by content: zstd magic bytes ->
 /// Shake&Tune, `#time,` -> Klipper raw, `freq,` -> Klipper processed, `Sample` -> M956.
 pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
+    use settle_files::looks::Looks;
     let file = path.display().to_string();
     let bytes = settle_files::read::read_bytes(path, settle_files::limit::RECORDING)?;
     let packed = settle_files::packed::Packed::of(&bytes);
@@ -454,9 +455,17 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
     if let Some(p) = packed.filter(|p| p.is_utf16()) {
         return Err(named(p));
     }
-    let mut text = String::from_utf8(bytes).map_err(|e| match packed {
-        Some(p) => named(p),
-        None => IdentifyError::format(
+    // What the file is when it is not a recording (a G-code job, a scenario, a model):
+    // named, with the command that reads it, in place of the reader's refusal.
+    let head = &bytes[..bytes.len().min(settle_files::looks::HEAD)];
+    let looks = settle_files::looks::Looks::of(head, &file, bytes.len() as u64)
+        .filter(|l| !matches!(l, Looks::Recording | Looks::Packed(_)));
+    let foreign =
+        |l: Looks| IdentifyError::format(&file, 1, format!("{}: {}", l.what(), l.then()), EXPECTED);
+    let mut text = String::from_utf8(bytes).map_err(|e| match (packed, looks) {
+        (Some(p), _) => named(p),
+        (None, Some(l)) => foreign(l),
+        (None, None) => IdentifyError::format(
             &file,
             1,
             format!("bytes that are not UTF-8 text ({e})"),
@@ -478,6 +487,8 @@ pub fn read_file(path: &Path) -> Result<FileData, IdentifyError> {
         klipper_psd::parse(&file, &text).map(FileData::Spectrum)
     } else if first.starts_with("Sample") {
         rrf::parse(&file, &text).map(|r| FileData::Recordings(vec![r]))
+    } else if let Some(l) = looks {
+        Err(foreign(l))
     } else {
         // The line is not repeated: a file that is not a recording (a wrong path,
         // /etc/shadow) is not shown on the terminal.

@@ -446,7 +446,9 @@ impl Study for GcodeRun {
         let mut j = open(run, job).map_err(|m| (run.blame("gcode.file"), m))?;
         j.run_to_end()
             .map_err(|e| (run.blame("gcode.file"), e.to_string()))?;
-        if let Some(why) = work::nothing_to_measure(&j.summary(), j.reader().lines_read()) {
+        if let Some(why) =
+            work::nothing_to_measure(&j.summary(), j.reader().lines_read(), j.reader().looks())
+        {
             return Err((
                 run.blame("gcode.file"),
                 format!("{}: {why}", job.file.display()),

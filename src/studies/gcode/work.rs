@@ -10,12 +10,25 @@ use settle_gcode::job::JobSummary;
 use settle_planner::firmware::Firmware;
 
 /// Why the planned job holds nothing to measure (`lines`: lines read), `None` when it
-/// does.
-pub fn nothing_to_measure(summary: &JobSummary, lines: u64) -> Option<String> {
+/// does. A file without a move that is text of another kind (`looks`, the reader's
+/// [`settle_gcode::Reader::looks`]: a config.g, Marlin's M503 reply) is named as that,
+/// with the command that reads it.
+pub fn nothing_to_measure(
+    summary: &JobSummary,
+    lines: u64,
+    looks: Option<settle_files::looks::Looks>,
+) -> Option<String> {
     if summary.moves == 0 {
-        return Some(format!(
-            "no move (G0, G1, G2, G3) in its {lines} lines: not a G-code job settle can replay"
-        ));
+        return Some(match looks {
+            Some(l) => format!(
+                "no move (G0, G1, G2, G3) in its {lines} lines: {}, not a G-code job: {}",
+                l.what(),
+                l.then()
+            ),
+            None => format!(
+                "no move (G0, G1, G2, G3) in its {lines} lines: not a G-code job settle can replay"
+            ),
+        });
     }
     if summary.layers.iter().any(|l| l.working_s > 0.0) {
         return None;

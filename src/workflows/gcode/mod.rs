@@ -864,9 +864,11 @@ fn simulate(
     }
     job.run_to_end().map_err(&err)?;
     let summary = job.summary();
-    if let Some(why) =
-        crate::studies::gcode::work::nothing_to_measure(&summary, job.reader().lines_read())
-    {
+    if let Some(why) = crate::studies::gcode::work::nothing_to_measure(
+        &summary,
+        job.reader().lines_read(),
+        job.reader().looks(),
+    ) {
         return Err(Error::input(&opts.file, why));
     }
     if let Some(why) = opts
