@@ -348,3 +348,45 @@ fn other_commands_name_a_file_of_another_kind() {
     check(cases, &out);
     assert!(!scenario_out.exists());
 }
+
+/// A job whose first 64 KiB look like a RepRapFirmware configuration (its M906, one move,
+/// then a long comment block such as a thumbnail) is a job once a move has been read: a
+/// bad line after it is reported at its own line, and `--skip-bad-lines` skips it.
+#[test]
+fn a_job_that_starts_like_a_config_is_a_job() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let mut job = "M906 X800 Y800\nG92 E0\nG1 X10 Y10 F3000\n".to_string();
+    for _ in 0..1000 {
+        job.push_str(&format!("; thumbnail {}\n", "A".repeat(68)));
+    }
+    job.push_str("G1 X20 Y10 E1 F1800\nG1 X20 Y20 E2\nG1 X2Q0 Y10\nG1 X10 Y20 E3\n");
+    assert!(
+        job.find("G1 X20 Y10").expect("there") > 64 * 1024,
+        "the head holds one move"
+    );
+    let file = put(d, "job.gcode", job.as_bytes());
+    let run = |skip: bool, out: &str| {
+        let mut c = settle();
+        c.arg("gcode")
+            .arg(&file)
+            .args(["--machine", "printer_xy", "--out"])
+            .arg(d.join(out));
+        if skip {
+            c.arg("--skip-bad-lines");
+        }
+        c.output().expect("runs")
+    };
+    let r = run(false, "out");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("job.gcode:1006:6: `G1` does not take parameter Q"),
+        "{err}"
+    );
+    assert!(!err.contains("RepRapFirmware configuration"), "{err}");
+    let r = run(true, "skipped");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    assert!(err.contains("skipped 1 bad lines"), "{err}");
+}

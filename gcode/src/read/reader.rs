@@ -102,8 +102,11 @@ pub struct Reader<R> {
     finished: bool,
     /// What the file looks like when it is text of another kind than G-code (a
     /// printer.cfg, a scenario: [`Looks`]), as [`Reader::open`] found: its first error is
-    /// reported as that.
+    /// reported as that until a move has been read (a file with moves is a job, whatever
+    /// its first lines look like).
     foreign: Option<Looks>,
+    /// A move has been yielded.
+    moved: bool,
 }
 
 #[derive(Debug)]
@@ -251,6 +254,7 @@ impl<R: BufRead> Reader<R> {
             error: None,
             finished: false,
             foreign: None,
+            moved: false,
         }
     }
 
@@ -329,7 +333,7 @@ impl<R: BufRead> Reader<R> {
     }
 
     fn fail(&mut self, e: GcodeError) {
-        if let Some(l) = self.foreign {
+        if let Some(l) = self.foreign.filter(|_| !self.moved) {
             // Not a bad line of a job: no line of it is G-code, skipped or not.
             self.error = Some(GcodeError::Packaged {
                 at: Location {
@@ -360,6 +364,7 @@ impl<R: BufRead> Iterator for Reader<R> {
     fn next(&mut self) -> Option<Self::Item> {
         loop {
             if let Some(e) = self.interp.queue.pop_front() {
+                self.moved |= matches!(e.kind, EventKind::Move(_));
                 return Some(Ok(e));
             }
             if let Some(e) = self.error.take() {
