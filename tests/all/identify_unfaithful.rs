@@ -8,17 +8,7 @@
 
 use std::path::Path;
 
-use crate::support::{root, settle, write};
-
-/// The example's test (`docs/guide/your-machine.md`): 30 to 90 Hz at 10 Hz/s.
-const TEST: [&str; 6] = [
-    "--freq-start",
-    "30",
-    "--freq-end",
-    "90",
-    "--hz-per-sec",
-    "10",
-];
+use crate::support::{EXAMPLE_TEST as TEST, root, settle, write};
 
 /// One ADXL345 x/y count in mm/s^2 as Klipper scales it: 0.003774 g x 9806.65 mm/s^2/g.
 const COUNT_MM_S2: f64 = 0.003774 * 9806.65;

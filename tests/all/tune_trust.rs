@@ -23,14 +23,7 @@ fn example(dir: &Path, config: &Path, machine: bool) -> (PathBuf, String) {
                 .arg("identify")
                 .arg("examples/data/raw_data_x_example.csv")
                 .arg("examples/data/raw_data_y_example.csv")
-                .args([
-                    "--freq-start",
-                    "30",
-                    "--freq-end",
-                    "90",
-                    "--hz-per-sec",
-                    "10",
-                ])
+                .args(crate::support::EXAMPLE_TEST)
                 .arg("--out")
                 .arg(dir.join("machine.toml")),
         );

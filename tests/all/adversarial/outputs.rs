@@ -5,14 +5,7 @@
 use super::{Case, Expect, Sandbox, check_all};
 
 /// The resonance test of the example recordings (30-90 Hz at 10 Hz/s).
-pub const TEST: [&str; 6] = [
-    "--freq-start",
-    "30",
-    "--freq-end",
-    "90",
-    "--hz-per-sec",
-    "10",
-];
+pub use crate::support::EXAMPLE_TEST as TEST;
 
 /// `settle identify rec_x.csv` with the example test and `more` arguments.
 fn identify(more: &[&str]) -> Vec<String> {

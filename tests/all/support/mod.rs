@@ -104,3 +104,14 @@ pub fn one_modal_run(scenario: &Path) -> settle::spec::run_spec::RunSpec {
     assert_eq!(runs.len(), 1, "one run");
     runs.remove(0)
 }
+
+/// The resonance test of the example recordings (examples/data/raw_data_*_example.csv,
+/// `docs/guide/your-machine.md`): 30 to 90 Hz at 10 Hz/s, as `settle identify` options.
+pub const EXAMPLE_TEST: [&str; 6] = [
+    "--freq-start",
+    "30",
+    "--freq-end",
+    "90",
+    "--hz-per-sec",
+    "10",
+];
