@@ -160,9 +160,9 @@ cargo test --workspace --profile ci --locked "${features[@]}" --no-run
 # feature's (profile ci-rerun) need nothing the phases in between make: they start now
 # and share the two cores with the test run, the gate, the book's commands and Slurm,
 # filling what those leave idle (a test binary's last long tests, the daemons' start,
-# the fresh clones); their phases wait for them. Cold on 2 cores the whole command takes
-# 23:01 this way, 37 s less than with each build in its own phase (the test run itself
-# takes 4:57 instead of 2:01: no test may depend on timing). Each runs in a session of its own, so under Linux's autogroup
+# the fresh clones); their phases wait for them. The CPU time is the same, only idle time
+# is filled; the test run itself takes about twice as long with them beside it (no test
+# may depend on timing). Each runs in a session of its own, so under Linux's autogroup
 # scheduling it gets an equal share of the CPU whatever its nice value. The rerun sink's
 # tests are in the harness's one test binary, tests/all, or in tests/outputs_rerun.rs:
 # whichever this tree has.
