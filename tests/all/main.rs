@@ -8,6 +8,7 @@ mod across_breakpoints;
 mod adversarial;
 mod cli;
 mod corners;
+mod export_roundtrip;
 mod faults;
 mod gcode_bgcode;
 mod gcode_config;

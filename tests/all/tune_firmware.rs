@@ -853,3 +853,95 @@ fn prusa_search_holds_only_the_frequencies_buddy_runs() {
         "the scales reach 118 Hz"
     );
 }
+
+/// One mode at `mode_hz` (damping 0.05) tuned for Marlin's Fixed-Time Motion at the mode's
+/// own frequency (`frequency_scales = [1.0]`), with a smoothing limit loose enough for a
+/// shaper that slow, written under `dir/out`.
+fn tune_ft_motion_at(dir: &Path, mode_hz: f64) -> settle::workflows::tune::Tuned {
+    let text =
+        scenario("firmware = \"marlin\"\nfrequency_scales = [1.0]\nmax_smoothing_mm = 5.0\n")
+            .replace(
+                "frequency_hz = 47.2",
+                &format!("frequency_hz = {mode_hz:?}"),
+            )
+            .replace("window_s = 0.4", "window_s = 2.0")
+            .replace("sample_rate_hz = 5000", "sample_rate_hz = 2000");
+    let p = write(dir, "ft.toml", &text);
+    settle::workflows::tune::tune_with(
+        &p,
+        Some(dir.join("out")),
+        &modal(),
+        &settle::execute::pool::quiet,
+    )
+    .expect("tunes")
+}
+
+/// Marlin's `M493` takes `A` from `FTM_MIN_SHAPE_FREQ` (10 Hz in Marlin's
+/// Configuration_adv.h) to `FTM_FS / 2` (`goodBaseFreq`, Marlin/src/module/ft_motion.h) and
+/// answers `?Invalid` to another frequency, keeping the old one. A machine whose mode is at
+/// 9 Hz is best shaped at 9.0 Hz (the mode times the only scale, 1.0): `marlin.gcode` is
+/// not written, says why, and `tune.md` lists no changes for it; settle's own Marlin reader
+/// refuses the line that would have been written. At 10 Hz the line is written and reads
+/// back as 10 Hz.
+#[test]
+fn marlin_export_below_ftm_min_shape_freq_is_not_written() {
+    use settle_gcode::{Dialect, EventKind, LimitChange, Reader, ReaderOptions};
+
+    let read = |text: &str| {
+        Reader::new(text.as_bytes(), ReaderOptions::new(Dialect::Marlin))
+            .collect::<Result<Vec<_>, _>>()
+    };
+    let winner = |t: &settle::workflows::tune::Tuned| {
+        let o = &t.axes[0].1;
+        let sh = o.scores[o.winner].candidate.shaper.expect("shaped");
+        assert!(
+            matches!(sh.shaper_type, Some(ShaperType::Marlin { .. })),
+            "{sh:?}"
+        );
+        sh
+    };
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let t = tune_ft_motion_at(dir.path(), 9.0);
+    let sh = winner(&t);
+    assert_eq!(sh.frequency_hz, 9.0);
+    let g = std::fs::read_to_string(t.out.join("marlin.gcode")).expect("marlin.gcode");
+    assert!(
+        g.starts_with("; no Marlin configuration: cannot export M493 X A = 9 (allowed: FTM_MIN_SHAPE_FREQ = 10 Hz up to FTM_FS / 2 = 500 Hz"),
+        "{g}"
+    );
+    assert!(!g.lines().any(|l| l.starts_with("M493")), "{g}");
+    assert!(
+        !t.markdown.contains("What changes in marlin.gcode"),
+        "{}",
+        t.markdown
+    );
+    // What would have been written is what settle's reader of Marlin refuses too.
+    let would = format!("M493 X C1 A9 I{}\n", sh.damping_ratio);
+    let err = read(&would).expect_err("refused").to_string();
+    assert!(
+        err.contains("A = 9") && err.contains("10 to 500 Hz"),
+        "{err}"
+    );
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let t = tune_ft_motion_at(dir.path(), 10.0);
+    let sh = winner(&t);
+    assert_eq!(sh.frequency_hz, 10.0);
+    let g = std::fs::read_to_string(t.out.join("marlin.gcode")).expect("marlin.gcode");
+    let events = read(&g).expect("settle reads its own export");
+    let x = events
+        .iter()
+        .find_map(|e| match &e.kind {
+            EventKind::Limits(LimitChange::FtMotion {
+                axes,
+                frequency_hz,
+                damping_ratio,
+                ..
+            }) if axes.x => Some((*frequency_hz, *damping_ratio)),
+            _ => None,
+        })
+        .expect("an M493 X line");
+    assert_eq!(x, (Some(10.0), Some(sh.damping_ratio)), "{g}");
+    assert!(t.markdown.contains("What changes in marlin.gcode"));
+}

@@ -13,6 +13,7 @@
 //! [`KlipperConfig`]: super::KlipperConfig
 
 use super::export_text::{Note, annotate, comment_text, refuse};
+use super::klipper::MAX_SHAPER_FREQUENCY_HZ;
 use super::klipper_shaper;
 use super::machine::ShaperSetting;
 use crate::error::GcodeError;
@@ -44,11 +45,15 @@ fn axis(out: &mut String, letter: char, s: &ShaperSetting) -> Result<(), GcodeEr
             format!("{} ({why})", klipper_shaper::ALLOWED),
         )
     })?;
-    if !(s.frequency_hz.is_finite() && s.frequency_hz >= 0.0) {
+    // Klipper takes any frequency >= 0 (`minval=0.` in klippy/extras/input_shaper.py);
+    // settle's reader of printer.cfg takes up to MAX_SHAPER_FREQUENCY_HZ back.
+    if !(s.frequency_hz.is_finite() && (0.0..=MAX_SHAPER_FREQUENCY_HZ).contains(&s.frequency_hz)) {
         return Err(refuse(
             &format!("shaper_freq_{letter}"),
             s.frequency_hz,
-            "a finite frequency >= 0 Hz (0 turns shaping off)",
+            format!(
+                "0 (shaping off) to {MAX_SHAPER_FREQUENCY_HZ} Hz, the most settle reads back from printer.cfg"
+            ),
         ));
     }
     if !(0.0..=family.max_damping_ratio).contains(&s.damping_ratio) {

@@ -9,7 +9,12 @@
 //! - [`MarlinZvExport`]: the built-in ZV shaper (`INPUT_SHAPING_X`/`_Y`, Marlin 2.1.2 and
 //!   later), one `M593 <axis> F<Hz> D<zeta>` line per axis, `F0` for an axis left unshaped
 //!   (Marlin/src/gcode/feature/input_shaping/M593.cpp takes `D` from 0 to 1, and `F` 0 or
-//!   above a bound of its stepper timer).
+//!   above a bound of its stepper timer); `F` is held to the 1 to 1000 Hz settle's G-code
+//!   reader takes back.
+//!
+//! `M493 A` is refused outside `FTM_MIN_SHAPE_FREQ` (10 Hz) to `FTM_FS / 2`, where Marlin's
+//! `M493` answers `?Invalid` and keeps the old frequency (`ft_config_t::goodBaseFreq`,
+//! Marlin/src/module/ft_motion.h).
 //!
 //! Both write `M201 X Y` and `M204 P T` after the shapers, the same lines, when
 //! accelerations are given (Marlin caps each move by both). The settings live in EEPROM
@@ -19,6 +24,7 @@
 use super::export_text::{Note, annotate, comment_text, m201_line, m204_line, refuse};
 use crate::FtShaper;
 use crate::error::GcodeError;
+use crate::read::limit_parse::{FTM_MIN_SHAPE_FREQ_HZ, SHAPER_FREQUENCY};
 
 /// Marlin's default trajectory rate `FTM_FS` (Hz, Configuration_adv.h): the highest shaper
 /// frequency it takes is half of it.
@@ -128,11 +134,13 @@ impl MarlinExport {
             return Ok(format!("M493 {axis} C0\n"));
         }
         let f_max = f64::from(self.ftm_fs_hz) / 2.0;
-        if !(a.frequency_hz > 0.0 && a.frequency_hz <= f_max) {
+        if !(a.frequency_hz >= FTM_MIN_SHAPE_FREQ_HZ && a.frequency_hz <= f_max) {
             return Err(refuse(
                 &format!("M493 {axis} A"),
                 a.frequency_hz,
-                format!("above 0, up to FTM_FS / 2 = {f_max} Hz"),
+                format!(
+                    "FTM_MIN_SHAPE_FREQ = {FTM_MIN_SHAPE_FREQ_HZ} Hz up to FTM_FS / 2 = {f_max} Hz: Marlin's M493 answers ?Invalid to another frequency and keeps the old one (goodBaseFreq, Marlin/src/module/ft_motion.h)"
+                ),
             ));
         }
         if !(0.01..1.0).contains(&a.damping_ratio) {
@@ -238,11 +246,12 @@ impl MarlinZvExport {
         if a.frequency_hz == 0.0 {
             return Ok(format!("M593 {axis} F0\n"));
         }
-        if !(a.frequency_hz.is_finite() && a.frequency_hz > 0.0) {
+        // What settle's reader takes back (a job's or an M503 reply's M593 F).
+        if !(SHAPER_FREQUENCY.ok)(a.frequency_hz) {
             return Err(refuse(
                 &format!("M593 {axis} F"),
                 a.frequency_hz,
-                "0 (off) or a frequency above 0 Hz",
+                SHAPER_FREQUENCY.allowed,
             ));
         }
         if !(0.0..=1.0).contains(&a.damping_ratio) {
@@ -335,6 +344,13 @@ mod tests {
         assert!(refused(ei('X', 500.5), 1000).contains("FTM_FS / 2 = 500 Hz"));
         assert!(e(ei('X', 500.0), 1000).to_config().is_ok());
         assert!(refused(ei('X', 300.0), 500).contains("250 Hz"));
+        // Below FTM_MIN_SHAPE_FREQ (10 Hz in Configuration_adv.h) M493 answers ?Invalid.
+        let low = refused(ei('X', 9.9), 1000);
+        assert!(
+            low.contains("M493 X A = 9.9") && low.contains("10 Hz"),
+            "{low}"
+        );
+        assert!(e(ei('X', 10.0), 1000).to_config().is_ok());
         let z = |d| FtAxisShaper {
             damping_ratio: d,
             ..ei('Y', 40.0)
@@ -416,6 +432,9 @@ mod tests {
         };
         assert!(refused('X', 40.0, 1.01).contains("M593 X D"));
         assert!(refused('Y', -3.0, 0.1).contains("M593 Y F"));
+        // settle's reader takes M593 F of 1 to 1000 Hz back (limit_parse's SHAPER_FREQUENCY).
+        assert!(refused('X', 1000.5, 0.1).contains("M593 X F = 1000.5"));
+        assert!(refused('X', 0.5, 0.1).contains("M593 X F = 0.5"));
         assert!(refused('Z', 40.0, 0.1).contains("X or Y"));
     }
 }

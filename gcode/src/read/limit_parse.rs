@@ -25,13 +25,19 @@ pub(crate) enum Outcome {
 
 const PER_MIN: f64 = 1.0 / 60.0;
 
+/// Marlin's `FTM_MIN_SHAPE_FREQ`, Hz: the lowest `M493 A` Fixed-Time Motion takes
+/// (`ft_config_t::goodBaseFreq`, `WITHIN(f, FTM_MIN_SHAPE_FREQ, (FTM_FS) / 2)`, in
+/// Marlin/src/module/ft_motion.h): 10 in Marlin's Configuration_adv.h, the lowest a Marlin
+/// release configures (later Configuration_adv.h files raise it to 20).
+pub(crate) const FTM_MIN_SHAPE_FREQ_HZ: f64 = 10.0;
+
 /// Marlin's `M493 A`, Hz: what `M493` takes (Marlin/src/gcode/feature/ft_motion/M493.cpp,
 /// `WITHIN(baseFreqVal, FTM_MIN_SHAPE_FREQ, (FTM_FS) / 2)`; it answers `?Invalid` and keeps
 /// the old frequency otherwise), with the lowest `FTM_MIN_SHAPE_FREQ` a Marlin release
 /// configures (10 Hz; later Configuration_adv.h files have 20) and the default `FTM_FS`
 /// (1000 Hz).
 pub(crate) const FT_FREQUENCY: Check = Check {
-    ok: |v| (10.0..=500.0).contains(&v),
+    ok: |v| (FTM_MIN_SHAPE_FREQ_HZ..=500.0).contains(&v),
     allowed: "10 to 500 Hz: Marlin's M493 refuses a frequency below FTM_MIN_SHAPE_FREQ (10 Hz at the least, 20 in later Configuration_adv.h files) or above FTM_FS / 2 (FTM_FS 1000 Hz), and keeps the old one (Marlin/src/gcode/feature/ft_motion/M493.cpp)",
 };
 

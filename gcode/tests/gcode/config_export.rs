@@ -104,6 +104,13 @@ fn klipper_export_refuses_what_klipper_refuses() {
         ),
         (
             KlipperExport {
+                x: shaper("zv", 1000.5, 0.1),
+                ..klipper_export()
+            },
+            "shaper_freq_x",
+        ),
+        (
+            KlipperExport {
                 minimum_cruise_ratio: Some(1.0),
                 ..klipper_export()
             },
@@ -122,6 +129,26 @@ fn klipper_export_refuses_what_klipper_refuses() {
             other => panic!("{key}: {other:?}"),
         }
     }
+}
+
+/// The highest shaper frequency written is the highest settle's printer.cfg reader takes
+/// back (`MAX_SHAPER_FREQUENCY_HZ`, 1000 Hz): 1000 Hz reads back as written, 1000.5 Hz is
+/// refused by the reader too, so the export does not write it (Klipper itself takes any
+/// frequency >= 0: `minval=0.` in klippy/extras/input_shaper.py).
+#[test]
+fn klipper_export_writes_only_frequencies_settle_reads_back() {
+    let at = |f: f64| KlipperExport {
+        x: shaper("zv", f, 0.1),
+        ..klipper_export()
+    };
+    let text = at(1000.0).to_config().expect("1000 Hz is written");
+    let head = "[printer]\nkinematics: cartesian\nmax_velocity: 300\nmax_accel: 1\n";
+    let c = KlipperConfig::parse(&format!("{head}{text}"), "p.cfg").expect("reads back");
+    assert_eq!(c.input_shaper.expect("section").x.frequency_hz, 1000.0);
+    let too_high = format!("{head}[input_shaper]\nshaper_type_x: zv\nshaper_freq_x: 1000.5\n");
+    let refused = KlipperConfig::parse(&too_high, "p.cfg").expect_err("the reader refuses it");
+    assert!(refused.to_string().contains("shaper_freq_x"), "{refused}");
+    assert!(at(1000.5).to_config().is_err());
 }
 
 #[test]

@@ -25,7 +25,9 @@
 //!   line per tuned axis, `F0` unshaped (settle-gcode's `MarlinZvExport`); Marlin shapes X
 //!   and Y apart. Then `M204 P T` when the acceleration changes, with `M201` as in
 //!   `rrf.g`. Read back by settle's G-code reader in `tests/all/tune_firmware.rs` and
-//!   `tests/all/import_marlin.rs`. An axis not tuned is left as it is, and said.
+//!   `tests/all/import_marlin.rs`. An axis not tuned is left as it is, and said. An
+//!   `M493 A` below `FTM_MIN_SHAPE_FREQ` (10 Hz) or above `FTM_FS / 2`, which Marlin's
+//!   `M493` answers with `?Invalid`, is not written (`tests/all/tune_firmware.rs`).
 //! - `prusa.gcode`: Prusa-Firmware-Buddy's `M593 <axis> T F D [R]` line per tuned axis
 //!   (settle-gcode's `PrusaExport`; `F0` unshaped), `M593 W` to store them, then `M201`
 //!   and `M204` as in `marlin.gcode` (Buddy plans with Marlin's planner). Written when
@@ -35,6 +37,10 @@
 //! - `tmc4361a.txt`: per axis, the TMC4361A ramp registers of the recommended move, from
 //!   the axis's own microsteps per mm; refused, with the reason, for what the chip cannot
 //!   run (a trapezoid's infinite bows, an input shaper, a value outside a register).
+//!
+//! A file whose exporter refuses a value says why in its place, and `tune.md` has no
+//! "What changes in" table for it (`tests/all/export_roundtrip.rs` reads each written file
+//! back against `candidates.csv`).
 
 use std::fmt::Write as _;
 
@@ -174,12 +180,9 @@ fn m201(axes: &[(String, Outcome)]) -> [(Option<f64>, Option<f64>); 2] {
     })
 }
 
-/// `klipper.cfg`: the snippet, or comments saying why it is not written.
-pub fn klipper(axes: &[(String, Outcome)], produced_by: &str) -> String {
-    let (x, y) = match (klipper_axis(axes, "x"), klipper_axis(axes, "y")) {
-        (Ok(x), Ok(y)) => (x, y),
-        (Err(e), _) | (_, Err(e)) => return format!("# no Klipper configuration: {e}\n"),
-    };
+/// What `klipper.cfg` writes, or why it is not written.
+fn klipper_export(axes: &[(String, Outcome)], produced_by: &str) -> Result<KlipperExport, String> {
+    let (x, y) = (klipper_axis(axes, "x")?, klipper_axis(axes, "y")?);
     let scv = axes.iter().find_map(|(_, o)| {
         o.plan
             .base
@@ -188,17 +191,25 @@ pub fn klipper(axes: &[(String, Outcome)], produced_by: &str) -> String {
             .map(|c| c.square_corner_velocity_mm_s)
     });
     let max_accel = accel(axes).and_then(|(a, changed)| changed.then_some(a));
-    let e = KlipperExport {
+    Ok(KlipperExport {
         produced_by: produced_by.to_string(),
         x,
         y,
         max_accel_mm_s2: max_accel,
         minimum_cruise_ratio: None,
         square_corner_velocity_mm_s: scv,
+    })
+}
+
+/// `klipper.cfg`: the snippet, or comments saying why it is not written.
+pub fn klipper(axes: &[(String, Outcome)], produced_by: &str) -> String {
+    let e = match klipper_export(axes, produced_by) {
+        Ok(e) => e,
+        Err(why) => return format!("# no Klipper configuration: {why}\n"),
     };
     let mut notes = header_notes(axes);
     notes.extend(
-        changes::klipper(axes, max_accel)
+        changes::klipper(axes, e.max_accel_mm_s2)
             .iter()
             .map(changes::Change::note),
     );
@@ -208,12 +219,12 @@ pub fn klipper(axes: &[(String, Outcome)], produced_by: &str) -> String {
     }
 }
 
-/// The changes `klipper.cfg` makes (empty when it is not written).
+/// The changes `klipper.cfg` makes (`None` when it is not written: a recommendation Klipper
+/// does not run, or a value its exporter refuses).
 pub fn klipper_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
-    klipper_axis(axes, "x").ok()?;
-    klipper_axis(axes, "y").ok()?;
-    let max_accel = accel(axes).and_then(|(a, changed)| changed.then_some(a));
-    Some(changes::klipper(axes, max_accel))
+    let e = klipper_export(axes, "").ok()?;
+    e.to_config().ok()?;
+    Some(changes::klipper(axes, e.max_accel_mm_s2))
 }
 
 /// The axis whose shaper `rrf.g` writes (the lowest-frequency tuned axis's), and its
@@ -258,20 +269,40 @@ fn rrf_refusal(axes: &[(String, Outcome)]) -> Option<String> {
     refusal(axes, Candidates::of(Firmware::Rrf), "RepRapFirmware")
 }
 
-/// `rrf.g`: the `M593` line (and `M204` when the acceleration changes), or comments saying
-/// why it is not written.
-pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
+/// What `rrf.g` writes and the axis whose shaper it is, or why it is not written.
+fn rrf_export<'a>(
+    axes: &'a [(String, Outcome)],
+    produced_by: &str,
+) -> Result<(RrfExport, &'a str), String> {
     if let Some(why) = rrf_refusal(axes) {
-        return format!("; no RepRapFirmware configuration: {why}\n");
+        return Err(why);
     }
     let Some((axis, w)) = rrf_axis(axes) else {
-        return "; no RepRapFirmware configuration: nothing was tuned\n".into();
+        return Err("nothing was tuned".into());
     };
     let shaper = shaper_of(w).unwrap_or(FirmwareShaper {
         name: "none".into(),
         frequency_hz: f64::NAN,
         damping_ratio: f64::NAN,
     });
+    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    let e = RrfExport {
+        produced_by: produced_by.to_string(),
+        shaper,
+        max_accel_xy_mm_s2: m201(axes).map(|(w, _)| w),
+        print_accel_mm_s2: a,
+        travel_accel_mm_s2: a,
+    };
+    Ok((e, axis))
+}
+
+/// `rrf.g`: the `M593` line (and `M204` when the acceleration changes), or comments saying
+/// why it is not written.
+pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
+    let (e, axis) = match rrf_export(axes, produced_by) {
+        Ok(found) => found,
+        Err(why) => return format!("; no RepRapFirmware configuration: {why}\n"),
+    };
     let mut others = String::new();
     for (a, o) in axes.iter().filter(|(a, _)| a != axis) {
         let _ = writeln!(
@@ -280,15 +311,8 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
             super::cells::shaper_text(&o.scores[o.winner])
         );
     }
-    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    let a = e.print_accel_mm_s2;
     let caps = m201(axes);
-    let e = RrfExport {
-        produced_by: produced_by.to_string(),
-        shaper,
-        max_accel_xy_mm_s2: caps.map(|(w, _)| w),
-        print_accel_mm_s2: a,
-        travel_accel_mm_s2: a,
-    };
     let mut notes = header_notes(axes);
     notes.extend(
         changes::rrf(axes, axis, caps, a)
@@ -302,14 +326,12 @@ pub fn rrf(axes: &[(String, Outcome)], produced_by: &str) -> String {
     }
 }
 
-/// The changes `rrf.g` makes (`None` when it is not written).
+/// The changes `rrf.g` makes (`None` when it is not written: a recommendation
+/// RepRapFirmware does not run, or a value its exporter refuses).
 pub fn rrf_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
-    if rrf_refusal(axes).is_some() {
-        return None;
-    }
-    let (axis, _) = rrf_axis(axes)?;
-    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
-    Some(changes::rrf(axes, axis, m201(axes), a))
+    let (e, axis) = rrf_export(axes, "").ok()?;
+    e.to_config().ok()?;
+    Some(changes::rrf(axes, axis, m201(axes), e.print_accel_mm_s2))
 }
 
 /// Marlin's input shaper the tune was for (`[tune] marlin_shaping`; Fixed-Time Motion
@@ -391,16 +413,27 @@ pub fn marlin(axes: &[(String, Outcome)], produced_by: &str) -> String {
     if let Some(why) = marlin_refusal(axes) {
         return format!("; no Marlin configuration: {why}\n");
     }
-    let shaping = marlin_shaping(axes);
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
-    let caps = m201(axes);
-    let max_accel_xy_mm_s2 = caps.map(|(w, _)| w);
     let mut notes = header_notes(axes);
     notes.extend(
-        changes::marlin(axes, shaping, caps, a)
+        changes::marlin(axes, marlin_shaping(axes), m201(axes), a)
             .iter()
             .map(changes::Change::note),
     );
+    marlin_text(axes, produced_by, &notes)
+        .unwrap_or_else(|err| format!("; no Marlin configuration: {err}\n"))
+}
+
+/// `marlin.gcode`'s lines with `notes` above theirs, or why the exporter refuses them (a
+/// value Marlin would not take: settle-gcode's `MarlinExport`, `MarlinZvExport`).
+fn marlin_text(
+    axes: &[(String, Outcome)],
+    produced_by: &str,
+    notes: &[Note],
+) -> Result<String, String> {
+    let shaping = marlin_shaping(axes);
+    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    let max_accel_xy_mm_s2 = m201(axes).map(|(w, _)| w);
     let (text, command) = match shaping {
         MarlinShaping::InputShaping => {
             let (axes_written, untuned) = per_axis(|l| marlin_zv_axis(axes, l));
@@ -411,7 +444,7 @@ pub fn marlin(axes: &[(String, Outcome)], produced_by: &str) -> String {
                 print_accel_mm_s2: a,
                 travel_accel_mm_s2: a,
             };
-            (e.to_config_with_notes(&notes), ("M593", untuned))
+            (e.to_config_with_notes(notes), ("M593", untuned))
         }
         MarlinShaping::FtMotion => {
             let (written, untuned) = per_axis(|l| marlin_axis(axes, l));
@@ -429,24 +462,19 @@ pub fn marlin(axes: &[(String, Outcome)], produced_by: &str) -> String {
                 print_accel_mm_s2: a,
                 travel_accel_mm_s2: a,
             };
-            (e.to_config_with_notes(&notes), ("M493", untuned))
+            (e.to_config_with_notes(notes), ("M493", untuned))
         }
     };
     let (command, untuned) = command;
-    match text {
-        Ok(text) => {
-            let mut out = text;
-            for letter in untuned {
-                let _ = writeln!(
-                    out,
-                    "; axis {letter} was not tuned: its {command} {} settings stay as they are (Marlin shapes X and Y apart; set both)",
-                    letter.to_ascii_uppercase()
-                );
-            }
-            out
-        }
-        Err(err) => format!("; no Marlin configuration: {err}\n"),
+    let mut out = text.map_err(|err| err.to_string())?;
+    for letter in untuned {
+        let _ = writeln!(
+            out,
+            "; axis {letter} was not tuned: its {command} {} settings stay as they are (Marlin shapes X and Y apart; set both)",
+            letter.to_ascii_uppercase()
+        );
     }
+    Ok(out)
 }
 
 /// What `of` gives for axes `x` and `y`, and the letters of those it gives nothing for
@@ -462,11 +490,14 @@ fn per_axis<T>(of: impl Fn(&str) -> Option<T>) -> (Vec<T>, Vec<&'static str>) {
     (given, not)
 }
 
-/// The changes `marlin.gcode` makes (`None` when it is not written).
+/// The changes `marlin.gcode` makes (`None` when it is not written: a recommendation
+/// Marlin does not run, or a value its exporter refuses, such as an `M493 A` below
+/// `FTM_MIN_SHAPE_FREQ`).
 pub fn marlin_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
     if marlin_refusal(axes).is_some() {
         return None;
     }
+    marlin_text(axes, "", &[]).ok()?;
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
     Some(changes::marlin(axes, marlin_shaping(axes), m201(axes), a))
 }
@@ -508,14 +539,7 @@ pub fn prusa(axes: &[(String, Outcome)], produced_by: &str) -> String {
             .iter()
             .map(changes::Change::note),
     );
-    let (written, untuned) = per_axis(|l| prusa_axis(axes, l));
-    let e = PrusaExport {
-        produced_by: produced_by.to_string(),
-        axes: written,
-        max_accel_xy_mm_s2: caps.map(|(w, _)| w),
-        print_accel_mm_s2: a,
-        travel_accel_mm_s2: a,
-    };
+    let (e, untuned) = prusa_export(axes, produced_by);
     match e.to_config_with_notes(&notes) {
         Ok(mut out) => {
             for letter in untuned {
@@ -531,11 +555,27 @@ pub fn prusa(axes: &[(String, Outcome)], produced_by: &str) -> String {
     }
 }
 
-/// The changes `prusa.gcode` makes (`None` when it is not written).
+/// What `prusa.gcode` writes, and the letters of the axes not tuned.
+fn prusa_export(axes: &[(String, Outcome)], produced_by: &str) -> (PrusaExport, Vec<&'static str>) {
+    let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
+    let (written, untuned) = per_axis(|l| prusa_axis(axes, l));
+    let e = PrusaExport {
+        produced_by: produced_by.to_string(),
+        axes: written,
+        max_accel_xy_mm_s2: m201(axes).map(|(w, _)| w),
+        print_accel_mm_s2: a,
+        travel_accel_mm_s2: a,
+    };
+    (e, untuned)
+}
+
+/// The changes `prusa.gcode` makes (`None` when it is not written: a recommendation
+/// Prusa-Firmware-Buddy does not run, or a value its exporter refuses).
 pub fn prusa_changes(axes: &[(String, Outcome)]) -> Option<Vec<changes::Change>> {
     if prusa_refusal(axes).is_some() {
         return None;
     }
+    prusa_export(axes, "").0.to_config().ok()?;
     let a = accel(axes).and_then(|(a, changed)| changed.then_some(a));
     Some(changes::prusa(axes, m201(axes), a))
 }
