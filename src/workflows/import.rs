@@ -270,7 +270,7 @@ pub fn read_current_files(
     firmware: Firmware,
     path: &Path,
 ) -> Result<(Current, Vec<PathBuf>), Error> {
-    not_a_config(path)?;
+    not_a_config(path, firmware, IMPORT_READS)?;
     match firmware {
         Firmware::Klipper => {
             let c = KlipperConfig::read(path).map_err(|e| config_error(path, e))?;
@@ -357,41 +357,69 @@ pub fn read_current_files(
     }
 }
 
-/// Refuses a file that is no firmware configuration at all, before a reader takes it for
+/// What `settle import` reads, as its refusals end.
+pub(crate) const IMPORT_READS: &str = "settle import reads a printer.cfg (klipper), a config.g (rrf), the reply to M503 (marlin) or the replies to M115, M503 and M593 (prusa)";
+
+/// Refuses a file that is not `firmware`'s configuration, before a reader takes it for
 /// one: a G-code job (a slicer writes M201, M203 and M204 into every job, and
 /// RepRapFirmware's defaults stand in for what a config.g does not set), a scenario, a
-/// machine file, a recording or a model ([`settle_files::looks`]), named with the command
-/// that reads it. (A zero byte alone is left to the reader: a terminal's log of a serial
-/// line may hold one from a reset.)
-fn not_a_config(path: &Path) -> Result<(), Error> {
+/// machine file, a recording or a model, and another firmware's configuration where its
+/// reader would read it as this one's (RepRapFirmware's reader takes Marlin's `M203` in
+/// mm/s as mm/min) or fail at its first line ([`settle_files::looks`]), named with the
+/// command that reads it, then what the asking command reads (`reads`): `settle import`
+/// ([`IMPORT_READS`]) and `settle gcode --config` both ask. (A zero
+/// byte alone is left to the reader: a terminal's log of a serial line may hold one from
+/// a reset. A Marlin reply copied without its `echo:` prefixes and holding `M906` or
+/// `M569` looks like a config.g here, so Marlin's and Prusa's readers, not this, refuse a
+/// config.g: at its first command that only RepRapFirmware has.)
+pub(crate) fn not_a_config(path: &Path, firmware: Firmware, reads: &str) -> Result<(), Error> {
     use settle_files::looks::Looks;
     let limit = crate::input::file::limit::FIRMWARE_CONFIG;
-    match settle_files::looks::file(path, limit) {
-        Some(
-            l @ (Looks::GcodeJob
-            | Looks::Bgcode
-            | Looks::SlicedThreeMf
-            | Looks::ThreeMf
-            | Looks::Ufp
-            | Looks::StlBinary
-            | Looks::StlAscii
-            | Looks::Scenario
-            | Looks::MachineFile
-            | Looks::Recording
-            | Looks::Json),
-        ) => Err(Error::Input {
-            at: Location {
-                line: Some(1),
-                ..Location::file(path)
-            },
-            message: format!(
-                "{}, not a firmware configuration: {}; settle import reads a printer.cfg (klipper), a config.g (rrf), the reply to M503 (marlin) or the replies to M115, M503 and M593 (prusa)",
-                l.what(),
-                l.then()
-            ),
-        }),
-        _ => Ok(()),
-    }
+    let Some(looks) = settle_files::looks::file(path, limit) else {
+        return Ok(());
+    };
+    let (expected, foreign): (&str, &[Looks]) = match firmware {
+        Firmware::Klipper => (
+            "a Klipper configuration",
+            &[Looks::RrfConfig, Looks::MarlinReply],
+        ),
+        Firmware::Rrf => (
+            "a RepRapFirmware configuration",
+            &[Looks::KlipperConfig, Looks::MarlinReply],
+        ),
+        Firmware::Marlin | Firmware::Prusa => ("a reply to M503", &[Looks::KlipperConfig]),
+        Firmware::Grbl => (
+            "GRBL's $$ settings",
+            &[Looks::KlipperConfig, Looks::RrfConfig, Looks::MarlinReply],
+        ),
+        Firmware::Settle | Firmware::Tmc4361a => ("a firmware configuration", &[]),
+    };
+    let expected = match looks {
+        Looks::GcodeJob
+        | Looks::Bgcode
+        | Looks::SlicedThreeMf
+        | Looks::ThreeMf
+        | Looks::Ufp
+        | Looks::StlBinary
+        | Looks::StlAscii
+        | Looks::Scenario
+        | Looks::MachineFile
+        | Looks::Recording
+        | Looks::Json => "a firmware configuration",
+        l if foreign.contains(&l) => expected,
+        _ => return Ok(()),
+    };
+    Err(Error::Input {
+        at: Location {
+            line: Some(1),
+            ..Location::file(path)
+        },
+        message: format!(
+            "{}, not {expected}: {}; {reads}",
+            looks.what(),
+            looks.then()
+        ),
+    })
 }
 
 /// A length, speed or acceleration of Marlin's planner (m, m/s, m/s^2) in the millimetres

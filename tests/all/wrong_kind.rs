@@ -390,3 +390,165 @@ fn a_job_that_starts_like_a_config_is_a_job() {
     assert_eq!(r.status.code(), Some(0), "{err}");
     assert!(err.contains("skipped 1 bad lines"), "{err}");
 }
+
+/// One firmware's configuration handed to another firmware's reader (`settle import` and
+/// `settle gcode --config`) is named as what it is, with the command that reads it:
+/// RepRapFirmware's reader would take Marlin's `M203` (mm/s) as mm/min, and Marlin's reader
+/// a config.g's `M203 X18000` (mm/min) as 18000 mm/s. Each file is a real one of the
+/// repository; a config.g given to Marlin's or Prusa's reader is refused at its first
+/// command that Marlin does not have (`M584` at line 44 of the RailCore's, `M550` at line 9
+/// of the mini 5+'s).
+#[test]
+fn a_configuration_of_another_firmware_is_named() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let out = d.join("out");
+    let printer = copy(d, "examples/klipper/printer.cfg", "printer.cfg");
+    let railcore = copy(d, "gcode/tests/data/real/railcore/sys/config.g", "config.g");
+    let mini = copy(d, "gcode/tests/data/rrf/mini5plus/sys/config.g", "mini.g");
+    let m503 = copy(
+        d,
+        "gcode/tests/data/real/marlin/ender3v2neo/m503_20241028.gcode",
+        "m503.txt",
+    );
+    let job = copy(d, "gcode/prints/cube_layer.gcode", "cube.gcode");
+    let rrf = "a RepRapFirmware configuration (config.g";
+    let marlin = "Marlin's reply to M503 (echo: lines)";
+    let klipper = "a Klipper configuration (printer.cfg";
+    let import = |firmware: &str, f: &Path| -> Vec<OsString> {
+        vec![
+            "import".into(),
+            firmware.into(),
+            f.into(),
+            "--out".into(),
+            out.clone().into(),
+        ]
+    };
+    let gcode = |firmware: Option<&str>, f: &Path| -> Vec<OsString> {
+        let mut a: Vec<OsString> = vec![
+            "gcode".into(),
+            job.clone().into(),
+            "--machine".into(),
+            "printer_xy".into(),
+            "--config".into(),
+            f.into(),
+            "--out".into(),
+            out.clone().into(),
+        ];
+        if let Some(fw) = firmware {
+            a.extend(["--firmware".into(), fw.into()]);
+        }
+        a
+    };
+    let refused_by_marlin = |file: &str, line: u32, command: &str| {
+        vec![
+            format!("{file}:{line}: {command} ("),
+            "is a RepRapFirmware command that Marlin does not have".into(),
+            "whose M203 is in mm/min where Marlin's is in mm/s".into(),
+            "settle import rrf".into(),
+        ]
+    };
+    let s = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let cases: Vec<(Vec<OsString>, Vec<String>)> = vec![
+        (
+            import("klipper", &railcore),
+            s(&[
+                "config.g:1: ",
+                rrf,
+                "not a Klipper configuration",
+                "settle import rrf FILE",
+                "settle import reads a printer.cfg (klipper)",
+            ]),
+        ),
+        (
+            import("klipper", &m503),
+            s(&[
+                "m503.txt:1: ",
+                marlin,
+                "not a Klipper configuration",
+                "settle import marlin FILE",
+            ]),
+        ),
+        (
+            import("rrf", &m503),
+            s(&[
+                "m503.txt:1: ",
+                marlin,
+                "not a RepRapFirmware configuration",
+                "settle import marlin FILE",
+            ]),
+        ),
+        (
+            import("rrf", &printer),
+            s(&[
+                "printer.cfg:1: ",
+                klipper,
+                "not a RepRapFirmware configuration",
+                "settle import klipper FILE",
+            ]),
+        ),
+        (
+            import("marlin", &printer),
+            s(&["printer.cfg:1: ", klipper, "not a reply to M503"]),
+        ),
+        (
+            import("prusa", &printer),
+            s(&["printer.cfg:1: ", klipper, "not a reply to M503"]),
+        ),
+        (
+            import("marlin", &railcore),
+            refused_by_marlin("config.g", 44, "M584"),
+        ),
+        (
+            import("prusa", &mini),
+            refused_by_marlin("mini.g", 9, "M550"),
+        ),
+        (
+            gcode(None, &m503),
+            s(&[
+                "m503.txt:1: ",
+                marlin,
+                "not a Klipper configuration",
+                "--firmware marlin --config FILE",
+                "--config reads a Klipper printer.cfg (--firmware klipper)",
+            ]),
+        ),
+        (
+            gcode(Some("rrf"), &m503),
+            s(&["m503.txt:1: ", marlin, "not a RepRapFirmware configuration"]),
+        ),
+        (
+            gcode(Some("klipper"), &railcore),
+            s(&["config.g:1: ", rrf, "not a Klipper configuration"]),
+        ),
+        (
+            gcode(Some("rrf"), &printer),
+            s(&[
+                "printer.cfg:1: ",
+                klipper,
+                "not a RepRapFirmware configuration",
+            ]),
+        ),
+        (
+            gcode(Some("grbl"), &m503),
+            s(&["m503.txt:1: ", marlin, "not GRBL's $$ settings"]),
+        ),
+        (
+            gcode(Some("marlin"), &mini),
+            refused_by_marlin("mini.g", 9, "M550"),
+        ),
+        (
+            gcode(None, &job),
+            s(&[
+                "cube.gcode:1: a G-code job",
+                "not a firmware configuration",
+                "--config reads",
+            ]),
+        ),
+    ];
+    let cases = cases
+        .into_iter()
+        .map(|(args, says)| Case { args, says })
+        .collect();
+    check(cases, &out);
+}

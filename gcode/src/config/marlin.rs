@@ -111,6 +111,29 @@ impl MarlinSettings {
 /// The commands of an `M503` reply the planner follows.
 const PLANNER_COMMANDS: [&str; 6] = ["M92", "M201", "M203", "M204", "M205", "M593"];
 
+/// Commands of a RepRapFirmware config.g that Marlin does not have (no case for them in
+/// Marlin's dispatcher, `GcodeSuite::process_parsed_command`, Marlin/src/gcode/gcode.cpp),
+/// so that no `M503` reply holds one: a file with one is a config.g, whose `M203` is in
+/// mm/min where Marlin's is in mm/s ([`rrf_only`]).
+const RRF_ONLY: [(&str, &str); 8] = [
+    ("M98", "call a macro"),
+    ("M550", "machine name"),
+    ("M551", "password"),
+    ("M558", "Z probe type"),
+    ("M574", "endstops"),
+    ("M584", "drive mapping"),
+    ("M586", "network protocols"),
+    ("M950", "create a heater, fan, GPIO or servo port"),
+];
+
+/// What a RepRapFirmware-only command ([`RRF_ONLY`]) does; `None` for any other.
+fn rrf_only(command: &str) -> Option<&'static str> {
+    RRF_ONLY
+        .iter()
+        .find(|(c, _)| *c == command)
+        .map(|(_, what)| *what)
+}
+
 /// What settle does not model, for the commands `M503` prints (settings.cpp).
 fn unused_reason(command: &str) -> Option<&'static str> {
     Some(match command {
@@ -480,6 +503,14 @@ impl MarlinSettings {
                             });
                     }
                     Some(c) if !prusa && c == "M493" && ft_report_is_current(t, &at(line))? => t,
+                    Some(c) if let Some(what) = rrf_only(&c) => {
+                        return Err(GcodeError::ConfigSyntax {
+                            at: at(line),
+                            what: format!(
+                                "{c} ({what}) is a RepRapFirmware command that Marlin does not have, so no M503 reply holds it: this is a RepRapFirmware config.g, whose M203 is in mm/min where Marlin's is in mm/s; read it as RepRapFirmware's (settle import rrf, settle gcode --firmware rrf --config)"
+                            ),
+                        });
+                    }
                     Some(c) => {
                         if c == "M493" || c == "M494" {
                             ft_words(&c, t, &at(line))?;

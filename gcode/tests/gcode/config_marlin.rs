@@ -77,3 +77,73 @@ fn a_real_octoprint_copy_of_m503_reads_its_values() {
     );
     assert!(s.notes[14].text.starts_with("C100: not a command"));
 }
+
+/// A RepRapFirmware config.g is not an `M503` reply: its `M203` is in mm/min where Marlin's
+/// is in mm/s (the mini 5+'s `M203 X18000.00` would be 18000 mm/s). Marlin's and Prusa's
+/// readers refuse it at its first command that Marlin does not have: the RailCore's
+/// `M584 X0.0 Y0.1 ...` at line 44, the mini 5+'s `M550 P"mini5plus"` at line 9.
+#[test]
+fn a_real_config_g_is_refused_at_its_first_reprapfirmware_command() {
+    for (file, line, command, prusa) in [
+        (
+            "real/railcore/sys/config.g",
+            44,
+            "M584 (drive mapping)",
+            false,
+        ),
+        (
+            "rrf/mini5plus/sys/config.g",
+            9,
+            "M550 (machine name)",
+            false,
+        ),
+        ("rrf/mini5plus/sys/config.g", 9, "M550 (machine name)", true),
+    ] {
+        let path = data_path(file);
+        let read = if prusa {
+            MarlinSettings::read_prusa(&path)
+        } else {
+            MarlinSettings::read(&path)
+        };
+        let e = read.expect_err("a config.g").to_string();
+        let at = format!("config.g:{line}: {command} is a RepRapFirmware command");
+        assert!(e.contains(&at), "{file}: {e}");
+        assert!(e.contains("settle import rrf"), "{e}");
+    }
+}
+
+/// The commands only RepRapFirmware has are not Marlin's: the reply of a Marlin with TMC
+/// drivers and Ethernet, copied without its `echo:` prefixes (as some hosts show it), with
+/// the `M906`, `M569` and `M552` lines Marlin's settings.cpp prints for them, reads the
+/// same planner values as the Ender-3 V2 Neo's own reply, and notes the three as read.
+#[test]
+fn marlin_commands_that_a_config_g_also_has_are_read_as_marlin() {
+    let path = data_path("real/marlin/ender3v2neo/m503_20241028.gcode");
+    let text = std::fs::read_to_string(&path).expect("reads");
+    let mut bare: String = text
+        .lines()
+        .filter(|l| !l.starts_with("Send:"))
+        .map(|l| {
+            let l = l.strip_prefix("Recv: ").unwrap_or(l);
+            format!("{}\n", l.strip_prefix("echo:").unwrap_or(l).trim())
+        })
+        .collect();
+    assert!(!bare.contains("echo:"));
+    bare.push_str("; Stepper driver current:\nM906 X580 Y580 Z580\nM906 T0 E650\n");
+    bare.push_str("; Driver stepping mode:\nM569 S1 X Y Z\nM552 P192.168.0.7\n");
+    let own = MarlinSettings::read(&path).unwrap_or_else(|e| panic!("{e}"));
+    let s = MarlinSettings::parse(&bare, "bare.txt").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.planner, own.planner);
+    assert_eq!(s.steps_per_mm, own.steps_per_mm);
+    for c in [
+        "M906 (stepper currents)",
+        "M569 (driver chopper mode)",
+        "M552 (network)",
+    ] {
+        assert!(
+            s.notes.iter().any(|n| n.text.starts_with(c)),
+            "{c}: {:?}",
+            s.notes
+        );
+    }
+}

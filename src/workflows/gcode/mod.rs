@@ -165,6 +165,9 @@ pub fn parse_shapers(s: &str) -> Result<XyShapers, String> {
     Ok(out)
 }
 
+/// What `--config` reads, as its refusals end.
+const CONFIG_READS: &str = "--config reads a Klipper printer.cfg (--firmware klipper), a RepRapFirmware config.g (--firmware rrf), GRBL's $$ settings (--firmware grbl), Marlin's M503 reply (--firmware marlin) or a Prusa's replies to M115, M503 and M593 (--firmware prusa)";
+
 impl GcodeOptions {
     /// `file` on `machine` with `firmware`'s defaults, the modal backend and the linear
     /// driver (what the modal backend solves exactly).
@@ -210,6 +213,7 @@ impl GcodeOptions {
         } else {
             Firmware::Klipper
         });
+        crate::workflows::import::not_a_config(&config, firmware, CONFIG_READS)?;
         let (job, mut notes, files): (JobConfig, Vec<String>, _) = match firmware {
             Firmware::Klipper => {
                 let c = settle_gcode::config::KlipperConfig::read(&config)
@@ -250,9 +254,7 @@ impl GcodeOptions {
                 return Err(Error::input_key(
                     &config,
                     "--config",
-                    format!(
-                        "--config reads a Klipper printer.cfg (--firmware klipper), a RepRapFirmware config.g (--firmware rrf), GRBL's $$ settings (--firmware grbl), Marlin's M503 reply (--firmware marlin) or a Prusa's replies to M115, M503 and M593 (--firmware prusa), not {firmware}'s settings"
-                    ),
+                    format!("{CONFIG_READS}, not {firmware}'s settings"),
                 ));
             }
         };
