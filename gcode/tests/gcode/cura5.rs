@@ -178,7 +178,9 @@ fn a_cura5_file_runs_on_a_prusa_minis_own_m503_reply_and_times_near_cura() {
     let text = text();
     // A Prusa MINI's reply to M503 (gcode/prints/prusaslicer/PROVENANCE.md): Marlin's
     // planner with the MINI's settings, classic jerk. Cura's MINI profile writes the same
-    // limits at the file's head (lines 13-15), so none is raised.
+    // X and Y limits and jerks at the file's head (lines 13-15), so none of the limits
+    // settle lists (`M204 P`/`T`, `M201`/`M203` of X and Y) is raised; its `M201 E5000`
+    // lifts the reply's E 4000, which is followed and not listed.
     let m503 = print_path("prusaslicer/M503_prusa_mini.txt");
     let settings = settle_gcode::config::MarlinSettings::read(&m503).expect("reads");
     let mm = |v: [f64; 4]| v.map(|x| x * 1e-3);

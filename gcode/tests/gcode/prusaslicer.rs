@@ -138,7 +138,8 @@ fn a_prusaslicer_vase_runs_as_the_mini_it_names_with_the_limits_it_raises() {
     // The limits the file sets above the MINI's own (Configuration_MINI.h: 1250 mm/s^2
     // for X, Y, print and travel; the table in docs/guide/your-print.md): line 1865
     // `M201 X2500 Y2500 Z400 E5000`, line 1867 `M204 P2000 R1250 T2500`, and the start
-    // G-code's `M204 T2500` after `G29` raises travel once more.
+    // G-code's `M204 T2500` after `G29` raises travel once more. (Its `E5000` above the
+    // MINI's E 4000 is followed; settle lists X, Y, print and travel limits only.)
     assert_eq!(
         text.lines().nth(1864),
         Some("M201 X2500 Y2500 Z400 E5000 ; sets maximum accelerations, mm/sec^2")
