@@ -1,6 +1,7 @@
 //! settle-gcode's tests: one binary, one module per subject.
 
 mod arcs;
+mod bambu;
 mod bgcode;
 mod config_export;
 mod config_klipper;
