@@ -271,6 +271,15 @@ impl Motion {
                 b"XYZEFIJRP",
                 "X Y Z E F I J, and P, which Klipper passes over",
             )?;
+        } else if self.dialect.is_marlin() {
+            // Marlin reads `P` (extra full turns) only in a build with ARC_P_CIRCLES and
+            // passes over it otherwise (Marlin/src/gcode/motion/G2_G3.cpp): the turns
+            // such an arc makes depend on the build, which settle does not know.
+            cmd.allow(
+                p,
+                b"XYZEFIJR",
+                "X Y Z E F I J R; P (full turns, as in the spiral lift Bambu Studio and OrcaSlicer write) is read only by a Marlin built with ARC_P_CIRCLES and passed over by others, so the turns depend on the build",
+            )?;
         } else {
             cmd.allow(p, b"XYZEFIJR", "X Y Z E F I J R")?;
         }

@@ -1,6 +1,7 @@
 //! settle-gcode's tests: one binary, one module per subject.
 
 mod arcs;
+mod bambu;
 mod bgcode;
 mod config_export;
 mod config_klipper;
@@ -8,6 +9,7 @@ mod config_marlin;
 mod config_real;
 mod config_rrf;
 mod cura;
+mod cura5;
 mod dialects;
 mod errors;
 mod features;
@@ -24,6 +26,7 @@ mod layer_bound;
 mod layers;
 mod orca;
 mod prusa_models;
+mod prusaslicer;
 mod roundtrip;
 mod segments;
 mod slic3r;
