@@ -2,8 +2,10 @@
 //! (`identify/tests/corpus/MANIFEST.md`): every line equal to what Klipper's
 //! `scripts/calibrate_shaper.py` printed for the same file
 //! (`identify/tests/corpus/klipper_calibrate_shaper.txt`, Klipper 84104bbbd762; for a
-//! Shake&Tune `.stdata` recording, on its samples written as a Klipper raw CSV), and
-//! `--out` writing the `[input_shaper]` lines of the recommendation per axis.
+//! Shake&Tune `.stdata` recording, on its samples written as a Klipper raw CSV; for a
+//! `SHAPER_CALIBRATE` file, on its PSD as written, which the script of today would
+//! normalise a second time), and `--out` writing the `[input_shaper]` lines of the
+//! recommendation per axis.
 
 use std::path::PathBuf;
 
@@ -14,12 +16,15 @@ fn corpus_dir() -> PathBuf {
 }
 
 /// The script's output per file: `(file, lines after "Processing resonances from ...")`.
+/// The file is the first word after the command; what follows it says how the script was
+/// run when not as it is.
 fn script_output() -> Vec<(String, Vec<String>)> {
     let text = std::fs::read_to_string(corpus_dir().join("klipper_calibrate_shaper.txt"))
         .expect("reads the recorded output");
     let mut out: Vec<(String, Vec<String>)> = Vec::new();
     for line in text.lines() {
-        if let Some(file) = line.strip_prefix("$ calibrate_shaper.py ") {
+        if let Some(rest) = line.strip_prefix("$ calibrate_shaper.py ") {
+            let file = rest.split_whitespace().next().expect("a file name");
             out.push((file.to_string(), Vec::new()));
         } else if !line.starts_with("Processing resonances from")
             && let Some(last) = out.last_mut()
@@ -33,8 +38,9 @@ fn script_output() -> Vec<(String, Vec<String>)> {
 #[test]
 fn klipper_criterion_equals_calibrate_shaper_on_the_corpus() {
     let expected = script_output();
-    // 20 processed spectra, 4 Klipper raw recordings and 2 Shake&Tune `.stdata`.
-    assert_eq!(expected.len(), 26);
+    // 22 processed spectra, 4 `SHAPER_CALIBRATE` files, 4 Klipper raw recordings and 2
+    // Shake&Tune `.stdata`.
+    assert_eq!(expected.len(), 32);
     for (file, want) in expected {
         let c = KlipperCriterion::from_args(vec![corpus_dir().join(&file)], None, None, None, None)
             .expect("options");
@@ -147,3 +153,46 @@ const MAX_SMOOTHING_LINES: [&str; 5] = [
     "To avoid too much smoothing with 'ei', suggested max_accel <= 7500 mm/sec^2",
     "Recommended shaper is mzv(n=4,t=0.8) @ 50.6 Hz",
 ];
+
+/// `SHAPER_CALIBRATE` files of before October 2025 (shaper columns straight after
+/// `psd_xyz`, no `shapers:` column) hold the PSD Klipper fitted, already normalised.
+/// settle fits them as written: its `zv` and `mzv` lines equal, word for word, the lines
+/// Klipper printed when it wrote each file, which the owner pasted into `v24/README.md`
+/// of bassco/klipper-configs in the same commit (identify/tests/corpus/MANIFEST.md).
+/// Normalised a second time, as today's calibrate_shaper.py does, the 2022 X file would
+/// give `mzv` at 45.8 Hz and the Y file `zv` at 50.4 Hz and `mzv` at 35.0 Hz.
+#[test]
+fn klipper_criterion_fits_shaper_calibrate_files_as_written() {
+    let published: [(&str, &[&str]); 3] = [
+        (
+            "bassco_calibration_data_x_20220611_200739.csv",
+            &["Fitted shaper 'mzv' frequency = 48.4 Hz (vibrations = 1.3%, smoothing ~= 0.087)"],
+        ),
+        (
+            "bassco_calibration_data_y_20220611_200739.csv",
+            &[
+                "Fitted shaper 'zv' frequency = 59.8 Hz (vibrations = 31.2%, smoothing ~= 0.050)",
+                "Fitted shaper 'mzv' frequency = 37.2 Hz (vibrations = 5.8%, smoothing ~= 0.147)",
+            ],
+        ),
+        (
+            "bassco_calibration_data_y_20230306_225431.csv",
+            &[
+                "Fitted shaper 'zv' frequency = 44.0 Hz (vibrations = 2.3%, smoothing ~= 0.085)",
+                "Fitted shaper 'mzv' frequency = 43.4 Hz (vibrations = 0.0%, smoothing ~= 0.108)",
+            ],
+        ),
+    ];
+    for (file, lines) in published {
+        let c = KlipperCriterion::from_args(vec![corpus_dir().join(file)], None, None, None, None)
+            .expect("options");
+        let r = report(&c).expect("chooses");
+        for want in lines {
+            assert!(
+                r.stdout.lines().any(|l| l == *want),
+                "{file}: no `{want}` in\n{}",
+                r.stdout
+            );
+        }
+    }
+}

@@ -7,12 +7,14 @@
 //! column `shapers:` (empty in every row) before them. Rows: frequency `%.1f`, PSD `%.3e`,
 //! shaper responses `%.3f`.
 //!
-//! Two generations of PSD, told apart exactly as Klipper's `scripts/calibrate_shaper.py`
-//! does: a file with shaper columns (`SHAPER_CALIBRATE`, `calibration_data_*`) holds the
-//! PSD after `CalibrationData.normalize_to_frequencies`, a file without them
-//! (`TEST_RESONANCES`, `resonances_*`) the PSD as computed. The normalisation divides by
-//! `f + 0.1` and removes low frequencies: until December 2024 by setting every bin below
-//! 5 Hz to zero, since then by multiplying bins below 10 Hz by
+//! Two kinds of PSD: a file with shaper columns (`SHAPER_CALIBRATE`, `calibration_data_*`)
+//! holds the PSD after `CalibrationData.normalize_to_frequencies`, a file without them
+//! (`TEST_RESONANCES`, `resonances_*`) the PSD as computed. (Klipper's
+//! `scripts/calibrate_shaper.py` told them apart by `'mzv' in header` until October 2025;
+//! since then only by the `shapers:` column, so it normalises older `calibration_data_*`
+//! files a second time: identify/tests/corpus/MANIFEST.md, the bassco files.) The
+//! normalisation divides by `f + 0.1` and removes low frequencies: until December 2024 by
+//! setting every bin below 5 Hz to zero, since then by multiplying bins below 10 Hz by
 //! `exp(1 - (10 / (f + 0.1))^2)`. The reader tells these apart by the bins between 0 and
 //! 5 Hz: all exactly zero means the older rule.
 

@@ -22,7 +22,7 @@ pub type Answer = Result<Vec<AxisIdentification>, IdentifyError>;
 #[derive(Clone, Copy)]
 enum Test {
     /// Klipper's pulse-only test before December 2024 (`accel_per_hz` 75, `max_freq`
-    /// 133.3 Hz): the older `resonances_*.csv`.
+    /// 133.3 Hz): the older `resonances_*.csv` and `calibration_data_*.csv`.
     KlipperLegacy,
     /// The Neptune 4 Pro's sweeping test, from the owner's `[resonance_tester]` and
     /// Shake&Tune's graph: 10 to 140 Hz at 1 Hz/s, `accel_per_hz` 60, sweeping accel 200
@@ -47,13 +47,14 @@ enum Expect {
 
 /// `(file, test, published main resonances (Hz), one frequency bin (Hz), expectation)`.
 /// Main resonances: Klipper processed files, the largest peak of the published spectrum
-/// `psd_xyz / (f + 0.1)` between 5 and 135 Hz; files with a Shake&Tune graph (`.stdata`
+/// `psd_xyz / (f + 0.1)` between 5 and 135 Hz (a `SHAPER_CALIBRATE` file's `psd_xyz` as
+/// written: Klipper divided it already); files with a Shake&Tune graph (`.stdata`
 /// and the raw `resonances_<date>_<axis>.csv`), the `w0` of the owner's graph; M956
 /// captures, the owner's M593 frequency. A bin: Klipper's grid (about 1.53 Hz, rounded
 /// to `%.1f`), Klipper's half-second Welch segment (256 samples at 391 Hz: 1.53 Hz; 2,048
 /// at 3.2 kHz: 1.56 Hz), one over an M956 capture's length (1.61 Hz).
 #[rustfmt::skip]
-const CORPUS: [(&str, Test, &[f64], f64, Expect); 28] = {
+const CORPUS: [(&str, Test, &[f64], f64, Expect); 34] = {
     use Expect::{Modes, Refused};
     use Test::{FreeDecay as M956, KlipperLegacy as L, Neptune4Pro as N4P};
     const ST75: Test = Test::ShakeTuneAxes(75.0);
@@ -62,6 +63,12 @@ const CORPUS: [(&str, Test, &[f64], f64, Expect); 28] = {
     // The captures hold the move itself: the vibration lasts to the last sample.
     const NO_DECAY: Expect = Refused("the free decay after the move holds");
     [
+        ("bassco_calibration_data_x_20220611_200739.csv", L, &[46.8], 1.6, NOT_MAIN),
+        ("bassco_calibration_data_x_20230306_225431.csv", L, &[51.8], 1.6, Modes),
+        ("bassco_calibration_data_y_20220611_200739.csv", L, &[57.4], 1.6, NOT_MAIN),
+        ("bassco_calibration_data_y_20230306_225431.csv", L, &[41.4], 1.6, Modes),
+        ("bassco_resonances_x_20230306_224517.csv", L, &[51.8], 1.6, Modes),
+        ("bassco_resonances_y_20230306_224919.csv", L, &[41.4], 1.6, Modes),
         ("metis_resonances_20240206_200114_X.csv", ST125, &[64.1], 1.5, Modes),
         ("metis_resonances_20240206_200335_Y.csv", ST125, &[55.0], 1.5, Modes),
         ("metis_resonances_x_20220520_114736.csv", L, &[57.6], 1.6, Modes),

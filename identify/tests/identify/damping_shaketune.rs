@@ -189,18 +189,52 @@ fn shaketune_rule_on_settles_model_gives_the_published_damping() {
 /// measured against settle's damping ratio of the mode at the published main resonance,
 /// shown per file (`--nocapture`) with the median, for `docs/guide/real-recordings.md`.
 /// The rule reads 0.62 to 0.77 of the true damping ratio on Klipper's spectra (above), so
-/// settle's must stand above it on every file, by 1.3 to 1.6 at the median.
+/// settle's must stand above it on every file, by 1.3 to 1.6 at the median. That holds for
+/// a peak of one mode: where settle finds the main mode's half-power band overlapping
+/// another mode's (`|f1 - f2| < zeta1 f1 + zeta2 f2`, closely spaced modes), the peak is
+/// the two together and the rule's bandwidth may span both (the bassco Y files of 2023,
+/// 42.5 and 47.0 Hz: the rule reads 0.047 and 0.051, settle's main mode 0.038 and 0.036),
+/// so the file is shown and left out of the comparison; which files those are is
+/// asserted.
 #[test]
 fn shaketune_rule_on_the_whole_corpus() {
     let mut ratios = Vec::new();
+    let mut overlapping = Vec::new();
     for (file, main_hz, id) in crate::corpus::identified() {
         let (on_measured, _) = shaketune_on_figure(id);
-        let settle = main_mode(id, main_hz).damping_ratio.value;
+        let main = main_mode(id, main_hz);
+        let settle = main.damping_ratio.value;
         let ratio = settle / on_measured;
-        println!("{file}: Shake&Tune's rule {on_measured:.3}, settle {settle:.3} ({ratio:.2} x)");
+        let half_band = |m: &IdentifiedMode| m.damping_ratio.value * m.frequency_hz.value;
+        let close = id.modes.iter().any(|m| {
+            !std::ptr::eq(m, main)
+                && (m.frequency_hz.value - main.frequency_hz.value).abs()
+                    < half_band(m) + half_band(main)
+        });
+        println!(
+            "{file}: Shake&Tune's rule {on_measured:.3}, settle {settle:.3} ({ratio:.2} x){}",
+            if close {
+                ", overlapping modes: left out"
+            } else {
+                ""
+            }
+        );
+        if close {
+            overlapping.push(file);
+            continue;
+        }
         assert!(ratio > 1.0, "{file}: {ratio}");
         ratios.push(ratio);
     }
+    assert_eq!(
+        overlapping,
+        [
+            "bassco_calibration_data_y_20230306_225431.csv",
+            "bassco_resonances_y_20230306_224919.csv",
+            "neptune4pro_inputshaper_20250707_143713_axis_X.stdata",
+            "voronpi_resonances_x_20221231_212825.csv",
+        ]
+    );
     let m = median(ratios);
     println!("median {m:.2} x");
     assert!((1.3..=1.6).contains(&m), "{m}");

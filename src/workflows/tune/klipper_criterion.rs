@@ -3,8 +3,13 @@
 //!
 //! - processed resonance CSVs (`resonances_*.csv`, `calibration_data_*.csv`): the PSD
 //!   columns (one data set per column, or `psd_xyz` of the per-axis layout), normalised
-//!   to the test's frequencies unless the header holds the `shapers:` column (the
-//!   script's rule);
+//!   to the test's frequencies unless the file holds shaper columns. A file with shaper
+//!   columns (`SHAPER_CALIBRATE`'s `calibration_data_*.csv`) was written normalised,
+//!   whether its header names them after a `shapers:` column (Klipper since October
+//!   2025) or straight after `psd_xyz` (before). Today's script takes only the first
+//!   as normalised and normalises the older ones a second time (its `parse_log` tests
+//!   `',shapers:' not in header`; before October 2025 it tested `'mzv' not in header`);
+//!   settle reads them as written, as the script of their day did;
 //! - raw accelerometer CSVs (`raw_data_*.csv`): the PSD computed as Klipper computes it
 //!   (settle-identify's [`klipper_response`]), summed over the axes and normalised.
 //!
@@ -274,8 +279,8 @@ const RESONANCE_BAND_LO_HZ: f64 = 10.0;
 /// ratio is about 1; the resonance tests of the corpus, identify/tests/corpus, reach 71 to
 /// 939): Klipper's fit would still name a shaper and a frequency for it, which answer for
 /// nothing. Refused, with the ratio.
-/// (A processed file with the `shapers:` column comes normalised as the script wrote it;
-/// the others are normalised when read, as the script does.)
+/// (A processed file with shaper columns comes normalised as Klipper wrote it; the others
+/// are normalised when read, as the script does.)
 fn holds_a_resonance(path: &Path, d: &CalibrationData) -> Result<(), Error> {
     let top_hz = SweepTest::klipper().freq_end_hz;
     let mut sorted: Vec<f64> = d
@@ -312,9 +317,10 @@ fn holds_a_resonance(path: &Path, d: &CalibrationData) -> Result<(), Error> {
 }
 
 /// A processed file's data sets: `psd_xyz` (with the axes) of the per-axis layout, else
-/// one per column; normalised unless the file holds the `shapers:` column.
+/// one per column; normalised unless the file holds shaper columns (with or without the
+/// `shapers:` column before them: Klipper wrote both normalised).
 fn processed(psd: &klipper_psd::ProcessedPsd) -> Vec<CalibrationData> {
-    let normalise = !psd.shapers_marker;
+    let normalise = psd.shapers.is_empty();
     let col = |k: usize| Some(psd.columns[k].1.clone());
     let sets: Vec<CalibrationData> = if psd.per_axis {
         vec![CalibrationData {
