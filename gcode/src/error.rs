@@ -271,6 +271,17 @@ pub enum GcodeError {
         /// Why it is needed (and, when includes were skipped, that one of them may set it).
         why: String,
     },
+    /// A section the firmware requires is not in the configuration at all: the file is a
+    /// fragment (a board's pins, a macro collection) rather than a whole configuration.
+    #[error("{source_name}: no [{section}] section: {why}")]
+    ConfigNoSection {
+        /// The main configuration file.
+        source_name: Arc<str>,
+        /// The section.
+        section: String,
+        /// What the section must hold, and what to give instead.
+        why: String,
+    },
     /// A file that includes itself, directly or through others.
     #[error("{at}: `{path}` is already being read (include cycle: {chain})")]
     IncludeCycle {
@@ -488,6 +499,7 @@ impl GcodeError {
             | GcodeError::Bgcode { .. }
             | GcodeError::File(_)
             | GcodeError::ConfigMissing { .. }
+            | GcodeError::ConfigNoSection { .. }
             | GcodeError::ExportValue { .. }
             | GcodeError::JobSetting { .. } => None,
             GcodeError::LineTooLong { at, .. }

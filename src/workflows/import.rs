@@ -212,6 +212,19 @@ pub(crate) fn config_error(path: &Path, e: settle_gcode::GcodeError) -> Error {
             settle_gcode::GcodeError::JobSetting { key, reason } => {
                 Error::input_key(path, key, reason)
             }
+            // These name their file first: the file is said once.
+            settle_gcode::GcodeError::ConfigMissing {
+                ref source_name, ..
+            }
+            | settle_gcode::GcodeError::ConfigNoSection {
+                ref source_name, ..
+            } => {
+                let prefix = format!("{source_name}: ");
+                Error::input(
+                    PathBuf::from(source_name.as_ref()),
+                    text.strip_prefix(&prefix).unwrap_or(&text),
+                )
+            }
             _ => Error::input(path, text),
         },
     }

@@ -463,3 +463,55 @@ fn a_config_g_value_is_refused_at_its_line() {
         assert!(!out.exists(), "{text}");
     }
 }
+
+/// Klipper's own example files through the command (settle-gcode's
+/// `tests/data/klipper-examples/`, `MANIFEST.md` there): a fragment without `[printer]` is
+/// named once and called a fragment; an option Klipper does not read in `[input_shaper]`
+/// is refused at its line with its key, as Klipper refuses to start on it (exit 2).
+#[test]
+fn klipper_fragments_and_unknown_options_are_refused_through_the_command() {
+    let examples = root().join("gcode/tests/data/klipper-examples");
+    let fragment = examples.join("sample-idex.cfg");
+    let r = crate::support::settle()
+        .args(["import", "klipper"])
+        .arg(&fragment)
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    assert_eq!(
+        err.trim_end(),
+        format!(
+            "error: {}: no [printer] section: the file is a fragment of a configuration, not a whole printer.cfg (Klipper requires [printer] with kinematics, max_velocity and max_accel: klippy/toolhead.py); give the printer.cfg that includes it",
+            fragment.display()
+        )
+    );
+    // example-corexy.cfg (79 lines) with an [input_shaper] whose Y frequency is misnamed.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cfg = dir.path().join("printer.cfg");
+    let text = std::fs::read_to_string(examples.join("example-corexy.cfg")).expect("reads");
+    let lines = text.lines().count();
+    std::fs::write(
+        &cfg,
+        format!("{text}[input_shaper]\nshaper_freq_x: 48\nshaper_freq: 40\n"),
+    )
+    .expect("writes");
+    let r = crate::support::settle()
+        .args(["import", "klipper"])
+        .arg(&cfg)
+        .arg("--out")
+        .arg(dir.path().join("o.toml"))
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(&format!(
+            "{}:{}: key `input_shaper.shaper_freq`: Klipper does not know this option of [input_shaper] and refuses to start",
+            cfg.display(),
+            lines + 3
+        )),
+        "{err}"
+    );
+    assert!(!dir.path().join("o.toml").exists());
+}

@@ -2,7 +2,9 @@
 //! `[printer]` (`klippy/toolhead.py`, the kinematics modules), `[input_shaper]`
 //! (`klippy/extras/input_shaper.py`), `[stepper_x|y|z]` (`klippy/stepper.py`) and their
 //! `[tmc2130|tmc2208|tmc2209|tmc2240|tmc2660|tmc5160 stepper_*]` drivers
-//! (`klippy/extras/tmc*.py`). Other sections and options are not read.
+//! (`klippy/extras/tmc*.py`). An option of `[printer]` or `[input_shaper]` that Klipper
+//! does not read is refused, as Klipper refuses it (see `unused`). Other sections and
+//! their options are not read.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -141,6 +143,15 @@ impl KlipperConfig {
             y: stepper(v, "stepper_y", &mut notes).map_err(skipped)?,
             z: stepper(v, "stepper_z", &mut notes).map_err(skipped)?,
         };
+        let allowed_printer = printer_options(&printer.kinematics);
+        unused(v, "printer", &allowed_printer, &loaded.autosave, &mut notes)?;
+        unused(
+            v,
+            "input_shaper",
+            &SHAPER_OPTIONS,
+            &loaded.autosave,
+            &mut notes,
+        )?;
         let set_at = loaded
             .store
             .sections()
@@ -161,6 +172,133 @@ impl KlipperConfig {
             set_at,
         })
     }
+}
+
+/// The options of `[printer]` that `klippy/toolhead.py` reads whatever the kinematics.
+const TOOLHEAD_OPTIONS: [&str; 5] = [
+    "kinematics",
+    "max_velocity",
+    "max_accel",
+    "minimum_cruise_ratio",
+    "square_corner_velocity",
+];
+
+/// The options of `[input_shaper]` (`klippy/extras/input_shaper.py`,
+/// `InputShaperParams`, for the axes x, y and z).
+const SHAPER_OPTIONS: [&str; 10] = [
+    "shaper_type",
+    "shaper_type_x",
+    "shaper_type_y",
+    "shaper_type_z",
+    "damping_ratio_x",
+    "damping_ratio_y",
+    "damping_ratio_z",
+    "shaper_freq_x",
+    "shaper_freq_y",
+    "shaper_freq_z",
+];
+
+/// Options of `[printer]` Klipper removed (`docs/Config_Changes.md`): Klipper now refuses
+/// them as it refuses any option it does not read, but none of them sets a speed, an
+/// acceleration or a shaper (they tuned how far ahead the host queued moves, and how far a
+/// step could stray from its time), so a configuration written before the removal still
+/// says everything settle reads: settle notes them and reads on. `max_accel_to_decel`,
+/// removed too, is read (see [`KlipperPrinter::minimum_cruise_ratio`]).
+const REMOVED_PRINTER_OPTIONS: [(&str, &str); 6] = [
+    ("buffer_time_low", "2023-12-07"),
+    ("buffer_time_high", "2023-12-07"),
+    ("buffer_time_start", "2023-12-07"),
+    ("move_flush_time", "2023-12-07"),
+    ("max_stepper_error", "2025-10-03"),
+    ("max_accel_to_decel", "2025-08-11"),
+];
+
+/// The options of `[printer]` Klipper reads with `kinematics` (`klippy/toolhead.py` and
+/// the module `klippy/kinematics/<kinematics>.py`).
+fn printer_options(kinematics: &str) -> Vec<&'static str> {
+    const Z: [&str; 2] = ["max_z_velocity", "max_z_accel"];
+    let own: &[&str] = match kinematics {
+        "cartesian" | "corexy" | "corexz" | "hybrid_corexy" | "hybrid_corexz"
+        | "generic_cartesian" => &Z,
+        "delta" => &[
+            "max_z_velocity",
+            "max_z_accel",
+            "delta_radius",
+            "print_radius",
+            "minimum_z_position",
+        ],
+        "deltesian" => &[
+            "max_z_velocity",
+            "max_z_accel",
+            "min_angle",
+            "print_width",
+            "minimum_z_position",
+            "slow_ratio",
+        ],
+        // rotary_delta.py reads no max_z_accel.
+        "rotary_delta" => &[
+            "max_z_velocity",
+            "shoulder_radius",
+            "shoulder_height",
+            "minimum_z_position",
+        ],
+        "polar" => &["max_z_velocity", "max_z_accel", "max_angular_velocity"],
+        // winch.py and none.py read nothing of [printer].
+        _ => &[],
+    };
+    TOOLHEAD_OPTIONS.iter().chain(own).copied().collect()
+}
+
+/// Klipper's check for options nobody read (`ConfigValidate.check_unused` in
+/// `klippy/configfile.py`): an option of `section` that is not in `allowed` (nor set by the
+/// SAVE_CONFIG block, which Klipper never refuses) stops Klipper with "Option '<option>' is
+/// not valid in section '<section>'"; settle refuses it likewise, at its line. Options of
+/// `[printer]` that Klipper removed are noted instead (`REMOVED_PRINTER_OPTIONS`).
+fn unused(
+    v: Values,
+    section: &str,
+    allowed: &[&str],
+    autosave: &[(String, String)],
+    notes: &mut Vec<ConfigNote>,
+) -> Result<(), GcodeError> {
+    let Some(sec) = v.store.section(section) else {
+        return Ok(());
+    };
+    for o in &sec.options {
+        let key = o.key.as_str();
+        if allowed.contains(&key) || autosave.iter().any(|(s, k)| s == section && k == key) {
+            continue;
+        }
+        if section == "printer"
+            && let Some((_, date)) = REMOVED_PRINTER_OPTIONS.iter().find(|(k, _)| *k == key)
+        {
+            if key != "max_accel_to_decel" {
+                notes.push(ConfigNote::at(
+                    o.at.clone(),
+                    format!(
+                        "{key} is not read: Klipper removed it on {date} and now refuses it (docs/Config_Changes.md); it sets no speed, acceleration or shaper"
+                    ),
+                ));
+            }
+            continue;
+        }
+        let with = match section {
+            "printer" => v
+                .text(section, "kinematics")
+                .map(|(_, k)| format!(" with kinematics {k}"))
+                .unwrap_or_default(),
+            _ => String::new(),
+        };
+        return Err(GcodeError::ConfigSetting {
+            at: o.at.clone(),
+            key: format!("{section}.{key}"),
+            reason: format!(
+                "Klipper does not know this option of [{section}]{with} and refuses to start (\"Option '{key}' is not valid in section '{section}'\", klippy/configfile.py); allowed: {}",
+                allowed.join(", ")
+            ),
+        });
+    }
+    Ok(())
 }
 
 fn missing(source: &Arc<str>, section: &str, key: &str, why: &'static str) -> GcodeError {
@@ -193,6 +331,22 @@ fn with_skipped(e: GcodeError, skipped: &[(Location, String)]) -> GcodeError {
                 skipped.len()
             ),
         },
+        // Not a fragment, perhaps: the section may be in a file that is not there.
+        (
+            GcodeError::ConfigNoSection {
+                source_name,
+                section,
+                ..
+            },
+            Some((at, what)),
+        ) => GcodeError::ConfigNoSection {
+            source_name,
+            section,
+            why: format!(
+                "Klipper requires it, with kinematics, max_velocity and max_accel (klippy/toolhead.py); {} [include]s of files that are not there were skipped, the first {what} at {at}: copy the files beside the configuration",
+                skipped.len()
+            ),
+        },
         (e, _) => e,
     }
 }
@@ -209,6 +363,13 @@ fn printer(
             .map_or(main.clone(), |sec| sec.at.source_name.clone())
     };
     let required = "Klipper requires it (klippy/toolhead.py)";
+    if v.store.section(S).is_none() {
+        return Err(GcodeError::ConfigNoSection {
+            source_name: main.clone(),
+            section: S.to_string(),
+            why: "the file is a fragment of a configuration, not a whole printer.cfg (Klipper requires [printer] with kinematics, max_velocity and max_accel: klippy/toolhead.py); give the printer.cfg that includes it".to_string(),
+        });
+    }
     let kinematics = match v.text(S, "kinematics") {
         Some((_, k)) if KINEMATICS.contains(&k.as_str()) => k,
         Some((opt, k)) => {

@@ -44,6 +44,10 @@ pub(crate) struct Loaded {
     pub(crate) notes: Vec<ConfigNote>,
     /// The `[include]`s skipped because their file is not there: where, and the include.
     pub(crate) skipped: Vec<(Location, String)>,
+    /// The options the SAVE_CONFIG block sets (after its duplicates are dropped), as
+    /// `(section, option)` in lower case: Klipper never refuses these as unused
+    /// (`ConfigValidate.check_unused` adds them to the options read).
+    pub(crate) autosave: Vec<(String, String)>,
 }
 
 /// `path` made absolute and normalised lexically (Python's `os.path.abspath`).
@@ -96,9 +100,21 @@ pub(crate) fn load(main: &Path, text: Option<&str>) -> Result<Loaded, GcodeError
     };
     parse_file(&mut ctx, main, regular, &source)?;
     let mut notes = std::mem::take(&mut ctx.notes);
+    let mut autosave_options = Vec::new();
     if let Some(mut lines) = autosave {
         strip_duplicates(&mut lines, &ctx.store, &source, &mut notes);
         let cut: Vec<(u64, &str)> = lines.iter().map(|(n, l)| (*n, cut_comment(l))).collect();
+        let mut block = Store::default();
+        parse_chunk(&mut block, &source, cut.iter().copied())?;
+        autosave_options = block
+            .sections()
+            .iter()
+            .flat_map(|s| {
+                s.options
+                    .iter()
+                    .map(|o| (s.name.to_lowercase(), o.key.clone()))
+            })
+            .collect();
         parse_chunk(&mut ctx.store, &source, cut)?;
     }
     if let Some(s) = ctx
@@ -120,6 +136,7 @@ pub(crate) fn load(main: &Path, text: Option<&str>) -> Result<Loaded, GcodeError
         files: ctx.files,
         notes,
         skipped: ctx.skipped,
+        autosave: autosave_options,
     })
 }
 

@@ -135,12 +135,26 @@ fn a_save_config_block_with_foreign_lines_is_ignored_whole() {
     let text = format!(
         "{PRINTER}\n#*# <---------------------- SAVE_CONFIG ---------------------->\n\
          #*# DO NOT EDIT THIS BLOCK OR BELOW. The contents are auto-generated.\n#*#\n\
-         #*# [input_shaper]\n#*# shaper_freq_x = 54.2\nshaper_freq_y: 30\n"
+         #*# [input_shaper]\n#*# shaper_freq_x = 54.2\nmax_z_velocity: 30\n"
     );
     let c = KlipperConfig::parse(&text, "printer.cfg").expect("valid");
     assert_eq!(c.input_shaper, None);
+    // The foreign line is read where it stands: in [printer], the `#*#` lines comments.
+    assert_eq!(c.printer.max_z_velocity_mm_s, 30.0);
     assert_eq!(c.notes.len(), 1);
     assert!(c.notes[0].to_string().contains("line 11"), "{}", c.notes[0]);
+    // So an [input_shaper] option there is one [printer] does not take, which Klipper
+    // refuses ("Option 'shaper_freq_y' is not valid in section 'printer'").
+    let e = KlipperConfig::parse(
+        &text.replace("max_z_velocity", "shaper_freq_y"),
+        "printer.cfg",
+    )
+    .expect_err("not an option of [printer]");
+    assert!(
+        e.to_string()
+            .starts_with("printer.cfg:11: key `printer.shaper_freq_y`: Klipper does not know"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -321,7 +335,7 @@ fn malformed_values_name_file_line_and_key() {
         "{e}"
     );
     let e = KlipperConfig::parse("[mcu]\nserial: x\n", "p.cfg").expect_err("no printer");
-    assert!(matches!(&e, GcodeError::ConfigMissing { section, .. } if section == "printer"));
+    assert!(matches!(&e, GcodeError::ConfigNoSection { section, .. } if section == "printer"));
     let e = KlipperConfig::parse(
         &format!("{PRINTER}[tmc2209 stepper_x]\nuart_pin: PA1\n[stepper_x]\nrotation_distance: 40\nmicrosteps: 16\n"),
         "p.cfg",
@@ -392,9 +406,10 @@ fn includes_missing_cyclic_and_misplaced() {
     .expect("write");
     let e = read_err(dir.path(), "split.cfg");
     assert!(
-        matches!(&e, GcodeError::ConfigMissing { key, .. } if key == "kinematics"),
+        matches!(&e, GcodeError::ConfigNoSection { section, .. } if section == "printer"),
         "{e:?}"
     );
+    assert!(!e.to_string().contains("fragment"), "{e}");
     let text = e.to_string();
     assert!(
         text.contains("1 [include]s of files that are not there were skipped, the first [include hardware.cfg] at ")

@@ -5,6 +5,7 @@ mod bambu;
 mod bgcode;
 mod config_export;
 mod config_klipper;
+mod config_klipper_examples;
 mod config_marlin;
 mod config_real;
 mod config_rrf;
