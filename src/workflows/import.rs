@@ -400,7 +400,11 @@ pub(crate) fn not_a_config(path: &Path, firmware: Firmware, reads: &str) -> Resu
             "a RepRapFirmware configuration",
             &[Looks::KlipperConfig, Looks::MarlinReply],
         ),
-        Firmware::Marlin | Firmware::Prusa => ("a reply to M503", &[Looks::KlipperConfig]),
+        Firmware::Marlin => ("Marlin's reply to M503", &[Looks::KlipperConfig]),
+        Firmware::Prusa => (
+            "a Prusa's replies to M115, M503 and M593",
+            &[Looks::KlipperConfig],
+        ),
         Firmware::Grbl => (
             "GRBL's $$ settings",
             &[Looks::KlipperConfig, Looks::RrfConfig, Looks::MarlinReply],

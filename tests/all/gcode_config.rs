@@ -124,7 +124,11 @@ fn a_configuration_settle_cannot_follow_exits_2_and_writes_nothing() {
     let cases: [(&[&str], &Path, &str); 4] = [
         (&[], &delta, "printer.kinematics"),
         (&[], &bad_value, "printer.max_accel"),
-        (&["--firmware", "marlin"], &delta, "not an M503 report"),
+        (
+            &["--firmware", "marlin"],
+            &delta,
+            "not Marlin's reply to M503",
+        ),
         (&[], &dir.path().join("missing.cfg"), "missing.cfg"),
     ];
     for (extra, config, key) in cases {

@@ -489,11 +489,15 @@ fn a_configuration_of_another_firmware_is_named() {
         ),
         (
             import("marlin", &printer),
-            s(&["printer.cfg:1: ", klipper, "not a reply to M503"]),
+            s(&["printer.cfg:1: ", klipper, "not Marlin's reply to M503"]),
         ),
         (
             import("prusa", &printer),
-            s(&["printer.cfg:1: ", klipper, "not a reply to M503"]),
+            s(&[
+                "printer.cfg:1: ",
+                klipper,
+                "not a Prusa's replies to M115, M503 and M593",
+            ]),
         ),
         (
             import("marlin", &railcore),
