@@ -17,7 +17,8 @@
 #     milled contour also with --layer-source markers); the
 #     real Fusion 360 (GRBL), LaserWeb and Inkscape Lasertools (GRBL, laser mode), Cura
 #     (Marlin), Slic3r and OrcaSlicer (Klipper) jobs in its cnc/, laser/, cura/, slic3r/
-#     and orca/ folders, and PrusaSlicer's binary G-code in bgcode/ (on marlin and on prusa);
+#     and orca/ folders, PrusaSlicer's binary G-code in bgcode/ (on marlin and on prusa),
+#     and the Prusa MINI's Cura 5 and PrusaSlicer files in cura5/ and prusaslicer/;
 #   - `settle identify` on the example recordings, `settle machine` on the presets and on
 #     what identify wrote, `settle import` of the example configurations and of the real
 #     ones of gcode/tests/data/real/ (a Marlin M503 reply among them; two, and the reply,
@@ -140,6 +141,10 @@ cases() {
   echo "gcode-prusaslicer-bgcode gcode $P/bgcode/mini_cube_ps2.8.1.bgcode --machine printer_xy --firmware marlin --skip-bad-lines --out {out}"
   # The same file as Prusa's firmware reads it, every line (its M593 T among them).
   echo "gcode-prusaslicer-bgcode-prusa gcode $P/bgcode/mini_cube_ps2.8.1.bgcode --machine printer_xy --firmware prusa --out {out}"
+  # Cura 5.4 for a Prusa MINI under the MINI's own M503 reply, and PrusaSlicer 2.6.1's
+  # ASCII vase for the MINI as Prusa's firmware reads it.
+  echo "gcode-cura5-mini gcode $P/cura5/prusa_mini_cura5.gcode --machine printer_xy --firmware marlin --config $P/prusaslicer/M503_prusa_mini.txt --out {out}"
+  echo "gcode-prusaslicer-mini gcode $P/prusaslicer/prusa_mini_2.gcode --machine printer_xy --firmware prusa --out {out}"
   echo "gcode-corner-modes gcode $S/gcode_corner.gcode --machine out/identify/machine.toml --firmware settle --out {out}"
   echo "machine-printer_xy machine printer_xy"
   echo "machine-leadscrew_stage machine leadscrew_stage"
