@@ -82,10 +82,7 @@ fn a_cura5_files_layers_features_box_filament_and_limits_are_the_files() {
     );
     // Per feature type, under Cura's names (the intro line has none).
     let names = r.features();
-    let mut counted: BTreeMap<&str, u32> = BTreeMap::new();
-    for f in per_feature {
-        *counted.entry(names[usize::from(f)].as_str()).or_insert(0) += 1;
-    }
+    let counted = crate::count_by_feature(names, &per_feature);
     assert_eq!(
         counted,
         BTreeMap::from([

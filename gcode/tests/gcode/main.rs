@@ -113,3 +113,16 @@ pub fn data_path(name: &str) -> std::path::PathBuf {
 pub fn close_rel(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * a.abs().max(b.abs())
 }
+
+/// How many moves each feature counts: `features` are the moves' feature indices
+/// (`Move::feature`), `names` the reader's feature names (`Reader::features`).
+pub fn count_by_feature<'a>(
+    names: &'a [String],
+    features: &[u16],
+) -> std::collections::BTreeMap<&'a str, u32> {
+    let mut counted = std::collections::BTreeMap::new();
+    for &f in features {
+        *counted.entry(names[usize::from(f)].as_str()).or_insert(0) += 1;
+    }
+    counted
+}

@@ -96,10 +96,7 @@ fn an_orca_file_reads_its_layers_features_arcs_and_spiral_lifts() {
     );
     assert_eq!(per_layer.values().sum::<u32>(), 44_598);
     let names = r.features();
-    let mut counted: BTreeMap<&str, u32> = BTreeMap::new();
-    for f in per_feature {
-        *counted.entry(names[usize::from(f)].as_str()).or_insert(0) += 1;
-    }
+    let counted = crate::count_by_feature(names, &per_feature);
     assert_eq!(
         counted,
         BTreeMap::from([

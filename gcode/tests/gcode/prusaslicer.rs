@@ -90,10 +90,7 @@ fn a_prusaslicer_vase_reads_its_layers_features_filament_and_printer() {
         assert!((4..=50).all(|l| per_layer[&l] == 20), "{per_layer:?}");
         assert_eq!(per_layer.values().sum::<u32>(), 1084);
         let names = r.features();
-        let mut counted: BTreeMap<&str, u32> = BTreeMap::new();
-        for f in per_feature {
-            *counted.entry(names[usize::from(f)].as_str()).or_insert(0) += 1;
-        }
+        let counted = crate::count_by_feature(names, &per_feature);
         assert_eq!(
             counted,
             BTreeMap::from([
