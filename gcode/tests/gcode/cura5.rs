@@ -8,7 +8,7 @@
 
 use std::collections::BTreeMap;
 
-use settle_gcode::job::{Job, JobConfig, JobSummary};
+use settle_gcode::job::{JobConfig, JobSummary};
 use settle_gcode::{Bounds, Dialect, EventKind, LimitChange, Reader, ReaderOptions};
 use settle_planner::firmware::Firmware;
 
@@ -155,9 +155,7 @@ fn a_cura5_files_layers_features_box_filament_and_limits_are_the_files() {
 }
 
 fn run(cfg: JobConfig) -> JobSummary {
-    let mut job = Job::open(print_path(FILE), cfg).expect("opens");
-    job.run_to_end().expect("plans");
-    job.summary()
+    crate::plan_print(FILE, cfg)
 }
 
 /// The commands listed as not followed, by name (`G29`, `M104`, ...).

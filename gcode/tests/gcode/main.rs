@@ -126,3 +126,10 @@ pub fn count_by_feature<'a>(
     }
     counted
 }
+
+/// The summary of the print `name` (in gcode/prints/) planned to its end under `cfg`.
+pub fn plan_print(name: &str, cfg: settle_gcode::job::JobConfig) -> settle_gcode::job::JobSummary {
+    let mut job = settle_gcode::job::Job::open(print_path(name), cfg).expect("opens");
+    job.run_to_end().expect("plans");
+    job.summary()
+}

@@ -10,7 +10,7 @@
 
 use std::collections::BTreeMap;
 
-use settle_gcode::job::{Job, JobConfig, JobSummary, PlannerConfig};
+use settle_gcode::job::{JobConfig, JobSummary, PlannerConfig};
 use settle_gcode::{Dialect, EventKind, Note, Path, Reader, ReaderOptions};
 use settle_planner::firmware::Firmware;
 
@@ -124,9 +124,7 @@ fn an_orca_file_reads_its_layers_features_arcs_and_spiral_lifts() {
 }
 
 fn run(cfg: JobConfig) -> JobSummary {
-    let mut job = Job::open(print_path(FILE), cfg).expect("opens");
-    job.run_to_end().expect("plans");
-    job.summary()
+    crate::plan_print(FILE, cfg)
 }
 
 #[test]

@@ -11,7 +11,7 @@
 
 use std::collections::BTreeMap;
 
-use settle_gcode::job::{Job, JobConfig, JobSummary};
+use settle_gcode::job::{JobConfig, JobSummary};
 use settle_gcode::{Dialect, EventKind, Note, Reader, ReaderOptions};
 use settle_planner::firmware::Firmware;
 
@@ -116,9 +116,7 @@ fn a_prusaslicer_vase_reads_its_layers_features_filament_and_printer() {
 }
 
 fn run(cfg: JobConfig) -> JobSummary {
-    let mut job = Job::open(print_path(FILE), cfg).expect("opens");
-    job.run_to_end().expect("plans");
-    job.summary()
+    crate::plan_print(FILE, cfg)
 }
 
 #[test]
