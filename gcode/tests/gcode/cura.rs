@@ -4,13 +4,30 @@
 
 use settle_gcode::{Bounds, Dialect, EventKind, Reader, ReaderOptions};
 
-/// The number after `;<key>:` in the header.
-fn header(text: &str, key: &str) -> f64 {
+/// The number after `;<key>:` in Cura's header (`m` of `;Filament used:` taken off).
+pub(crate) fn header(text: &str, key: &str) -> f64 {
     let line = text
         .lines()
         .find_map(|l| l.strip_prefix(&format!(";{key}:")))
         .unwrap_or_else(|| panic!("no {key}"));
     line.trim().trim_end_matches('m').parse().expect("a number")
+}
+
+/// Cura prints its box (`;MINX:` .. `;MAXZ:`) with up to three decimals, as the file's
+/// coordinates: `bounds` holds the same numbers.
+pub(crate) fn assert_cura_box(text: &str, bounds: &Bounds) {
+    for (k, axis) in ["X", "Y", "Z"].iter().enumerate() {
+        assert_eq!(
+            bounds.min_mm[k],
+            header(text, &format!("MIN{axis}")),
+            "MIN{axis}"
+        );
+        assert_eq!(
+            bounds.max_mm[k],
+            header(text, &format!("MAX{axis}")),
+            "MAX{axis}"
+        );
+    }
 }
 
 #[test]
@@ -30,20 +47,7 @@ fn a_cura_files_extent_filament_and_layers_are_curas() {
             _ => {}
         }
     }
-    // Cura prints its box with up to three decimals, as the file's coordinates: the
-    // same numbers.
-    for (k, axis) in ["X", "Y", "Z"].iter().enumerate() {
-        assert_eq!(
-            bounds.min_mm[k],
-            header(&text, &format!("MIN{axis}")),
-            "MIN{axis}"
-        );
-        assert_eq!(
-            bounds.max_mm[k],
-            header(&text, &format!("MAX{axis}")),
-            "MAX{axis}"
-        );
-    }
+    assert_cura_box(&text, &bounds);
     // Metres to five decimals (8.36128 m).
     let used_m = header(&text, "Filament used");
     assert!(

@@ -12,23 +12,13 @@ use settle_gcode::job::{JobConfig, JobSummary};
 use settle_gcode::{Bounds, Dialect, EventKind, LimitChange, Reader, ReaderOptions};
 use settle_planner::firmware::Firmware;
 
+use crate::cura::{assert_cura_box, header};
 use crate::print_path;
 
 const FILE: &str = "cura5/prusa_mini_cura5.gcode";
 
 fn text() -> String {
     std::fs::read_to_string(print_path(FILE)).expect("print")
-}
-
-/// The number after `;<key>:` in Cura's header.
-fn header(text: &str, key: &str) -> f64 {
-    text.lines()
-        .find_map(|l| l.strip_prefix(&format!(";{key}:")))
-        .unwrap_or_else(|| panic!("no {key}"))
-        .trim()
-        .trim_end_matches('m')
-        .parse()
-        .expect("a number")
 }
 
 #[test]
@@ -95,18 +85,7 @@ fn a_cura5_files_layers_features_box_filament_and_limits_are_the_files() {
         ])
     );
     // The box Cura wrote, to its three decimals: the file's own coordinates.
-    for (k, axis) in ["X", "Y", "Z"].iter().enumerate() {
-        assert_eq!(
-            bounds.min_mm[k],
-            header(&text, &format!("MIN{axis}")),
-            "MIN{axis}"
-        );
-        assert_eq!(
-            bounds.max_mm[k],
-            header(&text, &format!("MAX{axis}")),
-            "MAX{axis}"
-        );
-    }
+    assert_cura_box(&text, &bounds);
     // `;Filament used: 0.343517m`: the extrusion of the printing moves (each retraction
     // is pushed back before the next one), 343.51656 mm, to Cura's six digits.
     let used_m = header(&text, "Filament used");
